@@ -1,0 +1,43 @@
+// The injectable clock: a steady clock on a robot, a simulated clock in tests, the simulator and
+// trace replay. Nothing in tripodal reads the wall clock directly; it asks a Clock.
+#pragma once
+
+#include <atomic>
+
+#include "tripodal/core/time.hpp"
+
+namespace tripodal {
+
+/// Source of the current time for every component. Implementations are thread-safe.
+class Clock {
+ public:
+  virtual ~Clock() = default;
+  /// The current time since this clock's epoch; monotonic (never goes backwards).
+  [[nodiscard]] virtual Time now() const noexcept = 0;
+};
+
+/// Monotonic real time (std::chrono::steady_clock); its epoch is the moment it was constructed.
+class SteadyClock final : public Clock {
+ public:
+  SteadyClock() noexcept;
+  [[nodiscard]] Time now() const noexcept override;
+
+ private:
+  std::chrono::steady_clock::time_point start_;
+};
+
+/// Simulated time that only moves when told to; starts at `start` (default 0).
+class SimClock final : public Clock {
+ public:
+  explicit SimClock(Time start = Time{0}) noexcept : now_(start.count()) {}
+  [[nodiscard]] Time now() const noexcept override { return Time{now_.load(std::memory_order_acquire)}; }
+  /// Moves the time forward by `d` (a negative `d` is ignored: the clock is monotonic).
+  void advance(Duration d) noexcept;
+  /// Sets the time to `t` if `t` is not earlier than now; returns false (and keeps now) otherwise.
+  bool set(Time t) noexcept;
+
+ private:
+  std::atomic<Time::rep> now_;
+};
+
+}  // namespace tripodal

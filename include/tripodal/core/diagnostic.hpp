@@ -1,0 +1,65 @@
+// Located diagnostics for configuration files (nets, robot profiles, maps): every loader collects
+// all of a file's problems as Diagnostics and reports them gcc-style, FILE:LINE:COL: error: MSG,
+// so an author fixes them in one pass and an editor can jump to each one.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace tripodal {
+
+/// Where something was written. line and column count from 1; 0 means unknown.
+struct SourceLocation {
+  std::string file;
+  int line = 0;
+  int column = 0;
+
+  /// "file:line:col", omitting the parts that are unknown.
+  [[nodiscard]] std::string str() const;
+};
+
+enum class Severity { note, warning, error };
+
+struct Diagnostic {
+  Severity severity = Severity::error;
+  SourceLocation where;
+  std::string message;
+
+  /// gcc-style "FILE:LINE:COL: error: MESSAGE".
+  [[nodiscard]] std::string str() const;
+};
+
+/// A list of diagnostics being collected for one or more files.
+class Diagnostics {
+ public:
+  void error(SourceLocation where, std::string message);
+  void warning(SourceLocation where, std::string message);
+  void note(SourceLocation where, std::string message);
+  void add(Diagnostic d);
+  void append(const Diagnostics& other);
+
+  [[nodiscard]] bool has_errors() const noexcept { return errors_ > 0; }
+  [[nodiscard]] std::size_t error_count() const noexcept { return errors_; }
+  [[nodiscard]] const std::vector<Diagnostic>& all() const noexcept { return items_; }
+  [[nodiscard]] bool empty() const noexcept { return items_.empty(); }
+  /// Every diagnostic, one per line, in the order they were added.
+  [[nodiscard]] std::string str() const;
+
+ private:
+  std::vector<Diagnostic> items_;
+  std::size_t errors_ = 0;
+};
+
+/// Thrown by a loader when a file has errors; what() lists every diagnostic, one per line.
+class ConfigError : public std::runtime_error {
+ public:
+  explicit ConfigError(Diagnostics diagnostics);
+  ConfigError(SourceLocation where, const std::string& message);
+  [[nodiscard]] const Diagnostics& diagnostics() const noexcept { return diagnostics_; }
+
+ private:
+  Diagnostics diagnostics_;
+};
+
+}  // namespace tripodal

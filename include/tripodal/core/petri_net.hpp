@@ -1,0 +1,150 @@
+// The configuration-net model: a place/transition net with weighted, read and inhibitor arcs,
+// transitions triggered by events, guards, delays and priorities, and places that bind
+// behaviors, mark outcomes or refer to process modules. Loaders (native XML, PNML) produce it,
+// the engine executes it, the analyser explores it, the planner generates high-level ones.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+#include "tripodal/core/diagnostic.hpp"
+#include "tripodal/core/guard.hpp"
+#include "tripodal/core/time.hpp"
+#include "tripodal/core/value.hpp"
+
+namespace tripodal {
+
+using PlaceIndex = std::uint32_t;
+using TransitionIndex = std::uint32_t;
+using Tokens = std::uint32_t;
+
+/// Tokens per place, indexed by PlaceIndex.
+using Marking = std::vector<Tokens>;
+
+/// High-level nets plan a task from process modules; low-level nets run a process from behaviors.
+enum class NetLevel { low, high };
+
+/// What marking a place means to the process supervisor / planner.
+enum class Outcome { none, success, fault };
+
+enum class ArcKind {
+  normal,     ///< consumes (place->transition) or produces (transition->place) `weight` tokens
+  read,       ///< test arc: needs `weight` tokens in the place, consumes none
+  inhibitor,  ///< enabled only while the place holds fewer than `weight` tokens
+};
+
+/// A declared process parameter (fixed while a process runs) or fact (changes at run time, set
+/// by modules). Guards may read both; the analyser treats facts as free choices.
+struct VariableDecl {
+  std::string name;
+  ValueType type = ValueType::string;
+  std::optional<Value> default_value;
+  std::string description;
+  SourceLocation where;
+};
+
+/// name=value passed to a behavior or process. `value` is text; "$name" refers to a parameter of
+/// the enclosing process, resolved by the process supervisor when the place becomes marked.
+struct BindingParam {
+  std::string name;
+  std::string value;
+  SourceLocation where;
+};
+
+struct BehaviorBinding {
+  std::string behavior;
+  std::vector<BindingParam> params;
+};
+
+struct ProcessRef {
+  std::string process;
+  std::vector<BindingParam> params;
+};
+
+struct Place {
+  std::string id;           ///< unique within the net, e.g. "P1"
+  std::string name;         ///< short label for drawings; defaults to id
+  std::string description;  ///< as in the paper's tables
+  Tokens initial_tokens = 0;
+  std::optional<Tokens> capacity;  ///< a firing that would exceed it is not enabled
+  std::optional<BehaviorBinding> behavior;  ///< active while the place is marked
+  std::optional<ProcessRef> process;        ///< high-level nets: runs while the place is marked
+  Outcome outcome = Outcome::none;
+  std::string fault_message;  ///< for Outcome::fault, e.g. "localization fault"
+  SourceLocation where;
+};
+
+struct ArcRef {
+  PlaceIndex place = 0;
+  Tokens weight = 1;
+  SourceLocation where;
+};
+
+struct Transition {
+  std::string id;
+  std::string name;
+  std::string description;
+  std::string event;          ///< empty: no trigger; else fires only when this event is posted
+  std::optional<Guard> guard; ///< must hold for the transition to be enabled
+  Duration delay{0};          ///< must have stayed enabled this long before it may fire
+  int priority = 0;           ///< higher fires first among conflicting transitions
+  std::vector<ArcRef> inputs;      ///< normal arcs place -> transition (consume)
+  std::vector<ArcRef> outputs;     ///< normal arcs transition -> place (produce)
+  std::vector<ArcRef> reads;       ///< read arcs (test, no consumption)
+  std::vector<ArcRef> inhibitors;  ///< inhibitor arcs
+  SourceLocation where;
+};
+
+/// A configuration net. Built by loaders or programmatically through the add_* methods, which
+/// keep indices consistent and throw std::invalid_argument on misuse (duplicate id, unknown id,
+/// zero weight).
+class PetriNet {
+ public:
+  std::string id;
+  std::string name;
+  std::string description;
+  NetLevel level = NetLevel::low;
+  std::vector<VariableDecl> parameters;
+  std::vector<VariableDecl> facts;
+  SourceLocation where;  ///< the file (and element) it was loaded from
+
+  PlaceIndex add_place(Place p);
+  TransitionIndex add_transition(Transition t);
+  /// Adds an arc between a place and a transition given by id, in either direction for normal
+  /// arcs; read and inhibitor arcs go from a place to a transition.
+  void add_arc(std::string_view from_id, std::string_view to_id, Tokens weight = 1,
+               ArcKind kind = ArcKind::normal, SourceLocation arc_where = {});
+
+  [[nodiscard]] const std::vector<Place>& places() const noexcept { return places_; }
+  [[nodiscard]] const std::vector<Transition>& transitions() const noexcept { return transitions_; }
+  /// Mutable access for loaders and generators; changing a node's id is not supported.
+  [[nodiscard]] Place& place(PlaceIndex i) { return places_.at(i); }
+  [[nodiscard]] const Place& place(PlaceIndex i) const { return places_.at(i); }
+  [[nodiscard]] Transition& transition(TransitionIndex i) { return transitions_.at(i); }
+  [[nodiscard]] const Transition& transition(TransitionIndex i) const { return transitions_.at(i); }
+  [[nodiscard]] std::optional<PlaceIndex> find_place(std::string_view node_id) const noexcept;
+  [[nodiscard]] std::optional<TransitionIndex> find_transition(std::string_view node_id) const noexcept;
+  [[nodiscard]] const VariableDecl* find_parameter(std::string_view name) const noexcept;
+  [[nodiscard]] const VariableDecl* find_fact(std::string_view name) const noexcept;
+
+  [[nodiscard]] Marking initial_marking() const;
+
+ private:
+  struct NodeRef {
+    bool is_place;
+    std::uint32_t index;
+  };
+  std::vector<Place> places_;
+  std::vector<Transition> transitions_;
+  struct IdHash {
+    using is_transparent = void;
+    std::size_t operator()(std::string_view s) const noexcept { return std::hash<std::string_view>{}(s); }
+  };
+  std::unordered_map<std::string, NodeRef, IdHash, std::equal_to<>> ids_;  // O(1) lookups: loaders resolve every arc by id
+};
+
+}  // namespace tripodal

@@ -1,0 +1,27 @@
+// Time as the whole framework counts it: integer nanoseconds since the epoch of the clock in use.
+// Everything that needs the time receives it as an argument or from an injected Clock, so a
+// simulation or a trace replay runs faster than real time and repeats exactly.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+
+namespace tripodal {
+
+/// A span of time. Integer nanoseconds keep stepping exact and deterministic.
+using Duration = std::chrono::nanoseconds;
+
+/// A point in time, as the duration since the epoch of the clock that produced it.
+using Time = std::chrono::nanoseconds;
+
+/// Seconds (as a double) of a duration; for reports and SI-unit arithmetic.
+[[nodiscard]] constexpr double to_seconds(Duration d) noexcept {
+  return std::chrono::duration<double>(d).count();
+}
+
+/// A duration from seconds, rounded to the nearest nanosecond.
+[[nodiscard]] constexpr Duration from_seconds(double seconds) noexcept {
+  return std::chrono::round<Duration>(std::chrono::duration<double>(seconds));
+}
+
+}  // namespace tripodal

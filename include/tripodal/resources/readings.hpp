@@ -1,0 +1,98 @@
+// Typed, timestamped sensor readings: what resources publish, behaviors read, traces record and
+// the simulator produces. Plain value types with SI units; laser fields as ROS sensor_msgs/LaserScan.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "tripodal/core/time.hpp"
+
+namespace tripodal {
+
+/// A planar pose: frame-to-frame transform, e.g. map_from_base or odom_from_base.
+struct Pose2D {
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double theta_rad = 0.0;
+  friend bool operator==(const Pose2D&, const Pose2D&) = default;
+};
+
+/// A planar velocity in the body frame: forward, leftward, counter-clockwise yaw rate.
+/// It is also the motion command behaviors produce and controllers execute.
+struct Twist2D {
+  double vx_m_s = 0.0;
+  double vy_m_s = 0.0;
+  double wz_rad_s = 0.0;
+  friend bool operator==(const Twist2D&, const Twist2D&) = default;
+};
+
+/// Wheel odometry (or fused odometry): pose in the odom frame and body-frame twist.
+struct OdometryReading {
+  Time stamp{0};
+  Pose2D pose;    ///< odom_from_base
+  Twist2D twist;  ///< body frame
+  friend bool operator==(const OdometryReading&, const OdometryReading&) = default;
+};
+
+/// One revolution or sweep of a 2D laser scanner, as ROS sensor_msgs/LaserScan. Beam i points at
+/// angle_min_rad + i * angle_increment_rad in the scanner frame; a range outside
+/// [range_min_m, range_max_m] (or not finite) means no return.
+struct LaserScan {
+  Time stamp{0};  ///< time of the first beam
+  double angle_min_rad = 0.0;
+  double angle_max_rad = 0.0;
+  double angle_increment_rad = 0.0;
+  double time_increment_s = 0.0;  ///< between beams
+  double scan_time_s = 0.0;       ///< between scans
+  double range_min_m = 0.0;
+  double range_max_m = 0.0;
+  std::vector<float> ranges_m;
+  std::vector<float> intensities;  ///< empty when the device gives none
+  friend bool operator==(const LaserScan&, const LaserScan&) = default;
+};
+
+/// A ring or row of ultrasonic range finders, one range per transducer.
+struct SonarReading {
+  Time stamp{0};
+  double field_of_view_rad = 0.0;
+  double range_min_m = 0.0;
+  double range_max_m = 0.0;
+  std::vector<float> ranges_m;
+  friend bool operator==(const SonarReading&, const SonarReading&) = default;
+};
+
+/// Infrared sensors: downward cliff detectors (true = no floor seen) and sideways wall ranges.
+struct InfraredReading {
+  Time stamp{0};
+  std::vector<std::uint8_t> cliff;  ///< 1 = cliff detected under that sensor
+  std::vector<float> wall_ranges_m;
+  friend bool operator==(const InfraredReading&, const InfraredReading&) = default;
+};
+
+/// Bumper switches; bit i of pressed_mask is bumper i.
+struct BumperReading {
+  Time stamp{0};
+  std::uint32_t count = 0;
+  std::uint32_t pressed_mask = 0;
+  [[nodiscard]] bool any() const noexcept { return pressed_mask != 0; }
+  friend bool operator==(const BumperReading&, const BumperReading&) = default;
+};
+
+struct BatteryReading {
+  Time stamp{0};
+  double voltage_v = 0.0;
+  double current_a = 0.0;   ///< positive when charging
+  double percentage = 0.0;  ///< state of charge, 0..1 (as ROS BatteryState)
+  bool charging = false;
+  friend bool operator==(const BatteryReading&, const BatteryReading&) = default;
+};
+
+/// A single-axis (yaw) rate gyro, as the optical-fibre gyros of the PSR robots.
+struct GyroReading {
+  Time stamp{0};
+  double yaw_rate_rad_s = 0.0;
+  double yaw_rad = 0.0;  ///< integrated heading, if the device provides it
+  friend bool operator==(const GyroReading&, const GyroReading&) = default;
+};
+
+}  // namespace tripodal

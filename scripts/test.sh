@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# The README's test command: installs dependencies, then
+#   1. a Release build with -Werror and the whole test suite (ctest),
+#   2. the example consumer built against the *installed* package (find_package(tripodal)),
+#   3. the test suite again under AddressSanitizer + UndefinedBehaviorSanitizer,
+#   4. the shipped configuration nets checked by tripodal-net.
+# Build trees go to build/release, build/sanitize, build/consumer (override with BUILD_ROOT).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$(pwd)
+build_root=${BUILD_ROOT:-$root/build}
+jobs=${JOBS:-$(nproc)}
+
+scripts/install-deps.sh
+
+generator=()
+if command -v ninja >/dev/null; then generator=(-G Ninja); fi
+
+echo "== Release build (-Werror)"
+cmake -S . -B "$build_root/release" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
+  -DTRIPODAL_WERROR=ON -DTRIPODAL_BUILD_TESTS=ON -DTRIPODAL_BUILD_BENCH=ON \
+  -DCMAKE_INSTALL_PREFIX="$build_root/install"
+cmake --build "$build_root/release" -j "$jobs"
+echo "== Release tests"
+ctest --test-dir "$build_root/release" --output-on-failure -j "$jobs"
+
+echo "== Shipped configuration nets"
+"$build_root/release/tools/tripodal-net/tripodal-net" check configs/petri/*.xml
+
+echo "== Install and build the example consumer against the installed package"
+rm -rf "$build_root/install"
+cmake --install "$build_root/release" >/dev/null
+cmake -S examples/consumer -B "$build_root/consumer" "${generator[@]}" \
+  -DCMAKE_PREFIX_PATH="$build_root/install" -DCMAKE_COMPILE_WARNING_AS_ERROR=ON
+cmake --build "$build_root/consumer" -j "$jobs"
+"$build_root/consumer/tripodal_consumer"
+
+echo "== AddressSanitizer + UndefinedBehaviorSanitizer build"
+cmake -S . -B "$build_root/sanitize" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DTRIPODAL_WERROR=ON -DTRIPODAL_SANITIZE=ON -DTRIPODAL_BUILD_TESTS=ON -DTRIPODAL_BUILD_BENCH=OFF
+cmake --build "$build_root/sanitize" -j "$jobs"
+echo "== Sanitizer tests"
+ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  ctest --test-dir "$build_root/sanitize" --output-on-failure -j "$jobs"

@@ -1,0 +1,41 @@
+#include "tripodal/core/clock.hpp"
+
+#include <catch2/catch.hpp>
+#include <thread>
+
+#include "tripodal/version.hpp"
+
+using namespace tripodal;
+using namespace std::chrono_literals;
+
+TEST_CASE("SimClock moves only when told and never backwards") {
+  SimClock clock(5ms);
+  CHECK(clock.now() == 5ms);
+  clock.advance(10ms);
+  CHECK(clock.now() == 15ms);
+  clock.advance(-3ms);
+  CHECK(clock.now() == 15ms);
+  CHECK_FALSE(clock.set(1ms));
+  CHECK(clock.now() == 15ms);
+  CHECK(clock.set(20ms));
+  CHECK(clock.now() == 20ms);
+}
+
+TEST_CASE("SteadyClock is monotonic and starts near zero") {
+  SteadyClock clock;
+  const Time a = clock.now();
+  std::this_thread::sleep_for(1ms);
+  const Time b = clock.now();
+  CHECK(a >= 0ns);
+  CHECK(b - a >= 1ms);
+}
+
+TEST_CASE("seconds conversions round to the nearest nanosecond") {
+  CHECK(to_seconds(1500ms) == Approx(1.5));
+  CHECK(from_seconds(0.25) == 250ms);
+  CHECK(from_seconds(1e-9) == 1ns);
+}
+
+TEST_CASE("version string matches the CMake project version") {
+  CHECK(std::string(version_string()) == TRIPODAL_VERSION);
+}
