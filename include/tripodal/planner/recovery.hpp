@@ -1,0 +1,70 @@
+// Recovery rules of the deliberate layer: how the planner reorganizes the remaining plan when a
+// process fails with a fault message ("localization fault" -> insert PrGlobalLocalization, then
+// retry the failed module), with a retry limit after which the task fails with a report.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tripodal/core/diagnostic.hpp"
+#include "tripodal/planner/plan.hpp"
+
+namespace tripodal {
+
+enum class RecoveryAction {
+  retry,  ///< run the inserted processes, then the failed stage again
+  skip,   ///< run the inserted processes, then go on after the failed stage
+  abort,  ///< the task fails
+};
+
+struct RecoveryRule {
+  std::string fault;    ///< the fault message it handles (case-insensitive exact match)
+  std::string process;  ///< only faults of this process; empty: any process
+  std::vector<ProcessStep> insert;
+  RecoveryAction then = RecoveryAction::retry;
+  int max_retries = 1;  ///< how many times this rule may fire for one task before it gives up
+  SourceLocation where;
+};
+
+struct RecoveryDecision {
+  RecoveryAction action = RecoveryAction::abort;
+  std::vector<ProcessStep> insert;
+  const RecoveryRule* rule = nullptr;  ///< the rule that decided; null when none applies
+  std::string reason;                  ///< for the task report
+};
+
+class RecoveryPolicy {
+ public:
+  RecoveryPolicy() = default;
+  explicit RecoveryPolicy(std::vector<RecoveryRule> rules) : rules_(std::move(rules)) {}
+
+  /// Loads rules from YAML (`recovery:` list; docs/planner.md); throws ConfigError with every
+  /// error located.
+  static RecoveryPolicy load(const std::filesystem::path& file,
+                             const std::function<bool(std::string_view)>& is_known_process = {});
+  static RecoveryPolicy load_from_string(std::string_view yaml, std::string_view name,
+                                         const std::function<bool(std::string_view)>& is_known_process = {});
+
+  [[nodiscard]] const std::vector<RecoveryRule>& rules() const noexcept { return rules_; }
+
+  /// Decides what to do about `failed` ending with `message`, when the first matching rule has
+  /// already fired `times_fired` times in this task. The first rule that matches the message
+  /// (and process, when given) decides; a process-specific rule listed first wins.
+  [[nodiscard]] RecoveryDecision decide(const ProcessStep& failed, std::string_view message, int times_fired) const;
+
+  /// Index of the rule that handles this fault, or -1.
+  [[nodiscard]] int find_rule(const ProcessStep& failed, std::string_view message) const;
+
+  /// The plan that remains after stage `failed_stage` of `plan` failed and `decision` was taken:
+  /// the inserted processes followed by the failed stage (retry) or by the stages after it (skip);
+  /// empty for abort.
+  [[nodiscard]] static Plan remaining_plan(const Plan& plan, std::size_t failed_stage, const RecoveryDecision& decision);
+
+ private:
+  std::vector<RecoveryRule> rules_;
+};
+
+}  // namespace tripodal

@@ -1,0 +1,169 @@
+#include "tripodal/planner/recovery.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cctype>
+#include <fstream>
+#include <sstream>
+
+#include "yaml_util.hpp"
+
+namespace tripodal {
+
+namespace {
+
+using detail::kind_name;
+using detail::where;
+
+bool iequals(std::string_view a, std::string_view b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+           return std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y));
+         });
+}
+
+RecoveryPolicy parse(const std::string& text, const std::string& file,
+                     const std::function<bool(std::string_view)>& is_known_process) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(SourceLocation{file, e.mark.line + 1, e.mark.column + 1}, e.msg);
+  }
+  Diagnostics d;
+  std::vector<RecoveryRule> rules;
+  if (!root.IsMap() || !root["recovery"] || !root["recovery"].IsSequence()) {
+    d.error(where(file, root), "expected a map with a 'recovery' list at the top level");
+    throw ConfigError(d);
+  }
+  for (const auto& kv : root) {
+    if (kv.first.as<std::string>() != "recovery") {
+      d.error(where(file, kv.first), "unknown key '" + kv.first.as<std::string>() + "'; expected: recovery");
+    }
+  }
+  for (const auto& r : root["recovery"]) {
+    RecoveryRule rule;
+    rule.where = where(file, r);
+    if (!r.IsMap()) {
+      d.error(rule.where, "a recovery rule must be a map with fault, insert, then, max_retries; not " + kind_name(r));
+      continue;
+    }
+    for (const auto& kv : r) {
+      const auto key = kv.first.as<std::string>();
+      const YAML::Node v = kv.second;
+      if (key == "fault" && v.IsScalar()) {
+        rule.fault = v.as<std::string>();
+      } else if (key == "process" && v.IsScalar()) {
+        rule.process = v.as<std::string>();
+        if (is_known_process && !is_known_process(rule.process)) d.error(where(file, v), "unknown process '" + rule.process + "'");
+      } else if (key == "then" && v.IsScalar()) {
+        const auto a = v.as<std::string>();
+        if (a == "retry") rule.then = RecoveryAction::retry;
+        else if (a == "skip") rule.then = RecoveryAction::skip;
+        else if (a == "abort") rule.then = RecoveryAction::abort;
+        else d.error(where(file, v), "unknown action '" + a + "'; expected one of: retry, skip, abort");
+      } else if (key == "max_retries" && v.IsScalar()) {
+        int n = -1;
+        if (!YAML::convert<int>::decode(v, n) || n < 0) {
+          d.error(where(file, v), "max_retries must be a whole number >= 0, got '" + v.as<std::string>() + "'");
+        } else {
+          rule.max_retries = n;
+        }
+      } else if (key == "insert" && v.IsSequence()) {
+        for (const auto& s : v) {
+          if (!s.IsMap() || s.size() != 1) {
+            d.error(where(file, s), "an inserted step must be a map with one key, the process name: {PrGlobalLocalization: {}}");
+            continue;
+          }
+          const auto step_kv = *s.begin();
+          ProcessStep step{step_kv.first.as<std::string>(), {}};
+          if (is_known_process && !is_known_process(step.process)) {
+            d.error(where(file, step_kv.first), "unknown process '" + step.process + "'");
+          }
+          if (step_kv.second.IsMap()) {
+            for (const auto& p : step_kv.second) {
+              if (!p.second.IsScalar()) {
+                d.error(where(file, p.second), "parameter '" + p.first.as<std::string>() + "' must be a text");
+                continue;
+              }
+              step.params.push_back({p.first.as<std::string>(), p.second.as<std::string>(), where(file, p.second)});
+            }
+          } else if (!step_kv.second.IsNull()) {
+            d.error(where(file, step_kv.second), "parameters of '" + step.process + "' must be a map");
+          }
+          rule.insert.push_back(std::move(step));
+        }
+      } else if (key == "fault" || key == "process" || key == "then" || key == "max_retries" || key == "insert") {
+        d.error(where(file, v), "'" + key + "' has the wrong form (" + kind_name(v) + ")");
+      } else {
+        d.error(where(file, kv.first), "unknown key '" + key + "' in a recovery rule; expected: fault, process, insert, then, max_retries");
+      }
+    }
+    if (rule.fault.empty()) d.error(rule.where, "recovery rule without 'fault' (the fault message it handles)");
+    rules.push_back(std::move(rule));
+  }
+  if (d.has_errors()) throw ConfigError(d);
+  return RecoveryPolicy(std::move(rules));
+}
+
+}  // namespace
+
+RecoveryPolicy RecoveryPolicy::load(const std::filesystem::path& file,
+                                    const std::function<bool(std::string_view)>& is_known_process) {
+  std::ifstream in(file);
+  if (!in) throw ConfigError(SourceLocation{file.string(), 0, 0}, "cannot open recovery rules file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parse(ss.str(), file.string(), is_known_process);
+}
+
+RecoveryPolicy RecoveryPolicy::load_from_string(std::string_view yaml, std::string_view name,
+                                                const std::function<bool(std::string_view)>& is_known_process) {
+  return parse(std::string(yaml), std::string(name), is_known_process);
+}
+
+int RecoveryPolicy::find_rule(const ProcessStep& failed, std::string_view message) const {
+  for (std::size_t i = 0; i < rules_.size(); ++i) {
+    const auto& r = rules_[i];
+    if (iequals(r.fault, message) && (r.process.empty() || r.process == failed.process)) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+RecoveryDecision RecoveryPolicy::decide(const ProcessStep& failed, std::string_view message, int times_fired) const {
+  RecoveryDecision d;
+  const int i = find_rule(failed, message);
+  if (i < 0) {
+    d.reason = "no recovery rule for fault \"" + std::string(message) + "\" of " + failed.process;
+    return d;
+  }
+  const RecoveryRule& rule = rules_[static_cast<std::size_t>(i)];
+  d.rule = &rule;
+  if (times_fired >= rule.max_retries) {
+    d.reason = "retry limit reached: \"" + rule.fault + "\" recovered " + std::to_string(times_fired) + " time(s) (max_retries " +
+               std::to_string(rule.max_retries) + "), " + failed.process + " failed again";
+    return d;
+  }
+  d.action = rule.then;
+  d.insert = rule.insert;
+  std::string inserted;
+  for (const auto& s : rule.insert) inserted += (inserted.empty() ? "" : ", ") + s.process;
+  d.reason = "fault \"" + std::string(message) + "\" of " + failed.process + ": " +
+             (inserted.empty() ? std::string() : "insert " + inserted + ", then ") +
+             (rule.then == RecoveryAction::retry ? "retry" : rule.then == RecoveryAction::skip ? "skip" : "abort") + " (" +
+             std::to_string(times_fired + 1) + "/" + std::to_string(rule.max_retries) + ")";
+  return d;
+}
+
+Plan RecoveryPolicy::remaining_plan(const Plan& plan, std::size_t failed_stage, const RecoveryDecision& decision) {
+  Plan out;
+  out.task = plan.task;
+  out.command = plan.command;
+  if (decision.action == RecoveryAction::abort || failed_stage >= plan.stages.size()) return out;
+  for (const auto& step : decision.insert) out.stages.push_back(PlanStage{{step}});
+  const std::size_t from = decision.action == RecoveryAction::retry ? failed_stage : failed_stage + 1;
+  for (std::size_t s = from; s < plan.stages.size(); ++s) out.stages.push_back(plan.stages[s]);
+  return out;
+}
+
+}  // namespace tripodal
