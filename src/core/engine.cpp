@@ -690,10 +690,13 @@ void Engine::Impl::report_livelock() {
   const std::size_t length = std::min(window, instant_firings);
   // seq(i) = i-th of the last `length` firings, oldest first.
   auto seq = [&](std::size_t i) { return tail[(instant_firings - length + i) % window]; };
+  // The smallest period of the last half of the tail: the first half may still hold the
+  // firings that led into the loop.
+  const std::size_t half = length / 2;
   std::size_t period = 0;
-  for (std::size_t p = 1; p <= length / 2 && period == 0; ++p) {
+  for (std::size_t p = 1; p <= half / 2 && period == 0; ++p) {
     bool periodic = true;
-    for (std::size_t i = p; i < length && periodic; ++i) periodic = seq(i) == seq(i - p);
+    for (std::size_t i = length - half + p; i < length && periodic; ++i) periodic = seq(i) == seq(i - p);
     if (periodic) period = p;
   }
   result.loop.clear();
