@@ -304,9 +304,9 @@ TEST_CASE("a delayed transition fires once continuously enabled for its delay") 
   HistoryRecorder h;
   e.add_observer(h);
   REQUIRE(e.next_deadline() == at(2.0));
-  CHECK(fired(e, h, at(1.999)).empty());
 
   SECTION("fires at its deadline") {
+    CHECK(fired(e, h, at(1.999)).empty());
     CHECK(fired(e, h, at(2.0)) == Ids{"timeout"});
     CHECK_FALSE(e.next_deadline().has_value());
   }
