@@ -83,8 +83,24 @@ class RankSet {
     }
     return index;
   }
+  /// Smallest element >= i; kNone when there is none.
+  [[nodiscard]] std::uint32_t next(std::uint32_t i) const noexcept { return next_at(0, i); }
 
  private:
+  // Smallest set bit >= i at `level`: within i's word, else in the next non-empty word, which
+  // the level above finds.
+  [[nodiscard]] std::uint32_t next_at(std::size_t level, std::uint32_t i) const noexcept {
+    const auto& words = levels_[level];
+    const std::uint32_t w = i >> 6;
+    if (w >= words.size()) return kNone;
+    const std::uint64_t bits = words[w] & (~std::uint64_t{0} << (i & 63));
+    if (bits != 0) return w * 64 + static_cast<std::uint32_t>(std::countr_zero(bits));
+    if (level + 1 == levels_.size()) return kNone;
+    const std::uint32_t next_word = next_at(level + 1, w + 1);
+    if (next_word == kNone) return kNone;
+    return next_word * 64 + static_cast<std::uint32_t>(std::countr_zero(words[next_word]));
+  }
+
   std::vector<std::vector<std::uint64_t>> levels_;  // [0] = bottom
 };
 
@@ -240,12 +256,14 @@ struct Engine::Impl {
   std::unordered_map<std::string, EventId, StringHash, std::equal_to<>> event_ids;
   std::vector<std::uint32_t> listener_begin;  // per event, CSR, in rank order
   std::vector<TransitionIndex> listeners;
+  std::vector<std::uint32_t> listener_pos;    // per event transition: its position in its event's list
 
   // --- state ----------------------------------------------------------------------------------
   Marking marking;
   std::vector<std::uint8_t> enabled;
   std::vector<Time> since;
   RankSet ready;  // ranks of enabled immediate and due delayed transitions
+  std::vector<RankSet> event_enabled;  // per event: positions of its enabled listeners
   TimerHeap timers;
   Time now{0};
   std::size_t instant_firings = 0;
@@ -283,7 +301,7 @@ struct Engine::Impl {
           ready.erase(rank[t]);
         }
         break;
-      case Kind::event: break;
+      case Kind::event: event_enabled[event_of[t]].erase(listener_pos[t]); break;
     }
   }
 
@@ -299,7 +317,7 @@ struct Engine::Impl {
     switch (kind[t]) {
       case Kind::immediate: ready.insert(rank[t]); break;
       case Kind::delayed: timers.push(t, now + delay[t], rank[t]); break;
-      case Kind::event: break;
+      case Kind::event: event_enabled[event_of[t]].insert(listener_pos[t]); break;
     }
   }
 
@@ -368,9 +386,11 @@ struct Engine::Impl {
   }
 
   bool post(EventId e, std::string_view name) {
-    for (std::uint32_t i = listener_begin[e], end = listener_begin[e + 1]; i < end; ++i) {
-      const TransitionIndex t = listeners[i];
-      if (enabled[t] != 0 && since[t] + delay[t] <= now) {
+    // Enabled listeners in rank order; one waiting out its delay passes the event on.
+    const RankSet& candidates = event_enabled[e];
+    for (std::uint32_t i = candidates.next(0); i != kNone; i = candidates.next(i + 1)) {
+      const TransitionIndex t = listeners[listener_begin[e] + i];
+      if (since[t] + delay[t] <= now) {
         if (!fire(t, name)) return false;
         return settle();
       }
@@ -526,10 +546,15 @@ void Engine::Impl::compile_structure() {
     watch_begin.push_back(static_cast<std::uint32_t>(watchers.size()));
   }
   listener_begin.assign(1, 0);
-  for (auto& l : event_listeners) {
+  listener_pos.assign(nt, kNone);
+  event_enabled.resize(event_listeners.size());
+  for (std::size_t e = 0; e < event_listeners.size(); ++e) {
+    auto& l = event_listeners[e];
     std::stable_sort(l.begin(), l.end(), [&](TransitionIndex a, TransitionIndex b) { return rank[a] < rank[b]; });
+    for (std::uint32_t i = 0; i < l.size(); ++i) listener_pos[l[i]] = i;
     listeners.insert(listeners.end(), l.begin(), l.end());
     listener_begin.push_back(static_cast<std::uint32_t>(listeners.size()));
+    event_enabled[e].init(l.size());
   }
 
   bound.assign(np, 0);
@@ -650,6 +675,7 @@ void Engine::Impl::reset(Time start) {
   instant_firings = 0;
   std::fill(enabled.begin(), enabled.end(), 0);
   ready.clear();
+  for (auto& set : event_enabled) set.clear();
   timers.clear();
   for (FactId f = 0; f < net.facts.size(); ++f) {
     const auto& d = net.facts[f].default_value;
