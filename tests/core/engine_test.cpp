@@ -34,14 +34,13 @@ using Ids = std::vector<std::string>;
 }  // namespace
 
 TEST_CASE("API example: run a two-step net with an event") {
+  // The example of docs/engine.md.
   PetriNet net;
-  net.id = "example";
-  net.add_place(make_place("idle", 1));
-  net.add_place(make_place("working"));
-  net.add_place(make_place("done"));
-  net.place(2).outcome = Outcome::success;
-  net.add_transition(make_transition("start"));             // immediate
-  net.add_transition(make_transition("finish", "work.done"));  // waits for an event
+  net.add_place(Place{.id = "idle", .initial_tokens = 1});
+  net.add_place(Place{.id = "working"});
+  net.add_place(Place{.id = "done", .outcome = Outcome::success});
+  net.add_transition(Transition{.id = "start"});  // immediate
+  net.add_transition(Transition{.id = "finish", .event = "work.done"});
   net.add_arc("idle", "start");
   net.add_arc("start", "working");
   net.add_arc("working", "finish");
@@ -50,9 +49,9 @@ TEST_CASE("API example: run a two-step net with an event") {
   Engine engine(net);
   HistoryRecorder history;
   engine.add_observer(history);
-  engine.step(at(0.0));  // fires `start`
+  engine.step(from_seconds(0.0));  // fires start
   CHECK(engine.outcome().outcome == Outcome::none);
-  const StepResult& r = engine.step(at(1.0), {"work.done"});
+  const StepResult& r = engine.step(from_seconds(1.0), {"work.done"});  // fires finish
   CHECK(r.ok());
   CHECK(r.firings == 1);
   CHECK(engine.outcome().outcome == Outcome::success);
