@@ -100,13 +100,16 @@ TEST_CASE("FLASER beams follow CARMEN's angle convention and keep their ranges")
 
 TEST_CASE("ODOM lines become odometry readings with twist; backwards stamps are clamped") {
   const Imported im = import_and_read(kExcerpt);
-  // Line 174: ODOM 0.698035 -0.0132843 -0.460915 0 0 0 32.9068 pippo 32.9068
-  // Line 176: ODOM 0.600266 -0.0320327 -0.354665 0 0 0 0 pippo 0  (after FLASER at 32.9068)
+  // Line 173: ODOM ... 33.1085; line 174: ODOM 0.698035 -0.0132843 -0.460915 0 0 0 32.9068 (backwards);
+  // line 175: FLASER at 32.9068; line 176: ODOM 0.600266 -0.0320327 -0.354665 0 0 0 0 (backwards).
+  // All three are clamped to 33.1085, the latest stamp seen before them.
   const auto it = std::find_if(im.odometry.begin(), im.odometry.end(),
                                [](const auto& o) { return o.pose.x_m == 0.600266; });
   REQUIRE(it != im.odometry.end());
-  CHECK(it->stamp == from_seconds(32.9068));
+  CHECK(it->stamp == from_seconds(33.1085));
   CHECK(std::prev(it)->pose == Pose2D{0.698035, -0.0132843, -0.460915});
+  CHECK(std::prev(it)->stamp == from_seconds(33.1085));
+  CHECK(im.scans[0].stamp == from_seconds(33.1085));
   for (std::size_t i = 1; i < im.odometry.size(); ++i) CHECK(im.odometry[i].stamp >= im.odometry[i - 1].stamp);
 
   const Imported t = import_text("ODOM 1 2 0.5 0.3 -0.1 0 10.5 host 10.5\n");
