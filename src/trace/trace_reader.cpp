@@ -1,5 +1,6 @@
 #include "tripodal/trace/trace_reader.hpp"
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 

@@ -4,7 +4,6 @@
 // truncation status at a whole-record boundary, or an error that names a byte offset in the file.
 #include <catch2/catch.hpp>
 #include <random>
-#include <regex>
 
 #include "trace_test_util.hpp"
 #include "tripodal/trace/trace_reader.hpp"
@@ -23,6 +22,17 @@ struct Outcome {
   std::uint64_t error_offset = 0;
   std::string message;
 };
+
+// True when `message` contains "byte N: " (the located form of every TraceFormatError).
+bool located(const std::string& message) {
+  for (std::size_t at = message.find("byte "); at != std::string::npos; at = message.find("byte ", at + 1)) {
+    std::size_t i = at + 5;
+    const std::size_t digits = i;
+    while (i < message.size() && message[i] >= '0' && message[i] <= '9') ++i;
+    if (i > digits && message.compare(i, 2, ": ") == 0) return true;
+  }
+  return false;
+}
 
 Outcome read_damaged(const std::filesystem::path& path) {
   Outcome o;
@@ -97,7 +107,6 @@ TEST_CASE("random byte damage never crashes and is located") {
   std::uniform_int_distribution<std::size_t> pos(0, original.size() - 1);
   std::uniform_int_distribution<int> flips(1, 4);
   std::uniform_int_distribution<int> byte(0, 255);
-  const std::regex located("byte [0-9]+: ");
   int errors = 0;
   for (int trial = 0; trial < 3000; ++trial) {
     auto bytes = original;
@@ -114,7 +123,7 @@ TEST_CASE("random byte damage never crashes and is located") {
     INFO("trial " << trial << ": " << o.message);
     if (o.error) {
       ++errors;
-      CHECK(std::regex_search(o.message, located));
+      CHECK(located(o.message));
       CHECK(o.error_offset <= keep);
     }
     // Never more records than the file held; records before the first damaged byte are all read.
