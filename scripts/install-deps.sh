@@ -8,6 +8,7 @@ packages=(
   libeigen3-dev libyaml-cpp-dev libtinyxml2-dev libspdlog-dev
   catch2 libbenchmark-dev
   graphviz libxml2-utils
+  zlib1g-dev
 )
 
 missing=()

@@ -1,0 +1,208 @@
+#include <zlib.h>
+
+#include <catch2/catch.hpp>
+#include <numbers>
+#include <sstream>
+
+#include "trace_test_util.hpp"
+#include "tripodal/core/diagnostic.hpp"
+#include "tripodal/trace/carmen_import.hpp"
+#include "tripodal/trace/trace_reader.hpp"
+
+using namespace tripodal;
+using namespace tripodal::trace;
+using namespace tripodal::trace::test;
+
+namespace {
+
+const std::string kExcerpt = std::string(TRIPODAL_TEST_DATA_DIR) + "/trace/intel-excerpt.log";
+
+struct Imported {
+  CarmenImportReport report;
+  std::vector<LaserScan> scans;
+  std::vector<OdometryReading> odometry;
+  std::vector<OdometryReading> laser_poses;
+};
+
+Imported import_and_read(const std::filesystem::path& log) {
+  TempFile out("carmen");
+  Imported result;
+  {
+    TraceWriter w(out.path());
+    result.report = import_carmen_log(log, w);
+  }
+  TraceReader r(out.path());
+  TraceRecord rec;
+  while (r.next(rec)) {
+    const auto& name = r.channel(rec.channel).name;
+    if (name == "front_laser") result.scans.push_back(std::get<LaserScan>(rec.data));
+    else if (name == "odom") result.odometry.push_back(std::get<OdometryReading>(rec.data));
+    else if (name == "laser_pose") result.laser_poses.push_back(std::get<OdometryReading>(rec.data));
+    else FAIL("unexpected channel " << name);
+  }
+  CHECK(r.state() == ReadState::kEnd);
+  return result;
+}
+
+Imported import_text(const std::string& text, const std::string& name = "mem.log") {
+  TempFile log("carmen_text");
+  {
+    std::ofstream f(log.path());
+    f << text;
+  }
+  (void)name;
+  return import_and_read(log.path());
+}
+
+}  // namespace
+
+TEST_CASE("the Intel excerpt imports with the counts of its lines") {
+  const Imported im = import_and_read(kExcerpt);
+  // grep -c '^FLASER' / '^ODOM' on the excerpt: 30 and 659.
+  CHECK(im.report.laser_scans == 30);
+  CHECK(im.report.odometry_readings == 659);
+  CHECK(im.scans.size() == 30);
+  CHECK(im.odometry.size() == 659);
+  CHECK(im.laser_poses.size() == 30);
+  CHECK(im.report.lines == 722);
+  CHECK(im.report.comments == 2);
+  CHECK(im.report.params.size() == 2);
+  CHECK(im.report.params[0] == std::pair<std::string, std::string>{"robot_frontlaser_offset", "0.0"});
+  CHECK(im.report.skipped.at("NEFF") == 29);
+  // Each FLASER is followed by an ODOM stamped 0 (the corrected pose): those step backwards.
+  CHECK(im.report.backwards_steps == 117);
+  CHECK(im.report.first_stamp == from_seconds(0.000246));
+}
+
+TEST_CASE("FLASER beams follow CARMEN's angle convention and keep their ranges") {
+  const Imported im = import_and_read(kExcerpt);
+  REQUIRE(im.scans.size() >= 2);
+  const LaserScan& s = im.scans[1];  // line 187 of the excerpt
+  REQUIRE(s.ranges_m.size() == 180);
+  // 180 beams: 1 degree apart from -90 degrees, the last at +89 degrees (CARMEN readlog.c).
+  CHECK(s.angle_min_rad == Approx(-std::numbers::pi / 2));
+  CHECK(s.angle_increment_rad == Approx(std::numbers::pi / 180));
+  CHECK(s.angle_max_rad == Approx(89.0 * std::numbers::pi / 180));
+  CHECK(s.range_max_m == 80.0);
+  CHECK(s.intensities.empty());
+  CHECK(s.ranges_m[0] == 1.72f);
+  CHECK(s.ranges_m[1] == 1.66f);
+  CHECK(s.ranges_m[90] == 1.15f);
+  CHECK(s.ranges_m[179] == 2.15f);
+  CHECK(s.stamp == from_seconds(35.1051));
+  CHECK(im.laser_poses[1].pose == Pose2D{0.68231, -0.100086, -0.938803});
+  CHECK(im.laser_poses[1].stamp == s.stamp);
+  // 81.83 m readings (no return on the Intel SICK) lie beyond range_max: "no return" by contract.
+  const LaserScan& first = im.scans[0];
+  CHECK(first.ranges_m[110] == 81.83f);
+  CHECK(first.ranges_m[110] > first.range_max_m);
+}
+
+TEST_CASE("ODOM lines become odometry readings with twist; backwards stamps are clamped") {
+  const Imported im = import_and_read(kExcerpt);
+  // Line 173: ODOM ... 33.1085; line 174: ODOM 0.698035 -0.0132843 -0.460915 0 0 0 32.9068 (backwards);
+  // line 175: FLASER at 32.9068; line 176: ODOM 0.600266 -0.0320327 -0.354665 0 0 0 0 (backwards).
+  // All three are clamped to 33.1085, the latest stamp seen before them.
+  const auto it = std::find_if(im.odometry.begin(), im.odometry.end(),
+                               [](const auto& o) { return o.pose.x_m == 0.600266; });
+  REQUIRE(it != im.odometry.end());
+  CHECK(it->stamp == from_seconds(33.1085));
+  CHECK(std::prev(it)->pose == Pose2D{0.698035, -0.0132843, -0.460915});
+  CHECK(std::prev(it)->stamp == from_seconds(33.1085));
+  CHECK(im.scans[0].stamp == from_seconds(33.1085));
+  for (std::size_t i = 1; i < im.odometry.size(); ++i) CHECK(im.odometry[i].stamp >= im.odometry[i - 1].stamp);
+
+  const Imported t = import_text("ODOM 1 2 0.5 0.3 -0.1 0 10.5 host 10.5\n");
+  REQUIRE(t.odometry.size() == 1);
+  CHECK(t.odometry[0].pose == Pose2D{1, 2, 0.5});
+  CHECK(t.odometry[0].twist == Twist2D{0.3, 0.0, -0.1});
+  CHECK(t.odometry[0].stamp == from_seconds(10.5));
+}
+
+TEST_CASE("the gzip-compressed excerpt imports like the plain one") {
+  const Imported plain = import_and_read(kExcerpt);
+  const Imported gz = import_and_read(kExcerpt + ".gz");
+  REQUIRE(gz.scans.size() == plain.scans.size());
+  CHECK(gz.scans == plain.scans);
+  CHECK(gz.odometry == plain.odometry);
+}
+
+TEST_CASE("ROBOTLASER1 uses the scanner configuration of the line") {
+  // 5 beams from -0.5 rad, 0.25 rad apart, max 30 m, with 5 remissions.
+  const Imported im = import_text(
+      "ROBOTLASER1 0 -0.5 1.0 0.25 30.0 0.01 0 5 1.0 2.0 3.0 4.0 5.0 5 10 20 30 40 50 "
+      "1.0 2.0 0.1 0.9 1.9 0.1 0.2 0.3 0.5 0.6 0.7 1234.5 host 1234.6\n");
+  REQUIRE(im.scans.size() == 1);
+  const LaserScan& s = im.scans[0];
+  CHECK(s.angle_min_rad == -0.5);
+  CHECK(s.angle_increment_rad == 0.25);
+  CHECK(s.angle_max_rad == Approx(0.5));
+  CHECK(s.range_max_m == 30.0);
+  CHECK(s.ranges_m == std::vector<float>{1, 2, 3, 4, 5});
+  CHECK(s.intensities == std::vector<float>{10, 20, 30, 40, 50});
+  CHECK(s.stamp == from_seconds(1234.5));
+  CHECK(im.laser_poses[0].pose == Pose2D{1.0, 2.0, 0.1});
+}
+
+TEST_CASE("361-beam FLASER scans are 0.5 degree apart over 180 degrees") {
+  std::ostringstream line;
+  line << "FLASER 361";
+  for (int i = 0; i < 361; ++i) line << " 2.5";
+  line << " 0 0 0 0 0 0 1.13486e+09 b21 1.13486e+09\n";
+  const Imported im = import_text(line.str());
+  REQUIRE(im.scans.size() == 1);
+  CHECK(im.scans[0].angle_increment_rad == Approx(std::numbers::pi / 360));
+  CHECK(im.scans[0].angle_max_rad == Approx(std::numbers::pi / 2));
+}
+
+TEST_CASE("malformed lines are all reported with file:line:column") {
+  TempFile log("carmen_bad");
+  {
+    std::ofstream f(log.path());
+    f << "# comment\n"
+         "ODOM 1 2 x 0 0 0 10.0 host 10.0\n"
+         "FLASER 3 1.0 2.0\n"
+         "ODOM 1 2 3 0 0 0 11.0 host 11.0 extra\n"
+         "FLASER abc\n"
+         "FLASER 2 1.0 2.0 0 0\n"
+         "ODOM 1 2 3 0 0 0 12.0 host 12.0\n"
+         "SYNC tag 1.0 host 1.0\n";
+  }
+  TempFile out("carmen_bad_out");
+  TraceWriter w(out.path());
+  const std::string name = log.str();
+  try {
+    import_carmen_log(log.path(), w);
+    FAIL("expected a ConfigError");
+  } catch (const ConfigError& e) {
+    const std::string what = e.what();
+    CHECK_THAT(what, Catch::Contains(name + ":2:10: error: ODOM theta 'x' is not a finite number"));
+    CHECK_THAT(what, Catch::Contains(name + ":3:8: error: FLASER num_readings 3 exceeds the 2 fields left on the line"));
+    CHECK_THAT(what, Catch::Contains(name + ":4:33: error: ODOM has 1 unexpected fields after logger_timestamp"));
+    CHECK_THAT(what, Catch::Contains(name + ":5:8: error: FLASER num_readings 'abc' is not a count"));
+    CHECK_THAT(what, Catch::Contains(name + ":6:21: error: FLASER line ends before the theta field"));
+    CHECK(e.diagnostics().error_count() == 5);
+  }
+}
+
+TEST_CASE("unknown messages are skipped and counted") {
+  std::istringstream in("SYNC tag 1.0 host 1.0\nTRUEPOS 1 2 3 4 5 6 1.0 h 1.0\nSYNC x 2 h 2\n\n");
+  TempFile out("carmen_skip");
+  TraceWriter w(out.path());
+  const auto report = import_carmen_log(in, "in.log", w);
+  CHECK(report.skipped.at("SYNC") == 2);
+  CHECK(report.skipped.at("TRUEPOS") == 1);
+  CHECK(report.blank_lines == 1);
+  CHECK(report.laser_scans == 0);
+}
+
+TEST_CASE("a missing log is an I/O error, a damaged gzip stream too") {
+  TempFile out("carmen_io");
+  TraceWriter w(out.path());
+  CHECK_THROWS_AS(import_carmen_log(std::filesystem::path("/nonexistent/x.log.gz"), w), TraceIoError);
+  // The excerpt's gzip stream cut in half.
+  auto gz = read_all(kExcerpt + ".gz");
+  TempFile cut("carmen_cut.gz");
+  write_all(cut.path(), gz, gz.size() / 2);
+  CHECK_THROWS_AS(import_carmen_log(cut.path(), w), TraceIoError);
+}

@@ -1,0 +1,312 @@
+// `tripodal trace import|info|dump`: convert CARMEN logs to tripodal traces and inspect traces.
+#include <charconv>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <iomanip>
+#include <map>
+#include <ostream>
+#include <sstream>
+
+#include "command.hpp"
+#include "tripodal/core/diagnostic.hpp"
+#include "tripodal/trace/carmen_import.hpp"
+#include "tripodal/trace/trace_reader.hpp"
+
+namespace tripodal::tool {
+namespace {
+
+using namespace tripodal::trace;
+
+// Splits args into positionals and --name value options; returns false (after printing) on error.
+struct Parsed {
+  std::vector<std::string> positional;
+  std::map<std::string, std::string> options;
+  std::vector<std::string> flags;
+};
+
+bool parse(const std::vector<std::string>& args, const std::vector<std::string>& with_value,
+           const std::vector<std::string>& flags, Parsed& p, std::ostream& err) {
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a.size() > 1 && a[0] == '-') {
+      if (std::find(flags.begin(), flags.end(), a) != flags.end()) {
+        p.flags.push_back(a);
+      } else if (std::find(with_value.begin(), with_value.end(), a) != with_value.end()) {
+        if (i + 1 >= args.size()) {
+          err << "option " << a << " needs a value\n";
+          return false;
+        }
+        p.options[a] = args[++i];
+      } else {
+        err << "unknown option " << a << '\n';
+        return false;
+      }
+    } else {
+      p.positional.push_back(a);
+    }
+  }
+  return true;
+}
+
+std::string seconds(Time t) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(6) << to_seconds(t);
+  return s.str();
+}
+
+// ---------------------------------------------------------------------------------------------
+constexpr std::string_view kImportUsage =
+    "usage: tripodal trace import LOG OUT [--laser-channel NAME] [--odom-channel NAME]\n"
+    "                             [--laser-pose-channel NAME | --no-laser-pose]\n\n"
+    "Converts a CARMEN log (plain or gzip-compressed) to a tripodal trace.\n"
+    "FLASER/ROBOTLASER1 -> laser channel (default front_laser), RLASER/ROBOTLASER2 -> rear_laser,\n"
+    "ODOM -> odometry channel (default odom), the laser pose of each scan -> laser_pose.\n"
+    "Other messages are skipped and counted; time stamps that go backwards are clamped.\n"
+    "Malformed lines are reported as LOG:LINE:COL and OUT is removed (exit 1).\n";
+
+int trace_import(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  Parsed p;
+  if (!parse(args, {"--laser-channel", "--odom-channel", "--laser-pose-channel"}, {"--no-laser-pose"}, p, err) ||
+      p.positional.size() != 2) {
+    if (p.positional.size() != 2) err << "tripodal trace import: expected LOG and OUT\n";
+    err << kImportUsage;
+    return kUsage;
+  }
+  CarmenImportOptions options;
+  if (auto it = p.options.find("--laser-channel"); it != p.options.end()) options.laser_channel = it->second;
+  if (auto it = p.options.find("--odom-channel"); it != p.options.end()) options.odometry_channel = it->second;
+  if (auto it = p.options.find("--laser-pose-channel"); it != p.options.end()) options.laser_pose_channel = it->second;
+  if (!p.flags.empty()) options.laser_pose_channel.clear();
+  const std::filesystem::path log = p.positional[0];
+  const std::filesystem::path trace_path = p.positional[1];
+  if (!std::filesystem::exists(log)) {
+    err << "tripodal trace import: " << log.string() << ": no such file\n";
+    return kIoError;
+  }
+  CarmenImportReport report;
+  try {
+    TraceWriter writer(trace_path);
+    report = import_carmen_log(log, writer, options);
+    writer.close();
+  } catch (const ConfigError& e) {
+    err << e.what() << '\n';
+    std::error_code ec;
+    std::filesystem::remove(trace_path, ec);
+    return kBadInput;
+  } catch (const TraceIoError& e) {
+    err << "tripodal trace import: " << e.what() << '\n';
+    std::error_code ec;
+    std::filesystem::remove(trace_path, ec);
+    return kIoError;
+  }
+  out << "imported " << log.string() << " -> " << trace_path.string() << '\n'
+      << "lines: " << report.lines << '\n'
+      << "laser scans: " << report.laser_scans << '\n'
+      << "odometry readings: " << report.odometry_readings << '\n'
+      << "laser poses: " << report.laser_poses << '\n'
+      << "params: " << report.params.size() << '\n';
+  for (const auto& [type, n] : report.skipped) out << "skipped " << type << ": " << n << '\n';
+  out << "backwards time stamps clamped: " << report.backwards_steps;
+  if (report.backwards_steps > 0) out << " (largest step back " << to_seconds(report.largest_backwards_step) << " s)";
+  out << '\n' << "duration: " << to_seconds(report.last_stamp - report.first_stamp) << " s\n";
+  return kOk;
+}
+
+// ---------------------------------------------------------------------------------------------
+constexpr std::string_view kInfoUsage =
+    "usage: tripodal trace info FILE\n\n"
+    "Prints the format version, duration, channels and the number of records of each kind.\n"
+    "A trace cut inside a record (recorder killed) is summarised up to its last whole record\n"
+    "with a warning (exit 0); a corrupt trace is an error naming the byte offset (exit 1).\n";
+
+constexpr std::string_view kind_label(ChannelKind kind) {
+  switch (kind) {
+    case ChannelKind::kLaser: return "laser scans";
+    case ChannelKind::kOdometry: return "odometry readings";
+    case ChannelKind::kSonar: return "sonar readings";
+    case ChannelKind::kInfrared: return "infrared readings";
+    case ChannelKind::kBumper: return "bumper readings";
+    case ChannelKind::kBattery: return "battery readings";
+    case ChannelKind::kGyro: return "gyro readings";
+    case ChannelKind::kCommand: return "commands";
+    case ChannelKind::kEvent: return "events";
+  }
+  return "unknown";
+}
+
+int with_reader(const std::string& path, std::ostream& err, const std::function<int(TraceReader&)>& body) {
+  try {
+    TraceReader reader(path);
+    const int rc = body(reader);
+    if (reader.state() == ReadState::kTruncated) err << "warning: " << reader.warning() << '\n';
+    return rc;
+  } catch (const TraceFormatError& e) {
+    err << "error: " << e.what() << '\n';
+    return kBadInput;
+  } catch (const TraceIoError& e) {
+    err << "error: " << e.what() << '\n';
+    return kIoError;
+  }
+}
+
+int trace_info(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  Parsed p;
+  if (!parse(args, {}, {}, p, err) || p.positional.size() != 1) {
+    err << kInfoUsage;
+    return kUsage;
+  }
+  const std::string path = p.positional[0];
+  std::map<ChannelId, std::uint64_t> per_channel;
+  std::uint64_t records = 0;
+  Time first{0};
+  Time last{0};
+  std::uint64_t backwards = 0;
+  // Counted while reading so that a corrupt tail still shows what came before it.
+  const auto report = [&](TraceReader& r) {
+    out << "file: " << path << '\n'
+        << "format version: " << r.format_version() << '\n'
+        << "bytes: " << r.offset() << '\n'
+        << "records: " << records << '\n';
+    if (records > 0) {
+      out << "start: " << seconds(first) << " s\n"
+          << "end: " << seconds(last) << " s\n"
+          << "duration: " << seconds(last - first) << " s\n";
+    }
+    if (backwards > 0) out << "records stamped before their predecessor: " << backwards << '\n';
+    out << "channels:\n";
+    std::map<ChannelKind, std::uint64_t> per_kind;
+    for (const auto& c : r.channels()) {
+      const auto n = per_channel[c.id];
+      per_kind[c.kind] += n;
+      out << "  " << c.name << " (" << to_string(c.kind) << "): " << n << '\n';
+    }
+    for (const auto& [kind, n] : per_kind) out << kind_label(kind) << ": " << n << '\n';
+    out << "status: " << (r.state() == ReadState::kTruncated ? "truncated" : "complete") << '\n';
+  };
+  return with_reader(path, err, [&](TraceReader& r) {
+    TraceRecord rec;
+    try {
+      while (r.next(rec)) {
+        const Time t = stamp_of(rec.data);
+        if (records == 0) first = t;
+        if (records > 0 && t < last) ++backwards;
+        last = std::max(last, t);
+        ++records;
+        ++per_channel[rec.channel];
+      }
+    } catch (const TraceFormatError&) {
+      report(r);
+      throw;
+    }
+    report(r);
+    return static_cast<int>(kOk);
+  });
+}
+
+// ---------------------------------------------------------------------------------------------
+constexpr std::string_view kDumpUsage =
+    "usage: tripodal trace dump FILE [--limit N] [--beams K]\n\n"
+    "Prints one line per record: time stamp (s), channel, kind and values. --limit stops after N\n"
+    "records; --beams K shows the first K ranges of each scan (default 8, 0 for all).\n";
+
+template <typename T>
+void list(std::ostream& out, const std::vector<T>& v, std::size_t limit) {
+  const std::size_t n = limit == 0 ? v.size() : std::min(limit, v.size());
+  out << '[';
+  for (std::size_t i = 0; i < n; ++i) out << (i ? " " : "") << +v[i];
+  if (n < v.size()) out << " ...";
+  out << ']';
+}
+
+void dump_record(std::ostream& out, const ChannelInfo& c, const RecordData& data, std::size_t beams) {
+  out << seconds(stamp_of(data)) << ' ' << c.name << ' ' << to_string(c.kind);
+  std::visit(
+      [&](const auto& r) {
+        using T = std::decay_t<decltype(r)>;
+        if constexpr (std::is_same_v<T, LaserScan>) {
+          out << " beams=" << r.ranges_m.size() << " angle=[" << r.angle_min_rad << ", " << r.angle_max_rad
+              << "] inc=" << r.angle_increment_rad << " range=[" << r.range_min_m << ", " << r.range_max_m
+              << "] ranges=";
+          list(out, r.ranges_m, beams);
+          if (!r.intensities.empty()) {
+            out << " intensities=";
+            list(out, r.intensities, beams);
+          }
+        } else if constexpr (std::is_same_v<T, OdometryReading>) {
+          out << " x=" << r.pose.x_m << " y=" << r.pose.y_m << " theta=" << r.pose.theta_rad << " vx=" << r.twist.vx_m_s
+              << " vy=" << r.twist.vy_m_s << " wz=" << r.twist.wz_rad_s;
+        } else if constexpr (std::is_same_v<T, SonarReading>) {
+          out << " fov=" << r.field_of_view_rad << " range=[" << r.range_min_m << ", " << r.range_max_m << "] ranges=";
+          list(out, r.ranges_m, 0);
+        } else if constexpr (std::is_same_v<T, InfraredReading>) {
+          out << " cliff=";
+          list(out, r.cliff, 0);
+          out << " wall=";
+          list(out, r.wall_ranges_m, 0);
+        } else if constexpr (std::is_same_v<T, BumperReading>) {
+          out << " count=" << r.count << " pressed=0x" << std::hex << r.pressed_mask << std::dec;
+        } else if constexpr (std::is_same_v<T, BatteryReading>) {
+          out << " voltage=" << r.voltage_v << " current=" << r.current_a << " percentage=" << r.percentage
+              << " charging=" << (r.charging ? "yes" : "no");
+        } else if constexpr (std::is_same_v<T, GyroReading>) {
+          out << " yaw_rate=" << r.yaw_rate_rad_s << " yaw=" << r.yaw_rad;
+        } else if constexpr (std::is_same_v<T, CommandRecord>) {
+          out << " source=" << r.source << " vx=" << r.twist.vx_m_s << " vy=" << r.twist.vy_m_s
+              << " wz=" << r.twist.wz_rad_s;
+        } else {
+          out << " name=" << r.name;
+        }
+      },
+      data);
+  out << '\n';
+}
+
+bool to_count(const std::string& s, std::size_t& v) {
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  return ec == std::errc() && end == s.data() + s.size();
+}
+
+int trace_dump(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  Parsed p;
+  std::size_t limit = 0;
+  std::size_t beams = 8;
+  bool ok = parse(args, {"--limit", "--beams"}, {}, p, err) && p.positional.size() == 1;
+  if (ok && p.options.count("--limit") != 0 && !to_count(p.options["--limit"], limit)) {
+    err << "--limit needs a non-negative integer\n";
+    ok = false;
+  }
+  if (ok && p.options.count("--beams") != 0 && !to_count(p.options["--beams"], beams)) {
+    err << "--beams needs a non-negative integer\n";
+    ok = false;
+  }
+  if (!ok) {
+    err << kDumpUsage;
+    return kUsage;
+  }
+  return with_reader(p.positional[0], err, [&](TraceReader& r) {
+    TraceRecord rec;
+    std::size_t n = 0;
+    std::vector<bool> announced;
+    while ((limit == 0 || n < limit) && r.next(rec)) {
+      if (announced.size() <= rec.channel) announced.resize(rec.channel + 1u, false);
+      const ChannelInfo& c = r.channel(rec.channel);
+      if (!announced[rec.channel]) {
+        out << "# channel " << c.id << ": " << c.name << " (" << to_string(c.kind) << ")\n";
+        announced[rec.channel] = true;
+      }
+      dump_record(out, c, rec.data, beams);
+      ++n;
+    }
+    return static_cast<int>(kOk);
+  });
+}
+
+}  // namespace
+
+TRIPODAL_COMMAND("trace", "import", "convert a CARMEN log (.log or .log.gz) to a tripodal trace", kImportUsage,
+                 &trace_import);
+TRIPODAL_COMMAND("trace", "info", "duration, channels and record counts of a trace", kInfoUsage, &trace_info);
+TRIPODAL_COMMAND("trace", "dump", "print a trace's records, one per line", kDumpUsage, &trace_dump);
+
+}  // namespace tripodal::tool
