@@ -2,24 +2,9 @@
 // allocations around many steps. Its own executable, so the replacement affects no other suite.
 #include <catch2/catch.hpp>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
-
+#include "../support/counting_new.hpp"
 #include "engine_test_nets.hpp"
 #include "tripodal/core/engine.hpp"
-
-namespace {
-std::atomic<std::size_t> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 using namespace tripodal;
 
@@ -28,21 +13,21 @@ TEST_CASE("steady-state steps do not allocate: firings, delays, events, bindings
   Engine engine(ring);
   Time now{0};
   engine.step(now);
-  const std::size_t before = g_allocations.load();
+  const std::size_t before = test::allocations();
   std::size_t firings = 0;
   for (int i = 0; i < 1000; ++i) {
     now += Duration{1000};
     firings += engine.step(now).firings;
   }
   CHECK(firings == 100'000);
-  CHECK(g_allocations.load() == before);
+  CHECK(test::allocations() == before);
 
   const PetriNet net = test::pr_cleaning_net(1.0);
   Engine pr(net, {{"wheel_type", Value{std::string("differential")}}});
   const EventId lost = *pr.event_id("localizer.lost");
   const EventId ok = *pr.event_id("localizer.ok");
   pr.step(Time{0});
-  const std::size_t before_pr = g_allocations.load();
+  const std::size_t before_pr = test::allocations();
   Time t{0};
   std::size_t dropped = 0;
   for (int i = 0; i < 1000; ++i) {
@@ -54,5 +39,5 @@ TEST_CASE("steady-state steps do not allocate: firings, delays, events, bindings
   }
   CHECK(dropped > 0);
   CHECK(pr.outcome().outcome == Outcome::none);
-  CHECK(g_allocations.load() == before_pr);
+  CHECK(test::allocations() == before_pr);
 }
