@@ -57,6 +57,7 @@ class PnmlReader {
       if (const auto* ext = tripodal_extension(c, "net")) read_net_extension(ext);
     }
     read_container(e, true);
+    if (net_.name.empty()) net_.name = net_.id;  // as in the native format
     resolve_arcs();
   }
 

@@ -20,7 +20,7 @@ PetriNet read_native(const tinyxml2::XMLElement* root, const ReadContext& ctx) {
                                "xsi:noNamespaceSchemaLocation"});
   check_no_text(ctx, root);
   if (auto id = required(ctx, root, "id")) net.id = *id;
-  net.name = optional_attr(root, "name").value_or("");
+  net.name = optional_attr(root, "name").value_or(net.id);  // like nodes: the name defaults to the id
   net.description = optional_attr(root, "description").value_or("");
   if (auto level = optional_attr(root, "level")) {
     if (*level == "low") net.level = NetLevel::low;
