@@ -172,3 +172,25 @@ TEST_CASE("configs: PrCleaning without its wheel type is refused") {
   const PetriNet net = load_config("PrCleaning.xml");
   REQUIRE_THROWS_WITH(Engine(net), Catch::Contains("wheel_type"));
 }
+
+TEST_CASE("configs: the complete example of docs/net-format.md loads and runs") {
+  Diagnostics d;
+  const auto net = load_net(std::filesystem::path(TRIPODAL_SOURCE_DIR) / "docs" / "examples" / "net-format-example.xml", d);
+  INFO(d.str());
+  REQUIRE(net.has_value());
+  CHECK(d.empty());
+  Engine engine(*net, {{"room", Value{"2111"s}}});
+  const auto P = [&](const char* id) { return *net->find_place(id); };
+  engine.step(from_seconds(0.0));
+  CHECK(engine.tokens(P("P2")) == 1);
+  CHECK(engine.tokens(P("P3")) == 1);  // fog defaults to true
+  engine.step(from_seconds(1.0), {"bumper.hit", "bumper.hit"});
+  CHECK_FALSE(net->find_place("bumps"));  // "bumps" is P4's name; ids are what arcs and lookups use
+  CHECK(engine.tokens(P("P4")) == 2);
+  engine.set_fact("disinfectant_empty", Value{true});
+  engine.step(from_seconds(1.2));
+  CHECK(engine.outcome().outcome == Outcome::none);
+  engine.step(from_seconds(1.5));
+  CHECK(engine.outcome().outcome == Outcome::fault);
+  CHECK(engine.outcome().message == "disinfectant empty");
+}
