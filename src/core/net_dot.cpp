@@ -1,0 +1,126 @@
+#include "tripodal/core/net_dot.hpp"
+
+#include <stdexcept>
+
+namespace tripodal {
+
+namespace {
+
+// A DOT double-quoted string: quotes and backslashes escaped; "\n" stays a DOT line break.
+std::string quoted(std::string_view text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (c == '\n') {
+      out += "\\n";
+      continue;
+    }
+    out += c;
+  }
+  return out + "\"";
+}
+
+// The tokens as the paper draws them: dots for a few, a number beyond.
+std::string token_text(Tokens n) {
+  if (n == 0) return {};
+  if (n > 4) return std::to_string(n);
+  std::string out;
+  for (Tokens k = 0; k < n; ++k) out += k == 2 ? "\n\xE2\x97\x8F" : "\xE2\x97\x8F";  // U+25CF BLACK CIRCLE
+  return out;
+}
+
+// Text for an HTML-like Graphviz label.
+std::string html(std::string_view text) {
+  std::string out;
+  for (const char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+std::string seconds_text(Duration d) {
+  std::string s = std::to_string(to_seconds(d));
+  while (!s.empty() && s.back() == '0') s.pop_back();
+  if (!s.empty() && s.back() == '.') s.pop_back();
+  return s + " s";
+}
+
+}  // namespace
+
+std::string net_to_dot(const PetriNet& net, std::span<const Tokens> marking, const DotOptions& options) {
+  const auto& places = net.places();
+  if (!marking.empty() && marking.size() != places.size()) {
+    throw std::invalid_argument("marking has " + std::to_string(marking.size()) + " entries for " +
+                                std::to_string(places.size()) + " places");
+  }
+  std::string out = "digraph " + quoted(net.id.empty() ? "net" : net.id) + " {\n";
+  out += "  graph [rankdir=TB, nodesep=0.7, ranksep=0.5, forcelabels=true, fontname=\"Helvetica\"";
+  if (!net.description.empty()) out += ", label=" + quoted(net.description) + ", labelloc=t";
+  out += "];\n";
+  out += "  node [fontname=\"Helvetica\", fontsize=11];\n  edge [arrowsize=0.7];\n";
+  // The drawing carries the ids (as the paper's figures do); the descriptions go to a legend table
+  // beside it, like the paper's tables, so long texts do not pile up over the arcs.
+  for (std::size_t i = 0; i < places.size(); ++i) {
+    const Place& p = places[i];
+    const Tokens tokens = marking.empty() ? p.initial_tokens : marking[i];
+    std::string xlabel = p.name;
+    if (p.capacity) xlabel += " (" + std::to_string(*p.capacity) + ")";
+    out += "  " + quoted(p.id) + " [shape=circle, fixedsize=true, width=0.5, label=" + quoted(token_text(tokens)) +
+           ", xlabel=" + quoted(xlabel);
+    if (p.outcome != Outcome::none) out += ", peripheries=2";
+    if (p.outcome == Outcome::fault) out += ", color=\"#b00000\"";
+    if (p.behavior || p.process) out += ", style=filled, fillcolor=\"#eef3ff\"";
+    out += "];\n";
+  }
+  for (const auto& t : net.transitions()) {
+    std::string xlabel = t.name;
+    if (!t.event.empty()) xlabel += " [" + t.event + "]";
+    if (t.guard) xlabel += "\nif " + t.guard->text();
+    if (t.delay.count() != 0) xlabel += "\nafter " + seconds_text(t.delay);
+    if (t.priority != 0) xlabel += "\npriority " + std::to_string(t.priority);
+    out += "  " + quoted(t.id) +
+           " [shape=box, style=filled, fillcolor=black, label=\"\", width=0.45, height=0.07, fixedsize=true, xlabel=" +
+           quoted(xlabel) + "];\n";
+  }
+  for (const auto& t : net.transitions()) {
+    const auto weight = [](Tokens w) { return w > 1 ? "label=" + quoted(std::to_string(w)) : std::string(); };
+    const auto more = [&](Tokens w) { return w > 1 ? ", " + weight(w) : std::string(); };
+    for (const auto& a : t.inputs) out += "  " + quoted(places[a.place].id) + " -> " + quoted(t.id) + " [" + weight(a.weight) + "];\n";
+    for (const auto& a : t.outputs) out += "  " + quoted(t.id) + " -> " + quoted(places[a.place].id) + " [" + weight(a.weight) + "];\n";
+    for (const auto& a : t.reads) {
+      out += "  " + quoted(places[a.place].id) + " -> " + quoted(t.id) + " [style=dashed, arrowhead=none" + more(a.weight) + "];\n";
+    }
+    for (const auto& a : t.inhibitors) {
+      out += "  " + quoted(places[a.place].id) + " -> " + quoted(t.id) + " [arrowhead=odot" + more(a.weight) + "];\n";
+    }
+  }
+  if (options.descriptions) {
+    std::string rows;
+    const auto row = [&](const std::string& id, std::string text) {
+      if (text.empty()) return;
+      rows += "<TR><TD ALIGN=\"LEFT\">" + html(id) + "</TD><TD ALIGN=\"LEFT\">" + html(text) + "</TD></TR>";
+    };
+    for (const auto& p : places) {
+      std::string text = p.description;
+      if (p.behavior) text += (text.empty() ? "" : " ") + std::string("[behavior ") + p.behavior->behavior + "]";
+      if (p.process) text += (text.empty() ? "" : " ") + std::string("[process ") + p.process->process + "]";
+      if (p.outcome == Outcome::fault && !p.fault_message.empty()) text += " [fault: " + p.fault_message + "]";
+      row(p.name, text);
+    }
+    for (const auto& t : net.transitions()) row(t.name, t.description);
+    if (!rows.empty()) {
+      out += "  legend [shape=plaintext, fontsize=10, label=<<TABLE BORDER=\"0\" CELLBORDER=\"1\" CELLSPACING=\"0\" "
+             "CELLPADDING=\"3\"><TR><TD COLSPAN=\"2\"><B>Description</B></TD></TR>" +
+             rows + "</TABLE>>];\n";
+    }
+  }
+  return out + "}\n";
+}
+
+}  // namespace tripodal

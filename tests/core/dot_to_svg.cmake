@@ -1,0 +1,16 @@
+# Runs `tripodal-net dot NET [ARGS]` and renders the output with Graphviz's dot -Tsvg; fails
+# unless both succeed and an SVG comes out. -DTOOL -DNET -DOUT [-DARGS=a;b] -DDOT
+execute_process(COMMAND ${TOOL} dot ${NET} ${ARGS} -o ${OUT}.dot RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "tripodal-net dot failed (${rc}): ${err}")
+endif()
+execute_process(COMMAND ${DOT} -Tsvg ${OUT}.dot -o ${OUT}.svg RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT err STREQUAL "")
+  message(FATAL_ERROR "dot -Tsvg rejected the drawing (${rc}): ${err}")
+endif()
+file(READ ${OUT}.svg svg)
+file(READ ${OUT}.dot dot_text)
+message("${dot_text}")
+if(NOT svg MATCHES "<svg")
+  message(FATAL_ERROR "no SVG produced")
+endif()
