@@ -1,6 +1,7 @@
 #include "tripodal/analysis/analyzer.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <deque>
 
 #include "tripodal/core/diagnostic.hpp"
@@ -214,6 +215,85 @@ AnalysisReport analyze(const PetriNet& net, const AnalysisOptions& options) {
     }
   }
   return r;
+}
+
+}  // namespace tripodal::analysis
+
+namespace tripodal::analysis {
+
+namespace {
+
+std::string marking_ids(const PetriNet& net, const Marking& m) {
+  std::string out;
+  for (PlaceIndex p = 0; p < m.size(); ++p) {
+    if (m[p] == 0) continue;
+    out += (out.empty() ? "" : " ") + net.place(p).id + (m[p] > 1 ? "*" + std::to_string(m[p]) : "");
+  }
+  return out.empty() ? "(empty)" : out;
+}
+
+std::string path_ids(const PetriNet& net, const std::vector<TransitionIndex>& path) {
+  if (path.empty()) return "the initial marking";
+  std::string out;
+  for (const TransitionIndex t : path) {
+    const Transition& tr = net.transition(t);
+    out += (out.empty() ? "" : " -> ") + tr.id + (tr.event.empty() ? "" : " [" + tr.event + "]");
+  }
+  return out;
+}
+
+}  // namespace
+
+bool check_behaviour(const PetriNet& net, Diagnostics& diagnostics, const BehaviourCheckOptions& options) {
+  for (const VariableDecl& p : net.parameters) {
+    if (!p.default_value) {
+      diagnostics.note(net.where, "behaviour not checked: parameter '" + p.name +
+                                      "' has no default (run tripodal-net analyze with --param " + p.name + "=VALUE)");
+      return false;
+    }
+  }
+  AnalysisOptions o;
+  o.semantics = options.semantics;
+  o.max_states = options.max_states;
+  o.max_examples = 3;
+  o.invariants = false;
+  o.max_coverability_nodes = options.max_states;
+  const AnalysisReport r = analyze(net, o);
+  if (!r.complete()) {
+    diagnostics.note(net.where, "behaviour not checked: more than " + std::to_string(options.max_states) +
+                                    " reachable states (" + std::string(to_string(r.stop)) +
+                                    "); run tripodal-net analyze for the full analysis");
+    return false;
+  }
+  for (const Witness& w : r.deadlocks) {
+    diagnostics.error(net.where, "deadlock: nothing can fire in marking " + marking_ids(net, w.marking) +
+                                     ", reached by " + path_ids(net, w.path));
+  }
+  if (r.deadlock_count > r.deadlocks.size()) {
+    diagnostics.error(net.where, std::to_string(r.deadlock_count - r.deadlocks.size()) + " more deadlocks");
+  }
+  if (r.outcome == Verdict::fail) {
+    for (const Witness& w : r.stuck) {
+      diagnostics.error(net.where, "no outcome place can be reached from marking " + marking_ids(net, w.marking) +
+                                       ", reached by " + path_ids(net, w.path));
+    }
+    if (r.stuck_count > r.stuck.size()) {
+      diagnostics.error(net.where, std::to_string(r.stuck_count - r.stuck.size()) +
+                                       " more markings from which no outcome can be reached");
+    }
+  }
+  return r.deadlock_count == 0 && r.outcome != Verdict::fail;
+}
+
+Semantics default_semantics_for(std::string_view file_name, std::string_view head) {
+  auto ends_with_pnml = [](std::string_view s) {
+    if (s.size() < 5) return false;
+    std::string tail(s.substr(s.size() - 5));
+    for (char& c : tail) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return tail == ".pnml";
+  };
+  if (ends_with_pnml(file_name) || head.find("<pnml") != std::string_view::npos) return Semantics::interleaving;
+  return Semantics::engine;
 }
 
 }  // namespace tripodal::analysis

@@ -71,6 +71,7 @@ struct StateSpace::Impl {
   // --- store --------------------------------------------------------------------------------
   std::vector<std::uint8_t> arena;
   std::vector<std::uint64_t> table;  // 0 = empty, else (tag << 32) | (index + 1)
+  int table_shift = 32;
   std::size_t count = 0;
   std::vector<StateId> parent;
   std::vector<TransitionIndex> via;
@@ -89,6 +90,11 @@ struct StateSpace::Impl {
   std::vector<StateId> deadlocks;
   std::vector<StateId> outcome_states;
   std::size_t restarts = 0;
+
+  // --- scratch for the successors of one state ----------------------------------------------
+  std::vector<std::uint64_t> batch_words;
+  std::vector<TransitionIndex> batch_t;
+  std::vector<std::uint64_t> batch_hash;
 
   void layout(const std::vector<std::uint8_t>& b) {
     bits = b;
@@ -137,41 +143,61 @@ struct StateSpace::Impl {
     return h;
   }
 
+  // The slot of a hash is the top bits of its 32-bit tag, so growing the table re-slots every
+  // entry from the table alone, without touching the arena or hashing again.
+  [[nodiscard]] std::size_t slot_of(std::uint64_t tag) const noexcept { return static_cast<std::size_t>(tag >> table_shift); }
+
+  [[nodiscard]] bool equal(StateId s, const std::uint64_t* w) const noexcept {
+    const std::uint8_t* a = arena.data() + std::size_t{s} * stride;
+    std::size_t i = 0;
+    for (; i + 8 <= stride; i += 8) {
+      std::uint64_t x = 0;
+      std::memcpy(&x, a + i, 8);
+      if (x != w[i / 8]) return false;
+    }
+    if (i == stride) return true;
+    const auto* b = reinterpret_cast<const std::uint8_t*>(w);
+    for (; i < stride; ++i) {
+      if (a[i] != b[i]) return false;
+    }
+    return true;
+  }
+
   [[nodiscard]] StateId lookup(const std::uint64_t* w, std::uint64_t h) const noexcept {
     if (table.empty()) return kNoState;
     const std::size_t mask = table.size() - 1;
     const std::uint64_t tag = h >> 32;
-    for (std::size_t i = h & mask;; i = (i + 1) & mask) {
+    for (std::size_t i = slot_of(tag);; i = (i + 1) & mask) {
       const std::uint64_t e = table[i];
       if (e == 0) return kNoState;
       if ((e >> 32) == tag) {
         const StateId s = static_cast<StateId>((e & 0xFFFFFFFFULL) - 1);
-        if (std::memcmp(arena.data() + std::size_t{s} * stride, w, stride) == 0) return s;
+        if (equal(s, w)) return s;
       }
     }
   }
 
-  void place_in_table(std::uint64_t h, StateId s) noexcept {
+  void place_entry(std::uint64_t entry) noexcept {
     const std::size_t mask = table.size() - 1;
-    std::size_t i = h & mask;
+    std::size_t i = slot_of(entry >> 32);
     while (table[i] != 0) i = (i + 1) & mask;
-    table[i] = ((h >> 32) << 32) | (std::uint64_t{s} + 1);
+    table[i] = entry;
   }
 
   // Grows the table or the per-state arrays if needed; false when the memory cap forbids it.
   bool make_room() {
     if ((count + 1) * 10 > table.size() * 7) {
-      const std::size_t size = std::max<std::size_t>(table.size() * 2, 1024);
+      const std::size_t size = std::max<std::size_t>(table.size() * 2, 64);
       if (memory() + size * sizeof(std::uint64_t) > max_memory) return false;
-      table.assign(size, 0);
-      std::vector<std::uint64_t> w(words);
-      for (StateId s = 0; s < count; ++s) {
-        load(s, w.data());
-        place_in_table(hash(w.data()), s);
+      std::vector<std::uint64_t> old(size, 0);
+      old.swap(table);
+      table_shift = 32 - std::countr_zero(size);
+      for (const std::uint64_t e : old) {
+        if (e != 0) place_entry(e);
       }
     }
     if (count == parent.capacity()) {
-      const std::size_t cap = std::min(std::max<std::size_t>(parent.capacity() * 2, 1024), max_states);
+      const std::size_t cap = std::min(std::max<std::size_t>(parent.capacity() * 2, 64), max_states);
       const std::size_t per_state = stride + sizeof(StateId) + sizeof(TransitionIndex) +
                                     (keep_edges ? sizeof(std::uint64_t) : 0);
       if (memory() + cap * per_state > max_memory) return false;
@@ -184,8 +210,7 @@ struct StateSpace::Impl {
   }
 
   // Returns the state and whether it is new; kNoState with `stop` set when a limit is hit.
-  std::pair<StateId, bool> insert(const std::uint64_t* w, StateId from, TransitionIndex t) {
-    const std::uint64_t h = hash(w);
+  std::pair<StateId, bool> insert(const std::uint64_t* w, std::uint64_t h, StateId from, TransitionIndex t) {
     const StateId found = lookup(w, h);
     if (found != kNoState) return {found, false};
     if (count >= max_states) {
@@ -201,13 +226,14 @@ struct StateSpace::Impl {
     arena.insert(arena.end(), bytes, bytes + stride);
     parent.push_back(from);
     via.push_back(t);
-    place_in_table(h, s);
+    place_entry(((h >> 32) << 32) | (std::uint64_t{s} + 1));
     return {s, true};
   }
 
   void reset() {
     arena = {};
     table = {};
+    table_shift = 32;
     parent = {};
     via = {};
     edge_begin = {};
@@ -243,13 +269,12 @@ struct StateSpace::Impl {
     }
 
     std::vector<std::uint64_t> cur(words);
-    std::vector<std::uint64_t> next(words);
     std::vector<Tokens> m(std::max<std::size_t>(places, 1));
     for (std::size_t p = 0; p < places; ++p) {
       if (initial[p] > field_max[p]) return static_cast<PlaceIndex>(p);
     }
     pack(initial.data(), cur.data());
-    if (insert(cur.data(), kNoState, 0).first == kNoState) return std::nullopt;
+    if (insert(cur.data(), hash(cur.data()), kNoState, 0).first == kNoState) return std::nullopt;
     if (keep_edges) edge_begin.push_back(0);
 
     std::optional<PlaceIndex> overflow;
@@ -265,6 +290,7 @@ struct StateSpace::Impl {
       if (outcome) outcome_states.push_back(s);
       std::size_t successors = 0;
       bool abort = false;
+      batch_t.clear();
       if (!(outcome && stop_at_outcome)) {
         net.successors(m.data(), [&](TransitionIndex t) {
           if (abort) return;
@@ -277,12 +303,35 @@ struct StateSpace::Impl {
               return;
             }
           }
-          std::copy(cur.begin(), cur.end(), next.begin());
+          const std::size_t k = batch_t.size();
+          batch_t.push_back(t);
+          if (batch_words.size() < (k + 1) * words) batch_words.resize((k + 1) * words * 2);
+          std::uint64_t* next = batch_words.data() + k * words;
+          std::copy(cur.begin(), cur.end(), next);
           for (std::uint32_t i = delta_begin[t]; i < delta_begin[t + 1]; ++i) next[deltas[i].word] += deltas[i].add;
-          const auto [target, inserted] = insert(next.data(), s, t);
+        });
+      }
+      if (!abort) {
+        // Successors are looked up in a batch: first every hash-set slot is prefetched, then the
+        // arena entry each slot points to, so the cache misses of one state overlap.
+        const std::size_t k = batch_t.size();
+        batch_hash.resize(k);
+        for (std::size_t i = 0; i < k; ++i) {
+          batch_hash[i] = hash(batch_words.data() + i * words);
+          if (!table.empty()) __builtin_prefetch(&table[slot_of(batch_hash[i] >> 32)]);
+        }
+        if (!table.empty()) {
+          for (std::size_t i = 0; i < k; ++i) {
+            const std::uint64_t e = table[slot_of(batch_hash[i] >> 32)];
+            if (e != 0) __builtin_prefetch(arena.data() + ((e & 0xFFFFFFFFULL) - 1) * stride);
+          }
+        }
+        for (std::size_t i = 0; i < k && !abort; ++i) {
+          const TransitionIndex t = batch_t[i];
+          const auto [target, inserted] = insert(batch_words.data() + i * words, batch_hash[i], s, t);
           if (target == kNoState) {
             abort = true;
-            return;
+            break;
           }
           if (keep_edges) {
             if (edge_targets.size() == edge_targets.capacity()) {
@@ -290,7 +339,7 @@ struct StateSpace::Impl {
               if (memory() + cap * sizeof(StateId) > max_memory) {
                 stop = StopReason::max_memory;
                 abort = true;
-                return;
+                break;
               }
               edge_targets.reserve(cap);
             }
@@ -298,7 +347,7 @@ struct StateSpace::Impl {
           }
           ++successors;
           fired[t] = 1;
-        });
+        }
       }
       if (abort) {
         if (keep_edges) edge_targets.resize(edge_begin.back());

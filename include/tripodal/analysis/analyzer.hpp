@@ -116,3 +116,26 @@ struct AnalysisReport {
 [[nodiscard]] ParameterValues parse_parameter_assignments(const PetriNet& net, const std::vector<std::string>& kv);
 
 }  // namespace tripodal::analysis
+
+namespace tripodal::analysis {
+
+/// The state limit of the behavioural part of `tripodal-net check`: larger nets are reported as
+/// not checked (a note), never as failing; `tripodal-net analyze` has no such limit by default.
+inline constexpr std::size_t kCheckStateLimit = 200'000;
+
+struct BehaviourCheckOptions {
+  Semantics semantics = Semantics::engine;
+  std::size_t max_states = kCheckStateLimit;
+};
+
+/// What `tripodal-net check` runs on a net that loaded: reachable deadlocks and markings from
+/// which no outcome can be reached become errors located at the net (with the firing sequence),
+/// a net too large or needing parameters without defaults gets a note. Returns true when the
+/// checks ran to completion and found nothing.
+bool check_behaviour(const PetriNet& net, Diagnostics& diagnostics, const BehaviourCheckOptions& options = {});
+
+/// The default semantics for a file: interleaving for PNML (written for plain P/T tools), engine
+/// for tripodal's native XML. Decided by extension, then by a <pnml root element in `head`.
+[[nodiscard]] Semantics default_semantics_for(std::string_view file_name, std::string_view head);
+
+}  // namespace tripodal::analysis
