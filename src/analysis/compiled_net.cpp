@@ -1,0 +1,163 @@
+#include "compiled_net.hpp"
+
+#include <algorithm>
+#include <map>
+#include <unordered_map>
+
+#include "tripodal/core/diagnostic.hpp"
+
+namespace tripodal::analysis::detail {
+
+std::vector<Value> bind_parameters(const PetriNet& net, const ParameterValues& given) {
+  Diagnostics problems;
+  const std::string net_name = net.id.empty() ? std::string("the net") : "net '" + net.id + "'";
+  std::vector<Value> values(net.parameters.size());
+  for (std::size_t i = 0; i < net.parameters.size(); ++i) {
+    const VariableDecl& decl = net.parameters[i];
+    const auto it = given.find(decl.name);
+    if (it != given.end()) {
+      if (type_of(it->second) != decl.type) {
+        problems.error(net.where, "parameter '" + decl.name + "' of " + net_name + " must be a " +
+                                      std::string(to_string(decl.type)) + ", got " + tripodal::to_string(it->second));
+      }
+      values[i] = it->second;
+    } else if (decl.default_value) {
+      values[i] = *decl.default_value;
+    } else {
+      problems.error(net.where, "missing required parameter '" + decl.name + "' (" +
+                                    std::string(to_string(decl.type)) + ") of " + net_name +
+                                    ": give it with --param " + decl.name + "=VALUE");
+    }
+  }
+  for (const auto& [name, value] : given) {
+    if (net.find_parameter(name) == nullptr) {
+      std::string declared;
+      for (const auto& d : net.parameters) declared += (declared.empty() ? "" : ", ") + d.name;
+      problems.error(net.where, "unknown parameter '" + name + "' for " + net_name + " (declared: " +
+                                    (declared.empty() ? std::string("none") : declared) + ")");
+    }
+  }
+  for (const Transition& tr : net.transitions()) {
+    if (!tr.guard) continue;
+    for (const std::string& name : tr.guard->identifiers()) {
+      if (net.find_parameter(name) == nullptr && net.find_fact(name) == nullptr) {
+        problems.error(tr.where, "guard '" + tr.guard->text() + "' of transition '" + tr.id + "' reads '" + name +
+                                     "', which is neither a parameter nor a fact of " + net_name);
+      }
+    }
+  }
+  if (problems.has_errors()) throw ConfigError(std::move(problems));
+  return values;
+}
+
+CompiledNet::CompiledNet(const PetriNet& net, const ParameterValues& parameters, CompileOptions options)
+    : places(net.places().size()), transitions(net.transitions().size()), semantics(options.semantics) {
+  const std::vector<Value> values = bind_parameters(net, parameters);
+  const auto& pl = net.places();
+  kind.resize(transitions);
+  guard.resize(transitions);
+  decisive.assign(transitions, 0);
+  check_begin.assign(1, 0);
+  change_begin.assign(1, 0);
+  is_outcome.assign(places, 0);
+  for (PlaceIndex p = 0; p < places; ++p) is_outcome[p] = pl[p].outcome != Outcome::none ? 1 : 0;
+
+  for (TransitionIndex t = 0; t < transitions; ++t) {
+    const Transition& tr = net.transition(t);
+    kind[t] = !tr.event.empty() ? Kind::event : (tr.delay.count() > 0 ? Kind::delayed : Kind::immediate);
+    guard[t] = GuardState::always;
+    if (tr.guard) {
+      const auto& ids = tr.guard->identifiers();
+      std::vector<const Value*> slots(ids.size(), nullptr);
+      bool reads_fact = false;
+      for (std::size_t s = 0; s < ids.size(); ++s) {
+        for (std::size_t i = 0; i < net.parameters.size(); ++i) {
+          if (net.parameters[i].name == ids[s]) slots[s] = &values[i];
+        }
+        if (slots[s] == nullptr) reads_fact = true;
+      }
+      if (reads_fact) {
+        guard[t] = GuardState::maybe;
+      } else {
+        guard[t] = tr.guard->evaluate(slots) ? GuardState::always : GuardState::never;
+      }
+    }
+
+    std::map<PlaceIndex, Change> delta;
+    std::map<PlaceIndex, Check> bounds;
+    auto bound_of = [&](PlaceIndex p) -> Check& {
+      auto [it, inserted] = bounds.try_emplace(p);
+      if (inserted) it->second.place = p;
+      return it->second;
+    };
+    for (const ArcRef& a : tr.inputs) {
+      Change& d = delta[a.place];
+      d.place = a.place;
+      d.consumed += a.weight;
+    }
+    for (const ArcRef& a : tr.outputs) {
+      Change& d = delta[a.place];
+      d.place = a.place;
+      d.produced += a.weight;
+    }
+    for (const auto& [p, d] : delta) {
+      if (d.consumed > 0) bound_of(p).lo = std::max(bound_of(p).lo, d.consumed);
+      const auto& cap = pl[p].capacity;
+      if (cap && !options.monotone && d.produced > d.consumed) {
+        const Tokens gain = d.produced - d.consumed;
+        Check& c = bound_of(p);
+        if (gain > *cap) {
+          c.lo = 1;
+          c.hi = 0;
+        } else {
+          c.hi = std::min(c.hi, *cap - gain);
+        }
+      }
+    }
+    for (const ArcRef& a : tr.reads) bound_of(a.place).lo = std::max(bound_of(a.place).lo, a.weight);
+    if (!options.monotone) {
+      for (const ArcRef& a : tr.inhibitors) bound_of(a.place).hi = std::min(bound_of(a.place).hi, a.weight - 1);
+    }
+    for (const auto& [p, c] : bounds) checks.push_back(c);
+    for (const auto& [p, d] : delta) {
+      if (d.consumed != d.produced) changes.push_back(d);
+    }
+    check_begin.push_back(static_cast<std::uint32_t>(checks.size()));
+    change_begin.push_back(static_cast<std::uint32_t>(changes.size()));
+  }
+
+  // Conflict order as in the engine: priority descending, then declaration order.
+  std::vector<TransitionIndex> order(transitions);
+  for (TransitionIndex t = 0; t < transitions; ++t) order[t] = t;
+  std::stable_sort(order.begin(), order.end(), [&](TransitionIndex a, TransitionIndex b) {
+    return net.transition(a).priority > net.transition(b).priority;
+  });
+  std::vector<std::string> event_names;
+  std::vector<std::vector<TransitionIndex>> by_event;
+  for (const TransitionIndex t : order) {
+    const Transition& tr = net.transition(t);
+    if (kind[t] != Kind::event) {
+      urgent_order.push_back(t);
+      // An enabled immediate transition with a certain guard is always ready: it or something
+      // ranked above it fires, nothing below it.
+      if (kind[t] == Kind::immediate && guard[t] == GuardState::always) decisive[t] = 1;
+      continue;
+    }
+    const auto it = std::find(event_names.begin(), event_names.end(), tr.event);
+    if (it == event_names.end()) {
+      event_names.push_back(tr.event);
+      by_event.push_back({t});
+    } else {
+      by_event[static_cast<std::size_t>(it - event_names.begin())].push_back(t);
+    }
+    // A listener without delay and with a certain guard takes its event whenever it is enabled.
+    if (tr.delay.count() == 0 && guard[t] == GuardState::always) decisive[t] = 1;
+  }
+  event_begin.assign(1, 0);
+  for (const auto& l : by_event) {
+    listeners.insert(listeners.end(), l.begin(), l.end());
+    event_begin.push_back(static_cast<std::uint32_t>(listeners.size()));
+  }
+}
+
+}  // namespace tripodal::analysis::detail

@@ -1,0 +1,369 @@
+// Text and JSON forms of an AnalysisReport. JSON is written by hand (no dependency): strings are
+// escaped per RFC 8259, numbers printed in C locale.
+#include <cmath>
+#include <cstdio>
+#include <set>
+#include <sstream>
+
+#include "tripodal/analysis/analyzer.hpp"
+
+namespace tripodal::analysis {
+
+namespace {
+
+std::string json_string(std::string_view s) {
+  std::string out = "\"";
+  for (const char ch : s) {
+    const auto c = static_cast<unsigned char>(ch);
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\b': out += "\\b"; break;
+      case '\f': out += "\\f"; break;
+      case '\n': out += "\\n"; break;
+      case '\r': out += "\\r"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (c < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
+          out += buf;
+        } else {
+          out += ch;
+        }
+    }
+  }
+  out += '"';
+  return out;
+}
+
+std::string json_number(double x) {
+  if (!std::isfinite(x)) return "null";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
+}
+
+std::string json_value(const Value& v) {
+  switch (type_of(v)) {
+    case ValueType::boolean: return std::get<bool>(v) ? "true" : "false";
+    case ValueType::number: return json_number(std::get<double>(v));
+    case ValueType::string: return json_string(std::get<std::string>(v));
+  }
+  return "null";
+}
+
+std::string marking_text(const PetriNet& net, const Marking& m) {
+  std::string out;
+  for (PlaceIndex p = 0; p < m.size(); ++p) {
+    if (m[p] == 0) continue;
+    if (!out.empty()) out += ' ';
+    out += net.place(p).id;
+    if (m[p] > 1) out += "*" + std::to_string(m[p]);
+  }
+  return out.empty() ? "(empty)" : out;
+}
+
+std::string path_text(const PetriNet& net, const std::vector<TransitionIndex>& path) {
+  if (path.empty()) return "(initial marking)";
+  std::string out;
+  for (const TransitionIndex t : path) {
+    if (!out.empty()) out += " -> ";
+    const Transition& tr = net.transition(t);
+    out += tr.id;
+    if (!tr.event.empty()) out += " [" + tr.event + "]";
+  }
+  return out;
+}
+
+// The events the path needs, in order, and the fact guards it assumes true.
+std::vector<std::string> path_events(const PetriNet& net, const std::vector<TransitionIndex>& path) {
+  std::vector<std::string> events;
+  for (const TransitionIndex t : path) {
+    if (!net.transition(t).event.empty()) events.push_back(net.transition(t).event);
+  }
+  return events;
+}
+
+std::vector<std::string> path_fact_guards(const PetriNet& net, const std::vector<TransitionIndex>& path) {
+  std::vector<std::string> guards;
+  std::set<TransitionIndex> seen;
+  for (const TransitionIndex t : path) {
+    const Transition& tr = net.transition(t);
+    if (!tr.guard || !seen.insert(t).second) continue;
+    for (const auto& id : tr.guard->identifiers()) {
+      if (net.find_parameter(id) == nullptr) {
+        guards.push_back(tr.id + ": " + tr.guard->text());
+        break;
+      }
+    }
+  }
+  return guards;
+}
+
+std::string join(const std::vector<std::string>& items, std::string_view sep) {
+  std::string out;
+  for (const auto& s : items) {
+    if (!out.empty()) out += sep;
+    out += s;
+  }
+  return out;
+}
+
+std::string invariant_text(const PetriNet& net, const Invariant& inv, bool places) {
+  std::string out;
+  for (const auto& [i, w] : inv.weights) {
+    if (!out.empty()) out += " + ";
+    if (w != 1) out += std::to_string(w) + "*";
+    out += places ? net.place(i).id : net.transition(i).id;
+  }
+  if (places) out += " = " + std::to_string(inv.token_sum);
+  return out;
+}
+
+std::string bytes_text(std::size_t bytes) {
+  char buf[32];
+  if (bytes >= (std::size_t{1} << 20)) {
+    std::snprintf(buf, sizeof buf, "%.1f MiB", static_cast<double>(bytes) / (1024.0 * 1024.0));
+  } else {
+    std::snprintf(buf, sizeof buf, "%.1f KiB", static_cast<double>(bytes) / 1024.0);
+  }
+  return buf;
+}
+
+void witness_text(std::ostringstream& out, const PetriNet& net, const Witness& w) {
+  out << "  - marking: " << marking_text(net, w.marking) << '\n';
+  out << "    path (" << w.path.size() << " firings): " << path_text(net, w.path) << '\n';
+  const auto events = path_events(net, w.path);
+  if (!events.empty()) out << "    events needed: " << join(events, ", ") << '\n';
+  const auto guards = path_fact_guards(net, w.path);
+  if (!guards.empty()) out << "    assumes fact guards true: " << join(guards, "; ") << '\n';
+}
+
+std::string witness_json(const PetriNet& net, const Witness& w) {
+  std::string out = "{\"marking\":{";
+  bool first = true;
+  for (PlaceIndex p = 0; p < w.marking.size(); ++p) {
+    if (w.marking[p] == 0) continue;
+    out += (first ? "" : ",") + json_string(net.place(p).id) + ":" + std::to_string(w.marking[p]);
+    first = false;
+  }
+  out += "},\"path\":[";
+  for (std::size_t i = 0; i < w.path.size(); ++i) {
+    const Transition& tr = net.transition(w.path[i]);
+    out += (i == 0 ? "" : ",") + std::string("{\"transition\":") + json_string(tr.id) +
+           ",\"event\":" + (tr.event.empty() ? std::string("null") : json_string(tr.event)) + "}";
+  }
+  out += "],\"events\":[";
+  const auto events = path_events(net, w.path);
+  for (std::size_t i = 0; i < events.size(); ++i) out += (i == 0 ? "" : ",") + json_string(events[i]);
+  out += "],\"fact_guards\":[";
+  const auto guards = path_fact_guards(net, w.path);
+  for (std::size_t i = 0; i < guards.size(); ++i) out += (i == 0 ? "" : ",") + json_string(guards[i]);
+  out += "]}";
+  return out;
+}
+
+std::string ids_json(const PetriNet& net, const std::vector<std::uint32_t>& items, bool places) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    out += (i == 0 ? "" : ",") + json_string(places ? net.place(items[i]).id : net.transition(items[i]).id);
+  }
+  return out + "]";
+}
+
+std::string invariants_json(const PetriNet& net, const InvariantBasis& basis, bool places) {
+  std::string out = "{\"complete\":" + std::string(basis.complete ? "true" : "false") + ",\"items\":[";
+  for (std::size_t k = 0; k < basis.invariants.size(); ++k) {
+    const Invariant& inv = basis.invariants[k];
+    out += (k == 0 ? "" : ",") + std::string("{\"weights\":{");
+    for (std::size_t i = 0; i < inv.weights.size(); ++i) {
+      const auto [n, w] = inv.weights[i];
+      out += (i == 0 ? "" : ",") + json_string(places ? net.place(n).id : net.transition(n).id) + ":" + std::to_string(w);
+    }
+    out += "}";
+    if (places) out += ",\"token_sum\":" + std::to_string(inv.token_sum);
+    out += "}";
+  }
+  return out + "]}";
+}
+
+std::string_view kind_text(BoundKind k) {
+  switch (k) {
+    case BoundKind::exact: return "exact";
+    case BoundKind::unbounded: return "unbounded";
+    case BoundKind::at_least: return "at_least";
+  }
+  return "?";
+}
+
+double rate(const AnalysisReport& r) { return r.exploration_s > 0 ? static_cast<double>(r.expanded) / r.exploration_s : 0.0; }
+
+}  // namespace
+
+std::string format_text(const AnalysisReport& r, const PetriNet& net) {
+  std::ostringstream out;
+  out << "net '" << r.net_id << "': " << r.places << " places, " << r.transitions << " transitions; semantics: "
+      << to_string(r.semantics);
+  if (!r.parameters.empty()) {
+    out << "; parameters:";
+    for (const auto& [k, v] : r.parameters) out << ' ' << k << '=' << tripodal::to_string(v);
+  }
+  out << "\n\n";
+
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%.3f s, %.2f M states/s", r.exploration_s, rate(r) / 1e6);
+  out << "reachability graph: " << r.states << " states, " << r.edges << " edges";
+  if (r.complete()) {
+    out << " (complete, " << buf << ")\n";
+  } else {
+    out << " -- INCOMPLETE: stopped by " << to_string(r.stop) << " after expanding " << r.expanded << " states ("
+        << buf << "); the verdicts below cover only what was explored\n";
+  }
+  std::snprintf(buf, sizeof buf, "%.1f", r.bytes_per_state);
+  out << "memory: " << bytes_text(r.memory_bytes) << " (" << buf << " bytes per state, packed marking "
+      << r.bytes_per_marking << " bytes)\n\n";
+
+  if (r.deadlock_count == 0) {
+    out << "deadlocks: none" << (r.complete() ? "" : " found so far") << '\n';
+  } else {
+    out << "deadlocks: " << r.deadlock_count << " (markings where nothing can fire and no outcome place is marked)\n";
+    for (const Witness& w : r.deadlocks) witness_text(out, net, w);
+    if (r.deadlocks.size() < r.deadlock_count) out << "  ... " << r.deadlock_count - r.deadlocks.size() << " more\n";
+  }
+
+  out << "\nbounds: ";
+  switch (r.bounded) {
+    case Verdict::pass: out << "bounded"; break;
+    case Verdict::fail: out << "UNBOUNDED (Karp-Miller)"; break;
+    default: out << "unknown"; break;
+  }
+  out << "; 1-safe: " << (r.safe == Verdict::pass ? "yes" : r.safe == Verdict::fail ? "NO" : "unknown") << '\n';
+  for (PlaceIndex p = 0; p < r.places; ++p) {
+    const PlaceBound& b = r.bounds[p];
+    out << "  " << net.place(p).id << ": ";
+    if (b.kind == BoundKind::unbounded) {
+      out << "unbounded";
+    } else {
+      out << (b.kind == BoundKind::at_least ? ">= " : "") << b.max_seen;
+    }
+    if (b.structural) out << " (structural bound " << *b.structural << ")";
+    if (b.may_be_unbounded && b.kind != BoundKind::unbounded) out << " (may be unbounded: omega in the over-approximation)";
+    out << '\n';
+  }
+  if (r.coverability_ran) {
+    const CoverabilityResult& c = r.coverability;
+    out << "  coverability (Karp-Miller, " << c.nodes << " nodes" << (c.complete ? "" : ", incomplete")
+        << (c.exact ? "" : ", over-approximation without inhibitor arcs and capacities") << ")";
+    if (!c.pumped.empty()) {
+      std::vector<std::string> names;
+      for (const PlaceIndex p : c.pumped) names.push_back(net.place(p).id);
+      out << ": repeating " << path_text(net, c.pump) << " after " << path_text(net, c.prefix) << " grows "
+          << join(names, ", ");
+    }
+    out << '\n';
+  }
+
+  auto list = [&](const std::vector<std::uint32_t>& items, bool places) {
+    std::vector<std::string> names;
+    for (const auto i : items) names.push_back(places ? net.place(i).id : net.transition(i).id);
+    return names.empty() ? std::string("none") : join(names, ", ");
+  };
+  const char* so_far = r.complete() ? "" : " (so far)";
+  out << "\ndead transitions" << so_far << ": " << list(r.dead_transitions, false) << '\n';
+  out << "never-marked places" << so_far << ": " << list(r.never_marked, true) << '\n';
+
+  out << "\noutcome check: ";
+  switch (r.outcome) {
+    case Verdict::not_applicable: out << "not applicable (the net has no outcome place)\n"; break;
+    case Verdict::unknown: out << "unknown (exploration incomplete)\n"; break;
+    case Verdict::pass: out << "pass: an outcome place can be reached from every reachable marking\n"; break;
+    case Verdict::fail:
+      out << "FAIL: " << r.stuck_count << " reachable markings cannot reach any outcome place\n";
+      for (const Witness& w : r.stuck) witness_text(out, net, w);
+      if (r.stuck.size() < r.stuck_count) out << "  ... " << r.stuck_count - r.stuck.size() << " more\n";
+      break;
+  }
+
+  if (r.invariants_computed) {
+    out << "\nplace invariants (" << r.p_invariants.invariants.size()
+        << (r.p_invariants.complete ? "" : ", incomplete") << "):\n";
+    for (const Invariant& inv : r.p_invariants.invariants) out << "  " << invariant_text(net, inv, true) << '\n';
+    std::vector<std::uint32_t> uncovered;
+    for (PlaceIndex p = 0; p < r.places; ++p) {
+      if (r.p_invariants.covered[p] == 0) uncovered.push_back(p);
+    }
+    if (!uncovered.empty()) out << "  not covered: " << list(uncovered, true) << '\n';
+    out << "transition invariants (" << r.t_invariants.invariants.size()
+        << (r.t_invariants.complete ? "" : ", incomplete") << "):\n";
+    for (const Invariant& inv : r.t_invariants.invariants) out << "  " << invariant_text(net, inv, false) << '\n';
+  }
+  out << "\nverdict: " << (r.ok() ? "OK" : "PROBLEMS FOUND") << '\n';
+  return out.str();
+}
+
+std::string format_json(const AnalysisReport& r, const PetriNet& net) {
+  std::ostringstream out;
+  out << "{\"net\":{\"id\":" << json_string(r.net_id) << ",\"places\":" << r.places
+      << ",\"transitions\":" << r.transitions << "},";
+  out << "\"semantics\":" << json_string(to_string(r.semantics)) << ",\"parameters\":{";
+  bool first = true;
+  for (const auto& [k, v] : r.parameters) {
+    out << (first ? "" : ",") << json_string(k) << ':' << json_value(v);
+    first = false;
+  }
+  out << "},";
+  out << "\"graph\":{\"states\":" << r.states << ",\"edges\":" << r.edges << ",\"expanded\":" << r.expanded
+      << ",\"complete\":" << (r.complete() ? "true" : "false") << ",\"stop_reason\":" << json_string(to_string(r.stop))
+      << ",\"max_states\":" << r.max_states << ",\"exploration_s\":" << json_number(r.exploration_s)
+      << ",\"states_per_s\":" << json_number(rate(r)) << ",\"memory_bytes\":" << r.memory_bytes
+      << ",\"bytes_per_state\":" << json_number(r.bytes_per_state) << ",\"bytes_per_marking\":" << r.bytes_per_marking
+      << "},";
+  out << "\"deadlocks\":{\"count\":" << r.deadlock_count << ",\"examples\":[";
+  for (std::size_t i = 0; i < r.deadlocks.size(); ++i) out << (i == 0 ? "" : ",") << witness_json(net, r.deadlocks[i]);
+  out << "]},";
+  out << "\"bounds\":{\"bounded\":" << json_string(to_string(r.bounded)) << ",\"safe\":" << json_string(to_string(r.safe))
+      << ",\"places\":[";
+  for (PlaceIndex p = 0; p < r.places; ++p) {
+    const PlaceBound& b = r.bounds[p];
+    out << (p == 0 ? "" : ",") << "{\"id\":" << json_string(net.place(p).id) << ",\"max\":";
+    if (b.kind == BoundKind::unbounded) {
+      out << "null";
+    } else {
+      out << b.max_seen;
+    }
+    out << ",\"kind\":" << json_string(kind_text(b.kind)) << ",\"structural\":"
+        << (b.structural ? std::to_string(*b.structural) : std::string("null"))
+        << ",\"may_be_unbounded\":" << (b.may_be_unbounded ? "true" : "false") << '}';
+  }
+  out << "]},\"coverability\":";
+  if (!r.coverability_ran) {
+    out << "null";
+  } else {
+    const CoverabilityResult& c = r.coverability;
+    std::vector<std::uint32_t> omega;
+    for (PlaceIndex p = 0; p < c.bounds.size(); ++p) {
+      if (!c.bounds[p]) omega.push_back(p);
+    }
+    out << "{\"complete\":" << (c.complete ? "true" : "false") << ",\"exact\":" << (c.exact ? "true" : "false")
+        << ",\"nodes\":" << c.nodes << ",\"omega_places\":" << ids_json(net, omega, true)
+        << ",\"prefix\":" << ids_json(net, c.prefix, false) << ",\"pump\":" << ids_json(net, c.pump, false)
+        << ",\"pumped\":" << ids_json(net, c.pumped, true) << '}';
+  }
+  out << ",\"dead_transitions\":" << ids_json(net, r.dead_transitions, false)
+      << ",\"never_marked_places\":" << ids_json(net, r.never_marked, true) << ',';
+  out << "\"outcome\":{\"verdict\":" << json_string(to_string(r.outcome)) << ",\"outcome_states\":" << r.outcome_states
+      << ",\"stuck_count\":" << r.stuck_count << ",\"stuck\":[";
+  for (std::size_t i = 0; i < r.stuck.size(); ++i) out << (i == 0 ? "" : ",") << witness_json(net, r.stuck[i]);
+  out << "]},\"invariants\":";
+  if (!r.invariants_computed) {
+    out << "null";
+  } else {
+    out << "{\"place\":" << invariants_json(net, r.p_invariants, true)
+        << ",\"transition\":" << invariants_json(net, r.t_invariants, false) << '}';
+  }
+  out << ",\"ok\":" << (r.ok() ? "true" : "false") << "}\n";
+  return out.str();
+}
+
+}  // namespace tripodal::analysis
