@@ -29,10 +29,11 @@ void limit_axis(const AxisLimits& lim, double target, double dt, double& v, doub
   if (bound) acc = std::clamp(acc, -*bound, *bound);
   if (lim.max_jerk) {
     const double j = *lim.max_jerk;
-    // The acceleration must be able to fall back to zero (at the jerk limit) before the target is
-    // reached, or the velocity overshoots: |acc| <= sqrt(2 j |dv|).
     acc = std::clamp(acc, a - j * dt, a + j * dt);
-    const double reachable = std::sqrt(2.0 * j * std::abs(dv));
+    // The acceleration must be able to fall back to zero, one jerk step j*dt per period, before
+    // the target is reached, or the velocity overshoots. Ramping down from acc covers
+    // acc^2 / (2j) + acc * dt / 2 of velocity; solving for acc gives the bound.
+    const double reachable = j * (std::sqrt(0.25 * dt * dt + 2.0 * std::abs(dv) / j) - 0.5 * dt);
     acc = std::clamp(acc, -reachable, reachable);
   }
   double next = v + acc * dt;
