@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
@@ -357,21 +358,20 @@ void BhAvoidObstacle::on_activate(const ParameterSet& params, const BehaviorCont
            : name.empty()               ? context.resources->first<LaserScan>()
                                         : context.resources->find<LaserScan>(name);
   // Capacity reserved here so that step() never allocates, whatever the beam count.
-  cos_.clear();
-  sin_.clear();
-  cos_.reserve(kMaxTableBeams);
-  sin_.reserve(kMaxTableBeams);
+  cos_.resize(0);
+  sin_.resize(0);
   if (laser_ == nullptr) fail("no laser resource");
 }
 
 void BhAvoidObstacle::rebuild_table(const LaserScan& scan) noexcept {
-  const std::size_t n = std::min(scan.ranges_m.size(), kMaxTableBeams);
-  cos_.resize(n);  // within the reserved capacity: no allocation
+  const auto n = static_cast<Eigen::Index>(std::min(scan.ranges_m.size(), kMaxTableBeams));
+  // Fixed maximum size: resizing never allocates.
+  cos_.resize(n);
   sin_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
+  for (Eigen::Index i = 0; i < n; ++i) {
     const double a = laser_yaw_rad_ + scan.angle_min_rad + static_cast<double>(i) * scan.angle_increment_rad;
-    cos_[i] = std::cos(a);
-    sin_[i] = std::sin(a);
+    cos_[i] = static_cast<float>(std::cos(a));
+    sin_[i] = static_cast<float>(std::sin(a));
   }
   table_angle_min_ = scan.angle_min_rad;
   table_increment_ = scan.angle_increment_rad;
@@ -386,7 +386,7 @@ std::optional<Twist2D> BhAvoidObstacle::on_step(const BehaviorContext& context) 
     return std::nullopt;
   }
   const LaserScan& scan = laser_->latest();
-  if (cos_.size() != std::min(scan.ranges_m.size(), kMaxTableBeams) || table_angle_min_ != scan.angle_min_rad ||
+  if (static_cast<std::size_t>(cos_.size()) != std::min(scan.ranges_m.size(), kMaxTableBeams) || table_angle_min_ != scan.angle_min_rad ||
       table_increment_ != scan.angle_increment_rad) {
     rebuild_table(scan);
   }
@@ -395,13 +395,20 @@ std::optional<Twist2D> BhAvoidObstacle::on_step(const BehaviorContext& context) 
   constexpr double kInf = VelocityEnvelope::kInf;
   double front = kInf, back = kInf, left = kInf, right = kInf;
   const double r = radius_m_;
-  const double rmin = scan.range_min_m, rmax = scan.range_max_m;
-  const std::size_t n = cos_.size();
+  const auto n = static_cast<std::size_t>(cos_.size());
+  const float* ranges = scan.ranges_m.data();
+  // Only returns closer than the slow-down zone can restrict anything; testing the raw range
+  // first skips the far majority of beams with one well-predicted branch.
+  const auto rmin = static_cast<float>(scan.range_min_m);
+  const auto near = static_cast<float>(std::min(scan.range_max_m, r + slow_m_ + std::hypot(laser_x_m_, laser_y_m_)));
   for (std::size_t i = 0; i < n; ++i) {
-    const double range = scan.ranges_m[i];
-    if (!(range >= rmin && range <= rmax)) continue;  // also skips NaN
-    const double x = laser_x_m_ + range * cos_[i];
-    const double y = laser_y_m_ + range * sin_[i];
+    const float range = ranges[i];
+    if (!(range >= rmin && range <= near)) continue;  // also skips NaN and no-return values
+    const auto k = static_cast<Eigen::Index>(i);
+    const double x = laser_x_m_ + range * static_cast<double>(cos_[k]);
+    const double y = laser_y_m_ + range * static_cast<double>(sin_[k]);
+    // Clearance from the footprint along each axis direction, over the points in the corridor
+    // the footprint sweeps when moving along that axis.
     if (std::abs(y) <= r) {
       if (x > 0.0) front = std::min(front, x - r);
       else back = std::min(back, -x - r);
@@ -413,7 +420,7 @@ std::optional<Twist2D> BhAvoidObstacle::on_step(const BehaviorContext& context) 
   }
   const double span = slow_m_ - stop_m_;
   auto allowed = [&](double clearance) noexcept {
-    if (clearance == kInf) return kInf;
+    if (clearance > slow_m_) return kInf;
     return max_speed_ * std::clamp((clearance - stop_m_) / span, 0.0, 1.0);
   };
   env.vx_hi_m_s = allowed(front);

@@ -4,8 +4,8 @@
 // cannot move sideways.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstddef>
-#include <vector>
 
 #include "tripodal/behaviors/behavior.hpp"
 
@@ -100,7 +100,8 @@ class BhBackOff final : public CBehavior {
 /// it finds the clearance ahead, behind, left and right of a circular footprint of
 /// robot_radius_m and imposes a velocity envelope: speed toward an obstacle falls linearly from
 /// max_speed_m_s at slow_distance_m to 0 at stop_distance_m (clearances from the footprint);
-/// rotation is never restricted. With a stale or missing scan it blocks all translation. Never
+/// beyond slow_distance_m and in directions without returns nothing is restricted; rotation is
+/// never restricted. With a stale or missing scan it blocks all translation. Never
 /// finishes; commands nothing itself (step returns nothing, envelope() carries the limits).
 class BhAvoidObstacle final : public CBehavior {
  public:
@@ -116,8 +117,11 @@ class BhAvoidObstacle final : public CBehavior {
   const LaserResource* laser_ = nullptr;
   double stop_m_ = 0.0, slow_m_ = 0.0, max_speed_ = 0.0, radius_m_ = 0.0;
   double laser_x_m_ = 0.0, laser_y_m_ = 0.0, laser_yaw_rad_ = 0.0;
-  // Beam directions in the body frame, rebuilt only when the scan geometry changes.
-  std::vector<double> cos_, sin_;
+  static constexpr int kMaxBeams = 4096;  ///< beams beyond this are ignored
+  using BeamArray = Eigen::Array<float, Eigen::Dynamic, 1, 0, kMaxBeams, 1>;
+  // Beam directions in the body frame, rebuilt only when the scan geometry changes. Fixed maximum
+  // size: never allocated.
+  BeamArray cos_, sin_;
   double table_angle_min_ = 0.0, table_increment_ = 0.0;
 };
 
