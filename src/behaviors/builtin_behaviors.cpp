@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
@@ -401,9 +402,9 @@ std::optional<Twist2D> BhAvoidObstacle::on_step(const BehaviorContext& context) 
   // first skips the far majority of beams with one well-predicted branch.
   const auto rmin = static_cast<float>(scan.range_min_m);
   const auto near = static_cast<float>(std::min(scan.range_max_m, r + slow_m_ + std::hypot(laser_x_m_, laser_y_m_)));
-  for (std::size_t i = 0; i < n; ++i) {
+  auto visit = [&](std::size_t i) noexcept {
     const float range = ranges[i];
-    if (!(range >= rmin && range <= near)) continue;  // also skips NaN and no-return values
+    if (!(range >= rmin && range <= near)) return;  // also skips NaN and no-return values
     const auto k = static_cast<Eigen::Index>(i);
     const double x = laser_x_m_ + range * static_cast<double>(cos_[k]);
     const double y = laser_y_m_ + range * static_cast<double>(sin_[k]);
@@ -417,7 +418,21 @@ std::optional<Twist2D> BhAvoidObstacle::on_step(const BehaviorContext& context) 
       if (y > 0.0) left = std::min(left, y - r);
       else right = std::min(right, -y - r);
     }
+  };
+  // Blocks of kLanes beams are tested at once (SIMD compare) and skipped when none is near.
+  using Lanes = float __attribute__((vector_size(4 * sizeof(float))));
+  constexpr std::size_t kLanes = 4;
+  const Lanes lo = {rmin, rmin, rmin, rmin};
+  const Lanes hi = {near, near, near, near};
+  std::size_t i = 0;
+  for (; i + kLanes <= n; i += kLanes) {
+    Lanes v;
+    std::memcpy(&v, ranges + i, sizeof v);
+    const auto hit = (v >= lo) & (v <= hi);
+    if ((hit[0] | hit[1] | hit[2] | hit[3]) == 0) continue;
+    for (std::size_t j = i; j < i + kLanes; ++j) visit(j);
   }
+  for (; i < n; ++i) visit(i);
   const double span = slow_m_ - stop_m_;
   auto allowed = [&](double clearance) noexcept {
     if (clearance > slow_m_) return kInf;

@@ -252,3 +252,32 @@ TEST_CASE("BhAvoidObstacle limits speed toward obstacles from the laser scan") {
   REQUIRE_THROWS_WITH(b.activate({{"stop_distance_m", Value{1.0}}, {"slow_distance_m", Value{0.5}}}, w.ctx),
                       Catch::Contains("slow_distance_m must be greater than stop_distance_m"));
 }
+
+TEST_CASE("BhAvoidObstacle handles odd beam counts, NaN and out-of-range returns, and a mounted laser") {
+  KinematicWorld w;
+  LaserScan s;
+  s.stamp = w.ctx.now;
+  s.angle_min_rad = -kPi / 2;
+  s.angle_increment_rad = kPi / 360;  // 361 beams over 180 degrees: not a multiple of 4
+  s.angle_max_rad = kPi / 2;
+  s.range_min_m = 0.1;
+  s.range_max_m = 5.0;
+  s.ranges_m.assign(361, std::numeric_limits<float>::quiet_NaN());
+  s.ranges_m[0] = 0.05f;    // below range_min: ignored
+  s.ranges_m[1] = 50.0f;    // beyond range_max: ignored
+  s.ranges_m[360] = 0.45f;  // the last beam (+90 deg, left), handled after the SIMD blocks
+  w.laser.publish(s);
+  BhAvoidObstacle b;
+  // The laser looks backwards from 0.1 m behind the centre: its +90 deg beam points right.
+  b.activate({{"laser_x_m", Value{-0.1}}, {"laser_yaw_rad", Value{kPi}}, {"stop_distance_m", Value{0.1}},
+              {"slow_distance_m", Value{0.5}}, {"max_speed_m_s", Value{0.4}}},
+             w.ctx);
+  (void)b.step(w.ctx);
+  REQUIRE(b.envelope());
+  const VelocityEnvelope e = *b.envelope();
+  // The return is at body (-0.1, -0.45): 0.2 m right of the footprint's edge.
+  CHECK(e.vy_lo_m_s == Approx(-0.4 * (0.2 - 0.1) / 0.4).margin(1e-5));
+  CHECK(std::isinf(e.vy_hi_m_s));
+  CHECK(std::isinf(e.vx_hi_m_s));
+  CHECK(std::isinf(e.vx_lo_m_s));
+}
