@@ -1,11 +1,35 @@
 #include "tripodal/core/clock.hpp"
 
+#include <cerrno>
+#include <thread>
+#if defined(__linux__)
+#include <time.h>
+#endif
+
 namespace tripodal {
 
 SteadyClock::SteadyClock() noexcept : start_(std::chrono::steady_clock::now()) {}
 
 Time SteadyClock::now() const noexcept {
   return std::chrono::duration_cast<Time>(std::chrono::steady_clock::now() - start_);
+}
+
+void Clock::sleep_until(Time deadline) const noexcept {
+  while (now() < deadline) std::this_thread::yield();
+}
+
+void SteadyClock::sleep_until(Time deadline) const noexcept {
+#if defined(__linux__)
+  // libstdc++'s steady_clock is CLOCK_MONOTONIC: the deadline converts to that clock's timespec.
+  const auto abs = std::chrono::duration_cast<std::chrono::nanoseconds>(start_.time_since_epoch()) + deadline;
+  timespec ts{};
+  ts.tv_sec = static_cast<time_t>(abs.count() / 1'000'000'000);
+  ts.tv_nsec = static_cast<long>(abs.count() % 1'000'000'000);
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+  }
+#else
+  std::this_thread::sleep_until(start_ + deadline);
+#endif
 }
 
 void SimClock::advance(Duration d) noexcept {

@@ -14,6 +14,9 @@ class Clock {
   virtual ~Clock() = default;
   /// The current time since this clock's epoch; monotonic (never goes backwards).
   [[nodiscard]] virtual Time now() const noexcept = 0;
+  /// Blocks the calling thread until now() >= deadline. The default yields in a loop (right for
+  /// a clock another thread advances); SteadyClock sleeps on the OS's absolute monotonic timer.
+  virtual void sleep_until(Time deadline) const noexcept;
 };
 
 /// Monotonic real time (std::chrono::steady_clock); its epoch is the moment it was constructed.
@@ -21,6 +24,9 @@ class SteadyClock final : public Clock {
  public:
   SteadyClock() noexcept;
   [[nodiscard]] Time now() const noexcept override;
+  /// Absolute-deadline sleep (clock_nanosleep TIMER_ABSTIME on CLOCK_MONOTONIC where available),
+  /// so a periodic loop does not accumulate drift from relative sleeps.
+  void sleep_until(Time deadline) const noexcept override;
 
  private:
   std::chrono::steady_clock::time_point start_;

@@ -1,0 +1,378 @@
+#include "tripodal/reactive/reactive_config.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <initializer_list>
+#include <numbers>
+#include <set>
+#include <sstream>
+
+#include "tripodal/core/value.hpp"
+
+namespace tripodal {
+
+const ControllerConfig* ReactiveConfig::find_controller(std::string_view name) const noexcept {
+  for (const auto& c : controllers) {
+    if (c.name == name) return &c;
+  }
+  return nullptr;
+}
+
+const LoopConfig* ReactiveConfig::find_loop(std::string_view name) const noexcept {
+  for (const auto& l : loops) {
+    if (l.name == name) return &l;
+  }
+  return nullptr;
+}
+
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+enum class Bound { any, positive, non_negative };
+
+// Reads typed values out of yaml-cpp nodes, collecting located diagnostics.
+class Reader {
+ public:
+  Reader(std::string file, Diagnostics& diags) : file_(std::move(file)), d_(diags) {}
+
+  SourceLocation at(const YAML::Node& node) const {
+    const YAML::Mark m = node.Mark();
+    if (m.line < 0) return {file_, 0, 0};
+    return {file_, m.line + 1, m.column + 1};
+  }
+  void error(const YAML::Node& node, std::string message) { d_.error(at(node), std::move(message)); }
+
+  bool is_map(const YAML::Node& node, const std::string& what) {
+    if (node.IsMap()) return true;
+    error(node, what + " must be a map");
+    return false;
+  }
+
+  // Reports keys of `map` not in `allowed`, at the key itself.
+  void check_keys(const YAML::Node& map, std::initializer_list<std::string_view> allowed, const std::string& what) {
+    for (const auto& kv : map) {
+      const std::string key = kv.first.Scalar();
+      bool ok = false;
+      for (auto a : allowed) ok = ok || a == key;
+      if (ok) continue;
+      std::string list;
+      for (auto a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+      error(kv.first, "unknown key '" + key + "' in " + what + " (expected one of: " + list + ")");
+    }
+  }
+
+  std::optional<double> number(const YAML::Node& map, const std::string& key, bool required, Bound bound,
+                               const std::string& what) {
+    const YAML::Node v = map[key];
+    if (!v) {
+      if (required) error(map, what + ": missing '" + key + "' (a number)");
+      return std::nullopt;
+    }
+    std::optional<Value> parsed = v.IsScalar() ? parse_value(ValueType::number, v.Scalar()) : std::nullopt;
+    if (!parsed) {
+      error(v, what + ": '" + key + "' must be a number, got " + (v.IsScalar() ? "'" + v.Scalar() + "'" : std::string("a non-scalar")));
+      return std::nullopt;
+    }
+    const double x = std::get<double>(*parsed);
+    if (bound == Bound::positive && !(x > 0.0)) {
+      error(v, what + ": '" + key + "' must be > 0, got " + v.Scalar());
+      return std::nullopt;
+    }
+    if (bound == Bound::non_negative && !(x >= 0.0)) {
+      error(v, what + ": '" + key + "' must be >= 0, got " + v.Scalar());
+      return std::nullopt;
+    }
+    return x;
+  }
+
+  std::optional<std::string> text(const YAML::Node& map, const std::string& key, bool required, const std::string& what) {
+    const YAML::Node v = map[key];
+    if (!v) {
+      if (required) error(map, what + ": missing '" + key + "'");
+      return std::nullopt;
+    }
+    if (!v.IsScalar()) {
+      error(v, what + ": '" + key + "' must be a string");
+      return std::nullopt;
+    }
+    return v.Scalar();
+  }
+
+  std::optional<int> integer(const YAML::Node& map, const std::string& key, int lo, int hi, const std::string& what) {
+    const std::optional<double> x = number(map, key, false, Bound::any, what);
+    if (!x) return std::nullopt;
+    if (*x != std::floor(*x) || *x < lo || *x > hi) {
+      error(map[key], what + ": '" + key + "' must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                          "], got " + map[key].Scalar());
+      return std::nullopt;
+    }
+    return static_cast<int>(*x);
+  }
+
+ private:
+  std::string file_;
+  Diagnostics& d_;
+};
+
+AxisLimits read_axis(Reader& r, const YAML::Node& node, const std::string& what) {
+  AxisLimits a;
+  if (!r.is_map(node, what)) return a;
+  r.check_keys(node, {"max_velocity", "max_acceleration", "max_deceleration", "max_jerk"}, what);
+  a.max_velocity = r.number(node, "max_velocity", false, Bound::positive, what);
+  a.max_acceleration = r.number(node, "max_acceleration", false, Bound::positive, what);
+  a.max_deceleration = r.number(node, "max_deceleration", false, Bound::positive, what);
+  a.max_jerk = r.number(node, "max_jerk", false, Bound::positive, what);
+  return a;
+}
+
+ControllerConfig read_controller(Reader& r, const YAML::Node& node, std::size_t index, const ControllerRegistry& registry) {
+  ControllerConfig c;
+  c.where = r.at(node);
+  std::string what = "controller #" + std::to_string(index + 1);
+  if (!r.is_map(node, what)) return c;
+  if (auto n = r.text(node, "name", true, what)) {
+    c.name = *n;
+    what = "controller '" + c.name + "'";
+  }
+  r.check_keys(node, {"name", "type", "period_s", "cmd_timeout_s", "max_wheel_speed_rad_s", "limits", "wheel_separation_m",
+                      "wheel_radius_m", "base_radius_m", "wheel_angles_deg", "wheels", "half_length_m", "half_width_m"},
+               what);
+  if (auto t = r.text(node, "type", true, what)) {
+    c.type = *t;
+    if (!registry.contains(c.type)) {
+      std::string known;
+      for (const auto& n : registry.names()) known += (known.empty() ? "" : ", ") + n;
+      r.error(node["type"], what + ": unknown controller type '" + c.type + "' (expected one of: " + known + ")");
+    }
+  }
+  if (auto p = r.number(node, "period_s", false, Bound::positive, what)) c.period = from_seconds(*p);
+  if (auto t = r.number(node, "cmd_timeout_s", false, Bound::non_negative, what)) c.cmd_timeout = from_seconds(*t);
+  c.max_wheel_speed_rad_s = r.number(node, "max_wheel_speed_rad_s", false, Bound::positive, what);
+  if (const YAML::Node lim = node["limits"]) {
+    if (r.is_map(lim, what + " limits")) {
+      r.check_keys(lim, {"vx", "vy", "wz"}, what + " limits");
+      if (lim["vx"]) c.limits.vx = read_axis(r, lim["vx"], what + " limits.vx");
+      if (lim["vy"]) c.limits.vy = read_axis(r, lim["vy"], what + " limits.vy");
+      if (lim["wz"]) c.limits.wz = read_axis(r, lim["wz"], what + " limits.wz");
+    }
+  }
+
+  if (c.type == "differential") {
+    c.differential.wheel_separation_m = r.number(node, "wheel_separation_m", true, Bound::positive, what).value_or(0.0);
+    c.differential.wheel_radius_m = r.number(node, "wheel_radius_m", true, Bound::positive, what).value_or(0.0);
+  } else if (c.type == "mecanum") {
+    const double radius = r.number(node, "wheel_radius_m", true, Bound::positive, what).value_or(0.0);
+    const auto hl = r.number(node, "half_length_m", true, Bound::positive, what);
+    const auto hw = r.number(node, "half_width_m", true, Bound::positive, what);
+    if (hl && hw) c.holonomic = mecanum_base(radius, *hl, *hw);
+    c.holonomic.wheel_radius_m = radius;
+  } else if (c.type == "omni") {
+    c.holonomic.wheel_radius_m = r.number(node, "wheel_radius_m", true, Bound::positive, what).value_or(0.0);
+    const YAML::Node angles = node["wheel_angles_deg"];
+    const YAML::Node wheels = node["wheels"];
+    if (angles && wheels) {
+      r.error(wheels, what + ": give either 'wheel_angles_deg' (with 'base_radius_m') or 'wheels', not both");
+    } else if (angles) {
+      const auto base = r.number(node, "base_radius_m", true, Bound::positive, what);
+      std::vector<double> a;
+      if (!angles.IsSequence()) {
+        r.error(angles, what + ": 'wheel_angles_deg' must be a list of angles in degrees");
+      } else {
+        for (const auto& e : angles) {
+          auto v = e.IsScalar() ? parse_value(ValueType::number, e.Scalar()) : std::nullopt;
+          if (!v) {
+            r.error(e, what + ": a wheel angle must be a number (degrees)");
+          } else {
+            a.push_back(std::get<double>(*v) * kDeg);
+          }
+        }
+        if (angles.size() < 3 || angles.size() > HolonomicConfig::kMaxWheels) {
+          r.error(angles, what + ": an omni base needs 3 to " + std::to_string(HolonomicConfig::kMaxWheels) +
+                              " wheels, got " + std::to_string(angles.size()));
+        }
+      }
+      if (base) {
+        const double radius = c.holonomic.wheel_radius_m;
+        c.holonomic = omni_base(radius, *base, a);
+      }
+    } else if (wheels) {
+      if (!wheels.IsSequence()) {
+        r.error(wheels, what + ": 'wheels' must be a list of {x_m, y_m, drive_angle_deg, roller_angle_deg}");
+      } else {
+        std::size_t i = 0;
+        for (const auto& w : wheels) {
+          const std::string ww = what + " wheel #" + std::to_string(++i);
+          if (!r.is_map(w, ww)) continue;
+          r.check_keys(w, {"x_m", "y_m", "drive_angle_deg", "roller_angle_deg"}, ww);
+          OmniWheelConfig wc;
+          wc.x_m = r.number(w, "x_m", true, Bound::any, ww).value_or(0.0);
+          wc.y_m = r.number(w, "y_m", true, Bound::any, ww).value_or(0.0);
+          wc.drive_angle_rad = r.number(w, "drive_angle_deg", true, Bound::any, ww).value_or(0.0) * kDeg;
+          wc.roller_angle_rad = r.number(w, "roller_angle_deg", false, Bound::any, ww).value_or(0.0) * kDeg;
+          if (std::abs(std::cos(wc.roller_angle_rad)) < 1e-3) r.error(w, ww + ": roller_angle_deg must not be +-90");
+          c.holonomic.wheels.push_back(wc);
+        }
+        if (wheels.size() < 3 || wheels.size() > HolonomicConfig::kMaxWheels) {
+          r.error(wheels, what + ": an omni base needs 3 to " + std::to_string(HolonomicConfig::kMaxWheels) +
+                              " wheels, got " + std::to_string(wheels.size()));
+        }
+      }
+    } else {
+      r.error(node, what + ": missing wheel geometry: give 'wheel_angles_deg' with 'base_radius_m', or 'wheels'");
+    }
+  }
+  return c;
+}
+
+LoopConfig read_loop(Reader& r, const YAML::Node& node, std::size_t index) {
+  LoopConfig l;
+  l.where = r.at(node);
+  std::string what = "loop #" + std::to_string(index + 1);
+  if (!r.is_map(node, what)) return l;
+  if (auto n = r.text(node, "name", true, what)) {
+    l.name = *n;
+    what = "loop '" + l.name + "'";
+  }
+  r.check_keys(node, {"name", "period_s", "controller", "realtime_priority", "cpu", "max_behaviors", "coordinator"}, what);
+  if (auto p = r.number(node, "period_s", true, Bound::positive, what)) l.period = from_seconds(*p);
+  if (auto c = r.text(node, "controller", false, what)) l.controller = *c;
+  if (auto p = r.integer(node, "realtime_priority", 0, 99, what)) l.timing.realtime_priority = *p;
+  if (auto p = r.integer(node, "cpu", -1, 1023, what)) l.timing.cpu = *p;
+  if (auto p = r.integer(node, "max_behaviors", 1, 1024, what)) l.max_behaviors = static_cast<std::size_t>(*p);
+  const YAML::Node co = node["coordinator"];
+  if (!co) return l;
+  const std::string cw = what + " coordinator";
+  if (!r.is_map(co, cw)) return l;
+  r.check_keys(co, {"mode", "inputs", "locks"}, cw);
+  if (auto m = r.text(co, "mode", false, cw)) {
+    if (*m == "priority") {
+      l.coordinator.mode = CoordinationMode::priority;
+    } else if (*m == "weighted_sum") {
+      l.coordinator.mode = CoordinationMode::weighted_sum;
+    } else {
+      r.error(co["mode"], cw + ": unknown mode '" + *m + "' (expected priority or weighted_sum)");
+    }
+  }
+  std::set<std::string> names;
+  if (const YAML::Node inputs = co["inputs"]) {
+    if (!inputs.IsSequence()) {
+      r.error(inputs, cw + ": 'inputs' must be a list");
+    } else {
+      std::size_t i = 0;
+      for (const auto& in : inputs) {
+        const std::string iw = cw + " input #" + std::to_string(++i);
+        if (!r.is_map(in, iw)) continue;
+        r.check_keys(in, {"name", "priority", "timeout_s", "weight", "role"}, iw);
+        CoordinatorInputConfig c;
+        c.name = r.text(in, "name", true, iw).value_or("");
+        if (!c.name.empty() && !names.insert(c.name).second) r.error(in["name"], iw + ": duplicate input '" + c.name + "'");
+        c.priority = r.integer(in, "priority", -1000000, 1000000, iw).value_or(0);
+        c.timeout = from_seconds(r.number(in, "timeout_s", false, Bound::non_negative, iw).value_or(0.0));
+        c.weight = r.number(in, "weight", false, Bound::non_negative, iw).value_or(1.0);
+        if (auto role = r.text(in, "role", false, iw)) {
+          if (*role == "safety") {
+            c.role = InputRole::safety;
+          } else if (*role != "normal") {
+            r.error(in["role"], iw + ": unknown role '" + *role + "' (expected normal or safety)");
+          }
+        }
+        l.coordinator.inputs.push_back(std::move(c));
+      }
+    }
+  }
+  if (const YAML::Node locks = co["locks"]) {
+    if (!locks.IsSequence()) {
+      r.error(locks, cw + ": 'locks' must be a list");
+    } else {
+      std::size_t i = 0;
+      for (const auto& lk : locks) {
+        const std::string lw = cw + " lock #" + std::to_string(++i);
+        if (!r.is_map(lk, lw)) continue;
+        r.check_keys(lk, {"name", "priority", "timeout_s"}, lw);
+        CoordinatorLockConfig c;
+        c.name = r.text(lk, "name", true, lw).value_or("");
+        c.priority = r.integer(lk, "priority", -1000000, 1000000, lw).value_or(0);
+        c.timeout = from_seconds(r.number(lk, "timeout_s", false, Bound::non_negative, lw).value_or(0.0));
+        l.coordinator.locks.push_back(std::move(c));
+      }
+    }
+  }
+  return l;
+}
+
+}  // namespace
+
+ReactiveConfig parse_reactive_config(std::string_view text, const std::string& file, const ControllerRegistry& registry) {
+  Diagnostics diags;
+  Reader r(file, diags);
+  YAML::Node root;
+  try {
+    root = YAML::Load(std::string(text));
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(SourceLocation{file, e.mark.line + 1, e.mark.column + 1}, "YAML syntax error: " + e.msg);
+  }
+  ReactiveConfig out;
+  if (!root.IsMap()) {
+    throw ConfigError(SourceLocation{file, 1, 1}, "expected a map with 'controllers' and 'loops'");
+  }
+  r.check_keys(root, {"controllers", "loops"}, "the reactive configuration");
+  if (const YAML::Node cs = root["controllers"]) {
+    if (!cs.IsSequence()) {
+      r.error(cs, "'controllers' must be a list");
+    } else {
+      std::size_t i = 0;
+      for (const auto& c : cs) {
+        ControllerConfig cc = read_controller(r, c, i++, registry);
+        if (!cc.name.empty() && out.find_controller(cc.name) != nullptr) r.error(c, "duplicate controller '" + cc.name + "'");
+        out.controllers.push_back(std::move(cc));
+      }
+    }
+  }
+  if (const YAML::Node ls = root["loops"]) {
+    if (!ls.IsSequence()) {
+      r.error(ls, "'loops' must be a list");
+    } else {
+      std::size_t i = 0;
+      for (const auto& l : ls) {
+        LoopConfig lc = read_loop(r, l, i++);
+        if (!lc.name.empty() && out.find_loop(lc.name) != nullptr) r.error(l, "duplicate loop '" + lc.name + "'");
+        if (!lc.controller.empty() && out.find_controller(lc.controller) == nullptr) {
+          r.error(l["controller"], "loop '" + lc.name + "': unknown controller '" + lc.controller + "'");
+        }
+        out.loops.push_back(std::move(lc));
+      }
+    }
+  }
+  if (diags.has_errors()) throw ConfigError(std::move(diags));
+  return out;
+}
+
+ReactiveConfig load_reactive_config(const std::string& path, const ControllerRegistry& registry) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(SourceLocation{path, 0, 0}, "cannot read the file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_reactive_config(ss.str(), path, registry);
+}
+
+std::unique_ptr<ControlLoop> make_control_loop(const ReactiveConfig& reactive, const LoopConfig& config,
+                                               ResourceTable& resources, HardwareInterface* hardware,
+                                               const ControllerRegistry& registry) {
+  std::unique_ptr<CController> controller;
+  if (!config.controller.empty()) {
+    const ControllerConfig* cc = reactive.find_controller(config.controller);
+    if (cc == nullptr) throw ConfigError(config.where, "loop '" + config.name + "': unknown controller '" + config.controller + "'");
+    if (hardware == nullptr) throw ConfigError(config.where, "loop '" + config.name + "': controller '" + config.controller + "' needs a hardware interface");
+    controller = registry.create(*cc, *hardware);
+  }
+  ControlLoopOptions options;
+  options.name = config.name;
+  options.period = config.period;
+  options.max_behaviors = config.max_behaviors;
+  return std::make_unique<ControlLoop>(options, resources, CBehaviorCoordinator(config.coordinator), std::move(controller));
+}
+
+}  // namespace tripodal
