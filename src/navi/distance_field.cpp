@@ -51,19 +51,20 @@ DistanceField::DistanceField(const OccupancyGrid& grid, bool unknown_is_obstacle
     const Occupancy s = grid.state(i);
     obstacle[i] = s == Occupancy::occupied || (unknown_is_obstacle && s == Occupancy::unknown);
   }
-  compute(obstacle);
+  compute(obstacle, true);
 }
 
-DistanceField::DistanceField(int width, int height, double resolution_m, const std::vector<bool>& obstacle)
+DistanceField::DistanceField(int width, int height, double resolution_m, const std::vector<bool>& obstacle,
+                             bool outside_is_obstacle)
     : width_(width), height_(height), resolution_m_(resolution_m) {
   if (width < 0 || height < 0 ||
       obstacle.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height)) {
     throw std::invalid_argument("DistanceField: obstacle mask size does not match the grid");
   }
-  compute(obstacle);
+  compute(obstacle, outside_is_obstacle);
 }
 
-void DistanceField::compute(const std::vector<bool>& obstacle) {
+void DistanceField::compute(const std::vector<bool>& obstacle, bool outside_is_obstacle) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   // Pad by one ring of obstacle cells so the outside of the grid counts as obstacle.
   const int w = width_ + 2;
@@ -72,7 +73,7 @@ void DistanceField::compute(const std::vector<bool>& obstacle) {
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       const bool border = x == 0 || y == 0 || x == w - 1 || y == h - 1;
-      const bool obs = border || obstacle[static_cast<std::size_t>(y - 1) * static_cast<std::size_t>(width_) +
+      const bool obs = border ? outside_is_obstacle : obstacle[static_cast<std::size_t>(y - 1) * static_cast<std::size_t>(width_) +
                                           static_cast<std::size_t>(x - 1)];
       if (obs) sq[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] = 0.0;
     }

@@ -21,8 +21,10 @@ class DistanceField {
   /// Distances to the obstacles of grid (O(cells)).
   explicit DistanceField(const OccupancyGrid& grid, bool unknown_is_obstacle = true);
   /// Distances to the cells where obstacle[i] is true, on a width x height grid of the given
-  /// resolution (obstacle.size() == width * height); the outside of the grid counts as obstacle.
-  DistanceField(int width, int height, double resolution_m, const std::vector<bool>& obstacle);
+  /// resolution (obstacle.size() == width * height); the outside of the grid counts as obstacle
+  /// unless outside_is_obstacle is false (then a grid without obstacles is all +infinity).
+  DistanceField(int width, int height, double resolution_m, const std::vector<bool>& obstacle,
+                bool outside_is_obstacle = true);
 
   [[nodiscard]] int width() const noexcept { return width_; }
   [[nodiscard]] int height() const noexcept { return height_; }
@@ -36,7 +38,7 @@ class DistanceField {
   [[nodiscard]] const std::vector<float>& distances_m() const noexcept { return distance_m_; }
 
  private:
-  void compute(const std::vector<bool>& obstacle);
+  void compute(const std::vector<bool>& obstacle, bool outside_is_obstacle);
   int width_ = 0;
   int height_ = 0;
   double resolution_m_ = 0.05;
