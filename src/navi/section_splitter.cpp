@@ -21,6 +21,28 @@ std::string section_name(int i) {
 
 }  // namespace
 
+const ModuleManifest& CSectionSplitter::static_manifest() {
+  static const ModuleManifest m = navi_manifest(
+      "CSectionSplitter", "divides a large workspace into sections at virtual walls between bands of isolated obstacles",
+      {"occupancy_grid", "map_from_base"}, {"section_set"},
+      {ParameterSpec{"min_obstacle_area_m2", ValueType::number, Value{0.01}, "m^2",
+                     "occupied components smaller than this are noise, not isolated obstacles", 0.0, std::nullopt},
+       ParameterSpec{"min_gap_m", ValueType::number, Value{1.5}, "m",
+                     "obstacle-free rows needed between two bands for a virtual wall", 0.0, std::nullopt},
+       ParameterSpec{"min_section_height_m", ValueType::number, Value{3.0}, "m",
+                     "a wall is kept only if the strips on both sides are at least this tall", 0.0, std::nullopt},
+       ParameterSpec{"min_section_area_m2", ValueType::number, Value{2.0}, "m^2",
+                     "smaller free components merge into a neighbour across a virtual wall", 0.0, std::nullopt}});
+  return m;
+}
+
+void CSectionSplitter::on_configure(const ParameterSet& params) {
+  options_.min_obstacle_area_m2 = params.number("min_obstacle_area_m2");
+  options_.min_gap_m = params.number("min_gap_m");
+  options_.min_section_height_m = params.number("min_section_height_m");
+  options_.min_section_area_m2 = params.number("min_section_area_m2");
+}
+
 SectionSet CSectionSplitter::split(const OccupancyGrid& grid) const {
   SectionSet out;
   const int w = grid.width(), h = grid.height();

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "tripodal/navi/navi_modules.hpp"
 #include "tripodal/navi/occupancy_grid.hpp"
 
 namespace tripodal::navi {
@@ -62,11 +63,19 @@ struct SectionSet {
 ///  4. Sections are the 4-connected components of free cells, not crossing a virtual wall; a
 ///     component under min_section_area_m2 is merged into its largest neighbour across a wall.
 /// Every free cell ends up in exactly one section (unless dropped in 4).
-class CSectionSplitter final {
+///
+/// As a navigation module its parameters are the option fields (same names); split() may be
+/// called without configure() with the options given to the constructor.
+class CSectionSplitter final : public CNaviModules {
  public:
   explicit CSectionSplitter(SectionSplitterOptions options = {}) : options_(options) {}
+  static const ModuleManifest& static_manifest();
   [[nodiscard]] SectionSet split(const OccupancyGrid& grid) const;
   [[nodiscard]] const SectionSplitterOptions& options() const noexcept { return options_; }
+
+ protected:
+  [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  void on_configure(const ParameterSet& params) override;
 
  private:
   SectionSplitterOptions options_;
