@@ -344,10 +344,24 @@ CoverageResult CoveragePlanner::balloon(const Section& section, std::optional<Po
   }
   std::vector<CellIndex> chain;
   std::vector<Point2D> pts;
+  // The last, "ridge" round: where the offsets of both sides meet (the medial axis of the
+  // section), a strip narrower than the spacing stays unswept; its outline is walked once.
+  bool ridge = false;
   for (std::size_t k = 0;; ++k) {
     const float level = static_cast<float>(static_cast<double>(k) * spacing);
     boundary_cells.clear();
-    for (std::size_t li = 0; li < n; ++li) in_round[li] = ws.stand[li] != 0 && ws.offset[li] >= level ? 1 : 0;
+    if (!ridge) {
+      for (std::size_t li = 0; li < n; ++li) in_round[li] = ws.stand[li] != 0 && ws.offset[li] >= level ? 1 : 0;
+    } else {
+      CleanedCells swept(grid_);
+      swept.mark_path(r.path, options_.cleaning_width_m / 2.0);
+      for (int ly = 0; ly < ws.h; ++ly) {
+        for (int lx = 0; lx < ws.w; ++lx) {
+          const std::size_t li = ws.local(lx, ly);
+          in_round[li] = ws.stand[li] != 0 && !swept.cleaned(ws.global(lx, ly)) ? 1 : 0;
+        }
+      }
+    }
     for (int ly = 0; ly < ws.h; ++ly) {
       for (int lx = 0; lx < ws.w; ++lx) {
         const std::size_t li = ws.local(lx, ly);
@@ -366,7 +380,11 @@ CoverageResult CoveragePlanner::balloon(const Section& section, std::optional<Po
         }
       }
     }
-    if (boundary_cells.empty()) break;
+    if (boundary_cells.empty()) {
+      if (ridge) break;
+      ridge = true;
+      continue;
+    }
     ++r.rounds;
     for (;;) {
       // the nearest boundary cell not yet walked or beside a walked one
@@ -448,6 +466,7 @@ CoverageResult CoveragePlanner::balloon(const Section& section, std::optional<Po
       cur = closed ? first : last;
       ++r.passes;
     }
+    if (ridge) break;
   }
   finish(r, ws, cur);
   return r;
