@@ -1,0 +1,96 @@
+// Navigation benchmarks on the demo workspace (configs/worlds/workspace_map.yaml: 10.8 m x 32.8 m
+// at 5 cm, 216 x 656 cells): distance field, A* planning, section splitting and the two coverage
+// generators. Coverage runs report their path figures as counters.
+#include <benchmark/benchmark.h>
+
+#include <string>
+
+#include "tripodal/navi/coverage.hpp"
+#include "tripodal/navi/distance_field.hpp"
+#include "tripodal/navi/map_io.hpp"
+#include "tripodal/navi/path_planner.hpp"
+#include "tripodal/navi/section_splitter.hpp"
+
+using namespace tripodal::navi;
+
+namespace {
+
+const OccupancyGrid& workspace() {
+  static const OccupancyGrid g = load_map(std::string(TRIPODAL_SOURCE_DIR) + "/configs/worlds/workspace_map.yaml").grid;
+  return g;
+}
+
+const SectionSet& sections() {
+  static const SectionSet s = CSectionSplitter().split(workspace());
+  return s;
+}
+
+void BM_DistanceField(benchmark::State& state) {
+  for (auto _ : state) {
+    DistanceField f(workspace());
+    benchmark::DoNotOptimize(f.distances_m().data());
+  }
+  state.counters["cells"] = static_cast<double>(workspace().size());
+}
+BENCHMARK(BM_DistanceField)->Unit(benchmark::kMillisecond);
+
+// Corner to corner across all four obstacle bands (the longest plan in the workspace), and a
+// short hop within a section.
+void BM_AStar(benchmark::State& state) {
+  PathPlanner planner(workspace(), {.robot_radius_m = 0.3});
+  const bool long_plan = state.range(0) == 0;
+  const Point2D start = long_plan ? Point2D{0.8, 0.8} : Point2D{1.0, 9.5};
+  const Point2D goal = long_plan ? Point2D{9.0, 31.0} : Point2D{8.5, 13.5};
+  PlannedPath p;
+  for (auto _ : state) {
+    p = planner.plan(start, goal);
+    benchmark::DoNotOptimize(p.waypoints.data());
+  }
+  if (!p.ok()) state.SkipWithError(p.message.c_str());
+  state.counters["length_m"] = p.length_m;
+  state.counters["expanded"] = static_cast<double>(p.expanded);
+  state.counters["waypoints"] = static_cast<double>(p.waypoints.size());
+}
+BENCHMARK(BM_AStar)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+void BM_SectionSplitter(benchmark::State& state) {
+  std::size_t n = 0;
+  for (auto _ : state) {
+    const SectionSet s = CSectionSplitter().split(workspace());
+    n = s.sections.size();
+    benchmark::DoNotOptimize(s.label.data());
+  }
+  state.counters["sections"] = static_cast<double>(n);
+}
+BENCHMARK(BM_SectionSplitter)->Unit(benchmark::kMillisecond);
+
+// args: section index (0..3 = A..D), touch-up (1) or the passes alone (0)
+template <bool kBalloon>
+void BM_Coverage(benchmark::State& state) {
+  CoverageOptions o;
+  o.cleaning_width_m = 0.4;
+  o.touch_up = state.range(1) != 0;
+  CoveragePlanner cp(workspace(), o);
+  const Section& s = sections().sections.at(static_cast<std::size_t>(state.range(0)));
+  CoverageResult r;
+  for (auto _ : state) {
+    r = kBalloon ? cp.balloon(s) : cp.boustrophedon(s);
+    benchmark::DoNotOptimize(r.path.data());
+  }
+  state.SetLabel("section " + s.name + (o.touch_up ? "" : " passes only"));
+  state.counters["coverage_pct"] = 100.0 * r.coverage();
+  state.counters["length_m"] = r.stats.length_m;
+  state.counters["turns"] = static_cast<double>(r.stats.turns);
+  state.counters["turn_rad"] = r.stats.total_turn_rad;
+  state.counters["passes"] = static_cast<double>(r.passes);
+  state.counters["touch_ups"] = static_cast<double>(r.touch_ups);
+  state.counters["area_m2"] = s.area_m2;
+}
+void BM_Balloon(benchmark::State& state) { BM_Coverage<true>(state); }
+void BM_Boustrophedon(benchmark::State& state) { BM_Coverage<false>(state); }
+BENCHMARK(BM_Balloon)->ArgsProduct({{0, 1, 2, 3}, {1, 0}})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Boustrophedon)->ArgsProduct({{0, 1, 2, 3}, {1, 0}})->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,137 @@
+// Coverage for the cleaning task (paper, section 3.2): the record of cleaned cells on the grid,
+// and coverage paths for one section given by CSectionSplitter. The balloon coverage is the
+// paper's wall-following algorithm that BhCleaning / BhCleaningTwoWheel follow; the boustrophedon
+// (plowing) path is the baseline it is measured against.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "tripodal/navi/occupancy_grid.hpp"
+#include "tripodal/navi/path_planner.hpp"
+#include "tripodal/navi/section_splitter.hpp"
+
+namespace tripodal::navi {
+
+/// The cleaned-cells record: which cells of a grid a cleaning footprint has passed over. A cell
+/// is cleaned when its centre comes within the footprint radius of the robot's centre.
+class CleanedCells {
+ public:
+  CleanedCells() = default;
+  explicit CleanedCells(const OccupancyGrid& grid);
+
+  /// Marks the cells under a disc (the footprint at one pose).
+  void mark_disc(Point2D centre, double radius_m) noexcept;
+  /// Marks the swath a disc sweeps moving straight from a to b (a capsule).
+  void mark_segment(Point2D a, Point2D b, double radius_m) noexcept;
+  /// Marks the swath along a polyline.
+  void mark_path(const std::vector<Point2D>& path, double radius_m) noexcept;
+  void clear() noexcept;
+
+  [[nodiscard]] bool cleaned(CellIndex c) const noexcept {
+    return c.x >= 0 && c.y >= 0 && c.x < width_ && c.y < height_ && mask_[index(c)] != 0;
+  }
+  [[nodiscard]] bool cleaned(std::size_t i) const noexcept { return mask_[i] != 0; }
+  /// Number of cleaned cells in the whole grid.
+  [[nodiscard]] std::size_t count() const noexcept;
+  /// Fraction of `cells` (row-major indices) that are cleaned; 1 for an empty set.
+  [[nodiscard]] double coverage(const std::vector<std::size_t>& cells) const noexcept;
+  [[nodiscard]] const std::vector<std::uint8_t>& mask() const noexcept { return mask_; }
+
+ private:
+  [[nodiscard]] std::size_t index(CellIndex c) const noexcept {
+    return static_cast<std::size_t>(c.y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(c.x);
+  }
+  int width_ = 0;
+  int height_ = 0;
+  OccupancyGrid frame_;  // 0 x 0 cells: only the grid's world <-> cell transform
+  std::vector<std::uint8_t> mask_;
+};
+
+struct CoverageOptions {
+  double cleaning_width_m = 0.4;  ///< diameter of the cleaning footprint (a disc centred on the robot)
+  /// Radius of the robot's body: it keeps this clearance from physical obstacles. 0: half the
+  /// cleaning width (the footprint is the body).
+  double robot_radius_m = 0.0;
+  /// Passes (rounds or lanes) are spaced cleaning_width - overlap apart; one cell of overlap
+  /// absorbs the quantisation of the contours to grid cells.
+  double overlap_m = 0.05;
+  /// A vertex of the (simplified) path is a turn when the heading changes by more than this.
+  double turn_threshold_rad = 0.5235987755982988;  // 30 degrees
+  /// Douglas-Peucker tolerance of the path's shape on which length and turns are measured (the
+  /// path itself keeps every cell centre of the contours); 0: 0.75 cell.
+  double simplify_tolerance_m = 0.0;
+  /// After the passes, visit the reachable cells still uncleaned (points of the medial axis,
+  /// narrow places) one by one, nearest first.
+  bool touch_up = true;
+};
+
+/// Length and turns of a path.
+struct PathStats {
+  double length_m = 0.0;
+  std::size_t turns = 0;          ///< vertices where the heading changes by more than the threshold
+  double total_turn_rad = 0.0;    ///< sum of |heading change| over every vertex
+};
+
+[[nodiscard]] PathStats path_stats(const std::vector<Point2D>& path, double turn_threshold_rad) noexcept;
+
+struct CoverageResult {
+  /// Map frame, the whole route including the links between passes: contours as chains of cell
+  /// centres (dense), lanes and links as straight legs.
+  std::vector<Point2D> path;
+  std::size_t passes = 0;         ///< rounds' contour pieces or plough lanes
+  std::size_t rounds = 0;         ///< balloon only: offsets from the wall
+  std::size_t touch_ups = 0;      ///< points visited by the touch-up
+  PathStats stats;                ///< of the path simplified with simplify_tolerance_m
+  std::size_t section_cells = 0;
+  std::size_t reachable_cells = 0;  ///< free cells of the section the footprint can reach
+  std::size_t covered_cells = 0;    ///< of those, cleaned by following path
+  [[nodiscard]] double coverage() const noexcept {
+    return reachable_cells == 0 ? 1.0 : static_cast<double>(covered_cells) / static_cast<double>(reachable_cells);
+  }
+};
+
+/// Coverage path generators for the sections of one map. The distance field of the map's
+/// physical obstacles (and the planner that links passes) is computed once, in the constructor.
+///
+/// Where the robot may stand in a section: cells whose clearance from the section's boundary
+/// (walls, obstacles and virtual walls) is at least half the cleaning width and whose clearance
+/// from physical obstacles is at least the robot radius; their connected parts that the planner
+/// can link. The reachable area is every section cell within half the cleaning width of such a
+/// cell: the cells the footprint can clean at all (room corners a disc cannot enter are not in it).
+class CoveragePlanner final {
+ public:
+  CoveragePlanner(const OccupancyGrid& grid, CoverageOptions options = {});
+
+  /// The paper's wall-following "balloon" coverage. Round 0 keeps the footprint tangent to the
+  /// walls, obstacles and virtual walls of the section (the balloon's offset from the boundary is
+  /// half the cleaning width); each next round offsets the balloon inward by one spacing, so the
+  /// robot spirals inward. Each round is the boundary of the region where the offset field
+  /// E = min(section clearance - width/2, obstacle clearance - robot radius) >= k * spacing,
+  /// walked as cell chains that keep their heading where they can.
+  /// Rounds go outermost first; within a round the nearest piece comes next, entered at its
+  /// nearest point, so most links are a step inward.
+  [[nodiscard]] CoverageResult balloon(const Section& section, std::optional<Point2D> start = std::nullopt);
+
+  /// Boustrophedon (plowing): straight lanes parallel to the longer side of the section's
+  /// bounding box, one spacing apart, each the run of standing cells along a row (or column);
+  /// lanes are taken nearest-end-first, alternating direction. Same grid, width and touch-up.
+  [[nodiscard]] CoverageResult boustrophedon(const Section& section, std::optional<Point2D> start = std::nullopt);
+
+  [[nodiscard]] const CoverageOptions& options() const noexcept { return options_; }
+  [[nodiscard]] PathPlanner& planner() noexcept { return planner_; }
+
+ private:
+  struct Workspace;
+  [[nodiscard]] Workspace prepare(const Section& section);
+  void link(std::vector<Point2D>& path, CellIndex from, CellIndex to);
+  void finish(CoverageResult& r, Workspace& ws, CellIndex cur);
+
+  OccupancyGrid grid_;
+  CoverageOptions options_;
+  PathPlanner planner_;
+};
+
+}  // namespace tripodal::navi

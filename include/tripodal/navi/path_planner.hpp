@@ -1,0 +1,78 @@
+// The path planner of the navigation modules (sequencing layer): the shortest collision-free path
+// for a round robot on an occupancy grid, used by PrAutoMove/BhAutoMove to reach a goal or the
+// nearest uncleaned section, and by the coverage generators to link passes.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tripodal/navi/distance_field.hpp"
+#include "tripodal/navi/occupancy_grid.hpp"
+
+namespace tripodal::navi {
+
+struct PathPlannerOptions {
+  double robot_radius_m = 0.25;     ///< obstacles are inflated by this much (footprint disc)
+  bool unknown_is_obstacle = true;  ///< plan only through cells known to be free
+  bool shortcut = true;             ///< drop waypoints joined by a collision-free straight line
+};
+
+enum class PlanStatus { ok, start_outside_map, goal_outside_map, start_in_collision, goal_in_collision, unreachable };
+
+[[nodiscard]] const char* to_string(PlanStatus s) noexcept;
+
+struct PlannedPath {
+  PlanStatus status = PlanStatus::unreachable;
+  std::string message;              ///< why it failed, with the positions and clearances
+  std::vector<CellIndex> cells;     ///< the A* cell path, start to goal (before shortcutting)
+  std::vector<Point2D> waypoints;   ///< map frame: start, the corners kept, goal
+  double length_m = 0.0;            ///< along the waypoints
+  std::size_t expanded = 0;         ///< A* nodes expanded
+  [[nodiscard]] bool ok() const noexcept { return status == PlanStatus::ok; }
+};
+
+/// A* on the 8-connected grid (diagonal moves cost sqrt 2 and may not cut an obstacle corner)
+/// with the octile-distance heuristic, restricted to cells whose clearance (DistanceField) is at
+/// least the robot radius; then the path is shortcut: from each kept waypoint the farthest later
+/// cell visible along a straight line of collision-free cells becomes the next one. The distance
+/// field is computed once, in the constructor; planning reuses its buffers, so one planner must
+/// not plan from two threads at once. Failures are statuses with a message, never exceptions.
+class PathPlanner final {
+ public:
+  PathPlanner(const OccupancyGrid& grid, PathPlannerOptions options = {});
+
+  /// Plans from start to goal (map frame, metres).
+  [[nodiscard]] PlannedPath plan(Point2D start, Point2D goal);
+  /// Plans between two cells.
+  [[nodiscard]] PlannedPath plan(CellIndex start, CellIndex goal);
+
+  /// Whether the robot's disc centred on the cell touches no obstacle.
+  [[nodiscard]] bool traversable(CellIndex c) const noexcept {
+    return grid_.contains(c) && traversable_[grid_.index(c)] != 0;
+  }
+  /// Whether every cell on the straight segment a-b (supercover line) is traversable.
+  [[nodiscard]] bool line_of_sight(CellIndex a, CellIndex b) const noexcept;
+
+  [[nodiscard]] const OccupancyGrid& grid() const noexcept { return grid_; }
+  [[nodiscard]] const DistanceField& distance_field() const noexcept { return field_; }
+  [[nodiscard]] const PathPlannerOptions& options() const noexcept { return options_; }
+
+ private:
+  OccupancyGrid grid_;
+  PathPlannerOptions options_;
+  DistanceField field_;
+  std::vector<std::uint8_t> traversable_;
+  // A* scratch, reused across plans; a cell's entries are valid when stamp_ == search_id_.
+  std::vector<float> g_;
+  std::vector<std::uint32_t> parent_;
+  std::vector<std::uint32_t> stamp_;
+  std::vector<std::uint8_t> closed_;
+  std::uint32_t search_id_ = 0;
+};
+
+/// Length of a polyline, metres.
+[[nodiscard]] double polyline_length_m(const std::vector<Point2D>& points) noexcept;
+
+}  // namespace tripodal::navi

@@ -1,0 +1,84 @@
+// CSectionSplitter, the navigation module that divides a large open workspace into sections
+// (paper, section 3.2): the planner alternates PrCleaning over each section with PrAutoMove
+// between them, and the cleaning behaviors cover one section at a time.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "tripodal/navi/navi_modules.hpp"
+#include "tripodal/navi/occupancy_grid.hpp"
+
+namespace tripodal::navi {
+
+struct SectionSplitterOptions {
+  /// Occupied components smaller than this are noise, not isolated obstacles.
+  double min_obstacle_area_m2 = 0.01;
+  /// Obstacle rows closer than this belong to one band: only a gap at least this tall (a real
+  /// free passage across the map) hosts a virtual wall. Without it, one table and two pillars
+  /// at slightly different heights would cut the floor into slivers.
+  double min_gap_m = 1.5;
+  /// A virtual wall is kept only if the strips on both sides of it (to the neighbouring kept
+  /// wall or the end of the map) are at least this tall; closer walls are dropped.
+  double min_section_height_m = 3.0;
+  /// A free component smaller than this after the cut is merged into the section it shares the
+  /// longest virtual-wall border with (or dropped, if it touches none: a free speck inside walls).
+  double min_section_area_m2 = 2.0;
+};
+
+/// One section: a set of free cells with its extent.
+struct Section {
+  int id = 0;                     ///< index in SectionSet::sections
+  std::string name;               ///< "A", "B", ... in scan order (lowest first row first)
+  std::vector<std::size_t> cells; ///< row-major indices into the grid, ascending
+  CellIndex min;                  ///< bounding box, inclusive
+  CellIndex max;
+  double area_m2 = 0.0;
+  Point2D centroid;               ///< map frame
+};
+
+struct SectionSet {
+  std::vector<Section> sections;
+  /// Section id of every grid cell, -1 for cells in no section (not free, or dropped).
+  std::vector<int> label;
+  /// Virtual walls: a wall at row r separates rows r and r + 1 (it lies on the edge between them).
+  std::vector<int> virtual_wall_rows;
+  /// Rows (grid y) holding at least one isolated obstacle cell.
+  std::vector<int> obstacle_rows;
+  /// Number of isolated obstacles (occupied components not connected to the outer wall).
+  std::size_t isolated_obstacles = 0;
+};
+
+/// The section splitter. The rule, on the paper's criterion (isolated obstacles):
+///  1. The outer wall is every occupied or unknown cell 8-connected to the border of the grid
+///     through occupied/unknown cells; the other occupied components, at least
+///     min_obstacle_area_m2, are isolated obstacles (furniture, pillars standing in free space).
+///  2. Scanning the grid row by row (from row 0), rows holding isolated obstacle cells form
+///     obstacle bands; rows between two bands hold none. Bands separated by fewer than
+///     min_gap_m of obstacle-free rows are one band. A candidate virtual wall lies in the middle
+///     of every remaining gap between two consecutive bands, along the row.
+///  3. Walls closer than min_section_height_m to the previous kept wall (or to the first/last
+///     free row) are dropped, so no section is a thin strip.
+///  4. Sections are the 4-connected components of free cells, not crossing a virtual wall; a
+///     component under min_section_area_m2 is merged into its largest neighbour across a wall.
+/// Every free cell ends up in exactly one section (unless dropped in 4).
+///
+/// As a navigation module its parameters are the option fields (same names); split() may be
+/// called without configure() with the options given to the constructor.
+class CSectionSplitter final : public CNaviModules {
+ public:
+  explicit CSectionSplitter(SectionSplitterOptions options = {}) : options_(options) {}
+  static const ModuleManifest& static_manifest();
+  [[nodiscard]] SectionSet split(const OccupancyGrid& grid) const;
+  [[nodiscard]] const SectionSplitterOptions& options() const noexcept { return options_; }
+
+ protected:
+  [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  void on_configure(const ParameterSet& params) override;
+
+ private:
+  SectionSplitterOptions options_;
+};
+
+}  // namespace tripodal::navi

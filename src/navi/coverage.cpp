@@ -1,0 +1,563 @@
+#include "tripodal/navi/coverage.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "tripodal/navi/distance_field.hpp"
+
+namespace tripodal::navi {
+
+// ---------------------------------------------------------------- cleaned cells
+
+CleanedCells::CleanedCells(const OccupancyGrid& grid)
+    : width_(grid.width()), height_(grid.height()), frame_(0, 0, grid.resolution_m(), grid.origin()),
+      mask_(grid.size(), 0) {}
+
+void CleanedCells::clear() noexcept { std::fill(mask_.begin(), mask_.end(), 0); }
+
+void CleanedCells::mark_disc(Point2D centre, double radius_m) noexcept { mark_segment(centre, centre, radius_m); }
+
+void CleanedCells::mark_segment(Point2D a, Point2D b, double radius_m) noexcept {
+  if (width_ == 0 || height_ == 0) return;
+  // Work in the grid frame, in cells: the capsule around a-b.
+  const double res = frame_.resolution_m();
+  const Point2D ga = frame_.to_grid_frame(a), gb = frame_.to_grid_frame(b);
+  const double ax = ga.x_m / res, ay = ga.y_m / res, bx = gb.x_m / res, by = gb.y_m / res;
+  const double r = radius_m / res;
+  if (!std::isfinite(ax) || !std::isfinite(ay) || !std::isfinite(bx) || !std::isfinite(by) || !(r >= 0.0)) return;
+  const int x0 = std::max(0, static_cast<int>(std::floor(std::min(ax, bx) - r)));
+  const int x1 = std::min(width_ - 1, static_cast<int>(std::ceil(std::max(ax, bx) + r)));
+  const int y0 = std::max(0, static_cast<int>(std::floor(std::min(ay, by) - r)));
+  const int y1 = std::min(height_ - 1, static_cast<int>(std::ceil(std::max(ay, by) + r)));
+  const double dx = bx - ax, dy = by - ay;
+  const double len2 = dx * dx + dy * dy;
+  const double r2 = r * r + 1e-9;
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) {
+      const double px = x + 0.5 - ax, py = y + 0.5 - ay;
+      double t = len2 > 0.0 ? (px * dx + py * dy) / len2 : 0.0;
+      t = std::clamp(t, 0.0, 1.0);
+      const double ex = px - t * dx, ey = py - t * dy;
+      if (ex * ex + ey * ey <= r2) mask_[index({x, y})] = 1;
+    }
+  }
+}
+
+void CleanedCells::mark_path(const std::vector<Point2D>& path, double radius_m) noexcept {
+  if (path.size() == 1) mark_disc(path[0], radius_m);
+  for (std::size_t i = 1; i < path.size(); ++i) mark_segment(path[i - 1], path[i], radius_m);
+}
+
+std::size_t CleanedCells::count() const noexcept {
+  return static_cast<std::size_t>(std::count(mask_.begin(), mask_.end(), std::uint8_t{1}));
+}
+
+double CleanedCells::coverage(const std::vector<std::size_t>& cells) const noexcept {
+  if (cells.empty()) return 1.0;
+  std::size_t n = 0;
+  for (const std::size_t i : cells) n += mask_[i] != 0 ? 1 : 0;
+  return static_cast<double>(n) / static_cast<double>(cells.size());
+}
+
+// ---------------------------------------------------------------- path statistics
+
+PathStats path_stats(const std::vector<Point2D>& path, double turn_threshold_rad) noexcept {
+  PathStats s;
+  s.length_m = polyline_length_m(path);
+  // headings of the legs that have a length
+  double prev = 0.0;
+  bool have_prev = false;
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    const double dx = path[i].x_m - path[i - 1].x_m, dy = path[i].y_m - path[i - 1].y_m;
+    if (std::hypot(dx, dy) < 1e-9) continue;
+    const double h = std::atan2(dy, dx);
+    if (have_prev) {
+      double d = h - prev;
+      while (d > std::numbers::pi) d -= 2.0 * std::numbers::pi;
+      while (d < -std::numbers::pi) d += 2.0 * std::numbers::pi;
+      s.total_turn_rad += std::abs(d);
+      if (std::abs(d) > turn_threshold_rad) ++s.turns;
+    }
+    prev = h;
+    have_prev = true;
+  }
+  return s;
+}
+
+// ---------------------------------------------------------------- coverage planner
+
+namespace {
+
+// Douglas-Peucker on a chain of points; keeps the end points.
+void simplify(const std::vector<Point2D>& in, double tol, std::vector<Point2D>& out) {
+  if (in.size() <= 2) {
+    out.insert(out.end(), in.begin(), in.end());
+    return;
+  }
+  std::vector<std::uint8_t> keep(in.size(), 0);
+  keep.front() = keep.back() = 1;
+  std::vector<std::pair<std::size_t, std::size_t>> stack{{0, in.size() - 1}};
+  while (!stack.empty()) {
+    const auto [a, b] = stack.back();
+    stack.pop_back();
+    if (b <= a + 1) continue;
+    const double dx = in[b].x_m - in[a].x_m, dy = in[b].y_m - in[a].y_m;
+    const double len = std::hypot(dx, dy);
+    double worst = -1.0;
+    std::size_t at = a;
+    for (std::size_t i = a + 1; i < b; ++i) {
+      const double px = in[i].x_m - in[a].x_m, py = in[i].y_m - in[a].y_m;
+      const double d = len > 1e-12 ? std::abs(px * dy - py * dx) / len : std::hypot(px, py);
+      if (d > worst) {
+        worst = d;
+        at = i;
+      }
+    }
+    if (worst > tol) {
+      keep[at] = 1;
+      stack.emplace_back(a, at);
+      stack.emplace_back(at, b);
+    }
+  }
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    if (keep[i] != 0) out.push_back(in[i]);
+  }
+}
+
+}  // namespace
+
+// Per-section working data on a window around the section's bounding box.
+struct CoveragePlanner::Workspace {
+  int x0 = 0, y0 = 0, w = 0, h = 0;  // window in grid cells
+  std::vector<float> offset;           // E, metres; -inf outside the section
+  std::vector<std::uint8_t> stand;     // where the robot centre may be
+  std::vector<std::size_t> reachable;  // global indices
+  std::vector<std::size_t> stand_cells_global;
+  CleanedCells cleaned;
+  std::size_t section_cells = 0;
+
+  [[nodiscard]] bool inside(int lx, int ly) const noexcept { return lx >= 0 && ly >= 0 && lx < w && ly < h; }
+  [[nodiscard]] std::size_t local(int lx, int ly) const noexcept {
+    return static_cast<std::size_t>(ly) * static_cast<std::size_t>(w) + static_cast<std::size_t>(lx);
+  }
+  [[nodiscard]] CellIndex global(int lx, int ly) const noexcept { return {lx + x0, ly + y0}; }
+};
+
+CoveragePlanner::CoveragePlanner(const OccupancyGrid& grid, CoverageOptions options)
+    : grid_(grid), options_(options),
+      planner_(grid, PathPlannerOptions{options.robot_radius_m > 0.0 ? options.robot_radius_m
+                                                                      : options.cleaning_width_m / 2.0,
+                                        true, true}) {
+  if (options_.robot_radius_m <= 0.0) options_.robot_radius_m = options_.cleaning_width_m / 2.0;
+  if (options_.simplify_tolerance_m <= 0.0) options_.simplify_tolerance_m = 0.75 * grid.resolution_m();
+}
+
+CoveragePlanner::Workspace CoveragePlanner::prepare(const Section& section) {
+  Workspace ws;
+  ws.cleaned = CleanedCells(grid_);
+  ws.section_cells = section.cells.size();
+  if (section.cells.empty()) return ws;
+  ws.x0 = section.min.x - 1;
+  ws.y0 = section.min.y - 1;
+  ws.w = section.max.x - section.min.x + 3;
+  ws.h = section.max.y - section.min.y + 3;
+  const std::size_t n = static_cast<std::size_t>(ws.w) * static_cast<std::size_t>(ws.h);
+  std::vector<bool> outside(n, true);
+  for (const std::size_t i : section.cells) {
+    const CellIndex c = grid_.cell(i);
+    outside[ws.local(c.x - ws.x0, c.y - ws.y0)] = false;
+  }
+  const DistanceField dsec(ws.w, ws.h, grid_.resolution_m(), outside);
+  const DistanceField& dphys = planner_.distance_field();
+  const double half = options_.cleaning_width_m / 2.0;
+  ws.offset.assign(n, -std::numeric_limits<float>::infinity());
+  ws.stand.assign(n, 0);
+  for (int ly = 0; ly < ws.h; ++ly) {
+    for (int lx = 0; lx < ws.w; ++lx) {
+      const std::size_t li = ws.local(lx, ly);
+      if (outside[li]) continue;
+      const std::size_t gi = grid_.index(ws.global(lx, ly));
+      const double e = std::min(dsec.clearance_m(li) - half,
+                                dphys.distance_m(gi) > 0.0 ? dphys.clearance_m(gi) - options_.robot_radius_m : -1.0);
+      ws.offset[li] = static_cast<float>(e);
+      ws.stand[li] = e >= 0.0 ? 1 : 0;
+    }
+  }
+  // stand components (8-connected); keep those the planner can link to the largest one
+  std::vector<int> comp(n, -1);
+  std::vector<std::vector<std::size_t>> comps;
+  std::vector<std::size_t> stack;
+  for (std::size_t s = 0; s < n; ++s) {
+    if (ws.stand[s] == 0 || comp[s] >= 0) continue;
+    const int id = static_cast<int>(comps.size());
+    comps.emplace_back();
+    comp[s] = id;
+    stack.push_back(s);
+    while (!stack.empty()) {
+      const std::size_t li = stack.back();
+      stack.pop_back();
+      comps.back().push_back(li);
+      const int lx = static_cast<int>(li % static_cast<std::size_t>(ws.w));
+      const int ly = static_cast<int>(li / static_cast<std::size_t>(ws.w));
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          if (!ws.inside(lx + dx, ly + dy)) continue;
+          const std::size_t k = ws.local(lx + dx, ly + dy);
+          if (ws.stand[k] != 0 && comp[k] < 0) {
+            comp[k] = id;
+            stack.push_back(k);
+          }
+        }
+      }
+    }
+  }
+  if (comps.empty()) return ws;
+  std::size_t main = 0;
+  for (std::size_t k = 1; k < comps.size(); ++k) {
+    if (comps[k].size() > comps[main].size()) main = k;
+  }
+  const auto cell_of_local = [&](std::size_t li) {
+    return ws.global(static_cast<int>(li % static_cast<std::size_t>(ws.w)),
+                     static_cast<int>(li / static_cast<std::size_t>(ws.w)));
+  };
+  for (std::size_t k = 0; k < comps.size(); ++k) {
+    if (k == main) continue;
+    if (!planner_.plan(cell_of_local(comps[main].front()), cell_of_local(comps[k].front())).ok()) {
+      for (const std::size_t li : comps[k]) ws.stand[li] = 0;
+    }
+  }
+  // reachable: section cells within the footprint radius of a standing cell
+  std::vector<bool> is_stand(n);
+  for (std::size_t li = 0; li < n; ++li) is_stand[li] = ws.stand[li] != 0;
+  const DistanceField to_stand(ws.w, ws.h, grid_.resolution_m(), is_stand, false);
+  for (std::size_t li = 0; li < n; ++li) {
+    if (outside[li]) continue;
+    const std::size_t gi = grid_.index(cell_of_local(li));
+    if (ws.stand[li] != 0) ws.stand_cells_global.push_back(gi);
+    if (to_stand.distance_m(li) <= half + 1e-6) ws.reachable.push_back(gi);  // float distances
+  }
+  return ws;
+}
+
+void CoveragePlanner::link(std::vector<Point2D>& path, CellIndex from, CellIndex to) {
+  if (from == to) return;
+  if (planner_.line_of_sight(from, to)) {
+    path.push_back(grid_.cell_center(to));
+    return;
+  }
+  const PlannedPath p = planner_.plan(from, to);
+  if (!p.ok()) return;  // cannot happen for cells of linked components; leave a jump rather than fail
+  path.insert(path.end(), p.waypoints.begin() + 1, p.waypoints.end());
+}
+
+void CoveragePlanner::finish(CoverageResult& r, Workspace& ws, CellIndex cur) {
+  const double half = options_.cleaning_width_m / 2.0;
+  ws.cleaned.mark_path(r.path, half);
+  if (options_.touch_up && !ws.stand_cells_global.empty()) {
+    std::vector<std::size_t> todo;
+    for (const std::size_t i : ws.reachable) {
+      if (!ws.cleaned.cleaned(i)) todo.push_back(i);
+    }
+    const int reach = static_cast<int>(std::ceil(half / grid_.resolution_m()));
+    while (!todo.empty()) {
+      // nearest uncleaned cell
+      std::size_t best = 0;
+      long long best_d = std::numeric_limits<long long>::max();
+      for (std::size_t k = 0; k < todo.size(); ++k) {
+        const CellIndex c = grid_.cell(todo[k]);
+        const long long d = 1LL * (c.x - cur.x) * (c.x - cur.x) + 1LL * (c.y - cur.y) * (c.y - cur.y);
+        if (d < best_d) {
+          best_d = d;
+          best = k;
+        }
+      }
+      const CellIndex u = grid_.cell(todo[best]);
+      // a standing cell whose footprint covers u, the nearest to the robot
+      std::optional<CellIndex> target;
+      long long target_d = std::numeric_limits<long long>::max();
+      const double r2 = (half / grid_.resolution_m()) * (half / grid_.resolution_m()) + 1e-9;
+      for (int dy = -reach; dy <= reach; ++dy) {
+        for (int dx = -reach; dx <= reach; ++dx) {
+          if (dx * dx + dy * dy > r2) continue;
+          const int lx = u.x + dx - ws.x0, ly = u.y + dy - ws.y0;
+          if (!ws.inside(lx, ly) || ws.stand[ws.local(lx, ly)] == 0) continue;
+          const CellIndex t{u.x + dx, u.y + dy};
+          const long long d = 1LL * (t.x - cur.x) * (t.x - cur.x) + 1LL * (t.y - cur.y) * (t.y - cur.y);
+          if (d < target_d) {
+            target_d = d;
+            target = t;
+          }
+        }
+      }
+      const std::size_t before = r.path.size();
+      if (target) {
+        if (r.path.empty()) r.path.push_back(grid_.cell_center(*target));
+        link(r.path, cur, *target);
+        cur = *target;
+        ++r.touch_ups;
+        for (std::size_t k = before == 0 ? 0 : before - 1; k + 1 < r.path.size(); ++k) {
+          ws.cleaned.mark_segment(r.path[k], r.path[k + 1], half);
+        }
+        ws.cleaned.mark_disc(grid_.cell_center(cur), half);
+      }
+      ws.cleaned.mark_disc(grid_.cell_center(u), 0.0);  // never pick u again, even if unreachable
+      const auto unclean = [&](std::size_t i) { return !ws.cleaned.cleaned(i); };
+      std::vector<std::size_t> next;
+      next.reserve(todo.size());
+      for (const std::size_t i : todo) {
+        if (unclean(i)) next.push_back(i);
+      }
+      todo.swap(next);
+    }
+    // the forced marks above are not cleaning: recount from the path itself
+    ws.cleaned.clear();
+    ws.cleaned.mark_path(r.path, half);
+  }
+  // Measured on the path's shape: a chain of cell centres along a slanted contour is a staircase
+  // whose steps are not turns of the robot.
+  std::vector<Point2D> shape;
+  simplify(r.path, options_.simplify_tolerance_m, shape);
+  r.stats = path_stats(shape, options_.turn_threshold_rad);
+  r.section_cells = ws.section_cells;
+  r.reachable_cells = ws.reachable.size();
+  r.covered_cells = 0;
+  for (const std::size_t i : ws.reachable) r.covered_cells += ws.cleaned.cleaned(i) ? 1 : 0;
+}
+
+CoverageResult CoveragePlanner::balloon(const Section& section, std::optional<Point2D> start) {
+  CoverageResult r;
+  Workspace ws = prepare(section);
+  if (ws.stand_cells_global.empty()) {
+    finish(r, ws, {0, 0});
+    return r;
+  }
+  const double spacing = std::max(grid_.resolution_m(), options_.cleaning_width_m - options_.overlap_m);
+  const std::size_t n = ws.offset.size();
+  std::vector<std::uint8_t> in_round(n), boundary(n), used(n), near(n);
+  std::vector<std::size_t> boundary_cells;
+  CellIndex cur{-1, -1};
+  if (start) {
+    const auto c = grid_.world_to_cell(*start);
+    if (c) cur = *c;
+  }
+  std::vector<CellIndex> chain;
+  std::vector<Point2D> pts;
+  // The last, "ridge" round: where the offsets of both sides meet (the medial axis of the
+  // section), a strip narrower than the spacing stays unswept; its outline is walked once.
+  bool ridge = false;
+  for (std::size_t k = 0;; ++k) {
+    const float level = static_cast<float>(static_cast<double>(k) * spacing);
+    boundary_cells.clear();
+    if (!ridge) {
+      for (std::size_t li = 0; li < n; ++li) in_round[li] = ws.stand[li] != 0 && ws.offset[li] >= level ? 1 : 0;
+    } else {
+      CleanedCells swept(grid_);
+      swept.mark_path(r.path, options_.cleaning_width_m / 2.0);
+      for (int ly = 0; ly < ws.h; ++ly) {
+        for (int lx = 0; lx < ws.w; ++lx) {
+          const std::size_t li = ws.local(lx, ly);
+          in_round[li] = ws.stand[li] != 0 && !swept.cleaned(ws.global(lx, ly)) ? 1 : 0;
+        }
+      }
+    }
+    for (int ly = 0; ly < ws.h; ++ly) {
+      for (int lx = 0; lx < ws.w; ++lx) {
+        const std::size_t li = ws.local(lx, ly);
+        boundary[li] = 0;
+        used[li] = 0;
+        near[li] = 0;
+        if (in_round[li] == 0) continue;
+        const int nx[4] = {lx + 1, lx - 1, lx, lx};
+        const int ny[4] = {ly, ly, ly + 1, ly - 1};
+        for (int q = 0; q < 4; ++q) {
+          if (!ws.inside(nx[q], ny[q]) || in_round[ws.local(nx[q], ny[q])] == 0) {
+            boundary[li] = 1;
+            boundary_cells.push_back(li);
+            break;
+          }
+        }
+      }
+    }
+    if (boundary_cells.empty()) {
+      if (ridge) break;
+      ridge = true;
+      continue;
+    }
+    ++r.rounds;
+    for (;;) {
+      // the nearest boundary cell not yet walked or beside a walked one
+      std::size_t seed = n;
+      long long seed_d = std::numeric_limits<long long>::max();
+      for (const std::size_t li : boundary_cells) {
+        if (used[li] != 0 || near[li] != 0) continue;
+        const int lx = static_cast<int>(li % static_cast<std::size_t>(ws.w));
+        const int ly = static_cast<int>(li / static_cast<std::size_t>(ws.w));
+        const CellIndex g = ws.global(lx, ly);
+        const long long d = cur.x < 0 ? static_cast<long long>(li)
+                                      : 1LL * (g.x - cur.x) * (g.x - cur.x) + 1LL * (g.y - cur.y) * (g.y - cur.y);
+        if (d < seed_d) {
+          seed_d = d;
+          seed = li;
+        }
+      }
+      if (seed == n) break;
+      // walk the chain, keeping the heading where possible
+      chain.clear();
+      int lx = static_cast<int>(seed % static_cast<std::size_t>(ws.w));
+      int ly = static_cast<int>(seed / static_cast<std::size_t>(ws.w));
+      int hx = 0, hy = 0;
+      for (;;) {
+        const std::size_t li = ws.local(lx, ly);
+        used[li] = 1;
+        chain.push_back(ws.global(lx, ly));
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            if (ws.inside(lx + dx, ly + dy)) near[ws.local(lx + dx, ly + dy)] = 1;
+          }
+        }
+        int best_dx = 0, best_dy = 0;
+        double best_cost = std::numeric_limits<double>::infinity();
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            if ((dx == 0 && dy == 0) || !ws.inside(lx + dx, ly + dy)) continue;
+            const std::size_t k2 = ws.local(lx + dx, ly + dy);
+            if (boundary[k2] == 0 || used[k2] != 0) continue;
+            double cost = 0.0;
+            if (hx != 0 || hy != 0) {
+              const double dot = (dx * hx + dy * hy) / (std::hypot(dx, dy) * std::hypot(hx, hy));
+              cost = std::acos(std::clamp(dot, -1.0, 1.0));
+            }
+            if (dx != 0 && dy != 0) cost += 1e-3;  // on a tie, the side step
+            if (cost < best_cost) {
+              best_cost = cost;
+              best_dx = dx;
+              best_dy = dy;
+            }
+          }
+        }
+        if (!std::isfinite(best_cost) || best_cost > 2.0) break;  // dead end or a turn back
+        hx = best_dx;
+        hy = best_dy;
+        lx += best_dx;
+        ly += best_dy;
+      }
+      if (chain.size() < 3) continue;  // specks: the touch-up visits them if they matter
+      const CellIndex first = chain.front();
+      const CellIndex last = chain.back();
+      const bool closed = chain.size() > 4 && std::abs(first.x - last.x) <= 1 && std::abs(first.y - last.y) <= 1;
+      pts.clear();
+      for (const CellIndex& c : chain) pts.push_back(grid_.cell_center(c));
+      if (closed) pts.push_back(grid_.cell_center(first));
+      if (r.path.empty()) {
+        if (start) {
+          r.path.push_back(*start);
+          if (cur.x >= 0 && grid_.contains(cur) && planner_.traversable(cur)) link(r.path, cur, first);
+        }
+      } else {
+        link(r.path, cur, first);
+      }
+      std::size_t from = 0;
+      if (!r.path.empty() && std::hypot(r.path.back().x_m - pts.front().x_m, r.path.back().y_m - pts.front().y_m) < 1e-9) {
+        from = 1;
+      }
+      r.path.insert(r.path.end(), pts.begin() + static_cast<std::ptrdiff_t>(from), pts.end());
+      cur = closed ? first : last;
+      ++r.passes;
+    }
+    if (ridge) break;
+  }
+  finish(r, ws, cur);
+  return r;
+}
+
+CoverageResult CoveragePlanner::boustrophedon(const Section& section, std::optional<Point2D> start) {
+  CoverageResult r;
+  Workspace ws = prepare(section);
+  if (ws.stand_cells_global.empty()) {
+    finish(r, ws, {0, 0});
+    return r;
+  }
+  const bool rows = (section.max.x - section.min.x) >= (section.max.y - section.min.y);
+  const double spacing = std::max(grid_.resolution_m(), options_.cleaning_width_m - options_.overlap_m);
+  const int step = std::max(1, static_cast<int>(std::floor(spacing / grid_.resolution_m() + 1e-9)));
+  // lanes across the window: along rows (y fixed) or columns (x fixed)
+  const int lanes_extent = rows ? ws.h : ws.w;
+  const int along_extent = rows ? ws.w : ws.h;
+  const auto stand_at = [&](int lane, int a) {
+    return rows ? ws.stand[ws.local(a, lane)] != 0 : ws.stand[ws.local(lane, a)] != 0;
+  };
+  int lo = lanes_extent, hi = -1;
+  for (int l = 0; l < lanes_extent; ++l) {
+    for (int a = 0; a < along_extent; ++a) {
+      if (stand_at(l, a)) {
+        lo = std::min(lo, l);
+        hi = std::max(hi, l);
+        break;
+      }
+    }
+  }
+  std::vector<int> lanes;
+  for (int l = lo; l <= hi; l += step) lanes.push_back(l);
+  if (!lanes.empty() && lanes.back() != hi) lanes.push_back(hi);
+  struct Interval {
+    CellIndex a, b;
+    bool done = false;
+  };
+  std::vector<Interval> iv;
+  for (const int l : lanes) {
+    int a = 0;
+    while (a < along_extent) {
+      if (!stand_at(l, a)) {
+        ++a;
+        continue;
+      }
+      const int s = a;
+      while (a < along_extent && stand_at(l, a)) ++a;
+      const CellIndex ca = rows ? ws.global(s, l) : ws.global(l, s);
+      const CellIndex cb = rows ? ws.global(a - 1, l) : ws.global(l, a - 1);
+      iv.push_back({ca, cb, false});
+    }
+  }
+  CellIndex cur = iv.empty() ? CellIndex{0, 0} : iv.front().a;
+  if (start) {
+    const auto c = grid_.world_to_cell(*start);
+    if (c && planner_.traversable(*c)) {
+      cur = *c;
+      r.path.push_back(*start);
+    }
+  }
+  for (std::size_t done = 0; done < iv.size(); ++done) {
+    std::size_t best = iv.size();
+    bool flip = false;
+    long long best_d = std::numeric_limits<long long>::max();
+    for (std::size_t k = 0; k < iv.size(); ++k) {
+      if (iv[k].done) continue;
+      const auto d2 = [&](CellIndex c) { return 1LL * (c.x - cur.x) * (c.x - cur.x) + 1LL * (c.y - cur.y) * (c.y - cur.y); };
+      if (d2(iv[k].a) < best_d) {
+        best_d = d2(iv[k].a);
+        best = k;
+        flip = false;
+      }
+      if (d2(iv[k].b) < best_d) {
+        best_d = d2(iv[k].b);
+        best = k;
+        flip = true;
+      }
+    }
+    Interval& it = iv[best];
+    it.done = true;
+    const CellIndex from = flip ? it.b : it.a;
+    const CellIndex to = flip ? it.a : it.b;
+    if (r.path.empty()) r.path.push_back(grid_.cell_center(from));
+    else link(r.path, cur, from);
+    if (!(from == to)) r.path.push_back(grid_.cell_center(to));
+    cur = to;
+    ++r.passes;
+  }
+  finish(r, ws, cur);
+  return r;
+}
+
+}  // namespace tripodal::navi

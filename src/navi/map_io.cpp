@@ -1,0 +1,306 @@
+#include "tripodal/navi/map_io.hpp"
+
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "yaml_util.hpp"
+
+namespace tripodal::navi {
+
+namespace {
+
+using detail::as_double;
+using detail::kind_name;
+using detail::where;
+
+// ---------------------------------------------------------------- PGM
+
+class PgmParser {
+ public:
+  PgmParser(std::string_view bytes, const std::string& name) : b_(bytes), name_(name) {}
+
+  GrayImage parse() {
+    if (b_.size() < 2 || b_[0] != 'P' || (b_[1] != '5' && b_[1] != '2')) {
+      fail(0, "not a PGM image: expected the magic number P5 (binary) or P2 (ASCII)");
+    }
+    const bool ascii = b_[1] == '2';
+    pos_ = 2;
+    if (pos_ >= b_.size() || (std::isspace(static_cast<unsigned char>(b_[pos_])) == 0 && b_[pos_] != '#')) {
+      fail(pos_, "expected whitespace after the magic number");
+    }
+    GrayImage img;
+    img.width = header_int("width", 1, 1 << 20);
+    img.height = header_int("height", 1, 1 << 20);
+    img.maxval = header_int("maxval", 1, 65535);
+    const std::size_t n = static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height);
+    img.pixels.resize(n);
+    if (ascii) {
+      for (std::size_t i = 0; i < n; ++i) {
+        img.pixels[i] = static_cast<std::uint16_t>(
+            header_int("sample " + std::to_string(i) + " of " + std::to_string(n), 0, img.maxval));
+      }
+      return img;
+    }
+    // Exactly one whitespace byte separates maxval from the raster.
+    if (pos_ >= b_.size() || std::isspace(static_cast<unsigned char>(b_[pos_])) == 0) {
+      fail(pos_, "expected one whitespace byte after maxval, before the raster");
+    }
+    ++pos_;
+    const std::size_t bytes_per = img.maxval > 255 ? 2 : 1;
+    const std::size_t need = n * bytes_per;
+    if (b_.size() - pos_ < need) {
+      fail(b_.size(), "raster truncated: expected " + std::to_string(need) + " bytes for " +
+                          std::to_string(img.width) + " x " + std::to_string(img.height) + " samples, found " +
+                          std::to_string(b_.size() - pos_));
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t at = pos_ + i * bytes_per;
+      unsigned v = static_cast<unsigned char>(b_[at]);
+      if (bytes_per == 2) v = (v << 8U) | static_cast<unsigned char>(b_[at + 1]);
+      if (v > static_cast<unsigned>(img.maxval)) {
+        fail(at, "sample " + std::to_string(v) + " exceeds maxval " + std::to_string(img.maxval));
+      }
+      img.pixels[i] = static_cast<std::uint16_t>(v);
+    }
+    return img;
+  }
+
+ private:
+  [[noreturn]] void fail(std::size_t at, const std::string& what) const {
+    throw ConfigError(SourceLocation{name_, 0, 0}, "at byte " + std::to_string(at) + ": " + what);
+  }
+
+  // Skips whitespace and '#' comments (which run to the end of the line).
+  void skip_space() {
+    while (pos_ < b_.size()) {
+      const char c = b_[pos_];
+      if (c == '#') {
+        while (pos_ < b_.size() && b_[pos_] != '\n' && b_[pos_] != '\r') ++pos_;
+      } else if (std::isspace(static_cast<unsigned char>(c)) != 0) {
+        ++pos_;
+      } else {
+        break;
+      }
+    }
+  }
+
+  int header_int(const std::string& what, int lo, int hi) {
+    skip_space();
+    const std::size_t start = pos_;
+    long long v = 0;
+    while (pos_ < b_.size() && std::isdigit(static_cast<unsigned char>(b_[pos_])) != 0) {
+      v = v * 10 + (b_[pos_] - '0');
+      if (v > std::numeric_limits<int>::max()) fail(start, what + " is too large");
+      ++pos_;
+    }
+    if (pos_ == start) {
+      if (pos_ >= b_.size()) fail(pos_, "unexpected end of file: expected " + what);
+      fail(pos_, "expected " + what + " (a decimal number), found '" + std::string(1, b_[pos_]) + "'");
+    }
+    if (v < lo || v > hi) {
+      fail(start, what + " " + std::to_string(v) + " out of range: expected " + std::to_string(lo) + ".." +
+                      std::to_string(hi));
+    }
+    return static_cast<int>(v);
+  }
+
+  std::string_view b_;
+  const std::string& name_;
+  std::size_t pos_ = 0;
+};
+
+// ---------------------------------------------------------------- YAML
+
+const char* mode_name(MapMode m) {
+  switch (m) {
+    case MapMode::trinary: return "trinary";
+    case MapMode::scale: return "scale";
+    case MapMode::raw: return "raw";
+  }
+  return "trinary";
+}
+
+}  // namespace
+
+GrayImage parse_pgm(std::string_view bytes, const std::string& name) { return PgmParser(bytes, name).parse(); }
+
+GrayImage read_pgm(const std::filesystem::path& file) {
+  const std::string bytes = detail::read_text_file(file);
+  return parse_pgm(bytes, file.string());
+}
+
+void write_pgm(const std::filesystem::path& file, const GrayImage& image) {
+  std::ofstream out(file, std::ios::binary);
+  if (!out) throw std::runtime_error("cannot write " + file.string());
+  out << "P5\n" << image.width << ' ' << image.height << '\n' << image.maxval << '\n';
+  std::string raster;
+  const bool wide = image.maxval > 255;
+  raster.reserve(image.pixels.size() * (wide ? 2 : 1));
+  for (const std::uint16_t v : image.pixels) {
+    if (wide) raster.push_back(static_cast<char>(v >> 8U));
+    raster.push_back(static_cast<char>(v & 0xFFU));
+  }
+  out.write(raster.data(), static_cast<std::streamsize>(raster.size()));
+  if (!out) throw std::runtime_error("cannot write " + file.string());
+}
+
+MapMetadata parse_map_yaml(std::string_view text, const std::filesystem::path& file) {
+  const std::string name = file.string();
+  const YAML::Node root = detail::parse_yaml(text, name);
+  Diagnostics d;
+  MapMetadata m;
+  if (!root.IsMap()) {
+    d.error(where(name, root), "expected a map_server map description (a YAML map with image, resolution, origin, "
+                               "occupied_thresh, free_thresh), got " + kind_name(root));
+    throw ConfigError(d);
+  }
+  bool seen_image = false, seen_res = false, seen_origin = false, seen_occ = false, seen_free = false;
+  YAML::Node occ_node, free_node;
+  for (const auto& kv : root) {
+    const std::string key = kv.first.Scalar();
+    const YAML::Node& v = kv.second;
+    if (key == "image") {
+      seen_image = true;
+      if (!v.IsScalar() || v.Scalar().empty()) {
+        d.error(where(name, v), "'image' must be a file name, got " + kind_name(v));
+      } else {
+        m.image = v.Scalar();
+        m.image_path = m.image.is_absolute() ? m.image : file.parent_path() / m.image;
+      }
+    } else if (key == "resolution") {
+      seen_res = true;
+      if (auto r = as_double(v, name, "'resolution' (metres per cell)", d)) {
+        if (*r <= 0.0) d.error(where(name, v), "'resolution' must be positive (metres per cell), got " + v.Scalar());
+        else m.resolution_m = *r;
+      }
+    } else if (key == "origin") {
+      seen_origin = true;
+      if (!v.IsSequence() || v.size() != 3) {
+        d.error(where(name, v), "'origin' must be a list [x, y, yaw] of 3 numbers, got " + kind_name(v));
+      } else {
+        const auto x = as_double(v[0], name, "origin x", d);
+        const auto y = as_double(v[1], name, "origin y", d);
+        const auto yaw = as_double(v[2], name, "origin yaw", d);
+        if (x && y && yaw) m.origin = Pose2D{*x, *y, *yaw};
+      }
+    } else if (key == "occupied_thresh" || key == "free_thresh") {
+      const bool occ = key == "occupied_thresh";
+      (occ ? seen_occ : seen_free) = true;
+      (occ ? occ_node : free_node) = v;
+      if (auto t = as_double(v, name, "'" + key + "'", d)) {
+        if (*t < 0.0 || *t > 1.0) {
+          d.error(where(name, v), "'" + key + "' must be a probability in [0, 1], got " + v.Scalar());
+        } else {
+          (occ ? m.occupied_thresh : m.free_thresh) = *t;
+        }
+      }
+    } else if (key == "negate") {
+      const std::string s = v.IsScalar() ? v.Scalar() : std::string();
+      if (s == "0" || s == "false") m.negate = false;
+      else if (s == "1" || s == "true") m.negate = true;
+      else d.error(where(name, v), "'negate' must be 0 or 1 (or false/true), got " + kind_name(v));
+    } else if (key == "mode") {
+      const std::string s = v.IsScalar() ? v.Scalar() : std::string();
+      if (s == "trinary") m.mode = MapMode::trinary;
+      else if (s == "scale") m.mode = MapMode::scale;
+      else if (s == "raw") m.mode = MapMode::raw;
+      else d.error(where(name, v), "'mode' must be one of trinary, scale, raw; got " + kind_name(v));
+    } else {
+      d.error(where(name, kv.first), "unknown key '" + key +
+                                         "'; expected: image, resolution, origin, occupied_thresh, free_thresh, "
+                                         "negate, mode");
+    }
+  }
+  const auto missing = [&](bool seen, const char* key, const char* what) {
+    if (!seen) d.error(where(name, root), std::string("missing '") + key + "' (" + what + ")");
+  };
+  missing(seen_image, "image", "the PGM file, relative to this file");
+  missing(seen_res, "resolution", "metres per cell");
+  missing(seen_origin, "origin", "[x, y, yaw] of the lower-left pixel");
+  missing(seen_occ, "occupied_thresh", "e.g. 0.65");
+  missing(seen_free, "free_thresh", "e.g. 0.196");
+  if (seen_occ && seen_free && !d.has_errors() && !(m.free_thresh < m.occupied_thresh)) {
+    d.error(where(name, free_node), "'free_thresh' (" + free_node.Scalar() +
+                                         ") must be below 'occupied_thresh' (" + occ_node.Scalar() + ")");
+  }
+  if (d.has_errors()) throw ConfigError(d);
+  return m;
+}
+
+MapMetadata load_map_yaml(const std::filesystem::path& file) {
+  return parse_map_yaml(detail::read_text_file(file), file);
+}
+
+OccupancyGrid grid_from_image(const GrayImage& image, const MapMetadata& meta) {
+  OccupancyGrid grid(image.width, image.height, meta.resolution_m, meta.origin, Occupancy::unknown);
+  const double span = meta.occupied_thresh - meta.free_thresh;
+  for (int row = 0; row < image.height; ++row) {
+    for (int col = 0; col < image.width; ++col) {
+      const unsigned raw = image.at(col, row);
+      double v = image.maxval == 255 ? raw : std::round(raw * 255.0 / image.maxval);
+      if (meta.negate) v = 255.0 - v;
+      std::int8_t value = kUnknownValue;
+      if (meta.mode == MapMode::raw) {
+        value = v <= 100.0 ? static_cast<std::int8_t>(v) : kUnknownValue;
+      } else {
+        const double p = (255.0 - v) / 255.0;
+        if (p > meta.occupied_thresh) value = kOccupiedValue;
+        else if (p < meta.free_thresh) value = kFreeValue;
+        else if (meta.mode == MapMode::scale) value = static_cast<std::int8_t>(1.0 + 98.0 * (p - meta.free_thresh) / span);
+      }
+      grid.set_value({col, image.height - 1 - row}, value);
+    }
+  }
+  return grid;
+}
+
+MapFile load_map(const std::filesystem::path& yaml_file) {
+  MapFile out;
+  out.meta = load_map_yaml(yaml_file);
+  const GrayImage img = read_pgm(out.meta.image_path);
+  out.grid = grid_from_image(img, out.meta);
+  return out;
+}
+
+GrayImage image_from_grid(const OccupancyGrid& grid) {
+  GrayImage img;
+  img.width = grid.width();
+  img.height = grid.height();
+  img.maxval = 255;
+  img.pixels.resize(grid.size());
+  for (int y = 0; y < grid.height(); ++y) {
+    for (int x = 0; x < grid.width(); ++x) {
+      const std::int8_t v = grid.value({x, y});
+      std::uint16_t px = 205;
+      if (v == kFreeValue) px = 254;
+      else if (v == kOccupiedValue) px = 0;
+      else if (v > 0) px = static_cast<std::uint16_t>(std::lround(255.0 * (1.0 - v / 100.0)));
+      img.pixels[static_cast<std::size_t>(grid.height() - 1 - y) * static_cast<std::size_t>(img.width) +
+                 static_cast<std::size_t>(x)] = px;
+    }
+  }
+  return img;
+}
+
+void save_map(const OccupancyGrid& grid, const std::filesystem::path& yaml_file) {
+  std::filesystem::path pgm = yaml_file;
+  pgm.replace_extension(".pgm");
+  write_pgm(pgm, image_from_grid(grid));
+  std::ofstream out(yaml_file);
+  if (!out) throw std::runtime_error("cannot write " + yaml_file.string());
+  out.precision(17);
+  out << "image: " << pgm.filename().string() << '\n'
+      << "resolution: " << grid.resolution_m() << '\n'
+      << "origin: [" << grid.origin().x_m << ", " << grid.origin().y_m << ", " << grid.origin().theta_rad << "]\n"
+      << "negate: 0\n"
+      << "occupied_thresh: 0.65\n"
+      << "free_thresh: 0.196\n"
+      << "mode: " << mode_name(MapMode::trinary) << '\n';
+  if (!out) throw std::runtime_error("cannot write " + yaml_file.string());
+}
+
+}  // namespace tripodal::navi

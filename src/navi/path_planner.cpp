@@ -1,0 +1,224 @@
+#include "tripodal/navi/path_planner.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+#include <sstream>
+
+namespace tripodal::navi {
+
+const char* to_string(PlanStatus s) noexcept {
+  switch (s) {
+    case PlanStatus::ok: return "ok";
+    case PlanStatus::start_outside_map: return "start outside the map";
+    case PlanStatus::goal_outside_map: return "goal outside the map";
+    case PlanStatus::start_in_collision: return "start in collision";
+    case PlanStatus::goal_in_collision: return "goal in collision";
+    case PlanStatus::unreachable: return "goal unreachable";
+  }
+  return "?";
+}
+
+double polyline_length_m(const std::vector<Point2D>& points) noexcept {
+  double len = 0.0;
+  for (std::size_t i = 1; i < points.size(); ++i) {
+    len += std::hypot(points[i].x_m - points[i - 1].x_m, points[i].y_m - points[i - 1].y_m);
+  }
+  return len;
+}
+
+PathPlanner::PathPlanner(const OccupancyGrid& grid, PathPlannerOptions options)
+    : grid_(grid), options_(options), field_(grid, options.unknown_is_obstacle) {
+  traversable_.resize(grid_.size());
+  for (std::size_t i = 0; i < grid_.size(); ++i) {
+    traversable_[i] = field_.distance_m(i) > 0.0 && field_.clearance_m(i) >= options_.robot_radius_m ? 1 : 0;
+  }
+  g_.resize(grid_.size());
+  parent_.resize(grid_.size());
+  stamp_.assign(grid_.size(), 0);
+  closed_.resize(grid_.size());
+}
+
+bool PathPlanner::line_of_sight(CellIndex a, CellIndex b) const noexcept {
+  // Supercover walk: every cell the segment between the two centres passes through.
+  int x = a.x, y = a.y;
+  const int dx = std::abs(b.x - a.x), dy = std::abs(b.y - a.y);
+  const int sx = b.x > a.x ? 1 : -1, sy = b.y > a.y ? 1 : -1;
+  if (!traversable({x, y})) return false;
+  int ix = 0, iy = 0;
+  while (ix < dx || iy < dy) {
+    // compare (0.5 + ix) / dx with (0.5 + iy) / dy without division
+    const long long lhs = static_cast<long long>(1 + 2 * ix) * dy;
+    const long long rhs = static_cast<long long>(1 + 2 * iy) * dx;
+    if (lhs == rhs) {  // through a corner: both side cells must be free
+      if (!traversable({x + sx, y}) || !traversable({x, y + sy})) return false;
+      x += sx;
+      y += sy;
+      ++ix;
+      ++iy;
+    } else if (lhs < rhs) {
+      x += sx;
+      ++ix;
+    } else {
+      y += sy;
+      ++iy;
+    }
+    if (!traversable({x, y})) return false;
+  }
+  return true;
+}
+
+PlannedPath PathPlanner::plan(Point2D start, Point2D goal) {
+  PlannedPath out;
+  const auto s = grid_.world_to_cell(start);
+  const auto g = grid_.world_to_cell(goal);
+  std::ostringstream msg;
+  if (!s) {
+    out.status = PlanStatus::start_outside_map;
+    msg << "start (" << start.x_m << ", " << start.y_m << ") m is outside the map";
+    out.message = msg.str();
+    return out;
+  }
+  if (!g) {
+    out.status = PlanStatus::goal_outside_map;
+    msg << "goal (" << goal.x_m << ", " << goal.y_m << ") m is outside the map";
+    out.message = msg.str();
+    return out;
+  }
+  out = plan(*s, *g);
+  if (out.ok()) {
+    // Keep the exact end points rather than the cell centres.
+    out.waypoints.front() = start;
+    out.waypoints.back() = goal;
+    out.length_m = polyline_length_m(out.waypoints);
+  }
+  return out;
+}
+
+PlannedPath PathPlanner::plan(CellIndex start, CellIndex goal) {
+  PlannedPath out;
+  std::ostringstream msg;
+  const auto describe = [&](const char* what, CellIndex c) {
+    msg << what << " cell (" << c.x << ", " << c.y << ")";
+    if (grid_.contains(c)) {
+      msg << " has clearance " << field_.clearance_m(grid_.index(c)) << " m, the robot radius is "
+          << options_.robot_radius_m << " m";
+    } else {
+      msg << " is outside the " << grid_.width() << " x " << grid_.height() << " grid";
+    }
+  };
+  if (!grid_.contains(start)) {
+    out.status = PlanStatus::start_outside_map;
+    describe("start", start);
+  } else if (!grid_.contains(goal)) {
+    out.status = PlanStatus::goal_outside_map;
+    describe("goal", goal);
+  } else if (!traversable(start)) {
+    out.status = PlanStatus::start_in_collision;
+    describe("start", start);
+  } else if (!traversable(goal)) {
+    out.status = PlanStatus::goal_in_collision;
+    describe("goal", goal);
+  }
+  if (!msg.str().empty()) {
+    out.message = msg.str();
+    return out;
+  }
+
+  if (++search_id_ == 0) {  // wrapped: invalidate every stamp
+    std::fill(stamp_.begin(), stamp_.end(), 0);
+    search_id_ = 1;
+  }
+  constexpr float kSqrt2 = 1.41421356F;
+  const int w = grid_.width();
+  const auto octile = [&](int x, int y) {
+    const float dx = static_cast<float>(std::abs(x - goal.x));
+    const float dy = static_cast<float>(std::abs(y - goal.y));
+    return (dx > dy) ? dx + (kSqrt2 - 1.0F) * dy : dy + (kSqrt2 - 1.0F) * dx;
+  };
+  struct Node {
+    float f;
+    float h;
+    std::uint32_t i;
+  };
+  // Ties on f go to the node nearer the goal, which keeps A* from widening on open floors.
+  const auto worse = [](const Node& a, const Node& b) { return a.f > b.f || (a.f == b.f && a.h > b.h); };
+  std::vector<Node> heap_storage;
+  heap_storage.reserve(4096);
+  std::priority_queue<Node, std::vector<Node>, decltype(worse)> open(worse, std::move(heap_storage));
+  const auto si = static_cast<std::uint32_t>(grid_.index(start));
+  const auto gi = static_cast<std::uint32_t>(grid_.index(goal));
+  stamp_[si] = search_id_;
+  g_[si] = 0.0F;
+  closed_[si] = 0;
+  parent_[si] = si;
+  open.push({octile(start.x, start.y), octile(start.x, start.y), si});
+  static constexpr int kDx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
+  static constexpr int kDy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
+  bool found = false;
+  while (!open.empty()) {
+    const Node n = open.top();
+    open.pop();
+    if (closed_[n.i] != 0) continue;
+    closed_[n.i] = 1;
+    ++out.expanded;
+    if (n.i == gi) {
+      found = true;
+      break;
+    }
+    const int x = static_cast<int>(n.i % static_cast<std::uint32_t>(w));
+    const int y = static_cast<int>(n.i / static_cast<std::uint32_t>(w));
+    for (int k = 0; k < 8; ++k) {
+      const int nx = x + kDx[k], ny = y + kDy[k];
+      if (!traversable({nx, ny})) continue;
+      if (k >= 4 && (!traversable({nx, y}) || !traversable({x, ny}))) continue;  // no corner cutting
+      const auto ni = static_cast<std::uint32_t>(ny * w + nx);
+      const float ng = g_[n.i] + (k >= 4 ? kSqrt2 : 1.0F);
+      if (stamp_[ni] != search_id_) {
+        stamp_[ni] = search_id_;
+        closed_[ni] = 0;
+      } else if (closed_[ni] != 0 || ng >= g_[ni]) {
+        continue;
+      }
+      g_[ni] = ng;
+      parent_[ni] = n.i;
+      const float h = octile(nx, ny);
+      open.push({ng + h, h, ni});
+    }
+  }
+  if (!found) {
+    out.status = PlanStatus::unreachable;
+    msg << "no collision-free path from cell (" << start.x << ", " << start.y << ") to cell (" << goal.x << ", "
+        << goal.y << ") for a robot of radius " << options_.robot_radius_m << " m (" << out.expanded
+        << " cells reachable)";
+    out.message = msg.str();
+    return out;
+  }
+  for (std::uint32_t i = gi;; i = parent_[i]) {
+    out.cells.push_back(grid_.cell(i));
+    if (i == si) break;
+  }
+  std::reverse(out.cells.begin(), out.cells.end());
+
+  std::vector<CellIndex> kept;
+  if (options_.shortcut) {
+    std::size_t i = 0;
+    kept.push_back(out.cells[0]);
+    while (i + 1 < out.cells.size()) {
+      // extend the straight leg while the next path cell stays visible (string pulling)
+      std::size_t j = i + 1;
+      while (j + 1 < out.cells.size() && line_of_sight(out.cells[i], out.cells[j + 1])) ++j;
+      kept.push_back(out.cells[j]);
+      i = j;
+    }
+  } else {
+    kept = out.cells;
+  }
+  out.waypoints.reserve(kept.size());
+  for (const CellIndex& c : kept) out.waypoints.push_back(grid_.cell_center(c));
+  out.length_m = polyline_length_m(out.waypoints);
+  out.status = PlanStatus::ok;
+  return out;
+}
+
+}  // namespace tripodal::navi

@@ -1,0 +1,251 @@
+#include "tripodal/navi/section_splitter.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <map>
+
+namespace tripodal::navi {
+
+namespace {
+
+std::string section_name(int i) {
+  std::string s;
+  int n = i;
+  do {
+    s.insert(s.begin(), static_cast<char>('A' + n % 26));
+    n = n / 26 - 1;
+  } while (n >= 0);
+  return s;
+}
+
+}  // namespace
+
+const ModuleManifest& CSectionSplitter::static_manifest() {
+  static const ModuleManifest m = navi_manifest(
+      "CSectionSplitter", "divides a large workspace into sections at virtual walls between bands of isolated obstacles",
+      {"occupancy_grid", "map_from_base"}, {"section_set"},
+      {ParameterSpec{"min_obstacle_area_m2", ValueType::number, Value{0.01}, "m^2",
+                     "occupied components smaller than this are noise, not isolated obstacles", 0.0, std::nullopt},
+       ParameterSpec{"min_gap_m", ValueType::number, Value{1.5}, "m",
+                     "obstacle-free rows needed between two bands for a virtual wall", 0.0, std::nullopt},
+       ParameterSpec{"min_section_height_m", ValueType::number, Value{3.0}, "m",
+                     "a wall is kept only if the strips on both sides are at least this tall", 0.0, std::nullopt},
+       ParameterSpec{"min_section_area_m2", ValueType::number, Value{2.0}, "m^2",
+                     "smaller free components merge into a neighbour across a virtual wall", 0.0, std::nullopt}});
+  return m;
+}
+
+void CSectionSplitter::on_configure(const ParameterSet& params) {
+  options_.min_obstacle_area_m2 = params.number("min_obstacle_area_m2");
+  options_.min_gap_m = params.number("min_gap_m");
+  options_.min_section_height_m = params.number("min_section_height_m");
+  options_.min_section_area_m2 = params.number("min_section_area_m2");
+}
+
+SectionSet CSectionSplitter::split(const OccupancyGrid& grid) const {
+  SectionSet out;
+  const int w = grid.width(), h = grid.height();
+  const std::size_t n = grid.size();
+  out.label.assign(n, -1);
+  if (n == 0) return out;
+  const double cell_area = grid.resolution_m() * grid.resolution_m();
+
+  // 1. the outer wall: non-free cells reachable from the border through non-free cells
+  std::vector<std::uint8_t> wall(n, 0);
+  std::deque<std::size_t> queue;
+  const auto seed = [&](int x, int y) {
+    const std::size_t i = grid.index({x, y});
+    if (wall[i] == 0 && grid.state(i) != Occupancy::free) {
+      wall[i] = 1;
+      queue.push_back(i);
+    }
+  };
+  for (int x = 0; x < w; ++x) {
+    seed(x, 0);
+    seed(x, h - 1);
+  }
+  for (int y = 0; y < h; ++y) {
+    seed(0, y);
+    seed(w - 1, y);
+  }
+  while (!queue.empty()) {
+    const CellIndex c = grid.cell(queue.front());
+    queue.pop_front();
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const CellIndex nb{c.x + dx, c.y + dy};
+        if (grid.contains(nb)) seed(nb.x, nb.y);
+      }
+    }
+  }
+  // isolated obstacles: the remaining occupied components
+  std::vector<std::uint8_t> row_has(static_cast<std::size_t>(h), 0);
+  std::vector<std::uint8_t> seen(n, 0);
+  std::vector<std::size_t> comp;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (seen[i] != 0 || wall[i] != 0 || grid.state(i) != Occupancy::occupied) continue;
+    comp.clear();
+    seen[i] = 1;
+    queue.push_back(i);
+    while (!queue.empty()) {
+      const std::size_t j = queue.front();
+      queue.pop_front();
+      comp.push_back(j);
+      const CellIndex c = grid.cell(j);
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const CellIndex nb{c.x + dx, c.y + dy};
+          if (!grid.contains(nb)) continue;
+          const std::size_t k = grid.index(nb);
+          if (seen[k] == 0 && wall[k] == 0 && grid.state(k) == Occupancy::occupied) {
+            seen[k] = 1;
+            queue.push_back(k);
+          }
+        }
+      }
+    }
+    if (static_cast<double>(comp.size()) * cell_area < options_.min_obstacle_area_m2) continue;
+    ++out.isolated_obstacles;
+    for (const std::size_t j : comp) row_has[static_cast<std::size_t>(grid.cell(j).y)] = 1;
+  }
+  for (int y = 0; y < h; ++y) {
+    if (row_has[static_cast<std::size_t>(y)] != 0) out.obstacle_rows.push_back(y);
+  }
+
+  // 2. candidate walls in the middle of the gaps between obstacle bands
+  std::vector<int> candidates;
+  const int min_gap_rows = std::max(1, static_cast<int>(std::ceil(options_.min_gap_m / grid.resolution_m() - 1e-9)));
+  for (std::size_t k = 1; k < out.obstacle_rows.size(); ++k) {
+    const int prev = out.obstacle_rows[k - 1], next = out.obstacle_rows[k];
+    if (next - prev - 1 >= min_gap_rows) candidates.push_back((prev + next) / 2);  // wall between r and r+1
+  }
+  // 3. keep walls that leave tall enough strips; measure from the free rows actually present
+  int first_free = h, last_free = -1;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (grid.state(i) == Occupancy::free) {
+      first_free = std::min(first_free, grid.cell(i).y);
+      last_free = std::max(last_free, grid.cell(i).y);
+    }
+  }
+  const int min_rows = static_cast<int>(std::ceil(options_.min_section_height_m / grid.resolution_m()));
+  int last_kept = first_free - 1;  // the strip above a wall at r starts at r + 1
+  for (const int r : candidates) {
+    if (r - last_kept >= min_rows && last_free - r >= min_rows) {
+      out.virtual_wall_rows.push_back(r);
+      last_kept = r;
+    }
+  }
+  std::vector<std::uint8_t> cut_above(static_cast<std::size_t>(h), 0);
+  for (const int r : out.virtual_wall_rows) cut_above[static_cast<std::size_t>(r)] = 1;
+
+  // 4. free components, not crossing a virtual wall
+  std::vector<int> comp_of(n, -1);
+  std::vector<std::vector<std::size_t>> comps;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (comp_of[i] >= 0 || grid.state(i) != Occupancy::free) continue;
+    const int id = static_cast<int>(comps.size());
+    comps.emplace_back();
+    comp_of[i] = id;
+    queue.push_back(i);
+    while (!queue.empty()) {
+      const std::size_t j = queue.front();
+      queue.pop_front();
+      comps.back().push_back(j);
+      const CellIndex c = grid.cell(j);
+      const CellIndex nbs[4] = {{c.x + 1, c.y}, {c.x - 1, c.y}, {c.x, c.y + 1}, {c.x, c.y - 1}};
+      for (const CellIndex& nb : nbs) {
+        if (!grid.contains(nb)) continue;
+        if (nb.y > c.y && cut_above[static_cast<std::size_t>(c.y)] != 0) continue;
+        if (nb.y < c.y && cut_above[static_cast<std::size_t>(nb.y)] != 0) continue;
+        const std::size_t k = grid.index(nb);
+        if (comp_of[k] < 0 && grid.state(k) == Occupancy::free) {
+          comp_of[k] = id;
+          queue.push_back(k);
+        }
+      }
+    }
+  }
+  // merge small components into the neighbour across a wall with the longest shared border;
+  // smallest first so a chain of slivers ends in a large section
+  const std::size_t min_cells = static_cast<std::size_t>(std::ceil(options_.min_section_area_m2 / cell_area));
+  std::vector<int> parent(comps.size());
+  for (std::size_t k = 0; k < comps.size(); ++k) parent[k] = static_cast<int>(k);
+  const auto root = [&](int k) {
+    while (parent[static_cast<std::size_t>(k)] != k) k = parent[static_cast<std::size_t>(k)];
+    return k;
+  };
+  std::vector<std::size_t> size(comps.size());
+  for (std::size_t k = 0; k < comps.size(); ++k) size[k] = comps[k].size();
+  std::vector<std::size_t> order(comps.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return size[a] < size[b]; });
+  std::vector<std::uint8_t> dropped(comps.size(), 0);
+  for (const std::size_t k : order) {
+    const int rk = root(static_cast<int>(k));
+    if (size[static_cast<std::size_t>(rk)] >= min_cells) continue;
+    std::map<int, std::size_t> border;
+    for (const std::size_t j : comps[k]) {
+      const CellIndex c = grid.cell(j);
+      const CellIndex nbs[2] = {{c.x, c.y + 1}, {c.x, c.y - 1}};
+      for (const CellIndex& nb : nbs) {
+        if (!grid.contains(nb)) continue;
+        const int other = comp_of[grid.index(nb)];
+        if (other >= 0 && root(other) != rk) ++border[root(other)];
+      }
+    }
+    if (border.empty()) {
+      dropped[static_cast<std::size_t>(rk)] = 1;
+      continue;
+    }
+    const auto best = std::max_element(border.begin(), border.end(),
+                                       [](const auto& a, const auto& b) { return a.second < b.second; });
+    parent[static_cast<std::size_t>(rk)] = best->first;
+    size[static_cast<std::size_t>(best->first)] += size[static_cast<std::size_t>(rk)];
+  }
+  // sections in scan order: by their lowest cell index (row first)
+  std::map<int, int> section_of_root;
+  std::vector<std::pair<std::size_t, int>> firsts;  // (first cell, root)
+  for (std::size_t k = 0; k < comps.size(); ++k) {
+    const int r = root(static_cast<int>(k));
+    if (dropped[static_cast<std::size_t>(r)] != 0) continue;
+    firsts.emplace_back(comps[k].front(), r);
+  }
+  std::sort(firsts.begin(), firsts.end());
+  for (const auto& [first, r] : firsts) {
+    if (section_of_root.count(r) == 0) {
+      const int id = static_cast<int>(out.sections.size());
+      section_of_root[r] = id;
+      Section s;
+      s.id = id;
+      s.name = section_name(id);
+      out.sections.push_back(std::move(s));
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (comp_of[i] < 0) continue;
+    const int r = root(comp_of[i]);
+    const auto it = section_of_root.find(r);
+    if (it == section_of_root.end()) continue;
+    out.label[i] = it->second;
+    out.sections[static_cast<std::size_t>(it->second)].cells.push_back(i);
+  }
+  for (Section& s : out.sections) {
+    s.min = {w, h};
+    s.max = {-1, -1};
+    double sx = 0.0, sy = 0.0;
+    for (const std::size_t i : s.cells) {
+      const CellIndex c = grid.cell(i);
+      s.min = {std::min(s.min.x, c.x), std::min(s.min.y, c.y)};
+      s.max = {std::max(s.max.x, c.x), std::max(s.max.y, c.y)};
+      const Point2D p = grid.cell_center(c);
+      sx += p.x_m;
+      sy += p.y_m;
+    }
+    s.area_m2 = static_cast<double>(s.cells.size()) * cell_area;
+    if (!s.cells.empty()) s.centroid = {sx / static_cast<double>(s.cells.size()), sy / static_cast<double>(s.cells.size())};
+  }
+  return out;
+}
+
+}  // namespace tripodal::navi

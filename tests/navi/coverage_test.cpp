@@ -1,0 +1,157 @@
+#include "tripodal/navi/coverage.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <numbers>
+
+#include "navi_test_util.hpp"
+#include "tripodal/navi/map_io.hpp"
+
+using namespace tripodal;
+using namespace tripodal::navi;
+
+namespace {
+
+void put_block(OccupancyGrid& g, int x0, int y0, int x1, int y1) {
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) g.set_state({x, y}, Occupancy::occupied);
+  }
+}
+
+// Every path vertex is on a cell the robot may stand on (within the simplification tolerance).
+void check_path_clear(const CoverageResult& r, const OccupancyGrid& g, double robot_radius_m) {
+  const DistanceField f(g);
+  for (const Point2D& p : r.path) {
+    const auto c = g.world_to_cell(p);
+    REQUIRE(c.has_value());
+    CHECK(f.clearance_m(g.index(*c)) >= robot_radius_m - g.resolution_m());
+  }
+}
+
+}  // namespace
+
+TEST_CASE("CleanedCells: discs and swaths", "[navi][coverage]") {
+  const OccupancyGrid g(100, 100, 0.01, {}, Occupancy::free);
+  CleanedCells c(g);
+  c.mark_disc({0.5, 0.5}, 0.1);
+  // about pi r^2 / cell area = 314 cells
+  CHECK(static_cast<double>(c.count()) == Approx(std::numbers::pi * 100.0).epsilon(0.03));
+  CHECK(c.cleaned(CellIndex{50, 50}));
+  CHECK(c.cleaned(CellIndex{59, 50}));
+  CHECK_FALSE(c.cleaned(CellIndex{61, 50}));
+  c.clear();
+  CHECK(c.count() == 0);
+  c.mark_segment({0.2, 0.5}, {0.8, 0.5}, 0.05);
+  // a 0.6 x 0.1 rectangle plus two half discs
+  CHECK(static_cast<double>(c.count()) == Approx(600.0 + std::numbers::pi * 25.0).epsilon(0.05));
+  CHECK(c.cleaned(CellIndex{50, 54}));
+  CHECK_FALSE(c.cleaned(CellIndex{50, 56}));
+  // outside the grid and non-finite input: nothing, no crash
+  c.mark_disc({-5.0, -5.0}, 0.1);
+  c.mark_disc({std::nan(""), 0.0}, 0.1);
+  const std::vector<std::size_t> cells{g.index({50, 50}), g.index({0, 0})};
+  CHECK(c.coverage(cells) == Approx(0.5));
+  CHECK(c.coverage({}) == 1.0);
+}
+
+TEST_CASE("path_stats: length, turns over the threshold, total heading change", "[navi][coverage]") {
+  const std::vector<Point2D> square{{0, 0}, {1, 0}, {1, 1}, {0, 1}, {0, 0}};
+  const PathStats s = path_stats(square, 0.5);
+  CHECK(s.length_m == Approx(4.0));
+  CHECK(s.turns == 3);
+  CHECK(s.total_turn_rad == Approx(3 * std::numbers::pi / 2));
+  // gentle bends under the threshold are not turns; a repeated point is ignored
+  const std::vector<Point2D> bend{{0, 0}, {1, 0}, {1, 0}, {2, 0.2}, {3, 0.6}};
+  const PathStats b = path_stats(bend, 0.5);
+  CHECK(b.turns == 0);
+  CHECK(b.total_turn_rad > 0.3);
+  const std::vector<Point2D> uturn{{0, 0}, {1, 0}, {0, 0}};
+  CHECK(path_stats(uturn, 0.5).turns == 1);
+}
+
+TEST_CASE("Coverage: an empty room, balloon and boustrophedon both cover it", "[navi][coverage]") {
+  const OccupancyGrid g = test::room(82, 62, 0.05);  // 4 m x 3 m inside
+  const SectionSet sections = CSectionSplitter().split(g);
+  REQUIRE(sections.sections.size() == 1);
+  CoverageOptions o;
+  o.cleaning_width_m = 0.4;
+  CoveragePlanner cp(g, o);
+  const CoverageResult b = cp.balloon(sections.sections[0], Point2D{0.5, 0.5});
+  const CoverageResult p = cp.boustrophedon(sections.sections[0], Point2D{0.5, 0.5});
+  for (const CoverageResult* r : {&b, &p}) {
+    CHECK(r->coverage() >= 0.99);
+    CHECK(r->reachable_cells > 0);
+    CHECK(r->reachable_cells < sections.sections[0].cells.size());  // corners a disc cannot enter
+    CHECK(r->reachable_cells > sections.sections[0].cells.size() * 95 / 100);
+    check_path_clear(*r, g, 0.2);
+  }
+  // a 4 x 3 m room at 0.35 m spacing: rounds until the offsets meet in the middle
+  CHECK(b.rounds >= 4);
+  CHECK(b.rounds <= 5);
+  // the first pass is tangent to the walls: its vertices are 0.2 m from them
+  REQUIRE(b.path.size() > 2);
+  // plowing across 3 m (lanes along the 4 m side) needs about 3 / 0.35 lanes, two turns each
+  CHECK(p.passes >= 8);
+  CHECK(p.stats.turns >= 2 * (p.passes - 1) - 2);
+  INFO("balloon length " << b.stats.length_m << " turns " << b.stats.turns << "; plough length "
+                         << p.stats.length_m << " turns " << p.stats.turns);
+  // in a rectangle, every round of the spiral has 4 corners and every lane 2 ends: 2 D / spacing
+  // turns either way (D the short side); the balloon saves the lane ends' U-turn travel
+  CHECK(b.stats.turns <= p.stats.turns);
+  CHECK(b.stats.length_m < p.stats.length_m);
+}
+
+TEST_CASE("Coverage: a room with an isolated obstacle", "[navi][coverage]") {
+  OccupancyGrid g = test::room(102, 82, 0.05);
+  put_block(g, 40, 30, 60, 45);
+  const SectionSet sections = CSectionSplitter().split(g);
+  REQUIRE(sections.sections.size() == 1);
+  CoveragePlanner cp(g, {});
+  const CoverageResult b = cp.balloon(sections.sections[0]);
+  const CoverageResult p = cp.boustrophedon(sections.sections[0]);
+  CHECK(b.coverage() >= 0.99);
+  CHECK(p.coverage() >= 0.99);
+  check_path_clear(b, g, 0.2);
+  check_path_clear(p, g, 0.2);
+  // the obstacle's contour is a pass of its own in the first rounds
+  CHECK(b.passes > b.rounds);
+}
+
+TEST_CASE("Coverage: a bigger robot keeps its radius from walls; unreachable parts are not counted",
+          "[navi][coverage]") {
+  OccupancyGrid g = test::room(82, 62, 0.05);
+  // a closet behind a 0.3 m doorway: the robot (radius 0.3 m) cannot get in
+  put_block(g, 50, 1, 51, 60);
+  for (int y = 28; y < 34; ++y) g.set_state({50, y}, Occupancy::free), g.set_state({51, y}, Occupancy::free);
+  const SectionSet sections = CSectionSplitter().split(g);
+  REQUIRE(sections.sections.size() == 1);
+  CoverageOptions o;
+  o.cleaning_width_m = 0.4;
+  o.robot_radius_m = 0.3;
+  CoveragePlanner cp(g, o);
+  const CoverageResult b = cp.balloon(sections.sections[0]);
+  CHECK(b.coverage() >= 0.99);
+  // the closet right of x = 51 is not reachable: the reachable area is well below the section
+  CHECK(b.reachable_cells < sections.sections[0].cells.size() * 70 / 100);
+  check_path_clear(b, g, 0.3);
+  for (const Point2D& pt : b.path) CHECK(pt.x_m < 51 * 0.05);
+}
+
+TEST_CASE("Coverage: the four sections of the demo workspace at 0.4 m", "[navi][coverage][workspace]") {
+  const MapFile m = load_map(std::string(TRIPODAL_SOURCE_DIR) + "/configs/worlds/workspace_map.yaml");
+  const SectionSet sections = CSectionSplitter().split(m.grid);
+  REQUIRE(sections.sections.size() == 4);
+  CoveragePlanner cp(m.grid, {});
+  for (const Section& s : sections.sections) {
+    const CoverageResult b = cp.balloon(s);
+    const CoverageResult p = cp.boustrophedon(s);
+    INFO("section " << s.name << ": balloon cov " << b.coverage() << " len " << b.stats.length_m << " turns "
+                    << b.stats.turns << " touch-ups " << b.touch_ups << "; plough cov " << p.coverage() << " len "
+                    << p.stats.length_m << " turns " << p.stats.turns << " touch-ups " << p.touch_ups);
+    CHECK(b.coverage() >= 0.99);
+    CHECK(p.coverage() >= 0.99);
+    CHECK(b.reachable_cells == p.reachable_cells);
+    WARN("section " << s.name << ": balloon cov " << b.coverage() << " len " << b.stats.length_m << " turns " << b.stats.turns << " (" << b.stats.total_turn_rad << " rad) touch-ups " << b.touch_ups << " rounds " << b.rounds << " passes " << b.passes << "; plough cov " << p.coverage() << " len " << p.stats.length_m << " turns " << p.stats.turns << " (" << p.stats.total_turn_rad << " rad) touch-ups " << p.touch_ups << " passes " << p.passes);
+  }
+}

@@ -1,0 +1,136 @@
+#include "tripodal/navi/path_planner.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+#include "navi_test_util.hpp"
+#include "tripodal/navi/distance_field.hpp"
+#include "tripodal/navi/map_io.hpp"
+
+using namespace tripodal;
+using namespace tripodal::navi;
+
+namespace {
+
+void put_block(OccupancyGrid& g, int x0, int y0, int x1, int y1) {
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) g.set_state({x, y}, Occupancy::occupied);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("DistanceField: exact Euclidean distances against brute force", "[navi][planner]") {
+  std::mt19937 rng(42);
+  for (int trial = 0; trial < 20; ++trial) {
+    const int w = 5 + static_cast<int>(rng() % 20), h = 5 + static_cast<int>(rng() % 20);
+    OccupancyGrid g(w, h, 0.1, {}, Occupancy::free);
+    for (int k = 0; k < 6; ++k) g.set_state({static_cast<int>(rng() % static_cast<unsigned>(w)), static_cast<int>(rng() % static_cast<unsigned>(h))}, Occupancy::occupied);
+    g.set_state({static_cast<int>(rng() % static_cast<unsigned>(w)), 0}, Occupancy::unknown);
+    const DistanceField f(g);
+    const DistanceField known_only(g, false);
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        // the outside of the grid is an obstacle: nearest outside cell is one step past the border
+        double best = std::min({x + 1, y + 1, w - x, h - y}) * 1.0;
+        double best_known = best;
+        for (int yy = 0; yy < h; ++yy) {
+          for (int xx = 0; xx < w; ++xx) {
+            const double d = std::hypot(xx - x, yy - y);
+            if (g.state({xx, yy}) != Occupancy::free) best = std::min(best, d);
+            if (g.state({xx, yy}) == Occupancy::occupied) best_known = std::min(best_known, d);
+          }
+        }
+        REQUIRE(f.distance_m(g.index({x, y})) == Approx(best * 0.1).margin(1e-5));
+        REQUIRE(known_only.distance_m(g.index({x, y})) == Approx(best_known * 0.1).margin(1e-5));
+      }
+    }
+  }
+  // without the outside as obstacle and no obstacle at all: infinite
+  const DistanceField none(3, 3, 0.1, std::vector<bool>(9, false), false);
+  CHECK(std::isinf(none.distance_m(4)));
+  CHECK_THROWS_WITH(DistanceField(3, 3, 0.1, std::vector<bool>(8, false)), Catch::Contains("size does not match"));
+}
+
+TEST_CASE("PathPlanner: a straight line in an open room", "[navi][planner]") {
+  const OccupancyGrid g = test::room(100, 60, 0.05);
+  PathPlanner p(g, {.robot_radius_m = 0.2});
+  const PlannedPath r = p.plan(Point2D{0.5, 0.5}, Point2D{4.5, 2.5});
+  REQUIRE(r.ok());
+  CHECK(r.waypoints.size() == 2);
+  CHECK(r.length_m == Approx(std::hypot(4.0, 2.0)));
+  CHECK(r.waypoints.front() == Point2D{0.5, 0.5});
+  CHECK(r.waypoints.back() == Point2D{4.5, 2.5});
+  CHECK(r.cells.size() >= 80);
+}
+
+TEST_CASE("PathPlanner: around a wall with a gap, keeping the robot radius", "[navi][planner]") {
+  OccupancyGrid g = test::room(100, 100, 0.05);  // 5 x 5 m
+  put_block(g, 48, 1, 51, 80);                    // a wall from the bottom, gap above y = 4.05 m
+  PathPlanner p(g, {.robot_radius_m = 0.25});
+  const PlannedPath r = p.plan(Point2D{1.0, 1.0}, Point2D{4.0, 1.0});
+  REQUIRE(r.ok());
+  CHECK(r.length_m > 2.0 * std::hypot(1.5, 3.3));  // must go over the wall's end
+  CHECK(r.length_m < 9.0);
+  CHECK(r.waypoints.size() >= 3);
+  for (const CellIndex& c : r.cells) CHECK(p.traversable(c));
+  for (std::size_t i = 1; i < r.waypoints.size(); ++i) {
+    CHECK(p.line_of_sight(*g.world_to_cell(r.waypoints[i - 1]), *g.world_to_cell(r.waypoints[i])));
+  }
+  const DistanceField& f = p.distance_field();
+  for (const CellIndex& c : r.cells) CHECK(f.clearance_m(g.index(c)) >= 0.25);
+  // without shortcutting the cell path is kept, and is at least as long
+  PathPlanner raw(g, {.robot_radius_m = 0.25, .shortcut = false});
+  const PlannedPath q = raw.plan(Point2D{1.0, 1.0}, Point2D{4.0, 1.0});
+  REQUIRE(q.ok());
+  CHECK(q.waypoints.size() == q.cells.size());
+  CHECK(q.length_m >= r.length_m - 1e-9);
+  // A* is optimal on the 8-connected graph: the two plans have the same cell count
+  CHECK(q.cells.size() == r.cells.size());
+}
+
+TEST_CASE("PathPlanner: clear failures", "[navi][planner][errors]") {
+  OccupancyGrid g = test::room(100, 100, 0.05);
+  put_block(g, 48, 1, 51, 98);  // a full wall: two rooms
+  PathPlanner p(g, {.robot_radius_m = 0.25});
+  const PlannedPath unreachable = p.plan(Point2D{1.0, 1.0}, Point2D{4.0, 1.0});
+  CHECK(unreachable.status == PlanStatus::unreachable);
+  CHECK_THAT(unreachable.message, Catch::Contains("no collision-free path from cell (20, 20) to cell (80, 20)"));
+  CHECK_THAT(unreachable.message, Catch::Contains("radius 0.25 m"));
+  const PlannedPath start_hit = p.plan(Point2D{0.1, 1.0}, Point2D{1.0, 1.0});
+  CHECK(start_hit.status == PlanStatus::start_in_collision);
+  CHECK_THAT(start_hit.message, Catch::Contains("start cell (2, 20) has clearance 0.075 m, the robot radius is 0.25 m"));
+  const PlannedPath goal_hit = p.plan(Point2D{1.0, 1.0}, Point2D{2.45, 1.0});
+  CHECK(goal_hit.status == PlanStatus::goal_in_collision);
+  const PlannedPath out = p.plan(Point2D{-1.0, 1.0}, Point2D{1.0, 1.0});
+  CHECK(out.status == PlanStatus::start_outside_map);
+  CHECK_THAT(out.message, Catch::Contains("start (-1, 1) m is outside the map"));
+  CHECK(p.plan(Point2D{1.0, 1.0}, Point2D{1.0, 99.0}).status == PlanStatus::goal_outside_map);
+  CHECK(std::string(to_string(PlanStatus::goal_in_collision)) == "goal in collision");
+  // the planner is reusable after failures
+  CHECK(p.plan(Point2D{1.0, 1.0}, Point2D{1.5, 4.0}).ok());
+  // start == goal
+  const PlannedPath same = p.plan(Point2D{1.0, 1.0}, Point2D{1.0, 1.0});
+  REQUIRE(same.ok());
+  CHECK(same.length_m == 0.0);
+}
+
+TEST_CASE("PathPlanner: unknown cells block unless allowed", "[navi][planner]") {
+  OccupancyGrid g(60, 20, 0.1, {}, Occupancy::free);
+  for (int y = 0; y < 20; ++y) g.set_state({30, y}, Occupancy::unknown);
+  PathPlanner strict(g, {.robot_radius_m = 0.05});
+  CHECK(strict.plan(Point2D{1.0, 1.0}, Point2D{5.0, 1.0}).status == PlanStatus::unreachable);
+  PathPlanner lenient(g, {.robot_radius_m = 0.05, .unknown_is_obstacle = false});
+  CHECK(lenient.plan(Point2D{1.0, 1.0}, Point2D{5.0, 1.0}).ok());
+}
+
+TEST_CASE("PathPlanner: across the demo workspace", "[navi][planner][workspace]") {
+  const MapFile m = load_map(std::string(TRIPODAL_SOURCE_DIR) + "/configs/worlds/workspace_map.yaml");
+  PathPlanner p(m.grid, {.robot_radius_m = 0.3});
+  const PlannedPath r = p.plan(Point2D{0.8, 0.8}, Point2D{9.0, 31.0});
+  REQUIRE(r.ok());
+  CHECK(r.length_m >= std::hypot(8.2, 30.2));
+  CHECK(r.length_m < std::hypot(8.2, 30.2) * 1.15);
+}
