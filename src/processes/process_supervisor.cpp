@@ -297,7 +297,9 @@ void CProcessSupervisor::step() {
   for (std::size_t i = 0; i < n; ++i) {
     Run& run = *runs_[i];
     if (run.finished) continue;
-    std::vector<std::string> events;
+    // Module events were queued before this step; behavior status is read now, so it comes after.
+    std::vector<std::string> events = module_events;
+    std::vector<std::string> done_offered;
     // Behavior status becomes events of the run that holds the behavior, once per change.
     for (auto& a : run.active) {
       BehaviorReport rep;
@@ -318,8 +320,10 @@ void CProcessSupervisor::step() {
         }
       }
       if (rep.state == BehaviorState::succeeded && !a.done_posted) {
-        a.done_posted = true;
-        events.push_back(done_event(a.behavior));
+        // Level-triggered: offered every step until the net takes it, so a completion that
+        // arrives while the net cannot accept it (localization lost) is not lost.
+        done_offered.push_back(done_event(a.behavior));
+        events.push_back(done_offered.back());
       } else if (rep.state == BehaviorState::failed && !a.failure_posted) {
         a.failure_posted = true;
         const std::string reason = rep.reason.empty() ? std::string("no reason given") : rep.reason;
@@ -328,8 +332,13 @@ void CProcessSupervisor::step() {
         events.push_back(failed_event(a.behavior));
       }
     }
-    events.insert(events.end(), module_events.begin(), module_events.end());
     const std::vector<std::string> dropped = step_run(run, std::move(events), now);
+    for (const std::string& e : done_offered) {
+      if (std::find(dropped.begin(), dropped.end(), e) != dropped.end()) continue;
+      for (auto& a : run.active) {
+        if (done_event(a.behavior) == e) a.done_posted = true;
+      }
+    }
     for (const std::string& e : module_events) {
       if (std::find(dropped.begin(), dropped.end(), e) == dropped.end()) ++consumed[e];
     }
