@@ -1,0 +1,140 @@
+// CBehavior: the base of behaviors, the primitive actions of the reactive layer. The process
+// supervisor activates a behavior with typed parameters while a Petri-net place binding it is
+// marked; every sampling period the control loop steps it and hands its command to the behavior
+// coordinator. Its outcome becomes an event of the net: "<BehaviorName>.done" or
+// "<BehaviorName>.failed".
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "tripodal/core/manifest.hpp"
+#include "tripodal/core/time.hpp"
+#include "tripodal/resources/readings.hpp"
+#include "tripodal/resources/resource.hpp"
+
+namespace tripodal {
+
+/// Navigation data the sequencing layer (localizer, path planner) publishes for behaviors. The
+/// control loop holds one and behaviors read it through the context; `path` views storage owned
+/// by whoever set it (the loop copies into a fixed-capacity buffer, see CReactiveLoop).
+struct NavigationData {
+  Pose2D map_from_base;      ///< pose estimate in the map frame
+  Time pose_stamp{0};
+  bool localized = false;    ///< the localizer trusts map_from_base
+  bool has_goal = false;
+  Pose2D goal;               ///< current goal in the map frame
+  std::span<const Pose2D> path;  ///< planned path in the map frame (may be empty)
+};
+
+/// Per-axis velocity limits of the base in the body frame (all >= 0). A base that cannot move
+/// sideways (differential drive) has max_vy_m_s == 0: behaviors read this to steer by heading, so
+/// the same behavior code drives holonomic and differential bases.
+struct BaseCapabilities {
+  double max_vx_m_s = std::numeric_limits<double>::infinity();
+  double max_vy_m_s = std::numeric_limits<double>::infinity();
+  double max_wz_rad_s = std::numeric_limits<double>::infinity();
+  [[nodiscard]] bool holonomic() const noexcept { return max_vy_m_s > 0.0; }
+};
+
+/// A per-axis velocity envelope [lo, hi] a safety behavior imposes (see CBehaviorCoordinator's
+/// safety override). Unbounded by default.
+struct VelocityEnvelope {
+  static constexpr double kInf = std::numeric_limits<double>::infinity();
+  double vx_lo_m_s = -kInf, vx_hi_m_s = kInf;
+  double vy_lo_m_s = -kInf, vy_hi_m_s = kInf;
+  double wz_lo_rad_s = -kInf, wz_hi_rad_s = kInf;
+  friend bool operator==(const VelocityEnvelope&, const VelocityEnvelope&) = default;
+};
+
+/// What a behavior can see during activation and each step. Built by the control loop; holds
+/// references only, so building and passing it allocates nothing.
+struct BehaviorContext {
+  Time now{0};
+  Duration period{0};                 ///< nominal sampling period of the loop
+  const ResourceTable* resources = nullptr;
+  const NavigationData* navi = nullptr;
+  BaseCapabilities base;
+};
+
+enum class BehaviorStatus : std::uint8_t {
+  idle,       ///< not active
+  running,
+  succeeded,  ///< reported to the supervisor as "<BehaviorName>.done"
+  failed,     ///< reported as "<BehaviorName>.failed" with failure_reason()
+};
+[[nodiscard]] std::string_view to_string(BehaviorStatus status) noexcept;
+
+/// Names of the events a behavior's outcome posts to the process supervisor's net.
+[[nodiscard]] std::string done_event_name(std::string_view behavior_name);    // "<name>.done"
+[[nodiscard]] std::string failed_event_name(std::string_view behavior_name);  // "<name>.failed"
+
+/// Base of every behavior. Lifecycle: activate() (outside the loop: may allocate and throw) ->
+/// step() every period (noexcept, no allocation) until the status leaves running or the
+/// supervisor calls deactivate(). After success or failure step() returns nothing; the status
+/// stays until the next activate() or deactivate().
+class CBehavior {
+ public:
+  virtual ~CBehavior() = default;
+  CBehavior(const CBehavior&) = delete;
+  CBehavior& operator=(const CBehavior&) = delete;
+
+  /// The static manifest of the behavior type (name, inputs, outputs, parameters).
+  [[nodiscard]] const ModuleManifest& manifest() const noexcept { return do_manifest(); }
+  /// The registered type name, e.g. "BhGoToPose".
+  [[nodiscard]] std::string_view name() const noexcept { return manifest().name; }
+
+  /// Resolves `params` against the manifest (ConfigError listing every problem, located at
+  /// `where`), then calls on_activate(). Status becomes running unless on_activate() already
+  /// reported an outcome. May be called again to re-activate with new parameters.
+  void activate(const ParameterValues& params, const BehaviorContext& context,
+                const SourceLocation& where = {});
+  /// Activation with parameters already resolved.
+  void activate(const ParameterSet& params, const BehaviorContext& context);
+  /// Stops the behavior (status idle). Never throws.
+  void deactivate() noexcept;
+
+  /// One sampling period: the command of this period (body frame) or nothing (this behavior
+  /// does not want to drive now). Returns nothing unless running.
+  [[nodiscard]] std::optional<Twist2D> step(const BehaviorContext& context) noexcept;
+
+  [[nodiscard]] BehaviorStatus status() const noexcept { return status_; }
+  [[nodiscard]] bool running() const noexcept { return status_ == BehaviorStatus::running; }
+  /// Why the behavior failed ("" otherwise); text with static storage duration.
+  [[nodiscard]] std::string_view failure_reason() const noexcept { return failure_reason_; }
+  /// The envelope a safety behavior imposes this period, if any (set during step()).
+  [[nodiscard]] const std::optional<VelocityEnvelope>& envelope() const noexcept { return envelope_; }
+  /// Number of step() calls since the last activation.
+  [[nodiscard]] std::uint64_t steps() const noexcept { return steps_; }
+
+ protected:
+  CBehavior() = default;
+  virtual const ModuleManifest& do_manifest() const noexcept = 0;
+  /// Copies parameters into typed members and looks up resources (keep the pointers).
+  virtual void on_activate(const ParameterSet& params, const BehaviorContext& context) = 0;
+  /// The per-period computation. Must not throw or allocate.
+  virtual std::optional<Twist2D> on_step(const BehaviorContext& context) noexcept = 0;
+  virtual void on_deactivate() noexcept {}
+
+  /// Reports success (event "<name>.done"); later steps return nothing.
+  void succeed() noexcept { status_ = BehaviorStatus::succeeded; }
+  /// Reports failure with a reason that must have static storage duration (a string literal).
+  void fail(std::string_view static_reason) noexcept {
+    status_ = BehaviorStatus::failed;
+    failure_reason_ = static_reason;
+  }
+  /// Sets (or clears with nullopt) this period's safety envelope; cleared before every step.
+  void set_envelope(const std::optional<VelocityEnvelope>& envelope) noexcept { envelope_ = envelope; }
+
+ private:
+  BehaviorStatus status_ = BehaviorStatus::idle;
+  std::string_view failure_reason_;
+  std::optional<VelocityEnvelope> envelope_;
+  std::uint64_t steps_ = 0;
+};
+
+}  // namespace tripodal

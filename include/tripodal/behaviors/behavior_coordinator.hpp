@@ -1,0 +1,141 @@
+// CBehaviorCoordinator: a core component of the reactive layer. Every sampling period it fuses the
+// commands of the active behaviors into the one command the controller executes: priority
+// arbitration (as ROS twist_mux, with locks as dead-man switches) or weighted-sum fusion (motor
+// schemas), both under a safety override taking the most restrictive command.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tripodal/behaviors/behavior.hpp"
+#include "tripodal/core/time.hpp"
+#include "tripodal/resources/readings.hpp"
+
+namespace tripodal {
+
+enum class CoordinationMode : std::uint8_t {
+  priority,      ///< the live, unmasked input of highest priority wins alone
+  weighted_sum,  ///< live, unmasked inputs are averaged with their weights (motor schemas)
+};
+[[nodiscard]] std::string_view to_string(CoordinationMode mode) noexcept;
+
+enum class InputRole : std::uint8_t {
+  normal,  ///< takes part in arbitration or fusion
+  safety,  ///< never wins; restricts the fused command (see CBehaviorCoordinator)
+};
+
+struct CoordinatorInputConfig {
+  std::string name;        ///< usually the behavior's name, e.g. "BhGoToPose"
+  int priority = 0;        ///< higher wins (priority mode); compared with lock priorities
+  Duration timeout{0};     ///< a command older than this is ignored; 0 = never expires
+  double weight = 1.0;     ///< weighted_sum mode; >= 0
+  InputRole role = InputRole::normal;
+};
+
+/// A lock masks every input of priority <= its priority while engaged. A lock is engaged when
+/// its latest message said so, or (dead-man switch) when its timeout > 0 and no message arrived
+/// within the timeout, including before the first message.
+struct CoordinatorLockConfig {
+  std::string name;
+  int priority = 0;
+  Duration timeout{0};  ///< 0 = engaged only by an explicit message
+};
+
+struct CoordinatorConfig {
+  CoordinationMode mode = CoordinationMode::priority;
+  std::vector<CoordinatorInputConfig> inputs;
+  std::vector<CoordinatorLockConfig> locks;
+};
+
+using InputId = std::uint32_t;
+using LockId = std::uint32_t;
+
+/// What update() produced.
+struct CoordinatorOutput {
+  Time stamp{0};
+  Twist2D command;               ///< explicit zero when nothing is live
+  std::string_view winner;       ///< priority: winning input; weighted: "weighted_sum"; "" if none
+  std::optional<InputId> winner_id;
+  bool all_expired = false;      ///< no normal input was live and unmasked: command is zero
+  bool locked = false;           ///< at least one lock was engaged
+  std::string_view lock;         ///< the engaged lock of highest priority
+  bool safety_limited = false;   ///< a safety input changed the command
+  std::string_view limited_by;   ///< the first safety input that changed it
+  std::uint32_t live_inputs = 0; ///< normal inputs live and unmasked this update
+};
+
+/// Fuses behavior commands. Configuration (constructor, add_input, add_lock) happens outside the
+/// loop; submit(), withdraw(), set_lock() and update() are noexcept and allocate nothing.
+/// Not thread-safe: the control loop's thread calls everything after configuration.
+///
+/// Rules, applied by update(now):
+/// - An input is live when it has a command and (timeout == 0 or now - stamp <= timeout).
+/// - Locks mask inputs whose priority <= the lock's priority (twist_mux semantics).
+/// - priority mode: the live, unmasked normal input of highest priority wins; ties are broken by
+///   configuration order (the earlier input wins), so the result never depends on timing.
+/// - weighted_sum mode: sum(w_i * c_i) / sum(w_i) over live, unmasked normal inputs with w_i > 0;
+///   the winner reported is "weighted_sum" (winner_id the input of largest weight).
+/// - No live input: an explicit zero command, all_expired = true.
+/// - Safety override: every live safety input (masked by locks like the others) contributes an
+///   envelope (its behavior's VelocityEnvelope, or for a plain command c the envelope
+///   [min(0,c), max(0,c)] per axis). The envelopes are intersected (most restrictive) and the
+///   fused command is clamped into the intersection per axis; an empty intersection on an axis
+///   gives 0 on that axis.
+class CBehaviorCoordinator final {
+ public:
+  explicit CBehaviorCoordinator(CoordinatorConfig config = {});
+
+  /// Adds an input; throws std::invalid_argument for a duplicate name, negative weight or
+  /// negative timeout.
+  InputId add_input(CoordinatorInputConfig input);
+  LockId add_lock(CoordinatorLockConfig lock);
+  [[nodiscard]] std::optional<InputId> find_input(std::string_view name) const noexcept;
+  [[nodiscard]] std::optional<LockId> find_lock(std::string_view name) const noexcept;
+  [[nodiscard]] const CoordinatorInputConfig& input_config(InputId id) const noexcept;
+  [[nodiscard]] std::size_t input_count() const noexcept { return inputs_.size(); }
+  [[nodiscard]] CoordinationMode mode() const noexcept { return mode_; }
+  void set_mode(CoordinationMode mode) noexcept { mode_ = mode; }
+
+  /// A new command from input `id`, stamped `stamp`.
+  void submit(InputId id, const Twist2D& command, Time stamp) noexcept;
+  /// A new envelope from safety input `id` (replaces a plain command for this input).
+  void submit_envelope(InputId id, const VelocityEnvelope& envelope, Time stamp) noexcept;
+  /// Input `id` has nothing to say any more (its behavior returned nothing or stopped).
+  void withdraw(InputId id) noexcept;
+  /// A lock message: engaged or released, stamped `stamp` (refreshes the dead-man timer).
+  void set_lock(LockId id, bool engaged, Time stamp) noexcept;
+
+  /// Fuses at `now`; called once per sampling period (fixed rate) by the control loop.
+  const CoordinatorOutput& update(Time now) noexcept;
+  [[nodiscard]] const CoordinatorOutput& output() const noexcept { return output_; }
+
+  /// Forgets every submitted command and lock message (e.g. on loop restart).
+  void reset() noexcept;
+
+ private:
+  struct InputState {
+    CoordinatorInputConfig config;
+    bool has_command = false;
+    bool has_envelope = false;
+    Twist2D command;
+    VelocityEnvelope envelope;
+    Time stamp{0};
+  };
+  struct LockState {
+    CoordinatorLockConfig config;
+    bool has_message = false;
+    bool engaged = false;
+    Time stamp{0};
+  };
+
+  CoordinationMode mode_;
+  std::vector<InputState> inputs_;
+  std::vector<LockState> locks_;
+  CoordinatorOutput output_;
+};
+
+}  // namespace tripodal

@@ -1,0 +1,162 @@
+// CResource: the base of sensor drivers and fusion in the reactive layer. A resource holds the
+// latest timestamped reading of one kind; behaviors read it through the BehaviorContext and can
+// tell fresh data from stale data by the injected clock's time.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <string_view>
+#include <typeinfo>
+#include <utility>
+#include <vector>
+
+#include "tripodal/core/manifest.hpp"
+#include "tripodal/core/time.hpp"
+#include "tripodal/resources/readings.hpp"
+
+namespace tripodal {
+
+/// Base of every resource. Public non-virtual methods; drivers implement the protected hooks.
+/// Threading: a resource is read and written on its control loop's thread. A driver that
+/// receives data on another thread hands it over in on_poll() (called by the loop each cycle).
+class CResource {
+ public:
+  virtual ~CResource() = default;
+  CResource(const CResource&) = delete;
+  CResource& operator=(const CResource&) = delete;
+
+  /// The instance name ("laser", "odom"); behaviors look resources up by it.
+  [[nodiscard]] const std::string& name() const noexcept { return name_; }
+  /// The static manifest of the resource type.
+  [[nodiscard]] const ModuleManifest& manifest() const noexcept { return do_manifest(); }
+
+  /// Called by the control loop at the start of every cycle: lets a driver publish what it
+  /// received since the previous cycle. Never throws; must not allocate in steady state.
+  void poll(Time now) noexcept { on_poll(now); }
+
+  /// True once a reading has been published.
+  [[nodiscard]] bool has_reading() const noexcept { return has_reading_; }
+  /// Time stamp of the latest reading (the reading's own stamp).
+  [[nodiscard]] Time stamp() const noexcept { return stamp_; }
+  /// How old a reading may be and still count as fresh; 0 means it never goes stale.
+  [[nodiscard]] Duration max_age() const noexcept { return max_age_; }
+  void set_max_age(Duration max_age) noexcept { max_age_ = max_age; }
+  /// Fresh: a reading exists and now - stamp <= max_age (or max_age is 0). A reading stamped in
+  /// the future of `now` (clock skew between a driver and the loop) counts as fresh.
+  [[nodiscard]] bool is_fresh(Time now) const noexcept {
+    return has_reading_ && (max_age_.count() == 0 || now - stamp_ <= max_age_);
+  }
+  [[nodiscard]] bool is_stale(Time now) const noexcept { return !is_fresh(now); }
+  /// Number of readings published so far.
+  [[nodiscard]] std::size_t sequence() const noexcept { return sequence_; }
+
+  /// The type of the reading this resource holds (for typed lookups).
+  [[nodiscard]] virtual const std::type_info& reading_type() const noexcept = 0;
+
+ protected:
+  CResource(std::string name, Duration max_age) : name_(std::move(name)), max_age_(max_age) {}
+  virtual const ModuleManifest& do_manifest() const noexcept = 0;
+  /// Driver hook, default does nothing (data pushed by publish() from a simulator or replay).
+  virtual void on_poll(Time /*now*/) noexcept {}
+  /// Records that a reading stamped `stamp` was published.
+  void mark_published(Time stamp) noexcept {
+    stamp_ = stamp;
+    has_reading_ = true;
+    ++sequence_;
+  }
+
+ private:
+  std::string name_;
+  Duration max_age_;
+  Time stamp_{0};
+  bool has_reading_ = false;
+  std::size_t sequence_ = 0;
+};
+
+/// Static manifests of the generic typed resources, one per reading kind (type name and output
+/// information name): "OdometryResource"/"odometry", "LaserResource"/"laser_scan",
+/// "SonarResource"/"sonar", "InfraredResource"/"infrared", "BumperResource"/"bumpers",
+/// "BatteryResource"/"battery", "GyroResource"/"gyro".
+template <class Reading>
+const ModuleManifest& resource_manifest() noexcept;
+
+/// A resource holding the latest reading of type `Reading`, fed by a driver, the simulator or a
+/// trace replay through publish(). Publishing copies into storage kept from earlier readings, so
+/// readings of a steady size (a laser's beam count) allocate nothing after the first one.
+template <class Reading>
+class TypedResource : public CResource {
+ public:
+  explicit TypedResource(std::string name, Duration max_age = Duration{0})
+      : CResource(std::move(name), max_age) {}
+
+  /// Stores `reading` as the latest (copy-assigning: vector capacity is reused).
+  void publish(const Reading& reading) {
+    latest_ = reading;
+    mark_published(reading.stamp);
+  }
+  /// The latest reading; a default-constructed one before the first publish().
+  [[nodiscard]] const Reading& latest() const noexcept { return latest_; }
+  /// Writable access for a driver that fills the reading in place, followed by commit().
+  [[nodiscard]] Reading& edit() noexcept { return latest_; }
+  void commit() noexcept { mark_published(latest_.stamp); }
+
+  [[nodiscard]] const std::type_info& reading_type() const noexcept final { return typeid(Reading); }
+
+ protected:
+  const ModuleManifest& do_manifest() const noexcept override { return resource_manifest<Reading>(); }
+
+ private:
+  Reading latest_{};
+};
+
+using OdometryResource = TypedResource<OdometryReading>;
+using LaserResource = TypedResource<LaserScan>;
+using SonarResource = TypedResource<SonarReading>;
+using InfraredResource = TypedResource<InfraredReading>;
+using BumperResource = TypedResource<BumperReading>;
+using BatteryResource = TypedResource<BatteryReading>;
+using GyroResource = TypedResource<GyroReading>;
+
+template <> const ModuleManifest& resource_manifest<OdometryReading>() noexcept;
+template <> const ModuleManifest& resource_manifest<LaserScan>() noexcept;
+template <> const ModuleManifest& resource_manifest<SonarReading>() noexcept;
+template <> const ModuleManifest& resource_manifest<InfraredReading>() noexcept;
+template <> const ModuleManifest& resource_manifest<BumperReading>() noexcept;
+template <> const ModuleManifest& resource_manifest<BatteryReading>() noexcept;
+template <> const ModuleManifest& resource_manifest<GyroReading>() noexcept;
+
+/// The resources a control loop owns or references, looked up by name and reading type.
+/// Lookups are for activation time (behaviors keep the pointer); the table does not own.
+class ResourceTable {
+ public:
+  /// Adds `resource` (not owned; must outlive the table). Throws std::invalid_argument when a
+  /// resource of the same name is already present.
+  void add(CResource& resource);
+  [[nodiscard]] CResource* find(std::string_view name) const noexcept;
+  /// The resource named `name` holding `Reading`s; nullptr when absent or of another type.
+  template <class Reading>
+  [[nodiscard]] const TypedResource<Reading>* find(std::string_view name) const noexcept {
+    CResource* r = find(name);
+    if (r == nullptr || r->reading_type() != typeid(Reading)) return nullptr;
+    return static_cast<const TypedResource<Reading>*>(r);
+  }
+  /// The first resource (in order of addition) holding `Reading`s; nullptr when none.
+  template <class Reading>
+  [[nodiscard]] const TypedResource<Reading>* first() const noexcept {
+    for (CResource* r : resources_) {
+      if (r->reading_type() == typeid(Reading)) return static_cast<const TypedResource<Reading>*>(r);
+    }
+    return nullptr;
+  }
+  /// Polls every resource in order of addition.
+  void poll_all(Time now) noexcept {
+    for (CResource* r : resources_) r->poll(now);
+  }
+  [[nodiscard]] std::size_t size() const noexcept { return resources_.size(); }
+  [[nodiscard]] CResource& at(std::size_t i) const noexcept { return *resources_[i]; }
+
+ private:
+  std::vector<CResource*> resources_;
+};
+
+}  // namespace tripodal

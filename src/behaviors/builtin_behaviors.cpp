@@ -1,0 +1,437 @@
+#include "tripodal/behaviors/builtin_behaviors.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "tripodal/behaviors/behavior_registry.hpp"
+
+namespace tripodal {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+double wrap_angle(double a) noexcept {
+  a = std::fmod(a + kPi, 2.0 * kPi);
+  if (a < 0.0) a += 2.0 * kPi;
+  return a - kPi;
+}
+
+double clamp_abs(double v, double limit) noexcept { return std::clamp(v, -limit, limit); }
+
+ParameterSpec number(std::string name, double def, std::string unit, std::string description,
+                     std::optional<double> min = std::nullopt, std::optional<double> max = std::nullopt) {
+  return {std::move(name), ValueType::number, Value{def}, std::move(unit), std::move(description), min, max};
+}
+ParameterSpec text(std::string name, std::string def, std::string description) {
+  return {std::move(name), ValueType::string, Value{std::move(def)}, "", std::move(description), {}, {}};
+}
+ParameterSpec flag(std::string name, bool def, std::string description) {
+  return {std::move(name), ValueType::boolean, Value{def}, "", std::move(description), {}, {}};
+}
+
+ModuleManifest behavior_manifest(std::string name, std::string description, std::vector<std::string> inputs,
+                                 std::vector<ParameterSpec> parameters) {
+  ModuleManifest m;
+  m.name = std::move(name);
+  m.layer = Layer::reactive;
+  m.kind = ModuleKind::behavior;
+  m.description = std::move(description);
+  m.inputs = std::move(inputs);
+  m.outputs = {"behavior_command"};
+  m.parameters = std::move(parameters);
+  return m;
+}
+
+// The odometry resource named by the "odometry" parameter, or the first one when it is empty.
+const OdometryResource* find_odometry(const ParameterSet& params, const BehaviorContext& context) {
+  if (context.resources == nullptr) return nullptr;
+  const std::string& name = params.string("odometry");
+  return name.empty() ? context.resources->first<OdometryReading>()
+                      : context.resources->find<OdometryReading>(name);
+}
+
+// Tracks how long a resource has been stale; true once that exceeds `timeout`.
+bool stale_too_long(bool fresh, Time now, Duration timeout, bool& stale, Time& since) noexcept {
+  if (fresh) {
+    stale = false;
+    return false;
+  }
+  if (!stale) {
+    stale = true;
+    since = now;
+  }
+  return now - since > timeout;
+}
+
+// Body-frame translation toward a target at (dx, dy) in the body frame with speed `speed` (>= 0),
+// as the base can execute it: straight on a holonomic base; on a base without sideways motion,
+// forward only, scaled by cos(bearing) so the robot turns first and never drives away from the
+// target. `wz_toward` receives the yaw rate that points the robot at the target (unicycle only).
+Twist2D drive_toward(double dx, double dy, double speed, double k_alpha, double max_yaw_rate,
+                     const BaseCapabilities& base) noexcept {
+  Twist2D cmd;
+  const double rho = std::hypot(dx, dy);
+  if (rho <= 0.0) return cmd;
+  if (base.holonomic()) {
+    cmd.vx_m_s = clamp_abs(speed * dx / rho, base.max_vx_m_s);
+    cmd.vy_m_s = clamp_abs(speed * dy / rho, base.max_vy_m_s);
+  } else {
+    const double bearing = std::atan2(dy, dx);
+    cmd.vx_m_s = std::min(speed * std::max(0.0, std::cos(bearing)), base.max_vx_m_s);
+    cmd.wz_rad_s = clamp_abs(k_alpha * bearing, std::min(max_yaw_rate, base.max_wz_rad_s));
+  }
+  return cmd;
+}
+
+}  // namespace
+
+// --- BhStop ---------------------------------------------------------------------------------
+
+const ModuleManifest& BhStop::static_manifest() {
+  static const ModuleManifest m = behavior_manifest("BhStop", "commands zero velocity; never finishes", {}, {});
+  return m;
+}
+void BhStop::on_activate(const ParameterSet&, const BehaviorContext&) {}
+std::optional<Twist2D> BhStop::on_step(const BehaviorContext&) noexcept { return Twist2D{}; }
+
+// --- BhRotateInPlace ------------------------------------------------------------------------
+
+const ModuleManifest& BhRotateInPlace::static_manifest() {
+  static const ModuleManifest m = behavior_manifest(
+      "BhRotateInPlace", "turns on the spot by a relative angle measured by odometry", {"odometry"},
+      {number("angle_rad", 0.0, "rad", "relative turn, counter-clockwise positive", -100.0, 100.0),
+       number("max_yaw_rate_rad_s", 0.8, "rad/s", "yaw rate limit", 1e-6),
+       number("tolerance_rad", 0.02, "rad", "success when the remaining angle is below this", 1e-6),
+       number("gain", 2.0, "1/s", "proportional gain on the remaining angle", 1e-6),
+       number("stale_timeout_s", 0.5, "s", "fail when odometry stays stale longer than this", 0.0),
+       text("odometry", "", "odometry resource name; empty = the first one")});
+  return m;
+}
+
+void BhRotateInPlace::on_activate(const ParameterSet& params, const BehaviorContext& context) {
+  odom_ = find_odometry(params, context);
+  angle_rad_ = params.number("angle_rad");
+  max_rate_ = params.number("max_yaw_rate_rad_s");
+  tolerance_rad_ = params.number("tolerance_rad");
+  gain_ = params.number("gain");
+  stale_timeout_ = from_seconds(params.number("stale_timeout_s"));
+  started_ = false;
+  turned_rad_ = 0.0;
+  stale_ = false;
+  if (odom_ == nullptr) fail("no odometry resource");
+}
+
+std::optional<Twist2D> BhRotateInPlace::on_step(const BehaviorContext& context) noexcept {
+  const bool fresh = odom_->is_fresh(context.now);
+  if (stale_too_long(fresh, context.now, stale_timeout_, stale_, stale_since_)) {
+    fail("odometry stale");
+    return std::nullopt;
+  }
+  if (!fresh) return Twist2D{};
+  const double yaw = odom_->latest().pose.theta_rad;
+  if (!started_) {
+    started_ = true;
+    last_yaw_ = yaw;
+  }
+  // Accumulating wrapped increments counts full turns (angle_rad may exceed pi).
+  turned_rad_ += wrap_angle(yaw - last_yaw_);
+  last_yaw_ = yaw;
+  const double remaining = angle_rad_ - turned_rad_;
+  if (std::abs(remaining) <= tolerance_rad_) {
+    succeed();
+    return std::nullopt;
+  }
+  Twist2D cmd;
+  cmd.wz_rad_s = clamp_abs(gain_ * remaining, std::min(max_rate_, context.base.max_wz_rad_s));
+  return cmd;
+}
+
+// --- BhGoToPose -----------------------------------------------------------------------------
+
+const ModuleManifest& BhGoToPose::static_manifest() {
+  static const ModuleManifest m = behavior_manifest(
+      "BhGoToPose", "drives to a goal pose; holonomic and differential bases alike",
+      {"odometry", "map_from_base", "goal_pose"},
+      {number("goal_x_m", 0.0, "m", "goal x in the chosen frame"),
+       number("goal_y_m", 0.0, "m", "goal y in the chosen frame"),
+       number("goal_theta_rad", 0.0, "rad", "goal heading in the chosen frame"),
+       text("frame", "odom", "\"odom\" (odometry resource) or \"map\" (localizer pose)"),
+       flag("use_navigation_goal", false, "take the goal from the navigation data (map frame)"),
+       number("max_speed_m_s", 0.4, "m/s", "translation speed limit", 1e-6),
+       number("max_yaw_rate_rad_s", 1.0, "rad/s", "yaw rate limit", 1e-6),
+       number("position_tolerance_m", 0.03, "m", "position reached within this distance", 1e-6),
+       number("heading_tolerance_rad", 0.03, "rad", "heading reached within this angle", 1e-6),
+       number("k_rho", 1.0, "1/s", "speed per metre of remaining distance", 1e-6),
+       number("k_alpha", 2.5, "1/s", "yaw rate per radian of heading error", 1e-6),
+       number("timeout_s", 0.0, "s", "fail when the goal is not reached in this time; 0 = none", 0.0),
+       number("stale_timeout_s", 0.5, "s", "fail when the pose stays stale longer than this", 0.0),
+       text("odometry", "", "odometry resource name; empty = the first one")});
+  return m;
+}
+
+void BhGoToPose::on_activate(const ParameterSet& params, const BehaviorContext& context) {
+  const std::string& frame = params.string("frame");
+  if (frame != "odom" && frame != "map") {
+    throw ConfigError(SourceLocation{}, "BhGoToPose: parameter 'frame' must be \"odom\" or \"map\", got \"" + frame + "\"");
+  }
+  map_frame_ = frame == "map";
+  use_navi_goal_ = params.boolean("use_navigation_goal");
+  if (use_navi_goal_) map_frame_ = true;
+  goal_ = {params.number("goal_x_m"), params.number("goal_y_m"), params.number("goal_theta_rad")};
+  max_speed_ = params.number("max_speed_m_s");
+  max_yaw_rate_ = params.number("max_yaw_rate_rad_s");
+  pos_tol_ = params.number("position_tolerance_m");
+  heading_tol_ = params.number("heading_tolerance_rad");
+  k_rho_ = params.number("k_rho");
+  k_alpha_ = params.number("k_alpha");
+  timeout_ = from_seconds(params.number("timeout_s"));
+  stale_timeout_ = from_seconds(params.number("stale_timeout_s"));
+  started_ = context.now;
+  position_reached_ = false;
+  stale_ = false;
+  odom_ = map_frame_ ? nullptr : find_odometry(params, context);
+  if (!map_frame_ && odom_ == nullptr) fail("no odometry resource");
+}
+
+std::optional<Twist2D> BhGoToPose::on_step(const BehaviorContext& context) noexcept {
+  if (timeout_.count() > 0 && context.now - started_ > timeout_) {
+    fail("timeout");
+    return std::nullopt;
+  }
+  Pose2D pose;
+  Pose2D goal = goal_;
+  if (map_frame_) {
+    const bool ok = context.navi != nullptr && context.navi->localized;
+    if (stale_too_long(ok, context.now, stale_timeout_, stale_, stale_since_)) {
+      fail("not localized");
+      return std::nullopt;
+    }
+    if (!ok) return Twist2D{};
+    pose = context.navi->map_from_base;
+    if (use_navi_goal_) {
+      if (!context.navi->has_goal) return Twist2D{};
+      goal = context.navi->goal;
+    }
+  } else {
+    const bool fresh = odom_->is_fresh(context.now);
+    if (stale_too_long(fresh, context.now, stale_timeout_, stale_, stale_since_)) {
+      fail("odometry stale");
+      return std::nullopt;
+    }
+    if (!fresh) return Twist2D{};
+    pose = odom_->latest().pose;
+  }
+
+  // Goal in the body frame.
+  const double ex = goal.x_m - pose.x_m;
+  const double ey = goal.y_m - pose.y_m;
+  const double c = std::cos(pose.theta_rad);
+  const double s = std::sin(pose.theta_rad);
+  const double dx = c * ex + s * ey;
+  const double dy = -s * ex + c * ey;
+  const double rho = std::hypot(dx, dy);
+  const double heading_error = wrap_angle(goal.theta_rad - pose.theta_rad);
+  const double yaw_limit = std::min(max_yaw_rate_, context.base.max_wz_rad_s);
+
+  // Hysteresis: once the position is reached, only a clear drift resumes the approach, so the
+  // final turn of a differential base does not chase a bearing that is pure noise.
+  if (position_reached_ && rho > 2.0 * pos_tol_) position_reached_ = false;
+  if (!position_reached_ && rho <= pos_tol_) position_reached_ = true;
+
+  if (position_reached_) {
+    if (std::abs(heading_error) <= heading_tol_) {
+      succeed();
+      return std::nullopt;
+    }
+    Twist2D cmd;
+    cmd.wz_rad_s = clamp_abs(k_alpha_ * heading_error, yaw_limit);
+    return cmd;
+  }
+  const double speed = std::min(max_speed_, k_rho_ * rho);
+  Twist2D cmd = drive_toward(dx, dy, speed, k_alpha_, yaw_limit, context.base);
+  // A holonomic base turns to the final heading on the way.
+  if (context.base.holonomic()) cmd.wz_rad_s = clamp_abs(k_alpha_ * heading_error, yaw_limit);
+  return cmd;
+}
+
+// --- BhBackOff ------------------------------------------------------------------------------
+
+const ModuleManifest& BhBackOff::static_manifest() {
+  static const ModuleManifest m = behavior_manifest(
+      "BhBackOff", "backs straight off after a bump, then optionally turns", {"odometry"},
+      {number("distance_m", 0.2, "m", "distance to back off", 0.0, 10.0),
+       number("speed_m_s", 0.1, "m/s", "backing speed", 1e-6),
+       number("turn_rad", 0.0, "rad", "turn after backing off, counter-clockwise positive", -10.0, 10.0),
+       number("yaw_rate_rad_s", 0.5, "rad/s", "yaw rate of the turn", 1e-6),
+       number("stale_timeout_s", 0.5, "s", "fail when odometry stays stale longer than this", 0.0),
+       text("odometry", "", "odometry resource name; empty = the first one")});
+  return m;
+}
+
+void BhBackOff::on_activate(const ParameterSet& params, const BehaviorContext& context) {
+  odom_ = find_odometry(params, context);
+  distance_m_ = params.number("distance_m");
+  speed_ = params.number("speed_m_s");
+  turn_rad_ = params.number("turn_rad");
+  yaw_rate_ = params.number("yaw_rate_rad_s");
+  stale_timeout_ = from_seconds(params.number("stale_timeout_s"));
+  started_ = false;
+  turning_ = false;
+  turned_rad_ = 0.0;
+  stale_ = false;
+  if (odom_ == nullptr) fail("no odometry resource");
+}
+
+std::optional<Twist2D> BhBackOff::on_step(const BehaviorContext& context) noexcept {
+  const bool fresh = odom_->is_fresh(context.now);
+  if (stale_too_long(fresh, context.now, stale_timeout_, stale_, stale_since_)) {
+    fail("odometry stale");
+    return std::nullopt;
+  }
+  if (!fresh) return Twist2D{};
+  const Pose2D& pose = odom_->latest().pose;
+  if (!started_) {
+    started_ = true;
+    start_ = pose;
+    last_yaw_ = pose.theta_rad;
+  }
+  Twist2D cmd;
+  if (!turning_) {
+    const double travelled = std::hypot(pose.x_m - start_.x_m, pose.y_m - start_.y_m);
+    const double remaining = distance_m_ - travelled;
+    if (remaining > 0.005) {
+      // Slow down over the last few centimetres so the base does not overshoot by much.
+      cmd.vx_m_s = -std::min(speed_, std::max(0.02, 2.0 * remaining));
+      return cmd;
+    }
+    turning_ = true;
+    last_yaw_ = pose.theta_rad;
+  }
+  turned_rad_ += wrap_angle(pose.theta_rad - last_yaw_);
+  last_yaw_ = pose.theta_rad;
+  const double remaining = turn_rad_ - turned_rad_;
+  if (std::abs(remaining) <= 0.02) {
+    succeed();
+    return std::nullopt;
+  }
+  cmd.wz_rad_s = clamp_abs(2.0 * remaining, std::min(yaw_rate_, context.base.max_wz_rad_s));
+  return cmd;
+}
+
+// --- BhAvoidObstacle ------------------------------------------------------------------------
+
+namespace {
+constexpr std::size_t kMaxTableBeams = 4096;
+}
+
+const ModuleManifest& BhAvoidObstacle::static_manifest() {
+  static const ModuleManifest m = behavior_manifest(
+      "BhAvoidObstacle", "laser safety override: slows and stops translation toward obstacles", {"laser_scan"},
+      {number("stop_distance_m", 0.15, "m", "no motion toward an obstacle this close to the footprint", 0.0),
+       number("slow_distance_m", 0.8, "m", "full speed allowed beyond this clearance", 0.0),
+       number("max_speed_m_s", 1.0, "m/s", "speed allowed at slow_distance_m and beyond", 0.0),
+       number("robot_radius_m", 0.25, "m", "radius of the circular footprint", 0.0),
+       number("laser_x_m", 0.0, "m", "laser position in the body frame"),
+       number("laser_y_m", 0.0, "m", "laser position in the body frame"),
+       number("laser_yaw_rad", 0.0, "rad", "laser orientation in the body frame"),
+       text("laser", "", "laser resource name; empty = the first one")});
+  return m;
+}
+
+void BhAvoidObstacle::on_activate(const ParameterSet& params, const BehaviorContext& context) {
+  stop_m_ = params.number("stop_distance_m");
+  slow_m_ = params.number("slow_distance_m");
+  if (slow_m_ <= stop_m_) {
+    throw ConfigError(SourceLocation{}, "BhAvoidObstacle: slow_distance_m must be greater than stop_distance_m");
+  }
+  max_speed_ = params.number("max_speed_m_s");
+  radius_m_ = params.number("robot_radius_m");
+  laser_x_m_ = params.number("laser_x_m");
+  laser_y_m_ = params.number("laser_y_m");
+  laser_yaw_rad_ = params.number("laser_yaw_rad");
+  const std::string& name = params.string("laser");
+  laser_ = context.resources == nullptr ? nullptr
+           : name.empty()               ? context.resources->first<LaserScan>()
+                                        : context.resources->find<LaserScan>(name);
+  // Capacity reserved here so that step() never allocates, whatever the beam count.
+  cos_.clear();
+  sin_.clear();
+  cos_.reserve(kMaxTableBeams);
+  sin_.reserve(kMaxTableBeams);
+  if (laser_ == nullptr) fail("no laser resource");
+}
+
+void BhAvoidObstacle::rebuild_table(const LaserScan& scan) noexcept {
+  const std::size_t n = std::min(scan.ranges_m.size(), kMaxTableBeams);
+  cos_.resize(n);  // within the reserved capacity: no allocation
+  sin_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double a = laser_yaw_rad_ + scan.angle_min_rad + static_cast<double>(i) * scan.angle_increment_rad;
+    cos_[i] = std::cos(a);
+    sin_[i] = std::sin(a);
+  }
+  table_angle_min_ = scan.angle_min_rad;
+  table_increment_ = scan.angle_increment_rad;
+}
+
+std::optional<Twist2D> BhAvoidObstacle::on_step(const BehaviorContext& context) noexcept {
+  VelocityEnvelope env;
+  if (!laser_->is_fresh(context.now)) {
+    // Blind: no translation at all, rotation in place stays allowed.
+    env.vx_lo_m_s = env.vx_hi_m_s = env.vy_lo_m_s = env.vy_hi_m_s = 0.0;
+    set_envelope(env);
+    return std::nullopt;
+  }
+  const LaserScan& scan = laser_->latest();
+  if (cos_.size() != std::min(scan.ranges_m.size(), kMaxTableBeams) || table_angle_min_ != scan.angle_min_rad ||
+      table_increment_ != scan.angle_increment_rad) {
+    rebuild_table(scan);
+  }
+  // Clearance from the footprint along each body axis direction, over the beams whose return
+  // lies in the corridor the footprint sweeps when moving along that axis.
+  constexpr double kInf = VelocityEnvelope::kInf;
+  double front = kInf, back = kInf, left = kInf, right = kInf;
+  const double r = radius_m_;
+  const double rmin = scan.range_min_m, rmax = scan.range_max_m;
+  const std::size_t n = cos_.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const double range = scan.ranges_m[i];
+    if (!(range >= rmin && range <= rmax)) continue;  // also skips NaN
+    const double x = laser_x_m_ + range * cos_[i];
+    const double y = laser_y_m_ + range * sin_[i];
+    if (std::abs(y) <= r) {
+      if (x > 0.0) front = std::min(front, x - r);
+      else back = std::min(back, -x - r);
+    }
+    if (std::abs(x) <= r) {
+      if (y > 0.0) left = std::min(left, y - r);
+      else right = std::min(right, -y - r);
+    }
+  }
+  const double span = slow_m_ - stop_m_;
+  auto allowed = [&](double clearance) noexcept {
+    if (clearance == kInf) return kInf;
+    return max_speed_ * std::clamp((clearance - stop_m_) / span, 0.0, 1.0);
+  };
+  env.vx_hi_m_s = allowed(front);
+  env.vx_lo_m_s = -allowed(back);
+  env.vy_hi_m_s = allowed(left);
+  env.vy_lo_m_s = -allowed(right);
+  set_envelope(env);
+  return std::nullopt;
+}
+
+// --- registration ---------------------------------------------------------------------------
+
+void register_builtin_behaviors(BehaviorRegistry& registry) {
+  registry.add<BhStop>();
+  registry.add<BhRotateInPlace>();
+  registry.add<BhGoToPose>();
+  registry.add<BhBackOff>();
+  registry.add<BhAvoidObstacle>();
+}
+
+}  // namespace tripodal
