@@ -9,16 +9,6 @@
 
 namespace tripodal {
 
-std::string_view to_string(BehaviorState s) noexcept {
-  switch (s) {
-    case BehaviorState::idle: return "idle";
-    case BehaviorState::running: return "running";
-    case BehaviorState::succeeded: return "succeeded";
-    case BehaviorState::failed: return "failed";
-  }
-  return "?";
-}
-
 namespace {
 
 std::string seconds_text(Duration d) {
@@ -27,8 +17,8 @@ std::string seconds_text(Duration d) {
   return buf;
 }
 
-std::string done_event(std::string_view behavior) { return std::string(behavior) + ".done"; }
-std::string failed_event(std::string_view behavior) { return std::string(behavior) + ".failed"; }
+std::string done_event(std::string_view behavior) { return done_event_name(behavior); }
+std::string failed_event(std::string_view behavior) { return failed_event_name(behavior); }
 
 }  // namespace
 
@@ -306,25 +296,25 @@ void CProcessSupervisor::step() {
       try {
         rep = behaviors_.report(a.behavior);
       } catch (const std::exception& e) {
-        rep.state = BehaviorState::failed;
+        rep.state = BehaviorStatus::failed;
         rep.reason = std::string("status query threw: ") + e.what();
       } catch (...) {
-        rep.state = BehaviorState::failed;
+        rep.state = BehaviorStatus::failed;
         rep.reason = "status query threw an unknown exception";
       }
-      if (rep.state == BehaviorState::running && options_.behavior_watchdog > Duration{0} && rep.last_step) {
+      if (rep.state == BehaviorStatus::running && options_.behavior_watchdog > Duration{0} && rep.last_step) {
         const Time last = std::max(*rep.last_step, a.since);
         if (now - last > options_.behavior_watchdog) {
-          rep.state = BehaviorState::failed;
+          rep.state = BehaviorStatus::failed;
           rep.reason = "stopped answering (no step for " + seconds_text(now - last) + " s)";
         }
       }
-      if (rep.state == BehaviorState::succeeded && !a.done_posted) {
+      if (rep.state == BehaviorStatus::succeeded && !a.done_posted) {
         // Level-triggered: offered every step until the net takes it, so a completion that
         // arrives while the net cannot accept it (localization lost) is not lost.
         done_offered.push_back(done_event(a.behavior));
         events.push_back(done_offered.back());
-      } else if (rep.state == BehaviorState::failed && !a.failure_posted) {
+      } else if (rep.state == BehaviorStatus::failed && !a.failure_posted) {
         a.failure_posted = true;
         const std::string reason = rep.reason.empty() ? std::string("no reason given") : rep.reason;
         for (SupervisorObserver* o : observers_) o->on_fault(a.behavior, reason, now);

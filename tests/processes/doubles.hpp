@@ -31,7 +31,7 @@ class FakeBehaviors final : public BehaviorHost {
   struct State {
     bool active = false;
     Duration progress{0};
-    BehaviorState state = BehaviorState::idle;
+    BehaviorStatus state = BehaviorStatus::idle;
     ParameterValues params;
     Time last_step{0};
   };
@@ -46,12 +46,12 @@ class FakeBehaviors final : public BehaviorHost {
   /// One control period of `dt` ending at `now`.
   void advance(Time now, Duration dt) {
     for (auto& [name, s] : states) {
-      if (!s.active || s.state != BehaviorState::running) continue;
+      if (!s.active || s.state != BehaviorStatus::running) continue;
       const Spec& spec = specs.at(name);
       if (spec.silent) continue;
       s.last_step = now;
       if (!paused) s.progress += dt;
-      if (s.progress >= spec.work) s.state = spec.fail ? BehaviorState::failed : BehaviorState::succeeded;
+      if (s.progress >= spec.work) s.state = spec.fail ? BehaviorStatus::failed : BehaviorStatus::succeeded;
     }
   }
 
@@ -67,13 +67,13 @@ class FakeBehaviors final : public BehaviorHost {
     log.push_back(text + ")");
     if (spec.throw_on_activate) throw std::runtime_error("driver not ready");
     State& s = states[std::string(behavior)];
-    s = State{true, Duration{0}, BehaviorState::running, params, now};
+    s = State{true, Duration{0}, BehaviorStatus::running, params, now};
   }
   void deactivate(std::string_view behavior, Time now) override {
     log.push_back(stamp(now) + " deactivate " + std::string(behavior));
     State& s = states[std::string(behavior)];
     s.active = false;
-    s.state = BehaviorState::idle;
+    s.state = BehaviorStatus::idle;
   }
   [[nodiscard]] BehaviorReport report(std::string_view behavior) const override {
     if (specs.at(std::string(behavior)).throw_on_report) throw std::runtime_error("status register unreadable");
@@ -81,7 +81,7 @@ class FakeBehaviors final : public BehaviorHost {
     if (it == states.end()) return {};
     BehaviorReport r;
     r.state = it->second.state;
-    if (r.state == BehaviorState::failed) r.reason = specs.at(std::string(behavior)).reason;
+    if (r.state == BehaviorStatus::failed) r.reason = specs.at(std::string(behavior)).reason;
     r.last_step = it->second.last_step;
     return r;
   }

@@ -8,18 +8,15 @@
 #include <string>
 #include <string_view>
 
+#include "tripodal/behaviors/behavior.hpp"
 #include "tripodal/core/engine.hpp"
 #include "tripodal/core/time.hpp"
 
 namespace tripodal {
 
-enum class BehaviorState { idle, running, succeeded, failed };
-
-[[nodiscard]] std::string_view to_string(BehaviorState s) noexcept;
-
 /// A behavior's status as of its last period.
 struct BehaviorReport {
-  BehaviorState state = BehaviorState::idle;
+  BehaviorStatus state = BehaviorStatus::idle;
   std::string reason;             ///< why it failed
   std::optional<Time> last_step;  ///< when the control loop last stepped it; nullopt: not tracked
 };
