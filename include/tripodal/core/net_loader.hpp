@@ -41,4 +41,13 @@ PetriNet load_net_or_throw(const std::filesystem::path& file, const LoadOptions&
 /// ConfigError when the net cannot be represented in the target format.
 void save_net(const PetriNet& net, const std::filesystem::path& file);
 
+/// The text save_net writes: NetFormat::pnml gives PNML (ISO 2009 P/T net), anything else the
+/// native XML format. Throws ConfigError when the net cannot be represented.
+[[nodiscard]] std::string net_to_string(const PetriNet& net, NetFormat format);
+
+/// The structural warnings load_net adds (when LoadOptions::structural_warnings): places that no
+/// transition can ever mark and transitions that can never be enabled, ignoring guards,
+/// inhibitors and capacities (so a warning is certain, silence is not a proof).
+void structural_warnings(const PetriNet& net, Diagnostics& diagnostics);
+
 }  // namespace tripodal

@@ -1,0 +1,444 @@
+#include "net_reader.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <limits>
+#include <set>
+
+namespace tripodal::detail {
+
+namespace {
+
+std::string join_names(const std::vector<VariableDecl>& decls) {
+  std::string out;
+  for (const auto& d : decls) {
+    if (!out.empty()) out += ", ";
+    out += d.name;
+  }
+  return out.empty() ? std::string("none") : out;
+}
+
+std::string declared_list(const PetriNet& net) {
+  return "declared parameters: " + join_names(net.parameters) + "; facts: " + join_names(net.facts);
+}
+
+bool is_ident_char(char c) noexcept {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '.';
+}
+
+// Offset of the first whole-word occurrence of `word` in `text` outside string literals.
+std::size_t find_identifier(std::string_view text, std::string_view word) {
+  char quote = 0;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (quote != 0) {
+      if (c == quote) quote = 0;
+      continue;
+    }
+    if (c == '\'' || c == '"') {
+      quote = c;
+      continue;
+    }
+    if (text.substr(i, word.size()) == word && (i == 0 || !is_ident_char(text[i - 1])) &&
+        (i + word.size() >= text.size() || !is_ident_char(text[i + word.size()]))) {
+      return i;
+    }
+  }
+  return 0;
+}
+
+std::string type_name(ValueType t) { return std::string(to_string(t)); }
+
+void read_guard(const ReadContext& ctx, const tinyxml2::XMLElement* e, Transition& t, const PetriNet& net,
+                const std::string& text) {
+  try {
+    Guard g = Guard::parse(text);
+    bool ok = true;
+    const auto& ids = g.identifiers();
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+      const VariableDecl* decl = net.find_parameter(ids[i]);
+      if (decl == nullptr) decl = net.find_fact(ids[i]);
+      const auto at = find_identifier(text, ids[i]);
+      if (decl == nullptr) {
+        ctx.error_at_value(e, "guard", "unknown parameter '" + ids[i] + "' in guard of transition '" + t.id + "' (" +
+                                           declared_list(net) + ")",
+                           at);
+        ok = false;
+        continue;
+      }
+      const auto expected = g.expected_type(i);
+      if (expected && *expected != decl->type) {
+        ctx.error_at_value(e, "guard", "guard of transition '" + t.id + "' uses '" + ids[i] + "' as a " +
+                                           type_name(*expected) + ", but it is declared " + type_name(decl->type),
+                           at);
+        ok = false;
+      }
+    }
+    if (ok) t.guard = std::move(g);
+  } catch (const GuardSyntaxError& err) {
+    ctx.error_at_value(e, "guard", std::string("guard of transition '") + t.id + "' does not parse: " + err.what(),
+                       static_cast<std::size_t>(std::max(1, err.column()) - 1));
+  }
+}
+
+void read_binding_params(const ReadContext& ctx, const tinyxml2::XMLElement* e, std::vector<BindingParam>& params,
+                         const PetriNet& net, std::string_view owner) {
+  std::set<std::string, std::less<>> seen;
+  for (const auto* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
+    if (std::string_view(c->Name()) != "param") {
+      unknown_element(ctx, c, e->Name(), "param");
+      continue;
+    }
+    check_attributes(ctx, c, {"name", "value"});
+    check_no_text(ctx, c);
+    auto name = required(ctx, c, "name");
+    auto value = optional_attr(c, "value");
+    if (!value) {
+      ctx.error(c, "missing attribute 'value' on <param>");
+    }
+    if (!name || !value) continue;
+    if (!seen.insert(*name).second) {
+      ctx.error_at_value(c, "name", "duplicate parameter '" + *name + "' for " + std::string(owner));
+      continue;
+    }
+    if (!value->empty() && (*value)[0] == '$') {
+      const std::string ref = value->substr(1);
+      if (net.find_parameter(ref) == nullptr) {
+        ctx.error_at_value(c, "value", "unknown parameter '$" + ref + "' passed to " + std::string(owner) +
+                                           " (declared parameters: " + join_names(net.parameters) + ")");
+        continue;
+      }
+    }
+    params.push_back(BindingParam{*name, *value, ctx.loc.element(c)});
+  }
+}
+
+}  // namespace
+
+void ReadContext::error(const tinyxml2::XMLElement* e, const std::string& message) const {
+  diags.error(loc.element(e), message);
+}
+void ReadContext::error_at_attribute(const tinyxml2::XMLElement* e, std::string_view attr,
+                                     const std::string& message) const {
+  diags.error(loc.attribute(e, attr), message);
+}
+void ReadContext::error_at_value(const tinyxml2::XMLElement* e, std::string_view attr, const std::string& message,
+                                 std::size_t decoded_offset) const {
+  diags.error(loc.attribute_value(e, attr, decoded_offset), message);
+}
+
+void check_attributes(const ReadContext& ctx, const tinyxml2::XMLElement* e,
+                      std::initializer_list<std::string_view> allowed) {
+  for (const auto* a = e->FirstAttribute(); a != nullptr; a = a->Next()) {
+    const std::string_view name = a->Name();
+    if (std::find(allowed.begin(), allowed.end(), name) != allowed.end()) continue;
+    std::string list;
+    for (const auto& s : allowed) {
+      if (!list.empty()) list += ", ";
+      list += s;
+    }
+    ctx.error_at_attribute(e, name,
+                           "unknown attribute '" + std::string(name) + "' on <" + e->Name() + ">; expected one of: " + list);
+  }
+}
+
+void unknown_element(const ReadContext& ctx, const tinyxml2::XMLElement* e, std::string_view parent,
+                     std::string_view expected) {
+  ctx.error(e, "unknown element <" + std::string(e->Name()) + "> in <" + std::string(parent) +
+                   ">; expected " + (expected.empty() ? std::string("no child elements") : "one of: " + std::string(expected)));
+}
+
+void check_no_text(const ReadContext& ctx, const tinyxml2::XMLElement* e) {
+  if (!trimmed_text(e).empty()) {
+    ctx.error(e, "unexpected text in <" + std::string(e->Name()) + ">; values are written as attributes");
+  }
+}
+
+std::string trimmed_text(const tinyxml2::XMLElement* e) {
+  std::string out;
+  for (const auto* n = e->FirstChild(); n != nullptr; n = n->NextSibling()) {
+    if (const auto* t = n->ToText()) out += t->Value();
+  }
+  const auto first = out.find_first_not_of(" \t\r\n");
+  if (first == std::string::npos) return {};
+  const auto last = out.find_last_not_of(" \t\r\n");
+  return out.substr(first, last - first + 1);
+}
+
+std::optional<std::string> optional_attr(const tinyxml2::XMLElement* e, std::string_view attr) {
+  const char* v = e->Attribute(std::string(attr).c_str());
+  if (v == nullptr) return std::nullopt;
+  return std::string(v);
+}
+
+std::optional<std::string> required(const ReadContext& ctx, const tinyxml2::XMLElement* e, std::string_view attr) {
+  auto v = optional_attr(e, attr);
+  if (!v) {
+    ctx.error(e, "missing attribute '" + std::string(attr) + "' on <" + e->Name() + ">");
+    return std::nullopt;
+  }
+  if (v->empty()) {
+    ctx.error_at_attribute(e, attr, "empty attribute '" + std::string(attr) + "' on <" + e->Name() + ">");
+    return std::nullopt;
+  }
+  return v;
+}
+
+std::optional<Tokens> parse_count(const ReadContext& ctx, const SourceLocation& where, std::string_view text,
+                                  Tokens minimum, std::string_view what) {
+  std::uint64_t v = 0;
+  const bool digits = !text.empty() && std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  const bool ok = digits && ec == std::errc() && ptr == text.data() + text.size() &&
+                  v <= std::numeric_limits<Tokens>::max() && v >= minimum;
+  if (!ok) {
+    const std::string expected = minimum == 0 ? "a whole number >= 0" : "a whole number >= " + std::to_string(minimum);
+    const bool non_positive = minimum > 0 && (text == "0" || (!text.empty() && text[0] == '-'));
+    ctx.diags.error(where, std::string(non_positive ? "non-positive " : "bad ") + std::string(what) + " '" +
+                               std::string(text) + "': expected " + expected);
+    return std::nullopt;
+  }
+  return static_cast<Tokens>(v);
+}
+
+std::optional<Duration> parse_delay_text(std::string_view text, std::string& error) {
+  std::size_t i = 0;
+  while (i < text.size() && ((text[i] >= '0' && text[i] <= '9') || text[i] == '.' || text[i] == '-' || text[i] == '+')) ++i;
+  const std::string_view number = text.substr(0, i);
+  std::string_view unit = text.substr(i);
+  while (!unit.empty() && unit.front() == ' ') unit.remove_prefix(1);
+  double v = 0.0;
+  const auto [ptr, ec] = std::from_chars(number.data(), number.data() + number.size(), v);
+  if (number.empty() || ec != std::errc() || ptr != number.data() + number.size() || !std::isfinite(v)) {
+    error = "bad delay '" + std::string(text) + "': expected a number and a unit, e.g. '2s' or '500ms'";
+    return std::nullopt;
+  }
+  if (v < 0.0 || number.front() == '-') {
+    error = "negative delay '" + std::string(text) + "': a delay is a duration >= 0";
+    return std::nullopt;
+  }
+  double scale = 0.0;
+  if (unit == "ns") scale = 1e-9;
+  else if (unit == "us") scale = 1e-6;
+  else if (unit == "ms") scale = 1e-3;
+  else if (unit == "s") scale = 1.0;
+  else if (unit == "min") scale = 60.0;
+  else if (unit == "h") scale = 3600.0;
+  if (scale == 0.0) {
+    error = unit.empty() ? "delay '" + std::string(text) + "' has no unit: write e.g. '" + std::string(number) +
+                               "s' or '" + std::string(number) + "ms' (units: ns, us, ms, s, min, h)"
+                         : "unknown unit '" + std::string(unit) + "' in delay '" + std::string(text) +
+                               "': expected ns, us, ms, s, min or h";
+    return std::nullopt;
+  }
+  const double seconds = v * scale;
+  if (seconds > 1e9) {
+    error = "delay '" + std::string(text) + "' is too long (more than 1e9 s)";
+    return std::nullopt;
+  }
+  return from_seconds(seconds);
+}
+
+bool is_valid_name(std::string_view name) noexcept {
+  if (name.empty()) return false;
+  const auto letter = [](char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_'; };
+  if (!letter(name[0])) return false;
+  return std::all_of(name.begin(), name.end(), [&](char c) {
+    return letter(c) || (c >= '0' && c <= '9') || c == '.' || c == '-' || c == '/';
+  });
+}
+
+void read_declaration(const ReadContext& ctx, const tinyxml2::XMLElement* e, PetriNet& net, bool fact) {
+  check_attributes(ctx, e, {"name", "type", "default", "description"});
+  check_no_text(ctx, e);
+  for (const auto* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
+    unknown_element(ctx, c, e->Name(), "");
+  }
+  const auto name = required(ctx, e, "name");
+  const auto type_text = required(ctx, e, "type");
+  if (name && !is_valid_name(*name)) {
+    ctx.error_at_value(e, "name", "bad name '" + *name + "': expected a letter or '_' then letters, digits, '_', '.', '-', '/'");
+    return;
+  }
+  std::optional<ValueType> type;
+  if (type_text) {
+    type = parse_value_type(*type_text);
+    if (!type) ctx.error_at_value(e, "type", "unknown type '" + *type_text + "': expected boolean, number or string");
+  }
+  if (!name || !type) return;
+  if (net.find_parameter(*name) != nullptr || net.find_fact(*name) != nullptr) {
+    ctx.error_at_value(e, "name", "duplicate declaration of '" + *name + "'");
+    return;
+  }
+  VariableDecl d;
+  d.name = *name;
+  d.type = *type;
+  d.description = optional_attr(e, "description").value_or("");
+  d.where = ctx.loc.element(e);
+  if (const auto def = optional_attr(e, "default")) {
+    d.default_value = parse_value(*type, *def);
+    if (!d.default_value) {
+      ctx.error_at_value(e, "default", "default '" + *def + "' of '" + *name + "' is not a " + type_name(*type));
+      return;
+    }
+  }
+  (fact ? net.facts : net.parameters).push_back(std::move(d));
+}
+
+void read_place_details(const ReadContext& ctx, const tinyxml2::XMLElement* e, Place& place, const PetriNet& net,
+                        bool allow_tokens_and_name) {
+  if (allow_tokens_and_name) {
+    check_attributes(ctx, e, {"id", "name", "description", "tokens", "capacity", "outcome", "message"});
+    if (auto n = optional_attr(e, "name")) place.name = *n;
+    if (auto t = optional_attr(e, "tokens")) {
+      if (auto v = parse_count(ctx, ctx.loc.attribute_value(e, "tokens"), *t, 0, "token count")) place.initial_tokens = *v;
+    }
+  } else {
+    check_attributes(ctx, e, {"description", "capacity", "outcome", "message"});
+  }
+  check_no_text(ctx, e);
+  if (auto d = optional_attr(e, "description")) place.description = *d;
+  if (auto c = optional_attr(e, "capacity")) {
+    if (auto v = parse_count(ctx, ctx.loc.attribute_value(e, "capacity"), *c, 1, "capacity")) {
+      place.capacity = *v;
+      if (place.initial_tokens > *v) {
+        ctx.error_at_value(e, "capacity", "place '" + place.id + "' starts with " + std::to_string(place.initial_tokens) +
+                                              " tokens, more than its capacity " + std::to_string(*v));
+        place.capacity.reset();
+      }
+    }
+  }
+  if (auto o = optional_attr(e, "outcome")) {
+    if (*o == "success") place.outcome = Outcome::success;
+    else if (*o == "fault") place.outcome = Outcome::fault;
+    else if (*o == "none") place.outcome = Outcome::none;
+    else ctx.error_at_value(e, "outcome", "unknown outcome '" + *o + "': expected success or fault");
+  }
+  if (auto m = optional_attr(e, "message")) {
+    if (place.outcome != Outcome::fault) {
+      ctx.error_at_attribute(e, "message", "a message belongs to a fault place (outcome=\"fault\") only");
+    } else {
+      place.fault_message = *m;
+    }
+  }
+  for (const auto* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
+    const std::string_view kind = c->Name();
+    if (kind != "behavior" && kind != "process") {
+      unknown_element(ctx, c, e->Name(), "behavior, process");
+      continue;
+    }
+    check_attributes(ctx, c, {"name"});
+    check_no_text(ctx, c);
+    const auto name = required(ctx, c, "name");
+    if (!name) continue;
+    if (!is_valid_name(*name)) {
+      ctx.error_at_value(c, "name", "bad " + std::string(kind) + " name '" + *name + "'");
+      continue;
+    }
+    if (place.behavior || place.process) {
+      ctx.error(c, "place '" + place.id + "' already binds a " + (place.behavior ? "behavior" : "process") +
+                       "; a place binds at most one behavior or process");
+      continue;
+    }
+    const bool behavior = kind == "behavior";
+    const auto& known = behavior ? ctx.options.is_known_behavior : ctx.options.is_known_process;
+    if (known && !known(*name)) {
+      ctx.error_at_value(c, "name", "unknown " + std::string(kind) + " '" + *name + "'");
+    }
+    std::vector<BindingParam> params;
+    read_binding_params(ctx, c, params, net, std::string(kind) + " " + *name);
+    if (behavior) place.behavior = BehaviorBinding{*name, std::move(params)};
+    else place.process = ProcessRef{*name, std::move(params)};
+  }
+}
+
+void read_transition_details(const ReadContext& ctx, const tinyxml2::XMLElement* e, Transition& t, const PetriNet& net,
+                             bool allow_name) {
+  if (allow_name) {
+    check_attributes(ctx, e, {"id", "name", "description", "event", "guard", "delay", "priority"});
+    if (auto n = optional_attr(e, "name")) t.name = *n;
+  } else {
+    check_attributes(ctx, e, {"description", "event", "guard", "delay", "priority"});
+  }
+  check_no_text(ctx, e);
+  for (const auto* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
+    unknown_element(ctx, c, e->Name(), "");
+  }
+  if (auto d = optional_attr(e, "description")) t.description = *d;
+  if (auto ev = optional_attr(e, "event")) {
+    if (!is_valid_name(*ev)) {
+      ctx.error_at_value(e, "event", "bad event name '" + *ev +
+                                         "': expected a letter or '_' then letters, digits, '_', '.', '-', '/'");
+    } else {
+      t.event = *ev;
+    }
+  }
+  if (auto g = optional_attr(e, "guard")) read_guard(ctx, e, t, net, *g);
+  if (auto d = optional_attr(e, "delay")) {
+    std::string err;
+    if (auto v = parse_delay_text(*d, err)) t.delay = *v;
+    else ctx.error_at_value(e, "delay", err + " (transition '" + t.id + "')");
+  }
+  if (auto p = optional_attr(e, "priority")) {
+    int v = 0;
+    const auto [ptr, ec] = std::from_chars(p->data(), p->data() + p->size(), v);
+    if (p->empty() || ec != std::errc() || ptr != p->data() + p->size()) {
+      ctx.error_at_value(e, "priority", "bad priority '" + *p + "': expected an integer");
+    } else {
+      t.priority = v;
+    }
+  }
+}
+
+std::optional<ArcKind> parse_arc_kind(std::string_view text) noexcept {
+  if (text == "normal") return ArcKind::normal;
+  if (text == "read") return ArcKind::read;
+  if (text == "inhibitor") return ArcKind::inhibitor;
+  return std::nullopt;
+}
+
+std::string_view to_string(ArcKind kind) noexcept {
+  switch (kind) {
+    case ArcKind::normal: return "normal";
+    case ArcKind::read: return "read";
+    case ArcKind::inhibitor: return "inhibitor";
+  }
+  return "normal";
+}
+
+bool add_checked_arc(const ReadContext& ctx, const tinyxml2::XMLElement* e, PetriNet& net, const std::string& from,
+                     const std::string& to, Tokens weight, ArcKind kind) {
+  const auto fp = net.find_place(from);
+  const auto ft = net.find_transition(from);
+  const auto tp = net.find_place(to);
+  const auto tt = net.find_transition(to);
+  bool ok = true;
+  if (!fp && !ft) {
+    ctx.error_at_value(e, "source", "arc from unknown node '" + from + "'");
+    ok = false;
+  }
+  if (!tp && !tt) {
+    ctx.error_at_value(e, "target", "arc to unknown node '" + to + "'");
+    ok = false;
+  }
+  if (!ok) return false;
+  if (fp && tp) {
+    ctx.error(e, "arc between two places '" + from + "' and '" + to + "': an arc connects a place and a transition");
+    return false;
+  }
+  if (ft && tt) {
+    ctx.error(e, "arc between two transitions '" + from + "' and '" + to +
+                     "': an arc connects a place and a transition");
+    return false;
+  }
+  if (ft && kind != ArcKind::normal) {
+    ctx.error(e, "a " + std::string(to_string(kind)) + " arc goes from a place to a transition, not from transition '" +
+                     from + "' to place '" + to + "'");
+    return false;
+  }
+  net.add_arc(from, to, weight, kind, ctx.loc.element(e));
+  return true;
+}
+
+}  // namespace tripodal::detail

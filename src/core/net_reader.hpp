@@ -1,0 +1,78 @@
+// Internal: reading the parts of a net that the native XML format and the tripodal extension of
+// PNML (<toolspecific tool="tripodal">) share: node attributes, bindings, declarations, guards,
+// delays. Every problem becomes a located diagnostic; reading always continues.
+#pragma once
+
+#include <initializer_list>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include <tinyxml2.h>
+
+#include "tripodal/core/diagnostic.hpp"
+#include "tripodal/core/net_loader.hpp"
+#include "tripodal/core/petri_net.hpp"
+#include "xml_locator.hpp"
+
+namespace tripodal::detail {
+
+inline constexpr std::string_view kFormatVersion = "1";
+
+struct ReadContext {
+  const XmlLocator& loc;
+  Diagnostics& diags;
+  const LoadOptions& options;
+
+  void error(const tinyxml2::XMLElement* e, const std::string& message) const;
+  void error_at_attribute(const tinyxml2::XMLElement* e, std::string_view attr, const std::string& message) const;
+  void error_at_value(const tinyxml2::XMLElement* e, std::string_view attr, const std::string& message,
+                      std::size_t decoded_offset = 0) const;
+};
+
+/// Reports every attribute not in `allowed`.
+void check_attributes(const ReadContext& ctx, const tinyxml2::XMLElement* e,
+                      std::initializer_list<std::string_view> allowed);
+/// "unknown element <x> in <parent>; expected one of: ...".
+void unknown_element(const ReadContext& ctx, const tinyxml2::XMLElement* e, std::string_view parent,
+                     std::string_view expected);
+/// Reports an element's non-blank text content (the formats keep everything in attributes).
+void check_no_text(const ReadContext& ctx, const tinyxml2::XMLElement* e);
+
+/// A required attribute; reports it missing (or empty) and returns nullopt.
+std::optional<std::string> required(const ReadContext& ctx, const tinyxml2::XMLElement* e, std::string_view attr);
+/// An optional attribute's value; nullopt when absent.
+std::optional<std::string> optional_attr(const tinyxml2::XMLElement* e, std::string_view attr);
+
+/// A decimal count: tokens/capacity (min 0) or weight (min 1). Reports bad text.
+std::optional<Tokens> parse_count(const ReadContext& ctx, const SourceLocation& where, std::string_view text,
+                                  Tokens minimum, std::string_view what);
+/// "2s", "500ms", "1.5min": number and unit (ns, us, ms, s, min, h), not negative.
+std::optional<Duration> parse_delay_text(std::string_view text, std::string& error);
+/// A name that events, parameters and behaviors may use: letter or '_' first, then letters,
+/// digits, '_', '.', '-', '/'.
+bool is_valid_name(std::string_view name) noexcept;
+
+/// <parameter>/<fact name type default description/>; appends to net.parameters / net.facts.
+void read_declaration(const ReadContext& ctx, const tinyxml2::XMLElement* e, PetriNet& net, bool fact);
+
+/// Place attributes other than id (name, description, tokens, capacity, outcome, message) and
+/// the <behavior>/<process> children. `net` gives the declared parameters for "$param" checks.
+void read_place_details(const ReadContext& ctx, const tinyxml2::XMLElement* e, Place& place, const PetriNet& net,
+                        bool allow_tokens_and_name);
+/// Transition attributes other than id (name, description, event, guard, delay, priority).
+void read_transition_details(const ReadContext& ctx, const tinyxml2::XMLElement* e, Transition& t,
+                             const PetriNet& net, bool allow_name);
+/// "normal" | "read" | "inhibitor".
+std::optional<ArcKind> parse_arc_kind(std::string_view text) noexcept;
+[[nodiscard]] std::string_view to_string(ArcKind kind) noexcept;
+
+/// Connects the ends of an arc after every node was read: unknown node, two places, two
+/// transitions, a read/inhibitor arc leaving a transition. Returns false after reporting.
+bool add_checked_arc(const ReadContext& ctx, const tinyxml2::XMLElement* e, PetriNet& net, const std::string& from,
+                     const std::string& to, Tokens weight, ArcKind kind);
+
+/// The element's text content with blanks trimmed ("" when none).
+std::string trimmed_text(const tinyxml2::XMLElement* e);
+
+}  // namespace tripodal::detail

@@ -1,0 +1,229 @@
+// The native XML format of configuration nets: reader and writer (docs/net-format.md).
+#include <charconv>
+#include <map>
+#include <set>
+
+#include "net_formats.hpp"
+
+namespace tripodal::detail {
+
+namespace {
+
+constexpr std::string_view kNetChildren = "parameter, fact, place, transition, arc";
+
+}  // namespace
+
+PetriNet read_native(const tinyxml2::XMLElement* root, const ReadContext& ctx) {
+  PetriNet net;
+  net.where = ctx.loc.element(root);
+  check_attributes(ctx, root, {"id", "name", "description", "level", "version", "xmlns:xsi",
+                               "xsi:noNamespaceSchemaLocation"});
+  check_no_text(ctx, root);
+  if (auto id = required(ctx, root, "id")) net.id = *id;
+  net.name = optional_attr(root, "name").value_or(net.id);  // like nodes: the name defaults to the id
+  net.description = optional_attr(root, "description").value_or("");
+  if (auto level = optional_attr(root, "level")) {
+    if (*level == "low") net.level = NetLevel::low;
+    else if (*level == "high") net.level = NetLevel::high;
+    else ctx.error_at_value(root, "level", "unknown level '" + *level + "': expected low or high");
+  }
+  if (auto version = optional_attr(root, "version"); version && *version != kFormatVersion) {
+    ctx.error_at_value(root, "version", "format version '" + *version + "' is not supported: this build reads version " +
+                                            std::string(kFormatVersion));
+  }
+
+  // Declarations first so that guards and "$param" bindings can be checked wherever they appear.
+  for (const auto* c = root->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
+    const std::string_view n = c->Name();
+    if (n == "parameter" || n == "fact") read_declaration(ctx, c, net, n == "fact");
+    else if (n != "place" && n != "transition" && n != "arc") unknown_element(ctx, c, "net", kNetChildren);
+  }
+
+  std::map<std::string, SourceLocation, std::less<>> first_seen;
+  const auto claim_id = [&](const tinyxml2::XMLElement* e) -> std::optional<std::string> {
+    auto id = required(ctx, e, "id");
+    if (!id) return std::nullopt;
+    const auto [it, inserted] = first_seen.emplace(*id, ctx.loc.element(e));
+    if (!inserted) {
+      ctx.error_at_value(e, "id", "duplicate id '" + *id + "' (first defined at " + it->second.str() + ")");
+      return std::nullopt;
+    }
+    return id;
+  };
+
+  for (const auto* c = root->FirstChildElement("place"); c != nullptr; c = c->NextSiblingElement("place")) {
+    Place p;
+    const auto id = claim_id(c);
+    p.id = id.value_or("");
+    p.where = ctx.loc.element(c);
+    read_place_details(ctx, c, p, net, true);
+    if (id) net.add_place(std::move(p));
+  }
+  for (const auto* c = root->FirstChildElement("transition"); c != nullptr; c = c->NextSiblingElement("transition")) {
+    Transition t;
+    const auto id = claim_id(c);
+    t.id = id.value_or("");
+    t.where = ctx.loc.element(c);
+    read_transition_details(ctx, c, t, net, true);
+    if (id) net.add_transition(std::move(t));
+  }
+  for (const auto* c = root->FirstChildElement("arc"); c != nullptr; c = c->NextSiblingElement("arc")) {
+    check_attributes(ctx, c, {"source", "target", "weight", "kind"});
+    check_no_text(ctx, c);
+    for (const auto* g = c->FirstChildElement(); g != nullptr; g = g->NextSiblingElement()) unknown_element(ctx, g, "arc", "");
+    const auto source = required(ctx, c, "source");
+    const auto target = required(ctx, c, "target");
+    std::optional<Tokens> weight = 1;
+    if (auto w = optional_attr(c, "weight")) weight = parse_count(ctx, ctx.loc.attribute_value(c, "weight"), *w, 1, "weight");
+    std::optional<ArcKind> kind = ArcKind::normal;
+    if (auto k = optional_attr(c, "kind")) {
+      kind = parse_arc_kind(*k);
+      if (!kind) ctx.error_at_value(c, "kind", "unknown arc kind '" + *k + "': expected normal, read or inhibitor");
+    }
+    if (source && target && weight && kind) add_checked_arc(ctx, c, net, *source, *target, *weight, *kind);
+  }
+  return net;
+}
+
+std::string xml_escape(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\n': out += "&#10;"; break;
+      case '\r': out += "&#13;"; break;
+      case '\t': out += "&#9;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+std::string value_text(const Value& v) {
+  if (const auto* b = std::get_if<bool>(&v)) return *b ? "true" : "false";
+  if (const auto* d = std::get_if<double>(&v)) {
+    char buf[64];
+    const auto [ptr, ec] = std::to_chars(buf, buf + sizeof buf, *d);
+    return ec == std::errc() ? std::string(buf, ptr) : std::to_string(*d);
+  }
+  return std::get<std::string>(v);
+}
+
+std::string delay_text(Duration d) {
+  const auto ns = d.count();
+  if (ns % 1'000'000'000 == 0) return std::to_string(ns / 1'000'000'000) + "s";
+  if (ns % 1'000'000 == 0) return std::to_string(ns / 1'000'000) + "ms";
+  if (ns % 1'000 == 0) return std::to_string(ns / 1'000) + "us";
+  return std::to_string(ns) + "ns";
+}
+
+namespace {
+std::string attr(std::string_view name, std::string_view value) {
+  std::string out = " ";
+  out += name;
+  out += "=\"";
+  out += xml_escape(value);
+  out += '"';
+  return out;
+}
+}  // namespace
+
+std::string place_detail_attributes(const Place& p) {
+  std::string out;
+  if (!p.description.empty()) out += attr("description", p.description);
+  if (p.capacity) out += attr("capacity", std::to_string(*p.capacity));
+  if (p.outcome == Outcome::success) out += attr("outcome", "success");
+  if (p.outcome == Outcome::fault) {
+    out += attr("outcome", "fault");
+    if (!p.fault_message.empty()) out += attr("message", p.fault_message);
+  }
+  return out;
+}
+
+std::string transition_detail_attributes(const Transition& t) {
+  std::string out;
+  if (!t.description.empty()) out += attr("description", t.description);
+  if (!t.event.empty()) out += attr("event", t.event);
+  if (t.guard) out += attr("guard", t.guard->text());
+  if (t.delay.count() != 0) out += attr("delay", delay_text(t.delay));
+  if (t.priority != 0) out += attr("priority", std::to_string(t.priority));
+  return out;
+}
+
+std::string binding_elements(const Place& p, const std::string& indent) {
+  const std::string* name = nullptr;
+  const std::vector<BindingParam>* params = nullptr;
+  const char* kind = nullptr;
+  if (p.behavior) {
+    kind = "behavior";
+    name = &p.behavior->behavior;
+    params = &p.behavior->params;
+  } else if (p.process) {
+    kind = "process";
+    name = &p.process->process;
+    params = &p.process->params;
+  } else {
+    return {};
+  }
+  std::string out = indent + "<" + kind + attr("name", *name);
+  if (params->empty()) return out + "/>\n";
+  out += ">\n";
+  for (const auto& bp : *params) out += indent + "  <param" + attr("name", bp.name) + attr("value", bp.value) + "/>\n";
+  return out + indent + "</" + kind + ">\n";
+}
+
+std::string declaration_elements(const PetriNet& net, const std::string& indent) {
+  std::string out;
+  const auto one = [&](const char* kind, const VariableDecl& d) {
+    out += indent + "<" + kind + attr("name", d.name) + attr("type", to_string(d.type));
+    if (d.default_value) out += attr("default", value_text(*d.default_value));
+    if (!d.description.empty()) out += attr("description", d.description);
+    out += "/>\n";
+  };
+  for (const auto& d : net.parameters) one("parameter", d);
+  for (const auto& d : net.facts) one("fact", d);
+  return out;
+}
+
+std::string write_native(const PetriNet& net) {
+  std::string out = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<net";
+  out += attr("id", net.id.empty() ? std::string("net") : net.id);
+  if (!net.name.empty() && net.name != net.id) out += attr("name", net.name);
+  out += attr("level", net.level == NetLevel::high ? "high" : "low");
+  out += attr("version", kFormatVersion);
+  if (!net.description.empty()) out += attr("description", net.description);
+  out += ">\n";
+  out += declaration_elements(net, "  ");
+  for (const auto& p : net.places()) {
+    out += "  <place" + attr("id", p.id);
+    if (p.name != p.id) out += attr("name", p.name);
+    if (p.initial_tokens != 0) out += attr("tokens", std::to_string(p.initial_tokens));
+    out += place_detail_attributes(p);
+    const std::string bindings = binding_elements(p, "    ");
+    out += bindings.empty() ? "/>\n" : ">\n" + bindings + "  </place>\n";
+  }
+  for (const auto& t : net.transitions()) {
+    out += "  <transition" + attr("id", t.id);
+    if (t.name != t.id) out += attr("name", t.name);
+    out += transition_detail_attributes(t) + "/>\n";
+  }
+  for (const auto& t : net.transitions()) {
+    const auto arc = [&](const std::string& from, const std::string& to, const ArcRef& a, ArcKind kind) {
+      out += "  <arc" + attr("source", from) + attr("target", to);
+      if (a.weight != 1) out += attr("weight", std::to_string(a.weight));
+      if (kind != ArcKind::normal) out += attr("kind", to_string(kind));
+      out += "/>\n";
+    };
+    for (const auto& a : t.inputs) arc(net.place(a.place).id, t.id, a, ArcKind::normal);
+    for (const auto& a : t.reads) arc(net.place(a.place).id, t.id, a, ArcKind::read);
+    for (const auto& a : t.inhibitors) arc(net.place(a.place).id, t.id, a, ArcKind::inhibitor);
+    for (const auto& a : t.outputs) arc(t.id, net.place(a.place).id, a, ArcKind::normal);
+  }
+  return out + "</net>\n";
+}
+
+}  // namespace tripodal::detail
