@@ -190,9 +190,11 @@ std::string describe_text(const RobotDescription& r) {
     o << '\n' << to_string(layer) << " layer\n";
     for (const DescribedModule& m : r.modules) {
       if (m.layer != layer) continue;
-      o << "  " << m.name << " (" << (m.core ? "core, " : "") << to_string(m.kind);
-      if (m.type != m.name) o << ", " << m.type;
-      o << ")\n";
+      if (m.core) {
+        o << "  " << m.name << " (core, " << m.type << ")\n";
+      } else {
+        o << "  " << m.name << " (" << to_string(m.kind) << (m.type != m.name ? ", " + m.type : std::string()) << ")\n";
+      }
       o << "      in:  " << (m.inputs.empty() ? "-" : join(m.inputs)) << '\n';
       o << "      out: " << (m.outputs.empty() ? "-" : join(m.outputs)) << '\n';
     }
@@ -221,6 +223,7 @@ std::string describe_dot(const RobotDescription& r) {
       o << "    " << dot_id(m.name) << " [label=\"" << label << "\"" << (m.core ? ", penwidth=2" : "")
         << (m.kind == ModuleKind::behavior ? ", shape=ellipse" : "") << "];\n";
     }
+    o << "    \"_" << l << "\" [shape=point, style=invis, width=0, height=0, label=\"\"];\n";
     if (layer == Layer::sequencing) {
       std::string label = "configurations\\n<core>";
       for (const auto& p : r.processes) label += "\\n" + p;
@@ -238,8 +241,22 @@ std::string describe_dot(const RobotDescription& r) {
       }
     }
   }
+  // Stack the layers as in the paper: deliberate on top, reactive at the bottom. Information
+  // flowing up (sensor data to the localizer) must not pull a lower layer above a higher one.
+  std::map<std::string, int> rank;
+  for (const DescribedModule& m : r.modules) rank[m.name] = static_cast<int>(m.layer);
+  // Every node of a layer above the anchor of the next layer, every node below its own anchor.
+  auto below = [&](const std::string& node, Layer layer) {
+    if (layer != Layer::deliberate) o << "  \"_" << to_string(layer) << "\" -> " << dot_id(node) << " [style=invis];\n";
+    if (layer != Layer::reactive) {
+      o << "  " << dot_id(node) << " -> \"_" << to_string(static_cast<Layer>(static_cast<int>(layer) + 1)) << "\" [style=invis];\n";
+    }
+  };
+  for (const DescribedModule& m : r.modules) below(m.name, m.layer);
+  below("configurations", Layer::sequencing);
   for (const auto& [pc, infos] : edges) {
-    o << "  " << dot_id(pc.first) << " -> " << dot_id(pc.second) << " [label=" << dot_id(join(infos, ", ")) << "];\n";
+    o << "  " << dot_id(pc.first) << " -> " << dot_id(pc.second) << " [label=" << dot_id(join(infos, ", "))
+      << (rank[pc.first] > rank[pc.second] ? ", constraint=false" : "") << "];\n";
   }
   o << "  " << dot_id(CoreNames::kSupervisor) << " -> \"configurations\" [style=dashed, arrowhead=none, label=\"runs\"];\n";
   for (const DescribedModule& m : r.modules) {
