@@ -108,7 +108,7 @@ bool CProcessSupervisor::start(std::string run, const CProcess& process, Paramet
   r->forwarder.run = r.get();
   r->forwarder.observers = &observers_;
   r->engine->add_observer(r->forwarder);
-  for (SupervisorObserver* o : observers_) o->on_process_started(r->id, process, r->params, now);
+  for (SupervisorObserver* o : observers_) o->on_run_started(r->id, process, r->params, now);
   runs_.push_back(std::move(r));
   return true;
 }
@@ -135,7 +135,7 @@ void CProcessSupervisor::finish(Run& run, bool success, std::string message, std
   } else {
     spdlog::info("process {} ({}) failed: {}", run.process->name(), run.id, result.message);
   }
-  for (SupervisorObserver* o : observers_) o->on_process_finished(result);
+  for (SupervisorObserver* o : observers_) o->on_run_finished(result);
   results_.push_back(std::move(result));
 }
 

@@ -23,10 +23,10 @@ ProcessDefinition def(std::string name, PetriNet net) {
 // Records what the observers see, one line per item.
 struct Lines final : SupervisorObserver {
   std::vector<std::string> lines;
-  void on_process_started(std::string_view run, const CProcess& p, const ParameterValues&, Time now) override {
+  void on_run_started(std::string_view run, const CProcess& p, const ParameterValues&, Time now) override {
     lines.push_back(FakeBehaviors::stamp(now) + " start " + std::string(run) + " " + p.name());
   }
-  void on_process_finished(const ProcessResult& r) override {
+  void on_run_finished(const ProcessResult& r) override {
     lines.push_back(FakeBehaviors::stamp(r.finished) + " end " + r.run + (r.success ? " success" : " fault: " + r.message));
   }
   void on_firing(std::string_view run, const PetriNet&, const Firing& f) override {

@@ -29,9 +29,9 @@ class SupervisorObserver {
   SupervisorObserver(const SupervisorObserver&) = default;
   SupervisorObserver& operator=(const SupervisorObserver&) = default;
 
-  virtual void on_process_started(std::string_view /*run*/, const CProcess& /*process*/,
+  virtual void on_run_started(std::string_view /*run*/, const CProcess& /*process*/,
                                   const ParameterValues& /*params*/, Time /*now*/) {}
-  virtual void on_process_finished(const ProcessResult& /*result*/) {}
+  virtual void on_run_finished(const ProcessResult& /*result*/) {}
   virtual void on_behavior_activated(std::string_view /*run*/, std::string_view /*behavior*/,
                                      const ParameterValues& /*params*/, Time /*now*/) {}
   virtual void on_behavior_deactivated(std::string_view /*run*/, std::string_view /*behavior*/, Time /*now*/) {}
