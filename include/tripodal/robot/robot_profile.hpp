@@ -1,0 +1,86 @@
+// The robot profile: a YAML file that says what a robot is made of — controllers and loops,
+// resources, navigation modules, HRI and application modules, behaviors, processes, task templates
+// and recovery rules. Loaded once into typed structs with every error located (FILE:LINE:COL);
+// reference in docs/processes.md.
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tripodal/core/diagnostic.hpp"
+#include "tripodal/core/manifest.hpp"
+#include "tripodal/core/petri_net.hpp"
+#include "tripodal/core/time.hpp"
+
+namespace tripodal {
+
+/// One module instance of the profile (controller, resource, navigation, hri, other module, or
+/// behavior). The type names a registered manifest; a type that is not registered may be
+/// *declared* in the profile with layer/inputs/outputs, so a robot can be designed and described
+/// before its modules exist (it cannot be started until they are registered).
+struct ModuleEntry {
+  ModuleKind kind = ModuleKind::other;  ///< from the section it is listed in
+  std::string name;                     ///< instance name, unique in the robot
+  std::string type;                     ///< registered type; defaults to the name
+  std::optional<Layer> layer;           ///< declared layer (must agree with a registered manifest)
+  std::optional<std::vector<std::string>> inputs;   ///< replace the manifest's inputs
+  std::optional<std::vector<std::string>> outputs;  ///< replace the manifest's outputs
+  std::string description;
+  std::map<std::string, std::string, std::less<>> parameters;
+  std::optional<Duration> watchdog_timeout;  ///< supervisor watchdog on the module's heartbeat
+  std::string watchdog_event;                ///< posted on silence; default "<name>.fault"
+  SourceLocation where;
+};
+
+/// A control loop: a sampling period and the controller it drives.
+struct LoopEntry {
+  std::string name;
+  Duration period{0};
+  std::string controller;
+  SourceLocation where;
+};
+
+struct ProcessEntry {
+  std::string name;
+  std::string type = "net";                 ///< process factory type
+  std::filesystem::path net;                ///< resolved against the profile's directory
+  std::vector<BindingParam> parameters;     ///< configured values, located
+  std::filesystem::path recovery;           ///< optional: this process's own recovery rules
+  SourceLocation where;
+  SourceLocation net_where;
+};
+
+struct RobotProfile {
+  std::string name;
+  std::string description;
+  std::filesystem::path file;
+  SourceLocation where;
+  std::vector<ModuleEntry> controllers;
+  std::vector<LoopEntry> loops;
+  std::vector<ModuleEntry> resources;
+  std::vector<ModuleEntry> navigation;
+  std::vector<ModuleEntry> hri;
+  std::vector<ModuleEntry> modules;  ///< other application modules
+  std::vector<ModuleEntry> behaviors;
+  std::vector<ProcessEntry> processes;
+  std::filesystem::path tasks;     ///< task templates (empty: none)
+  std::filesystem::path recovery;  ///< recovery rules (empty: none)
+  SourceLocation tasks_where;
+  SourceLocation recovery_where;
+
+  /// Every module entry, in profile order: controllers, resources, navigation, hri, modules, behaviors.
+  [[nodiscard]] std::vector<const ModuleEntry*> all_modules() const;
+};
+
+/// Loads a profile; throws ConfigError listing every error (unknown keys, wrong kinds of values,
+/// duplicate names, bad periods, a loop naming an unknown controller, missing files).
+[[nodiscard]] RobotProfile load_robot_profile(const std::filesystem::path& file);
+/// As above from text; relative paths resolve against `base_dir`.
+[[nodiscard]] RobotProfile load_robot_profile_from_string(std::string_view yaml, std::string_view name,
+                                                          const std::filesystem::path& base_dir);
+
+}  // namespace tripodal

@@ -1,0 +1,271 @@
+#include "tripodal/robot/layering.hpp"
+
+#include <algorithm>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace tripodal {
+
+namespace {
+
+bool many(const std::string& input) { return !input.empty() && input.back() == '*'; }
+std::string base_name(const std::string& input) { return many(input) ? input.substr(0, input.size() - 1) : input; }
+
+std::optional<Layer> layer_of_kind(ModuleKind k) {
+  switch (k) {
+    case ModuleKind::behavior:
+    case ModuleKind::resource:
+    case ModuleKind::controller: return Layer::reactive;
+    case ModuleKind::navigation:
+    case ModuleKind::process: return Layer::sequencing;
+    case ModuleKind::planner:
+    case ModuleKind::hri: return Layer::deliberate;
+    case ModuleKind::other: return std::nullopt;
+  }
+  return std::nullopt;
+}
+
+std::string module_phrase(const DescribedModule& m) {
+  std::string kind = m.core ? "core component" : std::string(to_string(m.kind));
+  if (m.kind == ModuleKind::other && !m.core) kind = "module";
+  return std::string(to_string(m.layer)) + " " + kind + " '" + m.name + "'";
+}
+
+std::string join(const std::vector<std::string>& v, std::string_view sep = ", ") {
+  std::string out;
+  for (const auto& s : v) out += (out.empty() ? "" : std::string(sep)) + s;
+  return out;
+}
+
+std::string dot_id(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
+void check_layering(const std::vector<DescribedModule>& modules, Diagnostics& d) {
+  // R1: a module's kind fixes its layer (the paper's Fig. 5 guideline).
+  for (const DescribedModule& m : modules) {
+    auto expected = layer_of_kind(m.kind);
+    if (expected && *expected != m.layer) {
+      d.error(m.where, "module '" + m.name + "' is a " + std::string(to_string(m.kind)) + " but sits in the " +
+                           std::string(to_string(m.layer)) + " layer; " + std::string(to_string(m.kind)) +
+                           " modules belong to the " + std::string(to_string(*expected)) + " layer (rule R1)");
+    }
+  }
+  // R0: every input has exactly one provider (or any number, for a fused input "name*").
+  for (const DescribedModule& m : modules) {
+    for (const std::string& in : m.inputs) {
+      const std::string info = base_name(in);
+      std::vector<const DescribedModule*> providers;
+      for (const DescribedModule& p : modules) {
+        if (&p != &m && std::find(p.outputs.begin(), p.outputs.end(), info) != p.outputs.end()) providers.push_back(&p);
+      }
+      if (!many(in)) {
+        if (providers.empty()) {
+          d.error(m.where, "missing provider: " + module_phrase(m) + " needs '" + info + "', but no module provides it");
+        } else if (providers.size() > 1) {
+          std::string list;
+          for (const auto* p : providers) {
+            list += (list.empty() ? "" : ", ") + p->name + (p->where.line > 0 ? " (" + p->where.str() + ")" : std::string());
+          }
+          d.error(m.where, "duplicate providers: " + module_phrase(m) + " needs '" + info + "', which " +
+                               std::to_string(providers.size()) + " modules provide: " + list + "; exactly one must");
+        }
+      }
+      for (const DescribedModule* p : providers) {
+        // R2: the reactive layer keeps running whatever the planner does, so it never depends on it.
+        if (m.layer == Layer::reactive && p->layer == Layer::deliberate) {
+          d.error(m.where, "layering: " + module_phrase(m) + " takes '" + info + "' from " + module_phrase(*p) +
+                               "; reactive modules must not depend on the deliberate layer (rule R2)");
+        }
+        // R3: the sequencing layer extracts information from raw data for the deliberate layer.
+        if (m.layer == Layer::deliberate && p->layer == Layer::reactive) {
+          d.error(m.where, "layering: " + module_phrase(m) + " takes '" + info + "' from " + module_phrase(*p) +
+                               "; raw data reaches the deliberate layer only through a sequencing module (rule R3)");
+        }
+        // R4: resource -> behavior -> coordinator -> controller; a behavior never drives the base itself.
+        if (m.kind == ModuleKind::controller && p->kind == ModuleKind::behavior) {
+          d.error(m.where, "layering: controller '" + m.name + "' takes '" + info + "' directly from behavior '" + p->name +
+                               "'; motion commands reach controllers only through the behavior coordinator (rule R4)");
+        }
+        // R5: behaviors are independent primitives; only the coordinator combines them.
+        if (m.kind == ModuleKind::behavior && p->kind == ModuleKind::behavior) {
+          d.error(m.where, "layering: behavior '" + m.name + "' takes '" + info + "' from behavior '" + p->name +
+                               "'; behaviors are independent and combined only by the behavior coordinator (rule R5)");
+        }
+      }
+    }
+  }
+}
+
+std::vector<std::string> knowledge_inputs(const TaskLibrary& tasks) {
+  std::set<std::string> out;
+  std::function<void(const std::vector<TemplateNode>&)> walk = [&](const std::vector<TemplateNode>& nodes) {
+    for (const TemplateNode& n : nodes) {
+      if (n.kind == TemplateNode::Kind::foreach) {
+        const auto paren = n.list_expr.find('(');
+        if (paren != std::string::npos && paren > 0) out.insert(n.list_expr.substr(0, paren));
+      }
+      walk(n.body);
+    }
+  };
+  for (const TaskTemplate& t : tasks.templates()) walk(t.plan);
+  return {out.begin(), out.end()};
+}
+
+RobotDescription describe_robot(const RobotProfile& profile, const RobotCatalog& catalog,
+                                const std::vector<std::string>& planner_inputs, Diagnostics& d) {
+  RobotDescription out;
+  out.name = profile.name;
+  out.description = profile.description;
+  std::vector<std::string> pin = planner_inputs;
+  pin.push_back("process_result");
+  out.modules.push_back(DescribedModule{CoreNames::kPlanner, "CPlanner", ModuleKind::planner, Layer::deliberate, true,
+                                        "turns task commands into plans of process modules; recovers from faults",
+                                        pin, {"process_plan"}, profile.where});
+  out.modules.push_back(DescribedModule{CoreNames::kSupervisor, "CProcessSupervisor", ModuleKind::other, Layer::sequencing, true,
+                                        "runs the processes' nets, activates behaviors, posts faults",
+                                        {"process_plan"}, {"process_result"}, profile.where});
+  out.modules.push_back(DescribedModule{CoreNames::kCoordinator, "CBehaviorCoordinator", ModuleKind::other, Layer::reactive,
+                                        true, "fuses the commands of the active behaviors", {"behavior_command*"},
+                                        {"cmd_vel"}, profile.where});
+  for (const ModuleEntry* e : profile.all_modules()) {
+    const ModuleManifest* m = nullptr;
+    if (e->kind == ModuleKind::behavior && catalog.behaviors) m = catalog.behaviors->manifest(e->type);
+    if (e->kind == ModuleKind::controller && catalog.controllers) m = catalog.controllers->manifest(e->type);
+    if (m == nullptr && catalog.modules) m = catalog.modules->manifest(e->type);
+    DescribedModule dm;
+    dm.name = e->name;
+    dm.type = e->type;
+    dm.kind = e->kind;
+    dm.where = e->where;
+    dm.description = e->description;
+    if (m != nullptr) {
+      dm.layer = m->layer;
+      if (e->layer && *e->layer != m->layer) {
+        d.error(e->where, "module '" + e->name + "' declares the " + std::string(to_string(*e->layer)) + " layer, but its type '" +
+                              e->type + "' is a " + std::string(to_string(m->layer)) + "-layer module");
+      }
+      if (m->kind != ModuleKind::other && m->kind != e->kind) {
+        d.error(e->where, "module '" + e->name + "': type '" + e->type + "' is a " + std::string(to_string(m->kind)) +
+                              ", but it is listed as a " + std::string(to_string(e->kind)));
+      }
+      dm.inputs = e->inputs ? *e->inputs : m->inputs;
+      dm.outputs = e->outputs ? *e->outputs : m->outputs;
+      if (dm.description.empty()) dm.description = m->description;
+    } else if (e->layer) {
+      dm.layer = *e->layer;  // declared in the profile: a module designed before it is implemented
+      dm.inputs = e->inputs.value_or(std::vector<std::string>{});
+      dm.outputs = e->outputs.value_or(std::vector<std::string>{});
+    } else {
+      std::vector<std::string> known;
+      if (e->kind == ModuleKind::behavior && catalog.behaviors) known = catalog.behaviors->names();
+      else if (e->kind == ModuleKind::controller && catalog.controllers) known = catalog.controllers->names();
+      else if (catalog.modules) known = catalog.modules->names();
+      d.error(e->where, "unknown " + std::string(to_string(e->kind)) + " type '" + e->type + "' (registered: " +
+                            (known.empty() ? "none" : join(known)) +
+                            "); register it, or declare it here with layer, inputs and outputs");
+      continue;
+    }
+    out.modules.push_back(std::move(dm));
+  }
+  for (const ProcessEntry& p : profile.processes) out.processes.push_back(p.name);
+  check_layering(out.modules, d);
+  return out;
+}
+
+std::string describe_text(const RobotDescription& r) {
+  std::ostringstream o;
+  o << "robot " << r.name;
+  if (!r.description.empty()) o << ": " << r.description;
+  o << '\n';
+  for (Layer layer : {Layer::deliberate, Layer::sequencing, Layer::reactive}) {
+    o << '\n' << to_string(layer) << " layer\n";
+    for (const DescribedModule& m : r.modules) {
+      if (m.layer != layer) continue;
+      if (m.core) {
+        o << "  " << m.name << " (core, " << m.type << ")\n";
+      } else {
+        o << "  " << m.name << " (" << to_string(m.kind) << (m.type != m.name ? ", " + m.type : std::string()) << ")\n";
+      }
+      o << "      in:  " << (m.inputs.empty() ? "-" : join(m.inputs)) << '\n';
+      o << "      out: " << (m.outputs.empty() ? "-" : join(m.outputs)) << '\n';
+    }
+    if (layer == Layer::sequencing) {
+      o << "  configurations (core): " << (r.processes.empty() ? "-" : join(r.processes)) << '\n';
+    }
+  }
+  return o.str();
+}
+
+std::string describe_dot(const RobotDescription& r) {
+  std::ostringstream o;
+  o << "digraph " << dot_id(r.name.empty() ? "robot" : r.name) << " {\n"
+    << "  label=" << dot_id("Layered functionality diagram of " + r.name) << ";\n  labelloc=t;\n  rankdir=TB;\n  newrank=true;\n"
+    << "  node [shape=box, style=\"rounded,filled\", fillcolor=white, fontname=\"Helvetica\", fontsize=11];\n"
+    << "  edge [fontname=\"Helvetica\", fontsize=9];\n";
+  const std::map<Layer, const char*> colour{{Layer::deliberate, "#e8eef9"}, {Layer::sequencing, "#eaf5e6"}, {Layer::reactive, "#fbf0e2"}};
+  for (Layer layer : {Layer::deliberate, Layer::sequencing, Layer::reactive}) {
+    const std::string l(to_string(layer));
+    o << "  subgraph cluster_" << l << " {\n    label=" << dot_id(std::string(1, static_cast<char>(l[0] - 32)) + l.substr(1) + " layer")
+      << ";\n    style=filled; color=\"#999999\"; fillcolor=\"" << colour.at(layer) << "\";\n";
+    for (const DescribedModule& m : r.modules) {
+      if (m.layer != layer) continue;
+      std::string label = m.name + "\\n<" + std::string(to_string(m.kind)) + ">";
+      if (m.core) label = m.name + "\\n<core>";
+      o << "    " << dot_id(m.name) << " [label=\"" << label << "\"" << (m.core ? ", penwidth=2" : "")
+        << (m.kind == ModuleKind::behavior ? ", shape=ellipse" : "") << "];\n";
+    }
+    o << "    \"_" << l << "\" [shape=point, style=invis, width=0, height=0, label=\"\"];\n";
+    if (layer == Layer::sequencing) {
+      std::string label = "configurations\\n<core>";
+      for (const auto& p : r.processes) label += "\\n" + p;
+      o << "    \"configurations\" [shape=note, penwidth=2, label=\"" << label << "\"];\n";
+    }
+    o << "  }\n";
+  }
+  // Edges: provider -> consumer, one per pair with every information they exchange.
+  std::map<std::pair<std::string, std::string>, std::vector<std::string>> edges;
+  for (const DescribedModule& c : r.modules) {
+    for (const std::string& in : c.inputs) {
+      const std::string info = base_name(in);
+      for (const DescribedModule& p : r.modules) {
+        if (&p != &c && std::find(p.outputs.begin(), p.outputs.end(), info) != p.outputs.end()) edges[{p.name, c.name}].push_back(info);
+      }
+    }
+  }
+  // Stack the layers as in the paper: deliberate on top, reactive at the bottom. Information
+  // flowing up (sensor data to the localizer) must not pull a lower layer above a higher one.
+  std::map<std::string, int> rank;
+  for (const DescribedModule& m : r.modules) rank[m.name] = static_cast<int>(m.layer);
+  // Every node of a layer above the anchor of the next layer, every node below its own anchor.
+  auto below = [&](const std::string& node, Layer layer) {
+    if (layer != Layer::deliberate) o << "  \"_" << to_string(layer) << "\" -> " << dot_id(node) << " [style=invis];\n";
+    if (layer != Layer::reactive) {
+      o << "  " << dot_id(node) << " -> \"_" << to_string(static_cast<Layer>(static_cast<int>(layer) + 1)) << "\" [style=invis];\n";
+    }
+  };
+  for (const DescribedModule& m : r.modules) below(m.name, m.layer);
+  below("configurations", Layer::sequencing);
+  for (const auto& [pc, infos] : edges) {
+    o << "  " << dot_id(pc.first) << " -> " << dot_id(pc.second) << " [label=" << dot_id(join(infos, ", "))
+      << (rank[pc.first] > rank[pc.second] ? ", constraint=false" : "") << "];\n";
+  }
+  o << "  " << dot_id(CoreNames::kSupervisor) << " -> \"configurations\" [style=dashed, arrowhead=none, label=\"runs\"];\n";
+  for (const DescribedModule& m : r.modules) {
+    if (m.kind == ModuleKind::behavior) {
+      o << "  " << dot_id(CoreNames::kSupervisor) << " -> " << dot_id(m.name) << " [style=dashed, color=\"#777777\", label=\"activates\"];\n";
+    }
+  }
+  o << "}\n";
+  return o.str();
+}
+
+}  // namespace tripodal

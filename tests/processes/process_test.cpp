@@ -1,0 +1,126 @@
+// CProcess and the process registry: typed parameters, configuration checks, factories.
+#include <catch2/catch.hpp>
+
+#include "doubles.hpp"
+#include "tripodal/processes/process_registry.hpp"
+
+using namespace tripodal;
+using namespace tripodal::test;
+
+namespace {
+
+ProcessDefinition def(std::string name, PetriNet net, std::vector<BindingParam> params = {}) {
+  ProcessDefinition d;
+  d.name = std::move(name);
+  d.net = std::move(net);
+  d.parameters = std::move(params);
+  d.where = SourceLocation{"robot.yaml", 12, 5};
+  return d;
+}
+
+}  // namespace
+
+TEST_CASE("CProcess binds defaults, configured values and plan values by the net's types", "[processes]") {
+  PetriNet net = pr_cleaning();
+  net.parameters.push_back(decl("speed_m_s", ValueType::number, Value{0.3}));
+  CProcess p(def("PrCleaning", net, {BindingParam{"wheel_type", "two_wheel", {}}}));
+  CHECK(p.behaviors() == std::vector<std::string>{"BhCleaning"});
+
+  BoundParameters b = p.bind({BindingParam{"section", "A", {}}, BindingParam{"speed_m_s", "0.5", {}}});
+  REQUIRE(b.ok);
+  CHECK(std::get<std::string>(b.values.at("wheel_type")) == "two_wheel");
+  CHECK(std::get<std::string>(b.values.at("section")) == "A");
+  CHECK(std::get<double>(b.values.at("speed_m_s")) == 0.5);
+
+  BoundParameters missing = p.bind({});
+  CHECK_FALSE(missing.ok);
+  CHECK(missing.error == "PrCleaning: parameter 'section' is required");
+
+  BoundParameters bad = p.bind({BindingParam{"section", "A", {}}, BindingParam{"speed_m_s", "fast", {}}});
+  CHECK_FALSE(bad.ok);
+  CHECK(bad.error == "PrCleaning: parameter 'speed_m_s' expects a number, got 'fast'");
+
+  BoundParameters unknown = p.bind({BindingParam{"room", "3211", {}}});
+  CHECK_FALSE(unknown.ok);
+  CHECK(unknown.error == "PrCleaning: parameter 'room' is not declared by its net");
+}
+
+TEST_CASE("CProcess refuses a bad definition with every problem located", "[processes]") {
+  PetriNet net = pr_cleaning();
+  net.parameters.push_back(decl("speed_m_s", ValueType::number));
+  net.place(*net.find_place("P1")).behavior->params.push_back(BindingParam{"radius_m", "$radius", {"cleaning.xml", 7, 3}});
+  try {
+    CProcess p(def("PrCleaning", net,
+                   {BindingParam{"speed_m_s", "fast", {"robot.yaml", 14, 20}}, BindingParam{"colour", "red", {"robot.yaml", 15, 9}}}));
+    FAIL("no error");
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    CHECK_THAT(m, Catch::Contains("robot.yaml:14:20: error: process 'PrCleaning': parameter 'speed_m_s' expects a number, got 'fast'"));
+    CHECK_THAT(m, Catch::Contains("robot.yaml:15:9: error: process 'PrCleaning': parameter 'colour' is not declared by net 'PrCleaning' (declared: section, wheel_type, speed_m_s)"));
+    CHECK_THAT(m, Catch::Contains("cleaning.xml:7:3: error: process 'PrCleaning': place 'P1' passes $radius to BhCleaning, but the net declares no parameter 'radius'"));
+    CHECK(e.diagnostics().error_count() == 3);
+  }
+
+  PetriNet no_outcome;
+  no_outcome.id = "loop";
+  no_outcome.add_place(place("P0", 1));
+  REQUIRE_THROWS_WITH(CProcess(def("PrLoop", no_outcome)),
+                      Catch::Contains("robot.yaml:12:5: error: process 'PrLoop': net 'loop' has no outcome place"));
+  PetriNet high = pr_auto_move();
+  high.level = NetLevel::high;
+  REQUIRE_THROWS_WITH(CProcess(def("PrHigh", high)), Catch::Contains("is a high-level net"));
+}
+
+TEST_CASE("resolve_binding_params substitutes $name and keeps literals as text", "[processes]") {
+  ParameterValues run{{"section", Value{std::string("B")}}, {"speed", Value{0.4}}};
+  ParameterValues out;
+  std::string error;
+  REQUIRE(resolve_binding_params({{"section", "$section", {}}, {"v", "$speed", {}}, {"pattern", "balloon", {}}}, run, out, error));
+  CHECK(std::get<std::string>(out.at("section")) == "B");
+  CHECK(std::get<double>(out.at("v")) == 0.4);
+  CHECK(std::get<std::string>(out.at("pattern")) == "balloon");
+  CHECK_FALSE(resolve_binding_params({{"x", "$nope", {}}}, run, out, error));
+  CHECK(error == "parameter 'x' refers to $nope, which the process does not have");
+}
+
+namespace {
+// An application process that derives its goal from a room name, as a robot would from its map.
+class PrGoToRoom final : public CProcess {
+ public:
+  using CProcess::CProcess;
+
+ protected:
+  std::string on_bind(ParameterValues& values) const override {
+    const auto& goal = std::get<std::string>(values.at("goal"));
+    if (goal.rfind("room ", 0) != 0) return "PrGoToRoom: goal must name a room, got '" + goal + "'";
+    values["goal"] = Value{goal.substr(5) + ".door"};
+    return {};
+  }
+};
+}  // namespace
+
+TEST_CASE("ProcessRegistry builds processes by factory type and refuses duplicates", "[processes]") {
+  ProcessRegistry reg;
+  reg.add(def("PrCleaning", pr_cleaning()));
+  reg.register_type("go_to_room", [](ProcessDefinition d) { return std::make_unique<PrGoToRoom>(std::move(d)); });
+  ProcessDefinition g = def("PrGoToRoom", pr_auto_move());
+  g.type = "go_to_room";
+  reg.add(std::move(g));
+  CHECK(reg.names() == std::vector<std::string>{"PrCleaning", "PrGoToRoom"});
+  REQUIRE(reg.find("PrGoToRoom") != nullptr);
+  CHECK(reg.find("PrNope") == nullptr);
+  BoundParameters b = reg.find("PrGoToRoom")->bind({BindingParam{"goal", "room 2111", {}}});
+  REQUIRE(b.ok);
+  CHECK(std::get<std::string>(b.values.at("goal")) == "2111.door");
+  CHECK(reg.find("PrGoToRoom")->bind({BindingParam{"goal", "kitchen", {}}}).error ==
+        "PrGoToRoom: goal must name a room, got 'kitchen'");
+
+  REQUIRE_THROWS_WITH(reg.add(def("PrCleaning", pr_cleaning())),
+                      Catch::Contains("robot.yaml:12:5: error: process 'PrCleaning' is defined twice"));
+  ProcessDefinition u = def("PrX", pr_cleaning());
+  u.type = "scripted";
+  REQUIRE_THROWS_WITH(reg.add(std::move(u)),
+                      Catch::Contains("process 'PrX': unknown process type 'scripted' (registered: go_to_room, net)"));
+  REQUIRE_THROWS_AS(reg.register_type("net", [](ProcessDefinition d) { return std::make_unique<CProcess>(std::move(d)); }),
+                    std::invalid_argument);
+}

@@ -1,0 +1,17 @@
+# Runs `tripodal describe PROFILE --dot`, renders the output with Graphviz (dot -Tsvg) and fails
+# unless both succeed and an SVG comes out.
+execute_process(COMMAND ${TRIPODAL} describe ${PROFILE} --dot RESULT_VARIABLE rc OUTPUT_FILE ${OUT}.dot ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "tripodal describe --dot: exit code ${rc}: ${err}")
+endif()
+execute_process(COMMAND ${DOT} -Tsvg ${OUT}.dot -o ${OUT}.svg RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "dot -Tsvg refused the diagram: ${err}")
+endif()
+file(READ ${OUT}.svg svg)
+if(NOT svg MATCHES "<svg")
+  message(FATAL_ERROR "no SVG produced")
+endif()
+string(REGEX MATCHALL "class=\"cluster\"" clusters "${svg}")
+list(LENGTH clusters n)
+message("svg ok: ${n} layer clusters")

@@ -1,0 +1,225 @@
+// Start-up checks of a robot profile: located load errors, exactly one provider per input, the
+// layering rules R1-R5 (docs/processes.md), refusals to assemble, and the describe renderings.
+#include <catch2/catch.hpp>
+
+#include "robot_doubles.hpp"
+#include "tripodal/robot/layering.hpp"
+#include "tripodal/robot/robot.hpp"
+
+using namespace tripodal;
+using namespace tripodal::test;
+
+namespace {
+
+const std::filesystem::path kRobots = std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs/robots";
+
+// A small valid robot: a laser, a map, a localizer, a section splitter, two behaviors, a base.
+std::string profile(const std::string& resources, const std::string& navigation, const std::string& behaviors,
+                    const std::string& extra = {}) {
+  return "robot: {name: testbot}\n"
+         "controllers:\n  - {name: base, type: omni}\n"
+         "resources:\n" + resources +
+         "navigation:\n" + navigation +
+         "behaviors:\n" + behaviors +
+         "processes:\n"
+         "  - {name: PrAutoMove, net: ../petri/PrAutoMove.xml}\n"
+         "tasks: ../tasks/cleaning.yaml\n" + extra;
+}
+
+const std::string kResources = "  - {name: front_laser, type: LaserScanner}\n";
+const std::string kNavigation =
+    "  - {name: maps, type: GridMaps}\n"
+    "  - {name: localizer, type: Localizer}\n"
+    "  - {name: section_splitter, type: SectionSplitter}\n";
+const std::string kBehaviors = "  - BhAutoMove\n  - BhCleaning\n";
+
+struct Catalog {
+  TestWorld world;
+  BehaviorRegistry behaviors;
+  ModuleRegistry modules;
+  Catalog() {
+    register_test_behaviors(behaviors, world);
+    register_test_modules(modules, world);
+  }
+  RobotCatalog get() { return RobotCatalog{&modules, &behaviors, &default_controller_registry()}; }
+
+  // Runs the checks the robot runs at start-up; returns every diagnostic.
+  std::string check(const std::string& yaml, RobotDescription* out = nullptr) {
+    RobotProfile p = load_robot_profile_from_string(yaml, "testbot.yaml", kRobots);
+    TaskLibrary tasks = TaskLibrary::load(p.tasks);
+    Diagnostics d;
+    RobotDescription r = describe_robot(p, get(), knowledge_inputs(tasks), d);
+    if (out) *out = r;
+    return d.str();
+  }
+};
+
+}  // namespace
+
+TEST_CASE("A valid profile passes the checks", "[robot]") {
+  Catalog c;
+  RobotDescription r;
+  CHECK(c.check(profile(kResources, kNavigation, kBehaviors), &r).empty());
+  CHECK(r.modules.size() == 3 + 1 + 1 + 3 + 2);
+}
+
+TEST_CASE("Missing providers are refused with the consumer and the information named", "[robot]") {
+  Catalog c;
+  // No section splitter: the clean task asks sections(room); no map: the localizer needs grid_map.
+  const std::string diag = c.check(profile(kResources,
+                                           "  - {name: localizer, type: Localizer}\n", kBehaviors));
+  CHECK_THAT(diag, Catch::Contains("testbot.yaml:1:8: error: missing provider: deliberate core component 'planner' needs "
+                                   "'sections', but no module provides it"));
+  CHECK_THAT(diag, Catch::Contains("testbot.yaml:7:5: error: missing provider: sequencing navigation 'localizer' needs "
+                                   "'grid_map', but no module provides it"));
+  CHECK_THAT(diag, Catch::Contains("testbot.yaml:9:5: error: missing provider: reactive behavior 'BhAutoMove' needs 'grid_map'"));
+}
+
+TEST_CASE("Duplicate providers are refused with every provider located", "[robot]") {
+  Catalog c;
+  const std::string diag = c.check(profile(kResources + "  - {name: rear_laser, type: LaserScanner}\n", kNavigation, kBehaviors));
+  CHECK_THAT(diag, Catch::Contains("testbot.yaml:9:5: error: duplicate providers: sequencing navigation 'localizer' needs "
+                                   "'laser_scan', which 2 modules provide: front_laser (testbot.yaml:5:5), rear_laser "
+                                   "(testbot.yaml:6:5); exactly one must"));
+  // Rewiring in the profile resolves it: the rear laser provides its own information.
+  CHECK(c.check(profile(kResources + "  - {name: rear_laser, type: LaserScanner, outputs: [rear_scan]}\n", kNavigation, kBehaviors))
+            .empty());
+}
+
+TEST_CASE("Layering rules R1-R5 are enforced with the rule named", "[robot]") {
+  Catalog c;
+  SECTION("R1: a navigation module in the reactive layer") {
+    const std::string diag = c.check(profile(
+        kResources, kNavigation + "  - {name: planner_helper, type: Helper, layer: reactive, outputs: [hint]}\n", kBehaviors));
+    CHECK_THAT(diag, Catch::Contains("testbot.yaml:10:5: error: module 'planner_helper' is a navigation but sits in the reactive "
+                                     "layer; navigation modules belong to the sequencing layer (rule R1)"));
+  }
+  SECTION("R2: a resource depending on the deliberate layer") {
+    const std::string diag = c.check(profile(
+        kResources + "  - {name: display, type: Display, layer: reactive, inputs: [user_goal]}\n", kNavigation, kBehaviors,
+        "hri:\n  - {name: voice, type: Voice, layer: deliberate, outputs: [user_goal]}\n"));
+    CHECK_THAT(diag, Catch::Contains("testbot.yaml:6:5: error: layering: reactive resource 'display' takes 'user_goal' from "
+                                     "deliberate hri 'voice'; reactive modules must not depend on the deliberate layer (rule R2)"));
+  }
+  SECTION("R3: the deliberate layer reading raw sensor data") {
+    const std::string diag = c.check(profile(kResources, kNavigation, kBehaviors,
+                                             "hri:\n  - {name: voice, type: Voice, layer: deliberate, inputs: [laser_scan]}\n"));
+    CHECK_THAT(diag, Catch::Contains("error: layering: deliberate hri 'voice' takes 'laser_scan' from reactive resource "
+                                     "'front_laser'; raw data reaches the deliberate layer only through a sequencing module (rule R3)"));
+  }
+  SECTION("R4: a behavior driving the controller directly") {
+    const std::string diag = c.check(
+        "robot: {name: testbot}\n"
+        "controllers:\n  - {name: base, type: omni, inputs: [cmd_vel, stop_command]}\n"
+        "resources:\n" + kResources + "navigation:\n" + kNavigation +
+        "behaviors:\n" + kBehaviors + "  - {name: BhEmergencyStop, type: Stop, layer: reactive, outputs: [stop_command]}\n"
+        "tasks: ../tasks/cleaning.yaml\n");
+    CHECK_THAT(diag, Catch::Contains("testbot.yaml:3:5: error: layering: controller 'base' takes 'stop_command' directly from "
+                                     "behavior 'BhEmergencyStop'; motion commands reach controllers only through the behavior "
+                                     "coordinator (rule R4)"));
+  }
+  SECTION("R5: a behavior depending on another behavior") {
+    const std::string diag = c.check(profile(
+        kResources, kNavigation,
+        kBehaviors + "  - {name: BhA, type: A, layer: reactive, outputs: [waypoint, behavior_command]}\n"
+                     "  - {name: BhB, type: B, layer: reactive, inputs: [waypoint], outputs: [behavior_command]}\n"));
+    CHECK_THAT(diag, Catch::Contains("testbot.yaml:14:5: error: layering: behavior 'BhB' takes 'waypoint' from behavior 'BhA'; "
+                                     "behaviors are independent and combined only by the behavior coordinator (rule R5)"));
+  }
+}
+
+TEST_CASE("Module types: a declared layer must agree; unknown types must be declared", "[robot]") {
+  Catalog c;
+  std::string diag = c.check(profile("  - {name: front_laser, type: LaserScanner, layer: sequencing}\n", kNavigation, kBehaviors));
+  CHECK_THAT(diag, Catch::Contains("testbot.yaml:5:5: error: module 'front_laser' declares the sequencing layer, but its type "
+                                   "'LaserScanner' is a reactive-layer module"));
+  diag = c.check(profile(kResources, kNavigation, kBehaviors + "  - BhDance\n"));
+  CHECK_THAT(diag, Catch::Contains("testbot.yaml:13:5: error: unknown behavior type 'BhDance' (registered: BhAutoMove, BhCleaning, "
+                                   "BhCleaningTwoWheel, BhGlobalLocalization); register it, or declare it here with layer, inputs "
+                                   "and outputs"));
+  diag = c.check(profile("  - {name: front_laser, type: GridMaps}\n", kNavigation, kBehaviors));
+  CHECK_THAT(diag, Catch::Contains("module 'front_laser': type 'GridMaps' is a navigation, but it is listed as a resource"));
+}
+
+TEST_CASE("Profile load errors are all reported, located", "[robot]") {
+  const std::string bad =
+      "robot: {name: bad}\n"
+      "colour: red\n"
+      "controllers:\n  - {name: base, type: omni}\n"
+      "loops:\n  - {name: fast, period_s: -1, controller: wheels}\n"
+      "resources:\n  - {name: laser, type: LaserScanner, layer: upstairs, wires: 3}\n"
+      "navigation:\n  - {name: laser, type: GridMaps}\n"
+      "processes:\n  - {name: PrX, net: nowhere.xml}\n  - {name: PrY}\n";
+  try {
+    (void)load_robot_profile_from_string(bad, "bad.yaml", kRobots);
+    FAIL("no error");
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    CHECK_THAT(m, Catch::Contains("bad.yaml:2:1: error: unknown key 'colour'; expected: robot, controllers, loops"));
+    CHECK_THAT(m, Catch::Contains("bad.yaml:6:28: error: period_s must be a positive number of seconds, got '-1'"));
+    CHECK_THAT(m, Catch::Contains("bad.yaml:6:5: error: loop 'fast' drives controller 'wheels', which the profile does not list"));
+    CHECK_THAT(m, Catch::Contains("bad.yaml:8:46: error: unknown layer 'upstairs'; expected one of: deliberate, sequencing, reactive"));
+    CHECK_THAT(m, Catch::Contains("bad.yaml:8:56: error: unknown key 'wires' in a resource entry"));
+    CHECK_THAT(m, Catch::Contains("bad.yaml:10:5: error: module name 'laser' is used twice (first at bad.yaml:8:5)"));
+    CHECK_THAT(m, Catch::Contains("bad.yaml:12:22: error: net file 'nowhere.xml' not found"));
+    CHECK_THAT(m, Catch::Contains("bad.yaml:13:5: error: process 'PrY' needs a net file (net: FILE)"));
+    CHECK(e.diagnostics().error_count() == 8);
+  }
+}
+
+TEST_CASE("The robot refuses to start with every problem listed", "[robot]") {
+  SimClock clock;
+  SECTION("modules without implementations") {
+    BehaviorRegistry behaviors;
+    ModuleRegistry modules;
+    RobotCatalog catalog{&modules, &behaviors, &default_controller_registry()};
+    try {
+      (void)Robot::assemble(load_robot_profile(kRobots / "psr2.yaml"), catalog, clock);
+      FAIL("started");
+    } catch (const ConfigError& e) {
+      const std::string m = e.what();
+      CHECK_THAT(m, Catch::Contains("psr2.yaml:20:5: error: module 'front_laser' cannot be started: no factory is registered for "
+                                    "type 'LaserScanner'"));
+      CHECK_THAT(m, Catch::Contains("psr2.yaml:47:5: error: behavior 'BhAutoMove' cannot be started: no behavior type 'BhAutoMove' "
+                                    "is registered"));
+    }
+  }
+  SECTION("a process binding a behavior the robot lacks; a task naming a process it lacks") {
+    Catalog c;
+    const std::string yaml = profile(kResources, kNavigation, "  - BhCleaning\n");  // PrAutoMove binds BhAutoMove
+    try {
+      (void)Robot::assemble(load_robot_profile_from_string(yaml, "testbot.yaml", kRobots), c.get(), clock);
+      FAIL("started");
+    } catch (const ConfigError& e) {
+      const std::string m = e.what();
+      CHECK_THAT(m, Catch::Contains("unknown behavior 'BhAutoMove'"));
+      CHECK_THAT(m, Catch::Contains("cleaning.yaml:15:15: error: unknown process 'PrCleaning'"));
+    }
+  }
+  SECTION("a layering violation") {
+    Catalog c;
+    const std::string yaml = profile(kResources, kNavigation, kBehaviors,
+                                     "hri:\n  - {name: voice, type: Voice, layer: deliberate, inputs: [laser_scan]}\n");
+    REQUIRE_THROWS_WITH(Robot::assemble(load_robot_profile_from_string(yaml, "testbot.yaml", kRobots), c.get(), clock),
+                        Catch::Contains("(rule R3)"));
+  }
+}
+
+TEST_CASE("describe_text lists modules by layer; describe_dot draws clusters and information edges", "[robot]") {
+  Catalog c;
+  RobotDescription r;
+  REQUIRE(c.check(profile(kResources, kNavigation, kBehaviors), &r).empty());
+  const std::string text = describe_text(r);
+  CHECK_THAT(text, Catch::StartsWith("robot testbot\n\ndeliberate layer\n  planner (core, CPlanner)\n      in:  sections, process_result\n"));
+  CHECK_THAT(text, Catch::Contains("sequencing layer\n  process_supervisor (core, CProcessSupervisor)\n"));
+  CHECK_THAT(text, Catch::Contains("  localizer (navigation, Localizer)\n      in:  laser_scan, odometry, grid_map\n      out: map_from_base\n"));
+  CHECK_THAT(text, Catch::Contains("  configurations (core): PrAutoMove\n"));
+  CHECK_THAT(text, Catch::Contains("reactive layer\n  behavior_coordinator (core, CBehaviorCoordinator)\n      in:  behavior_command*\n"));
+  const std::string dot = describe_dot(r);
+  CHECK_THAT(dot, Catch::StartsWith("digraph \"testbot\" {"));
+  CHECK_THAT(dot, Catch::Contains("subgraph cluster_deliberate") && Catch::Contains("subgraph cluster_reactive"));
+  CHECK_THAT(dot, Catch::Contains("\"section_splitter\" -> \"planner\" [label=\"sections\", constraint=false];"));
+  CHECK_THAT(dot, Catch::Contains("\"front_laser\" -> \"localizer\" [label=\"laser_scan\", constraint=false];"));
+  CHECK_THAT(dot, Catch::Contains("\"behavior_coordinator\" -> \"base\" [label=\"cmd_vel\"];"));
+  CHECK_THAT(dot, Catch::Contains("\"process_supervisor\" -> \"BhCleaning\" [style=dashed"));
+}

@@ -1,0 +1,221 @@
+// The PSR-2 robot assembled from configs/robots/psr2.yaml with test doubles registered under the
+// profile's type names, running the cleaning task end to end through the planner, the process
+// supervisor, the paper's nets (configs/petri) and CBehavior instances.
+#include <catch2/catch.hpp>
+
+#include <functional>
+
+#include "robot_doubles.hpp"
+#include "tripodal/planner/lifecycle_recorder.hpp"
+#include "tripodal/robot/robot.hpp"
+
+using namespace tripodal;
+using namespace tripodal::test;
+
+namespace {
+
+const std::filesystem::path kProfile = std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs/robots/psr2.yaml";
+
+struct Psr2 {
+  SimClock clock;
+  TestWorld world;
+  BehaviorRegistry behaviors;
+  ModuleRegistry modules;
+  std::unique_ptr<Robot> robot;
+  LifecycleRecorder life{true};
+
+  Psr2() {
+    register_test_behaviors(behaviors, world);
+    register_test_modules(modules, world);
+    RobotCatalog catalog{&modules, &behaviors, &default_controller_registry()};
+    robot = Robot::assemble(load_robot_profile(kProfile), catalog, clock);
+    robot->planner().add_observer(life);
+    robot->supervisor().add_observer(life);
+  }
+
+  void run(double end_s, const std::function<void(double)>& at = {}) {
+    robot->step();
+    while (robot->planner().busy() && to_seconds(clock.now()) < end_s - 1e-9) {
+      clock.advance(from_seconds(0.1));
+      if (at) at(to_seconds(clock.now()));
+      robot->step();
+    }
+  }
+
+  [[nodiscard]] std::vector<std::string> task_lines() const {
+    std::vector<std::string> out;
+    for (const auto& e : life.entries()) {
+      if (e.text.rfind("  ", 0) == 0) continue;
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%.1f ", to_seconds(e.time));
+      out.push_back(buf + e.text);
+    }
+    return out;
+  }
+};
+
+bool at_time(double t, double x) { return t > x - 0.05 && t < x + 0.05; }
+
+}  // namespace
+
+TEST_CASE("PSR-2 assembles from its profile with the paper's nets", "[robot]") {
+  Psr2 p;
+  CHECK(p.robot->processes().names() == std::vector<std::string>{"PrAutoMove", "PrCleaning", "PrGlobalLocalization"});
+  CHECK(p.robot->behaviors().names() ==
+        std::vector<std::string>{"BhAutoMove", "BhCleaning", "BhCleaningTwoWheel", "BhGlobalLocalization"});
+  CHECK(p.robot->module("localizer") != nullptr);
+  CHECK(p.robot->module("BhCleaning") == nullptr);
+  CHECK(p.robot->coordinator().input_count() == 4);
+  const auto& mods = p.robot->description().modules;
+  REQUIRE(mods.size() == 3 + 1 + 2 + 3 + 4);
+  CHECK(mods[0].name == "planner");
+  CHECK(mods[0].inputs == std::vector<std::string>{"sections", "process_result"});
+}
+
+TEST_CASE("PSR-2 cleans a room of two sections: PrAutoMove and PrCleaning in order", "[robot]") {
+  Psr2 p;
+  REQUIRE(p.robot->command("clean the room 3211").accepted);
+  p.run(200.0);
+  CHECK(p.robot->planner().state() == TaskState::succeeded);
+  CHECK(p.task_lines() == std::vector<std::string>{
+                              "0.0 task clean started (\"clean the room 3211\"): PrAutoMove(goal=A.entry) -> "
+                              "PrCleaning(section=A) -> PrAutoMove(goal=B.entry) -> PrCleaning(section=B)",
+                              "0.0 process X0 PrAutoMove(goal=A.entry) started",
+                              "3.0 process X0 PrAutoMove succeeded",
+                              "3.0 process X1 PrCleaning(section=A) started",
+                              "13.0 process X1 PrCleaning succeeded",
+                              "13.0 process X2 PrAutoMove(goal=B.entry) started",
+                              "16.0 process X2 PrAutoMove succeeded",
+                              "16.0 process X3 PrCleaning(section=B) started",
+                              "26.0 process X3 PrCleaning succeeded",
+                              "26.0 task clean succeeded",
+                          });
+  // wheel_type = omni (profile) selects BhCleaning in the PrCleaning net, with the section.
+  CHECK_THAT(p.life.str(), Catch::Contains("X1 activate BhCleaning(section=A)") &&
+                               Catch::Contains("X1 PrCleaning fire t0") && !Catch::Contains("BhCleaningTwoWheel("));
+  CHECK(p.robot->coordinator().output().winner.empty());  // nothing drives once the task is done
+}
+
+TEST_CASE("PSR-2: a localization loss that recovers within the delay only pauses", "[robot]") {
+  Psr2 p;
+  REQUIRE(p.robot->command("clean the room 3211").accepted);
+  p.run(200.0, [&](double t) {
+    if (at_time(t, 6.0)) p.world.localized = false;
+    if (at_time(t, 9.0)) p.world.localized = true;
+  });
+  CHECK(p.robot->planner().state() == TaskState::succeeded);
+  CHECK(p.robot->planner().report().recoveries.empty());
+  CHECK_THAT(p.life.str(), Catch::Contains("X1 PrCleaning fire t3 [localizer.lost]") &&
+                               Catch::Contains("X1 PrCleaning fire t2 [localizer.ok]"));
+  // Three seconds standing still.
+  CHECK(to_seconds(*p.robot->planner().report().finished) == Approx(29.0));
+}
+
+TEST_CASE("PSR-2: a persistent loss inserts PrGlobalLocalization, retries, and the task succeeds", "[robot]") {
+  Psr2 p;
+  REQUIRE(p.robot->command("clean the room 3211").accepted);
+  p.run(200.0, [&](double t) {
+    if (at_time(t, 6.0)) p.world.localized = false;
+  });
+  CHECK(p.robot->planner().state() == TaskState::succeeded);
+  const auto lines = p.task_lines();
+  CHECK(lines == std::vector<std::string>{
+                     "0.0 task clean started (\"clean the room 3211\"): PrAutoMove(goal=A.entry) -> PrCleaning(section=A) -> "
+                     "PrAutoMove(goal=B.entry) -> PrCleaning(section=B)",
+                     "0.0 process X0 PrAutoMove(goal=A.entry) started",
+                     "3.0 process X0 PrAutoMove succeeded",
+                     "3.0 process X1 PrCleaning(section=A) started",
+                     "16.0 process X1 PrCleaning failed: localization fault",
+                     "16.0 recovery: fault \"localization fault\" of PrCleaning: insert PrGlobalLocalization, then retry (1/2); "
+                     "plan: PrGlobalLocalization() -> PrCleaning(section=A) -> PrAutoMove(goal=B.entry) -> PrCleaning(section=B)",
+                     "16.0 process X0 PrGlobalLocalization() started",
+                     "18.0 process X0 PrGlobalLocalization succeeded",
+                     "18.0 process X1 PrCleaning(section=A) started",
+                     "28.0 process X1 PrCleaning succeeded",
+                     "28.0 process X2 PrAutoMove(goal=B.entry) started",
+                     "31.0 process X2 PrAutoMove succeeded",
+                     "31.0 process X3 PrCleaning(section=B) started",
+                     "41.0 process X3 PrCleaning succeeded",
+                     "41.0 task clean succeeded",
+                 });
+  CHECK_THAT(p.life.str(), Catch::Contains("16.000 s    X1 PrCleaning fire t5") &&
+                               Catch::Contains("16.000 s    X1 deactivate BhCleaning"));
+}
+
+TEST_CASE("PSR-2: the retry limit makes the task fail with a report", "[robot]") {
+  Psr2 p;
+  REQUIRE(p.robot->command("clean the room 3211").accepted);
+  int cleaning_ticks = 0;
+  p.run(300.0, [&](double) {
+    // Lost one second into every cleaning run; only global localization finds the way again.
+    CBehavior* b = p.robot->behaviors().find("BhCleaning");
+    cleaning_ticks = b->running() ? cleaning_ticks + 1 : 0;
+    if (cleaning_ticks == 10) p.world.localized = false;
+  });
+  REQUIRE(p.robot->planner().state() == TaskState::failed);
+  const TaskReport& r = p.robot->planner().report();
+  CHECK(r.reason == "retry limit reached: \"localization fault\" recovered 2 time(s) (max_retries 2), PrCleaning failed again");
+  CHECK(r.recoveries.size() == 2);
+  CHECK(std::count_if(r.processes.begin(), r.processes.end(), [](const ProcessRecord& x) { return x.step.process == "PrCleaning"; }) == 3);
+  CHECK(p.robot->supervisor().active_behaviors().empty());
+  CHECK_THAT(r.str(), Catch::Contains("failed: retry limit reached") && Catch::Contains("recovery: fault \"localization fault\""));
+}
+
+TEST_CASE("PSR-2 refuses an unknown command and runs nothing", "[robot]") {
+  Psr2 p;
+  const CommandAnswer a = p.robot->command("fetch me the newspaper");
+  CHECK_FALSE(a.accepted);
+  CHECK_THAT(a.text, Catch::Contains("not understood") && Catch::Contains("Possible commands:") &&
+                         Catch::Contains("clean [the] room {room}") && Catch::Contains("patrol [the] [rooms] {rooms...}"));
+  p.run(5.0);
+  CHECK(p.robot->planner().state() == TaskState::idle);
+  CHECK(p.robot->supervisor().active_behaviors().empty());
+}
+
+TEST_CASE("PSR-2: a module that throws becomes a fault; the loop goes on", "[robot]") {
+  Psr2 p;
+  REQUIRE(p.robot->command("clean the room 3211").accepted);
+  REQUIRE_NOTHROW(p.run(200.0, [&](double t) {
+    if (at_time(t, 5.0)) p.world.localizer_throws = true;
+  }));
+  REQUIRE(p.robot->planner().state() == TaskState::failed);
+  CHECK(p.robot->planner().report().processes.back().message == "module localizer failed: scan matcher crashed");
+  CHECK(p.robot->planner().report().reason ==
+        "no recovery rule for fault \"module localizer failed: scan matcher crashed\" of PrCleaning");
+  // The robot still answers and runs after the failed task once the localizer works again.
+  p.world.localizer_throws = false;
+  REQUIRE(p.robot->command("clean room 2111").accepted);
+  p.run(400.0);
+  CHECK(p.robot->planner().state() == TaskState::succeeded);
+}
+
+TEST_CASE("PSR-2: a silent localizer trips the watchdog, which the net treats as a loss", "[robot]") {
+  Psr2 p;
+  REQUIRE(p.robot->command("clean the room 2111").accepted);
+  p.run(200.0, [&](double t) {
+    if (at_time(t, 5.0)) p.world.localizer_silent = true;
+  });
+  // Watchdog 1 s: localizer.lost at 5.9 s (last heartbeat 4.9 s); the completion of BhCleaning is
+  // then refused by the net until the 10 s delay ends in the fault place. The watchdog fires once
+  // per silence, so the retried PrCleaning (after global localization) completes.
+  CHECK_THAT(p.life.str(), Catch::Contains("fault localizer: stopped answering (no heartbeat for 1.000 s)"));
+  CHECK_THAT(p.life.str(), Catch::Contains("15.900 s  process X1 PrCleaning failed: localization fault"));
+  CHECK(p.robot->planner().state() == TaskState::succeeded);
+  CHECK(p.robot->planner().report().recoveries.size() == 1);
+}
+
+TEST_CASE("PSR-2: the same task and event sequence give the same trace", "[robot]") {
+  auto once = [] {
+    Psr2 p;
+    REQUIRE(p.robot->command("clean the room 3211").accepted);
+    p.run(300.0, [&](double t) {
+      if (at_time(t, 4.0)) p.world.localized = false;
+      if (at_time(t, 6.0)) p.world.localized = true;
+      if (at_time(t, 20.0)) p.world.localized = false;
+    });
+    return p.life.str();
+  };
+  const std::string a = once();
+  CHECK(a == once());
+  CHECK_THAT(a, Catch::Contains("recovery:") && Catch::EndsWith("task clean succeeded\n"));
+}
