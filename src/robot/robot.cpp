@@ -41,6 +41,7 @@ struct Robot::Impl {
   CBehaviorCoordinator coordinator;
   std::unique_ptr<CProcessSupervisor> supervisor;
   std::unique_ptr<CPlanner> planner;
+  BehaviorContext activation_context;  // what behaviors see when the supervisor activates them
 
   Impl(const Clock& c, RobotOptions o) : clock(c), options(std::move(o)), behaviors(c) {}
 };
@@ -134,6 +135,11 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotC
   // Wiring: the coordinator's inputs in profile order (earlier behaviors win ties by priority).
   int priority = static_cast<int>(profile.behaviors.size());
   for (const ModuleEntry& b : profile.behaviors) m->coordinator.add_input(CoordinatorInputConfig{b.name, priority--});
+  m->activation_context.period = m->options.period;
+  m->activation_context.resources = m->options.resources;
+  m->activation_context.navi = m->options.navigation;
+  m->activation_context.base = m->options.base;
+  m->behaviors.set_context(&m->activation_context);
   m->supervisor = std::make_unique<CProcessSupervisor>(m->behaviors, clock, m->options.supervisor);
   for (auto& [name, mod] : m->modules) {
     mod->attach(ModulePort(*m->supervisor, name));
@@ -169,6 +175,10 @@ void Robot::step() {
   BehaviorContext ctx;
   ctx.now = now;
   ctx.period = m.options.period;
+  ctx.resources = m.options.resources;
+  ctx.navi = m.options.navigation;
+  ctx.base = m.options.base;
+  m.activation_context = ctx;
   m.behaviors.step_active(ctx, [&](std::string_view name, const std::optional<Twist2D>& cmd) {
     auto id = m.coordinator.find_input(name);
     if (!id) return;

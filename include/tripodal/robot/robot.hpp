@@ -33,6 +33,11 @@ struct RobotOptions {
   std::function<void(ProcessRegistry&)> register_process_types;
   /// Loads a process net; default: load_net_or_throw checking behavior names against the profile.
   std::function<PetriNet(const std::filesystem::path&)> load_net;
+  /// What behaviors see in their context (BehaviorContext): the resources and navigation data
+  /// the robot program keeps up to date (not owned; nullptr: none) and the base's capabilities.
+  const ResourceTable* resources = nullptr;
+  const NavigationData* navigation = nullptr;
+  BaseCapabilities base;
 };
 
 class Robot final {

@@ -1,0 +1,534 @@
+#include "tripodal/behaviors/navigation_behaviors.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "tripodal/controllers/kinematics.hpp"
+
+namespace tripodal {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kCornerRad = 0.6;  // a bend of the path the lookahead point does not cross
+
+ParameterSpec number(std::string name, double def, std::string unit, std::string description,
+                     std::optional<double> min = std::nullopt, std::optional<double> max = std::nullopt) {
+  return {std::move(name), ValueType::number, Value{def}, std::move(unit), std::move(description), min, max};
+}
+ParameterSpec text(std::string name, std::string def, std::string description) {
+  return {std::move(name), ValueType::string, Value{std::move(def)}, "", std::move(description), {}, {}};
+}
+
+ModuleManifest behavior_manifest(std::string name, std::string description, std::vector<std::string> inputs,
+                                 std::vector<ParameterSpec> parameters) {
+  ModuleManifest m;
+  m.name = std::move(name);
+  m.layer = Layer::reactive;
+  m.kind = ModuleKind::behavior;
+  m.description = std::move(description);
+  m.inputs = std::move(inputs);
+  m.outputs = {"behavior_command"};
+  m.parameters = std::move(parameters);
+  return m;
+}
+
+std::vector<ParameterSpec> following_parameters(double speed, double lookahead) {
+  return {
+      number("max_speed_m_s", speed, "m/s", "Cruise speed along the path", 1e-3, 5.0),
+      number("lookahead_m", lookahead, "m", "Arc length from the closest path point to the point steered at", 0.02, 5.0),
+      number("max_yaw_rate_rad_s", 1.0, "rad/s", "Largest commanded yaw rate", 1e-3, 10.0),
+      number("stop_distance_m", 0.05, "m", "Translation stops when an obstacle ahead is this close to the body", 0.0, 2.0),
+      number("slow_distance_m", 0.4, "m", "Speed falls linearly from here to stop_distance_m", 0.0, 5.0),
+      number("blocked_timeout_s", 10.0, "s", "Fail with 'path blocked' after being stopped this long", 0.1, 3600.0),
+      text("laser", "", "Laser resource watched for obstacles (empty: the first laser)"),
+  };
+}
+
+double clamp_abs(double v, double limit) noexcept { return std::clamp(v, -limit, limit); }
+
+navi::Point2D point_of(const Pose2D& p) noexcept { return {p.x_m, p.y_m}; }
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// NaviWorkspace
+
+namespace {
+
+navi::CoverageOptions coverage_options(const NaviWorkspaceOptions& o) {
+  navi::CoverageOptions c;
+  c.cleaning_width_m = o.cleaning_width_m;
+  c.robot_radius_m = o.robot_radius_m;
+  c.overlap_m = o.overlap_m;
+  return c;
+}
+
+navi::PathPlannerOptions planner_options(const NaviWorkspaceOptions& o) {
+  navi::PathPlannerOptions p;
+  p.robot_radius_m = o.robot_radius_m;
+  return p;
+}
+
+}  // namespace
+
+NaviWorkspace::NaviWorkspace(navi::OccupancyGrid grid, navi::RegionMap regions, NaviWorkspaceOptions options)
+    : grid_(std::move(grid)),
+      regions_(std::move(regions)),
+      options_(options),
+      sections_(navi::CSectionSplitter(options.splitter).split(grid_)),
+      planner_(grid_, planner_options(options)),
+      coverage_(grid_, coverage_options(options)),
+      cleaned_(grid_) {}
+
+const navi::Section* NaviWorkspace::section(std::string_view name) const noexcept {
+  for (const navi::Section& s : sections_.sections) {
+    if (s.name == name) return &s;
+  }
+  return nullptr;
+}
+
+NaviWorkspace::RoomSections NaviWorkspace::sections_of_room(std::string_view room) const {
+  RoomSections out;
+  const navi::Region* r = regions_.room(room);
+  if (r == nullptr) {
+    out.error = "unknown room '" + std::string(room) + "' (known:";
+    for (const auto& n : regions_.room_names()) out.error += " " + n;
+    out.error += ")";
+    return out;
+  }
+  for (const navi::Section& s : sections_.sections) {
+    std::size_t inside = 0;
+    for (const std::size_t i : s.cells) inside += r->contains(grid_.cell_center(grid_.cell(i))) ? 1 : 0;
+    if (2 * inside > s.cells.size()) out.names.push_back(s.name);
+  }
+  if (out.names.empty()) {
+    out.error = "room '" + std::string(room) + "' holds no section of the map";
+    return out;
+  }
+  out.ok = true;
+  return out;
+}
+
+std::optional<navi::Point2D> NaviWorkspace::resolve_goal(std::string_view name, navi::Point2D from) {
+  constexpr std::string_view kEntry = ".entry";
+  if (name.size() > kEntry.size() && name.substr(name.size() - kEntry.size()) == kEntry) {
+    const std::string_view sec = name.substr(0, name.size() - kEntry.size());
+    const navi::Section* s = section(sec);
+    if (s == nullptr) return std::nullopt;
+    auto it = entry_plans_.find(sec);
+    if (it == entry_plans_.end()) it = entry_plans_.emplace(std::string(sec), coverage_.balloon(*s, from)).first;
+    if (it->second.path.empty()) return s->centroid;
+    return it->second.path.front();
+  }
+  if (const navi::MapNode* n = regions_.node(name)) return navi::Point2D{n->pose.x_m, n->pose.y_m};
+  if (const navi::Section* s = section(name)) return s->centroid;
+  if (const navi::Region* r = regions_.room(name)) {
+    navi::Point2D c;
+    for (const auto& p : r->polygon) {
+      c.x_m += p.x_m / static_cast<double>(r->polygon.size());
+      c.y_m += p.y_m / static_cast<double>(r->polygon.size());
+    }
+    return c;
+  }
+  return std::nullopt;
+}
+
+NaviWorkspace::SectionProgress& NaviWorkspace::progress(const navi::Section& section, navi::Point2D from) {
+  auto it = progress_.find(section.name);
+  if (it != progress_.end() && !it->second.finished) return it->second;
+  SectionProgress p;
+  if (auto e = entry_plans_.find(section.name); e != entry_plans_.end()) {
+    p.plan = std::move(e->second);  // the entry BhAutoMove went to is this path's first point
+    entry_plans_.erase(e);
+  } else {
+    p.plan = coverage_.balloon(section, from);
+  }
+  if (it == progress_.end()) return progress_.emplace(section.name, std::move(p)).first->second;
+  it->second = std::move(p);
+  return it->second;
+}
+
+bool NaviWorkspace::relocalize(Time now) const noexcept {
+  if (!relocalize_) return false;
+  try {
+    return relocalize_(now);
+  } catch (...) {
+    return false;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// PathTracker
+
+void PathTracker::reset(std::vector<navi::Point2D> path, double start_m) {
+  pts_ = std::move(path);
+  s_.assign(pts_.size(), 0.0);
+  for (std::size_t i = 1; i < pts_.size(); ++i) {
+    s_[i] = s_[i - 1] + std::hypot(pts_[i].x_m - pts_[i - 1].x_m, pts_[i].y_m - pts_[i - 1].y_m);
+  }
+  s_now_ = std::clamp(start_m, 0.0, length_m());
+  seg_ = 0;
+  while (seg_ + 1 < s_.size() && s_[seg_ + 1] <= s_now_) ++seg_;
+}
+
+navi::Point2D PathTracker::at(double s) const noexcept {
+  if (pts_.empty()) return {};
+  if (s <= 0.0) return pts_.front();
+  if (s >= s_.back()) return pts_.back();
+  const auto it = std::upper_bound(s_.begin(), s_.end(), s);
+  const std::size_t j = static_cast<std::size_t>(it - s_.begin());  // s_[j-1] <= s < s_[j]
+  const double len = s_[j] - s_[j - 1];
+  const double t = len > 0.0 ? (s - s_[j - 1]) / len : 0.0;
+  return {pts_[j - 1].x_m + t * (pts_[j].x_m - pts_[j - 1].x_m), pts_[j - 1].y_m + t * (pts_[j].y_m - pts_[j - 1].y_m)};
+}
+
+double PathTracker::heading_at(double s) const noexcept {
+  // Direction of a chord a few centimetres long: the dense cell-centre chains of the coverage
+  // paths zig-zag at the cell scale, a single segment's direction would be noise.
+  const navi::Point2D a = at(s - 0.05), b = at(s + 0.05);
+  return std::atan2(b.y_m - a.y_m, b.x_m - a.x_m);
+}
+
+PathTracker::Target PathTracker::update(navi::Point2D position, double lookahead_m, double search_m) noexcept {
+  Target t;
+  if (pts_.empty()) return t;
+  if (pts_.size() == 1) {
+    t.point = pts_.front();
+    t.cross_track_m = std::hypot(position.x_m - t.point.x_m, position.y_m - t.point.y_m);
+    return t;
+  }
+  double best_d2 = kInf, best_s = s_now_;
+  std::size_t best_seg = seg_;
+  for (std::size_t j = seg_; j + 1 < pts_.size() && s_[j] <= s_now_ + search_m; ++j) {
+    const navi::Point2D a = pts_[j], b = pts_[j + 1];
+    const double dx = b.x_m - a.x_m, dy = b.y_m - a.y_m;
+    const double len2 = dx * dx + dy * dy;
+    double u = len2 > 0.0 ? ((position.x_m - a.x_m) * dx + (position.y_m - a.y_m) * dy) / len2 : 0.0;
+    u = std::clamp(u, 0.0, 1.0);
+    const double s = s_[j] + u * (s_[j + 1] - s_[j]);
+    if (s < s_now_) continue;
+    const double px = a.x_m + u * dx - position.x_m, py = a.y_m + u * dy - position.y_m;
+    const double d2 = px * px + py * py;
+    if (d2 < best_d2 - 1e-12) {
+      best_d2 = d2;
+      best_s = s;
+      best_seg = j;
+    }
+  }
+  if (best_d2 < kInf) {
+    s_now_ = best_s;
+    seg_ = best_seg;
+    t.cross_track_m = std::sqrt(best_d2);
+  }
+  // The lookahead point stops at the first sharp bend within the lookahead: a point beyond it
+  // would make the robot cut the corner (and skip the short out-and-back legs of the touch-up
+  // visits), leaving uncleaned cells.
+  const double h0 = heading_at(s_now_ + 0.05);
+  double s_carrot = s_now_ + lookahead_m;
+  double corner = 0.0;
+  for (double s = s_now_ + 0.1; s <= s_now_ + lookahead_m + 1e-9; s += 0.05) {
+    corner = std::abs(wrap_angle(heading_at(s) - h0));
+    if (corner > kCornerRad) {
+      s_carrot = s - 0.05;
+      break;
+    }
+  }
+  t.point = at(std::max(s_carrot, s_now_ + 0.05));
+  t.remaining_m = length_m() - s_now_;
+  t.corner_rad = std::max(corner, std::abs(wrap_angle(heading_at(s_now_ + lookahead_m + 0.1) - h0)));
+  return t;
+}
+
+// ---------------------------------------------------------------------------------------------
+// CPathFollowingBehavior
+
+void CPathFollowingBehavior::configure_following(const ParameterSet& params, const BehaviorContext& context) {
+  speed_ = params.number("max_speed_m_s");
+  lookahead_m_ = params.number("lookahead_m");
+  yaw_rate_ = params.number("max_yaw_rate_rad_s");
+  stop_distance_m_ = params.number("stop_distance_m");
+  slow_distance_m_ = std::max(params.number("slow_distance_m"), stop_distance_m_);
+  blocked_timeout_ = from_seconds(params.number("blocked_timeout_s"));
+  laser_ = nullptr;
+  if (context.resources != nullptr) {
+    const std::string& name = params.string("laser");
+    laser_ = name.empty() ? context.resources->first<LaserScan>() : context.resources->find<LaserScan>(name);
+  }
+  blocked_ = false;
+  has_last_ = false;
+  if (context.navi != nullptr) hold_heading_rad_ = context.navi->map_from_base.theta_rad;
+}
+
+double CPathFollowingBehavior::clearance_along(double dx_body, double dy_body, Time now) const noexcept {
+  if (laser_ == nullptr || !laser_->is_fresh(now)) return kInf;
+  const double n = std::hypot(dx_body, dy_body);
+  if (n <= 0.0) return kInf;
+  const double ux = dx_body / n, uy = dy_body / n;
+  const double radius = workspace_.options().robot_radius_m;
+  // Walls the path runs along are tangent to the body: a point beside it (lateral distance near
+  // the radius) is not in the way, and range noise would make it look so.
+  const double corridor = 0.85 * radius;
+  const LaserScan& scan = laser_->latest();
+  double best = kInf;
+  const std::size_t count = scan.ranges_m.size();
+  for (std::size_t i = 0; i < count; ++i) {
+    const double r = scan.ranges_m[i];
+    if (!std::isfinite(r) || r < scan.range_min_m || r > scan.range_max_m) continue;
+    const double a = scan.angle_min_rad + static_cast<double>(i) * scan.angle_increment_rad;
+    const double px = r * std::cos(a), py = r * std::sin(a);
+    const double along = px * ux + py * uy;
+    const double lateral = std::abs(px * uy - py * ux);
+    if (along <= 0.0 || lateral >= corridor) continue;
+    best = std::min(best, along - std::sqrt(radius * radius - lateral * lateral));
+  }
+  return best;
+}
+
+Twist2D CPathFollowingBehavior::command_toward(const Pose2D& pose, const PathTracker::Target& target,
+                                               const BehaviorContext& context, bool& blocked) noexcept {
+  Twist2D cmd;
+  blocked = false;
+  const double dx = target.point.x_m - pose.x_m, dy = target.point.y_m - pose.y_m;
+  const double c = std::cos(pose.theta_rad), s = std::sin(pose.theta_rad);
+  const double bx = c * dx + s * dy, by = -s * dx + c * dy;  // body frame
+  const double dist = std::hypot(bx, by);
+  // Slow down for sharp corners of the path and at its end, so the footprint stays on the
+  // contour (the rounds overlap by only a few centimetres).
+  double speed = speed_ * std::clamp(std::cos(std::min(target.corner_rad, kPi / 2.0)), 0.35, 1.0);
+  speed = std::min(speed, std::max(0.05, 1.5 * (target.remaining_m + dist)));
+  if (dist < 1e-6) return cmd;
+  auto scale_by_clearance = [&](double clearance) {
+    if (clearance <= stop_distance_m_) {
+      blocked = true;
+      return 0.0;
+    }
+    if (clearance >= slow_distance_m_ || slow_distance_m_ <= stop_distance_m_) return 1.0;
+    return (clearance - stop_distance_m_) / (slow_distance_m_ - stop_distance_m_);
+  };
+  if (context.base.holonomic()) {
+    speed = std::min(speed, context.base.max_vx_m_s);
+    speed *= scale_by_clearance(clearance_along(bx, by, context.now));
+    cmd.vx_m_s = speed * bx / dist;
+    cmd.vy_m_s = speed * by / dist;
+    cmd.wz_rad_s = clamp_abs(k_heading_ * wrap_angle(hold_heading_rad_ - pose.theta_rad), yaw_rate_);
+  } else {
+    const double alpha = std::atan2(by, bx);
+    cmd.wz_rad_s = clamp_abs(k_heading_ * alpha, std::min(yaw_rate_, context.base.max_wz_rad_s));
+    if (std::abs(alpha) < 1.0) {
+      speed = std::min(speed, context.base.max_vx_m_s);
+      cmd.vx_m_s = speed * std::cos(alpha) * scale_by_clearance(clearance_along(1.0, 0.0, context.now));
+    }
+  }
+  return cmd;
+}
+
+bool CPathFollowingBehavior::blocked_too_long(bool blocked, Time now) noexcept {
+  if (!blocked) {
+    blocked_ = false;
+    return false;
+  }
+  if (!blocked_) {
+    blocked_ = true;
+    blocked_since_ = now;
+  }
+  return now - blocked_since_ > blocked_timeout_;
+}
+
+// ---------------------------------------------------------------------------------------------
+// BhAutoMove
+
+const ModuleManifest& BhAutoMove::static_manifest() {
+  static const ModuleManifest m = [] {
+    auto params = following_parameters(0.4, 0.35);
+    params.insert(params.begin(), text("goal", "", "Where to go: <section>.entry, a map node, a room or a section"));
+    params.push_back(number("goal_tolerance_m", 0.1, "m", "Success within this distance of the goal", 0.01, 2.0));
+    return behavior_manifest("BhAutoMove",
+                             "Follows the shortest collision-free path (A*) to a named goal; the laser stops it before "
+                             "unexpected obstacles; fails when blocked for blocked_timeout_s",
+                             {"map_from_base", "laser_scan", "grid_map"}, std::move(params));
+  }();
+  return m;
+}
+
+void BhAutoMove::on_activate(const ParameterSet& params, const BehaviorContext& context) {
+  configure_following(params, context);
+  goal_tol_m_ = params.number("goal_tolerance_m");
+  tracker_.reset({});
+  if (context.navi == nullptr) {
+    fail("not localized");
+    return;
+  }
+  const navi::Point2D from = point_of(context.navi->map_from_base);
+  const std::optional<navi::Point2D> goal = workspace_.resolve_goal(params.string("goal"), from);
+  if (!goal) {
+    fail("unknown goal");
+    return;
+  }
+  navi::PlannedPath plan = workspace_.planner().plan(from, *goal);
+  if (!plan.ok()) {
+    fail("no path to the goal");
+    return;
+  }
+  tracker_.reset(std::move(plan.waypoints));
+}
+
+std::optional<Twist2D> BhAutoMove::on_step(const BehaviorContext& context) noexcept {
+  if (context.navi == nullptr || !context.navi->localized) return Twist2D{};  // pause: the net decides
+  const Pose2D pose = context.navi->map_from_base;
+  const PathTracker::Target t = tracker_.update(point_of(pose), lookahead_m_, 1.0);
+  const navi::Point2D end = tracker_.points().empty() ? point_of(pose) : tracker_.points().back();
+  if (std::hypot(end.x_m - pose.x_m, end.y_m - pose.y_m) <= goal_tol_m_) {
+    succeed();
+    return Twist2D{};
+  }
+  bool blocked = false;
+  const Twist2D cmd = command_toward(pose, t, context, blocked);
+  if (blocked_too_long(blocked, context.now)) {
+    fail("path blocked");
+    return Twist2D{};
+  }
+  return cmd;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Cleaning
+
+namespace {
+
+std::vector<ParameterSpec> cleaning_parameters() {
+  auto params = following_parameters(0.3, 0.2);
+  params.insert(params.begin(), text("section", "", "The section to cover, as named by the section splitter"));
+  return params;
+}
+
+}  // namespace
+
+const ModuleManifest& BhCleaning::static_manifest() {
+  static const ModuleManifest m = behavior_manifest(
+      "BhCleaning",
+      "Wall-following full coverage of a section on an omni-directional base: follows the balloon path "
+      "(offset growing each round), marks cleaned cells, succeeds when the section is covered",
+      {"map_from_base", "laser_scan", "grid_map"}, cleaning_parameters());
+  return m;
+}
+
+const ModuleManifest& BhCleaningTwoWheel::static_manifest() {
+  static const ModuleManifest m = behavior_manifest(
+      "BhCleaningTwoWheel",
+      "Wall-following full coverage of a section on a two-wheel differential base: turns toward the "
+      "balloon path and drives forward, marks cleaned cells, succeeds when the section is covered",
+      {"map_from_base", "laser_scan", "grid_map"}, cleaning_parameters());
+  return m;
+}
+
+void CCleaningBehavior::on_activate(const ParameterSet& params, const BehaviorContext& context) {
+  configure_following(params, context);
+  section_ = nullptr;
+  progress_ = nullptr;
+  if (needs_holonomic_ && !context.base.holonomic()) {
+    fail("BhCleaning needs an omni-directional base");
+    return;
+  }
+  section_ = workspace_.section(params.string("section"));
+  if (section_ == nullptr) {
+    fail("unknown section");
+    return;
+  }
+  if (context.navi == nullptr) {
+    fail("not localized");
+    return;
+  }
+  progress_ = &workspace_.progress(*section_, point_of(context.navi->map_from_base));
+  tracker_.reset(progress_->plan.path, progress_->done_m);
+  // The reachable cells of the section, for section_coverage(): those the plan can clean.
+  navi::CleanedCells reach(workspace_.grid());
+  reach.mark_path(progress_->plan.path, workspace_.options().cleaning_width_m / 2.0);
+  reachable_.clear();
+  for (const std::size_t i : section_->cells) {
+    if (reach.cleaned(i)) reachable_.push_back(i);
+  }
+}
+
+double CCleaningBehavior::section_coverage() const noexcept { return workspace_.cleaned().coverage(reachable_); }
+
+std::optional<Twist2D> CCleaningBehavior::on_step(const BehaviorContext& context) noexcept {
+  if (context.navi == nullptr || !context.navi->localized) {
+    has_last_ = false;  // the estimate is not trusted: mark nothing
+    return Twist2D{};
+  }
+  const Pose2D pose = context.navi->map_from_base;
+  const double half = workspace_.options().cleaning_width_m / 2.0;
+  if (has_last_) workspace_.cleaned().mark_segment(point_of(last_pose_), point_of(pose), half);
+  else workspace_.cleaned().mark_disc(point_of(pose), half);
+  last_pose_ = pose;
+  has_last_ = true;
+  const PathTracker::Target t = tracker_.update(point_of(pose), lookahead_m_, 0.6);
+  progress_->done_m = tracker_.progress_m();
+  const navi::Point2D end = tracker_.points().empty() ? point_of(pose) : tracker_.points().back();
+  if (t.remaining_m < 0.05 && std::hypot(end.x_m - pose.x_m, end.y_m - pose.y_m) < 0.1) {
+    progress_->finished = true;
+    succeed();
+    return Twist2D{};
+  }
+  bool blocked = false;
+  const Twist2D cmd = command_toward(pose, t, context, blocked);
+  if (blocked_too_long(blocked, context.now)) {
+    fail("path blocked");
+    return Twist2D{};
+  }
+  return cmd;
+}
+
+void CCleaningBehavior::on_deactivate() noexcept { has_last_ = false; }
+
+// ---------------------------------------------------------------------------------------------
+// BhGlobalLocalization
+
+const ModuleManifest& BhGlobalLocalization::static_manifest() {
+  static const ModuleManifest m = behavior_manifest(
+      "BhGlobalLocalization",
+      "Turns in place and asks the localizer for a global position fix until one is accepted",
+      {"laser_scan"},
+      {number("yaw_rate_rad_s", 0.5, "rad/s", "Turning rate while searching", 0.0, 5.0),
+       number("attempt_period_s", 2.0, "s", "Time between two position fixes asked of the localizer", 0.01, 60.0),
+       number("timeout_s", 50.0, "s", "Fail with 'no position found' after this long", 0.1, 3600.0)});
+  return m;
+}
+
+void BhGlobalLocalization::on_activate(const ParameterSet& params, const BehaviorContext& context) {
+  yaw_rate_ = params.number("yaw_rate_rad_s");
+  attempt_ = from_seconds(params.number("attempt_period_s"));
+  timeout_ = from_seconds(params.number("timeout_s"));
+  started_ = context.now;
+  last_attempt_ = context.now;
+}
+
+std::optional<Twist2D> BhGlobalLocalization::on_step(const BehaviorContext& context) noexcept {
+  if (context.now - last_attempt_ >= attempt_) {
+    last_attempt_ = context.now;
+    if (workspace_.relocalize(context.now)) {
+      succeed();
+      return Twist2D{};
+    }
+  }
+  if (context.now - started_ > timeout_) {
+    fail("no position found");
+    return Twist2D{};
+  }
+  return Twist2D{0.0, 0.0, yaw_rate_};
+}
+
+void register_navigation_behaviors(BehaviorRegistry& registry, NaviWorkspace& workspace) {
+  registry.add(BhAutoMove::static_manifest(), [&workspace] { return std::unique_ptr<CBehavior>(std::make_unique<BhAutoMove>(workspace)); });
+  registry.add(BhCleaning::static_manifest(), [&workspace] { return std::unique_ptr<CBehavior>(std::make_unique<BhCleaning>(workspace)); });
+  registry.add(BhCleaningTwoWheel::static_manifest(),
+               [&workspace] { return std::unique_ptr<CBehavior>(std::make_unique<BhCleaningTwoWheel>(workspace)); });
+  registry.add(BhGlobalLocalization::static_manifest(),
+               [&workspace] { return std::unique_ptr<CBehavior>(std::make_unique<BhGlobalLocalization>(workspace)); });
+}
+
+}  // namespace tripodal
