@@ -1,0 +1,236 @@
+// The embedded 2D simulator, the default "hardware" of tripodal: it sits below the reactive layer
+// as the controllers' HardwareInterface (wheel velocities in, wheel states out), moves the base on
+// the world's grid, publishes the sensor resources (laser, bumpers, cliff, gyro, battery, encoder
+// odometry) and is the navi localizer's ground truth. Deterministic: the same world, base and
+// seed give a bit-identical run. Time advances only by step(); SimRunner steps it together with
+// the control loops on a SimClock, and RealtimePacer slows that to wall time for --realtime.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <random>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "tripodal/controllers/controller.hpp"
+#include "tripodal/controllers/controller_config.hpp"
+#include "tripodal/core/clock.hpp"
+#include "tripodal/navi/localizer.hpp"
+#include "tripodal/reactive/control_loop.hpp"
+#include "tripodal/resources/resource.hpp"
+#include "tripodal/sim/ray_caster.hpp"
+#include "tripodal/sim/world.hpp"
+
+namespace tripodal {
+class HolonomicController;
+class IdealWheelHardware;
+}  // namespace tripodal
+
+namespace tripodal::sim {
+
+/// Something that happened to the simulated robot or world, for the run's report.
+struct SimEvent {
+  enum class Kind : std::uint8_t {
+    collision,                ///< the footprint touched an occupied cell: the base stopped
+    obstacle_appeared,        ///< a DynamicObstacle appeared (blocked path)
+    obstacle_removed,
+    sensor_dead,              ///< a SensorOutage started
+    sensor_restored,
+    localization_loss_start,  ///< a localization fault window started (the localizer acts on it)
+    localization_loss_end,
+    fell,                     ///< the robot's centre entered a drop area
+    battery_empty,
+  };
+  Kind kind = Kind::collision;
+  Time stamp{0};
+  std::string detail;  ///< obstacle or sensor name
+};
+[[nodiscard]] std::string_view to_string(SimEvent::Kind kind) noexcept;
+
+/// The simulator. Threading: one thread calls everything (the SimRunner's caller).
+class Simulator final : public HardwareInterface, public navi::GroundTruthSource {
+ public:
+  /// `base` gives the wheel geometry: type "differential" (wheels [left, right]), "omni" or
+  /// "mecanum" (wheels in configuration order), exactly as the controller driving this simulator
+  /// is configured. `seed` drives every noise source (one independent stream per sensor). Time
+  /// starts at `start`, the robot at world.start_pose, and every sensor publishes a first reading
+  /// at `start`. Throws ConfigError (at base.where) for an invalid base configuration.
+  Simulator(World world, const ControllerConfig& base, std::uint64_t seed, Time start = Time{0});
+  ~Simulator() override;
+  Simulator(const Simulator&) = delete;
+  Simulator& operator=(const Simulator&) = delete;
+
+  // --- HardwareInterface (the controller's side) -----------------------------------------
+  [[nodiscard]] std::size_t wheel_count() const noexcept override { return wheels_; }
+  /// Stores the commanded wheel velocities; applied from now until the next write. Refused
+  /// (false) for a wrong count or non-finite values.
+  bool write_wheel_velocities(std::span<const double> wheel_rad_s) noexcept override;
+  /// The wheels' actual velocities (zero while blocked) and encoder positions (with the
+  /// odometry noise). False for wrong sizes or while the odometry sensor is dead.
+  bool read_wheel_states(std::span<double> velocity_rad_s, std::span<double> position_rad) noexcept override;
+
+  // --- GroundTruthSource (the navi localizer's side) -------------------------------------
+  /// The true map_from_base (whatever `now`: the simulator's current pose).
+  [[nodiscard]] std::optional<Pose2D> true_pose(Time now) const override;
+
+  // --- stepping --------------------------------------------------------------------------
+  /// Advances by dt (ignored when <= 0): the base moves in substeps of at most
+  /// robot.max_substep, each sensor samples when its period falls due (at the end of the substep
+  /// that reaches it), and scheduled faults start and end. Never throws or allocates in steady
+  /// state.
+  void step(Duration dt) noexcept;
+  /// Advances to `t` (nothing when t <= now()).
+  void step_until(Time t) noexcept { step(t - now_); }
+  [[nodiscard]] Time now() const noexcept { return now_; }
+
+  // --- commands for tests and tools (bypassing a controller) -----------------------------
+  /// Writes the wheel velocities that realise body twist `twist` (inverse kinematics).
+  void command_twist(const Twist2D& twist) noexcept;
+  /// Wheel velocities of a twist and the twist of wheel velocities for this base (least
+  /// squares for more than three holonomic wheels). Spans have wheel_count() entries.
+  void inverse_kinematics(const Twist2D& twist, std::span<double> wheel_rad_s) const noexcept;
+  [[nodiscard]] Twist2D forward_kinematics(std::span<const double> wheel_rad_s) const noexcept;
+
+  // --- state -----------------------------------------------------------------------------
+  [[nodiscard]] const Pose2D& pose() const noexcept { return pose_; }
+  /// Moves the robot (e.g. a test, or a kidnapping); returns false and stays when the footprint
+  /// would overlap a solid cell.
+  bool set_pose(const Pose2D& map_from_base) noexcept;
+  /// Body twist over the last substep (zero while blocked).
+  [[nodiscard]] const Twist2D& velocity() const noexcept { return velocity_; }
+  /// True while the last substep was stopped by a solid cell.
+  [[nodiscard]] bool blocked() const noexcept { return blocked_; }
+  [[nodiscard]] std::uint64_t collisions() const noexcept { return collisions_; }
+  [[nodiscard]] bool fallen() const noexcept { return fallen_; }
+  /// Ground-truth distance driven (m) and rotation (rad, absolute).
+  [[nodiscard]] double distance_m() const noexcept { return distance_m_; }
+  [[nodiscard]] double rotation_rad() const noexcept { return rotation_rad_; }
+  [[nodiscard]] double battery_charge() const noexcept { return soc_; }
+  void set_charging(bool charging) noexcept { charging_ = charging; }
+  [[nodiscard]] bool charging() const noexcept { return charging_; }
+  /// Whether `sensor` is silenced by the fault schedule at time t.
+  [[nodiscard]] bool sensor_dead(SensorKind sensor, Time t) const noexcept;
+  /// Whether a localization fault window covers t.
+  [[nodiscard]] bool localization_lost(Time t) const noexcept;
+
+  [[nodiscard]] const World& world() const noexcept { return world_; }
+  /// The static map plus the boxes present now.
+  [[nodiscard]] const SolidMap& solid_map() const noexcept { return solid_; }
+  /// What happened so far, in time order.
+  [[nodiscard]] const std::vector<SimEvent>& events() const noexcept { return events_; }
+
+  // --- sensor resources ------------------------------------------------------------------
+  [[nodiscard]] LaserResource& laser() noexcept { return laser_; }
+  [[nodiscard]] OdometryResource& odometry() noexcept { return odometry_; }
+  [[nodiscard]] GyroResource& gyro() noexcept { return gyro_; }
+  [[nodiscard]] BumperResource& bumpers() noexcept { return bumpers_; }
+  [[nodiscard]] InfraredResource& cliff() noexcept { return cliff_; }
+  [[nodiscard]] BatteryResource& battery() noexcept { return battery_; }
+  /// Adds the enabled sensors' resources (laser, gyro, bumpers, cliff, battery) to a control
+  /// loop's table. The encoder odometry resource is added only when `with_odometry` (a loop whose
+  /// controller publishes odometry usually has its own).
+  void add_resources(ResourceTable& table, bool with_odometry = false);
+
+ private:
+  struct Schedule {
+    Duration period{0};
+    Time next{0};
+  };
+  void substep(Duration dt) noexcept;
+  void update_faults() noexcept;
+  void sample_sensors() noexcept;
+  void update_bumpers() noexcept;
+  void set_obstacle(std::size_t index, bool present) noexcept;
+  void log(SimEvent::Kind kind, std::string_view detail) noexcept;
+  [[nodiscard]] bool due(Schedule& s) const noexcept;
+
+  World world_;
+  ControllerConfig base_;
+  std::size_t wheels_ = 0;
+  std::unique_ptr<IdealWheelHardware> model_hw_;
+  std::unique_ptr<HolonomicController> holonomic_;  // kinematics model of a holonomic base
+  SolidMap solid_;
+  std::vector<std::uint8_t> static_solid_;
+  std::vector<std::uint8_t> drop_;
+  std::vector<std::vector<std::size_t>> obstacle_cells_;
+  std::vector<std::uint8_t> obstacle_present_;
+  std::vector<std::uint8_t> outage_active_;
+  std::vector<std::uint8_t> loss_active_;
+
+  Time now_{0};
+  Pose2D pose_;
+  Twist2D velocity_;
+  std::vector<double> wheel_cmd_, wheel_vel_, wheel_pos_, wheel_scale_;
+  Pose2D odom_pose_;
+  Twist2D odom_twist_;
+  double gyro_yaw_ = 0.0;
+  bool blocked_ = false;
+  bool fallen_ = false;
+  bool charging_ = false;
+  bool battery_empty_ = false;
+  std::uint64_t collisions_ = 0;
+  double distance_m_ = 0.0;
+  double rotation_rad_ = 0.0;
+  double soc_ = 1.0;
+  double soc_rate_ = 0.0;  // fraction per second over the last substep, for the current
+
+  LaserModel laser_model_;
+  std::mt19937_64 odom_rng_, gyro_rng_;
+  std::normal_distribution<double> unit_normal_;
+  std::normal_distribution<double> gyro_normal_;
+
+  Schedule laser_due_, odom_due_, gyro_due_, bumper_due_, cliff_due_, battery_due_;
+  LaserResource laser_;
+  OdometryResource odometry_;
+  GyroResource gyro_;
+  BumperResource bumpers_;
+  InfraredResource cliff_;
+  BatteryResource battery_;
+  std::vector<SimEvent> events_;
+};
+
+/// Paces a simulation to wall time (for --realtime): pace(t) sleeps on `wall` until the wall
+/// time elapsed since the first call is (t - t_first) / speed. Uses only the Clock interface.
+class RealtimePacer final {
+ public:
+  explicit RealtimePacer(const Clock& wall, double speed = 1.0) noexcept : wall_(wall), speed_(speed > 0.0 ? speed : 1.0) {}
+  void pace(Time sim_now) noexcept;
+  [[nodiscard]] double speed() const noexcept { return speed_; }
+
+ private:
+  const Clock& wall_;
+  double speed_;
+  bool started_ = false;
+  Time sim_start_{0};
+  Time wall_start_{0};
+};
+
+/// Runs a Simulator and control loops together on one SimClock. Every physics period the
+/// simulator advances to t first (its sensors sample at t), then the loop cycles due by t run on
+/// those readings and write the wheel commands applied over the next period. Faster than real
+/// time unless a RealtimePacer is set.
+class SimRunner final {
+ public:
+  /// The clock is moved to the simulator's time if it is behind.
+  SimRunner(Simulator& sim, SimClock& clock, Duration physics_period = std::chrono::milliseconds(10));
+  /// Adds a loop (not owned); its first cycle is at the current time.
+  void add(ControlLoop& loop) { driver_.add(loop); }
+  /// Paces every physics period to wall time (nullptr: as fast as possible). Not owned.
+  void set_pacer(RealtimePacer* pacer) noexcept { pacer_ = pacer; }
+  /// Runs until `until`; returns the number of loop cycles run.
+  std::size_t run_until(Time until) noexcept;
+  std::size_t run_for(Duration d) noexcept { return run_until(clock_.now() + d); }
+  [[nodiscard]] Simulator& simulator() noexcept { return sim_; }
+  [[nodiscard]] Duration physics_period() const noexcept { return period_; }
+
+ private:
+  Simulator& sim_;
+  SimClock& clock_;
+  SimLoopDriver driver_;
+  Duration period_;
+  RealtimePacer* pacer_ = nullptr;
+};
+
+}  // namespace tripodal::sim

@@ -1,0 +1,472 @@
+#include "tripodal/sim/simulator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "tripodal/controllers/holonomic_controller.hpp"
+#include "tripodal/controllers/ideal_hardware.hpp"
+#include "tripodal/controllers/kinematics.hpp"
+
+namespace tripodal::sim {
+
+namespace {
+
+// One independent random stream per noise source, derived from the run's seed (splitmix64), so
+// turning a sensor off or on does not change the noise of the others.
+std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t stream) noexcept {
+  std::uint64_t z = seed + 0x9E3779B97F4A7C15ULL * (stream + 1);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
+
+Duration period_of(double rate_hz) noexcept {
+  return rate_hz > 0.0 && std::isfinite(rate_hz) ? from_seconds(1.0 / rate_hz) : Duration{0};
+}
+
+// Readings go stale after three missed periods: a dead sensor is detectable, jitter is not.
+Duration max_age_of(double rate_hz) noexcept { return 3 * period_of(rate_hz); }
+
+const ControllerConfig& checked_base(const ControllerConfig& base) {
+  Diagnostics d = validate(base);
+  if (base.type != "differential" && base.type != "omni" && base.type != "mecanum") {
+    d.error(base.where, "the simulated base must be of type \"differential\", \"omni\" or \"mecanum\", got \"" +
+                            base.type + "\"");
+  }
+  if (d.has_errors()) throw ConfigError(std::move(d));
+  return base;
+}
+
+}  // namespace
+
+std::string_view to_string(SimEvent::Kind kind) noexcept {
+  switch (kind) {
+    case SimEvent::Kind::collision: return "collision";
+    case SimEvent::Kind::obstacle_appeared: return "obstacle_appeared";
+    case SimEvent::Kind::obstacle_removed: return "obstacle_removed";
+    case SimEvent::Kind::sensor_dead: return "sensor_dead";
+    case SimEvent::Kind::sensor_restored: return "sensor_restored";
+    case SimEvent::Kind::localization_loss_start: return "localization_loss_start";
+    case SimEvent::Kind::localization_loss_end: return "localization_loss_end";
+    case SimEvent::Kind::fell: return "fell";
+    case SimEvent::Kind::battery_empty: return "battery_empty";
+  }
+  return "?";
+}
+
+Simulator::Simulator(World world, const ControllerConfig& base, std::uint64_t seed, Time start)
+    : world_(std::move(world)),
+      base_(checked_base(base)),
+      now_(start),
+      laser_model_(world_.robot.laser, stream_seed(seed, 1)),
+      odom_rng_(stream_seed(seed, 2)),
+      gyro_rng_(stream_seed(seed, 3)),
+      unit_normal_(0.0, 1.0),
+      gyro_normal_(0.0, world_.robot.gyro.noise_stddev_rad_s > 0.0 ? world_.robot.gyro.noise_stddev_rad_s : 1.0),
+      laser_(world_.robot.laser.name, max_age_of(world_.robot.laser.rate_hz)),
+      odometry_(world_.robot.odometry.name, max_age_of(world_.robot.odometry.rate_hz)),
+      gyro_(world_.robot.gyro.name, max_age_of(world_.robot.gyro.rate_hz)),
+      bumpers_(world_.robot.bumpers.name, max_age_of(world_.robot.bumpers.rate_hz)),
+      cliff_(world_.robot.cliff.name, max_age_of(world_.robot.cliff.rate_hz)),
+      battery_(world_.robot.battery.name, max_age_of(world_.robot.battery.rate_hz)) {
+  if (base_.type == "differential") {
+    wheels_ = 2;
+  } else {
+    wheels_ = base_.holonomic.wheels.size();
+    // The controller's own Jacobian and pseudo-inverse are the base's kinematics: the simulated
+    // wheels and the controller can never disagree about the geometry.
+    model_hw_ = std::make_unique<IdealWheelHardware>(wheels_, base_.period);
+    holonomic_ = std::make_unique<HolonomicController>(base_, *model_hw_);
+  }
+  wheel_cmd_.assign(wheels_, 0.0);
+  wheel_vel_.assign(wheels_, 0.0);
+  wheel_pos_.assign(wheels_, 0.0);
+  wheel_scale_.assign(wheels_, 1.0);
+  if (world_.robot.odometry.scale_error_stddev > 0.0) {
+    for (double& s : wheel_scale_) s = 1.0 + world_.robot.odometry.scale_error_stddev * unit_normal_(odom_rng_);
+  }
+
+  solid_ = SolidMap(world_.grid);
+  static_solid_ = solid_.cells();
+  drop_.assign(world_.grid.size(), 0);
+  for (const DropArea& a : world_.drops) {
+    navi::Region r{a.name, a.polygon, a.where};
+    for (std::size_t i : navi::cells_in_region(world_.grid, r)) drop_[i] = 1;
+  }
+  for (const DynamicObstacle& o : world_.obstacles) {
+    navi::Region r{o.name, o.polygon, o.where};
+    obstacle_cells_.push_back(navi::cells_in_region(world_.grid, r));
+  }
+  obstacle_present_.assign(world_.obstacles.size(), 0);
+  outage_active_.assign(world_.faults.dead_sensors.size(), 0);
+  loss_active_.assign(world_.faults.localization_loss.size(), 0);
+  events_.reserve(64);
+
+  pose_ = world_.start_pose;
+  odom_pose_ = world_.start_pose;
+  gyro_yaw_ = world_.start_pose.theta_rad;
+  soc_ = std::clamp(world_.robot.battery.initial, 0.0, 1.0);
+
+  const SimRobotConfig& rc = world_.robot;
+  laser_due_ = {rc.laser.enabled ? period_of(rc.laser.rate_hz) : Duration{0}, start};
+  odom_due_ = {period_of(rc.odometry.rate_hz), start};
+  gyro_due_ = {rc.gyro.enabled ? period_of(rc.gyro.rate_hz) : Duration{0}, start};
+  bumper_due_ = {rc.bumpers.enabled ? period_of(rc.bumpers.rate_hz) : Duration{0}, start};
+  cliff_due_ = {rc.cliff.enabled ? period_of(rc.cliff.rate_hz) : Duration{0}, start};
+  battery_due_ = {rc.battery.enabled ? period_of(rc.battery.rate_hz) : Duration{0}, start};
+  bumpers_.edit().count = rc.bumpers.sectors;
+  cliff_.edit().cliff.assign(rc.cliff.positions.size(), 0);
+
+  update_faults();
+  sample_sensors();
+}
+
+Simulator::~Simulator() = default;
+
+// --- kinematics ------------------------------------------------------------------------------
+
+void Simulator::inverse_kinematics(const Twist2D& twist, std::span<double> wheel_rad_s) const noexcept {
+  if (wheel_rad_s.size() != wheels_) return;
+  if (holonomic_) {
+    holonomic_->inverse(twist, wheel_rad_s);
+  } else {
+    differential_inverse(base_.differential.wheel_separation_m, base_.differential.wheel_radius_m, twist,
+                         wheel_rad_s[0], wheel_rad_s[1]);
+  }
+}
+
+Twist2D Simulator::forward_kinematics(std::span<const double> wheel_rad_s) const noexcept {
+  if (wheel_rad_s.size() != wheels_) return {};
+  if (holonomic_) return holonomic_->forward(wheel_rad_s);
+  return differential_forward(base_.differential.wheel_separation_m, base_.differential.wheel_radius_m,
+                              wheel_rad_s[0], wheel_rad_s[1]);
+}
+
+void Simulator::command_twist(const Twist2D& twist) noexcept {
+  inverse_kinematics(twist, wheel_cmd_);
+}
+
+// --- hardware interface ----------------------------------------------------------------------
+
+bool Simulator::write_wheel_velocities(std::span<const double> wheel_rad_s) noexcept {
+  if (wheel_rad_s.size() != wheels_) return false;
+  for (double w : wheel_rad_s) {
+    if (!std::isfinite(w)) return false;
+  }
+  std::copy(wheel_rad_s.begin(), wheel_rad_s.end(), wheel_cmd_.begin());
+  return true;
+}
+
+bool Simulator::read_wheel_states(std::span<double> velocity_rad_s, std::span<double> position_rad) noexcept {
+  if (velocity_rad_s.size() != wheels_ || position_rad.size() != wheels_) return false;
+  if (sensor_dead(SensorKind::odometry, now_)) return false;
+  std::copy(wheel_vel_.begin(), wheel_vel_.end(), velocity_rad_s.begin());
+  std::copy(wheel_pos_.begin(), wheel_pos_.end(), position_rad.begin());
+  return true;
+}
+
+std::optional<Pose2D> Simulator::true_pose(Time /*now*/) const { return pose_; }
+
+bool Simulator::set_pose(const Pose2D& map_from_base) noexcept {
+  if (solid_.disc_overlaps({map_from_base.x_m, map_from_base.y_m}, world_.robot.radius_m)) return false;
+  pose_ = map_from_base;
+  pose_.theta_rad = wrap_angle(pose_.theta_rad);
+  blocked_ = false;
+  return true;
+}
+
+// --- stepping --------------------------------------------------------------------------------
+
+void Simulator::step(Duration dt) noexcept {
+  if (dt.count() <= 0) return;
+  const Duration max_sub = world_.robot.max_substep.count() > 0 ? world_.robot.max_substep : dt;
+  // Equal integer substeps (the remainder spread one nanosecond at a time) keep the substep grid
+  // independent of floating point, hence the run bit-identical.
+  const auto n = (dt.count() + max_sub.count() - 1) / max_sub.count();
+  const auto base = dt.count() / n;
+  const auto rem = dt.count() % n;
+  for (Duration::rep i = 0; i < n; ++i) {
+    const Duration d{base + (i < rem ? 1 : 0)};
+    substep(d);
+    now_ += d;
+    update_faults();
+    sample_sensors();
+  }
+}
+
+void Simulator::substep(Duration dt) noexcept {
+  const double h = to_seconds(dt);
+  const SimRobotConfig& rc = world_.robot;
+  Twist2D actual{};
+  const bool immobile = fallen_ || battery_empty_;
+  if (!immobile) {
+    const Twist2D cmd = forward_kinematics(wheel_cmd_);
+    const double dx = cmd.vx_m_s * h, dy = cmd.vy_m_s * h, dth = cmd.wz_rad_s * h;
+    const Pose2D candidate = integrate_body_displacement(pose_, dx, dy, dth);
+    double frac = 1.0;
+    if (solid_.disc_overlaps({candidate.x_m, candidate.y_m}, rc.radius_m)) {
+      // Contact inside this substep: bisect the fraction of the motion that stays clear, so the
+      // robot stops against the obstacle rather than a whole substep short of it.
+      double lo = 0.0, hi = 1.0;
+      for (int k = 0; k < 16; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        const Pose2D p = integrate_body_displacement(pose_, dx * mid, dy * mid, dth * mid);
+        (solid_.disc_overlaps({p.x_m, p.y_m}, rc.radius_m) ? hi : lo) = mid;
+      }
+      frac = lo;
+      pose_ = integrate_body_displacement(pose_, dx * lo, dy * lo, dth * lo);
+      if (!blocked_) {
+        ++collisions_;
+        log(SimEvent::Kind::collision, {});
+      }
+      blocked_ = true;
+    } else {
+      pose_ = candidate;
+      blocked_ = false;
+    }
+    actual = {cmd.vx_m_s * frac, cmd.vy_m_s * frac, cmd.wz_rad_s * frac};
+    distance_m_ += std::hypot(actual.vx_m_s, actual.vy_m_s) * h;
+    rotation_rad_ += std::abs(actual.wz_rad_s) * h;
+  }
+  velocity_ = blocked_ ? Twist2D{} : actual;
+
+  // Encoders: the wheels' actual rotation, each read with a relative error (odometry drift
+  // proportional to the distance) and its constant scale error.
+  inverse_kinematics(actual, wheel_vel_);
+  const double ratio = rc.odometry.noise_ratio;
+  for (std::size_t i = 0; i < wheels_; ++i) {
+    const double e = unit_normal_(odom_rng_);
+    wheel_vel_[i] *= wheel_scale_[i] * (1.0 + ratio * e);
+    wheel_pos_[i] += wheel_vel_[i] * h;
+  }
+  odom_twist_ = forward_kinematics(wheel_vel_);
+  odom_pose_ = integrate_body_displacement(odom_pose_, odom_twist_.vx_m_s * h, odom_twist_.vy_m_s * h,
+                                           odom_twist_.wz_rad_s * h);
+  gyro_yaw_ = wrap_angle(gyro_yaw_ + (actual.wz_rad_s + rc.gyro.bias_rad_s) * h);
+
+  // Battery.
+  const BatteryConfig& bc = rc.battery;
+  if (bc.enabled) {
+    double d = -bc.drain_per_s * h - bc.drain_per_m * std::hypot(actual.vx_m_s, actual.vy_m_s) * h;
+    if (charging_) d += bc.charge_per_s * h;
+    const double before = soc_;
+    soc_ = std::clamp(soc_ + d, 0.0, 1.0);
+    soc_rate_ = h > 0.0 ? (soc_ - before) / h : 0.0;
+    if (soc_ <= 0.0 && !battery_empty_) {
+      battery_empty_ = true;
+      log(SimEvent::Kind::battery_empty, {});
+    } else if (soc_ > 0.0 && battery_empty_) {
+      battery_empty_ = false;
+    }
+  }
+
+  // A centre over a drop cell: the robot has fallen.
+  if (!fallen_) {
+    const navi::CellIndex c = world_.grid.cell_at({pose_.x_m, pose_.y_m});
+    if (world_.grid.contains(c) && drop_[world_.grid.index(c)] != 0) {
+      fallen_ = true;
+      velocity_ = {};
+      log(SimEvent::Kind::fell, {});
+    }
+  }
+}
+
+void Simulator::log(SimEvent::Kind kind, std::string_view detail) noexcept {
+  // Events are rare (faults, first contacts); the vector's reserve covers a normal run.
+  try {
+    events_.push_back({kind, now_, std::string(detail)});
+  } catch (...) {
+  }
+}
+
+void Simulator::update_faults() noexcept {
+  for (std::size_t i = 0; i < world_.obstacles.size(); ++i) {
+    const DynamicObstacle& o = world_.obstacles[i];
+    const bool present = now_ >= o.appear && (!o.disappear || now_ < *o.disappear);
+    if (present != (obstacle_present_[i] != 0)) {
+      set_obstacle(i, present);
+      log(present ? SimEvent::Kind::obstacle_appeared : SimEvent::Kind::obstacle_removed, o.name);
+    }
+  }
+  for (std::size_t i = 0; i < world_.faults.dead_sensors.size(); ++i) {
+    const SensorOutage& s = world_.faults.dead_sensors[i];
+    const bool active = now_ >= s.start && now_ < s.end;
+    if (active != (outage_active_[i] != 0)) {
+      outage_active_[i] = active ? 1 : 0;
+      log(active ? SimEvent::Kind::sensor_dead : SimEvent::Kind::sensor_restored, to_string(s.sensor));
+    }
+  }
+  for (std::size_t i = 0; i < world_.faults.localization_loss.size(); ++i) {
+    const navi::LocalizationFault& f = world_.faults.localization_loss[i];
+    const bool active = now_ >= f.start && now_ < f.end;
+    if (active != (loss_active_[i] != 0)) {
+      loss_active_[i] = active ? 1 : 0;
+      log(active ? SimEvent::Kind::localization_loss_start : SimEvent::Kind::localization_loss_end, {});
+    }
+  }
+}
+
+void Simulator::set_obstacle(std::size_t index, bool present) noexcept {
+  obstacle_present_[index] = present ? 1 : 0;
+  const navi::OccupancyGrid& g = world_.grid;
+  // Rebuild the cells of this obstacle from the static map, then lay every present obstacle
+  // back on them; a box never appears under the robot (it would trap it inside).
+  for (std::size_t i : obstacle_cells_[index]) {
+    const navi::CellIndex c = g.cell(i);
+    solid_.set_solid(c.x, c.y, static_solid_[i] != 0);
+  }
+  const double keep_out = world_.robot.radius_m + g.resolution_m();
+  for (std::size_t k = 0; k < obstacle_cells_.size(); ++k) {
+    if (obstacle_present_[k] == 0) continue;
+    for (std::size_t i : obstacle_cells_[k]) {
+      const navi::CellIndex c = g.cell(i);
+      const navi::Point2D p = g.cell_center(c);
+      if (std::hypot(p.x_m - pose_.x_m, p.y_m - pose_.y_m) < keep_out) continue;
+      solid_.set_solid(c.x, c.y, true);
+    }
+  }
+}
+
+bool Simulator::due(Schedule& s) const noexcept {
+  if (s.period.count() <= 0 || now_ < s.next) return false;
+  while (s.next <= now_) s.next += s.period;
+  return true;
+}
+
+bool Simulator::sensor_dead(SensorKind sensor, Time t) const noexcept {
+  for (const SensorOutage& s : world_.faults.dead_sensors) {
+    if (s.sensor == sensor && t >= s.start && t < s.end) return true;
+  }
+  return false;
+}
+
+bool Simulator::localization_lost(Time t) const noexcept {
+  for (const navi::LocalizationFault& f : world_.faults.localization_loss) {
+    if (t >= f.start && t < f.end) return true;
+  }
+  return false;
+}
+
+void Simulator::update_bumpers() noexcept {
+  const BumperConfig& bc = world_.robot.bumpers;
+  const navi::Point2D g = solid_.to_cells({pose_.x_m, pose_.y_m});
+  const double res = solid_.resolution_m();
+  const double r = (world_.robot.radius_m + bc.contact_margin_m) / res;
+  const int x0 = static_cast<int>(std::floor(g.x_m - r)), x1 = static_cast<int>(std::floor(g.x_m + r));
+  const int y0 = static_cast<int>(std::floor(g.y_m - r)), y1 = static_cast<int>(std::floor(g.y_m + r));
+  const double sector = 2.0 * std::numbers::pi / bc.sectors;
+  // Contact directions are found in the grid frame; the body heading in that frame turns them
+  // into the bumper's own frame.
+  const double heading = solid_.to_grid_angle(pose_.theta_rad);
+  std::uint32_t mask = 0;
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) {
+      if (!solid_.solid(x, y)) continue;
+      const double nx = std::clamp(g.x_m, static_cast<double>(x), x + 1.0) - g.x_m;
+      const double ny = std::clamp(g.y_m, static_cast<double>(y), y + 1.0) - g.y_m;
+      if (nx * nx + ny * ny >= r * r) continue;
+      const double a = std::atan2(ny, nx) - heading + 0.5 * sector;
+      double wrapped = std::fmod(a, 2.0 * std::numbers::pi);
+      if (wrapped < 0.0) wrapped += 2.0 * std::numbers::pi;
+      auto s = static_cast<std::uint32_t>(wrapped / sector);
+      if (s >= bc.sectors) s = bc.sectors - 1;
+      mask |= 1U << s;
+    }
+  }
+  BumperReading& b = bumpers_.edit();
+  b.stamp = now_;
+  b.count = bc.sectors;
+  b.pressed_mask = mask;
+}
+
+void Simulator::sample_sensors() noexcept {
+  const SimRobotConfig& rc = world_.robot;
+  if (due(laser_due_) && !sensor_dead(SensorKind::laser, now_)) {
+    laser_model_.scan(solid_, pose_, now_, laser_.edit());
+    laser_.commit();
+  }
+  if (due(odom_due_) && !sensor_dead(SensorKind::odometry, now_)) {
+    OdometryReading& o = odometry_.edit();
+    o.stamp = now_;
+    o.pose = odom_pose_;
+    o.twist = odom_twist_;
+    odometry_.commit();
+  }
+  if (due(gyro_due_) && !sensor_dead(SensorKind::gyro, now_)) {
+    GyroReading& gr = gyro_.edit();
+    gr.stamp = now_;
+    const double noise = rc.gyro.noise_stddev_rad_s > 0.0 ? gyro_normal_(gyro_rng_) : 0.0;
+    gr.yaw_rate_rad_s = velocity_.wz_rad_s + rc.gyro.bias_rad_s + noise;
+    gr.yaw_rad = gyro_yaw_;
+    gyro_.commit();
+  }
+  if (due(bumper_due_) && !sensor_dead(SensorKind::bumpers, now_)) {
+    update_bumpers();
+    bumpers_.commit();
+  }
+  if (due(cliff_due_) && !sensor_dead(SensorKind::cliff, now_)) {
+    InfraredReading& ir = cliff_.edit();
+    ir.stamp = now_;
+    const double c = std::cos(pose_.theta_rad), s = std::sin(pose_.theta_rad);
+    for (std::size_t i = 0; i < rc.cliff.positions.size() && i < ir.cliff.size(); ++i) {
+      const navi::Point2D& b = rc.cliff.positions[i];
+      const navi::CellIndex cell =
+          world_.grid.cell_at({pose_.x_m + c * b.x_m - s * b.y_m, pose_.y_m + s * b.x_m + c * b.y_m});
+      ir.cliff[i] = world_.grid.contains(cell) && drop_[world_.grid.index(cell)] != 0 ? 1 : 0;
+    }
+    cliff_.commit();
+  }
+  if (due(battery_due_) && !sensor_dead(SensorKind::battery, now_)) {
+    const BatteryConfig& bc = rc.battery;
+    BatteryReading& br = battery_.edit();
+    br.stamp = now_;
+    br.percentage = soc_;
+    br.voltage_v = bc.voltage_empty_v + soc_ * (bc.voltage_full_v - bc.voltage_empty_v);
+    br.current_a = soc_rate_ * bc.capacity_ah * 3600.0;
+    br.charging = charging_;
+    battery_.commit();
+  }
+}
+
+void Simulator::add_resources(ResourceTable& table, bool with_odometry) {
+  const SimRobotConfig& rc = world_.robot;
+  if (rc.laser.enabled) table.add(laser_);
+  if (with_odometry) table.add(odometry_);
+  if (rc.gyro.enabled) table.add(gyro_);
+  if (rc.bumpers.enabled) table.add(bumpers_);
+  if (rc.cliff.enabled) table.add(cliff_);
+  if (rc.battery.enabled) table.add(battery_);
+}
+
+// --- pacing and co-stepping ------------------------------------------------------------------
+
+void RealtimePacer::pace(Time sim_now) noexcept {
+  if (!started_) {
+    started_ = true;
+    sim_start_ = sim_now;
+    wall_start_ = wall_.now();
+    return;
+  }
+  const double elapsed = static_cast<double>((sim_now - sim_start_).count()) / speed_;
+  wall_.sleep_until(wall_start_ + Duration{static_cast<Duration::rep>(elapsed)});
+}
+
+SimRunner::SimRunner(Simulator& sim, SimClock& clock, Duration physics_period)
+    : sim_(sim), clock_(clock), driver_(clock), period_(physics_period.count() > 0 ? physics_period : std::chrono::milliseconds(10)) {
+  clock_.set(sim_.now());
+}
+
+std::size_t SimRunner::run_until(Time until) noexcept {
+  // Cycles due now run first, on the readings the simulator sampled at this time.
+  std::size_t cycles = driver_.run_until(std::max(clock_.now(), sim_.now()));
+  while (sim_.now() < until) {
+    const Time t = std::min(sim_.now() + period_, until);
+    sim_.step_until(t);
+    cycles += driver_.run_until(t);
+    if (pacer_ != nullptr) pacer_->pace(t);
+  }
+  return cycles;
+}
+
+}  // namespace tripodal::sim

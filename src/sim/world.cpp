@@ -1,0 +1,579 @@
+#include "tripodal/sim/world.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <initializer_list>
+#include <set>
+#include <sstream>
+
+#include "tripodal/sim/ray_caster.hpp"
+
+namespace tripodal::sim {
+
+std::string_view to_string(SensorKind kind) noexcept {
+  switch (kind) {
+    case SensorKind::laser: return "laser";
+    case SensorKind::odometry: return "odometry";
+    case SensorKind::gyro: return "gyro";
+    case SensorKind::bumpers: return "bumpers";
+    case SensorKind::cliff: return "cliff";
+    case SensorKind::battery: return "battery";
+  }
+  return "?";
+}
+
+namespace {
+
+constexpr double kDegToRad = std::numbers::pi / 180.0;
+
+// Reads one world file's YAML into typed values, collecting every problem with its location.
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  SourceLocation at(const YAML::Node& n) const {
+    const YAML::Mark m = n.Mark();
+    if (m.line < 0) return {file_, 0, 0};
+    return {file_, m.line + 1, m.column + 1};
+  }
+  void error(const YAML::Node& n, const std::string& msg) { d_.error(at(n), msg); }
+  Diagnostics& diagnostics() { return d_; }
+
+  static std::string kind(const YAML::Node& n) {
+    switch (n.Type()) {
+      case YAML::NodeType::Map: return "a map";
+      case YAML::NodeType::Sequence: return "a list";
+      case YAML::NodeType::Scalar: return "'" + n.Scalar() + "'";
+      case YAML::NodeType::Null: return "nothing";
+      default: return "undefined";
+    }
+  }
+
+  /// Reports keys of map `n` not in `allowed`; false when n is not a map.
+  bool check_map(const YAML::Node& n, const std::string& what, std::initializer_list<std::string_view> allowed) {
+    if (!n.IsMap()) {
+      error(n, what + " must be a map, got " + kind(n));
+      return false;
+    }
+    for (const auto& kv : n) {
+      const std::string key = kv.first.Scalar();
+      bool ok = false;
+      for (std::string_view a : allowed) ok = ok || key == a;
+      if (!ok) {
+        std::string list;
+        for (std::string_view a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+        error(kv.first, "unknown key '" + key + "' in " + what + ", expected one of: " + list);
+      }
+    }
+    return true;
+  }
+
+  std::optional<double> number(const YAML::Node& n, const std::string& what) {
+    if (n.IsScalar()) {
+      try {
+        const double v = n.as<double>();
+        if (std::isfinite(v)) return v;
+      } catch (const YAML::Exception&) {
+      }
+    }
+    error(n, what + " must be a finite number, got " + kind(n));
+    return std::nullopt;
+  }
+  /// A number >= lo (or > lo when strict) into `out` if the key is present.
+  void number_at_least(const YAML::Node& map, const char* key, double& out, double lo, bool strict,
+                       const std::string& where_in) {
+    const YAML::Node n = map[key];
+    if (!n) return;
+    const std::string what = where_in + "." + key;
+    if (auto v = number(n, what)) {
+      if (strict ? *v <= lo : *v < lo) {
+        std::ostringstream s;
+        s << what << " must be " << (strict ? "> " : ">= ") << lo << ", got " << *v;
+        error(n, s.str());
+      } else {
+        out = *v;
+      }
+    }
+  }
+  void boolean(const YAML::Node& map, const char* key, bool& out, const std::string& where_in) {
+    const YAML::Node n = map[key];
+    if (!n) return;
+    try {
+      if (n.IsScalar()) {
+        out = n.as<bool>();
+        return;
+      }
+    } catch (const YAML::Exception&) {
+    }
+    error(n, where_in + "." + key + " must be true or false, got " + kind(n));
+  }
+  void text(const YAML::Node& map, const char* key, std::string& out, const std::string& where_in) {
+    const YAML::Node n = map[key];
+    if (!n) return;
+    if (!n.IsScalar() || n.Scalar().empty()) {
+      error(n, where_in + "." + key + " must be a non-empty string, got " + kind(n));
+      return;
+    }
+    out = n.Scalar();
+  }
+  /// A list of `count` numbers (count_opt more optional), or an error.
+  std::optional<std::vector<double>> numbers(const YAML::Node& n, const std::string& what, std::size_t count,
+                                             std::size_t optional_extra, const std::string& expected) {
+    if (!n.IsSequence() || n.size() < count || n.size() > count + optional_extra) {
+      error(n, what + " must be " + expected + ", got " + kind(n) +
+                   (n.IsSequence() ? " of " + std::to_string(n.size()) + " items" : ""));
+      return std::nullopt;
+    }
+    std::vector<double> out;
+    bool ok = true;
+    for (const auto& item : n) {
+      auto v = number(item, what + " item");
+      ok = ok && v.has_value();
+      out.push_back(v.value_or(0.0));
+    }
+    if (!ok) return std::nullopt;
+    return out;
+  }
+  std::optional<Pose2D> pose(const YAML::Node& n, const std::string& what) {
+    auto v = numbers(n, what, 2, 1, "[x, y] or [x, y, theta] (metres, radians)");
+    if (!v) return std::nullopt;
+    return Pose2D{(*v)[0], (*v)[1], v->size() > 2 ? (*v)[2] : 0.0};
+  }
+  /// `rectangle: [x_min, y_min, x_max, y_max]` or `polygon: [[x, y], ...]` of an entry.
+  std::optional<std::vector<navi::Point2D>> shape(const YAML::Node& entry, const std::string& what) {
+    const YAML::Node rect = entry["rectangle"];
+    const YAML::Node poly = entry["polygon"];
+    if (rect && poly) {
+      error(entry, what + " has both rectangle and polygon, expected one");
+      return std::nullopt;
+    }
+    if (rect) {
+      auto v = numbers(rect, what + ".rectangle", 4, 0, "[x_min, y_min, x_max, y_max]");
+      if (!v) return std::nullopt;
+      const auto& r = *v;
+      if (r[2] <= r[0] || r[3] <= r[1]) {
+        error(rect, what + ".rectangle is empty: expected x_min < x_max and y_min < y_max");
+        return std::nullopt;
+      }
+      return std::vector<navi::Point2D>{{r[0], r[1]}, {r[2], r[1]}, {r[2], r[3]}, {r[0], r[3]}};
+    }
+    if (poly) {
+      if (!poly.IsSequence() || poly.size() < 3) {
+        error(poly, what + ".polygon must be a list of at least 3 [x, y] corners, got " + kind(poly));
+        return std::nullopt;
+      }
+      std::vector<navi::Point2D> out;
+      bool ok = true;
+      for (const auto& c : poly) {
+        auto v = numbers(c, what + ".polygon corner", 2, 0, "[x, y]");
+        ok = ok && v.has_value();
+        if (v) out.push_back({(*v)[0], (*v)[1]});
+      }
+      if (!ok) return std::nullopt;
+      return out;
+    }
+    return std::nullopt;  // the caller reports what is missing
+  }
+  /// A time window [start_s, end_s] in seconds.
+  std::optional<std::pair<Time, Time>> window(const YAML::Node& start, const YAML::Node& end,
+                                              const YAML::Node& entry, const std::string& what) {
+    if (!start || !end) {
+      error(entry, what + " needs start_s and end_s (seconds, 0 <= start_s < end_s)");
+      return std::nullopt;
+    }
+    auto a = number(start, what + ".start_s");
+    auto b = number(end, what + ".end_s");
+    if (!a || !b) return std::nullopt;
+    if (*a < 0.0 || *b <= *a) {
+      error(entry, what + " is not a window: expected 0 <= start_s < end_s, got " + start.Scalar() + " and " +
+                       end.Scalar());
+      return std::nullopt;
+    }
+    return std::make_pair(from_seconds(*a), from_seconds(*b));
+  }
+
+ private:
+  std::string file_;
+  Diagnostics d_;
+};
+
+void read_laser(Reader& r, const YAML::Node& n, LaserConfig& c) {
+  const std::string w = "robot.laser";
+  if (!r.check_map(n, w, {"preset", "enabled", "name", "angle_min_deg", "angle_max_deg", "beams", "range_min_m",
+                          "range_max_m", "rate_hz", "noise_stddev_m", "mount"})) {
+    return;
+  }
+  if (const YAML::Node p = n["preset"]) {
+    const std::string s = p.IsScalar() ? p.Scalar() : std::string();
+    if (s == "rplidar_a1") {
+      c = LaserConfig::rplidar_a1();
+    } else if (s == "sick_180") {
+      c = LaserConfig::sick_180();
+    } else {
+      r.error(p, "unknown robot.laser.preset " + Reader::kind(p) + ", expected rplidar_a1 or sick_180");
+    }
+  }
+  r.boolean(n, "enabled", c.enabled, w);
+  r.text(n, "name", c.name, w);
+  double min_deg = c.angle_min_rad / kDegToRad, max_deg = c.angle_max_rad / kDegToRad;
+  const YAML::Node amin = n["angle_min_deg"], amax = n["angle_max_deg"];
+  if (amin) {
+    if (auto v = r.number(amin, w + ".angle_min_deg")) min_deg = *v;
+  }
+  if (amax) {
+    if (auto v = r.number(amax, w + ".angle_max_deg")) max_deg = *v;
+  }
+  if (max_deg <= min_deg || max_deg - min_deg > 360.0 + 1e-9) {
+    r.error(amax ? amax : (amin ? amin : n), w + ": expected angle_min_deg < angle_max_deg spanning at most 360 degrees");
+  } else {
+    c.angle_min_rad = min_deg * kDegToRad;
+    c.angle_max_rad = max_deg * kDegToRad;
+  }
+  if (const YAML::Node b = n["beams"]) {
+    if (auto v = r.number(b, w + ".beams")) {
+      if (*v < 1.0 || *v > 100000.0 || std::floor(*v) != *v) {
+        r.error(b, w + ".beams must be a whole number from 1 to 100000, got " + b.Scalar());
+      } else {
+        c.beams = static_cast<std::uint32_t>(*v);
+      }
+    }
+  }
+  r.number_at_least(n, "range_min_m", c.range_min_m, 0.0, false, w);
+  r.number_at_least(n, "range_max_m", c.range_max_m, 0.0, true, w);
+  if (c.range_max_m <= c.range_min_m) {
+    r.error(n["range_max_m"] ? n["range_max_m"] : n, w + ": expected range_min_m < range_max_m");
+  }
+  r.number_at_least(n, "rate_hz", c.rate_hz, 0.0, true, w);
+  r.number_at_least(n, "noise_stddev_m", c.noise_stddev_m, 0.0, false, w);
+  if (const YAML::Node m = n["mount"]) {
+    if (auto p = r.pose(m, w + ".mount")) c.mount = *p;
+  }
+}
+
+void read_robot(Reader& r, const YAML::Node& n, SimRobotConfig& rc) {
+  if (!r.check_map(n, "robot", {"radius_m", "max_substep_s", "laser", "odometry", "gyro", "bumpers", "cliff", "battery"})) {
+    return;
+  }
+  r.number_at_least(n, "radius_m", rc.radius_m, 0.0, true, "robot");
+  if (const YAML::Node s = n["max_substep_s"]) {
+    if (auto v = r.number(s, "robot.max_substep_s")) {
+      if (*v <= 0.0 || *v > 1.0) {
+        r.error(s, "robot.max_substep_s must be in (0, 1] seconds, got " + s.Scalar());
+      } else {
+        rc.max_substep = from_seconds(*v);
+      }
+    }
+  }
+  if (const YAML::Node l = n["laser"]) read_laser(r, l, rc.laser);
+  if (const YAML::Node o = n["odometry"]) {
+    if (r.check_map(o, "robot.odometry", {"name", "noise_ratio", "scale_error_stddev", "rate_hz"})) {
+      r.text(o, "name", rc.odometry.name, "robot.odometry");
+      r.number_at_least(o, "noise_ratio", rc.odometry.noise_ratio, 0.0, false, "robot.odometry");
+      r.number_at_least(o, "scale_error_stddev", rc.odometry.scale_error_stddev, 0.0, false, "robot.odometry");
+      r.number_at_least(o, "rate_hz", rc.odometry.rate_hz, 0.0, true, "robot.odometry");
+    }
+  }
+  if (const YAML::Node g = n["gyro"]) {
+    if (r.check_map(g, "robot.gyro", {"name", "enabled", "noise_stddev_rad_s", "bias_rad_s", "rate_hz"})) {
+      r.text(g, "name", rc.gyro.name, "robot.gyro");
+      r.boolean(g, "enabled", rc.gyro.enabled, "robot.gyro");
+      r.number_at_least(g, "noise_stddev_rad_s", rc.gyro.noise_stddev_rad_s, 0.0, false, "robot.gyro");
+      if (const YAML::Node b = g["bias_rad_s"]) {
+        if (auto v = r.number(b, "robot.gyro.bias_rad_s")) rc.gyro.bias_rad_s = *v;
+      }
+      r.number_at_least(g, "rate_hz", rc.gyro.rate_hz, 0.0, true, "robot.gyro");
+    }
+  }
+  if (const YAML::Node b = n["bumpers"]) {
+    if (r.check_map(b, "robot.bumpers", {"name", "enabled", "sectors", "contact_margin_m", "rate_hz"})) {
+      r.text(b, "name", rc.bumpers.name, "robot.bumpers");
+      r.boolean(b, "enabled", rc.bumpers.enabled, "robot.bumpers");
+      if (const YAML::Node s = b["sectors"]) {
+        if (auto v = r.number(s, "robot.bumpers.sectors")) {
+          if (*v < 1.0 || *v > 32.0 || std::floor(*v) != *v) {
+            r.error(s, "robot.bumpers.sectors must be a whole number from 1 to 32, got " + s.Scalar());
+          } else {
+            rc.bumpers.sectors = static_cast<std::uint32_t>(*v);
+          }
+        }
+      }
+      r.number_at_least(b, "contact_margin_m", rc.bumpers.contact_margin_m, 0.0, false, "robot.bumpers");
+      r.number_at_least(b, "rate_hz", rc.bumpers.rate_hz, 0.0, true, "robot.bumpers");
+    }
+  }
+  if (const YAML::Node c = n["cliff"]) {
+    if (r.check_map(c, "robot.cliff", {"name", "enabled", "positions", "rate_hz"})) {
+      r.text(c, "name", rc.cliff.name, "robot.cliff");
+      r.boolean(c, "enabled", rc.cliff.enabled, "robot.cliff");
+      r.number_at_least(c, "rate_hz", rc.cliff.rate_hz, 0.0, true, "robot.cliff");
+      if (const YAML::Node p = c["positions"]) {
+        if (!p.IsSequence()) {
+          r.error(p, "robot.cliff.positions must be a list of [x, y] (base frame, metres), got " + Reader::kind(p));
+        } else {
+          rc.cliff.positions.clear();
+          for (const auto& item : p) {
+            if (auto v = r.numbers(item, "robot.cliff.positions", 2, 0, "[x, y] (base frame, metres)")) {
+              rc.cliff.positions.push_back({(*v)[0], (*v)[1]});
+            }
+          }
+        }
+      }
+    }
+  }
+  if (const YAML::Node b = n["battery"]) {
+    const std::string w = "robot.battery";
+    if (r.check_map(b, w, {"name", "enabled", "initial", "capacity_ah", "voltage_empty_v", "voltage_full_v",
+                           "drain_per_s", "drain_per_m", "charge_per_s", "rate_hz"})) {
+      BatteryConfig& bc = rc.battery;
+      r.text(b, "name", bc.name, w);
+      r.boolean(b, "enabled", bc.enabled, w);
+      r.number_at_least(b, "initial", bc.initial, 0.0, false, w);
+      if (bc.initial > 1.0) r.error(b["initial"], w + ".initial is a state of charge: expected 0..1, got " + b["initial"].Scalar());
+      r.number_at_least(b, "capacity_ah", bc.capacity_ah, 0.0, true, w);
+      r.number_at_least(b, "voltage_empty_v", bc.voltage_empty_v, 0.0, false, w);
+      r.number_at_least(b, "voltage_full_v", bc.voltage_full_v, 0.0, true, w);
+      if (bc.voltage_full_v <= bc.voltage_empty_v) {
+        r.error(b["voltage_full_v"] ? b["voltage_full_v"] : b, w + ": expected voltage_empty_v < voltage_full_v");
+      }
+      r.number_at_least(b, "drain_per_s", bc.drain_per_s, 0.0, false, w);
+      r.number_at_least(b, "drain_per_m", bc.drain_per_m, 0.0, false, w);
+      r.number_at_least(b, "charge_per_s", bc.charge_per_s, 0.0, false, w);
+      r.number_at_least(b, "rate_hz", bc.rate_hz, 0.0, true, w);
+    }
+  }
+}
+
+std::optional<SensorKind> sensor_of(const std::string& s) {
+  for (SensorKind k : {SensorKind::laser, SensorKind::odometry, SensorKind::gyro, SensorKind::bumpers,
+                       SensorKind::cliff, SensorKind::battery}) {
+    if (s == to_string(k)) return k;
+  }
+  return std::nullopt;
+}
+
+void read_faults(Reader& r, const YAML::Node& n, FaultSchedule& f) {
+  if (!r.check_map(n, "faults", {"localization_loss", "dead_sensors"})) return;
+  if (const YAML::Node l = n["localization_loss"]) {
+    if (l.IsScalar()) {
+      // The navi localizer's own schedule syntax, "10-20; 35.5-40".
+      try {
+        f.localization_loss = navi::parse_fault_schedule(l.Scalar(), r.at(l));
+      } catch (const ConfigError& e) {
+        r.diagnostics().append(e.diagnostics());
+      }
+    } else if (l.IsSequence()) {
+      for (const auto& item : l) {
+        if (item.IsMap()) {
+          if (!r.check_map(item, "a localization_loss window", {"start_s", "end_s"})) continue;
+          if (auto w = r.window(item["start_s"], item["end_s"], item, "localization_loss window")) {
+            f.localization_loss.push_back({w->first, w->second});
+          }
+        } else {
+          r.error(item, "a localization_loss window must be {start_s: S, end_s: E}, got " + Reader::kind(item));
+        }
+      }
+    } else {
+      r.error(l, "faults.localization_loss must be \"START-END; ...\" (seconds) or a list of {start_s, end_s}, got " +
+                     Reader::kind(l));
+    }
+  }
+  if (const YAML::Node s = n["dead_sensors"]) {
+    if (!s.IsSequence()) {
+      r.error(s, "faults.dead_sensors must be a list of {sensor, start_s, end_s}, got " + Reader::kind(s));
+      return;
+    }
+    for (const auto& item : s) {
+      if (!r.check_map(item, "a dead_sensors entry", {"sensor", "start_s", "end_s"})) continue;
+      SensorOutage o;
+      o.where = r.at(item);
+      const YAML::Node name = item["sensor"];
+      std::optional<SensorKind> k;
+      if (!name) {
+        r.error(item, "a dead_sensors entry needs sensor: one of laser, odometry, gyro, bumpers, cliff, battery");
+      } else if (!(k = sensor_of(name.IsScalar() ? name.Scalar() : std::string()))) {
+        r.error(name, "unknown sensor " + Reader::kind(name) + ", expected one of laser, odometry, gyro, bumpers, cliff, battery");
+      }
+      auto w = r.window(item["start_s"], item["end_s"], item, "dead_sensors entry");
+      if (k && w) {
+        o.sensor = *k;
+        o.start = w->first;
+        o.end = w->second;
+        f.dead_sensors.push_back(o);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+World parse_world(std::string_view text, const std::filesystem::path& file) {
+  const std::string fname = file.string();
+  YAML::Node root;
+  try {
+    root = YAML::Load(std::string(text));
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(SourceLocation{fname, e.mark.line + 1, e.mark.column + 1}, e.msg);
+  }
+  Reader r(fname);
+  World w;
+  w.file = file;
+  if (!r.check_map(root, "the world file", {"map", "regions", "start_pose", "seed", "robot", "drops", "obstacles", "faults"})) {
+    throw ConfigError(std::move(r.diagnostics()));
+  }
+  const std::filesystem::path dir = file.parent_path();
+  auto resolve = [&](const YAML::Node& n, const std::string& key) -> std::optional<std::filesystem::path> {
+    if (!n.IsScalar() || n.Scalar().empty()) {
+      r.error(n, key + " must be a file path, got " + Reader::kind(n));
+      return std::nullopt;
+    }
+    std::filesystem::path p = n.Scalar();
+    if (p.is_relative()) p = dir / p;
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(p, ec)) {
+      r.error(n, key + " file '" + n.Scalar() + "' not found (looked for " + p.string() + ")");
+      return std::nullopt;
+    }
+    return p;
+  };
+
+  bool have_map = false;
+  if (const YAML::Node m = root["map"]) {
+    if (auto p = resolve(m, "map")) {
+      try {
+        w.grid = navi::load_map(*p).grid;
+        w.map_file = *p;
+        have_map = true;
+      } catch (const ConfigError& e) {
+        r.diagnostics().append(e.diagnostics());
+      }
+    }
+  } else {
+    r.error(root, "the world file needs map: a ROS map_server YAML file (relative to the world file)");
+  }
+  if (const YAML::Node g = root["regions"]) {
+    if (auto p = resolve(g, "regions")) {
+      try {
+        w.regions = navi::load_regions(*p);
+        w.regions_file = *p;
+      } catch (const ConfigError& e) {
+        r.diagnostics().append(e.diagnostics());
+      }
+    }
+  }
+  const YAML::Node start = root["start_pose"];
+  if (start) {
+    if (auto p = r.pose(start, "start_pose")) w.start_pose = *p;
+  } else {
+    r.error(root, "the world file needs start_pose: [x, y, theta] (map frame, metres, radians)");
+  }
+  if (const YAML::Node s = root["seed"]) {
+    try {
+      w.seed = s.as<std::uint64_t>();
+    } catch (const YAML::Exception&) {
+      r.error(s, "seed must be a non-negative whole number, got " + Reader::kind(s));
+    }
+  }
+  if (const YAML::Node rb = root["robot"]) read_robot(r, rb, w.robot);
+
+  if (const YAML::Node drops = root["drops"]) {
+    if (!drops.IsSequence()) {
+      r.error(drops, "drops must be a list of {name, rectangle | polygon | region}, got " + Reader::kind(drops));
+    } else {
+      for (const auto& item : drops) {
+        if (!r.check_map(item, "a drops entry", {"name", "rectangle", "polygon", "region"})) continue;
+        DropArea a;
+        a.where = r.at(item);
+        r.text(item, "name", a.name, "drops entry");
+        const YAML::Node region = item["region"];
+        const int given = (item["rectangle"] ? 1 : 0) + (item["polygon"] ? 1 : 0) + (region ? 1 : 0);
+        if (given != 1) {
+          r.error(item, "a drops entry needs exactly one of rectangle, polygon or region (a room of the regions file)");
+          continue;
+        }
+        if (region) {
+          const navi::Region* room = region.IsScalar() ? w.regions.room(region.Scalar()) : nullptr;
+          if (room == nullptr) {
+            r.error(region, "unknown region " + Reader::kind(region) + (w.regions_file.empty() ? " (the world names no regions file)" : ""));
+            continue;
+          }
+          a.polygon = room->polygon;
+          if (a.name.empty()) a.name = room->name;
+        } else if (auto s = r.shape(item, "drops entry")) {
+          a.polygon = std::move(*s);
+        } else {
+          continue;
+        }
+        w.drops.push_back(std::move(a));
+      }
+    }
+  }
+
+  if (const YAML::Node obs = root["obstacles"]) {
+    if (!obs.IsSequence()) {
+      r.error(obs, "obstacles must be a list of {name, rectangle | polygon, appear_s, disappear_s}, got " + Reader::kind(obs));
+    } else {
+      std::set<std::string> names;
+      for (const auto& item : obs) {
+        if (!r.check_map(item, "an obstacles entry", {"name", "rectangle", "polygon", "appear_s", "disappear_s"})) continue;
+        DynamicObstacle o;
+        o.where = r.at(item);
+        r.text(item, "name", o.name, "obstacles entry");
+        if (o.name.empty()) o.name = "obstacle " + std::to_string(w.obstacles.size() + 1);
+        if (!names.insert(o.name).second) r.error(item["name"] ? item["name"] : item, "duplicate obstacle name '" + o.name + "'");
+        auto s = r.shape(item, "obstacle '" + o.name + "'");
+        if (!s && !item["rectangle"] && !item["polygon"]) {
+          r.error(item, "obstacle '" + o.name + "' needs rectangle: [x_min, y_min, x_max, y_max] or polygon: [[x, y], ...]");
+        }
+        double appear = 0.0;
+        if (const YAML::Node a = item["appear_s"]) {
+          if (auto v = r.number(a, "appear_s")) {
+            if (*v < 0.0) r.error(a, "appear_s must be >= 0, got " + a.Scalar());
+            appear = *v;
+          }
+        }
+        o.appear = from_seconds(appear);
+        if (const YAML::Node dis = item["disappear_s"]) {
+          if (auto v = r.number(dis, "disappear_s")) {
+            if (*v <= appear) {
+              r.error(dis, "disappear_s must be later than appear_s (" + std::to_string(appear) + "), got " + dis.Scalar());
+            }
+            o.disappear = from_seconds(*v);
+          }
+        }
+        if (s) {
+          o.polygon = std::move(*s);
+          w.obstacles.push_back(std::move(o));
+        }
+      }
+    }
+  }
+
+  if (const YAML::Node f = root["faults"]) read_faults(r, f, w.faults);
+
+  if (have_map && start && !r.diagnostics().has_errors()) {
+    const SolidMap solid(w.grid);
+    const navi::CellIndex c = w.grid.cell_at({w.start_pose.x_m, w.start_pose.y_m});
+    if (!w.grid.contains(c)) {
+      r.error(start, "start_pose is outside the map");
+    } else if (!w.grid.is_free(c)) {
+      r.error(start, "start_pose is not on a free cell of the map");
+    } else if (solid.disc_overlaps({w.start_pose.x_m, w.start_pose.y_m}, w.robot.radius_m)) {
+      r.error(start, "at start_pose the robot's footprint (radius " + std::to_string(w.robot.radius_m) +
+                         " m) overlaps an occupied cell or leaves the map");
+    }
+  }
+  if (r.diagnostics().has_errors()) throw ConfigError(std::move(r.diagnostics()));
+  return w;
+}
+
+World load_world(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw ConfigError(SourceLocation{file.string(), 0, 0}, "cannot open world file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parse_world(ss.str(), file);
+}
+
+}  // namespace tripodal::sim
