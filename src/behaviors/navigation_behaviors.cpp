@@ -13,7 +13,7 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kCornerRad = 0.6;  // a bend of the path the lookahead point does not cross
+constexpr double kCornerRad = 0.45;  // a bend of the path the lookahead point does not cross
 
 ParameterSpec number(std::string name, double def, std::string unit, std::string description,
                      std::optional<double> min = std::nullopt, std::optional<double> max = std::nullopt) {
@@ -254,16 +254,18 @@ void CPathFollowingBehavior::configure_following(const ParameterSet& params, con
   slow_distance_m_ = std::max(params.number("slow_distance_m"), stop_distance_m_);
   blocked_timeout_ = from_seconds(params.number("blocked_timeout_s"));
   laser_ = nullptr;
+  bumpers_ = nullptr;
   if (context.resources != nullptr) {
     const std::string& name = params.string("laser");
     laser_ = name.empty() ? context.resources->first<LaserScan>() : context.resources->find<LaserScan>(name);
+    bumpers_ = context.resources->first<BumperReading>();
   }
   blocked_ = false;
   has_last_ = false;
   if (context.navi != nullptr) hold_heading_rad_ = context.navi->map_from_base.theta_rad;
 }
 
-double CPathFollowingBehavior::clearance_along(double dx_body, double dy_body, Time now) const noexcept {
+double CPathFollowingBehavior::clearance_along(double dx_body, double dy_body, const Pose2D& pose, Time now) const noexcept {
   if (laser_ == nullptr || !laser_->is_fresh(now)) return kInf;
   const double n = std::hypot(dx_body, dy_body);
   if (n <= 0.0) return kInf;
@@ -271,7 +273,20 @@ double CPathFollowingBehavior::clearance_along(double dx_body, double dy_body, T
   const double radius = workspace_.options().robot_radius_m;
   // Walls the path runs along are tangent to the body: a point beside it (lateral distance near
   // the radius) is not in the way, and range noise would make it look so.
-  const double corridor = 0.85 * radius;
+  const double corridor = 0.95 * radius;
+  // Returns from obstacles of the map are not in the way: the path was planned around them with
+  // a margin; only what the map does not know (a box left in the corridor) stops the robot.
+  const navi::OccupancyGrid& grid = workspace_.grid();
+  const double c = std::cos(pose.theta_rad), s = std::sin(pose.theta_rad);
+  auto on_map = [&](double bx, double by) {
+    const navi::CellIndex cell = grid.cell_at({pose.x_m + c * bx - s * by, pose.y_m + s * bx + c * by});
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (grid.state(navi::CellIndex{cell.x + dx, cell.y + dy}) != navi::Occupancy::free) return true;
+      }
+    }
+    return false;
+  };
   const LaserScan& scan = laser_->latest();
   double best = kInf;
   const std::size_t count = scan.ranges_m.size();
@@ -282,7 +297,7 @@ double CPathFollowingBehavior::clearance_along(double dx_body, double dy_body, T
     const double px = r * std::cos(a), py = r * std::sin(a);
     const double along = px * ux + py * uy;
     const double lateral = std::abs(px * uy - py * ux);
-    if (along <= 0.0 || lateral >= corridor) continue;
+    if (along <= 0.0 || lateral >= corridor || on_map(px, py)) continue;
     best = std::min(best, along - std::sqrt(radius * radius - lateral * lateral));
   }
   return best;
@@ -311,7 +326,7 @@ Twist2D CPathFollowingBehavior::command_toward(const Pose2D& pose, const PathTra
   };
   if (context.base.holonomic()) {
     speed = std::min(speed, context.base.max_vx_m_s);
-    speed *= scale_by_clearance(clearance_along(bx, by, context.now));
+    speed *= scale_by_clearance(clearance_along(bx, by, pose, context.now));
     cmd.vx_m_s = speed * bx / dist;
     cmd.vy_m_s = speed * by / dist;
     cmd.wz_rad_s = clamp_abs(k_heading_ * wrap_angle(hold_heading_rad_ - pose.theta_rad), yaw_rate_);
@@ -320,13 +335,15 @@ Twist2D CPathFollowingBehavior::command_toward(const Pose2D& pose, const PathTra
     cmd.wz_rad_s = clamp_abs(k_heading_ * alpha, std::min(yaw_rate_, context.base.max_wz_rad_s));
     if (std::abs(alpha) < 1.0) {
       speed = std::min(speed, context.base.max_vx_m_s);
-      cmd.vx_m_s = speed * std::cos(alpha) * scale_by_clearance(clearance_along(1.0, 0.0, context.now));
+      cmd.vx_m_s = speed * std::cos(alpha) * scale_by_clearance(clearance_along(1.0, 0.0, pose, context.now));
     }
   }
   return cmd;
 }
 
 bool CPathFollowingBehavior::blocked_too_long(bool blocked, Time now) noexcept {
+  // A body in contact cannot follow the path (the laser misses what grazes the body's side).
+  if (bumpers_ != nullptr && bumpers_->is_fresh(now) && bumpers_->latest().any()) blocked = true;
   if (!blocked) {
     blocked_ = false;
     return false;
@@ -400,7 +417,7 @@ std::optional<Twist2D> BhAutoMove::on_step(const BehaviorContext& context) noexc
 namespace {
 
 std::vector<ParameterSpec> cleaning_parameters() {
-  auto params = following_parameters(0.3, 0.2);
+  auto params = following_parameters(0.3, 0.15);
   params.insert(params.begin(), text("section", "", "The section to cover, as named by the section splitter"));
   return params;
 }

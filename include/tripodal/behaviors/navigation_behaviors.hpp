@@ -131,16 +131,19 @@ class CPathFollowingBehavior : public CBehavior {
   /// Reads the shared parameters (speeds, lookahead, laser, blocked timeout).
   void configure_following(const ParameterSet& params, const BehaviorContext& context);
   /// The clearance (metres beyond the body disc) along the body-frame direction (dx, dy) from
-  /// the latest fresh scan; +inf without returns there or without a fresh scan.
-  [[nodiscard]] double clearance_along(double dx_body, double dy_body, Time now) const noexcept;
+  /// the latest fresh scan, counting only returns from obstacles the map does not hold (seen
+  /// from `pose`, map frame); +inf without such returns or without a fresh scan.
+  [[nodiscard]] double clearance_along(double dx_body, double dy_body, const Pose2D& pose, Time now) const noexcept;
   /// The command toward the lookahead target; `blocked` tells whether the laser stopped it.
   [[nodiscard]] Twist2D command_toward(const Pose2D& pose, const PathTracker::Target& target,
                                        const BehaviorContext& context, bool& blocked) noexcept;
-  /// Advances the blocked timer; true when blocked for longer than the timeout.
+  /// Advances the blocked timer (blocked: the laser stopped the robot, or a bumper is pressed);
+  /// true when blocked for longer than the timeout.
   [[nodiscard]] bool blocked_too_long(bool blocked, Time now) noexcept;
 
   NaviWorkspace& workspace_;
   const LaserResource* laser_ = nullptr;
+  const BumperResource* bumpers_ = nullptr;
   PathTracker tracker_;
   double speed_ = 0.3, lookahead_m_ = 0.25, yaw_rate_ = 1.0, k_heading_ = 2.0;
   double stop_distance_m_ = 0.05, slow_distance_m_ = 0.4;
