@@ -481,9 +481,10 @@ RunResult run_task(const RunOptions& o) {
   ro.navigation = &navi;
   ro.base = controller->capabilities();
   const auto robot = Robot::assemble(profile, RobotCatalog{&modules, &behaviors, &default_controller_registry()}, clock, ro);
-  LifecycleRecorder life(false);
+  LifecycleRecorder life(true);
   ReportObserver report;
   robot->planner().add_observer(life);
+  robot->supervisor().add_observer(life);
   robot->planner().add_observer(report);
 
   SteadyClock wall;
@@ -497,6 +498,7 @@ RunResult run_task(const RunOptions& o) {
     if (o.log == nullptr) return;
     for (; printed < life.entries().size(); ++printed) {
       const LifecycleEntry& e = life.entries()[printed];
+      if (e.text.find(" fire ") != std::string::npos) continue;  // every firing: in lifecycle.txt only
       *o.log << std::setw(9) << fixed(to_seconds(e.time), 1) << " s  " << e.text << '\n';
     }
     o.log->flush();

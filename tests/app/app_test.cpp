@@ -1,0 +1,145 @@
+// The pieces of `tripodal run` that are not the robot: the PNG encoder (decoded back with zlib),
+// the path figures of the report, the report's JSON, and the run's refusals of bad input.
+#include <zlib.h>
+
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+#include "tripodal/app/cleaning_run.hpp"
+#include "tripodal/app/png.hpp"
+#include "tripodal/core/diagnostic.hpp"
+
+using namespace tripodal;
+using namespace tripodal::app;
+
+namespace {
+
+std::uint32_t be32(const std::string& s, std::size_t at) {
+  return (static_cast<std::uint32_t>(static_cast<unsigned char>(s[at])) << 24) |
+         (static_cast<std::uint32_t>(static_cast<unsigned char>(s[at + 1])) << 16) |
+         (static_cast<std::uint32_t>(static_cast<unsigned char>(s[at + 2])) << 8) |
+         static_cast<std::uint32_t>(static_cast<unsigned char>(s[at + 3]));
+}
+
+struct Chunk {
+  std::string type, data;
+  std::uint32_t crc = 0;
+};
+
+std::vector<Chunk> chunks(const std::string& png) {
+  std::vector<Chunk> out;
+  std::size_t at = 8;
+  while (at + 12 <= png.size()) {
+    const std::uint32_t len = be32(png, at);
+    Chunk c;
+    c.type = png.substr(at + 4, 4);
+    c.data = png.substr(at + 8, len);
+    c.crc = be32(png, at + 8 + len);
+    out.push_back(c);
+    at += 12 + len;
+  }
+  return out;
+}
+
+const std::filesystem::path kSource = TRIPODAL_SOURCE_DIR;
+
+}  // namespace
+
+TEST_CASE("PNG: signature, header, CRCs, and pixels that zlib decodes back", "[app][png]") {
+  RgbImage img(3, 2, 10, 20, 30);
+  img.set(2, 1, 255, 0, 128);
+  img.blend(0, 0, 110, 120, 130, 0.5);
+  img.set(7, 7, 1, 1, 1);  // outside: ignored
+  const std::string png = encode_png(img);
+  REQUIRE(png.substr(0, 8) == std::string("\x89PNG\r\n\x1a\n", 8));
+  const auto cs = chunks(png);
+  REQUIRE(cs.size() == 3);
+  CHECK(cs[0].type == "IHDR");
+  CHECK(be32(cs[0].data, 0) == 3);
+  CHECK(be32(cs[0].data, 4) == 2);
+  CHECK(cs[0].data.substr(8) == std::string("\x08\x02\x00\x00\x00", 5));
+  CHECK(cs[2].type == "IEND");
+  CHECK(cs[2].crc == 0xAE426082u);  // the well-known CRC of an empty IEND chunk
+  for (const auto& c : cs) CHECK(c.crc == png_crc32(c.type + c.data));
+  REQUIRE(cs[1].type == "IDAT");
+  std::string raw(2 * (1 + 9), '\0');
+  uLongf size = raw.size();
+  REQUIRE(::uncompress(reinterpret_cast<Bytef*>(raw.data()), &size, reinterpret_cast<const Bytef*>(cs[1].data.data()),
+                       cs[1].data.size()) == Z_OK);
+  REQUIRE(size == raw.size());
+  const unsigned char bytes[] = {0, 60, 70, 80, 10, 20, 30, 10, 20, 30,  // filter 0, blended, fill, fill
+                                 0, 10, 20, 30, 10, 20, 30, 255, 0, 128};
+  const std::string expected(reinterpret_cast<const char*>(bytes), sizeof bytes);
+  CHECK(raw == expected);
+  CHECK_THROWS_WITH(encode_png(RgbImage{}), Catch::Contains("empty image"));
+  RgbImage broken(2, 2);
+  broken.rgb.pop_back();
+  CHECK_THROWS_WITH(encode_png(broken), Catch::Contains("wrong size"));
+  CHECK_THROWS_WITH(write_png("/nonexistent-dir/x.png", img), Catch::Contains("cannot write /nonexistent-dir/x.png"));
+}
+
+TEST_CASE("Path figures: length of the path, turns of its simplified shape", "[app]") {
+  using navi::Point2D;
+  // An L with a little zig-zag (1 cm) on the first leg: one turn, the zig-zag simplified away.
+  std::vector<Point2D> l;
+  for (int i = 0; i <= 100; ++i) l.push_back({0.01 * i, (i % 2) * 0.01});
+  for (int i = 1; i <= 50; ++i) l.push_back({1.0, 0.02 * i});
+  const PathFigures f = path_figures(l);
+  CHECK(f.turns == 1);
+  CHECK(f.length_m > 2.0);  // the zig-zag's own length counts: it is what the robot drove
+  const PathFigures square = path_figures({{0, 0}, {1, 0}, {1, 1}, {0, 1}, {0, 0}});
+  CHECK(square.turns == 3);
+  CHECK(square.length_m == Approx(4.0));
+  CHECK(path_figures({}).turns == 0);
+  CHECK(path_figures({{1, 1}}).length_m == 0.0);
+}
+
+TEST_CASE("The run report is JSON with the measured values, strings escaped", "[app]") {
+  RunResult r;
+  r.robot = "psr2";
+  r.task = "clean the \"big\" room";
+  r.state = "succeeded";
+  r.succeeded = true;
+  r.coverage = 0.98765;
+  r.total.length_m = 12.345;
+  r.total.turns = 7;
+  r.recoveries = {"310.000 fault"};
+  SectionFigures s;
+  s.name = "A";
+  s.balloon.turns = 3;
+  s.boustrophedon.turns = 9;
+  r.sections.push_back(s);
+  const std::string j = r.json();
+  CHECK_THAT(j, Catch::Contains("\"task\": \"clean the \\\"big\\\" room\"") && Catch::Contains("\"coverage\": 0.9877") &&
+                    Catch::Contains("\"path\": {\"length_m\": 12.35, \"turns\": 7") &&
+                    Catch::Contains("\"recoveries\": [\"310.000 fault\"]") &&
+                    Catch::Contains("\"balloon\": {\"length_m\": 0.00, \"turns\": 3") &&
+                    Catch::Contains("\"boustrophedon\": {\"length_m\": 0.00, \"turns\": 9") &&
+                    Catch::Contains("\"succeeded\": true"));
+}
+
+TEST_CASE("run_task refuses a profile whose controller names no configuration, with its location", "[app]") {
+  const auto dir = std::filesystem::temp_directory_path() / ("tripodal_app_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ifstream in(kSource / "configs/robots/psr2.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto at = text.find("    parameters: { config: ../reactive/psr_omni.yaml }");
+  REQUIRE(at != std::string::npos);
+  text.erase(at, text.find('\n', at) - at + 1);
+  // paths of the profile are relative to it: point them back at the source tree
+  for (const std::string key : {"../petri/", "../tasks/"}) {
+    for (auto p = text.find(key); p != std::string::npos; p = text.find(key, p + 1)) {
+      text.replace(p, 3, (kSource / "configs").string() + "/");
+    }
+  }
+  const auto profile = dir / "robot.yaml";
+  std::ofstream(profile) << text;
+  RunOptions o;
+  o.robot = profile;
+  o.world = kSource / "configs/worlds/workspace.yaml";
+  o.task = "clean the room 3211";
+  REQUIRE_THROWS_WITH(run_task(o), Catch::Contains("robot.yaml:11:5: error: controller 'base' needs parameters: {config: FILE}"));
+  std::filesystem::remove_all(dir);
+}
