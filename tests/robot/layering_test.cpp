@@ -178,9 +178,9 @@ TEST_CASE("The robot refuses to start with every problem listed", "[robot]") {
       FAIL("started");
     } catch (const ConfigError& e) {
       const std::string m = e.what();
-      CHECK_THAT(m, Catch::Contains("psr2.yaml:20:5: error: module 'front_laser' cannot be started: no factory is registered for "
+      CHECK_THAT(m, Catch::Contains("psr2.yaml:21:5: error: module 'front_laser' cannot be started: no factory is registered for "
                                     "type 'LaserScanner'"));
-      CHECK_THAT(m, Catch::Contains("psr2.yaml:47:5: error: behavior 'BhAutoMove' cannot be started: no behavior type 'BhAutoMove' "
+      CHECK_THAT(m, Catch::Contains("psr2.yaml:52:5: error: behavior 'BhAutoMove' cannot be started: no behavior type 'BhAutoMove' "
                                     "is registered"));
     }
   }
