@@ -13,7 +13,8 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kCornerRad = 0.45;  // a bend of the path the lookahead point does not cross
+constexpr double kCornerRad = 0.45;
+constexpr double kDriveWhileTurningRad = 0.5;  // differential: larger bearings turn in place  // a bend of the path the lookahead point does not cross
 
 ParameterSpec number(std::string name, double def, std::string unit, std::string description,
                      std::optional<double> min = std::nullopt, std::optional<double> max = std::nullopt) {
@@ -333,9 +334,12 @@ Twist2D CPathFollowingBehavior::command_toward(const Pose2D& pose, const PathTra
   } else {
     const double alpha = std::atan2(by, bx);
     cmd.wz_rad_s = clamp_abs(k_heading_ * alpha, std::min(yaw_rate_, context.base.max_wz_rad_s));
-    if (std::abs(alpha) < 1.0) {
+    // Turn in place first when the lookahead point is well off the heading: driving while
+    // turning would sweep an arc off the path, toward the obstacle the path goes around.
+    if (std::abs(alpha) < kDriveWhileTurningRad) {
       speed = std::min(speed, context.base.max_vx_m_s);
-      cmd.vx_m_s = speed * std::cos(alpha) * scale_by_clearance(clearance_along(1.0, 0.0, pose, context.now));
+      const double c_alpha = std::cos(alpha);
+      cmd.vx_m_s = speed * c_alpha * c_alpha * scale_by_clearance(clearance_along(1.0, 0.0, pose, context.now));
     }
   }
   return cmd;
@@ -417,7 +421,7 @@ std::optional<Twist2D> BhAutoMove::on_step(const BehaviorContext& context) noexc
 namespace {
 
 std::vector<ParameterSpec> cleaning_parameters() {
-  auto params = following_parameters(0.3, 0.15);
+  auto params = following_parameters(0.3, 0.1);
   params.insert(params.begin(), text("section", "", "The section to cover, as named by the section splitter"));
   return params;
 }
