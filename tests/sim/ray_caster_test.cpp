@@ -104,6 +104,47 @@ TEST_CASE("SolidMap: Amanatides-Woo traversal agrees with brute force on random 
   CHECK(misses > 50);
 }
 
+TEST_CASE("SolidMap: jumps over open floor give the same ranges as the plain traversal", "[sim][ray]") {
+  std::mt19937_64 rng(777);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int checked = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const int w = 30 + static_cast<int>(u(rng) * 60), h = 30 + static_cast<int>(u(rng) * 60);
+    navi::OccupancyGrid g(w, h, 0.05, {}, navi::Occupancy::free);
+    const double density = 0.002 + 0.02 * u(rng);  // sparse: long jumps
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        if (u(rng) < density) g.set_state({x, y}, navi::Occupancy::occupied);
+      }
+    }
+    SolidMap m(g);
+    REQUIRE(m.jumps_valid());
+    // Change a few cells: until refresh() rays go cell by cell, after it they jump again.
+    for (int k = 0; k < 5; ++k) {
+      m.set_solid(static_cast<int>(u(rng) * w), static_cast<int>(u(rng) * h), true);
+    }
+    for (int phase = 0; phase < 2; ++phase) {
+      CHECK(m.jumps_valid() == (phase == 1));
+      for (int ray = 0; ray < 40; ++ray) {
+        const double gx = u(rng) * w, gy = u(rng) * h;
+        if (m.solid(static_cast<int>(gx), static_cast<int>(gy))) continue;
+        const double a = u(rng) * 2.0 * kPi;
+        const double max_t = 200.0 * u(rng);
+        const double expected = brute_force(m, gx, gy, std::cos(a), std::sin(a), max_t);
+        const double got = m.cast_cells(gx, gy, std::cos(a), std::sin(a), max_t);
+        if (std::isinf(expected)) REQUIRE(std::isinf(got));
+        else REQUIRE(got == Approx(expected).margin(1e-9));
+        ++checked;
+      }
+      m.refresh();
+    }
+  }
+  CHECK(checked > 3000);
+  // A grid without any solid cell: nothing is ever hit.
+  const SolidMap empty(navi::OccupancyGrid(50, 50, 0.05, {}, navi::Occupancy::free));
+  CHECK(std::isinf(empty.cast_cells(25.5, 25.5, 0.6, 0.8, 1000.0)));
+}
+
 TEST_CASE("SolidMap: axis-aligned rays along cell boundaries and from outside the grid", "[sim][ray]") {
   const SolidMap m(room_grid(10, 10, 0.1));
   // From the middle of cell (5, 5) straight at each wall: the walls' inner faces are at 1 and 9.
