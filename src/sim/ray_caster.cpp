@@ -1,5 +1,7 @@
 #include "tripodal/sim/ray_caster.hpp"
 
+#include "tripodal/navi/distance_field.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -8,6 +10,14 @@ namespace tripodal::sim {
 
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// floor() for values well inside int's range, without a libm call (x86-64's baseline has no
+// SSE4.1 rounding instruction).
+inline int floor_int(double v) noexcept {
+  const int i = static_cast<int>(v);
+  return v < i ? i - 1 : i;
+}
+// Shorter jumps cost more (a restart of the traversal) than the cell steps they save.
+constexpr float kMinJump = 2.0F;
 }  // namespace
 
 SolidMap::SolidMap(const navi::OccupancyGrid& grid)
@@ -19,6 +29,22 @@ SolidMap::SolidMap(const navi::OccupancyGrid& grid)
       sin_yaw_(std::sin(grid.origin().theta_rad)),
       cells_(grid.size(), 0) {
   for (std::size_t i = 0; i < grid.size(); ++i) cells_[i] = grid.state(i) == navi::Occupancy::occupied ? 1 : 0;
+  refresh();
+}
+
+void SolidMap::refresh() {
+  std::vector<bool> obstacle(cells_.size());
+  for (std::size_t i = 0; i < cells_.size(); ++i) obstacle[i] = cells_[i] != 0;
+  // Centre-to-centre distances D in cell units. Any point of this cell is within sqrt(2)/2 of its
+  // centre, any point of a solid cell within sqrt(2)/2 of that one's: a jump shorter than
+  // D - sqrt(2) from anywhere in the cell cannot reach a solid cell; D - 1.5 leaves a margin.
+  const navi::DistanceField field(width_, height_, 1.0, obstacle, false);
+  jump_.resize(cells_.size());
+  for (std::size_t i = 0; i < cells_.size(); ++i) {
+    const float d = field.distances_m()[i];
+    jump_[i] = d > 1.5F ? d - 1.5F : 0.0F;
+  }
+  jumps_valid_ = true;
 }
 
 navi::Point2D SolidMap::to_cells(navi::Point2D p) const noexcept {
@@ -37,24 +63,39 @@ double SolidMap::cast(navi::Point2D from, double angle_rad, double max_range_m) 
 double SolidMap::cast_cells(double gx, double gy, double dx, double dy, double max_t) const noexcept {
   // Amanatides & Woo: visit the cells the ray crosses in order, stepping across whichever cell
   // boundary (vertical or horizontal) the ray reaches first; t is the ray parameter in cells.
-  int ix = static_cast<int>(std::floor(gx));
-  int iy = static_cast<int>(std::floor(gy));
-  if (!contains(ix, iy)) return kInf;
-  if (solid(ix, iy)) return 0.0;
   const int step_x = dx > 0.0 ? 1 : -1;
   const int step_y = dy > 0.0 ? 1 : -1;
-  double t_max_x = kInf, t_max_y = kInf, t_delta_x = kInf, t_delta_y = kInf;
-  if (dx != 0.0) {
-    t_delta_x = 1.0 / std::abs(dx);
-    t_max_x = (dx > 0.0 ? (ix + 1.0 - gx) : (gx - ix)) * t_delta_x;
-  }
-  if (dy != 0.0) {
-    t_delta_y = 1.0 / std::abs(dy);
-    t_max_y = (dy > 0.0 ? (iy + 1.0 - gy) : (gy - iy)) * t_delta_y;
-  }
+  const double t_delta_x = dx != 0.0 ? 1.0 / std::abs(dx) : kInf;
+  const double t_delta_y = dy != 0.0 ? 1.0 / std::abs(dy) : kInf;
+  int ix = 0, iy = 0;
+  double t_max_x = kInf, t_max_y = kInf;
+  // (Re)starts the traversal at ray parameter t0: the cell there and the next boundary crossings.
+  auto start_at = [&](double t0) noexcept {
+    const double px = gx + dx * t0, py = gy + dy * t0;
+    ix = floor_int(px);
+    iy = floor_int(py);
+    t_max_x = dx > 0.0 ? t0 + (ix + 1.0 - px) * t_delta_x : dx < 0.0 ? t0 + (px - ix) * t_delta_x : kInf;
+    t_max_y = dy > 0.0 ? t0 + (iy + 1.0 - py) * t_delta_y : dy < 0.0 ? t0 + (py - iy) * t_delta_y : kInf;
+  };
+  // Far outside (or not a number): outside the grid, and beyond what the integer cells can hold.
+  if (!(std::abs(gx) < 1e8 && std::abs(gy) < 1e8)) return kInf;
+  start_at(0.0);
+  if (!contains(ix, iy)) return kInf;
+  if (solid(ix, iy)) return 0.0;
   const std::size_t w = static_cast<std::size_t>(width_);
+  const bool jumps = jumps_valid_;
+  double t = 0.0;  // where the ray is: inside cell (ix, iy)
   for (;;) {
-    double t = 0.0;
+    const std::size_t here = static_cast<std::size_t>(iy) * w + static_cast<std::size_t>(ix);
+    if (jumps && jump_[here] >= kMinJump) {
+      // Open floor: no solid cell within jump_ of anywhere in this cell. The grid is convex, so a
+      // ray that jumps out of it never comes back.
+      t += jump_[here];
+      if (!(t <= max_t) || std::isinf(t)) return kInf;
+      start_at(t);
+      if (!contains(ix, iy)) return kInf;
+      continue;
+    }
     if (t_max_x < t_max_y) {
       t = t_max_x;
       ix += step_x;

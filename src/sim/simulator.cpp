@@ -326,6 +326,13 @@ void Simulator::set_obstacle(std::size_t index, bool present) noexcept {
       solid_.set_solid(c.x, c.y, true);
     }
   }
+  // Obstacles come and go rarely: recomputing the ray jumps (about a millisecond on the demo
+  // map) is cheaper than tracing every later scan cell by cell. The allocation is reused.
+  try {
+    solid_.refresh();
+  } catch (...) {
+    // Out of memory: the plain traversal stays exact, only slower.
+  }
 }
 
 bool Simulator::due(Schedule& s) const noexcept {
