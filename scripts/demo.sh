@@ -1,42 +1,49 @@
 #!/usr/bin/env bash
-# The README's demo command: installs dependencies, builds tripodal (Release) and runs the demo.
-# Until the simulator lands, the demo is the paper's process PrCleaning (configs/petri/PrCleaning.xml,
-# Fig. 3 / Table 2) run by `tripodal-net simulate` through three narratives: a normal run, a
-# temporary localization loss with a recovery, and a persistent loss that ends in the fault place.
+# The README's demo command: installs dependencies, builds tripodal (Release) and runs the paper's
+# cleaning task end to end in the embedded simulator: PSR-2 (omni-directional base) cleans room
+# 3211 (10 m x 32 m, four sections) with `tripodal run`; then the same task with an injected
+# localization loss, where the planner inserts PrGlobalLocalization and the task still completes.
+# Pictures, trajectories and reports go to demo-out/ (DEMO_OUT to change). DEMO_ALL=1 also runs
+# the two-wheel differential robot; DEMO_NETS=1 also replays the PrCleaning net narratives.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${BUILD_DIR:-build/release}
+out=${DEMO_OUT:-demo-out}
 scripts/install-deps.sh
 generator=()
 if command -v ninja >/dev/null; then generator=(-G Ninja); fi
 cmake -S . -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DTRIPODAL_BUILD_TESTS=OFF >/dev/null
-cmake --build "$build" -j "$(nproc)" --target tripodal-net
-net_tool="$build/tools/tripodal-net/tripodal-net"
-nets=configs/petri
-scenarios=$nets/scenarios
+cmake --build "$build" -j "$(nproc)" --target tripodal tripodal-net
+tool="$build/tools/tripodal/tripodal"
+world=configs/worlds/workspace.yaml
 
 echo
-echo "== tripodal-net check $nets/*"
-"$net_tool" check "$nets"/*
-
-run() {
-  local title=$1 wheel=$2 script=$3
-  echo
-  echo "== $title (wheel_type=$wheel)"
-  grep '^#' "$scenarios/$script" | sed 's/^# \{0,1\}/   /'
-  echo "   script:"
-  grep -v '^#' "$scenarios/$script" | sed '/^[[:space:]]*$/d; s/^/     /'
-  echo
-  "$net_tool" simulate "$nets/PrCleaning.xml" --param "wheel_type=$wheel" --events "$scenarios/$script"
-}
-
-run "PrCleaning: normal completion" omni PrCleaning-omni-normal.events
-run "PrCleaning: temporary localization loss, the robot pauses, then recovers" omni \
-  PrCleaning-omni-temporary-loss.events
-run "PrCleaning: persistent localization loss ends in the fault place" omni \
-  PrCleaning-omni-persistent-loss.events
-run "PrCleaning on a differential base: persistent localization loss" differential \
-  PrCleaning-differential-persistent-loss.events
+echo "== PSR-2 (omni): clean the room 3211"
+"$tool" run --robot configs/robots/psr2.yaml --world "$world" --task "clean the room 3211" --seed 1 --out "$out/psr2"
 
 echo
-echo "Draw a net like the paper's Fig. 3:  $net_tool dot $nets/PrCleaning.xml | dot -Tsvg > PrCleaning.svg"
+echo "== PSR-2 with a localization loss from 300 s to 330 s"
+"$tool" run --robot configs/robots/psr2.yaml --world "$world" --task "clean the room 3211" --seed 1 \
+  --faults "300-330" --out "$out/psr2-localization-loss"
+
+if [ "${DEMO_ALL:-0}" = 1 ]; then
+  echo
+  echo "== Two-wheel differential robot (BhCleaningTwoWheel by the net's wheel_type): clean the room 3211"
+  "$tool" run --robot configs/robots/jinny_differential.yaml --world "$world" --task "clean the room 3211" --seed 1 \
+    --out "$out/differential"
+fi
+
+if [ "${DEMO_NETS:-0}" = 1 ]; then
+  net_tool="$build/tools/tripodal-net/tripodal-net"
+  nets=configs/petri
+  for s in PrCleaning-omni-normal PrCleaning-omni-temporary-loss PrCleaning-omni-persistent-loss; do
+    echo
+    echo "== tripodal-net simulate PrCleaning.xml --events $s.events"
+    "$net_tool" simulate "$nets/PrCleaning.xml" --param wheel_type=omni --events "$nets/scenarios/$s.events"
+  done
+fi
+
+echo
+echo "Pictures: $out/*/map.png (sections tinted, cleaned cells green, missed reachable cells red, path blue)."
+echo "Reports:  $out/*/report.json; trajectories: $out/*/trajectory.csv; life cycles: $out/*/lifecycle.txt."
+echo "Watch one in real time (10x):  $tool run --robot configs/robots/psr2.yaml --world $world --task \"clean the room 3211\" --realtime 10"
