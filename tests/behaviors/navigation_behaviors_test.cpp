@@ -10,6 +10,7 @@
 
 #include "tripodal/controllers/controller_config.hpp"
 #include "tripodal/controllers/ideal_hardware.hpp"
+#include "tripodal/sim/ray_caster.hpp"
 
 using namespace tripodal;
 using namespace std::chrono_literals;
@@ -232,6 +233,21 @@ TEST_CASE("BhAutoMove stops before an obstacle the laser sees and fails when blo
   b.activate(params({{"goal", "door"}, {"blocked_timeout_s", "3"}}), rig.ctx);
   (void)rig.run(b, 60.0, [&] { rig.laser.publish(scan_with_obstacle_ahead(rig.now, 20.0, 0.3)); });
   CHECK(b.status() == BehaviorStatus::succeeded);
+}
+
+TEST_CASE("BhAutoMove is not stopped by the laser returns of walls and pillars the map holds", "[behaviors][navigation]") {
+  Rig rig(true, room(6.0, 4.0, true), regions_for(6.0, 4.0), Pose2D{0.6, 2.0, 0.0});
+  const sim::SolidMap solid(rig.ws.grid());
+  sim::LaserModel lidar(sim::LaserConfig::rplidar_a1(), 5);
+  BhAutoMove b(rig.ws);
+  b.activate(params({{"goal", "door"}, {"blocked_timeout_s", "2"}}), rig.ctx);
+  LaserScan scan;
+  (void)rig.run(b, 60.0, [&] {
+    lidar.scan(solid, rig.controller->odometry().pose, rig.now, scan);
+    rig.laser.publish(scan);
+  });
+  CHECK(b.status() == BehaviorStatus::succeeded);
+  CHECK(rig.min_clearance() >= 0.2 - 0.03);
 }
 
 TEST_CASE("BhAutoMove pauses while the robot is not localized", "[behaviors][navigation]") {
