@@ -388,7 +388,7 @@ std::string RunResult::json() const {
     o << "{\"length_m\": " << fixed(s.length_m, 2) << ", \"turns\": " << s.turns << ", \"total_turn_rad\": " << fixed(s.total_turn_rad, 2)
       << ", \"coverage\": " << fixed(cov, 4) << "}";
   };
-  o << "{\n  \"robot\": " << json_string(robot) << ",\n  \"task\": " << json_string(task) << ",\n  \"seed\": " << seed
+  o << "{\n  \"robot\": " << json_string(robot) << ",\n  \"task\": " << json_string(task) << ",\n  \"coverage_pattern\": " << json_string(coverage_pattern) << ",\n  \"seed\": " << seed
     << ",\n  \"state\": " << json_string(state) << ",\n  \"succeeded\": " << (succeeded ? "true" : "false")
     << ",\n  \"reason\": " << json_string(reason) << ",\n  \"duration_s\": " << fixed(duration_s, 2)
     << ",\n  \"coverage\": " << fixed(coverage, 4) << ",\n  \"reachable_cells\": " << reachable_cells
@@ -433,6 +433,8 @@ RunResult run_task(const RunOptions& o) {
     throw ConfigError(maps->where, "robot_radius_m " + fixed(wo.robot_radius_m, 3) + " m is smaller than the simulated body (" +
                                        fixed(world.robot.radius_m, 3) + " m): planned paths would collide");
   }
+  if (o.boustrophedon) wo.pattern = NaviWorkspaceOptions::Pattern::boustrophedon;
+  res.coverage_pattern = o.boustrophedon ? "boustrophedon" : "balloon";
   NaviWorkspace ws(world.grid, world.regions, wo);
 
   std::vector<navi::LocalizationFault> faults = world.faults.localization_loss;

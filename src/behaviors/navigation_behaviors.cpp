@@ -121,7 +121,7 @@ std::optional<navi::Point2D> NaviWorkspace::resolve_goal(std::string_view name, 
     const navi::Section* s = section(sec);
     if (s == nullptr) return std::nullopt;
     auto it = entry_plans_.find(sec);
-    if (it == entry_plans_.end()) it = entry_plans_.emplace(std::string(sec), coverage_.balloon(*s, from)).first;
+    if (it == entry_plans_.end()) it = entry_plans_.emplace(std::string(sec), plan_coverage(*s, from)).first;
     if (it->second.path.empty()) return s->centroid;
     return it->second.path.front();
   }
@@ -146,11 +146,16 @@ NaviWorkspace::SectionProgress& NaviWorkspace::progress(const navi::Section& sec
     p.plan = std::move(e->second);  // the entry BhAutoMove went to is this path's first point
     entry_plans_.erase(e);
   } else {
-    p.plan = coverage_.balloon(section, from);
+    p.plan = plan_coverage(section, from);
   }
   if (it == progress_.end()) return progress_.emplace(section.name, std::move(p)).first->second;
   it->second = std::move(p);
   return it->second;
+}
+
+navi::CoverageResult NaviWorkspace::plan_coverage(const navi::Section& section, navi::Point2D from) {
+  return options_.pattern == NaviWorkspaceOptions::Pattern::balloon ? coverage_.balloon(section, from)
+                                                                     : coverage_.boustrophedon(section, from);
 }
 
 bool NaviWorkspace::relocalize(Time now) const noexcept {

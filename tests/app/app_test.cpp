@@ -143,3 +143,25 @@ TEST_CASE("run_task refuses a profile whose controller names no configuration, w
   REQUIRE_THROWS_WITH(run_task(o), Catch::Contains("robot.yaml:11:5: error: controller 'base' needs parameters: {config: FILE}"));
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("run_task in process: PSR-2 cleans room 2111 and measures it", "[app][run]") {
+  RunOptions o;
+  o.robot = kSource / "configs/robots/psr2.yaml";
+  o.world = kSource / "configs/worlds/workspace.yaml";
+  o.task = "clean the room 2111";
+  o.seed = 2;
+  const RunResult r = run_task(o);
+  CHECK(r.succeeded);
+  CHECK(r.state == "succeeded");
+  CHECK(r.reachable_cells > 20000);  // about 60 m2 at 5 cm cells
+  CHECK(r.coverage >= 0.99);
+  CHECK(r.collisions == 0);
+  REQUIRE(r.sections.size() == 1);
+  CHECK(r.sections[0].name == "A");
+  CHECK(r.total.length_m > r.cleaning.length_m - 1e-9);
+  CHECK(r.processes.size() == 2);
+  o.task = "clean the kitchen now";
+  const RunResult refused = run_task(o);
+  CHECK(refused.state == "refused");
+  CHECK_THAT(refused.reason, Catch::Contains("not understood"));
+}

@@ -23,7 +23,7 @@ constexpr int kTaskFailed = 4;
 constexpr std::string_view kRunUsage =
     "usage: tripodal run --robot ROBOT.yaml --world WORLD.yaml --task \"COMMAND\"\n"
     "                    [--seed N] [--out DIR] [--realtime [SPEED]] [--faults SCHEDULE|FILE]\n"
-    "                    [--max-duration-s S]\n\n"
+    "                    [--max-duration-s S] [--boustrophedon]\n\n"
     "Runs the robot of a profile in the embedded simulator (the world file gives the map, the\n"
     "regions, the start pose and the faults) and gives it the task in plain words, e.g.\n"
     "\"clean the room 3211\". Prints the task and process life cycle and a progress bar (coverage\n"
@@ -32,7 +32,9 @@ constexpr std::string_view kRunUsage =
     "length, turns, duration, faults, recoveries, planned balloon vs boustrophedon paths) and\n"
     "lifecycle.txt. The same seed gives the same run. --faults adds localization losses, in\n"
     "seconds of simulated time: \"300-330; 900-905\" (or a file holding that text).\n"
-    "Faster than real time unless --realtime (SPEED times real time, default 1).\n\n"
+    "Faster than real time unless --realtime (SPEED times real time, default 1). --boustrophedon\n"
+    "makes the cleaning behaviors follow the plough path instead of the wall-following balloon,\n"
+    "to measure the baseline on the robot.\n\n"
     "exit codes: 0 task succeeded, 1 bad profile/world/faults, 2 bad command line, 3 I/O error,\n"
     "4 the task failed, was refused or timed out.\n";
 
@@ -59,6 +61,8 @@ int run(const std::vector<std::string>& args, std::ostream& out, std::ostream& e
     } else if (a == "--out") {
       ok = value(v);
       o.out = v;
+    } else if (a == "--boustrophedon") {
+      o.boustrophedon = true;
     } else if (a == "--faults") {
       ok = value(faults);
     } else if (a == "--seed" || a == "--max-duration-s") {

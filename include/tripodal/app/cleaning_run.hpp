@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <iosfwd>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,8 @@ struct RunOptions {
   std::filesystem::path out;    ///< folder for map.png, trajectory.csv, report.json (empty: none)
   /// Extra localization losses ("10-20; 35-40", seconds), added to the world's fault schedule.
   std::vector<navi::LocalizationFault> faults;
+  /// Follow the boustrophedon path instead of the balloon (the baseline, measured on the robot).
+  bool boustrophedon = false;
   double max_duration_s = 4.0 * 3600.0;  ///< the task is cancelled after this much simulated time
   Duration robot_period{std::chrono::milliseconds(50)};  ///< behaviors, modules, supervisor
   std::ostream* log = nullptr;       ///< task and process life cycle, as it happens
@@ -56,6 +59,7 @@ struct RunResult {
   std::string state;            ///< "succeeded", "failed", "timed out", "refused"
   std::string reason;
   std::string robot, task;
+  std::string coverage_pattern;  ///< "balloon" or "boustrophedon"
   std::uint64_t seed = 0;
   double duration_s = 0.0;      ///< simulated
   double coverage = 0.0;        ///< of the reachable free area of the room, from the true path

@@ -29,6 +29,10 @@ struct NaviWorkspaceOptions {
   /// Overlap of neighbouring coverage rounds.
   double overlap_m = 0.05;
   navi::SectionSplitterOptions splitter;
+  /// The coverage path the cleaning behaviors follow: the paper's wall-following balloon, or the
+  /// boustrophedon (plough) baseline, to measure one against the other on the robot.
+  enum class Pattern { balloon, boustrophedon };
+  Pattern pattern = Pattern::balloon;
 };
 
 /// What the navigation behaviors share with the sequencing layer: the grid map, the named
@@ -60,8 +64,8 @@ class NaviWorkspace final {
   [[nodiscard]] navi::CleanedCells& cleaned() noexcept { return cleaned_; }
   [[nodiscard]] const navi::CleanedCells& cleaned() const noexcept { return cleaned_; }
 
-  /// Where a goal name points: "<section>.entry" (the first point of the section's balloon
-  /// coverage entered from `from`), a map node, a room (its centroid) or a section (its
+  /// Where a goal name points: "<section>.entry" (the first point of the section's coverage
+  /// path entered from `from`), a map node, a room (its centroid) or a section (its
   /// centroid). nullopt for an unknown name.
   [[nodiscard]] std::optional<navi::Point2D> resolve_goal(std::string_view name, navi::Point2D from);
 
@@ -71,8 +75,8 @@ class NaviWorkspace final {
     double done_m = 0.0;   ///< arc length already followed
     bool finished = false;
   };
-  /// The progress record of a section, the balloon path computed from `from` on first use (and
-  /// again when the previous one finished).
+  /// The progress record of a section, the coverage path (options().pattern) computed from
+  /// `from` on first use (and again when the previous one finished).
   SectionProgress& progress(const navi::Section& section, navi::Point2D from);
   [[nodiscard]] const std::map<std::string, SectionProgress, std::less<>>& all_progress() const noexcept {
     return progress_;
@@ -90,6 +94,7 @@ class NaviWorkspace final {
   navi::PathPlanner planner_;
   navi::CoveragePlanner coverage_;
   navi::CleanedCells cleaned_;
+  [[nodiscard]] navi::CoverageResult plan_coverage(const navi::Section& section, navi::Point2D from);
   std::map<std::string, SectionProgress, std::less<>> progress_;
   std::map<std::string, navi::CoverageResult, std::less<>> entry_plans_;
   std::function<bool(Time)> relocalize_;
