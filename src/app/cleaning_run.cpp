@@ -496,8 +496,14 @@ RunResult run_task(const RunOptions& o) {
   robot->step();  // the localizer's first estimate, before the planner asks where to start
   const CommandAnswer answer = robot->command(o.task);
   std::size_t printed = 0;
+  bool bar_shown = false;  // a bar drawn in place on the terminal, to be wiped before a log line
   auto flush_log = [&] {
     if (o.log == nullptr) return;
+    if (bar_shown && printed < life.entries().size() && o.progress != nullptr) {
+      *o.progress << '\r' << std::string(100, ' ') << '\r';
+      o.progress->flush();
+      bar_shown = false;
+    }
     for (; printed < life.entries().size(); ++printed) {
       const LifecycleEntry& e = life.entries()[printed];
       if (e.text.find(" fire ") != std::string::npos) continue;  // every firing: in lifecycle.txt only
@@ -560,6 +566,7 @@ RunResult run_task(const RunOptions& o) {
                 << std::setw(7) << fixed(to_seconds(clock.now()), 0) << " s  " << (report.current.empty() ? "-" : report.current)
                 << (o.progress_is_terminal && !final ? "          " : "\n");
     o.progress->flush();
+    bar_shown = o.progress_is_terminal && !final;
   };
 
   std::int64_t tick = 0;
@@ -587,7 +594,7 @@ RunResult run_task(const RunOptions& o) {
       }
       if (to_seconds(now) >= next_progress_s) {
         draw_progress(false);
-        next_progress_s += o.progress_is_terminal ? 1.0 : 60.0;
+        next_progress_s += o.progress_is_terminal ? (o.realtime ? 1.0 : 10.0) : 60.0;
       }
     }
     controller->set_command(command, now);
