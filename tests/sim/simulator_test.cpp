@@ -131,6 +131,7 @@ TEST_CASE("Simulator: a wall stops the base against it and trips the facing bump
   CHECK(vel[1] == 0.0);
   REQUIRE(sim.events().size() == 1);
   CHECK(sim.events()[0].kind == SimEvent::Kind::collision);
+  CHECK(sim.events()[0].detail == "at (3.75, 2.00)");
   CHECK(to_seconds(sim.events()[0].stamp) == Approx(3.5).margin(0.01));
 
   // Backing off releases the bumper; turning to face the wall with the left side presses sector 1.
@@ -443,4 +444,16 @@ TEST_CASE("RealtimePacer: sleeps on the injected clock until wall time matches s
   runner.run_for(1s);
   CHECK(wall.now() == at(100.5) + at(1.0) - at(0.05));  // the first period only starts the pacing
   CHECK(sim.now() == at(1.0));
+}
+
+TEST_CASE("Simulator: the map's edge is a wall for the base and the bumpers", "[sim][collision]") {
+  World world;
+  world.grid = navi::OccupancyGrid(40, 40, 0.05, {}, navi::Occupancy::free);  // 2 m, no walls drawn
+  world.start_pose = {1.0, 1.0, kPi / 2.0};
+  Simulator sim(std::move(world), omni3_base(), 1);
+  sim.command_twist({0.4, 0.0, 0.0});  // forward = +y
+  run(sim, 5.0);
+  CHECK(sim.blocked());
+  CHECK(sim.pose().y_m == Approx(2.0 - 0.25).margin(1e-4));
+  CHECK(sim.bumpers().latest().pressed_mask == 0x1U);
 }
