@@ -17,7 +17,7 @@ inline int floor_int(double v) noexcept {
   return v < i ? i - 1 : i;
 }
 // Shorter jumps cost more (a restart of the traversal) than the cell steps they save.
-constexpr std::uint8_t kMinJump = 2;
+constexpr float kMinJump = 2.0F;
 }  // namespace
 
 SolidMap::SolidMap(const navi::OccupancyGrid& grid)
@@ -41,9 +41,8 @@ void SolidMap::refresh() {
   const navi::DistanceField field(width_, height_, 1.0, obstacle, false);
   jump_.resize(cells_.size());
   for (std::size_t i = 0; i < cells_.size(); ++i) {
-    // Whole cells, at most 255: one byte per cell keeps the table in cache with the grid.
-    const double d = static_cast<double>(field.distances_m()[i]) - 1.5;
-    jump_[i] = d <= 0.0 ? 0 : d >= 255.0 ? 255 : static_cast<std::uint8_t>(d);
+    const float d = field.distances_m()[i];
+    jump_[i] = d > 1.5F ? d - 1.5F : 0.0F;
   }
   jumps_valid_ = true;
 }

@@ -65,7 +65,7 @@ class SolidMap {
   double cos_yaw_ = 1.0;
   double sin_yaw_ = 0.0;
   std::vector<std::uint8_t> cells_;
-  std::vector<std::uint8_t> jump_;  // cells a ray may advance from anywhere in the cell without a hit
+  std::vector<float> jump_;  // cells a ray may advance from anywhere in the cell without a hit
   bool jumps_valid_ = false;
 };
 
