@@ -94,7 +94,7 @@ TEST_CASE("Simulator: a three-wheel omni base follows the analytic circle of a b
   }
 }
 
-TEST_CASE("Simulator: a mecanum base moves sideways; bad wheel commands are refused", "[sim][kinematics]") {
+TEST_CASE("Simulator: a mecanum base moves sideways, bad wheel commands are refused", "[sim][kinematics]") {
   Simulator sim(room_world(81, 81, {2.0, 1.0, 0.0}), mecanum_base4(), 1);
   REQUIRE(sim.wheel_count() == 4);
   sim.command_twist({0.0, 0.3, 0.0});
@@ -278,7 +278,7 @@ TEST_CASE("Simulator: localization loss windows drive the navi localizer from gr
   CHECK(sim.events()[1].kind == SimEvent::Kind::localization_loss_end);
 }
 
-TEST_CASE("Simulator: cliff sensors see a drop ahead; a robot driving into it falls", "[sim][cliff]") {
+TEST_CASE("Simulator: cliff sensors see a drop ahead, a robot driving into it falls", "[sim][cliff]") {
   World world = room_world(81, 81, {2.0, 2.0, 0.0});
   world.drops.push_back({"stairs", {{3.0, 1.0}, {3.5, 1.0}, {3.5, 3.0}, {3.0, 3.0}}, {}});
   Simulator sim(std::move(world), differential_base(), 1);
@@ -383,7 +383,7 @@ TEST_CASE("Simulator: a controller drives the simulated base through the Hardwar
   }
 }
 
-TEST_CASE("SimRunner: control loops and the simulator step together; BhGoToPose reaches a goal", "[sim][runner]") {
+TEST_CASE("SimRunner: control loops and the simulator step together, BhGoToPose reaches a goal", "[sim][runner]") {
   const ReactiveConfig rc = load_reactive_config(std::string(TRIPODAL_SOURCE_DIR) + "/configs/reactive/psr_omni.yaml");
   const ControllerConfig& base = *rc.find_controller("base");
   Simulator sim(room_world(81, 81, {1.0, 1.0, 0.0}), base, 5);
