@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include "tripodal/controllers/holonomic_controller.hpp"
@@ -218,7 +219,9 @@ void Simulator::substep(Duration dt) noexcept {
       pose_ = integrate_body_displacement(pose_, dx * lo, dy * lo, dth * lo);
       if (!blocked_) {
         ++collisions_;
-        log(SimEvent::Kind::collision, {});
+        char where[64];
+        std::snprintf(where, sizeof where, "at (%.2f, %.2f)", pose_.x_m, pose_.y_m);
+        log(SimEvent::Kind::collision, where);
       }
       blocked_ = true;
     } else {
@@ -369,7 +372,8 @@ void Simulator::update_bumpers() noexcept {
   std::uint32_t mask = 0;
   for (int y = y0; y <= y1; ++y) {
     for (int x = x0; x <= x1; ++x) {
-      if (!solid_.solid(x, y)) continue;
+      // Beyond the map's edge counts as a wall, as it does for collisions.
+      if (solid_.contains(x, y) && !solid_.solid(x, y)) continue;
       const double nx = std::clamp(g.x_m, static_cast<double>(x), x + 1.0) - g.x_m;
       const double ny = std::clamp(g.y_m, static_cast<double>(y), y + 1.0) - g.y_m;
       if (nx * nx + ny * ny >= r * r) continue;

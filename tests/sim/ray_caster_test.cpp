@@ -6,8 +6,10 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <string>
 
 #include "sim_test_util.hpp"
+#include "tripodal/navi/map_io.hpp"
 
 using namespace tripodal;
 using namespace tripodal::sim;
@@ -262,4 +264,33 @@ TEST_CASE("LaserModel: seeded Gaussian range noise, range limits", "[sim][laser]
   CHECK(s2.ranges_m[left] == Approx(1.8).margin(2e-3));   // within [1.6, 1.9]
   ln.scan(m, {2.0, 1.5, 0.0}, Time{0}, s2);
   CHECK(std::isinf(s2.ranges_m[left]));  // about 1.5 < range_min
+}
+
+TEST_CASE("LaserModel: on the demo workspace, jumping rays see what cell-by-cell rays see", "[sim][ray][laser]") {
+  const navi::OccupancyGrid grid =
+      navi::load_map(std::string(TRIPODAL_SOURCE_DIR) + "/configs/worlds/workspace_map.yaml").grid;
+  const SolidMap jumping(grid);
+  SolidMap plain(grid);
+  plain.set_solid(0, 0, plain.solid(0, 0));  // invalidates the jumps: every cell is visited
+  REQUIRE(jumping.jumps_valid());
+  REQUIRE_FALSE(plain.jumps_valid());
+  LaserConfig c = LaserConfig::rplidar_a1();
+  c.noise_stddev_m = 0.0;
+  LaserModel laser(c, 1);
+  LaserScan a, b;
+  int poses = 0;
+  for (double y = 1.0; y < 31.5; y += 2.3) {
+    for (double x = 0.7; x < 9.8; x += 1.3) {
+      if (jumping.disc_overlaps({x, y}, 0.2)) continue;
+      const Pose2D p{x, y, 0.1 * poses};
+      laser.scan_exact(jumping, p, Time{0}, a);
+      laser.scan_exact(plain, p, Time{0}, b);
+      for (std::size_t i = 0; i < a.ranges_m.size(); ++i) {
+        if (std::isinf(b.ranges_m[i])) REQUIRE(std::isinf(a.ranges_m[i]));
+        else REQUIRE(a.ranges_m[i] == Approx(b.ranges_m[i]).margin(1e-5));
+      }
+      ++poses;
+    }
+  }
+  CHECK(poses > 60);
 }

@@ -94,7 +94,7 @@ TEST_CASE("Simulator: a three-wheel omni base follows the analytic circle of a b
   }
 }
 
-TEST_CASE("Simulator: a mecanum base moves sideways; bad wheel commands are refused", "[sim][kinematics]") {
+TEST_CASE("Simulator: a mecanum base moves sideways, bad wheel commands are refused", "[sim][kinematics]") {
   Simulator sim(room_world(81, 81, {2.0, 1.0, 0.0}), mecanum_base4(), 1);
   REQUIRE(sim.wheel_count() == 4);
   sim.command_twist({0.0, 0.3, 0.0});
@@ -131,6 +131,7 @@ TEST_CASE("Simulator: a wall stops the base against it and trips the facing bump
   CHECK(vel[1] == 0.0);
   REQUIRE(sim.events().size() == 1);
   CHECK(sim.events()[0].kind == SimEvent::Kind::collision);
+  CHECK(sim.events()[0].detail == "at (3.75, 2.00)");
   CHECK(to_seconds(sim.events()[0].stamp) == Approx(3.5).margin(0.01));
 
   // Backing off releases the bumper; turning to face the wall with the left side presses sector 1.
@@ -277,7 +278,7 @@ TEST_CASE("Simulator: localization loss windows drive the navi localizer from gr
   CHECK(sim.events()[1].kind == SimEvent::Kind::localization_loss_end);
 }
 
-TEST_CASE("Simulator: cliff sensors see a drop ahead; a robot driving into it falls", "[sim][cliff]") {
+TEST_CASE("Simulator: cliff sensors see a drop ahead, a robot driving into it falls", "[sim][cliff]") {
   World world = room_world(81, 81, {2.0, 2.0, 0.0});
   world.drops.push_back({"stairs", {{3.0, 1.0}, {3.5, 1.0}, {3.5, 3.0}, {3.0, 3.0}}, {}});
   Simulator sim(std::move(world), differential_base(), 1);
@@ -382,7 +383,7 @@ TEST_CASE("Simulator: a controller drives the simulated base through the Hardwar
   }
 }
 
-TEST_CASE("SimRunner: control loops and the simulator step together; BhGoToPose reaches a goal", "[sim][runner]") {
+TEST_CASE("SimRunner: control loops and the simulator step together, BhGoToPose reaches a goal", "[sim][runner]") {
   const ReactiveConfig rc = load_reactive_config(std::string(TRIPODAL_SOURCE_DIR) + "/configs/reactive/psr_omni.yaml");
   const ControllerConfig& base = *rc.find_controller("base");
   Simulator sim(room_world(81, 81, {1.0, 1.0, 0.0}), base, 5);
@@ -443,4 +444,16 @@ TEST_CASE("RealtimePacer: sleeps on the injected clock until wall time matches s
   runner.run_for(1s);
   CHECK(wall.now() == at(100.5) + at(1.0) - at(0.05));  // the first period only starts the pacing
   CHECK(sim.now() == at(1.0));
+}
+
+TEST_CASE("Simulator: the map's edge is a wall for the base and the bumpers", "[sim][collision]") {
+  World world;
+  world.grid = navi::OccupancyGrid(40, 40, 0.05, {}, navi::Occupancy::free);  // 2 m, no walls drawn
+  world.start_pose = {1.0, 1.0, kPi / 2.0};
+  Simulator sim(std::move(world), omni3_base(), 1);
+  sim.command_twist({0.4, 0.0, 0.0});  // forward = +y
+  run(sim, 5.0);
+  CHECK(sim.blocked());
+  CHECK(sim.pose().y_m == Approx(2.0 - 0.25).margin(1e-4));
+  CHECK(sim.bumpers().latest().pressed_mask == 0x1U);
 }

@@ -45,7 +45,7 @@ struct SimEvent {
   };
   Kind kind = Kind::collision;
   Time stamp{0};
-  std::string detail;  ///< obstacle or sensor name
+  std::string detail;  ///< obstacle or sensor name; "at (x, y)" of a collision
 };
 [[nodiscard]] std::string_view to_string(SimEvent::Kind kind) noexcept;
 
