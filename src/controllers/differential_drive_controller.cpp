@@ -27,7 +27,7 @@ DifferentialDriveController::DifferentialDriveController(const ControllerConfig&
   if (d.has_errors()) throw ConfigError(std::move(d));
 }
 
-BaseCapabilities DifferentialDriveController::capabilities() const noexcept {
+BaseCapabilities DifferentialDriveController::do_capabilities() const noexcept {
   BaseCapabilities c;
   const auto& l = config_.limits;
   const auto& k = config_.differential;

@@ -81,7 +81,7 @@ HolonomicController::HolonomicController(const ControllerConfig& config, Hardwar
   last_pos_ = wheel_cmd_;
 }
 
-BaseCapabilities HolonomicController::capabilities() const noexcept {
+BaseCapabilities HolonomicController::do_capabilities() const noexcept {
   BaseCapabilities c;
   const auto& l = config_.limits;
   c.max_vx_m_s = l.vx.max_velocity.value_or(c.max_vx_m_s);

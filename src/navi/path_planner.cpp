@@ -33,10 +33,18 @@ PathPlanner::PathPlanner(const OccupancyGrid& grid, PathPlannerOptions options)
   for (std::size_t i = 0; i < grid_.size(); ++i) {
     traversable_[i] = field_.distance_m(i) > 0.0 && field_.clearance_m(i) >= options_.robot_radius_m ? 1 : 0;
   }
-  g_.resize(grid_.size());
-  parent_.resize(grid_.size());
-  stamp_.assign(grid_.size(), 0);
-  closed_.resize(grid_.size());
+  padded_width_ = grid_.width() + 2;
+  const std::size_t padded = static_cast<std::size_t>(padded_width_) * static_cast<std::size_t>(grid_.height() + 2);
+  open_cell_.assign(padded, 0);
+  for (int y = 0; y < grid_.height(); ++y) {
+    for (int x = 0; x < grid_.width(); ++x) {
+      open_cell_[static_cast<std::size_t>((y + 1) * padded_width_ + x + 1)] = traversable_[grid_.index({x, y})];
+    }
+  }
+  g_.resize(padded);
+  parent_.resize(padded);
+  stamp_.assign(padded, 0);
+  closed_.resize(padded);
 }
 
 bool PathPlanner::line_of_sight(CellIndex a, CellIndex b) const noexcept {
@@ -130,11 +138,16 @@ PlannedPath PathPlanner::plan(CellIndex start, CellIndex goal) {
     search_id_ = 1;
   }
   constexpr float kSqrt2 = 1.41421356F;
-  const int w = grid_.width();
-  const auto octile = [&](int x, int y) {
+  // Scaling h by (1 + 1/1000) breaks the ties among the many equal-cost grid paths in favour of
+  // progress; a path found is at most 0.1 % longer than the shortest (in practice equal).
+  constexpr float kTieBreak = 1.001F;
+  const int pw = padded_width_;
+  const auto octile = [&](std::uint32_t p) {
+    const int x = static_cast<int>(p % static_cast<std::uint32_t>(pw)) - 1;
+    const int y = static_cast<int>(p / static_cast<std::uint32_t>(pw)) - 1;
     const float dx = static_cast<float>(std::abs(x - goal.x));
     const float dy = static_cast<float>(std::abs(y - goal.y));
-    return (dx > dy) ? dx + (kSqrt2 - 1.0F) * dy : dy + (kSqrt2 - 1.0F) * dx;
+    return kTieBreak * ((dx > dy) ? dx + (kSqrt2 - 1.0F) * dy : dy + (kSqrt2 - 1.0F) * dx);
   };
   struct Node {
     float f;
@@ -146,15 +159,18 @@ PlannedPath PathPlanner::plan(CellIndex start, CellIndex goal) {
   std::vector<Node> heap_storage;
   heap_storage.reserve(4096);
   std::priority_queue<Node, std::vector<Node>, decltype(worse)> open(worse, std::move(heap_storage));
-  const auto si = static_cast<std::uint32_t>(grid_.index(start));
-  const auto gi = static_cast<std::uint32_t>(grid_.index(goal));
+  const auto padded = [&](CellIndex c) { return static_cast<std::uint32_t>((c.y + 1) * pw + c.x + 1); };
+  const std::uint32_t si = padded(start);
+  const std::uint32_t gi = padded(goal);
   stamp_[si] = search_id_;
   g_[si] = 0.0F;
   closed_[si] = 0;
   parent_[si] = si;
-  open.push({octile(start.x, start.y), octile(start.x, start.y), si});
-  static constexpr int kDx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
-  static constexpr int kDy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
+  open.push({octile(si), octile(si), si});
+  // straight moves first; diagonal k uses straight moves kSide[k][0..1] as its two sides
+  const std::int32_t kStep[8] = {1, -1, pw, -pw, pw + 1, -pw + 1, pw - 1, -pw - 1};
+  static constexpr int kSide[8][2] = {{0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 2}, {0, 3}, {1, 2}, {1, 3}};
+  const std::uint8_t* cell_open = open_cell_.data();
   bool found = false;
   while (!open.empty()) {
     const Node n = open.top();
@@ -166,14 +182,16 @@ PlannedPath PathPlanner::plan(CellIndex start, CellIndex goal) {
       found = true;
       break;
     }
-    const int x = static_cast<int>(n.i % static_cast<std::uint32_t>(w));
-    const int y = static_cast<int>(n.i / static_cast<std::uint32_t>(w));
+    const float gn = g_[n.i];
     for (int k = 0; k < 8; ++k) {
-      const int nx = x + kDx[k], ny = y + kDy[k];
-      if (!traversable({nx, ny})) continue;
-      if (k >= 4 && (!traversable({nx, y}) || !traversable({x, ny}))) continue;  // no corner cutting
-      const auto ni = static_cast<std::uint32_t>(ny * w + nx);
-      const float ng = g_[n.i] + (k >= 4 ? kSqrt2 : 1.0F);
+      const auto ni = static_cast<std::uint32_t>(static_cast<std::int32_t>(n.i) + kStep[k]);
+      if (cell_open[ni] == 0) continue;
+      if (k >= 4) {  // no corner cutting
+        const auto s0 = static_cast<std::uint32_t>(static_cast<std::int32_t>(n.i) + kStep[kSide[k][0]]);
+        const auto s1 = static_cast<std::uint32_t>(static_cast<std::int32_t>(n.i) + kStep[kSide[k][1]]);
+        if (cell_open[s0] == 0 || cell_open[s1] == 0) continue;
+      }
+      const float ng = gn + (k >= 4 ? kSqrt2 : 1.0F);
       if (stamp_[ni] != search_id_) {
         stamp_[ni] = search_id_;
         closed_[ni] = 0;
@@ -182,7 +200,7 @@ PlannedPath PathPlanner::plan(CellIndex start, CellIndex goal) {
       }
       g_[ni] = ng;
       parent_[ni] = n.i;
-      const float h = octile(nx, ny);
+      const float h = octile(ni);
       open.push({ng + h, h, ni});
     }
   }
@@ -195,22 +213,36 @@ PlannedPath PathPlanner::plan(CellIndex start, CellIndex goal) {
     return out;
   }
   for (std::uint32_t i = gi;; i = parent_[i]) {
-    out.cells.push_back(grid_.cell(i));
+    out.cells.push_back({static_cast<int>(i % static_cast<std::uint32_t>(pw)) - 1,
+                         static_cast<int>(i / static_cast<std::uint32_t>(pw)) - 1});
     if (i == si) break;
   }
   std::reverse(out.cells.begin(), out.cells.end());
 
   std::vector<CellIndex> kept;
   if (options_.shortcut) {
-    std::size_t i = 0;
-    kept.push_back(out.cells[0]);
-    while (i + 1 < out.cells.size()) {
-      // extend the straight leg while the next path cell stays visible (string pulling)
-      std::size_t j = i + 1;
-      while (j + 1 < out.cells.size() && line_of_sight(out.cells[i], out.cells[j + 1])) ++j;
-      kept.push_back(out.cells[j]);
-      i = j;
-    }
+    // String pulling: extend each straight leg while the next path cell stays visible. Done from
+    // both ends, the shorter result kept: the greedy pull depends on its direction.
+    const auto pull = [&](const std::vector<CellIndex>& cells) {
+      std::vector<CellIndex> k{cells[0]};
+      std::size_t i = 0;
+      while (i + 1 < cells.size()) {
+        std::size_t j = i + 1;
+        while (j + 1 < cells.size() && line_of_sight(cells[i], cells[j + 1])) ++j;
+        k.push_back(cells[j]);
+        i = j;
+      }
+      return k;
+    };
+    const auto length = [&](const std::vector<CellIndex>& k) {
+      double len = 0.0;
+      for (std::size_t i = 1; i < k.size(); ++i) len += std::hypot(k[i].x - k[i - 1].x, k[i].y - k[i - 1].y);
+      return len;
+    };
+    kept = pull(out.cells);
+    std::vector<CellIndex> reversed(out.cells.rbegin(), out.cells.rend());
+    std::vector<CellIndex> back = pull(reversed);
+    if (length(back) < length(kept) - 1e-9) kept.assign(back.rbegin(), back.rend());
   } else {
     kept = out.cells;
   }

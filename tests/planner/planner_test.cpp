@@ -293,3 +293,57 @@ TEST_CASE("Same robot, task and event sequence give the same trace", "[planner]"
   CHECK_THAT(a, Catch::Contains("X1 PrCleaning fire t3 [localizer.lost]") && Catch::Contains("recovery:"));
   CHECK_THAT(a, Catch::EndsWith("task clean succeeded\n"));
 }
+
+TEST_CASE("Parallel stages: the plan changes only at a quiet point, when every branch has ended", "[planner]") {
+  SimClock clock;
+  FakeBehaviors behaviors;
+  behaviors.add("BhAutoMove", 3.0);
+  behaviors.add("BhExplain", 5.0);
+  FakeSectionSplitter splitter;
+  ProcessRegistry processes;
+  processes.add(def("PrAutoMove", pr_auto_move()));
+  processes.add(def("PrExplain", motion_process_net("PrExplain", "BhExplain", {{"topic", "$topic"}}, {decl("topic")}, 5.0,
+                                                    "explanation failed")));
+  const TaskLibrary tasks = TaskLibrary::load_from_string(R"(tasks:
+  - name: guide
+    commands: ["guide me to [room] {room}"]
+    plan:
+      - parallel:
+          - PrAutoMove: { goal: "{room}" }
+          - PrExplain: { topic: "way to {room}" }
+)", "guide.yaml");
+  const RecoveryPolicy recovery = RecoveryPolicy::load_from_string(kRecovery, "recovery.yaml");
+  CProcessSupervisor supervisor(behaviors, clock);
+  CPlanner planner(tasks, recovery, splitter, processes, supervisor, clock);
+  LifecycleRecorder life;
+  planner.add_observer(life);
+  auto run = [&] {
+    planner.step();
+    while (planner.busy() && clock.now() < from_seconds(60.0)) {
+      clock.advance(from_seconds(0.1));
+      behaviors.advance(clock.now(), from_seconds(0.1));
+      planner.step();
+    }
+  };
+
+  SECTION("both branches succeed") {
+    REQUIRE(planner.command("guide me to room 2111").accepted);
+    run();
+    CHECK(planner.state() == TaskState::succeeded);
+    CHECK(to_seconds(*planner.report().finished) == Approx(5.0));
+    CHECK_THAT(life.str(), Catch::Contains("0.000 s  process X0 PrAutoMove(goal=2111) started") &&
+                               Catch::Contains("0.000 s  process X0_1 PrExplain(topic=way to 2111) started"));
+  }
+  SECTION("one branch fails: the recovery waits for the other") {
+    behaviors.specs["BhAutoMove"].fail = true;  // "path blocked" at 3 s -> rule: skip
+    REQUIRE(planner.command("guide me to room 2111").accepted);
+    run();
+    CHECK(planner.state() == TaskState::succeeded);  // skipping the only stage leaves nothing to do
+    const TaskReport& r = planner.report();
+    REQUIRE(r.recoveries.size() == 1);
+    CHECK(to_seconds(r.recoveries[0].time) == Approx(5.0));  // not 3.0: PrExplain was still running
+    CHECK(r.recoveries[0].reason == "fault \"path blocked\" of PrAutoMove: skip (1/1)");
+    CHECK(r.processes.at(1).success);
+    CHECK(to_seconds(*r.processes.at(0).finished) == Approx(3.0));
+  }
+}

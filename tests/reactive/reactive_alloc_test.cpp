@@ -3,23 +3,8 @@
 // cycles. Its own executable, so the replacement affects no other suite.
 #include <catch2/catch.hpp>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
-
 #include "reactive_rig.hpp"
-
-namespace {
-std::atomic<std::size_t> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+#include "../support/counting_new.hpp"
 
 using namespace tripodal;
 
@@ -32,13 +17,13 @@ TEST_CASE("A steady-state reactive cycle allocates nothing (8 behaviors, both mo
       // Warm-up: the activations join the loop, the laser table is built, events are handed over.
       for (int i = 0; i < 10; ++i) rig.cycle();
       REQUIRE(rig.loop->last_cycle().active_behaviors == 8);
-      const std::size_t before = g_allocations.load();
+      const std::size_t before = test::allocations();
       std::uint64_t limited = 0;
       for (int i = 0; i < 10'000; ++i) {
         const CycleReport& r = rig.cycle();
         limited += r.coordinator.safety_limited ? 1 : 0;
       }
-      const std::size_t during = g_allocations.load() - before;
+      const std::size_t during = test::allocations() - before;
       CHECK(during == 0);
       CHECK(rig.loop->cycles() == 10'010);
       // The cycles did real work: the base moved and behaviors are still running.
@@ -60,8 +45,8 @@ TEST_CASE("Supervisor-side changes applied by the loop allocate nothing on the l
   // Prepared outside the counted region: setters copy on the caller's side.
   rig.loop->set_navigation(navi);
   rig.loop->set_lock("pause", true, rig.clock.now());
-  const std::size_t before = g_allocations.load();
+  const std::size_t before = test::allocations();
   const CycleReport& r = rig.cycle();  // applies the path copy and the lock
-  CHECK(g_allocations.load() == before);
+  CHECK(test::allocations() == before);
   CHECK(r.coordinator.locked);
 }

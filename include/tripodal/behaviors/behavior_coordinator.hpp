@@ -64,7 +64,7 @@ struct CoordinatorOutput {
   bool locked = false;           ///< at least one lock was engaged
   std::string_view lock;         ///< the engaged lock of highest priority
   bool safety_limited = false;   ///< a safety input changed the command
-  std::string_view limited_by;   ///< the first safety input that changed it
+  std::string_view limited_by;   ///< when limited: the first live safety input (configuration order)
   std::uint32_t live_inputs = 0; ///< normal inputs live and unmasked this update
 };
 

@@ -87,13 +87,13 @@ class CController {
   CController(const CController&) = delete;
   CController& operator=(const CController&) = delete;
 
-  /// The registered type name, e.g. "differential" or "omni".
-  [[nodiscard]] virtual std::string_view type_name() const noexcept = 0;
+  /// The registered type name, e.g. "differential" or "omni" (the manifest's name).
+  [[nodiscard]] std::string_view type_name() const noexcept { return manifest().name; }
   /// The static manifest of the controller type.
   [[nodiscard]] const ModuleManifest& manifest() const noexcept { return do_manifest(); }
   /// What the base can do, for behaviors (BehaviorContext::base): velocity limits per axis,
   /// max_vy_m_s == 0 for a base that cannot move sideways.
-  [[nodiscard]] virtual BaseCapabilities capabilities() const noexcept = 0;
+  [[nodiscard]] BaseCapabilities capabilities() const noexcept { return do_capabilities(); }
 
   /// Records a new command (the coordinator's output) received at `now`; a command older than
   /// the configured timeout makes update() brake to zero.
@@ -110,7 +110,7 @@ class CController {
   /// The command after limits, as last sent to the wheels.
   [[nodiscard]] const Twist2D& limited_command() const noexcept { return limited_; }
   /// The wheel velocities (rad/s) last written to the hardware.
-  [[nodiscard]] virtual std::span<const double> wheel_commands() const noexcept = 0;
+  [[nodiscard]] std::span<const double> wheel_commands() const noexcept { return do_wheel_commands(); }
   [[nodiscard]] Duration nominal_period() const noexcept { return nominal_period_; }
   [[nodiscard]] ControlStatus last_status() const noexcept { return status_; }
 
@@ -118,6 +118,8 @@ class CController {
   explicit CController(Duration nominal_period) noexcept : nominal_period_(nominal_period) {}
 
   virtual const ModuleManifest& do_manifest() const noexcept = 0;
+  virtual BaseCapabilities do_capabilities() const noexcept = 0;
+  virtual std::span<const double> do_wheel_commands() const noexcept = 0;
   /// Applies limits and kinematics to `command` over `period` and writes the wheels; updates
   /// `limited` with what was actually commanded and `odometry` from the read wheel states.
   /// `timed_out` means `command` is zero because the command expired.

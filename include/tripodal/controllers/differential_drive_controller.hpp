@@ -21,13 +21,12 @@ class DifferentialDriveController final : public CController {
   DifferentialDriveController(const ControllerConfig& config, HardwareInterface& hardware);
 
   static const ModuleManifest& static_manifest();
-  [[nodiscard]] std::string_view type_name() const noexcept override { return "differential"; }
-  [[nodiscard]] BaseCapabilities capabilities() const noexcept override;
-  [[nodiscard]] std::span<const double> wheel_commands() const noexcept override { return wheel_cmd_; }
   [[nodiscard]] const ControllerConfig& config() const noexcept { return config_; }
 
  protected:
   const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  BaseCapabilities do_capabilities() const noexcept override;
+  std::span<const double> do_wheel_commands() const noexcept override { return wheel_cmd_; }
   ControlStatus on_update(Time now, Duration period, const Twist2D& command, bool timed_out,
                           Twist2D& limited, OdometryReading& odometry) noexcept override;
   [[nodiscard]] Duration command_timeout() const noexcept override { return config_.cmd_timeout; }

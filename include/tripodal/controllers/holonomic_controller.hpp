@@ -28,11 +28,6 @@ class HolonomicController final : public CController {
 
   static const ModuleManifest& omni_manifest();
   static const ModuleManifest& mecanum_manifest();
-  [[nodiscard]] std::string_view type_name() const noexcept override { return type_; }
-  [[nodiscard]] BaseCapabilities capabilities() const noexcept override;
-  [[nodiscard]] std::span<const double> wheel_commands() const noexcept override {
-    return {wheel_cmd_.data(), static_cast<std::size_t>(wheel_cmd_.size())};
-  }
   [[nodiscard]] const ControllerConfig& config() const noexcept { return config_; }
 
   /// Wheel angular velocities (rad/s) of a body twist, and the twist of wheel velocities
@@ -44,6 +39,10 @@ class HolonomicController final : public CController {
 
  protected:
   const ModuleManifest& do_manifest() const noexcept override;
+  BaseCapabilities do_capabilities() const noexcept override;
+  std::span<const double> do_wheel_commands() const noexcept override {
+    return {wheel_cmd_.data(), static_cast<std::size_t>(wheel_cmd_.size())};
+  }
   ControlStatus on_update(Time now, Duration period, const Twist2D& command, bool timed_out,
                           Twist2D& limited, OdometryReading& odometry) noexcept override;
   [[nodiscard]] Duration command_timeout() const noexcept override { return config_.cmd_timeout; }

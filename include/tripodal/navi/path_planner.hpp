@@ -64,7 +64,11 @@ class PathPlanner final {
   PathPlannerOptions options_;
   DistanceField field_;
   std::vector<std::uint8_t> traversable_;
-  // A* scratch, reused across plans; a cell's entries are valid when stamp_ == search_id_.
+  // A* works on a copy of traversable_ padded by one blocked cell on every side, so neighbours
+  // need no bounds check: padded index = (y + 1) * (width + 2) + (x + 1).
+  int padded_width_ = 0;
+  std::vector<std::uint8_t> open_cell_;
+  // A* scratch (padded indices), reused across plans; valid where stamp_ == search_id_.
   std::vector<float> g_;
   std::vector<std::uint32_t> parent_;
   std::vector<std::uint32_t> stamp_;

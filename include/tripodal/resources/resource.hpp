@@ -51,11 +51,12 @@ class CResource {
   [[nodiscard]] std::size_t sequence() const noexcept { return sequence_; }
 
   /// The type of the reading this resource holds (for typed lookups).
-  [[nodiscard]] virtual const std::type_info& reading_type() const noexcept = 0;
+  [[nodiscard]] const std::type_info& reading_type() const noexcept { return do_reading_type(); }
 
  protected:
   CResource(std::string name, Duration max_age) : name_(std::move(name)), max_age_(max_age) {}
   virtual const ModuleManifest& do_manifest() const noexcept = 0;
+  virtual const std::type_info& do_reading_type() const noexcept = 0;
   /// Driver hook, default does nothing (data pushed by publish() from a simulator or replay).
   virtual void on_poll(Time /*now*/) noexcept {}
   /// Records that a reading stamped `stamp` was published.
@@ -100,9 +101,8 @@ class TypedResource : public CResource {
   [[nodiscard]] Reading& edit() noexcept { return latest_; }
   void commit() noexcept { mark_published(latest_.stamp); }
 
-  [[nodiscard]] const std::type_info& reading_type() const noexcept final { return typeid(Reading); }
-
  protected:
+  const std::type_info& do_reading_type() const noexcept final { return typeid(Reading); }
   const ModuleManifest& do_manifest() const noexcept override { return resource_manifest<Reading>(); }
 
  private:

@@ -1,0 +1,69 @@
+// Module manifests: parameter resolution, the one-provider-per-input check, the layered diagram.
+#include "tripodal/core/manifest.hpp"
+
+#include <catch2/catch.hpp>
+
+using namespace tripodal;
+
+namespace {
+ModuleManifest module(std::string name, Layer layer, std::vector<std::string> in, std::vector<std::string> out) {
+  ModuleManifest m;
+  m.name = std::move(name);
+  m.layer = layer;
+  m.inputs = std::move(in);
+  m.outputs = std::move(out);
+  return m;
+}
+}  // namespace
+
+TEST_CASE("Layers and kinds have names") {
+  CHECK(to_string(Layer::sequencing) == "sequencing");
+  CHECK(parse_layer("reactive") == Layer::reactive);
+  CHECK_FALSE(parse_layer("middle").has_value());
+  CHECK(to_string(ModuleKind::controller) == "controller");
+}
+
+TEST_CASE("Parameters resolve with defaults, conversions and bounds") {
+  ModuleManifest m;
+  m.name = "BhTest";
+  m.parameters = {{"speed_m_s", ValueType::number, Value{0.5}, "m/s", "speed", 0.0, 2.0},
+                  {"room", ValueType::string, std::nullopt, "", "room name", {}, {}},
+                  {"careful", ValueType::boolean, Value{false}, "", "go slowly", {}, {}}};
+  const ParameterSet p = ParameterSet::resolve(m, {{"room", Value{std::string("3211")}}, {"careful", Value{std::string("true")}}});
+  CHECK(p.number("speed_m_s") == 0.5);
+  CHECK(p.string("room") == "3211");
+  CHECK(p.boolean("careful"));
+  CHECK(p.contains("room"));
+  CHECK_FALSE(p.contains("x"));
+  CHECK(m.find_parameter("room") != nullptr);
+  CHECK(m.find_parameter("nope") == nullptr);
+  REQUIRE_THROWS_WITH(ParameterSet::resolve(m, {{"speed_m_s", Value{3.0}}}, {"net.xml", 4, 2}),
+                      Catch::Contains("net.xml:4:2: error: BhTest: missing required parameter 'room' (string)") &&
+                          Catch::Contains("net.xml:4:2: error: BhTest: parameter 'speed_m_s' = 3 m/s is outside [0, 2]"));
+}
+
+TEST_CASE("Every input needs exactly one provider") {
+  const ModuleManifest laser = module("LaserResource", Layer::reactive, {}, {"laser_scan"});
+  const ModuleManifest odom = module("OdometryResource", Layer::reactive, {}, {"odometry"});
+  const ModuleManifest odom2 = module("GyroOdometry", Layer::reactive, {}, {"odometry"});
+  const ModuleManifest loc = module("Localizer", Layer::sequencing, {"laser_scan", "odometry", "map"}, {"map_from_base"});
+  const ModuleManifest go = module("BhGoToPose", Layer::reactive, {"odometry", "map_from_base"}, {"behavior_command"});
+  CHECK(check_providers({&laser, &odom, &go, &loc}).has_errors());  // "map" has no provider
+  const Diagnostics d = check_providers({&laser, &odom, &odom2, &loc, &go});
+  REQUIRE(d.error_count() == 2);
+  CHECK_THAT(d.str(), Catch::Contains("input 'odometry' of Localizer has 2 providers (OdometryResource, GyroOdometry); expected exactly one"));
+  CHECK_THAT(d.str(), Catch::Contains("input 'map' of Localizer has no provider"));
+  const ModuleManifest map = module("GridMap", Layer::sequencing, {}, {"map"});
+  CHECK_FALSE(check_providers({&laser, &odom, &loc, &go, &map}).has_errors());
+}
+
+TEST_CASE("The layered functionality diagram groups modules by layer and labels the flows") {
+  const ModuleManifest laser = module("LaserResource", Layer::reactive, {}, {"laser_scan"});
+  const ModuleManifest loc = module("Localizer", Layer::sequencing, {"laser_scan"}, {"map_from_base"});
+  const ModuleManifest planner = module("Planner", Layer::deliberate, {"map_from_base"}, {});
+  const std::string dot = functionality_diagram_dot({&laser, &loc, &planner});
+  CHECK_THAT(dot, Catch::Contains("subgraph cluster_deliberate") && Catch::Contains("subgraph cluster_reactive"));
+  CHECK_THAT(dot, Catch::Contains("\"LaserResource\" -> \"Localizer\" [label=\"laser_scan\"]"));
+  CHECK_THAT(dot, Catch::Contains("\"Localizer\" -> \"Planner\" [label=\"map_from_base\"]"));
+  CHECK(dot.find("cluster_deliberate") < dot.find("\"Planner\";"));
+}
