@@ -75,7 +75,7 @@ FileStatus check_file(const std::filesystem::path& file, const LoadOptions& opti
   out << file.string() << ": ok (" << net->places().size() << " places, " << net->transitions().size()
       << " transitions, " << arcs << " arcs";
   if (warnings > 0) out << ", " << warnings << " warning(s)";
-  if (behaviour) out << (checked ? "; no deadlock, an outcome always reachable" : "; behaviour not checked");
+  if (behaviour) out << (checked ? "; no deadlock, no marking that cannot reach an outcome" : "; behaviour not checked");
   out << ")\n";
   return FileStatus::valid;
 }
