@@ -202,7 +202,9 @@ AnalysisReport analyze(const PetriNet& net, const AnalysisOptions& options) {
   // Outcome check.
   r.outcome_states = space.outcome_states().size();
   if (has_outcome) {
-    if (!complete) {
+    // The reversed edges cost 8 bytes per state and 4 per edge beyond the store.
+    const std::size_t reverse_bytes = (space.states() + 1) * 8 + space.edges() * 4 + space.states();
+    if (!complete || space.memory_bytes() + reverse_bytes > options.max_memory_bytes) {
       r.outcome = Verdict::unknown;
     } else {
       const auto good = can_reach_outcome(space);
@@ -242,47 +244,106 @@ std::string path_ids(const PetriNet& net, const std::vector<TransitionIndex>& pa
   return out;
 }
 
-}  // namespace
-
-bool check_behaviour(const PetriNet& net, Diagnostics& diagnostics, const BehaviourCheckOptions& options) {
-  for (const VariableDecl& p : net.parameters) {
-    if (!p.default_value) {
-      diagnostics.note(net.where, "behaviour not checked: parameter '" + p.name +
-                                      "' has no default (run tripodal-net analyze with --param " + p.name + "=VALUE)");
-      return false;
+// The values a parameter without a default is checked with: the literals its guards compare it
+// with (for a number also one below and one above, for the ordered comparisons), both truth
+// values for a boolean. A parameter no guard reads changes nothing the analysis sees: one
+// placeholder value stands for all.
+std::vector<Value> candidate_values(const PetriNet& net, const VariableDecl& p) {
+  std::vector<Value> out;
+  auto add = [&](Value v) {
+    if (type_of(v) == p.type && std::find(out.begin(), out.end(), v) == out.end()) out.push_back(std::move(v));
+  };
+  if (p.type == ValueType::boolean) return {Value{false}, Value{true}};
+  for (const Transition& t : net.transitions()) {
+    if (!t.guard) continue;
+    const auto& ids = t.guard->identifiers();
+    for (std::size_t slot = 0; slot < ids.size(); ++slot) {
+      if (ids[slot] != p.name) continue;
+      for (Value& v : t.guard->compared_literals(slot)) {
+        if (const double* x = std::get_if<double>(&v)) {
+          add(Value{*x - 1.0});
+          add(Value{*x + 1.0});
+        }
+        add(std::move(v));
+      }
     }
   }
+  if (out.empty()) out.push_back(p.type == ValueType::number ? Value{0.0} : Value{std::string{}});
+  return out;
+}
+
+enum class CheckResult { passed, failed, not_decided };
+
+CheckResult check_once(const PetriNet& net, Diagnostics& diagnostics, const BehaviourCheckOptions& options,
+                       const ParameterValues& parameters, const std::string& prefix) {
   AnalysisOptions o;
   o.semantics = options.semantics;
+  o.parameters = parameters;
   o.max_states = options.max_states;
   o.max_examples = 3;
   o.invariants = false;
   o.max_coverability_nodes = options.max_states;
   const AnalysisReport r = analyze(net, o);
   if (!r.complete()) {
-    diagnostics.note(net.where, "behaviour not checked: more than " + std::to_string(options.max_states) +
+    diagnostics.note(net.where, prefix + "behaviour not checked: more than " + std::to_string(options.max_states) +
                                     " reachable states (" + std::string(to_string(r.stop)) +
                                     "); run tripodal-net analyze for the full analysis");
-    return false;
+    return CheckResult::not_decided;
   }
   for (const Witness& w : r.deadlocks) {
-    diagnostics.error(net.where, "deadlock: nothing can fire in marking " + marking_ids(net, w.marking) +
+    diagnostics.error(net.where, prefix + "deadlock: nothing can fire in marking " + marking_ids(net, w.marking) +
                                      ", reached by " + path_ids(net, w.path));
   }
   if (r.deadlock_count > r.deadlocks.size()) {
-    diagnostics.error(net.where, std::to_string(r.deadlock_count - r.deadlocks.size()) + " more deadlocks");
+    diagnostics.error(net.where, prefix + std::to_string(r.deadlock_count - r.deadlocks.size()) + " more deadlocks");
   }
   if (r.outcome == Verdict::fail) {
     for (const Witness& w : r.stuck) {
-      diagnostics.error(net.where, "no outcome place can be reached from marking " + marking_ids(net, w.marking) +
-                                       ", reached by " + path_ids(net, w.path));
+      diagnostics.error(net.where, prefix + "no outcome place can be reached from marking " +
+                                       marking_ids(net, w.marking) + ", reached by " + path_ids(net, w.path));
     }
     if (r.stuck_count > r.stuck.size()) {
-      diagnostics.error(net.where, std::to_string(r.stuck_count - r.stuck.size()) +
+      diagnostics.error(net.where, prefix + std::to_string(r.stuck_count - r.stuck.size()) +
                                        " more markings from which no outcome can be reached");
     }
   }
-  return r.deadlock_count == 0 && r.outcome != Verdict::fail;
+  return r.deadlock_count == 0 && r.outcome != Verdict::fail ? CheckResult::passed : CheckResult::failed;
+}
+
+}  // namespace
+
+bool check_behaviour(const PetriNet& net, Diagnostics& diagnostics, const BehaviourCheckOptions& options) {
+  // Parameters without a default are checked with every combination of the values their guards
+  // name (the process is meant to run with one of them).
+  std::vector<const VariableDecl*> open;
+  std::vector<std::vector<Value>> values;
+  std::size_t combinations = 1;
+  for (const VariableDecl& p : net.parameters) {
+    if (p.default_value) continue;
+    open.push_back(&p);
+    values.push_back(candidate_values(net, p));
+    combinations *= values.back().size();
+    if (combinations > kCheckParameterCombinations) {
+      diagnostics.note(net.where, "behaviour not checked: more than " + std::to_string(kCheckParameterCombinations) +
+                                      " combinations of the values the guards give parameters without defaults "
+                                      "(run tripodal-net analyze with --param NAME=VALUE)");
+      return false;
+    }
+  }
+  bool passed = true;
+  std::vector<std::size_t> pick(open.size(), 0);
+  for (std::size_t c = 0; c < combinations; ++c) {
+    ParameterValues parameters;
+    std::string prefix;
+    for (std::size_t i = 0; i < open.size(); ++i) {
+      parameters[open[i]->name] = values[i][pick[i]];
+      prefix += (prefix.empty() ? "with " : ", ") + open[i]->name + "=" + tripodal::to_string(values[i][pick[i]]);
+    }
+    if (!prefix.empty()) prefix += ": ";
+    passed = check_once(net, diagnostics, options, parameters, prefix) == CheckResult::passed && passed;
+    for (std::size_t i = 0; i < open.size() && ++pick[i] == values[i].size(); ++i) pick[i] = 0;
+  }
+  return passed;
 }
 
 Semantics default_semantics_for(std::string_view file_name, std::string_view head) {

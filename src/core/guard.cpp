@@ -8,6 +8,7 @@
 // IDENT is [A-Za-z_][A-Za-z0-9_.]* ; STRING is '...' or "..." without escapes.
 #include "tripodal/core/guard.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -311,6 +312,22 @@ const std::vector<std::string>& Guard::identifiers() const noexcept { return imp
 std::optional<ValueType> Guard::expected_type(std::size_t slot) const noexcept {
   return slot < impl_->expected.size() ? impl_->expected[slot] : std::nullopt;
 }
+std::vector<Value> Guard::compared_literals(std::size_t slot) const {
+  std::vector<Value> out;
+  for (const Node& n : impl_->nodes) {
+    if (n.op < Op::eq) continue;  // only the comparisons
+    const Node& a = impl_->nodes[n.a];
+    const Node& b = impl_->nodes[n.b];
+    const Node* literal = nullptr;
+    if (a.op == Op::ident && a.a == slot && b.op == Op::literal) literal = &b;
+    if (b.op == Op::ident && b.a == slot && a.op == Op::literal) literal = &a;
+    if (literal == nullptr) continue;
+    const Value& v = impl_->literals[literal->a];
+    if (std::find(out.begin(), out.end(), v) == out.end()) out.push_back(v);
+  }
+  return out;
+}
+
 bool Guard::evaluate(std::span<const Value* const> slots) const noexcept { return impl_->truth(impl_->root, slots); }
 
 }  // namespace tripodal

@@ -1,5 +1,6 @@
 #include "tripodal/core/net_loader.hpp"
 
+#include <cstdint>
 #include <fstream>
 #include <sstream>
 
@@ -51,25 +52,45 @@ std::string xml_error_message(const tinyxml2::XMLDocument& doc) {
 
 void structural_warnings(const PetriNet& net, Diagnostics& diagnostics) {
   // Over-approximation of markable places: a transition may become enabled once every place it
-  // consumes from or reads is markable; then its output places are markable. Fixpoint.
+  // consumes from or reads is markable; then its output places are markable. A worklist keeps it
+  // linear in the size of the net whatever the declaration order.
   const auto& places = net.places();
   const auto& transitions = net.transitions();
   std::vector<bool> markable(places.size(), false);
   std::vector<bool> fireable(transitions.size(), false);
-  for (std::size_t i = 0; i < places.size(); ++i) markable[i] = places[i].initial_tokens > 0;
-  bool changed = true;
-  while (changed) {
-    changed = false;
-    for (std::size_t t = 0; t < transitions.size(); ++t) {
-      if (fireable[t]) continue;
-      const auto& tr = transitions[t];
-      bool ok = true;
-      for (const auto& a : tr.inputs) ok = ok && markable[a.place];
-      for (const auto& a : tr.reads) ok = ok && markable[a.place];
-      if (!ok) continue;
-      fireable[t] = true;
-      changed = true;
-      for (const auto& a : tr.outputs) markable[a.place] = true;
+  std::vector<std::size_t> missing(transitions.size(), 0);  // needed places not yet markable
+  std::vector<std::vector<std::uint32_t>> needed_by(places.size());
+  std::vector<PlaceIndex> work;
+  for (std::size_t t = 0; t < transitions.size(); ++t) {
+    for (const auto* arcs : {&transitions[t].inputs, &transitions[t].reads}) {
+      for (const auto& a : *arcs) {
+        needed_by[a.place].push_back(static_cast<std::uint32_t>(t));
+        ++missing[t];
+      }
+    }
+  }
+  const auto mark = [&](PlaceIndex p) {
+    if (!markable[p]) {
+      markable[p] = true;
+      work.push_back(p);
+    }
+  };
+  const auto fire = [&](std::size_t t) {
+    fireable[t] = true;
+    for (const auto& a : transitions[t].outputs) mark(a.place);
+  };
+  for (std::size_t i = 0; i < places.size(); ++i) {
+    if (places[i].initial_tokens > 0) mark(static_cast<PlaceIndex>(i));
+  }
+  for (std::size_t t = 0; t < transitions.size(); ++t) {
+    if (missing[t] == 0) fire(t);
+  }
+  while (!work.empty()) {
+    const PlaceIndex p = work.back();
+    work.pop_back();
+    // A place counted once per arc: several arcs from one place decrement once each.
+    for (const auto t : needed_by[p]) {
+      if (--missing[t] == 0 && !fireable[t]) fire(t);
     }
   }
   for (std::size_t i = 0; i < places.size(); ++i) {

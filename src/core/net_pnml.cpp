@@ -289,6 +289,12 @@ class PnmlReader {
 
   // Arcs may name nodes declared later (or on another page): connected after everything is read.
   void resolve_arcs() {
+    // The transition -> place halves of read arcs, by (source, target).
+    std::map<std::pair<std::string, std::string>, std::vector<std::size_t>> returns;
+    for (std::size_t i = 0; i < arcs_.size(); ++i) {
+      const RawArc& b = arcs_[i];
+      if (b.tripodal_read && b.kind == ArcKind::normal) returns[{b.source, b.target}].push_back(i);
+    }
     for (std::size_t i = 0; i < arcs_.size(); ++i) {
       RawArc& a = arcs_[i];
       if (a.consumed) continue;
@@ -308,11 +314,14 @@ class PnmlReader {
         continue;
       }
       RawArc* back = nullptr;
-      for (auto& b : arcs_) {
-        if (!b.consumed && b.tripodal_read && b.source == a.target && b.target == a.source && b.weight == a.weight &&
-            b.kind == ArcKind::normal) {
-          back = &b;
-          break;
+      const auto candidates = returns.find({a.target, a.source});
+      if (candidates != returns.end()) {
+        for (const std::size_t k : candidates->second) {
+          RawArc& b = arcs_[k];
+          if (!b.consumed && b.weight == a.weight) {
+            back = &b;
+            break;
+          }
         }
       }
       if (back == nullptr) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <set>
+#include <stdexcept>
 
 namespace tripodal::detail {
 
@@ -409,6 +410,12 @@ std::string_view to_string(ArcKind kind) noexcept {
 
 bool add_checked_arc(const ReadContext& ctx, const tinyxml2::XMLElement* e, PetriNet& net, const std::string& from,
                      const std::string& to, Tokens weight, ArcKind kind) {
+  // The common case costs the net's own look-ups only; the diagnosis below runs after a refusal.
+  try {
+    net.add_arc(from, to, weight, kind, ctx.loc.element(e));
+    return true;
+  } catch (const std::invalid_argument&) {
+  }
   const auto fp = net.find_place(from);
   const auto ft = net.find_transition(from);
   const auto tp = net.find_place(to);
@@ -437,8 +444,8 @@ bool add_checked_arc(const ReadContext& ctx, const tinyxml2::XMLElement* e, Petr
                      from + "' to place '" + to + "'");
     return false;
   }
-  net.add_arc(from, to, weight, kind, ctx.loc.element(e));
-  return true;
+  ctx.error(e, "arc '" + from + "' -> '" + to + "' is refused");  // unreachable: add_arc refuses only the above
+  return false;
 }
 
 }  // namespace tripodal::detail

@@ -1,6 +1,7 @@
 #include "xml_locator.hpp"
 
 #include <algorithm>
+#include <cstdint>
 
 namespace tripodal::detail {
 
@@ -51,9 +52,9 @@ std::vector<std::size_t> start_tags(std::string_view s) {
   return out;
 }
 
-void preorder(const tinyxml2::XMLNode* node, std::vector<const tinyxml2::XMLElement*>& out) {
-  for (const auto* child = node->FirstChild(); child != nullptr; child = child->NextSibling()) {
-    if (const auto* e = child->ToElement()) {
+void preorder(tinyxml2::XMLNode* node, std::vector<tinyxml2::XMLElement*>& out) {
+  for (auto* child = node->FirstChild(); child != nullptr; child = child->NextSibling()) {
+    if (auto* e = child->ToElement()) {
       out.push_back(e);
       preorder(e, out);
     }
@@ -69,8 +70,8 @@ XmlLocator::XmlLocator(std::string_view text, std::string file) : text_(text), f
   }
 }
 
-void XmlLocator::index(const tinyxml2::XMLDocument& doc) {
-  std::vector<const tinyxml2::XMLElement*> elems;
+void XmlLocator::index(tinyxml2::XMLDocument& doc) {
+  std::vector<tinyxml2::XMLElement*> elems;
   preorder(&doc, elems);
   const auto tags = start_tags(text_);
   const std::size_t n = std::min(elems.size(), tags.size());
@@ -78,7 +79,8 @@ void XmlLocator::index(const tinyxml2::XMLDocument& doc) {
     // A mismatch means the scan and tinyxml2 disagree about this text; such elements fall back to
     // the start of their line rather than pointing somewhere wrong.
     if (offset(tags[k]).line != elems[k]->GetLineNum()) break;
-    elements_.emplace(elems[k], tags[k]);
+    // Offset + 1, so that null user data means "not located".
+    elems[k]->SetUserData(reinterpret_cast<void*>(static_cast<std::uintptr_t>(tags[k] + 1)));
   }
 }
 
@@ -99,9 +101,9 @@ SourceLocation XmlLocator::line(int line_number) const {
 }
 
 std::size_t XmlLocator::element_offset(const tinyxml2::XMLElement* e, bool& found) const {
-  const auto it = elements_.find(e);
-  found = it != elements_.end();
-  return found ? it->second : 0;
+  const auto stored = reinterpret_cast<std::uintptr_t>(e->GetUserData());
+  found = stored != 0;
+  return found ? static_cast<std::size_t>(stored - 1) : 0;
 }
 
 SourceLocation XmlLocator::element(const tinyxml2::XMLElement* e) const {

@@ -6,7 +6,6 @@
 #include <cstddef>
 #include <string>
 #include <string_view>
-#include <unordered_map>
 #include <vector>
 
 #include <tinyxml2.h>
@@ -21,8 +20,8 @@ class XmlLocator {
   XmlLocator(std::string_view text, std::string file);
 
   /// Call once after a successful parse: pairs the document's elements (pre-order) with the start
-  /// tags found in the text.
-  void index(const tinyxml2::XMLDocument& doc);
+  /// tags found in the text, keeping each offset in the element's user data (no lookup table).
+  void index(tinyxml2::XMLDocument& doc);
 
   [[nodiscard]] const std::string& file() const noexcept { return file_; }
   /// The '<' of the element's start tag.
@@ -48,7 +47,6 @@ class XmlLocator {
   std::string_view text_;
   std::string file_;
   std::vector<std::size_t> line_starts_;
-  std::unordered_map<const tinyxml2::XMLElement*, std::size_t> elements_;
 };
 
 }  // namespace tripodal::detail

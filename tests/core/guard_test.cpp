@@ -79,3 +79,11 @@ TEST_CASE("guards copy and move with their parsed form") {
   CHECK(b.evaluate(std::vector<const Value*>{&two}));
   CHECK(c.text() == "x > 1");
 }
+
+TEST_CASE("compared_literals lists the literals compared with one identifier", "[guard]") {
+  const Guard g = Guard::parse("speed_mps < 0.5 && (mode == 'fast' || 'slow' == mode || mode == 'fast') && !armed");
+  REQUIRE(g.identifiers() == std::vector<std::string>{"speed_mps", "mode", "armed"});
+  CHECK(g.compared_literals(0) == std::vector<Value>{Value{0.5}});
+  CHECK(g.compared_literals(1) == std::vector<Value>{Value{std::string("fast")}, Value{std::string("slow")}});
+  CHECK(g.compared_literals(2).empty());
+}

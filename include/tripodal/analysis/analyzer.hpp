@@ -122,6 +122,9 @@ namespace tripodal::analysis {
 /// The state limit of the behavioural part of `tripodal-net check`: larger nets are reported as
 /// not checked (a note), never as failing; `tripodal-net analyze` has no such limit by default.
 inline constexpr std::size_t kCheckStateLimit = 200'000;
+/// Parameters without defaults are checked with every combination of the values their guards
+/// name, up to this many combinations (more: a note, not checked).
+inline constexpr std::size_t kCheckParameterCombinations = 16;
 
 struct BehaviourCheckOptions {
   Semantics semantics = Semantics::engine;
@@ -130,8 +133,10 @@ struct BehaviourCheckOptions {
 
 /// What `tripodal-net check` runs on a net that loaded: reachable deadlocks and markings from
 /// which no outcome can be reached become errors located at the net (with the firing sequence),
-/// a net too large or needing parameters without defaults gets a note. Returns true when the
-/// checks ran to completion and found nothing.
+/// a net too large gets a note. A parameter without a default is given, in turn, each value its
+/// guards compare it with (both values for a boolean; a number also one below and one above each
+/// literal); the diagnostics then start "with NAME=VALUE: ". Returns true when every check ran to
+/// completion and found nothing.
 bool check_behaviour(const PetriNet& net, Diagnostics& diagnostics, const BehaviourCheckOptions& options = {});
 
 /// The default semantics for a file: interleaving for PNML (written for plain P/T tools), engine

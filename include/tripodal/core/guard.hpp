@@ -45,6 +45,9 @@ class Guard {
   /// (compared with a number literal -> number, used as a condition -> boolean); nullopt otherwise.
   /// Loaders use it to report a guard that compares a parameter with the wrong type.
   [[nodiscard]] std::optional<ValueType> expected_type(std::size_t slot) const noexcept;
+  /// The literals the identifier in `slot` is compared with directly (`wheel_type == 'omni'`),
+  /// each once, in order of appearance. The analysis uses them as the values that matter.
+  [[nodiscard]] std::vector<Value> compared_literals(std::size_t slot) const;
   /// Evaluates with slot values (slots.size() == identifiers().size()). Comparing values of
   /// different types is false, never an exception: a guard is a condition, not a program.
   [[nodiscard]] bool evaluate(std::span<const Value* const> slots) const noexcept;
