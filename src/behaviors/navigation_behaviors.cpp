@@ -13,8 +13,15 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kCornerRad = 0.45;
-constexpr double kDriveWhileTurningRad = 0.5;  // differential: larger bearings turn in place  // a bend of the path the lookahead point does not cross
+constexpr double kCornerRad = 0.45;  // a bend of the path the lookahead point does not cross
+constexpr double kDriveWhileTurningRad = 0.5;  // differential: larger bearings turn in place
+// Planning around unexpected obstacles: laser returns within this range are taken as obstacles,
+// the detour keeps this much more than the robot radius from them, and a cleaning detour takes
+// the coverage path up again this far beyond them (the laser sees only the near face of a box).
+constexpr double kObstacleRange_m = 3.0;
+constexpr double kCrawl_m_s = 0.02;  // slower than this before an obstacle counts as stopped
+constexpr double kDetourMargin_m = 0.1;
+constexpr double kResumeClearance_m = 0.3;
 
 ParameterSpec number(std::string name, double def, std::string unit, std::string description,
                      std::optional<double> min = std::nullopt, std::optional<double> max = std::nullopt) {
@@ -45,6 +52,9 @@ std::vector<ParameterSpec> following_parameters(double speed, double lookahead) 
       number("stop_distance_m", 0.05, "m", "Translation stops when an obstacle ahead is this close to the body", 0.0, 2.0),
       number("slow_distance_m", 0.4, "m", "Speed falls linearly from here to stop_distance_m", 0.0, 5.0),
       number("blocked_timeout_s", 10.0, "s", "Fail with 'path blocked' after being stopped this long", 0.1, 3600.0),
+      number("replan_after_s", 2.0, "s",
+             "Stopped this long by an obstacle the map does not hold, plan a way around it (0: never)", 0.0, 3600.0),
+      number("max_replans", 5.0, "", "Plans around unexpected obstacles allowed per activation", 0.0, 1000.0),
       text("laser", "", "Laser resource watched for obstacles (empty: the first laser)"),
   };
 }
@@ -181,6 +191,12 @@ void PathTracker::reset(std::vector<navi::Point2D> path, double start_m) {
   while (seg_ + 1 < s_.size() && s_[seg_ + 1] <= s_now_) ++seg_;
 }
 
+void PathTracker::jump_to(double s) noexcept {
+  s_now_ = std::clamp(s, 0.0, length_m());
+  seg_ = 0;
+  while (seg_ + 1 < s_.size() && s_[seg_ + 1] <= s_now_) ++seg_;
+}
+
 navi::Point2D PathTracker::at(double s) const noexcept {
   if (pts_.empty()) return {};
   if (s <= 0.0) return pts_.front();
@@ -268,7 +284,44 @@ void CPathFollowingBehavior::configure_following(const ParameterSet& params, con
   }
   blocked_ = false;
   has_last_ = false;
+  replan_after_ = from_seconds(params.number("replan_after_s"));
+  max_replans_ = static_cast<int>(params.number("max_replans"));
+  replans_ = 0;
+  seen_obstacles_.clear();
   if (context.navi != nullptr) hold_heading_rad_ = context.navi->map_from_base.theta_rad;
+}
+
+bool CPathFollowingBehavior::near_mapped_obstacle(navi::Point2D p) const noexcept {
+  const navi::OccupancyGrid& grid = workspace_.grid();
+  const navi::CellIndex cell = grid.cell_at(p);
+  for (int dy = -1; dy <= 1; ++dy) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      if (grid.state(navi::CellIndex{cell.x + dx, cell.y + dy}) != navi::Occupancy::free) return true;
+    }
+  }
+  return false;
+}
+
+bool CPathFollowingBehavior::replan_due(Time now) const noexcept {
+  if (!blocked_ || replan_after_ <= Duration{0} || replans_ >= max_replans_) return false;
+  if (now - blocked_since_ < replan_after_) return false;
+  return replans_ == 0 || now - last_replan_ >= replan_after_;
+}
+
+void CPathFollowingBehavior::note_unmapped_returns(const Pose2D& pose, Time now, double max_range_m) {
+  ++replans_;
+  last_replan_ = now;
+  if (laser_ == nullptr || !laser_->is_fresh(now)) return;
+  const LaserScan& scan = laser_->latest();
+  const double c = std::cos(pose.theta_rad), s = std::sin(pose.theta_rad);
+  for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
+    const double r = scan.ranges_m[i];
+    if (!std::isfinite(r) || r < scan.range_min_m || r > std::min<double>(scan.range_max_m, max_range_m)) continue;
+    const double a = scan.angle_min_rad + static_cast<double>(i) * scan.angle_increment_rad;
+    const double bx = r * std::cos(a), by = r * std::sin(a);
+    const navi::Point2D p{pose.x_m + c * bx - s * by, pose.y_m + s * bx + c * by};
+    if (!near_mapped_obstacle(p)) seen_obstacles_.push_back(p);
+  }
 }
 
 double CPathFollowingBehavior::clearance_along(double dx_body, double dy_body, const Pose2D& pose, Time now) const noexcept {
@@ -282,16 +335,9 @@ double CPathFollowingBehavior::clearance_along(double dx_body, double dy_body, c
   const double corridor = 0.95 * radius;
   // Returns from obstacles of the map are not in the way: the path was planned around them with
   // a margin; only what the map does not know (a box left in the corridor) stops the robot.
-  const navi::OccupancyGrid& grid = workspace_.grid();
   const double c = std::cos(pose.theta_rad), s = std::sin(pose.theta_rad);
   auto on_map = [&](double bx, double by) {
-    const navi::CellIndex cell = grid.cell_at({pose.x_m + c * bx - s * by, pose.y_m + s * bx + c * by});
-    for (int dy = -1; dy <= 1; ++dy) {
-      for (int dx = -1; dx <= 1; ++dx) {
-        if (grid.state(navi::CellIndex{cell.x + dx, cell.y + dy}) != navi::Occupancy::free) return true;
-      }
-    }
-    return false;
+    return near_mapped_obstacle({pose.x_m + c * bx - s * by, pose.y_m + s * bx + c * by});
   };
   const LaserScan& scan = laser_->latest();
   double best = kInf;
@@ -322,17 +368,23 @@ Twist2D CPathFollowingBehavior::command_toward(const Pose2D& pose, const PathTra
   double speed = speed_ * std::clamp(std::cos(std::min(target.corner_rad, kPi / 2.0)), 0.35, 1.0);
   speed = std::min(speed, std::max(0.05, 1.5 * (target.remaining_m + dist)));
   if (dist < 1e-6) return cmd;
-  auto scale_by_clearance = [&](double clearance) {
-    if (clearance <= stop_distance_m_) {
+  // The speed allowed by the clearance ahead: full beyond slow_distance_m, falling linearly to
+  // zero at stop_distance_m. Below a crawl the robot counts as stopped (blocked): approaching
+  // the stop distance asymptotically it would otherwise creep for ever and never time out.
+  auto limit_by_clearance = [&](double v, double clearance) {
+    if (clearance >= slow_distance_m_ || slow_distance_m_ <= stop_distance_m_) return v;
+    const double limited = clearance <= stop_distance_m_
+                               ? 0.0
+                               : v * (clearance - stop_distance_m_) / (slow_distance_m_ - stop_distance_m_);
+    if (limited < kCrawl_m_s) {
       blocked = true;
       return 0.0;
     }
-    if (clearance >= slow_distance_m_ || slow_distance_m_ <= stop_distance_m_) return 1.0;
-    return (clearance - stop_distance_m_) / (slow_distance_m_ - stop_distance_m_);
+    return limited;
   };
   if (context.base.holonomic()) {
     speed = std::min(speed, context.base.max_vx_m_s);
-    speed *= scale_by_clearance(clearance_along(bx, by, pose, context.now));
+    speed = limit_by_clearance(speed, clearance_along(bx, by, pose, context.now));
     cmd.vx_m_s = speed * bx / dist;
     cmd.vy_m_s = speed * by / dist;
     cmd.wz_rad_s = clamp_abs(k_heading_ * wrap_angle(hold_heading_rad_ - pose.theta_rad), yaw_rate_);
@@ -344,7 +396,7 @@ Twist2D CPathFollowingBehavior::command_toward(const Pose2D& pose, const PathTra
     if (std::abs(alpha) < kDriveWhileTurningRad) {
       speed = std::min(speed, context.base.max_vx_m_s);
       const double c_alpha = std::cos(alpha);
-      cmd.vx_m_s = speed * c_alpha * c_alpha * scale_by_clearance(clearance_along(1.0, 0.0, pose, context.now));
+      cmd.vx_m_s = limit_by_clearance(speed * c_alpha * c_alpha, clearance_along(1.0, 0.0, pose, context.now));
     }
   }
   return cmd;
@@ -399,7 +451,22 @@ void BhAutoMove::on_activate(const ParameterSet& params, const BehaviorContext& 
     fail("no path to the goal");
     return;
   }
+  goal_ = *goal;
   tracker_.reset(std::move(plan.waypoints));
+}
+
+void BhAutoMove::replan(const Pose2D& pose, Time now) noexcept {
+  try {
+    const std::size_t before = seen_obstacles_.size();
+    note_unmapped_returns(pose, now, kObstacleRange_m);
+    if (seen_obstacles_.size() == before) return;  // nothing new seen (a bumper): the same plan again
+    navi::PlannedPath plan = workspace_.planner().plan_around(point_of(pose), goal_, seen_obstacles_, kDetourMargin_m);
+    if (!plan.ok()) return;  // no way around (yet): wait, the obstacle may go, until blocked_timeout_s
+    tracker_.reset(std::move(plan.waypoints));
+    blocked_ = false;  // a new path: the blocked timer starts again
+  } catch (...) {
+    // Out of memory while planning: keep the current path; the blocked timeout decides.
+  }
 }
 
 std::optional<Twist2D> BhAutoMove::on_step(const BehaviorContext& context) noexcept {
@@ -417,6 +484,7 @@ std::optional<Twist2D> BhAutoMove::on_step(const BehaviorContext& context) noexc
     fail("path blocked");
     return Twist2D{};
   }
+  if (replan_due(context.now)) replan(pose, context.now);
   return cmd;
 }
 
@@ -470,6 +538,7 @@ void CCleaningBehavior::on_activate(const ParameterSet& params, const BehaviorCo
   }
   progress_ = &workspace_.progress(*section_, point_of(context.navi->map_from_base));
   tracker_.reset(progress_->plan.path, progress_->done_m);
+  detouring_ = false;
   // The reachable cells of the section, for section_coverage(): those the plan can clean.
   navi::CleanedCells reach(workspace_.grid());
   reach.mark_path(progress_->plan.path, workspace_.options().cleaning_width_m / 2.0);
@@ -492,6 +561,23 @@ std::optional<Twist2D> CCleaningBehavior::on_step(const BehaviorContext& context
   else workspace_.cleaned().mark_disc(point_of(pose), half);
   last_pose_ = pose;
   has_last_ = true;
+  if (detouring_) {
+    const PathTracker::Target d = detour_.update(point_of(pose), lookahead_m_, 1.0);
+    const navi::Point2D end = detour_.points().back();
+    if (d.remaining_m < 0.05 && std::hypot(end.x_m - pose.x_m, end.y_m - pose.y_m) < 0.1) {
+      detouring_ = false;  // back on the coverage path, beyond the obstacle
+      tracker_.jump_to(resume_m_);
+    } else {
+      bool blocked = false;
+      const Twist2D cmd = command_toward(pose, d, context, blocked);
+      if (blocked_too_long(blocked, context.now)) {
+        fail("path blocked");
+        return Twist2D{};
+      }
+      if (replan_due(context.now)) plan_detour(pose, context.now);
+      return cmd;
+    }
+  }
   const PathTracker::Target t = tracker_.update(point_of(pose), lookahead_m_, 0.6);
   progress_->done_m = tracker_.progress_m();
   const navi::Point2D end = tracker_.points().empty() ? point_of(pose) : tracker_.points().back();
@@ -506,10 +592,47 @@ std::optional<Twist2D> CCleaningBehavior::on_step(const BehaviorContext& context
     fail("path blocked");
     return Twist2D{};
   }
+  if (replan_due(context.now)) plan_detour(pose, context.now);
   return cmd;
 }
 
-void CCleaningBehavior::on_deactivate() noexcept { has_last_ = false; }
+void CCleaningBehavior::plan_detour(const Pose2D& pose, Time now) noexcept {
+  try {
+    const std::size_t before = seen_obstacles_.size();
+    note_unmapped_returns(pose, now, kObstacleRange_m);
+    if (seen_obstacles_.size() == before) return;
+    // The first point of the coverage path beyond the progress that is clear of everything
+    // seen, by the robot radius, the detour margin and the depth the laser could not see.
+    const double keep = workspace_.options().robot_radius_m + kDetourMargin_m + kResumeClearance_m;
+    const double keep2 = keep * keep;
+    double resume = -1.0;
+    for (double s = tracker_.progress_m() + 0.1; s <= tracker_.length_m(); s += 0.05) {
+      const navi::Point2D p = tracker_.at(s);
+      const bool clear = std::none_of(seen_obstacles_.begin(), seen_obstacles_.end(), [&](const navi::Point2D& o) {
+        return (o.x_m - p.x_m) * (o.x_m - p.x_m) + (o.y_m - p.y_m) * (o.y_m - p.y_m) < keep2;
+      });
+      if (clear) {
+        resume = s;
+        break;
+      }
+    }
+    if (resume < 0.0) resume = tracker_.length_m();  // the rest of the path is behind the obstacle
+    navi::PlannedPath plan =
+        workspace_.planner().plan_around(point_of(pose), tracker_.at(resume), seen_obstacles_, kDetourMargin_m);
+    if (!plan.ok()) return;  // no way around yet: wait; the obstacle may go before blocked_timeout_s
+    detour_.reset(std::move(plan.waypoints));
+    detouring_ = true;
+    resume_m_ = resume;
+    blocked_ = false;
+  } catch (...) {
+    // Out of memory while planning: keep going as before; the blocked timeout decides.
+  }
+}
+
+void CCleaningBehavior::on_deactivate() noexcept {
+  has_last_ = false;
+  detouring_ = false;
+}
 
 // ---------------------------------------------------------------------------------------------
 // BhGlobalLocalization

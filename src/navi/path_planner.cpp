@@ -103,6 +103,47 @@ PlannedPath PathPlanner::plan(Point2D start, Point2D goal) {
   return out;
 }
 
+PlannedPath PathPlanner::plan_around(Point2D start, Point2D goal, std::span<const Point2D> obstacles, double margin_m) {
+  // Close the cells around the points in traversable_ and in A*'s padded copy, plan, then
+  // reopen exactly the cells this call closed (also when planning throws).
+  struct Closed {
+    PathPlanner& planner;
+    std::vector<std::size_t> cells;  // grid indices
+    ~Closed() {
+      for (const std::size_t i : cells) {
+        planner.traversable_[i] = 1;
+        const CellIndex c = planner.grid_.cell(i);
+        planner.open_cell_[static_cast<std::size_t>((c.y + 1) * planner.padded_width_ + c.x + 1)] = 1;
+      }
+    }
+  } closed{*this, {}};
+  const std::optional<CellIndex> start_cell = grid_.world_to_cell(start);
+  const double r = options_.robot_radius_m;
+  const double outer = r + std::max(0.0, margin_m);
+  const double near_start = 2.0 * std::max(0.0, margin_m) + grid_.resolution_m();
+  const int reach = static_cast<int>(std::ceil(outer / grid_.resolution_m())) + 1;
+  for (const Point2D& p : obstacles) {
+    const std::optional<CellIndex> pc = grid_.world_to_cell(p);
+    if (!pc) continue;
+    for (int y = pc->y - reach; y <= pc->y + reach; ++y) {
+      for (int x = pc->x - reach; x <= pc->x + reach; ++x) {
+        const CellIndex c{x, y};
+        if (!grid_.contains(c) || (start_cell && c == *start_cell)) continue;
+        const std::size_t i = grid_.index(c);
+        if (traversable_[i] == 0) continue;
+        const Point2D cc = grid_.cell_center(c);
+        const double d = std::hypot(cc.x_m - p.x_m, cc.y_m - p.y_m);
+        if (d > outer) continue;
+        if (d > r && std::hypot(cc.x_m - start.x_m, cc.y_m - start.y_m) < near_start) continue;
+        traversable_[i] = 0;
+        open_cell_[static_cast<std::size_t>((y + 1) * padded_width_ + x + 1)] = 0;
+        closed.cells.push_back(i);
+      }
+    }
+  }
+  return plan(start, goal);
+}
+
 PlannedPath PathPlanner::plan(CellIndex start, CellIndex goal) {
   PlannedPath out;
   std::ostringstream msg;

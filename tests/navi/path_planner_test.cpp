@@ -117,6 +117,43 @@ TEST_CASE("PathPlanner: clear failures", "[navi][planner][errors]") {
   CHECK(same.length_m == 0.0);
 }
 
+TEST_CASE("PathPlanner: around obstacles the map does not hold, for one plan only", "[navi][planner]") {
+  const OccupancyGrid g = test::room(100, 60, 0.05);  // 5 x 3 m
+  PathPlanner p(g, {.robot_radius_m = 0.2});
+  // A box the laser saw across the straight line y = 1.5: its near face, x = 2.5, y 1.2..1.8.
+  std::vector<Point2D> seen;
+  for (double y = 1.2; y <= 1.8 + 1e-9; y += 0.05) seen.push_back({2.5, y});
+  const Point2D start{2.15, 1.5}, goal{4.5, 1.5};  // stopped 0.15 m before the face
+  const PlannedPath around = p.plan_around(start, goal, seen, 0.1);
+  REQUIRE(around.ok());
+  CHECK(around.waypoints.size() >= 3);
+  CHECK(around.length_m > 2.35 + 0.3);
+  // Every cell of the path keeps the radius from every point seen, the margin too away from the start.
+  for (const CellIndex& c : around.cells) {
+    const Point2D cc = g.cell_center(c);
+    const bool near_start = std::hypot(cc.x_m - start.x_m, cc.y_m - start.y_m) < 0.25 + 1e-9;
+    for (const Point2D& o : seen) {
+      const double d = std::hypot(cc.x_m - o.x_m, cc.y_m - o.y_m);
+      if (!(c == around.cells.front())) REQUIRE(d > 0.2);
+      if (!near_start) REQUIRE(d > 0.3 - 1e-9);
+    }
+  }
+  // The map and the next plan are unchanged: straight through again.
+  const PlannedPath straight = p.plan(start, goal);
+  REQUIRE(straight.ok());
+  CHECK(straight.waypoints.size() == 2);
+  for (std::size_t i = 0; i < g.size(); ++i) CHECK(p.traversable(g.cell(i)) == (p.distance_field().clearance_m(i) >= 0.2));
+  // A wall of seen points across the whole room: no way around, and still no change after.
+  std::vector<Point2D> wall;
+  for (double y = 0.0; y <= 3.0; y += 0.05) wall.push_back({2.5, y});
+  const PlannedPath blocked = p.plan_around(start, goal, wall, 0.1);
+  CHECK(blocked.status == PlanStatus::unreachable);
+  CHECK(p.plan(start, goal).waypoints.size() == 2);
+  // Points on the goal: the goal is in collision for this plan; outside the map: ignored.
+  CHECK(p.plan_around(start, goal, std::vector<Point2D>{goal}, 0.1).status == PlanStatus::goal_in_collision);
+  CHECK(p.plan_around(start, goal, std::vector<Point2D>{{-5.0, 1.5}, {50.0, 50.0}}, 0.1).waypoints.size() == 2);
+}
+
 TEST_CASE("PathPlanner: unknown cells block unless allowed", "[navi][planner]") {
   OccupancyGrid g(60, 20, 0.1, {}, Occupancy::free);
   for (int y = 0; y < 20; ++y) g.set_state({30, y}, Occupancy::unknown);

@@ -119,6 +119,8 @@ class PathTracker {
   [[nodiscard]] bool empty() const noexcept { return pts_.empty(); }
   [[nodiscard]] navi::Point2D at(double s) const noexcept;
   [[nodiscard]] const std::vector<navi::Point2D>& points() const noexcept { return pts_; }
+  /// Moves the progress to arc length s (clamped to the path), forward or back, keeping the path.
+  void jump_to(double s) noexcept;
 
  private:
   [[nodiscard]] double heading_at(double s) const noexcept;
@@ -145,6 +147,14 @@ class CPathFollowingBehavior : public CBehavior {
   /// Advances the blocked timer (blocked: the laser stopped the robot, or a bumper is pressed);
   /// true when blocked for longer than the timeout.
   [[nodiscard]] bool blocked_too_long(bool blocked, Time now) noexcept;
+  /// Whether it is time to plan around what blocks the robot: blocked for replan_after_s since
+  /// the last attempt (or since the block began), and attempts left.
+  [[nodiscard]] bool replan_due(Time now) const noexcept;
+  /// Appends to seen_obstacles_ the returns of the latest fresh scan within max_range_m that the
+  /// map does not explain (map frame, seen from `pose`); records the attempt.
+  void note_unmapped_returns(const Pose2D& pose, Time now, double max_range_m);
+  /// Whether a point (map frame) lies on or next to an obstacle of the map.
+  [[nodiscard]] bool near_mapped_obstacle(navi::Point2D p) const noexcept;
 
   NaviWorkspace& workspace_;
   const LaserResource* laser_ = nullptr;
@@ -156,6 +166,12 @@ class CPathFollowingBehavior : public CBehavior {
   Duration blocked_timeout_{0};
   bool blocked_ = false;
   Time blocked_since_{0};
+  // Planning around obstacles the map does not hold (replan_after_s, max_replans).
+  Duration replan_after_{0};  ///< 0: never replan, wait for blocked_timeout_s
+  int max_replans_ = 0;
+  int replans_ = 0;           ///< attempts of this activation
+  Time last_replan_{0};
+  std::vector<navi::Point2D> seen_obstacles_;  ///< unmapped returns that blocked this activation
   bool has_last_ = false;
   Pose2D last_pose_;
 };
@@ -165,14 +181,18 @@ class CPathFollowingBehavior : public CBehavior {
 /// tracked with a lookahead point; the laser slows and stops it before unexpected obstacles.
 /// Holonomic base: translates toward the lookahead point keeping its heading; differential:
 /// turns toward it and drives forward. Pauses while not localized. Succeeds within
-/// goal_tolerance_m of the goal. Fails: "unknown goal", "no path to the goal", "not localized"
-/// (no pose at activation), "path blocked" (stopped by an obstacle for blocked_timeout_s).
+/// goal_tolerance_m of the goal. Stopped by an obstacle the map does not hold for replan_after_s,
+/// it plans again around what the laser sees (navi::PathPlanner::plan_around), at most
+/// max_replans times. Fails: "unknown goal", "no path to the goal", "not localized" (no pose at
+/// activation), "path blocked" (stopped for blocked_timeout_s: no way around was found).
 class BhAutoMove final : public CPathFollowingBehavior {
  public:
   explicit BhAutoMove(NaviWorkspace& workspace) : CPathFollowingBehavior(workspace) {}
   static const ModuleManifest& static_manifest();
-  /// The planned path of the current activation (map frame).
+  /// The planned path of the current activation (map frame); the last replanned one.
   [[nodiscard]] const std::vector<navi::Point2D>& path() const noexcept { return tracker_.points(); }
+  /// Paths planned around unexpected obstacles in this activation.
+  [[nodiscard]] int replans() const noexcept { return replans_; }
 
  protected:
   const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
@@ -180,7 +200,9 @@ class BhAutoMove final : public CPathFollowingBehavior {
   std::optional<Twist2D> on_step(const BehaviorContext& context) noexcept override;
 
  private:
+  void replan(const Pose2D& pose, Time now) noexcept;
   double goal_tol_m_ = 0.1;
+  navi::Point2D goal_;
 };
 
 /// Shared implementation of the two cleaning behaviors: follows the balloon coverage path of the
@@ -200,7 +222,13 @@ class CCleaningBehavior : public CPathFollowingBehavior {
   void on_deactivate() noexcept override;
 
  private:
+  /// Plans a detour around what blocks the coverage path to the first point of the path
+  /// clear of it; the cells skipped are left to the section's touch-ups or a later pass.
+  void plan_detour(const Pose2D& pose, Time now) noexcept;
   bool needs_holonomic_;
+  PathTracker detour_;       ///< followed instead of the coverage path while detouring
+  bool detouring_ = false;
+  double resume_m_ = 0.0;    ///< where the coverage path is taken up again after the detour
   const navi::Section* section_ = nullptr;
   NaviWorkspace::SectionProgress* progress_ = nullptr;
   std::vector<std::size_t> reachable_;

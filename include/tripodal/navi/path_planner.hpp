@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,13 @@ class PathPlanner final {
   [[nodiscard]] PlannedPath plan(Point2D start, Point2D goal);
   /// Plans between two cells.
   [[nodiscard]] PlannedPath plan(CellIndex start, CellIndex goal);
+  /// Plans from start to goal around obstacles the map does not hold (points seen by a laser,
+  /// map frame), for this plan only: the cells within the robot radius of a point are closed,
+  /// and those within the radius plus margin_m too, except near the start (a robot stopped
+  /// before an obstacle stands inside that margin and must be able to back away from it). The
+  /// start cell itself is always open. The map and later plans are not changed.
+  [[nodiscard]] PlannedPath plan_around(Point2D start, Point2D goal, std::span<const Point2D> obstacles,
+                                        double margin_m = 0.1);
 
   /// Whether the robot's disc centred on the cell touches no obstacle.
   [[nodiscard]] bool traversable(CellIndex c) const noexcept {
