@@ -52,8 +52,8 @@ TEST_CASE("load_world: the demo workspace", "[sim][world]") {
   const World f = load_world(kWorlds + "workspace_faults.yaml");
   REQUIRE(f.obstacles.size() == 1);
   CHECK(f.obstacles[0].name == "cart");
-  CHECK(f.obstacles[0].appear == from_seconds(40.0));
-  CHECK(f.obstacles[0].disappear == from_seconds(160.0));
+  CHECK(f.obstacles[0].appear == from_seconds(30.0));
+  CHECK(f.obstacles[0].disappear == from_seconds(400.0));
   CHECK(f.obstacles[0].polygon.size() == 4);
   REQUIRE(f.faults.localization_loss.size() == 1);
   CHECK(f.faults.localization_loss[0] == navi::LocalizationFault{from_seconds(60.0), from_seconds(70.0)});
