@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The README's demo command: installs dependencies, builds tripodal (Release) and runs the paper's
 # cleaning task end to end in the embedded simulator: PSR-2 (omni-directional base) cleans room
-# 3211 (10 m x 32 m, four sections) with `tripodal run`; then the same task with an injected
-# localization loss, where the planner inserts PrGlobalLocalization and the task still completes.
+# 3211 (10 m x 32 m, four sections) with `tripodal run`; then the same task in the faults world: the
+# cleaning behavior detours around a cart on its path, and after a localization loss the planner
+# inserts PrGlobalLocalization and the task still completes.
 # Pictures, trajectories and reports go to demo-out/ (DEMO_OUT to change). DEMO_ALL=1 also runs
 # the two-wheel differential robot; DEMO_NETS=1 also replays the PrCleaning net narratives.
 set -euo pipefail
@@ -22,9 +23,9 @@ echo "== PSR-2 (omni): clean the room 3211"
 "$tool" run --robot configs/robots/psr2.yaml --world "$world" --task "clean the room 3211" --seed 1 --out "$out/psr2"
 
 echo
-echo "== PSR-2 with a localization loss from 300 s to 330 s"
-"$tool" run --robot configs/robots/psr2.yaml --world "$world" --task "clean the room 3211" --seed 1 \
-  --faults "300-330" --out "$out/psr2-localization-loss"
+echo "== PSR-2 in the faults world: a cart on its path, a localization loss at 60-70 s, a dead laser at 90-92 s"
+"$tool" run --robot configs/robots/psr2.yaml --world configs/worlds/workspace_faults.yaml --task "clean the room 3211" \
+  --seed 1 --out "$out/psr2-faults"
 
 if [ "${DEMO_ALL:-0}" = 1 ]; then
   echo
