@@ -570,9 +570,14 @@ RunResult run_task(const RunOptions& o) {
   };
 
   std::int64_t tick = 0;
+  std::size_t sim_events_noted = 0;
   while (robot->planner().busy() && clock.now() < deadline) {
     sim.step(physics);
     clock.set(sim.now());
+    for (; sim_events_noted < sim.events().size(); ++sim_events_noted) {
+      const sim::SimEvent& e = sim.events()[sim_events_noted];
+      life.note(e.stamp, "simulator: " + std::string(sim::to_string(e.kind)) + (e.detail.empty() ? "" : " " + e.detail));
+    }
     const Time now = clock.now();
     const Pose2D truth = sim.pose();
     const bool cleaning = is_cleaning();

@@ -26,6 +26,9 @@ class LifecycleRecorder final : public TaskObserver, public SupervisorObserver {
   /// One line per entry: "    12.300 s  process X1 PrCleaning(section=A) failed: localization fault".
   [[nodiscard]] std::string str() const;
   void clear() noexcept { entries_.clear(); }
+  /// Adds a line from outside the planner and supervisor (e.g. the simulator's injected faults),
+  /// so one log tells the whole story in time order.
+  void note(Time t, std::string text) { add(t, std::move(text)); }
 
   // TaskObserver
   void on_command_refused(std::string_view command, std::string_view answer, Time now) override;
