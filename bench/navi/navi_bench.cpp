@@ -4,6 +4,7 @@
 #include <benchmark/benchmark.h>
 
 #include <string>
+#include <vector>
 
 #include "tripodal/navi/coverage.hpp"
 #include "tripodal/navi/distance_field.hpp"
@@ -52,6 +53,23 @@ void BM_AStar(benchmark::State& state) {
   state.counters["waypoints"] = static_cast<double>(p.waypoints.size());
 }
 BENCHMARK(BM_AStar)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// A replan around what a laser saw: the long plan with a 1 m wall of 21 returns across its first
+// leg (BhAutoMove / the cleaning detour call plan_around with the returns of one scan).
+void BM_AStarAround(benchmark::State& state) {
+  PathPlanner planner(workspace(), {.robot_radius_m = 0.3});
+  std::vector<Point2D> seen;
+  for (int k = 0; k <= 20; ++k) seen.push_back({1.5 + 0.05 * k, 2.0});
+  PlannedPath p;
+  for (auto _ : state) {
+    p = planner.plan_around({0.8, 0.8}, {9.0, 31.0}, seen, 0.1);
+    benchmark::DoNotOptimize(p.waypoints.data());
+  }
+  if (!p.ok()) state.SkipWithError(p.message.c_str());
+  state.counters["length_m"] = p.length_m;
+  state.counters["expanded"] = static_cast<double>(p.expanded);
+}
+BENCHMARK(BM_AStarAround)->Unit(benchmark::kMillisecond);
 
 void BM_SectionSplitter(benchmark::State& state) {
   std::size_t n = 0;
