@@ -558,13 +558,17 @@ RunResult run_task(const RunOptions& o) {
   };
   auto draw_progress = [&](bool final) {
     if (o.progress == nullptr) return;
-    const double cov = res.reachable_cells == 0 ? 0.0 : static_cast<double>(covered()) / static_cast<double>(res.reachable_cells);
-    constexpr int kWidth = 30;
-    const int full = static_cast<int>(std::lround(cov * kWidth));
-    std::string bar = "[" + std::string(static_cast<std::size_t>(full), '#') + std::string(static_cast<std::size_t>(kWidth - full), '.') + "]";
-    *o.progress << (o.progress_is_terminal ? "\r" : "") << bar << ' ' << std::setw(5) << fixed(100.0 * cov, 1) << " %  t="
-                << std::setw(7) << fixed(to_seconds(clock.now()), 0) << " s  " << (report.current.empty() ? "-" : report.current)
-                << (o.progress_is_terminal && !final ? "          " : "\n");
+    *o.progress << (o.progress_is_terminal ? "\r" : "");
+    if (res.reachable_cells > 0) {  // a cleaning task: the bar is the coverage of the room
+      const double cov = static_cast<double>(covered()) / static_cast<double>(res.reachable_cells);
+      constexpr int kWidth = 30;
+      const int full = static_cast<int>(std::lround(cov * kWidth));
+      *o.progress << '[' << std::string(static_cast<std::size_t>(full), '#')
+                  << std::string(static_cast<std::size_t>(kWidth - full), '.') << "] " << std::setw(5) << fixed(100.0 * cov, 1)
+                  << " %  ";
+    }
+    *o.progress << "t=" << std::setw(7) << fixed(to_seconds(clock.now()), 0) << " s  "
+                << (report.current.empty() ? "-" : report.current) << (o.progress_is_terminal && !final ? "          " : "\n");
     o.progress->flush();
     bar_shown = o.progress_is_terminal && !final;
   };

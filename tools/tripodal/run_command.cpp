@@ -131,9 +131,11 @@ int run(const std::vector<std::string>& args, std::ostream& out, std::ostream& e
     o.progress_is_terminal = ::isatty(2) != 0;
     out << "tripodal run: robot " << o.robot.string() << ", world " << o.world.string() << ", task \"" << o.task << "\"\n";
     const app::RunResult r = app::run_task(o);
-    out << "task " << r.state << (r.reason.empty() ? "" : ": " + r.reason) << "; coverage " << r.coverage * 100.0
-        << " % of " << r.reachable_area_m2 << " m2 reachable; path " << r.total.length_m << " m, " << r.total.turns
-        << " turns; " << r.duration_s << " s simulated; " << r.recoveries.size() << " recoveries\n";
+    out << "task " << r.state << (r.reason.empty() ? "" : ": " + r.reason) << "; ";
+    if (r.reachable_cells > 0) out << "coverage " << r.coverage * 100.0 << " % of " << r.reachable_area_m2 << " m2 reachable; ";
+    else out << "no cleaning in this task; ";
+    out << "path " << r.total.length_m << " m, " << r.total.turns << " turns; " << r.duration_s << " s simulated; "
+        << r.recoveries.size() << " recoveries\n";
     if (!o.out.empty()) out << "wrote " << (o.out / "map.png").string() << ", trajectory.csv, report.json, lifecycle.txt\n";
     return r.succeeded ? kOk : kTaskFailed;
   } catch (const ConfigError& e) {
