@@ -302,6 +302,18 @@ bool CPathFollowingBehavior::near_mapped_obstacle(navi::Point2D p) const noexcep
   return false;
 }
 
+Twist2D CPathFollowingBehavior::drive_toward(const Pose2D& pose, const PathTracker::Target& target,
+                                             const BehaviorContext& context) noexcept {
+  bool blocked = false;
+  const Twist2D cmd = command_toward(pose, target, context, blocked);
+  if (blocked_too_long(blocked, context.now)) {
+    fail("path blocked");
+    return Twist2D{};
+  }
+  if (replan_due(context.now)) plan_around_obstacle(pose, context.now);
+  return cmd;
+}
+
 bool CPathFollowingBehavior::replan_due(Time now) const noexcept {
   if (!blocked_ || replan_after_ <= Duration{0} || replans_ >= max_replans_) return false;
   if (now - blocked_since_ < replan_after_) return false;
@@ -455,7 +467,7 @@ void BhAutoMove::on_activate(const ParameterSet& params, const BehaviorContext& 
   tracker_.reset(std::move(plan.waypoints));
 }
 
-void BhAutoMove::replan(const Pose2D& pose, Time now) noexcept {
+void BhAutoMove::plan_around_obstacle(const Pose2D& pose, Time now) noexcept {
   try {
     const std::size_t before = seen_obstacles_.size();
     note_unmapped_returns(pose, now, kObstacleRange_m);
@@ -478,14 +490,7 @@ std::optional<Twist2D> BhAutoMove::on_step(const BehaviorContext& context) noexc
     succeed();
     return Twist2D{};
   }
-  bool blocked = false;
-  const Twist2D cmd = command_toward(pose, t, context, blocked);
-  if (blocked_too_long(blocked, context.now)) {
-    fail("path blocked");
-    return Twist2D{};
-  }
-  if (replan_due(context.now)) replan(pose, context.now);
-  return cmd;
+  return drive_toward(pose, t, context);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -568,14 +573,7 @@ std::optional<Twist2D> CCleaningBehavior::on_step(const BehaviorContext& context
       detouring_ = false;  // back on the coverage path, beyond the obstacle
       tracker_.jump_to(resume_m_);
     } else {
-      bool blocked = false;
-      const Twist2D cmd = command_toward(pose, d, context, blocked);
-      if (blocked_too_long(blocked, context.now)) {
-        fail("path blocked");
-        return Twist2D{};
-      }
-      if (replan_due(context.now)) plan_detour(pose, context.now);
-      return cmd;
+      return drive_toward(pose, d, context);
     }
   }
   const PathTracker::Target t = tracker_.update(point_of(pose), lookahead_m_, 0.6);
@@ -586,17 +584,10 @@ std::optional<Twist2D> CCleaningBehavior::on_step(const BehaviorContext& context
     succeed();
     return Twist2D{};
   }
-  bool blocked = false;
-  const Twist2D cmd = command_toward(pose, t, context, blocked);
-  if (blocked_too_long(blocked, context.now)) {
-    fail("path blocked");
-    return Twist2D{};
-  }
-  if (replan_due(context.now)) plan_detour(pose, context.now);
-  return cmd;
+  return drive_toward(pose, t, context);
 }
 
-void CCleaningBehavior::plan_detour(const Pose2D& pose, Time now) noexcept {
+void CCleaningBehavior::plan_around_obstacle(const Pose2D& pose, Time now) noexcept {
   try {
     const std::size_t before = seen_obstacles_.size();
     note_unmapped_returns(pose, now, kObstacleRange_m);

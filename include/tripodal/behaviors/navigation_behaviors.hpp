@@ -147,6 +147,12 @@ class CPathFollowingBehavior : public CBehavior {
   /// Advances the blocked timer (blocked: the laser stopped the robot, or a bumper is pressed);
   /// true when blocked for longer than the timeout.
   [[nodiscard]] bool blocked_too_long(bool blocked, Time now) noexcept;
+  /// command_toward() with the blocked bookkeeping: fails "path blocked" (zero command) when
+  /// blocked longer than blocked_timeout_s, and calls plan_around_obstacle() when it is due.
+  [[nodiscard]] Twist2D drive_toward(const Pose2D& pose, const PathTracker::Target& target,
+                                     const BehaviorContext& context) noexcept;
+  /// Plans a way around what blocks the robot (seen_obstacles_ after note_unmapped_returns()).
+  virtual void plan_around_obstacle(const Pose2D& pose, Time now) noexcept = 0;
   /// Whether it is time to plan around what blocks the robot: blocked for replan_after_s since
   /// the last attempt (or since the block began), and attempts left.
   [[nodiscard]] bool replan_due(Time now) const noexcept;
@@ -200,7 +206,8 @@ class BhAutoMove final : public CPathFollowingBehavior {
   std::optional<Twist2D> on_step(const BehaviorContext& context) noexcept override;
 
  private:
-  void replan(const Pose2D& pose, Time now) noexcept;
+  /// Plans again to the goal around what the laser sees (PathPlanner::plan_around).
+  void plan_around_obstacle(const Pose2D& pose, Time now) noexcept override;
   double goal_tol_m_ = 0.1;
   navi::Point2D goal_;
 };
@@ -224,7 +231,7 @@ class CCleaningBehavior : public CPathFollowingBehavior {
  private:
   /// Plans a detour around what blocks the coverage path to the first point of the path
   /// clear of it; the cells skipped are left to the section's touch-ups or a later pass.
-  void plan_detour(const Pose2D& pose, Time now) noexcept;
+  void plan_around_obstacle(const Pose2D& pose, Time now) noexcept override;
   bool needs_holonomic_;
   PathTracker detour_;       ///< followed instead of the coverage path while detouring
   bool detouring_ = false;
