@@ -262,6 +262,7 @@ void BehaviorHarness::load_trace(const std::filesystem::path& trace_path) {
       any = true;
     }
     channels = reader.channels();
+    if (reader.state() == trace::ReadState::kTruncated) warning_ = reader.warning();
   }
   for (const auto& c : channels) {
     std::unique_ptr<CResource> r;

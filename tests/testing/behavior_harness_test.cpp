@@ -11,6 +11,7 @@
 #include "tripodal/behaviors/builtin_behaviors.hpp"
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/trace/carmen_import.hpp"
+#include "tripodal/trace/trace_reader.hpp"
 #include "tripodal/trace/trace_writer.hpp"
 
 using namespace tripodal;
@@ -201,4 +202,57 @@ TEST_CASE("harness: bad traces, bad parameters and misuse are reported", "[testi
              SourceLocation{"my_test.yaml", 3, 7});
   CHECK_THROWS_WITH(bad.run(), Contains("my_test.yaml:3:7") && Contains("stop_distance_m"));
   CHECK_THROWS_AS(bad.attach(std::make_unique<BhStop>()), std::logic_error);
+}
+
+TEST_CASE("harness: damaged traces are refused at load with the byte offset; a cut one replays to its last record",
+          "[testing][harness][errors]") {
+  ExcerptTrace excerpt;
+  const auto bytes = trace::test::read_all(excerpt.file.path());
+  std::vector<std::uint64_t> offsets;
+  Time stamp_of_last_whole{0};
+  {
+    trace::TraceReader r(excerpt.file.path());
+    trace::TraceRecord rec;
+    while (r.next(rec)) offsets.push_back(rec.offset);
+  }
+  REQUIRE(offsets.size() > 700);
+  TempFile bad("harness_bad");
+
+  SECTION("wrong version") {
+    auto b = bytes;
+    b[8] = 7;
+    trace::test::write_all(bad.path(), b, b.size());
+    BehaviorHarness h;
+    CHECK_THROWS_WITH(h.load_trace(bad.path()), Contains("byte 8: trace format version 7 is not supported"));
+  }
+  SECTION("a corrupted record deep in the file fails the first pass, before any behavior runs") {
+    auto b = bytes;
+    const std::uint64_t at = offsets[500];
+    b[at + 8 + 12] ^= 0x20;
+    trace::test::write_all(bad.path(), b, b.size());
+    BehaviorHarness h;
+    CHECK_THROWS_WITH(h.load_trace(bad.path()), Contains("byte " + std::to_string(at) + ": record checksum mismatch"));
+    CHECK_THROWS_AS(h.run(), std::logic_error);  // nothing loaded
+  }
+  SECTION("a recorder killed mid-write: replayed up to the last whole record, with the warning") {
+    const std::uint64_t cut = offsets[600] + 5;  // inside record 600's frame
+    trace::test::write_all(bad.path(), bytes, cut);
+    {
+      trace::TraceReader r(bad.path());
+      trace::TraceRecord rec;
+      while (r.next(rec)) stamp_of_last_whole = trace::stamp_of(rec.data);
+    }
+    BehaviorHarness h;
+    h.load_trace(bad.path());
+    CHECK_THAT(h.trace_warning(), Contains("truncated at byte " + std::to_string(offsets[600])));
+    CHECK(h.end_time() == stamp_of_last_whole);
+    h.attach(std::make_unique<test::BhBlindCruise>());
+    const RunLog& run = h.run();
+    CHECK(run.steps().back().t <= stamp_of_last_whole + 50ms);
+    CHECK(run.steps().back().t > stamp_of_last_whole);
+    BehaviorHarness whole;
+    whole.load_trace(excerpt.file.path());
+    CHECK(whole.trace_warning().empty());
+    CHECK(whole.end_time() > h.end_time());
+  }
 }

@@ -153,6 +153,11 @@ class BehaviorHarness final {
   [[nodiscard]] Time now() const noexcept { return now_; }
   /// The trace's first stamp (valid after load_trace).
   [[nodiscard]] Time start_time() const noexcept { return start_; }
+  /// Stamp of the trace's last whole record: run() ends one period after it.
+  [[nodiscard]] Time end_time() const noexcept { return last_record_; }
+  /// Empty, or the reader's warning for a trace cut inside a record (a recorder killed mid-write):
+  /// "FILE: truncated at byte N (...)". Such a trace is replayed up to its last whole record.
+  [[nodiscard]] const std::string& trace_warning() const noexcept { return warning_; }
 
  private:
   class Sink;
@@ -170,6 +175,7 @@ class BehaviorHarness final {
   std::vector<Attached> attached_;
   const LaserResource* laser_ = nullptr;
   RunLog log_;
+  std::string warning_;
   Time start_{0};
   Time now_{0};
   Time last_record_{0};
