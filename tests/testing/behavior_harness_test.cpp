@@ -147,7 +147,7 @@ TEST_CASE("harness: helpers report a failing behavior and unknown names", "[test
   CHECK_THAT(never_done.explanation, Contains("never succeeded in 41 steps") && Contains("last status: running"));
 }
 
-TEST_CASE("harness: two runs of the same trace give the same commands; run() continues", "[testing][harness]") {
+TEST_CASE("harness: two runs of the same trace give the same commands, and run() continues", "[testing][harness]") {
   ExcerptTrace excerpt;
   auto run_once = [&](std::optional<Time> until) {
     BehaviorHarness h;
@@ -204,7 +204,7 @@ TEST_CASE("harness: bad traces, bad parameters and misuse are reported", "[testi
   CHECK_THROWS_AS(bad.attach(std::make_unique<BhStop>()), std::logic_error);
 }
 
-TEST_CASE("harness: damaged traces are refused at load with the byte offset; a cut one replays to its last record",
+TEST_CASE("harness: damaged traces are refused at load with the byte offset, a cut one replays to its last record",
           "[testing][harness][errors]") {
   ExcerptTrace excerpt;
   const auto bytes = trace::test::read_all(excerpt.file.path());

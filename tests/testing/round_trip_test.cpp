@@ -147,7 +147,7 @@ TEST_CASE("round trip: a recorded simulated run replays into the same commands, 
   }
 }
 
-TEST_CASE("recorder: writes each reading once per publish, with its own stamp; misuse is refused", "[testing][recorder]") {
+TEST_CASE("recorder: writes each reading once per publish, with its own stamp, and refuses misuse", "[testing][recorder]") {
   trace::test::TempFile file("recorder");
   LaserResource laser("front_laser");
   OdometryResource odom("odom");
