@@ -264,6 +264,18 @@ void BehaviorHarness::load_trace(const std::filesystem::path& trace_path) {
     channels = reader.channels();
     if (reader.state() == trace::ReadState::kTruncated) warning_ = reader.warning();
   }
+  // Checked before any resource exists, so a failed load leaves the harness as it was.
+  auto has_channel = [&](const std::string& name, trace::ChannelKind kind) {
+    return std::any_of(channels.begin(), channels.end(), [&](const auto& c) { return c.name == name && c.kind == kind; });
+  };
+  if (!options_.laser.empty() && !has_channel(options_.laser, trace::ChannelKind::kLaser)) {
+    throw std::invalid_argument("BehaviorHarness: the trace " + trace_path.string() + " has no laser channel '" +
+                                options_.laser + "'");
+  }
+  if (!options_.localization_channel.empty() && !has_channel(options_.localization_channel, trace::ChannelKind::kOdometry)) {
+    throw std::invalid_argument("BehaviorHarness: the trace " + trace_path.string() + " has no odometry channel '" +
+                                options_.localization_channel + "' for the localization");
+  }
   for (const auto& c : channels) {
     std::unique_ptr<CResource> r;
     switch (c.kind) {
@@ -284,10 +296,7 @@ void BehaviorHarness::load_trace(const std::filesystem::path& trace_path) {
     owned_.push_back(std::move(r));
   }
   laser_ = options_.laser.empty() ? table_.first<LaserScan>() : table_.find<LaserScan>(options_.laser);
-  if (!options_.laser.empty() && laser_ == nullptr) {
-    throw std::invalid_argument("BehaviorHarness: the trace " + trace_path.string() + " has no laser channel '" +
-                                options_.laser + "'");
-  }
+  if (!options_.localization_channel.empty()) localization_ = table_.find<OdometryReading>(options_.localization_channel);
   replay_ = std::make_unique<trace::TraceReplay>(std::make_unique<trace::TraceReader>(trace_path));
   start_ = replay_->start_time();
   now_ = start_;
@@ -329,7 +338,11 @@ const RunLog& BehaviorHarness::run(std::optional<Time> until, bool stop_when_don
 
 void BehaviorHarness::step_once() {
   replay_->advance_to(now_, *sink_);
-  navi_.pose_stamp = now_;
+  if (localization_ != nullptr && localization_->has_reading()) {
+    navi_.map_from_base = localization_->latest().pose;
+    navi_.pose_stamp = localization_->stamp();
+    navi_.localized = true;
+  }
   BehaviorContext ctx;
   ctx.now = now_;
   ctx.period = options_.period;

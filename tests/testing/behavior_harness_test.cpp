@@ -256,3 +256,39 @@ TEST_CASE("harness: damaged traces are refused at load with the byte offset, a c
     CHECK(whole.end_time() > h.end_time());
   }
 }
+
+TEST_CASE("harness: a pose channel of the trace localizes map-frame behaviors", "[testing][harness]") {
+  ExcerptTrace excerpt;
+  // The corrected Intel log's laser poses are SLAM-corrected map poses; the first comes with the
+  // first scan at 33.1 s. A goal 1 m ahead of that pose is in the map frame.
+  const ParameterValues go = {{"frame", Value{std::string("map")}}, {"goal_x_m", Value{1.0}}, {"goal_y_m", Value{0.0}},
+                              {"stale_timeout_s", Value{40.0}}};
+  SECTION("without it the behavior is never localized") {
+    BehaviorHarness h;
+    h.load_trace(excerpt.file.path());
+    h.attach(std::make_unique<BhGoToPose>(), go);
+    const CheckResult r = h.run().never_fails("BhGoToPose");
+    CHECK_FALSE(r);
+    CHECK_THAT(r.explanation, Contains("failed at t=40.0") && Contains("not localized"));
+  }
+  SECTION("with laser_pose it drives once the first pose arrives") {
+    BehaviorHarness h({.localization_channel = "laser_pose"});
+    h.load_trace(excerpt.file.path());
+    h.attach(std::make_unique<BhGoToPose>(), go);
+    const RunLog& run = h.run(h.start_time() + 40s);
+    CHECK(run.never_fails("BhGoToPose"));
+    std::size_t driving = 0;
+    for (const auto& s : run.steps()) {
+      if (s.command.vx_m_s != 0.0 || s.command.wz_rad_s != 0.0) {
+        ++driving;
+        CHECK(to_seconds(s.t) > 33.0);
+      }
+    }
+    CHECK(driving > 0);
+  }
+  SECTION("a missing channel is refused before anything is created") {
+    BehaviorHarness h({.localization_channel = "slam_pose"});
+    CHECK_THROWS_WITH(h.load_trace(excerpt.file.path()), Contains("no odometry channel 'slam_pose'"));
+    CHECK(h.resources().size() == 0);
+  }
+}

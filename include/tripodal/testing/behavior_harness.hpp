@@ -52,6 +52,10 @@ struct HarnessOptions {
   double robot_radius_m = 0.25;
   Pose2D laser_in_body;
   std::string laser;  ///< laser resource for the obstacle check; empty = the first laser channel
+  /// An odometry channel whose pose is the localizer's map_from_base (NavigationData, localized
+  /// once it has a reading), e.g. "laser_pose" of an imported corrected CARMEN log. Empty: the
+  /// behaviors see localized = false.
+  std::string localization_channel;
 };
 
 /// What one behavior did in one period.
@@ -83,7 +87,7 @@ struct HarnessEvent {
 
 /// Everything a run produced, with the assertion helpers. Times are trace time (the stamps of the
 /// trace's records; the run starts at the first record's stamp).
-class RunLog {
+class RunLog final {
  public:
   [[nodiscard]] const std::vector<StepRecord>& steps() const noexcept { return steps_; }
   [[nodiscard]] const std::vector<HarnessEvent>& events() const noexcept { return events_; }
@@ -174,6 +178,7 @@ class BehaviorHarness final {
   std::unique_ptr<CBehaviorCoordinator> coordinator_;
   std::vector<Attached> attached_;
   const LaserResource* laser_ = nullptr;
+  const OdometryResource* localization_ = nullptr;
   RunLog log_;
   std::string warning_;
   Time start_{0};
