@@ -292,3 +292,25 @@ TEST_CASE("harness: a pose channel of the trace localizes map-frame behaviors", 
     CHECK(h.resources().size() == 0);
   }
 }
+
+TEST_CASE("harness: resource_max_age makes sparse scans go stale, and BhAvoidObstacle then blocks translation",
+          "[testing][harness]") {
+  ExcerptTrace excerpt;
+  BehaviorHarness h({.resource_max_age = 500ms});
+  h.load_trace(excerpt.file.path());
+  h.attach(std::make_unique<test::BhBlindCruise>(), {}, normal(1));
+  h.attach(std::make_unique<BhAvoidObstacle>(), avoid_params(), safety());
+  const RunLog& run = h.run();
+  std::size_t moving = 0;
+  for (const StepRecord& s : run.steps()) {
+    if (s.command.vx_m_s > 0.0) {
+      ++moving;
+      // Only within 0.5 s of a scan, and never before the first one (33.1 s).
+      CHECK(to_seconds(s.t) > 33.0);
+    }
+  }
+  // 30 scans, each fresh for at most 11 periods of 50 ms.
+  CHECK(moving > 0);
+  CHECK(moving <= 30u * 11u);
+  CHECK(run.never_drives_toward_obstacle_closer_than(0.7));
+}
