@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # The README's test command: installs dependencies, then
 #   1. a Release build with -Werror and the whole test suite (ctest),
-#   2. the example consumer built against the *installed* package (find_package(tripodal)),
+#   2. the example consumer and the behavior tutorial's test (examples/behavior_test) built
+#      against the *installed* package (find_package(tripodal)),
 #   3. the test suite again under AddressSanitizer + UndefinedBehaviorSanitizer,
-# Build trees go to build/release, build/sanitize, build/consumer (override with BUILD_ROOT).
+# Build trees go to build/release, build/sanitize, build/consumer,
+# build/behavior_test (override with BUILD_ROOT).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
@@ -30,6 +32,11 @@ cmake -S examples/consumer -B "$build_root/consumer" "${generator[@]}" \
   -DCMAKE_PREFIX_PATH="$build_root/install" -DCMAKE_COMPILE_WARNING_AS_ERROR=ON
 cmake --build "$build_root/consumer" -j "$jobs"
 "$build_root/consumer/tripodal_consumer"
+echo "== Build and run the behavior tutorial's trace test against the installed package"
+cmake -S examples/behavior_test -B "$build_root/behavior_test" "${generator[@]}" \
+  -DCMAKE_PREFIX_PATH="$build_root/install" -DCMAKE_COMPILE_WARNING_AS_ERROR=ON
+cmake --build "$build_root/behavior_test" -j "$jobs"
+"$build_root/behavior_test/bh_approach_test"
 
 echo "== AddressSanitizer + UndefinedBehaviorSanitizer build"
 cmake -S . -B "$build_root/sanitize" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
