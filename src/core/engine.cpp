@@ -33,34 +33,65 @@ constexpr std::size_t kTailWindow = 1024;  // firings kept to name the transitio
 
 enum class Kind : std::uint8_t { immediate, delayed, event };
 
+/// What a firing reads of a transition, in one record: a firing touches the records of the
+/// transition and of its neighbours only. No member is a char type, so that stores to the
+/// marking and flags do not force the compiler to reload every array pointer.
+struct TransitionCode {
+  std::uint32_t check_begin = 0;   // [check_begin, check_end) in checks
+  std::uint32_t check_end = 0;
+  std::uint32_t change_begin = 0;  // [change_begin, change_end) in changes
+  std::uint32_t change_end = 0;
+  std::uint32_t rank = 0;          // conflict order: priority descending, then declaration order
+  Kind kind = Kind::immediate;
+  bool enabled = false;
+  const Guard* guard = nullptr;
+};
+
+/// Per place: whether it binds a behavior or process (reported in StepResult::activated /
+/// deactivated), and whether this step changed its marking. Not a char type, for the same reason.
+enum class PlaceFlags : std::uint8_t { none = 0, bound = 1, touched = 2, bound_touched = 3 };
+
 struct Check {
   PlaceIndex place = 0;
   Tokens lo = 0;
   Tokens hi = std::numeric_limits<Tokens>::max();
 };
 
+/// A transition's Check on one place, listed under that place: when a firing changes the place,
+/// the bound alone decides whether an enabled watcher stays enabled.
+struct Watch {
+  TransitionIndex transition = 0;
+  Tokens lo = 0;
+  Tokens hi = std::numeric_limits<Tokens>::max();
+};
+
 /// A set of small integers with O(log64 n) insert, erase and find-first: one bit per element at
 /// the bottom level, one bit per non-empty word at each level above, a single word at the top.
+/// The levels share one array so that a step touches as few cache lines as possible.
 class RankSet {
  public:
   void init(std::size_t n) {
-    levels_.clear();
+    levels_ = 0;
     std::size_t bits = std::max<std::size_t>(n, 1);
+    std::size_t total = 0;
     for (;;) {
       const std::size_t words = (bits + 63) / 64;
-      levels_.emplace_back(words, 0);
+      if (levels_ == kMaxLevels) throw std::length_error("RankSet: too many elements");
+      begin_[levels_] = static_cast<std::uint32_t>(total);
+      size_[levels_] = static_cast<std::uint32_t>(words);
+      ++levels_;
+      total += words;
       if (words == 1) break;
       bits = words;
     }
+    words_.assign(total, 0);
   }
-  void clear() noexcept {
-    for (auto& level : levels_) std::fill(level.begin(), level.end(), 0);
-  }
-  [[nodiscard]] bool empty() const noexcept { return levels_.back()[0] == 0; }
-  [[nodiscard]] bool test(std::uint32_t i) const noexcept { return ((levels_[0][i >> 6] >> (i & 63)) & 1U) != 0; }
+  void clear() noexcept { std::fill(words_.begin(), words_.end(), 0); }
+  [[nodiscard]] bool empty() const noexcept { return words_[begin_[levels_ - 1]] == 0; }
+  [[nodiscard]] bool test(std::uint32_t i) const noexcept { return ((words_[i >> 6] >> (i & 63)) & 1U) != 0; }
   void insert(std::uint32_t i) noexcept {
-    for (auto& level : levels_) {
-      std::uint64_t& word = level[i >> 6];
+    for (std::uint32_t l = 0; l < levels_; ++l) {
+      std::uint64_t& word = words_[begin_[l] + (i >> 6)];
       const bool was_empty = word == 0;
       word |= std::uint64_t{1} << (i & 63);
       if (!was_empty) return;
@@ -68,8 +99,8 @@ class RankSet {
     }
   }
   void erase(std::uint32_t i) noexcept {
-    for (auto& level : levels_) {
-      std::uint64_t& word = level[i >> 6];
+    for (std::uint32_t l = 0; l < levels_; ++l) {
+      std::uint64_t& word = words_[begin_[l] + (i >> 6)];
       word &= ~(std::uint64_t{1} << (i & 63));
       if (word != 0) return;
       i >>= 6;
@@ -78,8 +109,8 @@ class RankSet {
   /// Smallest element; the set must not be empty.
   [[nodiscard]] std::uint32_t first() const noexcept {
     std::uint32_t index = 0;
-    for (auto level = levels_.rbegin(); level != levels_.rend(); ++level) {
-      index = index * 64 + static_cast<std::uint32_t>(std::countr_zero((*level)[index]));
+    for (std::uint32_t l = levels_; l-- > 0;) {
+      index = index * 64 + static_cast<std::uint32_t>(std::countr_zero(words_[begin_[l] + index]));
     }
     return index;
   }
@@ -87,21 +118,26 @@ class RankSet {
   [[nodiscard]] std::uint32_t next(std::uint32_t i) const noexcept { return next_at(0, i); }
 
  private:
+  static constexpr std::uint32_t kMaxLevels = 6;  // 64^6 elements
+
   // Smallest set bit >= i at `level`: within i's word, else in the next non-empty word, which
   // the level above finds.
-  [[nodiscard]] std::uint32_t next_at(std::size_t level, std::uint32_t i) const noexcept {
-    const auto& words = levels_[level];
+  [[nodiscard]] std::uint32_t next_at(std::uint32_t level, std::uint32_t i) const noexcept {
     const std::uint32_t w = i >> 6;
-    if (w >= words.size()) return kNone;
+    if (w >= size_[level]) return kNone;
+    const std::uint64_t* words = words_.data() + begin_[level];
     const std::uint64_t bits = words[w] & (~std::uint64_t{0} << (i & 63));
     if (bits != 0) return w * 64 + static_cast<std::uint32_t>(std::countr_zero(bits));
-    if (level + 1 == levels_.size()) return kNone;
+    if (level + 1 == levels_) return kNone;
     const std::uint32_t next_word = next_at(level + 1, w + 1);
     if (next_word == kNone) return kNone;
     return next_word * 64 + static_cast<std::uint32_t>(std::countr_zero(words[next_word]));
   }
 
-  std::vector<std::vector<std::uint64_t>> levels_;  // [0] = bottom
+  std::vector<std::uint64_t> words_;  // level 0 (one bit per element) first
+  std::uint32_t begin_[kMaxLevels] = {};
+  std::uint32_t size_[kMaxLevels] = {};
+  std::uint32_t levels_ = 0;
 };
 
 /// Min-heap of (deadline, rank) with a position index per transition, so a transition that stops
@@ -227,21 +263,17 @@ struct Engine::Impl {
   std::shared_ptr<spdlog::logger> log;
 
   // --- compiled net ---------------------------------------------------------------------------
-  std::vector<Kind> kind;
-  std::vector<std::uint32_t> rank;           // per transition
+  std::vector<TransitionCode> code;          // per transition
   std::vector<TransitionIndex> order;        // rank -> transition
   std::vector<Duration> delay;
   std::vector<EventId> event_of;             // kNone: no event
-  std::vector<std::uint32_t> check_begin;    // CSR into checks
   std::vector<Check> checks;
-  std::vector<std::uint32_t> change_begin;   // CSR into changes
   std::vector<PlaceChange> changes;
-  std::vector<const Guard*> guard;           // nullptr: no guard
   std::vector<std::uint32_t> slot_begin;     // into slots
   std::vector<const Value*> slots;
   std::vector<std::uint32_t> watch_begin;    // per place, CSR into watchers
-  std::vector<TransitionIndex> watchers;
-  std::vector<std::uint8_t> bound;           // place binds a behavior or refers to a process
+  std::vector<Watch> watchers;
+  std::vector<PlaceFlags> place_flags;
   std::vector<PlaceIndex> outcome_places;
 
   std::vector<Value> parameter_values;       // per declared parameter
@@ -260,105 +292,144 @@ struct Engine::Impl {
 
   // --- state ----------------------------------------------------------------------------------
   Marking marking;
-  std::vector<std::uint8_t> enabled;
   std::vector<Time> since;
   RankSet ready;  // ranks of enabled immediate and due delayed transitions
   std::vector<RankSet> event_enabled;  // per event: positions of its enabled listeners
   TimerHeap timers;
   Time now{0};
   std::size_t instant_firings = 0;
-  std::vector<TransitionIndex> tail;  // ring of the last firings at this instant
+  std::vector<TransitionIndex> tail;  // ring of the last firings at this instant (power-of-2 size)
+  std::size_t tail_mask = 0;
   std::vector<std::uint8_t> reported_active;
-  std::vector<std::uint8_t> touched;
   std::vector<PlaceIndex> touched_list;
   std::vector<EngineObserver*> observers;
   StepResult result;
+  bool debug_log = false;  // the logger's level, read once per step
 
   Impl(const PetriNet& n, const ParameterValues& parameters, EngineOptions opts);
   void compile_structure();
   void bind_variables(const ParameterValues& parameters, Diagnostics& problems);
 
   [[nodiscard]] bool check(TransitionIndex t) const noexcept {
-    for (std::uint32_t i = check_begin[t], e = check_begin[t + 1]; i < e; ++i) {
-      const Check& c = checks[i];
-      const Tokens m = marking[c.place];
-      if (m < c.lo || m > c.hi) return false;
+    const TransitionCode& tc = code[t];
+    const Check* c = checks.data() + tc.check_begin;
+    const Check* const end = checks.data() + tc.check_end;
+    const Tokens* const m = marking.data();
+    for (; c != end; ++c) {
+      const Tokens tokens = m[c->place];
+      if (tokens < c->lo || tokens > c->hi) return false;
     }
-    const Guard* g = guard[t];
-    if (g == nullptr) return true;
-    return g->evaluate(std::span<const Value* const>(slots.data() + slot_begin[t], slot_begin[t + 1] - slot_begin[t]));
+    if (tc.guard == nullptr) return true;
+    return tc.guard->evaluate(
+        std::span<const Value* const>(slots.data() + slot_begin[t], slot_begin[t + 1] - slot_begin[t]));
   }
 
   void disable(TransitionIndex t) noexcept {
-    if (enabled[t] == 0) return;
-    enabled[t] = 0;
-    switch (kind[t]) {
-      case Kind::immediate: ready.erase(rank[t]); break;
+    TransitionCode& tc = code[t];
+    if (!tc.enabled) return;
+    tc.enabled = false;
+    switch (tc.kind) {
+      case Kind::immediate: ready.erase(tc.rank); break;
       case Kind::delayed:
         if (timers.contains(t)) {
           timers.remove(t);
         } else {
-          ready.erase(rank[t]);
+          ready.erase(tc.rank);
         }
         break;
       case Kind::event: event_enabled[event_of[t]].erase(listener_pos[t]); break;
     }
   }
 
+  void enable(TransitionIndex t) noexcept {
+    TransitionCode& tc = code[t];
+    tc.enabled = true;
+    since[t] = now;
+    switch (tc.kind) {
+      case Kind::immediate: ready.insert(tc.rank); break;
+      case Kind::delayed: timers.push(t, now + delay[t], tc.rank); break;
+      case Kind::event: event_enabled[event_of[t]].insert(listener_pos[t]); break;
+    }
+  }
+
   void update(TransitionIndex t) noexcept {
     const bool en = check(t);
-    if (en == (enabled[t] != 0)) return;
-    if (!en) {
+    if (en == code[t].enabled) return;
+    if (en) {
+      enable(t);
+    } else {
       disable(t);
-      return;
     }
-    enabled[t] = 1;
+  }
+
+  // A transition that fired and is still enabled: immediate and event transitions stay where
+  // they are; a delayed one (it fired from the ready set) waits for its delay again.
+  void restart(TransitionIndex t) noexcept {
     since[t] = now;
-    switch (kind[t]) {
-      case Kind::immediate: ready.insert(rank[t]); break;
-      case Kind::delayed: timers.push(t, now + delay[t], rank[t]); break;
-      case Kind::event: event_enabled[event_of[t]].insert(listener_pos[t]); break;
+    const TransitionCode& tc = code[t];
+    if (tc.kind == Kind::delayed) {
+      ready.erase(tc.rank);
+      timers.push(t, now + delay[t], tc.rank);
     }
   }
 
   // Returns false when the livelock budget is exhausted (nothing fired then).
   bool fire(TransitionIndex t, std::string_view event) {
-    if (instant_firings == options.max_firings_per_instant) {
+    if (instant_firings == options.max_firings_per_instant) [[unlikely]] {
       report_livelock();
       return false;
     }
-    tail[instant_firings % tail.size()] = t;
+    tail[instant_firings & tail_mask] = t;
     ++instant_firings;
     ++result.firings;
-    const std::uint32_t begin = change_begin[t];
-    const std::uint32_t end = change_begin[t + 1];
-    for (std::uint32_t i = begin; i < end; ++i) {
-      const PlaceChange& c = changes[i];
-      marking[c.place] = marking[c.place] - c.consumed + c.produced;
-      if (bound[c.place] != 0 && touched[c.place] == 0) {
-        touched[c.place] = 1;
-        touched_list.push_back(c.place);
+    const std::uint32_t begin = code[t].change_begin;
+    const std::uint32_t end = code[t].change_end;
+    const PlaceChange* const first = changes.data() + begin;
+    const PlaceChange* const last = changes.data() + end;
+    for (const PlaceChange* c = first; c != last; ++c) {
+      marking[c->place] = marking[c->place] - c->consumed + c->produced;
+      if (place_flags[c->place] == PlaceFlags::bound) [[unlikely]] touch(c->place);
+    }
+    // Enabling is a conjunction of one bound per place (and the guard, which a firing does not
+    // change). An enabled watcher of a changed place therefore stays enabled exactly while that
+    // place's bound holds; a disabled one can only become enabled if that bound now holds, and
+    // then the whole check decides. Every flag is exact once all changed places are seen.
+    for (const PlaceChange* c = first; c != last; ++c) {
+      if (c->consumed == c->produced) continue;
+      const Tokens m = marking[c->place];
+      const Watch* w = watchers.data() + watch_begin[c->place];
+      const Watch* const we = watchers.data() + watch_begin[c->place + 1];
+      for (; w != we; ++w) {
+        const bool holds = m >= w->lo && m <= w->hi;
+        if (code[w->transition].enabled) {
+          if (!holds) disable(w->transition);
+        } else if (holds && check(w->transition)) {
+          enable(w->transition);
+        }
       }
     }
     // The fired transition starts a new enabling (its delay counts again) if it stays enabled.
-    disable(t);
-    for (std::uint32_t i = begin; i < end; ++i) {
-      const PlaceChange& c = changes[i];
-      if (c.consumed == c.produced) continue;
-      for (std::uint32_t w = watch_begin[c.place], we = watch_begin[c.place + 1]; w < we; ++w) update(watchers[w]);
-    }
-    update(t);
+    if (code[t].enabled) restart(t);
 
-    if (log->should_log(spdlog::level::debug)) {
+    if (debug_log || !observers.empty()) [[unlikely]] report_firing(t, event);
+    return true;
+  }
+
+  [[gnu::noinline]] void touch(PlaceIndex p) {
+    place_flags[p] = PlaceFlags::bound_touched;
+    touched_list.push_back(p);
+  }
+
+  [[gnu::noinline]] void report_firing(TransitionIndex t, std::string_view event) {
+    if (debug_log) {
       log->debug("{}: fire {} at {:.6f} s{}{}", net.id, net.transition(t).id, to_seconds(now),
                  event.empty() ? "" : " on event ", event);
     }
-    if (!observers.empty()) {
-      const Firing f{now, t, net.transitions()[t].id, event,
-                     std::span<const PlaceChange>(changes.data() + begin, end - begin), marking};
-      for (EngineObserver* o : observers) o->notify(f);
-    }
-    return true;
+    const TransitionCode& tc = code[t];
+    const Firing f{now, t, net.transitions()[t].id, event,
+                   std::span<const PlaceChange>(changes.data() + tc.change_begin, tc.change_end - tc.change_begin),
+                   marking};
+    for (EngineObserver* o : observers) o->notify(f);
   }
 
   bool settle() {
@@ -375,7 +446,7 @@ struct Engine::Impl {
         now = due;
         instant_firings = 0;
       }
-      while (!timers.empty() && timers.top().deadline <= now) ready.insert(rank[timers.pop()]);
+      while (!timers.empty() && timers.top().deadline <= now) ready.insert(code[timers.pop()].rank);
       if (!settle()) return false;
     }
     if (to > now) {
@@ -417,10 +488,11 @@ struct Engine::Impl {
     result.loop.clear();
     result.error.clear();
     instant_firings = 0;
+    debug_log = log->should_log(spdlog::level::debug);
   }
   void finish_step() {
     for (const PlaceIndex p : touched_list) {
-      touched[p] = 0;
+      place_flags[p] = PlaceFlags::bound;
       const std::uint8_t active = marking[p] > 0 ? 1 : 0;
       if (active == reported_active[p]) continue;
       reported_active[p] = active;
@@ -462,20 +534,17 @@ void Engine::Impl::compile_structure() {
   const std::size_t np = places.size();
   const std::size_t nt = transitions.size();
 
-  kind.resize(nt);
+  code.assign(nt, TransitionCode{});
   delay.resize(nt);
   event_of.assign(nt, kNone);
-  check_begin.assign(1, 0);
-  change_begin.assign(1, 0);
-  guard.assign(nt, nullptr);
 
-  std::vector<std::vector<TransitionIndex>> place_watchers(np);
+  std::vector<std::vector<Watch>> place_watchers(np);
   std::vector<std::vector<TransitionIndex>> event_listeners;
   for (TransitionIndex t = 0; t < nt; ++t) {
     const Transition& tr = transitions[t];
     delay[t] = tr.delay;
     if (!tr.event.empty()) {
-      kind[t] = Kind::event;
+      code[t].kind = Kind::event;
       auto [it, inserted] = event_ids.try_emplace(tr.event, static_cast<EventId>(event_names.size()));
       if (inserted) {
         event_names.push_back(tr.event);
@@ -484,9 +553,9 @@ void Engine::Impl::compile_structure() {
       event_of[t] = it->second;
       event_listeners[it->second].push_back(t);
     } else {
-      kind[t] = tr.delay.count() > 0 ? Kind::delayed : Kind::immediate;
+      code[t].kind = tr.delay.count() > 0 ? Kind::delayed : Kind::immediate;
     }
-    if (tr.guard) guard[t] = &*tr.guard;
+    if (tr.guard) code[t].guard = &*tr.guard;
 
     // Per touched place: tokens consumed and produced, and the folded enabling bounds.
     std::map<PlaceIndex, PlaceChange> delta;
@@ -522,13 +591,15 @@ void Engine::Impl::compile_structure() {
     }
     for (const ArcRef& a : tr.reads) bound_of(a.place).lo = std::max(bound_of(a.place).lo, a.weight);
     for (const ArcRef& a : tr.inhibitors) bound_of(a.place).hi = std::min(bound_of(a.place).hi, a.weight - 1);
+    code[t].check_begin = static_cast<std::uint32_t>(checks.size());
     for (const auto& [p, c] : bounds) {
       checks.push_back(c);
-      place_watchers[p].push_back(t);
+      place_watchers[p].push_back(Watch{t, c.lo, c.hi});
     }
+    code[t].change_begin = static_cast<std::uint32_t>(changes.size());
     for (const auto& [p, d] : delta) changes.push_back(d);
-    check_begin.push_back(static_cast<std::uint32_t>(checks.size()));
-    change_begin.push_back(static_cast<std::uint32_t>(changes.size()));
+    code[t].check_end = static_cast<std::uint32_t>(checks.size());
+    code[t].change_end = static_cast<std::uint32_t>(changes.size());
   }
 
   // Conflict order: priority descending, then declaration order.
@@ -537,8 +608,7 @@ void Engine::Impl::compile_structure() {
   std::stable_sort(order.begin(), order.end(), [&](TransitionIndex a, TransitionIndex b) {
     return transitions[a].priority > transitions[b].priority;
   });
-  rank.resize(nt);
-  for (std::uint32_t r = 0; r < nt; ++r) rank[order[r]] = r;
+  for (std::uint32_t r = 0; r < nt; ++r) code[order[r]].rank = r;
 
   watch_begin.assign(1, 0);
   for (const auto& w : place_watchers) {
@@ -550,27 +620,27 @@ void Engine::Impl::compile_structure() {
   event_enabled.resize(event_listeners.size());
   for (std::size_t e = 0; e < event_listeners.size(); ++e) {
     auto& l = event_listeners[e];
-    std::stable_sort(l.begin(), l.end(), [&](TransitionIndex a, TransitionIndex b) { return rank[a] < rank[b]; });
+    std::stable_sort(l.begin(), l.end(), [&](TransitionIndex a, TransitionIndex b) { return code[a].rank < code[b].rank; });
     for (std::uint32_t i = 0; i < l.size(); ++i) listener_pos[l[i]] = i;
     listeners.insert(listeners.end(), l.begin(), l.end());
     listener_begin.push_back(static_cast<std::uint32_t>(listeners.size()));
     event_enabled[e].init(l.size());
   }
 
-  bound.assign(np, 0);
+  place_flags.assign(np, PlaceFlags::none);
   for (PlaceIndex p = 0; p < np; ++p) {
-    if (places[p].behavior || places[p].process) bound[p] = 1;
+    if (places[p].behavior || places[p].process) place_flags[p] = PlaceFlags::bound;
     if (places[p].outcome != Outcome::none) outcome_places.push_back(p);
   }
 
   marking.assign(np, 0);
-  enabled.assign(nt, 0);
   since.assign(nt, Time{0});
   ready.init(nt);
   timers.init(nt);
-  tail.assign(std::min(kTailWindow, options.max_firings_per_instant), 0);
+  // A power-of-two ring indexes with a mask: a division per firing costs as much as the rest.
+  tail.assign(std::bit_ceil(std::min(kTailWindow, options.max_firings_per_instant)), 0);
+  tail_mask = tail.size() - 1;
   reported_active.assign(np, 0);
-  touched.assign(np, 0);
   touched_list.reserve(np);
   result.unconsumed_events.reserve(16);
   result.activated.reserve(np);
@@ -673,7 +743,7 @@ void Engine::Impl::reset(Time start) {
   marking = net.initial_marking();
   now = start;
   instant_firings = 0;
-  std::fill(enabled.begin(), enabled.end(), 0);
+  for (TransitionCode& tc : code) tc.enabled = false;
   ready.clear();
   for (auto& set : event_enabled) set.clear();
   timers.clear();
@@ -686,15 +756,17 @@ void Engine::Impl::reset(Time start) {
     }
   }
   std::fill(reported_active.begin(), reported_active.end(), 0);
-  std::fill(touched.begin(), touched.end(), 0);
+  for (PlaceFlags& f : place_flags) {
+    if (f == PlaceFlags::bound_touched) f = PlaceFlags::bound;
+  }
   touched_list.clear();
   for (PlaceIndex p = 0; p < marking.size(); ++p) {
-    if (bound[p] != 0 && marking[p] > 0) {
-      touched[p] = 1;
+    if (place_flags[p] == PlaceFlags::bound && marking[p] > 0) {
+      place_flags[p] = PlaceFlags::bound_touched;
       touched_list.push_back(p);
     }
   }
-  for (TransitionIndex t = 0; t < enabled.size(); ++t) update(t);
+  for (TransitionIndex t = 0; t < code.size(); ++t) update(t);
 }
 
 void Engine::Impl::set_fact(FactId f, Value value) {
@@ -839,7 +911,7 @@ const Value& Engine::parameter(std::string_view name) const {
 Time Engine::now() const noexcept { return impl_->now; }
 std::span<const Tokens> Engine::marking() const noexcept { return impl_->marking; }
 Tokens Engine::tokens(PlaceIndex place) const { return impl_->marking.at(place); }
-bool Engine::is_enabled(TransitionIndex t) const { return impl_->enabled.at(t) != 0; }
+bool Engine::is_enabled(TransitionIndex t) const { return impl_->code.at(t).enabled; }
 
 std::optional<Time> Engine::next_deadline() const noexcept {
   if (impl_->timers.empty()) return std::nullopt;
@@ -863,7 +935,7 @@ OutcomeState Engine::outcome() const noexcept {
 std::vector<PlaceIndex> Engine::active_bindings() const {
   std::vector<PlaceIndex> out;
   for (PlaceIndex p = 0; p < impl_->marking.size(); ++p) {
-    if (impl_->bound[p] != 0 && impl_->marking[p] > 0) out.push_back(p);
+    if (impl_->place_flags[p] != PlaceFlags::none && impl_->marking[p] > 0) out.push_back(p);
   }
   return out;
 }
