@@ -4,7 +4,7 @@
 #include <optional>
 #include <string>
 
-#include <tinyxml2.h>
+#include "xml_document.hpp"
 
 #include "net_reader.hpp"
 #include "tripodal/core/petri_net.hpp"
@@ -13,9 +13,9 @@ namespace tripodal::detail {
 
 /// Native XML (docs/net-format.md). The root element must be <net>. Returns the net even when
 /// errors were reported (the caller decides by the diagnostics).
-PetriNet read_native(const tinyxml2::XMLElement* root, const ReadContext& ctx);
+PetriNet read_native(const XmlElement* root, const ReadContext& ctx);
 /// PNML: ISO/IEC 15909-2 P/T nets (with <page>) and the JARP dialect (no <page>, <value> labels).
-PetriNet read_pnml(const tinyxml2::XMLElement* root, const ReadContext& ctx);
+PetriNet read_pnml(const XmlElement* root, const ReadContext& ctx);
 
 /// XML attribute/text escaping shared by the writers.
 std::string xml_escape(std::string_view text);

@@ -26,7 +26,7 @@ bool is_foreign_annotation(std::string_view name) {
 }
 
 struct RawArc {
-  const tinyxml2::XMLElement* e = nullptr;
+  const XmlElement* e = nullptr;
   std::string source;
   std::string target;
   Tokens weight = 1;
@@ -39,7 +39,7 @@ class PnmlReader {
  public:
   PnmlReader(const ReadContext& ctx, PetriNet& net) : ctx_(ctx), net_(net) {}
 
-  void read_net(const tinyxml2::XMLElement* e) {
+  void read_net(const XmlElement* e) {
     check_attributes(ctx_, e, {"id", "type"});
     if (auto id = required(ctx_, e, "id")) net_.id = *id;
     const auto type = optional_attr(e, "type");
@@ -47,13 +47,13 @@ class PnmlReader {
       ctx_.error(e, "missing attribute 'type' on <net>: expected a place/transition net type such as '" +
                         std::string(kIsoPtNet) + "'");
     } else if (!is_pt_net_type(*type)) {
-      ctx_.error_at_value(e, "type", "net type '" + *type +
+      ctx_.error_at_value(e, "type", "net type '" + std::string(*type) +
                                          "' is not a place/transition net; tripodal reads P/T nets only (" +
                                          std::string(kIsoPtNet) + " or JARP's PTNet)");
       return;
     }
     // The net's tripodal extension declares the parameters guards refer to: read it first.
-    for (const auto* c = e->FirstChildElement("toolspecific"); c != nullptr; c = c->NextSiblingElement("toolspecific")) {
+    for (const auto* c = e->first_child("toolspecific"); c != nullptr; c = c->next_sibling("toolspecific")) {
       if (const auto* ext = tripodal_extension(c, "net")) read_net_extension(ext);
     }
     read_container(e, true);
@@ -64,7 +64,7 @@ class PnmlReader {
  private:
   // The single child element of a tripodal toolspecific block, when it is one and its version is
   // supported; nullptr for other tools (which are allowed to say anything).
-  const tinyxml2::XMLElement* tripodal_extension(const tinyxml2::XMLElement* ts, std::string_view expected) {
+  const XmlElement* tripodal_extension(const XmlElement* ts, std::string_view expected) {
     check_attributes(ctx_, ts, {"tool", "version"});
     if (optional_attr(ts, "tool").value_or("") != kTool) return nullptr;
     const auto version = optional_attr(ts, "version");
@@ -73,13 +73,13 @@ class PnmlReader {
       return nullptr;
     }
     if (*version != kFormatVersion) {
-      ctx_.error_at_value(ts, "version", "tripodal extension version '" + *version +
+      ctx_.error_at_value(ts, "version", "tripodal extension version '" + std::string(*version) +
                                              "' is not supported: this build reads version " + std::string(kFormatVersion));
       return nullptr;
     }
-    const tinyxml2::XMLElement* found = nullptr;
-    for (const auto* c = ts->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
-      if (found != nullptr || std::string_view(c->Name()) != expected) {
+    const XmlElement* found = nullptr;
+    for (const auto* c = ts->first_child(); c != nullptr; c = c->next_sibling()) {
+      if (found != nullptr || std::string_view(c->name()) != expected) {
         unknown_element(ctx_, c, "toolspecific", expected);
         continue;
       }
@@ -89,55 +89,55 @@ class PnmlReader {
     return found;
   }
 
-  void read_net_extension(const tinyxml2::XMLElement* e) {
+  void read_net_extension(const XmlElement* e) {
     check_attributes(ctx_, e, {"level", "description"});
     check_no_text(ctx_, e);
     net_.description = optional_attr(e, "description").value_or("");
     if (auto level = optional_attr(e, "level")) {
       if (*level == "high") net_.level = NetLevel::high;
       else if (*level == "low") net_.level = NetLevel::low;
-      else ctx_.error_at_value(e, "level", "unknown level '" + *level + "': expected low or high");
+      else ctx_.error_at_value(e, "level", "unknown level '" + std::string(*level) + "': expected low or high");
     }
-    for (const auto* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
-      const std::string_view n = c->Name();
+    for (const auto* c = e->first_child(); c != nullptr; c = c->next_sibling()) {
+      const std::string_view n = c->name();
       if (n == "parameter" || n == "fact") read_declaration(ctx_, c, net_, n == "fact");
       else unknown_element(ctx_, c, "net", "parameter, fact");
     }
   }
 
   // A label's value: <text> (ISO) or <value> (JARP).
-  std::optional<std::pair<std::string, const tinyxml2::XMLElement*>> label_value(const tinyxml2::XMLElement* label) {
-    const tinyxml2::XMLElement* value = nullptr;
-    for (const auto* c = label->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
-      const std::string_view n = c->Name();
+  std::optional<std::pair<std::string, const XmlElement*>> label_value(const XmlElement* label) {
+    const XmlElement* value = nullptr;
+    for (const auto* c = label->first_child(); c != nullptr; c = c->next_sibling()) {
+      const std::string_view n = c->name();
       if (n == "text" || n == "value") {
-        if (value != nullptr) ctx_.error(c, "label <" + std::string(label->Name()) + "> has more than one value");
+        if (value != nullptr) ctx_.error(c, "label <" + std::string(label->name()) + "> has more than one value");
         value = c;
       } else if (n != "graphics" && n != "toolspecific") {
-        unknown_element(ctx_, c, label->Name(), "text, value, graphics, toolspecific");
+        unknown_element(ctx_, c, label->name(), "text, value, graphics, toolspecific");
       }
     }
     if (value == nullptr) {
-      ctx_.error(label, "label <" + std::string(label->Name()) + "> has no <text> (or JARP <value>)");
+      ctx_.error(label, "label <" + std::string(label->name()) + "> has no <text> (or JARP <value>)");
       return std::nullopt;
     }
     return std::make_pair(trimmed_text(value), value);
   }
 
-  std::optional<std::string> claim_id(const tinyxml2::XMLElement* e) {
+  std::optional<std::string> claim_id(const XmlElement* e) {
     auto id = required(ctx_, e, "id");
     if (!id) return std::nullopt;
     const auto [it, inserted] = ids_.emplace(*id, ctx_.loc.element(e));
     if (!inserted) {
-      ctx_.error_at_value(e, "id", "duplicate id '" + *id + "' (first defined at " + it->second.str() + ")");
+      ctx_.error_at_value(e, "id", "duplicate id '" + std::string(*id) + "' (first defined at " + it->second.str() + ")");
       return std::nullopt;
     }
-    return id;
+    return std::string(*id);
   }
 
-  void read_container(const tinyxml2::XMLElement* e, bool is_net) {
-    for (const auto* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
-      const std::string_view n = c->Name();
+  void read_container(const XmlElement* e, bool is_net) {
+    for (const auto* c = e->first_child(); c != nullptr; c = c->next_sibling()) {
+      const std::string_view n = c->name();
       if (n == "place") read_place(c);
       else if (n == "transition") read_transition(c);
       else if (n == "arc") read_arc(c);
@@ -159,25 +159,25 @@ class PnmlReader {
       } else if (is_foreign_annotation(n)) {
         ctx_.error(c, "<" + std::string(n) + "> belongs to colored/high-level nets, which tripodal cannot represent");
       } else {
-        unknown_element(ctx_, c, e->Name(), "page, place, transition, arc, name, graphics, toolspecific");
+        unknown_element(ctx_, c, e->name(), "page, place, transition, arc, name, graphics, toolspecific");
       }
     }
   }
 
-  void read_place(const tinyxml2::XMLElement* e) {
+  void read_place(const XmlElement* e) {
     check_attributes(ctx_, e, {"id"});
     Place p;
     const auto id = claim_id(e);
     p.id = id.value_or("");
     p.where = ctx_.loc.element(e);
-    const tinyxml2::XMLElement* ext = nullptr;
-    for (const auto* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
-      const std::string_view n = c->Name();
+    const XmlElement* ext = nullptr;
+    for (const auto* c = e->first_child(); c != nullptr; c = c->next_sibling()) {
+      const std::string_view n = c->name();
       if (n == "name") {
         if (auto v = label_value(c)) p.name = v->first;
       } else if (n == "initialMarking") {
         if (auto v = label_value(c)) {
-          if (auto tokens = parse_count(ctx_, ctx_.loc.element(v->second), v->first, 0, "token count")) {
+          if (auto tokens = parse_count(ctx_, v->second, "", v->first, 0, "token count")) {
             p.initial_tokens = *tokens;
           }
         }
@@ -196,14 +196,14 @@ class PnmlReader {
     if (id) net_.add_place(std::move(p));
   }
 
-  void read_transition(const tinyxml2::XMLElement* e) {
+  void read_transition(const XmlElement* e) {
     check_attributes(ctx_, e, {"id"});
     Transition t;
     const auto id = claim_id(e);
     t.id = id.value_or("");
     t.where = ctx_.loc.element(e);
-    for (const auto* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
-      const std::string_view n = c->Name();
+    for (const auto* c = e->first_child(); c != nullptr; c = c->next_sibling()) {
+      const std::string_view n = c->name();
       if (n == "name") {
         if (auto v = label_value(c)) t.name = v->first;
       } else if (n == "toolspecific") {
@@ -221,18 +221,18 @@ class PnmlReader {
   }
 
   // "normal" / "inhibitor" / "read" / "test"; nullopt (after an error) for anything else.
-  std::optional<ArcKind> arc_type(const tinyxml2::XMLElement* where, std::string_view attr, const std::string& text) {
+  std::optional<ArcKind> arc_type(const XmlElement* where, std::string_view attr, std::string_view text) {
     if (text == "normal") return ArcKind::normal;
     if (text == "inhibitor") return ArcKind::inhibitor;
     if (text == "read" || text == "test") return ArcKind::read;
-    const std::string message = "unknown arc type '" + text +
+    const std::string message = "unknown arc type '" + std::string(text) +
                                 "': tripodal represents normal, inhibitor and read (test) arcs only";
     if (attr.empty()) ctx_.error(where, message);
     else ctx_.error_at_value(where, attr, message);
     return std::nullopt;
   }
 
-  void read_arc(const tinyxml2::XMLElement* e) {
+  void read_arc(const XmlElement* e) {
     check_attributes(ctx_, e, {"id", "source", "target", "type"});
     RawArc arc;
     arc.e = e;
@@ -245,11 +245,11 @@ class PnmlReader {
       ok = ok && kind;
       if (kind) arc.kind = *kind;
     }
-    for (const auto* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
-      const std::string_view n = c->Name();
+    for (const auto* c = e->first_child(); c != nullptr; c = c->next_sibling()) {
+      const std::string_view n = c->name();
       if (n == "inscription") {
         if (auto v = label_value(c)) {
-          const auto w = parse_count(ctx_, ctx_.loc.element(v->second), v->first, 1, "weight");
+          const auto w = parse_count(ctx_, v->second, "", v->first, 1, "weight");
           ok = ok && w;
           if (w) arc.weight = *w;
         } else {
@@ -257,7 +257,8 @@ class PnmlReader {
         }
       } else if (n == "type") {
         // <type><text>inhibitor</text></type> and PIPE's <type value="inhibitor"/>.
-        std::optional<std::string> text = optional_attr(c, "value");
+        std::optional<std::string> text;
+        if (const auto value = optional_attr(c, "value")) text = std::string(*value);
         if (!text) {
           if (auto v = label_value(c)) text = v->first;
         }
@@ -267,9 +268,9 @@ class PnmlReader {
       } else if (n == "toolspecific") {
         if (const auto* x = tripodal_extension(c, "arc")) {
           check_attributes(ctx_, x, {"kind"});
-          const auto kind = optional_attr(x, "kind").value_or("");
+          const std::string_view kind = optional_attr(x, "kind").value_or("");
           if (kind == "read") arc.tripodal_read = true;
-          else ctx_.error_at_value(x, "kind", "unknown tripodal arc kind '" + kind + "': expected read");
+          else ctx_.error_at_value(x, "kind", "unknown tripodal arc kind '" + std::string(kind) + "': expected read");
         }
       } else if (n == "graphics") {
       } else if (is_foreign_annotation(n)) {
@@ -362,13 +363,13 @@ std::string toolspecific(const std::string& indent, const std::string& body) {
 
 }  // namespace
 
-PetriNet read_pnml(const tinyxml2::XMLElement* root, const ReadContext& ctx) {
+PetriNet read_pnml(const XmlElement* root, const ReadContext& ctx) {
   PetriNet net;
   net.where = ctx.loc.element(root);
   check_attributes(ctx, root, {"xmlns"});
-  const tinyxml2::XMLElement* net_element = nullptr;
-  for (const auto* c = root->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
-    if (std::string_view(c->Name()) != "net") {
+  const XmlElement* net_element = nullptr;
+  for (const auto* c = root->first_child(); c != nullptr; c = c->next_sibling()) {
+    if (std::string_view(c->name()) != "net") {
       unknown_element(ctx, c, "pnml", "net");
     } else if (net_element != nullptr) {
       ctx.error(c, "a second <net>: tripodal reads one net per file");

@@ -51,7 +51,7 @@ std::size_t find_identifier(std::string_view text, std::string_view word) {
 
 std::string type_name(ValueType t) { return std::string(to_string(t)); }
 
-void read_guard(const ReadContext& ctx, const tinyxml2::XMLElement* e, Transition& t, const PetriNet& net,
+void read_guard(const ReadContext& ctx, const XmlElement* e, Transition& t, const PetriNet& net,
                 const std::string& text) {
   try {
     Guard g = Guard::parse(text);
@@ -83,12 +83,12 @@ void read_guard(const ReadContext& ctx, const tinyxml2::XMLElement* e, Transitio
   }
 }
 
-void read_binding_params(const ReadContext& ctx, const tinyxml2::XMLElement* e, std::vector<BindingParam>& params,
+void read_binding_params(const ReadContext& ctx, const XmlElement* e, std::vector<BindingParam>& params,
                          const PetriNet& net, std::string_view owner) {
   std::set<std::string, std::less<>> seen;
-  for (const auto* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
-    if (std::string_view(c->Name()) != "param") {
-      unknown_element(ctx, c, e->Name(), "param");
+  for (const auto* c = e->first_child(); c != nullptr; c = c->next_sibling()) {
+    if (std::string_view(c->name()) != "param") {
+      unknown_element(ctx, c, e->name(), "param");
       continue;
     }
     check_attributes(ctx, c, {"name", "value"});
@@ -99,40 +99,40 @@ void read_binding_params(const ReadContext& ctx, const tinyxml2::XMLElement* e, 
       ctx.error(c, "missing attribute 'value' on <param>");
     }
     if (!name || !value) continue;
-    if (!seen.insert(*name).second) {
-      ctx.error_at_value(c, "name", "duplicate parameter '" + *name + "' for " + std::string(owner));
+    if (!seen.emplace(*name).second) {
+      ctx.error_at_value(c, "name", "duplicate parameter '" + std::string(*name) + "' for " + std::string(owner));
       continue;
     }
     if (!value->empty() && (*value)[0] == '$') {
-      const std::string ref = value->substr(1);
+      const std::string ref(value->substr(1));
       if (net.find_parameter(ref) == nullptr) {
         ctx.error_at_value(c, "value", "unknown parameter '$" + ref + "' passed to " + std::string(owner) +
                                            " (declared parameters: " + join_names(net.parameters) + ")");
         continue;
       }
     }
-    params.push_back(BindingParam{*name, *value, ctx.loc.element(c)});
+    params.push_back(BindingParam{std::string(*name), std::string(*value), ctx.loc.element(c)});
   }
 }
 
 }  // namespace
 
-void ReadContext::error(const tinyxml2::XMLElement* e, const std::string& message) const {
+void ReadContext::error(const XmlElement* e, const std::string& message) const {
   diags.error(loc.element(e), message);
 }
-void ReadContext::error_at_attribute(const tinyxml2::XMLElement* e, std::string_view attr,
+void ReadContext::error_at_attribute(const XmlElement* e, std::string_view attr,
                                      const std::string& message) const {
   diags.error(loc.attribute(e, attr), message);
 }
-void ReadContext::error_at_value(const tinyxml2::XMLElement* e, std::string_view attr, const std::string& message,
+void ReadContext::error_at_value(const XmlElement* e, std::string_view attr, const std::string& message,
                                  std::size_t decoded_offset) const {
   diags.error(loc.attribute_value(e, attr, decoded_offset), message);
 }
 
-void check_attributes(const ReadContext& ctx, const tinyxml2::XMLElement* e,
+void check_attributes(const ReadContext& ctx, const XmlElement* e,
                       std::initializer_list<std::string_view> allowed) {
-  for (const auto* a = e->FirstAttribute(); a != nullptr; a = a->Next()) {
-    const std::string_view name = a->Name();
+  for (const XmlAttribute& a : e->attributes()) {
+    const std::string_view name = a.name;
     if (std::find(allowed.begin(), allowed.end(), name) != allowed.end()) continue;
     std::string list;
     for (const auto& s : allowed) {
@@ -140,54 +140,44 @@ void check_attributes(const ReadContext& ctx, const tinyxml2::XMLElement* e,
       list += s;
     }
     ctx.error_at_attribute(e, name,
-                           "unknown attribute '" + std::string(name) + "' on <" + e->Name() + ">; expected one of: " + list);
+                           "unknown attribute '" + std::string(name) + "' on <" + std::string(e->name()) +
+                               ">; expected one of: " + list);
   }
 }
 
-void unknown_element(const ReadContext& ctx, const tinyxml2::XMLElement* e, std::string_view parent,
+void unknown_element(const ReadContext& ctx, const XmlElement* e, std::string_view parent,
                      std::string_view expected) {
-  ctx.error(e, "unknown element <" + std::string(e->Name()) + "> in <" + std::string(parent) +
+  ctx.error(e, "unknown element <" + std::string(e->name()) + "> in <" + std::string(parent) +
                    ">; expected " + (expected.empty() ? std::string("no child elements") : "one of: " + std::string(expected)));
 }
 
-void check_no_text(const ReadContext& ctx, const tinyxml2::XMLElement* e) {
-  if (!trimmed_text(e).empty()) {
-    ctx.error(e, "unexpected text in <" + std::string(e->Name()) + ">; values are written as attributes");
+void check_no_text(const ReadContext& ctx, const XmlElement* e) {
+  if (!e->text().empty()) {
+    ctx.error(e, "unexpected text in <" + std::string(e->name()) + ">; values are written as attributes");
   }
 }
 
-std::string trimmed_text(const tinyxml2::XMLElement* e) {
-  std::string out;
-  for (const auto* n = e->FirstChild(); n != nullptr; n = n->NextSibling()) {
-    if (const auto* t = n->ToText()) out += t->Value();
-  }
-  const auto first = out.find_first_not_of(" \t\r\n");
-  if (first == std::string::npos) return {};
-  const auto last = out.find_last_not_of(" \t\r\n");
-  return out.substr(first, last - first + 1);
+std::string trimmed_text(const XmlElement* e) { return std::string(e->text()); }
+
+std::optional<std::string_view> optional_attr(const XmlElement* e, std::string_view attr) {
+  return e->attribute(attr);
 }
 
-std::optional<std::string> optional_attr(const tinyxml2::XMLElement* e, std::string_view attr) {
-  const char* v = e->Attribute(std::string(attr).c_str());
-  if (v == nullptr) return std::nullopt;
-  return std::string(v);
-}
-
-std::optional<std::string> required(const ReadContext& ctx, const tinyxml2::XMLElement* e, std::string_view attr) {
-  auto v = optional_attr(e, attr);
+std::optional<std::string_view> required(const ReadContext& ctx, const XmlElement* e, std::string_view attr) {
+  auto v = e->attribute(attr);
   if (!v) {
-    ctx.error(e, "missing attribute '" + std::string(attr) + "' on <" + e->Name() + ">");
+    ctx.error(e, "missing attribute '" + std::string(attr) + "' on <" + std::string(e->name()) + ">");
     return std::nullopt;
   }
   if (v->empty()) {
-    ctx.error_at_attribute(e, attr, "empty attribute '" + std::string(attr) + "' on <" + e->Name() + ">");
+    ctx.error_at_attribute(e, attr, "empty attribute '" + std::string(attr) + "' on <" + std::string(e->name()) + ">");
     return std::nullopt;
   }
   return v;
 }
 
-std::optional<Tokens> parse_count(const ReadContext& ctx, const SourceLocation& where, std::string_view text,
-                                  Tokens minimum, std::string_view what) {
+std::optional<Tokens> parse_count(const ReadContext& ctx, const XmlElement* e, std::string_view attr,
+                                  std::string_view text, Tokens minimum, std::string_view what) {
   std::uint64_t v = 0;
   const bool digits = !text.empty() && std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
   const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
@@ -196,7 +186,9 @@ std::optional<Tokens> parse_count(const ReadContext& ctx, const SourceLocation& 
   if (!ok) {
     const std::string expected = minimum == 0 ? "a whole number >= 0" : "a whole number >= " + std::to_string(minimum);
     const bool non_positive = minimum > 0 && (text == "0" || (!text.empty() && text[0] == '-'));
-    ctx.diags.error(where, std::string(non_positive ? "non-positive " : "bad ") + std::string(what) + " '" +
+    // Located only now: a valid count costs no line lookup.
+    ctx.diags.error(attr.empty() ? ctx.loc.element(e) : ctx.loc.attribute_value(e, attr),
+                    std::string(non_positive ? "non-positive " : "bad ") + std::string(what) + " '" +
                                std::string(text) + "': expected " + expected);
     return std::nullopt;
   }
@@ -250,26 +242,26 @@ bool is_valid_name(std::string_view name) noexcept {
   });
 }
 
-void read_declaration(const ReadContext& ctx, const tinyxml2::XMLElement* e, PetriNet& net, bool fact) {
+void read_declaration(const ReadContext& ctx, const XmlElement* e, PetriNet& net, bool fact) {
   check_attributes(ctx, e, {"name", "type", "default", "description"});
   check_no_text(ctx, e);
-  for (const auto* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
-    unknown_element(ctx, c, e->Name(), "");
+  for (const auto* c = e->first_child(); c != nullptr; c = c->next_sibling()) {
+    unknown_element(ctx, c, e->name(), "");
   }
   const auto name = required(ctx, e, "name");
   const auto type_text = required(ctx, e, "type");
   if (name && !is_valid_name(*name)) {
-    ctx.error_at_value(e, "name", "bad name '" + *name + "': expected a letter or '_' then letters, digits, '_', '.', '-', '/'");
+    ctx.error_at_value(e, "name", "bad name '" + std::string(*name) + "': expected a letter or '_' then letters, digits, '_', '.', '-', '/'");
     return;
   }
   std::optional<ValueType> type;
   if (type_text) {
     type = parse_value_type(*type_text);
-    if (!type) ctx.error_at_value(e, "type", "unknown type '" + *type_text + "': expected boolean, number or string");
+    if (!type) ctx.error_at_value(e, "type", "unknown type '" + std::string(*type_text) + "': expected boolean, number or string");
   }
   if (!name || !type) return;
   if (net.find_parameter(*name) != nullptr || net.find_fact(*name) != nullptr) {
-    ctx.error_at_value(e, "name", "duplicate declaration of '" + *name + "'");
+    ctx.error_at_value(e, "name", "duplicate declaration of '" + std::string(*name) + "'");
     return;
   }
   VariableDecl d;
@@ -280,20 +272,20 @@ void read_declaration(const ReadContext& ctx, const tinyxml2::XMLElement* e, Pet
   if (const auto def = optional_attr(e, "default")) {
     d.default_value = parse_value(*type, *def);
     if (!d.default_value) {
-      ctx.error_at_value(e, "default", "default '" + *def + "' of '" + *name + "' is not a " + type_name(*type));
+      ctx.error_at_value(e, "default", "default '" + std::string(*def) + "' of '" + std::string(*name) + "' is not a " + type_name(*type));
       return;
     }
   }
   (fact ? net.facts : net.parameters).push_back(std::move(d));
 }
 
-void read_place_details(const ReadContext& ctx, const tinyxml2::XMLElement* e, Place& place, const PetriNet& net,
+void read_place_details(const ReadContext& ctx, const XmlElement* e, Place& place, const PetriNet& net,
                         bool allow_tokens_and_name) {
   if (allow_tokens_and_name) {
     check_attributes(ctx, e, {"id", "name", "description", "tokens", "capacity", "outcome", "message"});
     if (auto n = optional_attr(e, "name")) place.name = *n;
     if (auto t = optional_attr(e, "tokens")) {
-      if (auto v = parse_count(ctx, ctx.loc.attribute_value(e, "tokens"), *t, 0, "token count")) place.initial_tokens = *v;
+      if (auto v = parse_count(ctx, e, "tokens", *t, 0, "token count")) place.initial_tokens = *v;
     }
   } else {
     check_attributes(ctx, e, {"description", "capacity", "outcome", "message"});
@@ -301,7 +293,7 @@ void read_place_details(const ReadContext& ctx, const tinyxml2::XMLElement* e, P
   check_no_text(ctx, e);
   if (auto d = optional_attr(e, "description")) place.description = *d;
   if (auto c = optional_attr(e, "capacity")) {
-    if (auto v = parse_count(ctx, ctx.loc.attribute_value(e, "capacity"), *c, 1, "capacity")) {
+    if (auto v = parse_count(ctx, e, "capacity", *c, 1, "capacity")) {
       place.capacity = *v;
       if (place.initial_tokens > *v) {
         ctx.error_at_value(e, "capacity", "place '" + place.id + "' starts with " + std::to_string(place.initial_tokens) +
@@ -314,7 +306,7 @@ void read_place_details(const ReadContext& ctx, const tinyxml2::XMLElement* e, P
     if (*o == "success") place.outcome = Outcome::success;
     else if (*o == "fault") place.outcome = Outcome::fault;
     else if (*o == "none") place.outcome = Outcome::none;
-    else ctx.error_at_value(e, "outcome", "unknown outcome '" + *o + "': expected success or fault");
+    else ctx.error_at_value(e, "outcome", "unknown outcome '" + std::string(*o) + "': expected success or fault");
   }
   if (auto m = optional_attr(e, "message")) {
     if (place.outcome != Outcome::fault) {
@@ -323,10 +315,10 @@ void read_place_details(const ReadContext& ctx, const tinyxml2::XMLElement* e, P
       place.fault_message = *m;
     }
   }
-  for (const auto* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
-    const std::string_view kind = c->Name();
+  for (const auto* c = e->first_child(); c != nullptr; c = c->next_sibling()) {
+    const std::string_view kind = c->name();
     if (kind != "behavior" && kind != "process") {
-      unknown_element(ctx, c, e->Name(), "behavior, process");
+      unknown_element(ctx, c, e->name(), "behavior, process");
       continue;
     }
     check_attributes(ctx, c, {"name"});
@@ -334,7 +326,7 @@ void read_place_details(const ReadContext& ctx, const tinyxml2::XMLElement* e, P
     const auto name = required(ctx, c, "name");
     if (!name) continue;
     if (!is_valid_name(*name)) {
-      ctx.error_at_value(c, "name", "bad " + std::string(kind) + " name '" + *name + "'");
+      ctx.error_at_value(c, "name", "bad " + std::string(kind) + " name '" + std::string(*name) + "'");
       continue;
     }
     if (place.behavior || place.process) {
@@ -345,16 +337,16 @@ void read_place_details(const ReadContext& ctx, const tinyxml2::XMLElement* e, P
     const bool behavior = kind == "behavior";
     const auto& known = behavior ? ctx.options.is_known_behavior : ctx.options.is_known_process;
     if (known && !known(*name)) {
-      ctx.error_at_value(c, "name", "unknown " + std::string(kind) + " '" + *name + "'");
+      ctx.error_at_value(c, "name", "unknown " + std::string(kind) + " '" + std::string(*name) + "'");
     }
     std::vector<BindingParam> params;
-    read_binding_params(ctx, c, params, net, std::string(kind) + " " + *name);
-    if (behavior) place.behavior = BehaviorBinding{*name, std::move(params)};
-    else place.process = ProcessRef{*name, std::move(params)};
+    read_binding_params(ctx, c, params, net, std::string(kind) + " " + std::string(*name));
+    if (behavior) place.behavior = BehaviorBinding{std::string(*name), std::move(params)};
+    else place.process = ProcessRef{std::string(*name), std::move(params)};
   }
 }
 
-void read_transition_details(const ReadContext& ctx, const tinyxml2::XMLElement* e, Transition& t, const PetriNet& net,
+void read_transition_details(const ReadContext& ctx, const XmlElement* e, Transition& t, const PetriNet& net,
                              bool allow_name) {
   if (allow_name) {
     check_attributes(ctx, e, {"id", "name", "description", "event", "guard", "delay", "priority"});
@@ -363,19 +355,19 @@ void read_transition_details(const ReadContext& ctx, const tinyxml2::XMLElement*
     check_attributes(ctx, e, {"description", "event", "guard", "delay", "priority"});
   }
   check_no_text(ctx, e);
-  for (const auto* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
-    unknown_element(ctx, c, e->Name(), "");
+  for (const auto* c = e->first_child(); c != nullptr; c = c->next_sibling()) {
+    unknown_element(ctx, c, e->name(), "");
   }
   if (auto d = optional_attr(e, "description")) t.description = *d;
   if (auto ev = optional_attr(e, "event")) {
     if (!is_valid_name(*ev)) {
-      ctx.error_at_value(e, "event", "bad event name '" + *ev +
+      ctx.error_at_value(e, "event", "bad event name '" + std::string(*ev) +
                                          "': expected a letter or '_' then letters, digits, '_', '.', '-', '/'");
     } else {
       t.event = *ev;
     }
   }
-  if (auto g = optional_attr(e, "guard")) read_guard(ctx, e, t, net, *g);
+  if (auto g = optional_attr(e, "guard")) read_guard(ctx, e, t, net, std::string(*g));
   if (auto d = optional_attr(e, "delay")) {
     std::string err;
     if (auto v = parse_delay_text(*d, err)) t.delay = *v;
@@ -385,7 +377,7 @@ void read_transition_details(const ReadContext& ctx, const tinyxml2::XMLElement*
     int v = 0;
     const auto [ptr, ec] = std::from_chars(p->data(), p->data() + p->size(), v);
     if (p->empty() || ec != std::errc() || ptr != p->data() + p->size()) {
-      ctx.error_at_value(e, "priority", "bad priority '" + *p + "': expected an integer");
+      ctx.error_at_value(e, "priority", "bad priority '" + std::string(*p) + "': expected an integer");
     } else {
       t.priority = v;
     }
@@ -408,8 +400,8 @@ std::string_view to_string(ArcKind kind) noexcept {
   return "normal";
 }
 
-bool add_checked_arc(const ReadContext& ctx, const tinyxml2::XMLElement* e, PetriNet& net, const std::string& from,
-                     const std::string& to, Tokens weight, ArcKind kind) {
+bool add_checked_arc(const ReadContext& ctx, const XmlElement* e, PetriNet& net, std::string_view from,
+                     std::string_view to, Tokens weight, ArcKind kind) {
   // The common case costs the net's own look-ups only; the diagnosis below runs after a refusal.
   try {
     net.add_arc(from, to, weight, kind, ctx.loc.element(e));
@@ -422,29 +414,30 @@ bool add_checked_arc(const ReadContext& ctx, const tinyxml2::XMLElement* e, Petr
   const auto tt = net.find_transition(to);
   bool ok = true;
   if (!fp && !ft) {
-    ctx.error_at_value(e, "source", "arc from unknown node '" + from + "'");
+    ctx.error_at_value(e, "source", "arc from unknown node '" + std::string(from) + "'");
     ok = false;
   }
   if (!tp && !tt) {
-    ctx.error_at_value(e, "target", "arc to unknown node '" + to + "'");
+    ctx.error_at_value(e, "target", "arc to unknown node '" + std::string(to) + "'");
     ok = false;
   }
   if (!ok) return false;
   if (fp && tp) {
-    ctx.error(e, "arc between two places '" + from + "' and '" + to + "': an arc connects a place and a transition");
+    ctx.error(e, "arc between two places '" + std::string(from) + "' and '" + std::string(to) +
+                     "': an arc connects a place and a transition");
     return false;
   }
   if (ft && tt) {
-    ctx.error(e, "arc between two transitions '" + from + "' and '" + to +
+    ctx.error(e, "arc between two transitions '" + std::string(from) + "' and '" + std::string(to) +
                      "': an arc connects a place and a transition");
     return false;
   }
   if (ft && kind != ArcKind::normal) {
     ctx.error(e, "a " + std::string(to_string(kind)) + " arc goes from a place to a transition, not from transition '" +
-                     from + "' to place '" + to + "'");
+                     std::string(from) + "' to place '" + std::string(to) + "'");
     return false;
   }
-  ctx.error(e, "arc '" + from + "' -> '" + to + "' is refused");  // unreachable: add_arc refuses only the above
+  ctx.error(e, "arc '" + std::string(from) + "' -> '" + std::string(to) + "' is refused");  // unreachable: add_arc refuses only the above
   return false;
 }
 

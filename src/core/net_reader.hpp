@@ -8,7 +8,7 @@
 #include <string>
 #include <string_view>
 
-#include <tinyxml2.h>
+#include "xml_document.hpp"
 
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/core/net_loader.hpp"
@@ -24,29 +24,31 @@ struct ReadContext {
   Diagnostics& diags;
   const LoadOptions& options;
 
-  void error(const tinyxml2::XMLElement* e, const std::string& message) const;
-  void error_at_attribute(const tinyxml2::XMLElement* e, std::string_view attr, const std::string& message) const;
-  void error_at_value(const tinyxml2::XMLElement* e, std::string_view attr, const std::string& message,
+  void error(const XmlElement* e, const std::string& message) const;
+  void error_at_attribute(const XmlElement* e, std::string_view attr, const std::string& message) const;
+  void error_at_value(const XmlElement* e, std::string_view attr, const std::string& message,
                       std::size_t decoded_offset = 0) const;
 };
 
 /// Reports every attribute not in `allowed`.
-void check_attributes(const ReadContext& ctx, const tinyxml2::XMLElement* e,
+void check_attributes(const ReadContext& ctx, const XmlElement* e,
                       std::initializer_list<std::string_view> allowed);
 /// "unknown element <x> in <parent>; expected one of: ...".
-void unknown_element(const ReadContext& ctx, const tinyxml2::XMLElement* e, std::string_view parent,
+void unknown_element(const ReadContext& ctx, const XmlElement* e, std::string_view parent,
                      std::string_view expected);
 /// Reports an element's non-blank text content (the formats keep everything in attributes).
-void check_no_text(const ReadContext& ctx, const tinyxml2::XMLElement* e);
+void check_no_text(const ReadContext& ctx, const XmlElement* e);
 
-/// A required attribute; reports it missing (or empty) and returns nullopt.
-std::optional<std::string> required(const ReadContext& ctx, const tinyxml2::XMLElement* e, std::string_view attr);
-/// An optional attribute's value; nullopt when absent.
-std::optional<std::string> optional_attr(const tinyxml2::XMLElement* e, std::string_view attr);
+/// A required attribute's value (a view into the document); reports it missing (or empty) and
+/// returns nullopt.
+std::optional<std::string_view> required(const ReadContext& ctx, const XmlElement* e, std::string_view attr);
+/// An optional attribute's value (a view into the document); nullopt when absent.
+std::optional<std::string_view> optional_attr(const XmlElement* e, std::string_view attr);
 
-/// A decimal count: tokens/capacity (min 0) or weight (min 1). Reports bad text.
-std::optional<Tokens> parse_count(const ReadContext& ctx, const SourceLocation& where, std::string_view text,
-                                  Tokens minimum, std::string_view what);
+/// A decimal count: tokens/capacity (min 0) or weight (min 1). Reports bad text at the value of
+/// attribute `attr` of `e`, or at `e` itself when `attr` is empty (PNML labels).
+std::optional<Tokens> parse_count(const ReadContext& ctx, const XmlElement* e, std::string_view attr,
+                                  std::string_view text, Tokens minimum, std::string_view what);
 /// "2s", "500ms", "1.5min": number and unit (ns, us, ms, s, min, h), not negative.
 std::optional<Duration> parse_delay_text(std::string_view text, std::string& error);
 /// A name that events, parameters and behaviors may use: letter or '_' first, then letters,
@@ -54,14 +56,14 @@ std::optional<Duration> parse_delay_text(std::string_view text, std::string& err
 bool is_valid_name(std::string_view name) noexcept;
 
 /// <parameter>/<fact name type default description/>; appends to net.parameters / net.facts.
-void read_declaration(const ReadContext& ctx, const tinyxml2::XMLElement* e, PetriNet& net, bool fact);
+void read_declaration(const ReadContext& ctx, const XmlElement* e, PetriNet& net, bool fact);
 
 /// Place attributes other than id (name, description, tokens, capacity, outcome, message) and
 /// the <behavior>/<process> children. `net` gives the declared parameters for "$param" checks.
-void read_place_details(const ReadContext& ctx, const tinyxml2::XMLElement* e, Place& place, const PetriNet& net,
+void read_place_details(const ReadContext& ctx, const XmlElement* e, Place& place, const PetriNet& net,
                         bool allow_tokens_and_name);
 /// Transition attributes other than id (name, description, event, guard, delay, priority).
-void read_transition_details(const ReadContext& ctx, const tinyxml2::XMLElement* e, Transition& t,
+void read_transition_details(const ReadContext& ctx, const XmlElement* e, Transition& t,
                              const PetriNet& net, bool allow_name);
 /// "normal" | "read" | "inhibitor".
 std::optional<ArcKind> parse_arc_kind(std::string_view text) noexcept;
@@ -69,10 +71,10 @@ std::optional<ArcKind> parse_arc_kind(std::string_view text) noexcept;
 
 /// Connects the ends of an arc after every node was read: unknown node, two places, two
 /// transitions, a read/inhibitor arc leaving a transition. Returns false after reporting.
-bool add_checked_arc(const ReadContext& ctx, const tinyxml2::XMLElement* e, PetriNet& net, const std::string& from,
-                     const std::string& to, Tokens weight, ArcKind kind);
+bool add_checked_arc(const ReadContext& ctx, const XmlElement* e, PetriNet& net, std::string_view from,
+                     std::string_view to, Tokens weight, ArcKind kind);
 
 /// The element's text content with blanks trimmed ("" when none).
-std::string trimmed_text(const tinyxml2::XMLElement* e);
+std::string trimmed_text(const XmlElement* e);
 
 }  // namespace tripodal::detail

@@ -13,7 +13,7 @@ constexpr std::string_view kNetChildren = "parameter, fact, place, transition, a
 
 }  // namespace
 
-PetriNet read_native(const tinyxml2::XMLElement* root, const ReadContext& ctx) {
+PetriNet read_native(const XmlElement* root, const ReadContext& ctx) {
   PetriNet net;
   net.where = ctx.loc.element(root);
   check_attributes(ctx, root, {"id", "name", "description", "level", "version", "xmlns:xsi",
@@ -25,60 +25,72 @@ PetriNet read_native(const tinyxml2::XMLElement* root, const ReadContext& ctx) {
   if (auto level = optional_attr(root, "level")) {
     if (*level == "low") net.level = NetLevel::low;
     else if (*level == "high") net.level = NetLevel::high;
-    else ctx.error_at_value(root, "level", "unknown level '" + *level + "': expected low or high");
+    else ctx.error_at_value(root, "level", "unknown level '" + std::string(*level) + "': expected low or high");
   }
   if (auto version = optional_attr(root, "version"); version && *version != kFormatVersion) {
-    ctx.error_at_value(root, "version", "format version '" + *version + "' is not supported: this build reads version " +
+    ctx.error_at_value(root, "version", "format version '" + std::string(*version) + "' is not supported: this build reads version " +
                                             std::string(kFormatVersion));
   }
 
   // Declarations first so that guards and "$param" bindings can be checked wherever they appear.
-  for (const auto* c = root->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
-    const std::string_view n = c->Name();
+  for (const auto* c = root->first_child(); c != nullptr; c = c->next_sibling()) {
+    const std::string_view n = c->name();
     if (n == "parameter" || n == "fact") read_declaration(ctx, c, net, n == "fact");
     else if (n != "place" && n != "transition" && n != "arc") unknown_element(ctx, c, "net", kNetChildren);
   }
 
-  std::map<std::string, SourceLocation, std::less<>> first_seen;
-  const auto claim_id = [&](const tinyxml2::XMLElement* e) -> std::optional<std::string> {
+  // Every claimed id is added to the net, so the net's own index finds the first definition.
+  const auto claim_id = [&](const XmlElement* e) -> std::optional<std::string_view> {
     auto id = required(ctx, e, "id");
     if (!id) return std::nullopt;
-    const auto [it, inserted] = first_seen.emplace(*id, ctx.loc.element(e));
-    if (!inserted) {
-      ctx.error_at_value(e, "id", "duplicate id '" + *id + "' (first defined at " + it->second.str() + ")");
+    const SourceLocation* first = nullptr;
+    if (const auto p = net.find_place(*id)) first = &net.place(*p).where;
+    else if (const auto t = net.find_transition(*id)) first = &net.transition(*t).where;
+    if (first != nullptr) {
+      ctx.error_at_value(e, "id", "duplicate id '" + std::string(*id) + "' (first defined at " + first->str() + ")");
       return std::nullopt;
     }
     return id;
   };
 
-  for (const auto* c = root->FirstChildElement("place"); c != nullptr; c = c->NextSiblingElement("place")) {
+  // Reserve for what the document holds: no reallocation while ten thousand nodes arrive.
+  std::size_t place_count = 0;
+  std::size_t transition_count = 0;
+  for (const auto* c = root->first_child(); c != nullptr; c = c->next_sibling()) {
+    const std::string_view n = c->name();
+    if (n == "place") ++place_count;
+    else if (n == "transition") ++transition_count;
+  }
+  net.reserve(place_count, transition_count);
+
+  for (const auto* c = root->first_child("place"); c != nullptr; c = c->next_sibling("place")) {
     Place p;
     const auto id = claim_id(c);
-    p.id = id.value_or("");
+    p.id = id.value_or(std::string_view());
     p.where = ctx.loc.element(c);
     read_place_details(ctx, c, p, net, true);
     if (id) net.add_place(std::move(p));
   }
-  for (const auto* c = root->FirstChildElement("transition"); c != nullptr; c = c->NextSiblingElement("transition")) {
+  for (const auto* c = root->first_child("transition"); c != nullptr; c = c->next_sibling("transition")) {
     Transition t;
     const auto id = claim_id(c);
-    t.id = id.value_or("");
+    t.id = id.value_or(std::string_view());
     t.where = ctx.loc.element(c);
     read_transition_details(ctx, c, t, net, true);
     if (id) net.add_transition(std::move(t));
   }
-  for (const auto* c = root->FirstChildElement("arc"); c != nullptr; c = c->NextSiblingElement("arc")) {
+  for (const auto* c = root->first_child("arc"); c != nullptr; c = c->next_sibling("arc")) {
     check_attributes(ctx, c, {"source", "target", "weight", "kind"});
     check_no_text(ctx, c);
-    for (const auto* g = c->FirstChildElement(); g != nullptr; g = g->NextSiblingElement()) unknown_element(ctx, g, "arc", "");
+    for (const auto* g = c->first_child(); g != nullptr; g = g->next_sibling()) unknown_element(ctx, g, "arc", "");
     const auto source = required(ctx, c, "source");
     const auto target = required(ctx, c, "target");
     std::optional<Tokens> weight = 1;
-    if (auto w = optional_attr(c, "weight")) weight = parse_count(ctx, ctx.loc.attribute_value(c, "weight"), *w, 1, "weight");
+    if (auto w = optional_attr(c, "weight")) weight = parse_count(ctx, c, "weight", *w, 1, "weight");
     std::optional<ArcKind> kind = ArcKind::normal;
     if (auto k = optional_attr(c, "kind")) {
       kind = parse_arc_kind(*k);
-      if (!kind) ctx.error_at_value(c, "kind", "unknown arc kind '" + *k + "': expected normal, read or inhibitor");
+      if (!kind) ctx.error_at_value(c, "kind", "unknown arc kind '" + std::string(*k) + "': expected normal, read or inhibitor");
     }
     if (source && target && weight && kind) add_checked_arc(ctx, c, net, *source, *target, *weight, *kind);
   }

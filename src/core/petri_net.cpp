@@ -4,6 +4,12 @@
 
 namespace tripodal {
 
+void PetriNet::reserve(std::size_t places, std::size_t transitions) {
+  places_.reserve(places);
+  transitions_.reserve(transitions);
+  ids_.reserve(places + transitions);
+}
+
 PlaceIndex PetriNet::add_place(Place p) {
   if (p.id.empty()) throw std::invalid_argument("place id must not be empty");
   if (ids_.count(p.id) != 0) throw std::invalid_argument("duplicate node id '" + p.id + "'");
@@ -31,13 +37,14 @@ TransitionIndex PetriNet::add_transition(Transition t) {
 void PetriNet::add_arc(std::string_view from_id, std::string_view to_id, Tokens weight, ArcKind kind,
                        SourceLocation arc_where) {
   if (weight == 0) throw std::invalid_argument("arc weight must be positive");
-  const auto from_place = find_place(from_id);
-  const auto to_place = find_place(to_id);
-  const auto from_trans = find_transition(from_id);
-  const auto to_trans = find_transition(to_id);
-  if (from_place && to_trans) {
-    Transition& t = transitions_[*to_trans];
-    ArcRef ref{*from_place, weight, std::move(arc_where)};
+  // One look-up per end: loaders add tens of thousands of arcs.
+  const auto from = ids_.find(from_id);
+  const auto to = ids_.find(to_id);
+  if (from == ids_.end()) throw std::invalid_argument("arc from unknown node '" + std::string(from_id) + "'");
+  if (to == ids_.end()) throw std::invalid_argument("arc to unknown node '" + std::string(to_id) + "'");
+  if (from->second.is_place && !to->second.is_place) {
+    Transition& t = transitions_[to->second.index];
+    ArcRef ref{from->second.index, weight, std::move(arc_where)};
     switch (kind) {
       case ArcKind::normal: t.inputs.push_back(std::move(ref)); break;
       case ArcKind::read: t.reads.push_back(std::move(ref)); break;
@@ -45,16 +52,14 @@ void PetriNet::add_arc(std::string_view from_id, std::string_view to_id, Tokens 
     }
     return;
   }
-  if (from_trans && to_place) {
+  if (!from->second.is_place && to->second.is_place) {
     if (kind != ArcKind::normal) {
       throw std::invalid_argument("read and inhibitor arcs go from a place to a transition, not from '" +
                                   std::string(from_id) + "' to '" + std::string(to_id) + "'");
     }
-    transitions_[*from_trans].outputs.push_back(ArcRef{*to_place, weight, std::move(arc_where)});
+    transitions_[from->second.index].outputs.push_back(ArcRef{to->second.index, weight, std::move(arc_where)});
     return;
   }
-  if (!from_place && !from_trans) throw std::invalid_argument("arc from unknown node '" + std::string(from_id) + "'");
-  if (!to_place && !to_trans) throw std::invalid_argument("arc to unknown node '" + std::string(to_id) + "'");
   throw std::invalid_argument("arc must connect a place and a transition: '" + std::string(from_id) + "' -> '" +
                               std::string(to_id) + "'");
 }

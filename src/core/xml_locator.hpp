@@ -1,52 +1,38 @@
-// Internal: columns for XML diagnostics. tinyxml2 reports the line of an element but no column,
-// so the locator scans the source text once and maps elements, attributes and characters inside
-// attribute values to line:column (1-based, counted in bytes as gcc does).
+// Internal: source locations for diagnostics about a parsed XML document: the element's '<', an
+// attribute's name, a character inside an attribute's value (1-based line and byte column, as
+// gcc counts).
 #pragma once
 
 #include <cstddef>
 #include <string>
 #include <string_view>
-#include <vector>
-
-#include <tinyxml2.h>
 
 #include "tripodal/core/diagnostic.hpp"
+#include "xml_document.hpp"
 
 namespace tripodal::detail {
 
 class XmlLocator {
  public:
-  /// `text` must outlive the locator and be the exact text `doc` was parsed from.
-  XmlLocator(std::string_view text, std::string file);
-
-  /// Call once after a successful parse: pairs the document's elements (pre-order) with the start
-  /// tags found in the text, keeping each offset in the element's user data (no lookup table).
-  void index(tinyxml2::XMLDocument& doc);
+  /// `doc` must outlive the locator.
+  XmlLocator(const XmlDocument& doc, std::string file) : doc_(doc), file_(std::move(file)) {}
 
   [[nodiscard]] const std::string& file() const noexcept { return file_; }
   /// The '<' of the element's start tag.
-  [[nodiscard]] SourceLocation element(const tinyxml2::XMLElement* e) const;
+  [[nodiscard]] SourceLocation element(const XmlElement* e) const {
+    return SourceLocation{file_, e->line(), e->column()};
+  }
   /// The attribute's name; the element when the attribute is absent.
-  [[nodiscard]] SourceLocation attribute(const tinyxml2::XMLElement* e, std::string_view name) const;
-  /// The character at `decoded_offset` (0-based, in the value after entity decoding) of the
-  /// attribute's value; the element when the attribute is absent.
-  [[nodiscard]] SourceLocation attribute_value(const tinyxml2::XMLElement* e, std::string_view name,
+  [[nodiscard]] SourceLocation attribute(const XmlElement* e, std::string_view name) const;
+  /// The character that produced byte `decoded_offset` (0-based) of the attribute's decoded value
+  /// (an entity reference is one character); the element when the attribute is absent.
+  [[nodiscard]] SourceLocation attribute_value(const XmlElement* e, std::string_view name,
                                                std::size_t decoded_offset = 0) const;
-  /// The first non-blank byte of a line (for parser errors that only know the line).
-  [[nodiscard]] SourceLocation line(int line_number) const;
   [[nodiscard]] SourceLocation offset(std::size_t byte_offset) const;
 
  private:
-  struct AttrPos {
-    std::size_t name = 0;
-    std::size_t value = 0;  ///< first byte after the opening quote
-  };
-  [[nodiscard]] std::size_t find_attribute(std::size_t tag, std::string_view name, AttrPos& pos) const;
-  [[nodiscard]] std::size_t element_offset(const tinyxml2::XMLElement* e, bool& found) const;
-
-  std::string_view text_;
+  const XmlDocument& doc_;
   std::string file_;
-  std::vector<std::size_t> line_starts_;
 };
 
 }  // namespace tripodal::detail

@@ -138,7 +138,8 @@ TEST_CASE("native loader: delays take units") {
 
 TEST_CASE("native loader: malformed XML is located") {
   const auto e = errors_of("<net id=\"n\">\n  <place id=\"p\">\n</net>\n");
-  CHECK_THAT(e, Catch::Contains("bad.xml:2:3: error: malformed XML: end tag does not match the open element"));
+  CHECK_THAT(e, Catch::Contains("bad.xml:3:1: error: malformed XML: end tag </net> does not match the open element "
+                                "<place> (line 2, column 3)"));
   CHECK_THAT(errors_of(""), Catch::Contains("bad.xml:1:1: error: malformed XML: empty document"));
   CHECK_THAT(errors_of("<net id=\"n\">\n  <place id=\"p tokens=\"1\"/>\n</net>"), Catch::Contains("bad.xml:2:"));
 }

@@ -112,6 +112,8 @@ class PetriNet {
   std::vector<VariableDecl> facts;
   SourceLocation where;  ///< the file (and element) it was loaded from
 
+  /// Room for this many places and transitions (loaders know the counts up front).
+  void reserve(std::size_t places, std::size_t transitions);
   PlaceIndex add_place(Place p);
   TransitionIndex add_transition(Transition t);
   /// Adds an arc between a place and a transition given by id, in either direction for normal

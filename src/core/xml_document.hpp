@@ -1,0 +1,121 @@
+// Internal: the XML reader behind the net loaders (native format and PNML). It parses a whole
+// document in one pass into a read-only tree whose names, values and text are views into the
+// source (decoded copies only where references, line ends or Latin-1 bytes require one), and keeps
+// the byte offset of every element and attribute, so that each diagnostic can name LINE:COL.
+//
+// Well-formedness is checked as XML 1.0 says (one root, matching tags, quoted and unique
+// attributes, no '<' in values, known entity and valid character references, no control
+// characters, valid UTF-8); the first violation stops the parse with its offset. Not a validating
+// parser: a DOCTYPE is skipped, and an entity it declares is refused as unknown.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace tripodal::detail {
+
+class XmlDocument;
+
+struct XmlAttribute {
+  std::string_view name;
+  /// Decoded: references replaced, each literal tab, newline or CR (a CR LF pair counts once)
+  /// turned into a space as XML normalises attribute values.
+  std::string_view value;
+  std::uint32_t name_offset = 0;   ///< source offset of the name
+  std::uint32_t value_offset = 0;  ///< source offset of the first byte after the opening quote
+  std::uint32_t value_end = 0;     ///< source offset of the closing quote
+};
+
+class XmlElement {
+ public:
+  [[nodiscard]] std::string_view name() const noexcept { return name_; }
+  [[nodiscard]] std::span<const XmlAttribute> attributes() const noexcept;
+  [[nodiscard]] const XmlAttribute* find_attribute(std::string_view name) const noexcept;
+  /// The decoded value of an attribute; nullopt when the element has none of that name.
+  [[nodiscard]] std::optional<std::string_view> attribute(std::string_view name) const noexcept;
+  /// Child elements in document order, optionally only those of a given name.
+  [[nodiscard]] const XmlElement* first_child() const noexcept;
+  [[nodiscard]] const XmlElement* first_child(std::string_view name) const noexcept;
+  [[nodiscard]] const XmlElement* next_sibling() const noexcept;
+  [[nodiscard]] const XmlElement* next_sibling(std::string_view name) const noexcept;
+  /// The character data directly inside the element (text and CDATA sections between its
+  /// children, concatenated, references decoded), blanks at both ends removed.
+  [[nodiscard]] std::string_view text() const noexcept { return text_; }
+  /// Source offset of the '<' of the start tag, and its 1-based line and byte column.
+  [[nodiscard]] std::uint32_t offset() const noexcept { return offset_; }
+  [[nodiscard]] int line() const noexcept { return static_cast<int>(line_); }
+  [[nodiscard]] int column() const noexcept { return static_cast<int>(column_); }
+
+ private:
+  friend class XmlDocument;
+  friend class XmlParser;
+  static constexpr std::uint32_t kNone = 0xFFFFFFFFU;
+
+  const XmlDocument* doc_ = nullptr;
+  std::string_view name_;
+  std::string_view text_;
+  std::uint32_t first_attribute_ = 0;
+  std::uint32_t attribute_count_ = 0;
+  std::uint32_t first_child_ = kNone;
+  std::uint32_t next_sibling_ = kNone;
+  std::uint32_t offset_ = 0;
+  std::uint32_t line_ = 0;
+  std::uint32_t column_ = 0;
+};
+
+/// The first well-formedness error of a document: where and what.
+struct XmlError {
+  std::size_t offset = 0;
+  std::string message;
+};
+
+/// A parsed document. Views into the source: the text given to parse() must outlive it. Not
+/// copyable or movable (elements point back at it).
+class XmlDocument {
+ public:
+  XmlDocument() = default;
+  XmlDocument(const XmlDocument&) = delete;
+  XmlDocument& operator=(const XmlDocument&) = delete;
+  XmlDocument(XmlDocument&&) = delete;
+  XmlDocument& operator=(XmlDocument&&) = delete;
+  ~XmlDocument() = default;
+
+  /// Parses `text` (UTF-8; ISO-8859-1 when its XML declaration says so). Returns false at the
+  /// first error, described by error(); the tree is then empty.
+  bool parse(std::string_view text);
+
+  [[nodiscard]] const XmlElement* root() const noexcept { return elements_.empty() ? nullptr : &elements_[0]; }
+  [[nodiscard]] const XmlError& error() const noexcept { return error_; }
+  [[nodiscard]] std::string_view source() const noexcept { return text_; }
+  [[nodiscard]] std::size_t element_count() const noexcept { return elements_.size(); }
+
+  struct LineColumn {
+    int line = 1;
+    int column = 1;
+  };
+  /// 1-based line and byte column (as gcc counts) of a source offset.
+  [[nodiscard]] LineColumn line_column(std::size_t offset) const;
+  /// The source offset of the character that produced byte `decoded_offset` of the attribute's
+  /// decoded value (an entity reference is one character); value_end past the last one.
+  [[nodiscard]] std::size_t value_source_offset(const XmlAttribute& attribute, std::size_t decoded_offset) const;
+
+ private:
+  friend class XmlElement;
+  friend class XmlParser;
+
+  std::string_view text_;
+  std::vector<XmlElement> elements_;
+  std::vector<XmlAttribute> attributes_;
+  std::deque<std::string> decoded_;  // values and text that differ from the source; stable addresses
+  mutable std::vector<std::size_t> line_starts_;  // built on the first line_column() call
+  XmlError error_;
+  bool latin1_ = false;
+};
+
+}  // namespace tripodal::detail
