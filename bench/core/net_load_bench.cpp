@@ -12,7 +12,11 @@ namespace {
 using namespace tripodal;
 
 // A ring of n places and n transitions with what real nets carry: descriptions, events, guards
-// over a parameter, delays, read arcs and a behavior binding on some places.
+// over a parameter, delays, read arcs and a behavior binding on some places. The read arcs test a
+// "ready" place that holds a token (a condition many transitions share), so the net is live and
+// loads without warnings. (Until 2026-11-23 they read the place two steps ahead on the
+// one-token ring, which no marking can satisfy: every load then also formatted 19,999
+// structural warnings, docs/performance.md.)
 PetriNet generated_net(std::size_t n) {
   PetriNet net;
   net.id = "generated" + std::to_string(n);
@@ -25,6 +29,11 @@ PetriNet generated_net(std::size_t n) {
     if (i % 4 == 1) p.behavior = BehaviorBinding{"BhStep", {BindingParam{"mode", "$mode", {}}}};
     net.add_place(std::move(p));
   }
+  Place ready;
+  ready.id = "ready";
+  ready.initial_tokens = 1;
+  ready.description = "The robot is ready to move";
+  net.add_place(std::move(ready));
   for (std::size_t i = 0; i < n; ++i) {
     Transition t;
     t.id = "T" + std::to_string(i);
@@ -38,7 +47,7 @@ PetriNet generated_net(std::size_t n) {
     const std::string t = "T" + std::to_string(i);
     net.add_arc("P" + std::to_string(i), t);
     net.add_arc(t, "P" + std::to_string((i + 1) % n));
-    if (i % 3 == 0 && n > 2) net.add_arc("P" + std::to_string((i + 2) % n), t, 1, ArcKind::read);
+    if (i % 3 == 0) net.add_arc("ready", t, 1, ArcKind::read);
   }
   return net;
 }
@@ -50,7 +59,7 @@ void load_bench(benchmark::State& state, NetFormat format) {
   for (auto _ : state) {
     Diagnostics d;
     auto net = load_net_from_string(text, name, d);
-    if (!net || d.has_errors()) state.SkipWithError("generated net did not load");
+    if (!net || !d.empty()) state.SkipWithError("generated net did not load without diagnostics");
     benchmark::DoNotOptimize(net);
   }
   state.SetComplexityN(state.range(0));

@@ -4,33 +4,86 @@
 
 namespace tripodal {
 
+namespace {
+
+// FNV-1a: ids are a few bytes long, so a byte loop is as fast as anything and stays inline.
+std::uint32_t id_hash(std::string_view s) noexcept {
+  std::uint32_t h = 2166136261U;
+  for (const char c : s) {
+    h ^= static_cast<unsigned char>(c);
+    h *= 16777619U;
+  }
+  return h;
+}
+
+}  // namespace
+
 void PetriNet::reserve(std::size_t places, std::size_t transitions) {
   places_.reserve(places);
   transitions_.reserve(transitions);
-  ids_.reserve(places + transitions);
+  grow_index(places + transitions);
+}
+
+void PetriNet::grow_index(std::size_t nodes) {
+  std::size_t capacity = 16;
+  while (capacity < 2 * nodes) capacity *= 2;
+  if (capacity <= id_slots_.size()) return;
+  std::vector<IdSlot> old = std::move(id_slots_);
+  id_slots_.assign(capacity, IdSlot{});
+  const std::size_t mask = capacity - 1;
+  for (const IdSlot& slot : old) {
+    if (slot.node == 0) continue;
+    std::size_t i = slot.hash & mask;
+    while (id_slots_[i].node != 0) i = (i + 1) & mask;
+    id_slots_[i] = slot;
+  }
+}
+
+std::optional<PetriNet::NodeRef> PetriNet::find_node(std::string_view node_id) const noexcept {
+  if (id_slots_.empty()) return std::nullopt;
+  const std::uint32_t h = id_hash(node_id);
+  const std::size_t mask = id_slots_.size() - 1;
+  for (std::size_t i = h & mask;; i = (i + 1) & mask) {
+    const IdSlot& slot = id_slots_[i];
+    if (slot.node == 0) return std::nullopt;
+    if (slot.hash != h) continue;
+    const std::uint32_t code = slot.node - 1;
+    const NodeRef ref{(code & 1U) != 0, code >> 1};
+    const std::string& key = ref.is_place ? places_[ref.index].id : transitions_[ref.index].id;
+    if (key == node_id) return ref;
+  }
+}
+
+void PetriNet::index_node(std::string_view node_id, NodeRef ref) {
+  grow_index(places_.size() + transitions_.size() + 1);
+  const std::uint32_t h = id_hash(node_id);
+  const std::size_t mask = id_slots_.size() - 1;
+  std::size_t i = h & mask;
+  while (id_slots_[i].node != 0) i = (i + 1) & mask;
+  id_slots_[i] = IdSlot{h, ((ref.index << 1) | (ref.is_place ? 1U : 0U)) + 1};
 }
 
 PlaceIndex PetriNet::add_place(Place p) {
   if (p.id.empty()) throw std::invalid_argument("place id must not be empty");
-  if (ids_.count(p.id) != 0) throw std::invalid_argument("duplicate node id '" + p.id + "'");
+  if (find_node(p.id)) throw std::invalid_argument("duplicate node id '" + p.id + "'");
   if (p.capacity && p.initial_tokens > *p.capacity) {
     throw std::invalid_argument("place '" + p.id + "' starts with more tokens than its capacity");
   }
   if (p.name.empty()) p.name = p.id;
   const auto index = static_cast<PlaceIndex>(places_.size());
-  ids_.emplace(p.id, NodeRef{true, index});
   places_.push_back(std::move(p));
+  index_node(places_.back().id, NodeRef{true, index});
   return index;
 }
 
 TransitionIndex PetriNet::add_transition(Transition t) {
   if (t.id.empty()) throw std::invalid_argument("transition id must not be empty");
-  if (ids_.count(t.id) != 0) throw std::invalid_argument("duplicate node id '" + t.id + "'");
+  if (find_node(t.id)) throw std::invalid_argument("duplicate node id '" + t.id + "'");
   if (t.delay.count() < 0) throw std::invalid_argument("transition '" + t.id + "' has a negative delay");
   if (t.name.empty()) t.name = t.id;
   const auto index = static_cast<TransitionIndex>(transitions_.size());
-  ids_.emplace(t.id, NodeRef{false, index});
   transitions_.push_back(std::move(t));
+  index_node(transitions_.back().id, NodeRef{false, index});
   return index;
 }
 
@@ -38,13 +91,13 @@ void PetriNet::add_arc(std::string_view from_id, std::string_view to_id, Tokens 
                        SourceLocation arc_where) {
   if (weight == 0) throw std::invalid_argument("arc weight must be positive");
   // One look-up per end: loaders add tens of thousands of arcs.
-  const auto from = ids_.find(from_id);
-  const auto to = ids_.find(to_id);
-  if (from == ids_.end()) throw std::invalid_argument("arc from unknown node '" + std::string(from_id) + "'");
-  if (to == ids_.end()) throw std::invalid_argument("arc to unknown node '" + std::string(to_id) + "'");
-  if (from->second.is_place && !to->second.is_place) {
-    Transition& t = transitions_[to->second.index];
-    ArcRef ref{from->second.index, weight, std::move(arc_where)};
+  const auto from = find_node(from_id);
+  const auto to = find_node(to_id);
+  if (!from) throw std::invalid_argument("arc from unknown node '" + std::string(from_id) + "'");
+  if (!to) throw std::invalid_argument("arc to unknown node '" + std::string(to_id) + "'");
+  if (from->is_place && !to->is_place) {
+    Transition& t = transitions_[to->index];
+    ArcRef ref{from->index, weight, std::move(arc_where)};
     switch (kind) {
       case ArcKind::normal: t.inputs.push_back(std::move(ref)); break;
       case ArcKind::read: t.reads.push_back(std::move(ref)); break;
@@ -52,12 +105,12 @@ void PetriNet::add_arc(std::string_view from_id, std::string_view to_id, Tokens 
     }
     return;
   }
-  if (!from->second.is_place && to->second.is_place) {
+  if (!from->is_place && to->is_place) {
     if (kind != ArcKind::normal) {
       throw std::invalid_argument("read and inhibitor arcs go from a place to a transition, not from '" +
                                   std::string(from_id) + "' to '" + std::string(to_id) + "'");
     }
-    transitions_[from->second.index].outputs.push_back(ArcRef{to->second.index, weight, std::move(arc_where)});
+    transitions_[from->index].outputs.push_back(ArcRef{to->index, weight, std::move(arc_where)});
     return;
   }
   throw std::invalid_argument("arc must connect a place and a transition: '" + std::string(from_id) + "' -> '" +
@@ -65,15 +118,15 @@ void PetriNet::add_arc(std::string_view from_id, std::string_view to_id, Tokens 
 }
 
 std::optional<PlaceIndex> PetriNet::find_place(std::string_view node_id) const noexcept {
-  const auto it = ids_.find(node_id);
-  if (it == ids_.end() || !it->second.is_place) return std::nullopt;
-  return it->second.index;
+  const auto ref = find_node(node_id);
+  if (!ref || !ref->is_place) return std::nullopt;
+  return ref->index;
 }
 
 std::optional<TransitionIndex> PetriNet::find_transition(std::string_view node_id) const noexcept {
-  const auto it = ids_.find(node_id);
-  if (it == ids_.end() || it->second.is_place) return std::nullopt;
-  return it->second.index;
+  const auto ref = find_node(node_id);
+  if (!ref || ref->is_place) return std::nullopt;
+  return ref->index;
 }
 
 const VariableDecl* PetriNet::find_parameter(std::string_view n) const noexcept {

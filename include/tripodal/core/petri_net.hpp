@@ -8,7 +8,6 @@
 #include <optional>
 #include <string>
 #include <string_view>
-#include <unordered_map>
 #include <vector>
 
 #include "tripodal/core/diagnostic.hpp"
@@ -140,13 +139,20 @@ class PetriNet {
     bool is_place;
     std::uint32_t index;
   };
+  // Ids are found through an open-addressing table of (hash, node) pairs, linear probing, load
+  // factor at most 1/2: a look-up reads one short run of slots and compares one id, where a
+  // node-based hash map chases two or three pointers (the loaders resolve every arc by id).
+  struct IdSlot {
+    std::uint32_t hash = 0;
+    std::uint32_t node = 0;  ///< 0: empty; else (index << 1 | is_place) + 1
+  };
+  [[nodiscard]] std::optional<NodeRef> find_node(std::string_view node_id) const noexcept;
+  void index_node(std::string_view node_id, NodeRef ref);
+  void grow_index(std::size_t nodes);
+
   std::vector<Place> places_;
   std::vector<Transition> transitions_;
-  struct IdHash {
-    using is_transparent = void;
-    std::size_t operator()(std::string_view s) const noexcept { return std::hash<std::string_view>{}(s); }
-  };
-  std::unordered_map<std::string, NodeRef, IdHash, std::equal_to<>> ids_;  // O(1) lookups: loaders resolve every arc by id
+  std::vector<IdSlot> id_slots_;
 };
 
 }  // namespace tripodal
