@@ -21,6 +21,8 @@ std::uint32_t id_hash(std::string_view s) noexcept {
 void PetriNet::reserve(std::size_t places, std::size_t transitions) {
   places_.reserve(places);
   transitions_.reserve(transitions);
+  place_ids_.reserve(places);
+  transition_ids_.reserve(transitions);
   grow_index(places + transitions);
 }
 
@@ -49,8 +51,8 @@ std::optional<PetriNet::NodeRef> PetriNet::find_node(std::string_view node_id) c
     if (slot.hash != h) continue;
     const std::uint32_t code = slot.node - 1;
     const NodeRef ref{(code & 1U) != 0, code >> 1};
-    const std::string& key = ref.is_place ? places_[ref.index].id : transitions_[ref.index].id;
-    if (key == node_id) return ref;
+    const IdSpan span = ref.is_place ? place_ids_[ref.index] : transition_ids_[ref.index];
+    if (span.size == node_id.size() && id_chars_.compare(span.offset, span.size, node_id) == 0) return ref;
   }
 }
 
@@ -61,6 +63,9 @@ void PetriNet::index_node(std::string_view node_id, NodeRef ref) {
   std::size_t i = h & mask;
   while (id_slots_[i].node != 0) i = (i + 1) & mask;
   id_slots_[i] = IdSlot{h, ((ref.index << 1) | (ref.is_place ? 1U : 0U)) + 1};
+  (ref.is_place ? place_ids_ : transition_ids_)
+      .push_back(IdSpan{static_cast<std::uint32_t>(id_chars_.size()), static_cast<std::uint32_t>(node_id.size())});
+  id_chars_.append(node_id);
 }
 
 PlaceIndex PetriNet::add_place(Place p) {

@@ -264,36 +264,10 @@ void validate_encoding(std::string_view s, bool latin1) {
 
 // --- XmlElement ---------------------------------------------------------------------------
 
-std::span<const XmlAttribute> XmlElement::attributes() const noexcept {
-  return {doc_->attributes_.data() + first_attribute_, attribute_count_};
-}
-
-const XmlAttribute* XmlElement::find_attribute(std::string_view name) const noexcept {
-  const XmlAttribute* a = doc_->attributes_.data() + first_attribute_;
-  for (const XmlAttribute* const end = a + attribute_count_; a != end; ++a) {
-    if (a->name == name) return a;
-  }
-  return nullptr;
-}
-
-std::optional<std::string_view> XmlElement::attribute(std::string_view name) const noexcept {
-  const XmlAttribute* a = find_attribute(name);
-  if (a == nullptr) return std::nullopt;
-  return a->value;
-}
-
-const XmlElement* XmlElement::first_child() const noexcept {
-  return first_child_ == kNone ? nullptr : &doc_->elements_[first_child_];
-}
-
 const XmlElement* XmlElement::first_child(std::string_view name) const noexcept {
   const XmlElement* c = first_child();
   while (c != nullptr && c->name_ != name) c = c->next_sibling();
   return c;
-}
-
-const XmlElement* XmlElement::next_sibling() const noexcept {
-  return next_sibling_ == kNone ? nullptr : &doc_->elements_[next_sibling_];
 }
 
 const XmlElement* XmlElement::next_sibling(std::string_view name) const noexcept {

@@ -118,4 +118,26 @@ class XmlDocument {
   bool latin1_ = false;
 };
 
+// Inline: the readers walk every element through these.
+inline const XmlElement* XmlElement::first_child() const noexcept {
+  return first_child_ == kNone ? nullptr : &doc_->elements_[first_child_];
+}
+inline const XmlElement* XmlElement::next_sibling() const noexcept {
+  return next_sibling_ == kNone ? nullptr : &doc_->elements_[next_sibling_];
+}
+inline std::span<const XmlAttribute> XmlElement::attributes() const noexcept {
+  return {doc_->attributes_.data() + first_attribute_, attribute_count_};
+}
+inline const XmlAttribute* XmlElement::find_attribute(std::string_view name) const noexcept {
+  for (const XmlAttribute& a : attributes()) {
+    if (a.name == name) return &a;
+  }
+  return nullptr;
+}
+inline std::optional<std::string_view> XmlElement::attribute(std::string_view name) const noexcept {
+  const XmlAttribute* a = find_attribute(name);
+  if (a == nullptr) return std::nullopt;
+  return a->value;
+}
+
 }  // namespace tripodal::detail

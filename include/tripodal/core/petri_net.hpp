@@ -140,8 +140,9 @@ class PetriNet {
     std::uint32_t index;
   };
   // Ids are found through an open-addressing table of (hash, node) pairs, linear probing, load
-  // factor at most 1/2: a look-up reads one short run of slots and compares one id, where a
-  // node-based hash map chases two or three pointers (the loaders resolve every arc by id).
+  // factor at most 1/2, and compared against a copy of every id kept back to back: a look-up
+  // touches two small arrays, where a node-based hash map chases two or three pointers and
+  // the nodes themselves are hundreds of bytes apart (the loaders resolve every arc by id).
   struct IdSlot {
     std::uint32_t hash = 0;
     std::uint32_t node = 0;  ///< 0: empty; else (index << 1 | is_place) + 1
@@ -153,6 +154,13 @@ class PetriNet {
   std::vector<Place> places_;
   std::vector<Transition> transitions_;
   std::vector<IdSlot> id_slots_;
+  struct IdSpan {
+    std::uint32_t offset = 0;
+    std::uint32_t size = 0;
+  };
+  std::string id_chars_;
+  std::vector<IdSpan> place_ids_;       // per place, into id_chars_
+  std::vector<IdSpan> transition_ids_;  // per transition
 };
 
 }  // namespace tripodal
