@@ -10,6 +10,7 @@
 #include <cstring>
 #include <limits>
 #include <stdexcept>
+#include <unordered_set>
 
 namespace tripodal::detail {
 
@@ -440,28 +441,44 @@ class XmlParser {
     p_ = end + 2;
   }
 
-  // <!DOCTYPE name [internal subset]>: skipped, brackets and quotes respected.
+  // <!DOCTYPE name ExternalID? [internal subset]? >: skipped. Quotes are literals both outside
+  // and inside the subset; inside it, comments and processing instructions are skipped whole
+  // (a quote or bracket in them means nothing), and ']' ends the subset.
   void doctype() {
     const std::size_t start = p_;
+    const auto unterminated = [&] { return ParseFailure{start, "unterminated DOCTYPE"}; };
+    const auto skip_quoted = [&](std::size_t i) {
+      const std::size_t close = s_.find(s_[i], i + 1);
+      if (close == std::string_view::npos) throw unterminated();
+      return close + 1;
+    };
     std::size_t i = p_ + 9;
-    int brackets = 0;
-    char quote = 0;
-    for (; i < n_; ++i) {
-      const char c = s_[i];
-      if (quote != 0) {
-        if (c == quote) quote = 0;
-      } else if (c == '"' || c == '\'') {
-        quote = c;
-      } else if (c == '[') {
-        ++brackets;
-      } else if (c == ']') {
-        --brackets;
-      } else if (c == '>' && brackets <= 0) {
-        p_ = i + 1;
-        return;
+    while (i < n_ && s_[i] != '[' && s_[i] != '>') i = (s_[i] == '"' || s_[i] == '\'') ? skip_quoted(i) : i + 1;
+    if (i < n_ && s_[i] == '[') {
+      ++i;
+      for (;;) {
+        if (i >= n_) throw unterminated();
+        if (s_[i] == ']') {
+          ++i;
+          break;
+        }
+        std::string_view end;
+        if (s_.compare(i, 4, "<!--") == 0) end = "-->";
+        else if (s_.compare(i, 2, "<?") == 0) end = "?>";
+        if (!end.empty()) {
+          const std::size_t close = s_.find(end, i + 2);
+          if (close == std::string_view::npos) throw unterminated();
+          i = close + end.size();
+        } else if (s_[i] == '"' || s_[i] == '\'') {
+          i = skip_quoted(i);
+        } else {
+          ++i;
+        }
       }
+      while (i < n_ && (cls(s_[i]) & kSpace) != 0) ++i;
     }
-    throw ParseFailure{start, "unterminated DOCTYPE"};
+    if (i >= n_ || s_[i] != '>') throw unterminated();
+    p_ = i + 1;
   }
 
   std::uint32_t new_element(std::size_t at, std::string_view name) {
@@ -536,6 +553,8 @@ class XmlParser {
     const std::size_t name_at_offset = p_;
     const std::string_view raw_name = name_at(p_);
     p_ += raw_name.size();
+    const std::string_view name = intern(raw_name);
+    check_unique(name, name_at_offset, element_name, element, count);
     skip_space();
     if (p_ >= n_ || s_[p_] != '=') {
       throw ParseFailure{p_ < n_ ? p_ : name_at_offset, "attribute '" + std::string(raw_name) + "' of <" +
@@ -566,17 +585,6 @@ class XmlParser {
                                                  "': write &lt; for a literal '<'"};
       }
     }
-    const std::string_view name = intern(raw_name);
-    // Few attributes per element: a linear scan; many: checked once the tag ends.
-    if (count < kLinearDuplicateCheck) {
-      const XmlAttribute* prior = d_.attributes_.data() + d_.elements_[element].first_attribute_;
-      for (std::uint32_t k = 0; k < count; ++k) {
-        if (prior[k].name == name) {
-          throw ParseFailure{name_at_offset, "duplicate attribute '" + std::string(name) + "' on <" +
-                                                 std::string(element_name) + ">"};
-        }
-      }
-    }
     XmlAttribute& a = d_.attributes_.emplace_back();
     a.name = name;
     a.value = special ? decode_attribute(raw, value_start) : raw;
@@ -586,23 +594,28 @@ class XmlParser {
     p_ = value_end + 1;
   }
 
-  void finish_attributes(std::uint32_t element, std::uint32_t count) {
-    XmlElement& e = d_.elements_[element];
-    e.attribute_count_ = count;
-    if (count <= kLinearDuplicateCheck) return;
-    std::vector<const XmlAttribute*> sorted;
-    sorted.reserve(count);
-    for (std::uint32_t k = 0; k < count; ++k) sorted.push_back(&d_.attributes_[e.first_attribute_ + k]);
-    std::sort(sorted.begin(), sorted.end(), [](const XmlAttribute* a, const XmlAttribute* b) {
-      return a->name != b->name ? a->name < b->name : a->name_offset < b->name_offset;
-    });
-    for (std::size_t k = 1; k < sorted.size(); ++k) {
-      if (sorted[k]->name == sorted[k - 1]->name) {
-        throw ParseFailure{sorted[k]->name_offset,
-                           "duplicate attribute '" + std::string(sorted[k]->name) + "' on <" + std::string(e.name_) + ">"};
+  // Each name as it is read, so that the first duplicate in document order is the one reported.
+  // A few attributes: a linear scan; more: a set of the names seen (built once the count passes
+  // the linear limit, so a huge start tag costs linear time, not quadratic).
+  void check_unique(std::string_view name, std::size_t at, std::string_view element_name, std::uint32_t element,
+                    std::uint32_t count) {
+    const XmlAttribute* prior = d_.attributes_.data() + d_.elements_[element].first_attribute_;
+    bool duplicate = false;
+    if (count < kLinearDuplicateCheck) {
+      for (std::uint32_t k = 0; k < count && !duplicate; ++k) duplicate = prior[k].name == name;
+    } else {
+      if (count == kLinearDuplicateCheck) {
+        names_seen_.clear();
+        for (std::uint32_t k = 0; k < count; ++k) names_seen_.insert(prior[k].name);
       }
+      duplicate = !names_seen_.insert(name).second;
+    }
+    if (duplicate) {
+      throw ParseFailure{at, "duplicate attribute '" + std::string(name) + "' on <" + std::string(element_name) + ">"};
     }
   }
+
+  void finish_attributes(std::uint32_t element, std::uint32_t count) { d_.elements_[element].attribute_count_ = count; }
 
   // Attribute value normalisation (XML 1.0 section 3.3.3) after reference decoding.
   std::string_view decode_attribute(std::string_view raw, std::size_t source_offset) {
@@ -822,6 +835,7 @@ class XmlParser {
   std::size_t p_ = 0;
   std::vector<Open> stack_;
   std::size_t depth_ = 0;
+  std::unordered_set<std::string_view> names_seen_;  // attribute names of a start tag with many
 };
 
 // --- XmlDocument --------------------------------------------------------------------------
