@@ -43,10 +43,7 @@ PetriNet read_native(const XmlElement* root, const ReadContext& ctx) {
   const auto claim_id = [&](const XmlElement* e) -> std::optional<std::string_view> {
     auto id = required(ctx, e, "id");
     if (!id) return std::nullopt;
-    const SourceLocation* first = nullptr;
-    if (const auto p = net.find_place(*id)) first = &net.place(*p).where;
-    else if (const auto t = net.find_transition(*id)) first = &net.transition(*t).where;
-    if (first != nullptr) {
+    if (const SourceLocation* first = net.find_node_where(*id)) {
       ctx.error_at_value(e, "id", "duplicate id '" + std::string(*id) + "' (first defined at " + first->str() + ")");
       return std::nullopt;
     }

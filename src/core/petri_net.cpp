@@ -27,8 +27,9 @@ void PetriNet::reserve(std::size_t places, std::size_t transitions) {
 }
 
 void PetriNet::grow_index(std::size_t nodes) {
+  // Load factor at most 3/4: a 20,000-node net fits a 256 KiB table.
   std::size_t capacity = 16;
-  while (capacity < 2 * nodes) capacity *= 2;
+  while (capacity * 3 < nodes * 4) capacity *= 2;
   if (capacity <= id_slots_.size()) return;
   std::vector<IdSlot> old = std::move(id_slots_);
   id_slots_.assign(capacity, IdSlot{});
@@ -41,54 +42,83 @@ void PetriNet::grow_index(std::size_t nodes) {
   }
 }
 
-std::optional<PetriNet::NodeRef> PetriNet::find_node(std::string_view node_id) const noexcept {
-  if (id_slots_.empty()) return std::nullopt;
-  const std::uint32_t h = id_hash(node_id);
+std::size_t PetriNet::probe(std::string_view node_id, std::uint32_t hash, bool& found) const noexcept {
   const std::size_t mask = id_slots_.size() - 1;
-  for (std::size_t i = h & mask;; i = (i + 1) & mask) {
+  for (std::size_t i = hash & mask;; i = (i + 1) & mask) {
     const IdSlot& slot = id_slots_[i];
-    if (slot.node == 0) return std::nullopt;
-    if (slot.hash != h) continue;
+    if (slot.node == 0) {
+      found = false;
+      return i;
+    }
+    if (slot.hash != hash) continue;
     const std::uint32_t code = slot.node - 1;
-    const NodeRef ref{(code & 1U) != 0, code >> 1};
-    const IdSpan span = ref.is_place ? place_ids_[ref.index] : transition_ids_[ref.index];
-    if (span.size == node_id.size() && id_chars_.compare(span.offset, span.size, node_id) == 0) return ref;
+    const IdSpan span = (code & 1U) != 0 ? place_ids_[code >> 1] : transition_ids_[code >> 1];
+    if (span.size != node_id.size()) continue;
+    // Ids are short: a byte loop beats a call to memcmp.
+    const char* key = id_chars_.data() + span.offset;
+    std::size_t k = 0;
+    while (k < span.size && key[k] == node_id[k]) ++k;
+    if (k == span.size) {
+      found = true;
+      return i;
+    }
   }
 }
 
-void PetriNet::index_node(std::string_view node_id, NodeRef ref) {
+std::optional<PetriNet::NodeRef> PetriNet::find_node(std::string_view node_id) const noexcept {
+  if (id_slots_.empty()) return std::nullopt;
+  bool found = false;
+  const std::size_t i = probe(node_id, id_hash(node_id), found);
+  if (!found) return std::nullopt;
+  const std::uint32_t code = id_slots_[i].node - 1;
+  return NodeRef{(code & 1U) != 0, code >> 1};
+}
+
+std::size_t PetriNet::claim_slot(std::string_view node_id, std::uint32_t& hash) {
   grow_index(places_.size() + transitions_.size() + 1);
-  const std::uint32_t h = id_hash(node_id);
-  const std::size_t mask = id_slots_.size() - 1;
-  std::size_t i = h & mask;
-  while (id_slots_[i].node != 0) i = (i + 1) & mask;
-  id_slots_[i] = IdSlot{h, ((ref.index << 1) | (ref.is_place ? 1U : 0U)) + 1};
+  hash = id_hash(node_id);
+  bool found = false;
+  const std::size_t slot = probe(node_id, hash, found);
+  if (found) throw std::invalid_argument("duplicate node id '" + std::string(node_id) + "'");
+  return slot;
+}
+
+void PetriNet::fill_slot(std::size_t slot, std::uint32_t hash, std::string_view node_id, NodeRef ref) {
+  id_slots_[slot] = IdSlot{hash, ((ref.index << 1) | (ref.is_place ? 1U : 0U)) + 1};
   (ref.is_place ? place_ids_ : transition_ids_)
       .push_back(IdSpan{static_cast<std::uint32_t>(id_chars_.size()), static_cast<std::uint32_t>(node_id.size())});
   id_chars_.append(node_id);
 }
 
+const SourceLocation* PetriNet::find_node_where(std::string_view node_id) const noexcept {
+  const auto ref = find_node(node_id);
+  if (!ref) return nullptr;
+  return ref->is_place ? &places_[ref->index].where : &transitions_[ref->index].where;
+}
+
 PlaceIndex PetriNet::add_place(Place p) {
   if (p.id.empty()) throw std::invalid_argument("place id must not be empty");
-  if (find_node(p.id)) throw std::invalid_argument("duplicate node id '" + p.id + "'");
+  std::uint32_t hash = 0;
+  const std::size_t slot = claim_slot(p.id, hash);  // throws on a duplicate
   if (p.capacity && p.initial_tokens > *p.capacity) {
     throw std::invalid_argument("place '" + p.id + "' starts with more tokens than its capacity");
   }
   if (p.name.empty()) p.name = p.id;
   const auto index = static_cast<PlaceIndex>(places_.size());
   places_.push_back(std::move(p));
-  index_node(places_.back().id, NodeRef{true, index});
+  fill_slot(slot, hash, places_.back().id, NodeRef{true, index});
   return index;
 }
 
 TransitionIndex PetriNet::add_transition(Transition t) {
   if (t.id.empty()) throw std::invalid_argument("transition id must not be empty");
-  if (find_node(t.id)) throw std::invalid_argument("duplicate node id '" + t.id + "'");
+  std::uint32_t hash = 0;
+  const std::size_t slot = claim_slot(t.id, hash);  // throws on a duplicate
   if (t.delay.count() < 0) throw std::invalid_argument("transition '" + t.id + "' has a negative delay");
   if (t.name.empty()) t.name = t.id;
   const auto index = static_cast<TransitionIndex>(transitions_.size());
   transitions_.push_back(std::move(t));
-  index_node(transitions_.back().id, NodeRef{false, index});
+  fill_slot(slot, hash, transitions_.back().id, NodeRef{false, index});
   return index;
 }
 

@@ -129,6 +129,8 @@ class PetriNet {
   [[nodiscard]] const Transition& transition(TransitionIndex i) const { return transitions_.at(i); }
   [[nodiscard]] std::optional<PlaceIndex> find_place(std::string_view node_id) const noexcept;
   [[nodiscard]] std::optional<TransitionIndex> find_transition(std::string_view node_id) const noexcept;
+  /// Where the place or transition with this id was defined; nullptr when no node has it.
+  [[nodiscard]] const SourceLocation* find_node_where(std::string_view node_id) const noexcept;
   [[nodiscard]] const VariableDecl* find_parameter(std::string_view name) const noexcept;
   [[nodiscard]] const VariableDecl* find_fact(std::string_view name) const noexcept;
 
@@ -140,7 +142,7 @@ class PetriNet {
     std::uint32_t index;
   };
   // Ids are found through an open-addressing table of (hash, node) pairs, linear probing, load
-  // factor at most 1/2, and compared against a copy of every id kept back to back: a look-up
+  // factor at most 3/4, and compared against a copy of every id kept back to back: a look-up
   // touches two small arrays, where a node-based hash map chases two or three pointers and
   // the nodes themselves are hundreds of bytes apart (the loaders resolve every arc by id).
   struct IdSlot {
@@ -148,7 +150,10 @@ class PetriNet {
     std::uint32_t node = 0;  ///< 0: empty; else (index << 1 | is_place) + 1
   };
   [[nodiscard]] std::optional<NodeRef> find_node(std::string_view node_id) const noexcept;
-  void index_node(std::string_view node_id, NodeRef ref);
+  [[nodiscard]] std::size_t probe(std::string_view node_id, std::uint32_t hash, bool& found) const noexcept;
+  // The free slot for a new id (throws on a duplicate), then filled once the node is stored.
+  std::size_t claim_slot(std::string_view node_id, std::uint32_t& hash);
+  void fill_slot(std::size_t slot, std::uint32_t hash, std::string_view node_id, NodeRef ref);
   void grow_index(std::size_t nodes);
 
   std::vector<Place> places_;
