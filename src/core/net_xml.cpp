@@ -1,7 +1,6 @@
 // The native XML format of configuration nets: reader and writer (docs/net-format.md).
 #include <charconv>
-#include <map>
-#include <set>
+#include <vector>
 
 #include "net_formats.hpp"
 
@@ -32,11 +31,18 @@ PetriNet read_native(const XmlElement* root, const ReadContext& ctx) {
                                             std::string(kFormatVersion));
   }
 
-  // Declarations first so that guards and "$param" bindings can be checked wherever they appear.
+  // One pass sorts the children: declarations are read at once (guards and "$param" bindings
+  // are checked against them wherever they appear), then places, transitions and arcs in turn.
+  std::vector<const XmlElement*> places;
+  std::vector<const XmlElement*> transitions;
+  std::vector<const XmlElement*> arcs;
   for (const auto* c = root->first_child(); c != nullptr; c = c->next_sibling()) {
     const std::string_view n = c->name();
-    if (n == "parameter" || n == "fact") read_declaration(ctx, c, net, n == "fact");
-    else if (n != "place" && n != "transition" && n != "arc") unknown_element(ctx, c, "net", kNetChildren);
+    if (n == "arc") arcs.push_back(c);
+    else if (n == "place") places.push_back(c);
+    else if (n == "transition") transitions.push_back(c);
+    else if (n == "parameter" || n == "fact") read_declaration(ctx, c, net, n == "fact");
+    else unknown_element(ctx, c, "net", kNetChildren);
   }
 
   // Every claimed id is added to the net, so the net's own index finds the first definition.
@@ -50,17 +56,8 @@ PetriNet read_native(const XmlElement* root, const ReadContext& ctx) {
     return id;
   };
 
-  // Reserve for what the document holds: no reallocation while ten thousand nodes arrive.
-  std::size_t place_count = 0;
-  std::size_t transition_count = 0;
-  for (const auto* c = root->first_child(); c != nullptr; c = c->next_sibling()) {
-    const std::string_view n = c->name();
-    if (n == "place") ++place_count;
-    else if (n == "transition") ++transition_count;
-  }
-  net.reserve(place_count, transition_count);
-
-  for (const auto* c = root->first_child("place"); c != nullptr; c = c->next_sibling("place")) {
+  net.reserve(places.size(), transitions.size());  // no reallocation while the nodes arrive
+  for (const XmlElement* c : places) {
     Place p;
     const auto id = claim_id(c);
     p.id = id.value_or(std::string_view());
@@ -68,7 +65,7 @@ PetriNet read_native(const XmlElement* root, const ReadContext& ctx) {
     read_place_details(ctx, c, p, net, true);
     if (id) net.add_place(std::move(p));
   }
-  for (const auto* c = root->first_child("transition"); c != nullptr; c = c->next_sibling("transition")) {
+  for (const XmlElement* c : transitions) {
     Transition t;
     const auto id = claim_id(c);
     t.id = id.value_or(std::string_view());
@@ -76,7 +73,7 @@ PetriNet read_native(const XmlElement* root, const ReadContext& ctx) {
     read_transition_details(ctx, c, t, net, true);
     if (id) net.add_transition(std::move(t));
   }
-  for (const auto* c = root->first_child("arc"); c != nullptr; c = c->next_sibling("arc")) {
+  for (const XmlElement* c : arcs) {
     check_attributes(ctx, c, {"source", "target", "weight", "kind"});
     check_no_text(ctx, c);
     for (const auto* g = c->first_child(); g != nullptr; g = g->next_sibling()) unknown_element(ctx, g, "arc", "");
