@@ -69,25 +69,6 @@ constexpr std::uint64_t ascii_controls(std::uint64_t w) noexcept {
   return ~(((w & kLow7) + kOnes * 0x60) | w) & kHigh;
 }
 
-// How many '<' and '=' the text holds: upper bounds of its elements and attributes.
-std::pair<std::size_t, std::size_t> count_tags_and_equals(std::string_view s) noexcept {
-  std::size_t lt = 0;
-  std::size_t eq = 0;
-  std::size_t i = 0;
-  for (; i + 8 <= s.size(); i += 8) {
-    const std::uint64_t w = load8(s.data() + i);
-    // Each match is 0x80 in its byte: shifted to 1 and summed into the top byte (no popcount
-    // instruction in the baseline x86-64 set).
-    lt += static_cast<std::size_t>(((bytes_equal(w, '<') >> 7) * kOnes) >> 56);
-    eq += static_cast<std::size_t>(((bytes_equal(w, '=') >> 7) * kOnes) >> 56);
-  }
-  for (; i < s.size(); ++i) {
-    lt += s[i] == '<' ? 1 : 0;
-    eq += s[i] == '=' ? 1 : 0;
-  }
-  return {lt, eq};
-}
-
 // From `from`, the offset of the first byte that ends or complicates an attribute value: its
 // closing `quote`, or a byte the value cannot keep as it is ('&', '<', a tab/LF/CR, any byte
 // >= 0x80 in an ISO-8859-1 document); s.size() when there is none. One pass: most values have
@@ -201,11 +182,18 @@ std::size_t decode_reference(std::string_view s, std::size_t i, std::string& out
   return semi + 1;
 }
 
+struct SourceCounts {
+  std::size_t tags = 0;    // '<': an upper bound of the elements
+  std::size_t equals = 0;  // '=': an upper bound of the attributes
+};
+
 // Checks that the source is UTF-8 (any byte for ISO-8859-1) without control characters other than
-// tab, LF and CR. Eight bytes at a time: most words are plain printable ASCII and are skipped whole.
-void validate_encoding(std::string_view s, bool latin1) {
+// tab, LF and CR, and counts what the tree will need room for. Eight bytes at a time: most words
+// are plain printable ASCII and are checked and counted whole.
+SourceCounts validate_and_count(std::string_view s, bool latin1) {
   const auto* p = reinterpret_cast<const unsigned char*>(s.data());
   const std::size_t n = s.size();
+  SourceCounts counts;
   std::size_t i = 0;
   while (i < n) {
     if (i + 8 <= n) {
@@ -214,11 +202,17 @@ void validate_encoding(std::string_view s, bool latin1) {
       const std::uint64_t controls =
           ascii_controls(w) & ~(bytes_equal(w, '\t') | bytes_equal(w, '\n') | bytes_equal(w, '\r'));
       if (((w & kHigh) | controls) == 0) {
+        // Each match is 0x80 in its byte: shifted to 1 and summed into the top byte (no popcount
+        // instruction in the baseline x86-64 set).
+        counts.tags += static_cast<std::size_t>(((bytes_equal(w, '<') >> 7) * kOnes) >> 56);
+        counts.equals += static_cast<std::size_t>(((bytes_equal(w, '=') >> 7) * kOnes) >> 56);
         i += 8;
         continue;
       }
     }
     const unsigned char b = p[i];
+    counts.tags += b == '<' ? 1 : 0;
+    counts.equals += b == '=' ? 1 : 0;
     if (b < 0x80) {
       if (b < 0x20 && b != '\t' && b != '\n' && b != '\r') {
         throw ParseFailure{i, "control character " + byte_text(b) + " is not allowed in XML"};
@@ -259,6 +253,7 @@ void validate_encoding(std::string_view s, bool latin1) {
     }
     i += len;
   }
+  return counts;
 }
 
 }  // namespace
@@ -285,17 +280,16 @@ class XmlParser {
 
   void run() {
     if (n_ >= std::numeric_limits<std::uint32_t>::max()) throw ParseFailure{0, "document too large (4 GiB or more)"};
-    // Every element starts with '<' and every attribute has '=': reserving that many (an upper
-    // bound) spares the copies of growing vectors of tens of thousands of entries.
-    const auto [tags, equals] = count_tags_and_equals(s_);
-    d_.elements_.reserve(tags);
-    d_.attributes_.reserve(equals);
     if (starts_with(0, "\xEF\xBB\xBF")) p_ = 3;
     if (starts_with(0, "\xFE\xFF") || starts_with(0, "\xFF\xFE")) {
       throw ParseFailure{0, "UTF-16 is not supported: save the file as UTF-8"};
     }
     if (starts_with(p_, "<?xml") && p_ + 5 < n_ && (cls(s_[p_ + 5]) & kSpace) != 0) declaration();
-    validate_encoding(s_, d_.latin1_);
+    // Every element starts with '<' and every attribute has '=': reserving that many (an upper
+    // bound) spares the copies of growing vectors of tens of thousands of entries.
+    const SourceCounts counts = validate_and_count(s_, d_.latin1_);
+    d_.elements_.reserve(counts.tags);
+    d_.attributes_.reserve(counts.equals);
     misc(true);
     if (p_ >= n_) throw ParseFailure{p_, "empty document: expected a root element"};
     content();
