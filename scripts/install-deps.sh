@@ -5,7 +5,8 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config
-  libeigen3-dev libyaml-cpp-dev libtinyxml2-dev libspdlog-dev
+  libeigen3-dev libyaml-cpp-dev libspdlog-dev
+  libtinyxml2-dev  # tests only: the reference the XML reader is compared with
   catch2 libbenchmark-dev
   graphviz libxml2-utils
   zlib1g-dev
