@@ -690,30 +690,24 @@ class XmlParser {
   }
 
   void add_view(Open& o, std::string_view piece) {
-    if (!o.has_text) {
-      const std::size_t first = first_non_blank(piece);
-      if (first == piece.size()) return;
-      o.text = piece.substr(first);
-      o.has_text = true;
-      return;
-    }
-    if (!o.owned) {
-      o.buffer.assign(o.text);
-      o.owned = true;
-    }
-    o.buffer += o.gap;
-    o.gap.clear();
-    o.buffer += piece;
+    if (o.has_text) return append(o, piece);
+    const std::size_t first = first_non_blank(piece);
+    if (first == piece.size()) return;
+    o.text = piece.substr(first);
+    o.has_text = true;
   }
 
-  void add_decoded(Open& o, std::string piece) {
-    if (!o.has_text && first_non_blank(piece) == piece.size()) return;
-    if (!o.has_text) {
-      o.buffer = piece.substr(first_non_blank(piece));
-      o.owned = true;
-      o.has_text = true;
-      return;
-    }
+  void add_decoded(Open& o, const std::string& piece) {
+    if (o.has_text) return append(o, piece);
+    const std::size_t first = first_non_blank(piece);
+    if (first == piece.size()) return;
+    o.buffer.assign(piece, first);
+    o.owned = true;
+    o.has_text = true;
+  }
+
+  // A piece after earlier text: from now on the text lives in the buffer, with the blanks between.
+  static void append(Open& o, std::string_view piece) {
     if (!o.owned) {
       o.buffer.assign(o.text);
       o.owned = true;
