@@ -1,6 +1,8 @@
 #include "net_reader.hpp"
 
 #include <algorithm>
+#include <array>
+#include <span>
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -129,19 +131,41 @@ void ReadContext::error_at_value(const XmlElement* e, std::string_view attr, con
   diags.error(loc.attribute_value(e, attr, decoded_offset), message);
 }
 
+namespace {
+
+void unknown_attribute(const ReadContext& ctx, const XmlElement* e, std::string_view name,
+                       std::span<const std::string_view> allowed) {
+  std::string list;
+  for (const auto& s : allowed) {
+    if (!list.empty()) list += ", ";
+    list += s;
+  }
+  ctx.error_at_attribute(e, name,
+                         "unknown attribute '" + std::string(name) + "' on <" + std::string(e->name()) +
+                             ">; expected one of: " + list);
+}
+
+}  // namespace
+
 void check_attributes(const ReadContext& ctx, const XmlElement* e,
                       std::initializer_list<std::string_view> allowed) {
   for (const XmlAttribute& a : e->attributes()) {
-    const std::string_view name = a.name;
-    if (std::find(allowed.begin(), allowed.end(), name) != allowed.end()) continue;
-    std::string list;
-    for (const auto& s : allowed) {
-      if (!list.empty()) list += ", ";
-      list += s;
+    if (std::find(allowed.begin(), allowed.end(), a.name) == allowed.end()) {
+      unknown_attribute(ctx, e, a.name, std::span<const std::string_view>(allowed.begin(), allowed.size()));
     }
-    ctx.error_at_attribute(e, name,
-                           "unknown attribute '" + std::string(name) + "' on <" + std::string(e->name()) +
-                               ">; expected one of: " + list);
+  }
+}
+
+void read_attributes(const ReadContext& ctx, const XmlElement* e, std::span<const std::string_view> names,
+                     std::span<std::optional<std::string_view>> values) {
+  for (const XmlAttribute& a : e->attributes()) {
+    std::size_t k = 0;
+    while (k < names.size() && names[k] != a.name) ++k;
+    if (k < names.size()) {
+      values[k] = a.value;
+    } else {
+      unknown_attribute(ctx, e, a.name, names);
+    }
   }
 }
 
@@ -164,7 +188,11 @@ std::optional<std::string_view> optional_attr(const XmlElement* e, std::string_v
 }
 
 std::optional<std::string_view> required(const ReadContext& ctx, const XmlElement* e, std::string_view attr) {
-  auto v = e->attribute(attr);
+  return required(ctx, e, attr, e->attribute(attr));
+}
+
+std::optional<std::string_view> required(const ReadContext& ctx, const XmlElement* e, std::string_view attr,
+                                         std::optional<std::string_view> v) {
   if (!v) {
     ctx.error(e, "missing attribute '" + std::string(attr) + "' on <" + std::string(e->name()) + ">");
     return std::nullopt;
@@ -281,18 +309,20 @@ void read_declaration(const ReadContext& ctx, const XmlElement* e, PetriNet& net
 
 void read_place_details(const ReadContext& ctx, const XmlElement* e, Place& place, const PetriNet& net,
                         bool allow_tokens_and_name) {
-  if (allow_tokens_and_name) {
-    check_attributes(ctx, e, {"id", "name", "description", "tokens", "capacity", "outcome", "message"});
-    if (auto n = optional_attr(e, "name")) place.name = *n;
-    if (auto t = optional_attr(e, "tokens")) {
-      if (auto v = parse_count(ctx, e, "tokens", *t, 0, "token count")) place.initial_tokens = *v;
-    }
-  } else {
-    check_attributes(ctx, e, {"description", "capacity", "outcome", "message"});
+  // One pass over the attributes. PNML's <toolspecific> place carries only the last four.
+  static constexpr std::array<std::string_view, 7> kNames{"id",       "name",    "tokens", "description",
+                                                          "capacity", "outcome", "message"};
+  enum { kId, kName, kTokens, kDescription, kCapacity, kOutcome, kMessage };
+  std::array<std::optional<std::string_view>, kNames.size()> attr;
+  const std::size_t first = allow_tokens_and_name ? kId : kDescription;
+  read_attributes(ctx, e, std::span(kNames).subspan(first), std::span(attr).subspan(first));
+  if (const auto& n = attr[kName]) place.name = *n;
+  if (const auto& t = attr[kTokens]) {
+    if (auto v = parse_count(ctx, e, "tokens", *t, 0, "token count")) place.initial_tokens = *v;
   }
   check_no_text(ctx, e);
-  if (auto d = optional_attr(e, "description")) place.description = *d;
-  if (auto c = optional_attr(e, "capacity")) {
+  if (const auto& d = attr[kDescription]) place.description = *d;
+  if (const auto& c = attr[kCapacity]) {
     if (auto v = parse_count(ctx, e, "capacity", *c, 1, "capacity")) {
       place.capacity = *v;
       if (place.initial_tokens > *v) {
@@ -302,13 +332,13 @@ void read_place_details(const ReadContext& ctx, const XmlElement* e, Place& plac
       }
     }
   }
-  if (auto o = optional_attr(e, "outcome")) {
+  if (const auto& o = attr[kOutcome]) {
     if (*o == "success") place.outcome = Outcome::success;
     else if (*o == "fault") place.outcome = Outcome::fault;
     else if (*o == "none") place.outcome = Outcome::none;
     else ctx.error_at_value(e, "outcome", "unknown outcome '" + std::string(*o) + "': expected success or fault");
   }
-  if (auto m = optional_attr(e, "message")) {
+  if (const auto& m = attr[kMessage]) {
     if (place.outcome != Outcome::fault) {
       ctx.error_at_attribute(e, "message", "a message belongs to a fault place (outcome=\"fault\") only");
     } else {
@@ -348,18 +378,20 @@ void read_place_details(const ReadContext& ctx, const XmlElement* e, Place& plac
 
 void read_transition_details(const ReadContext& ctx, const XmlElement* e, Transition& t, const PetriNet& net,
                              bool allow_name) {
-  if (allow_name) {
-    check_attributes(ctx, e, {"id", "name", "description", "event", "guard", "delay", "priority"});
-    if (auto n = optional_attr(e, "name")) t.name = *n;
-  } else {
-    check_attributes(ctx, e, {"description", "event", "guard", "delay", "priority"});
-  }
+  // One pass over the attributes. PNML's <toolspecific> transition carries only the last five.
+  static constexpr std::array<std::string_view, 7> kNames{"id", "name", "description", "event", "guard", "delay",
+                                                          "priority"};
+  enum { kId, kName, kDescription, kEvent, kGuard, kDelay, kPriority };
+  std::array<std::optional<std::string_view>, kNames.size()> attr;
+  const std::size_t first = allow_name ? kId : kDescription;
+  read_attributes(ctx, e, std::span(kNames).subspan(first), std::span(attr).subspan(first));
+  if (const auto& n = attr[kName]) t.name = *n;
   check_no_text(ctx, e);
   for (const auto* c = e->first_child(); c != nullptr; c = c->next_sibling()) {
     unknown_element(ctx, c, e->name(), "");
   }
-  if (auto d = optional_attr(e, "description")) t.description = *d;
-  if (auto ev = optional_attr(e, "event")) {
+  if (const auto& d = attr[kDescription]) t.description = *d;
+  if (const auto& ev = attr[kEvent]) {
     if (!is_valid_name(*ev)) {
       ctx.error_at_value(e, "event", "bad event name '" + std::string(*ev) +
                                          "': expected a letter or '_' then letters, digits, '_', '.', '-', '/'");
@@ -367,13 +399,13 @@ void read_transition_details(const ReadContext& ctx, const XmlElement* e, Transi
       t.event = *ev;
     }
   }
-  if (auto g = optional_attr(e, "guard")) read_guard(ctx, e, t, net, std::string(*g));
-  if (auto d = optional_attr(e, "delay")) {
+  if (const auto& g = attr[kGuard]) read_guard(ctx, e, t, net, std::string(*g));
+  if (const auto& d = attr[kDelay]) {
     std::string err;
     if (auto v = parse_delay_text(*d, err)) t.delay = *v;
     else ctx.error_at_value(e, "delay", err + " (transition '" + t.id + "')");
   }
-  if (auto p = optional_attr(e, "priority")) {
+  if (const auto& p = attr[kPriority]) {
     int v = 0;
     const auto [ptr, ec] = std::from_chars(p->data(), p->data() + p->size(), v);
     if (p->empty() || ec != std::errc() || ptr != p->data() + p->size()) {

@@ -5,6 +5,7 @@
 
 #include <initializer_list>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -33,6 +34,10 @@ struct ReadContext {
 /// Reports every attribute not in `allowed`.
 void check_attributes(const ReadContext& ctx, const XmlElement* e,
                       std::initializer_list<std::string_view> allowed);
+/// One pass over the element's attributes: values[i] gets the value of names[i] (left nullopt
+/// when absent); every other attribute is reported as check_attributes does.
+void read_attributes(const ReadContext& ctx, const XmlElement* e, std::span<const std::string_view> names,
+                     std::span<std::optional<std::string_view>> values);
 /// "unknown element <x> in <parent>; expected one of: ...".
 void unknown_element(const ReadContext& ctx, const XmlElement* e, std::string_view parent,
                      std::string_view expected);
@@ -42,6 +47,9 @@ void check_no_text(const ReadContext& ctx, const XmlElement* e);
 /// A required attribute's value (a view into the document); reports it missing (or empty) and
 /// returns nullopt.
 std::optional<std::string_view> required(const ReadContext& ctx, const XmlElement* e, std::string_view attr);
+/// The same check on a value already read (read_attributes): missing or empty is reported.
+std::optional<std::string_view> required(const ReadContext& ctx, const XmlElement* e, std::string_view attr,
+                                         std::optional<std::string_view> value);
 /// An optional attribute's value (a view into the document); nullopt when absent.
 std::optional<std::string_view> optional_attr(const XmlElement* e, std::string_view attr);
 

@@ -1,4 +1,5 @@
 // The native XML format of configuration nets: reader and writer (docs/net-format.md).
+#include <array>
 #include <charconv>
 #include <vector>
 
@@ -73,16 +74,18 @@ PetriNet read_native(const XmlElement* root, const ReadContext& ctx) {
     read_transition_details(ctx, c, t, net, true);
     if (id) net.add_transition(std::move(t));
   }
+  static constexpr std::array<std::string_view, 4> kArcAttributes{"source", "target", "weight", "kind"};
   for (const XmlElement* c : arcs) {
-    check_attributes(ctx, c, {"source", "target", "weight", "kind"});
+    std::array<std::optional<std::string_view>, kArcAttributes.size()> attr;
+    read_attributes(ctx, c, kArcAttributes, attr);
     check_no_text(ctx, c);
     for (const auto* g = c->first_child(); g != nullptr; g = g->next_sibling()) unknown_element(ctx, g, "arc", "");
-    const auto source = required(ctx, c, "source");
-    const auto target = required(ctx, c, "target");
+    const auto source = required(ctx, c, "source", attr[0]);
+    const auto target = required(ctx, c, "target", attr[1]);
     std::optional<Tokens> weight = 1;
-    if (auto w = optional_attr(c, "weight")) weight = parse_count(ctx, c, "weight", *w, 1, "weight");
+    if (const auto& w = attr[2]) weight = parse_count(ctx, c, "weight", *w, 1, "weight");
     std::optional<ArcKind> kind = ArcKind::normal;
-    if (auto k = optional_attr(c, "kind")) {
+    if (const auto& k = attr[3]) {
       kind = parse_arc_kind(*k);
       if (!kind) ctx.error_at_value(c, "kind", "unknown arc kind '" + std::string(*k) + "': expected normal, read or inhibitor");
     }

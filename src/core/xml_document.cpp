@@ -199,8 +199,9 @@ SourceCounts validate_and_count(std::string_view s, bool latin1) {
     if (i + 8 <= n) {
       const std::uint64_t w = load8(p + i);
       // Plain words: no byte >= 0x80 and no control byte other than tab, LF and CR.
-      const std::uint64_t controls =
-          ascii_controls(w) & ~(bytes_equal(w, '\t') | bytes_equal(w, '\n') | bytes_equal(w, '\r'));
+      // (Most words have no byte below 0x20 at all: the exceptions are looked for only then.)
+      std::uint64_t controls = ascii_controls(w);
+      if (controls != 0) controls &= ~(bytes_equal(w, '\t') | bytes_equal(w, '\n') | bytes_equal(w, '\r'));
       if (((w & kHigh) | controls) == 0) {
         // Each match is 0x80 in its byte: shifted to 1 and summed into the top byte (no popcount
         // instruction in the baseline x86-64 set).
