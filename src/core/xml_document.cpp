@@ -582,7 +582,7 @@ class XmlParser {
     }
     XmlAttribute& a = d_.attributes_.emplace_back();
     a.name = name;
-    a.value = special ? decode_attribute(raw, value_start) : raw;
+    a.value = special ? std::string_view(d_.decoded_.emplace_back(decode(raw, value_start, Content::attribute))) : raw;
     a.name_offset = static_cast<std::uint32_t>(name_at_offset);
     a.value_offset = static_cast<std::uint32_t>(value_start);
     a.value_end = static_cast<std::uint32_t>(value_end);
@@ -612,43 +612,18 @@ class XmlParser {
 
   void finish_attributes(std::uint32_t element, std::uint32_t count) { d_.elements_[element].attribute_count_ = count; }
 
-  // Attribute value normalisation (XML 1.0 section 3.3.3) after reference decoding.
-  std::string_view decode_attribute(std::string_view raw, std::size_t source_offset) {
-    std::string out;
-    out.reserve(raw.size());
-    for (std::size_t i = 0; i < raw.size();) {
-      const char c = raw[i];
-      if (c == '&') {
-        try {
-          i = decode_reference(raw, i, out);
-        } catch (ParseFailure& f) {
-          f.offset += source_offset;
-          throw;
-        }
-      } else if (c == '\r') {
-        out += ' ';
-        i += (i + 1 < raw.size() && raw[i + 1] == '\n') ? 2 : 1;
-      } else if (c == '\t' || c == '\n') {
-        out += ' ';
-        ++i;
-      } else if (d_.latin1_ && static_cast<unsigned char>(c) >= 0x80) {
-        append_utf8(out, static_cast<unsigned char>(c));
-        ++i;
-      } else {
-        out += c;
-        ++i;
-      }
-    }
-    return d_.decoded_.emplace_back(std::move(out));
-  }
+  enum class Content { attribute, text, cdata };
 
-  // Text: references decoded (not in CDATA), CR LF and lone CR become LF.
-  std::string decode_text(std::string_view raw, std::size_t source_offset, bool cdata) {
+  // Decodes a raw value or text piece: references (not in CDATA), CR LF and lone CR as one line
+  // end, Latin-1 bytes to UTF-8. In an attribute value every line end, tab or LF becomes a space
+  // (XML 1.0 section 3.3.3); in text a line end becomes LF.
+  std::string decode(std::string_view raw, std::size_t source_offset, Content content) {
+    const bool attribute = content == Content::attribute;
     std::string out;
     out.reserve(raw.size());
     for (std::size_t i = 0; i < raw.size();) {
       const char c = raw[i];
-      if (c == '&' && !cdata) {
+      if (c == '&' && content != Content::cdata) {
         try {
           i = decode_reference(raw, i, out);
         } catch (ParseFailure& f) {
@@ -656,8 +631,11 @@ class XmlParser {
           throw;
         }
       } else if (c == '\r') {
-        out += '\n';
+        out += attribute ? ' ' : '\n';
         i += (i + 1 < raw.size() && raw[i + 1] == '\n') ? 2 : 1;
+      } else if (attribute && (c == '\t' || c == '\n')) {
+        out += ' ';
+        ++i;
       } else if (d_.latin1_ && static_cast<unsigned char>(c) >= 0x80) {
         append_utf8(out, static_cast<unsigned char>(c));
         ++i;
@@ -684,7 +662,7 @@ class XmlParser {
     }
     // References are decoded (and so checked) even in text nobody reads: a bad one is an error.
     if (special) {
-      add_decoded(o, decode_text(raw, source_offset, cdata));
+      add_decoded(o, decode(raw, source_offset, cdata ? Content::cdata : Content::text));
     } else {
       add_view(o, raw);
     }

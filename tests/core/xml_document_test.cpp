@@ -805,10 +805,10 @@ std::string tinyxml_text(const tinyxml2::XMLElement* e) {
 
 // Compares the two trees in document order (iteratively); returns the first disagreement.
 std::string compare_trees(const XmlElement* ours, const tinyxml2::XMLElement* theirs) {
-  std::vector<std::pair<const XmlElement*, const tinyxml2::XMLElement*>> todo{{ours, theirs}};
-  while (!todo.empty()) {
-    const auto [a, b] = todo.back();
-    todo.pop_back();
+  std::vector<std::pair<const XmlElement*, const tinyxml2::XMLElement*>> pending{{ours, theirs}};
+  while (!pending.empty()) {
+    const auto [a, b] = pending.back();
+    pending.pop_back();
     const std::string where = "element <" + std::string(a->name()) + "> line " + std::to_string(a->line()) + ": ";
     if (a->name() != b->Name()) return where + "name differs from tinyxml2's <" + b->Name() + ">";
     const tinyxml2::XMLAttribute* ta = b->FirstAttribute();
@@ -832,7 +832,7 @@ std::string compare_trees(const XmlElement* ours, const tinyxml2::XMLElement* th
       tc = tc->NextSiblingElement();
     }
     if (tc != nullptr) return where + "tinyxml2 has more children: <" + tc->Name() + ">";
-    todo.insert(todo.end(), children.rbegin(), children.rend());
+    pending.insert(pending.end(), children.rbegin(), children.rend());
   }
   return {};
 }
@@ -1071,13 +1071,13 @@ TEST_CASE("xml document: agrees with tinyxml2 on 400 seeded random well-formed d
     XmlDocument doc;
     REQUIRE(doc.parse(text));
     elements += doc.element_count();
-    std::vector<const XmlElement*> todo{doc.root()};
-    while (!todo.empty()) {
-      const XmlElement* e = todo.back();
-      todo.pop_back();
+    std::vector<const XmlElement*> pending{doc.root()};
+    while (!pending.empty()) {
+      const XmlElement* e = pending.back();
+      pending.pop_back();
       attributes_seen += e->attributes().size();
       if (!e->text().empty()) ++with_text;
-      for (const XmlElement* c = e->first_child(); c != nullptr; c = c->next_sibling()) todo.push_back(c);
+      for (const XmlElement* c = e->first_child(); c != nullptr; c = c->next_sibling()) pending.push_back(c);
     }
   }
   // The generator covers what it claims: many elements, attributes and texts.
