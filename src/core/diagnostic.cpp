@@ -1,11 +1,42 @@
 #include "tripodal/core/diagnostic.hpp"
 
+#include <mutex>
+#include <ostream>
+#include <unordered_set>
 #include <utility>
 
 namespace tripodal {
 
+namespace {
+
+// Node-based, so that an interned name never moves; names are never removed.
+struct FileNames {
+  std::mutex mutex;
+  std::unordered_set<std::string> names;
+};
+
+FileNames& file_names() {
+  static FileNames names;
+  return names;
+}
+
+const std::string kNoName;
+
+}  // namespace
+
+SourceFile::SourceFile(std::string_view name) {
+  if (name.empty()) return;
+  FileNames& interned = file_names();
+  const std::scoped_lock lock(interned.mutex);
+  name_ = &*interned.names.emplace(name).first;
+}
+
+const std::string& SourceFile::str() const noexcept { return name_ == nullptr ? kNoName : *name_; }
+
+std::ostream& operator<<(std::ostream& os, const SourceFile& file) { return os << file.str(); }
+
 std::string SourceLocation::str() const {
-  std::string out = file.empty() ? std::string("<input>") : file;
+  std::string out = file.empty() ? std::string("<input>") : file.str();
   if (line > 0) {
     out += ':' + std::to_string(line);
     if (column > 0) out += ':' + std::to_string(column);

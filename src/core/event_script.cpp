@@ -33,10 +33,10 @@ std::optional<std::size_t> bad_name_char(std::string_view s) {
 
 class LineParser {
  public:
-  LineParser(std::string_view source, int line, Diagnostics& diagnostics)
+  LineParser(SourceFile source, int line, Diagnostics& diagnostics)
       : source_(source), line_(line), diagnostics_(diagnostics) {}
 
-  SourceLocation at(int column) const { return SourceLocation{std::string(source_), line_, column}; }
+  SourceLocation at(int column) const { return SourceLocation{source_, line_, column}; }
   void error(int column, std::string message) { diagnostics_.error(at(column), std::move(message)); }
 
   // Splits into tokens, stopping at a '#' outside quotes. Returns false on an unterminated quote.
@@ -89,7 +89,7 @@ class LineParser {
   }
 
  private:
-  std::string_view source_;
+  SourceFile source_;
   int line_;
   Diagnostics& diagnostics_;
 };
@@ -103,6 +103,7 @@ EventScript parse_event_script(std::string_view text, std::string_view source) {
   double previous_s = 0.0;
   int previous_line = 0;
   int line_no = 0;
+  const SourceFile file(source);  // interned once, not per line
   std::vector<Token> tokens;
   std::size_t pos = 0;
   while (pos <= text.size()) {
@@ -110,7 +111,7 @@ EventScript parse_event_script(std::string_view text, std::string_view source) {
     const std::string_view line = text.substr(pos, eol - pos);
     pos = eol + 1;
     ++line_no;
-    LineParser p(source, line_no, diagnostics);
+    LineParser p(file, line_no, diagnostics);
     tokens.clear();
     if (!p.tokenize(line, tokens) || tokens.empty()) continue;
 

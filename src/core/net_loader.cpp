@@ -106,7 +106,7 @@ std::optional<PetriNet> load_net_from_string(std::string_view text, std::string_
                                              const LoadOptions& options) {
   const std::size_t errors_before = diagnostics.error_count();
   detail::XmlDocument doc;
-  detail::XmlLocator locator(doc, std::string(name));
+  detail::XmlLocator locator(doc, SourceFile(name));
   if (!doc.parse(text)) {
     diagnostics.error(locator.offset(doc.error().offset), "malformed XML: " + doc.error().message);
     return std::nullopt;

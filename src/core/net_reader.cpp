@@ -62,11 +62,10 @@ void read_guard(const ReadContext& ctx, const XmlElement* e, Transition& t, cons
     for (std::size_t i = 0; i < ids.size(); ++i) {
       const VariableDecl* decl = net.find_parameter(ids[i]);
       if (decl == nullptr) decl = net.find_fact(ids[i]);
-      const auto at = find_identifier(text, ids[i]);
       if (decl == nullptr) {
         ctx.error_at_value(e, "guard", "unknown parameter '" + ids[i] + "' in guard of transition '" + t.id + "' (" +
                                            declared_list(net) + ")",
-                           at);
+                           find_identifier(text, ids[i]));
         ok = false;
         continue;
       }
@@ -74,7 +73,7 @@ void read_guard(const ReadContext& ctx, const XmlElement* e, Transition& t, cons
       if (expected && *expected != decl->type) {
         ctx.error_at_value(e, "guard", "guard of transition '" + t.id + "' uses '" + ids[i] + "' as a " +
                                            type_name(*expected) + ", but it is declared " + type_name(decl->type),
-                           at);
+                           find_identifier(text, ids[i]));
         ok = false;
       }
     }
@@ -150,7 +149,7 @@ void unknown_attribute(const ReadContext& ctx, const XmlElement* e, std::string_
 void check_attributes(const ReadContext& ctx, const XmlElement* e,
                       std::initializer_list<std::string_view> allowed) {
   for (const XmlAttribute& a : e->attributes()) {
-    if (std::find(allowed.begin(), allowed.end(), a.name) == allowed.end()) {
+    if (std::none_of(allowed.begin(), allowed.end(), [&](std::string_view n) { return same_name(n, a.name); })) {
       unknown_attribute(ctx, e, a.name, std::span<const std::string_view>(allowed.begin(), allowed.size()));
     }
   }
@@ -160,7 +159,7 @@ void read_attributes(const ReadContext& ctx, const XmlElement* e, std::span<cons
                      std::span<std::optional<std::string_view>> values) {
   for (const XmlAttribute& a : e->attributes()) {
     std::size_t k = 0;
-    while (k < names.size() && names[k] != a.name) ++k;
+    while (k < names.size() && !same_name(names[k], a.name)) ++k;
     if (k < names.size()) {
       values[k] = a.value;
     } else {

@@ -6,7 +6,7 @@ namespace tripodal {
 
 namespace {
 
-// FNV-1a: ids are a few bytes long, so a byte loop is as fast as anything and stays inline.
+// FNV-1a, for ids longer than a slot holds.
 std::uint32_t id_hash(std::string_view s) noexcept {
   std::uint32_t h = 2166136261U;
   for (const char c : s) {
@@ -15,6 +15,9 @@ std::uint32_t id_hash(std::string_view s) noexcept {
   }
   return h;
 }
+
+constexpr std::size_t kShortId = 7;  // bytes a slot holds, with the length in the eighth
+constexpr std::uint64_t kLongId = 0xFFULL << 56;
 
 }  // namespace
 
@@ -28,6 +31,7 @@ void PetriNet::reserve(std::size_t places, std::size_t transitions) {
 
 void PetriNet::grow_index(std::size_t nodes) {
   // Load factor at most 3/4: a 20,000-node net fits a 256 KiB table.
+  if (nodes * 4 <= id_slots_.size() * 3) return;  // the common case: room enough
   std::size_t capacity = 16;
   while (capacity * 3 < nodes * 4) capacity *= 2;
   if (capacity <= id_slots_.size()) return;
@@ -42,23 +46,49 @@ void PetriNet::grow_index(std::size_t nodes) {
   }
 }
 
-std::size_t PetriNet::probe(std::string_view node_id, std::uint32_t hash, bool& found) const noexcept {
+PetriNet::IdKey PetriNet::id_key(std::string_view node_id) noexcept {
+  if (node_id.size() > kShortId) {
+    const std::uint32_t h = id_hash(node_id);
+    return IdKey{kLongId | h, h};
+  }
+  // The bytes in little-endian order whatever the machine. From 4 bytes on, two 4-byte loads
+  // that may overlap (an overlapping byte lands on the same place from both).
+  const auto* b = reinterpret_cast<const unsigned char*>(node_id.data());
+  const std::size_t n = node_id.size();
+  const auto load4 = [](const unsigned char* p) {
+    return std::uint64_t{p[0]} | std::uint64_t{p[1]} << 8 | std::uint64_t{p[2]} << 16 | std::uint64_t{p[3]} << 24;
+  };
+  std::uint64_t key = static_cast<std::uint64_t>(n) << 56;
+  if (n >= 4) {
+    key |= load4(b) | load4(b + n - 4) << (8 * (n - 4));
+  } else {
+    for (std::size_t k = 0; k < n; ++k) key |= std::uint64_t{b[k]} << (8 * k);
+  }
+  // A 64-bit finaliser (multiply, xor-shift): every byte of the key, the length included,
+  // reaches the low bits that pick the slot.
+  std::uint64_t h = key * 0x9E3779B97F4A7C15ULL;
+  h ^= h >> 32;
+  h *= 0xFF51AFD7ED558CCDULL;
+  h ^= h >> 29;
+  return IdKey{key, static_cast<std::uint32_t>(h)};
+}
+
+std::size_t PetriNet::probe(std::string_view node_id, IdKey key, bool& found) const noexcept {
   const std::size_t mask = id_slots_.size() - 1;
-  for (std::size_t i = hash & mask;; i = (i + 1) & mask) {
+  for (std::size_t i = key.hash & mask;; i = (i + 1) & mask) {
     const IdSlot& slot = id_slots_[i];
     if (slot.node == 0) {
       found = false;
       return i;
     }
-    if (slot.hash != hash) continue;
+    if (slot.key != key.key) continue;
+    if ((key.key & kLongId) != kLongId) {  // a short id: the key is the id
+      found = true;
+      return i;
+    }
     const std::uint32_t code = slot.node - 1;
     const IdSpan span = (code & 1U) != 0 ? place_ids_[code >> 1] : transition_ids_[code >> 1];
-    if (span.size != node_id.size()) continue;
-    // Ids are short: a byte loop beats a call to memcmp.
-    const char* key = id_chars_.data() + span.offset;
-    std::size_t k = 0;
-    while (k < span.size && key[k] == node_id[k]) ++k;
-    if (k == span.size) {
+    if (span.size == node_id.size() && std::string_view(id_chars_).substr(span.offset, span.size) == node_id) {
       found = true;
       return i;
     }
@@ -68,23 +98,23 @@ std::size_t PetriNet::probe(std::string_view node_id, std::uint32_t hash, bool& 
 std::optional<PetriNet::NodeRef> PetriNet::find_node(std::string_view node_id) const noexcept {
   if (id_slots_.empty()) return std::nullopt;
   bool found = false;
-  const std::size_t i = probe(node_id, id_hash(node_id), found);
+  const std::size_t i = probe(node_id, id_key(node_id), found);
   if (!found) return std::nullopt;
   const std::uint32_t code = id_slots_[i].node - 1;
   return NodeRef{(code & 1U) != 0, code >> 1};
 }
 
-std::size_t PetriNet::claim_slot(std::string_view node_id, std::uint32_t& hash) {
+std::size_t PetriNet::claim_slot(std::string_view node_id, IdKey& key) {
   grow_index(places_.size() + transitions_.size() + 1);
-  hash = id_hash(node_id);
+  key = id_key(node_id);
   bool found = false;
-  const std::size_t slot = probe(node_id, hash, found);
+  const std::size_t slot = probe(node_id, key, found);
   if (found) throw std::invalid_argument("duplicate node id '" + std::string(node_id) + "'");
   return slot;
 }
 
-void PetriNet::fill_slot(std::size_t slot, std::uint32_t hash, std::string_view node_id, NodeRef ref) {
-  id_slots_[slot] = IdSlot{hash, ((ref.index << 1) | (ref.is_place ? 1U : 0U)) + 1};
+void PetriNet::fill_slot(std::size_t slot, IdKey key, std::string_view node_id, NodeRef ref) {
+  id_slots_[slot] = IdSlot{key.key, key.hash, ((ref.index << 1) | (ref.is_place ? 1U : 0U)) + 1};
   (ref.is_place ? place_ids_ : transition_ids_)
       .push_back(IdSpan{static_cast<std::uint32_t>(id_chars_.size()), static_cast<std::uint32_t>(node_id.size())});
   id_chars_.append(node_id);
@@ -98,27 +128,27 @@ const SourceLocation* PetriNet::find_node_where(std::string_view node_id) const 
 
 PlaceIndex PetriNet::add_place(Place p) {
   if (p.id.empty()) throw std::invalid_argument("place id must not be empty");
-  std::uint32_t hash = 0;
-  const std::size_t slot = claim_slot(p.id, hash);  // throws on a duplicate
+  IdKey key;
+  const std::size_t slot = claim_slot(p.id, key);  // throws on a duplicate
   if (p.capacity && p.initial_tokens > *p.capacity) {
     throw std::invalid_argument("place '" + p.id + "' starts with more tokens than its capacity");
   }
   if (p.name.empty()) p.name = p.id;
   const auto index = static_cast<PlaceIndex>(places_.size());
   places_.push_back(std::move(p));
-  fill_slot(slot, hash, places_.back().id, NodeRef{true, index});
+  fill_slot(slot, key, places_.back().id, NodeRef{true, index});
   return index;
 }
 
 TransitionIndex PetriNet::add_transition(Transition t) {
   if (t.id.empty()) throw std::invalid_argument("transition id must not be empty");
-  std::uint32_t hash = 0;
-  const std::size_t slot = claim_slot(t.id, hash);  // throws on a duplicate
+  IdKey key;
+  const std::size_t slot = claim_slot(t.id, key);  // throws on a duplicate
   if (t.delay.count() < 0) throw std::invalid_argument("transition '" + t.id + "' has a negative delay");
   if (t.name.empty()) t.name = t.id;
   const auto index = static_cast<TransitionIndex>(transitions_.size());
   transitions_.push_back(std::move(t));
-  fill_slot(slot, hash, transitions_.back().id, NodeRef{false, index});
+  fill_slot(slot, key, transitions_.back().id, NodeRef{false, index});
   return index;
 }
 

@@ -12,6 +12,10 @@
 #include <stdexcept>
 #include <unordered_set>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace tripodal::detail {
 
 namespace {
@@ -76,6 +80,26 @@ constexpr std::uint64_t ascii_controls(std::uint64_t w) noexcept {
 std::size_t first_quote_or_special(std::string_view s, std::size_t from, char quote, bool latin1) noexcept {
   const std::size_t n = s.size();
   std::size_t i = from;
+#if defined(__SSE2__)
+  {
+    // Sixteen bytes at a time. "Below 0x20" is an unsigned test, done as a signed one on bytes
+    // with the top bit flipped; in Latin-1 the flip is left out, so that the signed test also
+    // catches every byte >= 0x80.
+    const auto* p = reinterpret_cast<const __m128i*>(s.data());
+    const __m128i q = _mm_set1_epi8(quote);
+    const __m128i amp = _mm_set1_epi8('&');
+    const __m128i lt = _mm_set1_epi8('<');
+    const __m128i flip = _mm_set1_epi8(static_cast<char>(latin1 ? 0x00 : 0x80));
+    const __m128i limit = _mm_set1_epi8(static_cast<char>(latin1 ? 0x20 : 0xA0));
+    for (; i + 16 <= n; i += 16) {
+      const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(reinterpret_cast<const char*>(p) + i));
+      const __m128i hit = _mm_or_si128(_mm_or_si128(_mm_cmpeq_epi8(v, q), _mm_cmpeq_epi8(v, amp)),
+                                       _mm_or_si128(_mm_cmpeq_epi8(v, lt), _mm_cmplt_epi8(_mm_xor_si128(v, flip), limit)));
+      const auto mask = static_cast<unsigned>(_mm_movemask_epi8(hit));
+      if (mask != 0) return i + static_cast<std::size_t>(std::countr_zero(mask));
+    }
+  }
+#endif
   const std::uint64_t high_mask = latin1 ? kHigh : 0;
   for (; i + 8 <= n; i += 8) {
     const std::uint64_t w = load8(s.data() + i);
@@ -187,30 +211,90 @@ struct SourceCounts {
   std::size_t equals = 0;  // '=': an upper bound of the attributes
 };
 
+// From `i`, skips whole blocks of plain bytes (printable ASCII, tab, LF, CR) while counting their
+// '<' and '='; returns where a block holds something else (or too few bytes remain).
+std::size_t skip_plain_words(const unsigned char* p, std::size_t n, std::size_t i, SourceCounts& counts) noexcept {
+  for (; i + 8 <= n; i += 8) {
+    const std::uint64_t w = load8(p + i);
+    // Most words have no byte below 0x20 at all: tab, LF and CR are looked for only then.
+    std::uint64_t controls = ascii_controls(w);
+    if (controls != 0) controls &= ~(bytes_equal(w, '\t') | bytes_equal(w, '\n') | bytes_equal(w, '\r'));
+    const std::uint64_t odd = (w & kHigh) | controls;
+    // The plain bytes before the first odd one are counted and skipped too.
+    const std::uint64_t keep = odd == 0 ? ~0ULL : (1ULL << (std::countr_zero(odd) & ~7)) - 1;
+    // Each match is 0x80 in its byte: shifted to 1 and summed into the top byte (no popcount
+    // instruction in the baseline x86-64 set).
+    counts.tags += static_cast<std::size_t>((((bytes_equal(w, '<') & keep) >> 7) * kOnes) >> 56);
+    counts.equals += static_cast<std::size_t>((((bytes_equal(w, '=') & keep) >> 7) * kOnes) >> 56);
+    if (odd != 0) return i + static_cast<std::size_t>(std::countr_zero(odd) >> 3);
+  }
+  return i;
+}
+
+#if defined(__SSE2__)
+std::size_t skip_plain(const unsigned char* p, std::size_t n, std::size_t i, SourceCounts& counts) noexcept {
+  const __m128i zero = _mm_setzero_si128();
+  const __m128i below = _mm_set1_epi8(0x20);
+  const __m128i tab = _mm_set1_epi8('\t');
+  const __m128i lf = _mm_set1_epi8('\n');
+  const __m128i cr = _mm_set1_epi8('\r');
+  const __m128i lt = _mm_set1_epi8('<');
+  const __m128i eq = _mm_set1_epi8('=');
+  // Matches are counted per byte lane (a compare gives -1, subtracted) and summed every 255
+  // blocks, before a lane can overflow.
+  __m128i tags = zero;
+  __m128i equals = zero;
+  int pending = 0;
+  const auto flush = [&] {
+    const __m128i t = _mm_sad_epu8(tags, zero);
+    const __m128i e = _mm_sad_epu8(equals, zero);
+    counts.tags += static_cast<std::size_t>(_mm_cvtsi128_si32(t) + _mm_cvtsi128_si32(_mm_srli_si128(t, 8)));
+    counts.equals += static_cast<std::size_t>(_mm_cvtsi128_si32(e) + _mm_cvtsi128_si32(_mm_srli_si128(e, 8)));
+    tags = zero;
+    equals = zero;
+    pending = 0;
+  };
+  for (; i + 16 <= n; i += 16) {
+    const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + i));
+    // Signed: true for the bytes below 0x20 and for every byte >= 0x80.
+    const __m128i odd = _mm_cmplt_epi8(v, below);
+    if (_mm_movemask_epi8(odd) != 0) {
+      const __m128i allowed = _mm_or_si128(_mm_or_si128(_mm_cmpeq_epi8(v, tab), _mm_cmpeq_epi8(v, lf)), _mm_cmpeq_epi8(v, cr));
+      const auto bad = static_cast<unsigned>(_mm_movemask_epi8(_mm_andnot_si128(allowed, odd)));
+      if (bad != 0) {
+        // The plain bytes before the first odd one are counted and skipped too.
+        const unsigned before = (1U << std::countr_zero(bad)) - 1;
+        counts.tags += static_cast<std::size_t>(std::popcount(static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(v, lt))) & before));
+        counts.equals += static_cast<std::size_t>(std::popcount(static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(v, eq))) & before));
+        i += static_cast<std::size_t>(std::countr_zero(bad));
+        break;
+      }
+    }
+    tags = _mm_sub_epi8(tags, _mm_cmpeq_epi8(v, lt));
+    equals = _mm_sub_epi8(equals, _mm_cmpeq_epi8(v, eq));
+    if (++pending == 255) flush();
+  }
+  flush();
+  // Fewer than 16 bytes left: words of eight, as on machines without SSE2.
+  return i + 16 > n && i < n ? skip_plain_words(p, n, i, counts) : i;
+}
+#else
+std::size_t skip_plain(const unsigned char* p, std::size_t n, std::size_t i, SourceCounts& counts) noexcept {
+  return skip_plain_words(p, n, i, counts);
+}
+#endif
+
 // Checks that the source is UTF-8 (any byte for ISO-8859-1) without control characters other than
-// tab, LF and CR, and counts what the tree will need room for. Eight bytes at a time: most words
-// are plain printable ASCII and are checked and counted whole.
+// tab, LF and CR, and counts what the tree will need room for. Blocks of plain bytes are checked
+// and counted whole; the byte loop below decides the rest, one character at a time.
 SourceCounts validate_and_count(std::string_view s, bool latin1) {
   const auto* p = reinterpret_cast<const unsigned char*>(s.data());
   const std::size_t n = s.size();
   SourceCounts counts;
   std::size_t i = 0;
   while (i < n) {
-    if (i + 8 <= n) {
-      const std::uint64_t w = load8(p + i);
-      // Plain words: no byte >= 0x80 and no control byte other than tab, LF and CR.
-      // (Most words have no byte below 0x20 at all: the exceptions are looked for only then.)
-      std::uint64_t controls = ascii_controls(w);
-      if (controls != 0) controls &= ~(bytes_equal(w, '\t') | bytes_equal(w, '\n') | bytes_equal(w, '\r'));
-      if (((w & kHigh) | controls) == 0) {
-        // Each match is 0x80 in its byte: shifted to 1 and summed into the top byte (no popcount
-        // instruction in the baseline x86-64 set).
-        counts.tags += static_cast<std::size_t>(((bytes_equal(w, '<') >> 7) * kOnes) >> 56);
-        counts.equals += static_cast<std::size_t>(((bytes_equal(w, '=') >> 7) * kOnes) >> 56);
-        i += 8;
-        continue;
-      }
-    }
+    i = skip_plain(p, n, i, counts);
+    if (i >= n) break;
     const unsigned char b = p[i];
     counts.tags += b == '<' ? 1 : 0;
     counts.equals += b == '=' ? 1 : 0;
@@ -263,13 +347,13 @@ SourceCounts validate_and_count(std::string_view s, bool latin1) {
 
 const XmlElement* XmlElement::first_child(std::string_view name) const noexcept {
   const XmlElement* c = first_child();
-  while (c != nullptr && c->name_ != name) c = c->next_sibling();
+  while (c != nullptr && !same_name(c->name_, name)) c = c->next_sibling();
   return c;
 }
 
 const XmlElement* XmlElement::next_sibling(std::string_view name) const noexcept {
   const XmlElement* c = next_sibling();
-  while (c != nullptr && c->name_ != name) c = c->next_sibling();
+  while (c != nullptr && !same_name(c->name_, name)) c = c->next_sibling();
   return c;
 }
 
@@ -597,7 +681,7 @@ class XmlParser {
     const XmlAttribute* prior = d_.attributes_.data() + d_.elements_[element].first_attribute_;
     bool duplicate = false;
     if (count < kLinearDuplicateCheck) {
-      for (std::uint32_t k = 0; k < count && !duplicate; ++k) duplicate = prior[k].name == name;
+      for (std::uint32_t k = 0; k < count && !duplicate; ++k) duplicate = same_name(prior[k].name, name);
     } else {
       if (count == kLinearDuplicateCheck) {
         names_seen_.clear();
@@ -727,14 +811,22 @@ class XmlParser {
     }
     if (!start_tag()) push(static_cast<std::uint32_t>(d_.elements_.size() - 1));
     while (depth_ > 0) {
-      const void* found = std::memchr(s_.data() + p_, '<', n_ - p_);
-      if (found == nullptr) {
-        const XmlElement& open = d_.elements_[stack_[depth_ - 1].element];
-        throw ParseFailure{open.offset_, "element <" + std::string(open.name_) + "> is never closed: expected </" +
-                                             std::string(open.name_) + "> before the end of the file"};
+      // Between two tags there is mostly a line end and indentation: skipped inline, and only
+      // kept when it falls between two pieces of text (blanks before any text are not text).
+      std::size_t lt = p_;
+      while (lt < n_ && (cls(s_[lt]) & kSpace) != 0) ++lt;
+      if (lt < n_ && s_[lt] == '<') {
+        if (lt > p_ && stack_[depth_ - 1].has_text) add_text(s_.substr(p_, lt - p_), p_, false);
+      } else {
+        const void* found = std::memchr(s_.data() + lt, '<', n_ - lt);
+        if (found == nullptr) {
+          const XmlElement& open = d_.elements_[stack_[depth_ - 1].element];
+          throw ParseFailure{open.offset_, "element <" + std::string(open.name_) + "> is never closed: expected </" +
+                                               std::string(open.name_) + "> before the end of the file"};
+        }
+        lt = static_cast<std::size_t>(static_cast<const char*>(found) - s_.data());
+        add_text(s_.substr(p_, lt - p_), p_, false);
       }
-      const auto lt = static_cast<std::size_t>(static_cast<const char*>(found) - s_.data());
-      if (lt > p_) add_text(s_.substr(p_, lt - p_), p_, false);
       p_ = lt;
       const char next = lt + 1 < n_ ? s_[lt + 1] : '\0';
       if (next == '/') {

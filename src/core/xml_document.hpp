@@ -22,6 +22,12 @@ namespace tripodal::detail {
 
 class XmlDocument;
 
+/// Names (of elements and attributes) are short and mostly differ in length or first byte: this
+/// settles those inline and calls memcmp only for the rest, where `==` calls it every time.
+[[nodiscard]] inline bool same_name(std::string_view a, std::string_view b) noexcept {
+  return a.size() == b.size() && (a.empty() || (a[0] == b[0] && a.compare(b) == 0));
+}
+
 struct XmlAttribute {
   std::string_view name;
   /// Decoded: references replaced, each literal tab, newline or CR (a CR LF pair counts once)
@@ -130,7 +136,7 @@ inline std::span<const XmlAttribute> XmlElement::attributes() const noexcept {
 }
 inline const XmlAttribute* XmlElement::find_attribute(std::string_view name) const noexcept {
   for (const XmlAttribute& a : attributes()) {
-    if (a.name == name) return &a;
+    if (same_name(a.name, name)) return &a;
   }
   return nullptr;
 }

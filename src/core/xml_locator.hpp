@@ -15,9 +15,9 @@ namespace tripodal::detail {
 class XmlLocator {
  public:
   /// `doc` must outlive the locator.
-  XmlLocator(const XmlDocument& doc, std::string file) : doc_(doc), file_(std::move(file)) {}
+  XmlLocator(const XmlDocument& doc, SourceFile file) : doc_(doc), file_(file) {}
 
-  [[nodiscard]] const std::string& file() const noexcept { return file_; }
+  [[nodiscard]] const std::string& file() const noexcept { return file_.str(); }
   /// The '<' of the element's start tag.
   [[nodiscard]] SourceLocation element(const XmlElement* e) const {
     return SourceLocation{file_, e->line(), e->column()};
@@ -32,7 +32,7 @@ class XmlLocator {
 
  private:
   const XmlDocument& doc_;
-  std::string file_;
+  SourceFile file_;  // interned once per document: locating an element does not allocate
 };
 
 }  // namespace tripodal::detail

@@ -39,3 +39,42 @@ TEST_CASE("misuse of the building API is refused with the offending id") {
   CHECK_THROWS_WITH(net.add_arc("t0", "P0", 1, ArcKind::inhibitor), Catch::Contains("from a place"));
   CHECK_THROWS_WITH(net.add_place({.id = "P5", .initial_tokens = 3, .capacity = 2}), Catch::Contains("capacity"));
 }
+
+TEST_CASE("ids of every length are found exactly, across table growth") {
+  // The id table keeps ids of up to 7 bytes inside its slots and longer ones by hash: ids on both
+  // sides of that line, ids that differ only in their last byte or their length, and bytes that
+  // are not letters (a NUL too: the building API takes any bytes) must all stay distinct.
+  std::vector<std::string> ids;
+  for (int i = 0; i < 3000; ++i) ids.push_back("P" + std::to_string(i));  // 2 to 5 bytes
+  for (const std::string stem : {"abcdef", "abcdefg", "abcdefgh", "state_machine_"}) {
+    for (char c = 'a'; c <= 'z'; ++c) ids.push_back(stem + c);  // 7, 8, 9 and 15 bytes
+  }
+  ids.push_back("x");
+  ids.push_back(std::string("x\0", 2));
+  ids.push_back(std::string("x\0\0", 3));
+  ids.push_back("\xC3\xA9tat");  // UTF-8
+
+  PetriNet net;  // no reserve: the table grows many times on the way
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (i % 2 == 0) net.add_place({.id = ids[i]});
+    else net.add_transition({.id = ids[i]});
+  }
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    INFO("id " << i << " '" << ids[i] << "'");
+    if (i % 2 == 0) {
+      REQUIRE(net.find_place(ids[i]) == PlaceIndex(i / 2));
+      CHECK_FALSE(net.find_transition(ids[i]));
+    } else {
+      REQUIRE(net.find_transition(ids[i]) == TransitionIndex(i / 2));
+      CHECK_FALSE(net.find_place(ids[i]));
+    }
+    CHECK_THROWS_WITH(net.add_place({.id = ids[i]}), Catch::Contains("duplicate node id"));
+  }
+  for (const std::string missing : {"P3000", "abcdef", "abcdef{", "abcdefg{", "abcdefgh{", "state_machine_", "state_machine_{", "y", "P"}) {
+    INFO("missing '" << missing << "'");
+    CHECK_FALSE(net.find_place(missing));
+    CHECK_FALSE(net.find_transition(missing));
+    CHECK(net.find_node_where(missing) == nullptr);
+  }
+  CHECK_FALSE(net.find_place(std::string("x\0\0\0", 4)));
+}

@@ -3,15 +3,42 @@
 // so an author fixes them in one pass and an editor can jump to each one.
 #pragma once
 
+#include <iosfwd>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace tripodal {
 
+/// The name of a file as diagnostics show it. Names are interned: each distinct name is stored
+/// once for the life of the process and a SourceFile points at it, so a SourceLocation (which
+/// every place, transition and arc of a loaded net keeps) copies without allocating whatever the
+/// path's length. Meant for the files a program loads, not for an endless stream of new names.
+class SourceFile {
+ public:
+  SourceFile() noexcept = default;
+  // Implicit, so that a location is written {"net.xml", 3, 1} or {path.string(), 0, 0}.
+  SourceFile(std::string_view name);  // NOLINT(google-explicit-constructor)
+  SourceFile(const std::string& name) : SourceFile(std::string_view(name)) {}  // NOLINT(google-explicit-constructor)
+  SourceFile(const char* name) : SourceFile(std::string_view(name)) {}         // NOLINT(google-explicit-constructor)
+
+  [[nodiscard]] const std::string& str() const noexcept;
+  [[nodiscard]] bool empty() const noexcept { return name_ == nullptr; }
+  operator const std::string&() const noexcept { return str(); }  // NOLINT(google-explicit-constructor)
+  operator std::string_view() const noexcept { return str(); }    // NOLINT(google-explicit-constructor)
+
+  friend bool operator==(const SourceFile& a, std::string_view b) noexcept { return std::string_view(a) == b; }
+
+ private:
+  const std::string* name_ = nullptr;  // interned; nullptr for no name
+};
+
+std::ostream& operator<<(std::ostream& os, const SourceFile& file);
+
 /// Where something was written. line and column count from 1; 0 means unknown.
 struct SourceLocation {
-  std::string file;
+  SourceFile file;
   int line = 0;
   int column = 0;
 

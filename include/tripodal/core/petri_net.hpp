@@ -141,19 +141,26 @@ class PetriNet {
     bool is_place;
     std::uint32_t index;
   };
-  // Ids are found through an open-addressing table of (hash, node) pairs, linear probing, load
-  // factor at most 3/4, and compared against a copy of every id kept back to back: a look-up
-  // touches two small arrays, where a node-based hash map chases two or three pointers and
-  // the nodes themselves are hundreds of bytes apart (the loaders resolve every arc by id).
+  // Ids are found through an open-addressing table, linear probing, load factor at most 3/4.
+  // A slot holds the id itself when it has at most 7 bytes (as ids such as "P12" or "T_dock"
+  // do), so that a look-up is one comparison in one array; a longer id's slot holds its hash,
+  // and a match is confirmed against a copy of every id kept back to back. A node-based hash map
+  // would chase two or three pointers per look-up (the loaders resolve every arc by id).
+  struct IdKey {
+    std::uint64_t key = 0;   ///< short: the bytes, length in the top byte; long: 0xFF, then the hash
+    std::uint32_t hash = 0;  ///< where probing starts
+  };
   struct IdSlot {
+    std::uint64_t key = 0;
     std::uint32_t hash = 0;
     std::uint32_t node = 0;  ///< 0: empty; else (index << 1 | is_place) + 1
   };
+  [[nodiscard]] static IdKey id_key(std::string_view node_id) noexcept;
   [[nodiscard]] std::optional<NodeRef> find_node(std::string_view node_id) const noexcept;
-  [[nodiscard]] std::size_t probe(std::string_view node_id, std::uint32_t hash, bool& found) const noexcept;
+  [[nodiscard]] std::size_t probe(std::string_view node_id, IdKey key, bool& found) const noexcept;
   // The free slot for a new id (throws on a duplicate), then filled once the node is stored.
-  std::size_t claim_slot(std::string_view node_id, std::uint32_t& hash);
-  void fill_slot(std::size_t slot, std::uint32_t hash, std::string_view node_id, NodeRef ref);
+  std::size_t claim_slot(std::string_view node_id, IdKey& key);
+  void fill_slot(std::size_t slot, IdKey key, std::string_view node_id, NodeRef ref);
   void grow_index(std::size_t nodes);
 
   std::vector<Place> places_;
