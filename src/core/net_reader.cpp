@@ -182,25 +182,12 @@ void check_no_text(const ReadContext& ctx, const XmlElement* e) {
 
 std::string trimmed_text(const XmlElement* e) { return std::string(e->text()); }
 
-std::optional<std::string_view> optional_attr(const XmlElement* e, std::string_view attr) {
-  return e->attribute(attr);
-}
-
-std::optional<std::string_view> required(const ReadContext& ctx, const XmlElement* e, std::string_view attr) {
-  return required(ctx, e, attr, e->attribute(attr));
-}
-
-std::optional<std::string_view> required(const ReadContext& ctx, const XmlElement* e, std::string_view attr,
-                                         std::optional<std::string_view> v) {
-  if (!v) {
+void report_missing(const ReadContext& ctx, const XmlElement* e, std::string_view attr, bool present) {
+  if (!present) {
     ctx.error(e, "missing attribute '" + std::string(attr) + "' on <" + std::string(e->name()) + ">");
-    return std::nullopt;
-  }
-  if (v->empty()) {
+  } else {
     ctx.error_at_attribute(e, attr, "empty attribute '" + std::string(attr) + "' on <" + std::string(e->name()) + ">");
-    return std::nullopt;
   }
-  return v;
 }
 
 std::optional<Tokens> parse_count(const ReadContext& ctx, const XmlElement* e, std::string_view attr,

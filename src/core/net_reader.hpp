@@ -44,14 +44,25 @@ void unknown_element(const ReadContext& ctx, const XmlElement* e, std::string_vi
 /// Reports an element's non-blank text content (the formats keep everything in attributes).
 void check_no_text(const ReadContext& ctx, const XmlElement* e);
 
+/// Reports a required attribute missing or empty (the cold half of required()).
+void report_missing(const ReadContext& ctx, const XmlElement* e, std::string_view attr, bool present);
+/// The check on a value already read (read_attributes): missing or empty is reported, nullopt.
+/// Inline: the readers check several attributes of every element.
+inline std::optional<std::string_view> required(const ReadContext& ctx, const XmlElement* e, std::string_view attr,
+                                                std::optional<std::string_view> value) {
+  if (value && !value->empty()) [[likely]] return value;
+  report_missing(ctx, e, attr, value.has_value());
+  return std::nullopt;
+}
 /// A required attribute's value (a view into the document); reports it missing (or empty) and
 /// returns nullopt.
-std::optional<std::string_view> required(const ReadContext& ctx, const XmlElement* e, std::string_view attr);
-/// The same check on a value already read (read_attributes): missing or empty is reported.
-std::optional<std::string_view> required(const ReadContext& ctx, const XmlElement* e, std::string_view attr,
-                                         std::optional<std::string_view> value);
+inline std::optional<std::string_view> required(const ReadContext& ctx, const XmlElement* e, std::string_view attr) {
+  return required(ctx, e, attr, e->attribute(attr));
+}
 /// An optional attribute's value (a view into the document); nullopt when absent.
-std::optional<std::string_view> optional_attr(const XmlElement* e, std::string_view attr);
+inline std::optional<std::string_view> optional_attr(const XmlElement* e, std::string_view attr) {
+  return e->attribute(attr);
+}
 
 /// A decimal count: tokens/capacity (min 0) or weight (min 1). Reports bad text at the value of
 /// attribute `attr` of `e`, or at `e` itself when `attr` is empty (PNML labels).

@@ -1,5 +1,7 @@
 #include "tripodal/core/petri_net.hpp"
 
+#include <bit>
+#include <cstring>
 #include <stdexcept>
 
 namespace tripodal {
@@ -56,7 +58,10 @@ PetriNet::IdKey PetriNet::id_key(std::string_view node_id) noexcept {
   const auto* b = reinterpret_cast<const unsigned char*>(node_id.data());
   const std::size_t n = node_id.size();
   const auto load4 = [](const unsigned char* p) {
-    return std::uint64_t{p[0]} | std::uint64_t{p[1]} << 8 | std::uint64_t{p[2]} << 16 | std::uint64_t{p[3]} << 24;
+    std::uint32_t w = 0;
+    std::memcpy(&w, p, 4);
+    if constexpr (std::endian::native == std::endian::big) w = __builtin_bswap32(w);
+    return std::uint64_t{w};
   };
   std::uint64_t key = static_cast<std::uint64_t>(n) << 56;
   if (n >= 4) {

@@ -404,17 +404,25 @@ class XmlParser {
     return at + what.size() <= n_ && s_.compare(at, what.size(), what) == 0;
   }
 
-  void skip_space() noexcept {
-    while (p_ < n_ && (cls(s_[p_]) & kSpace) != 0) ++p_;
+  // The scanning loops work on local copies: a char read may alias any member, so a loop over
+  // s_[p_] would reload s_ and p_ from memory at every byte.
+  [[nodiscard]] std::size_t space_end(std::size_t from) const noexcept {
+    const char* s = s_.data();
+    const std::size_t n = n_;
+    while (from < n && (cls(s[from]) & kSpace) != 0) ++from;
+    return from;
   }
+  void skip_space() noexcept { p_ = space_end(p_); }
 
   std::string_view name_at(std::size_t at) const noexcept {
+    const char* s = s_.data();
+    const std::size_t n = n_;
     std::size_t e = at;
-    if (e < n_ && (cls(s_[e]) & kNameStart) != 0) {
+    if (e < n && (cls(s[e]) & kNameStart) != 0) {
       ++e;
-      while (e < n_ && (cls(s_[e]) & kNameChar) != 0) ++e;
+      while (e < n && (cls(s[e]) & kNameChar) != 0) ++e;
     }
-    return s_.substr(at, e - at);
+    return {s + at, e - at};
   }
 
   std::string_view intern(std::string_view raw) {
@@ -633,7 +641,7 @@ class XmlParser {
     const std::string_view raw_name = name_at(p_);
     p_ += raw_name.size();
     const std::string_view name = intern(raw_name);
-    check_unique(name, name_at_offset, element_name, element, count);
+    if (count > 0) check_unique(name, name_at_offset, element_name, element, count);
     skip_space();
     if (p_ >= n_ || s_[p_] != '=') {
       throw ParseFailure{p_ < n_ ? p_ : name_at_offset, "attribute '" + std::string(raw_name) + "' of <" +
@@ -813,8 +821,7 @@ class XmlParser {
     while (depth_ > 0) {
       // Between two tags there is mostly a line end and indentation: skipped inline, and only
       // kept when it falls between two pieces of text (blanks before any text are not text).
-      std::size_t lt = p_;
-      while (lt < n_ && (cls(s_[lt]) & kSpace) != 0) ++lt;
+      std::size_t lt = space_end(p_);
       if (lt < n_ && s_[lt] == '<') {
         if (lt > p_ && stack_[depth_ - 1].has_text) add_text(s_.substr(p_, lt - p_), p_, false);
       } else {
