@@ -302,7 +302,7 @@ void read_place_details(const ReadContext& ctx, const XmlElement* e, Place& plac
   std::array<std::optional<std::string_view>, kNames.size()> attr;
   const std::size_t first = allow_tokens_and_name ? kId : kDescription;
   read_attributes(ctx, e, std::span(kNames).subspan(first), std::span(attr).subspan(first));
-  if (const auto& n = attr[kName]) place.name = *n;
+  if (const auto& n = attr[kName]; n && !n->empty()) place.name = *n;  // else the id, as add_place() sets
   if (const auto& t = attr[kTokens]) {
     if (auto v = parse_count(ctx, e, "tokens", *t, 0, "token count")) place.initial_tokens = *v;
   }
@@ -371,7 +371,7 @@ void read_transition_details(const ReadContext& ctx, const XmlElement* e, Transi
   std::array<std::optional<std::string_view>, kNames.size()> attr;
   const std::size_t first = allow_name ? kId : kDescription;
   read_attributes(ctx, e, std::span(kNames).subspan(first), std::span(attr).subspan(first));
-  if (const auto& n = attr[kName]) t.name = *n;
+  if (const auto& n = attr[kName]; n && !n->empty()) t.name = *n;  // else the id, as add_transition() sets
   check_no_text(ctx, e);
   for (const auto* c = e->first_child(); c != nullptr; c = c->next_sibling()) {
     unknown_element(ctx, c, e->name(), "");

@@ -1,6 +1,7 @@
 // The native XML format of configuration nets: reader and writer (docs/net-format.md).
 #include <array>
 #include <charconv>
+#include <stdexcept>
 #include <vector>
 
 #include "net_formats.hpp"
@@ -46,33 +47,49 @@ PetriNet read_native(const XmlElement* root, const ReadContext& ctx) {
     else unknown_element(ctx, c, "net", kNetChildren);
   }
 
-  // Every claimed id is added to the net, so the net's own index finds the first definition.
-  const auto claim_id = [&](const XmlElement* e) -> std::optional<std::string_view> {
-    auto id = required(ctx, e, "id");
-    if (!id) return std::nullopt;
-    if (const SourceLocation* first = net.find_node_where(*id)) {
-      ctx.error_at_value(e, "id", "duplicate id '" + std::string(*id) + "' (first defined at " + first->str() + ")");
-      return std::nullopt;
-    }
-    return id;
+  // A node joins the net as soon as its id is read, and its details are then read into it where
+  // it lies: the net's own index finds a duplicate id (and its first definition) in the same
+  // look-up that adds the node, and no node is built aside and moved in. A node that cannot be
+  // added (no id, or a duplicate) is still read, into a scratch node, for the errors it holds.
+  const auto duplicate = [&](const XmlElement* e, std::string_view id) {
+    const SourceLocation* first = net.find_node_where(id);
+    ctx.error_at_value(e, "id", "duplicate id '" + std::string(id) + "' (first defined at " +
+                                    (first != nullptr ? first->str() : std::string("?")) + ")");
   };
-
   net.reserve(places.size(), transitions.size());  // no reallocation while the nodes arrive
   for (const XmlElement* c : places) {
-    Place p;
-    const auto id = claim_id(c);
-    p.id = id.value_or(std::string_view());
-    p.where = ctx.loc.element(c);
-    read_place_details(ctx, c, p, net, true);
-    if (id) net.add_place(std::move(p));
+    const auto id = required(ctx, c, "id");
+    Place scratch;
+    Place* p = &scratch;
+    if (id) {
+      try {
+        p = &net.place(net.add_place(Place{.id = std::string(*id), .where = ctx.loc.element(c)}));
+      } catch (const std::invalid_argument&) {
+        duplicate(c, *id);
+      }
+    }
+    if (p == &scratch) {
+      scratch.id = id.value_or(std::string_view());
+      scratch.where = ctx.loc.element(c);
+    }
+    read_place_details(ctx, c, *p, net, true);
   }
   for (const XmlElement* c : transitions) {
-    Transition t;
-    const auto id = claim_id(c);
-    t.id = id.value_or(std::string_view());
-    t.where = ctx.loc.element(c);
-    read_transition_details(ctx, c, t, net, true);
-    if (id) net.add_transition(std::move(t));
+    const auto id = required(ctx, c, "id");
+    Transition scratch;
+    Transition* t = &scratch;
+    if (id) {
+      try {
+        t = &net.transition(net.add_transition(Transition{.id = std::string(*id), .where = ctx.loc.element(c)}));
+      } catch (const std::invalid_argument&) {
+        duplicate(c, *id);
+      }
+    }
+    if (t == &scratch) {
+      scratch.id = id.value_or(std::string_view());
+      scratch.where = ctx.loc.element(c);
+    }
+    read_transition_details(ctx, c, *t, net, true);
   }
   static constexpr std::array<std::string_view, 4> kArcAttributes{"source", "target", "weight", "kind"};
   for (const XmlElement* c : arcs) {

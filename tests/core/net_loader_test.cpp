@@ -182,6 +182,40 @@ TEST_CASE("native loader: every error of a file is reported, each with line and 
   CHECK(d.error_count() == 14);
 }
 
+TEST_CASE("native loader: a duplicate node keeps the first definition, and its own errors are still reported") {
+  const std::string text =
+      "<net id=\"n\">\n"
+      "  <place id=\"p\" name=\"\" tokens=\"2\" description=\"first\"/>\n"     // 2: empty name: the id
+      "  <place id=\"p\" tokens=\"x\" description=\"second\"/>\n"             // 3: duplicate, bad tokens
+      "  <transition id=\"p\" delay=\"5\"/>\n"                                // 4: id of a place, bad delay
+      "  <transition id=\"t\" name=\"go\"/>\n"                                // 5
+      "  <arc source=\"p\" target=\"t\"/>\n"
+      "</net>\n";
+  const auto e = errors_of(text);
+  CHECK_THAT(e, Catch::Contains("bad.xml:3:14: error: duplicate id 'p' (first defined at bad.xml:2:3)"));
+  CHECK_THAT(e, Catch::Contains("bad.xml:3:25: error: bad token count 'x'"));
+  CHECK_THAT(e, Catch::Contains("bad.xml:4:19: error: duplicate id 'p' (first defined at bad.xml:2:3)"));
+  CHECK_THAT(e, Catch::Contains("bad.xml:4:29: error: delay '5' has no unit"));
+  // The duplicate's message comes before the errors in the rest of its element.
+  CHECK(e.find("bad.xml:3:14") < e.find("bad.xml:3:25"));
+
+  // Without the bad lines the net loads: the first definition is the one kept.
+  Diagnostics d;
+  const auto net = load_net_from_string(
+      "<net id=\"n\">\n  <place id=\"p\" name=\"\" tokens=\"2\" description=\"first\"/>\n"
+      "  <transition id=\"t\" name=\"go\"/>\n  <arc source=\"p\" target=\"t\"/>\n</net>\n",
+      "good.xml", d);
+  REQUIRE(net);
+  CHECK(d.empty());
+  REQUIRE(net->places().size() == 1);
+  CHECK(net->place(0).name == "p");
+  CHECK(net->place(0).description == "first");
+  CHECK(net->place(0).initial_tokens == 2);
+  CHECK(net->place(0).where.str() == "good.xml:2:3");
+  CHECK(net->transition(0).name == "go");
+  CHECK(net->transition(0).inputs.at(0).where.str() == "good.xml:4:3");
+}
+
 TEST_CASE("native loader: guard errors point into the guard") {
   // "wheel_type == == 1": the second '==' is at guard column 15; the value starts at column 29.
   const auto e = errors_of(with("  <transition id=\"g\" guard=\"wheel_type == == 1\"/>\n"));
