@@ -156,12 +156,12 @@ void check_attributes(const ReadContext& ctx, const XmlElement* e,
 }
 
 void read_attributes(const ReadContext& ctx, const XmlElement* e, std::span<const std::string_view> names,
-                     std::span<std::optional<std::string_view>> values) {
+                     std::span<const XmlAttribute*> found) {
   for (const XmlAttribute& a : e->attributes()) {
     std::size_t k = 0;
     while (k < names.size() && !same_name(names[k], a.name)) ++k;
     if (k < names.size()) {
-      values[k] = a.value;
+      found[k] = &a;
     } else {
       unknown_attribute(ctx, e, a.name, names);
     }
@@ -299,9 +299,9 @@ void read_place_details(const ReadContext& ctx, const XmlElement* e, Place& plac
   static constexpr std::array<std::string_view, 7> kNames{"id",       "name",    "tokens", "description",
                                                           "capacity", "outcome", "message"};
   enum { kId, kName, kTokens, kDescription, kCapacity, kOutcome, kMessage };
-  std::array<std::optional<std::string_view>, kNames.size()> attr;
+  AttributeValues<kNames.size()> attr;
   const std::size_t first = allow_tokens_and_name ? kId : kDescription;
-  read_attributes(ctx, e, std::span(kNames).subspan(first), std::span(attr).subspan(first));
+  read_attributes(ctx, e, std::span(kNames).subspan(first), std::span(attr.found).subspan(first));
   if (const auto& n = attr[kName]; n && !n->empty()) place.name = *n;  // else the id, as add_place() sets
   if (const auto& t = attr[kTokens]) {
     if (auto v = parse_count(ctx, e, "tokens", *t, 0, "token count")) place.initial_tokens = *v;
@@ -368,9 +368,9 @@ void read_transition_details(const ReadContext& ctx, const XmlElement* e, Transi
   static constexpr std::array<std::string_view, 7> kNames{"id", "name", "description", "event", "guard", "delay",
                                                           "priority"};
   enum { kId, kName, kDescription, kEvent, kGuard, kDelay, kPriority };
-  std::array<std::optional<std::string_view>, kNames.size()> attr;
+  AttributeValues<kNames.size()> attr;
   const std::size_t first = allow_name ? kId : kDescription;
-  read_attributes(ctx, e, std::span(kNames).subspan(first), std::span(attr).subspan(first));
+  read_attributes(ctx, e, std::span(kNames).subspan(first), std::span(attr.found).subspan(first));
   if (const auto& n = attr[kName]; n && !n->empty()) t.name = *n;  // else the id, as add_transition() sets
   check_no_text(ctx, e);
   for (const auto* c = e->first_child(); c != nullptr; c = c->next_sibling()) {

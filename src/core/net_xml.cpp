@@ -57,44 +57,48 @@ PetriNet read_native(const XmlElement* root, const ReadContext& ctx) {
                                     (first != nullptr ? first->str() : std::string("?")) + ")");
   };
   net.reserve(places.size(), transitions.size());  // no reallocation while the nodes arrive
+  Place scratch_place;  // built once: clearing a node is not free, and most nodes are added
+  Transition scratch_transition;
   for (const XmlElement* c : places) {
     const auto id = required(ctx, c, "id");
-    Place scratch;
-    Place* p = &scratch;
+    Place* p = nullptr;
     if (id) {
       try {
-        p = &net.place(net.add_place(Place{.id = std::string(*id), .where = ctx.loc.element(c)}));
+        p = &net.new_place(*id, ctx.loc.element(c));
       } catch (const std::invalid_argument&) {
         duplicate(c, *id);
       }
     }
-    if (p == &scratch) {
-      scratch.id = id.value_or(std::string_view());
-      scratch.where = ctx.loc.element(c);
+    if (p == nullptr) {
+      scratch_place = Place{};
+      p = &scratch_place;
+      p->id = id.value_or(std::string_view());
+      p->where = ctx.loc.element(c);
     }
     read_place_details(ctx, c, *p, net, true);
   }
   for (const XmlElement* c : transitions) {
     const auto id = required(ctx, c, "id");
-    Transition scratch;
-    Transition* t = &scratch;
+    Transition* t = nullptr;
     if (id) {
       try {
-        t = &net.transition(net.add_transition(Transition{.id = std::string(*id), .where = ctx.loc.element(c)}));
+        t = &net.new_transition(*id, ctx.loc.element(c));
       } catch (const std::invalid_argument&) {
         duplicate(c, *id);
       }
     }
-    if (t == &scratch) {
-      scratch.id = id.value_or(std::string_view());
-      scratch.where = ctx.loc.element(c);
+    if (t == nullptr) {
+      scratch_transition = Transition{};
+      t = &scratch_transition;
+      t->id = id.value_or(std::string_view());
+      t->where = ctx.loc.element(c);
     }
     read_transition_details(ctx, c, *t, net, true);
   }
   static constexpr std::array<std::string_view, 4> kArcAttributes{"source", "target", "weight", "kind"};
   for (const XmlElement* c : arcs) {
-    std::array<std::optional<std::string_view>, kArcAttributes.size()> attr;
-    read_attributes(ctx, c, kArcAttributes, attr);
+    AttributeValues<kArcAttributes.size()> attr;
+    read_attributes(ctx, c, kArcAttributes, attr.found);
     check_no_text(ctx, c);
     for (const auto* g = c->first_child(); g != nullptr; g = g->next_sibling()) unknown_element(ctx, g, "arc", "");
     const auto source = required(ctx, c, "source", attr[0]);

@@ -28,6 +28,8 @@ void PetriNet::reserve(std::size_t places, std::size_t transitions) {
   transitions_.reserve(transitions);
   place_ids_.reserve(places);
   transition_ids_.reserve(transitions);
+  place_keys_.reserve(places);
+  transition_keys_.reserve(transitions);
   grow_index(places + transitions);
 }
 
@@ -86,13 +88,15 @@ std::size_t PetriNet::probe(std::string_view node_id, IdKey key, bool& found) co
       found = false;
       return i;
     }
-    if (slot.key != key.key) continue;
+    if (slot.hash != key.hash) continue;
+    const std::uint32_t code = slot.node - 1;
+    const bool is_place = (code & 1U) != 0;
+    if ((is_place ? place_keys_[code >> 1] : transition_keys_[code >> 1]) != key.key) continue;
     if ((key.key & kLongId) != kLongId) {  // a short id: the key is the id
       found = true;
       return i;
     }
-    const std::uint32_t code = slot.node - 1;
-    const IdSpan span = (code & 1U) != 0 ? place_ids_[code >> 1] : transition_ids_[code >> 1];
+    const IdSpan span = is_place ? place_ids_[code >> 1] : transition_ids_[code >> 1];
     if (span.size == node_id.size() && std::string_view(id_chars_).substr(span.offset, span.size) == node_id) {
       found = true;
       return i;
@@ -119,7 +123,8 @@ std::size_t PetriNet::claim_slot(std::string_view node_id, IdKey& key) {
 }
 
 void PetriNet::fill_slot(std::size_t slot, IdKey key, std::string_view node_id, NodeRef ref) {
-  id_slots_[slot] = IdSlot{key.key, key.hash, ((ref.index << 1) | (ref.is_place ? 1U : 0U)) + 1};
+  id_slots_[slot] = IdSlot{key.hash, ((ref.index << 1) | (ref.is_place ? 1U : 0U)) + 1};
+  (ref.is_place ? place_keys_ : transition_keys_).push_back(key.key);
   (ref.is_place ? place_ids_ : transition_ids_)
       .push_back(IdSpan{static_cast<std::uint32_t>(id_chars_.size()), static_cast<std::uint32_t>(node_id.size())});
   id_chars_.append(node_id);
@@ -143,6 +148,32 @@ PlaceIndex PetriNet::add_place(Place p) {
   places_.push_back(std::move(p));
   fill_slot(slot, key, places_.back().id, NodeRef{true, index});
   return index;
+}
+
+Place& PetriNet::new_place(std::string_view node_id, SourceLocation node_where) {
+  if (node_id.empty()) throw std::invalid_argument("place id must not be empty");
+  IdKey key;
+  const std::size_t slot = claim_slot(node_id, key);  // throws on a duplicate
+  const auto index = static_cast<PlaceIndex>(places_.size());
+  Place& p = places_.emplace_back();
+  p.id = node_id;
+  p.name = p.id;
+  p.where = node_where;
+  fill_slot(slot, key, p.id, NodeRef{true, index});
+  return p;
+}
+
+Transition& PetriNet::new_transition(std::string_view node_id, SourceLocation node_where) {
+  if (node_id.empty()) throw std::invalid_argument("transition id must not be empty");
+  IdKey key;
+  const std::size_t slot = claim_slot(node_id, key);  // throws on a duplicate
+  const auto index = static_cast<TransitionIndex>(transitions_.size());
+  Transition& t = transitions_.emplace_back();
+  t.id = node_id;
+  t.name = t.id;
+  t.where = node_where;
+  fill_slot(slot, key, t.id, NodeRef{false, index});
+  return t;
 }
 
 TransitionIndex PetriNet::add_transition(Transition t) {

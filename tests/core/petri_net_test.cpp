@@ -78,3 +78,26 @@ TEST_CASE("ids of every length are found exactly, across table growth") {
   }
   CHECK_FALSE(net.find_place(std::string("x\0\0\0", 4)));
 }
+
+TEST_CASE("new_place and new_transition add a node to be filled in where it lies") {
+  PetriNet net;
+  net.reserve(2, 1);
+  Place& p = net.new_place("P0", SourceLocation{"net.xml", 3, 5});
+  p.initial_tokens = 1;
+  p.description = "filled in place";
+  Transition& t = net.new_transition("T0");
+  t.priority = 2;
+  net.new_place("P1");
+  net.add_arc("P0", "T0");
+  net.add_arc("T0", "P1");
+  CHECK(net.place(0).name == "P0");  // the name defaults to the id, as with add_place
+  CHECK(net.place(0).description == "filled in place");
+  CHECK(net.place(0).where.str() == "net.xml:3:5");
+  CHECK(net.initial_marking() == Marking{1, 0});
+  CHECK(net.transition(0).priority == 2);
+  CHECK(net.find_place("P1") == PlaceIndex{1});
+  CHECK_THROWS_WITH(net.new_transition("P1"), Catch::Contains("duplicate node id 'P1'"));
+  CHECK_THROWS_WITH(net.new_place(""), Catch::Contains("must not be empty"));
+  CHECK(net.places().size() == 2);
+  CHECK(net.transitions().size() == 1);
+}

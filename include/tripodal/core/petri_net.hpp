@@ -115,6 +115,11 @@ class PetriNet {
   void reserve(std::size_t places, std::size_t transitions);
   PlaceIndex add_place(Place p);
   TransitionIndex add_transition(Transition t);
+  /// Adds a node with this id and defaults elsewhere, and returns it to be filled in where it
+  /// lies (the loaders read each node's details straight into the net). Throws like add_*; the
+  /// reference is valid until the next node of its kind is added beyond the reserved room.
+  Place& new_place(std::string_view node_id, SourceLocation node_where = {});
+  Transition& new_transition(std::string_view node_id, SourceLocation node_where = {});
   /// Adds an arc between a place and a transition given by id, in either direction for normal
   /// arcs; read and inhibitor arcs go from a place to a transition.
   void add_arc(std::string_view from_id, std::string_view to_id, Tokens weight = 1,
@@ -141,17 +146,17 @@ class PetriNet {
     bool is_place;
     std::uint32_t index;
   };
-  // Ids are found through an open-addressing table, linear probing, load factor at most 3/4.
-  // A slot holds the id itself when it has at most 7 bytes (as ids such as "P12" or "T_dock"
-  // do), so that a look-up is one comparison in one array; a longer id's slot holds its hash,
-  // and a match is confirmed against a copy of every id kept back to back. A node-based hash map
-  // would chase two or three pointers per look-up (the loaders resolve every arc by id).
+  // Ids are found through an open-addressing table of (hash, node) pairs, linear probing, load
+  // factor at most 3/4: 8 bytes a slot, so a 20,000-node net's table is 256 KiB, and a look-up
+  // that meets its hash confirms the match against the node's key, which holds the id itself
+  // when it has at most 7 bytes (as ids such as "P12" or "T_dock" do); a longer id is compared
+  // against a copy of every id kept back to back. A node-based hash map would chase two or three
+  // pointers per look-up (the loaders resolve every arc by id).
   struct IdKey {
     std::uint64_t key = 0;   ///< short: the bytes, length in the top byte; long: 0xFF, then the hash
     std::uint32_t hash = 0;  ///< where probing starts
   };
   struct IdSlot {
-    std::uint64_t key = 0;
     std::uint32_t hash = 0;
     std::uint32_t node = 0;  ///< 0: empty; else (index << 1 | is_place) + 1
   };
@@ -173,6 +178,8 @@ class PetriNet {
   std::string id_chars_;
   std::vector<IdSpan> place_ids_;       // per place, into id_chars_
   std::vector<IdSpan> transition_ids_;  // per transition
+  std::vector<std::uint64_t> place_keys_;       // per place, IdKey::key
+  std::vector<std::uint64_t> transition_keys_;  // per transition
 };
 
 }  // namespace tripodal
