@@ -511,10 +511,16 @@ class XmlParser {
     }
   }
 
+  // XML 1.0 forbids "--" inside a comment, so the first "--" must be the one that ends it.
   void comment() {
-    const std::size_t end = s_.find("-->", p_ + 4);
-    if (end == std::string_view::npos) throw ParseFailure{p_, "unterminated comment: expected '-->'"};
-    p_ = end + 3;
+    const std::size_t dashes = s_.find("--", p_ + 4);
+    if (dashes == std::string_view::npos || s_.find("-->", dashes) == std::string_view::npos) {
+      throw ParseFailure{p_, "unterminated comment: expected '-->'"};
+    }
+    if (dashes + 2 >= n_ || s_[dashes + 2] != '>') {
+      throw ParseFailure{dashes, "'--' is not allowed inside a comment: end the comment with '-->' first"};
+    }
+    p_ = dashes + 3;
   }
 
   void processing_instruction() {
@@ -740,6 +746,11 @@ class XmlParser {
   }
 
   void add_text(std::string_view raw, std::size_t source_offset, bool cdata) {
+    if (!cdata) {
+      if (const std::size_t k = raw.find("]]>"); k != std::string_view::npos) {
+        throw ParseFailure{source_offset + k, "']]>' is not allowed in text: write ']]&gt;'"};
+      }
+    }
     Open& o = stack_[depth_ - 1];
     bool blank = true;
     bool special = false;

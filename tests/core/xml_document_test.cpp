@@ -415,6 +415,13 @@ TEST_CASE("xml document: unterminated comments, CDATA sections, PIs and attribut
   check_error("<a/>\n<!-- x", 5, "unterminated comment: expected '-->'");
   check_error("<a><!--></a>", 3, "unterminated comment: expected '-->'");
   check_error("<a><!---></a>", 3, "unterminated comment: expected '-->'");
+  // XML 1.0 forbids "--" inside a comment, and so a comment that ends with "--->".
+  check_error("<a><!-- a -- b --></a>", 10, "'--' is not allowed inside a comment: end the comment with '-->' first");
+  check_error("<a><!-- a ---></a>", 10, "'--' is not allowed inside a comment: end the comment with '-->' first");
+  check_error("<!-- a -- b -->\n<a/>", 7, "'--' is not allowed inside a comment: end the comment with '-->' first");
+  // "]]>" may end a CDATA section only, never appear in text.
+  check_error("<a>x ]]> y</a>", 5, "']]>' is not allowed in text: write ']]&gt;'");
+  check_error("<a>\n  ]]>\n</a>", 6, "']]>' is not allowed in text: write ']]&gt;'");
   check_error("<a>x<![CDATA[y</a>", 4, "unterminated CDATA section: expected ']]>'");
   check_error("<a><![CDATA[y]]</a>", 3, "unterminated CDATA section: expected ']]>'");
   check_error("<a><?pi x</a>", 3, "unterminated processing instruction: expected '?>'");
