@@ -2,6 +2,7 @@
 #include <array>
 #include <charconv>
 #include <stdexcept>
+#include <type_traits>
 #include <vector>
 
 #include "net_formats.hpp"
@@ -57,44 +58,35 @@ PetriNet read_native(const XmlElement* root, const ReadContext& ctx) {
                                     (first != nullptr ? first->str() : std::string("?")) + ")");
   };
   net.reserve(places.size(), transitions.size());  // no reallocation while the nodes arrive
-  Place scratch_place;  // built once: clearing a node is not free, and most nodes are added
+  // `add` creates the node in the net; `scratch` (built once: most nodes are added) takes one
+  // that cannot be added.
+  const auto read_nodes = [&](const std::vector<const XmlElement*>& elements, auto add, auto& scratch, auto details) {
+    for (const XmlElement* c : elements) {
+      const auto id = required(ctx, c, "id");
+      auto* node = static_cast<std::remove_reference_t<decltype(scratch)>*>(nullptr);
+      if (id) {
+        try {
+          node = &add(*id, ctx.loc.element(c));
+        } catch (const std::invalid_argument&) {
+          duplicate(c, *id);
+        }
+      }
+      if (node == nullptr) {
+        scratch = {};
+        scratch.id = id.value_or(std::string_view());
+        scratch.where = ctx.loc.element(c);
+        node = &scratch;
+      }
+      details(ctx, c, *node, net, true);
+    }
+  };
+  Place scratch_place;
   Transition scratch_transition;
-  for (const XmlElement* c : places) {
-    const auto id = required(ctx, c, "id");
-    Place* p = nullptr;
-    if (id) {
-      try {
-        p = &net.new_place(*id, ctx.loc.element(c));
-      } catch (const std::invalid_argument&) {
-        duplicate(c, *id);
-      }
-    }
-    if (p == nullptr) {
-      scratch_place = Place{};
-      p = &scratch_place;
-      p->id = id.value_or(std::string_view());
-      p->where = ctx.loc.element(c);
-    }
-    read_place_details(ctx, c, *p, net, true);
-  }
-  for (const XmlElement* c : transitions) {
-    const auto id = required(ctx, c, "id");
-    Transition* t = nullptr;
-    if (id) {
-      try {
-        t = &net.new_transition(*id, ctx.loc.element(c));
-      } catch (const std::invalid_argument&) {
-        duplicate(c, *id);
-      }
-    }
-    if (t == nullptr) {
-      scratch_transition = Transition{};
-      t = &scratch_transition;
-      t->id = id.value_or(std::string_view());
-      t->where = ctx.loc.element(c);
-    }
-    read_transition_details(ctx, c, *t, net, true);
-  }
+  read_nodes(places, [&](std::string_view id, SourceLocation where) -> Place& { return net.new_place(id, where); },
+             scratch_place, read_place_details);
+  read_nodes(transitions,
+             [&](std::string_view id, SourceLocation where) -> Transition& { return net.new_transition(id, where); },
+             scratch_transition, read_transition_details);
   static constexpr std::array<std::string_view, 4> kArcAttributes{"source", "target", "weight", "kind"};
   for (const XmlElement* c : arcs) {
     AttributeValues<kArcAttributes.size()> attr;

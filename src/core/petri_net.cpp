@@ -150,30 +150,26 @@ PlaceIndex PetriNet::add_place(Place p) {
   return index;
 }
 
-Place& PetriNet::new_place(std::string_view node_id, SourceLocation node_where) {
-  if (node_id.empty()) throw std::invalid_argument("place id must not be empty");
+template <typename Node>
+Node& PetriNet::emplace_node(std::vector<Node>& nodes, bool is_place, std::string_view node_id, SourceLocation node_where) {
+  if (node_id.empty()) throw std::invalid_argument(std::string(is_place ? "place" : "transition") + " id must not be empty");
   IdKey key;
   const std::size_t slot = claim_slot(node_id, key);  // throws on a duplicate
-  const auto index = static_cast<PlaceIndex>(places_.size());
-  Place& p = places_.emplace_back();
-  p.id = node_id;
-  p.name = p.id;
-  p.where = node_where;
-  fill_slot(slot, key, p.id, NodeRef{true, index});
-  return p;
+  const auto index = static_cast<std::uint32_t>(nodes.size());
+  Node& node = nodes.emplace_back();
+  node.id = node_id;
+  node.name = node.id;
+  node.where = node_where;
+  fill_slot(slot, key, node.id, NodeRef{is_place, index});
+  return node;
+}
+
+Place& PetriNet::new_place(std::string_view node_id, SourceLocation node_where) {
+  return emplace_node(places_, true, node_id, node_where);
 }
 
 Transition& PetriNet::new_transition(std::string_view node_id, SourceLocation node_where) {
-  if (node_id.empty()) throw std::invalid_argument("transition id must not be empty");
-  IdKey key;
-  const std::size_t slot = claim_slot(node_id, key);  // throws on a duplicate
-  const auto index = static_cast<TransitionIndex>(transitions_.size());
-  Transition& t = transitions_.emplace_back();
-  t.id = node_id;
-  t.name = t.id;
-  t.where = node_where;
-  fill_slot(slot, key, t.id, NodeRef{false, index});
-  return t;
+  return emplace_node(transitions_, false, node_id, node_where);
 }
 
 TransitionIndex PetriNet::add_transition(Transition t) {

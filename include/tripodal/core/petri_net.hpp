@@ -167,6 +167,8 @@ class PetriNet {
   std::size_t claim_slot(std::string_view node_id, IdKey& key);
   void fill_slot(std::size_t slot, IdKey key, std::string_view node_id, NodeRef ref);
   void grow_index(std::size_t nodes);
+  template <typename Node>
+  Node& emplace_node(std::vector<Node>& nodes, bool is_place, std::string_view node_id, SourceLocation node_where);
 
   std::vector<Place> places_;
   std::vector<Transition> transitions_;
