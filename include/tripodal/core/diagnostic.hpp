@@ -19,14 +19,14 @@ class SourceFile {
  public:
   SourceFile() noexcept = default;
   // Implicit, so that a location is written {"net.xml", 3, 1} or {path.string(), 0, 0}.
-  SourceFile(std::string_view name);  // NOLINT(google-explicit-constructor)
-  SourceFile(const std::string& name) : SourceFile(std::string_view(name)) {}  // NOLINT(google-explicit-constructor)
-  SourceFile(const char* name) : SourceFile(std::string_view(name)) {}         // NOLINT(google-explicit-constructor)
+  SourceFile(std::string_view name);
+  SourceFile(const std::string& name) : SourceFile(std::string_view(name)) {}
+  SourceFile(const char* name) : SourceFile(std::string_view(name)) {}
 
   [[nodiscard]] const std::string& str() const noexcept;
   [[nodiscard]] bool empty() const noexcept { return name_ == nullptr; }
-  operator const std::string&() const noexcept { return str(); }  // NOLINT(google-explicit-constructor)
-  operator std::string_view() const noexcept { return str(); }    // NOLINT(google-explicit-constructor)
+  operator const std::string&() const noexcept { return str(); }
+  operator std::string_view() const noexcept { return str(); }
 
   friend bool operator==(const SourceFile& a, std::string_view b) noexcept { return std::string_view(a) == b; }
 
