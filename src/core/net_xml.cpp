@@ -63,7 +63,7 @@ PetriNet read_native(const XmlElement* root, const ReadContext& ctx) {
   const auto read_nodes = [&](const std::vector<const XmlElement*>& elements, auto add, auto& scratch, auto details) {
     for (const XmlElement* c : elements) {
       const auto id = required(ctx, c, "id");
-      auto* node = static_cast<std::remove_reference_t<decltype(scratch)>*>(nullptr);
+      std::remove_reference_t<decltype(scratch)>* node = nullptr;
       if (id) {
         try {
           node = &add(*id, ctx.loc.element(c));
