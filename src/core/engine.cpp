@@ -1,6 +1,7 @@
 // The engine compiles a net into flat arrays once:
 //  - per transition, one Check per place it depends on (lo <= marking <= hi folds input, read,
-//    inhibitor and capacity conditions together) and one PlaceChange per place it touches;
+//    inhibitor and capacity conditions together), one PlaceChange per place it touches (what
+//    observers see) and one Effect per place whose marking it changes (what a firing executes);
 //  - per place, the transitions whose Checks read it (CSR), per fact the transitions whose guards
 //    read it;
 //  - a rank per transition: the conflict order (priority descending, then declaration order).
@@ -39,17 +40,27 @@ enum class Kind : std::uint8_t { immediate, delayed, event };
 struct TransitionCode {
   std::uint32_t check_begin = 0;   // [check_begin, check_end) in checks
   std::uint32_t check_end = 0;
-  std::uint32_t change_begin = 0;  // [change_begin, change_end) in changes
-  std::uint32_t change_end = 0;
+  std::uint32_t effect_begin = 0;  // [effect_begin, effect_end) in effects
+  std::uint32_t effect_end = 0;
   std::uint32_t rank = 0;          // conflict order: priority descending, then declaration order
   Kind kind = Kind::immediate;
   bool enabled = false;
+  bool marks_bound = false;        // an effect changes a place that binds a behavior or process
   const Guard* guard = nullptr;
 };
 
 /// Per place: whether it binds a behavior or process (reported in StepResult::activated /
 /// deactivated), and whether this step changed its marking. Not a char type, for the same reason.
 enum class PlaceFlags : std::uint8_t { none = 0, bound = 1, touched = 2, bound_touched = 3 };
+
+/// What a firing does to one place whose marking it changes, with everything the firing then
+/// needs in one record: the place's watchers are found without a look-up in watch_begin.
+struct Effect {
+  PlaceIndex place = 0;
+  Tokens delta = 0;  // produced - consumed, modulo 2^32: the firing adds it
+  std::uint32_t watch_begin = 0;  // [watch_begin, watch_end) in watchers
+  std::uint32_t watch_end = 0;
+};
 
 struct Check {
   PlaceIndex place = 0;
@@ -84,33 +95,31 @@ class RankSet {
       if (words == 1) break;
       bits = words;
     }
+    top_ = begin_[levels_ - 1];
     words_.assign(total, 0);
   }
   void clear() noexcept { std::fill(words_.begin(), words_.end(), 0); }
-  [[nodiscard]] bool empty() const noexcept { return words_[begin_[levels_ - 1]] == 0; }
+  [[nodiscard]] bool empty() const noexcept { return words_[top_] == 0; }
   [[nodiscard]] bool test(std::uint32_t i) const noexcept { return ((words_[i >> 6] >> (i & 63)) & 1U) != 0; }
+  // Level 0 is handled inline: in most calls its word was already non-empty (insert) or stays
+  // non-empty (erase), and the levels above are not touched.
   void insert(std::uint32_t i) noexcept {
-    for (std::uint32_t l = 0; l < levels_; ++l) {
-      std::uint64_t& word = words_[begin_[l] + (i >> 6)];
-      const bool was_empty = word == 0;
-      word |= std::uint64_t{1} << (i & 63);
-      if (!was_empty) return;
-      i >>= 6;
-    }
+    std::uint64_t& word = words_[i >> 6];
+    const bool was_empty = word == 0;
+    word |= std::uint64_t{1} << (i & 63);
+    if (was_empty && levels_ > 1) insert_above(i >> 6);
   }
   void erase(std::uint32_t i) noexcept {
-    for (std::uint32_t l = 0; l < levels_; ++l) {
-      std::uint64_t& word = words_[begin_[l] + (i >> 6)];
-      word &= ~(std::uint64_t{1} << (i & 63));
-      if (word != 0) return;
-      i >>= 6;
-    }
+    std::uint64_t& word = words_[i >> 6];
+    word &= ~(std::uint64_t{1} << (i & 63));
+    if (word == 0 && levels_ > 1) erase_above(i >> 6);
   }
   /// Smallest element; the set must not be empty.
   [[nodiscard]] std::uint32_t first() const noexcept {
-    std::uint32_t index = 0;
-    for (std::uint32_t l = levels_; l-- > 0;) {
-      index = index * 64 + static_cast<std::uint32_t>(std::countr_zero(words_[begin_[l] + index]));
+    const std::uint64_t* words = words_.data();
+    auto index = static_cast<std::uint32_t>(std::countr_zero(words[top_]));
+    for (std::uint32_t l = levels_ - 1; l-- > 0;) {
+      index = index * 64 + static_cast<std::uint32_t>(std::countr_zero(words[begin_[l] + index]));
     }
     return index;
   }
@@ -119,6 +128,24 @@ class RankSet {
 
  private:
   static constexpr std::uint32_t kMaxLevels = 6;  // 64^6 elements
+
+  void insert_above(std::uint32_t i) noexcept {
+    for (std::uint32_t l = 1; l < levels_; ++l) {
+      std::uint64_t& word = words_[begin_[l] + (i >> 6)];
+      const bool was_empty = word == 0;
+      word |= std::uint64_t{1} << (i & 63);
+      if (!was_empty) return;
+      i >>= 6;
+    }
+  }
+  void erase_above(std::uint32_t i) noexcept {
+    for (std::uint32_t l = 1; l < levels_; ++l) {
+      std::uint64_t& word = words_[begin_[l] + (i >> 6)];
+      word &= ~(std::uint64_t{1} << (i & 63));
+      if (word != 0) return;
+      i >>= 6;
+    }
+  }
 
   // Smallest set bit >= i at `level`: within i's word, else in the next non-empty word, which
   // the level above finds.
@@ -138,6 +165,7 @@ class RankSet {
   std::uint32_t begin_[kMaxLevels] = {};
   std::uint32_t size_[kMaxLevels] = {};
   std::uint32_t levels_ = 0;
+  std::uint32_t top_ = 0;  // the single word of the top level
 };
 
 /// Min-heap of (deadline, rank) with a position index per transition, so a transition that stops
@@ -269,6 +297,8 @@ struct Engine::Impl {
   std::vector<EventId> event_of;             // kNone: no event
   std::vector<Check> checks;
   std::vector<PlaceChange> changes;
+  std::vector<std::uint32_t> change_begin;  // per transition, CSR into changes (for observers)
+  std::vector<Effect> effects;
   std::vector<std::uint32_t> slot_begin;     // into slots
   std::vector<const Value*> slots;
   std::vector<std::uint32_t> watch_begin;    // per place, CSR into watchers
@@ -305,6 +335,7 @@ struct Engine::Impl {
   std::vector<EngineObserver*> observers;
   StepResult result;
   bool debug_log = false;  // the logger's level, read once per step
+  bool reporting = false;  // debug_log or observers: a firing calls report_firing
 
   Impl(const PetriNet& n, const ParameterValues& parameters, EngineOptions opts);
   void compile_structure();
@@ -324,31 +355,46 @@ struct Engine::Impl {
         std::span<const Value* const>(slots.data() + slot_begin[t], slot_begin[t + 1] - slot_begin[t]));
   }
 
+  // Immediate transitions, the common case, are handled inline; the others out of line.
   void disable(TransitionIndex t) noexcept {
     TransitionCode& tc = code[t];
     if (!tc.enabled) return;
     tc.enabled = false;
-    switch (tc.kind) {
-      case Kind::immediate: ready.erase(tc.rank); break;
-      case Kind::delayed:
-        if (timers.contains(t)) {
-          timers.remove(t);
-        } else {
-          ready.erase(tc.rank);
-        }
-        break;
-      case Kind::event: event_enabled[event_of[t]].erase(listener_pos[t]); break;
+    if (tc.kind == Kind::immediate) {
+      ready.erase(tc.rank);
+    } else {
+      disable_timed_or_event(t);
     }
   }
 
   void enable(TransitionIndex t) noexcept {
     TransitionCode& tc = code[t];
     tc.enabled = true;
-    since[t] = now;
-    switch (tc.kind) {
-      case Kind::immediate: ready.insert(tc.rank); break;
-      case Kind::delayed: timers.push(t, now + delay[t], tc.rank); break;
-      case Kind::event: event_enabled[event_of[t]].insert(listener_pos[t]); break;
+    if (tc.kind == Kind::immediate) {
+      ready.insert(tc.rank);
+    } else {
+      enable_timed_or_event(t);
+    }
+  }
+
+  [[gnu::noinline]] void disable_timed_or_event(TransitionIndex t) noexcept {
+    const TransitionCode& tc = code[t];
+    if (tc.kind == Kind::event) {
+      event_enabled[event_of[t]].erase(listener_pos[t]);
+    } else if (timers.contains(t)) {
+      timers.remove(t);
+    } else {
+      ready.erase(tc.rank);  // due: it waits in the ready set
+    }
+  }
+
+  [[gnu::noinline]] void enable_timed_or_event(TransitionIndex t) noexcept {
+    const TransitionCode& tc = code[t];
+    if (tc.kind == Kind::event) {
+      since[t] = now;  // an event transition with a delay passes events on until it has waited
+      event_enabled[event_of[t]].insert(listener_pos[t]);
+    } else {
+      timers.push(t, now + delay[t], tc.rank);
     }
   }
 
@@ -365,11 +411,12 @@ struct Engine::Impl {
   // A transition that fired and is still enabled: immediate and event transitions stay where
   // they are; a delayed one (it fired from the ready set) waits for its delay again.
   void restart(TransitionIndex t) noexcept {
-    since[t] = now;
     const TransitionCode& tc = code[t];
     if (tc.kind == Kind::delayed) {
       ready.erase(tc.rank);
       timers.push(t, now + delay[t], tc.rank);
+    } else if (tc.kind == Kind::event) {
+      since[t] = now;
     }
   }
 
@@ -382,25 +429,21 @@ struct Engine::Impl {
     tail[instant_firings & tail_mask] = t;
     ++instant_firings;
     ++result.firings;
-    const std::uint32_t begin = code[t].change_begin;
-    const std::uint32_t end = code[t].change_end;
-    const PlaceChange* const first = changes.data() + begin;
-    const PlaceChange* const last = changes.data() + end;
-    for (const PlaceChange* c = first; c != last; ++c) {
-      marking[c->place] = marking[c->place] - c->consumed + c->produced;
-      if (place_flags[c->place] == PlaceFlags::bound) [[unlikely]] touch(c->place);
-    }
+    const TransitionCode& tc = code[t];
+    if (tc.marks_bound) [[unlikely]] touch_bound(tc);
     // Enabling is a conjunction of one bound per place (and the guard, which a firing does not
     // change). An enabled watcher of a changed place therefore stays enabled exactly while that
     // place's bound holds; a disabled one can only become enabled if that bound now holds, and
-    // then the whole check decides. Every flag is exact once all changed places are seen.
-    for (const PlaceChange* c = first; c != last; ++c) {
-      if (c->consumed == c->produced) continue;
-      const Tokens m = marking[c->place];
-      const Watch* w = watchers.data() + watch_begin[c->place];
-      const Watch* const we = watchers.data() + watch_begin[c->place + 1];
-      for (; w != we; ++w) {
-        const bool holds = m >= w->lo && m <= w->hi;
+    // then the whole check decides. A check may read a place this firing changes later; that
+    // place's own watchers are visited then, so every flag is exact after the last effect.
+    Tokens* const m = marking.data();
+    const Watch* const all_watchers = watchers.data();
+    const Effect* const last = effects.data() + tc.effect_end;
+    for (const Effect* e = effects.data() + tc.effect_begin; e != last; ++e) {
+      const Tokens tokens = m[e->place] += e->delta;
+      const Watch* const we = all_watchers + e->watch_end;
+      for (const Watch* w = all_watchers + e->watch_begin; w != we; ++w) {
+        const bool holds = tokens >= w->lo && tokens <= w->hi;
         if (code[w->transition].enabled) {
           if (!holds) disable(w->transition);
         } else if (holds && check(w->transition)) {
@@ -411,13 +454,18 @@ struct Engine::Impl {
     // The fired transition starts a new enabling (its delay counts again) if it stays enabled.
     if (code[t].enabled) restart(t);
 
-    if (debug_log || !observers.empty()) [[unlikely]] report_firing(t, event);
+    if (reporting) [[unlikely]] report_firing(t, event);
     return true;
   }
 
-  [[gnu::noinline]] void touch(PlaceIndex p) {
-    place_flags[p] = PlaceFlags::bound_touched;
-    touched_list.push_back(p);
+  // Records the bound places a firing changes, for StepResult::activated / deactivated.
+  [[gnu::noinline]] void touch_bound(const TransitionCode& tc) {
+    for (std::uint32_t i = tc.effect_begin; i != tc.effect_end; ++i) {
+      const PlaceIndex p = effects[i].place;
+      if (place_flags[p] != PlaceFlags::bound) continue;
+      place_flags[p] = PlaceFlags::bound_touched;
+      touched_list.push_back(p);
+    }
   }
 
   [[gnu::noinline]] void report_firing(TransitionIndex t, std::string_view event) {
@@ -425,9 +473,8 @@ struct Engine::Impl {
       log->debug("{}: fire {} at {:.6f} s{}{}", net.id, net.transition(t).id, to_seconds(now),
                  event.empty() ? "" : " on event ", event);
     }
-    const TransitionCode& tc = code[t];
     const Firing f{now, t, net.transitions()[t].id, event,
-                   std::span<const PlaceChange>(changes.data() + tc.change_begin, tc.change_end - tc.change_begin),
+                   std::span<const PlaceChange>(changes.data() + change_begin[t], change_begin[t + 1] - change_begin[t]),
                    marking};
     for (EngineObserver* o : observers) o->notify(f);
   }
@@ -489,6 +536,7 @@ struct Engine::Impl {
     result.error.clear();
     instant_firings = 0;
     debug_log = log->should_log(spdlog::level::debug);
+    reporting = debug_log || !observers.empty();  // observers cannot change during a step
   }
   void finish_step() {
     for (const PlaceIndex p : touched_list) {
@@ -535,6 +583,7 @@ void Engine::Impl::compile_structure() {
   const std::size_t nt = transitions.size();
 
   code.assign(nt, TransitionCode{});
+  change_begin.assign(1, 0);
   delay.resize(nt);
   event_of.assign(nt, kNone);
 
@@ -596,10 +645,14 @@ void Engine::Impl::compile_structure() {
       checks.push_back(c);
       place_watchers[p].push_back(Watch{t, c.lo, c.hi});
     }
-    code[t].change_begin = static_cast<std::uint32_t>(changes.size());
-    for (const auto& [p, d] : delta) changes.push_back(d);
+    code[t].effect_begin = static_cast<std::uint32_t>(effects.size());
+    for (const auto& [p, d] : delta) {
+      changes.push_back(d);
+      if (d.produced != d.consumed) effects.push_back(Effect{p, d.produced - d.consumed, 0, 0});
+    }
     code[t].check_end = static_cast<std::uint32_t>(checks.size());
-    code[t].change_end = static_cast<std::uint32_t>(changes.size());
+    change_begin.push_back(static_cast<std::uint32_t>(changes.size()));
+    code[t].effect_end = static_cast<std::uint32_t>(effects.size());
   }
 
   // Conflict order: priority descending, then declaration order.
@@ -614,6 +667,10 @@ void Engine::Impl::compile_structure() {
   for (const auto& w : place_watchers) {
     watchers.insert(watchers.end(), w.begin(), w.end());
     watch_begin.push_back(static_cast<std::uint32_t>(watchers.size()));
+  }
+  for (Effect& e : effects) {
+    e.watch_begin = watch_begin[e.place];
+    e.watch_end = watch_begin[e.place + 1];
   }
   listener_begin.assign(1, 0);
   listener_pos.assign(nt, kNone);
@@ -631,6 +688,11 @@ void Engine::Impl::compile_structure() {
   for (PlaceIndex p = 0; p < np; ++p) {
     if (places[p].behavior || places[p].process) place_flags[p] = PlaceFlags::bound;
     if (places[p].outcome != Outcome::none) outcome_places.push_back(p);
+  }
+  for (TransitionCode& tc : code) {
+    for (std::uint32_t i = tc.effect_begin; i != tc.effect_end; ++i) {
+      if (place_flags[effects[i].place] != PlaceFlags::none) tc.marks_bound = true;
+    }
   }
 
   marking.assign(np, 0);
