@@ -12,14 +12,15 @@
 #include <stdexcept>
 
 #include "tripodal/app/png.hpp"
-#include "tripodal/behaviors/navigation_behaviors.hpp"
-#include "tripodal/controllers/controller_config.hpp"
 #include "tripodal/core/clock.hpp"
+#include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/navi/localizer.hpp"
+#include "tripodal/navi/planning_modules.hpp"
+#include "tripodal/navi/section_splitter.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
-#include "tripodal/reactive/reactive_config.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/robot/robot_profile.hpp"
+#include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/sim/simulator.hpp"
 #include "tripodal/sim/world.hpp"
 
@@ -79,101 +80,12 @@ PathFigures path_figures(const std::vector<Point2D>& path, double tolerance_m) {
 
 namespace {
 
-// ---------------------------------------------------------------------------------------------
-// Modules of the profile, as this program implements them
-
-ModuleManifest manifest_of(std::string name, Layer layer, ModuleKind kind, std::vector<std::string> in,
-                           std::vector<std::string> out, std::string description) {
-  ModuleManifest m;
-  m.name = std::move(name);
-  m.layer = layer;
-  m.kind = kind;
-  m.inputs = std::move(in);
-  m.outputs = std::move(out);
-  m.description = std::move(description);
-  return m;
-}
-
-// Resources and the map are fed by the simulator / loaded once: nothing to do per period.
-class PassiveModule final : public RobotModule {};
-
-// The navi localizer as a robot module: updates the estimate each period, posts its events to
-// the nets, keeps the supervisor's watchdog fed, and publishes the pose behaviors read.
-class LocalizerModule final : public RobotModule {
- public:
-  LocalizerModule(navi::CLocalizer& localizer, NavigationData& navi) : localizer_(localizer), navi_(navi) {}
-
- protected:
-  void on_update(Time now) override {
-    events_.clear();
-    localizer_.update(now, events_);
-    for (const navi::NaviEvent& e : events_) port().post_event(e.name);
-    port().heartbeat();
-    localizer_.publish(navi_);
-  }
-
- private:
-  navi::CLocalizer& localizer_;
-  NavigationData& navi_;
-  std::vector<navi::NaviEvent> events_;
+// The robot's navigation modules, which the measures read.
+struct Navigation {
+  const navi::CGridMaps* maps = nullptr;
+  const navi::CSectionSplitter* splitter = nullptr;
+  navi::CCoverageModule* coverage = nullptr;
 };
-
-// The section splitter as the planner's knowledge: sections(room).
-class SectionSplitterModule final : public RobotModule {
- public:
-  explicit SectionSplitterModule(const NaviWorkspace& ws) : ws_(ws) {}
-
- protected:
-  std::optional<TaskKnowledge::ListResult> on_answer(std::string_view function, std::string_view room) const override {
-    if (function != "sections") return std::nullopt;
-    auto r = ws_.sections_of_room(room);
-    return TaskKnowledge::ListResult{r.ok, std::move(r.names), std::move(r.error)};
-  }
-
- private:
-  const NaviWorkspace& ws_;
-};
-
-const ModuleEntry* find_entry(const RobotProfile& p, std::string_view type) {
-  for (const ModuleEntry* e : p.all_modules()) {
-    if (e->type == type) return e;
-  }
-  return nullptr;
-}
-
-double number_parameter(const ModuleEntry* e, std::string_view name, double fallback) {
-  if (e == nullptr) return fallback;
-  const auto it = e->parameters.find(name);
-  if (it == e->parameters.end()) return fallback;
-  try {
-    std::size_t used = 0;
-    const double v = std::stod(it->second, &used);
-    if (used == it->second.size() && std::isfinite(v) && v > 0.0) return v;
-  } catch (const std::exception&) {
-  }
-  throw ConfigError(e->where, "parameter '" + std::string(name) + "' of '" + e->name + "' must be a positive number, not \"" +
-                                  it->second + "\"");
-}
-
-// The base controller: the profile's controller entry names its full configuration (limits,
-// wheel geometry) in a reactive configuration file, parameter `config`.
-ControllerConfig controller_config(const RobotProfile& p) {
-  if (p.controllers.empty()) throw ConfigError(p.where, "the robot has no controller; `tripodal run` needs one to drive its base");
-  const ModuleEntry& e = p.controllers.front();
-  const auto it = e.parameters.find("config");
-  if (it == e.parameters.end()) {
-    throw ConfigError(e.where, "controller '" + e.name +
-                                   "' needs parameters: {config: FILE}, the reactive configuration with its limits and wheels");
-  }
-  const std::filesystem::path file = p.file.parent_path() / it->second;
-  const ReactiveConfig rc = load_reactive_config(file.string());
-  const ControllerConfig* c = rc.find_controller(e.name);
-  if (c == nullptr) throw ConfigError(e.where, file.string() + " configures no controller named '" + e.name + "'");
-  if (c->type != e.type) {
-    throw ConfigError(e.where, "controller '" + e.name + "' is of type '" + e.type + "' here but '" + c->type + "' in " + file.string());
-  }
-  return *c;
-}
 
 // ---------------------------------------------------------------------------------------------
 // Output
@@ -226,10 +138,10 @@ constexpr std::array<std::array<std::uint8_t, 3>, 8> kSectionColours{{
 // The map (2 pixels per cell): walls black, unknown grey, sections tinted, cleaned cells green,
 // cells the footprint could reach but did not clean red, virtual walls dashed red, the true path
 // dark blue, start and end markers.
-RgbImage draw_map(const NaviWorkspace& ws, const navi::CleanedCells& cleaned, const std::vector<char>& reachable,
+RgbImage draw_map(const Navigation& nav, const navi::CleanedCells& cleaned, const std::vector<char>& reachable,
                   const std::vector<TrajectorySample>& traj) {
   constexpr int kScale = 2;
-  const navi::OccupancyGrid& g = ws.grid();
+  const navi::OccupancyGrid& g = nav.maps->grid();
   RgbImage img(g.width() * kScale, g.height() * kScale);
   auto fill_cell = [&](navi::CellIndex c, std::array<std::uint8_t, 3> rgb, double alpha) {
     for (int dy = 0; dy < kScale; ++dy) {
@@ -238,7 +150,7 @@ RgbImage draw_map(const NaviWorkspace& ws, const navi::CleanedCells& cleaned, co
       }
     }
   };
-  const auto& label = ws.sections().label;
+  const auto& label = nav.splitter->sections().label;
   for (std::size_t i = 0; i < g.size(); ++i) {
     const navi::CellIndex c = g.cell(i);
     switch (g.state(i)) {
@@ -250,7 +162,7 @@ RgbImage draw_map(const NaviWorkspace& ws, const navi::CleanedCells& cleaned, co
     if (cleaned.cleaned(i)) fill_cell(c, {60, 170, 60}, 0.45);
     else if (reachable[i] != 0) fill_cell(c, {230, 40, 40}, 0.6);
   }
-  for (const int row : ws.sections().virtual_wall_rows) {
+  for (const int row : nav.splitter->sections().virtual_wall_rows) {
     const int y = (g.height() - 1 - row) * kScale;  // the edge between rows row and row + 1
     for (int x = 0; x < img.width; ++x) {
       if ((x / 6) % 2 == 0) img.set(x, y, 220, 0, 0);
@@ -300,18 +212,19 @@ std::string trajectory_csv(const std::vector<TrajectorySample>& traj) {
 
 // The cells of the room a cleaning footprint can reach at all: within half the cleaning width of
 // a cell where the robot can stand (clearance >= its radius) connected to its start.
-std::vector<char> reachable_area(NaviWorkspace& ws, const std::vector<std::string>& sections, Pose2D start) {
-  const navi::OccupancyGrid& g = ws.grid();
+std::vector<char> reachable_area(const Navigation& nav, navi::PathPlanner& planner, const std::vector<std::string>& sections,
+                                 Pose2D start) {
+  const navi::OccupancyGrid& g = nav.maps->grid();
   std::vector<char> in_room(g.size(), 0);
   for (const std::string& name : sections) {
-    if (const navi::Section* s = ws.section(name)) {
+    if (const navi::Section* s = nav.splitter->section(name)) {
       for (const std::size_t i : s->cells) in_room[i] = 1;
     }
   }
   std::vector<char> stand(g.size(), 0);
   std::deque<navi::CellIndex> queue;
   const navi::CellIndex s0 = g.cell_at({start.x_m, start.y_m});
-  if (ws.planner().traversable(s0)) {
+  if (planner.traversable(s0)) {
     stand[g.index(s0)] = 1;
     queue.push_back(s0);
   }
@@ -320,12 +233,12 @@ std::vector<char> reachable_area(NaviWorkspace& ws, const std::vector<std::strin
     queue.pop_front();
     for (const auto& d : std::array<navi::CellIndex, 4>{{{1, 0}, {-1, 0}, {0, 1}, {0, -1}}}) {
       const navi::CellIndex n{c.x + d.x, c.y + d.y};
-      if (!ws.planner().traversable(n) || stand[g.index(n)] != 0) continue;
+      if (!planner.traversable(n) || stand[g.index(n)] != 0) continue;
       stand[g.index(n)] = 1;
       queue.push_back(n);
     }
   }
-  const double r_cells = ws.options().cleaning_width_m / 2.0 / g.resolution_m();
+  const double r_cells = nav.coverage->cleaning_width_m() / 2.0 / g.resolution_m();
   const int r = static_cast<int>(std::floor(r_cells));
   std::vector<navi::CellIndex> disc;
   for (int dy = -r; dy <= r; ++dy) {
@@ -418,71 +331,43 @@ std::string RunResult::json() const {
 
 RunResult run_task(const RunOptions& o) {
   const RobotProfile profile = load_robot_profile(o.robot);
-  sim::World world = sim::load_world(o.world);
+  auto world = std::make_shared<sim::World>(sim::load_world(o.world));
   RunResult res;
   res.robot = profile.name;
   res.task = o.task;
-  res.seed = o.seed.value_or(world.seed);
-
-  const ControllerConfig base = controller_config(profile);
-  const ModuleEntry* maps = find_entry(profile, "GridMaps");
-  NaviWorkspaceOptions wo;
-  wo.robot_radius_m = number_parameter(maps, "robot_radius_m", world.robot.radius_m);
-  wo.cleaning_width_m = number_parameter(maps, "cleaning_width_m", 2.0 * wo.robot_radius_m);
-  if (wo.robot_radius_m < world.robot.radius_m) {
-    throw ConfigError(maps->where, "robot_radius_m " + fixed(wo.robot_radius_m, 3) + " m is smaller than the simulated body (" +
-                                       fixed(world.robot.radius_m, 3) + " m): planned paths would collide");
-  }
-  if (o.boustrophedon) wo.pattern = NaviWorkspaceOptions::Pattern::boustrophedon;
+  res.seed = o.seed.value_or(world->seed);
   res.coverage_pattern = o.boustrophedon ? "boustrophedon" : "balloon";
-  NaviWorkspace ws(world.grid, world.regions, wo);
-
-  std::vector<navi::LocalizationFault> faults = world.faults.localization_loss;
+  std::vector<navi::LocalizationFault>& faults = world->faults.localization_loss;
   faults.insert(faults.end(), o.faults.begin(), o.faults.end());
-  world.faults.localization_loss = faults;
-  const Pose2D start = world.start_pose;
-  sim::Simulator sim(std::move(world), base, res.seed);
-  auto controller = default_controller_registry().create(base, sim);
-  controller->reset_odometry(start);
-  ResourceTable table;
-  sim.add_resources(table, true);
-  NavigationData navi;
-
-  // The localizer: its parameters from the profile, the run's seed, the fault schedule.
-  navi::CLocalizer localizer(&sim);
-  {
-    ParameterValues lp;
-    if (const ModuleEntry* e = find_entry(profile, "Localizer")) {
-      for (const auto& [k, v] : e->parameters) lp.emplace(k, Value{v});
-    }
-    lp.insert_or_assign("seed", Value{static_cast<double>(res.seed % (1ULL << 52))});
-    const ModuleEntry* e = find_entry(profile, "Localizer");
-    localizer.configure(lp, e != nullptr ? e->where : SourceLocation{});
-    for (const navi::LocalizationFault& f : faults) localizer.add_fault(f);
+  if (!profile.hardware || profile.hardware->type != "sim") {
+    throw ConfigError(profile.hardware ? profile.hardware->where : profile.where,
+                      "`tripodal run` runs the robot on the simulator: its profile needs hardware: {type: sim}");
   }
-  ws.set_relocalizer([&localizer](Time t) { return localizer.relocalize(t); });
 
-  BehaviorRegistry behaviors;
-  register_navigation_behaviors(behaviors, ws);
-  ModuleRegistry modules;
-  auto passive = [](const ModuleConfig&) { return std::make_unique<PassiveModule>(); };
-  modules.add(manifest_of("LaserScanner", Layer::reactive, ModuleKind::resource, {}, {"laser_scan"}, "simulated laser scanner"), passive);
-  modules.add(manifest_of("Gyro", Layer::reactive, ModuleKind::resource, {}, {"yaw_rate"}, "simulated gyro"), passive);
-  modules.add(manifest_of("GridMaps", Layer::sequencing, ModuleKind::navigation, {}, {"grid_map"}, "the world's map"), passive);
-  modules.add(manifest_of("Localizer", Layer::sequencing, ModuleKind::navigation, {"laser_scan", "odometry", "grid_map"},
-                          {"map_from_base"}, "navi::CLocalizer on the simulator's ground truth"),
-              [&](const ModuleConfig&) { return std::make_unique<LocalizerModule>(localizer, navi); });
-  modules.add(manifest_of("SectionSplitter", Layer::sequencing, ModuleKind::navigation, {"grid_map", "map_from_base"}, {"sections"},
-                          "navi::CSectionSplitter: sections(room)"),
-              [&](const ModuleConfig&) { return std::make_unique<SectionSplitterModule>(ws); });
-
-  SimClock clock;
+  // The robot, on simulated hardware in this world, with this run's seed and coverage pattern.
+  RobotPlugins plugins = RobotPlugins::with_builtins();
+  sim::register_sim_hardware(plugins.hardware, world);
   RobotOptions ro;
-  ro.period = o.robot_period;
-  ro.resources = &table;
-  ro.navigation = &navi;
-  ro.base = controller->capabilities();
-  const auto robot = Robot::assemble(profile, RobotCatalog{&modules, &behaviors, &default_controller_registry()}, clock, ro);
+  const std::string seed_text = std::to_string(res.seed);
+  ro.parameters.push_back({profile.hardware->name, "seed", seed_text});
+  for (const ModuleEntry& e : profile.navigation) {
+    if (e.type == navi::CLocalizer::static_manifest().name) ro.parameters.push_back({e.name, "seed", std::to_string(res.seed % (1ULL << 52))});
+    if (e.type == navi::CCoverageModule::static_manifest().name && o.boustrophedon) ro.parameters.push_back({e.name, "pattern", "boustrophedon"});
+  }
+  SimClock clock;
+  const auto robot = Robot::assemble(profile, plugins, clock, ro);
+  auto& sim = dynamic_cast<sim::SimHardware&>(*robot->hardware()).simulator();
+  Navigation nav{robot->module<navi::CGridMaps>(), robot->module<navi::CSectionSplitter>(), robot->module<navi::CCoverageModule>()};
+  if (nav.maps == nullptr || nav.splitter == nullptr || nav.coverage == nullptr) {
+    throw ConfigError(profile.where, "`tripodal run` measures cleaning: the robot needs GridMaps, SectionSplitter and CoveragePlanner modules");
+  }
+  if (nav.maps->robot_radius_m() < world->robot.radius_m) {
+    throw ConfigError(nav.maps->where(), "robot_radius_m " + fixed(nav.maps->robot_radius_m(), 3) +
+                                             " m is smaller than the simulated body (" + fixed(world->robot.radius_m, 3) +
+                                             " m): planned paths would collide");
+  }
+  const Pose2D start = world->start_pose;
+  if (CController* c = robot->behavior_loop().controller()) c->reset_odometry(start);
   LifecycleRecorder life(true);
   ReportObserver report;
   robot->planner().add_observer(life);
@@ -493,7 +378,7 @@ RunResult run_task(const RunOptions& o) {
   std::optional<sim::RealtimePacer> pacer;
   if (o.realtime) pacer.emplace(wall, o.realtime_speed);
 
-  robot->step();  // the localizer's first estimate, before the planner asks where to start
+  robot->run_until(clock.now());  // the localizer's first estimate, before the planner asks where to start
   const CommandAnswer answer = robot->command(o.task);
   std::size_t printed = 0;
   bool bar_shown = false;  // a bar drawn in place on the terminal, to be wiped before a log line
@@ -530,27 +415,21 @@ RunResult run_task(const RunOptions& o) {
       }
     }
   }
-  const std::vector<char> reachable = reachable_area(ws, room_sections, start);
+  navi::PathPlanner reach_planner(nav.maps->grid(), navi::PathPlannerOptions{.robot_radius_m = nav.maps->robot_radius_m()});
+  const std::vector<char> reachable = reachable_area(nav, reach_planner, room_sections, start);
   for (const char c : reachable) res.reachable_cells += c != 0 ? 1 : 0;
 
-  navi::CleanedCells cleaned(ws.grid());  // from the true pose, while a cleaning behavior runs
+  navi::CleanedCells cleaned(nav.maps->grid());  // from the true pose, while a cleaning behavior runs
   std::vector<TrajectorySample> traj;
   std::vector<Point2D> path_all, path_cleaning;
-  const double half_width = wo.cleaning_width_m / 2.0;
-  const Duration physics = base.period;
-  const auto per_robot_step = std::max<std::int64_t>(1, o.robot_period / physics);
+  const double half_width = nav.coverage->cleaning_width_m() / 2.0;
+  const Duration tick_period = robot->behavior_loop().period();
   const Time deadline = from_seconds(o.max_duration_s);
-  Twist2D command;
   bool was_cleaning = false;
   Pose2D last_truth = sim.pose();
   double next_progress_s = 0.0;
-  auto is_cleaning = [&] {
-    for (const char* name : {"BhCleaning", "BhCleaningTwoWheel"}) {
-      const CBehavior* b = robot->behaviors().find(name);
-      if (b != nullptr && b->running()) return true;
-    }
-    return false;
-  };
+  Time next_sample = clock.now();
+  auto is_cleaning = [&] { return robot->behavior_active("BhCleaning") || robot->behavior_active("BhCleaningTwoWheel"); };
   auto covered = [&] {
     std::size_t n = 0;
     for (std::size_t i = 0; i < reachable.size(); ++i) n += (reachable[i] != 0 && cleaned.cleaned(i)) ? 1 : 0;
@@ -573,11 +452,11 @@ RunResult run_task(const RunOptions& o) {
     bar_shown = o.progress_is_terminal && !final;
   };
 
-  std::int64_t tick = 0;
   std::size_t sim_events_noted = 0;
+  std::size_t sequencing_steps = 0;
   while (robot->planner().busy() && clock.now() < deadline) {
-    sim.step(physics);
-    clock.set(sim.now());
+    robot->run_for(tick_period);
+    ++sequencing_steps;
     for (; sim_events_noted < sim.events().size(); ++sim_events_noted) {
       const sim::SimEvent& e = sim.events()[sim_events_noted];
       life.note(e.stamp, "simulator: " + std::string(sim::to_string(e.kind)) + (e.detail.empty() ? "" : " " + e.detail));
@@ -591,28 +470,23 @@ RunResult run_task(const RunOptions& o) {
     }
     was_cleaning = cleaning;
     last_truth = truth;
-    if (++tick % per_robot_step == 0) {
-      robot->step();
-      ++res.robot_steps;
-      command = robot->coordinator().output().command;
-      flush_log();
-      if (tick % (per_robot_step * 2) == 0) {  // 10 Hz trajectory at the default periods
-        traj.push_back({now, truth, navi.map_from_base, navi.localized, cleaning});
-        path_all.push_back({truth.x_m, truth.y_m});
-        if (cleaning) path_cleaning.push_back({truth.x_m, truth.y_m});
-      }
-      if (to_seconds(now) >= next_progress_s) {
-        draw_progress(false);
-        next_progress_s += o.progress_is_terminal ? (o.realtime ? 1.0 : 10.0) : 60.0;
-      }
+    flush_log();
+    if (now >= next_sample) {  // 10 Hz trajectory
+      next_sample += std::chrono::milliseconds(100);
+      const NavigationData& navi = robot->navigation();
+      traj.push_back({now, truth, navi.map_from_base, navi.localized, cleaning});
+      path_all.push_back({truth.x_m, truth.y_m});
+      if (cleaning) path_cleaning.push_back({truth.x_m, truth.y_m});
     }
-    controller->set_command(command, now);
-    (void)controller->update(now);
+    if (to_seconds(now) >= next_progress_s) {
+      draw_progress(false);
+      next_progress_s += o.progress_is_terminal ? (o.realtime ? 1.0 : 10.0) : 60.0;
+    }
     if (pacer) pacer->pace(now);
   }
   if (robot->planner().busy()) {
     robot->planner().cancel("no end within " + fixed(o.max_duration_s, 0) + " s of simulated time");
-    robot->step();
+    robot->step_sequencing();
     res.state = "timed out";
   }
   flush_log();
@@ -625,7 +499,8 @@ RunResult run_task(const RunOptions& o) {
   res.duration_s = to_seconds(clock.now());
   res.cleaned_cells = covered();
   res.coverage = res.reachable_cells == 0 ? 0.0 : static_cast<double>(res.cleaned_cells) / static_cast<double>(res.reachable_cells);
-  res.reachable_area_m2 = static_cast<double>(res.reachable_cells) * ws.grid().resolution_m() * ws.grid().resolution_m();
+  const double res_m = nav.maps->grid().resolution_m();
+  res.reachable_area_m2 = static_cast<double>(res.reachable_cells) * res_m * res_m;
   res.total = path_figures(path_all);
   res.total.length_m = sim.distance_m();
   res.total.rotation_rad = sim.rotation_rad();
@@ -633,6 +508,7 @@ RunResult run_task(const RunOptions& o) {
   res.processes = report.processes;
   res.recoveries = report.recoveries;
   res.collisions = sim.collisions();
+  res.robot_steps = robot->behavior_loop().cycles();
   for (const navi::LocalizationFault& f : faults) {
     res.faults.push_back("localization loss " + fixed(to_seconds(f.start), 1) + "-" + fixed(to_seconds(f.end), 1) + " s");
   }
@@ -642,23 +518,24 @@ RunResult run_task(const RunOptions& o) {
 
   // The planned paths against the boustrophedon of the same sections (same grid and width).
   for (const std::string& name : room_sections) {
-    const navi::Section* s = ws.section(name);
+    const navi::Section* s = nav.splitter->section(name);
     if (s == nullptr) continue;
     SectionFigures f;
     f.name = name;
     f.area_m2 = s->area_m2;
-    const navi::CoverageResult b = ws.coverage_planner().balloon(*s);
-    const navi::CoverageResult p = ws.coverage_planner().boustrophedon(*s);
+    const navi::CoverageResult b = nav.coverage->planner().balloon(*s);
+    const navi::CoverageResult p = nav.coverage->planner().boustrophedon(*s);
     f.balloon = b.stats;
     f.boustrophedon = p.stats;
     f.balloon_coverage = b.coverage();
     f.boustrophedon_coverage = p.coverage();
     res.sections.push_back(f);
   }
+  (void)sequencing_steps;
 
   if (!o.out.empty()) {
     std::filesystem::create_directories(o.out);
-    write_png(o.out / "map.png", draw_map(ws, cleaned, reachable, traj));
+    write_png(o.out / "map.png", draw_map(nav, cleaned, reachable, traj));
     write_text(o.out / "trajectory.csv", trajectory_csv(traj));
     write_text(o.out / "report.json", res.json());
     write_text(o.out / "lifecycle.txt", life.str());

@@ -1,5 +1,7 @@
 #include "tripodal/navi/localizer.hpp"
 
+#include "tripodal/hardware/hardware.hpp"
+
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -53,10 +55,10 @@ CLocalizer::CLocalizer(const GroundTruthSource* truth, LocalizerOptions options)
 
 const ModuleManifest& CLocalizer::static_manifest() {
   static const ModuleManifest m = navi_manifest(
-      "CLocalizer",
+      "Localizer",
       "pose estimate from the simulator's ground truth with seeded noise and injected faults; posts "
       "localizer.ok / localizer.lost",
-      {"ground_truth_pose"}, {"map_from_base", "localizer.ok", "localizer.lost"},
+      {"ground_truth_pose"}, {"map_from_base", "position_fix", "localizer.ok", "localizer.lost"},
       {ParameterSpec{"noise_xy_m", ValueType::number, Value{0.02}, "m", "position noise (standard deviation per axis)",
                      0.0, std::nullopt},
        ParameterSpec{"noise_theta_rad", ValueType::number, Value{0.01}, "rad", "heading noise (standard deviation)", 0.0,
@@ -96,6 +98,7 @@ void CLocalizer::on_configure(const ParameterSet& params) {
 }
 
 bool CLocalizer::in_fault(Time now) const noexcept {
+  if (truth_ != nullptr && truth_->localization_lost(now)) return true;
   for (const LocalizationFault& f : options_.faults) {
     if (now >= f.start && now < f.end) return true;
   }
@@ -114,7 +117,37 @@ void CLocalizer::publish(NavigationData& data) const noexcept {
   data.localized = localized();
 }
 
-void CLocalizer::on_update(Time now, std::vector<NaviEvent>& out) noexcept {
+void CLocalizer::on_start(ModuleContext& context) {
+  if (truth_ == nullptr) truth_ = dynamic_cast<const GroundTruthSource*>(context.hardware);
+  if (truth_ == nullptr) {
+    throw ConfigError(where(), "Localizer estimates the pose from a simulation's ground truth, and the robot's hardware gives none");
+  }
+}
+
+void CLocalizer::on_update(ModuleContext& context) {
+  step(context.now, context.events);
+  if (searching_ && context.now - last_attempt_ >= attempt_period_) {
+    last_attempt_ = context.now;
+    if (relocalize(context.now)) ++fixes_;
+  }
+  context.heartbeat = true;
+  publish(*context.navigation);
+  context.navigation->fixes = fixes_;
+}
+
+void CLocalizer::on_behavior_activated(const BehaviorActivation& activation, ModuleContext& context) {
+  if (activation.behavior != "BhGlobalLocalization") return;
+  const ParameterSet params = activation.resolved();
+  attempt_period_ = from_seconds(params.number("attempt_period_s"));
+  last_attempt_ = context.now;
+  searching_ = true;
+}
+
+void CLocalizer::on_behavior_deactivated(std::string_view behavior, ModuleContext& /*context*/) {
+  if (behavior == "BhGlobalLocalization") searching_ = false;
+}
+
+void CLocalizer::step(Time now, std::vector<ModuleEvent>& out) noexcept {
   if (truth_ == nullptr) return;
   const std::optional<Pose2D> truth = truth_->true_pose(now);
   if (!truth) return;

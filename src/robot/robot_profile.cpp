@@ -66,8 +66,9 @@ struct Parser {
     return p;
   }
 
-  void module(const YAML::Node& n, ModuleKind kind, std::vector<ModuleEntry>& out) {
+  void module(const YAML::Node& n, ModuleKind kind, std::vector<ModuleEntry>& out, std::string default_name = {}) {
     ModuleEntry e;
+    e.name = std::move(default_name);
     e.kind = kind;
     e.where = at(n);
     if (n.IsScalar()) {  // "- BhCleaning": a registered type under its own name
@@ -210,8 +211,14 @@ struct Parser {
           const std::string rk = r.first.as<std::string>();
           if (rk == "name") scalar(r.second, prof.name, "robot name");
           else if (rk == "description") scalar(r.second, prof.description, "description");
-          else d.error(at(r.first), "unknown key '" + rk + "' in robot; expected: name, description");
+          else if (rk == "sequencing_period_s") {
+            if (auto s = positive_seconds(r.second, "sequencing_period_s")) prof.sequencing_period = from_seconds(*s);
+          } else d.error(at(r.first), "unknown key '" + rk + "' in robot; expected: name, description, sequencing_period_s");
         }
+      } else if (key == "hardware") {
+        std::vector<ModuleEntry> hw;
+        module(v, ModuleKind::other, hw, "hardware");
+        if (!hw.empty()) prof.hardware = std::move(hw.front());
       } else if (key == "controllers") {
         modules(v, ModuleKind::controller, prof.controllers, key);
       } else if (key == "resources") {
@@ -260,7 +267,7 @@ struct Parser {
         prof.recovery = path_of(v, "recovery file", prof.recovery_where);
       } else {
         d.error(at(kv.first), "unknown key '" + key +
-                                  "'; expected: robot, controllers, loops, resources, navigation, hri, modules, behaviors, processes, tasks, recovery");
+                                  "'; expected: robot, hardware, controllers, loops, resources, navigation, hri, modules, behaviors, processes, tasks, recovery");
       }
     }
     if (prof.name.empty()) d.error(prof.where, "the profile needs robot: {name: ...}");

@@ -9,6 +9,8 @@
 #include "tripodal/controllers/controller_config.hpp"
 #include "tripodal/planner/task_library.hpp"
 #include "tripodal/robot/layering.hpp"
+#include "tripodal/robot/robot.hpp"
+#include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/robot/robot_profile.hpp"
 
 namespace tripodal::tool {
@@ -60,10 +62,10 @@ int describe(const std::vector<std::string>& args, std::ostream& out, std::ostre
         d.append(e.diagnostics());
       }
     }
-    RobotCatalog catalog;
-    catalog.behaviors = &default_behavior_registry();
-    catalog.controllers = &default_controller_registry();
-    const RobotDescription r = describe_robot(profile, catalog, knowledge_inputs(tasks), d);
+    // The types this program knows: the framework's own and the simulator's hardware.
+    RobotPlugins plugins = RobotPlugins::with_builtins();
+    sim::register_sim_hardware(plugins.hardware);
+    const RobotDescription r = describe_robot(profile, plugins, knowledge_inputs(tasks), d);
     if (d.has_errors()) {
       err << d.str() << '\n' << "robot '" << profile.name << "' would refuse to start: " << d.error_count() << " error(s)\n";
       return kBadInput;

@@ -32,7 +32,6 @@ struct RunOptions {
   /// Follow the boustrophedon path instead of the balloon (the baseline, measured on the robot).
   bool boustrophedon = false;
   double max_duration_s = 4.0 * 3600.0;  ///< the task is cancelled after this much simulated time
-  Duration robot_period{std::chrono::milliseconds(50)};  ///< behaviors, modules, supervisor
   std::ostream* log = nullptr;       ///< task and process life cycle, as it happens
   std::ostream* progress = nullptr;  ///< progress bar
   bool progress_is_terminal = false; ///< redraw the bar in place ('\r') instead of new lines
