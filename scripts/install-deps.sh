@@ -6,6 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libyaml-cpp-dev libspdlog-dev
+  libfmt-dev nlohmann-json3-dev libcli11-dev
   libtinyxml2-dev  # tests only: the reference the XML reader is compared with
   catch2 libbenchmark-dev
   graphviz libxml2-utils

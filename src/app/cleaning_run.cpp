@@ -11,6 +11,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <nlohmann/json.hpp>
+
 #include "tripodal/app/png.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/navi/grid_maps.hpp"
@@ -33,45 +35,12 @@ using navi::Point2D;
 // ---------------------------------------------------------------------------------------------
 // Path figures
 
-void douglas_peucker(const std::vector<Point2D>& p, std::size_t a, std::size_t b, double tol, std::vector<char>& keep) {
-  // iterative, so a long trajectory cannot overflow the stack
-  std::vector<std::pair<std::size_t, std::size_t>> todo{{a, b}};
-  while (!todo.empty()) {
-    const auto [i, j] = todo.back();
-    todo.pop_back();
-    if (j <= i + 1) continue;
-    const double dx = p[j].x_m - p[i].x_m, dy = p[j].y_m - p[i].y_m;
-    const double len = std::hypot(dx, dy);
-    double worst = -1.0;
-    std::size_t at = i;
-    for (std::size_t k = i + 1; k < j; ++k) {
-      const double ex = p[k].x_m - p[i].x_m, ey = p[k].y_m - p[i].y_m;
-      const double d = len > 0.0 ? std::abs(ex * dy - ey * dx) / len : std::hypot(ex, ey);
-      if (d > worst) {
-        worst = d;
-        at = k;
-      }
-    }
-    if (worst > tol) {
-      keep[at] = 1;
-      todo.emplace_back(i, at);
-      todo.emplace_back(at, j);
-    }
-  }
-}
-
 }  // namespace
 
 PathFigures path_figures(const std::vector<Point2D>& path, double tolerance_m) {
   PathFigures f;
   if (path.size() < 2) return f;
-  std::vector<char> keep(path.size(), 0);
-  keep.front() = keep.back() = 1;
-  douglas_peucker(path, 0, path.size() - 1, tolerance_m, keep);
-  std::vector<Point2D> simple;
-  for (std::size_t i = 0; i < path.size(); ++i) {
-    if (keep[i] != 0) simple.push_back(path[i]);
-  }
+  const std::vector<Point2D> simple = douglas_peucker(path, tolerance_m);
   const navi::PathStats s = navi::path_stats(simple, std::numbers::pi / 6.0);
   f.length_m = navi::polyline_length_m(path);
   f.turns = s.turns;
@@ -94,27 +63,6 @@ std::string fixed(double v, int digits) {
   std::ostringstream s;
   s << std::fixed << std::setprecision(digits) << v;
   return s.str();
-}
-
-std::string json_string(std::string_view s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
-          out += buf;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
 }
 
 struct TrajectorySample {
@@ -287,46 +235,51 @@ class ReportObserver final : public TaskObserver {
 }  // namespace
 
 std::string RunResult::json() const {
-  std::ostringstream o;
-  auto list = [&](const std::vector<std::string>& v) {
-    o << "[";
-    for (std::size_t i = 0; i < v.size(); ++i) o << (i ? ", " : "") << json_string(v[i]);
-    o << "]";
+  using Json = nlohmann::ordered_json;  // keys in the order written
+  // Figures rounded to what the report means (cm, 0.01 % coverage); a value that is not finite
+  // stays NaN or inf, which the writer turns into null.
+  const auto rounded = [](double v, int digits) {
+    const double scale = std::pow(10.0, digits);
+    return std::isfinite(v) ? std::round(v * scale) / scale : v;
   };
-  auto figures = [&](const PathFigures& f) {
-    o << "{\"length_m\": " << fixed(f.length_m, 2) << ", \"turns\": " << f.turns << ", \"rotation_rad\": " << fixed(f.rotation_rad, 2)
-      << "}";
+  const auto figures = [&](const PathFigures& f) {
+    return Json{{"length_m", rounded(f.length_m, 2)}, {"turns", f.turns}, {"rotation_rad", rounded(f.rotation_rad, 2)}};
   };
-  auto stats = [&](const navi::PathStats& s, double cov) {
-    o << "{\"length_m\": " << fixed(s.length_m, 2) << ", \"turns\": " << s.turns << ", \"total_turn_rad\": " << fixed(s.total_turn_rad, 2)
-      << ", \"coverage\": " << fixed(cov, 4) << "}";
+  const auto stats = [&](const navi::PathStats& st, double cov) {
+    return Json{{"length_m", rounded(st.length_m, 2)},
+                {"turns", st.turns},
+                {"total_turn_rad", rounded(st.total_turn_rad, 2)},
+                {"coverage", rounded(cov, 4)}};
   };
-  o << "{\n  \"robot\": " << json_string(robot) << ",\n  \"task\": " << json_string(task) << ",\n  \"coverage_pattern\": " << json_string(coverage_pattern) << ",\n  \"seed\": " << seed
-    << ",\n  \"state\": " << json_string(state) << ",\n  \"succeeded\": " << (succeeded ? "true" : "false")
-    << ",\n  \"reason\": " << json_string(reason) << ",\n  \"duration_s\": " << fixed(duration_s, 2)
-    << ",\n  \"coverage\": " << fixed(coverage, 4) << ",\n  \"reachable_cells\": " << reachable_cells
-    << ",\n  \"cleaned_reachable_cells\": " << cleaned_cells << ",\n  \"reachable_area_m2\": " << fixed(reachable_area_m2, 2)
-    << ",\n  \"path\": ";
-  figures(total);
-  o << ",\n  \"cleaning_path\": ";
-  figures(cleaning);
-  o << ",\n  \"sections\": [";
-  for (std::size_t i = 0; i < sections.size(); ++i) {
-    const SectionFigures& s = sections[i];
-    o << (i ? ",\n" : "\n") << "    {\"name\": " << json_string(s.name) << ", \"area_m2\": " << fixed(s.area_m2, 2) << ", \"balloon\": ";
-    stats(s.balloon, s.balloon_coverage);
-    o << ", \"boustrophedon\": ";
-    stats(s.boustrophedon, s.boustrophedon_coverage);
-    o << "}";
+  Json section_list = Json::array();
+  for (const SectionFigures& sec : sections) {
+    section_list.push_back({{"name", sec.name},
+                            {"area_m2", rounded(sec.area_m2, 2)},
+                            {"balloon", stats(sec.balloon, sec.balloon_coverage)},
+                            {"boustrophedon", stats(sec.boustrophedon, sec.boustrophedon_coverage)}});
   }
-  o << "\n  ],\n  \"processes\": ";
-  list(processes);
-  o << ",\n  \"recoveries\": ";
-  list(recoveries);
-  o << ",\n  \"faults\": ";
-  list(faults);
-  o << ",\n  \"collisions\": " << collisions << ",\n  \"robot_steps\": " << robot_steps << "\n}\n";
-  return o.str();
+  const Json report = {{"robot", robot},
+                       {"task", task},
+                       {"coverage_pattern", coverage_pattern},
+                       {"seed", seed},
+                       {"state", state},
+                       {"succeeded", succeeded},
+                       {"reason", reason},
+                       {"duration_s", rounded(duration_s, 2)},
+                       {"coverage", rounded(coverage, 4)},
+                       {"reachable_cells", reachable_cells},
+                       {"cleaned_reachable_cells", cleaned_cells},
+                       {"reachable_area_m2", rounded(reachable_area_m2, 2)},
+                       {"path", figures(total)},
+                       {"cleaning_path", figures(cleaning)},
+                       {"sections", std::move(section_list)},
+                       {"processes", processes},
+                       {"recoveries", recoveries},
+                       {"faults", faults},
+                       {"collisions", collisions},
+                       {"robot_steps", robot_steps}};
+  // Task text and names come from the user: bytes that are not UTF-8 are replaced, not thrown on.
+  return report.dump(2, ' ', false, Json::error_handler_t::replace) + '\n';
 }
 
 RunResult run_task(const RunOptions& o) {

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <numbers>
 #include <stdexcept>
 
 #include "tripodal/behaviors/behavior_registry.hpp"
@@ -12,14 +11,6 @@
 namespace tripodal {
 
 namespace {
-
-constexpr double kPi = std::numbers::pi;
-
-double wrap_angle(double a) noexcept {
-  a = std::fmod(a + kPi, 2.0 * kPi);
-  if (a < 0.0) a += 2.0 * kPi;
-  return a - kPi;
-}
 
 double clamp_abs(double v, double limit) noexcept { return std::clamp(v, -limit, limit); }
 

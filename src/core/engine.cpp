@@ -16,7 +16,6 @@
 #include <algorithm>
 #include <bit>
 #include <cassert>
-#include <cstdio>
 #include <limits>
 #include <map>
 #include <stdexcept>
@@ -263,11 +262,7 @@ std::shared_ptr<spdlog::logger> engine_logger() {
   return logger;
 }
 
-std::string seconds_text(Time t) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.6f s", to_seconds(t));
-  return buf;
-}
+std::string seconds_text(Time t) { return format_seconds(t, 6) + " s"; }
 
 struct StringHash {
   using is_transparent = void;

@@ -44,12 +44,7 @@ std::string html(std::string_view text) {
   return out;
 }
 
-std::string seconds_text(Duration d) {
-  std::string s = std::to_string(to_seconds(d));
-  while (!s.empty() && s.back() == '0') s.pop_back();
-  if (!s.empty() && s.back() == '.') s.pop_back();
-  return s + " s";
-}
+std::string seconds_text(Duration d) { return format_seconds(d, kExactDigits) + " s"; }
 
 }  // namespace
 

@@ -8,16 +8,6 @@
 
 namespace tripodal::navi {
 
-namespace {
-
-double wrap(double a) noexcept {
-  while (a > std::numbers::pi) a -= 2.0 * std::numbers::pi;
-  while (a < -std::numbers::pi) a += 2.0 * std::numbers::pi;
-  return a;
-}
-
-}  // namespace
-
 std::vector<LocalizationFault> parse_fault_schedule(const std::string& text, const SourceLocation& where) {
   std::vector<LocalizationFault> out;
   Diagnostics d;
@@ -165,7 +155,7 @@ void CLocalizer::step(Time now, std::vector<ModuleEvent>& out) noexcept {
   const double ex = options_.noise_xy_m * nxy(rng_);
   const double ey = options_.noise_xy_m * nxy(rng_);
   const double et = options_.noise_theta_rad * nxy(rng_);
-  Pose2D est{truth->x_m + ex, truth->y_m + ey, wrap(truth->theta_rad + et)};
+  Pose2D est{truth->x_m + ex, truth->y_m + ey, wrap_angle(truth->theta_rad + et)};
   if (corrupted_) {
     est.x_m += offset_.x_m;
     est.y_m += offset_.y_m;
@@ -173,7 +163,7 @@ void CLocalizer::step(Time now, std::vector<ModuleEvent>& out) noexcept {
   estimate_ = est;
   stamp_ = now;
   error_m_ = std::hypot(est.x_m - truth->x_m, est.y_m - truth->y_m);
-  const double heading_error = std::abs(wrap(est.theta_rad - truth->theta_rad));
+  const double heading_error = std::abs(wrap_angle(est.theta_rad - truth->theta_rad));
   const bool agrees = error_m_ <= options_.lost_threshold_m && heading_error <= options_.lost_threshold_rad;
   const State next = agrees ? State::ok : State::lost;
   if (next == state_) return;

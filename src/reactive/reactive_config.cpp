@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "../common/yaml_reader.hpp"
 #include "tripodal/core/value.hpp"
 
 namespace tripodal {
@@ -33,35 +34,20 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 
 enum class Bound { any, positive, non_negative };
 
-// Reads typed values out of yaml-cpp nodes, collecting located diagnostics.
+// Reads typed values out of yaml-cpp nodes, collecting located diagnostics: the shared
+// yaml::Reader for the structure, and the bounds of controller and loop parameters.
 class Reader {
  public:
-  Reader(std::string file, Diagnostics& diags) : file_(std::move(file)), d_(diags) {}
+  Reader(std::string file, Diagnostics& diags) : r_(std::move(file), diags) {}
 
-  SourceLocation at(const YAML::Node& node) const {
-    const YAML::Mark m = node.Mark();
-    if (m.line < 0) return {file_, 0, 0};
-    return {file_, m.line + 1, m.column + 1};
-  }
-  void error(const YAML::Node& node, std::string message) { d_.error(at(node), std::move(message)); }
+  SourceLocation at(const YAML::Node& node) const { return r_.at(node); }
+  void error(const YAML::Node& node, std::string message) { r_.error(node, std::move(message)); }
 
-  bool is_map(const YAML::Node& node, const std::string& what) {
-    if (node.IsMap()) return true;
-    error(node, what + " must be a map");
-    return false;
-  }
+  bool is_map(const YAML::Node& node, const std::string& what) { return r_.expect_map(node, what); }
 
   // Reports keys of `map` not in `allowed`, at the key itself.
-  void check_keys(const YAML::Node& map, std::initializer_list<std::string_view> allowed, const std::string& what) {
-    for (const auto& kv : map) {
-      const std::string key = kv.first.Scalar();
-      bool ok = false;
-      for (auto a : allowed) ok = ok || a == key;
-      if (ok) continue;
-      std::string list;
-      for (auto a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
-      error(kv.first, "unknown key '" + key + "' in " + what + " (expected one of: " + list + ")");
-    }
+  void check_keys(const YAML::Node& map, yaml::KeyList allowed, const std::string& what) {
+    r_.expect_keys(map, allowed, what);
   }
 
   std::optional<double> number(const YAML::Node& map, const std::string& key, bool required, Bound bound,
@@ -113,8 +99,7 @@ class Reader {
   }
 
  private:
-  std::string file_;
-  Diagnostics& d_;
+  yaml::Reader r_;
 };
 
 AxisLimits read_axis(Reader& r, const YAML::Node& node, const std::string& what) {
@@ -308,12 +293,7 @@ LoopConfig read_loop(Reader& r, const YAML::Node& node, std::size_t index) {
 ReactiveConfig parse_reactive_config(std::string_view text, const std::string& file, const ControllerRegistry& registry) {
   Diagnostics diags;
   Reader r(file, diags);
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(text));
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(SourceLocation{file, e.mark.line + 1, e.mark.column + 1}, "YAML syntax error: " + e.msg);
-  }
+  const YAML::Node root = yaml::parse(text, file);
   ReactiveConfig out;
   if (!root.IsMap()) {
     throw ConfigError(SourceLocation{file, 1, 1}, "expected a map with 'controllers' and 'loops'");
@@ -351,11 +331,7 @@ ReactiveConfig parse_reactive_config(std::string_view text, const std::string& f
 }
 
 ReactiveConfig load_reactive_config(const std::string& path, const ControllerRegistry& registry) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(SourceLocation{path, 0, 0}, "cannot read the file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_reactive_config(ss.str(), path, registry);
+  return parse_reactive_config(yaml::read_file(path), path, registry);
 }
 
 std::unique_ptr<ControlLoop> make_control_loop(const ReactiveConfig& reactive, const LoopConfig& config,

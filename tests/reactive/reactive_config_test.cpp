@@ -164,7 +164,7 @@ loops:
     CHECK_THAT(what, Catch::Contains("many.yaml:6:20: error: controller 'base': 'cmd_timeout_s' must be >= 0, got -1"));
     CHECK_THAT(what, Catch::Contains("many.yaml:7:5: error: unknown key 'wheel_radus_m' in controller 'base'"));
     CHECK_THAT(what, Catch::Contains("many.yaml:9:49: error: controller 'base' limits.vx: 'max_acceleration' must be > 0, got -2"));
-    CHECK_THAT(what, Catch::Contains("many.yaml:10:7: error: unknown key 'yaw' in controller 'base' limits (expected one of: vx, vy, wz)"));
+    CHECK_THAT(what, Catch::Contains("many.yaml:10:7: error: unknown key 'yaw' in controller 'base' limits; expected one of: vx, vy, wz"));
     CHECK_THAT(what, Catch::Contains("many.yaml:13:15: error: loop 'motion': 'period_s' must be > 0, got 0"));
     CHECK_THAT(what, Catch::Contains("many.yaml:14:24: error: loop 'motion': 'realtime_priority' must be an integer in [0, 99], got 120"));
     CHECK_THAT(what, Catch::Contains("many.yaml:16:13: error: loop 'motion' coordinator: unknown mode 'fastest'"));

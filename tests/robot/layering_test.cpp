@@ -155,8 +155,8 @@ TEST_CASE("Profile load errors are all reported, located", "[robot]") {
     FAIL("no error");
   } catch (const ConfigError& e) {
     const std::string m = e.what();
-    CHECK_THAT(m, Catch::Contains("bad.yaml:2:1: error: unknown key 'colour'; expected: robot, controllers, loops"));
-    CHECK_THAT(m, Catch::Contains("bad.yaml:6:28: error: period_s must be a positive number of seconds, got '-1'"));
+    CHECK_THAT(m, Catch::Contains("bad.yaml:2:1: error: unknown key 'colour' in the robot profile; expected one of: robot, controllers, loops"));
+    CHECK_THAT(m, Catch::Contains("bad.yaml:6:28: error: period_s (seconds): expected a number > 0, got '-1'"));
     CHECK_THAT(m, Catch::Contains("bad.yaml:6:5: error: loop 'fast' drives controller 'wheels', which the profile does not list"));
     CHECK_THAT(m, Catch::Contains("bad.yaml:8:46: error: unknown layer 'upstairs'; expected one of: deliberate, sequencing, reactive"));
     CHECK_THAT(m, Catch::Contains("bad.yaml:8:56: error: unknown key 'wires' in a resource entry"));
