@@ -10,10 +10,7 @@
 
 #include "tripodal/behaviors/navigation_behaviors.hpp"
 #include "tripodal/core/net_loader.hpp"
-#include "tripodal/navi/grid_maps.hpp"
-#include "tripodal/navi/localizer.hpp"
-#include "tripodal/navi/planning_modules.hpp"
-#include "tripodal/navi/section_splitter.hpp"
+#include "tripodal/navi/navi_modules.hpp"
 #include "tripodal/reactive/reactive_config.hpp"
 
 namespace tripodal {
@@ -23,11 +20,7 @@ RobotPlugins RobotPlugins::with_builtins() {
   register_builtin_behaviors(p.behaviors);
   register_navigation_behaviors(p.behaviors);
   register_builtin_controllers(p.controllers);
-  p.modules.add<navi::CGridMaps>();
-  p.modules.add<navi::CSectionSplitter>();
-  p.modules.add<navi::CLocalizer>();
-  p.modules.add<navi::CPathPlanningModule>();
-  p.modules.add<navi::CCoverageModule>();
+  navi::register_navigation_modules(p.modules);
   return p;
 }
 

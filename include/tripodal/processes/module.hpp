@@ -17,6 +17,7 @@
 #include "tripodal/behaviors/behavior.hpp"
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/core/manifest.hpp"
+#include "tripodal/core/registry.hpp"
 #include "tripodal/core/time.hpp"
 #include "tripodal/resources/resource.hpp"
 
@@ -148,5 +149,8 @@ class CModule {
   bool configured_ = false;
   SourceLocation where_;
 };
+
+/// Module types (CModule subclasses with a default constructor) by name.
+using ModuleRegistry = Registry<CModule>;
 
 }  // namespace tripodal
