@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # The README's test command: installs dependencies, then
 #   1. a Release build with -Werror and the whole test suite (ctest),
-#   2. the example consumer and the behavior tutorial's test (examples/behavior_test) built
-#      against the *installed* package (find_package(tripodal)),
+#   2. the example consumer, the behavior tutorial's test (examples/behavior_test) and the
+#      application robot (examples/custom_robot) built against the *installed* package
+#      (find_package(tripodal)),
 #   3. the test suite again under AddressSanitizer + UndefinedBehaviorSanitizer,
 # Build trees go to build/release, build/sanitize, build/consumer,
-# build/behavior_test (override with BUILD_ROOT).
+# build/behavior_test, build/custom_robot (override with BUILD_ROOT).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
@@ -37,6 +38,11 @@ cmake -S examples/behavior_test -B "$build_root/behavior_test" "${generator[@]}"
   -DCMAKE_PREFIX_PATH="$build_root/install" -DCMAKE_COMPILE_WARNING_AS_ERROR=ON
 cmake --build "$build_root/behavior_test" -j "$jobs"
 "$build_root/behavior_test/bh_approach_test"
+echo "== Build and run the application robot (examples/custom_robot) against the installed package"
+cmake -S examples/custom_robot -B "$build_root/custom_robot" "${generator[@]}" \
+  -DCMAKE_PREFIX_PATH="$build_root/install" -DCMAKE_COMPILE_WARNING_AS_ERROR=ON
+cmake --build "$build_root/custom_robot" -j "$jobs"
+"$build_root/custom_robot/custom_robot"
 
 echo "== AddressSanitizer + UndefinedBehaviorSanitizer build"
 cmake -S . -B "$build_root/sanitize" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \

@@ -334,7 +334,7 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
     }
     collect([&] {
       ResourceConfig rc{e.name, ParameterSet::resolve(plugins.resources.manifest(e.type), parameters_of(e, m->options.parameters), e.where),
-                        e.where};
+                        e.where, m->hardware.get()};
       m->own_resources.push_back(plugins.resources.create_at(e.where, e.type, rc));
       m->resources.add(*m->own_resources.back());
     });

@@ -15,24 +15,36 @@ const ModuleManifest& SimHardware::static_manifest() {
   return m;
 }
 
+namespace {
+
+World world_of(const HardwareConfig& c, const std::shared_ptr<const World>& world) {
+  if (c.base == nullptr) throw ConfigError(c.where, "hardware '" + c.type + "' needs the robot's base controller (its wheel geometry)");
+  const std::string& file = c.parameters.string("world");
+  if (!file.empty()) return load_world(std::filesystem::path(c.where.file.str()).parent_path() / file);
+  if (world) return *world;
+  throw ConfigError(c.where, "hardware '" + c.type + "' needs a world: parameters: {world: FILE} (a world file, docs/simulator.md)");
+}
+
+std::uint64_t seed_of(const HardwareConfig& c, const World& w) {
+  const double s = c.parameters.number("seed");
+  return s < 0.0 ? w.seed : static_cast<std::uint64_t>(std::llround(s));
+}
+
+}  // namespace
+
 SimHardware::SimHardware(World world, const ControllerConfig& base, std::uint64_t seed)
     : seed_(seed), sim_(std::move(world), base, seed) {}
 
+SimHardware::SimHardware(const HardwareConfig& config, const std::shared_ptr<const World>& world)
+    : SimHardware(world_of(config, world), config) {}
+
+// world_of checked config.base; seed_ is initialised before sim_.
+SimHardware::SimHardware(World world, const HardwareConfig& config)
+    : seed_(seed_of(config, world)), sim_(std::move(world), *config.base, seed_) {}
+
 void register_sim_hardware(HardwareRegistry& registry, std::shared_ptr<const World> world) {
   registry.add(SimHardware::static_manifest(), [world](const HardwareConfig& c) -> std::unique_ptr<CHardware> {
-    if (c.base == nullptr) throw ConfigError(c.where, "hardware 'sim' needs the robot's base controller (its wheel geometry)");
-    World w;
-    const std::string& file = c.parameters.string("world");
-    if (!file.empty()) {
-      w = load_world(std::filesystem::path(c.where.file.str()).parent_path() / file);
-    } else if (world) {
-      w = *world;
-    } else {
-      throw ConfigError(c.where, "hardware 'sim' needs a world: parameters: {world: FILE} (a world file, docs/simulator.md)");
-    }
-    const double s = c.parameters.number("seed");
-    const std::uint64_t seed = s < 0.0 ? w.seed : static_cast<std::uint64_t>(std::llround(s));
-    return std::make_unique<SimHardware>(std::move(w), *c.base, seed);
+    return std::make_unique<SimHardware>(c, world);
   });
 }
 

@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "tripodal/processes/process.hpp"
@@ -23,6 +24,11 @@ class ProcessRegistry {
 
   /// Registers a factory under `type`; throws std::invalid_argument when the type exists.
   void register_type(std::string type, Factory factory);
+  /// Registers `P`, a CProcess subclass constructed from its definition, under `type`.
+  template <class P>
+  void register_type(std::string type) {
+    register_type(std::move(type), [](ProcessDefinition d) { return std::unique_ptr<CProcess>(std::make_unique<P>(std::move(d))); });
+  }
   [[nodiscard]] bool has_type(std::string_view type) const noexcept;
 
   /// Builds the process with the factory its definition names and keeps it. Throws ConfigError

@@ -87,8 +87,11 @@ const ModuleManifest& resource_manifest() noexcept;
 template <class Reading>
 class TypedResource : public CResource {
  public:
-  explicit TypedResource(std::string name, Duration max_age = Duration{0})
-      : CResource(std::move(name), max_age) {}
+  /// `manifest` (kept by reference) defaults to the generic one of the reading kind; an
+  /// application's own reading type passes its resource type's manifest.
+  explicit TypedResource(std::string name, Duration max_age = Duration{0},
+                         const ModuleManifest& manifest = resource_manifest<Reading>())
+      : CResource(std::move(name), max_age), manifest_(&manifest) {}
 
   /// Stores `reading` as the latest (copy-assigning: vector capacity is reused).
   void publish(const Reading& reading) {
@@ -103,9 +106,10 @@ class TypedResource : public CResource {
 
  protected:
   const std::type_info& do_reading_type() const noexcept final { return typeid(Reading); }
-  const ModuleManifest& do_manifest() const noexcept override { return resource_manifest<Reading>(); }
+  const ModuleManifest& do_manifest() const noexcept override { return *manifest_; }
 
  private:
+  const ModuleManifest* manifest_;
   Reading latest_{};
 };
 

@@ -13,11 +13,13 @@
 
 namespace tripodal {
 
-/// What the robot gives a resource type's factory: the instance name and its parameters.
+/// What the robot gives a resource type's factory: the instance name, its parameters, and the
+/// hardware whose device the resource's driver reads.
 struct ResourceConfig {
   std::string name;
   ParameterSet parameters;  ///< resolved against the type's manifest
   SourceLocation where;
+  CHardware* hardware = nullptr;  ///< the robot's hardware (built before its resources); nullptr: none
 };
 /// Resource types (sensor drivers: CResource subclasses) by name. The robot adds each to the
 /// reactive loops' resource table; the loop polls it every cycle (CResource::on_poll).

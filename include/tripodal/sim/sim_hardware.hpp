@@ -16,12 +16,18 @@
 
 namespace tripodal::sim {
 
-class SimHardware final : public CHardware, public navi::GroundTruthSource, public navi::MapSource {
+/// Not final: an application's hardware that adds devices to the simulated base derives from it
+/// (constructed from its HardwareConfig, with the parameters of "sim" in its own manifest).
+class SimHardware : public CHardware, public navi::GroundTruthSource, public navi::MapSource {
  public:
   /// Parameters of type "sim": world (a world file, relative to the profile) and seed (negative:
   /// the world's own).
   static const ModuleManifest& static_manifest();
   SimHardware(World world, const ControllerConfig& base, std::uint64_t seed);
+  /// From the profile's hardware entry: the parameters world and seed; `world`, when given, is the
+  /// world to run in if the parameter is left out. Throws ConfigError, located at the entry, when
+  /// there is no base controller or no world.
+  explicit SimHardware(const HardwareConfig& config, const std::shared_ptr<const World>& world = nullptr);
 
   [[nodiscard]] Simulator& simulator() noexcept { return sim_; }
   [[nodiscard]] const Simulator& simulator() const noexcept { return sim_; }
@@ -39,6 +45,7 @@ class SimHardware final : public CHardware, public navi::GroundTruthSource, publ
   void on_advance_to(Time now) noexcept override { sim_.step_until(now); }
 
  private:
+  SimHardware(World world, const HardwareConfig& config);
   std::uint64_t seed_;
   Simulator sim_;
 };
