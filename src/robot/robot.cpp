@@ -121,6 +121,14 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
   bool started = false;
 
   Impl(Clock& c, const RobotPlugins& p, RobotOptions o) : clock(c), plugins(p), options(std::move(o)) {}
+  // The supervisor deactivates the running behaviors as it goes, through this host: it must go
+  // while the loops, the modules and the record of active behaviors are still here.
+  ~Impl() override {
+    planner.reset();
+    supervisor.reset();
+  }
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
 
   [[nodiscard]] ControlLoop& behavior_loop() const { return *loops.front(); }
 
