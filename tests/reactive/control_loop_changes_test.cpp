@@ -48,6 +48,33 @@ class BhRecordNavigation final : public CBehavior {
   Seen& seen_;
 };
 
+// Follows a path for `cycles` cycles, reporting progress, then reports its end and succeeds.
+class BhFollowBriefly final : public CBehavior {
+ public:
+  explicit BhFollowBriefly(int cycles) : cycles_(cycles) {}
+  static const ModuleManifest& static_manifest() {
+    static const ModuleManifest m{"BhFollowBriefly", Layer::reactive, ModuleKind::behavior, "reports the end of a path",
+                                  {"path"}, {"behavior_command"}, {}};
+    return m;
+  }
+
+ protected:
+  const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  void on_activate(const ParameterSet&, const BehaviorContext&) override {}
+  std::optional<Twist2D> on_step(const BehaviorContext& ctx) noexcept override {
+    ctx.feedback->path_id = ctx.navi->path_id;
+    ctx.feedback->progress_m = 0.1 * static_cast<double>(steps());
+    if (static_cast<int>(steps()) >= cycles_) {
+      ctx.feedback->reached_end = true;
+      succeed();
+    }
+    return Twist2D{};
+  }
+
+ private:
+  int cycles_;
+};
+
 struct Loop {
   ResourceTable resources;
   std::unique_ptr<ControlLoop> loop;
@@ -159,4 +186,33 @@ TEST_CASE("set_navigation copies the path into the loop only when path_id change
   CHECK_FALSE(l.loop->set_navigation(with_path(long_path, 3)));
   (void)l.cycle();
   CHECK(seen.path_points == 4);
+}
+
+TEST_CASE("The report of a path followed to its end stays until the next report", "[reactive][loop]") {
+  // The sequencing layer reads the feedback every few cycles of the loop: the end of a path, the
+  // behavior's last report, must not be overwritten by the empty cycles after it.
+  Loop l;
+  const std::vector<Pose2D> path{{0, 0, 0}, {1, 0, 0}};
+  l.loop->set_navigation(with_path(path, 7));
+  l.loop->activate(std::make_unique<BhFollowBriefly>(3), {}, "record");
+  (void)l.cycle();  // joins, reports progress 0.1
+  (void)l.cycle();  // 0.2
+  (void)l.cycle();  // 0.3 and the end of the path; handed over at the start of the next cycle
+  CHECK(l.loop->navigation_feedback().progress_m == Approx(0.2));
+  CHECK_FALSE(l.loop->navigation_feedback().reached_end);
+  for (int k = 0; k < 10; ++k) (void)l.cycle();
+  NavigationFeedback fb = l.loop->navigation_feedback();
+  CHECK(fb.path_id == 7);
+  CHECK(fb.reached_end);
+  CHECK(fb.progress_m == Approx(0.3));
+  // The next behavior's report replaces it.
+  Seen seen;
+  l.loop->set_navigation(with_path(path, 8));
+  l.loop->activate(std::make_unique<BhRecordNavigation>(seen), {}, "record");
+  (void)l.cycle();
+  (void)l.cycle();
+  (void)l.cycle();
+  fb = l.loop->navigation_feedback();
+  CHECK(fb.path_id == 8);
+  CHECK_FALSE(fb.reached_end);
 }
