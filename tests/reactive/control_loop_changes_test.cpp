@@ -21,10 +21,11 @@ struct Seen {
   bool localized = false;
 };
 
-// Records what it sees and reports the path it was given as the one it follows.
+// Records what it sees and reports following the path it is given (0.1 m more each cycle); with
+// end_after_cycles, reports the end of the path then and succeeds.
 class BhRecordNavigation final : public CBehavior {
  public:
-  explicit BhRecordNavigation(Seen& seen) : seen_(seen) {}
+  explicit BhRecordNavigation(Seen& seen, int end_after_cycles = 0) : seen_(seen), end_after_(end_after_cycles) {}
   static const ModuleManifest& static_manifest() {
     static const ModuleManifest m{"BhRecordNavigation", Layer::reactive, ModuleKind::behavior, "records the navigation data",
                                   {"path"}, {"behavior_command"}, {}};
@@ -40,31 +41,9 @@ class BhRecordNavigation final : public CBehavior {
     seen_.path_points = ctx.navi->path.size();
     seen_.first_point = ctx.navi->path.empty() ? Pose2D{} : ctx.navi->path.front();
     seen_.localized = ctx.navi->localized;
-    if (ctx.feedback != nullptr) ctx.feedback->path_id = ctx.navi->path_id;
-    return Twist2D{};
-  }
-
- private:
-  Seen& seen_;
-};
-
-// Follows a path for `cycles` cycles, reporting progress, then reports its end and succeeds.
-class BhFollowBriefly final : public CBehavior {
- public:
-  explicit BhFollowBriefly(int cycles) : cycles_(cycles) {}
-  static const ModuleManifest& static_manifest() {
-    static const ModuleManifest m{"BhFollowBriefly", Layer::reactive, ModuleKind::behavior, "reports the end of a path",
-                                  {"path"}, {"behavior_command"}, {}};
-    return m;
-  }
-
- protected:
-  const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
-  void on_activate(const ParameterSet&, const BehaviorContext&) override {}
-  std::optional<Twist2D> on_step(const BehaviorContext& ctx) noexcept override {
     ctx.feedback->path_id = ctx.navi->path_id;
     ctx.feedback->progress_m = 0.1 * static_cast<double>(steps());
-    if (static_cast<int>(steps()) >= cycles_) {
+    if (end_after_ > 0 && static_cast<int>(steps()) >= end_after_) {
       ctx.feedback->reached_end = true;
       succeed();
     }
@@ -72,7 +51,8 @@ class BhFollowBriefly final : public CBehavior {
   }
 
  private:
-  int cycles_;
+  Seen& seen_;
+  int end_after_;
 };
 
 struct Loop {
@@ -192,9 +172,10 @@ TEST_CASE("The report of a path followed to its end stays until the next report"
   // The sequencing layer reads the feedback every few cycles of the loop: the end of a path, the
   // behavior's last report, must not be overwritten by the empty cycles after it.
   Loop l;
+  Seen seen;
   const std::vector<Pose2D> path{{0, 0, 0}, {1, 0, 0}};
   l.loop->set_navigation(with_path(path, 7));
-  l.loop->activate(std::make_unique<BhFollowBriefly>(3), {}, "record");
+  l.loop->activate(std::make_unique<BhRecordNavigation>(seen, 3), {}, "record");
   (void)l.cycle();  // joins, reports progress 0.1
   (void)l.cycle();  // 0.2
   (void)l.cycle();  // 0.3 and the end of the path; handed over at the start of the next cycle
@@ -206,7 +187,6 @@ TEST_CASE("The report of a path followed to its end stays until the next report"
   CHECK(fb.reached_end);
   CHECK(fb.progress_m == Approx(0.3));
   // The next behavior's report replaces it.
-  Seen seen;
   l.loop->set_navigation(with_path(path, 8));
   l.loop->activate(std::make_unique<BhRecordNavigation>(seen), {}, "record");
   (void)l.cycle();
