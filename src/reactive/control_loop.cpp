@@ -189,7 +189,10 @@ void ControlLoop::push_event(const LoopEvent& event) noexcept {
 }
 
 void ControlLoop::apply_pending() noexcept {
-  feedback_shared_ = feedback_;
+  // A report that a path was followed to its end stays until the next report: the behavior that
+  // made it has finished and reports no more, and the sequencing layer, slower than this loop,
+  // must not miss it (the coverage planner records a section as finished from it).
+  if (feedback_.path_id != 0 || !feedback_shared_.reached_end) feedback_shared_ = feedback_;
   if (holding_ > 0) {
     deferred_.fetch_add(1, std::memory_order_relaxed);
     return;

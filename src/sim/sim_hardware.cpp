@@ -20,7 +20,7 @@ namespace {
 World world_of(const HardwareConfig& c, const std::shared_ptr<const World>& world) {
   if (c.base == nullptr) throw ConfigError(c.where, "hardware '" + c.type + "' needs the robot's base controller (its wheel geometry)");
   const std::string& file = c.parameters.string("world");
-  if (!file.empty()) return load_world(std::filesystem::path(c.where.file.str()).parent_path() / file);
+  if (!file.empty()) return load_world(c.profile_dir / file);
   if (world) return *world;
   throw ConfigError(c.where, "hardware '" + c.type + "' needs a world: parameters: {world: FILE} (a world file, docs/simulator.md)");
 }

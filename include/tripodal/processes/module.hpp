@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -81,6 +82,7 @@ struct ModuleContext {
   CHardware* hardware = nullptr;                 ///< the robot's hardware (nullptr: none)
   const ModuleDirectory* modules = nullptr;
   std::uint32_t* path_ids = nullptr;             ///< the robot's path id counter
+  std::filesystem::path profile_dir;             ///< relative file parameters are relative to it
 
   std::vector<ModuleEvent> events;               ///< posted to the running processes' nets
   bool heartbeat = false;                        ///< the module is alive (supervisor watchdog)

@@ -101,7 +101,8 @@ class ControlLoop final {
   /// Navigation data for the next cycles. The path is copied only when navi.path_id differs from
   /// the last one given (false when it exceeds max_path_points: then it is truncated).
   bool set_navigation(const NavigationData& navi);
-  /// What the path-following behaviors reported in the last cycle that handed it over.
+  /// What the path-following behaviors reported in the last cycle that handed it over; a report
+  /// of the end of a path stays until the next report (the behavior that made it has finished).
   [[nodiscard]] NavigationFeedback navigation_feedback() const;
   /// Holds the changes made from now on (activations, deactivations, navigation, locks) until
   /// release_changes(), so that a loop running on another thread applies the changes of one
