@@ -129,7 +129,7 @@ int main(int argc, char** argv) try {
   const auto robot = Robot::assemble(load_robot_profile(argc > 1 ? argv[1] : PATROL_PROFILE), plugins, clock);
   LifecycleRecorder life;
   robot->planner().add_observer(life);
-  std::cout << robot->command(argc > 2 ? argv[2] : "patrol door_2111 and exhibit_planter").text << '\n';
+  std::cout << robot->command(argc > 2 ? argv[2] : "patrol door_2111 and door_2133").text << '\n';
   // Simulated time until the task ends; the rooms entered and the beacon join the life cycle.
   const auto* watcher = robot->module<RoomWatcher>();
   const auto* beacon = robot->resources().find<BeaconReading>("beacon");
