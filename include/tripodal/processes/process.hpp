@@ -13,8 +13,7 @@
 #include "tripodal/core/engine.hpp"
 #include "tripodal/core/petri_net.hpp"
 #include "tripodal/core/time.hpp"
-#include "tripodal/planner/plan.hpp"
-#include "tripodal/planner/recovery.hpp"
+#include "tripodal/processes/recovery_rule.hpp"
 
 namespace tripodal {
 
