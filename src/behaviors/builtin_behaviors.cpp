@@ -352,6 +352,7 @@ void BhAvoidObstacle::on_activate(const ParameterSet& params, const BehaviorCont
   // Capacity reserved here so that step() never allocates, whatever the beam count.
   cos_.resize(0);
   sin_.resize(0);
+  scan_seen_ = 0;
   if (laser_ == nullptr) fail("no laser resource");
 }
 
@@ -377,6 +378,13 @@ std::optional<Twist2D> BhAvoidObstacle::on_step(const BehaviorContext& context) 
     set_envelope(env);
     return std::nullopt;
   }
+  // The envelope depends on the scan alone: computed once per scan (a laser publishes far less
+  // often than the loop runs).
+  if (laser_->sequence() == scan_seen_) {
+    set_envelope(envelope_);
+    return std::nullopt;
+  }
+  scan_seen_ = laser_->sequence();
   const LaserScan& scan = laser_->latest();
   if (static_cast<std::size_t>(cos_.size()) != std::min(scan.ranges_m.size(), kMaxTableBeams) || table_angle_min_ != scan.angle_min_rad ||
       table_increment_ != scan.angle_increment_rad) {
@@ -433,6 +441,7 @@ std::optional<Twist2D> BhAvoidObstacle::on_step(const BehaviorContext& context) 
   env.vx_lo_m_s = -allowed(back);
   env.vy_hi_m_s = allowed(left);
   env.vy_lo_m_s = -allowed(right);
+  envelope_ = env;
   set_envelope(env);
   return std::nullopt;
 }
