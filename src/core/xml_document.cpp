@@ -492,14 +492,14 @@ class XmlTreeBuilder {
   std::size_t start_tag(std::size_t lt) {
     Tag tag;
     tag.offset = static_cast<std::uint32_t>(lt);
-    tag.first_attribute = static_cast<std::uint32_t>(attributes_.size());
+    tag.first_attribute = static_cast<std::uint32_t>(d_.attributes_.size());
     const std::size_t end = read_start_tag(s_, lt, tag.name, [&](const RawAttribute& raw) {
       if (raw.first_lt != std::string_view::npos) {
         throw ParseFailure{raw.first_lt, "'<' in the value of attribute '" + std::string(raw.name) +
                                              "': write &lt; for a literal '<'"};
       }
       if (raw.decoded) check_references(s_, raw.value_offset, raw.value_end);
-      XmlAttribute& a = attributes_.emplace_back();
+      XmlAttribute& a = d_.attributes_.emplace_back();
       a.name = raw.name;
       a.name_offset = static_cast<std::uint32_t>(raw.name_offset);
       a.value_offset = static_cast<std::uint32_t>(raw.value_offset);
@@ -507,7 +507,7 @@ class XmlTreeBuilder {
       // The common value needs no decoding: the text is tinyxml2's value, and its view is kept.
       if (!raw.decoded) a.value = s_.substr(raw.value_offset, raw.value_end - raw.value_offset);
     });
-    tag.attribute_count = static_cast<std::uint32_t>(attributes_.size()) - tag.first_attribute;
+    tag.attribute_count = static_cast<std::uint32_t>(d_.attributes_.size()) - tag.first_attribute;
     tags_.push_back(tag);
     return end;
   }
@@ -515,7 +515,6 @@ class XmlTreeBuilder {
   // Pre-order, as the scan found the tags: the k-th element is the k-th start tag.
   void walk(const tinyxml2::XMLElement* root) {
     d_.elements_.reserve(tags_.size());
-    d_.attributes_.reserve(attributes_.size());
     struct Open {
       std::uint32_t index;
       std::uint32_t last_child;
@@ -561,16 +560,19 @@ class XmlTreeBuilder {
     std::size_t line_start = tag.offset;
     while (line_start > 0 && s_[line_start - 1] != '\n') --line_start;
     e.column_ = static_cast<std::uint32_t>(tag.offset - line_start + 1);
-    e.first_attribute_ = static_cast<std::uint32_t>(d_.attributes_.size());
+    // The scan listed the attributes; tinyxml2 must have read the same ones, and gives the values
+    // that needed decoding.
+    e.first_attribute_ = tag.first_attribute;
+    e.attribute_count_ = tag.attribute_count;
     std::uint32_t k = tag.first_attribute;
-    for (const tinyxml2::XMLAttribute* a = x->FirstAttribute(); a != nullptr; a = a->Next(), ++k) {
-      if (k >= tag.first_attribute + tag.attribute_count || attributes_[k].name != a->Name()) {
-        throw ParseFailure{tag.offset, "the attributes of <" + std::string(name) + "> cannot be located in the text"};
-      }
-      XmlAttribute& attribute = d_.attributes_.emplace_back(attributes_[k]);
-      if (attribute.value.data() == nullptr) attribute.value = a->Value();
+    const std::uint32_t end = tag.first_attribute + tag.attribute_count;
+    const tinyxml2::XMLAttribute* a = x->FirstAttribute();
+    for (; a != nullptr && k < end && d_.attributes_[k].name == a->Name(); a = a->Next(), ++k) {
+      if (d_.attributes_[k].value.data() == nullptr) d_.attributes_[k].value = a->Value();
     }
-    e.attribute_count_ = static_cast<std::uint32_t>(d_.attributes_.size()) - e.first_attribute_;
+    if (a != nullptr || k != end) {
+      throw ParseFailure{tag.offset, "the attributes of <" + std::string(name) + "> cannot be located in the text"};
+    }
     e.text_ = text_of(x);
     return index;
   }
@@ -607,7 +609,6 @@ class XmlTreeBuilder {
   const tinyxml2::XMLDocument& xml_;
   std::string_view s_;
   std::vector<Tag> tags_;
-  std::vector<XmlAttribute> attributes_;  // of every tag, names and offsets (values come from tinyxml2)
 };
 
 // --- XmlDocument --------------------------------------------------------------------------
