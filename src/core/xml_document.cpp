@@ -544,8 +544,10 @@ class XmlTreeBuilder {
 
   std::uint32_t add(const tinyxml2::XMLElement* x) {
     const auto index = static_cast<std::uint32_t>(d_.elements_.size());
-    const std::string_view name = x->Name();
-    if (index >= tags_.size() || tags_[index].name != name) {
+    // Compared without strlen: tinyxml2's name ends with a NUL, the scanned one has a length.
+    const char* name = x->Name();
+    if (index >= tags_.size() || std::strncmp(name, tags_[index].name.data(), tags_[index].name.size()) != 0 ||
+        name[tags_[index].name.size()] != '\0') {
       // Only markup tinyxml2 reads differently from XML 1.0 can get here.
       throw ParseFailure{index < tags_.size() ? tags_[index].offset : s_.size(),
                          "element <" + std::string(name) + "> cannot be located in the text"};
@@ -560,14 +562,14 @@ class XmlTreeBuilder {
     std::size_t line_start = tag.offset;
     while (line_start > 0 && s_[line_start - 1] != '\n') --line_start;
     e.column_ = static_cast<std::uint32_t>(tag.offset - line_start + 1);
-    // The scan listed the attributes; tinyxml2 must have read the same ones, and gives the values
-    // that needed decoding.
+    // The scan listed the attributes; tinyxml2 must have read as many (the element's name agreed,
+    // so the same ones), and gives the values that needed decoding.
     e.first_attribute_ = tag.first_attribute;
     e.attribute_count_ = tag.attribute_count;
     std::uint32_t k = tag.first_attribute;
     const std::uint32_t end = tag.first_attribute + tag.attribute_count;
     const tinyxml2::XMLAttribute* a = x->FirstAttribute();
-    for (; a != nullptr && k < end && d_.attributes_[k].name == a->Name(); a = a->Next(), ++k) {
+    for (; a != nullptr && k < end; a = a->Next(), ++k) {
       if (d_.attributes_[k].value.data() == nullptr) d_.attributes_[k].value = a->Value();
     }
     if (a != nullptr || k != end) {
