@@ -1,8 +1,5 @@
 #include "tripodal/core/manifest.hpp"
 
-#include <algorithm>
-#include <map>
-#include <set>
 #include <stdexcept>
 
 namespace tripodal {
@@ -104,63 +101,5 @@ const std::string& ParameterSet::string(std::string_view name) const {
   return std::get<std::string>(value(name));
 }
 bool ParameterSet::contains(std::string_view name) const noexcept { return values_.find(name) != values_.end(); }
-
-Diagnostics check_providers(const std::vector<const ModuleManifest*>& modules) {
-  Diagnostics diags;
-  std::map<std::string, std::vector<std::string>, std::less<>> providers;
-  for (const auto* m : modules) {
-    for (const auto& out : m->outputs) providers[out].push_back(m->name);
-  }
-  std::set<std::string, std::less<>> reported;
-  for (const auto* m : modules) {
-    for (const auto& in : m->inputs) {
-      if (!reported.insert(in).second) continue;
-      auto it = providers.find(in);
-      if (it == providers.end()) {
-        diags.error({}, "input '" + in + "' of " + m->name + " has no provider");
-      } else if (it->second.size() > 1) {
-        std::string names;
-        for (const auto& n : it->second) names += (names.empty() ? "" : ", ") + n;
-        diags.error({}, "input '" + in + "' of " + m->name + " has " + std::to_string(it->second.size()) +
-                            " providers (" + names + "); expected exactly one");
-      }
-    }
-  }
-  return diags;
-}
-
-namespace {
-std::string dot_quote(std::string_view s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
-}  // namespace
-
-std::string functionality_diagram_dot(const std::vector<const ModuleManifest*>& modules) {
-  std::string out = "digraph functionality {\n  rankdir=TB;\n  node [shape=box];\n";
-  for (Layer layer : {Layer::deliberate, Layer::sequencing, Layer::reactive}) {
-    out += "  subgraph cluster_" + std::string(to_string(layer)) + " {\n    label=" +
-           dot_quote(std::string(to_string(layer)) + " layer") + ";\n";
-    for (const auto* m : modules) {
-      if (m->layer == layer) out += "    " + dot_quote(m->name) + ";\n";
-    }
-    out += "  }\n";
-  }
-  for (const auto* provider : modules) {
-    for (const auto& info : provider->outputs) {
-      for (const auto* consumer : modules) {
-        if (std::find(consumer->inputs.begin(), consumer->inputs.end(), info) != consumer->inputs.end()) {
-          out += "  " + dot_quote(provider->name) + " -> " + dot_quote(consumer->name) +
-                 " [label=" + dot_quote(info) + "];\n";
-        }
-      }
-    }
-  }
-  return out + "}\n";
-}
 
 }  // namespace tripodal

@@ -1,20 +1,10 @@
-// Module manifests: parameter resolution, the one-provider-per-input check, the layered diagram.
+// Module manifests: layer and kind names, parameter resolution. (The one-provider-per-input check
+// and the layered diagram of a robot are src/robot/layering's, tested in tests/robot.)
 #include "tripodal/core/manifest.hpp"
 
 #include <catch2/catch.hpp>
 
 using namespace tripodal;
-
-namespace {
-ModuleManifest module(std::string name, Layer layer, std::vector<std::string> in, std::vector<std::string> out) {
-  ModuleManifest m;
-  m.name = std::move(name);
-  m.layer = layer;
-  m.inputs = std::move(in);
-  m.outputs = std::move(out);
-  return m;
-}
-}  // namespace
 
 TEST_CASE("Layers and kinds have names") {
   CHECK(to_string(Layer::sequencing) == "sequencing");
@@ -40,30 +30,4 @@ TEST_CASE("Parameters resolve with defaults, conversions and bounds") {
   REQUIRE_THROWS_WITH(ParameterSet::resolve(m, {{"speed_m_s", Value{3.0}}}, {"net.xml", 4, 2}),
                       Catch::Contains("net.xml:4:2: error: BhTest: missing required parameter 'room' (string)") &&
                           Catch::Contains("net.xml:4:2: error: BhTest: parameter 'speed_m_s' = 3 m/s is outside [0, 2]"));
-}
-
-TEST_CASE("Every input needs exactly one provider") {
-  const ModuleManifest laser = module("LaserResource", Layer::reactive, {}, {"laser_scan"});
-  const ModuleManifest odom = module("OdometryResource", Layer::reactive, {}, {"odometry"});
-  const ModuleManifest odom2 = module("GyroOdometry", Layer::reactive, {}, {"odometry"});
-  const ModuleManifest loc = module("Localizer", Layer::sequencing, {"laser_scan", "odometry", "map"}, {"map_from_base"});
-  const ModuleManifest go = module("BhGoToPose", Layer::reactive, {"odometry", "map_from_base"}, {"behavior_command"});
-  CHECK(check_providers({&laser, &odom, &go, &loc}).has_errors());  // "map" has no provider
-  const Diagnostics d = check_providers({&laser, &odom, &odom2, &loc, &go});
-  REQUIRE(d.error_count() == 2);
-  CHECK_THAT(d.str(), Catch::Contains("input 'odometry' of Localizer has 2 providers (OdometryResource, GyroOdometry); expected exactly one"));
-  CHECK_THAT(d.str(), Catch::Contains("input 'map' of Localizer has no provider"));
-  const ModuleManifest map = module("GridMap", Layer::sequencing, {}, {"map"});
-  CHECK_FALSE(check_providers({&laser, &odom, &loc, &go, &map}).has_errors());
-}
-
-TEST_CASE("The layered functionality diagram groups modules by layer and labels the flows") {
-  const ModuleManifest laser = module("LaserResource", Layer::reactive, {}, {"laser_scan"});
-  const ModuleManifest loc = module("Localizer", Layer::sequencing, {"laser_scan"}, {"map_from_base"});
-  const ModuleManifest planner = module("Planner", Layer::deliberate, {"map_from_base"}, {});
-  const std::string dot = functionality_diagram_dot({&laser, &loc, &planner});
-  CHECK_THAT(dot, Catch::Contains("subgraph cluster_deliberate") && Catch::Contains("subgraph cluster_reactive"));
-  CHECK_THAT(dot, Catch::Contains("\"LaserResource\" -> \"Localizer\" [label=\"laser_scan\"]"));
-  CHECK_THAT(dot, Catch::Contains("\"Localizer\" -> \"Planner\" [label=\"map_from_base\"]"));
-  CHECK(dot.find("cluster_deliberate") < dot.find("\"Planner\";"));
 }

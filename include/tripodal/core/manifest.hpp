@@ -80,12 +80,4 @@ class ParameterSet {
   ParameterValues values_;
 };
 
-/// Checks, over a set of configured modules, that every input has exactly one provider.
-/// Reports an error per input with no provider or several providers (naming them).
-[[nodiscard]] Diagnostics check_providers(const std::vector<const ModuleManifest*>& modules);
-
-/// The layered functionality diagram of `modules` in Graphviz DOT: one cluster per layer, an edge
-/// from each provider to each module that needs one of its outputs, labelled with the information.
-[[nodiscard]] std::string functionality_diagram_dot(const std::vector<const ModuleManifest*>& modules);
-
 }  // namespace tripodal
