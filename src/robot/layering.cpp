@@ -138,8 +138,8 @@ RobotDescription describe_robot(const RobotProfile& profile, const RobotCatalog&
                                         {"cmd_vel"}, profile.where});
   for (const ModuleEntry* e : profile.all_modules()) {
     const ModuleManifest* m = nullptr;
-    if (e->kind == ModuleKind::behavior && catalog.behaviors) m = catalog.behaviors->manifest(e->type);
-    if (e->kind == ModuleKind::controller && catalog.controllers) m = catalog.controllers->manifest(e->type);
+    if (e->kind == ModuleKind::behavior && catalog.behaviors) m = catalog.behaviors->find(e->type);
+    if (e->kind == ModuleKind::controller && catalog.controllers) m = catalog.controllers->find(e->type);
     if (m == nullptr && catalog.modules) m = catalog.modules->manifest(e->type);
     DescribedModule dm;
     dm.name = e->name;
