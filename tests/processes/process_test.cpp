@@ -162,3 +162,23 @@ TEST_CASE("A process declares a manifest: its net's parameters and the behaviors
   CHECK(PrGoToRoom::static_manifest().name == "go_to_room");
   CHECK(CProcess::static_manifest().name == "net");
 }
+
+TEST_CASE("Every registered process type can be created by name and describes itself", "[processes]") {
+  ProcessRegistry reg;
+  reg.types().add<PrGoToRoom>();
+  for (const auto& type : reg.types().names()) {
+    INFO(type);
+    const ModuleManifest& m = reg.types().manifest(type);
+    CHECK(m.name == type);
+    CHECK(m.kind == ModuleKind::process);
+    CHECK(m.layer == Layer::sequencing);
+    CHECK_FALSE(m.description.empty());
+    ProcessDefinition d = def("Pr_" + type, pr_auto_move());
+    d.type = type;
+    const std::unique_ptr<CProcess> p = reg.types().create(type, std::move(d));
+    REQUIRE(p);
+    CHECK(p->name() == "Pr_" + type);
+    CHECK(p->type() == type);
+    CHECK(p->manifest().find_parameter("goal") != nullptr);
+  }
+}
