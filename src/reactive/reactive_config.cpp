@@ -125,7 +125,8 @@ bool is_wheel_list(std::string_view key) noexcept { return key == "wheel_angles_
 // Reports the keys of `map` that no parameter of `manifest` under `prefix` names, at the key,
 // listing the allowed ones; recurses into the maps of dotted names ("limits" -> "limits.vx").
 void check_parameter_keys(Reader& r, const YAML::Node& map, const ModuleManifest& manifest, const std::string& prefix,
-                          const std::string& what, bool& ok) {
+                          const std::string& entry, bool& ok) {
+  const std::string what = prefix.empty() ? entry : entry + " " + prefix.substr(0, prefix.size() - 1);
   std::vector<std::string> allowed;
   if (prefix.empty()) allowed = {"name", "type"};
   for (const auto& spec : manifest.parameters) {
@@ -144,10 +145,10 @@ void check_parameter_keys(Reader& r, const YAML::Node& map, const ModuleManifest
       ok = false;
     } else if (manifest.find_parameter(prefix + key) == nullptr && !(prefix.empty() && (key == "name" || key == "type"))) {
       const std::string group = prefix + key;  // the map of some dotted names
-      if (!r.is_map(kv.second, what + " " + group)) {
+      if (!r.is_map(kv.second, entry + " " + group)) {
         ok = false;
       } else {
-        check_parameter_keys(r, kv.second, manifest, group + ".", what + " " + group, ok);
+        check_parameter_keys(r, kv.second, manifest, group + ".", entry, ok);
       }
     }
   }
@@ -164,15 +165,14 @@ std::optional<ParameterSet> read_parameters(Reader& r, const YAML::Node& node, c
     if (is_wheel_list(spec.name)) continue;
     // A dotted name is a path through nested maps; a missing map is a missing value. (YAML::Node
     // assignment writes into the document: the walk rebinds with reset() and looks up const.)
-    YAML::Node v;
-    v.reset(node);
+    YAML::Node v(node);
     bool found = true;
-    for (std::size_t from = 0;;) {
+    for (std::size_t from = 0; found;) {
       const std::size_t dot = spec.name.find('.', from);
+      const std::string key = spec.name.substr(from, dot - from);
       const YAML::Node& map = v;
-      found = map.IsMap() && map[spec.name.substr(from, dot - from)];
-      if (!found) break;
-      v.reset(map[spec.name.substr(from, dot - from)]);
+      found = map.IsMap() && map[key];
+      if (found) v.reset(map[key]);
       if (dot == std::string::npos) break;
       from = dot + 1;
     }

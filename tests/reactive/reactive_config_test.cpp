@@ -273,6 +273,10 @@ loops:
   REQUIRE_THROWS_WITH(parse_reactive_config("controllers:\n  - {name: winch, type: gian}\n", "winch.yaml", registry),
                       Catch::Contains("winch.yaml:2:25: error: controller 'winch': unknown controller type 'gian'; known: "
                                       "differential, gain, mecanum, omni; did you mean 'gain'?"));
+  REQUIRE_THROWS_WITH(parse_reactive_config("controllers:\n  - {name: winch, type: gain, limits: {vx: 5, yaw: {}}}\n",
+                                            "winch.yaml", registry),
+                      Catch::Contains("winch.yaml:2:44: error: controller 'winch' limits.vx must be a map") &&
+                          Catch::Contains("unknown key 'yaw' in controller 'winch' limits (expected one of: vx, vy, wz)"));
   // The default registry does not know it.
   REQUIRE_THROWS_WITH(parse_reactive_config("controllers:\n  - {name: winch, type: gain}\n", "winch.yaml"),
                       Catch::Contains("unknown controller type 'gain'; known: differential, mecanum, omni"));
