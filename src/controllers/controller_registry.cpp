@@ -93,14 +93,14 @@ ModuleManifest controller_manifest(std::string name, std::string description, st
   for (const char* axis : {"vx", "vy", "wz"}) {
     const std::string a = std::string("limits.") + axis + ".";
     const bool linear = std::string_view(axis) != "wz";
-    auto limit = [&](const char* what, const char* unit, const char* unset) {
-      b.parameter(parameter::optional(parameter::positive(a + what, {}, linear ? unit : std::string("rad") + (unit + 1),
-                                                          std::string("unset: ") + unset)));
+    auto limit = [&](const char* what, const char* linear_unit, const char* angular_unit, const char* unset) {
+      b.parameter(parameter::optional(
+          parameter::positive(a + what, {}, linear ? linear_unit : angular_unit, std::string("unset: ") + unset)));
     };
-    limit("max_velocity", "m/s", "no limit");
-    limit("max_acceleration", "m/s^2", "no limit");
-    limit("max_deceleration", "m/s^2", "max_acceleration");
-    limit("max_jerk", "m/s^3", "no limit");
+    limit("max_velocity", "m/s", "rad/s", "no limit");
+    limit("max_acceleration", "m/s^2", "rad/s^2", "no limit");
+    limit("max_deceleration", "m/s^2", "rad/s^2", "max_acceleration");
+    limit("max_jerk", "m/s^3", "rad/s^3", "no limit");
   }
   return std::move(b).build();
 }

@@ -258,7 +258,10 @@ TEST_CASE("Controllers are created by name from configuration") {
     CHECK(manifest.kind == ModuleKind::controller);
     CHECK(manifest.layer == Layer::reactive);
     CHECK(manifest.find_parameter("period_s") != nullptr);
-    CHECK(manifest.find_parameter("limits.wz.max_velocity") != nullptr);
+    REQUIRE(manifest.find_parameter("limits.wz.max_velocity") != nullptr);
+    CHECK(manifest.find_parameter("limits.wz.max_velocity")->unit == "rad/s");
+    CHECK(manifest.find_parameter("limits.vx.max_jerk")->unit == "m/s^3");
+    CHECK(manifest.find_parameter("limits.vx.max_jerk")->optional);
     CHECK(manifest.find_parameter("wheel_radius_m") != nullptr);
     for (const auto& p : manifest.parameters) {
       INFO(p.name);
