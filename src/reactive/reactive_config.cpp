@@ -140,8 +140,8 @@ void check_parameter_keys(Reader& r, const YAML::Node& map, const ModuleManifest
       std::string list;
       for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
       const auto suggestion = closest_name(key, allowed);
-      r.error(kv.first, "unknown key '" + key + "' in " + what + " (expected one of: " + list +
-                            (suggestion ? "; did you mean '" + *suggestion + "'?" : std::string()) + ")");
+      r.error(kv.first, "unknown key '" + key + "' in " + what + "; expected one of: " + list +
+                            (suggestion ? "; did you mean '" + *suggestion + "'?" : std::string()));
       ok = false;
     } else if (manifest.find_parameter(prefix + key) == nullptr && !(prefix.empty() && (key == "name" || key == "type"))) {
       const std::string group = prefix + key;  // the map of some dotted names

@@ -162,11 +162,11 @@ loops:
     CHECK(e.diagnostics().error_count() == 11);
     CHECK_THAT(what, Catch::Contains("many.yaml:4:25: error: controller 'base': parameter 'wheel_separation_m' expects a number, got \"zero\""));
     CHECK_THAT(what, Catch::Contains("many.yaml:6:20: error: controller 'base': parameter 'cmd_timeout_s' = -1 s is outside [0, inf]"));
-    CHECK_THAT(what, Catch::Contains("many.yaml:7:5: error: unknown key 'wheel_radus_m' in controller 'base' (expected one of: name, type, "
+    CHECK_THAT(what, Catch::Contains("many.yaml:7:5: error: unknown key 'wheel_radus_m' in controller 'base'; expected one of: name, type, "
                                      "wheel_separation_m, wheel_radius_m, period_s, cmd_timeout_s, max_wheel_speed_rad_s, limits; "
-                                     "did you mean 'wheel_radius_m'?)"));
+                                     "did you mean 'wheel_radius_m'?"));
     CHECK_THAT(what, Catch::Contains("many.yaml:9:49: error: controller 'base': parameter 'limits.vx.max_acceleration' = -2 m/s^2 is outside (0, inf]"));
-    CHECK_THAT(what, Catch::Contains("many.yaml:10:7: error: unknown key 'yaw' in controller 'base' limits (expected one of: vx, vy, wz)"));
+    CHECK_THAT(what, Catch::Contains("many.yaml:10:7: error: unknown key 'yaw' in controller 'base' limits; expected one of: vx, vy, wz"));
     CHECK_THAT(what, Catch::Contains("many.yaml:13:15: error: loop 'motion': 'period_s' must be > 0, got 0"));
     CHECK_THAT(what, Catch::Contains("many.yaml:14:24: error: loop 'motion': 'realtime_priority' must be an integer in [0, 99], got 120"));
     CHECK_THAT(what, Catch::Contains("many.yaml:16:13: error: loop 'motion' coordinator: unknown mode 'fastest'"));
@@ -264,9 +264,9 @@ loops:
     gian: 3
     wheel_radius_m: 0.1
 )", "winch.yaml", registry),
-                      Catch::Contains("winch.yaml:4:5: error: unknown key 'gian' in controller 'winch' (expected one of: "
+                      Catch::Contains("winch.yaml:4:5: error: unknown key 'gian' in controller 'winch'; expected one of: "
                                       "name, type, gain, period_s, cmd_timeout_s, max_wheel_speed_rad_s, limits; did you "
-                                      "mean 'gain'?)") &&
+                                      "mean 'gain'?") &&
                           Catch::Contains("winch.yaml:5:5: error: unknown key 'wheel_radius_m' in controller 'winch'"));
   REQUIRE_THROWS_WITH(parse_reactive_config("controllers:\n  - {name: winch, type: gain, gain: 300}\n", "winch.yaml", registry),
                       Catch::Contains("winch.yaml:2:37: error: controller 'winch': parameter 'gain' = 300 rad/m is outside [0, 100]"));
@@ -276,7 +276,7 @@ loops:
   REQUIRE_THROWS_WITH(parse_reactive_config("controllers:\n  - {name: winch, type: gain, limits: {vx: 5, yaw: {}}}\n",
                                             "winch.yaml", registry),
                       Catch::Contains("winch.yaml:2:44: error: controller 'winch' limits.vx must be a map") &&
-                          Catch::Contains("unknown key 'yaw' in controller 'winch' limits (expected one of: vx, vy, wz)"));
+                          Catch::Contains("unknown key 'yaw' in controller 'winch' limits; expected one of: vx, vy, wz"));
   // The default registry does not know it.
   REQUIRE_THROWS_WITH(parse_reactive_config("controllers:\n  - {name: winch, type: gain}\n", "winch.yaml"),
                       Catch::Contains("unknown controller type 'gain'; known: differential, mecanum, omni"));
