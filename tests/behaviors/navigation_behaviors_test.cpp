@@ -359,4 +359,6 @@ TEST_CASE("register_navigation_behaviors registers the four behaviors by name", 
     CHECK(b->name() == n);
     for (const auto& p : b->manifest().parameters) CHECK_FALSE(p.description.empty());
   }
+  REQUIRE_THROWS_WITH(reg.create("BhClean"), Catch::Contains("unknown behavior type 'BhClean'; known: BhAutoMove, BhCleaning, "
+                                                             "BhCleaningTwoWheel, BhGlobalLocalization; did you mean 'BhCleaning'?"));
 }
