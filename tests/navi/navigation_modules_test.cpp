@@ -733,8 +733,15 @@ TEST_CASE(
     NavRobot r(
         omni, world(5.0, 4.0, false, kCorner, {box}),
         {{omni ? "BhCleaning" : "BhCleaningTwoWheel", {{"section", "A"}, {"blocked_timeout_s", "20"}}}});
-    const RunOutcome o = r.run(0, 900.0);
+    int detours = 0;  // paths published whose end is not the behavior's goal
+    std::uint32_t last_id = 0;
+    const RunOutcome o = r.run(0, 900.0, [&] {
+      const NavigationData& n = r.robot().navigation();
+      if (n.path_id != last_id && n.path_id != 0 && !n.path_final) ++detours;
+      last_id = n.path_id;
+    });
     CHECK(o.success);
+    CHECK(detours >= 1);
     CHECK(r.box_clearance() >= kRadius_m);
     CHECK(r.sim().collisions() == 0);
     // What the box hides is lost, the rest of the section is cleaned (the box and the ring
