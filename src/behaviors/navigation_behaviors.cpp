@@ -16,6 +16,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kCornerRad = 0.45;  // a bend of the path the lookahead point does not cross
 constexpr double kDriveWhileTurningRad = 0.5;  // differential: larger bearings turn in place
 constexpr double kCrawl_m_s = 0.02;  // slower than this before an obstacle counts as stopped
+constexpr std::size_t kMaxBeams = 4096;  // beams of a scan looked at (the beam table's capacity)
 
 ParameterSpec number(std::string name, double def, std::string unit, std::string description,
                      std::optional<double> min = std::nullopt, std::optional<double> max = std::nullopt) {
@@ -164,6 +165,11 @@ void CPathFollowingBehavior::configure_following(const ParameterSet& params, con
     bumpers_ = context.resources->first<BumperReading>();
   }
   if (tracker_.capacity() < kMaxPathPoints) tracker_.reserve(kMaxPathPoints);  // once per behavior
+  cos_.reserve(kMaxBeams);
+  sin_.reserve(kMaxBeams);
+  unexpected_.reserve(kMaxBeams);
+  unexpected_.clear();
+  scan_seen_ = 0;
   tracker_.reset({});
   path_id_ = 0;
   waiting_since_ = context.now;
@@ -209,6 +215,7 @@ bool CPathFollowingBehavior::track(const Pose2D& pose, const BehaviorContext& co
 
 Twist2D CPathFollowingBehavior::drive_toward(const Pose2D& pose, const PathTracker::Target& target,
                                              const BehaviorContext& context) noexcept {
+  update_unexpected(pose, context);
   bool blocked = false;
   const Twist2D cmd = command_toward(pose, target, context, blocked);
   const bool too_long = blocked_too_long(blocked, context.now);
@@ -223,8 +230,48 @@ Twist2D CPathFollowingBehavior::drive_toward(const Pose2D& pose, const PathTrack
   return cmd;
 }
 
-double CPathFollowingBehavior::clearance_along(double dx_body, double dy_body, const Pose2D& pose,
-                                               const BehaviorContext& context) const noexcept {
+void CPathFollowingBehavior::update_beam_table(const LaserScan& scan) noexcept {
+  const std::size_t n = std::min(scan.ranges_m.size(), kMaxBeams);
+  if (cos_.size() == n && table_angle_min_ == scan.angle_min_rad && table_increment_ == scan.angle_increment_rad) return;
+  cos_.resize(n);  // within the capacity reserved at activation
+  sin_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double a = scan.angle_min_rad + static_cast<double>(i) * scan.angle_increment_rad;
+    cos_[i] = static_cast<float>(std::cos(a));
+    sin_[i] = static_cast<float>(std::sin(a));
+  }
+  table_angle_min_ = scan.angle_min_rad;
+  table_increment_ = scan.angle_increment_rad;
+}
+
+void CPathFollowingBehavior::update_unexpected(const Pose2D& pose, const BehaviorContext& context) noexcept {
+  if (laser_ == nullptr || !laser_->is_fresh(context.now) || laser_->sequence() == scan_seen_) return;
+  scan_seen_ = laser_->sequence();
+  const LaserScan& scan = laser_->latest();
+  update_beam_table(scan);
+  unexpected_.clear();
+  // Only returns within slow_distance_m + 2 radii can limit the speed: a return in the corridor
+  // has clearance >= range - 2 * radius, and the speed is not limited beyond slow_distance_m.
+  // Testing the raw range first skips most beams with one well-predicted branch.
+  const double radius = context.navi->robot_radius_m;
+  const auto rmin = static_cast<float>(scan.range_min_m);
+  const auto near = static_cast<float>(std::min(scan.range_max_m, slow_distance_m_ + 2.0 * radius));
+  // Returns from obstacles of the map are not in the way: the path was planned around them with
+  // a margin; only what the map does not know (a box left in the corridor) stops the robot.
+  const ObstacleMap* map = context.navi->map;
+  const double c = std::cos(pose.theta_rad), s = std::sin(pose.theta_rad);
+  const std::size_t count = std::min(scan.ranges_m.size(), cos_.size());
+  const float* ranges = scan.ranges_m.data();
+  for (std::size_t i = 0; i < count; ++i) {
+    const float r = ranges[i];
+    if (!(r >= rmin && r <= near)) continue;  // also skips NaN and no-return values
+    const double px = r * static_cast<double>(cos_[i]), py = r * static_cast<double>(sin_[i]);
+    if (map != nullptr && map->near_obstacle(pose.x_m + c * px - s * py, pose.y_m + s * px + c * py)) continue;
+    unexpected_.push_back({px, py, 0.0});  // within the capacity reserved at activation
+  }
+}
+
+double CPathFollowingBehavior::clearance_along(double dx_body, double dy_body, const BehaviorContext& context) const noexcept {
   if (laser_ == nullptr || !laser_->is_fresh(context.now)) return kInf;
   const double n = std::hypot(dx_body, dy_body);
   if (n <= 0.0) return kInf;
@@ -233,24 +280,11 @@ double CPathFollowingBehavior::clearance_along(double dx_body, double dy_body, c
   // Walls the path runs along are tangent to the body: a point beside it (lateral distance near
   // the radius) is not in the way, and range noise would make it look so.
   const double corridor = 0.95 * radius;
-  // Returns from obstacles of the map are not in the way: the path was planned around them with
-  // a margin; only what the map does not know (a box left in the corridor) stops the robot.
-  const ObstacleMap* map = context.navi->map;
-  const double c = std::cos(pose.theta_rad), s = std::sin(pose.theta_rad);
-  auto on_map = [&](double bx, double by) {
-    return map != nullptr && map->near_obstacle(pose.x_m + c * bx - s * by, pose.y_m + s * bx + c * by);
-  };
-  const LaserScan& scan = laser_->latest();
   double best = kInf;
-  const std::size_t count = scan.ranges_m.size();
-  for (std::size_t i = 0; i < count; ++i) {
-    const double r = scan.ranges_m[i];
-    if (!std::isfinite(r) || r < scan.range_min_m || r > scan.range_max_m) continue;
-    const double a = scan.angle_min_rad + static_cast<double>(i) * scan.angle_increment_rad;
-    const double px = r * std::cos(a), py = r * std::sin(a);
-    const double along = px * ux + py * uy;
-    const double lateral = std::abs(px * uy - py * ux);
-    if (along <= 0.0 || lateral >= corridor || on_map(px, py)) continue;
+  for (const Pose2D& p : unexpected_) {
+    const double along = p.x_m * ux + p.y_m * uy;
+    const double lateral = std::abs(p.x_m * uy - p.y_m * ux);
+    if (along <= 0.0 || lateral >= corridor) continue;
     best = std::min(best, along - std::sqrt(radius * radius - lateral * lateral));
   }
   return best;
@@ -285,7 +319,7 @@ Twist2D CPathFollowingBehavior::command_toward(const Pose2D& pose, const PathTra
   };
   if (context.base.holonomic()) {
     speed = std::min(speed, context.base.max_vx_m_s);
-    speed = limit_by_clearance(speed, clearance_along(bx, by, pose, context));
+    speed = limit_by_clearance(speed, clearance_along(bx, by, context));
     cmd.vx_m_s = speed * bx / dist;
     cmd.vy_m_s = speed * by / dist;
     cmd.wz_rad_s = clamp_abs(k_heading_ * wrap_angle(hold_heading_rad_ - pose.theta_rad), yaw_rate_);
@@ -297,7 +331,7 @@ Twist2D CPathFollowingBehavior::command_toward(const Pose2D& pose, const PathTra
     if (std::abs(alpha) < kDriveWhileTurningRad) {
       speed = std::min(speed, context.base.max_vx_m_s);
       const double c_alpha = std::cos(alpha);
-      cmd.vx_m_s = limit_by_clearance(speed * c_alpha * c_alpha, clearance_along(1.0, 0.0, pose, context));
+      cmd.vx_m_s = limit_by_clearance(speed * c_alpha * c_alpha, clearance_along(1.0, 0.0, context));
     }
   }
   return cmd;

@@ -25,20 +25,20 @@ void CGridMaps::set_map(OccupancyGrid grid, RegionMap regions) {
   grid_ = std::move(grid);
   regions_ = std::move(regions);
   planner_.reset();
+  near_mask_.clear();
 }
 
 void CGridMaps::on_configure(const ParameterSet& params) {
   robot_radius_m_ = params.number("robot_radius_m");
   planner_.reset();
-  const std::string& map = params.string("map");
-  const std::string& regions = params.string("regions");
-  // Files are named relative to the profile that configures the module.
-  const std::filesystem::path base = std::filesystem::path(where().file.str()).parent_path();
-  if (!map.empty()) grid_ = load_map(base / map).grid;
-  if (!regions.empty()) regions_ = load_regions(base / regions);
+  map_file_ = params.string("map");
+  regions_file_ = params.string("regions");
 }
 
 void CGridMaps::on_start(ModuleContext& context) {
+  // Files are named relative to the profile that configures the module.
+  if (!map_file_.empty()) grid_ = load_map(context.profile_dir / map_file_).grid;
+  if (!regions_file_.empty()) regions_ = load_regions(context.profile_dir / regions_file_);
   if (!grid_) {
     const auto* source = dynamic_cast<const MapSource*>(context.hardware);
     if (source == nullptr) {
@@ -48,6 +48,18 @@ void CGridMaps::on_start(ModuleContext& context) {
     if (regions_.room_names().empty()) regions_ = source->world_regions();
   }
   (void)planner();  // built now, not in the first period that needs it
+  const OccupancyGrid& g = *grid_;
+  near_mask_.assign(g.size(), 0);
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    if (g.state(i) == Occupancy::free) continue;
+    const CellIndex c = g.cell(i);
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const CellIndex n{c.x + dx, c.y + dy};
+        if (g.contains(n)) near_mask_[g.index(n)] = 1;
+      }
+    }
+  }
   context.navigation->map = this;
   context.navigation->robot_radius_m = robot_radius_m_;
 }
@@ -74,6 +86,7 @@ PathPlanner& CGridMaps::planner() {
 bool CGridMaps::near_obstacle(double x_m, double y_m) const noexcept {
   if (!grid_) return false;
   const CellIndex cell = grid_->cell_at({x_m, y_m});
+  if (!near_mask_.empty()) return !grid_->contains(cell) || near_mask_[grid_->index(cell)] != 0;
   for (int dy = -1; dy <= 1; ++dy) {
     for (int dx = -1; dx <= 1; ++dx) {
       if (grid_->state(CellIndex{cell.x + dx, cell.y + dy}) != Occupancy::free) return true;

@@ -138,6 +138,7 @@ void CLocalizer::on_behavior_deactivated(std::string_view behavior, ModuleContex
 }
 
 void CLocalizer::step(Time now, std::vector<ModuleEvent>& out) noexcept {
+  if (!configured()) return;
   if (truth_ == nullptr) return;
   const std::optional<Pose2D> truth = truth_->true_pose(now);
   if (!truth) return;

@@ -1,5 +1,10 @@
 #include "tripodal/navi/navi_modules.hpp"
 
+#include "tripodal/navi/grid_maps.hpp"
+#include "tripodal/navi/localizer.hpp"
+#include "tripodal/navi/planning_modules.hpp"
+#include "tripodal/navi/section_splitter.hpp"
+
 namespace tripodal::navi {
 
 ModuleManifest navi_manifest(std::string name, std::string description, std::vector<std::string> inputs,
@@ -13,6 +18,14 @@ ModuleManifest navi_manifest(std::string name, std::string description, std::vec
   m.outputs = std::move(outputs);
   m.parameters = std::move(parameters);
   return m;
+}
+
+void register_navigation_modules(ModuleRegistry& registry) {
+  registry.add<CGridMaps>();
+  registry.add<CSectionSplitter>();
+  registry.add<CLocalizer>();
+  registry.add<CPathPlanningModule>();
+  registry.add<CCoverageModule>();
 }
 
 }  // namespace tripodal::navi

@@ -10,10 +10,7 @@
 
 #include "tripodal/behaviors/navigation_behaviors.hpp"
 #include "tripodal/core/net_loader.hpp"
-#include "tripodal/navi/grid_maps.hpp"
-#include "tripodal/navi/localizer.hpp"
-#include "tripodal/navi/planning_modules.hpp"
-#include "tripodal/navi/section_splitter.hpp"
+#include "tripodal/navi/navi_modules.hpp"
 #include "tripodal/reactive/reactive_config.hpp"
 
 namespace tripodal {
@@ -23,11 +20,7 @@ RobotPlugins RobotPlugins::with_builtins() {
   register_builtin_behaviors(p.behaviors);
   register_navigation_behaviors(p.behaviors);
   register_builtin_controllers(p.controllers);
-  p.modules.add<navi::CGridMaps>();
-  p.modules.add<navi::CSectionSplitter>();
-  p.modules.add<navi::CLocalizer>();
-  p.modules.add<navi::CPathPlanningModule>();
-  p.modules.add<navi::CCoverageModule>();
+  navi::register_navigation_modules(p.modules);
   return p;
 }
 
@@ -69,7 +62,7 @@ ControllerConfig controller_config(const RobotProfile& p, const ModuleEntry& e) 
     throw ConfigError(e.where, "controller '" + e.name +
                                    "' needs parameters: {config: FILE}, the reactive configuration with its limits and wheels");
   }
-  const std::filesystem::path file = p.file.parent_path() / it->second;
+  const std::filesystem::path file = p.dir / it->second;
   const ReactiveConfig rc = load_reactive_config(file.string());
   const ControllerConfig* c = rc.find_controller(e.name);
   if (c == nullptr) throw ConfigError(e.where, file.string() + " configures no controller named '" + e.name + "'");
@@ -90,6 +83,7 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
   TaskLibrary tasks;
   RecoveryPolicy recovery;
   Duration sequencing_period{0};
+  std::filesystem::path profile_dir;
 
   // Below the reactive layer, and the reactive layer.
   std::unique_ptr<CHardware> hardware;
@@ -128,6 +122,14 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
   bool started = false;
 
   Impl(Clock& c, const RobotPlugins& p, RobotOptions o) : clock(c), plugins(p), options(std::move(o)) {}
+  // The supervisor deactivates the running behaviors as it goes, through this host: it must go
+  // while the loops, the modules and the record of active behaviors are still here.
+  ~Impl() override {
+    planner.reset();
+    supervisor.reset();
+  }
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
 
   [[nodiscard]] ControlLoop& behavior_loop() const { return *loops.front(); }
 
@@ -139,6 +141,7 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
     ctx.hardware = hardware.get();
     ctx.modules = this;
     ctx.path_ids = &path_ids;
+    ctx.profile_dir = profile_dir;
     if (!loops.empty()) ctx.feedback = behavior_loop().navigation_feedback();
     return ctx;
   }
@@ -253,6 +256,7 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
                                        RobotOptions options) {
   auto m = std::make_unique<Impl>(clock, plugins, std::move(options));
   m->sequencing_period = profile.sequencing_period;
+  m->profile_dir = profile.dir;
   Diagnostics d;
   auto collect = [&](const auto& fn) {
     try {
@@ -330,6 +334,7 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
       hc.where = h.where;
       hc.parameters = ParameterSet::resolve(plugins.hardware.manifest(h.type), parameters_of(h, m->options.parameters), h.where);
       hc.base = m->controller_configs.empty() ? nullptr : &m->controller_configs.front();
+      hc.profile_dir = profile.dir;
       m->hardware = plugins.hardware.create_at(h.where, h.type, hc);
       m->hardware->add_resources(m->resources);
     });

@@ -141,6 +141,7 @@ struct Parser {
   RobotProfile parse(const std::string& text) {
     RobotProfile prof;
     prof.file = file;
+    prof.dir = base;
     const YAML::Node root = yaml::parse(text, file);
     prof.where = SourceLocation{file, 1, 1};
     if (!r.expect_keys(root, {"robot", "hardware", "controllers", "loops", "resources", "navigation", "hri", "modules", "behaviors",

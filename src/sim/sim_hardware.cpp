@@ -24,7 +24,7 @@ void register_sim_hardware(HardwareRegistry& registry, std::shared_ptr<const Wor
     World w;
     const std::string& file = c.parameters.string("world");
     if (!file.empty()) {
-      w = load_world(std::filesystem::path(c.where.file.str()).parent_path() / file);
+      w = load_world(c.profile_dir / file);
     } else if (world) {
       w = *world;
     } else {

@@ -161,7 +161,7 @@ TEST_CASE("run_task refuses a profile whose controller names no configuration, w
   o.robot = profile;
   o.world = kSource / "configs/worlds/workspace.yaml";
   o.task = "clean the room 3211";
-  REQUIRE_THROWS_WITH(run_task(o), Catch::Contains("robot.yaml:11:5: error: controller 'base' needs parameters: {config: FILE}"));
+  REQUIRE_THROWS_WITH(run_task(o), Catch::Contains("robot.yaml:16:5: error: controller 'base' needs parameters: {config: FILE}"));
   std::filesystem::remove_all(dir);
 }
 

@@ -74,10 +74,9 @@ class CPathFollowingBehavior : public CBehavior {
   bool track(const Pose2D& pose, const BehaviorContext& context, double search_m, double tolerance_m, bool along_path,
              PathTracker::Target& target) noexcept;
   /// The clearance (metres beyond the body disc) along the body-frame direction (dx, dy) from
-  /// the latest fresh scan, counting only returns from obstacles the map does not hold (seen
-  /// from `pose`, map frame); +inf without such returns or without a fresh scan.
-  [[nodiscard]] double clearance_along(double dx_body, double dy_body, const Pose2D& pose,
-                                       const BehaviorContext& context) const noexcept;
+  /// the latest fresh scan, counting only returns from obstacles the map does not hold;
+  /// +inf without such returns or without a fresh scan.
+  [[nodiscard]] double clearance_along(double dx_body, double dy_body, const BehaviorContext& context) const noexcept;
   /// The command toward the lookahead target; `blocked` tells whether the laser stopped it.
   [[nodiscard]] Twist2D command_toward(const Pose2D& pose, const PathTracker::Target& target,
                                        const BehaviorContext& context, bool& blocked) noexcept;
@@ -96,6 +95,16 @@ class CPathFollowingBehavior : public CBehavior {
 
  private:
   [[nodiscard]] bool blocked_too_long(bool blocked, Time now) noexcept;
+  /// The beams' directions in the body frame, computed once per scan geometry (a cycle reads
+  /// every beam: cos and sin per beam would dominate it).
+  void update_beam_table(const LaserScan& scan) noexcept;
+  /// Once per new scan: its near returns (body frame) that the map does not explain, seen from
+  /// `pose` (map frame). The scan changes at the laser's rate, the loop runs far faster.
+  void update_unexpected(const Pose2D& pose, const BehaviorContext& context) noexcept;
+  std::vector<Pose2D> unexpected_;
+  std::size_t scan_seen_ = 0;
+  std::vector<float> cos_, sin_;
+  double table_angle_min_ = 0.0, table_increment_ = 0.0;
   std::uint32_t path_id_ = 0;  ///< the path being tracked; 0: none yet
   Time waiting_since_{0};      ///< activation, for the "no path" timeout
   bool blocked_ = false;

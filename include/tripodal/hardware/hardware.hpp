@@ -4,6 +4,7 @@
 // sim/sim_hardware.hpp) or one an application registers (e.g. a serial control board).
 #pragma once
 
+#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -24,6 +25,7 @@ struct HardwareConfig {
   ParameterSet parameters;             ///< resolved against the type's manifest
   SourceLocation where;                ///< the profile's hardware entry
   const ControllerConfig* base = nullptr;  ///< the base controller's configuration (wheel geometry)
+  std::filesystem::path profile_dir;       ///< relative file parameters are relative to it
 };
 
 class CHardware {

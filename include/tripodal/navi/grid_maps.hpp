@@ -52,10 +52,12 @@ class CGridMaps final : public CNaviModules, public ObstacleMap {
   void on_update(ModuleContext& context) override;
 
  private:
+  std::string map_file_, regions_file_;
   std::optional<OccupancyGrid> grid_;
   RegionMap regions_;
   double robot_radius_m_ = 0.25;
   std::unique_ptr<PathPlanner> planner_;
+  std::vector<std::uint8_t> near_mask_;  ///< 1 where a cell or a neighbour is not free: one look-up per query
 };
 
 }  // namespace tripodal::navi

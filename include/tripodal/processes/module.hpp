@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -17,6 +18,7 @@
 #include "tripodal/behaviors/behavior.hpp"
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/core/manifest.hpp"
+#include "tripodal/core/registry.hpp"
 #include "tripodal/core/time.hpp"
 #include "tripodal/resources/resource.hpp"
 
@@ -80,6 +82,7 @@ struct ModuleContext {
   CHardware* hardware = nullptr;                 ///< the robot's hardware (nullptr: none)
   const ModuleDirectory* modules = nullptr;
   std::uint32_t* path_ids = nullptr;             ///< the robot's path id counter
+  std::filesystem::path profile_dir;             ///< relative file parameters are relative to it
 
   std::vector<ModuleEvent> events;               ///< posted to the running processes' nets
   bool heartbeat = false;                        ///< the module is alive (supervisor watchdog)
@@ -148,5 +151,8 @@ class CModule {
   bool configured_ = false;
   SourceLocation where_;
 };
+
+/// Module types (CModule subclasses with a default constructor) by name.
+using ModuleRegistry = Registry<CModule>;
 
 }  // namespace tripodal

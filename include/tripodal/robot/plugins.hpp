@@ -13,9 +13,6 @@
 
 namespace tripodal {
 
-/// Module types (CModule subclasses with a default constructor) by name.
-using ModuleRegistry = Registry<CModule>;
-
 /// What the robot gives a resource type's factory: the instance name and its parameters.
 struct ResourceConfig {
   std::string name;

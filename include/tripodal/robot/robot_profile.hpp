@@ -58,6 +58,7 @@ struct RobotProfile {
   std::string name;
   std::string description;
   std::filesystem::path file;
+  std::filesystem::path dir;  ///< what relative paths in the profile (and its modules' parameters) are relative to
   SourceLocation where;
   /// Period of the sequencing loop (navigation modules, process supervisor, planner).
   Duration sequencing_period{std::chrono::milliseconds(50)};
