@@ -215,12 +215,10 @@ class NavRobot {
       const std::string id = "task" + std::to_string(i);
       navi::test::write_file(nets_ / (id + ".xml"), task_net(id, tasks_[i]));
     }
-    robot_ = Robot::assemble(
-        // Named as if it were a file of configs/robots: the controllers' `config` files resolve
-        // against the profile's own folder, not base_dir.
-        load_robot_profile_from_string(profile(omni, localizer, nets_.path(), tasks_.size()),
-                                       (kRobots / "navtest.yaml").string(), kRobots),
-        plugins_, clock_);
+    robot_ =
+        Robot::assemble(load_robot_profile_from_string(profile(omni, localizer, nets_.path(), tasks_.size()),
+                                                       "navtest.yaml", kRobots),
+                        plugins_, clock_);
     for (std::size_t i = 0; i < w.grid.size(); ++i) {
       if (w.grid.is_occupied(w.grid.cell(i))) wall_cells_.push_back(w.grid.cell_center(w.grid.cell(i)));
     }
