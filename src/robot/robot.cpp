@@ -184,7 +184,7 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
     // Throws ConfigError for bad parameters: the supervisor makes it the behavior's failure.
     const BehaviorHandle h = behavior_loop().activate(plugins.behaviors.create(type->second), params, behavior);
     active.insert_or_assign(std::string(behavior), ActiveBehavior{h, BehaviorStatus::running, {}});
-    const BehaviorActivation a{behavior, params, now, plugins.behaviors.manifest(type->second)};
+    const BehaviorActivation a{behavior, params, now, plugins.behaviors.find(type->second)};
     ModuleContext ctx = context(now);
     for_each_module(ctx, [&](CModule& m) { m.behavior_activated(a, ctx); });
   }
@@ -280,7 +280,7 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
   m->description = describe_robot(profile, plugins, knowledge_inputs(m->tasks), d);
 
   // Processes: nets, parameters and their own recovery rules.
-  if (plugins.register_process_types) plugins.register_process_types(m->processes);
+  m->processes = ProcessRegistry(plugins.processes);
   auto load = m->options.load_net;
   if (!load) {
     load = [&](const std::filesystem::path& f) {
