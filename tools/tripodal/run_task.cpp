@@ -248,10 +248,8 @@ RunResult run_task(const RunOptions& o) {
   };
 
   std::size_t sim_events_noted = 0;
-  std::size_t sequencing_steps = 0;
   while (robot->planner().busy() && clock.now() < deadline) {
     robot->run_for(tick_period);
-    ++sequencing_steps;
     for (; sim_events_noted < sim.events().size(); ++sim_events_noted) {
       const sim::SimEvent& e = sim.events()[sim_events_noted];
       life.note(e.stamp, "simulator: " + std::string(sim::to_string(e.kind)) + (e.detail.empty() ? "" : " " + e.detail));
@@ -326,7 +324,6 @@ RunResult run_task(const RunOptions& o) {
     f.boustrophedon_coverage = p.coverage();
     res.sections.push_back(f);
   }
-  (void)sequencing_steps;
 
   if (!o.out.empty()) {
     std::filesystem::create_directories(o.out);
