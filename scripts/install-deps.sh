@@ -7,7 +7,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libyaml-cpp-dev libspdlog-dev
   libfmt-dev nlohmann-json3-dev libcli11-dev
-  libtinyxml2-dev  # tests only: the reference the XML reader is compared with
+  libtinyxml2-dev  # the net loaders read XML with it
   catch2 libbenchmark-dev
   graphviz libxml2-utils
   zlib1g-dev

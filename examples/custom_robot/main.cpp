@@ -42,8 +42,8 @@ class BeaconBase final : public sim::SimHardware {
 /// Resource type "BeaconResource": the beacon's driver, which the reactive loop polls every cycle.
 class BeaconResource final : public TypedResource<BeaconReading> {
  public:
-  static inline const ModuleManifest kManifest{.name = "BeaconResource", .kind = ModuleKind::resource, .description = "the beacon",
-                                               .inputs = {"beacon_state"}, .outputs = {"beacon"}};
+  static inline const ModuleManifest kManifest =
+      ManifestBuilder("BeaconResource", ModuleKind::resource).description("the beacon").input("beacon_state").output("beacon").build();
   static const ModuleManifest& static_manifest() { return kManifest; }
   explicit BeaconResource(const ResourceConfig& c)
       : TypedResource(c.name, Duration{0}, kManifest), board_(dynamic_cast<const BeaconBase*>(c.hardware)) {
@@ -57,11 +57,10 @@ class BeaconResource final : public TypedResource<BeaconReading> {
 /// BhAnnounce: announces an arrival by turning in place until the beacon has sounded for beacon_s.
 class BhAnnounce final : public CBehavior {
  public:
-  static inline const ModuleManifest kManifest{
-      .name = "BhAnnounce", .kind = ModuleKind::behavior, .description = "turns in place until the beacon has sounded beacon_s",
-      .inputs = {"beacon"}, .outputs = {"behavior_command"},
-      .parameters = {{.name = "yaw_rate_rad_s", .default_value = Value{1.0}, .unit = "rad/s", .description = "turn rate", .min = 0.5},
-                     {.name = "beacon_s", .default_value = Value{3.0}, .unit = "s", .description = "beacon time"}}};
+  static inline const ModuleManifest kManifest = behavior_manifest(
+      "BhAnnounce", "turns in place until the beacon has sounded beacon_s", {"beacon"},
+      {parameter::number("yaw_rate_rad_s", 1.0, "rad/s", "turn rate", 0.5),
+       parameter::number("beacon_s", 3.0, "s", "beacon time")});
   static const ModuleManifest& static_manifest() { return kManifest; }
  private:
   [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return kManifest; }
@@ -105,6 +104,7 @@ class RoomWatcher final : public navi::CNaviModules {
 /// Process type "announce": the profile counts an announcement in turns, the behavior in seconds.
 class PrAnnounce final : public CProcess {
  public:
+  static ModuleManifest static_manifest() { return ManifestBuilder("announce", ModuleKind::process, Layer::sequencing).build(); }
   using CProcess::CProcess;
  private:
   std::string on_bind(ParameterValues& values) const override {
@@ -124,7 +124,7 @@ int main(int argc, char** argv) try {
   plugins.resources.add<BeaconResource>();
   plugins.behaviors.add<BhAnnounce>();
   plugins.modules.add<RoomWatcher>();
-  plugins.register_process_types = [](ProcessRegistry& r) { r.register_type<PrAnnounce>("announce"); };
+  plugins.processes.add<PrAnnounce>();
   SimClock clock;
   const auto robot = Robot::assemble(load_robot_profile(argc > 1 ? argv[1] : PATROL_PROFILE), plugins, clock);
   LifecycleRecorder life;

@@ -18,26 +18,8 @@ constexpr double kDriveWhileTurningRad = 0.5;  // differential: larger bearings 
 constexpr double kCrawl_m_s = 0.02;  // slower than this before an obstacle counts as stopped
 constexpr std::size_t kMaxBeams = 4096;  // beams of a scan looked at (the beam table's capacity)
 
-ParameterSpec number(std::string name, double def, std::string unit, std::string description,
-                     std::optional<double> min = std::nullopt, std::optional<double> max = std::nullopt) {
-  return {std::move(name), ValueType::number, Value{def}, std::move(unit), std::move(description), min, max};
-}
-ParameterSpec text(std::string name, std::string def, std::string description) {
-  return {std::move(name), ValueType::string, Value{std::move(def)}, "", std::move(description), {}, {}};
-}
-
-ModuleManifest behavior_manifest(std::string name, std::string description, std::vector<std::string> inputs,
-                                 std::vector<ParameterSpec> parameters) {
-  ModuleManifest m;
-  m.name = std::move(name);
-  m.layer = Layer::reactive;
-  m.kind = ModuleKind::behavior;
-  m.description = std::move(description);
-  m.inputs = std::move(inputs);
-  m.outputs = {"behavior_command"};
-  m.parameters = std::move(parameters);
-  return m;
-}
+using parameter::number;
+using parameter::text;
 
 std::vector<ParameterSpec> following_parameters(double speed, double lookahead) {
   return {

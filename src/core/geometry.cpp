@@ -35,10 +35,10 @@ std::vector<Point2D> douglas_peucker(std::span<const Point2D> polyline, double t
   if (polyline.size() < 3) return {polyline.begin(), polyline.end()};
   std::vector<char> keep(polyline.size(), 0);
   keep.front() = keep.back() = 1;
-  std::vector<std::pair<std::size_t, std::size_t>> todo{{0, polyline.size() - 1}};
-  while (!todo.empty()) {
-    const auto [i, j] = todo.back();
-    todo.pop_back();
+  std::vector<std::pair<std::size_t, std::size_t>> pending{{0, polyline.size() - 1}};
+  while (!pending.empty()) {
+    const auto [i, j] = pending.back();
+    pending.pop_back();
     if (j <= i + 1) continue;
     const Point2D& a = polyline[i];
     const double dx = polyline[j].x_m - a.x_m;
@@ -58,8 +58,8 @@ std::vector<Point2D> douglas_peucker(std::span<const Point2D> polyline, double t
     }
     if (worst > tolerance_m) {
       keep[at] = 1;
-      todo.emplace_back(i, at);
-      todo.emplace_back(at, j);
+      pending.emplace_back(i, at);
+      pending.emplace_back(at, j);
     }
   }
   std::vector<Point2D> out;

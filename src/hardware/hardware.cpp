@@ -4,14 +4,11 @@ namespace tripodal {
 
 ModuleManifest hardware_manifest(std::string name, std::string description, std::vector<std::string> outputs,
                                  std::vector<ParameterSpec> parameters) {
-  ModuleManifest m;
-  m.name = std::move(name);
-  m.layer = Layer::reactive;
-  m.kind = ModuleKind::other;
-  m.description = std::move(description);
-  m.outputs = std::move(outputs);
-  m.parameters = std::move(parameters);
-  return m;
+  return ManifestBuilder(std::move(name), ModuleKind::other, Layer::reactive)
+      .description(std::move(description))
+      .outputs(std::move(outputs))
+      .parameters(std::move(parameters))
+      .build();
 }
 
 }  // namespace tripodal

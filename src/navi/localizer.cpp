@@ -66,11 +66,15 @@ const ModuleManifest& CLocalizer::static_manifest() {
                      std::nullopt},
        ParameterSpec{"faults", ValueType::string, Value{std::string()}, "s",
                      "loss windows \"START-END; START-END\" in seconds of simulated time", std::nullopt,
-                     std::nullopt}});
+                     std::nullopt},
+       ParameterSpec{"serves", ValueType::string, Value{std::string("BhGlobalLocalization")}, "",
+                     "the behavior during whose activation it attempts global position fixes (its parameter "
+                     "attempt_period_s)", std::nullopt, std::nullopt}});
   return m;
 }
 
 void CLocalizer::on_configure(const ParameterSet& params) {
+  serves_ = params.string("serves");
   LocalizerOptions o;
   o.noise_xy_m = params.number("noise_xy_m");
   o.noise_theta_rad = params.number("noise_theta_rad");
@@ -126,7 +130,7 @@ void CLocalizer::on_update(ModuleContext& context) {
 }
 
 void CLocalizer::on_behavior_activated(const BehaviorActivation& activation, ModuleContext& context) {
-  if (activation.behavior != "BhGlobalLocalization") return;
+  if (activation.behavior != serves_) return;
   const ParameterSet params = activation.resolved();
   attempt_period_ = from_seconds(params.number("attempt_period_s"));
   last_attempt_ = context.now;
@@ -134,7 +138,7 @@ void CLocalizer::on_behavior_activated(const BehaviorActivation& activation, Mod
 }
 
 void CLocalizer::on_behavior_deactivated(std::string_view behavior, ModuleContext& /*context*/) {
-  if (behavior == "BhGlobalLocalization") searching_ = false;
+  if (behavior == serves_) searching_ = false;
 }
 
 void CLocalizer::step(Time now, std::vector<ModuleEvent>& out) noexcept {

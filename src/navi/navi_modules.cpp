@@ -9,15 +9,12 @@ namespace tripodal::navi {
 
 ModuleManifest navi_manifest(std::string name, std::string description, std::vector<std::string> inputs,
                              std::vector<std::string> outputs, std::vector<ParameterSpec> parameters) {
-  ModuleManifest m;
-  m.name = std::move(name);
-  m.layer = Layer::sequencing;
-  m.kind = ModuleKind::navigation;
-  m.description = std::move(description);
-  m.inputs = std::move(inputs);
-  m.outputs = std::move(outputs);
-  m.parameters = std::move(parameters);
-  return m;
+  return ManifestBuilder(std::move(name), ModuleKind::navigation, Layer::sequencing)
+      .description(std::move(description))
+      .inputs(std::move(inputs))
+      .outputs(std::move(outputs))
+      .parameters(std::move(parameters))
+      .build();
 }
 
 void register_navigation_modules(ModuleRegistry& registry) {

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <initializer_list>
@@ -102,15 +103,88 @@ class Reader {
   yaml::Reader r_;
 };
 
-AxisLimits read_axis(Reader& r, const YAML::Node& node, const std::string& what) {
-  AxisLimits a;
-  if (!r.is_map(node, what)) return a;
-  r.check_keys(node, {"max_velocity", "max_acceleration", "max_deceleration", "max_jerk"}, what);
-  a.max_velocity = r.number(node, "max_velocity", false, Bound::positive, what);
-  a.max_acceleration = r.number(node, "max_acceleration", false, Bound::positive, what);
-  a.max_deceleration = r.number(node, "max_deceleration", false, Bound::positive, what);
-  a.max_jerk = r.number(node, "max_jerk", false, Bound::positive, what);
-  return a;
+// The omni wheel lists: read by the omni geometry code below, since a manifest parameter is a
+// scalar (the manifest declares them for the allowed keys and the documentation).
+bool is_wheel_list(std::string_view key) noexcept { return key == "wheel_angles_deg" || key == "wheels"; }
+
+// Reports the keys of `map` that no parameter of `manifest` under `prefix` names, at the key,
+// listing the allowed ones; recurses into the maps of dotted names ("limits" -> "limits.vx").
+void check_parameter_keys(Reader& r, const YAML::Node& map, const ModuleManifest& manifest, const std::string& prefix,
+                          const std::string& entry, bool& ok) {
+  const std::string what = prefix.empty() ? entry : entry + " " + prefix.substr(0, prefix.size() - 1);
+  std::vector<std::string> allowed;
+  if (prefix.empty()) allowed = {"name", "type"};
+  for (const auto& spec : manifest.parameters) {
+    if (spec.name.compare(0, prefix.size(), prefix) != 0) continue;
+    std::string key = spec.name.substr(prefix.size(), spec.name.find('.', prefix.size()) - prefix.size());
+    if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) allowed.push_back(std::move(key));
+  }
+  for (const auto& kv : map) {
+    const std::string key = kv.first.Scalar();
+    if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      const auto suggestion = closest_name(key, allowed);
+      r.error(kv.first, "unknown key '" + key + "' in " + what + "; expected one of: " + list +
+                            (suggestion ? "; did you mean '" + *suggestion + "'?" : std::string()));
+      ok = false;
+    } else if (manifest.find_parameter(prefix + key) == nullptr && !(prefix.empty() && (key == "name" || key == "type"))) {
+      const std::string group = prefix + key;  // the map of some dotted names
+      if (!r.is_map(kv.second, entry + " " + group)) {
+        ok = false;
+      } else {
+        check_parameter_keys(r, kv.second, manifest, group + ".", entry, ok);
+      }
+    }
+  }
+}
+
+// The controller's parameters as its type's manifest declares them, each checked at its value;
+// nullopt when any problem was reported.
+std::optional<ParameterSet> read_parameters(Reader& r, const YAML::Node& node, const ModuleManifest& manifest,
+                                            const std::string& what) {
+  bool ok = true;
+  check_parameter_keys(r, node, manifest, "", what, ok);
+  ParameterValues given;
+  for (const auto& spec : manifest.parameters) {
+    if (is_wheel_list(spec.name)) continue;
+    // A dotted name is a path through nested maps; a missing map is a missing value. (YAML::Node
+    // assignment writes into the document: the walk rebinds with reset() and looks up const.)
+    YAML::Node v(node);
+    bool found = true;
+    for (std::size_t from = 0; found;) {
+      const std::size_t dot = spec.name.find('.', from);
+      const std::string key = spec.name.substr(from, dot - from);
+      const YAML::Node& map = v;
+      found = map.IsMap() && map[key];
+      if (found) v.reset(map[key]);
+      if (dot == std::string::npos) break;
+      from = dot + 1;
+    }
+    if (!found) {
+      if (!spec.default_value && !spec.optional) {
+        r.error(node, what + ": missing '" + spec.name + "' (a " + std::string(to_string(spec.type)) + ")");
+        ok = false;
+      }
+      continue;
+    }
+    if (!v.IsScalar()) {
+      r.error(v, what + ": parameter '" + spec.name + "' expects a " + std::string(to_string(spec.type)) +
+                     (v.IsSequence() ? ", got a list" : ", got a map"));
+      ok = false;
+      continue;
+    }
+    Value value{v.Scalar()};
+    if (auto parsed = parse_value(spec.type, v.Scalar())) value = *parsed;
+    if (auto problem = check_parameter_value(spec, value)) {
+      r.error(v, what + ": " + *problem);
+      ok = false;
+      continue;
+    }
+    given.emplace(spec.name, std::move(value));
+  }
+  if (!ok) return std::nullopt;
+  return ParameterSet::resolve(manifest, given, r.at(node));
 }
 
 ControllerConfig read_controller(Reader& r, const YAML::Node& node, std::size_t index, const ControllerRegistry& registry) {
@@ -122,46 +196,30 @@ ControllerConfig read_controller(Reader& r, const YAML::Node& node, std::size_t 
     c.name = *n;
     what = "controller '" + c.name + "'";
   }
-  r.check_keys(node, {"name", "type", "period_s", "cmd_timeout_s", "max_wheel_speed_rad_s", "limits", "wheel_separation_m",
-                      "wheel_radius_m", "base_radius_m", "wheel_angles_deg", "wheels", "half_length_m", "half_width_m"},
-               what);
+  const ModuleManifest* manifest = nullptr;
   if (auto t = r.text(node, "type", true, what)) {
     c.type = *t;
-    if (!registry.contains(c.type)) {
-      std::string known;
-      for (const auto& n : registry.names()) known += (known.empty() ? "" : ", ") + n;
-      r.error(node["type"], what + ": unknown controller type '" + c.type + "' (expected one of: " + known + ")");
-    }
+    manifest = registry.find(c.type);
+    if (manifest == nullptr) r.error(node["type"], what + ": " + unknown_name_message(registry.kind(), c.type, registry.names()));
   }
-  if (auto p = r.number(node, "period_s", false, Bound::positive, what)) c.period = from_seconds(*p);
-  if (auto t = r.number(node, "cmd_timeout_s", false, Bound::non_negative, what)) c.cmd_timeout = from_seconds(*t);
-  c.max_wheel_speed_rad_s = r.number(node, "max_wheel_speed_rad_s", false, Bound::positive, what);
-  if (const YAML::Node lim = node["limits"]) {
-    if (r.is_map(lim, what + " limits")) {
-      r.check_keys(lim, {"vx", "vy", "wz"}, what + " limits");
-      if (lim["vx"]) c.limits.vx = read_axis(r, lim["vx"], what + " limits.vx");
-      if (lim["vy"]) c.limits.vy = read_axis(r, lim["vy"], what + " limits.vy");
-      if (lim["wz"]) c.limits.wz = read_axis(r, lim["wz"], what + " limits.wz");
-    }
+  if (manifest == nullptr) return c;
+  if (auto parameters = read_parameters(r, node, *manifest, what)) {
+    c.parameters = std::move(*parameters);
+    apply_parameters(c);
   }
 
-  if (c.type == "differential") {
-    c.differential.wheel_separation_m = r.number(node, "wheel_separation_m", true, Bound::positive, what).value_or(0.0);
-    c.differential.wheel_radius_m = r.number(node, "wheel_radius_m", true, Bound::positive, what).value_or(0.0);
-  } else if (c.type == "mecanum") {
-    const double radius = r.number(node, "wheel_radius_m", true, Bound::positive, what).value_or(0.0);
-    const auto hl = r.number(node, "half_length_m", true, Bound::positive, what);
-    const auto hw = r.number(node, "half_width_m", true, Bound::positive, what);
-    if (hl && hw) c.holonomic = mecanum_base(radius, *hl, *hw);
-    c.holonomic.wheel_radius_m = radius;
-  } else if (c.type == "omni") {
-    c.holonomic.wheel_radius_m = r.number(node, "wheel_radius_m", true, Bound::positive, what).value_or(0.0);
+  if (c.type == "omni") {
     const YAML::Node angles = node["wheel_angles_deg"];
     const YAML::Node wheels = node["wheels"];
     if (angles && wheels) {
       r.error(wheels, what + ": give either 'wheel_angles_deg' (with 'base_radius_m') or 'wheels', not both");
     } else if (angles) {
-      const auto base = r.number(node, "base_radius_m", true, Bound::positive, what);
+      std::optional<double> base;
+      if (c.parameters.contains("base_radius_m")) {
+        base = c.parameters.number("base_radius_m");
+      } else if (!node["base_radius_m"]) {
+        r.error(node, what + ": missing 'base_radius_m' (a number)");
+      }
       std::vector<double> a;
       if (!angles.IsSequence()) {
         r.error(angles, what + ": 'wheel_angles_deg' must be a list of angles in degrees");

@@ -143,8 +143,8 @@ RobotDescription describe_robot(const RobotProfile& profile, const RobotPlugins&
     const bool is_hardware = profile.hardware && e == &*profile.hardware;
     const ModuleManifest* m = nullptr;
     if (is_hardware) m = plugins.hardware.find(e->type);
-    else if (e->kind == ModuleKind::behavior) m = plugins.behaviors.manifest(e->type);
-    else if (e->kind == ModuleKind::controller) m = plugins.controllers.manifest(e->type);
+    else if (e->kind == ModuleKind::behavior) m = plugins.behaviors.find(e->type);
+    else if (e->kind == ModuleKind::controller) m = plugins.controllers.find(e->type);
     else if (e->kind == ModuleKind::resource) m = plugins.resources.find(e->type);
     else m = plugins.modules.find(e->type);
     DescribedModule dm;

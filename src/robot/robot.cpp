@@ -184,7 +184,7 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
     // Throws ConfigError for bad parameters: the supervisor makes it the behavior's failure.
     const BehaviorHandle h = behavior_loop().activate(plugins.behaviors.create(type->second), params, behavior);
     active.insert_or_assign(std::string(behavior), ActiveBehavior{h, BehaviorStatus::running, {}});
-    const BehaviorActivation a{behavior, params, now, plugins.behaviors.manifest(type->second)};
+    const BehaviorActivation a{behavior, params, now, plugins.behaviors.find(type->second)};
     ModuleContext ctx = context(now);
     for_each_module(ctx, [&](CModule& m) { m.behavior_activated(a, ctx); });
   }
@@ -210,24 +210,18 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
     for (const LoopEvent& e : loop_events) {
       switch (e.kind) {
         case LoopEvent::Kind::behavior_succeeded:
-        case LoopEvent::Kind::behavior_failed:
-          for (auto& [name, a] : active) {
-            if (a.handle != e.handle || &*loops.front() != loop_of(e)) continue;
-            a.state = e.kind == LoopEvent::Kind::behavior_succeeded ? BehaviorStatus::succeeded : BehaviorStatus::failed;
-            a.reason = std::string(e.reason);
-          }
+        case LoopEvent::Kind::behavior_failed: {
+          // The supervisor's behaviors run in the behavior loop, each on the input of its name.
+          const auto it = active.find(e.input);
+          if (e.loop != behavior_loop().name() || it == active.end() || it->second.handle != e.handle) break;
+          it->second.state = e.kind == LoopEvent::Kind::behavior_succeeded ? BehaviorStatus::succeeded : BehaviorStatus::failed;
+          it->second.reason = std::string(e.reason);
           break;
+        }
         case LoopEvent::Kind::controller_fault:
         case LoopEvent::Kind::controller_recovered: supervisor->post_event(e.event_name()); break;
       }
     }
-  }
-
-  [[nodiscard]] const ControlLoop* loop_of(const LoopEvent& e) const {
-    for (const auto& l : loops) {
-      if (l->name() == e.loop) return l.get();
-    }
-    return nullptr;
   }
 
   void step_sequencing() {
@@ -280,7 +274,7 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
   m->description = describe_robot(profile, plugins, knowledge_inputs(m->tasks), d);
 
   // Processes: nets, parameters and their own recovery rules.
-  if (plugins.register_process_types) plugins.register_process_types(m->processes);
+  m->processes = ProcessRegistry(plugins.processes);
   auto load = m->options.load_net;
   if (!load) {
     load = [&](const std::filesystem::path& f) {

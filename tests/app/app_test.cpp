@@ -10,8 +10,8 @@
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
-#include "tripodal/app/cleaning_run.hpp"
-#include "tripodal/app/png.hpp"
+#include "run_task.hpp"
+#include "png.hpp"
 #include "tripodal/core/diagnostic.hpp"
 
 using namespace tripodal;

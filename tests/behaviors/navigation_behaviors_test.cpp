@@ -107,14 +107,17 @@ struct Bench {
   }
 };
 
-double distance(const Pose2D& a, const Pose2D& b) { return std::hypot(a.x_m - b.x_m, a.y_m - b.y_m); }
+double distance(const Pose2D& a, const Pose2D& b) {
+  return std::hypot(a.x_m - b.x_m, a.y_m - b.y_m);
+}
 
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
 // PathTracker
 
-TEST_CASE("PathTracker takes a path up at an arc length and its progress never goes back", "[behaviors][navigation]") {
+TEST_CASE("PathTracker takes a path up at an arc length and its progress never goes back",
+          "[behaviors][navigation]") {
   PathTracker t;
   t.reserve(16);
   const std::vector<Pose2D> line{{0, 0, 0}, {2, 0, 0}, {4, 0, 0}};
@@ -192,8 +195,10 @@ TEST_CASE("A path-following behavior takes up each new path_id at path_start_m a
   CHECK(b.tracker().points().front().x_m == 0.6);
 }
 
-TEST_CASE("A path-following behavior fails with the reason the sequencing layer gives, or 'no path' after the timeout",
-          "[behaviors][navigation]") {
+TEST_CASE(
+    "A path-following behavior fails with the reason the sequencing layer gives, or 'no path' after the "
+    "timeout",
+    "[behaviors][navigation]") {
   Bench bench(false);
   BhAutoMove b;
   b.activate(params({{"goal", "kitchen"}}), bench.ctx);
@@ -213,8 +218,10 @@ TEST_CASE("A path-following behavior fails with the reason the sequencing layer 
   CHECK(distance(bench.navi.map_from_base, {0.6, 2.0, 0.0}) == 0.0);  // it stood still meanwhile
 }
 
-TEST_CASE("A path-following behavior stops before an obstacle the map does not hold, reports it blocked, fails when blocked too long",
-          "[behaviors][navigation]") {
+TEST_CASE(
+    "A path-following behavior stops before an obstacle the map does not hold, reports it blocked, fails "
+    "when blocked too long",
+    "[behaviors][navigation]") {
   for (const bool omni : {true, false}) {
     INFO((omni ? "omni" : "differential"));
     Bench bench(omni);
@@ -237,7 +244,8 @@ TEST_CASE("A path-following behavior stops before an obstacle the map does not h
   }
 }
 
-TEST_CASE("A path-following behavior is not stopped by laser returns of what the map holds", "[behaviors][navigation]") {
+TEST_CASE("A path-following behavior is not stopped by laser returns of what the map holds",
+          "[behaviors][navigation]") {
   Bench bench(true);
   WallBeyondOneMetre map;
   bench.navi.map = &map;
@@ -252,8 +260,10 @@ TEST_CASE("A path-following behavior is not stopped by laser returns of what the
   CHECK(t < 3.0);
 }
 
-TEST_CASE("BhAutoMove drives to the end of a final path and succeeds: an omni base keeps its heading, a differential one steers",
-          "[behaviors][navigation]") {
+TEST_CASE(
+    "BhAutoMove drives to the end of a final path and succeeds: an omni base keeps its heading, a "
+    "differential one steers",
+    "[behaviors][navigation]") {
   const std::vector<Pose2D> around{{0.6, 2.0, 0}, {2.0, 0.6, 0}, {4.0, 0.6, 0}, {5.4, 2.0, 0}};
   for (const bool omni : {true, false}) {
     INFO((omni ? "omni" : "differential"));
@@ -318,21 +328,26 @@ TEST_CASE("The path-following behaviors pause while the robot is not localized",
   CHECK(cmd->vx_m_s > 0.0);
 }
 
-TEST_CASE("Navigation behaviors refuse what they cannot do, with located parameter errors", "[behaviors][navigation]") {
+TEST_CASE("Navigation behaviors refuse what they cannot do, with located parameter errors",
+          "[behaviors][navigation]") {
   Bench bench(false);
   BhCleaning omni_only;
   omni_only.activate(params({{"section", "A"}}), bench.ctx);
   CHECK(omni_only.status() == BehaviorStatus::failed);
   CHECK(omni_only.failure_reason() == "BhCleaning needs an omni-directional base");
   BhAutoMove b;
-  REQUIRE_THROWS_WITH(b.activate(params({{"goal", "door"}, {"max_speed_m_s", "-1"}}), bench.ctx, SourceLocation{"PrAutoMove.xml", 9, 5}),
+  REQUIRE_THROWS_WITH(b.activate(params({{"goal", "door"}, {"max_speed_m_s", "-1"}}), bench.ctx,
+                                 SourceLocation{"PrAutoMove.xml", 9, 5}),
                       Catch::Contains("PrAutoMove.xml:9:5: error: BhAutoMove: parameter 'max_speed_m_s'"));
   BhCleaningTwoWheel c;
-  REQUIRE_THROWS_WITH(c.activate(params({{"section", "A"}, {"speed", "1"}}), bench.ctx, SourceLocation{"PrCleaning.xml", 20, 6}),
-                      Catch::Contains("PrCleaning.xml:20:6: error: BhCleaningTwoWheel: unknown parameter 'speed'"));
+  REQUIRE_THROWS_WITH(
+      c.activate(params({{"section", "A"}, {"speed", "1"}}), bench.ctx,
+                 SourceLocation{"PrCleaning.xml", 20, 6}),
+      Catch::Contains("PrCleaning.xml:20:6: error: BhCleaningTwoWheel: unknown parameter 'speed'"));
 }
 
-TEST_CASE("BhGlobalLocalization turns until the localizer accepts a fix, or gives up after timeout_s", "[behaviors][navigation]") {
+TEST_CASE("BhGlobalLocalization turns until the localizer accepts a fix, or gives up after timeout_s",
+          "[behaviors][navigation]") {
   Bench bench(true, {1.0, 1.0, 0.0});
   bench.navi.fixes = 3;  // fixes of earlier searches do not count
   BhGlobalLocalization b;
@@ -353,10 +368,13 @@ TEST_CASE("BhGlobalLocalization turns until the localizer accepts a fix, or give
 TEST_CASE("register_navigation_behaviors registers the four behaviors by name", "[behaviors][navigation]") {
   BehaviorRegistry reg;
   register_navigation_behaviors(reg);
-  CHECK(reg.names() == std::vector<std::string>{"BhAutoMove", "BhCleaning", "BhCleaningTwoWheel", "BhGlobalLocalization"});
+  CHECK(reg.names() ==
+        std::vector<std::string>{"BhAutoMove", "BhCleaning", "BhCleaningTwoWheel", "BhGlobalLocalization"});
   for (const auto& n : reg.names()) {
     auto b = reg.create(n);
     CHECK(b->name() == n);
     for (const auto& p : b->manifest().parameters) CHECK_FALSE(p.description.empty());
   }
+  REQUIRE_THROWS_WITH(reg.create("BhClean"), Catch::Contains("unknown behavior type 'BhClean'; known: BhAutoMove, BhCleaning, "
+                                                             "BhCleaningTwoWheel, BhGlobalLocalization; did you mean 'BhCleaning'?"));
 }

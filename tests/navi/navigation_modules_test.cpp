@@ -3,8 +3,6 @@
 // paths, replanning, goal names, coverage resume), then a whole small robot on the simulator, its
 // process supervisor running a one-place net that binds the behavior under test, with the modules
 // planning, replanning and recording in closed loop.
-#include "tripodal/navi/planning_modules.hpp"
-
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
@@ -18,6 +16,7 @@
 #include "navi_test_util.hpp"
 #include "tripodal/behaviors/navigation_behaviors.hpp"
 #include "tripodal/navi/localizer.hpp"
+#include "tripodal/navi/planning_modules.hpp"
 #include "tripodal/navi/section_splitter.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
@@ -107,7 +106,9 @@ struct Modules final : public ModuleDirectory {
     for (CModule* m : all()) m->start(c);
     navigation.localized = true;
   }
-  [[nodiscard]] std::vector<CModule*> all() const override { return {maps.get(), splitter.get(), coverage.get(), planner.get()}; }
+  [[nodiscard]] std::vector<CModule*> all() const override {
+    return {maps.get(), splitter.get(), coverage.get(), planner.get()};
+  }
   ModuleContext context(Time now, const NavigationFeedback& feedback = {}) {
     ModuleContext c;
     c.now = now;
@@ -150,37 +151,50 @@ struct Task {
 };
 
 std::string task_net(const std::string& id, const Task& t) {
-  std::string params;
-  for (const auto& [k, v] : t.params) params += "      <param name=\"" + k + "\" value=\"" + v + "\"/>\n";
-  return "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-         "<net id=\"" + id + "\" level=\"low\" version=\"1\" description=\"one behavior\">\n"
-         "  <place id=\"P0\" tokens=\"1\"/>\n"
-         "  <place id=\"P1\">\n    <behavior name=\"" + t.behavior + "\">\n" + params + "    </behavior>\n  </place>\n"
-         "  <place id=\"P2\" outcome=\"success\"/>\n"
-         "  <transition id=\"t0\"/>\n"
-         "  <transition id=\"t1\" event=\"" + t.behavior + ".done\"/>\n"
-         "  <arc source=\"P0\" target=\"t0\"/>\n  <arc source=\"t0\" target=\"P1\"/>\n"
-         "  <arc source=\"P1\" target=\"t1\"/>\n  <arc source=\"t1\" target=\"P2\"/>\n"
-         "</net>\n";
+  std::string xml = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+  xml += "<net id=\"" + id + "\" level=\"low\" version=\"1\" description=\"one behavior\">\n";
+  xml += "  <place id=\"P0\" tokens=\"1\"/>\n";
+  xml += "  <place id=\"P1\">\n";
+  xml += "    <behavior name=\"" + t.behavior + "\">\n";
+  for (const auto& [k, v] : t.params) xml += "      <param name=\"" + k + "\" value=\"" + v + "\"/>\n";
+  xml += "    </behavior>\n";
+  xml += "  </place>\n";
+  xml += "  <place id=\"P2\" outcome=\"success\"/>\n";
+  xml += "  <transition id=\"t0\"/>\n";
+  xml += "  <transition id=\"t1\" event=\"" + t.behavior + ".done\"/>\n";
+  xml += "  <arc source=\"P0\" target=\"t0\"/>\n";
+  xml += "  <arc source=\"t0\" target=\"P1\"/>\n";
+  xml += "  <arc source=\"P1\" target=\"t1\"/>\n";
+  xml += "  <arc source=\"t1\" target=\"P2\"/>\n";
+  return xml + "</net>\n";
 }
 
-// `localizer`: more parameters of the Localizer (", faults: 0-5").
-// The nets of the tasks are `folder`/task<i>.xml.
-std::string profile(bool omni, const std::string& localizer, const std::filesystem::path& folder, std::size_t tasks) {
-  std::string y = "robot: {name: navtest}\nhardware: {type: sim}\ncontrollers:\n";
-  y += omni ? "  - {name: base, type: omni, parameters: {config: ../reactive/psr_omni.yaml}}\n"
-            : "  - {name: base, type: differential, parameters: {config: ../reactive/jinny_differential.yaml}}\n";
-  y += "loops:\n  - {name: motion, period_s: 0.01, controller: base}\n"
-       "navigation:\n"
-       "  - {name: maps, type: GridMaps, parameters: {robot_radius_m: 0.25}}\n"
-       "  - {name: localizer, type: Localizer, parameters: {noise_xy_m: 0, noise_theta_rad: 0" + localizer + "}}\n"
-       "  - {name: section_splitter, type: SectionSplitter}\n"
-       "  - {name: path_planner, type: PathPlanner}\n"
-       "  - {name: coverage, type: CoveragePlanner, parameters: {cleaning_width_m: 0.45}}\n"
-       "behaviors: [BhAutoMove, BhCleaning, BhCleaningTwoWheel, BhGlobalLocalization]\n";
+// `localizer`: more parameters of the Localizer (", faults: 0-5"). The nets of the tasks are
+// `folder`/task<i>.xml.
+std::string profile(bool omni, const std::string& localizer, const std::filesystem::path& folder,
+                    std::size_t tasks) {
+  std::string y = "robot: {name: navtest}\n";
+  y += "hardware: {type: sim}\n";
+  y += "controllers:\n";
+  if (omni) {
+    y += "  - {name: base, type: omni, parameters: {config: ../reactive/psr_omni.yaml}}\n";
+  } else {
+    y += "  - {name: base, type: differential, parameters: {config: ../reactive/jinny_differential.yaml}}\n";
+  }
+  y += "loops:\n";
+  y += "  - {name: motion, period_s: 0.01, controller: base}\n";
+  y += "navigation:\n";
+  y += "  - {name: maps, type: GridMaps, parameters: {robot_radius_m: 0.25}}\n";
+  y += "  - {name: localizer, type: Localizer, parameters: {noise_xy_m: 0, noise_theta_rad: 0" + localizer +
+       "}}\n";
+  y += "  - {name: section_splitter, type: SectionSplitter}\n";
+  y += "  - {name: path_planner, type: PathPlanner}\n";
+  y += "  - {name: coverage, type: CoveragePlanner, parameters: {cleaning_width_m: 0.45}}\n";
+  y += "behaviors: [BhAutoMove, BhCleaning, BhCleaningTwoWheel, BhGlobalLocalization]\n";
   if (tasks > 0) y += "processes:\n";
   for (std::size_t i = 0; i < tasks; ++i) {
-    y += "  - {name: task" + std::to_string(i) + ", net: " + (folder / ("task" + std::to_string(i) + ".xml")).string() + "}\n";
+    const std::string id = "task" + std::to_string(i);
+    y += "  - {name: " + id + ", net: " + (folder / (id + ".xml")).string() + "}\n";
   }
   return y;
 }
@@ -188,7 +202,7 @@ std::string profile(bool omni, const std::string& localizer, const std::filesyst
 struct RunOutcome {
   bool finished = false;  ///< the process ended within the time given
   bool success = false;
-  std::string message;    ///< the fault message
+  std::string message;  ///< the fault message
   double duration_s = 0.0;
 };
 
@@ -201,12 +215,10 @@ class NavRobot {
       const std::string id = "task" + std::to_string(i);
       navi::test::write_file(nets_ / (id + ".xml"), task_net(id, tasks_[i]));
     }
-    robot_ = Robot::assemble(
-        // Named as if it were a file of configs/robots: the controllers' `config` files resolve
-        // against the profile's own folder, not base_dir.
-        load_robot_profile_from_string(profile(omni, localizer, nets_.path(), tasks_.size()), (kRobots / "navtest.yaml").string(),
-                                       kRobots),
-        plugins_, clock_);
+    robot_ =
+        Robot::assemble(load_robot_profile_from_string(profile(omni, localizer, nets_.path(), tasks_.size()),
+                                                       "navtest.yaml", kRobots),
+                        plugins_, clock_);
     for (std::size_t i = 0; i < w.grid.size(); ++i) {
       if (w.grid.is_occupied(w.grid.cell(i))) wall_cells_.push_back(w.grid.cell_center(w.grid.cell(i)));
     }
@@ -229,8 +241,9 @@ class NavRobot {
     }
     RunOutcome out;
     out.duration_s = to_seconds(clock_.now() - start);
-    UNSCOPED_INFO("run " << last_run_ << ": " << out.duration_s << " s, at (" << sim().pose().x_m << ", " << sim().pose().y_m << ", "
-                         << sim().pose().theta_rad << "), " << sim().collisions() << " collisions");
+    UNSCOPED_INFO("run " << last_run_ << ": " << out.duration_s << " s, at (" << sim().pose().x_m << ", "
+                         << sim().pose().y_m << ", " << sim().pose().theta_rad << "), " << sim().collisions()
+                         << " collisions");
     for (const ProcessResult& r : robot_->supervisor().take_results()) {
       if (r.run != last_run_) continue;
       out.finished = true;
@@ -249,8 +262,12 @@ class NavRobot {
   }
 
   [[nodiscard]] Robot& robot() { return *robot_; }
-  [[nodiscard]] sim::Simulator& sim() { return dynamic_cast<sim::SimHardware&>(*robot_->hardware()).simulator(); }
-  [[nodiscard]] navi::CPathPlanningModule& path_planner() { return *robot_->module<navi::CPathPlanningModule>(); }
+  [[nodiscard]] sim::Simulator& sim() {
+    return dynamic_cast<sim::SimHardware&>(*robot_->hardware()).simulator();
+  }
+  [[nodiscard]] navi::CPathPlanningModule& path_planner() {
+    return *robot_->module<navi::CPathPlanningModule>();
+  }
   [[nodiscard]] navi::CCoverageModule& coverage() { return *robot_->module<navi::CCoverageModule>(); }
   [[nodiscard]] const navi::Section& section(std::string_view name) {
     const navi::Section* s = robot_->module<navi::CSectionSplitter>()->section(name);
@@ -286,7 +303,8 @@ class NavRobot {
   [[nodiscard]] double clearance(const std::vector<Point2D>& cells) const {
     double best = 1e9;
     for (std::size_t k = 0; k < trajectory_.size(); k += 5) {
-      for (const Point2D& c : cells) best = std::min(best, std::hypot(c.x_m - trajectory_[k].x_m, c.y_m - trajectory_[k].y_m));
+      for (const Point2D& c : cells)
+        best = std::min(best, std::hypot(c.x_m - trajectory_[k].x_m, c.y_m - trajectory_[k].y_m));
     }
     return best;
   }
@@ -303,17 +321,20 @@ class NavRobot {
   double max_turn_rate_ = 0.0;
 };
 
-const Pose2D kWest{0.6, 2.0, 0.0};  // start of the moves to the door, across the room
+const Pose2D kWest{0.6, 2.0, 0.0};    // start of the moves to the door, across the room
 const Pose2D kCorner{0.3, 0.3, 0.0};  // start of the cleanings
 
-double distance(const Pose2D& a, Point2D b) { return std::hypot(a.x_m - b.x_m, a.y_m - b.y_m); }
+double distance(const Pose2D& a, Point2D b) {
+  return std::hypot(a.x_m - b.x_m, a.y_m - b.y_m);
+}
 
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
 // The pieces
 
-TEST_CASE("PublishedPath publishes under new ids, fails, and withdraws only what is still its own", "[navi][modules]") {
+TEST_CASE("PublishedPath publishes under new ids, fails, and withdraws only what is still its own",
+          "[navi][modules]") {
   NavigationData navigation;
   std::uint32_t ids = 0;
   ModuleContext c;
@@ -355,12 +376,14 @@ TEST_CASE("PublishedPath publishes under new ids, fails, and withdraws only what
   CHECK(navigation.path_failure.empty());
 }
 
-TEST_CASE("ObstacleReplanner is due replan_after_s into a blockage, then every replan_after_s, max_replans times",
-          "[navi][modules]") {
+TEST_CASE(
+    "ObstacleReplanner is due replan_after_s into a blockage, then every replan_after_s, max_replans times",
+    "[navi][modules]") {
   Modules m(6.0, 4.0, false);
   const auto params = [](double after_s, double max) {
-    return ParameterSet::resolve(BhAutoMove::static_manifest(),
-                                 {{"goal", Value{std::string("door")}}, {"replan_after_s", Value{after_s}}, {"max_replans", Value{max}}});
+    return ParameterSet::resolve(BhAutoMove::static_manifest(), {{"goal", Value{std::string("door")}},
+                                                                 {"replan_after_s", Value{after_s}},
+                                                                 {"max_replans", Value{max}}});
   };
   navi::ObstacleReplanner r;
   r.reset(params(2.0, 2.0));
@@ -410,7 +433,8 @@ TEST_CASE("ObstacleReplanner is due replan_after_s into a blockage, then every r
   CHECK_FALSE(r.due(fb, from_seconds(100.0)));
 }
 
-TEST_CASE("The path planner resolves goal names: <section>.entry, a node, a room, a section", "[navi][modules]") {
+TEST_CASE("The path planner resolves goal names: <section>.entry, a node, a room, a section",
+          "[navi][modules]") {
   Modules m(6.0, 4.0, true);
   const navi::Section* a = m.splitter->section("A");
   REQUIRE(a != nullptr);
@@ -535,12 +559,14 @@ TEST_CASE("The coverage planner resumes a section where its coverage stopped, an
 // ---------------------------------------------------------------------------------------------
 // A whole robot: the modules plan, the behaviors track, the simulator moves the body.
 
-TEST_CASE("BhAutoMove reaches a named goal around a pillar on the path the planner gives, omni and differential",
-          "[navi][modules][robot]") {
+TEST_CASE(
+    "BhAutoMove reaches a named goal around a pillar on the path the planner gives, omni and differential",
+    "[navi][modules][robot]") {
   for (const bool omni : {true, false}) {
     INFO((omni ? "omni" : "differential"));
     // Stopped for 2 s by the laser returns of the walls and the pillar, it would fail.
-    NavRobot r(omni, world(6.0, 4.0, true, kWest), {{"BhAutoMove", {{"goal", "door"}, {"blocked_timeout_s", "2"}}}});
+    NavRobot r(omni, world(6.0, 4.0, true, kWest),
+               {{"BhAutoMove", {{"goal", "door"}, {"blocked_timeout_s", "2"}}}});
     const RunOutcome o = r.run(0, 120.0);
     CHECK(o.success);
     CHECK(r.path_planner().path().points().size() >= 3);  // around the pillar
@@ -554,12 +580,15 @@ TEST_CASE("BhAutoMove reaches a named goal around a pillar on the path the plann
   }
 }
 
-TEST_CASE("BhAutoMove fails with the planner's reason for an unknown or unreachable goal, a cleaning for an unknown section",
-          "[navi][modules][robot]") {
+TEST_CASE(
+    "BhAutoMove fails with the planner's reason for an unknown or unreachable goal, a cleaning for an "
+    "unknown section",
+    "[navi][modules][robot]") {
   sim::World w = world(6.0, 4.0, true, kWest);
   w.regions.nodes.push_back(navi::MapNode{"inside_pillar", Pose2D{3.0, 2.0, 0.0}, "", {}});
   NavRobot r(false, w,
-             {{"BhAutoMove", {{"goal", "kitchen"}}}, {"BhAutoMove", {{"goal", "inside_pillar"}}},
+             {{"BhAutoMove", {{"goal", "kitchen"}}},
+              {"BhAutoMove", {{"goal", "inside_pillar"}}},
               {"BhCleaningTwoWheel", {{"section", "Q"}}}});
   RunOutcome o = r.run(0, 5.0);
   CHECK(o.finished);
@@ -572,8 +601,9 @@ TEST_CASE("BhAutoMove fails with the planner's reason for an unknown or unreacha
   CHECK(distance(r.sim().pose(), {kWest.x_m, kWest.y_m}) < 0.01);  // it never moved
 }
 
-TEST_CASE("BhAutoMove stops before a box the map does not hold and, not replanning, fails when blocked too long",
-          "[navi][modules][robot]") {
+TEST_CASE(
+    "BhAutoMove stops before a box the map does not hold and, not replanning, fails when blocked too long",
+    "[navi][modules][robot]") {
   // Wall to wall across the room: no way around it.
   NavRobot r(true, world(6.0, 4.0, false, kWest, {{2.75, 0.0, 3.25, 4.0, {}}}),
              {{"BhAutoMove", {{"goal", "door"}, {"blocked_timeout_s", "3"}, {"replan_after_s", "0"}}}});
@@ -587,7 +617,8 @@ TEST_CASE("BhAutoMove stops before a box the map does not hold and, not replanni
   CHECK(r.sim().collisions() == 0);
 }
 
-TEST_CASE("The path planner replans around a box the map does not hold, omni and differential", "[navi][modules][robot]") {
+TEST_CASE("The path planner replans around a box the map does not hold, omni and differential",
+          "[navi][modules][robot]") {
   for (const bool omni : {true, false}) {
     INFO((omni ? "omni" : "differential"));
     NavRobot r(omni, world(6.0, 4.0, false, kWest, {{2.75, 1.5, 3.25, 2.5, {}}}),  // across the straight line
@@ -607,8 +638,10 @@ TEST_CASE("The path planner replans around a box the map does not hold, omni and
   }
 }
 
-TEST_CASE("With no way around, BhAutoMove waits for blocked_timeout_s while the planner retries, or goes on when the way clears",
-          "[navi][modules][robot]") {
+TEST_CASE(
+    "With no way around, BhAutoMove waits for blocked_timeout_s while the planner retries, or goes on when "
+    "the way clears",
+    "[navi][modules][robot]") {
   const Task task{"BhAutoMove", {{"goal", "door"}, {"blocked_timeout_s", "6"}, {"replan_after_s", "1"}}};
   {
     NavRobot r(true, world(6.0, 4.0, false, kWest, {{2.75, 0.0, 3.25, 4.0, {}}}), {task});
@@ -633,7 +666,8 @@ TEST_CASE("With no way around, BhAutoMove waits for blocked_timeout_s while the 
   CHECK(distance(r.sim().pose(), {5.4, 2.0}) <= 0.1);
 }
 
-TEST_CASE("BhAutoMove pauses while the localizer is lost and goes on when it agrees again", "[navi][modules][robot]") {
+TEST_CASE("BhAutoMove pauses while the localizer is lost and goes on when it agrees again",
+          "[navi][modules][robot]") {
   NavRobot r(false, world(6.0, 4.0, false, kWest), {{"BhAutoMove", {{"goal", "door"}}}},
              ", faults: 2-5, recover_at_fault_end: true");
   Pose2D at_2_5, at_4_9;
@@ -642,7 +676,7 @@ TEST_CASE("BhAutoMove pauses while the localizer is lost and goes on when it agr
     if (std::abs(r.now_s() - 4.9) < 0.005) at_4_9 = r.sim().pose();
   });
   CHECK(o.success);
-  CHECK(at_2_5.x_m > kWest.x_m + 0.3);  // it was on its way
+  CHECK(at_2_5.x_m > kWest.x_m + 0.3);                        // it was on its way
   CHECK(distance(at_4_9, {at_2_5.x_m, at_2_5.y_m}) < 0.005);  // stood still while lost
   CHECK(distance(r.sim().pose(), {5.4, 2.0}) <= 0.1);
 }
@@ -677,7 +711,8 @@ TEST_CASE("BhCleaning covers a section with the balloon path on the omni base, k
   CHECK(o.duration_s < 300.0);
 }
 
-TEST_CASE("BhCleaningTwoWheel covers the section on the differential base", "[navi][modules][robot][cleaning]") {
+TEST_CASE("BhCleaningTwoWheel covers the section on the differential base",
+          "[navi][modules][robot][cleaning]") {
   NavRobot r(false, world(5.0, 4.0, true, kCorner), {{"BhCleaningTwoWheel", {{"section", "A"}}}});
   const RunOutcome o = r.run(0, 900.0);
   CHECK(o.success);
@@ -686,15 +721,25 @@ TEST_CASE("BhCleaningTwoWheel covers the section on the differential base", "[na
   CHECK(r.sim().collisions() == 0);
 }
 
-TEST_CASE("The coverage planner detours a cleaning around a box the map does not hold; without replanning it is blocked",
-          "[navi][modules][robot][cleaning]") {
+TEST_CASE(
+    "The coverage planner detours a cleaning around a box the map does not hold; without replanning it is "
+    "blocked",
+    "[navi][modules][robot][cleaning]") {
   const Box box{2.2, 0.05, 2.8, 0.6, {}};  // against the bottom wall, on the first rounds
   for (const bool omni : {true, false}) {
     INFO((omni ? "omni" : "differential"));
-    NavRobot r(omni, world(5.0, 4.0, false, kCorner, {box}),
-               {{omni ? "BhCleaning" : "BhCleaningTwoWheel", {{"section", "A"}, {"blocked_timeout_s", "20"}}}});
-    const RunOutcome o = r.run(0, 900.0);
+    NavRobot r(
+        omni, world(5.0, 4.0, false, kCorner, {box}),
+        {{omni ? "BhCleaning" : "BhCleaningTwoWheel", {{"section", "A"}, {"blocked_timeout_s", "20"}}}});
+    int detours = 0;  // paths published whose end is not the behavior's goal
+    std::uint32_t last_id = 0;
+    const RunOutcome o = r.run(0, 900.0, [&] {
+      const NavigationData& n = r.robot().navigation();
+      if (n.path_id != last_id && n.path_id != 0 && !n.path_final) ++detours;
+      last_id = n.path_id;
+    });
     CHECK(o.success);
+    CHECK(detours >= 1);
     CHECK(r.box_clearance() >= kRadius_m);
     CHECK(r.sim().collisions() == 0);
     // What the box hides is lost, the rest of the section is cleaned (the box and the ring
@@ -730,7 +775,8 @@ TEST_CASE("A cleaning interrupted and activated again resumes where it stopped; 
 
   std::optional<double> taken_up_at_m;
   const RunOutcome second = r.run(0, 600.0, [&] {
-    if (!taken_up_at_m && r.robot().navigation().path_id != 0) taken_up_at_m = r.robot().navigation().path_start_m;
+    if (!taken_up_at_m && r.robot().navigation().path_id != 0)
+      taken_up_at_m = r.robot().navigation().path_start_m;
   });
   CHECK(taken_up_at_m == done);
   CHECK(second.success);
@@ -744,7 +790,8 @@ TEST_CASE("BhGlobalLocalization turns while the localizer attempts fixes, until 
   {
     // Lost from the start; fixes are refused while the fault lasts (5 s). Attempts every 2 s of
     // the activation: at 2 and 4 s they fail, at 6 s one is accepted.
-    NavRobot r(true, world(5.0, 4.0, false, {1.0, 1.0, 0.0}), {{"BhGlobalLocalization", {}}}, ", faults: 0-5");
+    NavRobot r(true, world(5.0, 4.0, false, {1.0, 1.0, 0.0}), {{"BhGlobalLocalization", {}}},
+               ", faults: 0-5");
     CHECK_FALSE(r.robot().navigation().localized);
     const RunOutcome o = r.run(0, 60.0);
     CHECK(o.success);

@@ -2,7 +2,6 @@
 // held and applied together (hold_changes / release_changes, ChangeBatch), the feedback flowing
 // back meanwhile, and the navigation data's path copied into the loop only when its path_id is new.
 #include <catch2/catch.hpp>
-
 #include <vector>
 
 #include "tripodal/reactive/control_loop.hpp"
@@ -25,10 +24,16 @@ struct Seen {
 // end_after_cycles, reports the end of the path then and succeeds.
 class BhRecordNavigation final : public CBehavior {
  public:
-  explicit BhRecordNavigation(Seen& seen, int end_after_cycles = 0) : seen_(seen), end_after_(end_after_cycles) {}
+  explicit BhRecordNavigation(Seen& seen, int end_after_cycles = 0)
+      : seen_(seen), end_after_(end_after_cycles) {}
   static const ModuleManifest& static_manifest() {
-    static const ModuleManifest m{"BhRecordNavigation", Layer::reactive, ModuleKind::behavior, "records the navigation data",
-                                  {"path"}, {"behavior_command"}, {}};
+    static const ModuleManifest m{"BhRecordNavigation",
+                                  Layer::reactive,
+                                  ModuleKind::behavior,
+                                  "records the navigation data",
+                                  {"path"},
+                                  {"behavior_command"},
+                                  {}};
     return m;
   }
 
@@ -84,8 +89,10 @@ NavigationData with_path(const std::vector<Pose2D>& path, std::uint32_t id) {
 
 }  // namespace
 
-TEST_CASE("Changes made while held reach the loop together at release: a behavior never starts with the previous path",
-          "[reactive][loop]") {
+TEST_CASE(
+    "Changes made while held reach the loop together at release: a behavior never starts with the previous "
+    "path",
+    "[reactive][loop]") {
   Loop l;
   Seen seen;
   const std::vector<Pose2D> old_path{{0, 0, 0}, {1, 0, 0}};

@@ -11,7 +11,7 @@
 #include <sstream>
 
 #include "cli_tool.hpp"
-#include "tripodal/app/cleaning_run.hpp"
+#include "run_task.hpp"
 #include "tripodal/core/diagnostic.hpp"
 
 #include <spdlog/spdlog.h>

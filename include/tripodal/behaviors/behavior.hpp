@@ -12,6 +12,7 @@
 #include <string>
 #include <string_view>
 
+#include "tripodal/controllers/base_capabilities.hpp"
 #include "tripodal/core/manifest.hpp"
 #include "tripodal/core/time.hpp"
 #include "tripodal/resources/readings.hpp"
@@ -65,16 +66,6 @@ struct NavigationFeedback {
   bool blocked = false;       ///< stopped by an obstacle the map does not hold, or a bumper
   Time blocked_since{0};
   friend bool operator==(const NavigationFeedback&, const NavigationFeedback&) = default;
-};
-
-/// Per-axis velocity limits of the base in the body frame (all >= 0). A base that cannot move
-/// sideways (differential drive) has max_vy_m_s == 0: behaviors read this to steer by heading, so
-/// the same behavior code drives holonomic and differential bases.
-struct BaseCapabilities {
-  double max_vx_m_s = std::numeric_limits<double>::infinity();
-  double max_vy_m_s = std::numeric_limits<double>::infinity();
-  double max_wz_rad_s = std::numeric_limits<double>::infinity();
-  [[nodiscard]] bool holonomic() const noexcept { return max_vy_m_s > 0.0; }
 };
 
 /// A per-axis velocity envelope [lo, hi] a safety behavior imposes (see CBehaviorCoordinator's

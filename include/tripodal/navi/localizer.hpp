@@ -104,7 +104,8 @@ class CLocalizer final : public CNaviModules {
   std::optional<Pose2D> estimate_;
   Time stamp_{0};
   double error_m_ = 0.0;
-  // Global localization while BhGlobalLocalization is active.
+  // Global localization while the behavior it serves (BhGlobalLocalization) is active.
+  std::string serves_ = "BhGlobalLocalization";
   bool searching_ = false;
   Duration attempt_period_{0};
   Time last_attempt_{0};

@@ -11,10 +11,10 @@
 
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/core/engine.hpp"
+#include "tripodal/core/manifest.hpp"
 #include "tripodal/core/petri_net.hpp"
 #include "tripodal/core/time.hpp"
-#include "tripodal/planner/plan.hpp"
-#include "tripodal/planner/recovery.hpp"
+#include "tripodal/processes/recovery_rule.hpp"
 
 namespace tripodal {
 
@@ -60,7 +60,14 @@ class CProcess {
   CProcess(const CProcess&) = delete;
   CProcess& operator=(const CProcess&) = delete;
 
+  /// The manifest of the "net" type: a process given entirely by configuration.
+  static const ModuleManifest& static_manifest();
+
   [[nodiscard]] const std::string& name() const noexcept { return definition_.name; }
+  /// This process as a module of the sequencing layer: its name, kind process, the parameters its
+  /// net declares (types, defaults, descriptions) and, in the description, the behaviors it binds.
+  /// Built at construction, so a derived process type has it the same way.
+  [[nodiscard]] const ModuleManifest& manifest() const noexcept { return manifest_; }
   [[nodiscard]] const std::string& type() const noexcept { return definition_.type; }
   [[nodiscard]] const PetriNet& net() const noexcept { return definition_.net; }
   [[nodiscard]] const std::vector<RecoveryRule>& recovery() const noexcept { return definition_.recovery; }
@@ -82,6 +89,7 @@ class CProcess {
 
  private:
   ProcessDefinition definition_;
+  ModuleManifest manifest_;
 };
 
 /// The parameters a behavior binding passes: literal values as strings, "$name" replaced by the

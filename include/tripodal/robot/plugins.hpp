@@ -31,8 +31,8 @@ struct RobotPlugins {
   ModuleRegistry modules{"module type"};
   ResourceRegistry resources{"resource type"};
   HardwareRegistry hardware{"hardware type"};
-  /// Application process types (CProcess subclasses), registered on the robot's ProcessRegistry.
-  std::function<void(ProcessRegistry&)> register_process_types;
+  /// Process types: "net" (a plain CProcess) and the application's CProcess subclasses.
+  ProcessTypeRegistry processes;
 
   /// The framework's own types: the built-in and navigation behaviors, the differential, omni and
   /// mecanum controllers, and the navigation modules (GridMaps, SectionSplitter, Localizer,

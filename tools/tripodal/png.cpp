@@ -1,4 +1,4 @@
-#include "tripodal/app/png.hpp"
+#include "png.hpp"
 
 #include <zlib.h>
 

@@ -1,4 +1,4 @@
-#include "tripodal/app/cleaning_run.hpp"
+#include "run_task.hpp"
 
 #include <algorithm>
 #include <array>
@@ -11,9 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <nlohmann/json.hpp>
-
-#include "tripodal/app/png.hpp"
+#include "run_outputs.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/navi/localizer.hpp"
@@ -48,115 +46,6 @@ PathFigures path_figures(const std::vector<Point2D>& path, double tolerance_m) {
 }
 
 namespace {
-
-// The robot's navigation modules, which the measures read.
-struct Navigation {
-  const navi::CGridMaps* maps = nullptr;
-  const navi::CSectionSplitter* splitter = nullptr;
-  navi::CCoverageModule* coverage = nullptr;
-};
-
-// ---------------------------------------------------------------------------------------------
-// Output
-
-std::string fixed(double v, int digits) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(digits) << v;
-  return s.str();
-}
-
-struct TrajectorySample {
-  Time t{0};
-  Pose2D truth;
-  Pose2D estimate;
-  bool localized = false;
-  bool cleaning = false;
-};
-
-void write_text(const std::filesystem::path& file, const std::string& text) {
-  std::ofstream f(file, std::ios::binary | std::ios::trunc);
-  if (!f || !f.write(text.data(), static_cast<std::streamsize>(text.size()))) throw std::runtime_error("cannot write " + file.string());
-}
-
-constexpr std::array<std::array<std::uint8_t, 3>, 8> kSectionColours{{
-    {{255, 236, 179}}, {{200, 230, 255}}, {{225, 210, 255}}, {{255, 215, 215}},
-    {{215, 245, 215}}, {{255, 225, 190}}, {{210, 240, 240}}, {{240, 240, 200}},
-}};
-
-// The map (2 pixels per cell): walls black, unknown grey, sections tinted, cleaned cells green,
-// cells the footprint could reach but did not clean red, virtual walls dashed red, the true path
-// dark blue, start and end markers.
-RgbImage draw_map(const Navigation& nav, const navi::CleanedCells& cleaned, const std::vector<char>& reachable,
-                  const std::vector<TrajectorySample>& traj) {
-  constexpr int kScale = 2;
-  const navi::OccupancyGrid& g = nav.maps->grid();
-  RgbImage img(g.width() * kScale, g.height() * kScale);
-  auto fill_cell = [&](navi::CellIndex c, std::array<std::uint8_t, 3> rgb, double alpha) {
-    for (int dy = 0; dy < kScale; ++dy) {
-      for (int dx = 0; dx < kScale; ++dx) {
-        img.blend(c.x * kScale + dx, (g.height() - 1 - c.y) * kScale + dy, rgb[0], rgb[1], rgb[2], alpha);
-      }
-    }
-  };
-  const auto& label = nav.splitter->sections().label;
-  for (std::size_t i = 0; i < g.size(); ++i) {
-    const navi::CellIndex c = g.cell(i);
-    switch (g.state(i)) {
-      case navi::Occupancy::occupied: fill_cell(c, {0, 0, 0}, 1.0); continue;
-      case navi::Occupancy::unknown: fill_cell(c, {170, 170, 170}, 1.0); continue;
-      case navi::Occupancy::free: break;
-    }
-    if (label[i] >= 0) fill_cell(c, kSectionColours[static_cast<std::size_t>(label[i]) % kSectionColours.size()], 1.0);
-    if (cleaned.cleaned(i)) fill_cell(c, {60, 170, 60}, 0.45);
-    else if (reachable[i] != 0) fill_cell(c, {230, 40, 40}, 0.6);
-  }
-  for (const int row : nav.splitter->sections().virtual_wall_rows) {
-    const int y = (g.height() - 1 - row) * kScale;  // the edge between rows row and row + 1
-    for (int x = 0; x < img.width; ++x) {
-      if ((x / 6) % 2 == 0) img.set(x, y, 220, 0, 0);
-    }
-  }
-  auto to_px = [&](Pose2D p, double& px, double& py) {
-    const Point2D gf = g.to_grid_frame({p.x_m, p.y_m});
-    px = gf.x_m / g.resolution_m() * kScale;
-    py = (g.height() - gf.y_m / g.resolution_m()) * kScale;
-  };
-  for (std::size_t k = 1; k < traj.size(); ++k) {
-    double x0, y0, x1, y1;
-    to_px(traj[k - 1].truth, x0, y0);
-    to_px(traj[k].truth, x1, y1);
-    const int n = std::max(1, static_cast<int>(std::ceil(std::hypot(x1 - x0, y1 - y0))));
-    for (int s = 0; s <= n; ++s) {
-      const double t = static_cast<double>(s) / n;
-      img.blend(static_cast<int>(std::floor(x0 + t * (x1 - x0))), static_cast<int>(std::floor(y0 + t * (y1 - y0))), 20, 40, 140, 0.85);
-    }
-  }
-  auto marker = [&](Pose2D p, std::array<std::uint8_t, 3> rgb) {
-    double px, py;
-    to_px(p, px, py);
-    for (int dy = -4; dy <= 4; ++dy) {
-      for (int dx = -4; dx <= 4; ++dx) {
-        if (dx * dx + dy * dy <= 16) img.set(static_cast<int>(px) + dx, static_cast<int>(py) + dy, rgb[0], rgb[1], rgb[2]);
-      }
-    }
-  };
-  if (!traj.empty()) {
-    marker(traj.front().truth, {0, 120, 255});
-    marker(traj.back().truth, {255, 140, 0});
-  }
-  return img;
-}
-
-std::string trajectory_csv(const std::vector<TrajectorySample>& traj) {
-  std::string out = "t_s,x_m,y_m,theta_rad,estimate_x_m,estimate_y_m,estimate_theta_rad,localized,cleaning\n";
-  char buf[256];
-  for (const TrajectorySample& s : traj) {
-    std::snprintf(buf, sizeof buf, "%.3f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d,%d\n", to_seconds(s.t), s.truth.x_m, s.truth.y_m,
-                  s.truth.theta_rad, s.estimate.x_m, s.estimate.y_m, s.estimate.theta_rad, s.localized ? 1 : 0, s.cleaning ? 1 : 0);
-    out += buf;
-  }
-  return out;
-}
 
 // The cells of the room a cleaning footprint can reach at all: within half the cleaning width of
 // a cell where the robot can stand (clearance >= its radius) connected to its start.
@@ -234,53 +123,6 @@ class ReportObserver final : public TaskObserver {
 
 }  // namespace
 
-std::string RunResult::json() const {
-  using Json = nlohmann::ordered_json;  // keys in the order written
-  // Figures rounded to what the report means (cm, 0.01 % coverage); a value that is not finite
-  // stays NaN or inf, which the writer turns into null.
-  const auto rounded = [](double v, int digits) {
-    const double scale = std::pow(10.0, digits);
-    return std::isfinite(v) ? std::round(v * scale) / scale : v;
-  };
-  const auto figures = [&](const PathFigures& f) {
-    return Json{{"length_m", rounded(f.length_m, 2)}, {"turns", f.turns}, {"rotation_rad", rounded(f.rotation_rad, 2)}};
-  };
-  const auto stats = [&](const navi::PathStats& st, double cov) {
-    return Json{{"length_m", rounded(st.length_m, 2)},
-                {"turns", st.turns},
-                {"total_turn_rad", rounded(st.total_turn_rad, 2)},
-                {"coverage", rounded(cov, 4)}};
-  };
-  Json section_list = Json::array();
-  for (const SectionFigures& sec : sections) {
-    section_list.push_back({{"name", sec.name},
-                            {"area_m2", rounded(sec.area_m2, 2)},
-                            {"balloon", stats(sec.balloon, sec.balloon_coverage)},
-                            {"boustrophedon", stats(sec.boustrophedon, sec.boustrophedon_coverage)}});
-  }
-  const Json report = {{"robot", robot},
-                       {"task", task},
-                       {"coverage_pattern", coverage_pattern},
-                       {"seed", seed},
-                       {"state", state},
-                       {"succeeded", succeeded},
-                       {"reason", reason},
-                       {"duration_s", rounded(duration_s, 2)},
-                       {"coverage", rounded(coverage, 4)},
-                       {"reachable_cells", reachable_cells},
-                       {"cleaned_reachable_cells", cleaned_cells},
-                       {"reachable_area_m2", rounded(reachable_area_m2, 2)},
-                       {"path", figures(total)},
-                       {"cleaning_path", figures(cleaning)},
-                       {"sections", std::move(section_list)},
-                       {"processes", processes},
-                       {"recoveries", recoveries},
-                       {"faults", faults},
-                       {"collisions", collisions},
-                       {"robot_steps", robot_steps}};
-  // Task text and names come from the user: bytes that are not UTF-8 are replaced, not thrown on.
-  return report.dump(2, ' ', false, Json::error_handler_t::replace) + '\n';
-}
 
 RunResult run_task(const RunOptions& o) {
   const RobotProfile profile = load_robot_profile(o.robot);
@@ -406,10 +248,8 @@ RunResult run_task(const RunOptions& o) {
   };
 
   std::size_t sim_events_noted = 0;
-  std::size_t sequencing_steps = 0;
   while (robot->planner().busy() && clock.now() < deadline) {
     robot->run_for(tick_period);
-    ++sequencing_steps;
     for (; sim_events_noted < sim.events().size(); ++sim_events_noted) {
       const sim::SimEvent& e = sim.events()[sim_events_noted];
       life.note(e.stamp, "simulator: " + std::string(sim::to_string(e.kind)) + (e.detail.empty() ? "" : " " + e.detail));
@@ -484,7 +324,6 @@ RunResult run_task(const RunOptions& o) {
     f.boustrophedon_coverage = p.coverage();
     res.sections.push_back(f);
   }
-  (void)sequencing_steps;
 
   if (!o.out.empty()) {
     std::filesystem::create_directories(o.out);

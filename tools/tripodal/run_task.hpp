@@ -3,7 +3,8 @@
 // the controller's hardware and the sensor source, the localizer's ground truth), gives it a task
 // in plain words and runs it to its end; then it measures the run (coverage of the reachable free
 // area, path length, turns, faults, recoveries) and writes the picture, trajectory and report.
-// Application layer: it sits above the deliberate layer, like a robot program's main().
+// Application layer: it sits above the deliberate layer, like a robot program's main(); part of
+// the `tripodal` tool (tools/tripodal), not of the installed library.
 #pragma once
 
 #include <cstdint>
