@@ -156,9 +156,7 @@ RobotHarness::RobotHarness(Mode mode, const RobotProfile& profile, RobotPlugins 
       throw std::invalid_argument("RobotHarness: the plugins already register a hardware type '" + std::string(kClosedLoopType) + "'");
     }
     plugins_.hardware.add(std::move(m), [w](const HardwareConfig& c) -> std::unique_ptr<CHardware> {
-      if (c.base == nullptr) throw ConfigError(c.where, "hardware 'sim' needs the robot's base controller (its wheel geometry)");
-      const double s = c.parameters.number("seed");
-      return std::make_unique<sim::SimHardware>(*w, *c.base, s < 0.0 ? w->seed : static_cast<std::uint64_t>(s));
+      return std::make_unique<sim::SimHardware>(c, w);  // "world" is not kept: the run is in w
     });
     p.hardware->type = std::string(kClosedLoopType);
     p.hardware->parameters = std::move(kept);
