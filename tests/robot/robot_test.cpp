@@ -73,6 +73,36 @@ TEST_CASE("PSR-2 assembles from its profile with the paper's nets", "[robot]") {
   CHECK(mods[0].inputs == std::vector<std::string>{"sections", "process_result"});
 }
 
+TEST_CASE("A resource type is built with the robot's hardware and reports its type's manifest", "[robot]") {
+  SimClock clock;
+  TestWorld world;
+  RobotPlugins plugins = test_plugins(world);
+  const CHardware* given = nullptr;
+  static const ModuleManifest bumper = [] {
+    ModuleManifest m = resource_manifest<BumperReading>();
+    m.name = "BumperBoard";
+    return m;
+  }();
+  plugins.resources.add(bumper, [&given](const ResourceConfig& c) {
+    given = c.hardware;
+    return std::make_unique<BumperResource>(c.name, Duration{0}, bumper);
+  });
+  RobotProfile profile = load_robot_profile(kProfile);
+  ModuleEntry entry;
+  entry.kind = ModuleKind::resource;
+  entry.name = "front_bumper";
+  entry.type = "BumperBoard";
+  profile.resources.push_back(entry);
+  const auto robot = Robot::assemble(profile, plugins, clock);
+  REQUIRE(robot->hardware() != nullptr);
+  CHECK(given == robot->hardware());
+  const auto* resource = robot->resources().find<BumperReading>("front_bumper");
+  REQUIRE(resource != nullptr);
+  CHECK(resource->manifest().name == "BumperBoard");
+  // Without a manifest of its own, a typed resource is the generic one of its reading kind.
+  CHECK(BumperResource("b").manifest().name == "BumperResource");
+}
+
 TEST_CASE("PSR-2 cleans a room of two sections: PrAutoMove and PrCleaning in order", "[robot]") {
   Psr2 p;
   REQUIRE(p.robot->command("clean the room 3211").accepted);
