@@ -89,6 +89,9 @@ void BoardFirmware::handle(const FrameView& frame) noexcept {
   // Figure 3-5: SYNC echoed unchanged, then synchronisation, TYPE, the command table.
   if (body.size() >= 2 && body[1] == static_cast<std::uint8_t>(Command::sync)) {
     if (!link_.write(frame.bytes)) return;
+    // A SYNC (re)starts the session: a master that synchronises again has lost track of the
+    // board, so the wheels stop until it drives them again.
+    stop_motors();
     if (!synchronised_) ++counters_.resyncs;
     synchronised_ = true;
     link_lost_ = false;
