@@ -114,7 +114,7 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
   // Drivers.
   std::recursive_mutex sequencing_mutex;  // the sequencing loop vs. command() from another thread
   std::vector<Time> next_reactive;
-  Time next_sequencing{0};
+  Time next_sequencing{};
   bool schedule_started = false;
   std::vector<std::unique_ptr<LoopRunner>> runners;
   std::thread sequencing_thread;

@@ -186,14 +186,14 @@ TEST_CASE("The retry limit makes the task fail with a report", "[planner]") {
   World w;
   REQUIRE(w.planner->command("clean room 3211").accepted);
   // A flaky localizer: lost again one second into every cleaning run.
-  Time cleaning_since{-1};
+  Time cleaning_since = time_from_ns(-1);
   w.run(200.0, [&](double) {
     const bool cleaning = w.behaviors.active("BhCleaning");
     if (!cleaning) {
-      cleaning_since = Time{-1};
+      cleaning_since = time_from_ns(-1);
       return;
     }
-    if (cleaning_since < Time{0}) cleaning_since = w.clock.now();
+    if (cleaning_since < Time{}) cleaning_since = w.clock.now();
     if (w.clock.now() - cleaning_since >= from_seconds(1.0)) w.localized = false;
   });
   REQUIRE(w.planner->state() == TaskState::failed);
@@ -319,7 +319,7 @@ TEST_CASE("Parallel stages: the plan changes only at a quiet point, when every b
   planner.add_observer(life);
   auto run = [&] {
     planner.step();
-    while (planner.busy() && clock.now() < from_seconds(60.0)) {
+    while (planner.busy() && clock.now() < time_from_seconds(60.0)) {
       clock.advance(from_seconds(0.1));
       behaviors.advance(clock.now(), from_seconds(0.1));
       planner.step();

@@ -29,8 +29,8 @@ class GroundTruthSource {
 
 /// A window of localization loss: from start (inclusive) to end (exclusive).
 struct LocalizationFault {
-  Time start{0};
-  Time end{0};
+  Time start{};
+  Time end{};
   friend bool operator==(const LocalizationFault&, const LocalizationFault&) = default;
 };
 
@@ -102,13 +102,13 @@ class CLocalizer final : public CNaviModules {
   bool corrupted_ = false;      // the estimate is off by offset_ until relocalized
   Pose2D offset_;
   std::optional<Pose2D> estimate_;
-  Time stamp_{0};
+  Time stamp_{};
   double error_m_ = 0.0;
   // Global localization while the behavior it serves (BhGlobalLocalization) is active.
   std::string serves_ = "BhGlobalLocalization";
   bool searching_ = false;
   Duration attempt_period_{0};
-  Time last_attempt_{0};
+  Time last_attempt_{};
   std::uint32_t fixes_ = 0;
 };
 

@@ -25,8 +25,8 @@ struct ProcessResult {
   bool success = false;
   std::string message;  ///< the fault message ("localization fault"); empty on success
   std::string place;    ///< the outcome place reached; empty when the fault did not come from the net
-  Time started{0};
-  Time finished{0};
+  Time started{};
+  Time finished{};
 };
 
 /// What configuration says about one process: its net, configured parameter values (text, typed
