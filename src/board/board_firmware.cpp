@@ -63,7 +63,7 @@ void BoardFirmware::tick() noexcept {
 void BoardFirmware::receive() noexcept {
   while (true) {
     // Deadline 0: the firmware's loop polls the UART, it never waits on it.
-    const std::ptrdiff_t n = link_.read(rx_, Time{0});
+    const std::ptrdiff_t n = link_.read(rx_, Time{});
     if (n <= 0) return;
     std::span<const std::uint8_t> in(rx_.data(), static_cast<std::size_t>(n));
     while (true) {

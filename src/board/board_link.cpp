@@ -73,7 +73,7 @@ bool BoardLink::send(Command cmd, std::span<const std::uint8_t> payload, Time no
 void BoardLink::receive(Time now) noexcept {
   while (true) {
     // Deadline 0 (passed): take what has arrived, never wait in the control loop.
-    const std::ptrdiff_t n = stream_.read(rx_, Time{0});
+    const std::ptrdiff_t n = stream_.read(rx_, Time{});
     if (n < 0) {
       while (outstanding_size_ > 0) miss(now);
       return;

@@ -18,7 +18,7 @@ using Bytes = std::vector<std::uint8_t>;
 // A plant that integrates the wheel travel and reports fixed sensor values.
 struct StubPlant final : BoardPlant {
   double left_m = 0.0, right_m = 0.0;
-  Time last{0};
+  Time last{};
   PlantSensors view{};
   void drive(Time now, double l, double r) noexcept override {
     const double dt = to_seconds(now - last);

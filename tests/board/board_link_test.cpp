@@ -27,14 +27,14 @@ struct Rig {
   BoardLink link{line.host()};
   WheelSpeeds speeds{};
   std::uint64_t losses_seen = 0;
-  Time first_loss_seen{0};
+  Time first_loss_seen{};
 
   void run_for(Duration d) {
     const Time end = clock.now() + d;
     while (clock.now() < end) {
       clock.advance(1ms);
       board.run_until(clock.now());
-      if (clock.now().count() % 10'000'000 == 0) {
+      if (to_ns(clock.now()) % 10'000'000 == 0) {
         link.cycle(clock.now(), speeds);
         if (link.take_link_lost()) {
           if (losses_seen++ == 0) first_loss_seen = clock.now();

@@ -94,7 +94,7 @@ struct FirmwareCounters {
 class BoardFirmware {
  public:
   /// `link` is the UART (not owned); `plant` the world (not owned). Power-on at `start`.
-  BoardFirmware(const FirmwareConfig& config, ByteStream& link, BoardPlant& plant, Time start = Time{0});
+  BoardFirmware(const FirmwareConfig& config, ByteStream& link, BoardPlant& plant, Time start = Time{});
 
   /// Runs the 1 ms ticks due up to `now`: each one reads the UART, answers complete requests,
   /// and runs the device loop (link watchdog, motors, battery, tank, sensors). Never throws or
@@ -165,12 +165,12 @@ class BoardFirmware {
   std::uint64_t decoder_errors_seen_ = 0;
   std::array<std::uint8_t, 256> rx_{};
   std::array<std::uint8_t, kMaxFrameBytes> tx_{};
-  Time now_{0};
+  Time now_{};
   std::uint32_t tick_ms_ = 0;
-  Time last_request_{0};
-  Time next_motor_{0};
-  Time next_battery_{0};
-  Time link_lost_at_{0};
+  Time last_request_{};
+  Time next_motor_{};
+  Time next_battery_{};
+  Time link_lost_at_{};
   bool synchronised_ = false;
   bool link_lost_ = false;
   std::array<Motor, 2> motors_{};

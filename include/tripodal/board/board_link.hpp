@@ -82,7 +82,7 @@ class BoardLink {
  private:
   struct Outstanding {
     Command cmd = Command::sync;
-    Time sent{0};
+    Time sent{};
     bool actuator = false;  // the queue's front: popped when acknowledged
   };
   void receive(Time now) noexcept;
@@ -107,11 +107,11 @@ class BoardLink {
   std::uint32_t consecutive_missed_ = 0;
   bool synchronised_ = false;
   bool lost_pending_ = false;
-  Time lost_at_{0};
-  Time next_battery_{0}, next_tank_{0}, next_ranges_{0};
+  Time lost_at_{};
+  Time next_battery_{}, next_tank_{}, next_ranges_{};
   bool ranges_toggle_ = false;
   DriveState drive_{};
-  Time drive_stamp_{0};
+  Time drive_stamp_{};
   bool has_drive_ = false;
   BatteryState battery_{};
   bool has_battery_ = false;

@@ -32,7 +32,7 @@ class SerialLine {
       std::array<Time, kCapacity> arrival{};
       std::size_t head = 0;
       std::size_t size = 0;
-      Time line_free{0};  // when the transmitter finishes the last queued byte
+      Time line_free{};  // when the transmitter finishes the last queued byte
     };
     const Clock* clock_ = nullptr;
     Duration byte_time_{0};
