@@ -118,20 +118,24 @@ class LocalizerModule final : public RobotModule {
   std::vector<navi::NaviEvent> events_;
 };
 
-// The section splitter as the planner's knowledge: sections(room).
+// The section splitter as the planner's knowledge: sections(room), nearest first from the
+// localizer's position (paper, section 3.2: the sections are reported with the current position).
 class SectionSplitterModule final : public RobotModule {
  public:
-  explicit SectionSplitterModule(const NaviWorkspace& ws) : ws_(ws) {}
+  SectionSplitterModule(const NaviWorkspace& ws, const NavigationData& navi) : ws_(ws), navi_(navi) {}
 
  protected:
   std::optional<TaskKnowledge::ListResult> on_answer(std::string_view function, std::string_view room) const override {
     if (function != "sections") return std::nullopt;
     auto r = ws_.sections_of_room(room);
+    const Point2D at{navi_.map_from_base.x_m, navi_.map_from_base.y_m};
+    if (r.ok && navi_.localized) r.names = navi::order_nearest_first(ws_.grid(), ws_.sections(), r.names, at);
     return TaskKnowledge::ListResult{r.ok, std::move(r.names), std::move(r.error)};
   }
 
  private:
   const NaviWorkspace& ws_;
+  const NavigationData& navi_;
 };
 
 const ModuleEntry* find_entry(const RobotProfile& p, std::string_view type) {
@@ -474,7 +478,7 @@ RunResult run_task(const RunOptions& o) {
               [&](const ModuleConfig&) { return std::make_unique<LocalizerModule>(localizer, navi); });
   modules.add(manifest_of("SectionSplitter", Layer::sequencing, ModuleKind::navigation, {"grid_map", "map_from_base"}, {"sections"},
                           "navi::CSectionSplitter: sections(room)"),
-              [&](const ModuleConfig&) { return std::make_unique<SectionSplitterModule>(ws); });
+              [&](const ModuleConfig&) { return std::make_unique<SectionSplitterModule>(ws, navi); });
 
   SimClock clock;
   RobotOptions ro;

@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <functional>
+#include <limits>
 #include <map>
+#include <numbers>
+#include <queue>
 
 namespace tripodal::navi {
 
@@ -19,7 +23,138 @@ std::string section_name(int i) {
   return s;
 }
 
+constexpr double kUnreachable = std::numeric_limits<double>::infinity();
+
+constexpr std::size_t kNoCell = std::numeric_limits<std::size_t>::max();
+
+// The free cell nearest to p (p's own cell when it is free); kNoCell for a grid without free cells.
+std::size_t nearest_free_cell(const OccupancyGrid& grid, Point2D p) {
+  const CellIndex c = grid.cell_at(p);
+  if (grid.contains(c) && grid.is_free(c)) return grid.index(c);
+  std::size_t best = kNoCell;
+  double best_d2 = kUnreachable;
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    if (grid.state(i) != Occupancy::free) continue;
+    const Point2D q = grid.cell_center(grid.cell(i));
+    const double d2 = (q.x_m - p.x_m) * (q.x_m - p.x_m) + (q.y_m - p.y_m) * (q.y_m - p.y_m);
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      best = i;
+    }
+  }
+  return best;
+}
+
+// Grid path length from `source` to the nearest cell of each wanted section (indexed by section
+// id; +infinity for the others and the unreachable). Dijkstra over free cells, stopped once every
+// wanted section has been reached: the first cell of a section taken from the queue is its nearest.
+std::vector<double> path_lengths_to_sections(const OccupancyGrid& grid, const SectionSet& set, std::size_t source,
+                                             const std::vector<char>& wanted) {
+  std::vector<double> out(set.sections.size(), kUnreachable);
+  std::size_t missing = static_cast<std::size_t>(std::count(wanted.begin(), wanted.end(), char{1}));
+  std::vector<double> dist(grid.size(), kUnreachable);
+  using Item = std::pair<double, std::size_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
+  dist[source] = 0.0;
+  open.emplace(0.0, source);
+  const double straight = grid.resolution_m();
+  const double diagonal = straight * std::numbers::sqrt2;
+  const auto free_at = [&](int x, int y) { return grid.contains({x, y}) && grid.is_free({x, y}); };
+  while (!open.empty() && missing > 0) {
+    const auto [d, i] = open.top();
+    open.pop();
+    if (d > dist[i]) continue;
+    const int label = set.label[i];
+    if (label >= 0 && wanted[static_cast<std::size_t>(label)] != 0 && out[static_cast<std::size_t>(label)] == kUnreachable) {
+      out[static_cast<std::size_t>(label)] = d;
+      --missing;
+    }
+    const CellIndex c = grid.cell(i);
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        if ((dx == 0 && dy == 0) || !free_at(c.x + dx, c.y + dy)) continue;
+        // no corner cutting: a diagonal step needs both side cells free
+        if (dx != 0 && dy != 0 && (!free_at(c.x + dx, c.y) || !free_at(c.x, c.y + dy))) continue;
+        const std::size_t j = grid.index({c.x + dx, c.y + dy});
+        const double nd = d + ((dx != 0 && dy != 0) ? diagonal : straight);
+        if (nd < dist[j]) {
+          dist[j] = nd;
+          open.emplace(nd, j);
+        }
+      }
+    }
+  }
+  return out;
+}
+
+// Where the robot is taken to be once a section is cleaned: its cell nearest the centroid.
+std::size_t centre_cell(const OccupancyGrid& grid, const Section& s) {
+  std::size_t best = s.cells.front();
+  double best_d2 = kUnreachable;
+  for (const std::size_t i : s.cells) {
+    const Point2D q = grid.cell_center(grid.cell(i));
+    const double d2 = (q.x_m - s.centroid.x_m) * (q.x_m - s.centroid.x_m) + (q.y_m - s.centroid.y_m) * (q.y_m - s.centroid.y_m);
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      best = i;
+    }
+  }
+  return best;
+}
+
 }  // namespace
+
+SectionOrder order_nearest_first(const OccupancyGrid& grid, const SectionSet& set, std::span<const int> ids, Point2D from) {
+  SectionOrder out;
+  std::vector<int> remaining;
+  for (const int id : ids) {
+    const bool known = id >= 0 && static_cast<std::size_t>(id) < set.sections.size() &&
+                       !set.sections[static_cast<std::size_t>(id)].cells.empty();
+    if (known && std::find(remaining.begin(), remaining.end(), id) == remaining.end()) remaining.push_back(id);
+  }
+  std::size_t at = set.label.size() == grid.size() ? nearest_free_cell(grid, from) : kNoCell;
+  while (!remaining.empty()) {
+    std::vector<double> lengths(set.sections.size(), kUnreachable);
+    if (at != kNoCell) {
+      std::vector<char> wanted(set.sections.size(), 0);
+      for (const int id : remaining) wanted[static_cast<std::size_t>(id)] = 1;
+      lengths = path_lengths_to_sections(grid, set, at, wanted);
+    }
+    // the first of the nearest, in the order given
+    auto next = remaining.begin();
+    for (auto it = remaining.begin(); it != remaining.end(); ++it) {
+      if (lengths[static_cast<std::size_t>(*it)] < lengths[static_cast<std::size_t>(*next)]) next = it;
+    }
+    const double leg = lengths[static_cast<std::size_t>(*next)];
+    if (leg == kUnreachable) {  // nothing left can be reached: the rest as given
+      for (const int id : remaining) {
+        out.ids.push_back(id);
+        out.legs_m.push_back(kUnreachable);
+      }
+      break;
+    }
+    out.ids.push_back(*next);
+    out.legs_m.push_back(leg);
+    at = centre_cell(grid, set.sections[static_cast<std::size_t>(*next)]);
+    remaining.erase(next);
+  }
+  return out;
+}
+
+std::vector<std::string> order_nearest_first(const OccupancyGrid& grid, const SectionSet& set, std::span<const std::string> names,
+                                             Point2D from) {
+  std::vector<int> ids;
+  std::vector<std::string> unknown;
+  for (const std::string& name : names) {
+    const auto it = std::find_if(set.sections.begin(), set.sections.end(), [&](const Section& s) { return s.name == name; });
+    if (it != set.sections.end()) ids.push_back(it->id);
+    else unknown.push_back(name);
+  }
+  std::vector<std::string> out;
+  for (const int id : order_nearest_first(grid, set, ids, from).ids) out.push_back(set.sections[static_cast<std::size_t>(id)].name);
+  out.insert(out.end(), unknown.begin(), unknown.end());
+  return out;
+}
 
 const ModuleManifest& CSectionSplitter::static_manifest() {
   static const ModuleManifest m = navi_manifest(

@@ -49,6 +49,7 @@ CProcess::CProcess(ProcessDefinition definition) : definition_(std::move(definit
       }
     }
   }
+  if (definition_.module) check_module_net(*definition_.module, definition_.name, d);
   if (d.has_errors()) throw ConfigError(d);
 }
 

@@ -162,6 +162,8 @@ struct Parser {
       } else if (key == "net") {
         has_net = true;
         p.net = path_of(v, "net file", p.net_where);
+      } else if (key == "module") {
+        p.module = path_of(v, "module net file", p.module_where);
       } else if (key == "recovery") {
         SourceLocation loc;
         p.recovery = path_of(v, "recovery file", loc);
@@ -175,7 +177,7 @@ struct Parser {
           if (scalar(q.second, val, "parameter")) p.parameters.push_back(BindingParam{q.first.as<std::string>(), val, at(q.second)});
         }
       } else {
-        d.error(at(kv.first), "unknown key '" + key + "' in a process entry; expected: name, type, net, parameters, recovery");
+        d.error(at(kv.first), "unknown key '" + key + "' in a process entry; expected: name, type, net, module, parameters, recovery");
       }
     }
     if (p.name.empty()) d.error(p.where, "a process entry needs a name");

@@ -1,5 +1,6 @@
 // `tripodal-net check FILE...`: loads each net and reports every error and structural warning,
-// then runs the deadlock and outcome checks of the state-space analysis on nets small enough.
+// then runs the deadlock and outcome checks of the state-space analysis on nets small enough, and
+// checks recovery rules against the process nets (rules no net's fault can match).
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -9,12 +10,13 @@
 #include "command.hpp"
 #include "net_tool_util.hpp"
 #include "tripodal/analysis/analyzer.hpp"
+#include "tripodal/planner/recovery.hpp"
 
 namespace tripodal::net_tool {
 namespace {
 
 constexpr std::string_view kHelp =
-    "usage: tripodal-net check [--no-warnings] [--no-behaviour] FILE|DIR...\n\n"
+    "usage: tripodal-net check [--no-warnings] [--no-behaviour] [--recovery RULES.yaml]... FILE|DIR...\n\n"
     "Loads each configuration net (native XML or PNML, by extension then root element) and prints\n"
     "every problem gcc-style, FILE:LINE:COL: error|warning|note: MESSAGE, then one summary line per\n"
     "file. A directory stands for its *.xml and *.pnml files (not recursive).\n"
@@ -24,7 +26,10 @@ constexpr std::string_view kHelp =
     "without defaults, get a note instead (use tripodal-net analyze).\n\n"
     "  --no-warnings   leave out the structural warnings (places never marked, transitions never\n"
     "                  enabled)\n"
-    "  --no-behaviour  skip the deadlock and outcome checks\n\n"
+    "  --no-behaviour  skip the deadlock and outcome checks\n"
+    "  --recovery F    also check the recovery rules of F against the low-level nets given (a net's\n"
+    "                  id is its process name): a rule whose fault message none of them can post,\n"
+    "                  or naming or inserting a process without a net, is an error\n\n"
     "exit codes: 0 every net is valid (warnings allowed), 1 a net has errors, 2 bad command line,\n"
     "            3 a file or directory could not be read\n";
 
@@ -40,7 +45,7 @@ std::string file_head(const std::filesystem::path& file) {
 
 // Checks one net file: the loader's diagnostics, then the behavioural checks on a net that loaded.
 FileStatus check_file(const std::filesystem::path& file, const LoadOptions& options, bool behaviour,
-                      std::ostream& out, std::ostream& err) {
+                      std::vector<PetriNet>& loaded, std::ostream& out, std::ostream& err) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec)) {
     err << file.string() << ": error: cannot open file\n";
@@ -77,16 +82,30 @@ FileStatus check_file(const std::filesystem::path& file, const LoadOptions& opti
   if (warnings > 0) out << ", " << warnings << " warning(s)";
   if (behaviour) out << (checked ? "; no deadlock, no marking that cannot reach an outcome" : "; behaviour not checked");
   out << ")\n";
+  loaded.push_back(*net);
   return FileStatus::valid;
+}
+
+FileStatus check_recovery(const std::filesystem::path& file, const std::vector<PetriNet>& nets, std::ostream& out,
+                          std::ostream& err) {
+  Diagnostics diagnostics;
+  check_recovery_file(file, nets, diagnostics);
+  err << diagnostics.str();
+  if (diagnostics.has_errors()) out << file.string() << ": " << diagnostics.error_count() << " error(s)\n";
+  else out << file.string() << ": ok (every rule can match a fault of the nets)\n";
+  return diagnostics.has_errors() ? FileStatus::invalid : FileStatus::valid;
 }
 
 int run_check(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   LoadOptions options;
   bool behaviour = true;
-  std::vector<std::filesystem::path> files;
+  std::vector<std::filesystem::path> files, recovery_files;
   bool unreadable = false;
-  for (const auto& a : args) {
-    if (a == "--no-warnings") {
+  for (auto it = args.begin(); it != args.end(); ++it) {
+    const std::string& a = *it;
+    if (a == "--recovery" && it + 1 != args.end()) {
+      recovery_files.emplace_back(*++it);
+    } else if (a == "--no-warnings") {
       options.structural_warnings = false;
     } else if (a == "--no-behaviour") {
       behaviour = false;
@@ -115,11 +134,13 @@ int run_check(const std::vector<std::string>& args, std::ostream& out, std::ostr
     return kUsage;
   }
   bool invalid = false;
+  std::vector<PetriNet> loaded;
   for (const auto& f : files) {
-    const FileStatus s = check_file(f, options, behaviour, out, err);
+    const FileStatus s = check_file(f, options, behaviour, loaded, out, err);
     unreadable = unreadable || s == FileStatus::unreadable;
     invalid = invalid || s == FileStatus::invalid;
   }
+  for (const auto& f : recovery_files) invalid = check_recovery(f, loaded, out, err) == FileStatus::invalid || invalid;
   if (unreadable) return kIoError;
   return invalid ? kFindings : kOk;
 }

@@ -5,6 +5,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -35,6 +36,10 @@ struct ProcessDefinition {
   std::string name;
   std::string type = "net";  ///< the registered factory that builds it; "net" is a plain CProcess
   PetriNet net;
+  /// Its process module in high-level configuration (paper, Fig. 2: configs/petri/
+  /// PrCleaning-module.xml), which the planner composes into the plan's net; none: the default
+  /// module of that shape (default_module_net).
+  std::optional<PetriNet> module;
   std::vector<BindingParam> parameters;
   std::vector<RecoveryRule> recovery;
   SourceLocation where;
@@ -54,7 +59,8 @@ class CProcess {
   /// Checks the definition and throws ConfigError listing every problem, located: a configured
   /// parameter the net does not declare or whose text does not parse as the declared type, a
   /// behavior binding parameter "$name" that names no declared parameter, a net without any
-  /// outcome place (its result could never be reported), a high-level net.
+  /// outcome place (its result could never be reported), a high-level net, a module net the
+  /// planner cannot compose (check_module_net).
   explicit CProcess(ProcessDefinition definition);
   virtual ~CProcess() = default;
   CProcess(const CProcess&) = delete;
@@ -63,6 +69,8 @@ class CProcess {
   [[nodiscard]] const std::string& name() const noexcept { return definition_.name; }
   [[nodiscard]] const std::string& type() const noexcept { return definition_.type; }
   [[nodiscard]] const PetriNet& net() const noexcept { return definition_.net; }
+  /// The configured process module net; nullptr when the default is used.
+  [[nodiscard]] const PetriNet* module() const noexcept { return definition_.module ? &*definition_.module : nullptr; }
   [[nodiscard]] const std::vector<RecoveryRule>& recovery() const noexcept { return definition_.recovery; }
   [[nodiscard]] const std::vector<BindingParam>& configured_parameters() const noexcept { return definition_.parameters; }
   [[nodiscard]] const SourceLocation& where() const noexcept { return definition_.where; }
