@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <deque>
 #include <functional>
 #include <limits>
@@ -45,13 +46,16 @@ std::size_t nearest_free_cell(const OccupancyGrid& grid, Point2D p) {
   return best;
 }
 
-// Grid path length from `source` to the nearest cell of each wanted section (indexed by section
-// id; +infinity for the others and the unreachable). Dijkstra over free cells, stopped once every
-// wanted section has been reached: the first cell of a section taken from the queue is its nearest.
-std::vector<double> path_lengths_to_sections(const OccupancyGrid& grid, const SectionSet& set, std::size_t source,
-                                             const std::vector<char>& wanted) {
-  std::vector<double> out(set.sections.size(), kUnreachable);
-  std::size_t missing = static_cast<std::size_t>(std::count(wanted.begin(), wanted.end(), char{1}));
+// The section of `remaining` nearest to `source` by grid path, and that path's length to its
+// nearest cell: Dijkstra over free cells, stopped once the queue is past the first section
+// reached (ties within 1 um go to the section listed first). {-1, +inf} when none is reachable.
+std::pair<int, double> nearest_section(const OccupancyGrid& grid, const std::vector<std::uint8_t>& free,
+                                       const SectionSet& set, std::size_t source, const std::vector<int>& remaining) {
+  constexpr double kTie = 1e-6;
+  std::vector<std::size_t> rank(set.sections.size(), remaining.size());  // remaining.size(): not wanted
+  for (std::size_t k = 0; k < remaining.size(); ++k) rank[static_cast<std::size_t>(remaining[k])] = k;
+  int best = -1;
+  double best_m = kUnreachable;
   std::vector<double> dist(grid.size(), kUnreachable);
   using Item = std::pair<double, std::size_t>;
   std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
@@ -59,15 +63,17 @@ std::vector<double> path_lengths_to_sections(const OccupancyGrid& grid, const Se
   open.emplace(0.0, source);
   const double straight = grid.resolution_m();
   const double diagonal = straight * std::numbers::sqrt2;
-  const auto free_at = [&](int x, int y) { return grid.contains({x, y}) && grid.is_free({x, y}); };
-  while (!open.empty() && missing > 0) {
+  const int w = grid.width(), h = grid.height();
+  const auto free_at = [&](int x, int y) { return x >= 0 && y >= 0 && x < w && y < h && free[grid.index({x, y})] != 0; };
+  while (!open.empty() && open.top().first <= best_m + kTie) {
     const auto [d, i] = open.top();
     open.pop();
     if (d > dist[i]) continue;
     const int label = set.label[i];
-    if (label >= 0 && wanted[static_cast<std::size_t>(label)] != 0 && out[static_cast<std::size_t>(label)] == kUnreachable) {
-      out[static_cast<std::size_t>(label)] = d;
-      --missing;
+    if (label >= 0 && rank[static_cast<std::size_t>(label)] < remaining.size() &&
+        (best < 0 || rank[static_cast<std::size_t>(label)] < rank[static_cast<std::size_t>(best)])) {
+      best = label;
+      best_m = std::min(best_m, d);
     }
     const CellIndex c = grid.cell(i);
     for (int dy = -1; dy <= 1; ++dy) {
@@ -84,7 +90,7 @@ std::vector<double> path_lengths_to_sections(const OccupancyGrid& grid, const Se
       }
     }
   }
-  return out;
+  return {best, best_m};
 }
 
 // Where the robot is taken to be once a section is cleaned: its cell nearest the centroid.
@@ -112,31 +118,22 @@ SectionOrder order_nearest_first(const OccupancyGrid& grid, const SectionSet& se
                        !set.sections[static_cast<std::size_t>(id)].cells.empty();
     if (known && std::find(remaining.begin(), remaining.end(), id) == remaining.end()) remaining.push_back(id);
   }
+  std::vector<std::uint8_t> free(grid.size());
+  for (std::size_t i = 0; i < grid.size(); ++i) free[i] = grid.state(i) == Occupancy::free ? 1 : 0;
   std::size_t at = set.label.size() == grid.size() ? nearest_free_cell(grid, from) : kNoCell;
   while (!remaining.empty()) {
-    std::vector<double> lengths(set.sections.size(), kUnreachable);
-    if (at != kNoCell) {
-      std::vector<char> wanted(set.sections.size(), 0);
-      for (const int id : remaining) wanted[static_cast<std::size_t>(id)] = 1;
-      lengths = path_lengths_to_sections(grid, set, at, wanted);
-    }
-    // the first of the nearest, in the order given
-    auto next = remaining.begin();
-    for (auto it = remaining.begin(); it != remaining.end(); ++it) {
-      if (lengths[static_cast<std::size_t>(*it)] < lengths[static_cast<std::size_t>(*next)]) next = it;
-    }
-    const double leg = lengths[static_cast<std::size_t>(*next)];
-    if (leg == kUnreachable) {  // nothing left can be reached: the rest as given
+    const auto [next, leg_m] = at != kNoCell ? nearest_section(grid, free, set, at, remaining) : std::pair<int, double>{-1, kUnreachable};
+    if (next < 0) {  // nothing left can be reached: the rest as given
       for (const int id : remaining) {
         out.ids.push_back(id);
         out.legs_m.push_back(kUnreachable);
       }
       break;
     }
-    out.ids.push_back(*next);
-    out.legs_m.push_back(leg);
-    at = centre_cell(grid, set.sections[static_cast<std::size_t>(*next)]);
-    remaining.erase(next);
+    out.ids.push_back(next);
+    out.legs_m.push_back(leg_m);
+    at = centre_cell(grid, set.sections[static_cast<std::size_t>(next)]);
+    remaining.erase(std::find(remaining.begin(), remaining.end(), next));
   }
   return out;
 }

@@ -98,8 +98,8 @@ struct SectionOrder {
 /// inward from the walls and ends inside), and so on. A greedy tour, not an optimal one, as the
 /// paper's planner does it. Grid path distance (8-connected free cells, diagonals only between
 /// two free side cells) rather than straight-line distance because a section behind a wall is
-/// not near; one Dijkstra per leg, stopped once every remaining section is reached (the demo
-/// workspace's four sections: bench/navi, BM_OrderSectionsNearestFirst). A start outside the
+/// not near; one Dijkstra per leg, stopped at the first section it reaches, so a leg costs the
+/// cells nearer than that section (bench/navi, BM_OrderSectionsNearestFirst). A start outside the
 /// free cells starts from the nearest free cell. Ties go to the id given first. `grid` is the
 /// grid `set` was split from; ids not in `set` are ignored.
 [[nodiscard]] SectionOrder order_nearest_first(const OccupancyGrid& grid, const SectionSet& set, std::span<const int> ids,
