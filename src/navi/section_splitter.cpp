@@ -9,6 +9,7 @@
 #include <map>
 #include <numbers>
 #include <queue>
+#include <ranges>
 
 namespace tripodal::navi {
 
@@ -28,14 +29,13 @@ constexpr double kUnreachable = std::numeric_limits<double>::infinity();
 
 constexpr std::size_t kNoCell = std::numeric_limits<std::size_t>::max();
 
-// The free cell nearest to p (p's own cell when it is free); kNoCell for a grid without free cells.
-std::size_t nearest_free_cell(const OccupancyGrid& grid, Point2D p) {
-  const CellIndex c = grid.cell_at(p);
-  if (grid.contains(c) && grid.is_free(c)) return grid.index(c);
+// Of `cells`, the one whose centre is closest to p among those `accept` takes; kNoCell if none.
+template <typename Cells, typename Accept>
+std::size_t closest_cell(const OccupancyGrid& grid, Point2D p, const Cells& cells, Accept accept) {
   std::size_t best = kNoCell;
   double best_d2 = kUnreachable;
-  for (std::size_t i = 0; i < grid.size(); ++i) {
-    if (grid.state(i) != Occupancy::free) continue;
+  for (const std::size_t i : cells) {
+    if (!accept(i)) continue;
     const Point2D q = grid.cell_center(grid.cell(i));
     const double d2 = (q.x_m - p.x_m) * (q.x_m - p.x_m) + (q.y_m - p.y_m) * (q.y_m - p.y_m);
     if (d2 < best_d2) {
@@ -44,6 +44,14 @@ std::size_t nearest_free_cell(const OccupancyGrid& grid, Point2D p) {
     }
   }
   return best;
+}
+
+// The free cell nearest to p (p's own cell when it is free); kNoCell for a grid without free cells.
+std::size_t nearest_free_cell(const OccupancyGrid& grid, Point2D p) {
+  const CellIndex c = grid.cell_at(p);
+  if (grid.contains(c) && grid.is_free(c)) return grid.index(c);
+  return closest_cell(grid, p, std::views::iota(std::size_t{0}, grid.size()),
+                      [&](std::size_t i) { return grid.state(i) == Occupancy::free; });
 }
 
 // The section of `remaining` nearest to `source` by grid path, and that path's length to its
@@ -95,17 +103,7 @@ std::pair<int, double> nearest_section(const OccupancyGrid& grid, const std::vec
 
 // Where the robot is taken to be once a section is cleaned: its cell nearest the centroid.
 std::size_t centre_cell(const OccupancyGrid& grid, const Section& s) {
-  std::size_t best = s.cells.front();
-  double best_d2 = kUnreachable;
-  for (const std::size_t i : s.cells) {
-    const Point2D q = grid.cell_center(grid.cell(i));
-    const double d2 = (q.x_m - s.centroid.x_m) * (q.x_m - s.centroid.x_m) + (q.y_m - s.centroid.y_m) * (q.y_m - s.centroid.y_m);
-    if (d2 < best_d2) {
-      best_d2 = d2;
-      best = i;
-    }
-  }
-  return best;
+  return closest_cell(grid, s.centroid, s.cells, [](std::size_t) { return true; });
 }
 
 }  // namespace
