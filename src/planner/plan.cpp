@@ -166,11 +166,13 @@ void instantiate(PetriNet& net, const PetriNet& m, const ProcessStep& step, cons
     if (p == r.standby || p == r.success || m.place(p).outcome == Outcome::fault) continue;
     Place copy = m.place(p);
     copy.id = id_of(p);
+    if (copy.name == m.place(p).id) copy.name.clear();  // a label that only repeated the module's id
     if (p == r.executing) copy.process = ProcessRef{step.process, step.params};
     net.add_place(std::move(copy));
   }
   for (const Transition& t : m.transitions()) {
-    Transition copy{.id = PlanNetIds::module_node(x, t.id), .name = t.name, .description = t.description, .event = t.event,
+    Transition copy{.id = PlanNetIds::module_node(x, t.id), .name = t.name == t.id ? std::string() : t.name,
+                    .description = t.description, .event = t.event,
                     .guard = t.guard, .delay = t.delay, .priority = t.priority, .where = t.where};
     if (t.event == PlanNetIds::success_event(e)) copy.event = PlanNetIds::success_event(x);
     if (t.event == PlanNetIds::fault_event(e)) copy.event = PlanNetIds::fault_event(x);
