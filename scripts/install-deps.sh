@@ -6,7 +6,8 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libyaml-cpp-dev libspdlog-dev
-  libtinyxml2-dev  # tests only: the reference the XML reader is compared with
+  libfmt-dev nlohmann-json3-dev libcli11-dev
+  libtinyxml2-dev  # the net loaders read XML with it
   catch2 libbenchmark-dev
   graphviz libxml2-utils
   zlib1g-dev

@@ -8,7 +8,7 @@
 
 #include <string>
 
-#include "tripodal/app/cleaning_run.hpp"
+#include "run_task.hpp"
 
 namespace {
 

@@ -9,19 +9,15 @@ using namespace tripodal;
 namespace example {
 
 const ModuleManifest& BhApproach::static_manifest() {
-  static const ModuleManifest m{
-      .name = "BhApproach",
-      .layer = Layer::reactive,
-      .kind = ModuleKind::behavior,
-      .description = "approaches the obstacle ahead and stops short of it",
-      .inputs = {"laser_scan"},
-      .outputs = {"cmd_vel"},
-      .parameters = {
-          {.name = "speed_m_s", .default_value = Value{0.4}, .unit = "m/s", .description = "cruise speed", .min = 0.0},
-          {.name = "slow_distance_m", .default_value = Value{1.5}, .unit = "m", .description = "slow down below this clearance", .min = 0.0},
-          {.name = "stop_distance_m", .default_value = Value{0.8}, .unit = "m", .description = "succeed at this clearance", .min = 0.0},
-          {.name = "robot_radius_m", .default_value = Value{0.25}, .unit = "m", .description = "footprint radius", .min = 0.0},
-      }};
+  static const ModuleManifest m = ManifestBuilder("BhApproach", ModuleKind::behavior, Layer::reactive)
+                                      .description("approaches the obstacle ahead and stops short of it")
+                                      .input("laser_scan")
+                                      .output("cmd_vel")
+                                      .number("speed_m_s", 0.4, "m/s", "cruise speed", 0.0)
+                                      .number("slow_distance_m", 1.5, "m", "slow down below this clearance", 0.0)
+                                      .number("stop_distance_m", 0.8, "m", "succeed at this clearance", 0.0)
+                                      .number("robot_radius_m", 0.25, "m", "footprint radius", 0.0)
+                                      .build();
   return m;
 }
 

@@ -1,8 +1,6 @@
 #include "compiled_net.hpp"
 
 #include <algorithm>
-#include <map>
-#include <unordered_map>
 
 #include "tripodal/core/diagnostic.hpp"
 
@@ -61,6 +59,7 @@ CompiledNet::CompiledNet(const PetriNet& net, const ParameterValues& parameters,
   change_begin.assign(1, 0);
   is_outcome.assign(places, 0);
   for (PlaceIndex p = 0; p < places; ++p) is_outcome[p] = pl[p].outcome != Outcome::none ? 1 : 0;
+  std::vector<Change> scratch;
 
   for (TransitionIndex t = 0; t < transitions; ++t) {
     const Transition& tr = net.transition(t);
@@ -83,55 +82,18 @@ CompiledNet::CompiledNet(const PetriNet& net, const ParameterValues& parameters,
       }
     }
 
-    std::map<PlaceIndex, Change> delta;
-    std::map<PlaceIndex, Check> bounds;
-    auto bound_of = [&](PlaceIndex p) -> Check& {
-      auto [it, inserted] = bounds.try_emplace(p);
-      if (inserted) it->second.place = p;
-      return it->second;
-    };
-    for (const ArcRef& a : tr.inputs) {
-      Change& d = delta[a.place];
-      d.place = a.place;
-      d.consumed += a.weight;
-    }
-    for (const ArcRef& a : tr.outputs) {
-      Change& d = delta[a.place];
-      d.place = a.place;
-      d.produced += a.weight;
-    }
-    for (const auto& [p, d] : delta) {
-      if (d.consumed > 0) bound_of(p).lo = std::max(bound_of(p).lo, d.consumed);
-      const auto& cap = pl[p].capacity;
-      if (cap && !options.monotone && d.produced > d.consumed) {
-        const Tokens gain = d.produced - d.consumed;
-        Check& c = bound_of(p);
-        if (gain > *cap) {
-          c.lo = 1;
-          c.hi = 0;
-        } else {
-          c.hi = std::min(c.hi, *cap - gain);
-        }
-      }
-    }
-    for (const ArcRef& a : tr.reads) bound_of(a.place).lo = std::max(bound_of(a.place).lo, a.weight);
-    if (!options.monotone) {
-      for (const ArcRef& a : tr.inhibitors) bound_of(a.place).hi = std::min(bound_of(a.place).hi, a.weight - 1);
-    }
-    for (const auto& [p, c] : bounds) checks.push_back(c);
-    for (const auto& [p, d] : delta) {
+    // Only the places whose count a firing changes matter to the search.
+    scratch.clear();
+    tripodal::detail::fold_transition(net, tr, {.capacities_and_inhibitors = !options.monotone}, checks, scratch);
+    for (const Change& d : scratch) {
       if (d.consumed != d.produced) changes.push_back(d);
     }
     check_begin.push_back(static_cast<std::uint32_t>(checks.size()));
     change_begin.push_back(static_cast<std::uint32_t>(changes.size()));
   }
 
-  // Conflict order as in the engine: priority descending, then declaration order.
-  std::vector<TransitionIndex> order(transitions);
-  for (TransitionIndex t = 0; t < transitions; ++t) order[t] = t;
-  std::stable_sort(order.begin(), order.end(), [&](TransitionIndex a, TransitionIndex b) {
-    return net.transition(a).priority > net.transition(b).priority;
-  });
+  // Conflict order as in the engine.
+  const std::vector<TransitionIndex> order = tripodal::detail::conflict_order(net);
   std::vector<std::string> event_names;
   std::vector<std::vector<TransitionIndex>> by_event;
   for (const TransitionIndex t : order) {

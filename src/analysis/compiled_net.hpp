@@ -6,10 +6,10 @@
 #pragma once
 
 #include <cstdint>
-#include <limits>
 #include <string>
 #include <vector>
 
+#include "../core/net_compile.hpp"
 #include "tripodal/analysis/state_space.hpp"
 #include "tripodal/core/petri_net.hpp"
 
@@ -18,17 +18,9 @@ namespace tripodal::analysis::detail {
 enum class Kind : std::uint8_t { immediate, delayed, event };
 enum class GuardState : std::uint8_t { never, always, maybe };
 
-struct Check {
-  PlaceIndex place = 0;
-  Tokens lo = 0;
-  Tokens hi = std::numeric_limits<Tokens>::max();
-};
-
-struct Change {
-  PlaceIndex place = 0;
-  Tokens consumed = 0;
-  Tokens produced = 0;
-};
+// The engine's compile step (src/core/net_compile.hpp) gives both.
+using Check = tripodal::detail::PlaceBound;
+using Change = PlaceChange;
 
 struct CompileOptions {
   Semantics semantics = Semantics::engine;

@@ -1,5 +1,8 @@
-// Text and JSON forms of an AnalysisReport. JSON is written by hand (no dependency): strings are
-// escaped per RFC 8259, numbers printed in C locale.
+// Text and JSON forms of an AnalysisReport. The JSON is built with nlohmann-json (ordered, so the
+// keys come in the order docs/analysis.md lists them): strings escaped per RFC 8259, and a number
+// that is not finite written as null, never as nan or inf.
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <cstdio>
 #include <set>
@@ -11,46 +14,15 @@ namespace tripodal::analysis {
 
 namespace {
 
-std::string json_string(std::string_view s) {
-  std::string out = "\"";
-  for (const char ch : s) {
-    const auto c = static_cast<unsigned char>(ch);
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\b': out += "\\b"; break;
-      case '\f': out += "\\f"; break;
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (c < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
-          out += buf;
-        } else {
-          out += ch;
-        }
-    }
-  }
-  out += '"';
-  return out;
-}
+using Json = nlohmann::ordered_json;
 
-std::string json_number(double x) {
-  if (!std::isfinite(x)) return "null";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
-
-std::string json_value(const Value& v) {
+Json json_value(const Value& v) {
   switch (type_of(v)) {
-    case ValueType::boolean: return std::get<bool>(v) ? "true" : "false";
-    case ValueType::number: return json_number(std::get<double>(v));
-    case ValueType::string: return json_string(std::get<std::string>(v));
+    case ValueType::boolean: return std::get<bool>(v);
+    case ValueType::number: return std::get<double>(v);
+    case ValueType::string: return std::get<std::string>(v);
   }
-  return "null";
+  return nullptr;
 }
 
 std::string marking_text(const PetriNet& net, const Marking& m) {
@@ -140,52 +112,38 @@ void witness_text(std::ostringstream& out, const PetriNet& net, const Witness& w
   if (!guards.empty()) out << "    assumes fact guards true: " << join(guards, "; ") << '\n';
 }
 
-std::string witness_json(const PetriNet& net, const Witness& w) {
-  std::string out = "{\"marking\":{";
-  bool first = true;
+Json witness_json(const PetriNet& net, const Witness& w) {
+  Json marking = Json::object();
   for (PlaceIndex p = 0; p < w.marking.size(); ++p) {
-    if (w.marking[p] == 0) continue;
-    out += (first ? "" : ",") + json_string(net.place(p).id) + ":" + std::to_string(w.marking[p]);
-    first = false;
+    if (w.marking[p] != 0) marking[net.place(p).id] = w.marking[p];
   }
-  out += "},\"path\":[";
-  for (std::size_t i = 0; i < w.path.size(); ++i) {
-    const Transition& tr = net.transition(w.path[i]);
-    out += (i == 0 ? "" : ",") + std::string("{\"transition\":") + json_string(tr.id) +
-           ",\"event\":" + (tr.event.empty() ? std::string("null") : json_string(tr.event)) + "}";
+  Json path = Json::array();
+  for (const TransitionIndex t : w.path) {
+    const Transition& tr = net.transition(t);
+    path.push_back({{"transition", tr.id}, {"event", tr.event.empty() ? Json(nullptr) : Json(tr.event)}});
   }
-  out += "],\"events\":[";
-  const auto events = path_events(net, w.path);
-  for (std::size_t i = 0; i < events.size(); ++i) out += (i == 0 ? "" : ",") + json_string(events[i]);
-  out += "],\"fact_guards\":[";
-  const auto guards = path_fact_guards(net, w.path);
-  for (std::size_t i = 0; i < guards.size(); ++i) out += (i == 0 ? "" : ",") + json_string(guards[i]);
-  out += "]}";
+  return {{"marking", std::move(marking)},
+          {"path", std::move(path)},
+          {"events", path_events(net, w.path)},
+          {"fact_guards", path_fact_guards(net, w.path)}};
+}
+
+Json ids_json(const PetriNet& net, const std::vector<std::uint32_t>& items, bool places) {
+  Json out = Json::array();
+  for (const auto i : items) out.push_back(places ? net.place(i).id : net.transition(i).id);
   return out;
 }
 
-std::string ids_json(const PetriNet& net, const std::vector<std::uint32_t>& items, bool places) {
-  std::string out = "[";
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    out += (i == 0 ? "" : ",") + json_string(places ? net.place(items[i]).id : net.transition(items[i]).id);
+Json invariants_json(const PetriNet& net, const InvariantBasis& basis, bool places) {
+  Json items = Json::array();
+  for (const Invariant& inv : basis.invariants) {
+    Json weights = Json::object();
+    for (const auto& [n, w] : inv.weights) weights[places ? net.place(n).id : net.transition(n).id] = w;
+    Json item = {{"weights", std::move(weights)}};
+    if (places) item["token_sum"] = inv.token_sum;
+    items.push_back(std::move(item));
   }
-  return out + "]";
-}
-
-std::string invariants_json(const PetriNet& net, const InvariantBasis& basis, bool places) {
-  std::string out = "{\"complete\":" + std::string(basis.complete ? "true" : "false") + ",\"items\":[";
-  for (std::size_t k = 0; k < basis.invariants.size(); ++k) {
-    const Invariant& inv = basis.invariants[k];
-    out += (k == 0 ? "" : ",") + std::string("{\"weights\":{");
-    for (std::size_t i = 0; i < inv.weights.size(); ++i) {
-      const auto [n, w] = inv.weights[i];
-      out += (i == 0 ? "" : ",") + json_string(places ? net.place(n).id : net.transition(n).id) + ":" + std::to_string(w);
-    }
-    out += "}";
-    if (places) out += ",\"token_sum\":" + std::to_string(inv.token_sum);
-    out += "}";
-  }
-  return out + "]}";
+  return {{"complete", basis.complete}, {"items", std::move(items)}};
 }
 
 std::string_view kind_text(BoundKind k) {
@@ -303,67 +261,71 @@ std::string format_text(const AnalysisReport& r, const PetriNet& net) {
 }
 
 std::string format_json(const AnalysisReport& r, const PetriNet& net) {
-  std::ostringstream out;
-  out << "{\"net\":{\"id\":" << json_string(r.net_id) << ",\"places\":" << r.places
-      << ",\"transitions\":" << r.transitions << "},";
-  out << "\"semantics\":" << json_string(to_string(r.semantics)) << ",\"parameters\":{";
-  bool first = true;
-  for (const auto& [k, v] : r.parameters) {
-    out << (first ? "" : ",") << json_string(k) << ':' << json_value(v);
-    first = false;
-  }
-  out << "},";
-  out << "\"graph\":{\"states\":" << r.states << ",\"edges\":" << r.edges << ",\"expanded\":" << r.expanded
-      << ",\"complete\":" << (r.complete() ? "true" : "false") << ",\"stop_reason\":" << json_string(to_string(r.stop))
-      << ",\"max_states\":" << r.max_states << ",\"exploration_s\":" << json_number(r.exploration_s)
-      << ",\"states_per_s\":" << json_number(rate(r)) << ",\"memory_bytes\":" << r.memory_bytes
-      << ",\"bytes_per_state\":" << json_number(r.bytes_per_state) << ",\"bytes_per_marking\":" << r.bytes_per_marking
-      << "},";
-  out << "\"deadlocks\":{\"count\":" << r.deadlock_count << ",\"examples\":[";
-  for (std::size_t i = 0; i < r.deadlocks.size(); ++i) out << (i == 0 ? "" : ",") << witness_json(net, r.deadlocks[i]);
-  out << "]},";
-  out << "\"bounds\":{\"bounded\":" << json_string(to_string(r.bounded)) << ",\"safe\":" << json_string(to_string(r.safe))
-      << ",\"places\":[";
+  Json parameters = Json::object();
+  for (const auto& [k, v] : r.parameters) parameters[k] = json_value(v);
+  Json deadlocks = Json::array();
+  for (const Witness& w : r.deadlocks) deadlocks.push_back(witness_json(net, w));
+  Json places = Json::array();
   for (PlaceIndex p = 0; p < r.places; ++p) {
     const PlaceBound& b = r.bounds[p];
-    out << (p == 0 ? "" : ",") << "{\"id\":" << json_string(net.place(p).id) << ",\"max\":";
-    if (b.kind == BoundKind::unbounded) {
-      out << "null";
-    } else {
-      out << b.max_seen;
-    }
-    out << ",\"kind\":" << json_string(kind_text(b.kind)) << ",\"structural\":"
-        << (b.structural ? std::to_string(*b.structural) : std::string("null"))
-        << ",\"may_be_unbounded\":" << (b.may_be_unbounded ? "true" : "false") << '}';
+    places.push_back({{"id", net.place(p).id},
+                      {"max", b.kind == BoundKind::unbounded ? Json(nullptr) : Json(b.max_seen)},
+                      {"kind", kind_text(b.kind)},
+                      {"structural", b.structural ? Json(*b.structural) : Json(nullptr)},
+                      {"may_be_unbounded", b.may_be_unbounded}});
   }
-  out << "]},\"coverability\":";
-  if (!r.coverability_ran) {
-    out << "null";
-  } else {
+  Json coverability = nullptr;
+  if (r.coverability_ran) {
     const CoverabilityResult& c = r.coverability;
     std::vector<std::uint32_t> omega;
     for (PlaceIndex p = 0; p < c.bounds.size(); ++p) {
       if (!c.bounds[p]) omega.push_back(p);
     }
-    out << "{\"complete\":" << (c.complete ? "true" : "false") << ",\"exact\":" << (c.exact ? "true" : "false")
-        << ",\"nodes\":" << c.nodes << ",\"omega_places\":" << ids_json(net, omega, true)
-        << ",\"prefix\":" << ids_json(net, c.prefix, false) << ",\"pump\":" << ids_json(net, c.pump, false)
-        << ",\"pumped\":" << ids_json(net, c.pumped, true) << '}';
+    coverability = {{"complete", c.complete},
+                    {"exact", c.exact},
+                    {"nodes", c.nodes},
+                    {"omega_places", ids_json(net, omega, true)},
+                    {"prefix", ids_json(net, c.prefix, false)},
+                    {"pump", ids_json(net, c.pump, false)},
+                    {"pumped", ids_json(net, c.pumped, true)}};
   }
-  out << ",\"dead_transitions\":" << ids_json(net, r.dead_transitions, false)
-      << ",\"never_marked_places\":" << ids_json(net, r.never_marked, true) << ',';
-  out << "\"outcome\":{\"verdict\":" << json_string(to_string(r.outcome)) << ",\"outcome_states\":" << r.outcome_states
-      << ",\"stuck_count\":" << r.stuck_count << ",\"stuck\":[";
-  for (std::size_t i = 0; i < r.stuck.size(); ++i) out << (i == 0 ? "" : ",") << witness_json(net, r.stuck[i]);
-  out << "]},\"invariants\":";
-  if (!r.invariants_computed) {
-    out << "null";
-  } else {
-    out << "{\"place\":" << invariants_json(net, r.p_invariants, true)
-        << ",\"transition\":" << invariants_json(net, r.t_invariants, false) << '}';
+  Json stuck = Json::array();
+  for (const Witness& w : r.stuck) stuck.push_back(witness_json(net, w));
+  Json invariants = nullptr;
+  if (r.invariants_computed) {
+    invariants = {{"place", invariants_json(net, r.p_invariants, true)},
+                  {"transition", invariants_json(net, r.t_invariants, false)}};
   }
-  out << ",\"ok\":" << (r.ok() ? "true" : "false") << "}\n";
-  return out.str();
+  const Json out = {
+      {"net", {{"id", r.net_id}, {"places", r.places}, {"transitions", r.transitions}}},
+      {"semantics", to_string(r.semantics)},
+      {"parameters", std::move(parameters)},
+      {"graph",
+       {{"states", r.states},
+        {"edges", r.edges},
+        {"expanded", r.expanded},
+        {"complete", r.complete()},
+        {"stop_reason", to_string(r.stop)},
+        {"max_states", r.max_states},
+        {"exploration_s", r.exploration_s},
+        {"states_per_s", rate(r)},
+        {"memory_bytes", r.memory_bytes},
+        {"bytes_per_state", r.bytes_per_state},
+        {"bytes_per_marking", r.bytes_per_marking}}},
+      {"deadlocks", {{"count", r.deadlock_count}, {"examples", std::move(deadlocks)}}},
+      {"bounds", {{"bounded", to_string(r.bounded)}, {"safe", to_string(r.safe)}, {"places", std::move(places)}}},
+      {"coverability", std::move(coverability)},
+      {"dead_transitions", ids_json(net, r.dead_transitions, false)},
+      {"never_marked_places", ids_json(net, r.never_marked, true)},
+      {"outcome",
+       {{"verdict", to_string(r.outcome)},
+        {"outcome_states", r.outcome_states},
+        {"stuck_count", r.stuck_count},
+        {"stuck", std::move(stuck)}}},
+      {"invariants", std::move(invariants)},
+      {"ok", r.ok()}};
+  // Names come from net files: a byte sequence that is not UTF-8 is replaced, not thrown on.
+  return out.dump(-1, ' ', false, Json::error_handler_t::replace) + '\n';
 }
 
 }  // namespace tripodal::analysis

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <numbers>
 #include <stdexcept>
 
 #include "tripodal/behaviors/behavior_registry.hpp"
@@ -13,39 +12,7 @@ namespace tripodal {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
-double wrap_angle(double a) noexcept {
-  a = std::fmod(a + kPi, 2.0 * kPi);
-  if (a < 0.0) a += 2.0 * kPi;
-  return a - kPi;
-}
-
 double clamp_abs(double v, double limit) noexcept { return std::clamp(v, -limit, limit); }
-
-ParameterSpec number(std::string name, double def, std::string unit, std::string description,
-                     std::optional<double> min = std::nullopt, std::optional<double> max = std::nullopt) {
-  return {std::move(name), ValueType::number, Value{def}, std::move(unit), std::move(description), min, max};
-}
-ParameterSpec text(std::string name, std::string def, std::string description) {
-  return {std::move(name), ValueType::string, Value{std::move(def)}, "", std::move(description), {}, {}};
-}
-ParameterSpec flag(std::string name, bool def, std::string description) {
-  return {std::move(name), ValueType::boolean, Value{def}, "", std::move(description), {}, {}};
-}
-
-ModuleManifest behavior_manifest(std::string name, std::string description, std::vector<std::string> inputs,
-                                 std::vector<ParameterSpec> parameters) {
-  ModuleManifest m;
-  m.name = std::move(name);
-  m.layer = Layer::reactive;
-  m.kind = ModuleKind::behavior;
-  m.description = std::move(description);
-  m.inputs = std::move(inputs);
-  m.outputs = {"behavior_command"};
-  m.parameters = std::move(parameters);
-  return m;
-}
 
 // The odometry resource named by the "odometry" parameter, or the first one when it is empty.
 const OdometryResource* find_odometry(const ParameterSet& params, const BehaviorContext& context) {
@@ -104,12 +71,12 @@ std::optional<Twist2D> BhStop::on_step(const BehaviorContext&) noexcept { return
 const ModuleManifest& BhRotateInPlace::static_manifest() {
   static const ModuleManifest m = behavior_manifest(
       "BhRotateInPlace", "turns on the spot by a relative angle measured by odometry", {"odometry"},
-      {number("angle_rad", 0.0, "rad", "relative turn, counter-clockwise positive", -100.0, 100.0),
-       number("max_yaw_rate_rad_s", 0.8, "rad/s", "yaw rate limit", 1e-6),
-       number("tolerance_rad", 0.02, "rad", "success when the remaining angle is below this", 1e-6),
-       number("gain", 2.0, "1/s", "proportional gain on the remaining angle", 1e-6),
-       number("stale_timeout_s", 0.5, "s", "fail when odometry stays stale longer than this", 0.0),
-       text("odometry", "", "odometry resource name; empty = the first one")});
+      {parameter::number("angle_rad", 0.0, "rad", "relative turn, counter-clockwise positive", -100.0, 100.0),
+       parameter::number("max_yaw_rate_rad_s", 0.8, "rad/s", "yaw rate limit", 1e-6),
+       parameter::number("tolerance_rad", 0.02, "rad", "success when the remaining angle is below this", 1e-6),
+       parameter::number("gain", 2.0, "1/s", "proportional gain on the remaining angle", 1e-6),
+       parameter::number("stale_timeout_s", 0.5, "s", "fail when odometry stays stale longer than this", 0.0),
+       parameter::text("odometry", "", "odometry resource name; empty = the first one")});
   return m;
 }
 
@@ -157,20 +124,20 @@ const ModuleManifest& BhGoToPose::static_manifest() {
   static const ModuleManifest m = behavior_manifest(
       "BhGoToPose", "drives to a goal pose; holonomic and differential bases alike",
       {"odometry", "map_from_base", "goal_pose"},
-      {number("goal_x_m", 0.0, "m", "goal x in the chosen frame"),
-       number("goal_y_m", 0.0, "m", "goal y in the chosen frame"),
-       number("goal_theta_rad", 0.0, "rad", "goal heading in the chosen frame"),
-       text("frame", "odom", "\"odom\" (odometry resource) or \"map\" (localizer pose)"),
-       flag("use_navigation_goal", false, "take the goal from the navigation data (map frame)"),
-       number("max_speed_m_s", 0.4, "m/s", "translation speed limit", 1e-6),
-       number("max_yaw_rate_rad_s", 1.0, "rad/s", "yaw rate limit", 1e-6),
-       number("position_tolerance_m", 0.03, "m", "position reached within this distance", 1e-6),
-       number("heading_tolerance_rad", 0.03, "rad", "heading reached within this angle", 1e-6),
-       number("k_rho", 1.0, "1/s", "speed per metre of remaining distance", 1e-6),
-       number("k_alpha", 2.5, "1/s", "yaw rate per radian of heading error", 1e-6),
-       number("timeout_s", 0.0, "s", "fail when the goal is not reached in this time; 0 = none", 0.0),
-       number("stale_timeout_s", 0.5, "s", "fail when the pose stays stale longer than this", 0.0),
-       text("odometry", "", "odometry resource name; empty = the first one")});
+      {parameter::number("goal_x_m", 0.0, "m", "goal x in the chosen frame"),
+       parameter::number("goal_y_m", 0.0, "m", "goal y in the chosen frame"),
+       parameter::number("goal_theta_rad", 0.0, "rad", "goal heading in the chosen frame"),
+       parameter::text("frame", "odom", "\"odom\" (odometry resource) or \"map\" (localizer pose)"),
+       parameter::flag("use_navigation_goal", false, "take the goal from the navigation data (map frame)"),
+       parameter::number("max_speed_m_s", 0.4, "m/s", "translation speed limit", 1e-6),
+       parameter::number("max_yaw_rate_rad_s", 1.0, "rad/s", "yaw rate limit", 1e-6),
+       parameter::number("position_tolerance_m", 0.03, "m", "position reached within this distance", 1e-6),
+       parameter::number("heading_tolerance_rad", 0.03, "rad", "heading reached within this angle", 1e-6),
+       parameter::number("k_rho", 1.0, "1/s", "speed per metre of remaining distance", 1e-6),
+       parameter::number("k_alpha", 2.5, "1/s", "yaw rate per radian of heading error", 1e-6),
+       parameter::number("timeout_s", 0.0, "s", "fail when the goal is not reached in this time; 0 = none", 0.0),
+       parameter::number("stale_timeout_s", 0.5, "s", "fail when the pose stays stale longer than this", 0.0),
+       parameter::text("odometry", "", "odometry resource name; empty = the first one")});
   return m;
 }
 
@@ -264,12 +231,12 @@ std::optional<Twist2D> BhGoToPose::on_step(const BehaviorContext& context) noexc
 const ModuleManifest& BhBackOff::static_manifest() {
   static const ModuleManifest m = behavior_manifest(
       "BhBackOff", "backs straight off after a bump, then optionally turns", {"odometry"},
-      {number("distance_m", 0.2, "m", "distance to back off", 0.0, 10.0),
-       number("speed_m_s", 0.1, "m/s", "backing speed", 1e-6),
-       number("turn_rad", 0.0, "rad", "turn after backing off, counter-clockwise positive", -10.0, 10.0),
-       number("yaw_rate_rad_s", 0.5, "rad/s", "yaw rate of the turn", 1e-6),
-       number("stale_timeout_s", 0.5, "s", "fail when odometry stays stale longer than this", 0.0),
-       text("odometry", "", "odometry resource name; empty = the first one")});
+      {parameter::number("distance_m", 0.2, "m", "distance to back off", 0.0, 10.0),
+       parameter::number("speed_m_s", 0.1, "m/s", "backing speed", 1e-6),
+       parameter::number("turn_rad", 0.0, "rad", "turn after backing off, counter-clockwise positive", -10.0, 10.0),
+       parameter::number("yaw_rate_rad_s", 0.5, "rad/s", "yaw rate of the turn", 1e-6),
+       parameter::number("stale_timeout_s", 0.5, "s", "fail when odometry stays stale longer than this", 0.0),
+       parameter::text("odometry", "", "odometry resource name; empty = the first one")});
   return m;
 }
 
@@ -332,14 +299,14 @@ constexpr std::size_t kMaxTableBeams = 4096;
 const ModuleManifest& BhAvoidObstacle::static_manifest() {
   static const ModuleManifest m = behavior_manifest(
       "BhAvoidObstacle", "laser safety override: slows and stops translation toward obstacles", {"laser_scan"},
-      {number("stop_distance_m", 0.15, "m", "no motion toward an obstacle this close to the footprint", 0.0),
-       number("slow_distance_m", 0.8, "m", "full speed allowed beyond this clearance", 0.0),
-       number("max_speed_m_s", 1.0, "m/s", "speed allowed at slow_distance_m and beyond", 0.0),
-       number("robot_radius_m", 0.25, "m", "radius of the circular footprint", 0.0),
-       number("laser_x_m", 0.0, "m", "laser position in the body frame"),
-       number("laser_y_m", 0.0, "m", "laser position in the body frame"),
-       number("laser_yaw_rad", 0.0, "rad", "laser orientation in the body frame"),
-       text("laser", "", "laser resource name; empty = the first one")});
+      {parameter::number("stop_distance_m", 0.15, "m", "no motion toward an obstacle this close to the footprint", 0.0),
+       parameter::number("slow_distance_m", 0.8, "m", "full speed allowed beyond this clearance", 0.0),
+       parameter::number("max_speed_m_s", 1.0, "m/s", "speed allowed at slow_distance_m and beyond", 0.0),
+       parameter::number("robot_radius_m", 0.25, "m", "radius of the circular footprint", 0.0),
+       parameter::number("laser_x_m", 0.0, "m", "laser position in the body frame"),
+       parameter::number("laser_y_m", 0.0, "m", "laser position in the body frame"),
+       parameter::number("laser_yaw_rad", 0.0, "rad", "laser orientation in the body frame"),
+       parameter::text("laser", "", "laser resource name; empty = the first one")});
   return m;
 }
 
@@ -361,6 +328,7 @@ void BhAvoidObstacle::on_activate(const ParameterSet& params, const BehaviorCont
   // Capacity reserved here so that step() never allocates, whatever the beam count.
   cos_.resize(0);
   sin_.resize(0);
+  scan_seen_ = 0;
   if (laser_ == nullptr) fail("no laser resource");
 }
 
@@ -386,6 +354,13 @@ std::optional<Twist2D> BhAvoidObstacle::on_step(const BehaviorContext& context) 
     set_envelope(env);
     return std::nullopt;
   }
+  // The envelope depends on the scan alone: computed once per scan (a laser publishes far less
+  // often than the loop runs).
+  if (laser_->sequence() == scan_seen_) {
+    set_envelope(envelope_);
+    return std::nullopt;
+  }
+  scan_seen_ = laser_->sequence();
   const LaserScan& scan = laser_->latest();
   if (static_cast<std::size_t>(cos_.size()) != std::min(scan.ranges_m.size(), kMaxTableBeams) || table_angle_min_ != scan.angle_min_rad ||
       table_increment_ != scan.angle_increment_rad) {
@@ -442,6 +417,7 @@ std::optional<Twist2D> BhAvoidObstacle::on_step(const BehaviorContext& context) 
   env.vx_lo_m_s = -allowed(back);
   env.vy_hi_m_s = allowed(left);
   env.vy_lo_m_s = -allowed(right);
+  envelope_ = env;
   set_envelope(env);
   return std::nullopt;
 }

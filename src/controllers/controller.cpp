@@ -93,35 +93,3 @@ void CController::reset_odometry(const Pose2D& pose) noexcept {
 }
 
 }  // namespace tripodal
-
-#include "controller_manifest.hpp"
-
-namespace tripodal::detail {
-
-ModuleManifest controller_manifest(std::string name, std::string description, std::vector<ParameterSpec> specific) {
-  ModuleManifest m;
-  m.name = std::move(name);
-  m.layer = Layer::reactive;
-  m.kind = ModuleKind::controller;
-  m.description = std::move(description);
-  m.inputs = {"cmd_vel"};
-  m.outputs = {"odometry", "wheel_commands"};
-  auto num = [](std::string n, std::optional<Value> def, std::string unit, std::string desc) {
-    return ParameterSpec{std::move(n), ValueType::number, std::move(def), std::move(unit), std::move(desc), 0.0, {}};
-  };
-  m.parameters = std::move(specific);
-  m.parameters.push_back(num("period_s", Value{0.01}, "s", "nominal sampling period"));
-  m.parameters.push_back(num("cmd_timeout_s", Value{0.0}, "s", "brake to zero when no command came for this long; 0 disables"));
-  m.parameters.push_back(num("max_wheel_speed_rad_s", std::nullopt, "rad/s", "wheel saturation (unset: none); scaled keeping curvature"));
-  for (const char* axis : {"vx", "vy", "wz"}) {
-    const std::string a = axis;
-    const bool lin = a != "wz";
-    m.parameters.push_back(num("limits." + a + ".max_velocity", std::nullopt, lin ? "m/s" : "rad/s", "unset: no limit"));
-    m.parameters.push_back(num("limits." + a + ".max_acceleration", std::nullopt, lin ? "m/s^2" : "rad/s^2", "unset: no limit"));
-    m.parameters.push_back(num("limits." + a + ".max_deceleration", std::nullopt, lin ? "m/s^2" : "rad/s^2", "unset: max_acceleration"));
-    m.parameters.push_back(num("limits." + a + ".max_jerk", std::nullopt, lin ? "m/s^3" : "rad/s^3", "unset: no limit"));
-  }
-  return m;
-}
-
-}  // namespace tripodal::detail

@@ -1,6 +1,8 @@
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <string_view>
+#include <utility>
 
 #include "tripodal/controllers/controller_config.hpp"
 #include "tripodal/controllers/differential_drive_controller.hpp"
@@ -80,40 +82,59 @@ Diagnostics validate(const ControllerConfig& c) {
   return d;
 }
 
-void ControllerRegistry::add(const ModuleManifest& manifest, Factory factory) {
-  if (manifest.name.empty()) throw std::invalid_argument("a controller type needs a name");
-  if (!entries_.emplace(manifest.name, Entry{&manifest, std::move(factory)}).second) {
-    throw std::invalid_argument("controller type '" + manifest.name + "' is already registered");
+ModuleManifest controller_manifest(std::string name, std::string description, std::vector<ParameterSpec> specific) {
+  ManifestBuilder b(std::move(name), ModuleKind::controller, Layer::reactive);
+  b.description(std::move(description)).input("cmd_vel").outputs({"odometry", "wheel_commands"});
+  b.parameters(std::move(specific));
+  b.parameter(parameter::positive("period_s", 0.01, "s", "nominal sampling period"));
+  b.number("cmd_timeout_s", 0.0, "s", "brake to zero when no command came for this long; 0 disables", 0.0);
+  b.parameter(parameter::optional(
+      parameter::positive("max_wheel_speed_rad_s", {}, "rad/s", "wheel saturation (unset: none); scaled keeping curvature")));
+  for (const char* axis : {"vx", "vy", "wz"}) {
+    const std::string a = std::string("limits.") + axis + ".";
+    const bool linear = std::string_view(axis) != "wz";
+    auto limit = [&](const char* what, const char* linear_unit, const char* angular_unit, const char* unset) {
+      b.parameter(parameter::optional(
+          parameter::positive(a + what, {}, linear ? linear_unit : angular_unit, std::string("unset: ") + unset)));
+    };
+    limit("max_velocity", "m/s", "rad/s", "no limit");
+    limit("max_acceleration", "m/s^2", "rad/s^2", "no limit");
+    limit("max_deceleration", "m/s^2", "rad/s^2", "max_acceleration");
+    limit("max_jerk", "m/s^3", "rad/s^3", "no limit");
   }
+  return std::move(b).build();
 }
 
-bool ControllerRegistry::contains(std::string_view type) const noexcept { return entries_.find(type) != entries_.end(); }
-
-const ModuleManifest* ControllerRegistry::manifest(std::string_view type) const noexcept {
-  auto it = entries_.find(type);
-  return it == entries_.end() ? nullptr : it->second.manifest;
-}
-
-std::vector<std::string> ControllerRegistry::names() const {
-  std::vector<std::string> out;
-  for (const auto& [n, e] : entries_) out.push_back(n);
-  return out;
-}
-
-std::unique_ptr<CController> ControllerRegistry::create(const ControllerConfig& config, HardwareInterface& hardware) const {
-  auto it = entries_.find(config.type);
-  if (it == entries_.end()) {
-    std::string known;
-    for (const auto& [n, e] : entries_) known += (known.empty() ? "" : ", ") + n;
-    throw ConfigError(config.where, "unknown controller type '" + config.type + "' (expected one of: " + known + ")");
+void apply_parameters(ControllerConfig& c) {
+  const ParameterSet& p = c.parameters;
+  auto set = [&](std::string_view name, auto&& assign) {
+    if (p.contains(name)) assign(p.number(name));
+  };
+  set("period_s", [&](double s) { c.period = from_seconds(s); });
+  set("cmd_timeout_s", [&](double s) { c.cmd_timeout = from_seconds(s); });
+  set("max_wheel_speed_rad_s", [&](double v) { c.max_wheel_speed_rad_s = v; });
+  for (auto [axis, limits] : {std::pair{"vx", &c.limits.vx}, std::pair{"vy", &c.limits.vy}, std::pair{"wz", &c.limits.wz}}) {
+    const std::string a = std::string("limits.") + axis + ".";
+    set(a + "max_velocity", [&](double v) { limits->max_velocity = v; });
+    set(a + "max_acceleration", [&](double v) { limits->max_acceleration = v; });
+    set(a + "max_deceleration", [&](double v) { limits->max_deceleration = v; });
+    set(a + "max_jerk", [&](double v) { limits->max_jerk = v; });
   }
-  return it->second.factory(config, hardware);
+  if (c.type == "differential") {
+    set("wheel_separation_m", [&](double v) { c.differential.wheel_separation_m = v; });
+    set("wheel_radius_m", [&](double v) { c.differential.wheel_radius_m = v; });
+  } else if (c.type == "mecanum") {
+    if (p.contains("half_length_m") && p.contains("half_width_m")) {
+      c.holonomic = mecanum_base(0.0, p.number("half_length_m"), p.number("half_width_m"));
+    }
+    set("wheel_radius_m", [&](double v) { c.holonomic.wheel_radius_m = v; });
+  } else if (c.type == "omni") {
+    set("wheel_radius_m", [&](double v) { c.holonomic.wheel_radius_m = v; });
+  }
 }
 
 void register_builtin_controllers(ControllerRegistry& registry) {
-  registry.add(DifferentialDriveController::static_manifest(), [](const ControllerConfig& c, HardwareInterface& h) {
-    return std::unique_ptr<CController>(std::make_unique<DifferentialDriveController>(c, h));
-  });
+  registry.add<DifferentialDriveController>();
   auto holonomic = [](const ControllerConfig& c, HardwareInterface& h) {
     return std::unique_ptr<CController>(std::make_unique<HolonomicController>(c, h));
   };

@@ -3,16 +3,15 @@
 #include <algorithm>
 #include <cmath>
 
-#include "controller_manifest.hpp"
 #include "tripodal/controllers/kinematics.hpp"
 
 namespace tripodal {
 
 const ModuleManifest& DifferentialDriveController::static_manifest() {
-  static const ModuleManifest m = detail::controller_manifest(
+  static const ModuleManifest m = controller_manifest(
       "differential", "two-wheel differential drive, wheels [left, right]",
-      {{"wheel_separation_m", ValueType::number, std::nullopt, "m", "distance between the wheel contact points", 0.0, {}},
-       {"wheel_radius_m", ValueType::number, std::nullopt, "m", "wheel radius", 0.0, {}}});
+      {parameter::positive("wheel_separation_m", {}, "m", "distance between the wheel contact points (track width)"),
+       parameter::positive("wheel_radius_m", {}, "m", "wheel radius")});
   return m;
 }
 

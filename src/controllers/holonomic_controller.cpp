@@ -4,21 +4,24 @@
 #include <algorithm>
 #include <cmath>
 
-#include "controller_manifest.hpp"
 #include "tripodal/controllers/kinematics.hpp"
 
 namespace tripodal {
 
 namespace {
 std::vector<ParameterSpec> holonomic_parameters(bool mecanum) {
-  std::vector<ParameterSpec> p = {
-      {"wheel_radius_m", ValueType::number, std::nullopt, "m", "wheel radius", 0.0, {}}};
+  std::vector<ParameterSpec> p = {parameter::positive("wheel_radius_m", {}, "m", "wheel radius")};
   if (mecanum) {
-    p.push_back({"half_length_m", ValueType::number, std::nullopt, "m", "half the distance between front and rear axles", 0.0, {}});
-    p.push_back({"half_width_m", ValueType::number, std::nullopt, "m", "half the track width", 0.0, {}});
+    p.push_back(parameter::positive("half_length_m", {}, "m", "half the distance between front and rear axles"));
+    p.push_back(parameter::positive("half_width_m", {}, "m", "half the track width"));
   } else {
-    p.push_back({"base_radius_m", ValueType::number, std::nullopt, "m", "distance of the wheels from the centre", 0.0, {}});
-    p.push_back({"wheel_angles_deg", ValueType::string, std::nullopt, "deg", "list of wheel angles (>= 3); or `wheels` with x_m, y_m, drive_angle_deg, roller_angle_deg", {}, {}});
+    // The wheel lists are read by the YAML loader's omni geometry code: a parameter is a scalar.
+    p.push_back(parameter::optional(
+        parameter::positive("base_radius_m", {}, "m", "distance of the wheels from the centre (with wheel_angles_deg)")));
+    p.push_back(parameter::optional(
+        parameter::text("wheel_angles_deg", {}, "list of wheel angles in degrees (3 to 8), with base_radius_m")));
+    p.push_back(parameter::optional(
+        parameter::text("wheels", {}, "list of {x_m, y_m, drive_angle_deg, roller_angle_deg}, instead of wheel_angles_deg")));
   }
   return p;
 }
@@ -26,13 +29,13 @@ std::vector<ParameterSpec> holonomic_parameters(bool mecanum) {
 
 const ModuleManifest& HolonomicController::omni_manifest() {
   static const ModuleManifest m =
-      detail::controller_manifest("omni", "three or more omni wheels at given angles (PSR bases)", holonomic_parameters(false));
+      controller_manifest("omni", "three or more omni wheels at given angles (PSR bases)", holonomic_parameters(false));
   return m;
 }
 
 const ModuleManifest& HolonomicController::mecanum_manifest() {
   static const ModuleManifest m =
-      detail::controller_manifest("mecanum", "four mecanum wheels, X arrangement", holonomic_parameters(true));
+      controller_manifest("mecanum", "four mecanum wheels, X arrangement", holonomic_parameters(true));
   return m;
 }
 

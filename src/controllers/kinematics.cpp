@@ -1,7 +1,6 @@
 #include "tripodal/controllers/kinematics.hpp"
 
 #include <cmath>
-#include <numbers>
 
 namespace tripodal {
 
@@ -36,13 +35,6 @@ Twist2D differential_forward(double wheel_separation_m, double wheel_radius_m, d
                              double right_rad_s) noexcept {
   return {0.5 * wheel_radius_m * (left_rad_s + right_rad_s), 0.0,
           wheel_radius_m * (right_rad_s - left_rad_s) / wheel_separation_m};
-}
-
-double wrap_angle(double angle_rad) noexcept {
-  constexpr double kPi = std::numbers::pi;
-  double a = std::fmod(angle_rad + kPi, 2.0 * kPi);
-  if (a < 0.0) a += 2.0 * kPi;
-  return a - kPi;
 }
 
 }  // namespace tripodal

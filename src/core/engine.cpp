@@ -16,13 +16,12 @@
 #include <algorithm>
 #include <bit>
 #include <cassert>
-#include <cstdio>
 #include <limits>
-#include <map>
 #include <stdexcept>
 #include <unordered_map>
 #include <utility>
 
+#include "net_compile.hpp"
 #include "tripodal/core/diagnostic.hpp"
 
 namespace tripodal {
@@ -62,11 +61,7 @@ struct Effect {
   std::uint32_t watch_end = 0;
 };
 
-struct Check {
-  PlaceIndex place = 0;
-  Tokens lo = 0;
-  Tokens hi = std::numeric_limits<Tokens>::max();
-};
+using Check = detail::PlaceBound;
 
 /// A transition's Check on one place, listed under that place: when a firing changes the place,
 /// the bound alone decides whether an enabled watcher stays enabled.
@@ -263,11 +258,7 @@ std::shared_ptr<spdlog::logger> engine_logger() {
   return logger;
 }
 
-std::string seconds_text(Time t) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.6f s", to_seconds(t));
-  return buf;
-}
+std::string seconds_text(Time t) { return format_seconds(t, 6) + " s"; }
 
 struct StringHash {
   using is_transparent = void;
@@ -606,61 +597,23 @@ void Engine::Impl::compile_structure() {
     }
     if (tr.guard) code[t].guard = &*tr.guard;
 
-    // Per touched place: tokens consumed and produced, and the folded enabling bounds.
-    std::map<PlaceIndex, PlaceChange> delta;
-    std::map<PlaceIndex, Check> bounds;
-    auto bound_of = [&](PlaceIndex p) -> Check& {
-      auto [it, inserted] = bounds.try_emplace(p);
-      if (inserted) it->second.place = p;
-      return it->second;
-    };
-    for (const ArcRef& a : tr.inputs) {
-      auto& d = delta[a.place];
-      d.place = a.place;
-      d.consumed += a.weight;
-    }
-    for (const ArcRef& a : tr.outputs) {
-      auto& d = delta[a.place];
-      d.place = a.place;
-      d.produced += a.weight;
-    }
-    for (const auto& [p, d] : delta) {
-      if (d.consumed > 0) bound_of(p).lo = std::max(bound_of(p).lo, d.consumed);
-      const auto& cap = places[p].capacity;
-      if (cap && d.produced > d.consumed) {
-        const Tokens gain = d.produced - d.consumed;
-        Check& c = bound_of(p);
-        if (gain > *cap) {
-          c.lo = 1;  // can never fire: the gain alone exceeds the capacity
-          c.hi = 0;
-        } else {
-          c.hi = std::min(c.hi, *cap - gain);
-        }
-      }
-    }
-    for (const ArcRef& a : tr.reads) bound_of(a.place).lo = std::max(bound_of(a.place).lo, a.weight);
-    for (const ArcRef& a : tr.inhibitors) bound_of(a.place).hi = std::min(bound_of(a.place).hi, a.weight - 1);
     code[t].check_begin = static_cast<std::uint32_t>(checks.size());
-    for (const auto& [p, c] : bounds) {
-      checks.push_back(c);
-      place_watchers[p].push_back(Watch{t, c.lo, c.hi});
+    const std::size_t first_change = changes.size();
+    detail::fold_transition(net, tr, {}, checks, changes);
+    for (std::size_t i = code[t].check_begin; i < checks.size(); ++i) {
+      place_watchers[checks[i].place].push_back(Watch{t, checks[i].lo, checks[i].hi});
     }
     code[t].effect_begin = static_cast<std::uint32_t>(effects.size());
-    for (const auto& [p, d] : delta) {
-      changes.push_back(d);
-      if (d.produced != d.consumed) effects.push_back(Effect{p, d.produced - d.consumed, 0, 0});
+    for (std::size_t i = first_change; i < changes.size(); ++i) {
+      const PlaceChange& d = changes[i];
+      if (d.produced != d.consumed) effects.push_back(Effect{d.place, d.produced - d.consumed, 0, 0});
     }
     code[t].check_end = static_cast<std::uint32_t>(checks.size());
     change_begin.push_back(static_cast<std::uint32_t>(changes.size()));
     code[t].effect_end = static_cast<std::uint32_t>(effects.size());
   }
 
-  // Conflict order: priority descending, then declaration order.
-  order.resize(nt);
-  for (TransitionIndex t = 0; t < nt; ++t) order[t] = t;
-  std::stable_sort(order.begin(), order.end(), [&](TransitionIndex a, TransitionIndex b) {
-    return transitions[a].priority > transitions[b].priority;
-  });
+  order = detail::conflict_order(net);
   for (std::uint32_t r = 0; r < nt; ++r) code[order[r]].rank = r;
 
   watch_begin.assign(1, 0);

@@ -1,8 +1,5 @@
 #include "tripodal/core/manifest.hpp"
 
-#include <algorithm>
-#include <map>
-#include <set>
 #include <stdexcept>
 
 namespace tripodal {
@@ -44,6 +41,121 @@ const ParameterSpec* ModuleManifest::find_parameter(std::string_view parameter) 
   return nullptr;
 }
 
+std::optional<std::string> check_parameter_value(const ParameterSpec& spec, const Value& value) {
+  if (type_of(value) != spec.type) {
+    return "parameter '" + spec.name + "' expects a " + std::string(to_string(spec.type)) + ", got " + to_string(value);
+  }
+  if (spec.type != ValueType::number) return std::nullopt;
+  const double x = std::get<double>(value);
+  const bool below = spec.min && (spec.min_exclusive ? !(x > *spec.min) : !(x >= *spec.min));
+  const bool above = spec.max && !(x <= *spec.max);
+  if (!below && !above) return std::nullopt;
+  const std::string range = (spec.min_exclusive ? "(" : "[") +
+                            (spec.min ? to_string(Value{*spec.min}) : std::string("-inf")) + ", " +
+                            (spec.max ? to_string(Value{*spec.max}) : std::string("inf")) + "]";
+  return "parameter '" + spec.name + "' = " + to_string(value) + (spec.unit.empty() ? "" : " " + spec.unit) +
+         " is outside " + range;
+}
+
+namespace parameter {
+
+ParameterSpec number(std::string name, std::optional<double> default_value, std::string unit, std::string description,
+                     std::optional<double> min, std::optional<double> max) {
+  ParameterSpec p;
+  p.name = std::move(name);
+  p.type = ValueType::number;
+  if (default_value) p.default_value = Value{*default_value};
+  p.unit = std::move(unit);
+  p.description = std::move(description);
+  p.min = min;
+  p.max = max;
+  return p;
+}
+
+ParameterSpec positive(std::string name, std::optional<double> default_value, std::string unit, std::string description) {
+  ParameterSpec p = number(std::move(name), default_value, std::move(unit), std::move(description), 0.0);
+  p.min_exclusive = true;
+  return p;
+}
+
+ParameterSpec text(std::string name, std::optional<std::string> default_value, std::string description) {
+  ParameterSpec p;
+  p.name = std::move(name);
+  p.type = ValueType::string;
+  if (default_value) p.default_value = Value{std::move(*default_value)};
+  p.description = std::move(description);
+  return p;
+}
+
+ParameterSpec flag(std::string name, std::optional<bool> default_value, std::string description) {
+  ParameterSpec p;
+  p.name = std::move(name);
+  p.type = ValueType::boolean;
+  if (default_value) p.default_value = Value{*default_value};
+  p.description = std::move(description);
+  return p;
+}
+
+ParameterSpec optional(ParameterSpec spec) {
+  spec.default_value.reset();
+  spec.optional = true;
+  return spec;
+}
+
+}  // namespace parameter
+
+ManifestBuilder::ManifestBuilder(std::string name, ModuleKind kind, Layer layer) {
+  manifest_.name = std::move(name);
+  manifest_.kind = kind;
+  manifest_.layer = layer;
+}
+ManifestBuilder& ManifestBuilder::layer(Layer layer) {
+  manifest_.layer = layer;
+  return *this;
+}
+ManifestBuilder& ManifestBuilder::kind(ModuleKind kind) {
+  manifest_.kind = kind;
+  return *this;
+}
+ManifestBuilder& ManifestBuilder::description(std::string text) {
+  manifest_.description = std::move(text);
+  return *this;
+}
+ManifestBuilder& ManifestBuilder::input(std::string information) {
+  manifest_.inputs.push_back(std::move(information));
+  return *this;
+}
+ManifestBuilder& ManifestBuilder::inputs(std::vector<std::string> information) {
+  for (auto& i : information) manifest_.inputs.push_back(std::move(i));
+  return *this;
+}
+ManifestBuilder& ManifestBuilder::output(std::string information) {
+  manifest_.outputs.push_back(std::move(information));
+  return *this;
+}
+ManifestBuilder& ManifestBuilder::outputs(std::vector<std::string> information) {
+  for (auto& o : information) manifest_.outputs.push_back(std::move(o));
+  return *this;
+}
+ManifestBuilder& ManifestBuilder::parameter(ParameterSpec spec) {
+  manifest_.parameters.push_back(std::move(spec));
+  return *this;
+}
+ManifestBuilder& ManifestBuilder::parameters(std::vector<ParameterSpec> specs) {
+  for (auto& p : specs) manifest_.parameters.push_back(std::move(p));
+  return *this;
+}
+ManifestBuilder& ManifestBuilder::number(std::string name, std::optional<double> default_value, std::string unit,
+                                         std::string description, std::optional<double> min, std::optional<double> max) {
+  return parameter(tripodal::parameter::number(std::move(name), default_value, std::move(unit), std::move(description), min, max));
+}
+ManifestBuilder& ManifestBuilder::text(std::string name, std::optional<std::string> default_value, std::string description) {
+  return parameter(tripodal::parameter::text(std::move(name), std::move(default_value), std::move(description)));
+}
+ManifestBuilder& ManifestBuilder::flag(std::string name, std::optional<bool> default_value, std::string description) {
+  return parameter(tripodal::parameter::flag(std::move(name), default_value, std::move(description)));
+}
+
 ParameterSet ParameterSet::resolve(const ModuleManifest& manifest, const ParameterValues& given,
                                    const SourceLocation& where) {
   Diagnostics diags;
@@ -61,7 +173,7 @@ ParameterSet ParameterSet::resolve(const ModuleManifest& manifest, const Paramet
     if (it == given.end()) {
       if (spec.default_value) {
         out.values_.emplace(spec.name, *spec.default_value);
-      } else {
+      } else if (!spec.optional) {
         diags.error(where, manifest.name + ": missing required parameter '" + spec.name + "' (" +
                                std::string(to_string(spec.type)) + ")");
       }
@@ -72,20 +184,9 @@ ParameterSet ParameterSet::resolve(const ModuleManifest& manifest, const Paramet
     if (type_of(v) != spec.type && type_of(v) == ValueType::string) {
       if (auto parsed = parse_value(spec.type, std::get<std::string>(v))) v = *parsed;
     }
-    if (type_of(v) != spec.type) {
-      diags.error(where, manifest.name + ": parameter '" + spec.name + "' expects a " +
-                             std::string(to_string(spec.type)) + ", got " + to_string(it->second));
+    if (auto problem = check_parameter_value(spec, v)) {
+      diags.error(where, manifest.name + ": " + *problem);
       continue;
-    }
-    if (spec.type == ValueType::number) {
-      const double x = std::get<double>(v);
-      if ((spec.min && x < *spec.min) || (spec.max && x > *spec.max)) {
-        std::string range = "[" + (spec.min ? to_string(Value{*spec.min}) : std::string("-inf")) + ", " +
-                            (spec.max ? to_string(Value{*spec.max}) : std::string("inf")) + "]";
-        diags.error(where, manifest.name + ": parameter '" + spec.name + "' = " + to_string(v) +
-                               (spec.unit.empty() ? "" : " " + spec.unit) + " is outside " + range);
-        continue;
-      }
     }
     out.values_.emplace(spec.name, std::move(v));
   }
@@ -104,63 +205,5 @@ const std::string& ParameterSet::string(std::string_view name) const {
   return std::get<std::string>(value(name));
 }
 bool ParameterSet::contains(std::string_view name) const noexcept { return values_.find(name) != values_.end(); }
-
-Diagnostics check_providers(const std::vector<const ModuleManifest*>& modules) {
-  Diagnostics diags;
-  std::map<std::string, std::vector<std::string>, std::less<>> providers;
-  for (const auto* m : modules) {
-    for (const auto& out : m->outputs) providers[out].push_back(m->name);
-  }
-  std::set<std::string, std::less<>> reported;
-  for (const auto* m : modules) {
-    for (const auto& in : m->inputs) {
-      if (!reported.insert(in).second) continue;
-      auto it = providers.find(in);
-      if (it == providers.end()) {
-        diags.error({}, "input '" + in + "' of " + m->name + " has no provider");
-      } else if (it->second.size() > 1) {
-        std::string names;
-        for (const auto& n : it->second) names += (names.empty() ? "" : ", ") + n;
-        diags.error({}, "input '" + in + "' of " + m->name + " has " + std::to_string(it->second.size()) +
-                            " providers (" + names + "); expected exactly one");
-      }
-    }
-  }
-  return diags;
-}
-
-namespace {
-std::string dot_quote(std::string_view s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
-}  // namespace
-
-std::string functionality_diagram_dot(const std::vector<const ModuleManifest*>& modules) {
-  std::string out = "digraph functionality {\n  rankdir=TB;\n  node [shape=box];\n";
-  for (Layer layer : {Layer::deliberate, Layer::sequencing, Layer::reactive}) {
-    out += "  subgraph cluster_" + std::string(to_string(layer)) + " {\n    label=" +
-           dot_quote(std::string(to_string(layer)) + " layer") + ";\n";
-    for (const auto* m : modules) {
-      if (m->layer == layer) out += "    " + dot_quote(m->name) + ";\n";
-    }
-    out += "  }\n";
-  }
-  for (const auto* provider : modules) {
-    for (const auto& info : provider->outputs) {
-      for (const auto* consumer : modules) {
-        if (std::find(consumer->inputs.begin(), consumer->inputs.end(), info) != consumer->inputs.end()) {
-          out += "  " + dot_quote(provider->name) + " -> " + dot_quote(consumer->name) +
-                 " [label=" + dot_quote(info) + "];\n";
-        }
-      }
-    }
-  }
-  return out + "}\n";
-}
 
 }  // namespace tripodal

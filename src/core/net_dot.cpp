@@ -2,12 +2,14 @@
 
 #include <stdexcept>
 
+#include "net_formats.hpp"  // xml_escape: an HTML-like label is XML text
+
 namespace tripodal {
 
 namespace {
 
 // A DOT double-quoted string: quotes and backslashes escaped; "\n" stays a DOT line break.
-std::string quoted(std::string_view text) {
+std::string dot_quoted(std::string_view text) {
   std::string out = "\"";
   for (const char c : text) {
     if (c == '"' || c == '\\') out += '\\';
@@ -29,27 +31,7 @@ std::string token_text(Tokens n) {
   return out;
 }
 
-// Text for an HTML-like Graphviz label.
-std::string html(std::string_view text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
-std::string seconds_text(Duration d) {
-  std::string s = std::to_string(to_seconds(d));
-  while (!s.empty() && s.back() == '0') s.pop_back();
-  if (!s.empty() && s.back() == '.') s.pop_back();
-  return s + " s";
-}
+std::string seconds_text(Duration d) { return format_seconds(d, kExactDigits) + " s"; }
 
 }  // namespace
 
@@ -59,9 +41,9 @@ std::string net_to_dot(const PetriNet& net, std::span<const Tokens> marking, con
     throw std::invalid_argument("marking has " + std::to_string(marking.size()) + " entries for " +
                                 std::to_string(places.size()) + " places");
   }
-  std::string out = "digraph " + quoted(net.id.empty() ? "net" : net.id) + " {\n";
+  std::string out = "digraph " + dot_quoted(net.id.empty() ? "net" : net.id) + " {\n";
   out += "  graph [rankdir=TB, nodesep=0.7, ranksep=0.5, forcelabels=true, fontname=\"Helvetica\"";
-  if (!net.description.empty()) out += ", label=" + quoted(net.description) + ", labelloc=t";
+  if (!net.description.empty()) out += ", label=" + dot_quoted(net.description) + ", labelloc=t";
   out += "];\n";
   out += "  node [fontname=\"Helvetica\", fontsize=11];\n  edge [arrowsize=0.7];\n";
   // The drawing carries the ids (as the paper's figures do); the descriptions go to a legend table
@@ -71,8 +53,8 @@ std::string net_to_dot(const PetriNet& net, std::span<const Tokens> marking, con
     const Tokens tokens = marking.empty() ? p.initial_tokens : marking[i];
     std::string xlabel = p.name;
     if (p.capacity) xlabel += " (" + std::to_string(*p.capacity) + ")";
-    out += "  " + quoted(p.id) + " [shape=circle, fixedsize=true, width=0.5, label=" + quoted(token_text(tokens)) +
-           ", xlabel=" + quoted(xlabel);
+    out += "  " + dot_quoted(p.id) + " [shape=circle, fixedsize=true, width=0.5, label=" + dot_quoted(token_text(tokens)) +
+           ", xlabel=" + dot_quoted(xlabel);
     if (p.outcome != Outcome::none) out += ", peripheries=2";
     if (p.outcome == Outcome::fault) out += ", color=\"#b00000\"";
     if (p.behavior || p.process) out += ", style=filled, fillcolor=\"#eef3ff\"";
@@ -84,27 +66,27 @@ std::string net_to_dot(const PetriNet& net, std::span<const Tokens> marking, con
     if (t.guard) xlabel += "\nif " + t.guard->text();
     if (t.delay.count() != 0) xlabel += "\nafter " + seconds_text(t.delay);
     if (t.priority != 0) xlabel += "\npriority " + std::to_string(t.priority);
-    out += "  " + quoted(t.id) +
+    out += "  " + dot_quoted(t.id) +
            " [shape=box, style=filled, fillcolor=black, label=\"\", width=0.45, height=0.07, fixedsize=true, xlabel=" +
-           quoted(xlabel) + "];\n";
+           dot_quoted(xlabel) + "];\n";
   }
   for (const auto& t : net.transitions()) {
-    const auto weight = [](Tokens w) { return w > 1 ? "label=" + quoted(std::to_string(w)) : std::string(); };
+    const auto weight = [](Tokens w) { return w > 1 ? "label=" + dot_quoted(std::to_string(w)) : std::string(); };
     const auto more = [&](Tokens w) { return w > 1 ? ", " + weight(w) : std::string(); };
-    for (const auto& a : t.inputs) out += "  " + quoted(places[a.place].id) + " -> " + quoted(t.id) + " [" + weight(a.weight) + "];\n";
-    for (const auto& a : t.outputs) out += "  " + quoted(t.id) + " -> " + quoted(places[a.place].id) + " [" + weight(a.weight) + "];\n";
+    for (const auto& a : t.inputs) out += "  " + dot_quoted(places[a.place].id) + " -> " + dot_quoted(t.id) + " [" + weight(a.weight) + "];\n";
+    for (const auto& a : t.outputs) out += "  " + dot_quoted(t.id) + " -> " + dot_quoted(places[a.place].id) + " [" + weight(a.weight) + "];\n";
     for (const auto& a : t.reads) {
-      out += "  " + quoted(places[a.place].id) + " -> " + quoted(t.id) + " [style=dashed, arrowhead=none" + more(a.weight) + "];\n";
+      out += "  " + dot_quoted(places[a.place].id) + " -> " + dot_quoted(t.id) + " [style=dashed, arrowhead=none" + more(a.weight) + "];\n";
     }
     for (const auto& a : t.inhibitors) {
-      out += "  " + quoted(places[a.place].id) + " -> " + quoted(t.id) + " [arrowhead=odot" + more(a.weight) + "];\n";
+      out += "  " + dot_quoted(places[a.place].id) + " -> " + dot_quoted(t.id) + " [arrowhead=odot" + more(a.weight) + "];\n";
     }
   }
   if (options.descriptions) {
     std::string rows;
     const auto row = [&](const std::string& id, std::string text) {
       if (text.empty()) return;
-      rows += "<TR><TD ALIGN=\"LEFT\">" + html(id) + "</TD><TD ALIGN=\"LEFT\">" + html(text) + "</TD></TR>";
+      rows += "<TR><TD ALIGN=\"LEFT\">" + detail::xml_escape(id) + "</TD><TD ALIGN=\"LEFT\">" + detail::xml_escape(text) + "</TD></TR>";
     };
     for (const auto& p : places) {
       std::string text = p.description;

@@ -17,7 +17,7 @@ PetriNet read_native(const XmlElement* root, const ReadContext& ctx);
 /// PNML: ISO/IEC 15909-2 P/T nets (with <page>) and the JARP dialect (no <page>, <value> labels).
 PetriNet read_pnml(const XmlElement* root, const ReadContext& ctx);
 
-/// XML attribute/text escaping shared by the writers.
+/// XML attribute/text escaping shared by the writers and the DOT writer's HTML-like labels.
 std::string xml_escape(std::string_view text);
 /// The value as written in a file: true/false, shortest round-trip number, raw string.
 std::string value_text(const Value& v);

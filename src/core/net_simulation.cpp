@@ -1,17 +1,15 @@
 #include "tripodal/core/net_simulation.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
-#include <cstdio>
+
 
 namespace tripodal {
 
 namespace {
 
-std::string time_column(Time t) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%10.3f s", to_seconds(t));
-  return buf;
-}
+std::string time_column(Time t) { return fmt::format("{:>10} s", format_seconds(t)); }
 
 // Turns firings into trace entries while a run lasts.
 class TraceObserver final : public EngineObserver {

@@ -1,22 +1,27 @@
-// Internal: the XML reader behind the net loaders (native format and PNML). It parses a whole
-// document in one pass into a read-only tree whose names, values and text are views into the
-// source (decoded copies only where references, line ends or Latin-1 bytes require one), and keeps
-// the byte offset of every element and attribute, so that each diagnostic can name LINE:COL.
+// Internal: the XML document behind the net loaders (native format and PNML). tinyxml2 parses the
+// text; this adds what diagnostics need and tinyxml2 does not keep: the byte offset of every
+// element and attribute (so each diagnostic can name LINE:COL), names and values as views with
+// their lengths, and the few XML 1.0 well-formedness rules tinyxml2 lets through.
 //
-// Well-formedness is checked as XML 1.0 says (one root, matching tags, quoted and unique
-// attributes, no '<' in values, known entity and valid character references, no control
-// characters, valid UTF-8); the first violation stops the parse with its offset. Not a validating
-// parser: a DOCTYPE is skipped, and an entity it declares is refused as unknown.
+// Refused, at the offending byte: invalid UTF-8 and control characters, an unknown entity or a
+// bare '&', '<' inside an attribute value, a second root element, text outside the root, encodings
+// other than UTF-8 and ISO-8859-1 (the latter is decoded to UTF-8 first). Every other
+// well-formedness error is tinyxml2's, located at the line it names.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
+
+namespace tinyxml2 {
+class XMLDocument;
+}
 
 namespace tripodal::detail {
 
@@ -30,8 +35,7 @@ class XmlDocument;
 
 struct XmlAttribute {
   std::string_view name;
-  /// Decoded: references replaced, each literal tab, newline or CR (a CR LF pair counts once)
-  /// turned into a space as XML normalises attribute values.
+  /// As tinyxml2 decodes it: references replaced, CR LF and CR turned into LF.
   std::string_view value;
   std::uint32_t name_offset = 0;   ///< source offset of the name
   std::uint32_t value_offset = 0;  ///< source offset of the first byte after the opening quote
@@ -60,7 +64,7 @@ class XmlElement {
 
  private:
   friend class XmlDocument;
-  friend class XmlParser;
+  friend class XmlTreeBuilder;
   static constexpr std::uint32_t kNone = 0xFFFFFFFFU;
 
   const XmlDocument* doc_ = nullptr;
@@ -81,16 +85,16 @@ struct XmlError {
   std::string message;
 };
 
-/// A parsed document. Views into the source: the text given to parse() must outlive it. Not
-/// copyable or movable (elements point back at it).
+/// A parsed document. Views into the source and into tinyxml2's copy of it: the text given to
+/// parse() must outlive it. Not copyable or movable (elements point back at it).
 class XmlDocument {
  public:
-  XmlDocument() = default;
+  XmlDocument();
   XmlDocument(const XmlDocument&) = delete;
   XmlDocument& operator=(const XmlDocument&) = delete;
   XmlDocument(XmlDocument&&) = delete;
   XmlDocument& operator=(XmlDocument&&) = delete;
-  ~XmlDocument() = default;
+  ~XmlDocument();
 
   /// Parses `text` (UTF-8; ISO-8859-1 when its XML declaration says so). Returns false at the
   /// first error, described by error(); the tree is then empty.
@@ -98,6 +102,8 @@ class XmlDocument {
 
   [[nodiscard]] const XmlElement* root() const noexcept { return elements_.empty() ? nullptr : &elements_[0]; }
   [[nodiscard]] const XmlError& error() const noexcept { return error_; }
+  /// The text offsets refer to: the text given to parse(), or its UTF-8 decoding when the file
+  /// was declared ISO-8859-1 and had bytes beyond ASCII.
   [[nodiscard]] std::string_view source() const noexcept { return text_; }
   [[nodiscard]] std::size_t element_count() const noexcept { return elements_.size(); }
 
@@ -113,15 +119,18 @@ class XmlDocument {
 
  private:
   friend class XmlElement;
-  friend class XmlParser;
+  friend class XmlTreeBuilder;
 
+  void clear();
+
+  std::unique_ptr<tinyxml2::XMLDocument> xml_;
+  std::string latin1_decoded_;  // the source, when it had to be decoded from ISO-8859-1
   std::string_view text_;
   std::vector<XmlElement> elements_;
   std::vector<XmlAttribute> attributes_;
-  std::deque<std::string> decoded_;  // values and text that differ from the source; stable addresses
+  std::deque<std::string> joined_;  // texts of several pieces (around children, CDATA); stable addresses
   mutable std::vector<std::size_t> line_starts_;  // built on the first line_column() call
   XmlError error_;
-  bool latin1_ = false;
 };
 
 // Inline: the readers walk every element through these.

@@ -88,46 +88,6 @@ PathStats path_stats(const std::vector<Point2D>& path, double turn_threshold_rad
 
 // ---------------------------------------------------------------- coverage planner
 
-namespace {
-
-// Douglas-Peucker on a chain of points; keeps the end points.
-void simplify(const std::vector<Point2D>& in, double tol, std::vector<Point2D>& out) {
-  if (in.size() <= 2) {
-    out.insert(out.end(), in.begin(), in.end());
-    return;
-  }
-  std::vector<std::uint8_t> keep(in.size(), 0);
-  keep.front() = keep.back() = 1;
-  std::vector<std::pair<std::size_t, std::size_t>> stack{{0, in.size() - 1}};
-  while (!stack.empty()) {
-    const auto [a, b] = stack.back();
-    stack.pop_back();
-    if (b <= a + 1) continue;
-    const double dx = in[b].x_m - in[a].x_m, dy = in[b].y_m - in[a].y_m;
-    const double len = std::hypot(dx, dy);
-    double worst = -1.0;
-    std::size_t at = a;
-    for (std::size_t i = a + 1; i < b; ++i) {
-      const double px = in[i].x_m - in[a].x_m, py = in[i].y_m - in[a].y_m;
-      const double d = len > 1e-12 ? std::abs(px * dy - py * dx) / len : std::hypot(px, py);
-      if (d > worst) {
-        worst = d;
-        at = i;
-      }
-    }
-    if (worst > tol) {
-      keep[at] = 1;
-      stack.emplace_back(a, at);
-      stack.emplace_back(at, b);
-    }
-  }
-  for (std::size_t i = 0; i < in.size(); ++i) {
-    if (keep[i] != 0) out.push_back(in[i]);
-  }
-}
-
-}  // namespace
-
 // Per-section working data on a window around the section's bounding box.
 struct CoveragePlanner::Workspace {
   int x0 = 0, y0 = 0, w = 0, h = 0;  // window in grid cells
@@ -317,8 +277,7 @@ void CoveragePlanner::finish(CoverageResult& r, Workspace& ws, CellIndex cur) {
   }
   // Measured on the path's shape: a chain of cell centres along a slanted contour is a staircase
   // whose steps are not turns of the robot.
-  std::vector<Point2D> shape;
-  simplify(r.path, options_.simplify_tolerance_m, shape);
+  const std::vector<Point2D> shape = douglas_peucker(r.path, options_.simplify_tolerance_m);
   r.stats = path_stats(shape, options_.turn_threshold_rad);
   r.section_cells = ws.section_cells;
   r.reachable_cells = ws.reachable.size();

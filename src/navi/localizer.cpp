@@ -1,20 +1,12 @@
 #include "tripodal/navi/localizer.hpp"
 
+#include "tripodal/hardware/hardware.hpp"
+
 #include <cmath>
 #include <numbers>
 #include <sstream>
 
 namespace tripodal::navi {
-
-namespace {
-
-double wrap(double a) noexcept {
-  while (a > std::numbers::pi) a -= 2.0 * std::numbers::pi;
-  while (a < -std::numbers::pi) a += 2.0 * std::numbers::pi;
-  return a;
-}
-
-}  // namespace
 
 std::vector<LocalizationFault> parse_fault_schedule(const std::string& text, const SourceLocation& where) {
   std::vector<LocalizationFault> out;
@@ -53,10 +45,10 @@ CLocalizer::CLocalizer(const GroundTruthSource* truth, LocalizerOptions options)
 
 const ModuleManifest& CLocalizer::static_manifest() {
   static const ModuleManifest m = navi_manifest(
-      "CLocalizer",
+      "Localizer",
       "pose estimate from the simulator's ground truth with seeded noise and injected faults; posts "
       "localizer.ok / localizer.lost",
-      {"ground_truth_pose"}, {"map_from_base", "localizer.ok", "localizer.lost"},
+      {"ground_truth_pose"}, {"map_from_base", "position_fix", "localizer.ok", "localizer.lost"},
       {ParameterSpec{"noise_xy_m", ValueType::number, Value{0.02}, "m", "position noise (standard deviation per axis)",
                      0.0, std::nullopt},
        ParameterSpec{"noise_theta_rad", ValueType::number, Value{0.01}, "rad", "heading noise (standard deviation)", 0.0,
@@ -74,11 +66,15 @@ const ModuleManifest& CLocalizer::static_manifest() {
                      std::nullopt},
        ParameterSpec{"faults", ValueType::string, Value{std::string()}, "s",
                      "loss windows \"START-END; START-END\" in seconds of simulated time", std::nullopt,
-                     std::nullopt}});
+                     std::nullopt},
+       ParameterSpec{"serves", ValueType::string, Value{std::string("BhGlobalLocalization")}, "",
+                     "the behavior during whose activation it attempts global position fixes (its parameter "
+                     "attempt_period_s)", std::nullopt, std::nullopt}});
   return m;
 }
 
 void CLocalizer::on_configure(const ParameterSet& params) {
+  serves_ = params.string("serves");
   LocalizerOptions o;
   o.noise_xy_m = params.number("noise_xy_m");
   o.noise_theta_rad = params.number("noise_theta_rad");
@@ -96,6 +92,7 @@ void CLocalizer::on_configure(const ParameterSet& params) {
 }
 
 bool CLocalizer::in_fault(Time now) const noexcept {
+  if (truth_ != nullptr && truth_->localization_lost(now)) return true;
   for (const LocalizationFault& f : options_.faults) {
     if (now >= f.start && now < f.end) return true;
   }
@@ -114,7 +111,38 @@ void CLocalizer::publish(NavigationData& data) const noexcept {
   data.localized = localized();
 }
 
-void CLocalizer::on_update(Time now, std::vector<NaviEvent>& out) noexcept {
+void CLocalizer::on_start(ModuleContext& context) {
+  if (truth_ == nullptr) truth_ = dynamic_cast<const GroundTruthSource*>(context.hardware);
+  if (truth_ == nullptr) {
+    throw ConfigError(where(), "Localizer estimates the pose from a simulation's ground truth, and the robot's hardware gives none");
+  }
+}
+
+void CLocalizer::on_update(ModuleContext& context) {
+  step(context.now, context.events);
+  if (searching_ && context.now - last_attempt_ >= attempt_period_) {
+    last_attempt_ = context.now;
+    if (relocalize(context.now)) ++fixes_;
+  }
+  context.heartbeat = true;
+  publish(*context.navigation);
+  context.navigation->fixes = fixes_;
+}
+
+void CLocalizer::on_behavior_activated(const BehaviorActivation& activation, ModuleContext& context) {
+  if (activation.behavior != serves_) return;
+  const ParameterSet params = activation.resolved();
+  attempt_period_ = from_seconds(params.number("attempt_period_s"));
+  last_attempt_ = context.now;
+  searching_ = true;
+}
+
+void CLocalizer::on_behavior_deactivated(std::string_view behavior, ModuleContext& /*context*/) {
+  if (behavior == serves_) searching_ = false;
+}
+
+void CLocalizer::step(Time now, std::vector<ModuleEvent>& out) noexcept {
+  if (!configured()) return;
   if (truth_ == nullptr) return;
   const std::optional<Pose2D> truth = truth_->true_pose(now);
   if (!truth) return;
@@ -132,7 +160,7 @@ void CLocalizer::on_update(Time now, std::vector<NaviEvent>& out) noexcept {
   const double ex = options_.noise_xy_m * nxy(rng_);
   const double ey = options_.noise_xy_m * nxy(rng_);
   const double et = options_.noise_theta_rad * nxy(rng_);
-  Pose2D est{truth->x_m + ex, truth->y_m + ey, wrap(truth->theta_rad + et)};
+  Pose2D est{truth->x_m + ex, truth->y_m + ey, wrap_angle(truth->theta_rad + et)};
   if (corrupted_) {
     est.x_m += offset_.x_m;
     est.y_m += offset_.y_m;
@@ -140,7 +168,7 @@ void CLocalizer::on_update(Time now, std::vector<NaviEvent>& out) noexcept {
   estimate_ = est;
   stamp_ = now;
   error_m_ = std::hypot(est.x_m - truth->x_m, est.y_m - truth->y_m);
-  const double heading_error = std::abs(wrap(est.theta_rad - truth->theta_rad));
+  const double heading_error = std::abs(wrap_angle(est.theta_rad - truth->theta_rad));
   const bool agrees = error_m_ <= options_.lost_threshold_m && heading_error <= options_.lost_threshold_rad;
   const State next = agrees ? State::ok : State::lost;
   if (next == state_) return;

@@ -1,21 +1,20 @@
 #include "tripodal/navi/map_io.hpp"
 
+#include <fmt/format.h>
+
 #include <cctype>
 #include <cmath>
 #include <fstream>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
-#include "yaml_util.hpp"
+#include "../common/yaml_reader.hpp"
 
 namespace tripodal::navi {
 
 namespace {
-
-using detail::as_double;
-using detail::kind_name;
-using detail::where;
 
 // ---------------------------------------------------------------- PGM
 
@@ -129,7 +128,7 @@ const char* mode_name(MapMode m) {
 GrayImage parse_pgm(std::string_view bytes, const std::string& name) { return PgmParser(bytes, name).parse(); }
 
 GrayImage read_pgm(const std::filesystem::path& file) {
-  const std::string bytes = detail::read_text_file(file);
+  const std::string bytes = yaml::read_file(file);
   return parse_pgm(bytes, file.string());
 }
 
@@ -150,89 +149,56 @@ void write_pgm(const std::filesystem::path& file, const GrayImage& image) {
 
 MapMetadata parse_map_yaml(std::string_view text, const std::filesystem::path& file) {
   const std::string name = file.string();
-  const YAML::Node root = detail::parse_yaml(text, name);
+  const YAML::Node root = yaml::parse(text, name);
   Diagnostics d;
+  yaml::Reader r(name, d);
   MapMetadata m;
-  if (!root.IsMap()) {
-    d.error(where(name, root), "expected a map_server map description (a YAML map with image, resolution, origin, "
-                               "occupied_thresh, free_thresh), got " + kind_name(root));
+  if (!r.expect_keys(root, {"image", "resolution", "origin", "occupied_thresh", "free_thresh", "negate", "mode"},
+                     "a map_server map description")) {
     throw ConfigError(d);
   }
-  bool seen_image = false, seen_res = false, seen_origin = false, seen_occ = false, seen_free = false;
-  YAML::Node occ_node, free_node;
-  for (const auto& kv : root) {
-    const std::string key = kv.first.Scalar();
-    const YAML::Node& v = kv.second;
-    if (key == "image") {
-      seen_image = true;
-      if (!v.IsScalar() || v.Scalar().empty()) {
-        d.error(where(name, v), "'image' must be a file name, got " + kind_name(v));
-      } else {
-        m.image = v.Scalar();
-        m.image_path = m.image.is_absolute() ? m.image : file.parent_path() / m.image;
-      }
-    } else if (key == "resolution") {
-      seen_res = true;
-      if (auto r = as_double(v, name, "'resolution' (metres per cell)", d)) {
-        if (*r <= 0.0) d.error(where(name, v), "'resolution' must be positive (metres per cell), got " + v.Scalar());
-        else m.resolution_m = *r;
-      }
-    } else if (key == "origin") {
-      seen_origin = true;
-      if (!v.IsSequence() || v.size() != 3) {
-        d.error(where(name, v), "'origin' must be a list [x, y, yaw] of 3 numbers, got " + kind_name(v));
-      } else {
-        const auto x = as_double(v[0], name, "origin x", d);
-        const auto y = as_double(v[1], name, "origin y", d);
-        const auto yaw = as_double(v[2], name, "origin yaw", d);
-        if (x && y && yaw) m.origin = Pose2D{*x, *y, *yaw};
-      }
-    } else if (key == "occupied_thresh" || key == "free_thresh") {
-      const bool occ = key == "occupied_thresh";
-      (occ ? seen_occ : seen_free) = true;
-      (occ ? occ_node : free_node) = v;
-      if (auto t = as_double(v, name, "'" + key + "'", d)) {
-        if (*t < 0.0 || *t > 1.0) {
-          d.error(where(name, v), "'" + key + "' must be a probability in [0, 1], got " + v.Scalar());
-        } else {
-          (occ ? m.occupied_thresh : m.free_thresh) = *t;
-        }
-      }
-    } else if (key == "negate") {
-      const std::string s = v.IsScalar() ? v.Scalar() : std::string();
-      if (s == "0" || s == "false") m.negate = false;
-      else if (s == "1" || s == "true") m.negate = true;
-      else d.error(where(name, v), "'negate' must be 0 or 1 (or false/true), got " + kind_name(v));
-    } else if (key == "mode") {
-      const std::string s = v.IsScalar() ? v.Scalar() : std::string();
-      if (s == "trinary") m.mode = MapMode::trinary;
-      else if (s == "scale") m.mode = MapMode::scale;
-      else if (s == "raw") m.mode = MapMode::raw;
-      else d.error(where(name, v), "'mode' must be one of trinary, scale, raw; got " + kind_name(v));
-    } else {
-      d.error(where(name, kv.first), "unknown key '" + key +
-                                         "'; expected: image, resolution, origin, occupied_thresh, free_thresh, "
-                                         "negate, mode");
+  const YAML::Node image = r.require(root, "image", "the map description", "the PGM file, relative to this file");
+  const YAML::Node res = r.require(root, "resolution", "the map description", "metres per cell");
+  const YAML::Node origin = r.require(root, "origin", "the map description", "[x, y, yaw] of the lower-left pixel");
+  const YAML::Node occ_node = r.require(root, "occupied_thresh", "the map description", "e.g. 0.65");
+  const YAML::Node free_node = r.require(root, "free_thresh", "the map description", "e.g. 0.196");
+  if (image) {
+    if (auto file_name = r.text(image, "'image' (a file name)", true)) {
+      m.image = *file_name;
+      m.image_path = m.image.is_absolute() ? m.image : file.parent_path() / m.image;
     }
   }
-  const auto missing = [&](bool seen, const char* key, const char* what) {
-    if (!seen) d.error(where(name, root), std::string("missing '") + key + "' (" + what + ")");
-  };
-  missing(seen_image, "image", "the PGM file, relative to this file");
-  missing(seen_res, "resolution", "metres per cell");
-  missing(seen_origin, "origin", "[x, y, yaw] of the lower-left pixel");
-  missing(seen_occ, "occupied_thresh", "e.g. 0.65");
-  missing(seen_free, "free_thresh", "e.g. 0.196");
-  if (seen_occ && seen_free && !d.has_errors() && !(m.free_thresh < m.occupied_thresh)) {
-    d.error(where(name, free_node), "'free_thresh' (" + free_node.Scalar() +
-                                         ") must be below 'occupied_thresh' (" + occ_node.Scalar() + ")");
+  if (res) {
+    if (auto v = r.positive(res, "'resolution' (metres per cell)")) m.resolution_m = *v;
+  }
+  if (origin) {
+    if (auto v = r.numbers(origin, "'origin'", 3, 3, "[x, y, yaw]")) m.origin = Pose2D{(*v)[0], (*v)[1], (*v)[2]};
+  }
+  for (const auto& [node, key, out] : {std::tuple{occ_node, "occupied_thresh", &m.occupied_thresh},
+                                       std::tuple{free_node, "free_thresh", &m.free_thresh}}) {
+    if (!node) continue;
+    if (auto t = r.number(node, fmt::format("'{}'", key))) {
+      if (*t < 0.0 || *t > 1.0) r.error(node, fmt::format("'{}': expected a probability in [0, 1], got {}", key, node.Scalar()));
+      else *out = *t;
+    }
+  }
+  if (const YAML::Node negate = root["negate"]) {
+    if (auto v = r.boolean(negate, "'negate'")) m.negate = *v;
+  }
+  if (const YAML::Node mode = root["mode"]) {
+    if (auto v = r.choice(mode, "'mode'", {"trinary", "scale", "raw"})) {
+      m.mode = *v == "scale" ? MapMode::scale : *v == "raw" ? MapMode::raw : MapMode::trinary;
+    }
+  }
+  if (occ_node && free_node && !d.has_errors() && !(m.free_thresh < m.occupied_thresh)) {
+    r.error(free_node, "'free_thresh' (" + free_node.Scalar() + ") must be below 'occupied_thresh' (" + occ_node.Scalar() + ")");
   }
   if (d.has_errors()) throw ConfigError(d);
   return m;
 }
 
 MapMetadata load_map_yaml(const std::filesystem::path& file) {
-  return parse_map_yaml(detail::read_text_file(file), file);
+  return parse_map_yaml(yaml::read_file(file), file);
 }
 
 OccupancyGrid grid_from_image(const GrayImage& image, const MapMetadata& meta) {

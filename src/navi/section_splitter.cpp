@@ -1,5 +1,7 @@
 #include "tripodal/navi/section_splitter.hpp"
 
+#include "tripodal/navi/grid_maps.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -153,8 +155,9 @@ std::vector<std::string> order_nearest_first(const OccupancyGrid& grid, const Se
 
 const ModuleManifest& CSectionSplitter::static_manifest() {
   static const ModuleManifest m = navi_manifest(
-      "CSectionSplitter", "divides a large workspace into sections at virtual walls between bands of isolated obstacles",
-      {"occupancy_grid", "map_from_base"}, {"section_set"},
+      "SectionSplitter", "divides a large workspace into sections at virtual walls between bands of isolated obstacles; "
+      "answers sections(room)",
+      {"grid_map"}, {"sections"},
       {ParameterSpec{"min_obstacle_area_m2", ValueType::number, Value{0.01}, "m^2",
                      "occupied components smaller than this are noise, not isolated obstacles", 0.0, std::nullopt},
        ParameterSpec{"min_gap_m", ValueType::number, Value{1.5}, "m",
@@ -374,6 +377,62 @@ SectionSet CSectionSplitter::split(const OccupancyGrid& grid) const {
     }
     s.area_m2 = static_cast<double>(s.cells.size()) * cell_area;
     if (!s.cells.empty()) s.centroid = {sx / static_cast<double>(s.cells.size()), sy / static_cast<double>(s.cells.size())};
+  }
+  return out;
+}
+
+void CSectionSplitter::split_map(const OccupancyGrid& grid, const RegionMap& regions) {
+  sections_ = split(grid);
+  grid_ = &grid;
+  regions_ = &regions;
+}
+
+void CSectionSplitter::on_start(ModuleContext& context) {
+  const CGridMaps* maps = context.modules != nullptr ? context.modules->find<CGridMaps>() : nullptr;
+  if (maps == nullptr) throw ConfigError(where(), "SectionSplitter needs the robot's map: add a GridMaps module");
+  split_map(maps->grid(), maps->regions());
+}
+
+const Section* CSectionSplitter::section(std::string_view name) const noexcept {
+  for (const Section& s : sections_.sections) {
+    if (s.name == name) return &s;
+  }
+  return nullptr;
+}
+
+KnowledgeAnswer CSectionSplitter::sections_of_room(std::string_view room) const {
+  KnowledgeAnswer out;
+  const Region* r = regions_ != nullptr ? regions_->room(room) : nullptr;
+  if (r == nullptr) {
+    out.error = "unknown room '" + std::string(room) + "' (known:";
+    if (regions_ != nullptr) {
+      for (const auto& n : regions_->room_names()) out.error += " " + n;
+    }
+    out.error += ")";
+    return out;
+  }
+  for (const Section& s : sections_.sections) {
+    std::size_t inside = 0;
+    for (const std::size_t i : s.cells) inside += r->contains(grid_->cell_center(grid_->cell(i))) ? 1 : 0;
+    if (2 * inside > s.cells.size()) out.items.push_back(s.name);
+  }
+  if (out.items.empty()) {
+    out.error = "room '" + std::string(room) + "' holds no section of the map";
+    return out;
+  }
+  out.ok = true;
+  return out;
+}
+
+std::optional<KnowledgeAnswer> CSectionSplitter::on_answer(std::string_view function, std::string_view argument,
+                                                           const NavigationData& navigation) const {
+  if (function != "sections") return std::nullopt;
+  KnowledgeAnswer out = sections_of_room(argument);
+  // The plan is made once, from where the robot stands when it gets the task: an untrusted pose
+  // would order the sections from the wrong place, so scan order is the better guess then.
+  if (out.ok && navigation.localized && grid_ != nullptr) {
+    const Point2D at{navigation.map_from_base.x_m, navigation.map_from_base.y_m};
+    out.items = order_nearest_first(*grid_, sections_, out.items, at);
   }
   return out;
 }

@@ -1,6 +1,7 @@
 #include "tripodal/planner/lifecycle_recorder.hpp"
 
-#include <cstdio>
+#include <fmt/format.h>
+
 
 namespace tripodal {
 
@@ -18,11 +19,7 @@ std::string value_text(const Value& v) { return std::holds_alternative<std::stri
 
 std::string LifecycleRecorder::str() const {
   std::string out;
-  char buf[32];
-  for (const LifecycleEntry& e : entries_) {
-    std::snprintf(buf, sizeof buf, "%10.3f s  ", to_seconds(e.time));
-    out += buf + e.text + '\n';
-  }
+  for (const LifecycleEntry& e : entries_) out += fmt::format("{:>10} s  {}\n", format_seconds(e.time), e.text);
   return out;
 }
 

@@ -1,7 +1,6 @@
 #include "tripodal/planner/planner.hpp"
 
 #include <algorithm>
-#include <cstdio>
 #include <sstream>
 
 #include <spdlog/spdlog.h>
@@ -20,11 +19,7 @@ std::string_view to_string(TaskState s) noexcept {
 
 namespace {
 
-std::string stamp(Time t) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3f s", to_seconds(t));
-  return buf;
-}
+std::string stamp(Time t) { return format_seconds(t) + " s"; }
 
 std::string step_text(const ProcessStep& s) {
   std::string out = s.process + "(";

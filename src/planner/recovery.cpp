@@ -4,18 +4,13 @@
 
 #include <algorithm>
 #include <cctype>
-#include <fstream>
-#include <sstream>
 
+#include "../common/yaml_reader.hpp"
 #include "tripodal/core/net_loader.hpp"
-#include "yaml_util.hpp"
 
 namespace tripodal {
 
 namespace {
-
-using detail::kind_name;
-using detail::where;
 
 bool iequals(std::string_view a, std::string_view b) {
   return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
@@ -25,82 +20,53 @@ bool iequals(std::string_view a, std::string_view b) {
 
 RecoveryPolicy parse(const std::string& text, const std::string& file,
                      const std::function<bool(std::string_view)>& is_known_process) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError(SourceLocation{file, e.mark.line + 1, e.mark.column + 1}, e.msg);
-  }
+  const YAML::Node root = yaml::parse(text, file);
   Diagnostics d;
+  yaml::Reader r(file, d);
   std::vector<RecoveryRule> rules;
-  if (!root.IsMap() || !root["recovery"] || !root["recovery"].IsSequence()) {
-    d.error(where(file, root), "expected a map with a 'recovery' list at the top level");
-    throw ConfigError(d);
-  }
-  for (const auto& kv : root) {
-    if (kv.first.as<std::string>() != "recovery") {
-      d.error(where(file, kv.first), "unknown key '" + kv.first.as<std::string>() + "'; expected: recovery");
-    }
-  }
-  for (const auto& r : root["recovery"]) {
+  if (!r.expect_keys(root, {"recovery"}, "the recovery rules file")) throw ConfigError(d);
+  const YAML::Node list = r.require(root, "recovery", "the recovery rules file", "a list of rules");
+  if (!list || !r.expect_list(list, "'recovery'")) throw ConfigError(d);
+  for (const auto& rule_node : list) {
     RecoveryRule rule;
-    rule.where = where(file, r);
-    if (!r.IsMap()) {
-      d.error(rule.where, "a recovery rule must be a map with fault, insert, then, max_retries; not " + kind_name(r));
-      continue;
-    }
-    for (const auto& kv : r) {
-      const auto key = kv.first.as<std::string>();
-      const YAML::Node v = kv.second;
-      if (key == "fault" && v.IsScalar()) {
-        rule.fault = v.as<std::string>();
-      } else if (key == "process" && v.IsScalar()) {
-        rule.process = v.as<std::string>();
-        if (is_known_process && !is_known_process(rule.process)) d.error(where(file, v), "unknown process '" + rule.process + "'");
-      } else if (key == "then" && v.IsScalar()) {
-        const auto a = v.as<std::string>();
-        if (a == "retry") rule.then = RecoveryAction::retry;
-        else if (a == "skip") rule.then = RecoveryAction::skip;
-        else if (a == "abort") rule.then = RecoveryAction::abort;
-        else d.error(where(file, v), "unknown action '" + a + "'; expected one of: retry, skip, abort");
-      } else if (key == "max_retries" && v.IsScalar()) {
-        int n = -1;
-        if (!YAML::convert<int>::decode(v, n) || n < 0) {
-          d.error(where(file, v), "max_retries must be a whole number >= 0, got '" + v.as<std::string>() + "'");
-        } else {
-          rule.max_retries = n;
-        }
-      } else if (key == "insert" && v.IsSequence()) {
-        for (const auto& s : v) {
-          if (!s.IsMap() || s.size() != 1) {
-            d.error(where(file, s), "an inserted step must be a map with one key, the process name: {PrGlobalLocalization: {}}");
-            continue;
-          }
-          const auto step_kv = *s.begin();
-          ProcessStep step{step_kv.first.as<std::string>(), {}};
-          if (is_known_process && !is_known_process(step.process)) {
-            d.error(where(file, step_kv.first), "unknown process '" + step.process + "'");
-          }
-          if (step_kv.second.IsMap()) {
-            for (const auto& p : step_kv.second) {
-              if (!p.second.IsScalar()) {
-                d.error(where(file, p.second), "parameter '" + p.first.as<std::string>() + "' must be a text");
-                continue;
-              }
-              step.params.push_back({p.first.as<std::string>(), p.second.as<std::string>(), where(file, p.second)});
-            }
-          } else if (!step_kv.second.IsNull()) {
-            d.error(where(file, step_kv.second), "parameters of '" + step.process + "' must be a map");
-          }
-          rule.insert.push_back(std::move(step));
-        }
-      } else if (key == "fault" || key == "process" || key == "then" || key == "max_retries" || key == "insert") {
-        d.error(where(file, v), "'" + key + "' has the wrong form (" + kind_name(v) + ")");
-      } else {
-        d.error(where(file, kv.first), "unknown key '" + key + "' in a recovery rule; expected: fault, process, insert, then, max_retries");
+    rule.where = r.at(rule_node);
+    if (!r.expect_keys(rule_node, {"fault", "process", "insert", "then", "max_retries"}, "a recovery rule")) continue;
+    if (const YAML::Node v = rule_node["fault"]) rule.fault = r.text(v, "'fault'").value_or("");
+    if (const YAML::Node v = rule_node["process"]) {
+      rule.process = r.text(v, "'process'").value_or("");
+      if (!rule.process.empty() && is_known_process && !is_known_process(rule.process)) {
+        r.error(v, "unknown process '" + rule.process + "'");
       }
     }
-    if (rule.fault.empty()) d.error(rule.where, "recovery rule without 'fault' (the fault message it handles)");
+    if (const YAML::Node v = rule_node["then"]) {
+      if (auto a = r.choice(v, "'then'", {"retry", "skip", "abort"})) {
+        rule.then = *a == "retry" ? RecoveryAction::retry : *a == "skip" ? RecoveryAction::skip : RecoveryAction::abort;
+      }
+    }
+    if (const YAML::Node v = rule_node["max_retries"]) {
+      if (auto n = r.integer(v, "'max_retries'", 0, 1000000)) rule.max_retries = static_cast<int>(*n);
+    }
+    if (const YAML::Node v = rule_node["insert"]; v && r.expect_list(v, "'insert'")) {
+      for (const auto& s : v) {
+        if (!s.IsMap() || s.size() != 1) {
+          r.error(s, "an inserted step must be a map with one key, the process name: {PrGlobalLocalization: {}}");
+          continue;
+        }
+        const auto step_kv = *s.begin();
+        ProcessStep step{step_kv.first.as<std::string>(), {}};
+        if (is_known_process && !is_known_process(step.process)) r.error(step_kv.first, "unknown process '" + step.process + "'");
+        if (step_kv.second.IsMap()) {
+          for (const auto& p : step_kv.second) {
+            const std::string name = p.first.as<std::string>();
+            if (auto value = r.text(p.second, "parameter '" + name + "'")) step.params.push_back({name, *value, r.at(p.second)});
+          }
+        } else if (!step_kv.second.IsNull()) {
+          r.expect_map(step_kv.second, "the parameters of '" + step.process + "'");
+        }
+        rule.insert.push_back(std::move(step));
+      }
+    }
+    if (!rule_node["fault"]) r.error(rule_node, "a recovery rule: missing 'fault' (the fault message it handles)");
     rules.push_back(std::move(rule));
   }
   if (d.has_errors()) throw ConfigError(d);
@@ -111,11 +77,7 @@ RecoveryPolicy parse(const std::string& text, const std::string& file,
 
 RecoveryPolicy RecoveryPolicy::load(const std::filesystem::path& file,
                                     const std::function<bool(std::string_view)>& is_known_process) {
-  std::ifstream in(file);
-  if (!in) throw ConfigError(SourceLocation{file.string(), 0, 0}, "cannot open recovery rules file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parse(ss.str(), file.string(), is_known_process);
+  return parse(yaml::read_file(file), file.string(), is_known_process);
 }
 
 RecoveryPolicy RecoveryPolicy::load_from_string(std::string_view yaml, std::string_view name,

@@ -4,18 +4,13 @@
 
 #include <algorithm>
 #include <cctype>
-#include <fstream>
 #include <set>
-#include <sstream>
 
-#include "yaml_util.hpp"
+#include "../common/yaml_reader.hpp"
 
 namespace tripodal {
 
 namespace {
-
-using detail::kind_name;
-using detail::where;
 
 std::string lower(std::string_view s) {
   std::string out(s);
@@ -50,22 +45,14 @@ std::vector<std::string> tokenize(std::string_view text) {
 
 class Loader {
  public:
-  Loader(std::string file, const TaskLoadOptions& options) : file_(std::move(file)), options_(options) {}
+  Loader(std::string file, const TaskLoadOptions& options) : options_(options), r_(std::move(file), diags_) {}
 
   std::vector<TaskTemplate> load(const YAML::Node& root) {
     std::vector<TaskTemplate> out;
-    if (!root.IsMap() || !root["tasks"]) {
-      diags_.error(where(file_, root), "expected a map with a 'tasks' list at the top level");
-      throw ConfigError(diags_);
-    }
-    for (const auto& kv : root) {
-      const auto key = kv.first.as<std::string>();
-      if (key != "tasks") diags_.error(where(file_, kv.first), "unknown key '" + key + "'; expected: tasks");
-    }
-    const YAML::Node tasks = root["tasks"];
-    if (!tasks.IsSequence()) {
-      diags_.error(where(file_, tasks), "'tasks' must be a list of task templates, not " + kind_name(tasks));
-    } else {
+    if (!r_.expect_keys(root, {"tasks"}, "the task templates file")) throw ConfigError(diags_);
+    const YAML::Node tasks = r_.require(root, "tasks", "the task templates file", "a list of task templates");
+    if (!tasks) throw ConfigError(diags_);
+    if (r_.expect_list(tasks, "'tasks'")) {
       std::set<std::string> names;
       for (const auto& t : tasks) {
         TaskTemplate tt = load_template(t);
@@ -80,36 +67,20 @@ class Loader {
   }
 
  private:
-  std::string scalar(const YAML::Node& n, const std::string& what) {
-    if (!n.IsScalar()) {
-      diags_.error(where(file_, n), what + " must be a text, not " + kind_name(n));
-      return {};
-    }
-    return n.as<std::string>();
-  }
+  std::string scalar(const YAML::Node& n, const std::string& what) { return r_.text(n, what).value_or(""); }
 
   TaskTemplate load_template(const YAML::Node& t) {
     TaskTemplate tt;
-    tt.where = where(file_, t);
-    if (!t.IsMap()) {
-      diags_.error(tt.where, "a task template must be a map with name, commands and plan, not " + kind_name(t));
-      return tt;
-    }
-    for (const auto& kv : t) {
-      const auto key = kv.first.as<std::string>();
-      if (key != "name" && key != "description" && key != "commands" && key != "plan") {
-        diags_.error(where(file_, kv.first), "unknown key '" + key + "' in a task template; expected: name, description, commands, plan");
-      }
-    }
-    if (!t["name"]) diags_.error(tt.where, "task template without 'name'");
-    else tt.name = scalar(t["name"], "'name'");
+    tt.where = r_.at(t);
+    if (!r_.expect_keys(t, {"name", "description", "commands", "plan"}, "a task template")) return tt;
+    if (const YAML::Node name = r_.require(t, "name", "a task template", "the task's name")) tt.name = scalar(name, "'name'");
     if (t["description"]) tt.description = scalar(t["description"], "'description'");
 
     std::set<std::string> captured_everywhere;
     bool first_pattern = true;
     const YAML::Node commands = t["commands"];
     if (!commands || !commands.IsSequence() || commands.size() == 0) {
-      diags_.error(commands ? where(file_, commands) : tt.where,
+      diags_.error(commands ? r_.at(commands) : tt.where,
                    "task '" + tt.name + "' needs 'commands': a list of command patterns such as \"clean [the] room {room}\"");
     } else {
       for (const auto& c : commands) {
@@ -133,7 +104,7 @@ class Loader {
 
     const YAML::Node plan = t["plan"];
     if (!plan || !plan.IsSequence() || plan.size() == 0) {
-      diags_.error(plan ? where(file_, plan) : tt.where, "task '" + tt.name + "' needs 'plan': a list of process modules");
+      diags_.error(plan ? r_.at(plan) : tt.where, "task '" + tt.name + "' needs 'plan': a list of process modules");
     } else {
       for (const auto& n : plan) tt.plan.push_back(parse_node(n, captured_everywhere, true));
     }
@@ -142,7 +113,7 @@ class Loader {
 
   CommandPattern parse_pattern(const YAML::Node& n) {
     CommandPattern p;
-    p.where = where(file_, n);
+    p.where = r_.at(n);
     p.text = scalar(n, "a command pattern");
     std::set<std::string> seen;
     for (const auto& word : tokenize(p.text)) {
@@ -196,7 +167,7 @@ class Loader {
   TemplateNode parse_process(const YAML::Node& key, const YAML::Node& value, const std::set<std::string>& bound) {
     TemplateNode node;
     node.kind = TemplateNode::Kind::process;
-    node.where = where(file_, key);
+    node.where = r_.at(key);
     node.process = key.as<std::string>();
     if (options_.is_known_process && !options_.is_known_process(node.process)) {
       diags_.error(node.where, "unknown process '" + node.process + "'");
@@ -204,33 +175,33 @@ class Loader {
     if (value.IsMap()) {
       for (const auto& kv : value) {
         BindingParam param{kv.first.as<std::string>(), scalar(kv.second, "parameter '" + kv.first.as<std::string>() + "'"),
-                           where(file_, kv.second)};
+                           r_.at(kv.second)};
         check_refs(param.value, bound, param.where);
         node.params.push_back(std::move(param));
       }
     } else if (!value.IsNull()) {
-      diags_.error(where(file_, value), "parameters of '" + node.process + "' must be a map, not " + kind_name(value));
+      r_.expect_map(value, "the parameters of '" + node.process + "'");
     }
     return node;
   }
 
   TemplateNode parse_node(const YAML::Node& n, const std::set<std::string>& bound, bool allow_groups) {
     if (!n.IsMap() || n.size() != 1) {
-      diags_.error(where(file_, n), "a plan step must be a map with one key: a process name, 'foreach' or 'parallel'");
+      diags_.error(r_.at(n), "a plan step must be a map with one key: a process name, 'foreach' or 'parallel'");
       return {};
     }
     const auto kv = *n.begin();
     const auto key = kv.first.as<std::string>();
     if (key == "foreach" || key == "parallel") {
       if (!allow_groups) {
-        diags_.error(where(file_, kv.first), "'" + key + "' is not allowed inside a parallel group");
+        diags_.error(r_.at(kv.first), "'" + key + "' is not allowed inside a parallel group");
         return {};
       }
     }
     if (key == "foreach") {
       TemplateNode node;
       node.kind = TemplateNode::Kind::foreach;
-      node.where = where(file_, kv.first);
+      node.where = r_.at(kv.first);
       const YAML::Node spec = kv.second;
       if (!spec.IsMap() || !spec["var"] || !spec["in"] || !spec["do"]) {
         diags_.error(node.where, "'foreach' needs 'var', 'in' and 'do', e.g. {var: section, in: \"sections({room})\", do: [...]}");
@@ -238,15 +209,13 @@ class Loader {
       }
       node.variable = scalar(spec["var"], "'var'");
       node.list_expr = scalar(spec["in"], "'in'");
-      check_refs(node.list_expr, bound, where(file_, spec["in"]));
+      check_refs(node.list_expr, bound, r_.at(spec["in"]));
       if (bound.count(node.variable) != 0) {
-        diags_.error(where(file_, spec["var"]), "foreach variable '" + node.variable + "' hides a slot of the same name");
+        diags_.error(r_.at(spec["var"]), "foreach variable '" + node.variable + "' hides a slot of the same name");
       }
       std::set<std::string> inner = bound;
       inner.insert(node.variable);
-      if (!spec["do"].IsSequence()) {
-        diags_.error(where(file_, spec["do"]), "'do' must be a list of plan steps");
-      } else {
+      if (r_.expect_list(spec["do"], "'do' (the plan steps)")) {
         for (const auto& s : spec["do"]) node.body.push_back(parse_node(s, inner, true));
       }
       return node;
@@ -254,7 +223,7 @@ class Loader {
     if (key == "parallel") {
       TemplateNode node;
       node.kind = TemplateNode::Kind::parallel;
-      node.where = where(file_, kv.first);
+      node.where = r_.at(kv.first);
       if (!kv.second.IsSequence() || kv.second.size() < 2) {
         diags_.error(node.where, "'parallel' needs a list of at least two processes");
         return node;
@@ -265,19 +234,13 @@ class Loader {
     return parse_process(kv.first, kv.second, bound);
   }
 
-  std::string file_;
   const TaskLoadOptions& options_;
   Diagnostics diags_;
+  yaml::Reader r_;
 };
 
 std::vector<TaskTemplate> load_templates(const std::string& text, const std::string& name, const TaskLoadOptions& options) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError(SourceLocation{name, e.mark.line + 1, e.mark.column + 1}, e.msg);
-  }
-  return Loader(name, options).load(root);
+  return Loader(name, options).load(yaml::parse(text, name));
 }
 
 // ---------------------------------------------------------------- matching
@@ -455,12 +418,8 @@ class Expander {
 }  // namespace
 
 TaskLibrary TaskLibrary::load(const std::filesystem::path& file, const TaskLoadOptions& options) {
-  std::ifstream in(file);
-  if (!in) throw ConfigError(SourceLocation{file.string(), 0, 0}, "cannot open task templates file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
   TaskLibrary lib;
-  lib.templates_ = load_templates(ss.str(), file.string(), options);
+  lib.templates_ = load_templates(yaml::read_file(file), file.string(), options);
   return lib;
 }
 

@@ -49,8 +49,29 @@ CProcess::CProcess(ProcessDefinition definition) : definition_(std::move(definit
       }
     }
   }
-  if (definition_.module) check_module_net(*definition_.module, definition_.name, d);
   if (d.has_errors()) throw ConfigError(d);
+
+  ManifestBuilder b(definition_.name, ModuleKind::process, Layer::sequencing);
+  std::string bound;
+  for (const auto& behavior : behaviors()) bound += (bound.empty() ? "" : ", ") + behavior;
+  b.description("process module of low-level net '" + net.id + "'" + (bound.empty() ? "" : ", binding " + bound));
+  for (const VariableDecl& v : net.parameters) {
+    ParameterSpec spec;
+    spec.name = v.name;
+    spec.type = v.type;
+    spec.default_value = v.default_value;
+    spec.description = v.description;
+    b.parameter(std::move(spec));
+  }
+  manifest_ = std::move(b).build();
+}
+
+const ModuleManifest& CProcess::static_manifest() {
+  static const ModuleManifest m =
+      ManifestBuilder("net", ModuleKind::process, Layer::sequencing)
+          .description("a process given entirely by configuration: its low-level net, parameters and recovery rules")
+          .build();
+  return m;
 }
 
 std::vector<std::string> CProcess::behaviors() const {

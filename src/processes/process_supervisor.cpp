@@ -1,7 +1,6 @@
 #include "tripodal/processes/process_supervisor.hpp"
 
 #include <algorithm>
-#include <cstdio>
 #include <exception>
 #include <map>
 
@@ -10,12 +9,6 @@
 namespace tripodal {
 
 namespace {
-
-std::string seconds_text(Duration d) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3f", to_seconds(d));
-  return buf;
-}
 
 std::string done_event(std::string_view behavior) { return done_event_name(behavior); }
 std::string failed_event(std::string_view behavior) { return failed_event_name(behavior); }
@@ -253,7 +246,7 @@ void CProcessSupervisor::step() {
     for (auto& [module, w] : inbox_->watches) {
       if (w.fired || w.timeout <= Duration{0} || now - w.last < w.timeout) continue;
       w.fired = true;
-      const std::string why = "stopped answering (no heartbeat for " + seconds_text(now - w.last) + " s)";
+      const std::string why = "stopped answering (no heartbeat for " + format_seconds(now - w.last) + " s)";
       if (w.event.empty()) {
         faults.emplace_back(module, why);
       } else {
@@ -306,7 +299,7 @@ void CProcessSupervisor::step() {
         const Time last = std::max(*rep.last_step, a.since);
         if (now - last > options_.behavior_watchdog) {
           rep.state = BehaviorStatus::failed;
-          rep.reason = "stopped answering (no step for " + seconds_text(now - last) + " s)";
+          rep.reason = "stopped answering (no step for " + format_seconds(now - last) + " s)";
         }
       }
       if (rep.state == BehaviorStatus::succeeded && !a.done_posted) {

@@ -116,12 +116,33 @@ bool ControlLoop::deactivate(std::string_view input) {
 
 bool ControlLoop::set_navigation(const NavigationData& navi) {
   std::lock_guard lock(mutex_);
+  const bool new_path = navi.path_id != navi_shared_.path_id || (navi.path_id == 0 && navi.path.size() != path_shared_.size());
   navi_shared_ = navi;
-  const std::size_t n = std::min(navi.path.size(), options_.max_path_points);
-  path_shared_.assign(navi.path.begin(), navi.path.begin() + static_cast<std::ptrdiff_t>(n));
+  bool complete = true;
+  if (new_path) {
+    const std::size_t n = std::min(navi.path.size(), options_.max_path_points);
+    path_shared_.assign(navi.path.begin(), navi.path.begin() + static_cast<std::ptrdiff_t>(n));
+    complete = n == navi.path.size();
+    path_dirty_ = true;
+  }
   navi_shared_.path = path_shared_;
   navi_dirty_ = true;
-  return n == navi.path.size();
+  return complete;
+}
+
+NavigationFeedback ControlLoop::navigation_feedback() const {
+  std::lock_guard lock(mutex_);
+  return feedback_shared_;
+}
+
+void ControlLoop::hold_changes() {
+  std::lock_guard lock(mutex_);
+  ++holding_;
+}
+
+void ControlLoop::release_changes() {
+  std::lock_guard lock(mutex_);
+  if (holding_ > 0) --holding_;
 }
 
 void ControlLoop::set_lock(std::string_view lock_name, bool engaged, Time stamp) {
@@ -168,6 +189,14 @@ void ControlLoop::push_event(const LoopEvent& event) noexcept {
 }
 
 void ControlLoop::apply_pending() noexcept {
+  // A report that a path was followed to its end stays until the next report: the behavior that
+  // made it has finished and reports no more, and the sequencing layer, slower than this loop,
+  // must not miss it (the coverage planner records a section as finished from it).
+  if (feedback_.path_id != 0 || !feedback_shared_.reached_end) feedback_shared_ = feedback_;
+  if (holding_ > 0) {
+    deferred_.fetch_add(1, std::memory_order_relaxed);
+    return;
+  }
   for (const PendingDeactivation& d : pending_deactivations_) {
     Slot& slot = slots_[d.slot];
     if (slot.active && slot.generation == d.generation) retire(slot);
@@ -187,9 +216,9 @@ void ControlLoop::apply_pending() noexcept {
   pending_locks_.clear();
   if (navi_dirty_) {
     navi_ = navi_shared_;
-    path_.assign(path_shared_.begin(), path_shared_.end());  // within the reserved capacity
+    if (path_dirty_) path_.assign(path_shared_.begin(), path_shared_.end());  // within the reserved capacity
     navi_.path = path_;
-    navi_dirty_ = false;
+    navi_dirty_ = path_dirty_ = false;
   }
   // Hand events over; the supervisor's buffer has the ring's capacity.
   const std::size_t cap = local_events_.size();
@@ -220,6 +249,8 @@ const CycleReport& ControlLoop::step(Time now) noexcept {
   context.resources = &resources_;
   context.navi = &navi_;
   context.base = base_;
+  feedback_ = NavigationFeedback{};
+  context.feedback = &feedback_;
 
   std::uint32_t active = 0;
   for (Slot& slot : slots_) {

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <initializer_list>
@@ -9,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "../common/yaml_reader.hpp"
 #include "tripodal/core/value.hpp"
 
 namespace tripodal {
@@ -33,35 +35,20 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 
 enum class Bound { any, positive, non_negative };
 
-// Reads typed values out of yaml-cpp nodes, collecting located diagnostics.
+// Reads typed values out of yaml-cpp nodes, collecting located diagnostics: the shared
+// yaml::Reader for the structure, and the bounds of controller and loop parameters.
 class Reader {
  public:
-  Reader(std::string file, Diagnostics& diags) : file_(std::move(file)), d_(diags) {}
+  Reader(std::string file, Diagnostics& diags) : r_(std::move(file), diags) {}
 
-  SourceLocation at(const YAML::Node& node) const {
-    const YAML::Mark m = node.Mark();
-    if (m.line < 0) return {file_, 0, 0};
-    return {file_, m.line + 1, m.column + 1};
-  }
-  void error(const YAML::Node& node, std::string message) { d_.error(at(node), std::move(message)); }
+  SourceLocation at(const YAML::Node& node) const { return r_.at(node); }
+  void error(const YAML::Node& node, std::string message) { r_.error(node, std::move(message)); }
 
-  bool is_map(const YAML::Node& node, const std::string& what) {
-    if (node.IsMap()) return true;
-    error(node, what + " must be a map");
-    return false;
-  }
+  bool is_map(const YAML::Node& node, const std::string& what) { return r_.expect_map(node, what); }
 
   // Reports keys of `map` not in `allowed`, at the key itself.
-  void check_keys(const YAML::Node& map, std::initializer_list<std::string_view> allowed, const std::string& what) {
-    for (const auto& kv : map) {
-      const std::string key = kv.first.Scalar();
-      bool ok = false;
-      for (auto a : allowed) ok = ok || a == key;
-      if (ok) continue;
-      std::string list;
-      for (auto a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
-      error(kv.first, "unknown key '" + key + "' in " + what + " (expected one of: " + list + ")");
-    }
+  void check_keys(const YAML::Node& map, yaml::KeyList allowed, const std::string& what) {
+    r_.expect_keys(map, allowed, what);
   }
 
   std::optional<double> number(const YAML::Node& map, const std::string& key, bool required, Bound bound,
@@ -113,19 +100,91 @@ class Reader {
   }
 
  private:
-  std::string file_;
-  Diagnostics& d_;
+  yaml::Reader r_;
 };
 
-AxisLimits read_axis(Reader& r, const YAML::Node& node, const std::string& what) {
-  AxisLimits a;
-  if (!r.is_map(node, what)) return a;
-  r.check_keys(node, {"max_velocity", "max_acceleration", "max_deceleration", "max_jerk"}, what);
-  a.max_velocity = r.number(node, "max_velocity", false, Bound::positive, what);
-  a.max_acceleration = r.number(node, "max_acceleration", false, Bound::positive, what);
-  a.max_deceleration = r.number(node, "max_deceleration", false, Bound::positive, what);
-  a.max_jerk = r.number(node, "max_jerk", false, Bound::positive, what);
-  return a;
+// The omni wheel lists: read by the omni geometry code below, since a manifest parameter is a
+// scalar (the manifest declares them for the allowed keys and the documentation).
+bool is_wheel_list(std::string_view key) noexcept { return key == "wheel_angles_deg" || key == "wheels"; }
+
+// Reports the keys of `map` that no parameter of `manifest` under `prefix` names, at the key,
+// listing the allowed ones; recurses into the maps of dotted names ("limits" -> "limits.vx").
+void check_parameter_keys(Reader& r, const YAML::Node& map, const ModuleManifest& manifest, const std::string& prefix,
+                          const std::string& entry, bool& ok) {
+  const std::string what = prefix.empty() ? entry : entry + " " + prefix.substr(0, prefix.size() - 1);
+  std::vector<std::string> allowed;
+  if (prefix.empty()) allowed = {"name", "type"};
+  for (const auto& spec : manifest.parameters) {
+    if (spec.name.compare(0, prefix.size(), prefix) != 0) continue;
+    std::string key = spec.name.substr(prefix.size(), spec.name.find('.', prefix.size()) - prefix.size());
+    if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) allowed.push_back(std::move(key));
+  }
+  for (const auto& kv : map) {
+    const std::string key = kv.first.Scalar();
+    if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      const auto suggestion = closest_name(key, allowed);
+      r.error(kv.first, "unknown key '" + key + "' in " + what + "; expected one of: " + list +
+                            (suggestion ? "; did you mean '" + *suggestion + "'?" : std::string()));
+      ok = false;
+    } else if (manifest.find_parameter(prefix + key) == nullptr && !(prefix.empty() && (key == "name" || key == "type"))) {
+      const std::string group = prefix + key;  // the map of some dotted names
+      if (!r.is_map(kv.second, entry + " " + group)) {
+        ok = false;
+      } else {
+        check_parameter_keys(r, kv.second, manifest, group + ".", entry, ok);
+      }
+    }
+  }
+}
+
+// The controller's parameters as its type's manifest declares them, each checked at its value;
+// nullopt when any problem was reported.
+std::optional<ParameterSet> read_parameters(Reader& r, const YAML::Node& node, const ModuleManifest& manifest,
+                                            const std::string& what) {
+  bool ok = true;
+  check_parameter_keys(r, node, manifest, "", what, ok);
+  ParameterValues given;
+  for (const auto& spec : manifest.parameters) {
+    if (is_wheel_list(spec.name)) continue;
+    // A dotted name is a path through nested maps; a missing map is a missing value. (YAML::Node
+    // assignment writes into the document: the walk rebinds with reset() and looks up const.)
+    YAML::Node v(node);
+    bool found = true;
+    for (std::size_t from = 0; found;) {
+      const std::size_t dot = spec.name.find('.', from);
+      const std::string key = spec.name.substr(from, dot - from);
+      const YAML::Node& map = v;
+      found = map.IsMap() && map[key];
+      if (found) v.reset(map[key]);
+      if (dot == std::string::npos) break;
+      from = dot + 1;
+    }
+    if (!found) {
+      if (!spec.default_value && !spec.optional) {
+        r.error(node, what + ": missing '" + spec.name + "' (a " + std::string(to_string(spec.type)) + ")");
+        ok = false;
+      }
+      continue;
+    }
+    if (!v.IsScalar()) {
+      r.error(v, what + ": parameter '" + spec.name + "' expects a " + std::string(to_string(spec.type)) +
+                     (v.IsSequence() ? ", got a list" : ", got a map"));
+      ok = false;
+      continue;
+    }
+    Value value{v.Scalar()};
+    if (auto parsed = parse_value(spec.type, v.Scalar())) value = *parsed;
+    if (auto problem = check_parameter_value(spec, value)) {
+      r.error(v, what + ": " + *problem);
+      ok = false;
+      continue;
+    }
+    given.emplace(spec.name, std::move(value));
+  }
+  if (!ok) return std::nullopt;
+  return ParameterSet::resolve(manifest, given, r.at(node));
 }
 
 ControllerConfig read_controller(Reader& r, const YAML::Node& node, std::size_t index, const ControllerRegistry& registry) {
@@ -137,46 +196,30 @@ ControllerConfig read_controller(Reader& r, const YAML::Node& node, std::size_t 
     c.name = *n;
     what = "controller '" + c.name + "'";
   }
-  r.check_keys(node, {"name", "type", "period_s", "cmd_timeout_s", "max_wheel_speed_rad_s", "limits", "wheel_separation_m",
-                      "wheel_radius_m", "base_radius_m", "wheel_angles_deg", "wheels", "half_length_m", "half_width_m"},
-               what);
+  const ModuleManifest* manifest = nullptr;
   if (auto t = r.text(node, "type", true, what)) {
     c.type = *t;
-    if (!registry.contains(c.type)) {
-      std::string known;
-      for (const auto& n : registry.names()) known += (known.empty() ? "" : ", ") + n;
-      r.error(node["type"], what + ": unknown controller type '" + c.type + "' (expected one of: " + known + ")");
-    }
+    manifest = registry.find(c.type);
+    if (manifest == nullptr) r.error(node["type"], what + ": " + unknown_name_message(registry.kind(), c.type, registry.names()));
   }
-  if (auto p = r.number(node, "period_s", false, Bound::positive, what)) c.period = from_seconds(*p);
-  if (auto t = r.number(node, "cmd_timeout_s", false, Bound::non_negative, what)) c.cmd_timeout = from_seconds(*t);
-  c.max_wheel_speed_rad_s = r.number(node, "max_wheel_speed_rad_s", false, Bound::positive, what);
-  if (const YAML::Node lim = node["limits"]) {
-    if (r.is_map(lim, what + " limits")) {
-      r.check_keys(lim, {"vx", "vy", "wz"}, what + " limits");
-      if (lim["vx"]) c.limits.vx = read_axis(r, lim["vx"], what + " limits.vx");
-      if (lim["vy"]) c.limits.vy = read_axis(r, lim["vy"], what + " limits.vy");
-      if (lim["wz"]) c.limits.wz = read_axis(r, lim["wz"], what + " limits.wz");
-    }
+  if (manifest == nullptr) return c;
+  if (auto parameters = read_parameters(r, node, *manifest, what)) {
+    c.parameters = std::move(*parameters);
+    apply_parameters(c);
   }
 
-  if (c.type == "differential") {
-    c.differential.wheel_separation_m = r.number(node, "wheel_separation_m", true, Bound::positive, what).value_or(0.0);
-    c.differential.wheel_radius_m = r.number(node, "wheel_radius_m", true, Bound::positive, what).value_or(0.0);
-  } else if (c.type == "mecanum") {
-    const double radius = r.number(node, "wheel_radius_m", true, Bound::positive, what).value_or(0.0);
-    const auto hl = r.number(node, "half_length_m", true, Bound::positive, what);
-    const auto hw = r.number(node, "half_width_m", true, Bound::positive, what);
-    if (hl && hw) c.holonomic = mecanum_base(radius, *hl, *hw);
-    c.holonomic.wheel_radius_m = radius;
-  } else if (c.type == "omni") {
-    c.holonomic.wheel_radius_m = r.number(node, "wheel_radius_m", true, Bound::positive, what).value_or(0.0);
+  if (c.type == "omni") {
     const YAML::Node angles = node["wheel_angles_deg"];
     const YAML::Node wheels = node["wheels"];
     if (angles && wheels) {
       r.error(wheels, what + ": give either 'wheel_angles_deg' (with 'base_radius_m') or 'wheels', not both");
     } else if (angles) {
-      const auto base = r.number(node, "base_radius_m", true, Bound::positive, what);
+      std::optional<double> base;
+      if (c.parameters.contains("base_radius_m")) {
+        base = c.parameters.number("base_radius_m");
+      } else if (!node["base_radius_m"]) {
+        r.error(node, what + ": missing 'base_radius_m' (a number)");
+      }
       std::vector<double> a;
       if (!angles.IsSequence()) {
         r.error(angles, what + ": 'wheel_angles_deg' must be a list of angles in degrees");
@@ -308,12 +351,7 @@ LoopConfig read_loop(Reader& r, const YAML::Node& node, std::size_t index) {
 ReactiveConfig parse_reactive_config(std::string_view text, const std::string& file, const ControllerRegistry& registry) {
   Diagnostics diags;
   Reader r(file, diags);
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(text));
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(SourceLocation{file, e.mark.line + 1, e.mark.column + 1}, "YAML syntax error: " + e.msg);
-  }
+  const YAML::Node root = yaml::parse(text, file);
   ReactiveConfig out;
   if (!root.IsMap()) {
     throw ConfigError(SourceLocation{file, 1, 1}, "expected a map with 'controllers' and 'loops'");
@@ -351,11 +389,7 @@ ReactiveConfig parse_reactive_config(std::string_view text, const std::string& f
 }
 
 ReactiveConfig load_reactive_config(const std::string& path, const ControllerRegistry& registry) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(SourceLocation{path, 0, 0}, "cannot read the file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_reactive_config(ss.str(), path, registry);
+  return parse_reactive_config(yaml::read_file(path), path, registry);
 }
 
 std::unique_ptr<ControlLoop> make_control_loop(const ReactiveConfig& reactive, const LoopConfig& config,

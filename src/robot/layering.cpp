@@ -120,7 +120,7 @@ std::vector<std::string> knowledge_inputs(const TaskLibrary& tasks) {
   return {out.begin(), out.end()};
 }
 
-RobotDescription describe_robot(const RobotProfile& profile, const RobotCatalog& catalog,
+RobotDescription describe_robot(const RobotProfile& profile, const RobotPlugins& plugins,
                                 const std::vector<std::string>& planner_inputs, Diagnostics& d) {
   RobotDescription out;
   out.name = profile.name;
@@ -136,11 +136,17 @@ RobotDescription describe_robot(const RobotProfile& profile, const RobotCatalog&
   out.modules.push_back(DescribedModule{CoreNames::kCoordinator, "CBehaviorCoordinator", ModuleKind::other, Layer::reactive,
                                         true, "fuses the commands of the active behaviors", {"behavior_command*"},
                                         {"cmd_vel"}, profile.where});
-  for (const ModuleEntry* e : profile.all_modules()) {
+  std::vector<const ModuleEntry*> entries;
+  if (profile.hardware) entries.push_back(&*profile.hardware);
+  for (const ModuleEntry* e : profile.all_modules()) entries.push_back(e);
+  for (const ModuleEntry* e : entries) {
+    const bool is_hardware = profile.hardware && e == &*profile.hardware;
     const ModuleManifest* m = nullptr;
-    if (e->kind == ModuleKind::behavior && catalog.behaviors) m = catalog.behaviors->manifest(e->type);
-    if (e->kind == ModuleKind::controller && catalog.controllers) m = catalog.controllers->manifest(e->type);
-    if (m == nullptr && catalog.modules) m = catalog.modules->manifest(e->type);
+    if (is_hardware) m = plugins.hardware.find(e->type);
+    else if (e->kind == ModuleKind::behavior) m = plugins.behaviors.find(e->type);
+    else if (e->kind == ModuleKind::controller) m = plugins.controllers.find(e->type);
+    else if (e->kind == ModuleKind::resource) m = plugins.resources.find(e->type);
+    else m = plugins.modules.find(e->type);
     DescribedModule dm;
     dm.name = e->name;
     dm.type = e->type;
@@ -149,16 +155,19 @@ RobotDescription describe_robot(const RobotProfile& profile, const RobotCatalog&
     dm.description = e->description;
     if (m != nullptr) {
       dm.layer = m->layer;
-      if (e->layer && *e->layer != m->layer) {
-        d.error(e->where, "module '" + e->name + "' declares the " + std::string(to_string(*e->layer)) + " layer, but its type '" +
-                              e->type + "' is a " + std::string(to_string(m->layer)) + "-layer module");
+      if (e->layer || e->inputs || e->outputs) {
+        // One manifest per type: the diagram must show what the code does, not a second copy.
+        d.error(e->where, "module '" + e->name + "' re-declares " + (e->layer ? "layer" : e->inputs ? "inputs" : "outputs") +
+                              " of its registered type '" + e->type + "' (a " + std::string(to_string(m->layer)) +
+                              "-layer " + std::string(to_string(m->kind)) +
+                              "); remove layer, inputs and outputs: the diagram comes from the type's own manifest");
       }
-      if (m->kind != ModuleKind::other && m->kind != e->kind) {
+      if (!is_hardware && m->kind != ModuleKind::other && m->kind != e->kind) {
         d.error(e->where, "module '" + e->name + "': type '" + e->type + "' is a " + std::string(to_string(m->kind)) +
                               ", but it is listed as a " + std::string(to_string(e->kind)));
       }
-      dm.inputs = e->inputs ? *e->inputs : m->inputs;
-      dm.outputs = e->outputs ? *e->outputs : m->outputs;
+      dm.inputs = m->inputs;
+      dm.outputs = m->outputs;
       if (dm.description.empty()) dm.description = m->description;
     } else if (e->layer) {
       dm.layer = *e->layer;  // declared in the profile: a module designed before it is implemented
@@ -166,12 +175,21 @@ RobotDescription describe_robot(const RobotProfile& profile, const RobotCatalog&
       dm.outputs = e->outputs.value_or(std::vector<std::string>{});
     } else {
       std::vector<std::string> known;
-      if (e->kind == ModuleKind::behavior && catalog.behaviors) known = catalog.behaviors->names();
-      else if (e->kind == ModuleKind::controller && catalog.controllers) known = catalog.controllers->names();
-      else if (catalog.modules) known = catalog.modules->names();
-      d.error(e->where, "unknown " + std::string(to_string(e->kind)) + " type '" + e->type + "' (registered: " +
-                            (known.empty() ? "none" : join(known)) +
-                            "); register it, or declare it here with layer, inputs and outputs");
+      std::string kind = std::string(to_string(e->kind)) + " type";
+      if (is_hardware) {
+        known = plugins.hardware.names();
+        kind = "hardware type";
+      } else if (e->kind == ModuleKind::behavior) {
+        known = plugins.behaviors.names();
+      } else if (e->kind == ModuleKind::controller) {
+        known = plugins.controllers.names();
+      } else if (e->kind == ModuleKind::resource) {
+        known = plugins.resources.names();
+      } else {
+        known = plugins.modules.names();
+      }
+      d.error(e->where, unknown_name_message(kind, e->type, known) +
+                            "; register it, or declare it here with layer, inputs and outputs");
       continue;
     }
     out.modules.push_back(std::move(dm));

@@ -1,23 +1,41 @@
 #include "tripodal/robot/robot.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <map>
+#include <mutex>
 #include <optional>
+#include <stdexcept>
+#include <thread>
 
+#include "tripodal/behaviors/navigation_behaviors.hpp"
 #include "tripodal/core/net_loader.hpp"
+#include "tripodal/navi/navi_modules.hpp"
+#include "tripodal/reactive/reactive_config.hpp"
 
 namespace tripodal {
+
+RobotPlugins RobotPlugins::with_builtins() {
+  RobotPlugins p;
+  register_builtin_behaviors(p.behaviors);
+  register_navigation_behaviors(p.behaviors);
+  register_builtin_controllers(p.controllers);
+  navi::register_navigation_modules(p.modules);
+  return p;
+}
 
 namespace {
 
 // The planner's questions go to the module that lists the question among its outputs.
 class RobotKnowledge final : public TaskKnowledge {
  public:
-  std::vector<std::pair<std::string, RobotModule*>> providers;  // output name -> module
+  std::vector<std::pair<std::string, const CModule*>> providers;  // output name -> module
+  const NavigationData* navigation = nullptr;
   [[nodiscard]] ListResult list(std::string_view function, std::string_view argument) const override {
     for (const auto& [info, m] : providers) {
       if (info != function) continue;
       try {
-        if (auto r = m->answer(function, argument)) return *r;
+        if (auto r = m->answer(function, argument, *navigation)) return {r->ok, std::move(r->items), std::move(r->error)};
       } catch (const std::exception& e) {
         return {false, {}, "the module providing '" + std::string(function) + "' failed: " + e.what()};
       }
@@ -26,32 +44,213 @@ class RobotKnowledge final : public TaskKnowledge {
   }
 };
 
+// The profile's text parameters of one entry, with the run's overrides applied.
+ParameterValues parameters_of(const ModuleEntry& e, const std::vector<ParameterOverride>& overrides) {
+  ParameterValues out;
+  for (const auto& [k, v] : e.parameters) out.emplace(k, Value{v});
+  for (const ParameterOverride& o : overrides) {
+    if (o.module == e.name) out.insert_or_assign(o.parameter, Value{o.value});
+  }
+  return out;
+}
+
+// A controller's full configuration (limits, wheel geometry): the reactive configuration file its
+// profile entry names in the parameter `config`.
+ControllerConfig controller_config(const RobotProfile& p, const ModuleEntry& e) {
+  const auto it = e.parameters.find("config");
+  if (it == e.parameters.end()) {
+    throw ConfigError(e.where, "controller '" + e.name +
+                                   "' needs parameters: {config: FILE}, the reactive configuration with its limits and wheels");
+  }
+  const std::filesystem::path file = p.dir / it->second;
+  const ReactiveConfig rc = load_reactive_config(file.string());
+  const ControllerConfig* c = rc.find_controller(e.name);
+  if (c == nullptr) throw ConfigError(e.where, file.string() + " configures no controller named '" + e.name + "'");
+  if (c->type != e.type) {
+    throw ConfigError(e.where, "controller '" + e.name + "' is of type '" + e.type + "' here but '" + c->type + "' in " + file.string());
+  }
+  return *c;
+}
+
 }  // namespace
 
-struct Robot::Impl {
-  const Clock& clock;
+struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
+  Clock& clock;
+  const RobotPlugins& plugins;
   RobotOptions options;
   RobotDescription description;
-  BehaviorSet behaviors;
   ProcessRegistry processes;
   TaskLibrary tasks;
   RecoveryPolicy recovery;
-  std::vector<std::pair<std::string, std::unique_ptr<RobotModule>>> modules;
+  Duration sequencing_period{0};
+  std::filesystem::path profile_dir;
+
+  // Below the reactive layer, and the reactive layer.
+  std::unique_ptr<CHardware> hardware;
+  std::vector<ControllerConfig> controller_configs;
+  std::vector<std::unique_ptr<CResource>> own_resources;
+  OdometryResource odometry{"odometry"};
+  ResourceTable resources;
+  std::vector<std::unique_ptr<ControlLoop>> loops;
+  std::map<std::string, std::string, std::less<>> behavior_types;  // profile name -> type
+
+  // The sequencing layer.
+  std::vector<std::pair<std::string, std::unique_ptr<CModule>>> modules;
+  NavigationData navigation;
+  std::uint32_t path_ids = 0;
   RobotKnowledge knowledge;
-  CBehaviorCoordinator coordinator;
   std::unique_ptr<CProcessSupervisor> supervisor;
   std::unique_ptr<CPlanner> planner;
-  BehaviorContext activation_context;  // what behaviors see when the supervisor activates them
 
-  Impl(const Clock& c, RobotOptions o) : clock(c), options(std::move(o)), behaviors(c) {}
+  // The behaviors the supervisor activated, as the reactive loop reports them.
+  struct ActiveBehavior {
+    BehaviorHandle handle;
+    BehaviorStatus state = BehaviorStatus::running;
+    std::string reason;
+  };
+  std::map<std::string, ActiveBehavior, std::less<>> active;
+  std::vector<LoopEvent> loop_events;
+
+  // Drivers.
+  std::recursive_mutex sequencing_mutex;  // the sequencing loop vs. command() from another thread
+  std::vector<Time> next_reactive;
+  Time next_sequencing{0};
+  bool schedule_started = false;
+  std::vector<std::unique_ptr<LoopRunner>> runners;
+  std::thread sequencing_thread;
+  std::atomic<bool> stop_requested{false};
+  bool started = false;
+
+  Impl(Clock& c, const RobotPlugins& p, RobotOptions o) : clock(c), plugins(p), options(std::move(o)) {}
+  // The supervisor deactivates the running behaviors as it goes, through this host: it must go
+  // while the loops, the modules and the record of active behaviors are still here.
+  ~Impl() override {
+    planner.reset();
+    supervisor.reset();
+  }
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+
+  [[nodiscard]] ControlLoop& behavior_loop() const { return *loops.front(); }
+
+  ModuleContext context(Time now) {
+    ModuleContext ctx;
+    ctx.now = now;
+    ctx.resources = &resources;
+    ctx.navigation = &navigation;
+    ctx.hardware = hardware.get();
+    ctx.modules = this;
+    ctx.path_ids = &path_ids;
+    ctx.profile_dir = profile_dir;
+    if (!loops.empty()) ctx.feedback = behavior_loop().navigation_feedback();
+    return ctx;
+  }
+
+  // What a module posted goes to the supervisor under the module's name.
+  void deliver(std::string_view module, ModuleContext& ctx) {
+    for (ModuleEvent& e : ctx.events) supervisor->post_event(std::move(e.name));
+    ctx.events.clear();
+    if (ctx.heartbeat) supervisor->heartbeat(module);
+    ctx.heartbeat = false;
+  }
+
+  template <class Fn>
+  void for_each_module(ModuleContext& ctx, const Fn& fn) {
+    for (auto& [name, m] : modules) {
+      try {
+        fn(*m);
+      } catch (const std::exception& e) {
+        supervisor->report_module_fault(name, e.what());
+      } catch (...) {
+        supervisor->report_module_fault(name, "unknown exception");
+      }
+      deliver(name, ctx);
+    }
+  }
+
+  // ModuleDirectory
+  [[nodiscard]] std::vector<CModule*> all() const override {
+    std::vector<CModule*> out;
+    for (const auto& [name, m] : modules) out.push_back(m.get());
+    return out;
+  }
+
+  // BehaviorHost: the supervisor's behaviors run in the behavior loop.
+  [[nodiscard]] bool has(std::string_view behavior) const override { return behavior_types.count(behavior) != 0; }
+
+  void activate(std::string_view behavior, const ParameterValues& params, Time now) override {
+    const auto type = behavior_types.find(behavior);
+    if (type == behavior_types.end()) throw std::out_of_range("no behavior '" + std::string(behavior) + "'");
+    // Throws ConfigError for bad parameters: the supervisor makes it the behavior's failure.
+    const BehaviorHandle h = behavior_loop().activate(plugins.behaviors.create(type->second), params, behavior);
+    active.insert_or_assign(std::string(behavior), ActiveBehavior{h, BehaviorStatus::running, {}});
+    const BehaviorActivation a{behavior, params, now, plugins.behaviors.find(type->second)};
+    ModuleContext ctx = context(now);
+    for_each_module(ctx, [&](CModule& m) { m.behavior_activated(a, ctx); });
+  }
+
+  void deactivate(std::string_view behavior, Time now) override {
+    const auto it = active.find(behavior);
+    if (it == active.end()) return;
+    behavior_loop().deactivate(it->second.handle);
+    active.erase(it);
+    ModuleContext ctx = context(now);
+    for_each_module(ctx, [&](CModule& m) { m.behavior_deactivated(behavior, ctx); });
+  }
+
+  [[nodiscard]] BehaviorReport report(std::string_view behavior) const override {
+    const auto it = active.find(behavior);
+    if (it == active.end()) return {};
+    return BehaviorReport{it->second.state, it->second.reason, std::nullopt};
+  }
+
+  void collect_loop_reports() {
+    loop_events.clear();
+    for (auto& loop : loops) loop->collect_events(loop_events);
+    for (const LoopEvent& e : loop_events) {
+      switch (e.kind) {
+        case LoopEvent::Kind::behavior_succeeded:
+        case LoopEvent::Kind::behavior_failed: {
+          // The supervisor's behaviors run in the behavior loop, each on the input of its name.
+          const auto it = active.find(e.input);
+          if (e.loop != behavior_loop().name() || it == active.end() || it->second.handle != e.handle) break;
+          it->second.state = e.kind == LoopEvent::Kind::behavior_succeeded ? BehaviorStatus::succeeded : BehaviorStatus::failed;
+          it->second.reason = std::string(e.reason);
+          break;
+        }
+        case LoopEvent::Kind::controller_fault:
+        case LoopEvent::Kind::controller_recovered: supervisor->post_event(e.event_name()); break;
+      }
+    }
+  }
+
+  void step_sequencing() {
+    std::lock_guard lock(sequencing_mutex);
+    const Time now = clock.now();
+    // The changes of this period (activations, the paths planned for them) reach the loops together.
+    std::vector<std::unique_ptr<ControlLoop::ChangeBatch>> batches;
+    for (auto& loop : loops) batches.push_back(std::make_unique<ControlLoop::ChangeBatch>(*loop));
+    collect_loop_reports();
+    ModuleContext ctx = context(now);
+    for_each_module(ctx, [&](CModule& m) { m.update(ctx); });
+    if (planner->busy()) {
+      planner->step();
+    } else {
+      supervisor->step();  // module events and watchdogs keep flowing between tasks
+    }
+    if (!loops.empty()) behavior_loop().set_navigation(navigation);
+  }
 };
 
 Robot::Robot(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
-Robot::~Robot() = default;
 
-std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotCatalog& catalog, const Clock& clock,
+Robot::~Robot() { stop(); }
+
+std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotPlugins& plugins, Clock& clock,
                                        RobotOptions options) {
-  auto m = std::make_unique<Impl>(clock, std::move(options));
+  auto m = std::make_unique<Impl>(clock, plugins, std::move(options));
+  m->sequencing_period = profile.sequencing_period;
+  m->profile_dir = profile.dir;
   Diagnostics d;
   auto collect = [&](const auto& fn) {
     try {
@@ -64,19 +263,18 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotC
   std::vector<std::string> process_names;
   for (const ProcessEntry& p : profile.processes) process_names.push_back(p.name);
   auto is_process = [&](std::string_view n) { return std::find(process_names.begin(), process_names.end(), n) != process_names.end(); };
-  std::vector<std::string> behavior_names;
-  for (const ModuleEntry& b : profile.behaviors) behavior_names.push_back(b.name);
-  auto is_behavior = [&](std::string_view n) { return std::find(behavior_names.begin(), behavior_names.end(), n) != behavior_names.end(); };
+  for (const ModuleEntry& b : profile.behaviors) m->behavior_types.emplace(b.name, b.type);
+  auto is_behavior = [&](std::string_view n) { return m->behavior_types.count(n) != 0; };
 
   if (!profile.tasks.empty()) {
     collect([&] { m->tasks = TaskLibrary::load(profile.tasks, TaskLoadOptions{is_process}); });
   }
   if (!profile.recovery.empty()) collect([&] { m->recovery = RecoveryPolicy::load(profile.recovery, is_process); });
 
-  m->description = describe_robot(profile, catalog, knowledge_inputs(m->tasks), d);
+  m->description = describe_robot(profile, plugins, knowledge_inputs(m->tasks), d);
 
   // Processes: nets, parameters and their own recovery rules.
-  if (m->options.register_process_types) m->options.register_process_types(m->processes);
+  m->processes = ProcessRegistry(plugins.processes);
   auto load = m->options.load_net;
   if (!load) {
     load = [&](const std::filesystem::path& f) {
@@ -94,7 +292,10 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotC
       def.parameters = p.parameters;
       def.where = p.where;
       def.net = load(p.net);
-      if (!p.module.empty()) def.module = load(p.module);
+      if (!p.module.empty()) {
+        def.module = load(p.module);
+        check_module_net(*def.module, p.name, d);
+      }
       if (!p.recovery.empty()) def.recovery = RecoveryPolicy::load(p.recovery, is_process).rules();
       for (const Place& place : def.net.places()) {
         if (place.behavior && !is_behavior(place.behavior->behavior)) {
@@ -107,105 +308,219 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotC
     });
   }
 
-  // Behaviors and modules.
+  // Behaviors are created anew at each activation; here their types are checked.
   for (const ModuleEntry& b : profile.behaviors) {
-    if (catalog.behaviors == nullptr || !catalog.behaviors->contains(b.type)) {
-      d.error(b.where, "behavior '" + b.name + "' cannot be started: no behavior type '" + b.type + "' is registered");
+    if (!plugins.behaviors.contains(b.type)) continue;  // describe_robot reported it
+    if (b.name != b.type) {
+      d.error(b.where, "behavior '" + b.name + "' is of type '" + b.type + "'; behaviors are known to the nets by their type name");
+    }
+  }
+
+  // The hardware and the base controllers on it.
+  for (const LoopEntry& l : profile.loops) {
+    if (l.controller.empty()) continue;
+    for (const ModuleEntry& c : profile.controllers) {
+      if (c.name == l.controller) collect([&] { m->controller_configs.push_back(controller_config(profile, c)); });
+    }
+  }
+  if (profile.hardware && plugins.hardware.contains(profile.hardware->type)) {
+    const ModuleEntry& h = *profile.hardware;
+    collect([&] {
+      HardwareConfig hc;
+      hc.name = h.name;
+      hc.type = h.type;
+      hc.where = h.where;
+      hc.parameters = ParameterSet::resolve(plugins.hardware.manifest(h.type), parameters_of(h, m->options.parameters), h.where);
+      hc.base = m->controller_configs.empty() ? nullptr : &m->controller_configs.front();
+      hc.profile_dir = profile.dir;
+      m->hardware = plugins.hardware.create_at(h.where, h.type, hc);
+      m->hardware->add_resources(m->resources);
+    });
+  }
+  for (const ModuleEntry& e : profile.resources) {
+    if (!plugins.resources.contains(e.type)) {
+      if (e.layer || e.inputs || e.outputs) d.error(e.where, "resource '" + e.name + "' cannot be started: no resource type '" + e.type + "' is registered");
       continue;
     }
     collect([&] {
-      auto inst = catalog.behaviors->create(b.type);
-      if (inst->name() != b.name) {
-        throw ConfigError(b.where, "behavior '" + b.name + "': type '" + b.type + "' creates '" + std::string(inst->name()) +
-                                       "'; behaviors are known to the nets by their type name");
-      }
-      m->behaviors.add(std::move(inst));
+      ResourceConfig rc{e.name, ParameterSet::resolve(plugins.resources.manifest(e.type), parameters_of(e, m->options.parameters), e.where),
+                        e.where};
+      m->own_resources.push_back(plugins.resources.create_at(e.where, e.type, rc));
+      m->resources.add(*m->own_resources.back());
     });
-  }
-  for (const auto* list : {&profile.resources, &profile.navigation, &profile.hri, &profile.modules}) {
-    for (const ModuleEntry& e : *list) {
-      if (catalog.modules == nullptr || !catalog.modules->can_create(e.type)) {
-        d.error(e.where, "module '" + e.name + "' cannot be started: no factory is registered for type '" + e.type + "'");
-        continue;
-      }
-      collect([&] { m->modules.emplace_back(e.name, catalog.modules->create(ModuleConfig{e.name, e.type, e.parameters, e.where})); });
-    }
   }
   if (d.has_errors()) throw ConfigError(d);
 
-  // Wiring: the coordinator's inputs in profile order (earlier behaviors win ties by priority).
-  int priority = static_cast<int>(profile.behaviors.size());
-  for (const ModuleEntry& b : profile.behaviors) m->coordinator.add_input(CoordinatorInputConfig{b.name, priority--});
-  m->activation_context.period = m->options.period;
-  m->activation_context.resources = m->options.resources;
-  m->activation_context.navi = m->options.navigation;
-  m->activation_context.base = m->options.base;
-  m->behaviors.set_context(&m->activation_context);
-  m->supervisor = std::make_unique<CProcessSupervisor>(m->behaviors, clock, m->options.supervisor);
+  // The reactive loops. The first runs the behaviors; its coordinator's inputs are the profile's
+  // behaviors in order (earlier ones win ties by priority).
+  m->resources.add(m->odometry);
+  bool first = true;
+  std::size_t controller_index = 0;
+  for (const LoopEntry& l : profile.loops) {
+    collect([&] {
+      std::unique_ptr<CController> controller;
+      if (!l.controller.empty()) {
+        if (!m->hardware) throw ConfigError(l.where, "loop '" + l.name + "' drives controller '" + l.controller + "', and the robot has no hardware");
+        controller = plugins.controllers.create(m->controller_configs.at(controller_index++), m->hardware->wheels());
+      }
+      CoordinatorConfig cc;
+      if (first) {
+        int priority = static_cast<int>(profile.behaviors.size());
+        for (const ModuleEntry& b : profile.behaviors) cc.inputs.push_back(CoordinatorInputConfig{b.name, priority--});
+      }
+      ControlLoopOptions lo;
+      lo.name = l.name;
+      lo.period = l.period;
+      lo.max_path_points = CPathFollowingBehavior::kMaxPathPoints;
+      auto loop = std::make_unique<ControlLoop>(lo, m->resources, CBehaviorCoordinator(cc), std::move(controller));
+      if (first && loop->controller() != nullptr) loop->set_odometry_output(&m->odometry);
+      m->loops.push_back(std::move(loop));
+      first = false;
+    });
+  }
+  if (m->loops.empty() && !profile.behaviors.empty()) {
+    d.error(profile.where, "the robot lists behaviors but no loop to run them: add loops: [{name, period_s, controller}]");
+  }
+
+  // The modules of the sequencing loop.
+  for (const auto* list : {&profile.navigation, &profile.hri, &profile.modules}) {
+    for (const ModuleEntry& e : *list) {
+      if (!plugins.modules.contains(e.type)) {
+        if (e.layer) d.error(e.where, "module '" + e.name + "' cannot be started: no module type '" + e.type + "' is registered");
+        continue;  // an unknown undeclared type: describe_robot reported it
+      }
+      collect([&] {
+        auto mod = plugins.modules.create_at(e.where, e.type);
+        mod->configure(parameters_of(e, m->options.parameters), e.where);
+        m->modules.emplace_back(e.name, std::move(mod));
+      });
+    }
+  }
+  if (d.has_errors()) throw ConfigError(d);
+  {
+    ModuleContext ctx = m->context(clock.now());
+    for (auto& [name, mod] : m->modules) collect([&] { mod->start(ctx); });
+  }
+  if (d.has_errors()) throw ConfigError(d);
+
+  m->supervisor = std::make_unique<CProcessSupervisor>(*m, clock, m->options.supervisor);
+  m->knowledge.navigation = &m->navigation;
   for (auto& [name, mod] : m->modules) {
-    mod->attach(ModulePort(*m->supervisor, name));
     for (const DescribedModule& dm : m->description.modules) {
       if (dm.name != name) continue;
       for (const std::string& out : dm.outputs) m->knowledge.providers.emplace_back(out, mod.get());
     }
   }
-  for (const auto* list : {&profile.resources, &profile.navigation, &profile.hri, &profile.modules}) {
+  for (const auto* list : {&profile.navigation, &profile.hri, &profile.modules}) {
     for (const ModuleEntry& e : *list) {
       if (e.watchdog_timeout) m->supervisor->watch_module(e.name, *e.watchdog_timeout, e.watchdog_event);
     }
   }
   m->planner = std::make_unique<CPlanner>(m->tasks, m->recovery, m->knowledge, m->processes, *m->supervisor, clock,
                                           m->options.planner);
+  if (!m->loops.empty()) m->behavior_loop().set_navigation(m->navigation);
   return std::unique_ptr<Robot>(new Robot(std::move(m)));
 }
 
-CommandAnswer Robot::command(std::string_view text) { return impl_->planner->command(text); }
-
-void Robot::step() {
-  Impl& m = *impl_;
-  const Time now = m.clock.now();
-  for (auto& [name, mod] : m.modules) {
-    try {
-      mod->update(now);
-    } catch (const std::exception& e) {
-      m.supervisor->report_module_fault(name, e.what());
-    } catch (...) {
-      m.supervisor->report_module_fault(name, "unknown exception");
-    }
-  }
-  BehaviorContext ctx;
-  ctx.now = now;
-  ctx.period = m.options.period;
-  ctx.resources = m.options.resources;
-  ctx.navi = m.options.navigation;
-  ctx.base = m.options.base;
-  m.activation_context = ctx;
-  m.behaviors.step_active(ctx, [&](std::string_view name, const std::optional<Twist2D>& cmd) {
-    auto id = m.coordinator.find_input(name);
-    if (!id) return;
-    if (cmd) m.coordinator.submit(*id, *cmd, now);
-    else m.coordinator.withdraw(*id);
-  });
-  m.coordinator.update(now);
-  if (m.planner->busy()) {
-    m.planner->step();
-  } else {
-    m.supervisor->step();  // module events and watchdogs keep flowing between tasks
-  }
+CommandAnswer Robot::command(std::string_view text) {
+  std::lock_guard lock(impl_->sequencing_mutex);
+  return impl_->planner->command(text);
 }
 
+void Robot::step_sequencing() { impl_->step_sequencing(); }
+
+void Robot::run_until(Time until) {
+  Impl& m = *impl_;
+  auto* clock = dynamic_cast<SimClock*>(&m.clock);
+  if (clock == nullptr) throw std::logic_error("Robot::run_until needs a SimClock; on real time use start()");
+  if (m.started) throw std::logic_error("Robot::run_until: the robot's threads are running");
+  SimClock& sim_clock = *clock;
+  if (!m.schedule_started) {
+    m.next_sequencing = sim_clock.now();
+    m.next_reactive.assign(m.loops.size(), sim_clock.now());
+    m.schedule_started = true;
+  }
+  while (true) {
+    Time t = m.next_sequencing;
+    for (const Time r : m.next_reactive) t = std::min(t, r);
+    if (t > until) break;
+    sim_clock.set(t);
+    if (m.hardware) m.hardware->advance_to(t);
+    if (m.next_sequencing == t) {
+      m.step_sequencing();
+      m.next_sequencing += m.sequencing_period;
+    }
+    for (std::size_t i = 0; i < m.loops.size(); ++i) {
+      if (m.next_reactive[i] != t) continue;
+      m.loops[i]->step(t);
+      m.next_reactive[i] += m.loops[i]->period();
+    }
+  }
+  if (sim_clock.now() < until) sim_clock.set(until);
+}
+
+void Robot::run_for(Duration d) { run_until(impl_->clock.now() + d); }
+
+void Robot::start() {
+  Impl& m = *impl_;
+  if (m.started) throw std::logic_error("Robot::start: already started");
+  if (m.hardware) m.hardware->start();
+  m.stop_requested = false;
+  for (auto& loop : m.loops) {
+    m.runners.push_back(std::make_unique<LoopRunner>(*loop, m.clock));
+    m.runners.back()->start();
+  }
+  m.sequencing_thread = std::thread([&m] {
+    Time deadline = m.clock.now();
+    while (!m.stop_requested.load(std::memory_order_acquire)) {
+      m.step_sequencing();
+      deadline += m.sequencing_period;
+      m.clock.sleep_until(deadline);
+    }
+  });
+  m.started = true;
+}
+
+void Robot::stop() noexcept {
+  Impl& m = *impl_;
+  if (!m.started) return;
+  m.stop_requested = true;
+  if (m.sequencing_thread.joinable()) m.sequencing_thread.join();
+  for (auto& r : m.runners) r->stop();
+  m.runners.clear();
+  if (m.hardware) m.hardware->stop();
+  m.started = false;
+}
+
+bool Robot::started() const noexcept { return impl_->started; }
 const RobotDescription& Robot::description() const noexcept { return impl_->description; }
 CPlanner& Robot::planner() noexcept { return *impl_->planner; }
 CProcessSupervisor& Robot::supervisor() noexcept { return *impl_->supervisor; }
-BehaviorSet& Robot::behaviors() noexcept { return impl_->behaviors; }
 const ProcessRegistry& Robot::processes() const noexcept { return impl_->processes; }
-const CBehaviorCoordinator& Robot::coordinator() const noexcept { return impl_->coordinator; }
+ControlLoop& Robot::behavior_loop() noexcept { return impl_->behavior_loop(); }
+CHardware* Robot::hardware() noexcept { return impl_->hardware.get(); }
+const ResourceTable& Robot::resources() const noexcept { return impl_->resources; }
+const NavigationData& Robot::navigation() const noexcept { return impl_->navigation; }
 
-RobotModule* Robot::module(std::string_view name) noexcept {
+bool Robot::behavior_active(std::string_view name) const noexcept {
+  const auto it = impl_->active.find(name);
+  return it != impl_->active.end() && it->second.state == BehaviorStatus::running;
+}
+
+ControlLoop* Robot::loop(std::string_view name) noexcept {
+  for (auto& l : impl_->loops) {
+    if (l->name() == name) return l.get();
+  }
+  return nullptr;
+}
+
+CModule* Robot::module(std::string_view name) noexcept {
   for (auto& [n, mod] : impl_->modules) {
     if (n == name) return mod.get();
   }
   return nullptr;
 }
+
+std::vector<CModule*> Robot::modules() const { return impl_->all(); }
 
 }  // namespace tripodal

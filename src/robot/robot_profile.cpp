@@ -7,52 +7,33 @@
 #include <set>
 #include <sstream>
 
-#include "../planner/yaml_util.hpp"
+#include "../common/yaml_reader.hpp"
 
 namespace tripodal {
 
 namespace {
 
-using detail::kind_name;
-using detail::where;
-
 struct Parser {
+  Parser(std::string file_name, std::filesystem::path base_dir)
+      : file(std::move(file_name)), base(std::move(base_dir)), r(file, d) {}
+
   std::string file;
   std::filesystem::path base;
   Diagnostics d;
+  yaml::Reader r;
 
-  SourceLocation at(const YAML::Node& n) const { return where(file, n); }
+  SourceLocation at(const YAML::Node& n) const { return r.at(n); }
 
   bool scalar(const YAML::Node& n, std::string& out, std::string_view what) {
-    if (!n.IsScalar()) {
-      d.error(at(n), std::string(what) + " must be a scalar, not " + kind_name(n));
-      return false;
-    }
-    out = n.as<std::string>();
-    return true;
+    auto text = r.text(n, what);
+    if (text) out = std::move(*text);
+    return text.has_value();
   }
 
-  std::optional<std::vector<std::string>> names(const YAML::Node& n, std::string_view what) {
-    if (!n.IsSequence()) {
-      d.error(at(n), std::string(what) + " must be a list of names, not " + kind_name(n));
-      return std::nullopt;
-    }
-    std::vector<std::string> out;
-    for (const auto& item : n) {
-      std::string s;
-      if (scalar(item, s, what)) out.push_back(s);
-    }
-    return out;
-  }
+  std::optional<std::vector<std::string>> names(const YAML::Node& n, std::string_view what) { return r.names(n, what); }
 
   std::optional<double> positive_seconds(const YAML::Node& n, std::string_view what) {
-    double v = 0.0;
-    if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !std::isfinite(v) || v <= 0.0) {
-      d.error(at(n), std::string(what) + " must be a positive number of seconds, got '" +
-                         (n.IsScalar() ? n.as<std::string>() : kind_name(n)) + "'");
-      return std::nullopt;
-    }
-    return v;
+    return r.positive(n, std::string(what) + " (seconds)");
   }
 
   std::filesystem::path path_of(const YAML::Node& n, std::string_view what, SourceLocation& loc) {
@@ -66,8 +47,9 @@ struct Parser {
     return p;
   }
 
-  void module(const YAML::Node& n, ModuleKind kind, std::vector<ModuleEntry>& out) {
+  void module(const YAML::Node& n, ModuleKind kind, std::vector<ModuleEntry>& out, std::string default_name = {}) {
     ModuleEntry e;
+    e.name = std::move(default_name);
     e.kind = kind;
     e.where = at(n);
     if (n.IsScalar()) {  // "- BhCleaning": a registered type under its own name
@@ -75,8 +57,8 @@ struct Parser {
       out.push_back(std::move(e));
       return;
     }
-    if (!n.IsMap()) {
-      d.error(e.where, "a " + std::string(to_string(kind)) + " entry must be a name or a map with name, type, ...; not " + kind_name(n));
+    const std::string entry = "a " + std::string(to_string(kind)) + " entry";
+    if (!r.expect_keys(n, {"name", "type", "description", "layer", "inputs", "outputs", "parameters", "watchdog"}, entry)) {
       return;
     }
     for (const auto& kv : n) {
@@ -99,37 +81,21 @@ struct Parser {
       } else if (key == "outputs") {
         e.outputs = names(v, "outputs");
       } else if (key == "parameters") {
-        if (!v.IsMap()) {
-          d.error(at(v), "parameters must be a map of name: value, not " + kind_name(v));
-          continue;
-        }
+        if (!r.expect_map(v, "parameters")) continue;
         for (const auto& p : v) {
           std::string val;
           if (scalar(p.second, val, "parameter '" + p.first.as<std::string>() + "'")) e.parameters[p.first.as<std::string>()] = val;
         }
       } else if (key == "watchdog") {
-        if (!v.IsMap()) {
-          d.error(at(v), "watchdog must be a map with timeout_s and optionally event, not " + kind_name(v));
-          continue;
+        if (!r.expect_keys(v, {"timeout_s", "event"}, "watchdog")) continue;
+        if (const YAML::Node t = r.require(v, "timeout_s", "watchdog", "seconds")) {
+          if (auto s = positive_seconds(t, "watchdog timeout_s")) e.watchdog_timeout = from_seconds(*s);
         }
-        for (const auto& w : v) {
-          const std::string wk = w.first.as<std::string>();
-          if (wk == "timeout_s") {
-            if (auto s = positive_seconds(w.second, "watchdog timeout_s")) e.watchdog_timeout = from_seconds(*s);
-          } else if (wk == "event") {
-            scalar(w.second, e.watchdog_event, "watchdog event");
-          } else {
-            d.error(at(w.first), "unknown key '" + wk + "' in watchdog; expected: timeout_s, event");
-          }
-        }
-        if (!e.watchdog_timeout) d.error(at(v), "watchdog needs timeout_s");
-      } else {
-        d.error(at(kv.first), "unknown key '" + key + "' in a " + std::string(to_string(kind)) +
-                                  " entry; expected: name, type, description, layer, inputs, outputs, parameters, watchdog");
+        if (const YAML::Node ev = v["event"]) scalar(ev, e.watchdog_event, "watchdog event");
       }
     }
     if (e.name.empty()) {
-      d.error(e.where, "a " + std::string(to_string(kind)) + " entry needs a name");
+      if (!n["name"]) r.require(n, "name", entry, "the module's name");
       return;
     }
     if (e.type.empty()) e.type = e.name;
@@ -137,20 +103,14 @@ struct Parser {
   }
 
   void modules(const YAML::Node& n, ModuleKind kind, std::vector<ModuleEntry>& out, std::string_view section) {
-    if (!n.IsSequence()) {
-      d.error(at(n), std::string(section) + " must be a list, not " + kind_name(n));
-      return;
-    }
+    if (!r.expect_list(n, section)) return;
     for (const auto& m : n) module(m, kind, out);
   }
 
   void process(const YAML::Node& n, std::vector<ProcessEntry>& out) {
     ProcessEntry p;
     p.where = at(n);
-    if (!n.IsMap()) {
-      d.error(p.where, "a process entry must be a map with name, net, parameters; not " + kind_name(n));
-      return;
-    }
+    if (!r.expect_keys(n, {"name", "type", "net", "module", "parameters", "recovery"}, "a process entry")) return;
     bool has_net = false;
     for (const auto& kv : n) {
       const std::string key = kv.first.as<std::string>();
@@ -168,19 +128,14 @@ struct Parser {
         SourceLocation loc;
         p.recovery = path_of(v, "recovery file", loc);
       } else if (key == "parameters") {
-        if (!v.IsMap()) {
-          d.error(at(v), "parameters must be a map of name: value, not " + kind_name(v));
-          continue;
-        }
+        if (!r.expect_map(v, "parameters")) continue;
         for (const auto& q : v) {
           std::string val;
           if (scalar(q.second, val, "parameter")) p.parameters.push_back(BindingParam{q.first.as<std::string>(), val, at(q.second)});
         }
-      } else {
-        d.error(at(kv.first), "unknown key '" + key + "' in a process entry; expected: name, type, net, module, parameters, recovery");
       }
     }
-    if (p.name.empty()) d.error(p.where, "a process entry needs a name");
+    if (!n["name"]) r.require(n, "name", "a process entry", "the process's name");
     if (!has_net) d.error(p.where, "process '" + p.name + "' needs a net file (net: FILE)");
     if (!p.name.empty()) out.push_back(std::move(p));
   }
@@ -188,32 +143,29 @@ struct Parser {
   RobotProfile parse(const std::string& text) {
     RobotProfile prof;
     prof.file = file;
-    YAML::Node root;
-    try {
-      root = YAML::Load(text);
-    } catch (const YAML::ParserException& e) {
-      throw ConfigError(SourceLocation{file, e.mark.line + 1, e.mark.column + 1}, e.msg);
-    }
+    prof.dir = base;
+    const YAML::Node root = yaml::parse(text, file);
     prof.where = SourceLocation{file, 1, 1};
-    if (!root.IsMap()) {
-      d.error(at(root), "a robot profile must be a map with robot, behaviors, processes, ...; not " + kind_name(root));
+    if (!r.expect_keys(root, {"robot", "hardware", "controllers", "loops", "resources", "navigation", "hri", "modules", "behaviors",
+                              "processes", "tasks", "recovery"},
+                       "the robot profile")) {
       throw ConfigError(d);
     }
     for (const auto& kv : root) {
       const std::string key = kv.first.as<std::string>();
       const YAML::Node v = kv.second;
       if (key == "robot") {
-        if (!v.IsMap()) {
-          d.error(at(v), "robot must be a map with name and description");
-          continue;
-        }
+        if (!r.expect_keys(v, {"name", "description", "sequencing_period_s"}, "robot")) continue;
         prof.where = at(v);
-        for (const auto& r : v) {
-          const std::string rk = r.first.as<std::string>();
-          if (rk == "name") scalar(r.second, prof.name, "robot name");
-          else if (rk == "description") scalar(r.second, prof.description, "description");
-          else d.error(at(r.first), "unknown key '" + rk + "' in robot; expected: name, description");
+        if (const YAML::Node name = v["name"]) scalar(name, prof.name, "robot name");
+        if (const YAML::Node description = v["description"]) scalar(description, prof.description, "description");
+        if (const YAML::Node period = v["sequencing_period_s"]) {
+          if (auto s = positive_seconds(period, "sequencing_period_s")) prof.sequencing_period = from_seconds(*s);
         }
+      } else if (key == "hardware") {
+        std::vector<ModuleEntry> hw;
+        module(v, ModuleKind::other, hw, "hardware");
+        if (!hw.empty()) prof.hardware = std::move(hw.front());
       } else if (key == "controllers") {
         modules(v, ModuleKind::controller, prof.controllers, key);
       } else if (key == "resources") {
@@ -227,42 +179,25 @@ struct Parser {
       } else if (key == "behaviors") {
         modules(v, ModuleKind::behavior, prof.behaviors, key);
       } else if (key == "loops") {
-        if (!v.IsSequence()) {
-          d.error(at(v), "loops must be a list, not " + kind_name(v));
-          continue;
-        }
+        if (!r.expect_list(v, "loops")) continue;
         for (const auto& l : v) {
           LoopEntry loop;
           loop.where = at(l);
-          if (!l.IsMap()) {
-            d.error(loop.where, "a loop must be a map with name, period_s, controller");
-            continue;
+          if (!r.expect_keys(l, {"name", "period_s", "controller"}, "a loop")) continue;
+          if (const YAML::Node name = r.require(l, "name", "a loop", "the loop's name")) scalar(name, loop.name, "name");
+          if (const YAML::Node c = l["controller"]) scalar(c, loop.controller, "controller");
+          if (const YAML::Node p = r.require(l, "period_s", "a loop", "seconds")) {
+            if (auto s = positive_seconds(p, "period_s")) loop.period = from_seconds(*s);
           }
-          for (const auto& lk : l) {
-            const std::string k = lk.first.as<std::string>();
-            if (k == "name") scalar(lk.second, loop.name, "name");
-            else if (k == "controller") scalar(lk.second, loop.controller, "controller");
-            else if (k == "period_s") {
-              if (auto s = positive_seconds(lk.second, "period_s")) loop.period = from_seconds(*s);
-            } else d.error(at(lk.first), "unknown key '" + k + "' in a loop; expected: name, period_s, controller");
-          }
-          if (loop.name.empty()) d.error(loop.where, "a loop needs a name");
-          if (loop.period <= Duration{0} && !l["period_s"]) d.error(loop.where, "loop '" + loop.name + "' needs period_s");
           prof.loops.push_back(std::move(loop));
         }
       } else if (key == "processes") {
-        if (!v.IsSequence()) {
-          d.error(at(v), "processes must be a list, not " + kind_name(v));
-          continue;
-        }
+        if (!r.expect_list(v, "processes")) continue;
         for (const auto& p : v) process(p, prof.processes);
       } else if (key == "tasks") {
         prof.tasks = path_of(v, "tasks file", prof.tasks_where);
       } else if (key == "recovery") {
         prof.recovery = path_of(v, "recovery file", prof.recovery_where);
-      } else {
-        d.error(at(kv.first), "unknown key '" + key +
-                                  "'; expected: robot, controllers, loops, resources, navigation, hri, modules, behaviors, processes, tasks, recovery");
       }
     }
     if (prof.name.empty()) d.error(prof.where, "the profile needs robot: {name: ...}");
@@ -298,15 +233,11 @@ std::vector<const ModuleEntry*> RobotProfile::all_modules() const {
 }
 
 RobotProfile load_robot_profile(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw ConfigError(SourceLocation{file.string(), 0, 0}, "cannot read the robot profile");
-  std::stringstream s;
-  s << in.rdbuf();
-  return load_robot_profile_from_string(s.str(), file.string(), file.parent_path());
+  return load_robot_profile_from_string(yaml::read_file(file), file.string(), file.parent_path());
 }
 
 RobotProfile load_robot_profile_from_string(std::string_view yaml, std::string_view name, const std::filesystem::path& base_dir) {
-  Parser p{std::string(name), base_dir, {}};
+  Parser p(std::string(name), base_dir);
   return p.parse(std::string(yaml));
 }
 

@@ -1,5 +1,6 @@
 #include "tripodal/sim/world.hpp"
 
+#include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -8,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "../common/yaml_reader.hpp"
 #include "tripodal/sim/ray_caster.hpp"
 
 namespace tripodal::sim {
@@ -28,59 +30,24 @@ namespace {
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
 
-// Reads one world file's YAML into typed values, collecting every problem with its location.
+// Reads one world file's YAML into typed values, collecting every problem with its location:
+// the shared yaml::Reader plus the shapes and windows of world files.
 class Reader {
  public:
-  explicit Reader(std::string file) : file_(std::move(file)) {}
+  explicit Reader(std::string file) : r_(std::move(file), d_) {}
 
-  SourceLocation at(const YAML::Node& n) const {
-    const YAML::Mark m = n.Mark();
-    if (m.line < 0) return {file_, 0, 0};
-    return {file_, m.line + 1, m.column + 1};
-  }
-  void error(const YAML::Node& n, const std::string& msg) { d_.error(at(n), msg); }
+  SourceLocation at(const YAML::Node& n) const { return r_.at(n); }
+  void error(const YAML::Node& n, const std::string& msg) { r_.error(n, msg); }
   Diagnostics& diagnostics() { return d_; }
 
-  static std::string kind(const YAML::Node& n) {
-    switch (n.Type()) {
-      case YAML::NodeType::Map: return "a map";
-      case YAML::NodeType::Sequence: return "a list";
-      case YAML::NodeType::Scalar: return "'" + n.Scalar() + "'";
-      case YAML::NodeType::Null: return "nothing";
-      default: return "undefined";
-    }
-  }
+  static std::string kind(const YAML::Node& n) { return yaml::kind(n); }
 
   /// Reports keys of map `n` not in `allowed`; false when n is not a map.
-  bool check_map(const YAML::Node& n, const std::string& what, std::initializer_list<std::string_view> allowed) {
-    if (!n.IsMap()) {
-      error(n, what + " must be a map, got " + kind(n));
-      return false;
-    }
-    for (const auto& kv : n) {
-      const std::string key = kv.first.Scalar();
-      bool ok = false;
-      for (std::string_view a : allowed) ok = ok || key == a;
-      if (!ok) {
-        std::string list;
-        for (std::string_view a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
-        error(kv.first, "unknown key '" + key + "' in " + what + ", expected one of: " + list);
-      }
-    }
-    return true;
+  bool check_map(const YAML::Node& n, const std::string& what, yaml::KeyList allowed) {
+    return r_.expect_keys(n, allowed, what);
   }
 
-  std::optional<double> number(const YAML::Node& n, const std::string& what) {
-    if (n.IsScalar()) {
-      try {
-        const double v = n.as<double>();
-        if (std::isfinite(v)) return v;
-      } catch (const YAML::Exception&) {
-      }
-    }
-    error(n, what + " must be a finite number, got " + kind(n));
-    return std::nullopt;
-  }
+  std::optional<double> number(const YAML::Node& n, const std::string& what) { return r_.number(n, what); }
   /// A number >= lo (or > lo when strict) into `out` if the key is present.
   void number_at_least(const YAML::Node& map, const char* key, double& out, double lo, bool strict,
                        const std::string& where_in) {
@@ -88,53 +55,20 @@ class Reader {
     if (!n) return;
     const std::string what = where_in + "." + key;
     if (auto v = number(n, what)) {
-      if (strict ? *v <= lo : *v < lo) {
-        std::ostringstream s;
-        s << what << " must be " << (strict ? "> " : ">= ") << lo << ", got " << *v;
-        error(n, s.str());
-      } else {
-        out = *v;
-      }
+      if (strict ? *v <= lo : *v < lo) error(n, fmt::format("{}: expected a number {} {}, got {}", what, strict ? ">" : ">=", lo, *v));
+      else out = *v;
     }
   }
   void boolean(const YAML::Node& map, const char* key, bool& out, const std::string& where_in) {
-    const YAML::Node n = map[key];
-    if (!n) return;
-    try {
-      if (n.IsScalar()) {
-        out = n.as<bool>();
-        return;
-      }
-    } catch (const YAML::Exception&) {
-    }
-    error(n, where_in + "." + key + " must be true or false, got " + kind(n));
+    if (const YAML::Node n = map[key]) out = r_.boolean(n, where_in + "." + key).value_or(out);
   }
   void text(const YAML::Node& map, const char* key, std::string& out, const std::string& where_in) {
-    const YAML::Node n = map[key];
-    if (!n) return;
-    if (!n.IsScalar() || n.Scalar().empty()) {
-      error(n, where_in + "." + key + " must be a non-empty string, got " + kind(n));
-      return;
-    }
-    out = n.Scalar();
+    if (const YAML::Node n = map[key]) out = r_.text(n, where_in + "." + key, true).value_or(out);
   }
-  /// A list of `count` numbers (count_opt more optional), or an error.
+  /// A list of `count` numbers (optional_extra more allowed), or an error.
   std::optional<std::vector<double>> numbers(const YAML::Node& n, const std::string& what, std::size_t count,
                                              std::size_t optional_extra, const std::string& expected) {
-    if (!n.IsSequence() || n.size() < count || n.size() > count + optional_extra) {
-      error(n, what + " must be " + expected + ", got " + kind(n) +
-                   (n.IsSequence() ? " of " + std::to_string(n.size()) + " items" : ""));
-      return std::nullopt;
-    }
-    std::vector<double> out;
-    bool ok = true;
-    for (const auto& item : n) {
-      auto v = number(item, what + " item");
-      ok = ok && v.has_value();
-      out.push_back(v.value_or(0.0));
-    }
-    if (!ok) return std::nullopt;
-    return out;
+    return r_.numbers(n, what, count, count + optional_extra, expected);
   }
   std::optional<Pose2D> pose(const YAML::Node& n, const std::string& what) {
     auto v = numbers(n, what, 2, 1, "[x, y] or [x, y, theta] (metres, radians)");
@@ -195,8 +129,8 @@ class Reader {
   }
 
  private:
-  std::string file_;
   Diagnostics d_;
+  yaml::Reader r_;
 };
 
 void read_laser(Reader& r, const YAML::Node& n, LaserConfig& c) {
@@ -410,12 +344,7 @@ void read_faults(Reader& r, const YAML::Node& n, FaultSchedule& f) {
 
 World parse_world(std::string_view text, const std::filesystem::path& file) {
   const std::string fname = file.string();
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(text));
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError(SourceLocation{fname, e.mark.line + 1, e.mark.column + 1}, e.msg);
-  }
+  const YAML::Node root = yaml::parse(text, fname);
   Reader r(fname);
   World w;
   w.file = file;
@@ -569,11 +498,7 @@ World parse_world(std::string_view text, const std::filesystem::path& file) {
 }
 
 World load_world(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw ConfigError(SourceLocation{file.string(), 0, 0}, "cannot open world file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parse_world(ss.str(), file);
+  return parse_world(yaml::read_file(file), file);
 }
 
 }  // namespace tripodal::sim

@@ -13,11 +13,7 @@ namespace tripodal::testing {
 
 namespace {
 
-std::string seconds(Time t) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3f s", to_seconds(t));
-  return buf;
-}
+std::string seconds(Time t) { return format_seconds(t) + " s"; }
 
 std::string num(double v) {
   char buf[32];

@@ -4,6 +4,8 @@
 #include <catch2/catch.hpp>
 
 #include <cctype>
+#include <cmath>
+#include <limits>
 
 #include "analysis_test_nets.hpp"
 #include "tripodal/analysis/analyzer.hpp"
@@ -276,4 +278,16 @@ TEST_CASE("The JSON report is well-formed and escapes names", "[analysis][report
   CHECK_THAT(kanban, Catch::Contains(R"("states":160)"));
   CHECK_FALSE(JsonChecker(R"({"a":1,})").ok());  // the checker itself rejects bad JSON
   CHECK_FALSE(JsonChecker("{\"a\":\"\x01\"}").ok());
+}
+
+TEST_CASE("The JSON report writes a number that is not finite as null", "[analysis][report][json]") {
+  const PetriNet net = process_net();
+  AnalysisReport r = analyze(net);
+  r.exploration_s = std::nan("");
+  r.bytes_per_state = std::numeric_limits<double>::infinity();
+  const std::string json = format_json(r, net);
+  CHECK(JsonChecker(json).ok());
+  CHECK_THAT(json, Catch::Contains(R"("exploration_s":null,"states_per_s":0.0)") &&
+                       Catch::Contains(R"("bytes_per_state":null)"));
+  CHECK_THAT(json, !Catch::Contains("nan") && !Catch::Contains("inf"));
 }

@@ -3,13 +3,16 @@
 #include <zlib.h>
 
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <unistd.h>
 
-#include "tripodal/app/cleaning_run.hpp"
-#include "tripodal/app/png.hpp"
+#include "run_task.hpp"
+#include "png.hpp"
 #include "tripodal/core/diagnostic.hpp"
 
 using namespace tripodal;
@@ -114,11 +117,29 @@ TEST_CASE("The run report is JSON with the measured values, strings escaped", "[
   r.sections.push_back(s);
   const std::string j = r.json();
   CHECK_THAT(j, Catch::Contains("\"task\": \"clean the \\\"big\\\" room\"") && Catch::Contains("\"coverage\": 0.9877") &&
-                    Catch::Contains("\"path\": {\"length_m\": 12.35, \"turns\": 7") &&
-                    Catch::Contains("\"recoveries\": [\"310.000 fault\"]") &&
-                    Catch::Contains("\"balloon\": {\"length_m\": 0.00, \"turns\": 3") &&
-                    Catch::Contains("\"boustrophedon\": {\"length_m\": 0.00, \"turns\": 9") &&
+                    Catch::Contains("\"path\": {\n    \"length_m\": 12.35,\n    \"turns\": 7") &&
+                    Catch::Contains("\"recoveries\": [\n    \"310.000 fault\"\n  ]") &&
+                    Catch::Contains("\"balloon\": {\n        \"length_m\": 0.0,\n        \"turns\": 3") &&
+                    Catch::Contains("\"boustrophedon\": {\n        \"length_m\": 0.0,\n        \"turns\": 9") &&
                     Catch::Contains("\"succeeded\": true"));
+  // The keys in the documented order, the whole report parsed back.
+  const auto parsed = nlohmann::json::parse(j);
+  CHECK(parsed.at("sections").at(0).at("name") == "A");
+  CHECK(parsed.at("path").at("length_m") == 12.35);
+  CHECK(j.find("\"robot\"") < j.find("\"task\""));
+  CHECK(j.find("\"faults\"") < j.find("\"robot_steps\""));
+}
+
+TEST_CASE("The run report never prints a number that is not JSON", "[app]") {
+  RunResult r;
+  r.coverage = std::nan("");
+  r.duration_s = std::numeric_limits<double>::infinity();
+  r.total.length_m = -std::numeric_limits<double>::infinity();
+  const std::string j = r.json();
+  CHECK_THAT(j, Catch::Contains("\"coverage\": null") && Catch::Contains("\"duration_s\": null") &&
+                    Catch::Contains("\"length_m\": null"));
+  CHECK_THAT(j, !Catch::Contains("nan") && !Catch::Contains("inf"));
+  CHECK_NOTHROW(nlohmann::json::parse(j));
 }
 
 TEST_CASE("run_task refuses a profile whose controller names no configuration, with its location", "[app]") {
@@ -141,7 +162,7 @@ TEST_CASE("run_task refuses a profile whose controller names no configuration, w
   o.robot = profile;
   o.world = kSource / "configs/worlds/workspace.yaml";
   o.task = "clean the room 3211";
-  REQUIRE_THROWS_WITH(run_task(o), Catch::Contains("robot.yaml:11:5: error: controller 'base' needs parameters: {config: FILE}"));
+  REQUIRE_THROWS_WITH(run_task(o), Catch::Contains("robot.yaml:16:5: error: controller 'base' needs parameters: {config: FILE}"));
   std::filesystem::remove_all(dir);
 }
 

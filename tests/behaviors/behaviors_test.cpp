@@ -69,7 +69,9 @@ TEST_CASE("Every registered behavior can be created by name and describes itself
     REQUIRE(b);
     CHECK(b->name() == name);
     const ModuleManifest& m = b->manifest();
-    CHECK(&m == reg.manifest(name));
+    REQUIRE(reg.find(name) != nullptr);
+    CHECK(reg.find(name)->name == m.name);
+    CHECK(reg.find(name)->parameters.size() == m.parameters.size());
     CHECK(m.layer == Layer::reactive);
     CHECK(m.kind == ModuleKind::behavior);
     CHECK_FALSE(m.description.empty());
@@ -87,7 +89,14 @@ TEST_CASE("Every registered behavior can be created by name and describes itself
     CHECK(b->status() == BehaviorStatus::idle);
     CHECK_FALSE(b->step(w.ctx).has_value());
   }
-  REQUIRE_THROWS_WITH(reg.create("BhFly"), Catch::Contains("unknown behavior 'BhFly'") && Catch::Contains("BhGoToPose"));
+  REQUIRE_THROWS_AS(reg.create("BhFly"), ConfigError);
+  REQUIRE_THROWS_WITH(reg.create("BhFly"),
+                      Catch::Contains("unknown behavior type 'BhFly'; known: BhAvoidObstacle, BhBackOff, BhGoToPose, "
+                                      "BhRotateInPlace, BhStop") &&
+                          !Catch::Contains("did you mean"));
+  REQUIRE_THROWS_WITH(reg.create_at({"clean.xml", 4, 7}, "BhGoToPos"),
+                      Catch::Contains("clean.xml:4:7: error: unknown behavior type 'BhGoToPos'; known: ") &&
+                          Catch::Contains("; did you mean 'BhGoToPose'?"));
   BehaviorRegistry mine;
   mine.add<BhStop>();
   CHECK_THROWS_WITH(mine.add<BhStop>(), Catch::Contains("'BhStop' is already registered"));

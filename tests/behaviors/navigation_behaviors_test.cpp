@@ -1,143 +1,25 @@
-// BhAutoMove, BhCleaning, BhCleaningTwoWheel and BhGlobalLocalization driven on the ideal wheel
-// hardware double through the real omni and differential controllers: the controller's
-// odometry is the robot's pose (a perfect localizer), the behaviors' commands go through the
-// controller's limits and kinematics.
+// The navigation behaviors on their own: PathTracker, and BhAutoMove, BhCleaning,
+// BhCleaningTwoWheel and BhGlobalLocalization stepped by hand with the NavigationData the
+// sequencing layer would publish (path, path_id, path_start_m, path_final, path_failure, fixes) and
+// the feedback they report back. The body moves by integrating the commands (an ideal base), so
+// these tests see what the behaviors themselves do; the modules in closed loop on the simulator are
+// tests/navi/navigation_modules_test.cpp.
 #include "tripodal/behaviors/navigation_behaviors.hpp"
 
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <functional>
+#include <limits>
 #include <numbers>
-
-#include "tripodal/controllers/controller_config.hpp"
-#include "tripodal/controllers/ideal_hardware.hpp"
-#include "tripodal/sim/ray_caster.hpp"
+#include <optional>
+#include <vector>
 
 using namespace tripodal;
 using namespace std::chrono_literals;
-using navi::Occupancy;
-using navi::OccupancyGrid;
-using navi::Point2D;
 
 namespace {
 
-// A w x h metre room (5 cm cells) with a one-cell wall, and optionally a square pillar.
-OccupancyGrid room(double w_m, double h_m, bool pillar) {
-  const int w = static_cast<int>(std::lround(w_m / 0.05)), h = static_cast<int>(std::lround(h_m / 0.05));
-  OccupancyGrid g(w, h, 0.05, Pose2D{}, Occupancy::free);
-  for (int x = 0; x < w; ++x) {
-    g.set_state({x, 0}, Occupancy::occupied);
-    g.set_state({x, h - 1}, Occupancy::occupied);
-  }
-  for (int y = 0; y < h; ++y) {
-    g.set_state({0, y}, Occupancy::occupied);
-    g.set_state({w - 1, y}, Occupancy::occupied);
-  }
-  if (pillar) {
-    // 0.6 m x 1.6 m, standing from the bottom wall's side in the middle of the room
-    for (int y = h / 2 - 16; y < h / 2 + 16; ++y) {
-      for (int x = w / 2 - 6; x < w / 2 + 6; ++x) g.set_state({x, y}, Occupancy::occupied);
-    }
-  }
-  return g;
-}
-
-navi::RegionMap regions_for(double w_m, double h_m) {
-  navi::RegionMap r;
-  r.rooms.push_back(navi::Region{"101", {{0, 0}, {w_m, 0}, {w_m, h_m}, {0, h_m}}, {}});
-  r.nodes.push_back(navi::MapNode{"door", Pose2D{w_m - 0.6, h_m / 2, 0.0}, "", {}});
-  return r;
-}
-
-ControllerConfig controller_config(bool omni) {
-  ControllerConfig c;
-  c.period = 10ms;
-  c.limits.vx = AxisLimits{0.8, 1.5, {}, {}};
-  c.limits.vy = AxisLimits{0.8, 1.5, {}, {}};
-  c.limits.wz = AxisLimits{2.0, 4.0, {}, {}};
-  if (omni) {
-    c.type = "omni";
-    const double angles[] = {std::numbers::pi / 3, std::numbers::pi, 5 * std::numbers::pi / 3};
-    c.holonomic = omni_base(0.05, 0.22, angles);
-  } else {
-    c.type = "differential";
-    c.differential = {0.42, 0.09};
-  }
-  return c;
-}
-
-// A robot on the ideal wheels: behaviors at 20 Hz, the controller at 100 Hz.
-struct Rig {
-  NaviWorkspace ws;
-  IdealWheelHardware hw;
-  std::unique_ptr<CController> controller;
-  LaserResource laser{"laser", 500ms};
-  ResourceTable table;
-  NavigationData navi;
-  BehaviorContext ctx;
-  Time now{0};
-  navi::CleanedCells truth_cleaned;  // from the controller's pose, independent of the behavior
-  std::vector<Pose2D> trajectory;
-  double max_turn_rate = 0.0;
-
-  Rig(bool omni, OccupancyGrid grid, navi::RegionMap regions, Pose2D start, NaviWorkspaceOptions o = small_robot())
-      : ws(std::move(grid), std::move(regions), o), hw(omni ? 3 : 2, 10ms), truth_cleaned(ws.grid()) {
-    controller = default_controller_registry().create(controller_config(omni), hw);
-    controller->reset_odometry(start);
-    table.add(laser);
-    ctx.period = 50ms;
-    ctx.resources = &table;
-    ctx.navi = &navi;
-    ctx.base = controller->capabilities();
-    publish();
-  }
-  static NaviWorkspaceOptions small_robot() {
-    NaviWorkspaceOptions o;
-    o.robot_radius_m = 0.2;
-    o.cleaning_width_m = 0.45;  // the side brushes reach 2.5 cm beyond the body
-    return o;
-  }
-  void publish() {
-    navi.map_from_base = controller->odometry().pose;
-    navi.pose_stamp = now;
-    navi.localized = true;
-    ctx.now = now;
-  }
-  // Steps `b` until it leaves running or max_s passes; returns the simulated seconds.
-  double run(CBehavior& b, double max_s, const std::function<void()>& each = {}) {
-    const Time start = now;
-    while (b.running() && now - start < from_seconds(max_s)) {
-      if (each) each();
-      const auto cmd = b.step(ctx);
-      for (int k = 0; k < 5; ++k) {
-        controller->set_command(cmd.value_or(Twist2D{}), now);
-        (void)controller->update(now);
-        now += 10ms;
-        const Pose2D p = controller->odometry().pose;
-        if (!trajectory.empty()) {
-          truth_cleaned.mark_segment({trajectory.back().x_m, trajectory.back().y_m}, {p.x_m, p.y_m}, ws.options().cleaning_width_m / 2);
-        }
-        trajectory.push_back(p);
-        max_turn_rate = std::max(max_turn_rate, std::abs(controller->odometry().twist.wz_rad_s));
-      }
-      publish();
-    }
-    return to_seconds(now - start);
-  }
-  // The smallest clearance of the trajectory from physical obstacles.
-  [[nodiscard]] double min_clearance() const {
-    double best = 1e9;
-    const auto& g = ws.grid();
-    for (std::size_t k = 0; k < trajectory.size(); k += 10) {
-      const Pose2D& p = trajectory[k];
-      for (std::size_t i = 0; i < g.size(); ++i) {
-        if (!g.is_occupied(g.cell(i))) continue;
-        const Point2D c = g.cell_center(g.cell(i));
-        best = std::min(best, std::hypot(c.x_m - p.x_m, c.y_m - p.y_m));
-      }
-    }
-    return best;
-  }
-};
+constexpr double kPi = std::numbers::pi;
 
 ParameterValues params(std::initializer_list<std::pair<const std::string, std::string>> kv) {
   ParameterValues v;
@@ -145,12 +27,13 @@ ParameterValues params(std::initializer_list<std::pair<const std::string, std::s
   return v;
 }
 
-// A scan (360 beams) with a return at `range_m` within +-half_width_rad of straight ahead.
+// A scan (360 beams, robot frame) with a return at `range_m` within +-half_width_rad of straight
+// ahead, nothing elsewhere.
 LaserScan scan_with_obstacle_ahead(Time stamp, double range_m, double half_width_rad) {
   LaserScan s;
   s.stamp = stamp;
-  s.angle_min_rad = -std::numbers::pi;
-  s.angle_increment_rad = 2 * std::numbers::pi / 360;
+  s.angle_min_rad = -kPi;
+  s.angle_increment_rad = 2 * kPi / 360;
   s.angle_max_rad = s.angle_min_rad + 359 * s.angle_increment_rad;
   s.range_min_m = 0.05;
   s.range_max_m = 12.0;
@@ -162,326 +45,336 @@ LaserScan scan_with_obstacle_ahead(Time stamp, double range_m, double half_width
   return s;
 }
 
-// The world as the laser sees it: the map plus boxes the map does not hold.
-struct World {
-  sim::SolidMap solid;
-  sim::LaserModel lidar{sim::LaserConfig::rplidar_a1(), 5};
-  std::vector<Point2D> box_cells;  // centres of the cells of the boxes
-  explicit World(const OccupancyGrid& g) : solid(g) {}
-  void box(const OccupancyGrid& g, double x0, double y0, double x1, double y1, bool solid_now = true) {
-    for (int y = 0; y < g.height(); ++y) {
-      for (int x = 0; x < g.width(); ++x) {
-        const Point2D c = g.cell_center({x, y});
-        if (c.x_m < x0 || c.x_m > x1 || c.y_m < y0 || c.y_m > y1) continue;
-        solid.set_solid(x, y, solid_now);
-        if (solid_now) box_cells.push_back(c);
-      }
-    }
-    solid.refresh();
+// The map of the test: everything beyond x = 1 m is a wall it holds.
+class WallBeyondOneMetre final : public ObstacleMap {
+ public:
+  [[nodiscard]] bool near_obstacle(double x_m, double /*y_m*/) const noexcept override { return x_m > 1.0; }
+};
+
+// What the reactive loop gives a behavior, by hand: 20 Hz steps; the commands move an ideal base.
+struct Bench {
+  NavigationData navi;
+  LaserResource laser{"laser", 500ms};
+  ResourceTable table;
+  NavigationFeedback feedback;
+  BehaviorContext ctx;
+  std::vector<Pose2D> path;
+  Time now{0};
+  double max_turn_rate = 0.0;
+
+  explicit Bench(bool omni, Pose2D start = {0.6, 2.0, 0.0}) {
+    table.add(laser);
+    ctx.period = 50ms;
+    ctx.resources = &table;
+    ctx.navi = &navi;
+    ctx.feedback = &feedback;
+    ctx.base = BaseCapabilities{0.8, omni ? 0.8 : 0.0, 2.0};
+    navi.map_from_base = start;
+    navi.localized = true;
+    navi.robot_radius_m = 0.2;
   }
-  void scan_into(Rig& rig) {
-    LaserScan scan;
-    lidar.scan(solid, rig.controller->odometry().pose, rig.now, scan);
-    rig.laser.publish(scan);
+  // What a path planner would publish.
+  void publish(std::vector<Pose2D> points, std::uint32_t id, double start_m = 0.0, bool final = true) {
+    path = std::move(points);
+    navi.path = path;
+    navi.path_id = id;
+    navi.path_start_m = start_m;
+    navi.path_final = final;
   }
-  // Closest approach of the trajectory's centre to a box cell's centre.
-  [[nodiscard]] double min_distance(const Rig& rig) const {
-    double best = 1e9;
-    for (const Pose2D& p : rig.trajectory) {
-      for (const Point2D& c : box_cells) best = std::min(best, std::hypot(c.x_m - p.x_m, c.y_m - p.y_m));
+  // One period: the behavior's command, executed for the period.
+  std::optional<Twist2D> step(CBehavior& b) {
+    ctx.now = now;
+    feedback = NavigationFeedback{};
+    const std::optional<Twist2D> cmd = b.step(ctx);
+    const Twist2D v = cmd.value_or(Twist2D{});
+    Pose2D& p = navi.map_from_base;
+    const double dt = to_seconds(ctx.period);
+    p.x_m += (std::cos(p.theta_rad) * v.vx_m_s - std::sin(p.theta_rad) * v.vy_m_s) * dt;
+    p.y_m += (std::sin(p.theta_rad) * v.vx_m_s + std::cos(p.theta_rad) * v.vy_m_s) * dt;
+    p.theta_rad = wrap_angle(p.theta_rad + v.wz_rad_s * dt);
+    max_turn_rate = std::max(max_turn_rate, std::abs(v.wz_rad_s));
+    now += ctx.period;
+    return cmd;
+  }
+  // Steps while `b` runs, at most max_s; returns the seconds stepped.
+  double run(CBehavior& b, double max_s, const std::function<void()>& each = {}) {
+    const Time start = now;
+    while (b.running() && now - start < from_seconds(max_s)) {
+      if (each) each();
+      (void)step(b);
     }
-    return best;
+    return to_seconds(now - start);
   }
 };
 
+double distance(const Pose2D& a, const Pose2D& b) {
+  return std::hypot(a.x_m - b.x_m, a.y_m - b.y_m);
+}
+
 }  // namespace
 
-TEST_CASE("NaviWorkspace: sections of a room, goal names, bad names", "[behaviors][navigation]") {
-  NaviWorkspace ws(room(6.0, 4.0, true), regions_for(6.0, 4.0), Rig::small_robot());
-  const auto sec = ws.sections_of_room("101");
-  REQUIRE(sec.ok);
-  REQUIRE_FALSE(sec.names.empty());
-  CHECK(sec.names.front() == "A");
-  const auto bad = ws.sections_of_room("999");
-  CHECK_FALSE(bad.ok);
-  CHECK_THAT(bad.error, Catch::Contains("unknown room '999'") && Catch::Contains("101"));
-  const auto door = ws.resolve_goal("door", {1, 1});
-  REQUIRE(door);
-  CHECK(door->x_m == Approx(5.4));
-  const auto entry = ws.resolve_goal("A.entry", {1, 1});
-  REQUIRE(entry);
-  // the entry is the first point of the balloon path: on round 0, tangent to the walls
-  CHECK(ws.planner().traversable(ws.grid().cell_at(*entry)));
-  CHECK_FALSE(ws.resolve_goal("Z.entry", {1, 1}));
-  CHECK_FALSE(ws.resolve_goal("nowhere", {1, 1}));
+// ---------------------------------------------------------------------------------------------
+// PathTracker
+
+TEST_CASE("PathTracker takes a path up at an arc length and its progress never goes back",
+          "[behaviors][navigation]") {
+  PathTracker t;
+  t.reserve(16);
+  const std::vector<Pose2D> line{{0, 0, 0}, {2, 0, 0}, {4, 0, 0}};
+  t.reset(line, 1.5);
+  CHECK(t.length_m() == Approx(4.0));
+  CHECK(t.progress_m() == Approx(1.5));
+  CHECK(t.at(3.0).x_m == Approx(3.0));
+  CHECK(t.at(-1.0).x_m == 0.0);
+  CHECK(t.at(9.0).x_m == 4.0);
+  // Beside the path at x = 2.2: progress there, lookahead point ahead of it on the path.
+  PathTracker::Target target = t.update({2.2, 0.1, 0.0}, 0.5, 1.0);
+  CHECK(t.progress_m() == Approx(2.2));
+  CHECK(target.cross_track_m == Approx(0.1));
+  CHECK(target.point.x_m == Approx(2.7));
+  CHECK(target.point.y_m == Approx(0.0).margin(1e-9));
+  CHECK(target.remaining_m == Approx(1.8));
+  // Pushed back behind it: the progress stays.
+  (void)t.update({1.0, 0.0, 0.0}, 0.5, 1.0);
+  CHECK(t.progress_m() == Approx(2.2));
+  // A start beyond the end is clamped to it.
+  t.reset(line, 10.0);
+  CHECK(t.progress_m() == Approx(4.0));
 }
 
-TEST_CASE("BhAutoMove drives around an obstacle to a named goal, omni and differential", "[behaviors][navigation]") {
-  for (const bool omni : {true, false}) {
-    INFO((omni ? "omni" : "differential"));
-    Rig rig(omni, room(6.0, 4.0, true), regions_for(6.0, 4.0), Pose2D{0.6, 2.0, 0.0});
-    BhAutoMove b(rig.ws);
-    b.activate(params({{"goal", "door"}}), rig.ctx);
-    REQUIRE(b.running());
-    REQUIRE(b.path().size() >= 3);  // the straight line crosses the pillar: corners around it
-    const double t = rig.run(b, 120.0);
-    CHECK(b.status() == BehaviorStatus::succeeded);
-    const Pose2D end = rig.controller->odometry().pose;
-    CHECK(std::hypot(end.x_m - 5.4, end.y_m - 2.0) <= 0.1);
-    CHECK(rig.min_clearance() >= 0.2 - 0.03);  // the body never touched the pillar or a wall
-    CHECK(t < 40.0);
-    if (omni) CHECK(std::abs(end.theta_rad) < 0.05);  // translated, kept its heading
-  }
+TEST_CASE("PathTracker searches only a short arc ahead, stops the lookahead at corners, keeps its capacity",
+          "[behaviors][navigation]") {
+  PathTracker t;
+  t.reserve(8);
+  // Out along y = 0 and back along y = 0.3, a round of a spiral: near the start, the way back
+  // is closer than the way out but far ahead along the path.
+  const std::vector<Pose2D> u{{0, 0, 0}, {2, 0, 0}, {2, 0.3, 0}, {0, 0.3, 0}};
+  t.reset(u);
+  (void)t.update({0.1, 0.2, 0.0}, 0.1, 1.0);
+  CHECK(t.progress_m() == Approx(0.1));
+  // The lookahead point stops before the corner at (2, 0) instead of cutting it.
+  t.reset(u);
+  const PathTracker::Target target = t.update({1.8, 0.0, 0.0}, 0.6, 1.0);
+  CHECK(target.point.x_m <= 2.0 + 1e-9);
+  CHECK(target.point.y_m == Approx(0.0).margin(1e-9));
+  CHECK(target.corner_rad > 0.45);
+  // Points beyond the reserved capacity are dropped: reset never allocates.
+  std::vector<Pose2D> long_path;
+  for (int i = 0; i < 20; ++i) long_path.push_back({0.1 * i, 0.0, 0.0});
+  t.reset(long_path);
+  CHECK(t.points().size() == 8);
+  CHECK(t.capacity() == 8);
 }
 
-TEST_CASE("BhAutoMove fails with a reason for an unknown or unreachable goal", "[behaviors][navigation]") {
-  navi::RegionMap regions = regions_for(6.0, 4.0);
-  regions.nodes.push_back(navi::MapNode{"inside_pillar", Pose2D{3.0, 2.0, 0.0}, "", {}});
-  Rig rig(true, room(6.0, 4.0, true), regions, Pose2D{0.6, 2.0, 0.0});
-  BhAutoMove b(rig.ws);
-  b.activate(params({{"goal", "kitchen"}}), rig.ctx);
+// ---------------------------------------------------------------------------------------------
+// The path-following behaviors against hand-made navigation data
+
+TEST_CASE("A path-following behavior takes up each new path_id at path_start_m and reports its progress",
+          "[behaviors][navigation]") {
+  Bench bench(true);
+  BhAutoMove b;
+  b.activate(params({{"goal", "door"}}), bench.ctx);
+  REQUIRE(b.running());
+  bench.publish({{0.6, 2.0, 0}, {5.4, 2.0, 0}}, 1);
+  (void)bench.step(b);
+  CHECK(b.tracker().points().size() == 2);
+  CHECK(bench.feedback.path_id == 1);
+  CHECK(bench.feedback.progress_m == Approx(0.0).margin(1e-9));
+  CHECK_FALSE(bench.feedback.blocked);
+  // A detour published under a new id, taken up 1 m along.
+  bench.publish({{0.6, 2.0, 0}, {0.6, 3.0, 0}, {3.0, 3.0, 0}}, 2, 1.0, false);
+  (void)bench.step(b);
+  CHECK(b.tracker().points().size() == 3);
+  CHECK(bench.feedback.path_id == 2);
+  CHECK(bench.feedback.progress_m >= 1.0);
+  // The same id with other points is not a new path: the behavior keeps what it took up.
+  std::vector<Pose2D> other{{9, 9, 0}, {9, 8, 0}};
+  bench.navi.path = other;
+  (void)bench.step(b);
+  CHECK(b.tracker().points().size() == 3);
+  CHECK(b.tracker().points().front().x_m == 0.6);
+}
+
+TEST_CASE(
+    "A path-following behavior fails with the reason the sequencing layer gives, or 'no path' after the "
+    "timeout",
+    "[behaviors][navigation]") {
+  Bench bench(false);
+  BhAutoMove b;
+  b.activate(params({{"goal", "kitchen"}}), bench.ctx);
+  bench.navi.path_failure = "unknown goal";
+  const auto cmd = bench.step(b);
+  CHECK_FALSE(cmd);
   CHECK(b.status() == BehaviorStatus::failed);
   CHECK(b.failure_reason() == "unknown goal");
-  b.activate(params({{"goal", "inside_pillar"}}), rig.ctx);
-  CHECK(b.status() == BehaviorStatus::failed);
-  CHECK(b.failure_reason() == "no path to the goal");
-  REQUIRE_THROWS_WITH(b.activate(params({{"goal", "door"}, {"max_speed_m_s", "-1"}}), rig.ctx, SourceLocation{"PrAutoMove.xml", 9, 5}),
-                      Catch::Contains("PrAutoMove.xml:9:5: error: BhAutoMove: parameter 'max_speed_m_s'"));
+
+  bench.navi.path_failure = {};
+  BhCleaningTwoWheel c;
+  c.activate(params({{"section", "A"}, {"blocked_timeout_s", "2"}}), bench.ctx);
+  const double t = bench.run(c, 10.0, [&] { CHECK(bench.navi.path_id == 0); });
+  CHECK(c.status() == BehaviorStatus::failed);
+  CHECK(c.failure_reason() == "no path");
+  CHECK(t == Approx(2.05).margin(0.06));
+  CHECK(distance(bench.navi.map_from_base, {0.6, 2.0, 0.0}) == 0.0);  // it stood still meanwhile
 }
 
-TEST_CASE("BhAutoMove stops before an obstacle the laser sees and fails when blocked too long", "[behaviors][navigation]") {
-  Rig rig(true, room(6.0, 4.0, false), regions_for(6.0, 4.0), Pose2D{0.6, 2.0, 0.0});
-  BhAutoMove b(rig.ws);
-  // Without planning around it (replan_after_s 0): the obstacle moves with the robot here.
-  b.activate(params({{"goal", "door"}, {"blocked_timeout_s", "3"}, {"replan_after_s", "0"}}), rig.ctx);
-  REQUIRE(b.running());
-  // Something not on the map 0.24 m ahead of the body's centre: 4 cm from the footprint.
-  const double t = rig.run(b, 20.0, [&] { rig.laser.publish(scan_with_obstacle_ahead(rig.now, 0.24, 0.3)); });
-  CHECK(b.status() == BehaviorStatus::failed);
-  CHECK(b.failure_reason() == "path blocked");
-  CHECK(t > 3.0);
-  CHECK(t < 4.5);
-  CHECK(rig.controller->odometry().pose.x_m < 0.7);  // it did not drive into it
-  // Without the obstacle the same goal is reached.
-  b.activate(params({{"goal", "door"}, {"blocked_timeout_s", "3"}}), rig.ctx);
-  (void)rig.run(b, 60.0, [&] { rig.laser.publish(scan_with_obstacle_ahead(rig.now, 20.0, 0.3)); });
-  CHECK(b.status() == BehaviorStatus::succeeded);
-}
-
-TEST_CASE("BhAutoMove plans around a box the map does not hold, omni and differential", "[behaviors][navigation]") {
+TEST_CASE(
+    "A path-following behavior stops before an obstacle the map does not hold, reports it blocked, fails "
+    "when blocked too long",
+    "[behaviors][navigation]") {
   for (const bool omni : {true, false}) {
     INFO((omni ? "omni" : "differential"));
-    Rig rig(omni, room(6.0, 4.0, false), regions_for(6.0, 4.0), Pose2D{0.6, 2.0, 0.0});
-    World world(rig.ws.grid());
-    world.box(rig.ws.grid(), 2.75, 1.5, 3.25, 2.5);  // across the straight line to the door
-    BhAutoMove b(rig.ws);
-    b.activate(params({{"goal", "door"}, {"blocked_timeout_s", "20"}}), rig.ctx);
-    REQUIRE(b.path().size() == 2);  // the map is empty: straight at first
-    const double t = rig.run(b, 120.0, [&] { world.scan_into(rig); });
-    CHECK(b.status() == BehaviorStatus::succeeded);
-    CHECK(b.replans() >= 1);
-    CHECK(b.path().size() >= 3);  // the last plan has corners around the box
-    // The body (radius 0.2 m) never entered the box: centre to cell centre >= 0.2 + half a cell - slack.
-    CHECK(world.min_distance(rig) >= 0.2);
-    CHECK(t < 60.0);
+    Bench bench(omni);
+    BhAutoMove b;
+    b.activate(params({{"goal", "door"}, {"blocked_timeout_s", "3"}}), bench.ctx);
+    bench.publish({{0.6, 2.0, 0}, {5.4, 2.0, 0}}, 1);
+    // Something 0.24 m ahead of the body's centre, moving with it: 4 cm from the footprint.
+    std::optional<Time> blocked_since;
+    const double t = bench.run(b, 20.0, [&] {
+      bench.laser.publish(scan_with_obstacle_ahead(bench.now, 0.24, 0.3));
+      if (bench.feedback.blocked && !blocked_since) blocked_since = bench.feedback.blocked_since;
+    });
+    CHECK(b.status() == BehaviorStatus::failed);
+    CHECK(b.failure_reason() == "path blocked");
+    REQUIRE(blocked_since);
+    CHECK(to_seconds(*blocked_since) < 0.1);  // stopped from the first period
+    CHECK(t > 3.0);
+    CHECK(t < 3.2);
+    CHECK(bench.navi.map_from_base.x_m < 0.61);  // it did not drive into it
   }
 }
 
-TEST_CASE("BhAutoMove with no way around waits for blocked_timeout_s, or goes on when the way clears",
+TEST_CASE("A path-following behavior is not stopped by laser returns of what the map holds",
           "[behaviors][navigation]") {
-  Rig rig(true, room(6.0, 4.0, false), regions_for(6.0, 4.0), Pose2D{0.6, 2.0, 0.0});
-  World world(rig.ws.grid());
-  world.box(rig.ws.grid(), 2.75, 0.0, 3.25, 4.0);  // wall to wall
-  BhAutoMove b(rig.ws);
-  b.activate(params({{"goal", "door"}, {"blocked_timeout_s", "6"}, {"replan_after_s", "1"}}), rig.ctx);
-  const double t = rig.run(b, 60.0, [&] { world.scan_into(rig); });
-  CHECK(b.status() == BehaviorStatus::failed);
-  CHECK(b.failure_reason() == "path blocked");
-  CHECK(b.replans() >= 2);  // tried again while waiting
-  // About 9 s to drive up to the box and stop (slowing from 0.4 m of clearance), then 6 s.
-  CHECK(t > 6.0 + 6.0);
-  CHECK(t < 6.0 + 14.0);
-  CHECK(world.min_distance(rig) >= 0.2);
-  // The same, but the obstacle goes away after 4 s of waiting (a cart pushed on): it arrives.
-  b.activate(params({{"goal", "door"}, {"blocked_timeout_s", "6"}, {"replan_after_s", "1"}}), rig.ctx);
-  const Time start = rig.now;
-  bool gone = false;
-  (void)rig.run(b, 60.0, [&] {
-    if (!gone && rig.now - start > 4s) {
-      world.box(rig.ws.grid(), 2.75, 0.0, 3.25, 4.0, false);
-      gone = true;
-    }
-    world.scan_into(rig);
-  });
-  CHECK(gone);
-  CHECK(b.status() == BehaviorStatus::succeeded);
-}
-
-TEST_CASE("BhAutoMove is not stopped by the laser returns of walls and pillars the map holds", "[behaviors][navigation]") {
-  Rig rig(true, room(6.0, 4.0, true), regions_for(6.0, 4.0), Pose2D{0.6, 2.0, 0.0});
-  const sim::SolidMap solid(rig.ws.grid());
-  sim::LaserModel lidar(sim::LaserConfig::rplidar_a1(), 5);
-  BhAutoMove b(rig.ws);
-  b.activate(params({{"goal", "door"}, {"blocked_timeout_s", "2"}}), rig.ctx);
-  LaserScan scan;
-  (void)rig.run(b, 60.0, [&] {
-    lidar.scan(solid, rig.controller->odometry().pose, rig.now, scan);
-    rig.laser.publish(scan);
+  Bench bench(true);
+  WallBeyondOneMetre map;
+  bench.navi.map = &map;
+  BhAutoMove b;
+  b.activate(params({{"goal", "door"}, {"blocked_timeout_s", "1"}}), bench.ctx);
+  bench.publish({{0.6, 2.0, 0}, {0.95, 2.0, 0}}, 1);
+  // The wall at 1.05 m is 0.25 m ahead of the centre at the start: the map's, not in the way.
+  const double t = bench.run(b, 20.0, [&] {
+    bench.laser.publish(scan_with_obstacle_ahead(bench.now, 1.05 - bench.navi.map_from_base.x_m, 0.3));
   });
   CHECK(b.status() == BehaviorStatus::succeeded);
-  CHECK(rig.min_clearance() >= 0.2 - 0.03);
+  CHECK(t < 3.0);
 }
 
-TEST_CASE("BhAutoMove pauses while the robot is not localized", "[behaviors][navigation]") {
-  Rig rig(false, room(6.0, 4.0, false), regions_for(6.0, 4.0), Pose2D{0.6, 2.0, 0.0});
-  BhAutoMove b(rig.ws);
-  b.activate(params({{"goal", "door"}}), rig.ctx);
-  rig.navi.localized = false;
-  const auto cmd = b.step(rig.ctx);
-  REQUIRE(cmd);
-  CHECK(*cmd == Twist2D{});
-  CHECK(b.running());
-}
-
-TEST_CASE("BhCleaning covers a section with the balloon path on the omni base, keeping its heading",
-          "[behaviors][navigation][cleaning]") {
-  Rig rig(true, room(5.0, 4.0, true), regions_for(5.0, 4.0), Pose2D{0.3, 0.3, 0.0});
-  BhCleaning b(rig.ws);
-  b.activate(params({{"section", "A"}}), rig.ctx);
-  REQUIRE(b.running());
-  const auto& prog = rig.ws.all_progress().at("A");
-  CHECK(prog.plan.rounds >= 3);
-  const double t = rig.run(b, 600.0);
-  CHECK(b.status() == BehaviorStatus::succeeded);
-  CHECK(prog.finished);
-  CHECK(b.section_coverage() >= 0.99);
-  // Coverage of the reachable free cells measured on the true trajectory.
-  const navi::Section& s = *rig.ws.section("A");
-  navi::CleanedCells reach(rig.ws.grid());
-  reach.mark_path(prog.plan.path, rig.ws.options().cleaning_width_m / 2);
-  std::vector<std::size_t> reachable;
-  for (auto i : s.cells) {
-    if (reach.cleaned(i)) reachable.push_back(i);
-  }
-  CHECK(rig.truth_cleaned.coverage(reachable) >= 0.98);
-  CHECK(rig.max_turn_rate < 0.2);  // an omni base never needs to turn
-  CHECK(rig.min_clearance() >= 0.2 - 0.04);
-  CHECK(t < 300.0);
-}
-
-TEST_CASE("BhCleaningTwoWheel covers the section on the differential base", "[behaviors][navigation][cleaning]") {
-  Rig rig(false, room(5.0, 4.0, true), regions_for(5.0, 4.0), Pose2D{0.3, 0.3, 0.0});
-  BhCleaningTwoWheel b(rig.ws);
-  b.activate(params({{"section", "A"}}), rig.ctx);
-  REQUIRE(b.running());
-  (void)rig.run(b, 900.0);
-  CHECK(b.status() == BehaviorStatus::succeeded);
-  CHECK(b.section_coverage() >= 0.98);
-  CHECK(rig.max_turn_rate > 0.5);  // steering by heading
-}
-
-TEST_CASE("A cleaning behavior blocked by a box the map does not hold detours around it and finishes",
-          "[behaviors][navigation][cleaning]") {
+TEST_CASE(
+    "BhAutoMove drives to the end of a final path and succeeds: an omni base keeps its heading, a "
+    "differential one steers",
+    "[behaviors][navigation]") {
+  const std::vector<Pose2D> around{{0.6, 2.0, 0}, {2.0, 0.6, 0}, {4.0, 0.6, 0}, {5.4, 2.0, 0}};
   for (const bool omni : {true, false}) {
     INFO((omni ? "omni" : "differential"));
-    Rig rig(omni, room(5.0, 4.0, false), regions_for(5.0, 4.0), Pose2D{0.3, 0.3, 0.0});
-    World world(rig.ws.grid());
-    world.box(rig.ws.grid(), 2.2, 0.05, 2.8, 0.6);  // against the bottom wall, on the first rounds
-    std::unique_ptr<CBehavior> b;
-    if (omni) b = std::make_unique<BhCleaning>(rig.ws);
-    else b = std::make_unique<BhCleaningTwoWheel>(rig.ws);
-    b->activate(params({{"section", "A"}, {"blocked_timeout_s", "20"}}), rig.ctx);
-    REQUIRE(b->running());
-    (void)rig.run(*b, 900.0, [&] { world.scan_into(rig); });
-    CHECK(b->status() == BehaviorStatus::succeeded);
-    CHECK(world.min_distance(rig) >= 0.2);
-    // What the box hides is lost, the rest of the section is cleaned (the box and the ring
-    // around it where the body cannot go are about 5 % of the section).
-    CHECK(dynamic_cast<CCleaningBehavior&>(*b).section_coverage() >= 0.85);
+    Bench bench(omni, {0.6, 2.0, 0.3});
+    BhAutoMove b;
+    b.activate(params({{"goal", "door"}}), bench.ctx);
+    bench.publish(around, 1);
+    double worst_cross_track = 0.0;
+    const double t = bench.run(b, 60.0, [&] {
+      const Pose2D& p = bench.navi.map_from_base;
+      if (p.x_m > 2.2 && p.x_m < 3.8) worst_cross_track = std::max(worst_cross_track, std::abs(p.y_m - 0.6));
+    });
+    CHECK(b.status() == BehaviorStatus::succeeded);
+    CHECK(distance(bench.navi.map_from_base, {5.4, 2.0, 0}) <= 0.1);
+    CHECK(worst_cross_track < 0.05);  // on the path, not cutting across
+    CHECK(t < 30.0);
+    if (omni) {
+      CHECK(bench.navi.map_from_base.theta_rad == Approx(0.3).margin(0.01));
+    } else {
+      CHECK(bench.max_turn_rate > 0.5);
+    }
   }
-  // Without replanning the same run ends in "path blocked".
-  Rig rig(true, room(5.0, 4.0, false), regions_for(5.0, 4.0), Pose2D{0.3, 0.3, 0.0});
-  World world(rig.ws.grid());
-  world.box(rig.ws.grid(), 2.2, 0.05, 2.8, 0.6);
-  BhCleaning b(rig.ws);
-  b.activate(params({{"section", "A"}, {"blocked_timeout_s", "5"}, {"replan_after_s", "0"}}), rig.ctx);
-  (void)rig.run(b, 900.0, [&] { world.scan_into(rig); });
-  CHECK(b.status() == BehaviorStatus::failed);
-  CHECK(b.failure_reason() == "path blocked");
 }
 
-TEST_CASE("Cleaning behaviors refuse what they cannot do", "[behaviors][navigation][cleaning]") {
-  Rig rig(false, room(5.0, 4.0, false), regions_for(5.0, 4.0), Pose2D{0.3, 0.3, 0.0});
-  BhCleaning omni_only(rig.ws);
-  omni_only.activate(params({{"section", "A"}}), rig.ctx);
-  CHECK(omni_only.status() == BehaviorStatus::failed);
-  CHECK(omni_only.failure_reason() == "BhCleaning needs an omni-directional base");
-  BhCleaningTwoWheel b(rig.ws);
-  b.activate(params({{"section", "Q"}}), rig.ctx);
-  CHECK(b.status() == BehaviorStatus::failed);
-  CHECK(b.failure_reason() == "unknown section");
-  REQUIRE_THROWS_WITH(b.activate(params({{"section", "A"}, {"speed", "1"}}), rig.ctx, SourceLocation{"PrCleaning.xml", 20, 6}),
-                      Catch::Contains("PrCleaning.xml:20:6: error: BhCleaningTwoWheel: unknown parameter 'speed'"));
+TEST_CASE("A cleaning behavior holds at the end of a detour and succeeds at the end of the coverage path",
+          "[behaviors][navigation][cleaning]") {
+  Bench bench(true, {0.5, 0.5, 0.0});
+  BhCleaning b;
+  b.activate(params({{"section", "A"}}), bench.ctx);
+  bench.publish({{0.5, 0.5, 0}, {0.5, 1.5, 0}, {1.5, 1.5, 0}}, 1, 0.0, false);  // a detour
+  (void)bench.run(b, 20.0);
+  REQUIRE(b.running());  // 20 s later: still waiting for the way on
+  CHECK(bench.feedback.reached_end);
+  CHECK(distance(bench.navi.map_from_base, {1.5, 1.5, 0}) < 0.1);
+  const auto held = bench.step(b);
+  REQUIRE(held);
+  CHECK(*held == Twist2D{});
+  // The coverage path again, taken up beyond the obstacle: it ends there.
+  bench.publish({{0.5, 0.5, 0}, {1.5, 0.5, 0}, {1.5, 1.5, 0}, {2.5, 1.5, 0}}, 2, 2.0, true);
+  const double t = bench.run(b, 20.0);
+  CHECK(b.status() == BehaviorStatus::succeeded);
+  CHECK(distance(bench.navi.map_from_base, {2.5, 1.5, 0}) <= 0.1);
+  CHECK(t < 8.0);
 }
 
-TEST_CASE("A cleaning interrupted and activated again resumes where it paused", "[behaviors][navigation][cleaning]") {
-  Rig rig(true, room(5.0, 4.0, false), regions_for(5.0, 4.0), Pose2D{0.3, 0.3, 0.0});
-  BhCleaning b(rig.ws);
-  b.activate(params({{"section", "A"}}), rig.ctx);
-  (void)rig.run(b, 30.0);
-  REQUIRE(b.running());
-  const auto& prog = rig.ws.all_progress().at("A");
-  const double done = prog.done_m;
-  CHECK(done > 5.0);
-  // Lost: the behavior stands still and marks nothing.
-  rig.navi.localized = false;
-  const std::size_t cleaned = rig.ws.cleaned().count();
-  for (int k = 0; k < 10; ++k) {
-    const auto cmd = b.step(rig.ctx);
+TEST_CASE("The path-following behaviors pause while the robot is not localized", "[behaviors][navigation]") {
+  Bench bench(false);
+  BhAutoMove b;
+  b.activate(params({{"goal", "door"}, {"blocked_timeout_s", "1"}}), bench.ctx);
+  bench.publish({{0.6, 2.0, 0}, {5.4, 2.0, 0}}, 1);
+  bench.navi.localized = false;
+  for (int k = 0; k < 40; ++k) {  // longer than the timeouts: pausing is not failing
+    const auto cmd = bench.step(b);
     REQUIRE(cmd);
     CHECK(*cmd == Twist2D{});
   }
-  CHECK(rig.ws.cleaned().count() == cleaned);
-  b.deactivate();
-  rig.navi.localized = true;
-  b.activate(params({{"section", "A"}}), rig.ctx);
-  CHECK(prog.done_m == Approx(done));
-  const double t = rig.run(b, 600.0);
-  CHECK(b.status() == BehaviorStatus::succeeded);
-  CHECK(b.section_coverage() >= 0.99);
-  // the remaining part only: well under the whole path's duration at 0.3 m/s
-  CHECK(t < (prog.plan.stats.length_m - done) / 0.3 * 1.6 + 5.0);
+  CHECK(b.running());
+  CHECK(bench.feedback.path_id == 0);  // nothing tracked, nothing reported
+  bench.navi.localized = true;
+  const auto cmd = bench.step(b);
+  REQUIRE(cmd);
+  CHECK(cmd->vx_m_s > 0.0);
 }
 
-TEST_CASE("BhGlobalLocalization turns until the localizer accepts a fix, or gives up", "[behaviors][navigation]") {
-  Rig rig(true, room(5.0, 4.0, false), regions_for(5.0, 4.0), Pose2D{1.0, 1.0, 0.0});
-  int attempts = 0;
-  rig.ws.set_relocalizer([&](Time now) {
-    ++attempts;
-    return to_seconds(now) >= 5.0;
+TEST_CASE("Navigation behaviors refuse what they cannot do, with located parameter errors",
+          "[behaviors][navigation]") {
+  Bench bench(false);
+  BhCleaning omni_only;
+  omni_only.activate(params({{"section", "A"}}), bench.ctx);
+  CHECK(omni_only.status() == BehaviorStatus::failed);
+  CHECK(omni_only.failure_reason() == "BhCleaning needs an omni-directional base");
+  BhAutoMove b;
+  REQUIRE_THROWS_WITH(b.activate(params({{"goal", "door"}, {"max_speed_m_s", "-1"}}), bench.ctx,
+                                 SourceLocation{"PrAutoMove.xml", 9, 5}),
+                      Catch::Contains("PrAutoMove.xml:9:5: error: BhAutoMove: parameter 'max_speed_m_s'"));
+  BhCleaningTwoWheel c;
+  REQUIRE_THROWS_WITH(
+      c.activate(params({{"section", "A"}, {"speed", "1"}}), bench.ctx,
+                 SourceLocation{"PrCleaning.xml", 20, 6}),
+      Catch::Contains("PrCleaning.xml:20:6: error: BhCleaningTwoWheel: unknown parameter 'speed'"));
+}
+
+TEST_CASE("BhGlobalLocalization turns until the localizer accepts a fix, or gives up after timeout_s",
+          "[behaviors][navigation]") {
+  Bench bench(true, {1.0, 1.0, 0.0});
+  bench.navi.fixes = 3;  // fixes of earlier searches do not count
+  BhGlobalLocalization b;
+  b.activate(ParameterValues{}, bench.ctx);
+  const double t = bench.run(b, 60.0, [&] {
+    if (bench.now >= 6s) bench.navi.fixes = 4;
   });
-  BhGlobalLocalization b(rig.ws);
-  b.activate(ParameterValues{}, rig.ctx);
-  const double t = rig.run(b, 60.0);
   CHECK(b.status() == BehaviorStatus::succeeded);
-  CHECK(t == Approx(6.0).margin(0.06));  // attempts every 2 s: 2, 4 fail, 6 succeeds
-  CHECK(attempts == 3);
-  CHECK(std::abs(rig.controller->odometry().pose.theta_rad) > 0.5);  // it turned meanwhile
-  rig.ws.set_relocalizer([](Time) { return false; });
-  b.activate(params({{"timeout_s", "5"}}), rig.ctx);
-  (void)rig.run(b, 60.0);
+  CHECK(t == Approx(6.05).margin(0.06));
+  CHECK(std::abs(bench.navi.map_from_base.theta_rad) > 0.5);  // it turned meanwhile
+  b.activate(params({{"timeout_s", "5"}}), bench.ctx);
+  const double t2 = bench.run(b, 60.0);
   CHECK(b.status() == BehaviorStatus::failed);
   CHECK(b.failure_reason() == "no position found");
+  CHECK(t2 == Approx(5.05).margin(0.06));
 }
 
 TEST_CASE("register_navigation_behaviors registers the four behaviors by name", "[behaviors][navigation]") {
-  NaviWorkspace ws(room(5.0, 4.0, false), regions_for(5.0, 4.0), Rig::small_robot());
   BehaviorRegistry reg;
-  register_navigation_behaviors(reg, ws);
-  CHECK(reg.names() == std::vector<std::string>{"BhAutoMove", "BhCleaning", "BhCleaningTwoWheel", "BhGlobalLocalization"});
+  register_navigation_behaviors(reg);
+  CHECK(reg.names() ==
+        std::vector<std::string>{"BhAutoMove", "BhCleaning", "BhCleaningTwoWheel", "BhGlobalLocalization"});
   for (const auto& n : reg.names()) {
     auto b = reg.create(n);
     CHECK(b->name() == n);
     for (const auto& p : b->manifest().parameters) CHECK_FALSE(p.description.empty());
   }
+  REQUIRE_THROWS_WITH(reg.create("BhClean"), Catch::Contains("unknown behavior type 'BhClean'; known: BhAutoMove, BhCleaning, "
+                                                             "BhCleaningTwoWheel, BhGlobalLocalization; did you mean 'BhCleaning'?"));
 }

@@ -3,6 +3,7 @@
 
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <map>
 #include <numbers>
 
 #include "tripodal/controllers/controller_config.hpp"
@@ -247,11 +248,40 @@ TEST_CASE("Controllers are created by name from configuration") {
   CHECK(mc->type_name() == "mecanum");
   CHECK(mc->manifest().find_parameter("half_width_m") != nullptr);
 
+  // Every registered type is created by name from a configuration of its own.
+  std::map<std::string, std::pair<ControllerConfig, HardwareInterface*>> examples{
+      {"differential", {diff_config(), &two}}, {"omni", {omni_config(), &three}}, {"mecanum", {m, &four}}};
+  for (const auto& name : reg.names()) {
+    INFO(name);
+    REQUIRE(examples.count(name) == 1);
+    const ModuleManifest& manifest = reg.manifest(name);
+    CHECK(manifest.kind == ModuleKind::controller);
+    CHECK(manifest.layer == Layer::reactive);
+    CHECK(manifest.find_parameter("period_s") != nullptr);
+    REQUIRE(manifest.find_parameter("limits.wz.max_velocity") != nullptr);
+    CHECK(manifest.find_parameter("limits.wz.max_velocity")->unit == "rad/s");
+    CHECK(manifest.find_parameter("limits.vx.max_jerk")->unit == "m/s^3");
+    CHECK(manifest.find_parameter("limits.vx.max_jerk")->optional);
+    CHECK(manifest.find_parameter("wheel_radius_m") != nullptr);
+    for (const auto& p : manifest.parameters) {
+      INFO(p.name);
+      CHECK_FALSE(p.description.empty());
+    }
+    auto [config, hardware] = examples.at(name);
+    auto made = reg.create(name, config, *hardware);
+    CHECK(made->type_name() == name);
+    CHECK(made->update(10ms) == ControlStatus::ok);
+  }
+
   ControllerConfig bad = diff_config();
   bad.type = "tank";
   bad.where = {"robot.yaml", 7, 5};
-  REQUIRE_THROWS_WITH(reg.create(bad, two), Catch::Contains("robot.yaml:7:5") && Catch::Contains("unknown controller type 'tank'") &&
-                                                Catch::Contains("differential, mecanum, omni"));
+  REQUIRE_THROWS_WITH(reg.create(bad, two),
+                      Catch::Contains("robot.yaml:7:5: error: unknown controller type 'tank'; known: differential, mecanum, omni") &&
+                          !Catch::Contains("did you mean"));
+  bad.type = "Omni";
+  REQUIRE_THROWS_WITH(reg.create(bad, two), Catch::Contains("unknown controller type 'Omni'; known: differential, mecanum, "
+                                                            "omni; did you mean 'omni'?"));
 }
 
 TEST_CASE("Invalid controller configurations are rejected with every problem") {

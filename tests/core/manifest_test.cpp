@@ -1,20 +1,10 @@
-// Module manifests: parameter resolution, the one-provider-per-input check, the layered diagram.
+// Module manifests: layer and kind names, parameter resolution. (The one-provider-per-input check
+// and the layered diagram of a robot are src/robot/layering's, tested in tests/robot.)
 #include "tripodal/core/manifest.hpp"
 
 #include <catch2/catch.hpp>
 
 using namespace tripodal;
-
-namespace {
-ModuleManifest module(std::string name, Layer layer, std::vector<std::string> in, std::vector<std::string> out) {
-  ModuleManifest m;
-  m.name = std::move(name);
-  m.layer = layer;
-  m.inputs = std::move(in);
-  m.outputs = std::move(out);
-  return m;
-}
-}  // namespace
 
 TEST_CASE("Layers and kinds have names") {
   CHECK(to_string(Layer::sequencing) == "sequencing");
@@ -42,28 +32,56 @@ TEST_CASE("Parameters resolve with defaults, conversions and bounds") {
                           Catch::Contains("net.xml:4:2: error: BhTest: parameter 'speed_m_s' = 3 m/s is outside [0, 2]"));
 }
 
-TEST_CASE("Every input needs exactly one provider") {
-  const ModuleManifest laser = module("LaserResource", Layer::reactive, {}, {"laser_scan"});
-  const ModuleManifest odom = module("OdometryResource", Layer::reactive, {}, {"odometry"});
-  const ModuleManifest odom2 = module("GyroOdometry", Layer::reactive, {}, {"odometry"});
-  const ModuleManifest loc = module("Localizer", Layer::sequencing, {"laser_scan", "odometry", "map"}, {"map_from_base"});
-  const ModuleManifest go = module("BhGoToPose", Layer::reactive, {"odometry", "map_from_base"}, {"behavior_command"});
-  CHECK(check_providers({&laser, &odom, &go, &loc}).has_errors());  // "map" has no provider
-  const Diagnostics d = check_providers({&laser, &odom, &odom2, &loc, &go});
-  REQUIRE(d.error_count() == 2);
-  CHECK_THAT(d.str(), Catch::Contains("input 'odometry' of Localizer has 2 providers (OdometryResource, GyroOdometry); expected exactly one"));
-  CHECK_THAT(d.str(), Catch::Contains("input 'map' of Localizer has no provider"));
-  const ModuleManifest map = module("GridMap", Layer::sequencing, {}, {"map"});
-  CHECK_FALSE(check_providers({&laser, &odom, &loc, &go, &map}).has_errors());
+TEST_CASE("The public builders make manifests and parameter declarations") {
+  const ModuleManifest m = ManifestBuilder("BhApproach", ModuleKind::behavior)
+                               .description("drives toward the closest obstacle")
+                               .input("laser_scan")
+                               .inputs({"odometry"})
+                               .output("behavior_command")
+                               .number("stop_distance_m", 0.3, "m", "stops this close", 0.05, 2.0)
+                               .text("laser", "", "laser resource name")
+                               .flag("careful", false, "go slowly")
+                               .parameter(parameter::positive("gain", std::nullopt, "1/s", "proportional gain"))
+                               .parameters({parameter::optional(parameter::number("limit_m_s", 1.0, "m/s", "unset: none"))})
+                               .build();
+  CHECK(m.name == "BhApproach");
+  CHECK(m.kind == ModuleKind::behavior);
+  CHECK(m.layer == Layer::reactive);
+  CHECK(m.inputs == std::vector<std::string>{"laser_scan", "odometry"});
+  CHECK(m.outputs == std::vector<std::string>{"behavior_command"});
+  REQUIRE(m.parameters.size() == 5);
+  const ParameterSpec& stop = *m.find_parameter("stop_distance_m");
+  CHECK(stop.type == ValueType::number);
+  CHECK(stop.default_value == Value{0.3});
+  CHECK(stop.unit == "m");
+  CHECK(stop.min == 0.05);
+  CHECK(stop.max == 2.0);
+  CHECK(m.find_parameter("laser")->default_value == Value{std::string()});
+  CHECK(m.find_parameter("careful")->type == ValueType::boolean);
+  CHECK(m.find_parameter("gain")->min_exclusive);
+  CHECK_FALSE(m.find_parameter("gain")->default_value.has_value());
+  CHECK(m.find_parameter("limit_m_s")->optional);
+  CHECK_FALSE(m.find_parameter("limit_m_s")->default_value.has_value());  // optional drops the default
+
+  // A required parameter must be given, an optional one may stay unset, an exclusive bound is > .
+  const ParameterSet p = ParameterSet::resolve(m, {{"gain", Value{2.0}}});
+  CHECK(p.number("stop_distance_m") == 0.3);
+  CHECK_FALSE(p.contains("limit_m_s"));
+  REQUIRE_THROWS_WITH(ParameterSet::resolve(m, {{"gain", Value{0.0}}, {"stop_distance_m", Value{3.0}}}, {"net.xml", 2, 3}),
+                      Catch::Contains("net.xml:2:3: error: BhApproach: parameter 'gain' = 0 1/s is outside (0, inf]") &&
+                          Catch::Contains("BhApproach: parameter 'stop_distance_m' = 3 m is outside [0.05, 2]"));
+  REQUIRE_THROWS_WITH(ParameterSet::resolve(m, {}), Catch::Contains("BhApproach: missing required parameter 'gain' (number)"));
 }
 
-TEST_CASE("The layered functionality diagram groups modules by layer and labels the flows") {
-  const ModuleManifest laser = module("LaserResource", Layer::reactive, {}, {"laser_scan"});
-  const ModuleManifest loc = module("Localizer", Layer::sequencing, {"laser_scan"}, {"map_from_base"});
-  const ModuleManifest planner = module("Planner", Layer::deliberate, {"map_from_base"}, {});
-  const std::string dot = functionality_diagram_dot({&laser, &loc, &planner});
-  CHECK_THAT(dot, Catch::Contains("subgraph cluster_deliberate") && Catch::Contains("subgraph cluster_reactive"));
-  CHECK_THAT(dot, Catch::Contains("\"LaserResource\" -> \"Localizer\" [label=\"laser_scan\"]"));
-  CHECK_THAT(dot, Catch::Contains("\"Localizer\" -> \"Planner\" [label=\"map_from_base\"]"));
-  CHECK(dot.find("cluster_deliberate") < dot.find("\"Planner\";"));
+TEST_CASE("A parameter value is checked against its declaration with one message") {
+  const ParameterSpec radius = parameter::positive("wheel_radius_m", std::nullopt, "m", "wheel radius");
+  CHECK_FALSE(check_parameter_value(radius, Value{0.05}).has_value());
+  CHECK(check_parameter_value(radius, Value{-0.05}) == "parameter 'wheel_radius_m' = -0.05 m is outside (0, inf]");
+  CHECK(check_parameter_value(radius, Value{std::string("big")}) ==
+        "parameter 'wheel_radius_m' expects a number, got \"big\"");
+  const ParameterSpec angle = parameter::number("angle_rad", 0.0, "rad", "turn", std::nullopt, 3.5);
+  CHECK(check_parameter_value(angle, Value{4.0}) == "parameter 'angle_rad' = 4 rad is outside [-inf, 3.5]");
+  CHECK_FALSE(check_parameter_value(angle, Value{-1e9}).has_value());
+  CHECK(check_parameter_value(parameter::flag("careful", true, "go slowly"), Value{1.0}) ==
+        "parameter 'careful' expects a bool, got 1");
 }

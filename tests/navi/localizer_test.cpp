@@ -20,9 +20,9 @@ class Straight final : public GroundTruthSource {
 
 Time at(double s) { return from_seconds(s); }
 
-std::vector<NaviEvent> run(CLocalizer& loc, double until_s, double dt_s = 0.1) {
-  std::vector<NaviEvent> events;
-  for (double t = 0.0; t <= until_s + 1e-9; t += dt_s) loc.update(at(t), events);
+std::vector<ModuleEvent> run(CLocalizer& loc, double until_s, double dt_s = 0.1) {
+  std::vector<ModuleEvent> events;
+  for (double t = 0.0; t <= until_s + 1e-9; t += dt_s) loc.step(at(t), events);
   return events;
 }
 
@@ -32,14 +32,14 @@ TEST_CASE("CLocalizer: ok at start, lost during a fault, ok after global localiz
   Straight truth;
   CLocalizer loc(&truth);
   loc.configure({{"faults", Value{std::string("2-4")}}, {"seed", Value{7.0}}});
-  std::vector<NaviEvent> ev = run(loc, 1.0);
+  std::vector<ModuleEvent> ev = run(loc, 1.0);
   REQUIRE(ev.size() == 1);
   CHECK(ev[0].name == "localizer.ok");
   CHECK(ev[0].stamp == at(0));
   CHECK(loc.localized());
   CHECK(loc.position_error_m() < 0.1);
   ev.clear();
-  for (double t = 1.1; t < 6.0; t += 0.1) loc.update(at(t), ev);
+  for (double t = 1.1; t < 6.0; t += 0.1) loc.step(at(t), ev);
   REQUIRE(ev.size() == 1);
   CHECK(ev[0].name == "localizer.lost");
   CHECK(to_seconds(ev[0].stamp) == Approx(2.0).margin(0.11));
@@ -50,7 +50,7 @@ TEST_CASE("CLocalizer: ok at start, lost during a fault, ok after global localiz
   CHECK_FALSE(loc.relocalize(at(3.0)));
   REQUIRE(loc.relocalize(at(6.0)));
   ev.clear();
-  loc.update(at(6.1), ev);
+  loc.step(at(6.1), ev);
   REQUIRE(ev.size() == 1);
   CHECK(ev[0].name == "localizer.ok");
   NavigationData nd;
@@ -67,7 +67,7 @@ TEST_CASE("CLocalizer: recover_at_fault_end brings the estimate back by itself",
   o.faults = {{at(1.0), at(2.0)}};
   CLocalizer loc(&truth, o);
   loc.configure({{"recover_at_fault_end", Value{true}}, {"faults", Value{std::string("1-2")}}});
-  const std::vector<NaviEvent> ev = run(loc, 3.0);
+  const std::vector<ModuleEvent> ev = run(loc, 3.0);
   REQUIRE(ev.size() == 3);
   CHECK(ev[0].name == "localizer.ok");
   CHECK(ev[1].name == "localizer.lost");
@@ -81,9 +81,9 @@ TEST_CASE("CLocalizer: the same seed gives the same estimates, another seed othe
     CLocalizer loc(&truth);
     loc.configure({{"seed", Value{seed}}, {"faults", Value{std::string("0.5-0.8")}}});
     std::vector<Pose2D> poses;
-    std::vector<NaviEvent> ev;
+    std::vector<ModuleEvent> ev;
     for (int i = 0; i < 20; ++i) {
-      loc.update(at(0.1 * i), ev);
+      loc.step(at(0.1 * i), ev);
       poses.push_back(*loc.estimate());
     }
     return poses;
@@ -96,16 +96,16 @@ TEST_CASE("CLocalizer: noise beyond the threshold reads as lost; no truth, no ev
   Straight truth;
   CLocalizer noisy(&truth);
   noisy.configure({{"noise_xy_m", Value{5.0}}});
-  std::vector<NaviEvent> ev = run(noisy, 2.0);
+  std::vector<ModuleEvent> ev = run(noisy, 2.0);
   bool lost = false;
-  for (const NaviEvent& e : ev) lost = lost || e.name == "localizer.lost";
+  for (const ModuleEvent& e : ev) lost = lost || e.name == "localizer.lost";
   CHECK(lost);
   CLocalizer blind(nullptr);
   blind.configure();
   CHECK(run(blind, 1.0).empty());
   CHECK_FALSE(blind.estimate().has_value());
   CHECK_FALSE(blind.relocalize(at(0)));
-  // before configure() an update does nothing
+  // before configure() a step does nothing
   CLocalizer unconfigured(&truth);
   CHECK(run(unconfigured, 1.0).empty());
 }
@@ -123,28 +123,25 @@ TEST_CASE("CLocalizer: bad parameters and fault schedules are reported", "[navi]
   CHECK(parse_fault_schedule("").empty());
 }
 
-TEST_CASE("NaviModuleRegistry: every built-in module is created by name and configured with defaults",
-          "[navi][modules]") {
-  const NaviModuleRegistry reg = NaviModuleRegistry::with_builtins();
-  REQUIRE(reg.names() == std::vector<std::string>{"CLocalizer", "CSectionSplitter"});
+TEST_CASE("Navigation modules: every one is created by name and configured with defaults", "[navi][modules]") {
+  ModuleRegistry reg("module type");
+  register_navigation_modules(reg);
+  REQUIRE(reg.names() == std::vector<std::string>{"CoveragePlanner", "GridMaps", "Localizer", "PathPlanner", "SectionSplitter"});
   for (const std::string& name : reg.names()) {
-    std::unique_ptr<CNaviModules> m = reg.create(name);
+    std::unique_ptr<CModule> m = reg.create(name);
     REQUIRE(m != nullptr);
-    CHECK(m->name() == name);
+    CHECK(m->type_name() == name);
     CHECK(m->manifest().layer == Layer::sequencing);
     CHECK(m->manifest().kind == ModuleKind::navigation);
+    CHECK(&reg.manifest(name) != &m->manifest());  // the registry keeps its own copy...
+    CHECK(reg.manifest(name).inputs == m->manifest().inputs);  // ...of the same manifest
     CHECK_FALSE(m->configured());
     m->configure();
     CHECK(m->configured());
-    std::vector<NaviEvent> ev;
-    m->update(at(0), ev);  // no ground truth / nothing to post
-    CHECK(ev.empty());
-    CHECK(reg.manifest(name) == &m->manifest());
   }
-  CHECK(reg.create("CNoSuchModule") == nullptr);
-  NaviModuleRegistry again = NaviModuleRegistry::with_builtins();
-  CHECK_THROWS_WITH(again.add(CLocalizer::static_manifest(), [] { return std::make_unique<CLocalizer>(); }),
-                    Catch::Contains("already registered"));
+  CHECK_THROWS_WITH(reg.create("Localiser"), Catch::Contains("unknown module type 'Localiser'") &&
+                                                 Catch::Contains("did you mean 'Localizer'?"));
+  CHECK_THROWS_WITH(reg.add<CLocalizer>(), Catch::Contains("already registered"));
 }
 
 TEST_CASE("CSectionSplitter: configured from parameters", "[navi][modules]") {

@@ -156,21 +156,21 @@ TEST_CASE("map_io: YAML errors are located and collected", "[navi][map][errors]"
       "mode: fancy\n"
       "colour: red\n";
   const std::string what = message_of([&] { (void)parse_map_yaml(bad, "dir/bad.yaml"); });
-  CHECK_THAT(what, Catch::Contains("dir/bad.yaml:2:13: error: 'resolution' must be positive"));
-  CHECK_THAT(what, Catch::Contains("dir/bad.yaml:3:9: error: 'origin' must be a list [x, y, yaw] of 3 numbers"));
-  CHECK_THAT(what, Catch::Contains("dir/bad.yaml:4:18: error: 'occupied_thresh' must be a probability in [0, 1], got 1.5"));
-  CHECK_THAT(what, Catch::Contains("dir/bad.yaml:6:9: error: 'negate' must be 0 or 1"));
-  CHECK_THAT(what, Catch::Contains("dir/bad.yaml:7:7: error: 'mode' must be one of trinary, scale, raw; got 'fancy'"));
-  CHECK_THAT(what, Catch::Contains("dir/bad.yaml:8:1: error: unknown key 'colour'"));
+  CHECK_THAT(what, Catch::Contains("dir/bad.yaml:2:13: error: 'resolution' (metres per cell): expected a number > 0"));
+  CHECK_THAT(what, Catch::Contains("dir/bad.yaml:3:9: error: 'origin': expected [x, y, yaw], got a list of 2 items"));
+  CHECK_THAT(what, Catch::Contains("dir/bad.yaml:4:18: error: 'occupied_thresh': expected a probability in [0, 1], got 1.5"));
+  CHECK_THAT(what, Catch::Contains("dir/bad.yaml:6:9: error: 'negate': expected true or false"));
+  CHECK_THAT(what, Catch::Contains("dir/bad.yaml:7:7: error: 'mode': expected one of trinary, scale, raw; got 'fancy'"));
+  CHECK_THAT(what, Catch::Contains("dir/bad.yaml:8:1: error: unknown key 'colour' in a map_server map description; expected one of: image, resolution,"));
 
   CHECK_THROWS_WITH(parse_map_yaml("image: m.pgm\nresolution: 0.05\n", "m.yaml"),
-                    Catch::Contains("m.yaml:1:1: error: missing 'origin'") && Catch::Contains("missing 'free_thresh'"));
+                    Catch::Contains("m.yaml:1:1: error: the map description: missing 'origin'") && Catch::Contains("missing 'free_thresh'"));
   CHECK_THROWS_WITH(parse_map_yaml("image: m.pgm\nresolution: abc\norigin: [0,0,0]\noccupied_thresh: 0.6\nfree_thresh: 0.2\n", "m.yaml"),
-                    Catch::Contains("m.yaml:2:13: error: 'resolution' (metres per cell) must be a finite number, got 'abc'"));
+                    Catch::Contains("m.yaml:2:13: error: 'resolution' (metres per cell): expected a number > 0, got 'abc'"));
   CHECK_THROWS_WITH(parse_map_yaml("image: m.pgm\nresolution: 0.1\norigin: [0,0,0]\noccupied_thresh: 0.3\nfree_thresh: 0.4\n", "m.yaml"),
                     Catch::Contains("m.yaml:5:14: error: 'free_thresh' (0.4) must be below 'occupied_thresh' (0.3)"));
   CHECK_THROWS_WITH(parse_map_yaml("image: [a, b\n", "m.yaml"), Catch::Contains("m.yaml:"));
-  CHECK_THROWS_WITH(parse_map_yaml("- 1\n- 2\n", "m.yaml"), Catch::Contains("m.yaml:1:1: error: expected a map_server map"));
+  CHECK_THROWS_WITH(parse_map_yaml("- 1\n- 2\n", "m.yaml"), Catch::Contains("m.yaml:1:1: error: a map_server map description: expected a map, got a list"));
 }
 
 TEST_CASE("map_io: PGM errors name the file and the byte", "[navi][map][errors]") {
@@ -190,11 +190,11 @@ TEST_CASE("map_io: PGM errors name the file and the byte", "[navi][map][errors]"
                     Catch::Contains("at byte 10: expected one whitespace byte after maxval"));
   CHECK_THROWS_WITH(parse_pgm(std::string("P5\n1 1\n100\n\xC8", 12), "v.pgm"),
                     Catch::Contains("at byte 11: sample 200 exceeds maxval 100"));
-  CHECK_THROWS_WITH(read_pgm("/nonexistent/x.pgm"), Catch::Contains("/nonexistent/x.pgm: error: cannot open file"));
+  CHECK_THROWS_WITH(read_pgm("/nonexistent/x.pgm"), Catch::Contains("/nonexistent/x.pgm: error: cannot read the file"));
 }
 
 TEST_CASE("map_io: a missing image is reported with the resolved path", "[navi][map][errors]") {
   TempDir dir("missing");
   write_file(dir / "m.yaml", kYaml);
-  CHECK_THROWS_WITH(load_map(dir / "m.yaml"), Catch::Contains((dir / "m.pgm").string() + ": error: cannot open file"));
+  CHECK_THROWS_WITH(load_map(dir / "m.yaml"), Catch::Contains((dir / "m.pgm").string() + ": error: cannot read the file"));
 }

@@ -70,18 +70,18 @@ TEST_CASE("regions: every mistake of a file is reported with its place", "[navi]
   } catch (const ConfigError& e) {
     what = e.what();
   }
-  CHECK_THAT(what, Catch::Contains("bad.yaml:3:16: error: 'rectangle' must be [x_min, y_min, x_max, y_max]"));
+  CHECK_THAT(what, Catch::Contains("bad.yaml:3:16: error: 'rectangle': expected [x_min, y_min, x_max, y_max]"));
   CHECK_THAT(what, Catch::Contains("bad.yaml:4:11: error: duplicate room name 'A'"));
-  CHECK_THAT(what, Catch::Contains("bad.yaml:5:14: error: 'polygon' must be a list of at least 3 corners [x, y], got 2 corners"));
+  CHECK_THAT(what, Catch::Contains("bad.yaml:5:14: error: 'polygon': expected a list of at least 3 corners [x, y], got 2 corners"));
   CHECK_THAT(what, Catch::Contains("bad.yaml:8:5: error: room 'B' has both a rectangle and a polygon"));
-  CHECK_THAT(what, Catch::Contains("bad.yaml:10:5: error: unknown key 'colour' in room"));
+  CHECK_THAT(what, Catch::Contains("bad.yaml:10:5: error: unknown key 'colour' in a room; expected one of: name, rectangle, polygon"));
   CHECK_THAT(what, Catch::Contains("bad.yaml:9:5: error: room 'C' needs a 'rectangle' or a 'polygon'"));
-  CHECK_THAT(what, Catch::Contains("bad.yaml:11:5: error: a room needs a 'name'"));
+  CHECK_THAT(what, Catch::Contains("bad.yaml:11:5: error: a room: missing 'name'"));
   CHECK_THAT(what, Catch::Contains("bad.yaml:11:16: error: 'rectangle' is empty"));
-  CHECK_THAT(what, Catch::Contains("bad.yaml:14:15: error: pose y must be a finite number, got 'x'"));
+  CHECK_THAT(what, Catch::Contains("bad.yaml:14:15: error: pose y: expected a number, got 'x'"));
   CHECK_THAT(what, Catch::Contains("bad.yaml:15:5: error: node 'n2' needs a 'pose'"));
-  CHECK_THAT(what, Catch::Contains("bad.yaml:16:1: error: unknown key 'floors'; expected: rooms, nodes"));
-  CHECK_THROWS_WITH(load_regions("/nonexistent/r.yaml"), Catch::Contains("/nonexistent/r.yaml: error: cannot open file"));
+  CHECK_THAT(what, Catch::Contains("bad.yaml:16:1: error: unknown key 'floors' in the regions file; expected one of: rooms, nodes"));
+  CHECK_THROWS_WITH(load_regions("/nonexistent/r.yaml"), Catch::Contains("/nonexistent/r.yaml: error: cannot read the file"));
   CHECK_THROWS_WITH(parse_regions("rooms: [a, {", "s.yaml"), Catch::Contains("s.yaml:"));
 }
 

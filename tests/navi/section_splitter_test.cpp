@@ -7,7 +7,9 @@
 #include <set>
 
 #include "navi_test_util.hpp"
+#include "tripodal/behaviors/behavior.hpp"
 #include "tripodal/navi/map_io.hpp"
+#include "tripodal/navi/regions.hpp"
 
 using namespace tripodal;
 using namespace tripodal::navi;
@@ -202,6 +204,41 @@ TEST_CASE("order_nearest_first: the demo workspace from a start in section A and
   // a name that is no section keeps its place at the end
   const std::vector<std::string> with_unknown{"Z", "B", "A"};
   CHECK(order_nearest_first(m.grid, s, with_unknown, {0.8, 31.0}) == std::vector<std::string>{"B", "A", "Z"});
+}
+
+TEST_CASE("CSectionSplitter answers sections(room) nearest first from the localized pose, in scan order without one",
+          "[navi][splitter][order][workspace]") {
+  // The question the planner asks when it makes the plan (paper, section 5.1): the sequencing loop
+  // passes the robot's NavigationData, and the answer's order is the order of the PrCleaning steps.
+  const std::string worlds = std::string(TRIPODAL_SOURCE_DIR) + "/configs/worlds/";
+  const MapFile m = load_map(worlds + "workspace_map.yaml");
+  const RegionMap regions = load_regions(worlds + "workspace_regions.yaml");
+  CSectionSplitter splitter;
+  splitter.split_map(m.grid, regions);
+  NavigationData at_charger;  // configs/worlds/workspace.yaml
+  at_charger.localized = true;
+  at_charger.map_from_base = {0.8, 0.8, 0.0};
+  NavigationData in_d = at_charger;  // configs/worlds/workspace_start_d.yaml
+  in_d.map_from_base = {0.8, 31.0, 0.0};
+  const auto a = splitter.answer("sections", "3211", at_charger);
+  REQUIRE(a);
+  REQUIRE(a->ok);
+  CHECK(a->items == std::vector<std::string>{"A", "B", "C", "D"});
+  const auto d = splitter.answer("sections", "3211", in_d);
+  REQUIRE(d);
+  CHECK(d->items == std::vector<std::string>{"D", "C", "B", "A"});
+  // room 2133 is the top of the hall: only D
+  CHECK(splitter.answer("sections", "2133", at_charger)->items == std::vector<std::string>{"D"});
+  // a pose the localizer does not trust orders nothing: scan order
+  NavigationData lost = in_d;
+  lost.localized = false;
+  CHECK(splitter.answer("sections", "3211", lost)->items == std::vector<std::string>{"A", "B", "C", "D"});
+  // errors and other questions are untouched
+  const auto bad = splitter.answer("sections", "9999", in_d);
+  REQUIRE(bad);
+  CHECK_FALSE(bad->ok);
+  CHECK_THAT(bad->error, Catch::Contains("unknown room '9999'"));
+  CHECK_FALSE(splitter.answer("rooms", "3211", in_d));
 }
 
 TEST_CASE("order_nearest_first: path distance, not straight-line: a section behind a wall is not near",

@@ -65,11 +65,11 @@ TEST_CASE("malformed recovery rules are located") {
     FAIL("expected ConfigError");
   } catch (const ConfigError& e) {
     const std::string w = e.what();
-    CHECK_THAT(w, Catch::Contains("r.yaml:3:11: error: unknown action 'restart'"));
-    CHECK_THAT(w, Catch::Contains("r.yaml:4:18: error: max_retries must be a whole number >= 0, got '-1'"));
+    CHECK_THAT(w, Catch::Contains("r.yaml:3:11: error: 'then': expected one of retry, skip, abort; got 'restart'"));
+    CHECK_THAT(w, Catch::Contains("r.yaml:4:18: error: 'max_retries': expected a whole number from 0 to 1000000, got '-1'"));
     CHECK_THAT(w, Catch::Contains("r.yaml:5:15: error: an inserted step must be a map"));
-    CHECK_THAT(w, Catch::Contains("r.yaml:6:5: error: unknown key 'colour'"));
-    CHECK_THAT(w, Catch::Contains("r.yaml:5:5: error: recovery rule without 'fault'"));
+    CHECK_THAT(w, Catch::Contains("r.yaml:6:5: error: unknown key 'colour' in a recovery rule; expected one of: fault, process, insert, then, max_retries"));
+    CHECK_THAT(w, Catch::Contains("r.yaml:5:5: error: a recovery rule: missing 'fault'"));
   }
 }
 

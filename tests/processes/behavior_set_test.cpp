@@ -50,7 +50,9 @@ TEST_CASE("BehaviorSet holds registry behaviors by name", "[processes]") {
   CHECK(rig.set.has("BhStop"));
   CHECK_FALSE(rig.set.has("BhFly"));
   REQUIRE_THROWS_AS(rig.set.add(default_behavior_registry(), "BhStop"), std::invalid_argument);
-  REQUIRE_THROWS_AS(rig.set.add(default_behavior_registry(), "BhFly"), std::out_of_range);
+  REQUIRE_THROWS_AS(rig.set.add(default_behavior_registry(), "BhFly"), ConfigError);
+  REQUIRE_THROWS_WITH(rig.set.add(default_behavior_registry(), "BhStpo"),
+                      Catch::Contains("unknown behavior type 'BhStpo'; known: ") && Catch::Contains("did you mean 'BhStop'?"));
 }
 
 TEST_CASE("Text parameters from a net are converted to the manifest's types", "[processes]") {

@@ -88,6 +88,13 @@ namespace {
 class PrGoToRoom final : public CProcess {
  public:
   using CProcess::CProcess;
+  // Its own type manifest: the one inherited from CProcess is that of the type "net".
+  static const ModuleManifest& static_manifest() {
+    static const ModuleManifest m = ManifestBuilder("go_to_room", ModuleKind::process, Layer::sequencing)
+                                        .description("goes to the door of the room named by 'goal'")
+                                        .build();
+    return m;
+  }
 
  protected:
   std::string on_bind(ParameterValues& values) const override {
@@ -102,7 +109,9 @@ class PrGoToRoom final : public CProcess {
 TEST_CASE("ProcessRegistry builds processes by factory type and refuses duplicates", "[processes]") {
   ProcessRegistry reg;
   reg.add(def("PrCleaning", pr_cleaning()));
-  reg.register_type("go_to_room", [](ProcessDefinition d) { return std::make_unique<PrGoToRoom>(std::move(d)); });
+  reg.types().add<PrGoToRoom>();
+  CHECK(reg.types().names() == std::vector<std::string>{"go_to_room", "net"});
+  CHECK(reg.types().manifest("go_to_room").kind == ModuleKind::process);
   ProcessDefinition g = def("PrGoToRoom", pr_auto_move());
   g.type = "go_to_room";
   reg.add(std::move(g));
@@ -120,7 +129,56 @@ TEST_CASE("ProcessRegistry builds processes by factory type and refuses duplicat
   ProcessDefinition u = def("PrX", pr_cleaning());
   u.type = "scripted";
   REQUIRE_THROWS_WITH(reg.add(std::move(u)),
-                      Catch::Contains("process 'PrX': unknown process type 'scripted' (registered: go_to_room, net)"));
-  REQUIRE_THROWS_AS(reg.register_type("net", [](ProcessDefinition d) { return std::make_unique<CProcess>(std::move(d)); }),
-                    std::invalid_argument);
+                      Catch::Contains("robot.yaml:12:5: error: unknown process type 'scripted'; known: go_to_room, net") &&
+                          !Catch::Contains("did you mean"));
+  ProcessDefinition n = def("PrY", pr_cleaning());
+  n.type = "nett";
+  REQUIRE_THROWS_WITH(reg.add(std::move(n)),
+                      Catch::Contains("unknown process type 'nett'; known: go_to_room, net; did you mean 'net'?"));
+  CHECK_FALSE(reg.contains("PrY"));
+  REQUIRE_THROWS_AS(reg.types().add<CProcess>(), std::invalid_argument);
+}
+
+TEST_CASE("A process declares a manifest: its net's parameters and the behaviors it binds", "[processes]") {
+  PetriNet net = pr_cleaning();
+  net.parameters.push_back(decl("speed_m_s", ValueType::number, Value{0.3}));
+  const CProcess p(def("PrCleaning", net));
+  const ModuleManifest& m = p.manifest();
+  CHECK(m.name == "PrCleaning");
+  CHECK(m.kind == ModuleKind::process);
+  CHECK(m.layer == Layer::sequencing);
+  CHECK_THAT(m.description, Catch::Contains("binding BhCleaning"));
+  REQUIRE(m.find_parameter("speed_m_s") != nullptr);
+  CHECK(m.find_parameter("speed_m_s")->type == ValueType::number);
+  CHECK(m.find_parameter("speed_m_s")->default_value == Value{0.3});
+  REQUIRE(m.find_parameter("section") != nullptr);
+  CHECK_FALSE(m.find_parameter("section")->default_value.has_value());  // required, as the net declares it
+  CHECK(m.parameters.size() == net.parameters.size());
+
+  // A process type of an application gets its manifest the same way.
+  const PrGoToRoom g(def("PrGoToRoom", pr_auto_move()));
+  CHECK(g.manifest().name == "PrGoToRoom");
+  CHECK(g.manifest().kind == ModuleKind::process);
+  CHECK(PrGoToRoom::static_manifest().name == "go_to_room");
+  CHECK(CProcess::static_manifest().name == "net");
+}
+
+TEST_CASE("Every registered process type can be created by name and describes itself", "[processes]") {
+  ProcessRegistry reg;
+  reg.types().add<PrGoToRoom>();
+  for (const auto& type : reg.types().names()) {
+    INFO(type);
+    const ModuleManifest& m = reg.types().manifest(type);
+    CHECK(m.name == type);
+    CHECK(m.kind == ModuleKind::process);
+    CHECK(m.layer == Layer::sequencing);
+    CHECK_FALSE(m.description.empty());
+    ProcessDefinition d = def("Pr_" + type, pr_auto_move());
+    d.type = type;
+    const std::unique_ptr<CProcess> p = reg.types().create(type, std::move(d));
+    REQUIRE(p);
+    CHECK(p->name() == "Pr_" + type);
+    CHECK(p->type() == type);
+    CHECK(p->manifest().find_parameter("goal") != nullptr);
+  }
 }

@@ -85,7 +85,7 @@ TEST_CASE("A negative radius is reported at its value") {
     wheel_separation_m: 0.4
     wheel_radius_m: -0.05
 )", "robot.yaml"),
-                      Catch::Contains("robot.yaml:5:21: error: controller 'base': 'wheel_radius_m' must be > 0, got -0.05"));
+                      Catch::Contains("robot.yaml:5:21: error: controller 'base': parameter 'wheel_radius_m' = -0.05 m is outside (0, inf]"));
 }
 
 TEST_CASE("A missing wheel is reported") {
@@ -129,7 +129,7 @@ loops:
     period_s: 0.01
     controller: basis
 )", "robot.yaml"),
-                      Catch::Contains("robot.yaml:3:11: error: controller 'base': unknown controller type 'tracked' (expected one of: differential, mecanum, omni)") &&
+                      Catch::Contains("robot.yaml:3:11: error: controller 'base': unknown controller type 'tracked'; known: differential, mecanum, omni") &&
                           Catch::Contains("robot.yaml:7:17: error: loop 'motion': unknown controller 'basis'"));
 }
 
@@ -160,11 +160,13 @@ loops:
     const std::string what = e.what();
     INFO(what);
     CHECK(e.diagnostics().error_count() == 11);
-    CHECK_THAT(what, Catch::Contains("many.yaml:4:25: error: controller 'base': 'wheel_separation_m' must be a number, got 'zero'"));
-    CHECK_THAT(what, Catch::Contains("many.yaml:6:20: error: controller 'base': 'cmd_timeout_s' must be >= 0, got -1"));
-    CHECK_THAT(what, Catch::Contains("many.yaml:7:5: error: unknown key 'wheel_radus_m' in controller 'base'"));
-    CHECK_THAT(what, Catch::Contains("many.yaml:9:49: error: controller 'base' limits.vx: 'max_acceleration' must be > 0, got -2"));
-    CHECK_THAT(what, Catch::Contains("many.yaml:10:7: error: unknown key 'yaw' in controller 'base' limits (expected one of: vx, vy, wz)"));
+    CHECK_THAT(what, Catch::Contains("many.yaml:4:25: error: controller 'base': parameter 'wheel_separation_m' expects a number, got \"zero\""));
+    CHECK_THAT(what, Catch::Contains("many.yaml:6:20: error: controller 'base': parameter 'cmd_timeout_s' = -1 s is outside [0, inf]"));
+    CHECK_THAT(what, Catch::Contains("many.yaml:7:5: error: unknown key 'wheel_radus_m' in controller 'base'; expected one of: name, type, "
+                                     "wheel_separation_m, wheel_radius_m, period_s, cmd_timeout_s, max_wheel_speed_rad_s, limits; "
+                                     "did you mean 'wheel_radius_m'?"));
+    CHECK_THAT(what, Catch::Contains("many.yaml:9:49: error: controller 'base': parameter 'limits.vx.max_acceleration' = -2 m/s^2 is outside (0, inf]"));
+    CHECK_THAT(what, Catch::Contains("many.yaml:10:7: error: unknown key 'yaw' in controller 'base' limits; expected one of: vx, vy, wz"));
     CHECK_THAT(what, Catch::Contains("many.yaml:13:15: error: loop 'motion': 'period_s' must be > 0, got 0"));
     CHECK_THAT(what, Catch::Contains("many.yaml:14:24: error: loop 'motion': 'realtime_priority' must be an integer in [0, 99], got 120"));
     CHECK_THAT(what, Catch::Contains("many.yaml:16:13: error: loop 'motion' coordinator: unknown mode 'fastest'"));
@@ -181,4 +183,101 @@ TEST_CASE("Syntax errors and unreadable files are located too") {
                       Catch::Contains("list.yaml:1:1: error: expected a map with 'controllers' and 'loops'"));
   REQUIRE_THROWS_WITH(load_reactive_config("/nonexistent/reactive.yaml"),
                       Catch::Contains("/nonexistent/reactive.yaml: error: cannot read the file"));
+}
+
+namespace {
+
+// An application's controller type with a parameter of its own: one wheel driven at gain * vx.
+class GainController final : public CController {
+ public:
+  GainController(const ControllerConfig& config, HardwareInterface& hardware)
+      : CController(config.period), hardware_(hardware), gain_(config.parameters.number("gain")) {}
+
+  static const ModuleManifest& static_manifest() {
+    static const ModuleManifest m =
+        controller_manifest("gain", "one wheel at gain times the forward speed",
+                            {parameter::number("gain", 1.0, "rad/m", "wheel speed per forward speed", 0.0, 100.0)});
+    return m;
+  }
+  [[nodiscard]] double gain() const noexcept { return gain_; }
+
+ protected:
+  const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  BaseCapabilities do_capabilities() const noexcept override { return {}; }
+  std::span<const double> do_wheel_commands() const noexcept override { return {&wheel_, 1}; }
+  ControlStatus on_update(Time, Duration, const Twist2D& command, bool, Twist2D& limited, OdometryReading&) noexcept override {
+    wheel_ = gain_ * command.vx_m_s;
+    limited = command;
+    return hardware_.write_wheel_velocities({&wheel_, 1}) ? ControlStatus::ok : ControlStatus::hardware_fault;
+  }
+  [[nodiscard]] Duration command_timeout() const noexcept override { return Duration{0}; }
+
+ private:
+  HardwareInterface& hardware_;
+  double gain_;
+  double wheel_ = 0.0;
+};
+
+ControllerRegistry registry_with_gain() {
+  ControllerRegistry r;
+  register_builtin_controllers(r);
+  r.add<GainController>();
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("An application's controller type takes its own parameters through its manifest") {
+  const ControllerRegistry registry = registry_with_gain();
+  const ReactiveConfig c = parse_reactive_config(R"(controllers:
+  - name: winch
+    type: gain
+    gain: 2.5
+    period_s: 0.02
+    limits:
+      vx: {max_velocity: 0.3}
+  - name: winch_default
+    type: gain
+loops:
+  - name: motion
+    period_s: 0.02
+    controller: winch
+)", "winch.yaml", registry);
+  REQUIRE(c.controllers.size() == 2);
+  CHECK(c.controllers[0].parameters.number("gain") == 2.5);
+  CHECK(c.controllers[0].period == 20ms);
+  CHECK(c.controllers[0].limits.vx.max_velocity == 0.3);
+  CHECK(c.controllers[1].parameters.number("gain") == 1.0);  // the manifest's default
+  CHECK_FALSE(c.controllers[1].parameters.contains("max_wheel_speed_rad_s"));
+
+  IdealWheelHardware one(1, 20ms);
+  ResourceTable resources;
+  auto loop = make_control_loop(c, c.loops[0], resources, &one, registry);
+  REQUIRE(loop->controller() != nullptr);
+  CHECK(loop->controller()->type_name() == "gain");
+  CHECK(dynamic_cast<const GainController&>(*loop->controller()).gain() == 2.5);
+
+  // Its keys are checked against its manifest, and so are its values.
+  REQUIRE_THROWS_WITH(parse_reactive_config(R"(controllers:
+  - name: winch
+    type: gain
+    gian: 3
+    wheel_radius_m: 0.1
+)", "winch.yaml", registry),
+                      Catch::Contains("winch.yaml:4:5: error: unknown key 'gian' in controller 'winch'; expected one of: "
+                                      "name, type, gain, period_s, cmd_timeout_s, max_wheel_speed_rad_s, limits; did you "
+                                      "mean 'gain'?") &&
+                          Catch::Contains("winch.yaml:5:5: error: unknown key 'wheel_radius_m' in controller 'winch'"));
+  REQUIRE_THROWS_WITH(parse_reactive_config("controllers:\n  - {name: winch, type: gain, gain: 300}\n", "winch.yaml", registry),
+                      Catch::Contains("winch.yaml:2:37: error: controller 'winch': parameter 'gain' = 300 rad/m is outside [0, 100]"));
+  REQUIRE_THROWS_WITH(parse_reactive_config("controllers:\n  - {name: winch, type: gian}\n", "winch.yaml", registry),
+                      Catch::Contains("winch.yaml:2:25: error: controller 'winch': unknown controller type 'gian'; known: "
+                                      "differential, gain, mecanum, omni; did you mean 'gain'?"));
+  REQUIRE_THROWS_WITH(parse_reactive_config("controllers:\n  - {name: winch, type: gain, limits: {vx: 5, yaw: {}}}\n",
+                                            "winch.yaml", registry),
+                      Catch::Contains("winch.yaml:2:44: error: controller 'winch' limits.vx: expected a map, got '5'") &&
+                          Catch::Contains("unknown key 'yaw' in controller 'winch' limits; expected one of: vx, vy, wz"));
+  // The default registry does not know it.
+  REQUIRE_THROWS_WITH(parse_reactive_config("controllers:\n  - {name: winch, type: gain}\n", "winch.yaml"),
+                      Catch::Contains("unknown controller type 'gain'; known: differential, mecanum, omni"));
 }

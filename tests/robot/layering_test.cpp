@@ -35,20 +35,14 @@ const std::string kBehaviors = "  - BhAutoMove\n  - BhCleaning\n";
 
 struct Catalog {
   TestWorld world;
-  BehaviorRegistry behaviors;
-  ModuleRegistry modules;
-  Catalog() {
-    register_test_behaviors(behaviors, world);
-    register_test_modules(modules, world);
-  }
-  RobotCatalog get() { return RobotCatalog{&modules, &behaviors, &default_controller_registry()}; }
+  RobotPlugins plugins = test_plugins(world);
 
   // Runs the checks the robot runs at start-up; returns every diagnostic.
   std::string check(const std::string& yaml, RobotDescription* out = nullptr) {
     RobotProfile p = load_robot_profile_from_string(yaml, "testbot.yaml", kRobots);
     TaskLibrary tasks = TaskLibrary::load(p.tasks);
     Diagnostics d;
-    RobotDescription r = describe_robot(p, get(), knowledge_inputs(tasks), d);
+    RobotDescription r = describe_robot(p, plugins, knowledge_inputs(tasks), d);
     if (out) *out = r;
     return d.str();
   }
@@ -72,7 +66,9 @@ TEST_CASE("Missing providers are refused with the consumer and the information n
                                    "'sections', but no module provides it"));
   CHECK_THAT(diag, Catch::Contains("testbot.yaml:7:5: error: missing provider: sequencing navigation 'localizer' needs "
                                    "'grid_map', but no module provides it"));
-  CHECK_THAT(diag, Catch::Contains("testbot.yaml:9:5: error: missing provider: reactive behavior 'BhAutoMove' needs 'grid_map'"));
+  std::size_t errors = 0;
+  for (std::size_t at = diag.find("error:"); at != std::string::npos; at = diag.find("error:", at + 1)) ++errors;
+  CHECK(errors == 2);
 }
 
 TEST_CASE("Duplicate providers are refused with every provider located", "[robot]") {
@@ -81,8 +77,15 @@ TEST_CASE("Duplicate providers are refused with every provider located", "[robot
   CHECK_THAT(diag, Catch::Contains("testbot.yaml:9:5: error: duplicate providers: sequencing navigation 'localizer' needs "
                                    "'laser_scan', which 2 modules provide: front_laser (testbot.yaml:5:5), rear_laser "
                                    "(testbot.yaml:6:5); exactly one must"));
-  // Rewiring in the profile resolves it: the rear laser provides its own information.
-  CHECK(c.check(profile(kResources + "  - {name: rear_laser, type: LaserScanner, outputs: [rear_scan]}\n", kNavigation, kBehaviors))
+  // A registered type's manifest is its own: the profile cannot rewire it...
+  CHECK_THAT(c.check(profile(kResources + "  - {name: rear_laser, type: LaserScanner, outputs: [rear_scan]}\n", kNavigation,
+                             kBehaviors)),
+             Catch::Contains("testbot.yaml:6:5: error: module 'rear_laser' re-declares outputs of its registered type "
+                             "'LaserScanner' (a reactive-layer resource); remove layer, inputs and outputs: the diagram "
+                             "comes from the type's own manifest"));
+  // ...but a type designed before it is implemented is declared with what it provides.
+  CHECK(c.check(profile(kResources + "  - {name: rear_laser, type: RearLaser, layer: reactive, outputs: [rear_scan]}\n",
+                        kNavigation, kBehaviors))
             .empty());
 }
 
@@ -110,7 +113,7 @@ TEST_CASE("Layering rules R1-R5 are enforced with the rule named", "[robot]") {
   SECTION("R4: a behavior driving the controller directly") {
     const std::string diag = c.check(
         "robot: {name: testbot}\n"
-        "controllers:\n  - {name: base, type: omni, inputs: [cmd_vel, stop_command]}\n"
+        "controllers:\n  - {name: base, type: StoppableBase, layer: reactive, inputs: [cmd_vel, stop_command], outputs: [odometry]}\n"
         "resources:\n" + kResources + "navigation:\n" + kNavigation +
         "behaviors:\n" + kBehaviors + "  - {name: BhEmergencyStop, type: Stop, layer: reactive, outputs: [stop_command]}\n"
         "tasks: ../tasks/cleaning.yaml\n");
@@ -128,17 +131,18 @@ TEST_CASE("Layering rules R1-R5 are enforced with the rule named", "[robot]") {
   }
 }
 
-TEST_CASE("Module types: a declared layer must agree; unknown types must be declared", "[robot]") {
+TEST_CASE("Module types: a registered type's manifest is not declared again; unknown types must be declared", "[robot]") {
   Catalog c;
   std::string diag = c.check(profile("  - {name: front_laser, type: LaserScanner, layer: sequencing}\n", kNavigation, kBehaviors));
-  CHECK_THAT(diag, Catch::Contains("testbot.yaml:5:5: error: module 'front_laser' declares the sequencing layer, but its type "
-                                   "'LaserScanner' is a reactive-layer module"));
-  diag = c.check(profile(kResources, kNavigation, kBehaviors + "  - BhDance\n"));
-  CHECK_THAT(diag, Catch::Contains("testbot.yaml:13:5: error: unknown behavior type 'BhDance' (registered: BhAutoMove, BhCleaning, "
-                                   "BhCleaningTwoWheel, BhGlobalLocalization); register it, or declare it here with layer, inputs "
-                                   "and outputs"));
+  CHECK_THAT(diag, Catch::Contains("testbot.yaml:5:5: error: module 'front_laser' re-declares layer of its registered type "
+                                   "'LaserScanner' (a reactive-layer resource)"));
+  diag = c.check(profile(kResources, kNavigation, kBehaviors + "  - BhCleanig\n"));
+  CHECK_THAT(diag, Catch::Contains("testbot.yaml:13:5: error: unknown behavior type 'BhCleanig'; known: BhAutoMove, BhCleaning, "
+                                   "BhCleaningTwoWheel, BhGlobalLocalization; did you mean 'BhCleaning'?; register it, or declare "
+                                   "it here with layer, inputs and outputs"));
+  // Types are looked up in their own family: a navigation module is no resource.
   diag = c.check(profile("  - {name: front_laser, type: GridMaps}\n", kNavigation, kBehaviors));
-  CHECK_THAT(diag, Catch::Contains("module 'front_laser': type 'GridMaps' is a navigation, but it is listed as a resource"));
+  CHECK_THAT(diag, Catch::Contains("testbot.yaml:5:5: error: unknown resource type 'GridMaps'; known: LaserScanner;"));
 }
 
 TEST_CASE("Profile load errors are all reported, located", "[robot]") {
@@ -155,8 +159,8 @@ TEST_CASE("Profile load errors are all reported, located", "[robot]") {
     FAIL("no error");
   } catch (const ConfigError& e) {
     const std::string m = e.what();
-    CHECK_THAT(m, Catch::Contains("bad.yaml:2:1: error: unknown key 'colour'; expected: robot, controllers, loops"));
-    CHECK_THAT(m, Catch::Contains("bad.yaml:6:28: error: period_s must be a positive number of seconds, got '-1'"));
+    CHECK_THAT(m, Catch::Contains("bad.yaml:2:1: error: unknown key 'colour' in the robot profile; expected one of: robot, hardware, controllers, loops"));
+    CHECK_THAT(m, Catch::Contains("bad.yaml:6:28: error: period_s (seconds): expected a number > 0, got '-1'"));
     CHECK_THAT(m, Catch::Contains("bad.yaml:6:5: error: loop 'fast' drives controller 'wheels', which the profile does not list"));
     CHECK_THAT(m, Catch::Contains("bad.yaml:8:46: error: unknown layer 'upstairs'; expected one of: deliberate, sequencing, reactive"));
     CHECK_THAT(m, Catch::Contains("bad.yaml:8:56: error: unknown key 'wires' in a resource entry"));
@@ -170,25 +174,23 @@ TEST_CASE("Profile load errors are all reported, located", "[robot]") {
 TEST_CASE("The robot refuses to start with every problem listed", "[robot]") {
   SimClock clock;
   SECTION("modules without implementations") {
-    BehaviorRegistry behaviors;
-    ModuleRegistry modules;
-    RobotCatalog catalog{&modules, &behaviors, &default_controller_registry()};
+    RobotPlugins nothing;
     try {
-      (void)Robot::assemble(load_robot_profile(kRobots / "psr2.yaml"), catalog, clock);
+      (void)Robot::assemble(load_robot_profile(kRobots / "psr2.yaml"), nothing, clock);
       FAIL("started");
     } catch (const ConfigError& e) {
       const std::string m = e.what();
-      CHECK_THAT(m, Catch::Contains("psr2.yaml:21:5: error: module 'front_laser' cannot be started: no factory is registered for "
-                                    "type 'LaserScanner'"));
-      CHECK_THAT(m, Catch::Contains("psr2.yaml:52:5: error: behavior 'BhAutoMove' cannot be started: no behavior type 'BhAutoMove' "
-                                    "is registered"));
+      CHECK_THAT(m, Catch::Contains("psr2.yaml:13:3: error: unknown hardware type 'sim'; known: none; register it"));
+      CHECK_THAT(m, Catch::Contains("psr2.yaml:16:5: error: unknown controller type 'omni'; known: none; register it"));
+      CHECK_THAT(m, Catch::Contains("psr2.yaml:26:5: error: unknown navigation type 'GridMaps'; known: none; register it"));
+      CHECK_THAT(m, Catch::Contains("psr2.yaml:47:13: error: unknown behavior type 'BhAutoMove'; known: none; register it"));
     }
   }
   SECTION("a process binding a behavior the robot lacks; a task naming a process it lacks") {
     Catalog c;
     const std::string yaml = profile(kResources, kNavigation, "  - BhCleaning\n");  // PrAutoMove binds BhAutoMove
     try {
-      (void)Robot::assemble(load_robot_profile_from_string(yaml, "testbot.yaml", kRobots), c.get(), clock);
+      (void)Robot::assemble(load_robot_profile_from_string(yaml, "testbot.yaml", kRobots), c.plugins, clock);
       FAIL("started");
     } catch (const ConfigError& e) {
       const std::string m = e.what();
@@ -196,11 +198,20 @@ TEST_CASE("The robot refuses to start with every problem listed", "[robot]") {
       CHECK_THAT(m, Catch::Contains("cleaning.yaml:15:15: error: unknown process 'PrCleaning'"));
     }
   }
+  SECTION("a process module net the planner cannot compose") {
+    Catalog c;
+    std::string yaml = profile(kResources, kNavigation, kBehaviors);
+    const std::string entry = "{name: PrAutoMove, net: ../petri/PrAutoMove.xml}";
+    yaml.replace(yaml.find(entry), entry.size(), "{name: PrAutoMove, net: ../petri/PrAutoMove.xml, module: ../petri/PrCleaning-module.xml}");
+    REQUIRE_THROWS_WITH(Robot::assemble(load_robot_profile_from_string(yaml, "testbot.yaml", kRobots), c.plugins, clock),
+                        Catch::Contains("PrCleaning-module.xml:15:3: error: process module of PrAutoMove: place 'P1' runs process "
+                                        "'PrCleaning'; the module's executing place must run 'PrAutoMove'"));
+  }
   SECTION("a layering violation") {
     Catalog c;
     const std::string yaml = profile(kResources, kNavigation, kBehaviors,
                                      "hri:\n  - {name: voice, type: Voice, layer: deliberate, inputs: [laser_scan]}\n");
-    REQUIRE_THROWS_WITH(Robot::assemble(load_robot_profile_from_string(yaml, "testbot.yaml", kRobots), c.get(), clock),
+    REQUIRE_THROWS_WITH(Robot::assemble(load_robot_profile_from_string(yaml, "testbot.yaml", kRobots), c.plugins, clock),
                         Catch::Contains("(rule R3)"));
   }
 }

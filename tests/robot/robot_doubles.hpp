@@ -1,7 +1,7 @@
-// Test doubles of the modules the PSR-2 profile (configs/robots/psr2.yaml) names, registered under
-// the same type names: behaviors as real CBehavior subclasses that work for a number of periods
-// (pausing while the robot is lost), and navigation modules and resources as RobotModules — a
-// localizer that posts localizer.lost/ok, a section splitter that answers sections(room).
+// Test doubles of the types the PSR-2 profile (configs/robots/psr2.yaml) names, registered under
+// the same type names: behaviors as real CBehavior subclasses that work for a while (pausing while
+// the robot is lost), navigation modules as CModules — a localizer that posts localizer.lost/ok, a
+// section splitter that answers sections(room) — and a hardware "sim" of ideal wheels.
 #pragma once
 
 #include <map>
@@ -11,7 +11,9 @@
 
 #include "tripodal/behaviors/behavior.hpp"
 #include "tripodal/behaviors/behavior_registry.hpp"
-#include "tripodal/robot/module.hpp"
+#include "tripodal/controllers/ideal_hardware.hpp"
+#include "tripodal/navi/navi_modules.hpp"
+#include "tripodal/robot/plugins.hpp"
 
 namespace tripodal::test {
 
@@ -42,23 +44,20 @@ inline ParameterSpec text_param(std::string name, std::optional<std::string> def
   return p;
 }
 
-/// Works `steps` periods, then succeeds; stands still (zero command, no progress) while the robot
-/// is lost unless it is the one that localizes; BhGlobalLocalization restores localization.
+/// Works for `work` (time counted only while the robot is localized, unless it is the one that
+/// localizes), then succeeds; BhGlobalLocalization restores localization.
 class TestBehavior final : public CBehavior {
  public:
-  TestBehavior(const ModuleManifest& manifest, TestWorld& world, int steps, bool localizes)
-      : manifest_(manifest), world_(world), steps_(steps), localizes_(localizes) {}
-  std::string last_param;
+  TestBehavior(const ModuleManifest& manifest, TestWorld& world, Duration work, bool localizes)
+      : manifest_(manifest), world_(world), work_(work), localizes_(localizes) {}
 
  protected:
   const ModuleManifest& do_manifest() const noexcept override { return manifest_; }
-  void on_activate(const ParameterSet& params, const BehaviorContext&) override {
-    progress_ = 0;
-    last_param = params.values().empty() ? std::string() : to_string(params.values().begin()->second);
-  }
-  std::optional<Twist2D> on_step(const BehaviorContext&) noexcept override {
+  void on_activate(const ParameterSet&, const BehaviorContext&) override { done_ = Duration{0}; }
+  std::optional<Twist2D> on_step(const BehaviorContext& c) noexcept override {
     if (!localizes_ && !world_.localized) return Twist2D{};
-    if (++progress_ >= steps_) {
+    done_ += c.period;
+    if (done_ >= work_) {
       if (localizes_) world_.localized = true;
       succeed();
     }
@@ -68,87 +67,140 @@ class TestBehavior final : public CBehavior {
  private:
   const ModuleManifest& manifest_;
   TestWorld& world_;
-  int steps_;
+  Duration work_;
   bool localizes_;
-  int progress_ = 0;
+  Duration done_{0};
 };
 
-/// Registers BhAutoMove (30 periods), BhCleaning and BhCleaningTwoWheel (100), BhGlobalLocalization (20).
+/// Registers BhAutoMove (3 s), BhCleaning and BhCleaningTwoWheel (10 s), BhGlobalLocalization (2 s).
 inline void register_test_behaviors(BehaviorRegistry& reg, TestWorld& world) {
-  static const ModuleManifest automove = behavior_manifest("BhAutoMove", {"map_from_base", "laser_scan", "grid_map"}, {text_param("goal")});
-  static const ModuleManifest cleaning =
-      behavior_manifest("BhCleaning", {"map_from_base", "laser_scan", "grid_map"}, {text_param("section")});
-  static const ModuleManifest two_wheel =
-      behavior_manifest("BhCleaningTwoWheel", {"map_from_base", "laser_scan", "grid_map"}, {text_param("section")});
-  static const ModuleManifest global = behavior_manifest("BhGlobalLocalization", {"laser_scan"}, {});
-  reg.add(automove, [&world] { return std::make_unique<TestBehavior>(automove, world, 30, false); });
-  reg.add(cleaning, [&world] { return std::make_unique<TestBehavior>(cleaning, world, 100, false); });
-  reg.add(two_wheel, [&world] { return std::make_unique<TestBehavior>(two_wheel, world, 100, false); });
-  reg.add(global, [&world] { return std::make_unique<TestBehavior>(global, world, 20, true); });
+  static const ModuleManifest automove = behavior_manifest("BhAutoMove", {"map_from_base"}, {text_param("goal")});
+  static const ModuleManifest cleaning = behavior_manifest("BhCleaning", {"map_from_base"}, {text_param("section")});
+  static const ModuleManifest two_wheel = behavior_manifest("BhCleaningTwoWheel", {"map_from_base"}, {text_param("section")});
+  static const ModuleManifest global = behavior_manifest("BhGlobalLocalization", {}, {});
+  using std::chrono::seconds;
+  reg.add(automove, [&world] { return std::make_unique<TestBehavior>(automove, world, seconds(3), false); });
+  reg.add(cleaning, [&world] { return std::make_unique<TestBehavior>(cleaning, world, seconds(10), false); });
+  reg.add(two_wheel, [&world] { return std::make_unique<TestBehavior>(two_wheel, world, seconds(10), false); });
+  reg.add(global, [&world] { return std::make_unique<TestBehavior>(global, world, seconds(2), true); });
+}
+
+inline ModuleManifest module_manifest(std::string name, std::vector<std::string> in, std::vector<std::string> out,
+                                      std::vector<ParameterSpec> params = {}) {
+  return navi::navi_manifest(std::move(name), "test double", std::move(in), std::move(out), std::move(params));
 }
 
 /// Posts localizer.lost / localizer.ok when the world's localization changes; heartbeats.
-class TestLocalizer final : public RobotModule {
+class TestLocalizer final : public navi::CNaviModules {
  public:
-  explicit TestLocalizer(TestWorld& w) : world_(w) {}
+  static TestWorld* world;
+  static const ModuleManifest& static_manifest() {
+    static const ModuleManifest m =
+        module_manifest("Localizer", {"laser_scan", "odometry", "grid_map"}, {"map_from_base"},
+                        {ParameterSpec{"noise_xy_m", ValueType::number, Value{0.0}, "m", "", {}, {}},
+                         ParameterSpec{"noise_theta_rad", ValueType::number, Value{0.0}, "rad", "", {}, {}}});
+    return m;
+  }
 
  protected:
-  void on_update(Time) override {
-    if (world_.localizer_throws) throw std::runtime_error("scan matcher crashed");
-    if (world_.localizer_silent) return;
-    port().heartbeat();
-    if (world_.localized != reported_) {
-      reported_ = world_.localized;
-      port().post_event(reported_ ? "localizer.ok" : "localizer.lost");
+  const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  void on_update(ModuleContext& c) override {
+    if (world->localizer_throws) throw std::runtime_error("scan matcher crashed");
+    if (world->localizer_silent) return;
+    c.heartbeat = true;
+    c.navigation->localized = world->localized;
+    if (world->localized != reported_) {
+      reported_ = world->localized;
+      c.post(reported_ ? "localizer.ok" : "localizer.lost");
     }
   }
 
  private:
-  TestWorld& world_;
   bool reported_ = true;
 };
+inline TestWorld* TestLocalizer::world = nullptr;
 
-class TestSectionSplitter final : public RobotModule {
+class TestSectionSplitter final : public navi::CNaviModules {
  public:
-  explicit TestSectionSplitter(TestWorld& w) : world_(w) {}
-
- protected:
-  std::optional<TaskKnowledge::ListResult> on_answer(std::string_view function, std::string_view room) const override {
-    if (function != "sections") return std::nullopt;
-    auto it = world_.sections.find(std::string(room));
-    if (it == world_.sections.end()) return TaskKnowledge::ListResult{false, {}, "unknown room '" + std::string(room) + "'"};
-    return TaskKnowledge::ListResult{true, it->second, {}};
+  static TestWorld* world;
+  static const ModuleManifest& static_manifest() {
+    static const ModuleManifest m = module_manifest("SectionSplitter", {"grid_map"}, {"sections"});
+    return m;
   }
 
+ protected:
+  const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  std::optional<KnowledgeAnswer> on_answer(std::string_view function, std::string_view room, const NavigationData&) const override {
+    if (function != "sections") return std::nullopt;
+    auto it = world->sections.find(std::string(room));
+    if (it == world->sections.end()) return KnowledgeAnswer{false, {}, "unknown room '" + std::string(room) + "'"};
+    return KnowledgeAnswer{true, it->second, {}};
+  }
+};
+inline TestWorld* TestSectionSplitter::world = nullptr;
+
+/// A module that does nothing, under a type name of the profile.
+template <int N>
+class PassiveModule final : public navi::CNaviModules {
+ public:
+  static ModuleManifest* manifest_of;
+  static const ModuleManifest& static_manifest() { return *manifest_of; }
+
+ protected:
+  const ModuleManifest& do_manifest() const noexcept override { return *manifest_of; }
+};
+template <int N>
+ModuleManifest* PassiveModule<N>::manifest_of = nullptr;
+
+/// Hardware "sim": ideal wheels, no sensors.
+class TestHardware final : public CHardware {
+ public:
+  static const ModuleManifest& static_manifest() {
+    static const ModuleManifest m = hardware_manifest("sim", "ideal wheels and a laser", {"laser_scan"}, {});
+    return m;
+  }
+  explicit TestHardware(const HardwareConfig& c)
+      : wheels_(c.base == nullptr || c.base->type == "differential" ? 2 : c.base->holonomic.wheels.size(),
+                c.base != nullptr ? c.base->period : std::chrono::milliseconds(10)) {}
+
+ protected:
+  const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  HardwareInterface& do_wheels() noexcept override { return wheels_; }
+
  private:
-  TestWorld& world_;
+  IdealWheelHardware wheels_;
 };
 
-class PassiveModule final : public RobotModule {};
-
-inline ModuleManifest module_manifest(std::string name, Layer layer, ModuleKind kind, std::vector<std::string> in,
-                                      std::vector<std::string> out) {
-  ModuleManifest m;
-  m.name = std::move(name);
-  m.layer = layer;
-  m.kind = kind;
-  m.inputs = std::move(in);
-  m.outputs = std::move(out);
-  return m;
-}
-
-/// The PSR-2 profile's module types.
-inline void register_test_modules(ModuleRegistry& reg, TestWorld& world) {
-  auto passive = [](const ModuleConfig&) { return std::make_unique<PassiveModule>(); };
-  reg.add(module_manifest("LaserScanner", Layer::reactive, ModuleKind::resource, {}, {"laser_scan"}), passive);
-  reg.add(module_manifest("Gyro", Layer::reactive, ModuleKind::resource, {}, {"yaw_rate"}), passive);
-  reg.add(module_manifest("GridMaps", Layer::sequencing, ModuleKind::navigation, {}, {"grid_map"}), passive);
-  reg.add(module_manifest("Localizer", Layer::sequencing, ModuleKind::navigation, {"laser_scan", "odometry", "grid_map"},
-                          {"map_from_base"}),
-          [&world](const ModuleConfig&) { return std::make_unique<TestLocalizer>(world); });
-  reg.add(module_manifest("SectionSplitter", Layer::sequencing, ModuleKind::navigation, {"grid_map", "map_from_base"},
-                          {"sections"}),
-          [&world](const ModuleConfig&) { return std::make_unique<TestSectionSplitter>(world); });
+/// The PSR-2 profile's types, as doubles: behaviors, the navigation modules, the hardware, and the
+/// real controllers.
+inline RobotPlugins test_plugins(TestWorld& world) {
+  RobotPlugins p;
+  register_test_behaviors(p.behaviors, world);
+  register_builtin_controllers(p.controllers);
+  TestLocalizer::world = &world;
+  TestSectionSplitter::world = &world;
+  p.modules.add<TestLocalizer>();
+  p.modules.add<TestSectionSplitter>();
+  static ModuleManifest maps = module_manifest("GridMaps", {}, {"grid_map"},
+                                               {ParameterSpec{"robot_radius_m", ValueType::number, Value{0.3}, "m", "", {}, {}}});
+  static ModuleManifest planner = module_manifest("PathPlanner", {"grid_map", "map_from_base"}, {"path"});
+  static ModuleManifest coverage = module_manifest(
+      "CoveragePlanner", {"grid_map", "sections"}, {"coverage_path"},
+      {ParameterSpec{"cleaning_width_m", ValueType::number, Value{0.4}, "m", "", {}, {}}});
+  PassiveModule<0>::manifest_of = &maps;
+  PassiveModule<1>::manifest_of = &planner;
+  PassiveModule<2>::manifest_of = &coverage;
+  p.modules.add<PassiveModule<0>>();
+  p.modules.add<PassiveModule<1>>();
+  p.modules.add<PassiveModule<2>>();
+  static const ModuleManifest laser = [] {
+    ModuleManifest m = resource_manifest<LaserScan>();
+    m.name = "LaserScanner";
+    return m;
+  }();
+  p.resources.add(laser, [](const ResourceConfig& c) { return std::make_unique<LaserResource>(c.name); });
+  p.hardware.add(TestHardware::static_manifest(), [](const HardwareConfig& c) { return std::make_unique<TestHardware>(c); });
+  return p;
 }
 
 }  // namespace tripodal::test

@@ -19,26 +19,22 @@ const std::filesystem::path kProfile = std::filesystem::path(TRIPODAL_SOURCE_DIR
 struct Psr2 {
   SimClock clock;
   TestWorld world;
-  BehaviorRegistry behaviors;
-  ModuleRegistry modules;
+  RobotPlugins plugins = test_plugins(world);
   std::unique_ptr<Robot> robot;
   LifecycleRecorder life{true};
 
   Psr2() {
-    register_test_behaviors(behaviors, world);
-    register_test_modules(modules, world);
-    RobotCatalog catalog{&modules, &behaviors, &default_controller_registry()};
-    robot = Robot::assemble(load_robot_profile(kProfile), catalog, clock);
+    robot = Robot::assemble(load_robot_profile(kProfile), plugins, clock);
     robot->planner().add_observer(life);
     robot->supervisor().add_observer(life);
   }
 
+  // Runs the robot 0.1 s at a time (its loops at their own periods) while the task lasts.
   void run(double end_s, const std::function<void(double)>& at = {}) {
-    robot->step();
+    robot->run_until(clock.now());
     while (robot->planner().busy() && to_seconds(clock.now()) < end_s - 1e-9) {
-      clock.advance(from_seconds(0.1));
+      robot->run_for(from_seconds(0.1));
       if (at) at(to_seconds(clock.now()));
-      robot->step();
     }
   }
 
@@ -47,7 +43,7 @@ struct Psr2 {
     for (const auto& e : life.entries()) {
       if (e.text.rfind("  ", 0) == 0) continue;
       char buf[32];
-      std::snprintf(buf, sizeof buf, "%.1f ", to_seconds(e.time));
+      std::snprintf(buf, sizeof buf, "%.2f ", to_seconds(e.time));
       out.push_back(buf + e.text);
     }
     return out;
@@ -61,13 +57,18 @@ bool at_time(double t, double x) { return t > x - 0.05 && t < x + 0.05; }
 TEST_CASE("PSR-2 assembles from its profile with the paper's nets", "[robot]") {
   Psr2 p;
   CHECK(p.robot->processes().names() == std::vector<std::string>{"PrAutoMove", "PrCleaning", "PrGlobalLocalization", "PrWait"});
-  CHECK(p.robot->behaviors().names() ==
-        std::vector<std::string>{"BhAutoMove", "BhCleaning", "BhCleaningTwoWheel", "BhGlobalLocalization"});
   CHECK(p.robot->module("localizer") != nullptr);
   CHECK(p.robot->module("BhCleaning") == nullptr);
-  CHECK(p.robot->coordinator().input_count() == 4);
+  CHECK(p.robot->modules().size() == 5);
+  CHECK(p.robot->hardware() != nullptr);
+  REQUIRE(p.robot->loop("motion") != nullptr);
+  CHECK(&p.robot->behavior_loop() == p.robot->loop("motion"));
+  CHECK(p.robot->behavior_loop().coordinator().input_count() == 4);
+  CHECK(p.robot->behavior_loop().controller() != nullptr);
+  CHECK(p.robot->behavior_loop().period() == std::chrono::milliseconds(10));
   const auto& mods = p.robot->description().modules;
-  REQUIRE(mods.size() == 3 + 1 + 2 + 3 + 4);
+  // core components, hardware, controller, five navigation modules, four behaviors
+  REQUIRE(mods.size() == 3 + 1 + 1 + 5 + 4);
   CHECK(mods[0].name == "planner");
   CHECK(mods[0].inputs == std::vector<std::string>{"sections", "process_result"});
 }
@@ -78,22 +79,22 @@ TEST_CASE("PSR-2 cleans a room of two sections: PrAutoMove and PrCleaning in ord
   p.run(200.0);
   CHECK(p.robot->planner().state() == TaskState::succeeded);
   CHECK(p.task_lines() == std::vector<std::string>{
-                              "0.0 task clean started (\"clean the room 3211\"): PrAutoMove(goal=A.entry) -> "
+                              "0.00 task clean started (\"clean the room 3211\"): PrAutoMove(goal=A.entry) -> "
                               "PrCleaning(section=A) -> PrAutoMove(goal=B.entry) -> PrCleaning(section=B)",
-                              "0.0 process X0 PrAutoMove(goal=A.entry) started",
-                              "3.0 process X0 PrAutoMove succeeded",
-                              "3.0 process X1 PrCleaning(section=A) started",
-                              "13.0 process X1 PrCleaning succeeded",
-                              "13.0 process X2 PrAutoMove(goal=B.entry) started",
-                              "16.0 process X2 PrAutoMove succeeded",
-                              "16.0 process X3 PrCleaning(section=B) started",
-                              "26.0 process X3 PrCleaning succeeded",
-                              "26.0 task clean succeeded",
+                              "0.00 process X0 PrAutoMove(goal=A.entry) started",
+                              "3.05 process X0 PrAutoMove succeeded",
+                              "3.05 process X1 PrCleaning(section=A) started",
+                              "13.10 process X1 PrCleaning succeeded",
+                              "13.10 process X2 PrAutoMove(goal=B.entry) started",
+                              "16.15 process X2 PrAutoMove succeeded",
+                              "16.15 process X3 PrCleaning(section=B) started",
+                              "26.20 process X3 PrCleaning succeeded",
+                              "26.20 task clean succeeded",
                           });
   // wheel_type = omni (profile) selects BhCleaning in the PrCleaning net, with the section.
   CHECK_THAT(p.life.str(), Catch::Contains("X1 activate BhCleaning(section=A)") &&
                                Catch::Contains("X1 PrCleaning fire t0") && !Catch::Contains("BhCleaningTwoWheel("));
-  CHECK(p.robot->coordinator().output().winner.empty());  // nothing drives once the task is done
+  CHECK(p.robot->behavior_loop().last_cycle().coordinator.winner.empty());  // nothing drives once the task is done
 }
 
 TEST_CASE("PSR-2: a localization loss that recovers within the delay only pauses", "[robot]") {
@@ -107,8 +108,8 @@ TEST_CASE("PSR-2: a localization loss that recovers within the delay only pauses
   CHECK(p.robot->planner().report().recoveries.empty());
   CHECK_THAT(p.life.str(), Catch::Contains("X1 PrCleaning fire t3 [localizer.lost]") &&
                                Catch::Contains("X1 PrCleaning fire t2 [localizer.ok]"));
-  // Three seconds standing still.
-  CHECK(to_seconds(*p.robot->planner().report().finished) == Approx(29.0));
+  // Three seconds standing still: 26.20 s of work and detection (as without the loss) + 3 s.
+  CHECK(to_seconds(*p.robot->planner().report().finished) == Approx(29.2));
 }
 
 TEST_CASE("PSR-2: a persistent loss inserts PrGlobalLocalization, retries, and the task succeeds", "[robot]") {
@@ -120,26 +121,26 @@ TEST_CASE("PSR-2: a persistent loss inserts PrGlobalLocalization, retries, and t
   CHECK(p.robot->planner().state() == TaskState::succeeded);
   const auto lines = p.task_lines();
   CHECK(lines == std::vector<std::string>{
-                     "0.0 task clean started (\"clean the room 3211\"): PrAutoMove(goal=A.entry) -> PrCleaning(section=A) -> "
+                     "0.00 task clean started (\"clean the room 3211\"): PrAutoMove(goal=A.entry) -> PrCleaning(section=A) -> "
                      "PrAutoMove(goal=B.entry) -> PrCleaning(section=B)",
-                     "0.0 process X0 PrAutoMove(goal=A.entry) started",
-                     "3.0 process X0 PrAutoMove succeeded",
-                     "3.0 process X1 PrCleaning(section=A) started",
-                     "16.0 process X1 PrCleaning failed: localization fault",
-                     "16.0 recovery: fault \"localization fault\" of PrCleaning: insert PrGlobalLocalization, then retry (1/2); "
+                     "0.00 process X0 PrAutoMove(goal=A.entry) started",
+                     "3.05 process X0 PrAutoMove succeeded",
+                     "3.05 process X1 PrCleaning(section=A) started",
+                     "16.05 process X1 PrCleaning failed: localization fault",
+                     "16.05 recovery: fault \"localization fault\" of PrCleaning: insert PrGlobalLocalization, then retry (1/2); "
                      "plan: PrGlobalLocalization() -> PrCleaning(section=A) -> PrAutoMove(goal=B.entry) -> PrCleaning(section=B)",
-                     "16.0 process X0 PrGlobalLocalization() started",
-                     "18.0 process X0 PrGlobalLocalization succeeded",
-                     "18.0 process X1 PrCleaning(section=A) started",
-                     "28.0 process X1 PrCleaning succeeded",
-                     "28.0 process X2 PrAutoMove(goal=B.entry) started",
-                     "31.0 process X2 PrAutoMove succeeded",
-                     "31.0 process X3 PrCleaning(section=B) started",
-                     "41.0 process X3 PrCleaning succeeded",
-                     "41.0 task clean succeeded",
+                     "16.05 process X0 PrGlobalLocalization() started",
+                     "18.10 process X0 PrGlobalLocalization succeeded",
+                     "18.10 process X1 PrCleaning(section=A) started",
+                     "28.15 process X1 PrCleaning succeeded",
+                     "28.15 process X2 PrAutoMove(goal=B.entry) started",
+                     "31.20 process X2 PrAutoMove succeeded",
+                     "31.20 process X3 PrCleaning(section=B) started",
+                     "41.25 process X3 PrCleaning succeeded",
+                     "41.25 task clean succeeded",
                  });
-  CHECK_THAT(p.life.str(), Catch::Contains("16.000 s    X1 PrCleaning fire t5") &&
-                               Catch::Contains("16.000 s    X1 deactivate BhCleaning"));
+  CHECK_THAT(p.life.str(), Catch::Contains("16.050 s    X1 PrCleaning fire t5") &&
+                               Catch::Contains("16.050 s    X1 deactivate BhCleaning"));
 }
 
 TEST_CASE("PSR-2: the retry limit makes the task fail with a report", "[robot]") {
@@ -148,8 +149,7 @@ TEST_CASE("PSR-2: the retry limit makes the task fail with a report", "[robot]")
   int cleaning_ticks = 0;
   p.run(300.0, [&](double) {
     // Lost one second into every cleaning run; only global localization finds the way again.
-    CBehavior* b = p.robot->behaviors().find("BhCleaning");
-    cleaning_ticks = b->running() ? cleaning_ticks + 1 : 0;
+    cleaning_ticks = p.robot->behavior_active("BhCleaning") ? cleaning_ticks + 1 : 0;
     if (cleaning_ticks == 10) p.world.localized = false;
   });
   REQUIRE(p.robot->planner().state() == TaskState::failed);
@@ -195,11 +195,12 @@ TEST_CASE("PSR-2: a silent localizer trips the watchdog, which the net treats as
   p.run(200.0, [&](double t) {
     if (at_time(t, 5.0)) p.world.localizer_silent = true;
   });
-  // Watchdog 1 s: localizer.lost at 5.9 s (last heartbeat 4.9 s); the completion of BhCleaning is
-  // then refused by the net until the 10 s delay ends in the fault place. The watchdog fires once
-  // per silence, so the retried PrCleaning (after global localization) completes.
-  CHECK_THAT(p.life.str(), Catch::Contains("fault localizer: stopped answering (no heartbeat for 1.000 s)"));
-  CHECK_THAT(p.life.str(), Catch::Contains("15.900 s  process X1 PrCleaning failed: localization fault"));
+  // Watchdog 1 s: localizer.lost at 6.0 s (last heartbeat at the 5.0 s sequencing period); the
+  // completion of BhCleaning is then refused by the net until the 10 s delay ends in the fault
+  // place. The watchdog fires once per silence, so the retried PrCleaning (after global
+  // localization) completes.
+  CHECK_THAT(p.life.str(), Catch::Contains("6.000 s    fault localizer: stopped answering (no heartbeat for 1.000 s)"));
+  CHECK_THAT(p.life.str(), Catch::Contains("16.000 s  process X1 PrCleaning failed: localization fault"));
   CHECK(p.robot->planner().state() == TaskState::succeeded);
   CHECK(p.robot->planner().report().recoveries.size() == 1);
 }

@@ -259,10 +259,10 @@ TEST_CASE("Simulator: localization loss windows drive the navi localizer from gr
   navi::CLocalizer loc(&sim);
   loc.configure({{"seed", Value{3.0}}});
   for (const navi::LocalizationFault& f : sim.world().faults.localization_loss) loc.add_fault(f);
-  std::vector<navi::NaviEvent> ev;
+  std::vector<ModuleEvent> ev;
   sim.command_twist({0.2, 0.0, 0.0});
   for (int k = 0; k < 30; ++k) {
-    loc.update(sim.now(), ev);
+    loc.step(sim.now(), ev);
     run(sim, 0.1);
   }
   REQUIRE(ev.size() >= 2);

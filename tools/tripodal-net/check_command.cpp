@@ -4,10 +4,11 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <ostream>
 #include <string>
 
-#include "command.hpp"
+#include "cli_tool.hpp"
 #include "net_tool_util.hpp"
 #include "tripodal/analysis/analyzer.hpp"
 #include "tripodal/planner/recovery.hpp"
@@ -15,23 +16,30 @@
 namespace tripodal::net_tool {
 namespace {
 
-constexpr std::string_view kHelp =
-    "usage: tripodal-net check [--no-warnings] [--no-behaviour] [--recovery RULES.yaml]... FILE|DIR...\n\n"
+using namespace cli;
+
+constexpr std::string_view kDescription =
     "Loads each configuration net (native XML or PNML, by extension then root element) and prints\n"
     "every problem gcc-style, FILE:LINE:COL: error|warning|note: MESSAGE, then one summary line per\n"
     "file. A directory stands for its *.xml and *.pnml files (not recursive).\n"
     "A net that loads is then explored with its default parameters, every event order included\n"
     "(docs/analysis.md): a reachable deadlock, or a reachable marking from which no outcome place\n"
     "can be reached, is an error. Nets with more than 200000 reachable states, or parameters\n"
-    "without defaults, get a note instead (use tripodal-net analyze).\n\n"
-    "  --no-warnings   leave out the structural warnings (places never marked, transitions never\n"
-    "                  enabled)\n"
-    "  --no-behaviour  skip the deadlock and outcome checks\n"
-    "  --recovery F    also check the recovery rules of F against the low-level nets given (a net's\n"
-    "                  id is its process name): a rule whose fault message none of them can post,\n"
-    "                  or naming or inserting a process without a net, is an error\n\n"
+    "without defaults, get a note instead (use tripodal-net analyze).\n"
+    "With --recovery RULES.yaml, the recovery rules are checked against the low-level nets given\n"
+    "(a net's id is its process name): a rule whose fault message none of them can post, or that\n"
+    "names or inserts a process without a net, is an error.";
+
+constexpr std::string_view kExitCodes =
     "exit codes: 0 every net is valid (warnings allowed), 1 a net has errors, 2 bad command line,\n"
-    "            3 a file or directory could not be read\n";
+    "            3 a file or directory could not be read";
+
+struct Args {
+  std::vector<std::string> inputs;
+  std::vector<std::filesystem::path> recovery_files;
+  bool no_warnings = false;
+  bool no_behaviour = false;
+};
 
 enum class FileStatus { valid, invalid, unreadable };
 
@@ -96,23 +104,14 @@ FileStatus check_recovery(const std::filesystem::path& file, const std::vector<P
   return diagnostics.has_errors() ? FileStatus::invalid : FileStatus::valid;
 }
 
-int run_check(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+int run_check(const Args& args, std::ostream& out, std::ostream& err) {
   LoadOptions options;
-  bool behaviour = true;
-  std::vector<std::filesystem::path> files, recovery_files;
+  options.structural_warnings = !args.no_warnings;
+  const bool behaviour = !args.no_behaviour;
+  std::vector<std::filesystem::path> files;
   bool unreadable = false;
-  for (auto it = args.begin(); it != args.end(); ++it) {
-    const std::string& a = *it;
-    if (a == "--recovery" && it + 1 != args.end()) {
-      recovery_files.emplace_back(*++it);
-    } else if (a == "--no-warnings") {
-      options.structural_warnings = false;
-    } else if (a == "--no-behaviour") {
-      behaviour = false;
-    } else if (a.size() > 1 && a[0] == '-') {
-      err << "tripodal-net check: unknown option " << a << "\n" << kHelp;
-      return kUsage;
-    } else if (std::filesystem::is_directory(a)) {
+  for (const auto& a : args.inputs) {
+    if (std::filesystem::is_directory(a)) {
       std::vector<std::filesystem::path> found;
       std::error_code ec;
       for (const auto& entry : std::filesystem::directory_iterator(a, ec)) {
@@ -130,7 +129,7 @@ int run_check(const std::vector<std::string>& args, std::ostream& out, std::ostr
     }
   }
   if (files.empty() && !unreadable) {
-    err << "tripodal-net check: no net files given\n" << kHelp;
+    err << "tripodal-net check: no net files in " << args.inputs.front() << '\n';
     return kUsage;
   }
   bool invalid = false;
@@ -140,13 +139,26 @@ int run_check(const std::vector<std::string>& args, std::ostream& out, std::ostr
     unreadable = unreadable || s == FileStatus::unreadable;
     invalid = invalid || s == FileStatus::invalid;
   }
-  for (const auto& f : recovery_files) invalid = check_recovery(f, loaded, out, err) == FileStatus::invalid || invalid;
+  for (const auto& f : args.recovery_files) invalid = check_recovery(f, loaded, out, err) == FileStatus::invalid || invalid;
   if (unreadable) return kIoError;
-  return invalid ? kFindings : kOk;
+  return invalid ? kBadInput : kOk;
+}
+
+cli::Action setup(CLI::App& cmd) {
+  auto a = std::make_shared<Args>();
+  cmd.add_option("FILE|DIR", a->inputs, "nets, or directories of *.xml and *.pnml nets")->required();
+  cmd.add_flag("--no-warnings", a->no_warnings,
+               "leave out the structural warnings (places never marked, transitions never enabled)");
+  cmd.add_flag("--no-behaviour", a->no_behaviour, "skip the deadlock and outcome checks");
+  cmd.add_option("--recovery", a->recovery_files,
+                 "RULES.yaml: also check these recovery rules against the low-level nets given (repeatable)")
+      ->allow_extra_args(false);
+  return [a](std::ostream& out, std::ostream& err) { return run_check(*a, out, err); };
 }
 
 }  // namespace
 
-TRIPODAL_NET_COMMAND("check", "validate nets: located errors and warnings, deadlock and outcome checks", kHelp, &run_check);
+TRIPODAL_CLI_COMMAND("", "check", "validate nets: located errors and warnings, deadlock and outcome checks", kDescription,
+                     kExitCodes, &setup);
 
 }  // namespace tripodal::net_tool

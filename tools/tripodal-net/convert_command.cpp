@@ -1,42 +1,46 @@
 // `tripodal-net convert IN OUT`: native XML <-> PNML, by the files' extensions.
 #include <fstream>
+#include <memory>
 #include <ostream>
 
-#include "command.hpp"
+#include "cli_tool.hpp"
 #include "net_tool_util.hpp"
 
 namespace tripodal::net_tool {
 namespace {
 
-constexpr std::string_view kHelp =
-    "usage: tripodal-net convert IN OUT\n\n"
+using namespace cli;
+
+constexpr std::string_view kDescription =
     "Converts a net between tripodal's native XML (.xml) and PNML (.pnml), by the extensions: IN\n"
     "is read like `check` reads it, OUT is written as PNML when it ends in .pnml (an ISO/IEC\n"
     "15909-2 2009 P/T net with <page>; guards, events, delays, bindings, outcomes, priorities and\n"
-    "read arcs in <toolspecific tool=\"tripodal\">), else as native XML.\n\n"
-    "exit codes: 0 written, 1 IN has errors or cannot be represented in OUT's format,\n"
-    "            2 bad command line, 3 a file could not be read or written\n";
+    "read arcs in <toolspecific tool=\"tripodal\">), else as native XML.";
 
-int run_convert(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  if (args.size() != 2 || (args[0].size() > 1 && args[0][0] == '-') || (args[1].size() > 1 && args[1][0] == '-')) {
-    err << kHelp;
-    return kUsage;
-  }
-  const std::filesystem::path in = args[0];
-  const std::filesystem::path target = args[1];
+constexpr std::string_view kExitCodes =
+    "exit codes: 0 written, 1 IN has errors or cannot be represented in OUT's format,\n"
+    "            2 bad command line, 3 a file could not be read or written";
+
+struct Args {
+  std::filesystem::path in, target;
+};
+
+int run_convert(const Args& args, std::ostream& out, std::ostream& err) {
+  const std::filesystem::path& in = args.in;
+  const std::filesystem::path& target = args.target;
   if (!std::filesystem::is_regular_file(in)) {
     err << in.string() << ": error: cannot open file\n";
     return kIoError;
   }
   const auto net = load_reporting(in, err);
-  if (!net) return kFindings;
+  if (!net) return kBadInput;
   const bool pnml = target.extension() == ".pnml";
   std::string text;
   try {
     text = net_to_string(*net, pnml ? NetFormat::pnml : NetFormat::native_xml);
   } catch (const ConfigError& e) {
     err << e.what();
-    return kFindings;
+    return kBadInput;
   }
   std::ofstream f(target, std::ios::binary | std::ios::trunc);
   f << text;
@@ -50,8 +54,16 @@ int run_convert(const std::vector<std::string>& args, std::ostream& out, std::os
   return kOk;
 }
 
+cli::Action setup(CLI::App& cmd) {
+  auto a = std::make_shared<Args>();
+  cmd.add_option("IN", a->in, "the net to read (.xml or .pnml)")->required();
+  cmd.add_option("OUT", a->target, "the file to write: PNML when it ends in .pnml, else native XML")->required();
+  return [a](std::ostream& out, std::ostream& err) { return run_convert(*a, out, err); };
+}
+
 }  // namespace
 
-TRIPODAL_NET_COMMAND("convert", "convert a net between native XML and PNML (by extension)", kHelp, &run_convert);
+TRIPODAL_CLI_COMMAND("", "convert", "convert a net between native XML and PNML (by extension)", kDescription, kExitCodes,
+                     &setup);
 
 }  // namespace tripodal::net_tool

@@ -1,61 +1,47 @@
 // `tripodal-net dot FILE [--marking P=N,...]`: Graphviz drawing of a net like the paper's figures.
 #include <charconv>
 #include <fstream>
+#include <memory>
 #include <ostream>
 
-#include "command.hpp"
+#include "cli_tool.hpp"
 #include "net_tool_util.hpp"
 #include "tripodal/core/net_dot.hpp"
 
 namespace tripodal::net_tool {
 namespace {
 
-constexpr std::string_view kHelp =
-    "usage: tripodal-net dot FILE [--marking P=N,...] [--no-descriptions] [-o OUT]\n\n"
+using namespace cli;
+
+constexpr std::string_view kDescription =
     "Writes the net as a Graphviz digraph drawn like the paper's figures: places are circles with\n"
     "their tokens, transitions black bars, labels the ids and descriptions; read arcs dashed,\n"
     "inhibitor arcs ending in a circle, outcome places doubled (faults in red).\n"
-    "Render with e.g.  tripodal-net dot net.xml | dot -Tsvg > net.svg\n\n"
-    "  --marking P=N,...   draw this marking instead of the initial one (unlisted places: 0)\n"
-    "  --no-descriptions   ids and annotations only\n"
-    "  -o OUT              write to OUT instead of standard output\n\n"
-    "exit codes: 0 ok, 1 the net has errors or the marking names an unknown place,\n"
-    "            2 bad command line, 3 a file could not be read or written\n";
+    "Render with e.g.  tripodal-net dot net.xml | dot -Tsvg > net.svg";
 
-int run_dot(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+constexpr std::string_view kExitCodes =
+    "exit codes: 0 ok, 1 the net has errors or the marking names an unknown place,\n"
+    "            2 bad command line, 3 a file could not be read or written";
+
+struct Args {
   std::string file;
   std::optional<std::string> marking_text;
   std::optional<std::string> output;
+  bool no_descriptions = false;
+};
+
+int run_dot(const Args& args, std::ostream& out, std::ostream& err) {
+  const std::string& file = args.file;
+  const std::optional<std::string>& marking_text = args.marking_text;
+  const std::optional<std::string>& output = args.output;
   DotOptions options;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--marking") {
-      marking_text = option_value(args, i, err);
-      if (!marking_text) return kUsage;
-    } else if (args[i] == "-o") {
-      output = option_value(args, i, err);
-      if (!output) return kUsage;
-    } else if (args[i] == "--no-descriptions") {
-      options.descriptions = false;
-    } else if (args[i].size() > 1 && args[i][0] == '-') {
-      err << "tripodal-net dot: unknown option " << args[i] << "\n" << kHelp;
-      return kUsage;
-    } else if (file.empty()) {
-      file = args[i];
-    } else {
-      err << "tripodal-net dot: one net at a time\n" << kHelp;
-      return kUsage;
-    }
-  }
-  if (file.empty()) {
-    err << kHelp;
-    return kUsage;
-  }
+  options.descriptions = !args.no_descriptions;
   if (!std::filesystem::is_regular_file(file)) {
     err << file << ": error: cannot open file\n";
     return kIoError;
   }
   const auto net = load_reporting(file, err);
-  if (!net) return kFindings;
+  if (!net) return kBadInput;
   Marking marking;
   if (marking_text) {
     marking.assign(net->places().size(), 0);
@@ -78,7 +64,7 @@ int run_dot(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       const auto place = net->find_place(id);
       if (!place) {
         err << "tripodal-net dot: --marking: no place '" << id << "' in " << file << "\n";
-        return kFindings;
+        return kBadInput;
       }
       marking[*place] = n;
     }
@@ -98,8 +84,17 @@ int run_dot(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   return kOk;
 }
 
+cli::Action setup(CLI::App& cmd) {
+  auto a = std::make_shared<Args>();
+  cmd.add_option("FILE", a->file, "the net (native XML or PNML)")->required();
+  cmd.add_option("--marking", a->marking_text, "P=N,...: draw this marking instead of the initial one (unlisted places: 0)");
+  cmd.add_flag("--no-descriptions", a->no_descriptions, "ids and annotations only");
+  cmd.add_option("-o", a->output, "OUT: write to OUT instead of standard output");
+  return [a](std::ostream& out, std::ostream& err) { return run_dot(*a, out, err); };
+}
+
 }  // namespace
 
-TRIPODAL_NET_COMMAND("dot", "draw a net as Graphviz DOT, like the paper's figures", kHelp, &run_dot);
+TRIPODAL_CLI_COMMAND("", "dot", "draw a net as Graphviz DOT, like the paper's figures", kDescription, kExitCodes, &setup);
 
 }  // namespace tripodal::net_tool

@@ -1,72 +1,44 @@
 // `tripodal-net simulate FILE [--param K=V]... [--events SCRIPT]`: runs a net against a script of
 // timed events and prints the firing trace.
-#include <charconv>
+#include <memory>
 #include <ostream>
 
-#include "command.hpp"
+#include "cli_tool.hpp"
 #include "net_tool_util.hpp"
 #include "tripodal/core/net_simulation.hpp"
 
 namespace tripodal::net_tool {
 namespace {
 
-constexpr std::string_view kHelp =
-    "usage: tripodal-net simulate FILE [--param NAME=VALUE]... [--events SCRIPT] [--until SECONDS]\n"
-    "                             [--no-stop] [--allow-unknown-events]\n\n"
+using namespace cli;
+
+constexpr std::string_view kDescription =
     "Runs the net from its initial marking at time 0 against a script of timed events and fact\n"
     "changes (format in docs/engine.md, e.g. configs/petri/scenarios/*.events) and prints every\n"
-    "firing with its time, consumed event, description and the marking after it, then the outcome.\n\n"
-    "  --param NAME=VALUE       a process parameter (typed by its declaration in the net)\n"
-    "  --events SCRIPT          the event script (none: only immediate and delayed transitions)\n"
-    "  --until SECONDS          stop at this time at the latest (default 3600)\n"
-    "  --no-stop                keep running after an outcome place is marked\n"
-    "  --allow-unknown-events   accept script events no transition waits for (they are dropped)\n\n"
+    "firing with its time, consumed event, description and the marking after it, then the outcome.";
+
+constexpr std::string_view kExitCodes =
     "exit codes: 0 the simulation ran (whatever outcome it reached), 1 the net, the parameters or\n"
     "            the script have errors, or the net livelocked, 2 bad command line,\n"
-    "            3 a file could not be read\n";
+    "            3 a file could not be read";
 
-int run_simulate(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+struct Args {
   std::string file;
   std::vector<std::string> params;
   std::optional<std::string> events;
+  double until_s = 3600.0;
+  bool no_stop = false;
+  bool allow_unknown_events = false;
+};
+
+int run_simulate(const Args& args, std::ostream& out, std::ostream& err) {
+  const std::string& file = args.file;
+  const std::vector<std::string>& params = args.params;
+  const std::optional<std::string>& events = args.events;
   SimulationOptions options;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "--param") {
-      auto v = option_value(args, i, err);
-      if (!v) return kUsage;
-      params.push_back(*v);
-    } else if (a == "--events") {
-      events = option_value(args, i, err);
-      if (!events) return kUsage;
-    } else if (a == "--until") {
-      auto v = option_value(args, i, err);
-      if (!v) return kUsage;
-      double s = 0;
-      const auto [ptr, ec] = std::from_chars(v->data(), v->data() + v->size(), s);
-      if (ec != std::errc() || ptr != v->data() + v->size() || !(s >= 0.0) || s > 1e9) {
-        err << "tripodal-net simulate: --until: bad time '" << *v << "' (seconds)\n";
-        return kUsage;
-      }
-      options.end_time = from_seconds(s);
-    } else if (a == "--no-stop") {
-      options.stop_at_outcome = false;
-    } else if (a == "--allow-unknown-events") {
-      options.allow_unknown_events = true;
-    } else if (a.size() > 1 && a[0] == '-') {
-      err << "tripodal-net simulate: unknown option " << a << "\n" << kHelp;
-      return kUsage;
-    } else if (file.empty()) {
-      file = a;
-    } else {
-      err << "tripodal-net simulate: one net at a time (the script goes after --events)\n" << kHelp;
-      return kUsage;
-    }
-  }
-  if (file.empty()) {
-    err << kHelp;
-    return kUsage;
-  }
+  options.end_time = from_seconds(args.until_s);
+  options.stop_at_outcome = !args.no_stop;
+  options.allow_unknown_events = args.allow_unknown_events;
   for (const auto& path : {std::optional<std::string>(file), events}) {
     if (path && !std::filesystem::is_regular_file(*path)) {
       err << *path << ": error: cannot open file\n";
@@ -74,7 +46,7 @@ int run_simulate(const std::vector<std::string>& args, std::ostream& out, std::o
     }
   }
   const auto net = load_reporting(file, err);
-  if (!net) return kFindings;
+  if (!net) return kBadInput;
 
   ParameterValues values;
   for (const auto& p : params) {
@@ -91,13 +63,13 @@ int run_simulate(const std::vector<std::string>& args, std::ostream& out, std::o
       for (const auto& d : net->parameters) declared += (declared.empty() ? "" : ", ") + d.name;
       err << "tripodal-net simulate: the net declares no parameter '" << name << "' (declared: "
           << (declared.empty() ? "none" : declared) << ")\n";
-      return kFindings;
+      return kBadInput;
     }
     auto value = parse_value(decl->type, text);
     if (!value) {
       err << "tripodal-net simulate: parameter '" << name << "' is a " << to_string(decl->type) << ", not '" << text
           << "'\n";
-      return kFindings;
+      return kBadInput;
     }
     values[name] = std::move(*value);
   }
@@ -116,14 +88,29 @@ int run_simulate(const std::vector<std::string>& args, std::ostream& out, std::o
   if (!result.error.empty() || result.status != StepStatus::ok) {
     err << "tripodal-net simulate: " << (result.error.empty() ? std::string(to_string(result.status)) : result.error)
         << "\n";
-    return kFindings;
+    return kBadInput;
   }
   return kOk;
 }
 
+cli::Action setup(CLI::App& cmd) {
+  auto a = std::make_shared<Args>();
+  cmd.add_option("FILE", a->file, "the net (native XML or PNML)")->required();
+  cmd.add_option("--param", a->params, "NAME=VALUE: a process parameter (typed by its declaration in the net)")
+      ->allow_extra_args(false);
+  cmd.add_option("--events", a->events, "SCRIPT: the event script (none: only immediate and delayed transitions)");
+  cmd.add_option("--until", a->until_s, "SECONDS: stop at this time at the latest")
+      ->check(CLI::Range(0.0, 1e9))
+      ->capture_default_str();
+  cmd.add_flag("--no-stop", a->no_stop, "keep running after an outcome place is marked");
+  cmd.add_flag("--allow-unknown-events", a->allow_unknown_events,
+               "accept script events no transition waits for (they are dropped)");
+  return [a](std::ostream& out, std::ostream& err) { return run_simulate(*a, out, err); };
+}
+
 }  // namespace
 
-TRIPODAL_NET_COMMAND("simulate", "run a net against a script of timed events, print the firings", kHelp,
-                     &run_simulate);
+TRIPODAL_CLI_COMMAND("", "simulate", "run a net against a script of timed events, print the firings", kDescription,
+                     kExitCodes, &setup);
 
 }  // namespace tripodal::net_tool

@@ -5,12 +5,13 @@
 
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <iostream>
 #include <ostream>
 #include <sstream>
 
-#include "command.hpp"
-#include "tripodal/app/cleaning_run.hpp"
+#include "cli_tool.hpp"
+#include "run_task.hpp"
 #include "tripodal/core/diagnostic.hpp"
 
 #include <spdlog/spdlog.h>
@@ -18,12 +19,11 @@
 namespace tripodal::tool {
 namespace {
 
+using namespace cli;
+
 constexpr int kTaskFailed = 4;
 
-constexpr std::string_view kRunUsage =
-    "usage: tripodal run --robot ROBOT.yaml --world WORLD.yaml --task \"COMMAND\"\n"
-    "                    [--seed N] [--out DIR] [--realtime [SPEED]] [--faults SCHEDULE|FILE]\n"
-    "                    [--max-duration-s S] [--boustrophedon]\n\n"
+constexpr std::string_view kDescription =
     "Runs the robot of a profile in the embedded simulator (the world file gives the map, the\n"
     "regions, the start pose and the faults) and gives it the task in plain words, e.g.\n"
     "\"clean the room 3211\". Prints the task and process life cycle and a progress bar (coverage\n"
@@ -34,76 +34,24 @@ constexpr std::string_view kRunUsage =
     "seconds of simulated time: \"300-330; 900-905\" (or a file holding that text).\n"
     "Faster than real time unless --realtime (SPEED times real time, default 1). --boustrophedon\n"
     "makes the cleaning behaviors follow the plough path instead of the wall-following balloon,\n"
-    "to measure the baseline on the robot.\n\n"
-    "exit codes: 0 task succeeded, 1 bad profile/world/faults, 2 bad command line, 3 I/O error,\n"
-    "4 the task failed, was refused or timed out.\n";
+    "to measure the baseline on the robot.";
 
-int run(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  app::RunOptions o;
+constexpr std::string_view kExitCodes =
+    "exit codes: 0 task succeeded, 1 bad profile/world/faults, 2 bad command line, 3 I/O error,\n"
+    "            4 the task failed, was refused or timed out.";
+
+struct Args {
+  app::RunOptions options;
   std::string faults;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&](std::string& into) {
-      if (i + 1 >= args.size()) return false;
-      into = args[++i];
-      return true;
-    };
-    std::string v;
-    bool ok = true;
-    if (a == "--robot") {
-      ok = value(v);
-      o.robot = v;
-    } else if (a == "--world") {
-      ok = value(v);
-      o.world = v;
-    } else if (a == "--task") {
-      ok = value(o.task);
-    } else if (a == "--out") {
-      ok = value(v);
-      o.out = v;
-    } else if (a == "--boustrophedon") {
-      o.boustrophedon = true;
-    } else if (a == "--faults") {
-      ok = value(faults);
-    } else if (a == "--seed" || a == "--max-duration-s") {
-      ok = value(v);
-      try {
-        std::size_t used = 0;
-        if (a == "--seed") {
-          o.seed = std::stoull(v, &used);
-        } else {
-          o.max_duration_s = std::stod(v, &used);
-          ok = ok && o.max_duration_s > 0.0;
-        }
-        ok = ok && used == v.size();
-      } catch (const std::exception&) {
-        ok = false;
-      }
-    } else if (a == "--realtime") {
-      o.realtime = true;
-      if (i + 1 < args.size() && !args[i + 1].empty() && args[i + 1][0] != '-') {
-        try {
-          std::size_t used = 0;
-          o.realtime_speed = std::stod(args[i + 1], &used);
-          ok = used == args[i + 1].size() && o.realtime_speed > 0.0;
-          ++i;
-        } catch (const std::exception&) {
-          ok = false;
-        }
-      }
-    } else {
-      err << "tripodal run: unknown argument " << a << '\n' << kRunUsage;
-      return kUsage;
-    }
-    if (!ok) {
-      err << "tripodal run: " << a << " needs a valid value\n" << kRunUsage;
-      return kUsage;
-    }
-  }
-  if (o.robot.empty() || o.world.empty() || o.task.empty()) {
-    err << "tripodal run: --robot, --world and --task are required\n" << kRunUsage;
-    return kUsage;
-  }
+  CLI::Option* realtime = nullptr;  // given at all (with or without SPEED)
+  double realtime_speed = 0.0;      // 0: --realtime without SPEED
+};
+
+int run(Args& args, std::ostream& out, std::ostream& err) {
+  app::RunOptions& o = args.options;
+  const std::string& faults = args.faults;
+  o.realtime = args.realtime->count() > 0;
+  if (args.realtime_speed > 0.0) o.realtime_speed = args.realtime_speed;
   for (const auto& f : {o.robot, o.world}) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(f, ec)) {
@@ -147,8 +95,29 @@ int run(const std::vector<std::string>& args, std::ostream& out, std::ostream& e
   }
 }
 
+cli::Action setup(CLI::App& cmd) {
+  auto a = std::make_shared<Args>();
+  app::RunOptions& o = a->options;
+  cmd.add_option("--robot", o.robot, "ROBOT.yaml: the robot profile")->required();
+  cmd.add_option("--world", o.world, "WORLD.yaml: map, regions, start pose and faults")->required();
+  cmd.add_option("--task", o.task, "\"COMMAND\": the task in plain words")->required();
+  cmd.add_option("--seed", o.seed, "N: the simulator's seed (default: the world's)");
+  cmd.add_option("--out", o.out, "DIR: where map.png, trajectory.csv, report.json and lifecycle.txt go");
+  // Without SPEED CLI11 hands the option an empty value, which leaves realtime_speed at 0.
+  a->realtime = cmd.add_option("--realtime", a->realtime_speed, "[SPEED]: SPEED times real time (default 1)")
+                    ->expected(0, 1)
+                    ->check(cli::positive_number() | CLI::IsMember({"", "true"}));
+  cmd.add_option("--faults", a->faults, "SCHEDULE|FILE: localization losses, \"300-330; 900-905\" (s)");
+  cmd.add_option("--max-duration-s", o.max_duration_s, "S: simulated time limit")
+      ->check(cli::positive_number())
+      ->capture_default_str();
+  cmd.add_flag("--boustrophedon", o.boustrophedon, "clean along the plough path instead of the balloon");
+  return [a](std::ostream& out, std::ostream& err) { return run(*a, out, err); };
+}
+
 }  // namespace
 
-TRIPODAL_COMMAND("", "run", "run a robot in the simulator on a task (clean the room 3211)", kRunUsage, run);
+TRIPODAL_CLI_COMMAND("", "run", "run a robot in the simulator on a task (clean the room 3211)", kDescription, kExitCodes,
+                     &setup);
 
 }  // namespace tripodal::tool

@@ -1,14 +1,12 @@
 // `tripodal trace import|info|dump`: convert CARMEN logs to tripodal traces and inspect traces.
-#include <charconv>
-#include <cstdio>
+#include <algorithm>
 #include <filesystem>
 #include <functional>
-#include <iomanip>
 #include <map>
+#include <memory>
 #include <ostream>
-#include <sstream>
 
-#include "command.hpp"
+#include "cli_tool.hpp"
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/trace/carmen_import.hpp"
 #include "tripodal/trace/trace_reader.hpp"
@@ -17,69 +15,31 @@ namespace tripodal::tool {
 namespace {
 
 using namespace tripodal::trace;
+using namespace cli;
 
-// Splits args into positionals and --name value options; returns false (after printing) on error.
-struct Parsed {
-  std::vector<std::string> positional;
-  std::map<std::string, std::string> options;
-  std::vector<std::string> flags;
-};
-
-bool parse(const std::vector<std::string>& args, const std::vector<std::string>& with_value,
-           const std::vector<std::string>& flags, Parsed& p, std::ostream& err) {
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a.size() > 1 && a[0] == '-') {
-      if (std::find(flags.begin(), flags.end(), a) != flags.end()) {
-        p.flags.push_back(a);
-      } else if (std::find(with_value.begin(), with_value.end(), a) != with_value.end()) {
-        if (i + 1 >= args.size()) {
-          err << "option " << a << " needs a value\n";
-          return false;
-        }
-        p.options[a] = args[++i];
-      } else {
-        err << "unknown option " << a << '\n';
-        return false;
-      }
-    } else {
-      p.positional.push_back(a);
-    }
-  }
-  return true;
-}
-
-std::string seconds(Time t) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(6) << to_seconds(t);
-  return s.str();
-}
+std::string seconds(Time t) { return format_seconds(t, 6); }
 
 // ---------------------------------------------------------------------------------------------
-constexpr std::string_view kImportUsage =
-    "usage: tripodal trace import LOG OUT [--laser-channel NAME] [--odom-channel NAME]\n"
-    "                             [--laser-pose-channel NAME | --no-laser-pose]\n\n"
+constexpr std::string_view kImportDescription =
     "Converts a CARMEN log (plain or gzip-compressed) to a tripodal trace.\n"
     "FLASER/ROBOTLASER1 -> laser channel (default front_laser), RLASER/ROBOTLASER2 -> rear_laser,\n"
     "ODOM -> odometry channel (default odom), the laser pose of each scan -> laser_pose.\n"
     "Other messages are skipped and counted; time stamps that go backwards are clamped.\n"
-    "Malformed lines are reported as LOG:LINE:COL and OUT is removed (exit 1).\n";
+    "Malformed lines are reported as LOG:LINE:COL and OUT is removed (exit 1).";
 
-int trace_import(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  Parsed p;
-  if (!parse(args, {"--laser-channel", "--odom-channel", "--laser-pose-channel"}, {"--no-laser-pose"}, p, err) ||
-      p.positional.size() != 2) {
-    if (p.positional.size() != 2) err << "tripodal trace import: expected LOG and OUT\n";
-    err << kImportUsage;
-    return kUsage;
-  }
+constexpr std::string_view kExitCodes = "exit codes: 0 ok, 1 bad input, 2 bad command line, 3 I/O error";
+
+struct ImportArgs {
+  std::filesystem::path log, trace;
+  bool no_laser_pose = false;
   CarmenImportOptions options;
-  if (auto it = p.options.find("--laser-channel"); it != p.options.end()) options.laser_channel = it->second;
-  if (auto it = p.options.find("--odom-channel"); it != p.options.end()) options.odometry_channel = it->second;
-  if (auto it = p.options.find("--laser-pose-channel"); it != p.options.end()) options.laser_pose_channel = it->second;
-  if (!p.flags.empty()) options.laser_pose_channel.clear();
-  const std::filesystem::path log = p.positional[0];
-  const std::filesystem::path trace_path = p.positional[1];
+};
+
+int trace_import(const ImportArgs& args, std::ostream& out, std::ostream& err) {
+  CarmenImportOptions options = args.options;
+  if (args.no_laser_pose) options.laser_pose_channel.clear();
+  const std::filesystem::path& log = args.log;
+  const std::filesystem::path& trace_path = args.trace;
   if (!std::filesystem::exists(log)) {
     err << "tripodal trace import: " << log.string() << ": no such file\n";
     return kIoError;
@@ -108,17 +68,16 @@ int trace_import(const std::vector<std::string>& args, std::ostream& out, std::o
       << "params: " << report.params.size() << '\n';
   for (const auto& [type, n] : report.skipped) out << "skipped " << type << ": " << n << '\n';
   out << "backwards time stamps clamped: " << report.backwards_steps;
-  if (report.backwards_steps > 0) out << " (largest step back " << to_seconds(report.largest_backwards_step) << " s)";
-  out << '\n' << "duration: " << to_seconds(report.last_stamp - report.first_stamp) << " s\n";
+  if (report.backwards_steps > 0) out << " (largest step back " << seconds(report.largest_backwards_step) << " s)";
+  out << '\n' << "duration: " << seconds(report.last_stamp - report.first_stamp) << " s\n";
   return kOk;
 }
 
 // ---------------------------------------------------------------------------------------------
-constexpr std::string_view kInfoUsage =
-    "usage: tripodal trace info FILE\n\n"
+constexpr std::string_view kInfoDescription =
     "Prints the format version, duration, channels and the number of records of each kind.\n"
     "A trace cut inside a record (recorder killed) is summarised up to its last whole record\n"
-    "with a warning (exit 0); a corrupt trace is an error naming the byte offset (exit 1).\n";
+    "with a warning (exit 0); a corrupt trace is an error naming the byte offset (exit 1).";
 
 constexpr std::string_view kind_label(ChannelKind kind) {
   switch (kind) {
@@ -150,13 +109,7 @@ int with_reader(const std::string& path, std::ostream& err, const std::function<
   }
 }
 
-int trace_info(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  Parsed p;
-  if (!parse(args, {}, {}, p, err) || p.positional.size() != 1) {
-    err << kInfoUsage;
-    return kUsage;
-  }
-  const std::string path = p.positional[0];
+int trace_info(const std::string& path, std::ostream& out, std::ostream& err) {
   std::map<ChannelId, std::uint64_t> per_channel;
   std::uint64_t records = 0;
   Time first{0};
@@ -205,10 +158,15 @@ int trace_info(const std::vector<std::string>& args, std::ostream& out, std::ost
 }
 
 // ---------------------------------------------------------------------------------------------
-constexpr std::string_view kDumpUsage =
-    "usage: tripodal trace dump FILE [--limit N] [--beams K]\n\n"
+constexpr std::string_view kDumpDescription =
     "Prints one line per record: time stamp (s), channel, kind and values. --limit stops after N\n"
-    "records; --beams K shows the first K ranges of each scan (default 8, 0 for all).\n";
+    "records; --beams K shows the first K ranges of each scan (default 8, 0 for all).";
+
+struct DumpArgs {
+  std::string file;
+  std::size_t limit = 0;
+  std::size_t beams = 8;
+};
 
 template <typename T>
 void list(std::ostream& out, const std::vector<T>& v, std::size_t limit) {
@@ -262,29 +220,10 @@ void dump_record(std::ostream& out, const ChannelInfo& c, const RecordData& data
   out << '\n';
 }
 
-bool to_count(const std::string& s, std::size_t& v) {
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  return ec == std::errc() && end == s.data() + s.size();
-}
-
-int trace_dump(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  Parsed p;
-  std::size_t limit = 0;
-  std::size_t beams = 8;
-  bool ok = parse(args, {"--limit", "--beams"}, {}, p, err) && p.positional.size() == 1;
-  if (ok && p.options.count("--limit") != 0 && !to_count(p.options["--limit"], limit)) {
-    err << "--limit needs a non-negative integer\n";
-    ok = false;
-  }
-  if (ok && p.options.count("--beams") != 0 && !to_count(p.options["--beams"], beams)) {
-    err << "--beams needs a non-negative integer\n";
-    ok = false;
-  }
-  if (!ok) {
-    err << kDumpUsage;
-    return kUsage;
-  }
-  return with_reader(p.positional[0], err, [&](TraceReader& r) {
+int trace_dump(const DumpArgs& args, std::ostream& out, std::ostream& err) {
+  const std::size_t limit = args.limit;
+  const std::size_t beams = args.beams;
+  return with_reader(args.file, err, [&](TraceReader& r) {
     TraceRecord rec;
     std::size_t n = 0;
     std::vector<bool> announced;
@@ -302,11 +241,38 @@ int trace_dump(const std::vector<std::string>& args, std::ostream& out, std::ost
   });
 }
 
+cli::Action setup_import(CLI::App& cmd) {
+  auto a = std::make_shared<ImportArgs>();
+  cmd.add_option("LOG", a->log, "the CARMEN log (.log or .log.gz)")->required();
+  cmd.add_option("OUT", a->trace, "the trace to write")->required();
+  cmd.add_option("--laser-channel", a->options.laser_channel, "NAME: channel of the front laser")->capture_default_str();
+  cmd.add_option("--odom-channel", a->options.odometry_channel, "NAME: channel of the odometry")->capture_default_str();
+  auto* pose = cmd.add_option("--laser-pose-channel", a->options.laser_pose_channel, "NAME: channel of the laser poses")
+                   ->capture_default_str();
+  cmd.add_flag("--no-laser-pose", a->no_laser_pose, "leave the laser poses out")->excludes(pose);
+  return [a](std::ostream& out, std::ostream& err) { return trace_import(*a, out, err); };
+}
+
+cli::Action setup_info(CLI::App& cmd) {
+  auto file = std::make_shared<std::string>();
+  cmd.add_option("FILE", *file, "the trace")->required();
+  return [file](std::ostream& out, std::ostream& err) { return trace_info(*file, out, err); };
+}
+
+cli::Action setup_dump(CLI::App& cmd) {
+  auto a = std::make_shared<DumpArgs>();
+  cmd.add_option("FILE", a->file, "the trace")->required();
+  cmd.add_option("--limit", a->limit, "N: stop after N records (0: all)")->capture_default_str();
+  cmd.add_option("--beams", a->beams, "K: the first K ranges of each scan (0: all)")->capture_default_str();
+  return [a](std::ostream& out, std::ostream& err) { return trace_dump(*a, out, err); };
+}
+
 }  // namespace
 
-TRIPODAL_COMMAND("trace", "import", "convert a CARMEN log (.log or .log.gz) to a tripodal trace", kImportUsage,
-                 &trace_import);
-TRIPODAL_COMMAND("trace", "info", "duration, channels and record counts of a trace", kInfoUsage, &trace_info);
-TRIPODAL_COMMAND("trace", "dump", "print a trace's records, one per line", kDumpUsage, &trace_dump);
+TRIPODAL_CLI_COMMAND("trace", "import", "convert a CARMEN log (.log or .log.gz) to a tripodal trace", kImportDescription,
+                     kExitCodes, &setup_import);
+TRIPODAL_CLI_COMMAND("trace", "info", "duration, channels and record counts of a trace", kInfoDescription, kExitCodes,
+                     &setup_info);
+TRIPODAL_CLI_COMMAND("trace", "dump", "print a trace's records, one per line", kDumpDescription, kExitCodes, &setup_dump);
 
 }  // namespace tripodal::tool

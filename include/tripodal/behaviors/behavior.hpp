@@ -12,6 +12,7 @@
 #include <string>
 #include <string_view>
 
+#include "tripodal/controllers/base_capabilities.hpp"
 #include "tripodal/core/manifest.hpp"
 #include "tripodal/core/time.hpp"
 #include "tripodal/resources/readings.hpp"
@@ -19,26 +20,52 @@
 
 namespace tripodal {
 
-/// Navigation data the sequencing layer (localizer, path planner) publishes for behaviors. The
-/// control loop holds one and behaviors read it through the context; `path` views storage owned
-/// by whoever set it (the loop copies into a fixed-capacity buffer, see CReactiveLoop).
+/// What the map says about a point, for behaviors that must tell the walls they follow from
+/// obstacles the map does not hold. Implemented by the sequencing layer's map module over an
+/// immutable grid, so the reactive loop may read it from its own thread.
+class ObstacleMap {
+ public:
+  virtual ~ObstacleMap() = default;
+  /// True when (x_m, y_m), map frame, lies on or next to an obstacle of the map.
+  [[nodiscard]] virtual bool near_obstacle(double x_m, double y_m) const noexcept = 0;
+};
+
+/// Navigation data the sequencing layer (localizer, path and coverage planners) publishes for the
+/// reactive layer's behaviors. The control loop holds a copy; `path` views storage owned by
+/// whoever set it (the loop copies it into a fixed-capacity buffer when path_id changes).
 struct NavigationData {
   Pose2D map_from_base;      ///< pose estimate in the map frame
   Time pose_stamp{0};
   bool localized = false;    ///< the localizer trusts map_from_base
+  std::uint32_t fixes = 0;   ///< global position fixes accepted so far (BhGlobalLocalization)
   bool has_goal = false;
   Pose2D goal;               ///< current goal in the map frame
-  std::span<const Pose2D> path;  ///< planned path in the map frame (may be empty)
+  /// The path to follow, map frame (theta unused). A new path_id is a new path: a following
+  /// behavior takes it up at path_start_m. 0: no path.
+  std::span<const Pose2D> path;
+  std::uint32_t path_id = 0;
+  double path_start_m = 0.0;
+  /// True when the end of the path is the behavior's goal (it succeeds there); false for a
+  /// detour, after which the sequencing layer publishes the way on.
+  bool path_final = true;
+  /// Why the sequencing layer could not give a path for the active behavior ("unknown goal",
+  /// "no path to the goal"); static storage. Empty: none.
+  std::string_view path_failure;
+  /// Radius of the body disc the paths were planned with (clearance checks use it).
+  double robot_radius_m = 0.25;
+  const ObstacleMap* map = nullptr;  ///< nullptr: every laser return counts as an obstacle
 };
 
-/// Per-axis velocity limits of the base in the body frame (all >= 0). A base that cannot move
-/// sideways (differential drive) has max_vy_m_s == 0: behaviors read this to steer by heading, so
-/// the same behavior code drives holonomic and differential bases.
-struct BaseCapabilities {
-  double max_vx_m_s = std::numeric_limits<double>::infinity();
-  double max_vy_m_s = std::numeric_limits<double>::infinity();
-  double max_wz_rad_s = std::numeric_limits<double>::infinity();
-  [[nodiscard]] bool holonomic() const noexcept { return max_vy_m_s > 0.0; }
+/// What a path-following behavior reports back to the sequencing layer every period (written in
+/// step(), published by the loop): where it is along the path and whether something the map does
+/// not hold stops it, so the sequencing layer can replan around it.
+struct NavigationFeedback {
+  std::uint32_t path_id = 0;  ///< the path being followed; 0: none
+  double progress_m = 0.0;    ///< arc length reached along it
+  bool reached_end = false;   ///< at the end of the path
+  bool blocked = false;       ///< stopped by an obstacle the map does not hold, or a bumper
+  Time blocked_since{0};
+  friend bool operator==(const NavigationFeedback&, const NavigationFeedback&) = default;
 };
 
 /// A per-axis velocity envelope [lo, hi] a safety behavior imposes (see CBehaviorCoordinator's
@@ -59,6 +86,9 @@ struct BehaviorContext {
   const ResourceTable* resources = nullptr;
   const NavigationData* navi = nullptr;
   BaseCapabilities base;
+  /// Where path-following behaviors report (nullptr outside a loop); the loop resets it to
+  /// "no path" before every cycle.
+  NavigationFeedback* feedback = nullptr;
 };
 
 enum class BehaviorStatus : std::uint8_t {

@@ -123,6 +123,8 @@ class BhAvoidObstacle final : public CBehavior {
   // size: never allocated.
   BeamArray cos_, sin_;
   double table_angle_min_ = 0.0, table_increment_ = 0.0;
+  std::size_t scan_seen_ = 0;    ///< sequence of the scan envelope_ was computed from
+  VelocityEnvelope envelope_;
 };
 
 }  // namespace tripodal

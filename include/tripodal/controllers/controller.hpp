@@ -11,7 +11,7 @@
 #include <span>
 #include <string_view>
 
-#include "tripodal/behaviors/behavior.hpp"
+#include "tripodal/controllers/base_capabilities.hpp"
 #include "tripodal/core/manifest.hpp"
 #include "tripodal/core/time.hpp"
 #include "tripodal/resources/readings.hpp"

@@ -1,10 +1,9 @@
 // Typed configuration of the base controllers and the registry that creates a controller by its
-// type name ("differential", "omni", "mecanum") from that configuration. The YAML loader
-// (reactive_config.hpp) produces these structs; nothing past it sees YAML.
+// type name ("differential", "omni", "mecanum", or an application's) from that configuration.
+// Each type's manifest declares its parameters; the YAML loader (reactive_config.hpp) checks a
+// configuration against them and produces these structs; nothing past it sees YAML.
 #pragma once
 
-#include <functional>
-#include <map>
 #include <memory>
 #include <optional>
 #include <span>
@@ -15,6 +14,7 @@
 #include "tripodal/controllers/controller.hpp"
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/core/manifest.hpp"
+#include "tripodal/core/registry.hpp"
 #include "tripodal/core/time.hpp"
 
 namespace tripodal {
@@ -53,42 +53,47 @@ struct HolonomicConfig {
 /// Everything a controller needs, whatever its type.
 struct ControllerConfig {
   std::string name = "base";       ///< instance name
-  std::string type;                ///< registered type: "differential", "omni", "mecanum"
+  std::string type;                ///< registered type: "differential", "omni", "mecanum", or an application's
   Duration period{std::chrono::milliseconds(10)};  ///< nominal sampling period, > 0
   Duration cmd_timeout{0};         ///< 0 disables; on expiry brake to zero through the limits
   BodyLimits limits;
   std::optional<double> max_wheel_speed_rad_s;  ///< wheel saturation, scaled keeping curvature
   DifferentialDriveConfig differential;         ///< type "differential"
   HolonomicConfig holonomic;                    ///< types "omni" and "mecanum"
+  /// The configured parameters, resolved against the type's manifest (defaults filled in): an
+  /// application's controller type reads its own here (parameters.number("gain")). Loaders fill
+  /// it and then the typed fields above with apply_parameters(); empty when built in code.
+  ParameterSet parameters;
   SourceLocation where;                         ///< of the controller's entry, for messages
 };
 
 /// Checks a configuration; every problem is reported at `config.where`.
 [[nodiscard]] Diagnostics validate(const ControllerConfig& config);
 
-/// Creates controllers by type name. The built-in types are registered by
-/// default_controller_registry().
-class ControllerRegistry {
- public:
-  using Factory =
-      std::function<std::unique_ptr<CController>(const ControllerConfig&, HardwareInterface&)>;
-  /// Throws std::invalid_argument for an empty or duplicate name.
-  void add(const ModuleManifest& manifest, Factory factory);
-  [[nodiscard]] bool contains(std::string_view type) const noexcept;
-  [[nodiscard]] const ModuleManifest* manifest(std::string_view type) const noexcept;
-  [[nodiscard]] std::vector<std::string> names() const;
-  /// Creates a controller of config.type driving `hardware` (which must outlive it). Throws
-  /// ConfigError located at config.where for an unknown type, an invalid configuration, or a
-  /// hardware interface whose wheel count differs from the configuration's.
-  [[nodiscard]] std::unique_ptr<CController> create(const ControllerConfig& config,
-                                                    HardwareInterface& hardware) const;
+/// The manifest of a controller type: reactive layer, kind controller, "cmd_vel" in, "odometry"
+/// and "wheel_commands" out; its parameters are `specific` followed by those every controller
+/// takes (period_s, cmd_timeout_s, max_wheel_speed_rad_s, limits.<vx|vy|wz>.<max_velocity|
+/// max_acceleration|max_deceleration|max_jerk>). A dotted name is a key of nested maps in YAML.
+[[nodiscard]] ModuleManifest controller_manifest(std::string name, std::string description,
+                                                 std::vector<ParameterSpec> specific);
 
- private:
-  struct Entry {
-    const ModuleManifest* manifest;
-    Factory factory;
-  };
-  std::map<std::string, Entry, std::less<>> entries_;
+/// Sets the typed fields of `config` from config.parameters: the common ones, and the geometry
+/// of the built-in types (differential wheels, mecanum half length and width, omni wheel radius).
+/// Parameters that are not set leave their field as it is.
+void apply_parameters(ControllerConfig& config);
+
+/// Controller types by name; each is created from its configuration on a hardware interface
+/// (which must outlive it). The built-in types are registered by default_controller_registry().
+class ControllerRegistry : public Registry<CController, const ControllerConfig&, HardwareInterface&> {
+ public:
+  ControllerRegistry() : Registry("controller type") {}
+  using Registry::create;
+  /// Creates a controller of config.type. Throws ConfigError located at config.where for an
+  /// unknown type, an invalid configuration, or a hardware interface whose wheel count differs
+  /// from the configuration's.
+  [[nodiscard]] std::unique_ptr<CController> create(const ControllerConfig& config, HardwareInterface& hardware) const {
+    return create_at(config.where, config.type, config, hardware);
+  }
 };
 
 /// Adds "differential", "omni" and "mecanum" to `registry`.

@@ -1,6 +1,6 @@
 // Planar kinematics shared by the controllers and the simulator: exact integration of a constant
 // body twist over a period (the SE(2) exponential), and the wheel Jacobians of differential and
-// holonomic (omni, mecanum) bases.
+// holonomic (omni, mecanum) bases. (wrap_angle lives in core/geometry.hpp.)
 #pragma once
 
 #include "tripodal/resources/readings.hpp"
@@ -18,8 +18,5 @@ void differential_inverse(double wheel_separation_m, double wheel_radius_m, cons
                           double& left_rad_s, double& right_rad_s) noexcept;
 [[nodiscard]] Twist2D differential_forward(double wheel_separation_m, double wheel_radius_m,
                                            double left_rad_s, double right_rad_s) noexcept;
-
-/// Angle wrapped to [-pi, pi).
-[[nodiscard]] double wrap_angle(double angle_rad) noexcept;
 
 }  // namespace tripodal

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "tripodal/core/diagnostic.hpp"
@@ -33,9 +34,32 @@ struct ParameterSpec {
   std::optional<Value> default_value;
   std::string unit;               ///< SI unit ("m", "m/s", "rad", "s") or "" for none
   std::string description;
-  std::optional<double> min;      ///< numbers only: inclusive bounds checked at activation
+  std::optional<double> min;      ///< numbers only: bounds checked at activation, inclusive ...
   std::optional<double> max;
+  bool min_exclusive = false;     ///< ... except min when this is set (a radius must be > 0)
+  bool optional = false;          ///< without a default: may stay unset rather than being required
 };
+
+/// The problem with `value` for `spec` ("'wheel_radius_m' must be > 0, got -0.05"), or nullopt
+/// when it is of the declared type and within the bounds. Every reader of parameters (net
+/// bindings, YAML configuration) reports through this, so the messages are the same everywhere.
+[[nodiscard]] std::optional<std::string> check_parameter_value(const ParameterSpec& spec, const Value& value);
+
+/// Builders of parameter declarations, for manifests written in code: `parameter::number(
+/// "wheel_radius_m", std::nullopt, "m", "wheel radius", 0.0)`. A nullopt default makes the
+/// parameter required.
+namespace parameter {
+[[nodiscard]] ParameterSpec number(std::string name, std::optional<double> default_value, std::string unit,
+                                   std::string description, std::optional<double> min = std::nullopt,
+                                   std::optional<double> max = std::nullopt);
+/// A number that must be > 0 (lengths, periods, gains).
+[[nodiscard]] ParameterSpec positive(std::string name, std::optional<double> default_value, std::string unit,
+                                     std::string description);
+[[nodiscard]] ParameterSpec text(std::string name, std::optional<std::string> default_value, std::string description);
+[[nodiscard]] ParameterSpec flag(std::string name, std::optional<bool> default_value, std::string description);
+/// `spec` without a default and not required: left unset unless configured ("no limit").
+[[nodiscard]] ParameterSpec optional(ParameterSpec spec);
+}  // namespace parameter
 
 /// Static description of a plugin type. Inputs and outputs are names of information
 /// ("laser_scan", "odometry", "map_from_base", "goal_pose", "cmd_vel"): a configured robot is
@@ -52,6 +76,34 @@ struct ModuleManifest {
   [[nodiscard]] const ParameterSpec* find_parameter(std::string_view parameter) const noexcept;
 };
 
+/// Builds a manifest in one expression, the way every plugin type declares its static manifest:
+///   ManifestBuilder("BhGoToPose", ModuleKind::behavior).input("odometry").output("behavior_command")
+///       .number("max_speed_m_s", 0.5, "m/s", "cruise speed", 0.0, 2.0).build()
+class ManifestBuilder {
+ public:
+  ManifestBuilder(std::string name, ModuleKind kind, Layer layer = Layer::reactive);
+  ManifestBuilder& layer(Layer layer);
+  ManifestBuilder& kind(ModuleKind kind);
+  ManifestBuilder& description(std::string text);
+  ManifestBuilder& input(std::string information);
+  ManifestBuilder& inputs(std::vector<std::string> information);
+  ManifestBuilder& output(std::string information);
+  ManifestBuilder& outputs(std::vector<std::string> information);
+  /// Appends a parameter; see parameter::number and friends for the arguments.
+  ManifestBuilder& parameter(ParameterSpec spec);
+  ManifestBuilder& parameters(std::vector<ParameterSpec> specs);
+  ManifestBuilder& number(std::string name, std::optional<double> default_value, std::string unit,
+                          std::string description, std::optional<double> min = std::nullopt,
+                          std::optional<double> max = std::nullopt);
+  ManifestBuilder& text(std::string name, std::optional<std::string> default_value, std::string description);
+  ManifestBuilder& flag(std::string name, std::optional<bool> default_value, std::string description);
+  [[nodiscard]] ModuleManifest build() const& { return manifest_; }
+  [[nodiscard]] ModuleManifest build() && { return std::move(manifest_); }
+
+ private:
+  ModuleManifest manifest_;
+};
+
 /// Parameter values by name, as given to an activation (same type as the engine's).
 using ParameterValues = std::map<std::string, Value, std::less<>>;
 
@@ -62,7 +114,8 @@ class ParameterSet {
  public:
   ParameterSet() = default;
   /// Resolves `given` against `manifest`. Throws ConfigError listing every problem: an unknown
-  /// name, a wrong type, a missing required parameter, a number outside [min, max]. `where` is
+  /// name, a wrong type, a missing required parameter, a number outside [min, max]. An optional
+  /// parameter without a value stays absent (contains() is false). `where` is
   /// used for the location of the messages (e.g. the net file and the place binding it).
   static ParameterSet resolve(const ModuleManifest& manifest, const ParameterValues& given,
                               const SourceLocation& where = {});
@@ -79,13 +132,5 @@ class ParameterSet {
  private:
   ParameterValues values_;
 };
-
-/// Checks, over a set of configured modules, that every input has exactly one provider.
-/// Reports an error per input with no provider or several providers (naming them).
-[[nodiscard]] Diagnostics check_providers(const std::vector<const ModuleManifest*>& modules);
-
-/// The layered functionality diagram of `modules` in Graphviz DOT: one cluster per layer, an edge
-/// from each provider to each module that needs one of its outputs, labelled with the information.
-[[nodiscard]] std::string functionality_diagram_dot(const std::vector<const ModuleManifest*>& modules);
 
 }  // namespace tripodal

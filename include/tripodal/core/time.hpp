@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <string>
 
 namespace tripodal {
 
@@ -23,5 +24,13 @@ using Time = std::chrono::nanoseconds;
 [[nodiscard]] constexpr Duration from_seconds(double seconds) noexcept {
   return std::chrono::round<Duration>(std::chrono::duration<double>(seconds));
 }
+
+/// digits for format_seconds: as many decimals as the duration needs to be exact (at most 9).
+inline constexpr int kExactDigits = -1;
+
+/// Seconds of a duration as text, without a unit, for logs, reports and drawings: `digits`
+/// decimals rounded half away from zero (format_seconds(1234567891ns) is "1.235"), or with
+/// kExactDigits the exact value without trailing zeros ("2.5", "1", "-0.000001").
+[[nodiscard]] std::string format_seconds(Duration d, int digits = 3);
 
 }  // namespace tripodal

@@ -24,6 +24,8 @@ class GroundTruthSource {
   virtual ~GroundTruthSource() = default;
   /// map_from_base of the robot at time now, or nothing if unknown.
   [[nodiscard]] virtual std::optional<Pose2D> true_pose(Time now) const = 0;
+  /// Whether the world denies localization at `now` (a scheduled fault window of a simulation).
+  [[nodiscard]] virtual bool localization_lost(Time /*now*/) const noexcept { return false; }
 };
 
 /// A window of localization loss: from start (inclusive) to end (exclusive).
@@ -50,6 +52,10 @@ struct LocalizerOptions {
   std::vector<LocalizationFault> faults;
 };
 
+/// Type "Localizer". As a module of the robot it takes the ground truth from the robot's hardware
+/// (the simulator) at start, updates and publishes its estimate every sequencing period, keeps the
+/// supervisor's watchdog fed, and attempts a global position fix every attempt_period_s while
+/// BhGlobalLocalization is active (NavigationData::fixes counts the fixes accepted).
 class CLocalizer final : public CNaviModules {
  public:
   explicit CLocalizer(const GroundTruthSource* truth = nullptr, LocalizerOptions options = {});
@@ -74,12 +80,17 @@ class CLocalizer final : public CNaviModules {
   [[nodiscard]] double position_error_m() const noexcept { return error_m_; }
   /// Copies the estimate into the navigation data behaviors read.
   void publish(NavigationData& data) const noexcept;
+  /// One update at `now` on its own: the estimate, and the events it posts appended to `out`.
+  void step(Time now, std::vector<ModuleEvent>& out) noexcept;
   [[nodiscard]] const LocalizerOptions& options() const noexcept { return options_; }
 
  protected:
   [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
   void on_configure(const ParameterSet& params) override;
-  void on_update(Time now, std::vector<NaviEvent>& out) noexcept override;
+  void on_start(ModuleContext& context) override;
+  void on_update(ModuleContext& context) override;
+  void on_behavior_activated(const BehaviorActivation& activation, ModuleContext& context) override;
+  void on_behavior_deactivated(std::string_view behavior, ModuleContext& context) override;
 
  private:
   enum class State { unknown, ok, lost };
@@ -94,6 +105,12 @@ class CLocalizer final : public CNaviModules {
   std::optional<Pose2D> estimate_;
   Time stamp_{0};
   double error_m_ = 0.0;
+  // Global localization while the behavior it serves (BhGlobalLocalization) is active.
+  std::string serves_ = "BhGlobalLocalization";
+  bool searching_ = false;
+  Duration attempt_period_{0};
+  Time last_attempt_{0};
+  std::uint32_t fixes_ = 0;
 };
 
 }  // namespace tripodal::navi

@@ -8,6 +8,7 @@
 #include <optional>
 #include <vector>
 
+#include "tripodal/core/geometry.hpp"
 #include "tripodal/resources/readings.hpp"
 
 namespace tripodal::navi {
@@ -30,12 +31,8 @@ struct CellIndex {
   friend bool operator==(const CellIndex&, const CellIndex&) = default;
 };
 
-/// A point in the map frame, metres.
-struct Point2D {
-  double x_m = 0.0;
-  double y_m = 0.0;
-  friend bool operator==(const Point2D&, const Point2D&) = default;
-};
+// Point2D moved to the shared vocabulary (core/geometry.hpp); navi::Point2D still names it.
+using tripodal::Point2D;
 
 /// A rectangular grid of cells of side resolution_m. origin is map_from_grid: the pose of the
 /// lower-left corner of cell (0, 0) in the map frame (the yaw of map_server's origin is honoured:

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "tripodal/navi/navi_modules.hpp"
+#include "tripodal/navi/regions.hpp"
 #include "tripodal/navi/occupancy_grid.hpp"
 
 namespace tripodal::navi {
@@ -65,8 +66,12 @@ struct SectionSet {
 ///     component under min_section_area_m2 is merged into its largest neighbour across a wall.
 /// Every free cell ends up in exactly one section (unless dropped in 4).
 ///
-/// As a navigation module its parameters are the option fields (same names); split() may be
-/// called without configure() with the options given to the constructor.
+/// As a navigation module (type "SectionSplitter") its parameters are the option fields (same
+/// names); it splits the map of the robot's GridMaps at start and answers the planner's question
+/// sections(room): the room's sections nearest first from the robot's pose when the localizer
+/// trusts it (order_nearest_first; paper, section 5.1: the order of the processes follows the
+/// initial position), else in scan order. split() may be called without configure() with the
+/// options given to the constructor.
 class CSectionSplitter final : public CNaviModules {
  public:
   explicit CSectionSplitter(SectionSplitterOptions options = {}) : options_(options) {}
@@ -74,12 +79,29 @@ class CSectionSplitter final : public CNaviModules {
   [[nodiscard]] SectionSet split(const OccupancyGrid& grid) const;
   [[nodiscard]] const SectionSplitterOptions& options() const noexcept { return options_; }
 
+  /// The sections of the robot's map (after start, or split_map()).
+  [[nodiscard]] const SectionSet& sections() const noexcept { return sections_; }
+  /// Splits `grid` and keeps the result with the regions it is read against (start does this
+  /// with the robot's map).
+  void split_map(const OccupancyGrid& grid, const RegionMap& regions);
+  /// The section called `name` ("A"), nullptr when there is none.
+  [[nodiscard]] const Section* section(std::string_view name) const noexcept;
+  /// Names of the sections most of whose cells lie in the room, in scan order; an error naming
+  /// the known rooms for an unknown room.
+  [[nodiscard]] KnowledgeAnswer sections_of_room(std::string_view room) const;
+
  protected:
   [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
   void on_configure(const ParameterSet& params) override;
+  void on_start(ModuleContext& context) override;
+  [[nodiscard]] std::optional<KnowledgeAnswer> on_answer(std::string_view function, std::string_view argument,
+                                                         const NavigationData& navigation) const override;
 
  private:
   SectionSplitterOptions options_;
+  SectionSet sections_;
+  const OccupancyGrid* grid_ = nullptr;
+  const RegionMap* regions_ = nullptr;
 };
 
 /// The order in which to visit sections, and the path length of each leg.

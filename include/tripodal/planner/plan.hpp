@@ -13,21 +13,9 @@
 
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/core/petri_net.hpp"
+#include "tripodal/processes/process_step.hpp"
 
 namespace tripodal {
-
-/// One process module to run, with its parameters (values already substituted).
-struct ProcessStep {
-  std::string process;  ///< e.g. "PrCleaning"
-  std::vector<BindingParam> params;
-  friend bool operator==(const ProcessStep& a, const ProcessStep& b) {
-    if (a.process != b.process || a.params.size() != b.params.size()) return false;
-    for (std::size_t i = 0; i < a.params.size(); ++i) {
-      if (a.params[i].name != b.params[i].name || a.params[i].value != b.params[i].value) return false;
-    }
-    return true;
-  }
-};
 
 /// A stage runs one step, or several steps in parallel (it ends when all have succeeded).
 struct PlanStage {

@@ -14,23 +14,9 @@
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/core/petri_net.hpp"
 #include "tripodal/planner/plan.hpp"
+#include "tripodal/processes/recovery_rule.hpp"
 
 namespace tripodal {
-
-enum class RecoveryAction {
-  retry,  ///< run the inserted processes, then the failed stage again
-  skip,   ///< run the inserted processes, then go on after the failed stage
-  abort,  ///< the task fails
-};
-
-struct RecoveryRule {
-  std::string fault;    ///< the fault message it handles (case-insensitive exact match)
-  std::string process;  ///< only faults of this process; empty: any process
-  std::vector<ProcessStep> insert;
-  RecoveryAction then = RecoveryAction::retry;
-  int max_retries = 1;  ///< how many times this rule may fire for one task before it gives up
-  SourceLocation where;
-};
 
 struct RecoveryDecision {
   RecoveryAction action = RecoveryAction::abort;

@@ -12,10 +12,10 @@
 
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/core/engine.hpp"
+#include "tripodal/core/manifest.hpp"
 #include "tripodal/core/petri_net.hpp"
 #include "tripodal/core/time.hpp"
-#include "tripodal/planner/plan.hpp"
-#include "tripodal/planner/recovery.hpp"
+#include "tripodal/processes/recovery_rule.hpp"
 
 namespace tripodal {
 
@@ -38,7 +38,8 @@ struct ProcessDefinition {
   PetriNet net;
   /// Its process module in high-level configuration (paper, Fig. 2: configs/petri/
   /// PrCleaning-module.xml), which the planner composes into the plan's net; none: the default
-  /// module of that shape (default_module_net).
+  /// module of that shape (planner/plan.hpp, default_module_net). Its shape is the planner's
+  /// business (check_module_net, run when the robot is assembled and when a plan is composed).
   std::optional<PetriNet> module;
   std::vector<BindingParam> parameters;
   std::vector<RecoveryRule> recovery;
@@ -59,14 +60,20 @@ class CProcess {
   /// Checks the definition and throws ConfigError listing every problem, located: a configured
   /// parameter the net does not declare or whose text does not parse as the declared type, a
   /// behavior binding parameter "$name" that names no declared parameter, a net without any
-  /// outcome place (its result could never be reported), a high-level net, a module net the
-  /// planner cannot compose (check_module_net).
+  /// outcome place (its result could never be reported), a high-level net.
   explicit CProcess(ProcessDefinition definition);
   virtual ~CProcess() = default;
   CProcess(const CProcess&) = delete;
   CProcess& operator=(const CProcess&) = delete;
 
+  /// The manifest of the "net" type: a process given entirely by configuration.
+  static const ModuleManifest& static_manifest();
+
   [[nodiscard]] const std::string& name() const noexcept { return definition_.name; }
+  /// This process as a module of the sequencing layer: its name, kind process, the parameters its
+  /// net declares (types, defaults, descriptions) and, in the description, the behaviors it binds.
+  /// Built at construction, so a derived process type has it the same way.
+  [[nodiscard]] const ModuleManifest& manifest() const noexcept { return manifest_; }
   [[nodiscard]] const std::string& type() const noexcept { return definition_.type; }
   [[nodiscard]] const PetriNet& net() const noexcept { return definition_.net; }
   /// The configured process module net; nullptr when the default is used.
@@ -90,6 +97,7 @@ class CProcess {
 
  private:
   ProcessDefinition definition_;
+  ModuleManifest manifest_;
 };
 
 /// The parameters a behavior binding passes: literal values as strings, "$name" replaced by the

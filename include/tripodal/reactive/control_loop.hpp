@@ -98,9 +98,28 @@ class ControlLoop final {
   bool deactivate(BehaviorHandle handle);
   /// Removes whatever behavior is bound to `input`; false when none.
   bool deactivate(std::string_view input);
-  /// Navigation data for the next cycles; the path is copied (false when it exceeds
-  /// max_path_points: then it is truncated).
+  /// Navigation data for the next cycles. The path is copied only when navi.path_id differs from
+  /// the last one given (false when it exceeds max_path_points: then it is truncated).
   bool set_navigation(const NavigationData& navi);
+  /// What the path-following behaviors reported in the last cycle that handed it over; a report
+  /// of the end of a path stays until the next report (the behavior that made it has finished).
+  [[nodiscard]] NavigationFeedback navigation_feedback() const;
+  /// Holds the changes made from now on (activations, deactivations, navigation, locks) until
+  /// release_changes(), so that a loop running on another thread applies the changes of one
+  /// supervision step together (a behavior never starts with the previous step's path).
+  void hold_changes();
+  void release_changes();
+  /// hold_changes() for a scope.
+  class ChangeBatch {
+   public:
+    explicit ChangeBatch(ControlLoop& loop) : loop_(loop) { loop_.hold_changes(); }
+    ~ChangeBatch() { loop_.release_changes(); }
+    ChangeBatch(const ChangeBatch&) = delete;
+    ChangeBatch& operator=(const ChangeBatch&) = delete;
+
+   private:
+    ControlLoop& loop_;
+  };
   /// A lock message for the coordinator, stamped `stamp` (see CoordinatorLockConfig).
   void set_lock(std::string_view lock, bool engaged, Time stamp);
   /// Moves the events reported since the last call into `out` (appends).
@@ -166,6 +185,7 @@ class ControlLoop final {
   std::vector<Slot> slots_;
   NavigationData navi_;
   std::vector<Pose2D> path_;
+  NavigationFeedback feedback_;
   CycleReport report_;
   bool controller_faulted_ = false;
   std::vector<LoopEvent> local_events_;  // ring buffer of events not yet handed over
@@ -184,8 +204,11 @@ class ControlLoop final {
   std::vector<PendingDeactivation> pending_deactivations_;
   std::vector<PendingLock> pending_locks_;
   bool navi_dirty_ = false;
+  bool path_dirty_ = false;
+  int holding_ = 0;  // hold_changes() depth
   NavigationData navi_shared_;
   std::vector<Pose2D> path_shared_;
+  NavigationFeedback feedback_shared_;
   std::vector<std::unique_ptr<CBehavior>> retired_;  // destroyed on the supervisor's side
   std::vector<LoopEvent> events_out_;
   // The supervisor's view of each slot.

@@ -5,26 +5,10 @@
 #include <cstdint>
 #include <vector>
 
+#include "tripodal/core/geometry.hpp"
 #include "tripodal/core/time.hpp"
 
 namespace tripodal {
-
-/// A planar pose: frame-to-frame transform, e.g. map_from_base or odom_from_base.
-struct Pose2D {
-  double x_m = 0.0;
-  double y_m = 0.0;
-  double theta_rad = 0.0;
-  friend bool operator==(const Pose2D&, const Pose2D&) = default;
-};
-
-/// A planar velocity in the body frame: forward, leftward, counter-clockwise yaw rate.
-/// It is also the motion command behaviors produce and controllers execute.
-struct Twist2D {
-  double vx_m_s = 0.0;
-  double vy_m_s = 0.0;
-  double wz_rad_s = 0.0;
-  friend bool operator==(const Twist2D&, const Twist2D&) = default;
-};
 
 /// Wheel odometry (or fused odometry): pose in the odom frame and body-frame twist.
 struct OdometryReading {

@@ -12,17 +12,11 @@
 #include "tripodal/controllers/controller_config.hpp"
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/core/manifest.hpp"
-#include "tripodal/robot/module.hpp"
+#include "tripodal/planner/task_library.hpp"
+#include "tripodal/robot/plugins.hpp"
 #include "tripodal/robot/robot_profile.hpp"
 
 namespace tripodal {
-
-/// The registries a robot's module types are looked up in. Null members are skipped.
-struct RobotCatalog {
-  const ModuleRegistry* modules = nullptr;        ///< resources, navigation, hri, other modules
-  const BehaviorRegistry* behaviors = nullptr;    ///< behavior types
-  const ControllerRegistry* controllers = nullptr;  ///< controller types
-};
 
 /// One module of the diagram. An input ending in '*' accepts any number of providers (the
 /// behavior coordinator fuses every behavior_command); every other input needs exactly one.
@@ -52,11 +46,12 @@ struct CoreNames {
   static constexpr const char* kCoordinator = "behavior_coordinator";
 };
 
-/// Builds the diagram of `profile`: resolves each entry's manifest (registered type, or the
-/// layer/inputs/outputs declared in the profile), adds the core components (the planner's inputs
+/// Builds the diagram of `profile`: resolves each entry's manifest (the registered type's own, or
+/// for a type not registered, the layer/inputs/outputs declared in the profile; re-declaring a
+/// registered type's manifest is an error), adds the core components (the planner's inputs
 /// are the knowledge its task templates ask for, e.g. "sections"), then checks providers and the
 /// layering rules. Every problem is appended to `diagnostics`, located at the entry.
-[[nodiscard]] RobotDescription describe_robot(const RobotProfile& profile, const RobotCatalog& catalog,
+[[nodiscard]] RobotDescription describe_robot(const RobotProfile& profile, const RobotPlugins& plugins,
                                               const std::vector<std::string>& planner_inputs, Diagnostics& diagnostics);
 
 /// Only the checks, over an already resolved list of modules: exactly one provider per input

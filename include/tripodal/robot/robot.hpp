@@ -1,7 +1,11 @@
-// Robot: a whole Tripodal robot assembled from a robot profile — its modules created by type from
-// the registries, its behaviors, processes, task templates and recovery rules, and the core
-// components (planner, process supervisor, configurations, behavior coordinator). It refuses to
-// start when an input lacks exactly one provider or a layering rule is broken.
+// Robot: one Tripodal robot assembled from its profile and run on one path. It owns everything the
+// profile names — the hardware (hardware slot), the resources its sensors publish, the controllers
+// and the reactive control loops (ControlLoop: resources -> behaviors -> coordinator -> controller at
+// each loop's period), the modules of the sequencing loop (navigation, HRI, application modules),
+// the process supervisor and the planner — and drives them by its clock: on simulated time with
+// run_until() (the caller's thread), or in real time with start() (a LoopRunner thread per reactive
+// loop, one thread for the sequencing loop). The same code runs either way. It refuses to start when
+// an input lacks exactly one provider or a layering rule is broken.
 #pragma once
 
 #include <filesystem>
@@ -13,40 +17,41 @@
 
 #include "tripodal/behaviors/behavior_coordinator.hpp"
 #include "tripodal/core/clock.hpp"
+#include "tripodal/hardware/hardware.hpp"
 #include "tripodal/planner/planner.hpp"
-#include "tripodal/processes/behavior_set.hpp"
+#include "tripodal/processes/module.hpp"
 #include "tripodal/processes/process_registry.hpp"
 #include "tripodal/processes/process_supervisor.hpp"
+#include "tripodal/reactive/control_loop.hpp"
 #include "tripodal/robot/layering.hpp"
-#include "tripodal/robot/module.hpp"
+#include "tripodal/robot/plugins.hpp"
 #include "tripodal/robot/robot_profile.hpp"
 
 namespace tripodal {
 
+/// A value that replaces the profile's: parameter `parameter` of module `module` (a module,
+/// controller or the hardware, by instance name) — e.g. a run's seed.
+struct ParameterOverride {
+  std::string module;
+  std::string parameter;
+  std::string value;
+};
+
 struct RobotOptions {
   SupervisorOptions supervisor;
   PlannerOptions planner;
-  /// Sampling period the behaviors are stepped with by Robot::step().
-  Duration period{std::chrono::milliseconds(100)};
-  /// Registers application process types (CProcess subclasses) before the profile's processes
-  /// are built.
-  std::function<void(ProcessRegistry&)> register_process_types;
+  std::vector<ParameterOverride> parameters;
   /// Loads a process net; default: load_net_or_throw checking behavior names against the profile.
   std::function<PetriNet(const std::filesystem::path&)> load_net;
-  /// What behaviors see in their context (BehaviorContext): the resources and navigation data
-  /// the robot program keeps up to date (not owned; nullptr: none) and the base's capabilities.
-  const ResourceTable* resources = nullptr;
-  const NavigationData* navigation = nullptr;
-  BaseCapabilities base;
 };
 
 class Robot final {
  public:
-  /// Builds the robot. Throws ConfigError listing every problem, located: unknown module types,
-  /// modules without a factory, missing or duplicate providers, layering violations, nets that do
-  /// not load, processes binding behaviors the robot lacks, task templates or recovery rules
-  /// naming unknown processes.
-  static std::unique_ptr<Robot> assemble(const RobotProfile& profile, const RobotCatalog& catalog, const Clock& clock,
+  /// Builds the robot. Throws ConfigError listing every problem, located: unknown types (the
+  /// closest registered name suggested), missing or duplicate providers, layering violations,
+  /// nets that do not load, processes binding behaviors the robot lacks, task templates or
+  /// recovery rules naming unknown processes, modules that do not configure or start.
+  static std::unique_ptr<Robot> assemble(const RobotProfile& profile, const RobotPlugins& plugins, Clock& clock,
                                          RobotOptions options = {});
   ~Robot();
   Robot(const Robot&) = delete;
@@ -54,19 +59,49 @@ class Robot final {
 
   /// A task command in plain words (CPlanner::command).
   CommandAnswer command(std::string_view text);
-  /// One period at the clock's time: modules update (an exception becomes a module fault), the
-  /// active behaviors step and the coordinator fuses their commands, then the planner steps the
-  /// plan and the supervisor.
-  void step();
+
+  /// Simulated time: runs, in time order on the caller's thread, everything due up to `until` —
+  /// the hardware advanced to each instant, then the sequencing loop when due, then each reactive
+  /// loop when due — and leaves the clock at `until`. Requires the robot's clock to be a SimClock
+  /// (std::logic_error otherwise) and the robot not started.
+  void run_until(Time until);
+  void run_for(Duration d);
+  /// Real time: starts the hardware, a LoopRunner per reactive loop and the sequencing thread.
+  void start();
+  /// Stops the threads and the hardware; idempotent.
+  void stop() noexcept;
+  [[nodiscard]] bool started() const noexcept;
+
+  /// One period of the sequencing loop at the clock's time (what run_until() and the sequencing
+  /// thread call): the reactive loops' reports in, the modules' update, the planner or the
+  /// supervisor, the navigation data out. The loops' changes of one period apply together.
+  void step_sequencing();
 
   [[nodiscard]] const RobotDescription& description() const noexcept;
   [[nodiscard]] CPlanner& planner() noexcept;
   [[nodiscard]] CProcessSupervisor& supervisor() noexcept;
-  [[nodiscard]] BehaviorSet& behaviors() noexcept;
   [[nodiscard]] const ProcessRegistry& processes() const noexcept;
-  [[nodiscard]] const CBehaviorCoordinator& coordinator() const noexcept;
-  /// The module instance `name`; nullptr when there is none (or it is a behavior or controller).
-  [[nodiscard]] RobotModule* module(std::string_view name) noexcept;
+  /// The reactive loop running the behaviors (the profile's first loop).
+  [[nodiscard]] ControlLoop& behavior_loop() noexcept;
+  /// The reactive loop `name`; nullptr when there is none.
+  [[nodiscard]] ControlLoop* loop(std::string_view name) noexcept;
+  [[nodiscard]] CHardware* hardware() noexcept;
+  [[nodiscard]] const ResourceTable& resources() const noexcept;
+  /// The navigation data the sequencing loop publishes (as of its last period).
+  [[nodiscard]] const NavigationData& navigation() const noexcept;
+  /// Whether the behavior `name` is active (activated by the supervisor, not yet finished).
+  [[nodiscard]] bool behavior_active(std::string_view name) const noexcept;
+  /// The module instance `name`; nullptr when there is none.
+  [[nodiscard]] CModule* module(std::string_view name) noexcept;
+  /// The first module of type T; nullptr when there is none.
+  template <class T>
+  [[nodiscard]] T* module() noexcept {
+    for (CModule* m : modules()) {
+      if (auto* t = dynamic_cast<T*>(m)) return t;
+    }
+    return nullptr;
+  }
+  [[nodiscard]] std::vector<CModule*> modules() const;
 
   struct Impl;
 

@@ -60,7 +60,13 @@ struct RobotProfile {
   std::string name;
   std::string description;
   std::filesystem::path file;
+  std::filesystem::path dir;  ///< what relative paths in the profile (and its modules' parameters) are relative to
   SourceLocation where;
+  /// Period of the sequencing loop (navigation modules, process supervisor, planner).
+  Duration sequencing_period{std::chrono::milliseconds(50)};
+  /// The hardware slot: `hardware: {type: sim, parameters: {...}}`; none: the robot has no
+  /// hardware (a description, or a test that drives the loops itself).
+  std::optional<ModuleEntry> hardware;
   std::vector<ModuleEntry> controllers;
   std::vector<LoopEntry> loops;
   std::vector<ModuleEntry> resources;

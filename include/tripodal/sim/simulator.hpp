@@ -113,7 +113,7 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   /// Whether `sensor` is silenced by the fault schedule at time t.
   [[nodiscard]] bool sensor_dead(SensorKind sensor, Time t) const noexcept;
   /// Whether a localization fault window covers t.
-  [[nodiscard]] bool localization_lost(Time t) const noexcept;
+  [[nodiscard]] bool localization_lost(Time t) const noexcept override;
 
   [[nodiscard]] const World& world() const noexcept { return world_; }
   /// The static map plus the boxes present now.

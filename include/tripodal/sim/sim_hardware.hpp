@@ -1,0 +1,51 @@
+// The embedded simulator as a robot's hardware (type "sim" of the profile's hardware slot): its
+// wheels are the simulated base, its sensors publish into the robot's resources, and it moves with
+// the robot's simulated clock. It also tells the localizer the ground truth and the world's
+// localization faults, and gives the world's map to a robot whose profile names none.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+
+#include "tripodal/hardware/hardware.hpp"
+#include "tripodal/navi/grid_maps.hpp"
+#include "tripodal/navi/localizer.hpp"
+#include "tripodal/sim/simulator.hpp"
+#include "tripodal/sim/world.hpp"
+
+namespace tripodal::sim {
+
+class SimHardware final : public CHardware, public navi::GroundTruthSource, public navi::MapSource {
+ public:
+  /// Parameters of type "sim": world (a world file, relative to the profile) and seed (negative:
+  /// the world's own).
+  static const ModuleManifest& static_manifest();
+  SimHardware(World world, const ControllerConfig& base, std::uint64_t seed);
+
+  [[nodiscard]] Simulator& simulator() noexcept { return sim_; }
+  [[nodiscard]] const Simulator& simulator() const noexcept { return sim_; }
+  [[nodiscard]] std::uint64_t seed() const noexcept { return seed_; }
+
+  [[nodiscard]] std::optional<Pose2D> true_pose(Time now) const override { return sim_.true_pose(now); }
+  [[nodiscard]] bool localization_lost(Time now) const noexcept override { return sim_.localization_lost(now); }
+  [[nodiscard]] const navi::OccupancyGrid& world_map() const noexcept override { return sim_.world().grid; }
+  [[nodiscard]] const navi::RegionMap& world_regions() const noexcept override { return sim_.world().regions; }
+
+ protected:
+  [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  [[nodiscard]] HardwareInterface& do_wheels() noexcept override { return sim_; }
+  void on_add_resources(ResourceTable& table) override { sim_.add_resources(table, false); }
+  void on_advance_to(Time now) noexcept override { sim_.step_until(now); }
+
+ private:
+  std::uint64_t seed_;
+  Simulator sim_;
+};
+
+/// Registers the hardware type "sim". With `world`, every robot built from the registry runs in
+/// that world (an application that loaded it, as `tripodal run --world` does) and the parameter
+/// `world` may be left out; otherwise the parameter names the world file.
+void register_sim_hardware(HardwareRegistry& registry, std::shared_ptr<const World> world = nullptr);
+
+}  // namespace tripodal::sim

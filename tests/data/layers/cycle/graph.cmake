@@ -1,0 +1,10 @@
+# An area graph with a cycle through a PRIVATE link: a -> b -> c -> a (d sits above it).
+set(TRIPODAL_AREAS "a;b;c;d")
+set(TRIPODAL_AREA_a_PUBLIC "b")
+set(TRIPODAL_AREA_a_PRIVATE "")
+set(TRIPODAL_AREA_b_PUBLIC "")
+set(TRIPODAL_AREA_b_PRIVATE "c")
+set(TRIPODAL_AREA_c_PUBLIC "a")
+set(TRIPODAL_AREA_c_PRIVATE "")
+set(TRIPODAL_AREA_d_PUBLIC "a")
+set(TRIPODAL_AREA_d_PRIVATE "")

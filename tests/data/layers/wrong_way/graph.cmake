@@ -1,0 +1,10 @@
+# A small area graph for tests/layers: low < priv < mid < high; mid links priv only PRIVATE.
+set(TRIPODAL_AREAS "low;priv;mid;high")
+set(TRIPODAL_AREA_low_PUBLIC "")
+set(TRIPODAL_AREA_low_PRIVATE "")
+set(TRIPODAL_AREA_priv_PUBLIC "low")
+set(TRIPODAL_AREA_priv_PRIVATE "")
+set(TRIPODAL_AREA_mid_PUBLIC "low")
+set(TRIPODAL_AREA_mid_PRIVATE "priv")
+set(TRIPODAL_AREA_high_PUBLIC "mid")
+set(TRIPODAL_AREA_high_PRIVATE "")

@@ -1,0 +1,2 @@
+#pragma once
+#include "tripodal/mid/mid.hpp"

@@ -1,0 +1,2 @@
+// A header folder without an area library.
+#pragma once

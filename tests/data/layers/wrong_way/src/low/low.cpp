@@ -1,0 +1,3 @@
+#include "tripodal/low/low.hpp"
+
+#include "tripodal/mid/mid.hpp"

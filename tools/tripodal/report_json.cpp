@@ -1,0 +1,58 @@
+// report.json of `tripodal run`: the figures of a run (RunResult) as JSON.
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "run_task.hpp"
+
+namespace tripodal::app {
+
+std::string RunResult::json() const {
+  using Json = nlohmann::ordered_json;  // keys in the order written
+  // Figures rounded to what the report means (cm, 0.01 % coverage); a value that is not finite
+  // stays NaN or inf, which the writer turns into null.
+  const auto rounded = [](double v, int digits) {
+    const double scale = std::pow(10.0, digits);
+    return std::isfinite(v) ? std::round(v * scale) / scale : v;
+  };
+  const auto figures = [&](const PathFigures& f) {
+    return Json{{"length_m", rounded(f.length_m, 2)}, {"turns", f.turns}, {"rotation_rad", rounded(f.rotation_rad, 2)}};
+  };
+  const auto stats = [&](const navi::PathStats& st, double cov) {
+    return Json{{"length_m", rounded(st.length_m, 2)},
+                {"turns", st.turns},
+                {"total_turn_rad", rounded(st.total_turn_rad, 2)},
+                {"coverage", rounded(cov, 4)}};
+  };
+  Json section_list = Json::array();
+  for (const SectionFigures& sec : sections) {
+    section_list.push_back({{"name", sec.name},
+                            {"area_m2", rounded(sec.area_m2, 2)},
+                            {"balloon", stats(sec.balloon, sec.balloon_coverage)},
+                            {"boustrophedon", stats(sec.boustrophedon, sec.boustrophedon_coverage)}});
+  }
+  const Json report = {{"robot", robot},
+                       {"task", task},
+                       {"coverage_pattern", coverage_pattern},
+                       {"seed", seed},
+                       {"state", state},
+                       {"succeeded", succeeded},
+                       {"reason", reason},
+                       {"duration_s", rounded(duration_s, 2)},
+                       {"coverage", rounded(coverage, 4)},
+                       {"reachable_cells", reachable_cells},
+                       {"cleaned_reachable_cells", cleaned_cells},
+                       {"reachable_area_m2", rounded(reachable_area_m2, 2)},
+                       {"path", figures(total)},
+                       {"cleaning_path", figures(cleaning)},
+                       {"sections", std::move(section_list)},
+                       {"processes", processes},
+                       {"recoveries", recoveries},
+                       {"faults", faults},
+                       {"collisions", collisions},
+                       {"robot_steps", robot_steps}};
+  // Task text and names come from the user: bytes that are not UTF-8 are replaced, not thrown on.
+  return report.dump(2, ' ', false, Json::error_handler_t::replace) + '\n';
+}
+
+}  // namespace tripodal::app

@@ -1,0 +1,338 @@
+#include "run_task.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <deque>
+#include <fstream>
+#include <iomanip>
+#include <numbers>
+#include <ostream>
+#include <sstream>
+#include <stdexcept>
+
+#include "run_outputs.hpp"
+#include "tripodal/core/clock.hpp"
+#include "tripodal/navi/grid_maps.hpp"
+#include "tripodal/navi/localizer.hpp"
+#include "tripodal/navi/planning_modules.hpp"
+#include "tripodal/navi/section_splitter.hpp"
+#include "tripodal/planner/lifecycle_recorder.hpp"
+#include "tripodal/robot/robot.hpp"
+#include "tripodal/robot/robot_profile.hpp"
+#include "tripodal/sim/sim_hardware.hpp"
+#include "tripodal/sim/simulator.hpp"
+#include "tripodal/sim/world.hpp"
+
+namespace tripodal::app {
+
+namespace {
+
+using navi::Point2D;
+
+// ---------------------------------------------------------------------------------------------
+// Path figures
+
+}  // namespace
+
+PathFigures path_figures(const std::vector<Point2D>& path, double tolerance_m) {
+  PathFigures f;
+  if (path.size() < 2) return f;
+  const std::vector<Point2D> simple = douglas_peucker(path, tolerance_m);
+  const navi::PathStats s = navi::path_stats(simple, std::numbers::pi / 6.0);
+  f.length_m = navi::polyline_length_m(path);
+  f.turns = s.turns;
+  return f;
+}
+
+namespace {
+
+// The cells of the room a cleaning footprint can reach at all: within half the cleaning width of
+// a cell where the robot can stand (clearance >= its radius) connected to its start.
+std::vector<char> reachable_area(const Navigation& nav, navi::PathPlanner& planner, const std::vector<std::string>& sections,
+                                 Pose2D start) {
+  const navi::OccupancyGrid& g = nav.maps->grid();
+  std::vector<char> in_room(g.size(), 0);
+  for (const std::string& name : sections) {
+    if (const navi::Section* s = nav.splitter->section(name)) {
+      for (const std::size_t i : s->cells) in_room[i] = 1;
+    }
+  }
+  std::vector<char> stand(g.size(), 0);
+  std::deque<navi::CellIndex> queue;
+  const navi::CellIndex s0 = g.cell_at({start.x_m, start.y_m});
+  if (planner.traversable(s0)) {
+    stand[g.index(s0)] = 1;
+    queue.push_back(s0);
+  }
+  while (!queue.empty()) {
+    const navi::CellIndex c = queue.front();
+    queue.pop_front();
+    for (const auto& d : std::array<navi::CellIndex, 4>{{{1, 0}, {-1, 0}, {0, 1}, {0, -1}}}) {
+      const navi::CellIndex n{c.x + d.x, c.y + d.y};
+      if (!planner.traversable(n) || stand[g.index(n)] != 0) continue;
+      stand[g.index(n)] = 1;
+      queue.push_back(n);
+    }
+  }
+  const double r_cells = nav.coverage->cleaning_width_m() / 2.0 / g.resolution_m();
+  const int r = static_cast<int>(std::floor(r_cells));
+  std::vector<navi::CellIndex> disc;
+  for (int dy = -r; dy <= r; ++dy) {
+    for (int dx = -r; dx <= r; ++dx) {
+      if (dx * dx + dy * dy <= r_cells * r_cells + 1e-9) disc.push_back({dx, dy});
+    }
+  }
+  std::vector<char> reach(g.size(), 0);
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    if (stand[i] == 0) continue;
+    const navi::CellIndex c = g.cell(i);
+    for (const navi::CellIndex& d : disc) {
+      const navi::CellIndex n{c.x + d.x, c.y + d.y};
+      if (g.contains(n) && in_room[g.index(n)] != 0) reach[g.index(n)] = 1;
+    }
+  }
+  return reach;
+}
+
+std::string step_text(const ProcessStep& s) {
+  std::string out = s.process + "(";
+  for (std::size_t i = 0; i < s.params.size(); ++i) out += (i ? ", " : "") + s.params[i].name + "=" + s.params[i].value;
+  return out + ")";
+}
+
+// Collects the processes and recoveries of the task for the report.
+class ReportObserver final : public TaskObserver {
+ public:
+  std::vector<std::string> processes, recoveries;
+  std::string current;  // the process running now, for the progress bar
+  void on_process_started(const ProcessRecord& p) override { current = step_text(p.step); }
+  void on_process_succeeded(const ProcessRecord& p) override { add(p, "succeeded"); }
+  void on_process_failed(const ProcessRecord& p) override { add(p, "failed: " + p.message); }
+  void on_recovery(const RecoveryRecord& r) override {
+    recoveries.push_back(fixed(to_seconds(r.time), 3) + " " + r.reason);
+  }
+
+ private:
+  void add(const ProcessRecord& p, const std::string& how) {
+    processes.push_back(fixed(to_seconds(p.started), 3) + "-" + fixed(to_seconds(p.finished.value_or(p.started)), 3) + " " + p.run +
+                        " " + step_text(p.step) + " " + how);
+    current.clear();
+  }
+};
+
+}  // namespace
+
+
+RunResult run_task(const RunOptions& o) {
+  const RobotProfile profile = load_robot_profile(o.robot);
+  auto world = std::make_shared<sim::World>(sim::load_world(o.world));
+  RunResult res;
+  res.robot = profile.name;
+  res.task = o.task;
+  res.seed = o.seed.value_or(world->seed);
+  res.coverage_pattern = o.boustrophedon ? "boustrophedon" : "balloon";
+  std::vector<navi::LocalizationFault>& faults = world->faults.localization_loss;
+  faults.insert(faults.end(), o.faults.begin(), o.faults.end());
+  if (!profile.hardware || profile.hardware->type != "sim") {
+    throw ConfigError(profile.hardware ? profile.hardware->where : profile.where,
+                      "`tripodal run` runs the robot on the simulator: its profile needs hardware: {type: sim}");
+  }
+
+  // The robot, on simulated hardware in this world, with this run's seed and coverage pattern.
+  RobotPlugins plugins = RobotPlugins::with_builtins();
+  sim::register_sim_hardware(plugins.hardware, world);
+  RobotOptions ro;
+  const std::string seed_text = std::to_string(res.seed);
+  ro.parameters.push_back({profile.hardware->name, "seed", seed_text});
+  for (const ModuleEntry& e : profile.navigation) {
+    if (e.type == navi::CLocalizer::static_manifest().name) ro.parameters.push_back({e.name, "seed", std::to_string(res.seed % (1ULL << 52))});
+    if (e.type == navi::CCoverageModule::static_manifest().name && o.boustrophedon) ro.parameters.push_back({e.name, "pattern", "boustrophedon"});
+  }
+  SimClock clock;
+  const auto robot = Robot::assemble(profile, plugins, clock, ro);
+  auto& sim = dynamic_cast<sim::SimHardware&>(*robot->hardware()).simulator();
+  Navigation nav{robot->module<navi::CGridMaps>(), robot->module<navi::CSectionSplitter>(), robot->module<navi::CCoverageModule>()};
+  if (nav.maps == nullptr || nav.splitter == nullptr || nav.coverage == nullptr) {
+    throw ConfigError(profile.where, "`tripodal run` measures cleaning: the robot needs GridMaps, SectionSplitter and CoveragePlanner modules");
+  }
+  if (nav.maps->robot_radius_m() < world->robot.radius_m) {
+    throw ConfigError(nav.maps->where(), "robot_radius_m " + fixed(nav.maps->robot_radius_m(), 3) +
+                                             " m is smaller than the simulated body (" + fixed(world->robot.radius_m, 3) +
+                                             " m): planned paths would collide");
+  }
+  const Pose2D start = world->start_pose;
+  if (CController* c = robot->behavior_loop().controller()) c->reset_odometry(start);
+  LifecycleRecorder life(true);
+  ReportObserver report;
+  robot->planner().add_observer(life);
+  robot->supervisor().add_observer(life);
+  robot->planner().add_observer(report);
+
+  SteadyClock wall;
+  std::optional<sim::RealtimePacer> pacer;
+  if (o.realtime) pacer.emplace(wall, o.realtime_speed);
+
+  robot->run_until(clock.now());  // the localizer's first estimate, before the planner asks where to start
+  const CommandAnswer answer = robot->command(o.task);
+  std::size_t printed = 0;
+  bool bar_shown = false;  // a bar drawn in place on the terminal, to be wiped before a log line
+  auto flush_log = [&] {
+    if (o.log == nullptr) return;
+    if (bar_shown && printed < life.entries().size() && o.progress != nullptr) {
+      *o.progress << '\r' << std::string(100, ' ') << '\r';
+      o.progress->flush();
+      bar_shown = false;
+    }
+    for (; printed < life.entries().size(); ++printed) {
+      const LifecycleEntry& e = life.entries()[printed];
+      if (e.text.find(" fire ") != std::string::npos) continue;  // every firing: in lifecycle.txt only
+      *o.log << std::setw(9) << fixed(to_seconds(e.time), 1) << " s  " << e.text << '\n';
+    }
+    o.log->flush();
+  };
+  if (!answer.accepted) {
+    res.state = "refused";
+    res.reason = answer.text;
+    if (o.log != nullptr) *o.log << answer.text << '\n';
+    return res;
+  }
+  flush_log();
+
+  // The room's sections and the reachable area, for the measures.
+  std::vector<std::string> room_sections;
+  for (const PlanStage& stage : robot->planner().current_plan().stages) {
+    for (const ProcessStep& step : stage.steps) {
+      for (const BindingParam& p : step.params) {
+        if (p.name == "section" && std::find(room_sections.begin(), room_sections.end(), p.value) == room_sections.end()) {
+          room_sections.push_back(p.value);
+        }
+      }
+    }
+  }
+  navi::PathPlanner reach_planner(nav.maps->grid(), navi::PathPlannerOptions{.robot_radius_m = nav.maps->robot_radius_m()});
+  const std::vector<char> reachable = reachable_area(nav, reach_planner, room_sections, start);
+  for (const char c : reachable) res.reachable_cells += c != 0 ? 1 : 0;
+
+  navi::CleanedCells cleaned(nav.maps->grid());  // from the true pose, while a cleaning behavior runs
+  std::vector<TrajectorySample> traj;
+  std::vector<Point2D> path_all, path_cleaning;
+  const double half_width = nav.coverage->cleaning_width_m() / 2.0;
+  const Duration tick_period = robot->behavior_loop().period();
+  const Time deadline = from_seconds(o.max_duration_s);
+  bool was_cleaning = false;
+  Pose2D last_truth = sim.pose();
+  double next_progress_s = 0.0;
+  Time next_sample = clock.now();
+  auto is_cleaning = [&] { return robot->behavior_active("BhCleaning") || robot->behavior_active("BhCleaningTwoWheel"); };
+  auto covered = [&] {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < reachable.size(); ++i) n += (reachable[i] != 0 && cleaned.cleaned(i)) ? 1 : 0;
+    return n;
+  };
+  auto draw_progress = [&](bool final) {
+    if (o.progress == nullptr) return;
+    *o.progress << (o.progress_is_terminal ? "\r" : "");
+    if (res.reachable_cells > 0) {  // a cleaning task: the bar is the coverage of the room
+      const double cov = static_cast<double>(covered()) / static_cast<double>(res.reachable_cells);
+      constexpr int kWidth = 30;
+      const int full = static_cast<int>(std::lround(cov * kWidth));
+      *o.progress << '[' << std::string(static_cast<std::size_t>(full), '#')
+                  << std::string(static_cast<std::size_t>(kWidth - full), '.') << "] " << std::setw(5) << fixed(100.0 * cov, 1)
+                  << " %  ";
+    }
+    *o.progress << "t=" << std::setw(7) << fixed(to_seconds(clock.now()), 0) << " s  "
+                << (report.current.empty() ? "-" : report.current) << (o.progress_is_terminal && !final ? "          " : "\n");
+    o.progress->flush();
+    bar_shown = o.progress_is_terminal && !final;
+  };
+
+  std::size_t sim_events_noted = 0;
+  while (robot->planner().busy() && clock.now() < deadline) {
+    robot->run_for(tick_period);
+    for (; sim_events_noted < sim.events().size(); ++sim_events_noted) {
+      const sim::SimEvent& e = sim.events()[sim_events_noted];
+      life.note(e.stamp, "simulator: " + std::string(sim::to_string(e.kind)) + (e.detail.empty() ? "" : " " + e.detail));
+    }
+    const Time now = clock.now();
+    const Pose2D truth = sim.pose();
+    const bool cleaning = is_cleaning();
+    if (cleaning) {
+      if (was_cleaning) cleaned.mark_segment({last_truth.x_m, last_truth.y_m}, {truth.x_m, truth.y_m}, half_width);
+      else cleaned.mark_disc({truth.x_m, truth.y_m}, half_width);
+    }
+    was_cleaning = cleaning;
+    last_truth = truth;
+    flush_log();
+    if (now >= next_sample) {  // 10 Hz trajectory
+      next_sample += std::chrono::milliseconds(100);
+      const NavigationData& navi = robot->navigation();
+      traj.push_back({now, truth, navi.map_from_base, navi.localized, cleaning});
+      path_all.push_back({truth.x_m, truth.y_m});
+      if (cleaning) path_cleaning.push_back({truth.x_m, truth.y_m});
+    }
+    if (to_seconds(now) >= next_progress_s) {
+      draw_progress(false);
+      next_progress_s += o.progress_is_terminal ? (o.realtime ? 1.0 : 10.0) : 60.0;
+    }
+    if (pacer) pacer->pace(now);
+  }
+  if (robot->planner().busy()) {
+    robot->planner().cancel("no end within " + fixed(o.max_duration_s, 0) + " s of simulated time");
+    robot->step_sequencing();
+    res.state = "timed out";
+  }
+  flush_log();
+  draw_progress(true);
+
+  const TaskReport tr = robot->planner().report();
+  res.succeeded = tr.state == TaskState::succeeded;
+  if (res.state.empty()) res.state = std::string(to_string(tr.state));
+  res.reason = tr.reason;
+  res.duration_s = to_seconds(clock.now());
+  res.cleaned_cells = covered();
+  res.coverage = res.reachable_cells == 0 ? 0.0 : static_cast<double>(res.cleaned_cells) / static_cast<double>(res.reachable_cells);
+  const double res_m = nav.maps->grid().resolution_m();
+  res.reachable_area_m2 = static_cast<double>(res.reachable_cells) * res_m * res_m;
+  res.total = path_figures(path_all);
+  res.total.length_m = sim.distance_m();
+  res.total.rotation_rad = sim.rotation_rad();
+  res.cleaning = path_figures(path_cleaning);
+  res.processes = report.processes;
+  res.recoveries = report.recoveries;
+  res.collisions = sim.collisions();
+  res.robot_steps = robot->behavior_loop().cycles();
+  for (const navi::LocalizationFault& f : faults) {
+    res.faults.push_back("localization loss " + fixed(to_seconds(f.start), 1) + "-" + fixed(to_seconds(f.end), 1) + " s");
+  }
+  for (const sim::SimEvent& e : sim.events()) {
+    res.faults.push_back(fixed(to_seconds(e.stamp), 3) + " " + std::string(sim::to_string(e.kind)) + (e.detail.empty() ? "" : " " + e.detail));
+  }
+
+  // The planned paths against the boustrophedon of the same sections (same grid and width).
+  for (const std::string& name : room_sections) {
+    const navi::Section* s = nav.splitter->section(name);
+    if (s == nullptr) continue;
+    SectionFigures f;
+    f.name = name;
+    f.area_m2 = s->area_m2;
+    const navi::CoverageResult b = nav.coverage->planner().balloon(*s);
+    const navi::CoverageResult p = nav.coverage->planner().boustrophedon(*s);
+    f.balloon = b.stats;
+    f.boustrophedon = p.stats;
+    f.balloon_coverage = b.coverage();
+    f.boustrophedon_coverage = p.coverage();
+    res.sections.push_back(f);
+  }
+
+  if (!o.out.empty()) {
+    std::filesystem::create_directories(o.out);
+    write_png(o.out / "map.png", draw_map(nav, cleaned, reachable, traj));
+    write_text(o.out / "trajectory.csv", trajectory_csv(traj));
+    write_text(o.out / "report.json", res.json());
+    write_text(o.out / "lifecycle.txt", life.str());
+  }
+  return res;
+}
+
+}  // namespace tripodal::app

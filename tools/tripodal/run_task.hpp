@@ -1,0 +1,87 @@
+// A whole robot in simulation: `tripodal run` assembles the robot of a profile (planner, process
+// supervisor, nets, behaviors, modules), puts it on the embedded simulator (sim::Simulator as
+// the controller's hardware and the sensor source, the localizer's ground truth), gives it a task
+// in plain words and runs it to its end; then it measures the run (coverage of the reachable free
+// area, path length, turns, faults, recoveries) and writes the picture, trajectory and report.
+// Application layer: it sits above the deliberate layer, like a robot program's main(); part of
+// the `tripodal` tool (tools/tripodal), not of the installed library.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tripodal/core/time.hpp"
+#include "tripodal/navi/coverage.hpp"
+#include "tripodal/navi/localizer.hpp"
+
+namespace tripodal::app {
+
+struct RunOptions {
+  std::filesystem::path robot;  ///< robot profile (YAML)
+  std::filesystem::path world;  ///< world file (sim::load_world)
+  std::string task;             ///< the command in plain words
+  std::optional<std::uint64_t> seed;  ///< default: the world's seed
+  bool realtime = false;        ///< pace the simulation to wall time
+  double realtime_speed = 1.0;
+  std::filesystem::path out;    ///< folder for map.png, trajectory.csv, report.json (empty: none)
+  /// Extra localization losses ("10-20; 35-40", seconds), added to the world's fault schedule.
+  std::vector<navi::LocalizationFault> faults;
+  /// Follow the boustrophedon path instead of the balloon (the baseline, measured on the robot).
+  bool boustrophedon = false;
+  double max_duration_s = 4.0 * 3600.0;  ///< the task is cancelled after this much simulated time
+  std::ostream* log = nullptr;       ///< task and process life cycle, as it happens
+  std::ostream* progress = nullptr;  ///< progress bar
+  bool progress_is_terminal = false; ///< redraw the bar in place ('\r') instead of new lines
+};
+
+/// Figures of a coverage path (executed or planned).
+struct PathFigures {
+  double length_m = 0.0;
+  std::size_t turns = 0;       ///< heading changes over 30 degrees of the simplified path
+  double rotation_rad = 0.0;   ///< of the robot's body (executed paths only)
+};
+
+struct SectionFigures {
+  std::string name;
+  double area_m2 = 0.0;
+  navi::PathStats balloon;        ///< the planned balloon (wall-following) path
+  navi::PathStats boustrophedon;  ///< the plough path over the same section, grid and width
+  double balloon_coverage = 0.0;
+  double boustrophedon_coverage = 0.0;
+};
+
+struct RunResult {
+  bool succeeded = false;
+  std::string state;            ///< "succeeded", "failed", "timed out", "refused"
+  std::string reason;
+  std::string robot, task;
+  std::string coverage_pattern;  ///< "balloon" or "boustrophedon"
+  std::uint64_t seed = 0;
+  double duration_s = 0.0;      ///< simulated
+  double coverage = 0.0;        ///< of the reachable free area of the room, from the true path
+  std::size_t reachable_cells = 0, cleaned_cells = 0;
+  double reachable_area_m2 = 0.0;
+  PathFigures total;            ///< the whole run
+  PathFigures cleaning;         ///< while a cleaning behavior was active
+  std::vector<SectionFigures> sections;
+  std::vector<std::string> processes;  ///< "12.300 X1 PrCleaning(section=A) succeeded"
+  std::vector<std::string> recoveries;
+  std::vector<std::string> faults;     ///< injected faults and what happened (simulator events)
+  std::size_t collisions = 0;
+  std::size_t robot_steps = 0;
+  [[nodiscard]] std::string json() const;
+};
+
+/// Runs the task; throws ConfigError for a bad profile or world (located), std::runtime_error
+/// when an output file cannot be written. A task that fails is a result, not an exception.
+[[nodiscard]] RunResult run_task(const RunOptions& options);
+
+/// Length and turns of a path as the report counts them: simplified with Douglas-Peucker at
+/// tolerance_m, then navi::path_stats with the 30-degree threshold.
+[[nodiscard]] PathFigures path_figures(const std::vector<navi::Point2D>& path, double tolerance_m = 0.0375);
+
+}  // namespace tripodal::app
