@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "tripodal/trace/trace_reader.hpp"
+#include "tripodal/trace/trace_resources.hpp"
 
 namespace tripodal::testing {
 
@@ -206,36 +207,22 @@ struct BehaviorHarness::Attached {
   BehaviorStatus last = BehaviorStatus::idle;
 };
 
-// Publishes replayed readings into the resource created for their channel (indexed by channel id).
-class BehaviorHarness::Sink final : public trace::TraceSink {
+// Keeps the trace's commands and events; TraceResources publishes the readings.
+class BehaviorHarness::Sink final : public trace::TraceResources {
  public:
-  explicit Sink(RunLog& log) : log_(log) {}
-  std::vector<CResource*> by_channel;
-
-  void on_laser(const trace::ChannelInfo& c, const LaserScan& r) override { publish(c, r); }
-  void on_odometry(const trace::ChannelInfo& c, const OdometryReading& r) override { publish(c, r); }
-  void on_sonar(const trace::ChannelInfo& c, const SonarReading& r) override { publish(c, r); }
-  void on_infrared(const trace::ChannelInfo& c, const InfraredReading& r) override { publish(c, r); }
-  void on_bumper(const trace::ChannelInfo& c, const BumperReading& r) override { publish(c, r); }
-  void on_battery(const trace::ChannelInfo& c, const BatteryReading& r) override { publish(c, r); }
-  void on_gyro(const trace::ChannelInfo& c, const GyroReading& r) override { publish(c, r); }
+  Sink(const std::vector<trace::ChannelInfo>& channels, Duration max_age, RunLog& log)
+      : TraceResources(channels, max_age), log_(log) {}
   void on_command(const trace::ChannelInfo& /*c*/, const trace::CommandRecord& r) override { log_.recorded_.push_back(r); }
   void on_event(const trace::ChannelInfo& /*c*/, const trace::EventRecord& r) override {
     log_.events_.push_back(HarnessEvent{r.stamp, "trace:" + r.name, {}});
   }
 
  private:
-  template <class Reading>
-  void publish(const trace::ChannelInfo& c, const Reading& r) {
-    if (c.id < by_channel.size() && by_channel[c.id] != nullptr) {
-      static_cast<TypedResource<Reading>*>(by_channel[c.id])->publish(r);
-    }
-  }
   RunLog& log_;
 };
 
 BehaviorHarness::BehaviorHarness(HarnessOptions options)
-    : options_(std::move(options)), sink_(std::make_unique<Sink>(log_)) {
+    : options_(std::move(options)) {
   if (options_.period <= Duration{0}) throw std::invalid_argument("BehaviorHarness: period must be positive");
   coordinator_ = std::make_unique<CBehaviorCoordinator>(CoordinatorConfig{options_.mode, {}, {}});
 }
@@ -246,57 +233,27 @@ void BehaviorHarness::load_trace(const std::filesystem::path& trace_path) {
   if (replay_) throw std::logic_error("BehaviorHarness: a trace is already loaded");
   // First pass: the channel declarations (resources must exist before behaviors activate) and the
   // last stamp (where the run ends). Streams: nothing is kept but the channels.
-  Time last{0};
-  bool any = false;
-  std::vector<trace::ChannelInfo> channels;
-  {
-    trace::TraceReader reader(trace_path);
-    trace::TraceRecord rec;
-    while (reader.next(rec)) {
-      const Time s = trace::stamp_of(rec.data);
-      last = any ? std::max(last, s) : s;
-      any = true;
-    }
-    channels = reader.channels();
-    if (reader.state() == trace::ReadState::kTruncated) warning_ = reader.warning();
-  }
+  trace::TraceSummary summary = trace::summarize_trace(trace_path);
+  warning_ = summary.warning;
+  const auto& channels = summary.channels;
   // Checked before any resource exists, so a failed load leaves the harness as it was.
-  auto has_channel = [&](const std::string& name, trace::ChannelKind kind) {
-    return std::any_of(channels.begin(), channels.end(), [&](const auto& c) { return c.name == name && c.kind == kind; });
-  };
-  if (!options_.laser.empty() && !has_channel(options_.laser, trace::ChannelKind::kLaser)) {
+  if (!options_.laser.empty() && trace::find_channel(channels, options_.laser, trace::ChannelKind::kLaser) == nullptr) {
     throw std::invalid_argument("BehaviorHarness: the trace " + trace_path.string() + " has no laser channel '" +
                                 options_.laser + "'");
   }
-  if (!options_.localization_channel.empty() && !has_channel(options_.localization_channel, trace::ChannelKind::kOdometry)) {
+  if (!options_.localization_channel.empty() &&
+      trace::find_channel(channels, options_.localization_channel, trace::ChannelKind::kOdometry) == nullptr) {
     throw std::invalid_argument("BehaviorHarness: the trace " + trace_path.string() + " has no odometry channel '" +
                                 options_.localization_channel + "' for the localization");
   }
-  for (const auto& c : channels) {
-    std::unique_ptr<CResource> r;
-    switch (c.kind) {
-      case trace::ChannelKind::kLaser: r = std::make_unique<LaserResource>(c.name, options_.resource_max_age); break;
-      case trace::ChannelKind::kOdometry: r = std::make_unique<OdometryResource>(c.name, options_.resource_max_age); break;
-      case trace::ChannelKind::kSonar: r = std::make_unique<SonarResource>(c.name, options_.resource_max_age); break;
-      case trace::ChannelKind::kInfrared: r = std::make_unique<InfraredResource>(c.name, options_.resource_max_age); break;
-      case trace::ChannelKind::kBumper: r = std::make_unique<BumperResource>(c.name, options_.resource_max_age); break;
-      case trace::ChannelKind::kBattery: r = std::make_unique<BatteryResource>(c.name, options_.resource_max_age); break;
-      case trace::ChannelKind::kGyro: r = std::make_unique<GyroResource>(c.name, options_.resource_max_age); break;
-      case trace::ChannelKind::kCommand:
-      case trace::ChannelKind::kEvent: break;
-    }
-    if (!r) continue;
-    table_.add(*r);
-    if (sink_->by_channel.size() <= c.id) sink_->by_channel.resize(c.id + 1u, nullptr);
-    sink_->by_channel[c.id] = r.get();
-    owned_.push_back(std::move(r));
-  }
+  sink_ = std::make_unique<Sink>(channels, options_.resource_max_age, log_);
+  sink_->add_to(table_);
   laser_ = options_.laser.empty() ? table_.first<LaserScan>() : table_.find<LaserScan>(options_.laser);
   if (!options_.localization_channel.empty()) localization_ = table_.find<OdometryReading>(options_.localization_channel);
   replay_ = std::make_unique<trace::TraceReplay>(std::make_unique<trace::TraceReader>(trace_path));
   start_ = replay_->start_time();
   now_ = start_;
-  last_record_ = any ? last : start_;
+  last_record_ = summary.empty ? start_ : summary.last;
 }
 
 CBehavior& BehaviorHarness::attach(std::unique_ptr<CBehavior> behavior, ParameterValues params, CoordinatorInputConfig input,
@@ -382,13 +339,18 @@ void BehaviorHarness::step_once() {
 }
 
 double BehaviorHarness::clearance_along(const Twist2D& command) const noexcept {
+  if (laser_ == nullptr || !laser_->has_reading()) return std::numeric_limits<double>::infinity();
+  return footprint_clearance_m(laser_->latest(), options_.laser_in_body, options_.robot_radius_m, command);
+}
+
+double footprint_clearance_m(const LaserScan& scan, const Pose2D& laser_in_body, double robot_radius_m,
+                             const Twist2D& command) noexcept {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   const double speed = std::hypot(command.vx_m_s, command.vy_m_s);
-  if (laser_ == nullptr || !laser_->has_reading() || !(speed > 0.0)) return kInf;
+  if (!(speed > 0.0)) return kInf;
   const double ux = command.vx_m_s / speed, uy = command.vy_m_s / speed;
-  const LaserScan& scan = laser_->latest();
-  const Pose2D& m = options_.laser_in_body;
-  const double r = options_.robot_radius_m;
+  const Pose2D& m = laser_in_body;
+  const double r = robot_radius_m;
   double best = kInf;
   for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
     const double range = scan.ranges_m[i];
@@ -404,6 +366,18 @@ double BehaviorHarness::clearance_along(const Twist2D& command) const noexcept {
     best = std::min(best, along - r);
   }
   return best;
+}
+
+CheckResult RunLog::event_never_happens(std::string_view name) const {
+  CheckResult r;
+  for (const auto& e : events_) {
+    if (e.name != name) continue;
+    r.explanation = "event " + std::string(name) + " at t=" + seconds(e.t) + (e.detail.empty() ? "" : ": " + e.detail);
+    return r;
+  }
+  r.passed = true;
+  r.explanation = "event " + std::string(name) + " never happened in " + std::to_string(steps_.size()) + " steps";
+  return r;
 }
 
 }  // namespace tripodal::testing

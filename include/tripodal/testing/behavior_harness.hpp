@@ -78,7 +78,9 @@ struct StepRecord {
 };
 
 /// Something that happened: "<Behavior>.done", "<Behavior>.failed" (detail: the reason), or an
-/// event record of the trace ("trace:<name>").
+/// event record of the trace ("trace:<name>"). A whole robot (RobotHarness) adds the events its
+/// process nets consumed or dropped ("localizer.lost"), "<Process>.started|succeeded|failed",
+/// "task.started|succeeded|failed|refused", "recovery" and "fault:<source>" (detail: the reason).
 struct HarnessEvent {
   Time t{0};
   std::string name;
@@ -109,6 +111,8 @@ class RunLog final {
                                                                       double min_speed_m_s = 1e-6) const;
   /// An event named `name` happened at or before `t`.
   [[nodiscard]] CheckResult event_before(std::string_view name, Time t) const;
+  /// No event named `name` happened (e.g. "PrAutoMove.failed", "task.failed").
+  [[nodiscard]] CheckResult event_never_happens(std::string_view name) const;
   /// The fused commands equal `expected` (stamp and twist, bit for bit), in order.
   [[nodiscard]] CheckResult commands_equal(const std::vector<trace::CommandRecord>& expected) const;
 
@@ -117,12 +121,18 @@ class RunLog final {
 
  private:
   friend class BehaviorHarness;
+  friend class RobotHarness;
   [[nodiscard]] std::optional<std::size_t> require_index(std::string_view behavior, CheckResult& out) const;
   std::vector<StepRecord> steps_;
   std::vector<HarnessEvent> events_;
   std::vector<trace::CommandRecord> recorded_;
   std::vector<std::string> names_;
 };
+
+/// Free distance from a footprint of radius `robot_radius_m` to the nearest return of `scan` in the
+/// corridor it sweeps moving along `command`'s translation (infinite: no translation or no return).
+[[nodiscard]] double footprint_clearance_m(const LaserScan& scan, const Pose2D& laser_in_body, double robot_radius_m,
+                                           const Twist2D& command) noexcept;
 
 /// Loads a trace, attaches behaviors with parameters and steps them on a simulated clock: every
 /// period, the trace's records stamped up to now are published into resources named as their
@@ -170,7 +180,6 @@ class BehaviorHarness final {
   [[nodiscard]] double clearance_along(const Twist2D& command) const noexcept;
 
   HarnessOptions options_;
-  std::vector<std::unique_ptr<CResource>> owned_;
   ResourceTable table_;
   NavigationData navi_;
   std::unique_ptr<trace::TraceReplay> replay_;
