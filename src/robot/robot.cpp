@@ -292,6 +292,10 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
       def.parameters = p.parameters;
       def.where = p.where;
       def.net = load(p.net);
+      if (!p.module.empty()) {
+        def.module = load(p.module);
+        check_module_net(*def.module, p.name, d);
+      }
       if (!p.recovery.empty()) def.recovery = RecoveryPolicy::load(p.recovery, is_process).rules();
       for (const Place& place : def.net.places()) {
         if (place.behavior && !is_behavior(place.behavior->behavior)) {

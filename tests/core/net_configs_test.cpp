@@ -166,6 +166,11 @@ TEST_CASE("configs: PrAutoMove narratives") {
   CHECK(persistent.outcome == Outcome::fault);
   CHECK(persistent.outcome_place == "P5");
   CHECK(persistent.fault_message == "localization fault");
+  // the fault the `path blocked` rule of configs/tasks/recovery.yaml matches
+  const SimulationResult blocked = simulate(net, params, "PrAutoMove-path-blocked.events");
+  CHECK(fired(blocked) == std::vector<std::string>{"t0@0.00", "t5@12.0"});
+  CHECK(blocked.outcome_place == "P6");
+  CHECK(blocked.fault_message == "path blocked");
 }
 
 TEST_CASE("configs: PrCleaning without its wheel type is refused") {

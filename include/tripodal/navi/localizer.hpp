@@ -1,8 +1,9 @@
 // CLocalizer, the localizer navigation module for simulation (sequencing layer): it estimates the
 // robot's pose from a ground-truth source (the simulator) with seeded noise and an injectable
 // fault schedule, and posts localizer.ok / localizer.lost when its estimate starts or stops
-// agreeing with the actual position, the events PrCleaning's nets wait for (paper, Table 1:
-// t2, t3). A scan-matching localizer would post the same events from its own consistency test.
+// agreeing with the actual position, the events the process PrCleaning's low-level net waits for
+// (paper, Fig. 3 / Table 2: t2 and t3; PrAutoMove.xml's t1 and t2 alike). A scan-matching
+// localizer would post the same events from its own consistency test.
 #pragma once
 
 #include <cstdint>
