@@ -15,7 +15,7 @@ void BM_RingFirings(benchmark::State& state) {
   EngineOptions options;
   options.max_firings_per_instant = n + 1;
   Engine engine(test::ring_net(n, Duration{1}), {}, options);
-  Time now{0};
+  Time now{};
   std::size_t firings = 0;
   for (auto _ : state) {
     now += Duration{1};
@@ -34,7 +34,7 @@ void BM_EventDispatch(benchmark::State& state) {
   for (TransitionIndex t = 0; t < net.transitions().size(); ++t) net.transition(t).event = "tick";
   Engine engine(net);
   const EventId tick = *engine.event_id("tick");
-  Time now{0};
+  Time now{};
   std::size_t firings = 0;
   for (auto _ : state) {
     now += Duration{1};
@@ -50,7 +50,7 @@ void BM_EventDispatchByName(benchmark::State& state) {
   PetriNet net = test::ring_net(10);
   for (TransitionIndex t = 0; t < net.transitions().size(); ++t) net.transition(t).event = "localizer.lost";
   Engine engine(net);
-  Time now{0};
+  Time now{};
   for (auto _ : state) {
     now += Duration{1};
     benchmark::DoNotOptimize(engine.step(now, {"localizer.lost"}).firings);

@@ -1,6 +1,6 @@
 // Navigation benchmarks on the demo workspace (configs/worlds/workspace_map.yaml: 10.8 m x 32.8 m
-// at 5 cm, 216 x 656 cells): distance field, A* planning, section splitting and the two coverage
-// generators. Coverage runs report their path figures as counters.
+// at 5 cm, 216 x 656 cells): distance field, A* planning, section splitting and ordering, and the
+// two coverage generators. Coverage runs report their path figures as counters.
 #include <benchmark/benchmark.h>
 
 #include <string>
@@ -81,6 +81,23 @@ void BM_SectionSplitter(benchmark::State& state) {
   state.counters["sections"] = static_cast<double>(n);
 }
 BENCHMARK(BM_SectionSplitter)->Unit(benchmark::kMillisecond);
+
+// The planner's section order (nearest uncleaned next by grid path distance, four Dijkstra legs)
+// from the charger in section A (arg 0) and from the upper left corner in section D (arg 1).
+void BM_OrderSectionsNearestFirst(benchmark::State& state) {
+  const std::vector<int> ids{0, 1, 2, 3};
+  const Point2D from = state.range(0) == 0 ? Point2D{0.8, 0.8} : Point2D{0.8, 31.0};
+  SectionOrder o;
+  for (auto _ : state) {
+    o = order_nearest_first(workspace(), sections(), ids, from);
+    benchmark::DoNotOptimize(o.ids.data());
+  }
+  double total_m = 0.0;
+  for (const double leg : o.legs_m) total_m += leg;
+  state.counters["first"] = o.ids.empty() ? -1.0 : static_cast<double>(o.ids.front());
+  state.counters["legs_m"] = total_m;
+}
+BENCHMARK(BM_OrderSectionsNearestFirst)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // args: section index (0..3 = A..D), touch-up (1) or the passes alone (0)
 template <bool kBalloon>

@@ -44,7 +44,7 @@ static void BM_CoordinatorFuse(benchmark::State& state) {
   CBehaviorCoordinator co(test::eight_inputs(mode));
   VelocityEnvelope env;
   env.vx_hi_m_s = 0.3;
-  Time now{0};
+  Time now{};
   for (auto _ : state) {
     now += std::chrono::milliseconds(10);
     co.submit_envelope(0, env, now);
@@ -60,7 +60,7 @@ static void BM_ControllerUpdate(benchmark::State& state) {
   const ControllerConfig config = state.range(0) != 0 ? test::omni_base_psr() : test::differential_base();
   IdealWheelHardware hw(config.type == "differential" ? 2 : 3, config.period);
   auto ctl = default_controller_registry().create(config, hw);
-  Time now{0};
+  Time now{};
   for (auto _ : state) {
     now += config.period;
     ctl->set_command({0.5, 0.2, 0.7}, now);

@@ -40,7 +40,7 @@ void scan_bench(benchmark::State& state, const LaserConfig& config) {
   LaserScan scan;
   std::size_t i = 0;
   for (auto _ : state) {
-    laser.scan(m, ps[i], Time{0}, scan);
+    laser.scan(m, ps[i], Time{}, scan);
     benchmark::DoNotOptimize(scan.ranges_m.data());
     i = (i + 1) % ps.size();
   }

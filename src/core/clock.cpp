@@ -11,7 +11,7 @@ namespace tripodal {
 SteadyClock::SteadyClock() noexcept : start_(std::chrono::steady_clock::now()) {}
 
 Time SteadyClock::now() const noexcept {
-  return std::chrono::duration_cast<Time>(std::chrono::steady_clock::now() - start_);
+  return Time{std::chrono::duration_cast<Duration>(std::chrono::steady_clock::now() - start_)};
 }
 
 void Clock::sleep_until(Time deadline) const noexcept {
@@ -21,14 +21,14 @@ void Clock::sleep_until(Time deadline) const noexcept {
 void SteadyClock::sleep_until(Time deadline) const noexcept {
 #if defined(__linux__)
   // libstdc++'s steady_clock is CLOCK_MONOTONIC: the deadline converts to that clock's timespec.
-  const auto abs = std::chrono::duration_cast<std::chrono::nanoseconds>(start_.time_since_epoch()) + deadline;
+  const auto abs = std::chrono::duration_cast<std::chrono::nanoseconds>(start_.time_since_epoch()) + deadline.time_since_epoch();
   timespec ts{};
   ts.tv_sec = static_cast<time_t>(abs.count() / 1'000'000'000);
   ts.tv_nsec = static_cast<long>(abs.count() % 1'000'000'000);
   while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
   }
 #else
-  std::this_thread::sleep_until(start_ + deadline);
+  std::this_thread::sleep_until(start_ + deadline.time_since_epoch());
 #endif
 }
 
@@ -38,8 +38,8 @@ void SimClock::advance(Duration d) noexcept {
 
 bool SimClock::set(Time t) noexcept {
   Time::rep current = now_.load(std::memory_order_acquire);
-  while (t.count() >= current) {
-    if (now_.compare_exchange_weak(current, t.count(), std::memory_order_acq_rel)) return true;
+  while (to_ns(t) >= current) {
+    if (now_.compare_exchange_weak(current, to_ns(t), std::memory_order_acq_rel)) return true;
   }
   return false;
 }

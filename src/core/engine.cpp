@@ -168,7 +168,7 @@ class RankSet {
 class TimerHeap {
  public:
   struct Entry {
-    Time deadline{0};
+    Time deadline{};
     std::uint32_t rank = 0;
     TransitionIndex transition = 0;
   };
@@ -317,7 +317,7 @@ struct Engine::Impl {
   RankSet ready;  // ranks of enabled immediate and due delayed transitions
   std::vector<RankSet> event_enabled;  // per event: positions of its enabled listeners
   TimerHeap timers;
-  Time now{0};
+  Time now{};
   std::size_t instant_firings = 0;
   std::vector<TransitionIndex> tail;  // ring of the last firings at this instant (power-of-2 size)
   std::size_t tail_mask = 0;
@@ -649,7 +649,7 @@ void Engine::Impl::compile_structure() {
   }
 
   marking.assign(np, 0);
-  since.assign(nt, Time{0});
+  since.assign(nt, Time{});
   ready.init(nt);
   timers.init(nt);
   // A power-of-two ring indexes with a mask: a division per firing costs as much as the rest.

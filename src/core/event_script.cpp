@@ -141,7 +141,7 @@ EventScript parse_event_script(std::string_view text, std::string_view source) {
       continue;
     }
     ScriptEntry entry;
-    entry.time = from_seconds(seconds);
+    entry.time = time_from_seconds(seconds);
     entry.where = p.at(time_tok.column);
     std::size_t expected_tokens = 2;
     if (tokens[1].text == "set" && !tokens[1].quoted) {

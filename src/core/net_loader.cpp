@@ -24,7 +24,7 @@ bool has_extension(std::string_view name, std::string_view ext) {
 
 }  // namespace
 
-void structural_warnings(const PetriNet& net, Diagnostics& diagnostics) {
+std::vector<bool> structurally_markable(const PetriNet& net) {
   // Over-approximation of markable places: a transition may become enabled once every place it
   // consumes from or reads is markable; then its output places are markable. A worklist keeps it
   // linear in the size of the net whatever the declaration order.
@@ -80,16 +80,31 @@ void structural_warnings(const PetriNet& net, Diagnostics& diagnostics) {
       if (--missing[t] == 0 && !fireable[t]) fire(t);
     }
   }
+  return markable;
+}
+
+void structural_warnings(const PetriNet& net, Diagnostics& diagnostics) {
+  const auto& places = net.places();
+  const auto& transitions = net.transitions();
+  const std::vector<bool> markable = structurally_markable(net);
+  // A transition can fire in the over-approximation exactly when every place it needs is markable.
+  const auto fireable = [&](const Transition& tr) {
+    for (const auto* arcs : {&tr.inputs, &tr.reads}) {
+      for (const auto& a : *arcs) {
+        if (!markable[a.place]) return false;
+      }
+    }
+    return true;
+  };
   for (std::size_t i = 0; i < places.size(); ++i) {
     if (markable[i]) continue;
     diagnostics.warning(places[i].where, "place '" + places[i].id +
                                              "' can never be marked: it has no initial tokens and no transition that "
                                              "can fire puts tokens into it");
   }
-  for (std::size_t t = 0; t < transitions.size(); ++t) {
-    if (fireable[t]) continue;
+  for (const auto& tr : transitions) {
+    if (fireable(tr)) continue;
     std::string blocked;
-    const auto& tr = transitions[t];
     for (const auto* arcs : {&tr.inputs, &tr.reads}) {
       for (const auto& a : *arcs) {
         if (markable[a.place]) continue;

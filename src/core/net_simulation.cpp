@@ -120,7 +120,7 @@ void NetSimulation::validate(const EventScript& script) const {
 SimulationResult NetSimulation::run(const EventScript& script) {
   validate(script);
   SimulationResult result;
-  engine_.reset(Time{0});
+  engine_.reset(Time{});
   TraceObserver observer(engine_.net(), result.trace);
   const ObserverGuard guard(engine_, observer);
 
@@ -139,7 +139,7 @@ SimulationResult NetSimulation::run(const EventScript& script) {
 
   const auto& entries = script.entries;
   std::size_t next_entry = 0;
-  bool running = record(engine_.step(Time{0}));
+  bool running = record(engine_.step(Time{}));
   while (running && !finished()) {
     Time next = options_.end_time;
     if (next_entry < entries.size()) next = std::min(next, entries[next_entry].time);

@@ -28,7 +28,7 @@ std::vector<LocalizationFault> parse_fault_schedule(const std::string& text, con
       std::string rest;
       in >> rest;
       if (read && dash == '-' && rest.empty() && std::isfinite(a) && std::isfinite(b) && a >= 0.0 && b > a) {
-        out.push_back({from_seconds(a), from_seconds(b)});
+        out.push_back({time_from_seconds(a), time_from_seconds(b)});
       } else {
         d.error(where, "bad localization fault '" + item + "': expected START-END in seconds with 0 <= START < END, "
                        "windows separated by ';' (e.g. \"10-20; 35.5-40\")");

@@ -43,7 +43,7 @@ void ObstacleReplanner::reset(const ParameterSet& behavior_params) {
   after_ = behavior_params.contains("replan_after_s") ? from_seconds(behavior_params.number("replan_after_s")) : Duration{0};
   max_ = behavior_params.contains("max_replans") ? static_cast<int>(behavior_params.number("max_replans")) : 0;
   attempts_ = 0;
-  last_ = Time{0};
+  last_ = Time{};
   seen_.clear();
 }
 

@@ -4,8 +4,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <deque>
+#include <functional>
+#include <limits>
 #include <map>
+#include <numbers>
+#include <queue>
+#include <ranges>
 
 namespace tripodal::navi {
 
@@ -21,7 +27,131 @@ std::string section_name(int i) {
   return s;
 }
 
+constexpr double kUnreachable = std::numeric_limits<double>::infinity();
+
+constexpr std::size_t kNoCell = std::numeric_limits<std::size_t>::max();
+
+// Of `cells`, the one whose centre is closest to p among those `accept` takes; kNoCell if none.
+template <typename Cells, typename Accept>
+std::size_t closest_cell(const OccupancyGrid& grid, Point2D p, const Cells& cells, Accept accept) {
+  std::size_t best = kNoCell;
+  double best_d2 = kUnreachable;
+  for (const std::size_t i : cells) {
+    if (!accept(i)) continue;
+    const Point2D q = grid.cell_center(grid.cell(i));
+    const double d2 = (q.x_m - p.x_m) * (q.x_m - p.x_m) + (q.y_m - p.y_m) * (q.y_m - p.y_m);
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      best = i;
+    }
+  }
+  return best;
+}
+
+// The free cell nearest to p (p's own cell when it is free); kNoCell for a grid without free cells.
+std::size_t nearest_free_cell(const OccupancyGrid& grid, Point2D p) {
+  const CellIndex c = grid.cell_at(p);
+  if (grid.contains(c) && grid.is_free(c)) return grid.index(c);
+  return closest_cell(grid, p, std::views::iota(std::size_t{0}, grid.size()),
+                      [&](std::size_t i) { return grid.state(i) == Occupancy::free; });
+}
+
+// The section of `remaining` nearest to `source` by grid path, and that path's length to its
+// nearest cell: Dijkstra over free cells, stopped once the queue is past the first section
+// reached (ties within 1 um go to the section listed first). {-1, +inf} when none is reachable.
+std::pair<int, double> nearest_section(const OccupancyGrid& grid, const std::vector<std::uint8_t>& free,
+                                       const SectionSet& set, std::size_t source, const std::vector<int>& remaining) {
+  constexpr double kTie = 1e-6;
+  std::vector<std::size_t> rank(set.sections.size(), remaining.size());  // remaining.size(): not wanted
+  for (std::size_t k = 0; k < remaining.size(); ++k) rank[static_cast<std::size_t>(remaining[k])] = k;
+  int best = -1;
+  double best_m = kUnreachable;
+  std::vector<double> dist(grid.size(), kUnreachable);
+  using Item = std::pair<double, std::size_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
+  dist[source] = 0.0;
+  open.emplace(0.0, source);
+  const double straight = grid.resolution_m();
+  const double diagonal = straight * std::numbers::sqrt2;
+  const int w = grid.width(), h = grid.height();
+  const auto free_at = [&](int x, int y) { return x >= 0 && y >= 0 && x < w && y < h && free[grid.index({x, y})] != 0; };
+  while (!open.empty() && open.top().first <= best_m + kTie) {
+    const auto [d, i] = open.top();
+    open.pop();
+    if (d > dist[i]) continue;
+    const int label = set.label[i];
+    if (label >= 0 && rank[static_cast<std::size_t>(label)] < remaining.size() &&
+        (best < 0 || rank[static_cast<std::size_t>(label)] < rank[static_cast<std::size_t>(best)])) {
+      best = label;
+      best_m = std::min(best_m, d);
+    }
+    const CellIndex c = grid.cell(i);
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        if ((dx == 0 && dy == 0) || !free_at(c.x + dx, c.y + dy)) continue;
+        // no corner cutting: a diagonal step needs both side cells free
+        if (dx != 0 && dy != 0 && (!free_at(c.x + dx, c.y) || !free_at(c.x, c.y + dy))) continue;
+        const std::size_t j = grid.index({c.x + dx, c.y + dy});
+        const double nd = d + ((dx != 0 && dy != 0) ? diagonal : straight);
+        if (nd < dist[j]) {
+          dist[j] = nd;
+          open.emplace(nd, j);
+        }
+      }
+    }
+  }
+  return {best, best_m};
+}
+
+// Where the robot is taken to be once a section is cleaned: its cell nearest the centroid.
+std::size_t centre_cell(const OccupancyGrid& grid, const Section& s) {
+  return closest_cell(grid, s.centroid, s.cells, [](std::size_t) { return true; });
+}
+
 }  // namespace
+
+SectionOrder order_nearest_first(const OccupancyGrid& grid, const SectionSet& set, std::span<const int> ids, Point2D from) {
+  SectionOrder out;
+  std::vector<int> remaining;
+  for (const int id : ids) {
+    const bool known = id >= 0 && static_cast<std::size_t>(id) < set.sections.size() &&
+                       !set.sections[static_cast<std::size_t>(id)].cells.empty();
+    if (known && std::find(remaining.begin(), remaining.end(), id) == remaining.end()) remaining.push_back(id);
+  }
+  std::vector<std::uint8_t> free(grid.size());
+  for (std::size_t i = 0; i < grid.size(); ++i) free[i] = grid.state(i) == Occupancy::free ? 1 : 0;
+  std::size_t at = set.label.size() == grid.size() ? nearest_free_cell(grid, from) : kNoCell;
+  while (!remaining.empty()) {
+    const auto [next, leg_m] = at != kNoCell ? nearest_section(grid, free, set, at, remaining) : std::pair<int, double>{-1, kUnreachable};
+    if (next < 0) {  // nothing left can be reached: the rest as given
+      for (const int id : remaining) {
+        out.ids.push_back(id);
+        out.legs_m.push_back(kUnreachable);
+      }
+      break;
+    }
+    out.ids.push_back(next);
+    out.legs_m.push_back(leg_m);
+    at = centre_cell(grid, set.sections[static_cast<std::size_t>(next)]);
+    remaining.erase(std::find(remaining.begin(), remaining.end(), next));
+  }
+  return out;
+}
+
+std::vector<std::string> order_nearest_first(const OccupancyGrid& grid, const SectionSet& set, std::span<const std::string> names,
+                                             Point2D from) {
+  std::vector<int> ids;
+  std::vector<std::string> unknown;
+  for (const std::string& name : names) {
+    const auto it = std::find_if(set.sections.begin(), set.sections.end(), [&](const Section& s) { return s.name == name; });
+    if (it != set.sections.end()) ids.push_back(it->id);
+    else unknown.push_back(name);
+  }
+  std::vector<std::string> out;
+  for (const int id : order_nearest_first(grid, set, ids, from).ids) out.push_back(set.sections[static_cast<std::size_t>(id)].name);
+  out.insert(out.end(), unknown.begin(), unknown.end());
+  return out;
+}
 
 const ModuleManifest& CSectionSplitter::static_manifest() {
   static const ModuleManifest m = navi_manifest(
@@ -295,9 +425,16 @@ KnowledgeAnswer CSectionSplitter::sections_of_room(std::string_view room) const 
 }
 
 std::optional<KnowledgeAnswer> CSectionSplitter::on_answer(std::string_view function, std::string_view argument,
-                                                           const NavigationData& /*navigation*/) const {
+                                                           const NavigationData& navigation) const {
   if (function != "sections") return std::nullopt;
-  return sections_of_room(argument);
+  KnowledgeAnswer out = sections_of_room(argument);
+  // The plan is made once, from where the robot stands when it gets the task: an untrusted pose
+  // would order the sections from the wrong place, so scan order is the better guess then.
+  if (out.ok && navigation.localized && grid_ != nullptr) {
+    const Point2D at{navigation.map_from_base.x_m, navigation.map_from_base.y_m};
+    out.items = order_nearest_first(*grid_, sections_, out.items, at);
+  }
+  return out;
 }
 
 }  // namespace tripodal::navi

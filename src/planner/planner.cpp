@@ -79,7 +79,10 @@ struct CPlanner::Impl {
       : tasks(t), recovery(r), knowledge(k), processes(p), supervisor(s), clock(c), options(o) {}
 
   void build_net(Time now) {
-    PetriNet n = plan_to_net(plan, "plan");
+    PetriNet n = plan_to_net(plan, "plan", [this](std::string_view name) -> const PetriNet* {
+      const CProcess* p = processes.find(name);
+      return p != nullptr ? p->module() : nullptr;
+    });
     stage_of.clear();
     for (std::size_t s = 0; s < plan.stages.size(); ++s) {
       for (std::size_t b = 0; b < plan.stages[s].steps.size(); ++b) stage_of[PlanNetIds::executing(s, b)] = {s, b};

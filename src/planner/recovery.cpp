@@ -6,6 +6,7 @@
 #include <cctype>
 
 #include "../common/yaml_reader.hpp"
+#include "tripodal/core/net_loader.hpp"
 
 namespace tripodal {
 
@@ -126,6 +127,84 @@ Plan RecoveryPolicy::remaining_plan(const Plan& plan, std::size_t failed_stage, 
   const std::size_t from = decision.action == RecoveryAction::retry ? failed_stage : failed_stage + 1;
   for (std::size_t s = from; s < plan.stages.size(); ++s) out.stages.push_back(plan.stages[s]);
   return out;
+}
+
+std::vector<std::string> postable_fault_messages(const PetriNet& net) {
+  std::vector<std::string> out;
+  const std::vector<bool> markable = structurally_markable(net);
+  for (std::size_t i = 0; i < net.places().size(); ++i) {
+    const Place& p = net.places()[i];
+    if (p.outcome != Outcome::fault || !markable[i]) continue;
+    if (std::find(out.begin(), out.end(), p.fault_message) == out.end()) out.push_back(p.fault_message);
+  }
+  return out;
+}
+
+bool is_supervisor_fault_message(std::string_view message) noexcept {
+  const auto starts = [&](std::string_view prefix) { return message.substr(0, prefix.size()) == prefix; };
+  const auto failed = message.find(" failed: ");
+  return starts("stopped: ") || ((starts("behavior ") || starts("module ")) && failed != std::string_view::npos);
+}
+
+void check_recovery_rules(const RecoveryPolicy& policy, std::span<const ProcessNet> nets, Diagnostics& diagnostics) {
+  std::vector<std::pair<std::string, std::vector<std::string>>> posts;  // process -> its messages
+  for (const ProcessNet& p : nets) {
+    if (p.net != nullptr) posts.emplace_back(p.process, postable_fault_messages(*p.net));
+  }
+  const auto has_net = [&](std::string_view process) {
+    return std::any_of(posts.begin(), posts.end(), [&](const auto& e) { return e.first == process; });
+  };
+  // "\"localization fault\" (PrAutoMove, PrCleaning), ..." for the processes `of` accepts
+  const auto what_they_post = [&](const std::function<bool(const std::string&)>& of) {
+    std::vector<std::pair<std::string, std::string>> seen;  // message, processes
+    for (const auto& [process, messages] : posts) {
+      if (!of(process)) continue;
+      for (const std::string& m : messages) {
+        auto it = std::find_if(seen.begin(), seen.end(), [&](const auto& e) { return iequals(e.first, m); });
+        if (it == seen.end()) seen.emplace_back(m, process);
+        else it->second += ", " + process;
+      }
+    }
+    std::string text;
+    for (const auto& [m, processes] : seen) text += (text.empty() ? "\"" : ", \"") + m + "\" (" + processes + ")";
+    return text.empty() ? std::string("no fault message at all") : text;
+  };
+  for (const RecoveryRule& rule : policy.rules()) {
+    const std::string which = "recovery rule for \"" + rule.fault + "\"" + (rule.process.empty() ? "" : " of " + rule.process);
+    if (!rule.process.empty() && !has_net(rule.process)) {
+      diagnostics.error(rule.where, which + " names process '" + rule.process + "', which has no net here");
+    } else if (!is_supervisor_fault_message(rule.fault)) {
+      const auto applies = [&](const std::string& process) { return rule.process.empty() || process == rule.process; };
+      const bool posted = std::any_of(posts.begin(), posts.end(), [&](const auto& e) {
+        return applies(e.first) &&
+               std::any_of(e.second.begin(), e.second.end(), [&](const std::string& m) { return iequals(m, rule.fault); });
+      });
+      if (!posted) {
+        diagnostics.error(rule.where, which + " can never match: " +
+                                          (rule.process.empty() ? "no net posts this fault message (the nets post "
+                                                                : "the net of " + rule.process +
+                                                                      " does not post this fault message (it posts ") +
+                                          what_they_post(applies) + ")");
+      }
+    }
+    for (const ProcessStep& step : rule.insert) {
+      if (!has_net(step.process)) {
+        diagnostics.error(rule.where, which + " inserts process '" + step.process + "', which has no net here");
+      }
+    }
+  }
+}
+
+void check_recovery_file(const std::filesystem::path& rules, std::span<const PetriNet> nets, Diagnostics& diagnostics) {
+  std::vector<ProcessNet> processes;
+  for (const PetriNet& n : nets) {
+    if (n.level == NetLevel::low) processes.push_back({n.id, &n});
+  }
+  try {
+    check_recovery_rules(RecoveryPolicy::load(rules), processes, diagnostics);
+  } catch (const ConfigError& e) {
+    diagnostics.append(e.diagnostics());
+  }
 }
 
 }  // namespace tripodal

@@ -20,7 +20,7 @@ struct CProcessSupervisor::Run {
   struct Active {
     PlaceIndex place = 0;
     std::string behavior;
-    Time since{0};
+    Time since{};
     bool done_posted = false;
     bool failure_posted = false;
   };
@@ -40,7 +40,7 @@ struct CProcessSupervisor::Run {
   const CProcess* process = nullptr;
   ParameterValues params;
   std::unique_ptr<Engine> engine;
-  Time started{0};
+  Time started{};
   std::vector<Active> active;
   std::map<std::string, std::string, std::less<>> failure_messages;  // failure event -> message
   Forwarder forwarder;
@@ -51,7 +51,7 @@ struct CProcessSupervisor::Inbox {
   struct Watch {
     Duration timeout{0};
     std::string event;
-    Time last{0};
+    Time last{};
     bool fired = false;
   };
   std::mutex mutex;

@@ -56,7 +56,7 @@ BehaviorHandle ControlLoop::activate(std::unique_ptr<CBehavior> behavior, const 
   std::lock_guard lock(mutex_);
   retired_.clear();  // destroyed here, on the supervisor's thread, not in a cycle
   BehaviorContext context;
-  context.now = Time{last_now_.load(std::memory_order_acquire)};
+  context.now = time_from_ns(last_now_.load(std::memory_order_acquire));
   context.period = options_.period;
   context.resources = &resources_;
   context.navi = &navi_shared_;
@@ -240,7 +240,7 @@ const CycleReport& ControlLoop::step(Time now) noexcept {
   } else {
     deferred_.fetch_add(1, std::memory_order_relaxed);
   }
-  last_now_.store(now.count(), std::memory_order_release);
+  last_now_.store(to_ns(now), std::memory_order_release);
   resources_.poll_all(now);
 
   BehaviorContext context;

@@ -114,7 +114,7 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
   // Drivers.
   std::recursive_mutex sequencing_mutex;  // the sequencing loop vs. command() from another thread
   std::vector<Time> next_reactive;
-  Time next_sequencing{0};
+  Time next_sequencing{};
   bool schedule_started = false;
   std::vector<std::unique_ptr<LoopRunner>> runners;
   std::thread sequencing_thread;
@@ -292,6 +292,10 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
       def.parameters = p.parameters;
       def.where = p.where;
       def.net = load(p.net);
+      if (!p.module.empty()) {
+        def.module = load(p.module);
+        check_module_net(*def.module, p.name, d);
+      }
       if (!p.recovery.empty()) def.recovery = RecoveryPolicy::load(p.recovery, is_process).rules();
       for (const Place& place : def.net.places()) {
         if (place.behavior && !is_behavior(place.behavior->behavior)) {

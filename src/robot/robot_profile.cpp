@@ -110,7 +110,7 @@ struct Parser {
   void process(const YAML::Node& n, std::vector<ProcessEntry>& out) {
     ProcessEntry p;
     p.where = at(n);
-    if (!r.expect_keys(n, {"name", "type", "net", "parameters", "recovery"}, "a process entry")) return;
+    if (!r.expect_keys(n, {"name", "type", "net", "module", "parameters", "recovery"}, "a process entry")) return;
     bool has_net = false;
     for (const auto& kv : n) {
       const std::string key = kv.first.as<std::string>();
@@ -122,6 +122,8 @@ struct Parser {
       } else if (key == "net") {
         has_net = true;
         p.net = path_of(v, "net file", p.net_where);
+      } else if (key == "module") {
+        p.module = path_of(v, "module net file", p.module_where);
       } else if (key == "recovery") {
         SourceLocation loc;
         p.recovery = path_of(v, "recovery file", loc);

@@ -125,7 +125,7 @@ class Reader {
                        end.Scalar());
       return std::nullopt;
     }
-    return std::make_pair(from_seconds(*a), from_seconds(*b));
+    return std::make_pair(time_from_seconds(*a), time_from_seconds(*b));
   }
 
  private:
@@ -462,13 +462,13 @@ World parse_world(std::string_view text, const std::filesystem::path& file) {
             appear = *v;
           }
         }
-        o.appear = from_seconds(appear);
+        o.appear = time_from_seconds(appear);
         if (const YAML::Node dis = item["disappear_s"]) {
           if (auto v = r.number(dis, "disappear_s")) {
             if (*v <= appear) {
               r.error(dis, "disappear_s must be later than appear_s (" + std::to_string(appear) + "), got " + dis.Scalar());
             }
-            o.disappear = from_seconds(*v);
+            o.disappear = time_from_seconds(*v);
           }
         }
         if (s) {

@@ -105,8 +105,8 @@ RobotHarness::RobotHarness(Mode mode, const RobotProfile& profile, RobotPlugins 
     : mode_(mode),
       options_(std::move(options)),
       summary_(trace::summarize_trace(trace)),
-      offset_(mode == Mode::closed_loop ? summary_.first : Time{0}),
-      clock_(mode == Mode::replay ? summary_.first : Time{0}),
+      offset_(mode == Mode::closed_loop ? summary_.first.time_since_epoch() : Duration{}),
+      clock_(mode == Mode::replay ? summary_.first : Time{}),
       plugins_(std::move(plugins)) {
   if (summary_.empty) throw std::invalid_argument("RobotHarness: the trace " + trace.string() + " has no records");
   if (!options_.localization_channel.empty() &&

@@ -138,7 +138,7 @@ class Fields {
       throw LineError{tokens_[next_ + 2].column, std::string(type_) + " has " + std::to_string(rest - 2) +
                                                      " unexpected fields after logger_timestamp"};
     }
-    return from_seconds(seconds);
+    return time_from_seconds(seconds);
   }
 
   [[nodiscard]] std::size_t left() const noexcept { return tokens_.size() - next_; }
@@ -331,7 +331,7 @@ class Importer {
   LaserScan scan_;  // reused: no allocation per scan once the largest scan was seen
   std::optional<ChannelId> front_id_, rear_id_, odom_id_, pose_id_;
   bool started_ = false;
-  Time last_{0};
+  Time last_{};
 };
 
 class StreamLines {

@@ -22,7 +22,7 @@ void head(std::vector<std::uint8_t>& out, std::uint8_t type, ChannelId channel, 
   ByteWriter w(out);
   w.u8(type);
   w.u16(channel);
-  w.i64(stamp.count());
+  w.i64(to_ns(stamp));
 }
 
 void floats(ByteWriter& w, const std::vector<float>& v) {
@@ -172,7 +172,7 @@ void encode(ChannelId channel, const EventRecord& r, std::vector<std::uint8_t>& 
 }
 
 void encode_declaration(const ChannelInfo& channel, std::vector<std::uint8_t>& out) {
-  head(out, kChannelDeclaration, channel.id, Time{0});
+  head(out, kChannelDeclaration, channel.id, Time{});
   ByteWriter w(out);
   w.u8(static_cast<std::uint8_t>(channel.kind));
   w.str16(channel.name);

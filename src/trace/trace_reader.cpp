@@ -128,7 +128,7 @@ bool TraceReader::next(TraceRecord& record) {
       detail::ByteReader in(body_.data(), length);
       const std::uint8_t type = in.u8();
       const ChannelId channel = in.u16();
-      const Time stamp{in.i64()};
+      const Time stamp = time_from_ns(in.i64());
       if (type == detail::kChannelDeclaration) {
         const std::size_t kind_at = in.position();
         const auto kind = static_cast<ChannelKind>(in.u8());

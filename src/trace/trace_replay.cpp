@@ -67,8 +67,8 @@ std::size_t TraceReplay::advance_to(Time t, TraceSink& sink) {
 std::size_t TraceReplay::play(TraceSink& sink) {
   std::size_t n = 0;
   const bool paced = options_.pacing == ReplayPacing::kRealTime;
-  const Time clock_start = paced ? options_.clock->now() : Time{0};
-  const Time trace_start = pending_ ? stamp_of(record_.data) : Time{0};
+  const Time clock_start = paced ? options_.clock->now() : Time{};
+  const Time trace_start = pending_ ? stamp_of(record_.data) : Time{};
   while (pending_) {
     if (paced) {
       const Duration trace_elapsed = std::max(Duration{0}, stamp_of(record_.data) - trace_start);

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <unistd.h>
 
 #include "run_task.hpp"
@@ -185,4 +186,37 @@ TEST_CASE("run_task in process: PSR-2 cleans room 2111 and measures it", "[app][
   const RunResult refused = run_task(o);
   CHECK(refused.state == "refused");
   CHECK_THAT(refused.reason, Catch::Contains("not understood"));
+}
+
+TEST_CASE("run_task: the order of the processes follows the start (section D first from D, A first from the charger)",
+          "[app][run][order]") {
+  // Paper, section 5.1: the order of PrAutoMove and PrCleaning changes with the initial position.
+  // A minute of simulated time is enough to see the plan and the first PrAutoMove end in the
+  // first section; the whole run from D is the CLI test tripodal_run_cli:start_in_d_cleans_d_first.
+  RunOptions o;
+  o.robot = kSource / "configs/robots/psr2.yaml";
+  o.task = "clean the room 3211";
+  o.max_duration_s = 60.0;
+  std::ostringstream log;
+  o.log = &log;
+
+  o.world = kSource / "configs/worlds/workspace_start_d.yaml";
+  const RunResult d = run_task(o);
+  CHECK(d.state == "timed out");
+  CHECK_THAT(log.str(), Catch::Contains("PrAutoMove(goal=D.entry) -> PrCleaning(section=D) -> PrAutoMove(goal=C.entry) -> "
+                                        "PrCleaning(section=C) -> PrAutoMove(goal=B.entry) -> PrCleaning(section=B) -> "
+                                        "PrAutoMove(goal=A.entry) -> PrCleaning(section=A)"));
+  REQUIRE(d.processes.size() == 2);
+  CHECK_THAT(d.processes[0], Catch::EndsWith("X0 PrAutoMove(goal=D.entry) succeeded"));
+  CHECK_THAT(d.processes[1], Catch::Contains("X1 PrCleaning(section=D) failed: stopped: no end within 60 s"));
+
+  log.str({});
+  o.world = kSource / "configs/worlds/workspace.yaml";  // the charger, in section A
+  const RunResult a = run_task(o);
+  CHECK_THAT(log.str(), Catch::Contains("PrAutoMove(goal=A.entry) -> PrCleaning(section=A) -> PrAutoMove(goal=B.entry) -> "
+                                        "PrCleaning(section=B) -> PrAutoMove(goal=C.entry) -> PrCleaning(section=C) -> "
+                                        "PrAutoMove(goal=D.entry) -> PrCleaning(section=D)"));
+  REQUIRE(a.processes.size() == 2);
+  CHECK_THAT(a.processes[0], Catch::EndsWith("X0 PrAutoMove(goal=A.entry) succeeded"));
+  CHECK_THAT(a.processes[1], Catch::Contains("X1 PrCleaning(section=A) failed: stopped"));
 }

@@ -22,20 +22,20 @@ TEST_CASE("Priority mode: the live input of highest priority wins and is named")
   const InputId joy = *co.find_input("joystick");
   const InputId go = *co.find_input("BhGoToPose");
   const InputId stop = *co.find_input("BhStop");
-  co.submit(stop, {}, 0ms);
-  co.submit(go, {0.3, 0.0, 0.1}, 0ms);
-  auto out = co.update(10ms);
+  co.submit(stop, {}, Time{0ms});
+  co.submit(go, {0.3, 0.0, 0.1}, Time{0ms});
+  auto out = co.update(Time{10ms});
   CHECK(out.winner == "BhGoToPose");
   CHECK(out.winner_id == go);
   CHECK(out.command == Twist2D{0.3, 0.0, 0.1});
   CHECK(out.live_inputs == 2);
   CHECK_FALSE(out.all_expired);
-  co.submit(joy, {-0.1, 0.2, 0.0}, 20ms);
-  out = co.update(20ms);
+  co.submit(joy, {-0.1, 0.2, 0.0}, Time{20ms});
+  out = co.update(Time{20ms});
   CHECK(out.winner == "joystick");
   CHECK(out.command == Twist2D{-0.1, 0.2, 0.0});
   co.withdraw(joy);
-  CHECK(co.update(30ms).winner == "BhGoToPose");
+  CHECK(co.update(Time{30ms}).winner == "BhGoToPose");
 }
 
 TEST_CASE("Per-input timeouts; an explicit zero when every input expired") {
@@ -44,29 +44,29 @@ TEST_CASE("Per-input timeouts; an explicit zero when every input expired") {
   CBehaviorCoordinator co(c);
   const InputId joy = *co.find_input("joystick");
   const InputId go = *co.find_input("BhGoToPose");
-  co.submit(joy, {0.5, 0, 0}, 0ms);
-  co.submit(go, {0.2, 0, 0}, 0ms);
-  CHECK(co.update(500ms).winner == "joystick");  // exactly at the timeout: still live
-  auto out = co.update(501ms);
+  co.submit(joy, {0.5, 0, 0}, Time{0ms});
+  co.submit(go, {0.2, 0, 0}, Time{0ms});
+  CHECK(co.update(Time{500ms}).winner == "joystick");  // exactly at the timeout: still live
+  auto out = co.update(Time{501ms});
   CHECK(out.winner == "");  // go expired at 200 ms too
   CHECK(out.all_expired);
   CHECK(out.command == Twist2D{});
   CHECK_FALSE(out.winner_id.has_value());
-  co.submit(go, {0.2, 0, 0}, 600ms);
-  out = co.update(700ms);
+  co.submit(go, {0.2, 0, 0}, Time{600ms});
+  out = co.update(Time{700ms});
   CHECK(out.winner == "BhGoToPose");
-  CHECK(co.update(801ms).all_expired);
+  CHECK(co.update(Time{801ms}).all_expired);
 }
 
 TEST_CASE("Ties go to the input configured first, whatever the submission order") {
   CoordinatorConfig c;
   c.inputs = {{"a", 5, 0ms}, {"b", 5, 0ms}, {"c", 5, 0ms}};
   CBehaviorCoordinator co(c);
-  co.submit(2, {3, 0, 0}, 0ms);
-  co.submit(1, {2, 0, 0}, 1ms);
-  CHECK(co.update(2ms).winner == "b");
-  co.submit(0, {1, 0, 0}, 3ms);
-  CHECK(co.update(4ms).winner == "a");
+  co.submit(2, {3, 0, 0}, Time{0ms});
+  co.submit(1, {2, 0, 0}, Time{1ms});
+  CHECK(co.update(Time{2ms}).winner == "b");
+  co.submit(0, {1, 0, 0}, Time{3ms});
+  CHECK(co.update(Time{4ms}).winner == "a");
   CHECK(co.output().command.vx_m_s == 1.0);
 }
 
@@ -75,22 +75,22 @@ TEST_CASE("Locks mask inputs at or below their priority") {
   c.locks = {{"pause", 50, 0ms}};
   CBehaviorCoordinator co(c);
   const LockId pause = *co.find_lock("pause");
-  co.submit(*co.find_input("BhGoToPose"), {0.3, 0, 0}, 0ms);
-  co.submit(*co.find_input("BhStop"), {}, 0ms);
-  CHECK_FALSE(co.update(0ms).locked);  // a lock without timeout is released until told otherwise
-  co.set_lock(pause, true, 1ms);
-  auto out = co.update(2ms);
+  co.submit(*co.find_input("BhGoToPose"), {0.3, 0, 0}, Time{0ms});
+  co.submit(*co.find_input("BhStop"), {}, Time{0ms});
+  CHECK_FALSE(co.update(Time{0ms}).locked);  // a lock without timeout is released until told otherwise
+  co.set_lock(pause, true, Time{1ms});
+  auto out = co.update(Time{2ms});
   CHECK(out.locked);
   CHECK(out.lock == "pause");
   CHECK(out.all_expired);
   CHECK(out.command == Twist2D{});
   // The joystick (priority 100) is above the lock.
-  co.submit(*co.find_input("joystick"), {0.1, 0, 0}, 3ms);
-  out = co.update(3ms);
+  co.submit(*co.find_input("joystick"), {0.1, 0, 0}, Time{3ms});
+  out = co.update(Time{3ms});
   CHECK(out.winner == "joystick");
   co.withdraw(*co.find_input("joystick"));
-  co.set_lock(pause, false, 4ms);
-  CHECK(co.update(5ms).winner == "BhGoToPose");
+  co.set_lock(pause, false, Time{4ms});
+  CHECK(co.update(Time{5ms}).winner == "BhGoToPose");
 }
 
 TEST_CASE("A lock with a timeout is a dead-man switch") {
@@ -98,41 +98,41 @@ TEST_CASE("A lock with a timeout is a dead-man switch") {
   c.locks = {{"heartbeat", 1000, 100ms}};
   CBehaviorCoordinator co(c);
   const LockId hb = *co.find_lock("heartbeat");
-  co.submit(*co.find_input("joystick"), {0.4, 0, 0}, 0ms);
-  CHECK(co.update(0ms).locked);  // engaged before the first message
-  co.set_lock(hb, false, 10ms);
-  CHECK(co.update(50ms).winner == "joystick");
-  co.submit(*co.find_input("joystick"), {0.4, 0, 0}, 100ms);
-  CHECK(co.update(110ms).winner == "joystick");  // 100 ms after the message: still released
-  auto out = co.update(111ms);                   // heartbeat silent: everything stops
+  co.submit(*co.find_input("joystick"), {0.4, 0, 0}, Time{0ms});
+  CHECK(co.update(Time{0ms}).locked);  // engaged before the first message
+  co.set_lock(hb, false, Time{10ms});
+  CHECK(co.update(Time{50ms}).winner == "joystick");
+  co.submit(*co.find_input("joystick"), {0.4, 0, 0}, Time{100ms});
+  CHECK(co.update(Time{110ms}).winner == "joystick");  // 100 ms after the message: still released
+  auto out = co.update(Time{111ms});                   // heartbeat silent: everything stops
   CHECK(out.locked);
   CHECK(out.lock == "heartbeat");
   CHECK(out.command == Twist2D{});
-  co.set_lock(hb, false, 120ms);
-  CHECK(co.update(120ms).winner == "joystick");
+  co.set_lock(hb, false, Time{120ms});
+  CHECK(co.update(Time{120ms}).winner == "joystick");
 }
 
 TEST_CASE("The highest engaged lock is reported") {
   CoordinatorConfig c = three_inputs();
   c.locks = {{"low", 5, 0ms}, {"high", 20, 0ms}};
   CBehaviorCoordinator co(c);
-  co.submit(*co.find_input("BhGoToPose"), {0.3, 0, 0}, 0ms);
-  co.submit(*co.find_input("BhStop"), {}, 0ms);
-  co.set_lock(0, true, 0ms);
-  auto out = co.update(0ms);
+  co.submit(*co.find_input("BhGoToPose"), {0.3, 0, 0}, Time{0ms});
+  co.submit(*co.find_input("BhStop"), {}, Time{0ms});
+  co.set_lock(0, true, Time{0ms});
+  auto out = co.update(Time{0ms});
   CHECK(out.lock == "low");
   CHECK(out.winner == "BhGoToPose");  // priority 10 > 5
-  co.set_lock(1, true, 0ms);
-  out = co.update(0ms);
+  co.set_lock(1, true, Time{0ms});
+  out = co.update(Time{0ms});
   CHECK(out.lock == "high");
   CHECK(out.all_expired);
 }
 
 TEST_CASE("Weighted-sum mode averages the live inputs with their weights") {
   CBehaviorCoordinator co(three_inputs(CoordinationMode::weighted_sum));
-  co.submit(*co.find_input("joystick"), {1.0, 0.0, 0.4}, 0ms);    // weight 1
-  co.submit(*co.find_input("BhGoToPose"), {0.2, 0.4, 0.0}, 0ms);  // weight 3
-  auto out = co.update(10ms);
+  co.submit(*co.find_input("joystick"), {1.0, 0.0, 0.4}, Time{0ms});    // weight 1
+  co.submit(*co.find_input("BhGoToPose"), {0.2, 0.4, 0.0}, Time{0ms});  // weight 3
+  auto out = co.update(Time{10ms});
   CHECK(out.winner == "weighted_sum");
   CHECK(out.winner_id == *co.find_input("BhGoToPose"));
   CHECK(out.command.vx_m_s == Approx((1.0 + 3 * 0.2) / 4));
@@ -140,10 +140,10 @@ TEST_CASE("Weighted-sum mode averages the live inputs with their weights") {
   CHECK(out.command.wz_rad_s == Approx(0.4 / 4));
   CHECK(out.live_inputs == 2);
   // After BhGoToPose expires only the joystick counts.
-  out = co.update(300ms);
+  out = co.update(Time{300ms});
   CHECK(out.command == Twist2D{1.0, 0.0, 0.4});
   co.set_mode(CoordinationMode::priority);
-  CHECK(co.update(300ms).winner == "joystick");
+  CHECK(co.update(Time{300ms}).winner == "joystick");
 }
 
 TEST_CASE("A zero-weight input takes no part in the weighted sum") {
@@ -151,10 +151,10 @@ TEST_CASE("A zero-weight input takes no part in the weighted sum") {
   c.mode = CoordinationMode::weighted_sum;
   c.inputs = {{"a", 0, 0ms, 0.0}, {"b", 0, 0ms, 2.0}};
   CBehaviorCoordinator co(c);
-  co.submit(0, {5, 5, 5}, 0ms);
-  CHECK(co.update(0ms).all_expired);
-  co.submit(1, {1, 0, 0}, 0ms);
-  CHECK(co.update(0ms).command == Twist2D{1, 0, 0});
+  co.submit(0, {5, 5, 5}, Time{0ms});
+  CHECK(co.update(Time{0ms}).all_expired);
+  co.submit(1, {1, 0, 0}, Time{0ms});
+  CHECK(co.update(Time{0ms}).command == Twist2D{1, 0, 0});
 }
 
 TEST_CASE("Safety inputs restrict the fused command to the most restrictive envelope") {
@@ -166,12 +166,12 @@ TEST_CASE("Safety inputs restrict the fused command to the most restrictive enve
     const InputId go = *co.find_input("BhGoToPose");
     const InputId avoid = *co.find_input("BhAvoidObstacle");
     const InputId cliff = *co.find_input("cliff");
-    co.submit(go, {0.5, 0.3, 0.2}, 0ms);
+    co.submit(go, {0.5, 0.3, 0.2}, Time{0ms});
     VelocityEnvelope e;
     e.vx_hi_m_s = 0.1;   // obstacle ahead
     e.vy_lo_m_s = -0.05;
-    co.submit_envelope(avoid, e, 0ms);
-    auto out = co.update(0ms);
+    co.submit_envelope(avoid, e, Time{0ms});
+    auto out = co.update(Time{0ms});
     CHECK(out.safety_limited);
     CHECK(out.limited_by == "BhAvoidObstacle");
     CHECK(out.command.vx_m_s == Approx(0.1));
@@ -179,26 +179,26 @@ TEST_CASE("Safety inputs restrict the fused command to the most restrictive enve
     CHECK(out.command.wz_rad_s == Approx(0.2));
     // A plain command from a safety input allows [0, c] per axis: here no forward motion, no
     // turning left; the intersection with the obstacle envelope is the most restrictive.
-    co.submit(cliff, {0.0, 0.1, 0.0}, 0ms);
-    out = co.update(0ms);
+    co.submit(cliff, {0.0, 0.1, 0.0}, Time{0ms});
+    out = co.update(Time{0ms});
     CHECK(out.command.vx_m_s == 0.0);
     CHECK(out.command.vy_m_s == Approx(0.1));
     CHECK(out.command.wz_rad_s == 0.0);
     // Backing away is allowed by the obstacle envelope but not by the cliff's [0, 0].
-    co.submit(go, {-0.2, 0.0, 0.0}, 0ms);
-    CHECK(co.update(0ms).command.vx_m_s == 0.0);
+    co.submit(go, {-0.2, 0.0, 0.0}, Time{0ms});
+    CHECK(co.update(Time{0ms}).command.vx_m_s == 0.0);
     co.withdraw(cliff);
-    CHECK(co.update(0ms).command.vx_m_s == Approx(-0.2));
+    CHECK(co.update(Time{0ms}).command.vx_m_s == Approx(-0.2));
     CHECK_FALSE(co.output().safety_limited);
     // Safety inputs never win on their own.
     co.withdraw(go);
-    out = co.update(0ms);
+    out = co.update(Time{0ms});
     CHECK(out.winner == "");
     CHECK(out.all_expired);
     CHECK(out.command == Twist2D{});
     // Expired safety input no longer restricts.
-    co.submit(go, {0.5, 0, 0}, 300ms);
-    CHECK(co.update(300ms).command.vx_m_s == Approx(0.5));
+    co.submit(go, {0.5, 0, 0}, Time{300ms});
+    CHECK(co.update(Time{300ms}).command.vx_m_s == Approx(0.5));
   }
 }
 
@@ -206,13 +206,13 @@ TEST_CASE("An empty envelope intersection stops that axis") {
   CoordinatorConfig c;
   c.inputs = {{"go", 0, 0ms}, {"s1", 0, 0ms, 1.0, InputRole::safety}, {"s2", 0, 0ms, 1.0, InputRole::safety}};
   CBehaviorCoordinator co(c);
-  co.submit(0, {0.3, 0.0, 0.5}, 0ms);
+  co.submit(0, {0.3, 0.0, 0.5}, Time{0ms});
   VelocityEnvelope a, b;
   a.vx_lo_m_s = 0.2;   // must go forward at least 0.2
   b.vx_hi_m_s = -0.1;  // must go backward
-  co.submit_envelope(1, a, 0ms);
-  co.submit_envelope(2, b, 0ms);
-  const auto out = co.update(0ms);
+  co.submit_envelope(1, a, Time{0ms});
+  co.submit_envelope(2, b, Time{0ms});
+  const auto out = co.update(Time{0ms});
   CHECK(out.command.vx_m_s == 0.0);
   CHECK(out.command.wz_rad_s == 0.5);
 }
@@ -225,9 +225,9 @@ TEST_CASE("Coordinator configuration errors") {
   CHECK_THROWS_WITH(co.add_input({"t", 1, -1ms}), Catch::Contains("timeout must be >= 0"));
   CHECK_FALSE(co.find_input("zzz").has_value());
   // Unknown ids are ignored rather than trusted.
-  co.submit(99, {1, 1, 1}, 0ms);
-  CHECK(co.update(0ms).all_expired);
-  co.submit(0, {1, 0, 0}, 0ms);
+  co.submit(99, {1, 1, 1}, Time{0ms});
+  CHECK(co.update(Time{0ms}).all_expired);
+  co.submit(0, {1, 0, 0}, Time{0ms});
   co.reset();
-  CHECK(co.update(0ms).all_expired);
+  CHECK(co.update(Time{0ms}).all_expired);
 }

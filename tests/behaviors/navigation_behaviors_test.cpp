@@ -59,7 +59,7 @@ struct Bench {
   NavigationFeedback feedback;
   BehaviorContext ctx;
   std::vector<Pose2D> path;
-  Time now{0};
+  Time now{};
   double max_turn_rate = 0.0;
 
   explicit Bench(bool omni, Pose2D start = {0.6, 2.0, 0.0}) {
@@ -353,7 +353,7 @@ TEST_CASE("BhGlobalLocalization turns until the localizer accepts a fix, or give
   BhGlobalLocalization b;
   b.activate(ParameterValues{}, bench.ctx);
   const double t = bench.run(b, 60.0, [&] {
-    if (bench.now >= 6s) bench.navi.fixes = 4;
+    if (bench.now >= Time{6s}) bench.navi.fixes = 4;
   });
   CHECK(b.status() == BehaviorStatus::succeeded);
   CHECK(t == Approx(6.05).margin(0.06));

@@ -45,7 +45,7 @@ TEST_CASE("A step command ramps at the configured acceleration within 1e-6") {
   c.limits.wz.max_acceleration = 2.0;
   IdealWheelHardware hw(2, c.period);
   DifferentialDriveController ctl(c, hw);
-  Time t = 0ms;
+  Time t = Time{0ms};
   ctl.set_command({1.0, 0.0, 1.0}, t);
   for (int k = 1; k <= 150; ++k) {
     t += 10ms;
@@ -64,18 +64,18 @@ TEST_CASE("Limits use the measured period") {
   c.limits.vx.max_acceleration = 1.0;
   IdealWheelHardware hw(2, c.period);
   DifferentialDriveController ctl(c, hw);
-  ctl.set_command({1.0, 0.0, 0.0}, 0ms);
-  ctl.update(0ms);  // nominal period: 0.01
+  ctl.set_command({1.0, 0.0, 0.0}, Time{0ms});
+  ctl.update(Time{0ms});  // nominal period: 0.01
   CHECK(ctl.limited_command().vx_m_s == Approx(0.01).margin(1e-9));
-  ctl.update(5ms);
+  ctl.update(Time{5ms});
   CHECK(ctl.limited_command().vx_m_s == Approx(0.015).margin(1e-9));
-  ctl.update(20ms);
+  ctl.update(Time{20ms});
   CHECK(ctl.limited_command().vx_m_s == Approx(0.030).margin(1e-9));
   // A stall longer than two periods is counted as two: no jump.
-  ctl.update(1020ms);
+  ctl.update(Time{1020ms});
   CHECK(ctl.limited_command().vx_m_s == Approx(0.050).margin(1e-9));
   // Same time again: no change.
-  ctl.update(1020ms);
+  ctl.update(Time{1020ms});
   CHECK(ctl.limited_command().vx_m_s == Approx(0.050).margin(1e-9));
 }
 
@@ -136,8 +136,8 @@ TEST_CASE("Wheel saturation scales the twist and keeps the curvature (differenti
   IdealWheelHardware hw(2, c.period);
   DifferentialDriveController ctl(c, hw);
   const Twist2D cmd{1.5, 0.0, 2.0};  // curvature 4/3; wheels (1.5 -+ 0.4)/0.1 = 11, 19 rad/s
-  ctl.set_command(cmd, 0ms);
-  CHECK(ctl.update(0ms) == ControlStatus::limited);
+  ctl.set_command(cmd, Time{0ms});
+  CHECK(ctl.update(Time{0ms}) == ControlStatus::limited);
   const Twist2D out = ctl.limited_command();
   CHECK(out.wz_rad_s / out.vx_m_s == Approx(cmd.wz_rad_s / cmd.vx_m_s).epsilon(1e-12));
   const auto w = ctl.wheel_commands();
@@ -155,8 +155,8 @@ TEST_CASE("Wheel saturation keeps direction and curvature (omni)") {
   IdealWheelHardware hw(3, c.period);
   HolonomicController ctl(c, hw);
   const Twist2D cmd{0.9, -0.6, 1.2};
-  ctl.set_command(cmd, 0ms);
-  CHECK(ctl.update(0ms) == ControlStatus::limited);
+  ctl.set_command(cmd, Time{0ms});
+  CHECK(ctl.update(Time{0ms}) == ControlStatus::limited);
   const Twist2D out = ctl.limited_command();
   const double s = out.vx_m_s / cmd.vx_m_s;
   CHECK(s < 1.0);
@@ -174,8 +174,8 @@ TEST_CASE("Command timeout brakes to zero through the deceleration limit") {
   c.limits.vx.max_deceleration = 1.0;
   IdealWheelHardware hw(2, c.period);
   DifferentialDriveController ctl(c, hw);
-  ctl.set_command({0.5, 0.0, 0.0}, 0ms);
-  Time t = 0ms;
+  ctl.set_command({0.5, 0.0, 0.0}, Time{0ms});
+  Time t = Time{0ms};
   ctl.update(t);
   for (int k = 0; k < 10; ++k) ctl.update(t += 10ms);
   REQUIRE(ctl.limited_command().vx_m_s == Approx(0.5));
@@ -201,7 +201,7 @@ TEST_CASE("A zero command timeout disables the timeout") {
   HolonomicController* unused = nullptr;
   (void)unused;
   DifferentialDriveController ctl(c, hw);
-  ctl.set_command({0.3, 0.0, 0.1}, 0ms);
+  ctl.set_command({0.3, 0.0, 0.1}, Time{0ms});
   for (int k = 0; k <= 1000; ++k) REQUIRE(ctl.update(Time{k * 10ms}) == ControlStatus::ok);
   CHECK(ctl.limited_command() == Twist2D{0.3, 0.0, 0.1});
 }
@@ -211,7 +211,7 @@ TEST_CASE("With a timeout and no command at all the base stays still") {
   c.cmd_timeout = 50ms;
   IdealWheelHardware hw(3, c.period);
   HolonomicController ctl(c, hw);
-  CHECK(ctl.update(0ms) == ControlStatus::timed_out);
+  CHECK(ctl.update(Time{0ms}) == ControlStatus::timed_out);
   CHECK(ctl.limited_command() == Twist2D{});
 }
 
@@ -219,15 +219,15 @@ TEST_CASE("Hardware faults are reported, not thrown") {
   ControllerConfig c = diff_config();
   IdealWheelHardware hw(2, c.period);
   DifferentialDriveController ctl(c, hw);
-  ctl.set_command({0.1, 0, 0}, 0ms);
-  CHECK(ctl.update(0ms) == ControlStatus::ok);
+  ctl.set_command({0.1, 0, 0}, Time{0ms});
+  CHECK(ctl.update(Time{0ms}) == ControlStatus::ok);
   hw.set_refuse_writes(true);
-  CHECK(ctl.update(10ms) == ControlStatus::hardware_fault);
+  CHECK(ctl.update(Time{10ms}) == ControlStatus::hardware_fault);
   hw.set_refuse_writes(false);
   hw.set_stale_reads(true);
-  CHECK(ctl.update(20ms) == ControlStatus::hardware_fault);
+  CHECK(ctl.update(Time{20ms}) == ControlStatus::hardware_fault);
   hw.set_stale_reads(false);
-  CHECK(ctl.update(30ms) == ControlStatus::ok);
+  CHECK(ctl.update(Time{30ms}) == ControlStatus::ok);
 }
 
 TEST_CASE("Controllers are created by name from configuration") {
@@ -270,7 +270,7 @@ TEST_CASE("Controllers are created by name from configuration") {
     auto [config, hardware] = examples.at(name);
     auto made = reg.create(name, config, *hardware);
     CHECK(made->type_name() == name);
-    CHECK(made->update(10ms) == ControlStatus::ok);
+    CHECK(made->update(Time{10ms}) == ControlStatus::ok);
   }
 
   ControllerConfig bad = diff_config();

@@ -126,7 +126,7 @@ TEST_CASE("Odometry of a circle closes (differential and omni)") {
     c.differential = {0.4, 0.1};
     IdealWheelHardware hw(2, c.period);
     DifferentialDriveController ctl(c, hw);
-    ctl.set_command({0.5, 0.0, wz}, 0ms);
+    ctl.set_command({0.5, 0.0, wz}, Time{0ms});
     double max_dist = 0;
     for (int k = 0; k <= 1000; ++k) {
       ctl.update(Time{k * 10ms});
@@ -145,7 +145,7 @@ TEST_CASE("Odometry of a circle closes (differential and omni)") {
     IdealWheelHardware hw(3, c.period);
     HolonomicController ctl(c, hw);
     ctl.reset_odometry({2.0, 1.0, 0.5});
-    ctl.set_command({0.3, 0.4, wz}, 0ms);
+    ctl.set_command({0.3, 0.4, wz}, Time{0ms});
     double max_dist = 0;
     for (int k = 0; k <= 1000; ++k) {
       ctl.update(Time{k * 10ms});

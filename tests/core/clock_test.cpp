@@ -9,16 +9,16 @@ using namespace tripodal;
 using namespace std::chrono_literals;
 
 TEST_CASE("SimClock moves only when told and never backwards") {
-  SimClock clock(5ms);
-  CHECK(clock.now() == 5ms);
+  SimClock clock(Time{5ms});
+  CHECK(clock.now() == Time{5ms});
   clock.advance(10ms);
-  CHECK(clock.now() == 15ms);
+  CHECK(clock.now() == Time{15ms});
   clock.advance(-3ms);
-  CHECK(clock.now() == 15ms);
-  CHECK_FALSE(clock.set(1ms));
-  CHECK(clock.now() == 15ms);
-  CHECK(clock.set(20ms));
-  CHECK(clock.now() == 20ms);
+  CHECK(clock.now() == Time{15ms});
+  CHECK_FALSE(clock.set(Time{1ms}));
+  CHECK(clock.now() == Time{15ms});
+  CHECK(clock.set(Time{20ms}));
+  CHECK(clock.now() == Time{20ms});
 }
 
 TEST_CASE("SteadyClock is monotonic and starts near zero") {
@@ -26,7 +26,7 @@ TEST_CASE("SteadyClock is monotonic and starts near zero") {
   const Time a = clock.now();
   std::this_thread::sleep_for(1ms);
   const Time b = clock.now();
-  CHECK(a >= 0ns);
+  CHECK(a >= Time{0ns});
   CHECK(b - a >= 1ms);
 }
 

@@ -11,7 +11,7 @@ using namespace tripodal;
 TEST_CASE("steady-state steps do not allocate: firings, delays, events, bindings, outcomes") {
   const PetriNet ring = test::ring_net(100, Duration{1000});
   Engine engine(ring);
-  Time now{0};
+  Time now{};
   engine.step(now);
   const std::size_t before = test::allocations();
   std::size_t firings = 0;
@@ -26,9 +26,9 @@ TEST_CASE("steady-state steps do not allocate: firings, delays, events, bindings
   Engine pr(net, {{"wheel_type", Value{std::string("differential")}}});
   const EventId lost = *pr.event_id("localizer.lost");
   const EventId ok = *pr.event_id("localizer.ok");
-  pr.step(Time{0});
+  pr.step(Time{});
   const std::size_t before_pr = test::allocations();
-  Time t{0};
+  Time t{};
   std::size_t dropped = 0;
   for (int i = 0; i < 1000; ++i) {
     t += from_seconds(0.1);

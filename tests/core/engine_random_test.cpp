@@ -21,7 +21,7 @@ using namespace tripodal;
 namespace {
 
 struct Fired {
-  Time time{0};
+  Time time{};
   TransitionIndex transition = 0;
   std::string event;
   bool operator==(const Fired&) const = default;
@@ -39,7 +39,7 @@ class ReferenceEngine {
       if (!parameters_.count(p.name) && p.default_value) parameters_[p.name] = *p.default_value;
     }
     enabled_.assign(net.transitions().size(), false);
-    since_.assign(net.transitions().size(), Time{0});
+    since_.assign(net.transitions().size(), Time{});
     refresh(std::nullopt);
   }
 
@@ -165,7 +165,7 @@ class ReferenceEngine {
   Marking marking_;
   std::vector<bool> enabled_;
   std::vector<Time> since_;
-  Time cur_{0};
+  Time cur_{};
   std::size_t count_ = 0;
   std::vector<Fired> fired_;
 };
@@ -269,7 +269,7 @@ Scenario random_net(std::mt19937& rng, bool conservative) {
 }
 
 struct Action {
-  Time time{0};
+  Time time{};
   std::vector<std::string> events;
   std::optional<std::pair<std::string, Value>> fact;
 };
@@ -277,7 +277,7 @@ struct Action {
 std::vector<Action> random_actions(std::mt19937& rng) {
   auto uniform = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
   std::vector<Action> actions;
-  Time t{0};
+  Time t{};
   for (int i = uniform(5, 40); i > 0; --i) {
     t += from_seconds(0.125 * uniform(0, 8));  // on the delays' grid: deadlines and steps coincide
     Action a;

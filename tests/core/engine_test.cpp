@@ -15,7 +15,7 @@ using tripodal::test::make_transition;
 
 namespace {
 
-Time at(double seconds) { return from_seconds(seconds); }
+Time at(double seconds) { return time_from_seconds(seconds); }
 
 PlaceIndex place_of(const PetriNet& net, std::string_view id) { return *net.find_place(id); }
 
@@ -49,9 +49,9 @@ TEST_CASE("API example: run a two-step net with an event") {
   Engine engine(net);
   HistoryRecorder history;
   engine.add_observer(history);
-  engine.step(from_seconds(0.0));  // fires start
+  engine.step(time_from_seconds(0.0));  // fires start
   CHECK(engine.outcome().outcome == Outcome::none);
-  const StepResult& r = engine.step(from_seconds(1.0), {"work.done"});  // fires finish
+  const StepResult& r = engine.step(time_from_seconds(1.0), {"work.done"});  // fires finish
   CHECK(r.ok());
   CHECK(r.firings == 1);
   CHECK(engine.outcome().outcome == Outcome::success);

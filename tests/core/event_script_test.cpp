@@ -20,7 +20,7 @@ TEST_CASE("event scripts: events, fact changes, comments and blank lines") {
   REQUIRE(s.entries.size() == 5);
   CHECK(s.source == "loss.script");
   CHECK(s.entries[0].kind == ScriptEntry::Kind::event);
-  CHECK(s.entries[0].time == from_seconds(0.5));
+  CHECK(s.entries[0].time == time_from_seconds(0.5));
   CHECK(s.entries[0].name == "localizer.lost");
   CHECK(s.entries[0].where.str() == "loss.script:3:1");
   CHECK(s.entries[1].kind == ScriptEntry::Kind::set_fact);
@@ -30,8 +30,8 @@ TEST_CASE("event scripts: events, fact changes, comments and blank lines") {
   CHECK(s.entries[1].value_where.str() == "loss.script:4:23");
   CHECK(s.entries[2].value_text == "kitchen 2");
   CHECK(s.entries[2].value_quoted);
-  CHECK(s.entries[3].time == from_seconds(3.0));
-  CHECK(s.entries[4].time == from_seconds(10.0));
+  CHECK(s.entries[3].time == time_from_seconds(3.0));
+  CHECK(s.entries[4].time == time_from_seconds(10.0));
   CHECK(parse_event_script("").entries.empty());
   CHECK(parse_event_script("# only a comment").entries.empty());
 }

@@ -125,7 +125,7 @@ TEST_CASE("configs: PrCleaning narratives for both wheel types") {
     CHECK(persistent.outcome == Outcome::fault);
     CHECK(persistent.outcome_place == b.fault);
     CHECK(persistent.fault_message == "localization fault");
-    CHECK(persistent.end_time == from_seconds(30.0));
+    CHECK(persistent.end_time == time_from_seconds(30.0));
   }
 }
 
@@ -133,19 +133,19 @@ TEST_CASE("configs: while localization is lost the robot pauses and cannot compl
   const PetriNet net = load_config("PrCleaning.xml");
   Engine engine(net, {{"wheel_type", Value{"omni"s}}});
   const auto P = [&](const char* id) { return *net.find_place(id); };
-  engine.step(from_seconds(0.0));
+  engine.step(time_from_seconds(0.0));
   CHECK(engine.tokens(P("P1")) == 1);
-  engine.step(from_seconds(20.0), {"localizer.lost"});
+  engine.step(time_from_seconds(20.0), {"localizer.lost"});
   CHECK(engine.tokens(P("P4")) == 1);
   // The behavior reports completion during the pause: not accepted (the coverage is not sure).
-  const StepResult& paused = engine.step(from_seconds(22.0), {"BhCleaning.done"});
+  const StepResult& paused = engine.step(time_from_seconds(22.0), {"BhCleaning.done"});
   CHECK(paused.firings == 0);
   CHECK(paused.unconsumed_events == std::vector<std::string>{"BhCleaning.done"});
   CHECK(engine.tokens(P("P1")) == 1);
-  CHECK(engine.next_deadline() == from_seconds(30.0));
-  engine.step(from_seconds(25.0), {"localizer.ok"});  // recovered before the fault delay
+  CHECK(engine.next_deadline() == time_from_seconds(30.0));
+  engine.step(time_from_seconds(25.0), {"localizer.ok"});  // recovered before the fault delay
   CHECK(engine.next_deadline() == std::nullopt);
-  engine.step(from_seconds(40.0), {"BhCleaning.done"});
+  engine.step(time_from_seconds(40.0), {"BhCleaning.done"});
   CHECK(engine.outcome().outcome == Outcome::success);
   CHECK(engine.outcome().place_id == "P5");
 }
@@ -166,6 +166,11 @@ TEST_CASE("configs: PrAutoMove narratives") {
   CHECK(persistent.outcome == Outcome::fault);
   CHECK(persistent.outcome_place == "P5");
   CHECK(persistent.fault_message == "localization fault");
+  // the fault the `path blocked` rule of configs/tasks/recovery.yaml matches
+  const SimulationResult blocked = simulate(net, params, "PrAutoMove-path-blocked.events");
+  CHECK(fired(blocked) == std::vector<std::string>{"t0@0.00", "t5@12.0"});
+  CHECK(blocked.outcome_place == "P6");
+  CHECK(blocked.fault_message == "path blocked");
 }
 
 TEST_CASE("configs: PrCleaning without its wheel type is refused") {
@@ -181,16 +186,16 @@ TEST_CASE("configs: the complete example of docs/net-format.md loads and runs") 
   CHECK(d.empty());
   Engine engine(*net, {{"room", Value{"2111"s}}});
   const auto P = [&](const char* id) { return *net->find_place(id); };
-  engine.step(from_seconds(0.0));
+  engine.step(time_from_seconds(0.0));
   CHECK(engine.tokens(P("P2")) == 1);
   CHECK(engine.tokens(P("P3")) == 1);  // fog defaults to true
-  engine.step(from_seconds(1.0), {"bumper.hit", "bumper.hit"});
+  engine.step(time_from_seconds(1.0), {"bumper.hit", "bumper.hit"});
   CHECK_FALSE(net->find_place("bumps"));  // "bumps" is P4's name; ids are what arcs and lookups use
   CHECK(engine.tokens(P("P4")) == 2);
   engine.set_fact("disinfectant_empty", Value{true});
-  engine.step(from_seconds(1.2));
+  engine.step(time_from_seconds(1.2));
   CHECK(engine.outcome().outcome == Outcome::none);
-  engine.step(from_seconds(1.5));
+  engine.step(time_from_seconds(1.5));
   CHECK(engine.outcome().outcome == Outcome::fault);
   CHECK(engine.outcome().message == "disinfectant empty");
 }

@@ -120,7 +120,7 @@ TEST_CASE("native loader: a complete net loads with every field") {
 
   // It runs: start fires (guard true), work gets 2 tokens.
   Engine engine(*net);
-  engine.step(Time{0});
+  engine.step(Time{});
   CHECK(engine.tokens(*net->find_place("work")) == 2);
 }
 

@@ -28,7 +28,7 @@ TEST_CASE("simulation: PrCleaning completes normally") {
   CHECK(fired_ids(r) == Ids{"t0", "t4"});
   CHECK(r.outcome == Outcome::success);
   CHECK(r.outcome_place == "P5");
-  CHECK(r.end_time == from_seconds(20));
+  CHECK(r.end_time == time_from_seconds(20));
   const std::string text = r.str(net);
   CHECK_THAT(text, Catch::Contains("     0.000 s  fire t0  Start behavior BhCleaning  -> P1 P3"));
   CHECK_THAT(text, Catch::Contains("    20.000 s  fire t4 [BhCleaning.done]"));
@@ -46,7 +46,7 @@ TEST_CASE("simulation: temporary loss, recovery, completion") {
   CHECK(fired_ids(r) == Ids{"t0", "t3", "t2", "t4"});
   REQUIRE(r.trace[2].kind == TraceEntry::Kind::event_dropped);
   CHECK(r.trace[2].name == "BhCleaning.done");
-  CHECK(r.trace[2].time == from_seconds(4));
+  CHECK(r.trace[2].time == time_from_seconds(4));
   CHECK(r.outcome == Outcome::success);
   CHECK_THAT(r.str(net), Catch::Contains("drop BhCleaning.done"));
 }
@@ -56,33 +56,33 @@ TEST_CASE("simulation: persistent loss ends in a localization fault at the delay
   NetSimulation sim(net, {{"wheel_type", Value{std::string("two_wheel")}}});
   const SimulationResult r = sim.run(parse_event_script("2 localizer.lost\n60 localizer.ok\n"));
   CHECK(fired_ids(r) == Ids{"t1", "t3", "t7"});
-  CHECK(r.trace.back().time == from_seconds(7));  // stepped at the deadline, not at the next event
+  CHECK(r.trace.back().time == time_from_seconds(7));  // stepped at the deadline, not at the next event
   CHECK(r.outcome == Outcome::fault);
   CHECK(r.outcome_place == "P8");
   CHECK(r.fault_message == "localization fault");
-  CHECK(r.end_time == from_seconds(7));  // stopped at the outcome
+  CHECK(r.end_time == time_from_seconds(7));  // stopped at the outcome
   CHECK_THAT(r.str(net), Catch::Contains("end: fault at P8: localization fault"));
 }
 
 TEST_CASE("simulation: end time, running on after an outcome, and reuse") {
   const PetriNet net = test::pr_cleaning_net(5.0);
   SimulationOptions options;
-  options.end_time = from_seconds(4);
+  options.end_time = time_from_seconds(4);
   NetSimulation sim(net, kDifferential, options);
   const EventScript script = parse_event_script("2 localizer.lost\n");
   const SimulationResult r = sim.run(script);
   CHECK(r.outcome == Outcome::none);
-  CHECK(r.end_time == from_seconds(4));
+  CHECK(r.end_time == time_from_seconds(4));
   const SimulationResult again = sim.run(script);  // starts over from the initial marking
   CHECK(fired_ids(again) == fired_ids(r));
 
   SimulationOptions on;
   on.stop_at_outcome = false;
-  on.end_time = from_seconds(100);
+  on.end_time = time_from_seconds(100);
   NetSimulation keep_going(net, kDifferential, on);
   const SimulationResult k = keep_going.run(parse_event_script("1 BhCleaning.done\n50 localizer.lost\n"));
   CHECK(fired_ids(k) == Ids{"t0", "t4", "t3"});
-  CHECK(k.end_time == from_seconds(100));
+  CHECK(k.end_time == time_from_seconds(100));
 }
 
 TEST_CASE("simulation: facts set by the script drive guards") {
@@ -100,7 +100,7 @@ TEST_CASE("simulation: facts set by the script drive guards") {
   NetSimulation sim(net, {});
   const SimulationResult r = sim.run(parse_event_script("1 set room lab\n2 set battery_low true\n3 set room 'hall'\n"));
   CHECK(fired_ids(r) == Ids{"go_dock"});
-  CHECK(r.trace.back().time == from_seconds(3));
+  CHECK(r.trace.back().time == time_from_seconds(3));
   CHECK_THAT(r.str(net), Catch::Contains("set battery_low = true") && Catch::Contains("set room = \"hall\""));
 }
 

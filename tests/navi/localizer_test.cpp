@@ -13,12 +13,12 @@ namespace {
 class Straight final : public GroundTruthSource {
  public:
   std::optional<Pose2D> true_pose(Time now) const override {
-    if (now < Time{0}) return std::nullopt;
+    if (now < Time{}) return std::nullopt;
     return Pose2D{0.5 * to_seconds(now), 1.0, 0.0};
   }
 };
 
-Time at(double s) { return from_seconds(s); }
+Time at(double s) { return time_from_seconds(s); }
 
 std::vector<ModuleEvent> run(CLocalizer& loc, double until_s, double dt_s = 0.1) {
   std::vector<ModuleEvent> events;

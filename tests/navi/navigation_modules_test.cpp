@@ -77,7 +77,7 @@ sim::World world(double w_m, double h_m, bool pillar, Pose2D start, const std::v
     sim::DynamicObstacle o;
     o.name = "box" + std::to_string(w.obstacles.size());
     o.polygon = {{b.x0_m, b.y0_m}, {b.x1_m, b.y0_m}, {b.x1_m, b.y1_m}, {b.x0_m, b.y1_m}};
-    if (b.gone_s) o.disappear = from_seconds(*b.gone_s);
+    if (b.gone_s) o.disappear = time_from_seconds(*b.gone_s);
     w.obstacles.push_back(std::move(o));
   }
   return w;
@@ -102,7 +102,7 @@ struct Modules final : public ModuleDirectory {
     splitter->configure();
     coverage->configure({{"cleaning_width_m", Value{kCleaningWidth_m}}});
     planner->configure();
-    ModuleContext c = context(Time{0});
+    ModuleContext c = context(Time{});
     for (CModule* m : all()) m->start(c);
     navigation.localized = true;
   }
@@ -389,11 +389,11 @@ TEST_CASE(
   r.reset(params(2.0, 2.0));
   NavigationFeedback fb;
   fb.path_id = 1;
-  CHECK_FALSE(r.due(fb, from_seconds(100.0)));  // not blocked
+  CHECK_FALSE(r.due(fb, time_from_seconds(100.0)));  // not blocked
   fb.blocked = true;
-  fb.blocked_since = from_seconds(10.0);
-  CHECK_FALSE(r.due(fb, from_seconds(11.9)));
-  CHECK(r.due(fb, from_seconds(12.0)));
+  fb.blocked_since = time_from_seconds(10.0);
+  CHECK_FALSE(r.due(fb, time_from_seconds(11.9)));
+  CHECK(r.due(fb, time_from_seconds(12.0)));
 
   // The laser sees a box at (3, 2) the map does not hold, and the wall at x = 6 it does.
   LaserResource laser("laser", 500ms);
@@ -406,10 +406,10 @@ TEST_CASE(
   scan.range_min_m = 0.05;
   scan.range_max_m = 12.0;
   scan.ranges_m = {5.4f, 2.4f, 5.4f};
-  scan.stamp = from_seconds(12.0);
+  scan.stamp = time_from_seconds(12.0);
   laser.publish(scan);
   m.navigation.map_from_base = kWest;
-  ModuleContext c = m.context(from_seconds(12.0));
+  ModuleContext c = m.context(time_from_seconds(12.0));
   c.resources = &table;
   CHECK(r.observe(*m.maps, c));
   CHECK(r.attempts() == 1);
@@ -417,20 +417,20 @@ TEST_CASE(
   CHECK(r.obstacles()[0].x_m == Approx(3.0).margin(1e-6));
   CHECK(r.obstacles()[0].y_m == Approx(2.0).margin(1e-6));
 
-  CHECK_FALSE(r.due(fb, from_seconds(13.9)));  // replan_after_s since the last attempt
-  CHECK(r.due(fb, from_seconds(14.0)));
+  CHECK_FALSE(r.due(fb, time_from_seconds(13.9)));  // replan_after_s since the last attempt
+  CHECK(r.due(fb, time_from_seconds(14.0)));
   scan.ranges_m = {5.4f, 5.4f, 5.4f};  // the box went: only what the map holds
-  scan.stamp = from_seconds(14.0);
+  scan.stamp = time_from_seconds(14.0);
   laser.publish(scan);
-  c.now = from_seconds(14.0);
+  c.now = time_from_seconds(14.0);
   CHECK_FALSE(r.observe(*m.maps, c));  // nothing new: the same plan again would not help
   CHECK(r.attempts() == 2);
-  CHECK_FALSE(r.due(fb, from_seconds(30.0)));  // max_replans used up
+  CHECK_FALSE(r.due(fb, time_from_seconds(30.0)));  // max_replans used up
 
   r.reset(params(0.0, 5.0));  // replan_after_s 0: never
   CHECK(r.attempts() == 0);
   CHECK(r.obstacles().empty());
-  CHECK_FALSE(r.due(fb, from_seconds(100.0)));
+  CHECK_FALSE(r.due(fb, time_from_seconds(100.0)));
 }
 
 TEST_CASE("The path planner resolves goal names: <section>.entry, a node, a room, a section",
@@ -462,7 +462,7 @@ TEST_CASE("The path planner resolves goal names: <section>.entry, a node, a room
   REQUIRE(entry);
   CHECK(m.maps->planner().traversable(m.maps->grid().cell_at(*entry)));
   m.navigation.map_from_base = {entry->x_m, entry->y_m, 0.0};
-  m.activated(BhCleaning::static_manifest(), {{"section", Value{std::string("A")}}}, Time{0});
+  m.activated(BhCleaning::static_manifest(), {{"section", Value{std::string("A")}}}, Time{});
   REQUIRE_FALSE(m.navigation.path.empty());
   CHECK(m.navigation.path.front().x_m == entry->x_m);
   CHECK(m.navigation.path.front().y_m == entry->y_m);
@@ -481,21 +481,21 @@ TEST_CASE("The path planner plans at activation and fails the behavior for an un
   Modules m(6.0, 4.0, true, {navi::MapNode{"inside_pillar", Pose2D{3.0, 2.0, 0.0}, "", {}}});
   m.navigation.map_from_base = kWest;
   const ModuleManifest& bh = BhAutoMove::static_manifest();
-  m.activated(bh, {{"goal", Value{std::string("door")}}}, Time{0});
+  m.activated(bh, {{"goal", Value{std::string("door")}}}, Time{});
   CHECK(m.navigation.path_failure.empty());
   CHECK(m.navigation.path_id == m.planner->path().id());
   CHECK(m.navigation.path.size() >= 3);  // the straight line crosses the pillar: corners around it
   CHECK(m.navigation.path.back().x_m == Approx(5.4));
-  m.deactivated("BhAutoMove", Time{0});
+  m.deactivated("BhAutoMove", Time{});
   CHECK(m.navigation.path_id == 0);
 
-  m.activated(bh, {{"goal", Value{std::string("kitchen")}}}, Time{0});
+  m.activated(bh, {{"goal", Value{std::string("kitchen")}}}, Time{});
   CHECK(m.navigation.path_failure == "unknown goal");
-  m.activated(bh, {{"goal", Value{std::string("inside_pillar")}}}, Time{0});
+  m.activated(bh, {{"goal", Value{std::string("inside_pillar")}}}, Time{});
   CHECK(m.navigation.path_failure == "no path to the goal");
   // Not served: another behavior's activation leaves the path alone.
   const std::uint32_t id = m.navigation.path_id;
-  m.activated(BhGlobalLocalization::static_manifest(), {}, Time{0});
+  m.activated(BhGlobalLocalization::static_manifest(), {}, Time{});
   CHECK(m.navigation.path_id == id);
 }
 
@@ -505,7 +505,7 @@ TEST_CASE("The coverage planner resumes a section where its coverage stopped, an
   m.navigation.map_from_base = kCorner;
   const ModuleManifest& bh = BhCleaning::static_manifest();
   const ParameterValues section_a{{"section", Value{std::string("A")}}};
-  m.activated(bh, section_a, Time{0});
+  m.activated(bh, section_a, Time{});
   const std::uint32_t first = m.navigation.path_id;
   REQUIRE(first != 0);
   const std::vector<Pose2D> path(m.navigation.path.begin(), m.navigation.path.end());
@@ -518,23 +518,23 @@ TEST_CASE("The coverage planner resumes a section where its coverage stopped, an
   NavigationFeedback fb;
   fb.path_id = first;
   fb.progress_m = 4.0;
-  m.update(from_seconds(1.0), fb);
+  m.update(time_from_seconds(1.0), fb);
   CHECK(progress.done_m == 4.0);
   CHECK_FALSE(progress.finished);
   const std::size_t cleaned = m.coverage->cleaned().count();
   CHECK(cleaned > 0);
   m.navigation.localized = false;  // lost: nothing is marked from a pose nobody trusts
   m.navigation.map_from_base = {2.5, 2.0, 0.0};
-  m.update(from_seconds(1.1), fb);
+  m.update(time_from_seconds(1.1), fb);
   CHECK(m.coverage->cleaned().count() == cleaned);
   m.navigation.localized = true;
 
-  m.deactivated("BhCleaning", from_seconds(2.0));
+  m.deactivated("BhCleaning", time_from_seconds(2.0));
   CHECK(m.navigation.path_id == 0);
   CHECK(progress.done_m == 4.0);
 
   // Activated again for the same section: the same path, taken up where it stopped.
-  m.activated(bh, section_a, from_seconds(3.0));
+  m.activated(bh, section_a, time_from_seconds(3.0));
   CHECK(m.navigation.path_id != first);
   CHECK(m.navigation.path_start_m == 4.0);
   REQUIRE(m.navigation.path.size() == path.size());
@@ -545,14 +545,14 @@ TEST_CASE("The coverage planner resumes a section where its coverage stopped, an
   fb.path_id = m.navigation.path_id;
   fb.progress_m = m.coverage->progress().at("A").plan.stats.length_m;
   fb.reached_end = true;
-  m.update(from_seconds(4.0), fb);
+  m.update(time_from_seconds(4.0), fb);
   CHECK(m.coverage->progress().at("A").finished);
-  m.deactivated("BhCleaning", from_seconds(5.0));
-  m.activated(bh, section_a, from_seconds(6.0));
+  m.deactivated("BhCleaning", time_from_seconds(5.0));
+  m.activated(bh, section_a, time_from_seconds(6.0));
   CHECK(m.navigation.path_start_m == 0.0);
   CHECK_FALSE(m.coverage->progress().at("A").finished);
 
-  m.activated(bh, {{"section", Value{std::string("Q")}}}, from_seconds(7.0));
+  m.activated(bh, {{"section", Value{std::string("Q")}}}, time_from_seconds(7.0));
   CHECK(m.navigation.path_failure == "unknown section");
 }
 

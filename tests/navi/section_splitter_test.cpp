@@ -3,10 +3,13 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 
 #include "navi_test_util.hpp"
+#include "tripodal/behaviors/behavior.hpp"
 #include "tripodal/navi/map_io.hpp"
+#include "tripodal/navi/regions.hpp"
 
 using namespace tripodal;
 using namespace tripodal::navi;
@@ -145,4 +148,142 @@ TEST_CASE("CSectionSplitter: the demo workspace splits into four large sections"
   }
   CHECK(s.sections[0].name == "A");
   CHECK(s.sections[3].name == "D");
+}
+
+namespace {
+
+struct Box {
+  const char* name;
+  int x0, y0, x1, y1;  // inclusive
+};
+
+// Sections drawn by hand: the free cells of each box, in the order given (ids 0, 1, ...).
+SectionSet sections_in_boxes(const OccupancyGrid& g, const std::vector<Box>& boxes) {
+  SectionSet s;
+  s.label.assign(g.size(), -1);
+  for (const Box& b : boxes) {
+    Section sec;
+    sec.id = static_cast<int>(s.sections.size());
+    sec.name = b.name;
+    double sx = 0.0, sy = 0.0;
+    for (int y = b.y0; y <= b.y1; ++y) {
+      for (int x = b.x0; x <= b.x1; ++x) {
+        if (!g.is_free({x, y})) continue;
+        sec.cells.push_back(g.index({x, y}));
+        s.label[g.index({x, y})] = sec.id;
+        sx += g.cell_center({x, y}).x_m;
+        sy += g.cell_center({x, y}).y_m;
+      }
+    }
+    std::sort(sec.cells.begin(), sec.cells.end());
+    sec.centroid = {sx / static_cast<double>(sec.cells.size()), sy / static_cast<double>(sec.cells.size())};
+    s.sections.push_back(std::move(sec));
+  }
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("order_nearest_first: the demo workspace from a start in section A and from a start in section D",
+          "[navi][splitter][order][workspace]") {
+  const MapFile m = load_map(std::string(TRIPODAL_SOURCE_DIR) + "/configs/worlds/workspace_map.yaml");
+  const SectionSet s = CSectionSplitter().split(m.grid);
+  REQUIRE(s.sections.size() == 4);
+  const std::vector<std::string> scan{"A", "B", "C", "D"};
+  // the charger, lower left corner (configs/worlds/workspace.yaml): the scan order
+  CHECK(order_nearest_first(m.grid, s, scan, {0.8, 0.8}) == scan);
+  // the upper left corner, in section D (configs/worlds/workspace_start_d.yaml): D first, then back down
+  CHECK(order_nearest_first(m.grid, s, scan, {0.8, 31.0}) == std::vector<std::string>{"D", "C", "B", "A"});
+  // only some sections asked for, in any order; the legs are path lengths
+  const std::vector<int> ids{3, 0};
+  const SectionOrder o = order_nearest_first(m.grid, s, ids, {0.8, 0.8});
+  REQUIRE(o.ids == std::vector<int>{0, 3});
+  CHECK(o.legs_m[0] == 0.0);  // the start is in A
+  CHECK(o.legs_m[1] > 10.0);  // from A's centre (about y = 3.9 m) to D's first row (about y = 23.8 m)
+  CHECK(o.legs_m[1] < 25.0);
+  // a name that is no section keeps its place at the end
+  const std::vector<std::string> with_unknown{"Z", "B", "A"};
+  CHECK(order_nearest_first(m.grid, s, with_unknown, {0.8, 31.0}) == std::vector<std::string>{"B", "A", "Z"});
+}
+
+TEST_CASE("CSectionSplitter answers sections(room) nearest first from the localized pose, in scan order without one",
+          "[navi][splitter][order][workspace]") {
+  // The question the planner asks when it makes the plan (paper, section 5.1): the sequencing loop
+  // passes the robot's NavigationData, and the answer's order is the order of the PrCleaning steps.
+  const std::string worlds = std::string(TRIPODAL_SOURCE_DIR) + "/configs/worlds/";
+  const MapFile m = load_map(worlds + "workspace_map.yaml");
+  const RegionMap regions = load_regions(worlds + "workspace_regions.yaml");
+  CSectionSplitter splitter;
+  splitter.split_map(m.grid, regions);
+  NavigationData at_charger;  // configs/worlds/workspace.yaml
+  at_charger.localized = true;
+  at_charger.map_from_base = {0.8, 0.8, 0.0};
+  NavigationData in_d = at_charger;  // configs/worlds/workspace_start_d.yaml
+  in_d.map_from_base = {0.8, 31.0, 0.0};
+  const auto a = splitter.answer("sections", "3211", at_charger);
+  REQUIRE(a);
+  REQUIRE(a->ok);
+  CHECK(a->items == std::vector<std::string>{"A", "B", "C", "D"});
+  const auto d = splitter.answer("sections", "3211", in_d);
+  REQUIRE(d);
+  CHECK(d->items == std::vector<std::string>{"D", "C", "B", "A"});
+  // room 2133 is the top of the hall: only D
+  CHECK(splitter.answer("sections", "2133", at_charger)->items == std::vector<std::string>{"D"});
+  // a pose the localizer does not trust orders nothing: scan order
+  NavigationData lost = in_d;
+  lost.localized = false;
+  CHECK(splitter.answer("sections", "3211", lost)->items == std::vector<std::string>{"A", "B", "C", "D"});
+  // errors and other questions are untouched
+  const auto bad = splitter.answer("sections", "9999", in_d);
+  REQUIRE(bad);
+  CHECK_FALSE(bad->ok);
+  CHECK_THAT(bad->error, Catch::Contains("unknown room '9999'"));
+  CHECK_FALSE(splitter.answer("rooms", "3211", in_d));
+}
+
+TEST_CASE("order_nearest_first: path distance, not straight-line: a section behind a wall is not near",
+          "[navi][splitter][order]") {
+  // 1 m cells. The robot stands at (6, 3); section R (x 8..10, y 5..8) is 2.8 m away in a
+  // straight line but 8 m by the opening in the wall at the bottom; section F (x 1..3, y 7..8) is
+  // 5 m away in a straight line and 5.2 m by path.
+  const OccupancyGrid g = test::grid_from_art(
+      {
+          "############",
+          "#......#...#",
+          "#......#...#",
+          "#......#...#",
+          "#......#...#",
+          "#......#...#",
+          "#......#...#",
+          "#......#...#",
+          "#..........#",
+          "############",
+      },
+      1.0);
+  const SectionSet s = sections_in_boxes(g, {{"R", 8, 5, 10, 8}, {"F", 1, 7, 3, 8}});
+  const Point2D start = g.cell_center({6, 3});
+  const std::vector<int> ids{0, 1};
+  const SectionOrder o = order_nearest_first(g, s, ids, start);
+  REQUIRE(o.ids == std::vector<int>{1, 0});  // F, then R
+  CHECK(o.legs_m[0] == Approx(3.0 * std::sqrt(2.0) + 1.0));  // three diagonal steps and one up to (3, 7)
+  // from F's centre (2, 7.5 -> cell (2, 7)) down to the opening and up again into R
+  CHECK(o.legs_m[1] > 10.0);
+
+  SECTION("a start on a wall starts from the nearest free cell") {
+    // 0.3 m right of the centre of the wall cell (7, 3): the free cell (8, 3) is nearer than (6, 3)
+    CHECK(order_nearest_first(g, s, ids, {7.8, 3.5}).ids == std::vector<int>{0, 1});
+  }
+  SECTION("a section no path reaches comes last, with an infinite leg") {
+    OccupancyGrid closed = g;
+    for (int x = 8; x <= 10; ++x) closed.set_state({x, 1}, Occupancy::occupied);
+    closed.set_state({7, 1}, Occupancy::occupied);
+    const SectionSet cs = sections_in_boxes(closed, {{"R", 8, 5, 10, 8}, {"F", 1, 7, 3, 8}});
+    const SectionOrder co = order_nearest_first(closed, cs, ids, start);
+    REQUIRE(co.ids == std::vector<int>{1, 0});
+    CHECK(std::isinf(co.legs_m[1]));
+  }
+  SECTION("unknown ids and repeats are ignored") {
+    const std::vector<int> odd{7, 0, 0, -1};
+    CHECK(order_nearest_first(g, s, odd, start).ids == std::vector<int>{0});
+  }
 }

@@ -6,6 +6,7 @@
 #include <functional>
 
 #include "../processes/doubles.hpp"
+#include "tripodal/core/net_loader.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
 #include "tripodal/planner/planner.hpp"
 
@@ -49,11 +50,14 @@ struct World {
   bool localized = true;
   bool reported_localized = true;
 
-  World() {
+  // with_modules: PrCleaning's module net is configs/petri/PrCleaning-module.xml (else the default)
+  explicit World(bool with_modules = false) {
     behaviors.add("BhCleaning", 10.0);
     behaviors.add("BhAutoMove", 3.0);
     behaviors.add("BhGlobalLocalization", 2.0);
-    processes.add(def("PrCleaning", pr_cleaning(5.0)));
+    ProcessDefinition cleaning = def("PrCleaning", pr_cleaning(5.0));
+    if (with_modules) cleaning.module = load_net_or_throw(std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs/petri/PrCleaning-module.xml");
+    processes.add(std::move(cleaning));
     processes.add(def("PrAutoMove", pr_auto_move(5.0)));
     processes.add(def("PrGlobalLocalization", pr_global_localization()));
     auto known = [&](std::string_view n) { return processes.contains(n); };
@@ -186,14 +190,14 @@ TEST_CASE("The retry limit makes the task fail with a report", "[planner]") {
   World w;
   REQUIRE(w.planner->command("clean room 3211").accepted);
   // A flaky localizer: lost again one second into every cleaning run.
-  Time cleaning_since{-1};
+  Time cleaning_since = time_from_ns(-1);
   w.run(200.0, [&](double) {
     const bool cleaning = w.behaviors.active("BhCleaning");
     if (!cleaning) {
-      cleaning_since = Time{-1};
+      cleaning_since = time_from_ns(-1);
       return;
     }
-    if (cleaning_since < Time{0}) cleaning_since = w.clock.now();
+    if (cleaning_since < Time{}) cleaning_since = w.clock.now();
     if (w.clock.now() - cleaning_since >= from_seconds(1.0)) w.localized = false;
   });
   REQUIRE(w.planner->state() == TaskState::failed);
@@ -230,6 +234,25 @@ TEST_CASE("A fault no rule handles, and a skip rule", "[planner]") {
     REQUIRE(w.planner->state() == TaskState::failed);
     CHECK(w.planner->report().reason == "no recovery rule for fault \"cleaning behavior failed\" of PrCleaning");
   }
+}
+
+TEST_CASE("The planner runs the processes' module nets; a fault keeps the failing process's message", "[planner]") {
+  World w(true);
+  w.behaviors.specs["BhCleaning"].fail = true;
+  REQUIRE(w.planner->command("clean room 2111").accepted);
+  w.planner->step();
+  REQUIRE(w.planner->net_engine() != nullptr);
+  const PetriNet& net = w.planner->net_engine()->net();
+  // PrCleaning's stage is Fig. 2 as configs/petri/PrCleaning-module.xml draws it; PrAutoMove's the default
+  CHECK(net.transition(*net.find_transition("X1.t2")).description ==
+        "Process supervisor (PS) posts fault message \"localization fault\"");
+  CHECK(net.transition(*net.find_transition("X0.t2")).description ==
+        "Process supervisor (PS) posts the fault message of PrAutoMove");
+  w.run(100.0);
+  REQUIRE(w.planner->state() == TaskState::failed);
+  // not the module's "localization fault": the message PrCleaning's net ended with
+  CHECK(w.planner->report().processes.at(1).message == "cleaning behavior failed");
+  CHECK(w.planner->report().reason == "no recovery rule for fault \"cleaning behavior failed\" of PrCleaning");
 }
 
 TEST_CASE("An unknown command is refused and nothing runs", "[planner]") {
@@ -319,7 +342,7 @@ TEST_CASE("Parallel stages: the plan changes only at a quiet point, when every b
   planner.add_observer(life);
   auto run = [&] {
     planner.step();
-    while (planner.busy() && clock.now() < from_seconds(60.0)) {
+    while (planner.busy() && clock.now() < time_from_seconds(60.0)) {
       clock.advance(from_seconds(0.1));
       behaviors.advance(clock.now(), from_seconds(0.1));
       planner.step();

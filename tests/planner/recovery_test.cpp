@@ -2,6 +2,11 @@
 
 #include <catch2/catch.hpp>
 
+#include <string>
+#include <vector>
+
+#include "tripodal/core/net_loader.hpp"
+
 using namespace tripodal;
 
 namespace {
@@ -66,4 +71,103 @@ TEST_CASE("malformed recovery rules are located") {
     CHECK_THAT(w, Catch::Contains("r.yaml:6:5: error: unknown key 'colour' in a recovery rule; expected one of: fault, process, insert, then, max_retries"));
     CHECK_THAT(w, Catch::Contains("r.yaml:5:5: error: a recovery rule: missing 'fault'"));
   }
+}
+
+namespace {
+
+PetriNet shipped_net(const char* file) { return load_net_or_throw(std::string(TRIPODAL_SOURCE_DIR "/configs/petri/") + file); }
+
+// A process net with one fault place per message, each marked by its own event from P1, and one
+// more fault place ("never posted") that no transition can mark.
+PetriNet net_posting(const std::string& id, const std::vector<std::string>& messages) {
+  std::string xml = "<net id=\"" + id + "\" level=\"low\">\n<place id=\"P0\" tokens=\"1\"/>\n<place id=\"P1\"/>\n"
+                    "<place id=\"OK\" outcome=\"success\"/>\n<place id=\"DEAD\" outcome=\"fault\" message=\"never posted\"/>\n"
+                    "<transition id=\"t0\"/>\n<transition id=\"ok\" event=\"done\"/>\n"
+                    "<arc source=\"P0\" target=\"t0\"/>\n<arc source=\"t0\" target=\"P1\"/>\n"
+                    "<arc source=\"P1\" target=\"ok\"/>\n<arc source=\"ok\" target=\"OK\"/>\n"
+                    "<transition id=\"never\"/>\n<arc source=\"never\" target=\"DEAD\"/>\n<place id=\"NOWHERE\"/>\n"
+                    "<arc source=\"NOWHERE\" target=\"never\"/>\n";
+  for (std::size_t i = 0; i < messages.size(); ++i) {
+    const std::string f = "F" + std::to_string(i), t = "f" + std::to_string(i);
+    xml += "<place id=\"" + f + "\" outcome=\"fault\" message=\"" + messages[i] + "\"/>\n<transition id=\"" + t +
+           "\" event=\"e" + std::to_string(i) + "\"/>\n<arc source=\"P1\" target=\"" + t + "\"/>\n<arc source=\"" + t +
+           "\" target=\"" + f + "\"/>\n";
+  }
+  Diagnostics d;
+  LoadOptions lo;
+  lo.structural_warnings = false;
+  auto net = load_net_from_string(xml + "</net>\n", id + ".xml", d, lo);
+  REQUIRE(net);
+  return *net;
+}
+
+}  // namespace
+
+TEST_CASE("the fault messages a net can post: its fault places that can be marked") {
+  CHECK(postable_fault_messages(net_posting("P", {"path blocked", "localization fault", "path blocked"})) ==
+        std::vector<std::string>{"path blocked", "localization fault"});
+  CHECK(postable_fault_messages(shipped_net("PrAutoMove.xml")) == std::vector<std::string>{"localization fault", "path blocked"});
+  CHECK(postable_fault_messages(shipped_net("PrCleaning.xml")) == std::vector<std::string>{"localization fault"});
+  CHECK(postable_fault_messages(shipped_net("PrWait.xml")).empty());
+}
+
+TEST_CASE("every shipped recovery rule matches a fault a shipped net posts, and inserts a process that has a net") {
+  const PetriNet automove = shipped_net("PrAutoMove.xml"), cleaning = shipped_net("PrCleaning.xml"),
+                 global = shipped_net("PrGlobalLocalization.xml"), wait = shipped_net("PrWait.xml");
+  const std::vector<ProcessNet> nets{
+      {"PrAutoMove", &automove}, {"PrCleaning", &cleaning}, {"PrGlobalLocalization", &global}, {"PrWait", &wait}};
+  for (const char* file : {"recovery.yaml"}) {
+    INFO(file);
+    Diagnostics d;
+    check_recovery_rules(RecoveryPolicy::load(std::string(TRIPODAL_SOURCE_DIR "/configs/tasks/") + file), nets, d);
+    CHECK(d.str().empty());
+  }
+}
+
+TEST_CASE("recovery rules that can never match are reported at the rule, with what the nets post") {
+  const RecoveryPolicy policy = RecoveryPolicy::load_from_string(R"(recovery:
+  - fault: path blocked
+    process: PrAutoMove
+    insert:
+      - PrWait: {}
+    then: retry
+  - fault: Localization Fault
+    insert:
+      - PrGlobalLocalization: {}
+  - fault: never posted
+    then: abort
+  - fault: battery low
+    process: PrDock
+    then: abort
+  - fault: "module localizer failed: scan matcher crashed"
+    then: abort
+)",
+                                                                 "rules.yaml");
+  // PrAutoMove as it was before its "path blocked" fault place; no PrWait, no PrDock
+  const PetriNet automove = net_posting("PrAutoMove", {"localization fault"});
+  const PetriNet cleaning = net_posting("PrCleaning", {"localization fault", "cleaning failed"});
+  const PetriNet global = net_posting("PrGlobalLocalization", {});
+  const std::vector<ProcessNet> nets{{"PrAutoMove", &automove}, {"PrCleaning", &cleaning}, {"PrGlobalLocalization", &global}};
+  Diagnostics d;
+  check_recovery_rules(policy, nets, d);
+  INFO(d.str());
+  REQUIRE(d.error_count() == 4);
+  const auto& all = d.all();
+  CHECK(all[0].str() ==
+        "rules.yaml:2:5: error: recovery rule for \"path blocked\" of PrAutoMove can never match: the net of PrAutoMove does "
+        "not post this fault message (it posts \"localization fault\" (PrAutoMove))");
+  CHECK(all[1].str() == "rules.yaml:2:5: error: recovery rule for \"path blocked\" of PrAutoMove inserts process 'PrWait', "
+                        "which has no net here");
+  // "Localization Fault" matches case-insensitively; "never posted" is a fault place no firing marks
+  CHECK(all[2].str() ==
+        "rules.yaml:10:5: error: recovery rule for \"never posted\" can never match: no net posts this fault message (the nets "
+        "post \"localization fault\" (PrAutoMove, PrCleaning), \"cleaning failed\" (PrCleaning))");
+  CHECK(all[3].str() == "rules.yaml:12:5: error: recovery rule for \"battery low\" of PrDock names process 'PrDock', which "
+                        "has no net here");
+  // the supervisor's own messages are not the nets' to post
+  CHECK(is_supervisor_fault_message("module localizer failed: scan matcher crashed"));
+  CHECK(is_supervisor_fault_message("behavior BhAutoMove failed: unknown goal"));
+  CHECK(is_supervisor_fault_message("stopped: cancelled"));
+  CHECK_FALSE(is_supervisor_fault_message("path blocked"));
+  CHECK_FALSE(is_supervisor_fault_message("behavior failed"));
 }

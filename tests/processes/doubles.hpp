@@ -33,7 +33,7 @@ class FakeBehaviors final : public BehaviorHost {
     Duration progress{0};
     BehaviorStatus state = BehaviorStatus::idle;
     ParameterValues params;
-    Time last_step{0};
+    Time last_step{};
   };
 
   std::map<std::string, Spec, std::less<>> specs;

@@ -63,7 +63,7 @@ class BhRecordNavigation final : public CBehavior {
 struct Loop {
   ResourceTable resources;
   std::unique_ptr<ControlLoop> loop;
-  Time now{0};
+  Time now{};
   explicit Loop(std::size_t max_path_points = 4096) {
     CoordinatorConfig cc;
     cc.inputs = {{"record", 10, 200ms}};

@@ -116,7 +116,7 @@ TEST_CASE("Activation, replacement, deactivation and status through the loop") {
   CHECK_THROWS_WITH(loop.activate(reg.create("BhStop"), {}), Catch::Contains("no input named 'BhStop'"));
   CHECK_THROWS_WITH(loop.activate(reg.create("BhGoToPose"), {{"speed", Value{1.0}}}, "goto_a", {"PrAutoMove.xml", 3, 9}),
                     Catch::Contains("PrAutoMove.xml:3:9") && Catch::Contains("unknown parameter 'speed'"));
-  CHECK_THROWS_WITH(loop.set_lock("nope", true, 0ms), Catch::Contains("no coordinator lock named 'nope'"));
+  CHECK_THROWS_WITH(loop.set_lock("nope", true, Time{0ms}), Catch::Contains("no coordinator lock named 'nope'"));
 }
 
 TEST_CASE("Behavior outcomes become supervisor events; a failure carries its reason") {
@@ -197,14 +197,14 @@ TEST_CASE("Several loops with different periods are stepped by simulated time, i
   SimLoopDriver driver(clock);
   driver.add(a);
   driver.add(b);
-  CHECK(driver.run_until(100ms) == 11 + 5);
+  CHECK(driver.run_until(Time{100ms}) == 11 + 5);
   CHECK(a.cycles() == 11);  // 0, 10, ..., 100 ms
   CHECK(b.cycles() == 5);   // 0, 25, 50, 75, 100 ms
-  CHECK(a.last_cycle().now == 100ms);
-  CHECK(b.last_cycle().now == 100ms);
-  CHECK(clock.now() == 100ms);
-  CHECK(driver.run_until(105ms) == 0);
-  CHECK(clock.now() == 105ms);
+  CHECK(a.last_cycle().now == Time{100ms});
+  CHECK(b.last_cycle().now == Time{100ms});
+  CHECK(clock.now() == Time{100ms});
+  CHECK(driver.run_until(Time{105ms}) == 0);
+  CHECK(clock.now() == Time{105ms});
   CHECK(driver.run_for(5ms) == 1);  // fast at 110 ms
 }
 
@@ -213,10 +213,10 @@ namespace {
 // A clock whose sleeps return at once at the deadline: the runner's timing becomes deterministic.
 class JumpClock final : public Clock {
  public:
-  Time now() const noexcept override { return Time{t_.load()}; }
+  Time now() const noexcept override { return time_from_ns(t_.load()); }
   void sleep_until(Time deadline) const noexcept override {
     Time::rep cur = t_.load();
-    while (deadline.count() > cur && !t_.compare_exchange_weak(cur, deadline.count())) {
+    while (to_ns(deadline) > cur && !t_.compare_exchange_weak(cur, to_ns(deadline))) {
     }
   }
   void advance(Duration d) const noexcept { t_.fetch_add(d.count()); }
@@ -280,8 +280,8 @@ TEST_CASE("The runner keeps absolute deadlines and skips the ticks an overrun mi
   // The behavior joins at the first cycle (1 ms); cycles run at 1, 2, ... ms. Cycle index 5
   // (at 6 ms) ends at 8.5 ms: ticks 7 and 8 ms are skipped, the next cycle runs at 9 ms.
   for (int i = 0; i <= 5; ++i) CHECK(rec.times[static_cast<std::size_t>(i)] == Time{(i + 1) * 1ms});
-  CHECK(rec.times[6] == 9ms);
-  CHECK(rec.times[7] == 10ms);
+  CHECK(rec.times[6] == Time{9ms});
+  CHECK(rec.times[7] == Time{10ms});
   const LoopStatistics& s = runner.statistics();
   CHECK(s.overruns() == 1);
   CHECK(s.skipped_ticks() == 2);

@@ -35,22 +35,22 @@ TEST_CASE("A reading is fresh until it is older than max_age") {
   CHECK_FALSE(laser.has_reading());
   CHECK(laser.is_stale(clock.now()));
   LaserScan s;
-  s.stamp = 10ms;
+  s.stamp = Time{10ms};
   s.ranges_m = {1.0f, 2.0f};
   laser.publish(s);
   CHECK(laser.has_reading());
-  CHECK(laser.stamp() == 10ms);
+  CHECK(laser.stamp() == Time{10ms});
   CHECK(laser.sequence() == 1);
-  clock.set(110ms);
+  clock.set(Time{110ms});
   CHECK(laser.is_fresh(clock.now()));
-  clock.set(111ms);
+  clock.set(Time{111ms});
   CHECK(laser.is_stale(clock.now()));
   CHECK(laser.latest().ranges_m.size() == 2);
   // A reading stamped after now (driver clock ahead) is fresh.
-  CHECK(laser.is_fresh(5ms));
+  CHECK(laser.is_fresh(Time{5ms}));
   // max_age 0: never stale once a reading exists.
   laser.set_max_age(0ms);
-  CHECK(laser.is_fresh(1000s));
+  CHECK(laser.is_fresh(Time{1000s}));
 }
 
 TEST_CASE("Publishing a reading of the same size reuses storage") {
@@ -60,15 +60,15 @@ TEST_CASE("Publishing a reading of the same size reuses storage") {
   laser.publish(s);
   const float* storage = laser.latest().ranges_m.data();
   s.ranges_m.assign(720, 2.0f);
-  s.stamp = 1ms;
+  s.stamp = Time{1ms};
   laser.publish(s);
   CHECK(laser.latest().ranges_m.data() == storage);
   CHECK(laser.latest().ranges_m[5] == 2.0f);
   // Drivers may fill in place.
   laser.edit().ranges_m[0] = 7.0f;
-  laser.edit().stamp = 2ms;
+  laser.edit().stamp = Time{2ms};
   laser.commit();
-  CHECK(laser.stamp() == 2ms);
+  CHECK(laser.stamp() == Time{2ms});
   CHECK(laser.sequence() == 3);
 }
 
@@ -89,16 +89,16 @@ TEST_CASE("Drivers publish from poll(); the table finds resources by name and re
   CHECK(table.first<GyroReading>() == nullptr);
   CHECK(table.find("odom") == &odom);
 
-  table.poll_all(5ms);
+  table.poll_all(Time{5ms});
   CHECK_FALSE(bumpers.has_reading());
   bumpers.device_mask = 0b0101;
   bumpers.device_has_data = true;
-  table.poll_all(6ms);
+  table.poll_all(Time{6ms});
   CHECK(bumpers.latest().any());
   CHECK(bumpers.latest().pressed_mask == 5);
-  CHECK(bumpers.stamp() == 6ms);
-  CHECK(bumpers.is_fresh(56ms));
-  CHECK(bumpers.is_stale(57ms));
+  CHECK(bumpers.stamp() == Time{6ms});
+  CHECK(bumpers.is_fresh(Time{56ms}));
+  CHECK(bumpers.is_stale(Time{57ms}));
 }
 
 TEST_CASE("Every reading kind has a resource manifest naming what it provides") {

@@ -198,6 +198,15 @@ TEST_CASE("The robot refuses to start with every problem listed", "[robot]") {
       CHECK_THAT(m, Catch::Contains("cleaning.yaml:15:15: error: unknown process 'PrCleaning'"));
     }
   }
+  SECTION("a process module net the planner cannot compose") {
+    Catalog c;
+    std::string yaml = profile(kResources, kNavigation, kBehaviors);
+    const std::string entry = "{name: PrAutoMove, net: ../petri/PrAutoMove.xml}";
+    yaml.replace(yaml.find(entry), entry.size(), "{name: PrAutoMove, net: ../petri/PrAutoMove.xml, module: ../petri/PrCleaning-module.xml}");
+    REQUIRE_THROWS_WITH(Robot::assemble(load_robot_profile_from_string(yaml, "testbot.yaml", kRobots), c.plugins, clock),
+                        Catch::Contains("PrCleaning-module.xml:15:3: error: process module of PrAutoMove: place 'P1' runs process "
+                                        "'PrCleaning'; the module's executing place must run 'PrAutoMove'"));
+  }
   SECTION("a layering violation") {
     Catalog c;
     const std::string yaml = profile(kResources, kNavigation, kBehaviors,

@@ -23,7 +23,7 @@ TEST_CASE("The PSR-2 robot's reactive loop allocates nothing over 10,000 periods
   const auto robot = Robot::assemble(load_robot_profile(configs / "robots/psr2.yaml"), plugins, clock);
   REQUIRE(robot->command("clean the room 3211").accepted);
   // Into the first section's coverage, past the first seconds of it.
-  while (!robot->behavior_active("BhCleaning") && clock.now() < from_seconds(300)) robot->run_for(std::chrono::milliseconds(100));
+  while (!robot->behavior_active("BhCleaning") && clock.now() < time_from_seconds(300)) robot->run_for(std::chrono::milliseconds(100));
   REQUIRE(robot->behavior_active("BhCleaning"));
   robot->run_for(std::chrono::seconds(20));
 

@@ -56,7 +56,7 @@ bool at_time(double t, double x) { return t > x - 0.05 && t < x + 0.05; }
 
 TEST_CASE("PSR-2 assembles from its profile with the paper's nets", "[robot]") {
   Psr2 p;
-  CHECK(p.robot->processes().names() == std::vector<std::string>{"PrAutoMove", "PrCleaning", "PrGlobalLocalization"});
+  CHECK(p.robot->processes().names() == std::vector<std::string>{"PrAutoMove", "PrCleaning", "PrGlobalLocalization", "PrWait"});
   CHECK(p.robot->module("localizer") != nullptr);
   CHECK(p.robot->module("BhCleaning") == nullptr);
   CHECK(p.robot->modules().size() == 5);

@@ -171,9 +171,9 @@ TEST_CASE("LaserModel: known distances in a box room, with the mounting offset a
   c.beams = 1440;  // a beam every 0.25 degrees: 0, 90, 180, 270 degrees are beams
   LaserModel laser(c, 1);
   LaserScan scan;
-  laser.scan(m, {2.0, 1.5, 0.0}, Time{5}, scan);
+  laser.scan(m, {2.0, 1.5, 0.0}, time_from_ns(5), scan);
   REQUIRE(scan.ranges_m.size() == 1440);
-  CHECK(scan.stamp == Time{5});
+  CHECK(scan.stamp == time_from_ns(5));
   // Beam i is at -pi + i * 0.25 deg: 720 -> 0, 1080 -> +90, 0 -> 180, 360 -> -90.
   CHECK(scan.ranges_m[720] == Approx(2.0).margin(1e-5));
   CHECK(scan.ranges_m[1080] == Approx(1.5).margin(1e-5));
@@ -185,7 +185,7 @@ TEST_CASE("LaserModel: known distances in a box room, with the mounting offset a
   // Facing +y, and a scanner mounted 0.1 m ahead of the base centre.
   c.mount = {0.1, 0.0, 0.0};
   LaserModel mounted(c, 1);
-  mounted.scan(m, {2.0, 1.5, kPi / 2.0}, Time{0}, scan);
+  mounted.scan(m, {2.0, 1.5, kPi / 2.0}, Time{}, scan);
   CHECK(scan.ranges_m[720] == Approx(1.4).margin(1e-5));   // ahead: +y, from y = 1.6
   CHECK(scan.ranges_m[1080] == Approx(1.95).margin(1e-5)); // left: -x
   CHECK(scan.ranges_m[360] == Approx(2.0).margin(1e-5));   // right: +x
@@ -197,7 +197,7 @@ TEST_CASE("LaserModel: scan fields match the configured sensor", "[sim][laser]")
   SECTION("RPLIDAR A1") {
     const LaserConfig c = LaserConfig::rplidar_a1();
     LaserModel laser(c, 3);
-    laser.scan(m, {2.0, 1.5, 0.3}, Time{0}, scan);
+    laser.scan(m, {2.0, 1.5, 0.3}, Time{}, scan);
     CHECK(scan.ranges_m.size() == 1450);
     CHECK(scan.angle_min_rad == Approx(-kPi));
     CHECK(scan.angle_increment_rad == Approx(2.0 * kPi / 1450.0));
@@ -217,7 +217,7 @@ TEST_CASE("LaserModel: scan fields match the configured sensor", "[sim][laser]")
   SECTION("SICK 180") {
     const LaserConfig c = LaserConfig::sick_180();
     LaserModel laser(c, 3);
-    laser.scan(m, {2.0, 1.5, 0.0}, Time{0}, scan);
+    laser.scan(m, {2.0, 1.5, 0.0}, Time{}, scan);
     CHECK(scan.ranges_m.size() == 361);
     CHECK(scan.angle_min_rad == Approx(-kPi / 2));
     CHECK(scan.angle_max_rad == Approx(kPi / 2));
@@ -233,11 +233,11 @@ TEST_CASE("LaserModel: seeded Gaussian range noise, range limits", "[sim][laser]
   LaserConfig c = LaserConfig::rplidar_a1();
   c.noise_stddev_m = 0.02;
   LaserScan exact, a, b, other;
-  LaserModel(c, 1).scan_exact(m, {2.0, 1.5, 0.0}, Time{0}, exact);
+  LaserModel(c, 1).scan_exact(m, {2.0, 1.5, 0.0}, Time{}, exact);
   LaserModel la(c, 9), lb(c, 9), lo(c, 10);
-  la.scan(m, {2.0, 1.5, 0.0}, Time{0}, a);
-  lb.scan(m, {2.0, 1.5, 0.0}, Time{0}, b);
-  lo.scan(m, {2.0, 1.5, 0.0}, Time{0}, other);
+  la.scan(m, {2.0, 1.5, 0.0}, Time{}, a);
+  lb.scan(m, {2.0, 1.5, 0.0}, Time{}, b);
+  lo.scan(m, {2.0, 1.5, 0.0}, Time{}, other);
   CHECK(a == b);
   CHECK_FALSE(a == other);
   double sum = 0.0, sum2 = 0.0;
@@ -256,13 +256,13 @@ TEST_CASE("LaserModel: seeded Gaussian range noise, range limits", "[sim][laser]
   near.range_min_m = 1.6;
   near.range_max_m = 1.9;
   LaserModel ln(near, 1);
-  ln.scan(m, {2.0, 1.5, 0.0}, Time{0}, a);
+  ln.scan(m, {2.0, 1.5, 0.0}, Time{}, a);
   const std::size_t ahead = 725, left = 1087;  // 0 and ~90 degrees of 1450 beams
   CHECK(std::isinf(a.ranges_m[ahead]));  // 2.0 > range_max
   LaserScan s2;
-  ln.scan(m, {2.0, 1.2, 0.0}, Time{0}, s2);
+  ln.scan(m, {2.0, 1.2, 0.0}, Time{}, s2);
   CHECK(s2.ranges_m[left] == Approx(1.8).margin(2e-3));   // within [1.6, 1.9]
-  ln.scan(m, {2.0, 1.5, 0.0}, Time{0}, s2);
+  ln.scan(m, {2.0, 1.5, 0.0}, Time{}, s2);
   CHECK(std::isinf(s2.ranges_m[left]));  // about 1.5 < range_min
 }
 
@@ -283,8 +283,8 @@ TEST_CASE("LaserModel: on the demo workspace, jumping rays see what cell-by-cell
     for (double x = 0.7; x < 9.8; x += 1.3) {
       if (jumping.disc_overlaps({x, y}, 0.2)) continue;
       const Pose2D p{x, y, 0.1 * poses};
-      laser.scan_exact(jumping, p, Time{0}, a);
-      laser.scan_exact(plain, p, Time{0}, b);
+      laser.scan_exact(jumping, p, Time{}, a);
+      laser.scan_exact(plain, p, Time{}, b);
       for (std::size_t i = 0; i < a.ranges_m.size(); ++i) {
         if (std::isinf(b.ranges_m[i])) REQUIRE(std::isinf(a.ranges_m[i]));
         else REQUIRE(a.ranges_m[i] == Approx(b.ranges_m[i]).margin(1e-5));

@@ -24,7 +24,7 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-Time at(double s) { return from_seconds(s); }
+Time at(double s) { return time_from_seconds(s); }
 
 void run(Simulator& sim, double seconds, Duration dt = 10ms) {
   const Time end = sim.now() + from_seconds(seconds);
@@ -442,7 +442,7 @@ TEST_CASE("RealtimePacer: sleeps on the injected clock until wall time matches s
   RealtimePacer paced(wall);
   runner.set_pacer(&paced);
   runner.run_for(1s);
-  CHECK(wall.now() == at(100.5) + at(1.0) - at(0.05));  // the first period only starts the pacing
+  CHECK(wall.now() == at(100.5) + from_seconds(1.0) - from_seconds(0.05));  // the first period only starts the pacing
   CHECK(sim.now() == at(1.0));
 }
 

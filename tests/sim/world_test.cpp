@@ -52,15 +52,15 @@ TEST_CASE("load_world: the demo workspace", "[sim][world]") {
   const World f = load_world(kWorlds + "workspace_faults.yaml");
   REQUIRE(f.obstacles.size() == 1);
   CHECK(f.obstacles[0].name == "cart");
-  CHECK(f.obstacles[0].appear == from_seconds(30.0));
-  CHECK(f.obstacles[0].disappear == from_seconds(400.0));
+  CHECK(f.obstacles[0].appear == time_from_seconds(30.0));
+  CHECK(f.obstacles[0].disappear == time_from_seconds(400.0));
   CHECK(f.obstacles[0].polygon.size() == 4);
   REQUIRE(f.faults.localization_loss.size() == 1);
-  CHECK(f.faults.localization_loss[0] == navi::LocalizationFault{from_seconds(60.0), from_seconds(70.0)});
+  CHECK(f.faults.localization_loss[0] == navi::LocalizationFault{time_from_seconds(60.0), time_from_seconds(70.0)});
   REQUIRE(f.faults.dead_sensors.size() == 1);
   CHECK(f.faults.dead_sensors[0].sensor == SensorKind::laser);
-  CHECK(f.faults.dead_sensors[0].start == from_seconds(90.0));
-  CHECK(f.faults.dead_sensors[0].end == from_seconds(92.0));
+  CHECK(f.faults.dead_sensors[0].start == time_from_seconds(90.0));
+  CHECK(f.faults.dead_sensors[0].end == time_from_seconds(92.0));
 
   // The workspace's scan from the start pose: every beam inside 12 m returns off the walls.
   Simulator sim(w, omni3_base(), w.seed);
@@ -123,10 +123,10 @@ faults:
   CHECK(w.drops[0].name == "2111");
   CHECK(w.drops[1].polygon.size() == 4);
   REQUIRE(w.obstacles.size() == 1);
-  CHECK(w.obstacles[0].appear == std::chrono::milliseconds(12500));
+  CHECK(w.obstacles[0].appear == Time{std::chrono::milliseconds(12500)});
   CHECK_FALSE(w.obstacles[0].disappear.has_value());
   REQUIRE(w.faults.localization_loss.size() == 1);
-  CHECK(w.faults.localization_loss[0].end == from_seconds(20.0));
+  CHECK(w.faults.localization_loss[0].end == time_from_seconds(20.0));
   CHECK(w.faults.dead_sensors.at(0).sensor == SensorKind::bumpers);
 }
 

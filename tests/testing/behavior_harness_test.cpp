@@ -78,7 +78,7 @@ TEST_CASE("harness: BhAvoidObstacle keeps a cruising behavior away from the exce
   CHECK_FALSE(too_fast);
   CHECK_THAT(too_fast.explanation, Contains("exceeds the limits (|vx| <= 0.5") && Contains("vx 0.6 m/s"));
   CHECK(run.never_fails("BhAvoidObstacle"));
-  CHECK(run.status_at("BhAvoidObstacle", 60s) == BehaviorStatus::running);
+  CHECK(run.status_at("BhAvoidObstacle", Time{60s}) == BehaviorStatus::running);
 }
 
 TEST_CASE("harness: the obstacle helper fails on a behavior that drives blind", "[testing][harness]") {
@@ -107,20 +107,20 @@ TEST_CASE("harness: succeeds_before and events of a behavior that finishes", "[t
   h.attach(std::make_unique<test::BhStopAtWall>(), {{"stop_distance_m", Value{1.0}}});
   const RunLog& run = h.run(std::nullopt, /*stop_when_done=*/true);
   // Clearances ahead: 1.775 m in the scan of 32.91 s, 0.73 m in the scan of 35.11 s.
-  const CheckResult ok = run.succeeds_before("BhStopAtWall", 36s);
+  const CheckResult ok = run.succeeds_before("BhStopAtWall", Time{36s});
   INFO(ok);
   CHECK(ok);
-  const CheckResult late = run.succeeds_before("BhStopAtWall", 35s);
+  const CheckResult late = run.succeeds_before("BhStopAtWall", Time{35s});
   CHECK_FALSE(late);
   CHECK_THAT(late.explanation, Contains("succeeded at t=35.1") && Contains("after 35.000 s"));
-  CHECK(run.event_before("BhStopAtWall.done", 36s));
-  CHECK_FALSE(run.event_before("BhStopAtWall.done", 35s));
-  CHECK_FALSE(run.event_before("BhStopAtWall.failed", 200s));
+  CHECK(run.event_before("BhStopAtWall.done", Time{36s}));
+  CHECK_FALSE(run.event_before("BhStopAtWall.done", Time{35s}));
+  CHECK_FALSE(run.event_before("BhStopAtWall.failed", Time{200s}));
   CHECK(run.never_fails("BhStopAtWall"));
   // stop_when_done: the run ended at the success, long before the trace.
   CHECK(to_seconds(run.steps().back().t) < 36.0);
-  CHECK(run.status_at("BhStopAtWall", 30s) == BehaviorStatus::running);
-  CHECK(run.status_at("BhStopAtWall", 40s) == BehaviorStatus::succeeded);
+  CHECK(run.status_at("BhStopAtWall", Time{30s}) == BehaviorStatus::running);
+  CHECK(run.status_at("BhStopAtWall", Time{40s}) == BehaviorStatus::succeeded);
 }
 
 TEST_CASE("harness: helpers report a failing behavior and unknown names", "[testing][harness]") {
@@ -132,17 +132,17 @@ TEST_CASE("harness: helpers report a failing behavior and unknown names", "[test
   const CheckResult never = run.never_fails("BhStopAtWall");
   CHECK_FALSE(never);
   CHECK_THAT(never.explanation, Contains("failed at t=0.000 s: no laser resource"));
-  const CheckResult succ = run.succeeds_before("BhStopAtWall", 100s);
+  const CheckResult succ = run.succeeds_before("BhStopAtWall", Time{100s});
   CHECK_FALSE(succ);
   CHECK_THAT(succ.explanation, Contains("failed at") && Contains("no laser resource"));
-  const CheckResult unknown = run.succeeds_before("BhNope", 100s);
+  const CheckResult unknown = run.succeeds_before("BhNope", Time{100s});
   CHECK_FALSE(unknown);
   CHECK_THAT(unknown.explanation, Contains("no behavior named 'BhNope'") && Contains("BhStopAtWall"));
   // A behavior that never finishes is reported with its last status.
   BehaviorHarness h2;
   h2.load_trace(excerpt.file.path());
   h2.attach(std::make_unique<test::BhBlindCruise>());
-  const CheckResult never_done = h2.run(h2.start_time() + 2s).succeeds_before("BhBlindCruise", 100s);
+  const CheckResult never_done = h2.run(h2.start_time() + 2s).succeeds_before("BhBlindCruise", Time{100s});
   CHECK_FALSE(never_done);
   CHECK_THAT(never_done.explanation, Contains("never succeeded in 41 steps") && Contains("last status: running"));
 }
@@ -209,7 +209,7 @@ TEST_CASE("harness: damaged traces are refused at load with the byte offset, a c
   ExcerptTrace excerpt;
   const auto bytes = trace::test::read_all(excerpt.file.path());
   std::vector<std::uint64_t> offsets;
-  Time stamp_of_last_whole{0};
+  Time stamp_of_last_whole{};
   {
     trace::TraceReader r(excerpt.file.path());
     trace::TraceRecord rec;

@@ -35,7 +35,7 @@ std::shared_ptr<const sim::World> workspace() {
 struct Recording {
   std::vector<trace::CommandRecord> commands;
   Pose2D start, end;
-  Time finished{0};
+  Time finished{};
   bool succeeded = false;
 };
 
@@ -65,7 +65,7 @@ Recording record_patrol(const std::filesystem::path& out) {
   robot->run_until(clock.now());
   sample();
   REQUIRE(robot->command(kTask).accepted);
-  while (robot->planner().busy() && clock.now() < from_seconds(120.0)) {
+  while (robot->planner().busy() && clock.now() < time_from_seconds(120.0)) {
     robot->run_for(10ms);
     sample();
     recorder.record_command(clock.now(), robot->behavior_loop().last_cycle().coordinator.command, "coordinator");
@@ -78,7 +78,7 @@ Recording record_patrol(const std::filesystem::path& out) {
   }
   writer.close();
   rec.succeeded = robot->planner().report().state == TaskState::succeeded;
-  rec.finished = robot->planner().report().finished.value_or(Time{0});
+  rec.finished = robot->planner().report().finished.value_or(Time{});
   rec.end = sim.pose();
   return rec;
 }
@@ -145,7 +145,7 @@ TEST_CASE("robot harness, replay: a trace cut before the goal does not let the t
     trace::TraceRecord r;
     std::map<trace::ChannelId, trace::ChannelId> ids;
     while (reader.next(r)) {
-      if (trace::stamp_of(r.data) > from_seconds(5.0)) break;
+      if (trace::stamp_of(r.data) > time_from_seconds(5.0)) break;
       if (!ids.contains(r.channel)) {
         const trace::ChannelInfo& c = reader.channel(r.channel);
         ids[r.channel] = writer.add_channel(c.name, c.kind);
@@ -156,11 +156,11 @@ TEST_CASE("robot harness, replay: a trace cut before the goal does not let the t
   }
   testing::RobotHarness h(testing::RobotHarness::Mode::replay, psr2(), RobotPlugins::with_builtins(), cut.path(), options());
   REQUIRE(h.command(kTask).accepted);
-  const testing::RunLog& log = h.run(from_seconds(60.0));
+  const testing::RunLog& log = h.run(time_from_seconds(60.0));
   // The replay ends with the trace, the robot still on its way.
-  CHECK(h.now() <= from_seconds(5.0) + 20ms);
+  CHECK(h.now() <= time_from_seconds(5.0) + 20ms);
   CHECK(h.robot().planner().busy());
-  const testing::CheckResult r = log.event_before("task.succeeded", from_seconds(60.0));
+  const testing::CheckResult r = log.event_before("task.succeeded", time_from_seconds(60.0));
   CHECK_FALSE(r);
   CHECK_THAT(r.explanation, Contains("never happened"));
   CHECK(log.status_at("BhAutoMove", h.now()) == BehaviorStatus::running);

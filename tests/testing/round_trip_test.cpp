@@ -157,9 +157,9 @@ TEST_CASE("recorder: writes each reading once per publish, with its own stamp, a
     CHECK(rec.watch(laser) == 0);
     CHECK(rec.watch(odom) == 1);
     CHECK_THROWS_AS(rec.watch(laser), std::invalid_argument);  // name already declared
-    CHECK_THROWS_AS(rec.record_command(Time{0}, Twist2D{}, "x"), std::logic_error);
-    CHECK_THROWS_AS(rec.record_event(Time{0}, "x"), std::logic_error);
-    CHECK(rec.record(Time{0}) == 0);  // nothing published yet
+    CHECK_THROWS_AS(rec.record_command(Time{}, Twist2D{}, "x"), std::logic_error);
+    CHECK_THROWS_AS(rec.record_event(Time{}, "x"), std::logic_error);
+    CHECK(rec.record(Time{}) == 0);  // nothing published yet
     LaserScan s;
     s.stamp = Time{5ms};
     s.ranges_m = {1.0f, 2.0f};

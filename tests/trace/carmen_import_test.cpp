@@ -71,7 +71,7 @@ TEST_CASE("the Intel excerpt imports with the counts of its lines") {
   CHECK(im.report.skipped.at("NEFF") == 29);
   // Each FLASER is followed by an ODOM stamped 0 (the corrected pose): those step backwards.
   CHECK(im.report.backwards_steps == 117);
-  CHECK(im.report.first_stamp == from_seconds(0.000246));
+  CHECK(im.report.first_stamp == time_from_seconds(0.000246));
 }
 
 TEST_CASE("FLASER beams follow CARMEN's angle convention and keep their ranges") {
@@ -89,7 +89,7 @@ TEST_CASE("FLASER beams follow CARMEN's angle convention and keep their ranges")
   CHECK(s.ranges_m[1] == 1.66f);
   CHECK(s.ranges_m[90] == 1.15f);
   CHECK(s.ranges_m[179] == 2.15f);
-  CHECK(s.stamp == from_seconds(35.1051));
+  CHECK(s.stamp == time_from_seconds(35.1051));
   CHECK(im.laser_poses[1].pose == Pose2D{0.68231, -0.100086, -0.938803});
   CHECK(im.laser_poses[1].stamp == s.stamp);
   // 81.83 m readings (no return on the Intel SICK) lie beyond range_max: "no return" by contract.
@@ -106,17 +106,17 @@ TEST_CASE("ODOM lines become odometry readings with twist; backwards stamps are 
   const auto it = std::find_if(im.odometry.begin(), im.odometry.end(),
                                [](const auto& o) { return o.pose.x_m == 0.600266; });
   REQUIRE(it != im.odometry.end());
-  CHECK(it->stamp == from_seconds(33.1085));
+  CHECK(it->stamp == time_from_seconds(33.1085));
   CHECK(std::prev(it)->pose == Pose2D{0.698035, -0.0132843, -0.460915});
-  CHECK(std::prev(it)->stamp == from_seconds(33.1085));
-  CHECK(im.scans[0].stamp == from_seconds(33.1085));
+  CHECK(std::prev(it)->stamp == time_from_seconds(33.1085));
+  CHECK(im.scans[0].stamp == time_from_seconds(33.1085));
   for (std::size_t i = 1; i < im.odometry.size(); ++i) CHECK(im.odometry[i].stamp >= im.odometry[i - 1].stamp);
 
   const Imported t = import_text("ODOM 1 2 0.5 0.3 -0.1 0 10.5 host 10.5\n");
   REQUIRE(t.odometry.size() == 1);
   CHECK(t.odometry[0].pose == Pose2D{1, 2, 0.5});
   CHECK(t.odometry[0].twist == Twist2D{0.3, 0.0, -0.1});
-  CHECK(t.odometry[0].stamp == from_seconds(10.5));
+  CHECK(t.odometry[0].stamp == time_from_seconds(10.5));
 }
 
 TEST_CASE("the gzip-compressed excerpt imports like the plain one") {
@@ -140,7 +140,7 @@ TEST_CASE("ROBOTLASER1 uses the scanner configuration of the line") {
   CHECK(s.range_max_m == 30.0);
   CHECK(s.ranges_m == std::vector<float>{1, 2, 3, 4, 5});
   CHECK(s.intensities == std::vector<float>{10, 20, 30, 40, 50});
-  CHECK(s.stamp == from_seconds(1234.5));
+  CHECK(s.stamp == time_from_seconds(1234.5));
   CHECK(im.laser_poses[0].pose == Pose2D{1.0, 2.0, 0.1});
 }
 

@@ -53,7 +53,7 @@ Outcome read_damaged(const std::filesystem::path& path) {
 std::vector<std::uint8_t> small_trace(const std::filesystem::path& path, std::vector<std::uint64_t>& ends) {
   {
     TraceWriter w(path);
-    const auto records = one_of_each(Time{123456789});
+    const auto records = one_of_each(time_from_ns(123456789));
     for (const auto& r : records) {
       const auto id = w.add_channel(std::string(to_string(kind_of(r))), kind_of(r));
       w.write(id, r);

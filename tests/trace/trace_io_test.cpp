@@ -15,7 +15,7 @@ namespace {
 // Writes one record of every kind, each on its own channel, plus a second laser channel.
 std::vector<RecordData> write_sample(const std::filesystem::path& path) {
   TraceWriter w(path);
-  const auto records = one_of_each(Time{1'700'000'000'000'000'000});
+  const auto records = one_of_each(time_from_ns(1'700'000'000'000'000'000));
   std::vector<ChannelId> ids;
   for (const auto& r : records) {
     ids.push_back(w.add_channel("ch_" + std::string(to_string(kind_of(r))), kind_of(r)));
@@ -55,7 +55,7 @@ TEST_CASE("every reading kind survives a write/read round trip") {
 
 TEST_CASE("a NaN range keeps its bits") {
   TempFile file("nan");
-  LaserScan scan = sample_scan(5ms, 10);
+  LaserScan scan = sample_scan(Time{5ms}, 10);
   scan.ranges_m[3] = std::nanf("");
   {
     TraceWriter w(file.path());
@@ -75,11 +75,11 @@ TEST_CASE("several channels of the same kind keep their names") {
     TraceWriter w(file.path());
     const auto front = w.add_channel("front_laser", ChannelKind::kLaser);
     const auto rear = w.add_channel("rear_laser", ChannelKind::kLaser);
-    w.write(front, sample_scan(1ms, 4));
-    w.write(rear, sample_scan(2ms, 6));
+    w.write(front, sample_scan(Time{1ms}, 4));
+    w.write(rear, sample_scan(Time{2ms}, 6));
     // A channel can be declared in the middle of a recording.
     const auto late = w.add_channel("late_odom", ChannelKind::kOdometry);
-    w.write(late, OdometryReading{3ms, {}, {}});
+    w.write(late, OdometryReading{Time{3ms}, {}, {}});
   }
   TraceReader r(file.path());
   const auto recs = read_everything(r);
@@ -95,7 +95,7 @@ TEST_CASE("the writer refuses records its channel does not carry") {
   TempFile file("contract");
   TraceWriter w(file.path());
   const auto odom = w.add_channel("odom", ChannelKind::kOdometry);
-  CHECK_THROWS_WITH(w.write(odom, sample_scan(0ms, 3)), Catch::Contains("carries odometry records, not laser"));
+  CHECK_THROWS_WITH(w.write(odom, sample_scan(Time{0ms}, 3)), Catch::Contains("carries odometry records, not laser"));
   CHECK_THROWS_WITH(w.write(ChannelId{7}, OdometryReading{}), Catch::Contains("channel 7 is not declared"));
   CHECK_THROWS_WITH(w.add_channel("odom", ChannelKind::kLaser), Catch::Contains("'odom' is already declared"));
   CHECK_THROWS_AS(w.add_channel("", ChannelKind::kLaser), std::invalid_argument);
@@ -111,8 +111,8 @@ TEST_CASE("a trace larger than the reader's buffer streams through it") {
     const auto laser = w.add_channel("front_laser", ChannelKind::kLaser);
     const auto odom = w.add_channel("odom", ChannelKind::kOdometry);
     for (int i = 0; i < kScans; ++i) {
-      w.write(laser, sample_scan(Time{i * 100'000'000LL}, 360));
-      w.write(odom, OdometryReading{Time{i * 100'000'000LL + 1}, Pose2D{0.01 * i, 0, 0}, {}});
+      w.write(laser, sample_scan(time_from_ns(i * 100'000'000LL), 360));
+      w.write(odom, OdometryReading{time_from_ns(i * 100'000'000LL + 1), Pose2D{0.01 * i, 0, 0}, {}});
     }
     CHECK(w.records_written() == 2 * kScans);
   }
@@ -125,8 +125,8 @@ TEST_CASE("a trace larger than the reader's buffer streams through it") {
   int odoms = 0;
   while (r.next(rec)) {
     if (const auto* s = std::get_if<LaserScan>(&rec.data)) {
-      CHECK(s->stamp == Time{scans * 100'000'000LL});
-      CHECK(s->ranges_m.back() == sample_scan(0ms, 360).ranges_m.back());
+      CHECK(s->stamp == time_from_ns(scans * 100'000'000LL));
+      CHECK(s->ranges_m.back() == sample_scan(Time{0ms}, 360).ranges_m.back());
       ++scans;
     } else {
       CHECK(std::get<OdometryReading>(rec.data).pose.x_m == 0.01 * odoms);
@@ -244,7 +244,7 @@ TEST_CASE("a recorder killed mid-write leaves a readable trace") {
   // writer is still open, as if the process had been killed at that moment.
   TraceWriter w(file.path(), TraceWriterOptions{.flush_every_records = 2});
   const auto odom = w.add_channel("odom", ChannelKind::kOdometry);
-  for (int i = 0; i < 5; ++i) w.write(odom, OdometryReading{Time{i}, Pose2D{1.0 * i, 0, 0}, {}});
+  for (int i = 0; i < 5; ++i) w.write(odom, OdometryReading{time_from_ns(i), Pose2D{1.0 * i, 0, 0}, {}});
   TempFile snapshot("killed_snapshot");
   const auto on_disk = read_all(file.path());
   write_all(snapshot.path(), on_disk, on_disk.size());

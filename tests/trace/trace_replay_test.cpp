@@ -28,7 +28,7 @@ class RecordingSink final : public TraceSink {
 
  private:
   void add(const ChannelInfo& c, const std::string& what, Time t) {
-    got.push_back(c.name + ":" + what + "@" + std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(t).count()));
+    got.push_back(c.name + ":" + what + "@" + std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(t.time_since_epoch()).count()));
   }
 };
 
@@ -47,13 +47,13 @@ TEST_CASE("advance_to delivers every record stamped at or before t, in order, to
   }
   TraceReplay replay(open(file));
   RecordingSink sink;
-  CHECK(replay.start_time() == 1000ms);
+  CHECK(replay.start_time() == Time{1000ms});
   CHECK(replay.next_stamp() == Time{1000ms});
-  CHECK(replay.advance_to(999ms, sink) == 0);
-  CHECK(replay.advance_to(1002ms, sink) == 3);
+  CHECK(replay.advance_to(Time{999ms}, sink) == 0);
+  CHECK(replay.advance_to(Time{1002ms}, sink) == 3);
   CHECK(sink.got == std::vector<std::string>{"laser:laser@1000", "odometry:odometry@1001", "sonar:sonar@1002"});
-  CHECK(replay.advance_to(1002ms, sink) == 0);
-  CHECK(replay.advance_to(2000ms, sink) == 6);
+  CHECK(replay.advance_to(Time{1002ms}, sink) == 0);
+  CHECK(replay.advance_to(Time{2000ms}, sink) == 6);
   CHECK(sink.got.back() == "event:event:bumper_hit@1008");
   CHECK(sink.got[7] == "command:command:BhAvoidObstacle@1007");
   CHECK(replay.finished());
@@ -87,14 +87,14 @@ TEST_CASE("out-of-order stamps are delivered in file order and counted") {
   {
     TraceWriter w(file.path());
     const auto ev = w.add_channel("events", ChannelKind::kEvent);
-    w.write(ev, EventRecord{10ms, "a"});
-    w.write(ev, EventRecord{30ms, "b"});
-    w.write(ev, EventRecord{20ms, "c"});
-    w.write(ev, EventRecord{40ms, "d"});
+    w.write(ev, EventRecord{Time{10ms}, "a"});
+    w.write(ev, EventRecord{Time{30ms}, "b"});
+    w.write(ev, EventRecord{Time{20ms}, "c"});
+    w.write(ev, EventRecord{Time{40ms}, "d"});
   }
   TraceReplay replay(open(file));
   RecordingSink sink;
-  CHECK(replay.advance_to(35ms, sink) == 3);
+  CHECK(replay.advance_to(Time{35ms}, sink) == 3);
   CHECK(sink.got == std::vector<std::string>{"events:event:a@10", "events:event:b@30", "events:event:c@20"});
   CHECK(replay.out_of_order() == 1);
 }

@@ -1,5 +1,6 @@
 // `tripodal-net check FILE...`: loads each net and reports every error and structural warning,
-// then runs the deadlock and outcome checks of the state-space analysis on nets small enough.
+// then runs the deadlock and outcome checks of the state-space analysis on nets small enough, and
+// checks recovery rules against the process nets (rules no net's fault can match).
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -10,6 +11,7 @@
 #include "cli_tool.hpp"
 #include "net_tool_util.hpp"
 #include "tripodal/analysis/analyzer.hpp"
+#include "tripodal/planner/recovery.hpp"
 
 namespace tripodal::net_tool {
 namespace {
@@ -23,7 +25,10 @@ constexpr std::string_view kDescription =
     "A net that loads is then explored with its default parameters, every event order included\n"
     "(docs/analysis.md): a reachable deadlock, or a reachable marking from which no outcome place\n"
     "can be reached, is an error. Nets with more than 200000 reachable states, or parameters\n"
-    "without defaults, get a note instead (use tripodal-net analyze).";
+    "without defaults, get a note instead (use tripodal-net analyze).\n"
+    "With --recovery RULES.yaml, the recovery rules are checked against the low-level nets given\n"
+    "(a net's id is its process name): a rule whose fault message none of them can post, or that\n"
+    "names or inserts a process without a net, is an error.";
 
 constexpr std::string_view kExitCodes =
     "exit codes: 0 every net is valid (warnings allowed), 1 a net has errors, 2 bad command line,\n"
@@ -31,6 +36,7 @@ constexpr std::string_view kExitCodes =
 
 struct Args {
   std::vector<std::string> inputs;
+  std::vector<std::filesystem::path> recovery_files;
   bool no_warnings = false;
   bool no_behaviour = false;
 };
@@ -47,7 +53,7 @@ std::string file_head(const std::filesystem::path& file) {
 
 // Checks one net file: the loader's diagnostics, then the behavioural checks on a net that loaded.
 FileStatus check_file(const std::filesystem::path& file, const LoadOptions& options, bool behaviour,
-                      std::ostream& out, std::ostream& err) {
+                      std::vector<PetriNet>& loaded, std::ostream& out, std::ostream& err) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec)) {
     err << file.string() << ": error: cannot open file\n";
@@ -84,7 +90,18 @@ FileStatus check_file(const std::filesystem::path& file, const LoadOptions& opti
   if (warnings > 0) out << ", " << warnings << " warning(s)";
   if (behaviour) out << (checked ? "; no deadlock, no marking that cannot reach an outcome" : "; behaviour not checked");
   out << ")\n";
+  loaded.push_back(*net);
   return FileStatus::valid;
+}
+
+FileStatus check_recovery(const std::filesystem::path& file, const std::vector<PetriNet>& nets, std::ostream& out,
+                          std::ostream& err) {
+  Diagnostics diagnostics;
+  check_recovery_file(file, nets, diagnostics);
+  err << diagnostics.str();
+  if (diagnostics.has_errors()) out << file.string() << ": " << diagnostics.error_count() << " error(s)\n";
+  else out << file.string() << ": ok (every rule can match a fault of the nets)\n";
+  return diagnostics.has_errors() ? FileStatus::invalid : FileStatus::valid;
 }
 
 int run_check(const Args& args, std::ostream& out, std::ostream& err) {
@@ -116,11 +133,13 @@ int run_check(const Args& args, std::ostream& out, std::ostream& err) {
     return kUsage;
   }
   bool invalid = false;
+  std::vector<PetriNet> loaded;
   for (const auto& f : files) {
-    const FileStatus s = check_file(f, options, behaviour, out, err);
+    const FileStatus s = check_file(f, options, behaviour, loaded, out, err);
     unreadable = unreadable || s == FileStatus::unreadable;
     invalid = invalid || s == FileStatus::invalid;
   }
+  for (const auto& f : args.recovery_files) invalid = check_recovery(f, loaded, out, err) == FileStatus::invalid || invalid;
   if (unreadable) return kIoError;
   return invalid ? kBadInput : kOk;
 }
@@ -131,6 +150,9 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_flag("--no-warnings", a->no_warnings,
                "leave out the structural warnings (places never marked, transitions never enabled)");
   cmd.add_flag("--no-behaviour", a->no_behaviour, "skip the deadlock and outcome checks");
+  cmd.add_option("--recovery", a->recovery_files,
+                 "RULES.yaml: also check these recovery rules against the low-level nets given (repeatable)")
+      ->allow_extra_args(false);
   return [a](std::ostream& out, std::ostream& err) { return run_check(*a, out, err); };
 }
 

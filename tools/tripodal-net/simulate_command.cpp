@@ -36,7 +36,7 @@ int run_simulate(const Args& args, std::ostream& out, std::ostream& err) {
   const std::vector<std::string>& params = args.params;
   const std::optional<std::string>& events = args.events;
   SimulationOptions options;
-  options.end_time = from_seconds(args.until_s);
+  options.end_time = time_from_seconds(args.until_s);
   options.stop_at_outcome = !args.no_stop;
   options.allow_unknown_events = args.allow_unknown_events;
   for (const auto& path : {std::optional<std::string>(file), events}) {

@@ -26,7 +26,7 @@ struct Navigation {
 
 /// One 10 Hz sample of the run: the simulator's true pose and the robot's estimate.
 struct TrajectorySample {
-  Time t{0};
+  Time t{};
   Pose2D truth;
   Pose2D estimate;
   bool localized = false;

@@ -219,7 +219,7 @@ RunResult run_task(const RunOptions& o) {
   std::vector<Point2D> path_all, path_cleaning;
   const double half_width = nav.coverage->cleaning_width_m() / 2.0;
   const Duration tick_period = robot->behavior_loop().period();
-  const Time deadline = from_seconds(o.max_duration_s);
+  const Time deadline = time_from_seconds(o.max_duration_s);
   bool was_cleaning = false;
   Pose2D last_truth = sim.pose();
   double next_progress_s = 0.0;

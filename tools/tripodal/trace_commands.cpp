@@ -18,6 +18,7 @@ using namespace tripodal::trace;
 using namespace cli;
 
 std::string seconds(Time t) { return format_seconds(t, 6); }
+std::string seconds(Duration d) { return format_seconds(d, 6); }
 
 // ---------------------------------------------------------------------------------------------
 constexpr std::string_view kImportDescription =
@@ -112,8 +113,8 @@ int with_reader(const std::string& path, std::ostream& err, const std::function<
 int trace_info(const std::string& path, std::ostream& out, std::ostream& err) {
   std::map<ChannelId, std::uint64_t> per_channel;
   std::uint64_t records = 0;
-  Time first{0};
-  Time last{0};
+  Time first{};
+  Time last{};
   std::uint64_t backwards = 0;
   // Counted while reading so that a corrupt tail still shows what came before it.
   const auto report = [&](TraceReader& r) {

@@ -35,7 +35,7 @@ class ObstacleMap {
 /// whoever set it (the loop copies it into a fixed-capacity buffer when path_id changes).
 struct NavigationData {
   Pose2D map_from_base;      ///< pose estimate in the map frame
-  Time pose_stamp{0};
+  Time pose_stamp{};
   bool localized = false;    ///< the localizer trusts map_from_base
   std::uint32_t fixes = 0;   ///< global position fixes accepted so far (BhGlobalLocalization)
   bool has_goal = false;
@@ -64,7 +64,7 @@ struct NavigationFeedback {
   double progress_m = 0.0;    ///< arc length reached along it
   bool reached_end = false;   ///< at the end of the path
   bool blocked = false;       ///< stopped by an obstacle the map does not hold, or a bumper
-  Time blocked_since{0};
+  Time blocked_since{};
   friend bool operator==(const NavigationFeedback&, const NavigationFeedback&) = default;
 };
 
@@ -81,7 +81,7 @@ struct VelocityEnvelope {
 /// What a behavior can see during activation and each step. Built by the control loop; holds
 /// references only, so building and passing it allocates nothing.
 struct BehaviorContext {
-  Time now{0};
+  Time now{};
   Duration period{0};                 ///< nominal sampling period of the loop
   const ResourceTable* resources = nullptr;
   const NavigationData* navi = nullptr;

@@ -56,7 +56,7 @@ using LockId = std::uint32_t;
 
 /// What update() produced.
 struct CoordinatorOutput {
-  Time stamp{0};
+  Time stamp{};
   Twist2D command;               ///< explicit zero when nothing is live
   std::string_view winner;       ///< priority: winning input; weighted: "weighted_sum"; "" if none
   std::optional<InputId> winner_id;
@@ -123,13 +123,13 @@ class CBehaviorCoordinator final {
     bool has_envelope = false;
     Twist2D command;
     VelocityEnvelope envelope;
-    Time stamp{0};
+    Time stamp{};
   };
   struct LockState {
     CoordinatorLockConfig config;
     bool has_message = false;
     bool engaged = false;
-    Time stamp{0};
+    Time stamp{};
   };
 
   CoordinationMode mode_;

@@ -41,7 +41,7 @@ class BhRotateInPlace final : public CBehavior {
   Duration stale_timeout_{0};
   bool started_ = false;
   double last_yaw_ = 0.0, turned_rad_ = 0.0;
-  Time stale_since_{0};
+  Time stale_since_{};
   bool stale_ = false;
 };
 
@@ -68,10 +68,10 @@ class BhGoToPose final : public CBehavior {
   double max_speed_ = 0.0, max_yaw_rate_ = 0.0, pos_tol_ = 0.0, heading_tol_ = 0.0;
   double k_rho_ = 0.0, k_alpha_ = 0.0;
   Duration timeout_{0}, stale_timeout_{0};
-  Time started_{0};
+  Time started_{};
   bool position_reached_ = false;
   bool stale_ = false;
-  Time stale_since_{0};
+  Time stale_since_{};
 };
 
 /// Backs straight off by distance_m at speed_m_s (after a bump), then optionally turns by
@@ -93,7 +93,7 @@ class BhBackOff final : public CBehavior {
   Pose2D start_;
   double last_yaw_ = 0.0, turned_rad_ = 0.0;
   bool stale_ = false;
-  Time stale_since_{0};
+  Time stale_since_{};
 };
 
 /// Laser-based safety override (configure its coordinator input with role safety). Every period

@@ -106,9 +106,9 @@ class CPathFollowingBehavior : public CBehavior {
   std::vector<float> cos_, sin_;
   double table_angle_min_ = 0.0, table_increment_ = 0.0;
   std::uint32_t path_id_ = 0;  ///< the path being tracked; 0: none yet
-  Time waiting_since_{0};      ///< activation, for the "no path" timeout
+  Time waiting_since_{};      ///< activation, for the "no path" timeout
   bool blocked_ = false;
-  Time blocked_since_{0};
+  Time blocked_since_{};
 };
 
 /// Moves to a named goal (parameter goal: "<section>.entry", a map node, a room or a section)
@@ -184,7 +184,7 @@ class BhGlobalLocalization final : public CBehavior {
  private:
   double yaw_rate_ = 0.5;
   Duration timeout_{0};
-  Time started_{0};
+  Time started_{};
   std::uint32_t fixes_at_start_ = 0;
 };
 

@@ -133,9 +133,9 @@ class CController {
  private:
   Duration nominal_period_;
   Twist2D command_;
-  Time command_stamp_{0};
+  Time command_stamp_{};
   bool has_command_ = false;
-  Time last_update_{0};
+  Time last_update_{};
   bool has_updated_ = false;
   Twist2D limited_;
   OdometryReading odometry_;

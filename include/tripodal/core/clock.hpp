@@ -35,8 +35,8 @@ class SteadyClock final : public Clock {
 /// Simulated time that only moves when told to; starts at `start` (default 0).
 class SimClock final : public Clock {
  public:
-  explicit SimClock(Time start = Time{0}) noexcept : now_(start.count()) {}
-  [[nodiscard]] Time now() const noexcept override { return Time{now_.load(std::memory_order_acquire)}; }
+  explicit SimClock(Time start = Time{}) noexcept : now_(to_ns(start)) {}
+  [[nodiscard]] Time now() const noexcept override { return time_from_ns(now_.load(std::memory_order_acquire)); }
   /// Moves the time forward by `d` (a negative `d` is ignored: the clock is monotonic).
   void advance(Duration d) noexcept;
   /// Sets the time to `t` if `t` is not earlier than now; returns false (and keeps now) otherwise.

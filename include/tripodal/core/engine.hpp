@@ -41,7 +41,7 @@ struct EngineOptions {
   std::size_t max_firings_per_instant = 100'000;
   /// The engine's time before the first step; transitions enabled by the initial marking count
   /// their delay from here.
-  Time start_time{0};
+  Time start_time{};
 };
 
 /// Tokens taken from and put into one place by one firing.
@@ -53,7 +53,7 @@ struct PlaceChange {
 
 /// One firing as observers see it. Views are valid during the observer call only.
 struct Firing {
-  Time time{0};
+  Time time{};
   TransitionIndex transition = 0;
   std::string_view transition_id;
   std::string_view event;                ///< the event it consumed; empty if none

@@ -14,7 +14,7 @@ namespace tripodal {
 
 struct ScriptEntry {
   enum class Kind { event, set_fact };
-  Time time{0};
+  Time time{};
   Kind kind = Kind::event;
   std::string name;        ///< the event, or the fact to set
   std::string value_text;  ///< set_fact: the value as written (quotes removed)

@@ -11,7 +11,7 @@
 namespace tripodal {
 
 struct RecordedFiring {
-  Time time{0};
+  Time time{};
   TransitionIndex transition = 0;
   std::string transition_id;
   std::string event;  ///< empty when the transition has no event

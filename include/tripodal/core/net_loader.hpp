@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/core/petri_net.hpp"
@@ -44,6 +45,11 @@ void save_net(const PetriNet& net, const std::filesystem::path& file);
 /// The text save_net writes: NetFormat::pnml gives PNML (ISO 2009 P/T net), anything else the
 /// native XML format. Throws ConfigError when the net cannot be represented.
 [[nodiscard]] std::string net_to_string(const PetriNet& net, NetFormat format);
+
+/// Places some firing sequence might mark, by a fixpoint that ignores guards, inhibitors,
+/// capacities and events (a transition fires once every place it consumes from or reads is
+/// markable): false is certain, true is not a proof. Indexed by PlaceIndex.
+[[nodiscard]] std::vector<bool> structurally_markable(const PetriNet& net);
 
 /// The structural warnings load_net adds (when LoadOptions::structural_warnings): places that no
 /// transition can ever mark and transitions that can never be enabled, ignoring guards,

@@ -13,7 +13,7 @@
 namespace tripodal {
 
 struct SimulationOptions {
-  Time end_time = from_seconds(3600.0);  ///< stop here at the latest
+  Time end_time = time_from_seconds(3600.0);  ///< stop here at the latest
   bool stop_at_outcome = true;           ///< stop once an outcome place is marked
   /// false: a script event no transition of the net waits for is an error (likely a typo).
   bool allow_unknown_events = false;
@@ -24,7 +24,7 @@ struct SimulationOptions {
 struct TraceEntry {
   enum class Kind { firing, fact_set, event_dropped, error };
   Kind kind = Kind::firing;
-  Time time{0};
+  Time time{};
   TransitionIndex transition = 0;  ///< firing
   std::string name;                ///< transition id, fact name or event name
   std::string detail;              ///< firing: description; fact_set: value; error: message
@@ -36,7 +36,7 @@ struct SimulationResult {
   std::vector<TraceEntry> trace;
   StepStatus status = StepStatus::ok;  ///< livelock ends the simulation
   std::string error;
-  Time end_time{0};  ///< the engine's time when the simulation stopped
+  Time end_time{};  ///< the engine's time when the simulation stopped
   Outcome outcome = Outcome::none;
   std::string outcome_place;
   std::string fault_message;

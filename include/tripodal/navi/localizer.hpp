@@ -1,8 +1,9 @@
 // CLocalizer, the localizer navigation module for simulation (sequencing layer): it estimates the
 // robot's pose from a ground-truth source (the simulator) with seeded noise and an injectable
 // fault schedule, and posts localizer.ok / localizer.lost when its estimate starts or stops
-// agreeing with the actual position, the events PrCleaning's nets wait for (paper, Table 1:
-// t2, t3). A scan-matching localizer would post the same events from its own consistency test.
+// agreeing with the actual position, the events the process PrCleaning's low-level net waits for
+// (paper, Fig. 3 / Table 2: t2 and t3; PrAutoMove.xml's t1 and t2 alike). A scan-matching
+// localizer would post the same events from its own consistency test.
 #pragma once
 
 #include <cstdint>
@@ -29,8 +30,8 @@ class GroundTruthSource {
 
 /// A window of localization loss: from start (inclusive) to end (exclusive).
 struct LocalizationFault {
-  Time start{0};
-  Time end{0};
+  Time start{};
+  Time end{};
   friend bool operator==(const LocalizationFault&, const LocalizationFault&) = default;
 };
 
@@ -102,13 +103,13 @@ class CLocalizer final : public CNaviModules {
   bool corrupted_ = false;      // the estimate is off by offset_ until relocalized
   Pose2D offset_;
   std::optional<Pose2D> estimate_;
-  Time stamp_{0};
+  Time stamp_{};
   double error_m_ = 0.0;
   // Global localization while the behavior it serves (BhGlobalLocalization) is active.
   std::string serves_ = "BhGlobalLocalization";
   bool searching_ = false;
   Duration attempt_period_{0};
-  Time last_attempt_{0};
+  Time last_attempt_{};
   std::uint32_t fixes_ = 0;
 };
 

@@ -42,7 +42,7 @@ class ObstacleReplanner {
   Duration after_{0};
   int max_ = 0;
   int attempts_ = 0;
-  Time last_{0};
+  Time last_{};
   std::vector<Point2D> seen_;
 };
 

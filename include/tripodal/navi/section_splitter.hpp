@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -67,8 +68,10 @@ struct SectionSet {
 ///
 /// As a navigation module (type "SectionSplitter") its parameters are the option fields (same
 /// names); it splits the map of the robot's GridMaps at start and answers the planner's question
-/// sections(room). split() may be called without configure() with the options given to the
-/// constructor.
+/// sections(room): the room's sections nearest first from the robot's pose when the localizer
+/// trusts it (order_nearest_first; paper, section 5.1: the order of the processes follows the
+/// initial position), else in scan order. split() may be called without configure() with the
+/// options given to the constructor.
 class CSectionSplitter final : public CNaviModules {
  public:
   explicit CSectionSplitter(SectionSplitterOptions options = {}) : options_(options) {}
@@ -100,5 +103,33 @@ class CSectionSplitter final : public CNaviModules {
   const OccupancyGrid* grid_ = nullptr;
   const RegionMap* regions_ = nullptr;
 };
+
+/// The order in which to visit sections, and the path length of each leg.
+struct SectionOrder {
+  std::vector<int> ids;        ///< section ids, the first to visit first
+  /// legs_m[k]: grid path length to ids[k] (to its nearest cell) from the start point (k = 0) or
+  /// from where the robot is taken to end the previous section (k > 0); +infinity when no path
+  /// of free cells leads there (such sections come last, in the order given).
+  std::vector<double> legs_m;
+};
+
+/// Nearest uncleaned section next (paper, sections 3.1 and 5.1: the order of the PrCleaning
+/// processes "changed according to the robot's initial position"): from `from`, the next section
+/// is the one whose nearest cell is the fewest metres of grid path away; the robot is then taken
+/// to be at that section's centre (its cell nearest the centroid: the balloon coverage spirals
+/// inward from the walls and ends inside), and so on. A greedy tour, not an optimal one, as the
+/// paper's planner does it. Grid path distance (8-connected free cells, diagonals only between
+/// two free side cells) rather than straight-line distance because a section behind a wall is
+/// not near; one Dijkstra per leg, stopped at the first section it reaches, so a leg costs the
+/// cells nearer than that section (bench/navi, BM_OrderSectionsNearestFirst). A start outside the
+/// free cells starts from the nearest free cell. Ties go to the id given first. `grid` is the
+/// grid `set` was split from; ids not in `set` are ignored.
+[[nodiscard]] SectionOrder order_nearest_first(const OccupancyGrid& grid, const SectionSet& set, std::span<const int> ids,
+                                               Point2D from);
+
+/// The same over section names ("A", "B", ...), as the planner's knowledge answers them; names
+/// that are not sections of `set` keep their place at the end.
+[[nodiscard]] std::vector<std::string> order_nearest_first(const OccupancyGrid& grid, const SectionSet& set,
+                                                           std::span<const std::string> names, Point2D from);
 
 }  // namespace tripodal::navi

@@ -13,7 +13,7 @@
 namespace tripodal {
 
 struct LifecycleEntry {
-  Time time{0};
+  Time time{};
   std::string text;
 };
 

@@ -26,14 +26,14 @@ namespace tripodal {
 struct ProcessRecord {
   std::string run;      ///< the high-level net's executing place, e.g. "X1"
   ProcessStep step;     ///< the process and its plan parameters
-  Time started{0};
+  Time started{};
   std::optional<Time> finished;
   bool success = false;
   std::string message;  ///< fault message
 };
 
 struct RecoveryRecord {
-  Time time{0};
+  Time time{};
   std::string failed_process;
   std::string fault;   ///< the fault message
   std::string reason;  ///< the decision, e.g. "fault \"localization fault\" of PrCleaning: insert PrGlobalLocalization, then retry (1/2)"
@@ -50,7 +50,7 @@ struct TaskReport {
   TaskState state = TaskState::idle;
   std::string reason;   ///< why it failed
   std::string initial_plan;
-  Time started{0};
+  Time started{};
   std::optional<Time> finished;
   std::vector<ProcessRecord> processes;
   std::vector<RecoveryRecord> recoveries;

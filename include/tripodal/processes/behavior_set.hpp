@@ -54,7 +54,7 @@ class BehaviorSet final : public BehaviorHost {
   struct Entry {
     std::unique_ptr<CBehavior> behavior;
     mutable std::uint64_t seen_steps = 0;  // steps() when last reported
-    mutable Time last_step{0};             // clock time at which a new step was first seen
+    mutable Time last_step{};             // clock time at which a new step was first seen
   };
   const Clock& clock_;
   const BehaviorContext* context_ = nullptr;

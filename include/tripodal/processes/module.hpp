@@ -29,7 +29,7 @@ class CModule;
 
 /// An event a module posts: the name a net's transition waits for ("localizer.lost"), and why.
 struct ModuleEvent {
-  Time stamp{0};
+  Time stamp{};
   std::string name;
   std::string message;  ///< for logs and fault messages
   friend bool operator==(const ModuleEvent&, const ModuleEvent&) = default;
@@ -39,7 +39,7 @@ struct ModuleEvent {
 struct BehaviorActivation {
   std::string_view behavior;      ///< "BhAutoMove"
   const ParameterValues& params;  ///< as the net gives them (text literals not yet typed)
-  Time now{0};
+  Time now{};
   const ModuleManifest* manifest = nullptr;  ///< the behavior type's, to type the parameters
 
   /// The parameters typed and completed with the manifest's defaults (ConfigError when they do
@@ -75,7 +75,7 @@ class ModuleDirectory {
 /// the robot; events, facts and the heartbeat are handed to the process supervisor under the
 /// module's name after the call.
 struct ModuleContext {
-  Time now{0};
+  Time now{};
   const ResourceTable* resources = nullptr;      ///< the reactive loop's sensors (read, never written)
   NavigationData* navigation = nullptr;          ///< what the reactive loop's behaviors will see next
   NavigationFeedback feedback;                   ///< what the path-following behavior reported last

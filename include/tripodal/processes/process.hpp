@@ -5,6 +5,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -25,8 +26,8 @@ struct ProcessResult {
   bool success = false;
   std::string message;  ///< the fault message ("localization fault"); empty on success
   std::string place;    ///< the outcome place reached; empty when the fault did not come from the net
-  Time started{0};
-  Time finished{0};
+  Time started{};
+  Time finished{};
 };
 
 /// What configuration says about one process: its net, configured parameter values (text, typed
@@ -35,6 +36,11 @@ struct ProcessDefinition {
   std::string name;
   std::string type = "net";  ///< the registered factory that builds it; "net" is a plain CProcess
   PetriNet net;
+  /// Its process module in high-level configuration (paper, Fig. 2: configs/petri/
+  /// PrCleaning-module.xml), which the planner composes into the plan's net; none: the default
+  /// module of that shape (planner/plan.hpp, default_module_net). Its shape is the planner's
+  /// business (check_module_net, run when the robot is assembled and when a plan is composed).
+  std::optional<PetriNet> module;
   std::vector<BindingParam> parameters;
   std::vector<RecoveryRule> recovery;
   SourceLocation where;
@@ -70,6 +76,8 @@ class CProcess {
   [[nodiscard]] const ModuleManifest& manifest() const noexcept { return manifest_; }
   [[nodiscard]] const std::string& type() const noexcept { return definition_.type; }
   [[nodiscard]] const PetriNet& net() const noexcept { return definition_.net; }
+  /// The configured process module net; nullptr when the default is used.
+  [[nodiscard]] const PetriNet* module() const noexcept { return definition_.module ? &*definition_.module : nullptr; }
   [[nodiscard]] const std::vector<RecoveryRule>& recovery() const noexcept { return definition_.recovery; }
   [[nodiscard]] const std::vector<BindingParam>& configured_parameters() const noexcept { return definition_.parameters; }
   [[nodiscard]] const SourceLocation& where() const noexcept { return definition_.where; }

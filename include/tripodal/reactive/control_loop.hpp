@@ -44,7 +44,7 @@ struct LoopEvent {
     controller_recovered,  ///< the next cycle without a fault: "<loop>.controller_recovered"
   };
   Kind kind = Kind::behavior_succeeded;
-  Time stamp{0};
+  Time stamp{};
   BehaviorHandle handle;
   std::string_view behavior;  ///< behavior type name, e.g. "BhGoToPose"
   std::string_view input;     ///< coordinator input it was bound to
@@ -65,7 +65,7 @@ struct ControlLoopOptions {
 
 /// The result of one cycle.
 struct CycleReport {
-  Time now{0};
+  Time now{};
   CoordinatorOutput coordinator;
   ControlStatus controller_status = ControlStatus::ok;
   std::uint32_t active_behaviors = 0;
@@ -166,7 +166,7 @@ class ControlLoop final {
   struct PendingLock {
     LockId lock = 0;
     bool engaged = false;
-    Time stamp{0};
+    Time stamp{};
   };
 
   void apply_pending() noexcept;

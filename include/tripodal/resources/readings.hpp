@@ -12,7 +12,7 @@ namespace tripodal {
 
 /// Wheel odometry (or fused odometry): pose in the odom frame and body-frame twist.
 struct OdometryReading {
-  Time stamp{0};
+  Time stamp{};
   Pose2D pose;    ///< odom_from_base
   Twist2D twist;  ///< body frame
   friend bool operator==(const OdometryReading&, const OdometryReading&) = default;
@@ -22,7 +22,7 @@ struct OdometryReading {
 /// angle_min_rad + i * angle_increment_rad in the scanner frame; a range outside
 /// [range_min_m, range_max_m] (or not finite) means no return.
 struct LaserScan {
-  Time stamp{0};  ///< time of the first beam
+  Time stamp{};  ///< time of the first beam
   double angle_min_rad = 0.0;
   double angle_max_rad = 0.0;
   double angle_increment_rad = 0.0;
@@ -37,7 +37,7 @@ struct LaserScan {
 
 /// A ring or row of ultrasonic range finders, one range per transducer.
 struct SonarReading {
-  Time stamp{0};
+  Time stamp{};
   double field_of_view_rad = 0.0;
   double range_min_m = 0.0;
   double range_max_m = 0.0;
@@ -47,7 +47,7 @@ struct SonarReading {
 
 /// Infrared sensors: downward cliff detectors (true = no floor seen) and sideways wall ranges.
 struct InfraredReading {
-  Time stamp{0};
+  Time stamp{};
   std::vector<std::uint8_t> cliff;  ///< 1 = cliff detected under that sensor
   std::vector<float> wall_ranges_m;
   friend bool operator==(const InfraredReading&, const InfraredReading&) = default;
@@ -55,7 +55,7 @@ struct InfraredReading {
 
 /// Bumper switches; bit i of pressed_mask is bumper i.
 struct BumperReading {
-  Time stamp{0};
+  Time stamp{};
   std::uint32_t count = 0;
   std::uint32_t pressed_mask = 0;
   [[nodiscard]] bool any() const noexcept { return pressed_mask != 0; }
@@ -63,7 +63,7 @@ struct BumperReading {
 };
 
 struct BatteryReading {
-  Time stamp{0};
+  Time stamp{};
   double voltage_v = 0.0;
   double current_a = 0.0;   ///< positive when charging
   double percentage = 0.0;  ///< state of charge, 0..1 (as ROS BatteryState)
@@ -73,7 +73,7 @@ struct BatteryReading {
 
 /// A single-axis (yaw) rate gyro, as the optical-fibre gyros of the PSR robots.
 struct GyroReading {
-  Time stamp{0};
+  Time stamp{};
   double yaw_rate_rad_s = 0.0;
   double yaw_rad = 0.0;  ///< integrated heading, if the device provides it
   friend bool operator==(const GyroReading&, const GyroReading&) = default;

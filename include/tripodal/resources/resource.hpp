@@ -69,7 +69,7 @@ class CResource {
  private:
   std::string name_;
   Duration max_age_;
-  Time stamp_{0};
+  Time stamp_{};
   bool has_reading_ = false;
   std::size_t sequence_ = 0;
 };

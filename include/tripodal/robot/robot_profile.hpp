@@ -48,10 +48,12 @@ struct ProcessEntry {
   std::string name;
   std::string type = "net";                 ///< process factory type
   std::filesystem::path net;                ///< resolved against the profile's directory
+  std::filesystem::path module;             ///< optional: its process module net (high-level, Fig. 2)
   std::vector<BindingParam> parameters;     ///< configured values, located
   std::filesystem::path recovery;           ///< optional: this process's own recovery rules
   SourceLocation where;
   SourceLocation net_where;
+  SourceLocation module_where;
 };
 
 struct RobotProfile {

@@ -44,7 +44,7 @@ struct SimEvent {
     battery_empty,
   };
   Kind kind = Kind::collision;
-  Time stamp{0};
+  Time stamp{};
   std::string detail;  ///< obstacle or sensor name; "at (x, y)" of a collision
 };
 [[nodiscard]] std::string_view to_string(SimEvent::Kind kind) noexcept;
@@ -57,7 +57,7 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   /// is configured. `seed` drives every noise source (one independent stream per sensor). Time
   /// starts at `start`, the robot at world.start_pose, and every sensor publishes a first reading
   /// at `start`. Throws ConfigError (at base.where) for an invalid base configuration.
-  Simulator(World world, const ControllerConfig& base, std::uint64_t seed, Time start = Time{0});
+  Simulator(World world, const ControllerConfig& base, std::uint64_t seed, Time start = Time{});
   ~Simulator() override;
   Simulator(const Simulator&) = delete;
   Simulator& operator=(const Simulator&) = delete;
@@ -136,7 +136,7 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
  private:
   struct Schedule {
     Duration period{0};
-    Time next{0};
+    Time next{};
   };
   void substep(Duration dt) noexcept;
   void update_faults() noexcept;
@@ -159,7 +159,7 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   std::vector<std::uint8_t> outage_active_;
   std::vector<std::uint8_t> loss_active_;
 
-  Time now_{0};
+  Time now_{};
   Pose2D pose_;
   Twist2D velocity_;
   std::vector<double> wheel_cmd_, wheel_vel_, wheel_pos_, wheel_scale_;
@@ -203,8 +203,8 @@ class RealtimePacer final {
   const Clock& wall_;
   double speed_;
   bool started_ = false;
-  Time sim_start_{0};
-  Time wall_start_{0};
+  Time sim_start_{};
+  Time wall_start_{};
 };
 
 /// Runs a Simulator and control loops together on one SimClock. Every physics period the

@@ -120,7 +120,7 @@ struct SimRobotConfig {
 struct DynamicObstacle {
   std::string name;
   std::vector<navi::Point2D> polygon;  ///< map frame; a rectangle is stored as its 4 corners
-  Time appear{0};
+  Time appear{};
   std::optional<Time> disappear;
   SourceLocation where;
 };
@@ -141,8 +141,8 @@ enum class SensorKind : std::uint8_t { laser, odometry, gyro, bumpers, cliff, ba
 /// the last reading, whose age makes CResource::is_stale() true once past the max age.
 struct SensorOutage {
   SensorKind sensor = SensorKind::laser;
-  Time start{0};
-  Time end{0};
+  Time start{};
+  Time end{};
   SourceLocation where;
 };
 

@@ -67,7 +67,7 @@ struct BehaviorSample {
 
 /// One sampling period of a run.
 struct StepRecord {
-  Time t{0};
+  Time t{};
   Twist2D command;  ///< the coordinator's fused command: what the controller would execute
   bool safety_limited = false;
   bool all_expired = false;
@@ -82,7 +82,7 @@ struct StepRecord {
 /// process nets consumed or dropped ("localizer.lost"), "<Process>.started|succeeded|failed",
 /// "task.started|succeeded|failed|refused", "recovery" and "fault:<source>" (detail: the reason).
 struct HarnessEvent {
-  Time t{0};
+  Time t{};
   std::string name;
   std::string detail;
 };
@@ -190,9 +190,9 @@ class BehaviorHarness final {
   const OdometryResource* localization_ = nullptr;
   RunLog log_;
   std::string warning_;
-  Time start_{0};
-  Time now_{0};
-  Time last_record_{0};
+  Time start_{};
+  Time now_{};
+  Time last_record_{};
   bool started_ = false;
 };
 

@@ -39,8 +39,8 @@ struct CarmenImportReport {
   /// message's stamp so the trace is in time order.
   std::uint64_t backwards_steps = 0;
   Duration largest_backwards_step{0};
-  Time first_stamp{0};
-  Time last_stamp{0};
+  Time first_stamp{};
+  Time last_stamp{};
 };
 
 /// Imports the CARMEN log at `path` (plain text, or gzip-compressed: detected from the content).

@@ -45,7 +45,7 @@ struct ChannelInfo {
 
 /// A motion command issued during a run, with the behavior or controller that issued it.
 struct CommandRecord {
-  Time stamp{0};
+  Time stamp{};
   Twist2D twist;
   std::string source;
   friend bool operator==(const CommandRecord&, const CommandRecord&) = default;
@@ -53,7 +53,7 @@ struct CommandRecord {
 
 /// A named event of a run (a net transition fired, a fault raised, a mission step reached).
 struct EventRecord {
-  Time stamp{0};
+  Time stamp{};
   std::string name;
   friend bool operator==(const EventRecord&, const EventRecord&) = default;
 };

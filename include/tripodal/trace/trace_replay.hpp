@@ -80,8 +80,8 @@ class TraceReplay final {
   TraceReplayOptions options_;
   TraceRecord record_;
   bool pending_ = false;
-  Time start_{0};
-  Time last_{0};
+  Time start_{};
+  Time last_{};
   std::uint64_t delivered_ = 0;
   std::uint64_t out_of_order_ = 0;
 };

@@ -18,8 +18,8 @@ namespace tripodal::trace {
 struct TraceSummary {
   std::vector<ChannelInfo> channels;
   bool empty = true;
-  Time first{0};  ///< stamp of the first record (0 for an empty trace)
-  Time last{0};   ///< the latest stamp of a whole record
+  Time first{};  ///< stamp of the first record (0 for an empty trace)
+  Time last{};   ///< the latest stamp of a whole record
   /// Empty, or the reader's warning for a trace cut inside a record: it replays up to `last`.
   std::string warning;
 };

@@ -1,0 +1,70 @@
+// The disinfection robot's hardware as its robot profile names it: type "board", a differential
+// base behind the control board's UART (seed 001). The wheels are the board's motors (speeds out
+// in DRIVE, odometry from its encoders), its sensors are the robot's resources (battery,
+// ultrasonic, cliff infrared, bumpers), and a missing, late or corrupt response makes the wheels
+// refuse writes (the base controller reports a hardware fault) within two control periods.
+#pragma once
+
+#include <memory>
+
+#include "tripodal/board/board_link.hpp"
+#include "tripodal/board/serial_port.hpp"
+#include "tripodal/core/clock.hpp"
+#include "tripodal/hardware/hardware.hpp"
+
+namespace tripodal::board {
+
+struct BoardHardwareConfig {
+  double wheel_radius_m = 0.09;
+  double pulses_per_m = 5000.0;  ///< the board's encoder resolution (FirmwareConfig::pulses_per_m)
+  LinkConfig link;
+};
+
+class BoardHardware final : public CHardware, public HardwareInterface {
+ public:
+  /// Parameters of type "board": port (the tty), baud, pulses_per_m, response_timeout_s, max_missed.
+  static const ModuleManifest& static_manifest();
+  /// Talks over `stream` (not owned; `owned` may hold it).
+  BoardHardware(ByteStream& stream, BoardHardwareConfig config, std::unique_ptr<ByteStream> owned = nullptr);
+  ~BoardHardware() override;
+
+  // HardwareInterface: wheels [left, right].
+  [[nodiscard]] std::size_t wheel_count() const noexcept override { return 2; }
+  /// Takes the speeds for the next DRIVE; false while the link is not synchronised.
+  bool write_wheel_velocities(std::span<const double> wheel_rad_s) noexcept override;
+  /// From the latest DRIVE response; false before one or while the link is lost.
+  bool read_wheel_states(std::span<double> velocity_rad_s, std::span<double> position_rad) noexcept override;
+
+  /// One link cycle (the "board_link" resource's poll calls it every control period).
+  void cycle(Time now) noexcept;
+  /// True once per link loss: what a module posts as `board.link_lost`.
+  [[nodiscard]] bool take_link_lost() noexcept { return link_.take_link_lost(); }
+  [[nodiscard]] BoardLink& link() noexcept { return link_; }
+  /// Queues an actuator command (UV lamp, atomizer, voice, LCD): sent until acknowledged.
+  bool command(Command cmd, std::span<const std::uint8_t> payload) noexcept { return link_.queue(cmd, payload); }
+
+ protected:
+  [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  [[nodiscard]] HardwareInterface& do_wheels() noexcept override { return *this; }
+  void on_add_resources(ResourceTable& table) override;
+
+ private:
+  class LinkResource;
+  void publish(Time now) noexcept;
+
+  std::unique_ptr<ByteStream> owned_;
+  BoardHardwareConfig config_;
+  BoardLink link_;
+  WheelSpeeds speeds_{};
+  std::unique_ptr<LinkResource> link_resource_;
+  BatteryResource battery_{"battery"};
+  SonarResource ultrasonic_{"ultrasonic"};
+  InfraredResource cliff_{"cliff"};
+  BumperResource bumpers_{"bumpers"};
+};
+
+/// Registers the hardware type "board": opens `port` (a tty, e.g. /dev/ttyUSB0 or the
+/// pseudo-terminal tripodal-board-sim prints) raw 8N1.
+void register_board_hardware(HardwareRegistry& registry);
+
+}  // namespace tripodal::board

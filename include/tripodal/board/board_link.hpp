@@ -1,0 +1,128 @@
+// The host side of the control-board link (the navigation board, the master of section 3.3.2):
+// each control period it sends DRIVE with the wheel speeds (and at most one other request: a
+// queued actuator command, or a sensor poll), matches the responses in order, and monitors the
+// link: a missing, late or corrupt response marks the link lost within two control periods. No
+// allocation and no waiting in a cycle; driven by the control loop's time.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "tripodal/board/commands.hpp"
+#include "tripodal/board/frame.hpp"
+#include "tripodal/board/serial_port.hpp"
+#include "tripodal/core/time.hpp"
+
+namespace tripodal::board {
+
+struct LinkConfig {
+  /// A response must be decoded within this of its request (the control period: the next cycle
+  /// checks it).
+  Duration response_timeout{std::chrono::milliseconds(10)};
+  /// Consecutive missing, late or erroneous responses that make the link lost (1: the first).
+  std::uint32_t max_missed = 1;
+  Duration battery_period{std::chrono::seconds(3)};
+  Duration tank_period{std::chrono::seconds(1)};
+  Duration ranges_period{std::chrono::milliseconds(100)};  ///< ultrasonic and infrared, alternately
+};
+
+/// Link statistics, for the report and the tests.
+struct LinkStats {
+  std::uint64_t requests = 0;
+  std::uint64_t responses = 0;
+  std::uint64_t missed = 0;           ///< no response by the timeout (missing or late)
+  std::uint64_t error_responses = 0;  ///< the board answered with an error code
+  std::uint64_t retries = 0;          ///< actuator commands sent again
+  std::uint64_t link_losses = 0;
+  std::uint64_t resyncs = 0;
+  Duration max_round_trip{0};
+  Duration last_round_trip{0};
+  Duration total_round_trip{0};
+};
+
+/// An actuator command waiting for its acknowledgement (never dropped: sent again until acked).
+struct ActuatorCommand {
+  Command cmd = Command::uv_lamp;
+  std::array<std::uint8_t, kMaxLcdText + 1> payload{};
+  std::uint8_t size = 0;
+};
+
+class BoardLink {
+ public:
+  BoardLink(ByteStream& stream, LinkConfig config = {}) noexcept;
+
+  /// One control cycle at `now`: takes the responses that arrived, times out the overdue ones,
+  /// then sends SYNC (link not synchronised) or DRIVE with `speeds` and at most one other request.
+  void cycle(Time now, WheelSpeeds speeds) noexcept;
+
+  /// Queues an actuator command (UV lamp, atomizer, voice, LCD); false when the queue is full.
+  bool queue(Command cmd, std::span<const std::uint8_t> payload) noexcept;
+
+  [[nodiscard]] bool synchronised() const noexcept { return synchronised_; }
+  /// Lost since the last check: true once per loss (the event to post).
+  [[nodiscard]] bool take_link_lost() noexcept;
+  [[nodiscard]] Time link_lost_at() const noexcept { return lost_at_; }
+  /// The latest DRIVE response and when it was received; sensors polled less often.
+  [[nodiscard]] const DriveState& drive() const noexcept { return drive_; }
+  [[nodiscard]] Time drive_stamp() const noexcept { return drive_stamp_; }
+  [[nodiscard]] bool has_drive() const noexcept { return has_drive_; }
+  [[nodiscard]] const BatteryState& battery() const noexcept { return battery_; }
+  [[nodiscard]] bool has_battery() const noexcept { return has_battery_; }
+  [[nodiscard]] std::uint8_t tank_percent() const noexcept { return tank_percent_; }
+  [[nodiscard]] bool tank_empty() const noexcept { return tank_empty_; }
+  [[nodiscard]] std::span<const std::uint16_t> ultrasonic_mm() const noexcept { return {ultrasonic_.data(), ultrasonic_count_}; }
+  [[nodiscard]] std::span<const std::uint16_t> infrared_mm() const noexcept { return {infrared_.data(), infrared_count_}; }
+  [[nodiscard]] std::size_t cliff_count() const noexcept { return cliff_count_; }
+  [[nodiscard]] std::size_t pending_actuator_commands() const noexcept { return queue_size_; }
+  [[nodiscard]] const LinkStats& stats() const noexcept { return stats_; }
+  [[nodiscard]] const DecoderStats& decoder_stats() const noexcept { return decoder_.stats(); }
+
+ private:
+  struct Outstanding {
+    Command cmd = Command::sync;
+    Time sent{};
+    bool actuator = false;  // the queue's front: popped when acknowledged
+  };
+  void receive(Time now) noexcept;
+  void on_frame(const FrameView& frame, Time now) noexcept;
+  void miss(Time now, bool rescan = true) noexcept;
+  void lose(Time now) noexcept;
+  bool send(Command cmd, std::span<const std::uint8_t> payload, Time now, bool actuator) noexcept;
+
+  ByteStream& stream_;
+  LinkConfig config_;
+  FrameDecoder decoder_;
+  std::array<std::uint8_t, 256> rx_{};
+  std::array<std::uint8_t, kMaxFrameBytes> tx_{};
+  std::array<std::uint8_t, 8> sync_frame_{};
+  std::size_t sync_size_ = 0;
+  std::array<Outstanding, 4> outstanding_{};
+  std::size_t outstanding_size_ = 0;
+  std::array<ActuatorCommand, 8> queue_{};
+  std::size_t queue_head_ = 0;
+  std::size_t queue_size_ = 0;
+  bool actuator_in_flight_ = false;
+  std::uint32_t consecutive_missed_ = 0;
+  bool synchronised_ = false;
+  bool lost_pending_ = false;
+  Time lost_at_{};
+  Time next_battery_{}, next_tank_{}, next_ranges_{};
+  bool ranges_toggle_ = false;
+  DriveState drive_{};
+  Time drive_stamp_{};
+  bool has_drive_ = false;
+  BatteryState battery_{};
+  bool has_battery_ = false;
+  std::uint8_t tank_percent_ = 0;
+  bool tank_empty_ = false;
+  std::array<std::uint16_t, kMaxUltrasonic> ultrasonic_{};
+  std::size_t ultrasonic_count_ = 0;
+  std::array<std::uint16_t, 2 * kMaxInfrared> infrared_{};
+  std::size_t infrared_count_ = 0;
+  std::size_t cliff_count_ = 0;
+  LinkStats stats_;
+};
+
+}  // namespace tripodal::board

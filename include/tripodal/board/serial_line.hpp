@@ -1,0 +1,61 @@
+// A simulated UART line between the host and the simulated board, in process and in simulated
+// time: each byte arrives one character time (10 bits at the baud rate: 86.8 us at 115200) after
+// the previous one left, so round trips and link utilisation are those of the real line. Both
+// ends are ByteStreams; nothing blocks (a read returns what has arrived by the clock's now).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "tripodal/board/serial_port.hpp"
+#include "tripodal/core/clock.hpp"
+
+namespace tripodal::board {
+
+class SerialLine {
+ public:
+  /// One direction: a fixed ring of bytes with their arrival times.
+  class End final : public ByteStream {
+   public:
+    bool write(std::span<const std::uint8_t> bytes) noexcept override;
+    std::ptrdiff_t read(std::span<std::uint8_t> out, Time deadline) noexcept override;
+    /// Cuts the line (a board that stops answering): writes are lost until reconnected.
+    void set_connected(bool connected) noexcept { connected_ = connected; }
+    [[nodiscard]] std::uint64_t bytes_sent() const noexcept { return sent_; }
+
+   private:
+    friend class SerialLine;
+    struct Direction {
+      static constexpr std::size_t kCapacity = 8192;
+      std::array<std::uint8_t, kCapacity> bytes{};
+      std::array<Time, kCapacity> arrival{};
+      std::size_t head = 0;
+      std::size_t size = 0;
+      Time line_free{};  // when the transmitter finishes the last queued byte
+    };
+    const Clock* clock_ = nullptr;
+    Duration byte_time_{0};
+    Direction* out_ = nullptr;
+    Direction* in_ = nullptr;
+    bool connected_ = true;
+    std::uint64_t sent_ = 0;
+  };
+
+  SerialLine(const Clock& clock, std::uint32_t baud = 115200) noexcept;
+  SerialLine(const SerialLine&) = delete;
+  SerialLine& operator=(const SerialLine&) = delete;
+
+  [[nodiscard]] End& host() noexcept { return host_; }
+  [[nodiscard]] End& board() noexcept { return board_; }
+  /// One character: start bit, 8 data bits, stop bit.
+  [[nodiscard]] Duration byte_time() const noexcept { return host_.byte_time_; }
+
+ private:
+  End::Direction to_board_;
+  End::Direction to_host_;
+  End host_;
+  End board_;
+};
+
+}  // namespace tripodal::board

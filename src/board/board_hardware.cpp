@@ -1,0 +1,148 @@
+#include "tripodal/board/board_hardware.hpp"
+
+#include <cmath>
+#include <limits>
+#include <typeinfo>
+
+namespace tripodal::board {
+
+// Runs the link once per control cycle: the loop polls its resources at the start of each cycle.
+class BoardHardware::LinkResource final : public CResource {
+ public:
+  explicit LinkResource(BoardHardware& hw) : CResource("board_link", Duration{0}), hw_(hw) {}
+
+ protected:
+  const ModuleManifest& do_manifest() const noexcept override {
+    static const ModuleManifest m = ManifestBuilder("BoardLink", ModuleKind::resource)
+                                        .description("the control board's UART link: one exchange per control period")
+                                        .output("board_link")
+                                        .build();
+    return m;
+  }
+  const std::type_info& do_reading_type() const noexcept override { return typeid(LinkStats); }
+  void on_poll(Time now) noexcept override {
+    hw_.cycle(now);
+    mark_published(now);
+  }
+
+ private:
+  BoardHardware& hw_;
+};
+
+const ModuleManifest& BoardHardware::static_manifest() {
+  static const ModuleManifest m = hardware_manifest(
+      "board", "a differential base behind the disinfection robot's control board (UART, docs/board-protocol.md)",
+      {"odometry", "battery", "sonar", "cliff", "bumpers", "board_link"},
+      {ParameterSpec{"port", ValueType::string, Value{std::string()}, "", "the board's tty (e.g. /dev/ttyUSB0)", {}, {}},
+       ParameterSpec{"baud", ValueType::number, Value{115200.0}, "bit/s", "line rate", 9600.0, 921600.0},
+       ParameterSpec{"pulses_per_m", ValueType::number, Value{5000.0}, "1/m", "encoder pulses per metre of wheel travel", 1.0, 1e6},
+       ParameterSpec{"response_timeout_s", ValueType::number, Value{0.01}, "s", "a response later than this is missed", 0.001, 1.0},
+       ParameterSpec{"max_missed", ValueType::number, Value{1.0}, "", "consecutive missed responses that lose the link", 1.0, 100.0}});
+  return m;
+}
+
+BoardHardware::BoardHardware(ByteStream& stream, BoardHardwareConfig config, std::unique_ptr<ByteStream> owned)
+    : owned_(std::move(owned)), config_(config), link_(stream, config.link), link_resource_(std::make_unique<LinkResource>(*this)) {}
+
+BoardHardware::~BoardHardware() = default;
+
+bool BoardHardware::write_wheel_velocities(std::span<const double> wheel_rad_s) noexcept {
+  if (wheel_rad_s.size() != 2 || !std::isfinite(wheel_rad_s[0]) || !std::isfinite(wheel_rad_s[1])) return false;
+  const auto mm_s = [&](double rad_s) {
+    return static_cast<std::int16_t>(std::clamp(std::lround(rad_s * config_.wheel_radius_m * 1000.0), -32768L, 32767L));
+  };
+  speeds_ = WheelSpeeds{mm_s(wheel_rad_s[0]), mm_s(wheel_rad_s[1])};
+  return link_.synchronised();
+}
+
+bool BoardHardware::read_wheel_states(std::span<double> velocity_rad_s, std::span<double> position_rad) noexcept {
+  if (velocity_rad_s.size() != 2 || position_rad.size() != 2 || !link_.has_drive() || !link_.synchronised()) return false;
+  const EncoderState& e = link_.drive().encoders;
+  const double per_rad = config_.pulses_per_m * config_.wheel_radius_m;  // pulses per radian of wheel
+  position_rad[0] = e.left_pulses / per_rad;
+  position_rad[1] = e.right_pulses / per_rad;
+  velocity_rad_s[0] = e.left_mm_s / 1000.0 / config_.wheel_radius_m;
+  velocity_rad_s[1] = e.right_mm_s / 1000.0 / config_.wheel_radius_m;
+  return true;
+}
+
+void BoardHardware::cycle(Time now) noexcept {
+  link_.cycle(now, speeds_);
+  publish(now);
+}
+
+void BoardHardware::publish(Time now) noexcept {
+  if (link_.has_drive() && link_.drive_stamp() == now) {
+    const std::uint32_t bits = link_.drive().sensors;
+    BumperReading& b = bumpers_.edit();
+    b.stamp = now;
+    b.count = 8;
+    b.pressed_mask = (bits >> kBumpShift) & kSegmentMask;
+    bumpers_.commit();
+    InfraredReading& c = cliff_.edit();
+    c.stamp = now;
+    const std::size_t n = link_.cliff_count() > 0 ? link_.cliff_count() : 3;
+    c.cliff.resize(n);  // the count is fixed after the first reading: no allocation after it
+    for (std::size_t i = 0; i < n; ++i) c.cliff[i] = static_cast<std::uint8_t>((bits >> (kCliffShift + i)) & 1U);
+    const auto ir = link_.infrared_mm();
+    c.wall_ranges_m.resize(ir.size() > n ? ir.size() - n : 0);
+    for (std::size_t i = 0; i < c.wall_ranges_m.size(); ++i) {
+      const std::uint16_t mm = ir[n + i];
+      c.wall_ranges_m[i] = mm == kNoEcho ? std::numeric_limits<float>::infinity() : static_cast<float>(mm) / 1000.0F;
+    }
+    cliff_.commit();
+  }
+  if (link_.has_battery()) {
+    BatteryReading& b = battery_.edit();
+    const BatteryState& s = link_.battery();
+    b.stamp = now;
+    b.percentage = s.percent / 100.0;
+    b.voltage_v = s.voltage_mv / 1000.0;
+    b.charging = s.charging;
+    battery_.commit();
+  }
+  const auto us = link_.ultrasonic_mm();
+  if (!us.empty()) {
+    SonarReading& r = ultrasonic_.edit();
+    r.stamp = now;
+    r.range_min_m = 0.02;
+    r.range_max_m = 4.5;
+    r.field_of_view_rad = 0.26;
+    r.ranges_m.resize(us.size());
+    for (std::size_t i = 0; i < us.size(); ++i) {
+      r.ranges_m[i] = us[i] == kNoEcho ? std::numeric_limits<float>::infinity() : static_cast<float>(us[i]) / 1000.0F;
+    }
+    ultrasonic_.commit();
+  }
+}
+
+void BoardHardware::on_add_resources(ResourceTable& table) {
+  table.add(*link_resource_);  // first: the link runs before the others are read
+  table.add(battery_);
+  table.add(ultrasonic_);
+  table.add(cliff_);
+  table.add(bumpers_);
+}
+
+void register_board_hardware(HardwareRegistry& registry) {
+  registry.add(BoardHardware::static_manifest(), [](const HardwareConfig& c) -> std::unique_ptr<CHardware> {
+    if (c.base == nullptr || c.base->type != "differential") {
+      throw ConfigError(c.where, "hardware 'board' drives a differential base; expected a base controller of type 'differential'");
+    }
+    const std::string& port = c.parameters.string("port");
+    if (port.empty()) throw ConfigError(c.where, "hardware 'board' needs its port: parameters: {port: /dev/ttyUSB0}");
+    // The port's reads are bounded by its own steady clock; the link never waits on them.
+    static const SteadyClock port_clock;
+    auto stream = std::make_unique<SerialPort>(port, port_clock,
+                                               SerialSettings{static_cast<std::uint32_t>(c.parameters.number("baud"))});
+    BoardHardwareConfig config;
+    config.wheel_radius_m = c.base->differential.wheel_radius_m;
+    config.pulses_per_m = c.parameters.number("pulses_per_m");
+    config.link.response_timeout = from_seconds(c.parameters.number("response_timeout_s"));
+    config.link.max_missed = static_cast<std::uint32_t>(c.parameters.number("max_missed"));
+    ByteStream& s = *stream;
+    return std::make_unique<BoardHardware>(s, config, std::move(stream));
+  });
+}
+
+}  // namespace tripodal::board

@@ -1,0 +1,187 @@
+#include "tripodal/board/board_link.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+namespace tripodal::board {
+
+BoardLink::BoardLink(ByteStream& stream, LinkConfig config) noexcept : stream_(stream), config_(config) {}
+
+bool BoardLink::queue(Command cmd, std::span<const std::uint8_t> payload) noexcept {
+  if (queue_size_ == queue_.size() || payload.size() > queue_[0].payload.size()) return false;
+  ActuatorCommand& c = queue_[(queue_head_ + queue_size_) % queue_.size()];
+  c.cmd = cmd;
+  c.size = static_cast<std::uint8_t>(payload.size());
+  if (!payload.empty()) std::memcpy(c.payload.data(), payload.data(), payload.size());
+  ++queue_size_;
+  return true;
+}
+
+bool BoardLink::take_link_lost() noexcept {
+  const bool lost = lost_pending_;
+  lost_pending_ = false;
+  return lost;
+}
+
+void BoardLink::cycle(Time now, WheelSpeeds speeds) noexcept {
+  receive(now);
+  while (outstanding_size_ > 0 && now - outstanding_[0].sent >= config_.response_timeout) miss(now);
+  if (outstanding_size_ > 0) return;  // still waiting within the period: one exchange at a time
+
+  if (!synchronised_) {
+    (void)send(Command::sync, {}, now, false);
+    return;
+  }
+  std::array<std::uint8_t, 4> p{};
+  ByteWriter w(p);
+  pack(w, speeds);
+  (void)send(Command::drive, w.written(), now, false);
+  // At most one other request per period, so the exchange fits the line (docs/board-protocol.md).
+  if (queue_size_ > 0) {
+    const ActuatorCommand& c = queue_[queue_head_];
+    (void)send(c.cmd, std::span<const std::uint8_t>(c.payload.data(), c.size), now, true);
+  } else if (now >= next_battery_) {
+    next_battery_ = now + config_.battery_period;
+    (void)send(Command::battery, {}, now, false);
+  } else if (now >= next_tank_) {
+    next_tank_ = now + config_.tank_period;
+    (void)send(Command::liquid_level, {}, now, false);
+  } else if (now >= next_ranges_) {
+    next_ranges_ = now + config_.ranges_period / 2;
+    ranges_toggle_ = !ranges_toggle_;
+    (void)send(ranges_toggle_ ? Command::ultrasonic : Command::infrared, {}, now, false);
+  }
+}
+
+bool BoardLink::send(Command cmd, std::span<const std::uint8_t> payload, Time now, bool actuator) noexcept {
+  if (outstanding_size_ == outstanding_.size()) return false;
+  const std::size_t n = encode_request(static_cast<std::uint8_t>(cmd), payload, tx_);
+  if (n == 0) return false;
+  if (cmd == Command::sync) {
+    std::memcpy(sync_frame_.data(), tx_.data(), n);
+    sync_size_ = n;
+  }
+  if (!stream_.write(std::span<const std::uint8_t>(tx_.data(), n))) {
+    miss(now);
+    return false;
+  }
+  outstanding_[outstanding_size_++] = Outstanding{cmd, now, actuator};
+  ++stats_.requests;
+  return true;
+}
+
+void BoardLink::receive(Time now) noexcept {
+  while (true) {
+    // Deadline 0 (passed): take what has arrived, never wait in the control loop.
+    const std::ptrdiff_t n = stream_.read(rx_, Time{});
+    if (n < 0) {
+      while (outstanding_size_ > 0) miss(now);
+      return;
+    }
+    if (n == 0) return;
+    decoder_.feed(std::span<const std::uint8_t>(rx_.data(), static_cast<std::size_t>(n)),
+                  [&](const FrameView& f) { on_frame(f, now); });
+  }
+}
+
+void BoardLink::on_frame(const FrameView& frame, Time now) noexcept {
+  const std::optional<Response> r = parse_response(frame.body);
+  if (!r || outstanding_size_ == 0) return;  // nothing asked: stray bytes
+  const Outstanding front = outstanding_[0];
+  const bool echo = front.cmd == Command::sync && frame.bytes.size() == sync_size_ &&
+                    std::equal(frame.bytes.begin(), frame.bytes.end(), sync_frame_.begin());
+  const bool matches = echo || r->resp == static_cast<std::uint8_t>(front.cmd) || r->is_error();
+  if (!matches) {
+    // The front's response never came (this one answers a later request). No re-scan: the
+    // decoder is mid-feed.
+    miss(now, false);
+    if (outstanding_size_ > 0) on_frame(frame, now);
+    return;
+  }
+  std::copy(outstanding_.begin() + 1, outstanding_.begin() + static_cast<std::ptrdiff_t>(outstanding_size_), outstanding_.begin());
+  --outstanding_size_;
+  const Duration rtt = now - front.sent;
+  stats_.last_round_trip = rtt;
+  stats_.max_round_trip = std::max(stats_.max_round_trip, rtt);
+  stats_.total_round_trip += rtt;
+  if (r->is_error()) {
+    ++stats_.error_responses;
+    if (front.actuator) ++stats_.retries;  // stays queued: sent again next period
+    if (r->error() == ErrorCode::not_synchronised) {
+      lose(now);  // the board's watchdog tripped: it stopped the motors and wants SYNC
+    } else if (++consecutive_missed_ >= config_.max_missed) {
+      lose(now);
+    }
+    return;
+  }
+  ++stats_.responses;
+  consecutive_missed_ = 0;
+  if (front.actuator && queue_size_ > 0) {
+    queue_head_ = (queue_head_ + 1) % queue_.size();
+    --queue_size_;
+  }
+  switch (front.cmd) {
+    case Command::sync:
+      if (!synchronised_) ++stats_.resyncs;
+      synchronised_ = true;
+      break;
+    case Command::drive:
+      if (const auto d = unpack_drive(r->payload)) {
+        drive_ = *d;
+        drive_stamp_ = now;
+        has_drive_ = true;
+      }
+      break;
+    case Command::battery:
+      if (const auto b = unpack_battery(r->payload)) {
+        battery_ = *b;
+        has_battery_ = true;
+      }
+      break;
+    case Command::liquid_level:
+      if (r->payload.size() == 2) {
+        tank_percent_ = r->payload[0];
+        tank_empty_ = r->payload[1] != 0;
+      }
+      break;
+    case Command::ultrasonic: {
+      ByteReader rd(r->payload);
+      ultrasonic_count_ = std::min<std::size_t>(rd.u8(), kMaxUltrasonic);
+      for (std::size_t i = 0; i < ultrasonic_count_; ++i) ultrasonic_[i] = rd.u16();
+      if (rd.failed()) ultrasonic_count_ = 0;
+      break;
+    }
+    case Command::infrared: {
+      ByteReader rd(r->payload);
+      cliff_count_ = std::min<std::size_t>(rd.u8(), kMaxInfrared);
+      infrared_count_ = cliff_count_ + std::min<std::size_t>(rd.u8(), kMaxInfrared);
+      for (std::size_t i = 0; i < infrared_count_; ++i) infrared_[i] = rd.u16();
+      if (rd.failed()) infrared_count_ = cliff_count_ = 0;
+      break;
+    }
+    default: break;
+  }
+}
+
+void BoardLink::miss(Time now, bool rescan) noexcept {
+  if (outstanding_size_ > 0) {
+    if (outstanding_[0].actuator) ++stats_.retries;  // stays queued
+    std::copy(outstanding_.begin() + 1, outstanding_.begin() + static_cast<std::ptrdiff_t>(outstanding_size_), outstanding_.begin());
+    --outstanding_size_;
+  }
+  ++stats_.missed;
+  // A frame cut short by the loss would hold up the next one: give it up and re-scan.
+  if (rescan && decoder_.partial()) (void)decoder_.abandon_partial();
+  if (++consecutive_missed_ >= config_.max_missed) lose(now);
+}
+
+void BoardLink::lose(Time now) noexcept {
+  consecutive_missed_ = 0;
+  if (!synchronised_) return;  // already lost: SYNC until the board answers
+  synchronised_ = false;
+  lost_pending_ = true;
+  lost_at_ = now;
+  ++stats_.link_losses;
+}
+
+}  // namespace tripodal::board

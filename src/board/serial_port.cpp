@@ -1,0 +1,159 @@
+#include "tripodal/board/serial_port.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <pty.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace tripodal::board {
+namespace {
+
+struct BaudRate {
+  std::uint32_t baud;
+  speed_t speed;
+};
+constexpr std::array<BaudRate, 8> kBaudRates{{{9600, B9600},
+                                               {19200, B19200},
+                                               {38400, B38400},
+                                               {57600, B57600},
+                                               {115200, B115200},
+                                               {230400, B230400},
+                                               {460800, B460800},
+                                               {921600, B921600}}};
+
+[[noreturn]] void fail_os(const std::string& what, const char* step) {
+  throw std::runtime_error(fmt::format("{}: {}: {}", what, step, std::strerror(errno)));
+}
+
+// One bounded wait for input, then one non-blocking read.
+std::ptrdiff_t read_fd(int fd, std::span<std::uint8_t> out, Duration wait) noexcept {
+  if (fd < 0) return -1;
+  if (out.empty()) return 0;
+  pollfd p{fd, POLLIN, 0};
+  const auto ns = wait.count();
+  const timespec timeout{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
+  const int ready = ::ppoll(&p, 1, &timeout, nullptr);
+  if (ready < 0) return errno == EINTR ? 0 : -1;
+  if (ready == 0) return 0;
+  if ((p.revents & POLLIN) == 0) return (p.revents & (POLLERR | POLLHUP | POLLNVAL)) != 0 ? -1 : 0;
+  const ssize_t n = ::read(fd, out.data(), out.size());
+  if (n < 0) return (errno == EAGAIN || errno == EINTR) ? 0 : -1;
+  // Readable but nothing read: end of file, the other end hung up.
+  if (n == 0) return -1;
+  return n;
+}
+
+// Writes everything, waiting for room at most kMaxReadWait at a time (a UART's output queue
+// drains at the line rate; a full queue for longer than that is a stuck line).
+bool write_fd(int fd, std::span<const std::uint8_t> bytes) noexcept {
+  if (fd < 0) return false;
+  while (!bytes.empty()) {
+    const ssize_t n = ::write(fd, bytes.data(), bytes.size());
+    if (n > 0) {
+      bytes = bytes.subspan(static_cast<std::size_t>(n));
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && errno != EAGAIN) return false;
+    pollfd p{fd, POLLOUT, 0};
+    const timespec timeout{0, static_cast<long>(kMaxReadWait.count())};
+    if (::ppoll(&p, 1, &timeout, nullptr) <= 0) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+Duration read_wait(Time now, Time deadline) noexcept {
+  return std::clamp(deadline - now, Duration{0}, kMaxReadWait);
+}
+
+void configure_raw(int fd, std::uint32_t baud, const std::string& what) {
+  const auto rate = std::find_if(kBaudRates.begin(), kBaudRates.end(), [&](const BaudRate& r) { return r.baud == baud; });
+  if (rate == kBaudRates.end()) {
+    throw std::runtime_error(fmt::format("{}: baud {} is not supported; expected one of 9600, 19200, 38400, 57600, "
+                                         "115200, 230400, 460800, 921600",
+                                         what, baud));
+  }
+  termios t{};
+  if (::tcgetattr(fd, &t) != 0) fail_os(what, "tcgetattr");
+  ::cfmakeraw(&t);  // no echo, no line editing, no signals, no translation, 8 bits
+  t.c_cflag &= ~static_cast<tcflag_t>(PARENB | CSTOPB | CSIZE | CRTSCTS);
+  t.c_cflag |= CS8 | CLOCAL | CREAD;
+  t.c_iflag &= ~static_cast<tcflag_t>(IXON | IXOFF | IXANY);
+  t.c_cc[VMIN] = 0;  // reads never block: the waiting is ppoll's, bounded
+  t.c_cc[VTIME] = 0;
+  if (::cfsetispeed(&t, rate->speed) != 0 || ::cfsetospeed(&t, rate->speed) != 0) fail_os(what, "cfsetspeed");
+  if (::tcsetattr(fd, TCSANOW, &t) != 0) fail_os(what, "tcsetattr");
+}
+
+SerialPort::SerialPort(const std::filesystem::path& path, const Clock& clock, SerialSettings settings)
+    : path_(path), clock_(clock) {
+  const std::string what = fmt::format("serial port {}", path.string());
+  fd_ = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+  if (fd_ < 0) fail_os(what, "open");
+  try {
+    configure_raw(fd_, settings.baud, what);
+    ::tcflush(fd_, TCIOFLUSH);  // nothing of a previous session
+  } catch (...) {
+    ::close(fd_);
+    throw;
+  }
+}
+
+SerialPort::~SerialPort() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+bool SerialPort::write(std::span<const std::uint8_t> bytes) noexcept {
+  const bool ok = write_fd(fd_, bytes);
+  if (ok) written_ += bytes.size();
+  return ok;
+}
+
+std::ptrdiff_t SerialPort::read(std::span<std::uint8_t> out, Time deadline) noexcept {
+  const std::ptrdiff_t n = read_fd(fd_, out, read_wait(clock_.now(), deadline));
+  if (n > 0) read_ += static_cast<std::uint64_t>(n);
+  return n;
+}
+
+PseudoTerminal::PseudoTerminal(const Clock& clock, SerialSettings settings) : clock_(clock) {
+  std::array<char, 256> name{};
+  if (::openpty(&master_, &slave_, name.data(), nullptr, nullptr) != 0) fail_os("pseudo-terminal", "openpty");
+  slave_path_ = name.data();
+  try {
+    const std::string what = fmt::format("pseudo-terminal {}", slave_path_.string());
+    configure_raw(slave_, settings.baud, what);
+    configure_raw(master_, settings.baud, what);
+    const int flags = ::fcntl(master_, F_GETFL);
+    if (flags < 0 || ::fcntl(master_, F_SETFL, flags | O_NONBLOCK) != 0) fail_os(what, "fcntl");
+    ::fcntl(master_, F_SETFD, FD_CLOEXEC);
+    ::fcntl(slave_, F_SETFD, FD_CLOEXEC);
+  } catch (...) {
+    ::close(master_);
+    ::close(slave_);
+    throw;
+  }
+}
+
+PseudoTerminal::~PseudoTerminal() {
+  if (master_ >= 0) ::close(master_);
+  if (slave_ >= 0) ::close(slave_);
+}
+
+bool PseudoTerminal::write(std::span<const std::uint8_t> bytes) noexcept { return write_fd(master_, bytes); }
+
+std::ptrdiff_t PseudoTerminal::read(std::span<std::uint8_t> out, Time deadline) noexcept {
+  return read_fd(master_, out, read_wait(clock_.now(), deadline));
+}
+
+}  // namespace tripodal::board

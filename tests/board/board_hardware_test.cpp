@@ -1,0 +1,100 @@
+#include "tripodal/board/board_hardware.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <array>
+
+#include "tripodal/board/board_firmware.hpp"
+#include "tripodal/board/serial_line.hpp"
+
+using namespace tripodal;
+using namespace tripodal::board;
+using namespace std::chrono_literals;
+
+namespace {
+
+struct StillPlant final : BoardPlant {
+  void drive(Time, double, double) noexcept override {}
+  void sense(Time, PlantSensors& out) noexcept override {
+    out.ultrasonic_m = {0.8F, 1.0F, 1.2F};
+    out.cliff_floor_m = {0.02F, 0.5F, 0.02F};
+    out.bumps = 0x01;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("hardware 'board': wheels through DRIVE, odometry from the encoders, sensors as resources", "[board][hardware]") {
+  SimClock clock;
+  SerialLine line(clock);
+  StillPlant plant;
+  BoardFirmware board(FirmwareConfig{}, line.board(), plant);
+  BoardHardware hw(line.host(), BoardHardwareConfig{});
+  ResourceTable table;
+  hw.add_resources(table);
+  REQUIRE(table.size() == 5);
+  CHECK(table.at(0).name() == "board_link");
+  REQUIRE(table.find<BatteryReading>("battery") != nullptr);
+  REQUIRE(table.find<SonarReading>("ultrasonic") != nullptr);
+  REQUIRE(table.find<InfraredReading>("cliff") != nullptr);
+  REQUIRE(table.find<BumperReading>("bumpers") != nullptr);
+  CHECK(hw.manifest().name == "board");
+
+  const std::array<double, 2> wheels{2.0, 2.0};  // rad/s at r = 0.09 m: 180 mm/s
+  std::array<double, 2> vel{}, pos{};
+  bool accepted = false;
+  for (int ms = 1; ms <= 2000; ++ms) {
+    clock.advance(1ms);
+    board.run_until(clock.now());
+    if (ms % 10 == 0) {
+      table.poll_all(clock.now());
+      accepted = hw.wheels().write_wheel_velocities(wheels);
+    }
+  }
+  CHECK(accepted);
+  CHECK(board.required_m_s(0) == Approx(0.18));
+  REQUIRE(hw.wheels().read_wheel_states(vel, pos));
+  CHECK(vel[0] == Approx(2.0).margin(0.1));
+  CHECK(pos[0] == Approx(board.pulses(0) / (5000.0 * 0.09)).margin(0.05));
+  CHECK(table.find<BumperReading>("bumpers")->latest().pressed_mask == 0x01);
+  CHECK(table.find<InfraredReading>("cliff")->latest().cliff == std::vector<std::uint8_t>{0, 1, 0});
+  CHECK(table.find<SonarReading>("ultrasonic")->latest().ranges_m.size() == 3);
+  CHECK(table.find<BatteryReading>("battery")->latest().percentage == Approx(1.0));
+
+  // The board stops answering: the wheels refuse writes (the controller's hardware fault) within
+  // two control periods, and the link-lost event is there to post once.
+  line.board().set_connected(false);
+  int refused_after_ms = -1;
+  for (int ms = 1; ms <= 100 && refused_after_ms < 0; ++ms) {
+    clock.advance(1ms);
+    board.run_until(clock.now());
+    if (ms % 10 == 0) {
+      table.poll_all(clock.now());
+      if (!hw.wheels().write_wheel_velocities(wheels)) refused_after_ms = ms;
+    }
+  }
+  CHECK(refused_after_ms > 0);
+  CHECK(refused_after_ms <= 20);
+  CHECK(hw.take_link_lost());
+  CHECK_FALSE(hw.take_link_lost());
+  CHECK_FALSE(hw.wheels().read_wheel_states(vel, pos));
+}
+
+TEST_CASE("hardware 'board' is registered with its parameters and refuses a wrong configuration", "[board][hardware]") {
+  HardwareRegistry registry("hardware type");
+  register_board_hardware(registry);
+  REQUIRE(registry.contains("board"));
+  HardwareConfig c;
+  c.type = "board";
+  c.where = SourceLocation{SourceFile(std::string_view("robot.yaml")), 12, 3};
+  c.parameters = ParameterSet::resolve(registry.manifest("board"), {}, c.where);
+  ControllerConfig base;
+  base.type = "omni";
+  c.base = &base;
+  REQUIRE_THROWS_WITH(registry.create("board", c), Catch::Contains("robot.yaml:12:3: error: hardware 'board' drives a differential base"));
+  base.type = "differential";
+  base.differential = {0.42, 0.09};
+  REQUIRE_THROWS_WITH(registry.create("board", c), Catch::Contains("hardware 'board' needs its port"));
+  c.parameters = ParameterSet::resolve(registry.manifest("board"), {{"port", Value{std::string("/nonexistent/ttyBOARD")}}}, c.where);
+  REQUIRE_THROWS_WITH(registry.create("board", c), Catch::Contains("serial port /nonexistent/ttyBOARD: open: No such file or directory"));
+}

@@ -1,0 +1,117 @@
+#include "tripodal/board/serial_port.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <termios.h>
+
+#include <array>
+#include <cstdint>
+#include <fstream>
+#include <memory>
+#include <vector>
+
+#include "tripodal/board/frame.hpp"
+
+using namespace tripodal;
+using namespace tripodal::board;
+using namespace std::chrono_literals;
+
+namespace {
+
+// Reads until `n` bytes came or `tries` bounded reads (1 ms each at most) passed: no sleeps, and
+// a simulated clock that stands still makes every read wait its whole 1 ms budget at most.
+std::vector<std::uint8_t> read_n(ByteStream& s, std::size_t n, const Clock& clock, int tries = 2000) {
+  std::vector<std::uint8_t> got;
+  std::array<std::uint8_t, 256> buf{};
+  while (got.size() < n && tries-- > 0) {
+    const std::ptrdiff_t r = s.read(buf, clock.now() + 1s);
+    REQUIRE(r >= 0);
+    got.insert(got.end(), buf.begin(), buf.begin() + r);
+  }
+  return got;
+}
+
+}  // namespace
+
+TEST_CASE("a read waits for its deadline, never more than 1 ms", "[board][serial]") {
+  CHECK(read_wait(Time{}, Time{5s}) == 1ms);
+  CHECK(read_wait(Time{10ms}, Time{10ms + 300us}) == 300us);
+  CHECK(read_wait(Time{10ms}, Time{10ms}) == 0ns);
+  CHECK(read_wait(Time{10ms}, Time{9ms}) == 0ns);  // deadline passed: just poll
+}
+
+TEST_CASE("the port is raw 115200 8N1 and carries every byte value unchanged", "[board][serial]") {
+  SimClock clock;
+  PseudoTerminal pty(clock);
+  SerialPort port(pty.slave_path(), clock);
+
+  termios t{};
+  REQUIRE(::tcgetattr(port.fd(), &t) == 0);
+  CHECK(::cfgetispeed(&t) == B115200);
+  CHECK(::cfgetospeed(&t) == B115200);
+  CHECK((t.c_cflag & CSIZE) == CS8);
+  CHECK((t.c_cflag & PARENB) == 0);
+  CHECK((t.c_cflag & CSTOPB) == 0);
+  CHECK((t.c_cflag & CRTSCTS) == 0);
+  CHECK((t.c_lflag & (ICANON | ECHO | ISIG | IEXTEN)) == 0);
+  CHECK((t.c_iflag & (ICRNL | INLCR | IGNCR | IXON | IXOFF | ISTRIP)) == 0);
+  CHECK((t.c_oflag & OPOST) == 0);
+  CHECK(t.c_cc[VMIN] == 0);
+
+  // All 256 values, CR, LF, XON/XOFF, ^C and DEL included, both ways.
+  std::vector<std::uint8_t> all(256);
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::uint8_t>(i);
+  REQUIRE(port.write(all));
+  CHECK(read_n(pty, all.size(), clock) == all);
+  REQUIRE(pty.write(all));
+  CHECK(read_n(port, all.size(), clock) == all);
+  CHECK(port.bytes_written() == 256);
+  CHECK(port.bytes_read() == 256);
+}
+
+TEST_CASE("frames cross the pseudo-terminal and decode on the other side", "[board][serial]") {
+  SimClock clock;
+  PseudoTerminal pty(clock);
+  SerialPort port(pty.slave_path(), clock);
+  std::array<std::uint8_t, kMaxFrameBytes> out{};
+  const std::array<std::uint8_t, 4> speeds{0xC8, 0x00, 0xFA, 0x00};
+  const std::size_t n = encode_request(0x12, speeds, out);
+  for (int i = 0; i < 10; ++i) REQUIRE(port.write(std::span<const std::uint8_t>(out).first(n)));
+  const auto got = read_n(pty, 10 * n, clock);
+  FrameDecoder d;
+  CHECK(d.feed(got) == 10);
+  CHECK(d.frame().body[1] == 0x12);
+}
+
+TEST_CASE("a read with nothing to read returns 0 at its deadline", "[board][serial]") {
+  SimClock clock(Time{1s});
+  PseudoTerminal pty(clock);
+  SerialPort port(pty.slave_path(), clock);
+  std::array<std::uint8_t, 16> buf{};
+  CHECK(port.read(buf, clock.now()) == 0);       // deadline now: a poll
+  CHECK(port.read(buf, clock.now() + 1h) == 0);  // bounded to 1 ms
+  CHECK(pty.read(buf, clock.now()) == 0);
+}
+
+TEST_CASE("a port whose other end hangs up reports it", "[board][serial]") {
+  SimClock clock;
+  auto pty = std::make_unique<PseudoTerminal>(clock);
+  SerialPort port(pty->slave_path(), clock);
+  pty.reset();
+  std::array<std::uint8_t, 16> buf{};
+  CHECK(port.read(buf, clock.now() + 1s) == -1);
+}
+
+TEST_CASE("opening a port that is not one fails with the path and the reason", "[board][serial]") {
+  SimClock clock;
+  REQUIRE_THROWS_WITH(SerialPort("/nonexistent/ttyBOARD", clock),
+                      "serial port /nonexistent/ttyBOARD: open: No such file or directory");
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / "tripodal_not_a_tty";
+  std::ofstream(file) << "x";
+  REQUIRE_THROWS_WITH(SerialPort(file, clock),
+                      Catch::Contains("tripodal_not_a_tty: tcgetattr: Inappropriate ioctl for device"));
+  std::filesystem::remove(file);
+  PseudoTerminal pty(clock);
+  REQUIRE_THROWS_WITH(SerialPort(pty.slave_path(), clock, SerialSettings{1234}),
+                      Catch::Contains("baud 1234 is not supported; expected one of 9600"));
+}
