@@ -15,7 +15,7 @@
 using namespace tripodal;
 namespace {
 
-struct BeaconReading { Time stamp{0}; bool on = false; };  // what the beacon's driver reads: flashing and beeping?
+struct BeaconReading { Time stamp{}; bool on = false; };  // what the beacon's driver reads: flashing and beeping?
 
 /// Hardware "sim_with_beacon": the simulator (parameters as "sim") and the warning beacon (LED +
 /// buzzer) its base board sounds while the base turns in place, to warn the people around.
@@ -136,7 +136,7 @@ int main(int argc, char** argv) try {
   if (watcher == nullptr || beacon == nullptr) throw ConfigError({}, "the robot needs a RoomWatcher and a resource 'beacon'");
   std::string room;
   bool beacon_on = false;
-  while (robot->planner().busy() && clock.now() < from_seconds(600.0)) {
+  while (robot->planner().busy() && clock.now() < time_from_seconds(600.0)) {
     robot->run_for(robot->behavior_loop().period());
     if (watcher->room() != room) life.note(clock.now(), "entered room " + (room = watcher->room()));
     if (beacon->latest().on != beacon_on) life.note(clock.now(), (beacon_on = beacon->latest().on) ? "beacon on" : "beacon off");

@@ -52,7 +52,7 @@ TEST_CASE("SimHardware from a hardware entry: the given world, the world's seed 
   CHECK(SimHardware(entry(&base, {{"seed", Value{7.0}}}), world).seed() == 7);
   const SimHardware hw(entry(&base), world);
   CHECK(hw.simulator().world().grid.width() == 40);
-  CHECK(hw.true_pose(Time{0})->x_m == Approx(1.0));
+  CHECK(hw.true_pose(Time{})->x_m == Approx(1.0));
 }
 
 TEST_CASE("SimHardware from a hardware entry refuses, located, a robot without base or world", "[sim]") {
@@ -68,8 +68,8 @@ TEST_CASE("An application's hardware derived from SimHardware moves with the sim
   const ControllerConfig base = test::differential_base();
   CountingBase hw(entry(&base), seeded_room(3));
   CHECK(&hw.wheels() == &hw.simulator());
-  hw.advance_to(from_seconds(0.1));
-  hw.advance_to(from_seconds(0.2));
+  hw.advance_to(time_from_seconds(0.1));
+  hw.advance_to(time_from_seconds(0.2));
   CHECK(hw.advances == 2);
-  CHECK(hw.simulator().now() == from_seconds(0.2));
+  CHECK(hw.simulator().now() == time_from_seconds(0.2));
 }
