@@ -3,8 +3,6 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 namespace tripodal::yaml {
 
@@ -29,13 +27,7 @@ std::optional<double> finite(const YAML::Node& node) {
 
 }  // namespace
 
-std::string read_file(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw ConfigError(SourceLocation{file.string(), 0, 0}, "cannot read the file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+std::string read_file(const std::filesystem::path& file) { return read_config_file(file); }
 
 YAML::Node parse(std::string_view text, const std::string& file) {
   try {

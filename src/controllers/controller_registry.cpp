@@ -113,8 +113,10 @@ void apply_parameters(ControllerConfig& c) {
   set("period_s", [&](double s) { c.period = from_seconds(s); });
   set("cmd_timeout_s", [&](double s) { c.cmd_timeout = from_seconds(s); });
   set("max_wheel_speed_rad_s", [&](double v) { c.max_wheel_speed_rad_s = v; });
-  for (auto [axis, limits] : {std::pair{"vx", &c.limits.vx}, std::pair{"vy", &c.limits.vy}, std::pair{"wz", &c.limits.wz}}) {
-    const std::string a = std::string("limits.") + axis + ".";
+  for (const auto& axis_limits : {std::pair{"vx", &c.limits.vx}, std::pair{"vy", &c.limits.vy}, std::pair{"wz", &c.limits.wz}}) {
+    // Not a structured binding: clang 14 (the fuzzing compiler) cannot capture one in a lambda.
+    auto* const limits = axis_limits.second;
+    const std::string a = std::string("limits.") + axis_limits.first + ".";
     set(a + "max_velocity", [&](double v) { limits->max_velocity = v; });
     set(a + "max_acceleration", [&](double v) { limits->max_acceleration = v; });
     set(a + "max_deceleration", [&](double v) { limits->max_deceleration = v; });

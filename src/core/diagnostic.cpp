@@ -1,7 +1,9 @@
 #include "tripodal/core/diagnostic.hpp"
 
+#include <fstream>
 #include <mutex>
 #include <ostream>
+#include <sstream>
 #include <unordered_set>
 #include <utility>
 
@@ -87,5 +89,22 @@ Diagnostics single(SourceLocation where, const std::string& message) {
 
 ConfigError::ConfigError(SourceLocation where, const std::string& message)
     : ConfigError(single(std::move(where), message)) {}
+
+std::string read_config_file(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw ConfigError(SourceLocation{file.string(), 0, 0}, "cannot read the file");
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(file, ec);
+  // A size that cannot be told (a pipe, /dev/stdin) is read as it comes.
+  if (!ec && size > kMaxConfigFileBytes) {
+    throw ConfigError(SourceLocation{file.string(), 0, 0},
+                      "the file has " + std::to_string(size) + " bytes, more than the " +
+                          std::to_string(kMaxConfigFileBytes) + " a configuration file may have");
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw ConfigError(SourceLocation{file.string(), 0, 0}, "cannot read the file");
+  return text.str();
+}
 
 }  // namespace tripodal

@@ -317,3 +317,22 @@ TEST_CASE("a checksum-valid record with a bad payload is refused, located") {
     CHECK_THROWS_WITH(r.next(rec), Catch::Contains("record on undeclared channel 9"));
   }
 }
+
+TEST_CASE("a length field promising more than the file holds reads as a truncated tail") {
+  // The reader grows a record's buffer as its bytes arrive, so this 24-byte file does not cost
+  // the 60 MiB its frame announces.
+  TempFile file("long_frame");
+  { TraceWriter w(file.path()); }
+  auto bytes = read_all(file.path());
+  const std::uint32_t length = 60u << 20;
+  for (const std::uint32_t v : {length, ~length}) {
+    for (int i = 0; i < 4; ++i) bytes.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+  }
+  bytes.insert(bytes.end(), {1, 2, 3});
+  write_all(file.path(), bytes, bytes.size());
+  TraceReader r(file.path());
+  TraceRecord rec;
+  CHECK_FALSE(r.next(rec));
+  CHECK(r.state() == ReadState::kTruncated);
+  CHECK_THAT(r.warning(), Catch::Contains("truncated at byte 16 (a record of 62914572 bytes has only 11)"));
+}
