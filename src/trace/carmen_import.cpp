@@ -137,7 +137,7 @@ class Fields {
   Time stamp() {
     const int column = tokens_[std::min(next_, tokens_.size() - 1)].column;
     const double seconds = number("timestamp");
-    if (std::fabs(seconds) > 9.0e9) {
+    if (std::fabs(seconds) > kMaxSeconds) {
       throw LineError{column, std::string(type_) + " timestamp " + std::to_string(seconds) + " s is out of range"};
     }
     const std::size_t rest = tokens_.size() - next_;

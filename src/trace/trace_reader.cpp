@@ -142,6 +142,11 @@ bool TraceReader::next(TraceRecord& record) {
       const ChannelId channel = in.u16();
       const Time stamp{in.i64()};
       if (type == detail::kChannelDeclaration) {
+        // Stamped 0 by the format, so that a trace re-writes to its own bytes.
+        if (stamp.count() != 0) {
+          throw detail::DecodeError{3, "channel declaration stamped " + std::to_string(stamp.count()) +
+                                           " (declarations are stamped 0)"};
+        }
         const std::size_t kind_at = in.position();
         const auto kind = static_cast<ChannelKind>(in.u8());
         if (!is_valid(kind)) {

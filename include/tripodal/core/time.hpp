@@ -20,9 +20,17 @@ using Time = std::chrono::nanoseconds;
   return std::chrono::duration<double>(d).count();
 }
 
-/// A duration from seconds, rounded to the nearest nanosecond.
+/// The largest magnitude from_seconds converts exactly enough: 9e9 s (285 years); a Duration of
+/// 64-bit nanoseconds ends at 9.22e9 s.
+inline constexpr double kMaxSeconds = 9.0e9;
+
+/// A duration from seconds, rounded to the nearest nanosecond. Saturates at +-kMaxSeconds (NaN
+/// gives 0): seconds read from a file can be anything, and converting a double beyond the range
+/// of the integer is undefined behaviour (found by fuzzing event scripts).
 [[nodiscard]] constexpr Duration from_seconds(double seconds) noexcept {
-  return std::chrono::round<Duration>(std::chrono::duration<double>(seconds));
+  if (seconds != seconds) return Duration{0};
+  const double s = seconds > kMaxSeconds ? kMaxSeconds : seconds < -kMaxSeconds ? -kMaxSeconds : seconds;
+  return std::chrono::round<Duration>(std::chrono::duration<double>(s));
 }
 
 /// digits for format_seconds: as many decimals as the duration needs to be exact (at most 9).
