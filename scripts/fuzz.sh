@@ -22,8 +22,9 @@ jobs=${JOBS:-$(nproc)}
 scripts/install-deps.sh fuzz
 
 cmake -S . -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Fuzz \
-  "-DCMAKE_CXX_FLAGS_FUZZ=-O1 -gline-tables-only" -DTRIPODAL_FUZZ=ON -DTRIPODAL_WERROR=ON \
+  "-DCMAKE_CXX_FLAGS_FUZZ=-O1 -gline-tables-only" -DTRIPODAL_FUZZ=ON \
   -DTRIPODAL_BUILD_TESTS=OFF -DTRIPODAL_BUILD_TOOLS=OFF -DTRIPODAL_BUILD_BENCH=OFF >/dev/null
+# -Werror is left to the g++ builds: clang 14 warns differently, and this build checks inputs.
 cmake --build "$build" -j "$jobs" --target fuzz_all
 
 targets=("$@")

@@ -16,7 +16,7 @@ cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DTRIPODAL_BUILD_TEST
 log="$build/tidy.log"
 # -Wno-unknown-warning-option: the commands are g++'s, whose -Wno-restrict clang does not know.
 run-clang-tidy -quiet -j "$jobs" -p "$build" -extra-arg=-Wno-unknown-warning-option \
-  "$root/src/" "$root/tools/" >"$log" 2>&1 || true
+  "$root/src/" "$root/tools/" 2>&1 | sed 's/\x1b\[[0-9;]*m//g' >"$log" || true
 warnings=$(grep -cE '^/.*: (warning|error): ' "$log" || true)
 if [[ $warnings -ne 0 ]]; then
   grep -E '^/.*: (warning|error): ' "$log" | sort -u

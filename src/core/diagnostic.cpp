@@ -52,13 +52,13 @@ std::string Diagnostic::str() const {
 }
 
 void Diagnostics::error(SourceLocation where, std::string message) {
-  add({Severity::error, std::move(where), std::move(message)});
+  add({Severity::error, where, std::move(message)});
 }
 void Diagnostics::warning(SourceLocation where, std::string message) {
-  add({Severity::warning, std::move(where), std::move(message)});
+  add({Severity::warning, where, std::move(message)});
 }
 void Diagnostics::note(SourceLocation where, std::string message) {
-  add({Severity::note, std::move(where), std::move(message)});
+  add({Severity::note, where, std::move(message)});
 }
 void Diagnostics::add(Diagnostic d) {
   if (d.severity == Severity::error) ++errors_;
@@ -82,13 +82,13 @@ ConfigError::ConfigError(Diagnostics diagnostics)
 namespace {
 Diagnostics single(SourceLocation where, const std::string& message) {
   Diagnostics d;
-  d.error(std::move(where), message);
+  d.error(where, message);
   return d;
 }
 }  // namespace
 
 ConfigError::ConfigError(SourceLocation where, const std::string& message)
-    : ConfigError(single(std::move(where), message)) {}
+    : ConfigError(single(where, message)) {}
 
 std::string read_config_file(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
