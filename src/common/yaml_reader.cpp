@@ -50,7 +50,9 @@ std::string kind(const YAML::Node& node) {
 
 SourceLocation Reader::at(const YAML::Node& node) const {
   const YAML::Mark m = node.Mark();
-  if (m.line < 0) return {file_, 0, 0};
+  // Only a document with no node at all (an empty file) has no position: its start is where to
+  // write the missing content (found by fuzz_robot_profile: an empty profile was reported unlocated).
+  if (m.line < 0) return {file_, 1, 1};
   return {file_, m.line + 1, m.column + 1};
 }
 

@@ -20,14 +20,14 @@ HolonomicConfig omni_base(double wheel_radius_m, double base_radius_m, std::span
 }
 
 HolonomicConfig mecanum_base(double wheel_radius_m, double half_length_m, double half_width_m) {
-  constexpr double q = std::numbers::pi / 4.0;
+  constexpr double kQuarterPi = std::numbers::pi / 4.0;
   HolonomicConfig c;
   c.wheel_radius_m = wheel_radius_m;
   // X arrangement: front-left and rear-right rollers at -45 degrees, the others at +45.
-  c.wheels = {{half_length_m, half_width_m, 0.0, -q},
-              {half_length_m, -half_width_m, 0.0, q},
-              {-half_length_m, half_width_m, 0.0, q},
-              {-half_length_m, -half_width_m, 0.0, -q}};
+  c.wheels = {{half_length_m, half_width_m, 0.0, -kQuarterPi},
+              {half_length_m, -half_width_m, 0.0, kQuarterPi},
+              {-half_length_m, half_width_m, 0.0, kQuarterPi},
+              {-half_length_m, -half_width_m, 0.0, -kQuarterPi}};
   return c;
 }
 
