@@ -11,8 +11,9 @@
 TRIPODAL_FUZZ_TARGET(bytes) {
   using namespace tripodal;
   using namespace tripodal::trace;
-  auto sink = std::make_unique<std::ostringstream>();
-  std::ostringstream* text = sink.get();
+  // The writer owns (and on close() destroys) its stream; the buffer stays ours.
+  std::stringbuf text;
+  auto sink = std::make_unique<std::ostream>(&text);
   CarmenImportReport report;
   std::string trace;
   {
@@ -25,8 +26,8 @@ TRIPODAL_FUZZ_TARGET(bytes) {
       return;
     }
     writer.close();
-    trace = text->str();  // the writer owns (and destroys) the stream
   }
+  trace = text.str();
   TraceReader reader(std::make_unique<std::istringstream>(std::move(trace)), "fuzz.trace");
   TraceRecord record;
   std::uint64_t records = 0;

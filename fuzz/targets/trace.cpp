@@ -23,8 +23,9 @@ Rewrite rewrite(std::string input) {
   using namespace tripodal;
   using namespace tripodal::trace;
   Rewrite out;
-  auto sink = std::make_unique<std::ostringstream>();
-  std::ostringstream* text = sink.get();
+  // The writer owns (and on close() destroys) its stream; the buffer stays ours.
+  std::stringbuf text;
+  auto sink = std::make_unique<std::ostream>(&text);
   {
     TraceWriter writer(std::move(sink), "rewrite");
     try {
@@ -53,8 +54,8 @@ Rewrite rewrite(std::string input) {
                               "a trace format error names the file and the byte", what);
     }
     writer.close();
-    out.bytes = text->str();  // the writer owns (and destroys) the stream
   }
+  out.bytes = text.str();
   return out;
 }
 
