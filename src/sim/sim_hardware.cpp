@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <utility>
 
 namespace tripodal::sim {
 
@@ -19,7 +20,7 @@ SimHardware::SimHardware(World world, const ControllerConfig& base, std::uint64_
     : seed_(seed), sim_(std::move(world), base, seed) {}
 
 void register_sim_hardware(HardwareRegistry& registry, std::shared_ptr<const World> world) {
-  registry.add(SimHardware::static_manifest(), [world](const HardwareConfig& c) -> std::unique_ptr<CHardware> {
+  registry.add(SimHardware::static_manifest(), [world = std::move(world)](const HardwareConfig& c) -> std::unique_ptr<CHardware> {
     if (c.base == nullptr) throw ConfigError(c.where, "hardware 'sim' needs the robot's base controller (its wheel geometry)");
     World w;
     const std::string& file = c.parameters.string("world");
