@@ -30,7 +30,7 @@ TEST_CASE("BhApproach stops short of the first wall of the Intel excerpt") {
   harness.attach(std::make_unique<example::BhApproach>(), {{"stop_distance_m", Value{0.8}}});
   const testing::RunLog& run = harness.run(std::nullopt, /*stop_when_done=*/true);
 
-  CHECK(run.succeeds_before("BhApproach", 40s));
+  CHECK(run.succeeds_before("BhApproach", Time{40s}));
   CHECK(run.never_fails("BhApproach"));
   CHECK(run.command_never_exceeds({.max_vx_m_s = 0.4, .max_vy_m_s = 0.0, .max_wz_rad_s = 0.0}));
   CHECK(run.never_drives_toward_obstacle_closer_than(0.8));
