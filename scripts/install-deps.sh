@@ -1,6 +1,11 @@
 #!/usr/bin/env bash
 # Installs the Debian packages tripodal needs to build, test and benchmark. Idempotent: packages
 # already present are left alone and apt is not touched at all when nothing is missing.
+#
+#   scripts/install-deps.sh [GROUP...]   also the packages of the hardening scripts that need them:
+#     fuzz   clang and its runtime (libFuzzer, ASan, UBSan), for scripts/fuzz.sh
+#     tidy   clang-tidy, for scripts/tidy.sh
+#   (ThreadSanitizer, scripts/tsan.sh, needs nothing more: libtsan2 comes with g++.)
 set -euo pipefail
 
 packages=(
@@ -12,6 +17,15 @@ packages=(
   graphviz libxml2-utils
   zlib1g-dev
 )
+
+for group in "$@"; do
+  case $group in
+    # libclang-rt-14-dev holds libFuzzer itself (libclang_rt.fuzzer), which -fsanitize=fuzzer links.
+    fuzz) packages+=(clang libclang-rt-14-dev) ;;
+    tidy) packages+=(clang-tidy) ;;
+    *) echo "install-deps: unknown group '$group' (expected fuzz or tidy)" >&2; exit 2 ;;
+  esac
+done
 
 missing=()
 for p in "${packages[@]}"; do

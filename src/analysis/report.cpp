@@ -224,6 +224,7 @@ std::string format_text(const AnalysisReport& r, const PetriNet& net) {
 
   auto list = [&](const std::vector<std::uint32_t>& items, bool places) {
     std::vector<std::string> names;
+    names.reserve(items.size());
     for (const auto i : items) names.push_back(places ? net.place(i).id : net.transition(i).id);
     return names.empty() ? std::string("none") : join(names, ", ");
   };

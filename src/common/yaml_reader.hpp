@@ -41,7 +41,8 @@ class Reader {
   [[nodiscard]] const std::string& file() const noexcept { return file_; }
   [[nodiscard]] Diagnostics& diagnostics() noexcept { return d_; }
 
-  /// FILE:LINE:COL of a node (yaml-cpp counts from 0, diagnostics from 1; 0 when unknown).
+  /// FILE:LINE:COL of a node (yaml-cpp counts from 0, diagnostics from 1); 1:1 for the empty
+  /// document, the one node without a position.
   [[nodiscard]] SourceLocation at(const YAML::Node& node) const;
   void error(const YAML::Node& node, std::string message);
 

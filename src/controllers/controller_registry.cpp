@@ -20,14 +20,14 @@ HolonomicConfig omni_base(double wheel_radius_m, double base_radius_m, std::span
 }
 
 HolonomicConfig mecanum_base(double wheel_radius_m, double half_length_m, double half_width_m) {
-  constexpr double q = std::numbers::pi / 4.0;
+  constexpr double kQuarterPi = std::numbers::pi / 4.0;
   HolonomicConfig c;
   c.wheel_radius_m = wheel_radius_m;
   // X arrangement: front-left and rear-right rollers at -45 degrees, the others at +45.
-  c.wheels = {{half_length_m, half_width_m, 0.0, -q},
-              {half_length_m, -half_width_m, 0.0, q},
-              {-half_length_m, half_width_m, 0.0, q},
-              {-half_length_m, -half_width_m, 0.0, -q}};
+  c.wheels = {{half_length_m, half_width_m, 0.0, -kQuarterPi},
+              {half_length_m, -half_width_m, 0.0, kQuarterPi},
+              {-half_length_m, half_width_m, 0.0, kQuarterPi},
+              {-half_length_m, -half_width_m, 0.0, -kQuarterPi}};
   return c;
 }
 
@@ -113,8 +113,10 @@ void apply_parameters(ControllerConfig& c) {
   set("period_s", [&](double s) { c.period = from_seconds(s); });
   set("cmd_timeout_s", [&](double s) { c.cmd_timeout = from_seconds(s); });
   set("max_wheel_speed_rad_s", [&](double v) { c.max_wheel_speed_rad_s = v; });
-  for (auto [axis, limits] : {std::pair{"vx", &c.limits.vx}, std::pair{"vy", &c.limits.vy}, std::pair{"wz", &c.limits.wz}}) {
-    const std::string a = std::string("limits.") + axis + ".";
+  for (const auto& axis_limits : {std::pair{"vx", &c.limits.vx}, std::pair{"vy", &c.limits.vy}, std::pair{"wz", &c.limits.wz}}) {
+    // Not a structured binding: clang 14 (the fuzzing compiler) cannot capture one in a lambda.
+    auto* const limits = axis_limits.second;
+    const std::string a = std::string("limits.") + axis_limits.first + ".";
     set(a + "max_velocity", [&](double v) { limits->max_velocity = v; });
     set(a + "max_acceleration", [&](double v) { limits->max_acceleration = v; });
     set(a + "max_deceleration", [&](double v) { limits->max_deceleration = v; });

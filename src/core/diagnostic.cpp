@@ -1,7 +1,9 @@
 #include "tripodal/core/diagnostic.hpp"
 
+#include <fstream>
 #include <mutex>
 #include <ostream>
+#include <sstream>
 #include <unordered_set>
 #include <utility>
 
@@ -50,13 +52,13 @@ std::string Diagnostic::str() const {
 }
 
 void Diagnostics::error(SourceLocation where, std::string message) {
-  add({Severity::error, std::move(where), std::move(message)});
+  add({Severity::error, where, std::move(message)});
 }
 void Diagnostics::warning(SourceLocation where, std::string message) {
-  add({Severity::warning, std::move(where), std::move(message)});
+  add({Severity::warning, where, std::move(message)});
 }
 void Diagnostics::note(SourceLocation where, std::string message) {
-  add({Severity::note, std::move(where), std::move(message)});
+  add({Severity::note, where, std::move(message)});
 }
 void Diagnostics::add(Diagnostic d) {
   if (d.severity == Severity::error) ++errors_;
@@ -80,12 +82,29 @@ ConfigError::ConfigError(Diagnostics diagnostics)
 namespace {
 Diagnostics single(SourceLocation where, const std::string& message) {
   Diagnostics d;
-  d.error(std::move(where), message);
+  d.error(where, message);
   return d;
 }
 }  // namespace
 
 ConfigError::ConfigError(SourceLocation where, const std::string& message)
-    : ConfigError(single(std::move(where), message)) {}
+    : ConfigError(single(where, message)) {}
+
+std::string read_config_file(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw ConfigError(SourceLocation{file.string(), 0, 0}, "cannot read the file");
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(file, ec);
+  // A size that cannot be told (a pipe, /dev/stdin) is read as it comes.
+  if (!ec && size > kMaxConfigFileBytes) {
+    throw ConfigError(SourceLocation{file.string(), 0, 0},
+                      "the file has " + std::to_string(size) + " bytes, more than the " +
+                          std::to_string(kMaxConfigFileBytes) + " a configuration file may have");
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw ConfigError(SourceLocation{file.string(), 0, 0}, "cannot read the file");
+  return text.str();
+}
 
 }  // namespace tripodal

@@ -3,7 +3,6 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <optional>
 #include <sstream>
 
@@ -183,11 +182,7 @@ EventScript parse_event_script(std::string_view text, std::string_view source) {
 }
 
 EventScript load_event_script(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw ConfigError(SourceLocation{file.string()}, "cannot read the event script");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  return parse_event_script(buffer.str(), file.string());
+  return parse_event_script(read_config_file(file), file.string());
 }
 
 }  // namespace tripodal

@@ -234,9 +234,10 @@ Operand operand_of(const Value& v) noexcept {
   Operand o;
   o.type = type_of(v);
   switch (o.type) {
-    case ValueType::boolean: o.boolean = std::get<bool>(v); break;
-    case ValueType::number: o.number = std::get<double>(v); break;
-    case ValueType::string: o.string = &std::get<std::string>(v); break;
+    // get_if, not get: the type is known, and get's bad_variant_access could not leave noexcept.
+    case ValueType::boolean: o.boolean = *std::get_if<bool>(&v); break;
+    case ValueType::number: o.number = *std::get_if<double>(&v); break;
+    case ValueType::string: o.string = std::get_if<std::string>(&v); break;
   }
   return o;
 }

@@ -84,7 +84,7 @@ std::string net_to_dot(const PetriNet& net, std::span<const Tokens> marking, con
   }
   if (options.descriptions) {
     std::string rows;
-    const auto row = [&](const std::string& id, std::string text) {
+    const auto row = [&](const std::string& id, const std::string& text) {
       if (text.empty()) return;
       rows += "<TR><TD ALIGN=\"LEFT\">" + detail::xml_escape(id) + "</TD><TD ALIGN=\"LEFT\">" + detail::xml_escape(text) + "</TD></TR>";
     };

@@ -2,7 +2,6 @@
 
 #include <cstdint>
 #include <fstream>
-#include <sstream>
 
 #include "net_formats.hpp"
 #include "xml_locator.hpp"
@@ -148,18 +147,14 @@ std::optional<PetriNet> load_net_from_string(std::string_view text, std::string_
 
 std::optional<PetriNet> load_net(const std::filesystem::path& file, Diagnostics& diagnostics,
                                  const LoadOptions& options) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) {
-    diagnostics.error(SourceLocation{file.string(), 0, 0}, "cannot open file");
+  std::string text;
+  try {
+    text = read_config_file(file);
+  } catch (const ConfigError& e) {
+    diagnostics.append(e.diagnostics());
     return std::nullopt;
   }
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) {
-    diagnostics.error(SourceLocation{file.string(), 0, 0}, "cannot read file");
-    return std::nullopt;
-  }
-  return load_net_from_string(buffer.str(), file.string(), diagnostics, options);
+  return load_net_from_string(text, file.string(), diagnostics, options);
 }
 
 PetriNet load_net_or_throw(const std::filesystem::path& file, const LoadOptions& options) {

@@ -194,11 +194,11 @@ void PetriNet::add_arc(std::string_view from_id, std::string_view to_id, Tokens 
   if (!to) throw std::invalid_argument("arc to unknown node '" + std::string(to_id) + "'");
   if (from->is_place && !to->is_place) {
     Transition& t = transitions_[to->index];
-    ArcRef ref{from->index, weight, std::move(arc_where)};
+    ArcRef ref{from->index, weight, arc_where};
     switch (kind) {
-      case ArcKind::normal: t.inputs.push_back(std::move(ref)); break;
-      case ArcKind::read: t.reads.push_back(std::move(ref)); break;
-      case ArcKind::inhibitor: t.inhibitors.push_back(std::move(ref)); break;
+      case ArcKind::normal: t.inputs.push_back(ref); break;
+      case ArcKind::read: t.reads.push_back(ref); break;
+      case ArcKind::inhibitor: t.inhibitors.push_back(ref); break;
     }
     return;
   }
@@ -207,7 +207,7 @@ void PetriNet::add_arc(std::string_view from_id, std::string_view to_id, Tokens 
       throw std::invalid_argument("read and inhibitor arcs go from a place to a transition, not from '" +
                                   std::string(from_id) + "' to '" + std::string(to_id) + "'");
     }
-    transitions_[from->index].outputs.push_back(ArcRef{to->index, weight, std::move(arc_where)});
+    transitions_[from->index].outputs.push_back(ArcRef{to->index, weight, arc_where});
     return;
   }
   throw std::invalid_argument("arc must connect a place and a transition: '" + std::string(from_id) + "' -> '" +

@@ -82,13 +82,15 @@ void DistanceField::compute(const std::vector<bool>& obstacle, bool outside_is_o
   std::vector<double> f(static_cast<std::size_t>(n)), d(static_cast<std::size_t>(n));
   std::vector<int> v(static_cast<std::size_t>(n));
   std::vector<double> z(static_cast<std::size_t>(n) + 1);
+  // Index arithmetic in size_t: an int product could overflow before it is widened.
+  const auto at = [w](int x, int y) { return static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x); };
   for (int x = 0; x < w; ++x) {  // columns
-    for (int y = 0; y < h; ++y) f[static_cast<std::size_t>(y)] = sq[static_cast<std::size_t>(y * w + x)];
+    for (int y = 0; y < h; ++y) f[static_cast<std::size_t>(y)] = sq[at(x, y)];
     edt_1d(f.data(), d.data(), h, v.data(), z.data());
-    for (int y = 0; y < h; ++y) sq[static_cast<std::size_t>(y * w + x)] = d[static_cast<std::size_t>(y)];
+    for (int y = 0; y < h; ++y) sq[at(x, y)] = d[static_cast<std::size_t>(y)];
   }
   for (int y = 0; y < h; ++y) {  // rows
-    double* row = &sq[static_cast<std::size_t>(y * w)];
+    double* row = &sq[at(0, y)];
     for (int x = 0; x < w; ++x) f[static_cast<std::size_t>(x)] = row[x];
     edt_1d(f.data(), row, w, v.data(), z.data());
   }
@@ -96,7 +98,7 @@ void DistanceField::compute(const std::vector<bool>& obstacle, bool outside_is_o
   for (int y = 0; y < height_; ++y) {
     for (int x = 0; x < width_; ++x) {
       distance_m_[static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x)] =
-          static_cast<float>(std::sqrt(sq[static_cast<std::size_t>((y + 1) * w + (x + 1))]) * resolution_m_);
+          static_cast<float>(std::sqrt(sq[at(x + 1, y + 1)]) * resolution_m_);
     }
   }
 }

@@ -32,12 +32,27 @@ class PgmParser {
       fail(pos_, "expected whitespace after the magic number");
     }
     GrayImage img;
+    skip_space();
+    const std::size_t size_at = pos_;
     img.width = header_int("width", 1, 1 << 20);
     img.height = header_int("height", 1, 1 << 20);
-    img.maxval = header_int("maxval", 1, 65535);
     const std::size_t n = static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height);
-    img.pixels.resize(n);
+    // The header's numbers are checked against the documented maximum and against the bytes the
+    // file holds before anything is allocated, so a 20-byte file cannot ask for a terabyte.
+    if (n > kMaxPgmPixels) {
+      fail(size_at, "image of " + std::to_string(img.width) + " x " + std::to_string(img.height) + " = " +
+                        std::to_string(n) + " pixels exceeds the maximum of " + std::to_string(kMaxPgmPixels) +
+                        " pixels");
+    }
+    img.maxval = header_int("maxval", 1, 65535);
     if (ascii) {
+      // Each ASCII sample takes at least one digit.
+      if (b_.size() - pos_ < n) {
+        fail(b_.size(), "raster truncated: " + std::to_string(img.width) + " x " + std::to_string(img.height) +
+                            " ASCII samples need at least " + std::to_string(n) + " bytes, found " +
+                            std::to_string(b_.size() - pos_));
+      }
+      img.pixels.resize(n);
       for (std::size_t i = 0; i < n; ++i) {
         img.pixels[i] = static_cast<std::uint16_t>(
             header_int("sample " + std::to_string(i) + " of " + std::to_string(n), 0, img.maxval));
@@ -56,6 +71,7 @@ class PgmParser {
                           std::to_string(img.width) + " x " + std::to_string(img.height) + " samples, found " +
                           std::to_string(b_.size() - pos_));
     }
+    img.pixels.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
       const std::size_t at = pos_ + i * bytes_per;
       unsigned v = static_cast<unsigned char>(b_[at]);

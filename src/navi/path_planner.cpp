@@ -38,7 +38,7 @@ PathPlanner::PathPlanner(const OccupancyGrid& grid, PathPlannerOptions options)
   open_cell_.assign(padded, 0);
   for (int y = 0; y < grid_.height(); ++y) {
     for (int x = 0; x < grid_.width(); ++x) {
-      open_cell_[static_cast<std::size_t>((y + 1) * padded_width_ + x + 1)] = traversable_[grid_.index({x, y})];
+      open_cell_[padded_index(x, y)] = traversable_[grid_.index({x, y})];
     }
   }
   g_.resize(padded);
@@ -113,7 +113,7 @@ PlannedPath PathPlanner::plan_around(Point2D start, Point2D goal, std::span<cons
       for (const std::size_t i : cells) {
         planner.traversable_[i] = 1;
         const CellIndex c = planner.grid_.cell(i);
-        planner.open_cell_[static_cast<std::size_t>((c.y + 1) * planner.padded_width_ + c.x + 1)] = 1;
+        planner.open_cell_[planner.padded_index(c.x, c.y)] = 1;
       }
     }
   } closed{*this, {}};
@@ -136,7 +136,7 @@ PlannedPath PathPlanner::plan_around(Point2D start, Point2D goal, std::span<cons
         if (d > outer) continue;
         if (d > r && std::hypot(cc.x_m - start.x_m, cc.y_m - start.y_m) < near_start) continue;
         traversable_[i] = 0;
-        open_cell_[static_cast<std::size_t>((y + 1) * padded_width_ + x + 1)] = 0;
+        open_cell_[padded_index(x, y)] = 0;
         closed.cells.push_back(i);
       }
     }
@@ -209,7 +209,7 @@ PlannedPath PathPlanner::plan(CellIndex start, CellIndex goal) {
   parent_[si] = si;
   open.push({octile(si), octile(si), si});
   // straight moves first; diagonal k uses straight moves kSide[k][0..1] as its two sides
-  const std::int32_t kStep[8] = {1, -1, pw, -pw, pw + 1, -pw + 1, pw - 1, -pw - 1};
+  const std::int32_t steps[8] = {1, -1, pw, -pw, pw + 1, -pw + 1, pw - 1, -pw - 1};
   static constexpr int kSide[8][2] = {{0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 2}, {0, 3}, {1, 2}, {1, 3}};
   const std::uint8_t* cell_open = open_cell_.data();
   bool found = false;
@@ -225,11 +225,11 @@ PlannedPath PathPlanner::plan(CellIndex start, CellIndex goal) {
     }
     const float gn = g_[n.i];
     for (int k = 0; k < 8; ++k) {
-      const auto ni = static_cast<std::uint32_t>(static_cast<std::int32_t>(n.i) + kStep[k]);
+      const auto ni = static_cast<std::uint32_t>(static_cast<std::int32_t>(n.i) + steps[k]);
       if (cell_open[ni] == 0) continue;
       if (k >= 4) {  // no corner cutting
-        const auto s0 = static_cast<std::uint32_t>(static_cast<std::int32_t>(n.i) + kStep[kSide[k][0]]);
-        const auto s1 = static_cast<std::uint32_t>(static_cast<std::int32_t>(n.i) + kStep[kSide[k][1]]);
+        const auto s0 = static_cast<std::uint32_t>(static_cast<std::int32_t>(n.i) + steps[kSide[k][0]]);
+        const auto s1 = static_cast<std::uint32_t>(static_cast<std::int32_t>(n.i) + steps[kSide[k][1]]);
         if (cell_open[s0] == 0 || cell_open[s1] == 0) continue;
       }
       const float ng = gn + (k >= 4 ? kSqrt2 : 1.0F);

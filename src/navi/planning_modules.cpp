@@ -64,7 +64,7 @@ bool ObstacleReplanner::observe(const CGridMaps& maps, const ModuleContext& cont
   return seen_.size() != before;
 }
 
-void PublishedPath::publish(std::vector<Point2D> points, double start_m, bool final, ModuleContext& context) {
+void PublishedPath::publish(const std::vector<Point2D>& points, double start_m, bool final, ModuleContext& context) {
   points_.clear();
   s_.clear();
   for (const Point2D& p : points) {
@@ -179,7 +179,7 @@ void CPathPlanningModule::on_behavior_activated(const BehaviorActivation& activa
     return;
   }
   goal_ = *goal;
-  path_.publish(std::move(plan.waypoints), 0.0, true, context);
+  path_.publish(plan.waypoints, 0.0, true, context);
 }
 
 void CPathPlanningModule::on_update(ModuleContext& context) {
@@ -188,7 +188,7 @@ void CPathPlanningModule::on_update(ModuleContext& context) {
   PlannedPath plan = maps_->planner().plan_around(point_of(context.navigation->map_from_base), goal_, replanner_.obstacles(),
                                                   kDetourMargin_m);
   // No way around (yet): the behavior waits, the obstacle may go, until its blocked timeout.
-  if (plan.ok()) path_.publish(std::move(plan.waypoints), 0.0, true, context);
+  if (plan.ok()) path_.publish(plan.waypoints, 0.0, true, context);
 }
 
 void CPathPlanningModule::on_behavior_deactivated(std::string_view behavior, ModuleContext& context) {
@@ -344,7 +344,7 @@ void CCoverageModule::plan_detour(const Pose2D& pose, ModuleContext& context) {
   if (resume < 0.0) resume = coverage_path_.length_m();  // the rest of the path is behind the obstacle
   PlannedPath plan = maps_->planner().plan_around(point_of(pose), coverage_path_.at(resume), seen, kDetourMargin_m);
   if (!plan.ok()) return;  // no way around yet: the behavior waits; the obstacle may go before its timeout
-  detour_.publish(std::move(plan.waypoints), 0.0, false, context);
+  detour_.publish(plan.waypoints, 0.0, false, context);
   detouring_ = true;
   resume_m_ = resume;
 }

@@ -344,7 +344,7 @@ class Expander {
   Expander(const TaskKnowledge& knowledge, const std::map<std::string, std::vector<std::string>>& lists)
       : knowledge_(knowledge), lists_(lists) {}
 
-  bool expand(const std::vector<TemplateNode>& nodes, std::map<std::string, std::string> vars, Plan& plan) {
+  bool expand(const std::vector<TemplateNode>& nodes, const std::map<std::string, std::string>& vars, Plan& plan) {
     for (const auto& node : nodes) {
       switch (node.kind) {
         case TemplateNode::Kind::process:

@@ -399,7 +399,8 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
   if (d.has_errors()) throw ConfigError(d);
   {
     ModuleContext ctx = m->context(clock.now());
-    for (auto& [name, mod] : m->modules) collect([&] { mod->start(ctx); });
+    // Not a structured binding: clang 14 (the fuzzing compiler) cannot capture one in a lambda.
+    for (auto& named : m->modules) collect([&] { named.second->start(ctx); });
   }
   if (d.has_errors()) throw ConfigError(d);
 

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <utility>
 
 namespace tripodal::sim {
 
@@ -43,7 +44,7 @@ SimHardware::SimHardware(World world, const HardwareConfig& config)
     : seed_(seed_of(config, world)), sim_(std::move(world), *config.base, seed_) {}
 
 void register_sim_hardware(HardwareRegistry& registry, std::shared_ptr<const World> world) {
-  registry.add(SimHardware::static_manifest(), [world](const HardwareConfig& c) -> std::unique_ptr<CHardware> {
+  registry.add(SimHardware::static_manifest(), [world = std::move(world)](const HardwareConfig& c) -> std::unique_ptr<CHardware> {
     return std::make_unique<SimHardware>(c, world);
   });
 }

@@ -265,7 +265,7 @@ CBehavior& BehaviorHarness::attach(std::unique_ptr<CBehavior> behavior, Paramete
   Attached a;
   a.input = coordinator_->add_input(std::move(input));
   a.params = std::move(params);
-  a.where = std::move(where);
+  a.where = where;
   a.behavior = std::move(behavior);
   attached_.push_back(std::move(a));
   log_.names_.push_back(name);

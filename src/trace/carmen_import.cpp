@@ -20,6 +20,13 @@ struct Token {
   int column = 0;  // 1-based
 };
 
+// A line longer than kCarmenMaxLineBytes is kept only up to one byte past the limit (the importer
+// reports it), so a file without newlines cannot grow the line buffer without bound.
+void append_capped(std::string& line, std::string_view piece) {
+  const std::size_t room = kCarmenMaxLineBytes + 1 - std::min(line.size(), kCarmenMaxLineBytes + 1);
+  line.append(piece.substr(0, std::min(room, piece.size())));
+}
+
 // Reads lines from a file through zlib, which also reads uncompressed files unchanged.
 class GzLines {
  public:
@@ -61,13 +68,13 @@ class GzLines {
       }
       const char* begin = chunk_.data() + pos_;
       const auto* nl = static_cast<const char*>(std::memchr(begin, '\n', len_ - pos_));
+      const std::size_t piece = nl == nullptr ? len_ - pos_ : static_cast<std::size_t>(nl - begin);
+      append_capped(line, std::string_view(begin, piece));
       if (nl == nullptr) {
-        line.append(begin, len_ - pos_);
         pos_ = len_;
         continue;
       }
-      line.append(begin, static_cast<std::size_t>(nl - begin));
-      pos_ += static_cast<std::size_t>(nl - begin) + 1;
+      pos_ += piece + 1;
       return true;
     }
   }
@@ -130,7 +137,7 @@ class Fields {
   Time stamp() {
     const int column = tokens_[std::min(next_, tokens_.size() - 1)].column;
     const double seconds = number("timestamp");
-    if (std::fabs(seconds) > 9.0e9) {
+    if (std::fabs(seconds) > kMaxSeconds) {
       throw LineError{column, std::string(type_) + " timestamp " + std::to_string(seconds) + " s is out of range"};
     }
     const std::size_t rest = tokens_.size() - next_;
@@ -171,6 +178,12 @@ class Importer {
     while (lines.getline(line)) {
       ++line_number;
       ++report_.lines;
+      if (line.size() > kCarmenMaxLineBytes) {
+        diagnostics_.error(SourceLocation{name_, line_number, static_cast<int>(kCarmenMaxLineBytes) + 1},
+                           "line longer than " + std::to_string(kCarmenMaxLineBytes) +
+                               " bytes (a CARMEN message is one line; is this a CARMEN log?)");
+        continue;
+      }
       split(line, tokens);
       if (tokens.empty()) {
         ++report_.blank_lines;
@@ -337,7 +350,18 @@ class Importer {
 class StreamLines {
  public:
   explicit StreamLines(std::istream& in) : in_(in) {}
-  bool getline(std::string& line) { return static_cast<bool>(std::getline(in_, line)); }
+  bool getline(std::string& line) {
+    line.clear();
+    std::streambuf* buf = in_.rdbuf();
+    bool any = false;
+    for (int c = buf->sbumpc(); c != std::char_traits<char>::eof(); c = buf->sbumpc()) {
+      any = true;
+      if (c == '\n') return true;
+      if (line.size() <= kCarmenMaxLineBytes) line.push_back(static_cast<char>(c));
+    }
+    in_.setstate(std::ios::eofbit);
+    return any;
+  }
 
  private:
   std::istream& in_;

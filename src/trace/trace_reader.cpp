@@ -15,6 +15,8 @@ std::uint32_t le32(const std::uint8_t* p) noexcept {
          static_cast<std::uint32_t>(p[2]) << 16 | static_cast<std::uint32_t>(p[3]) << 24;
 }
 
+constexpr std::size_t kBodyChunkBytes = std::size_t{1} << 20;
+
 std::string hex32(std::uint32_t v) {
   std::ostringstream s;
   s << "0x" << std::hex << v;
@@ -109,9 +111,19 @@ bool TraceReader::next(TraceRecord& record) {
       fail(frame_at, "record length " + std::to_string(length) + " outside [" + std::to_string(detail::kBodyHeadBytes) +
                          ", " + std::to_string(options_.max_record_bytes) + "]");
     }
-    body_.resize(length + detail::kFrameTailBytes);
-    const std::size_t body_got = read_bytes(body_.data(), body_.size());
-    if (body_got < body_.size()) {
+    // The body grows as its bytes arrive, so a length field that promises more than the file
+    // holds costs at most one chunk beyond what the file has.
+    const std::size_t want = length + detail::kFrameTailBytes;
+    std::size_t body_got = 0;
+    body_.clear();
+    while (body_got < want) {
+      const std::size_t step = std::min<std::size_t>(want - body_got, kBodyChunkBytes);
+      body_.resize(body_got + step);
+      const std::size_t got_now = read_bytes(body_.data() + body_got, step);
+      body_got += got_now;
+      if (got_now < step) break;
+    }
+    if (body_got < want) {
       state_ = ReadState::kTruncated;
       warning_ = name_ + ": truncated at byte " + std::to_string(frame_at) + " (a record of " +
                  std::to_string(length + detail::kFrameHeadBytes + detail::kFrameTailBytes) + " bytes has only " +
@@ -130,6 +142,11 @@ bool TraceReader::next(TraceRecord& record) {
       const ChannelId channel = in.u16();
       const Time stamp = time_from_ns(in.i64());
       if (type == detail::kChannelDeclaration) {
+        // Stamped 0 by the format, so that a trace re-writes to its own bytes.
+        if (to_ns(stamp) != 0) {
+          throw detail::DecodeError{3, "channel declaration stamped " + std::to_string(to_ns(stamp)) +
+                                           " (declarations are stamped 0)"};
+        }
         const std::size_t kind_at = in.position();
         const auto kind = static_cast<ChannelKind>(in.u8());
         if (!is_valid(kind)) {

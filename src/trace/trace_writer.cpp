@@ -60,14 +60,14 @@ ChannelId TraceWriter::add_channel(std::string_view name, ChannelKind kind) {
 template <typename T>
 void TraceWriter::write_record(ChannelId channel, const T& data) {
   check_open();
-  constexpr ChannelKind kind = detail::kind_for<T>();
+  constexpr ChannelKind kKind = detail::kind_for<T>();
   if (channel >= channels_.size()) {
     throw std::invalid_argument(name_ + ": channel " + std::to_string(channel) + " is not declared");
   }
-  if (channels_[channel].kind != kind) {
+  if (channels_[channel].kind != kKind) {
     throw std::invalid_argument(name_ + ": channel '" + channels_[channel].name + "' carries " +
                                 std::string(to_string(channels_[channel].kind)) + " records, not " +
-                                std::string(to_string(kind)));
+                                std::string(to_string(kKind)));
   }
   body_.clear();
   detail::encode(channel, data, body_);
@@ -95,8 +95,8 @@ void TraceWriter::write_frame() {
   std::array<std::uint8_t, 12> frame{};
   const std::uint32_t crc = detail::crc32(body_.data(), body_.size());
   const std::uint32_t fields[3] = {length, ~length, crc};
-  for (int f = 0; f < 3; ++f) {
-    for (int i = 0; i < 4; ++i) frame[static_cast<std::size_t>(f * 4 + i)] = static_cast<std::uint8_t>(fields[f] >> (8 * i));
+  for (std::size_t f = 0; f < 3; ++f) {
+    for (std::size_t i = 0; i < 4; ++i) frame[f * 4 + i] = static_cast<std::uint8_t>(fields[f] >> (8 * i));
   }
   // Head, body, tail in that order: a recorder killed mid-record leaves a frame the reader sees as
   // a truncated tail, never as a whole record.

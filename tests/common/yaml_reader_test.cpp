@@ -89,3 +89,11 @@ TEST_CASE("yaml::Reader typed reads accept good values and locate bad ones", "[y
   CHECK_THAT(e, Catch::Contains("name: expected a non-empty text, got an empty text"));
   CHECK_THAT(e, Catch::Contains("name: expected text, got a list"));
 }
+
+TEST_CASE("yaml::Reader locates the empty document at 1:1") {
+  // Found by fuzz_robot_profile: an empty profile's "expected a map, got nothing" had no line.
+  Diagnostics d;
+  yaml::Reader r("empty.yaml", d);
+  const SourceLocation where = r.at(yaml::parse("", "empty.yaml"));
+  CHECK(where.str() == "empty.yaml:1:1");
+}

@@ -28,7 +28,7 @@ TEST_CASE("ConfigError carries every diagnostic in what()") {
   CHECK(e.diagnostics().error_count() == 2);
 }
 
-TEST_CASE("SourceFile: one interned copy per name, safe to create from several threads") {
+TEST_CASE("SourceFile: one interned copy per name, safe to create from several threads", "[threads]") {
   const SourceFile none;
   CHECK(none.empty());
   CHECK(none.str().empty());

@@ -80,3 +80,10 @@ TEST_CASE("event scripts load from files; a missing file is an error naming it")
                     Catch::Contains("missing.script") && Catch::Contains("cannot read"));
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("event scripts: a time beyond the range of a Time saturates instead of overflowing") {
+  // Found by fuzz_event_script: 8.9e58 s was converted to 64-bit nanoseconds, undefined behaviour.
+  const EventScript s = parse_event_script(std::string(59, '8') + " cr\n\n", "fuzz.events");
+  REQUIRE(s.entries.size() == 1);
+  CHECK(s.entries[0].time == time_from_seconds(kMaxSeconds));
+}

@@ -295,8 +295,8 @@ TEST_CASE("native loader: files, errors as exceptions, and save/load round trip"
   std::filesystem::create_directories(dir);
   Diagnostics d;
   CHECK_FALSE(load_net(dir / "missing.xml", d));
-  CHECK_THAT(d.str(), Catch::Contains("missing.xml: error: cannot open file"));
-  REQUIRE_THROWS_WITH(load_net_or_throw(dir / "missing.xml"), Catch::Contains("cannot open file"));
+  CHECK_THAT(d.str(), Catch::Contains("missing.xml: error: cannot read the file"));
+  REQUIRE_THROWS_WITH(load_net_or_throw(dir / "missing.xml"), Catch::Contains("cannot read the file"));
 
   Diagnostics d2;
   const auto net = load_net_from_string(kGood, "good.xml", d2);

@@ -33,3 +33,12 @@ TEST_CASE("format_seconds with kExactDigits prints the exact value without trail
   CHECK(format_seconds(Duration{1'000'000'000'123'456'789}, kExactDigits) == "1000000000.123456789");
   CHECK(format_seconds(Duration{std::numeric_limits<std::int64_t>::min()}, kExactDigits) == "-9223372036.854775808");
 }
+
+TEST_CASE("from_seconds saturates at kMaxSeconds and maps NaN to zero") {
+  CHECK(from_seconds(1.5) == 1500ms);
+  CHECK(from_seconds(1e300) == from_seconds(kMaxSeconds));
+  CHECK(from_seconds(-1e300) == -from_seconds(kMaxSeconds));
+  CHECK(from_seconds(std::numeric_limits<double>::infinity()) == from_seconds(kMaxSeconds));
+  CHECK(from_seconds(std::numeric_limits<double>::quiet_NaN()) == Duration{0});
+  CHECK(to_seconds(from_seconds(kMaxSeconds)) == kMaxSeconds);
+}

@@ -198,3 +198,43 @@ TEST_CASE("map_io: a missing image is reported with the resolved path", "[navi][
   write_file(dir / "m.yaml", kYaml);
   CHECK_THROWS_WITH(load_map(dir / "m.yaml"), Catch::Contains((dir / "m.pgm").string() + ": error: cannot read the file"));
 }
+
+TEST_CASE("map_io: a PGM header larger than the file or the maximum is refused before allocation",
+          "[navi][map][errors][limits]") {
+  // Found by hand (issue 23): a 20-byte file declaring 10^12 pixels ended `tripodal run` with
+  // std::bad_alloc, the raster being allocated before the file was checked to hold it.
+  TempDir dir("huge");
+  write_file(dir / "m.yaml", kYaml);
+  const std::string huge = "P5 1000000 1000000 1";
+  REQUIRE(huge.size() == 20);
+  write_file(dir / "m.pgm", huge);
+  CHECK_THROWS_WITH(load_map(dir / "m.yaml"),
+                    Catch::Contains((dir / "m.pgm").string() + ": error: at byte 3: image of 1000000 x 1000000 = "
+                                    "1000000000000 pixels exceeds the maximum of 67108864 pixels"));
+  // Within the maximum but longer than the file: refused from the sizes alone, binary and ASCII.
+  CHECK_THROWS_WITH(parse_pgm("P5\n8000 8000\n255\n", "b.pgm"),
+                    Catch::Contains("b.pgm: error: at byte 17: raster truncated: expected 64000000 bytes for 8000 x "
+                                    "8000 samples, found 0"));
+  CHECK_THROWS_WITH(parse_pgm("P5\n8000 8000\n65535\n", "w.pgm"),
+                    Catch::Contains("w.pgm: error: at byte 19: raster truncated: expected 128000000 bytes"));
+  CHECK_THROWS_WITH(parse_pgm("P2\n8000 8000\n255\n1 2 3\n", "a.pgm"),
+                    Catch::Contains("a.pgm: error: at byte 23: raster truncated: 8000 x 8000 ASCII samples need at "
+                                    "least 64000000 bytes, found 7"));
+  // The largest side alone is fine when the other is small.
+  const GrayImage strip = parse_pgm("P5\n1048576 1\n255\n" + std::string(1 << 20, '\x10'), "s.pgm");
+  CHECK(strip.pixels.size() == std::size_t{1} << 20);
+}
+
+TEST_CASE("map_io: a map file beyond the configuration file limit is refused unread", "[navi][map][errors][limits]") {
+  TempDir dir("big");
+  write_file(dir / "m.yaml", kYaml);
+  {
+    std::ofstream f(dir / "m.pgm", std::ios::binary);
+    f << "P5\n1 1\n255\n";
+  }
+  // A sparse file: the size is what counts, nothing is read.
+  std::filesystem::resize_file(dir / "m.pgm", kMaxConfigFileBytes + 1);
+  CHECK_THROWS_WITH(load_map(dir / "m.yaml"),
+                    Catch::Contains((dir / "m.pgm").string() + ": error: the file has 268435457 bytes, more than the "
+                                    "268435456 a configuration file may have"));
+}

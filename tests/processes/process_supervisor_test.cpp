@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <functional>
+#include <thread>
 
 #include "doubles.hpp"
 #include "tripodal/processes/process_registry.hpp"
@@ -320,4 +321,38 @@ TEST_CASE("Facts reach the running nets that declare them", "[processes]") {
   REQUIRE(rig.results.size() == 1);
   CHECK(rig.results[0].place == "P7");
   CHECK(to_seconds(rig.results[0].finished) == Approx(0.5));
+}
+
+TEST_CASE("Modules post events, facts, heartbeats and faults from their own threads while the supervisor steps",
+          "[processes][threads]") {
+  // The supervisor's inbox is the one part of it other threads touch (scripts/tsan.sh runs this
+  // under ThreadSanitizer); the counts are bounded, not timed.
+  Rig rig;
+  rig.supervisor.watch_module("localizer", from_seconds(100.0));
+  rig.start("X0", "PrCleaning", {{"section", "A", {}}});
+  bool done = false;
+  std::vector<std::thread> modules;
+  modules.emplace_back([&] {
+    for (int i = 0; i < 200; ++i) rig.supervisor.post_event(i % 2 == 0 ? "localizer.lost" : "localizer.ok");
+  });
+  modules.emplace_back([&] {
+    for (int i = 0; i < 200; ++i) rig.supervisor.heartbeat("localizer");
+  });
+  modules.emplace_back([&] {
+    for (int i = 0; i < 200; ++i) rig.supervisor.set_fact("retries_allowed", Value(i % 2 == 0));
+    rig.supervisor.report_module_fault("camera", "unplugged");
+  });
+  int steps = 0;
+  for (; steps < 1000 && !done; ++steps) {
+    rig.supervisor.step();
+    for (auto& r : rig.supervisor.take_results()) rig.results.push_back(r);
+    done = rig.results.size() == 1;
+  }
+  for (std::thread& t : modules) t.join();
+  rig.supervisor.step();
+  for (auto& r : rig.supervisor.take_results()) rig.results.push_back(r);
+  // The camera fault reaches the run whatever the interleaving: nothing in PrCleaning consumes it.
+  REQUIRE(rig.results.size() == 1);
+  CHECK_FALSE(rig.results[0].success);
+  CHECK_THAT(rig.results[0].message, Catch::Contains("module camera failed: unplugged"));
 }

@@ -259,7 +259,7 @@ class BhRecorder final : public CBehavior {
 
 }  // namespace
 
-TEST_CASE("The runner keeps absolute deadlines and skips the ticks an overrun missed") {
+TEST_CASE("The runner keeps absolute deadlines and skips the ticks an overrun missed", "[threads]") {
   JumpClock clock;
   ResourceTable resources;
   ControlLoopOptions o;
@@ -292,7 +292,7 @@ TEST_CASE("The runner keeps absolute deadlines and skips the ticks an overrun mi
   CHECK(s.cycles() >= 40);
 }
 
-TEST_CASE("A runner on the steady clock runs, and asks for real-time priority without failing") {
+TEST_CASE("A runner on the steady clock runs, and asks for real-time priority without failing", "[threads]") {
   SteadyClock clock;
   ResourceTable resources;
   ControlLoopOptions o;

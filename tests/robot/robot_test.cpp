@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <functional>
+#include <thread>
 
 #include "robot_doubles.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
@@ -249,4 +250,26 @@ TEST_CASE("PSR-2: the same task and event sequence give the same trace", "[robot
   const std::string a = once();
   CHECK(a == once());
   CHECK_THAT(a, Catch::Contains("recovery:") && Catch::EndsWith("task clean succeeded\n"));
+}
+
+TEST_CASE("PSR-2 on its threads takes a command from another thread and stops cleanly", "[robot][threads]") {
+  // Real time: the hardware, a LoopRunner per reactive loop and the sequencing thread run while a
+  // second thread commands the planner (scripts/tsan.sh runs this under ThreadSanitizer). What is
+  // checked does not depend on how far the robot got.
+  SteadyClock clock;
+  TestWorld world;
+  const RobotPlugins plugins = test_plugins(world);
+  const std::unique_ptr<Robot> robot = Robot::assemble(load_robot_profile(kProfile), plugins, clock);
+  robot->start();
+  CHECK(robot->started());
+  CHECK_THROWS_AS(robot->start(), std::logic_error);
+  bool accepted = false;
+  std::thread operator_thread([&] { accepted = robot->command("clean the room 3211").accepted; });
+  operator_thread.join();
+  clock.sleep_until(clock.now() + std::chrono::milliseconds(200));
+  robot->stop();
+  robot->stop();  // idempotent
+  CHECK_FALSE(robot->started());
+  CHECK(accepted);
+  CHECK(robot->planner().busy());
 }

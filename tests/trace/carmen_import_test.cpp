@@ -206,3 +206,21 @@ TEST_CASE("a missing log is an I/O error, a damaged gzip stream too") {
   write_all(cut.path(), gz, gz.size() / 2);
   CHECK_THROWS_AS(import_carmen_log(cut.path(), w), TraceIoError);
 }
+
+TEST_CASE("a line longer than the limit is reported at the limit, the lines after it still import") {
+  std::string text = "ODOM 1 2 3 0 0 0 10.0 host 10.0\nPARAM robot_name ";
+  text.append(kCarmenMaxLineBytes, 'x');
+  text += "\nODOM 1 2 3 0 0 0 11.0 host 11.0\nFLASER zz\n";
+  std::istringstream in(text);
+  TempFile out("carmen_long");
+  TraceWriter w(out.path());
+  try {
+    import_carmen_log(in, "long.log", w);
+    FAIL("expected a ConfigError");
+  } catch (const ConfigError& e) {
+    const std::string what = e.what();
+    CHECK_THAT(what, Catch::Contains("long.log:2:1048577: error: line longer than 1048576 bytes"));
+    CHECK_THAT(what, Catch::Contains("long.log:4:8: error: FLASER num_readings 'zz' is not a count"));
+    CHECK(e.diagnostics().error_count() == 2);
+  }
+}

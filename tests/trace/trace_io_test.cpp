@@ -1,6 +1,8 @@
 #include <catch2/catch.hpp>
 #include <sstream>
 
+#include <zlib.h>
+
 #include "trace_test_util.hpp"
 #include "tripodal/trace/trace_reader.hpp"
 #include "tripodal/trace/trace_writer.hpp"
@@ -316,4 +318,43 @@ TEST_CASE("a checksum-valid record with a bad payload is refused, located") {
     TraceRecord rec;
     CHECK_THROWS_WITH(r.next(rec), Catch::Contains("record on undeclared channel 9"));
   }
+}
+
+TEST_CASE("a length field promising more than the file holds reads as a truncated tail") {
+  // The reader grows a record's buffer as its bytes arrive, so this 24-byte file does not cost
+  // the 60 MiB its frame announces.
+  TempFile file("long_frame");
+  { TraceWriter w(file.path()); }
+  auto bytes = read_all(file.path());
+  const std::uint32_t length = 60u << 20;
+  for (const std::uint32_t v : {length, ~length}) {
+    for (int i = 0; i < 4; ++i) bytes.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+  }
+  bytes.insert(bytes.end(), {1, 2, 3});
+  write_all(file.path(), bytes, bytes.size());
+  TraceReader r(file.path());
+  TraceRecord rec;
+  CHECK_FALSE(r.next(rec));
+  CHECK(r.state() == ReadState::kTruncated);
+  CHECK_THAT(r.warning(), Catch::Contains("truncated at byte 16 (a record of 62914572 bytes has only 11)"));
+}
+
+TEST_CASE("a channel declaration stamped other than 0 is refused, located at its stamp") {
+  // The format stamps declarations 0; fuzz_trace's re-write property (a trace re-writes to its
+  // own bytes) failed on declarations with other stamps until the reader refused them.
+  TempFile file("decl_stamp");
+  { TraceWriter w(file.path()); }
+  auto bytes = read_all(file.path());
+  std::vector<std::uint8_t> body = {0, 0, 0, 5, 0, 0, 0, 0, 0, 0, 0, static_cast<std::uint8_t>(ChannelKind::kEvent), 1, 0, 'e'};
+  const auto length = static_cast<std::uint32_t>(body.size());
+  const std::uint32_t crc = static_cast<std::uint32_t>(crc32(0L, body.data(), static_cast<unsigned>(body.size())));
+  for (const std::uint32_t v : {length, ~length}) {
+    for (int i = 0; i < 4; ++i) bytes.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+  }
+  bytes.insert(bytes.end(), body.begin(), body.end());
+  for (int i = 0; i < 4; ++i) bytes.push_back(static_cast<std::uint8_t>(crc >> (8 * i)));
+  write_all(file.path(), bytes, bytes.size());
+  TraceReader r(file.path());
+  TraceRecord rec;
+  CHECK_THROWS_WITH(r.next(rec), Catch::Contains("byte 27: channel declaration stamped 5 (declarations are stamped 0)"));
 }

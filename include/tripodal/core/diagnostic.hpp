@@ -3,6 +3,8 @@
 // so an author fixes them in one pass and an editor can jump to each one.
 #pragma once
 
+#include <cstdint>
+#include <filesystem>
 #include <iosfwd>
 #include <stdexcept>
 #include <string>
@@ -88,5 +90,15 @@ class ConfigError : public std::runtime_error {
  private:
   Diagnostics diagnostics_;
 };
+
+/// The largest file a configuration loader reads (nets, event scripts, YAML files, map images):
+/// 256 MiB, four times the largest map image (kMaxPgmPixels 16-bit samples). A bigger file is
+/// refused before it is read, so a mistaken path to a disk image cannot exhaust memory.
+inline constexpr std::uintmax_t kMaxConfigFileBytes = std::uintmax_t{256} << 20;
+
+/// The whole of a configuration file, the one way every loader reads one. Throws ConfigError at
+/// FILE: "cannot read the file" or "the file has N bytes, more than the M a configuration file
+/// may have".
+[[nodiscard]] std::string read_config_file(const std::filesystem::path& file);
 
 }  // namespace tripodal

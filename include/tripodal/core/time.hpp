@@ -36,9 +36,17 @@ using Time = TimeEpoch::time_point;
 /// Seconds (as a double) since the epoch; for reports, logs and file formats.
 [[nodiscard]] constexpr double to_seconds(Time t) noexcept { return to_seconds(t.time_since_epoch()); }
 
-/// A duration from seconds, rounded to the nearest nanosecond.
+/// The largest magnitude from_seconds converts exactly enough: 9e9 s (285 years); a Duration of
+/// 64-bit nanoseconds ends at 9.22e9 s.
+inline constexpr double kMaxSeconds = 9.0e9;
+
+/// A duration from seconds, rounded to the nearest nanosecond. Saturates at +-kMaxSeconds (NaN
+/// gives 0): seconds read from a file can be anything, and converting a double beyond the range
+/// of the integer is undefined behaviour (found by fuzzing event scripts).
 [[nodiscard]] constexpr Duration from_seconds(double seconds) noexcept {
-  return std::chrono::round<Duration>(std::chrono::duration<double>(seconds));
+  if (seconds != seconds) return Duration{0};
+  const double s = seconds > kMaxSeconds ? kMaxSeconds : seconds < -kMaxSeconds ? -kMaxSeconds : seconds;
+  return std::chrono::round<Duration>(std::chrono::duration<double>(s));
 }
 
 /// The time `seconds` after the epoch, rounded to the nearest nanosecond.

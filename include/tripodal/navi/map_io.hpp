@@ -39,9 +39,14 @@ struct GrayImage {
   }
 };
 
+/// The largest image parse_pgm accepts: 2^26 pixels (8192 x 8192, a 409 m square at 5 cm per
+/// cell). Larger headers are refused before anything is allocated.
+inline constexpr std::size_t kMaxPgmPixels = std::size_t{1} << 26;
+
 /// Parses a PGM image (P5 binary or P2 ASCII, maxval up to 65535; 16-bit samples big-endian as
 /// the format says). name is used in errors. Throws ConfigError "NAME: at byte N: what, expected
-/// ..." for a malformed header, a bad sample or a truncated raster.
+/// ..." for a malformed header, a bad sample or a truncated raster; the header's size is checked
+/// against kMaxPgmPixels and against the length of `bytes` before the raster is allocated.
 [[nodiscard]] GrayImage parse_pgm(std::string_view bytes, const std::string& name);
 /// Reads and parses a PGM file; ConfigError when it cannot be read or is malformed.
 [[nodiscard]] GrayImage read_pgm(const std::filesystem::path& file);

@@ -75,6 +75,9 @@ class PathPlanner final {
   // A* works on a copy of traversable_ padded by one blocked cell on every side, so neighbours
   // need no bounds check: padded index = (y + 1) * (width + 2) + (x + 1).
   int padded_width_ = 0;
+  [[nodiscard]] std::size_t padded_index(int x, int y) const noexcept {
+    return static_cast<std::size_t>(y + 1) * static_cast<std::size_t>(padded_width_) + static_cast<std::size_t>(x + 1);
+  }
   std::vector<std::uint8_t> open_cell_;
   // A* scratch (padded indices), reused across plans; valid where stamp_ == search_id_.
   std::vector<float> g_;

@@ -50,7 +50,7 @@ class ObstacleReplanner {
 class PublishedPath {
  public:
   /// Publishes `points` under a new id, taken up at start_m; `final`: its end is the goal.
-  void publish(std::vector<Point2D> points, double start_m, bool final, ModuleContext& context);
+  void publish(const std::vector<Point2D>& points, double start_m, bool final, ModuleContext& context);
   /// Publishes a failure reason (static storage) for the active behavior.
   void fail(std::string_view reason, ModuleContext& context);
   /// Withdraws what this module published (if it is still what the loop is given).

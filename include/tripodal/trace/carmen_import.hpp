@@ -43,6 +43,11 @@ struct CarmenImportReport {
   Time last_stamp{};
 };
 
+/// The longest line the importer reads: a 1081-beam ROBOTLASER1 line with remissions is about
+/// 20 kB, so 1 MiB leaves room for any real scanner. A longer line is reported as an error at its
+/// column kCarmenMaxLineBytes + 1 and only that much of it is ever held in memory.
+inline constexpr std::size_t kCarmenMaxLineBytes = std::size_t{1} << 20;
+
 /// Imports the CARMEN log at `path` (plain text, or gzip-compressed: detected from the content).
 /// Reads every line before reporting: throws ConfigError listing each malformed line as
 /// "FILE:LINE:COL: error: ..." (records of the well-formed lines are then already written).

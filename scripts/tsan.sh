@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Builds the test suites whose tests use threads with ThreadSanitizer (-DTRIPODAL_TSAN=ON, g++) and
+# runs the tests tagged [threads]: LoopRunner, the process supervisor's inbox fed from module
+# threads, Robot::start/stop with a command from another thread, SourceFile interning. A data race
+# or a lock-order inversion fails the run (halt_on_error). Build tree: $BUILD_ROOT/tsan.
+#
+# A new threaded component (the monitor server, a DDS transport) joins by tagging its tests
+# [threads] and adding its suite to `suites` below.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$(pwd)
+build="${BUILD_ROOT:-$root/build}/tsan"
+jobs=${JOBS:-$(nproc)}
+suites=(tripodal_core_tests tripodal_reactive_tests tripodal_processes_tests tripodal_robot_tests)
+
+scripts/install-deps.sh
+
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTRIPODAL_TSAN=ON -DTRIPODAL_WERROR=ON \
+  -DTRIPODAL_BUILD_TESTS=ON -DTRIPODAL_BUILD_TOOLS=OFF -DTRIPODAL_BUILD_BENCH=OFF >/dev/null
+cmake --build "$build" -j "$jobs" --target "${suites[@]}"
+export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1"
+for suite in "${suites[@]}"; do
+  exe=$(find "$build/tests" -type f -name "$suite" -perm -u+x | head -n 1)
+  echo "== $suite [threads] under ThreadSanitizer"
+  "$exe" "[threads]"
+done
+echo "tsan: no data race in the [threads] tests of ${#suites[@]} suites"
