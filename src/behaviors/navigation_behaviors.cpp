@@ -67,8 +67,22 @@ Pose2D PathTracker::at(double s) const noexcept {
   if (pts_.empty()) return {};
   if (s <= 0.0) return pts_.front();
   if (s >= s_.back()) return pts_.back();
-  const auto it = std::upper_bound(s_.begin(), s_.end(), s);
-  const std::size_t j = static_cast<std::size_t>(it - s_.begin());  // s_[j-1] <= s < s_[j]
+  // The first j with s < s_[j]. The points asked for lie a few centimetres around the progress
+  // point (segment seg_): a short walk from there finds j before a search of the whole path would.
+  const auto first_after = [&](std::size_t from, std::size_t to) {
+    const auto begin = s_.begin();
+    return static_cast<std::size_t>(
+        std::upper_bound(begin + static_cast<std::ptrdiff_t>(from), begin + static_cast<std::ptrdiff_t>(to), s) - begin);
+  };
+  std::size_t j = 0;
+  if (s_[seg_] <= s) {
+    j = seg_ + 1;
+    for (int k = 0; k < 8 && j < s_.size() && s_[j] <= s; ++k) ++j;
+    if (j < s_.size() && s_[j] <= s) j = first_after(j, s_.size());
+  } else {
+    j = first_after(0, seg_ + 1);  // s_[seg_] > s: j <= seg_
+  }
+  // s_[j-1] <= s < s_[j]
   const double len = s_[j] - s_[j - 1];
   const double t = len > 0.0 ? (s - s_[j - 1]) / len : 0.0;
   return {pts_[j - 1].x_m + t * (pts_[j].x_m - pts_[j - 1].x_m), pts_[j - 1].y_m + t * (pts_[j].y_m - pts_[j - 1].y_m), 0.0};
