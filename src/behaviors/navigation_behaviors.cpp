@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <numbers>
 
 #include "tripodal/controllers/kinematics.hpp"
@@ -57,6 +59,7 @@ void PathTracker::reset(std::span<const Pose2D> path, double start_m) noexcept {
   }
   s_now_ = std::clamp(start_m, 0.0, length_m());
   seg_ = 0;
+  memo_valid_ = false;
   while (seg_ + 1 < s_.size() && s_[seg_ + 1] <= s_now_) ++seg_;
 }
 
@@ -64,8 +67,22 @@ Pose2D PathTracker::at(double s) const noexcept {
   if (pts_.empty()) return {};
   if (s <= 0.0) return pts_.front();
   if (s >= s_.back()) return pts_.back();
-  const auto it = std::upper_bound(s_.begin(), s_.end(), s);
-  const std::size_t j = static_cast<std::size_t>(it - s_.begin());  // s_[j-1] <= s < s_[j]
+  // The first j with s < s_[j]. The points asked for lie a few centimetres around the progress
+  // point (segment seg_): a short walk from there finds j before a search of the whole path would.
+  const auto first_after = [&](std::size_t from, std::size_t to) {
+    const auto begin = s_.begin();
+    return static_cast<std::size_t>(
+        std::upper_bound(begin + static_cast<std::ptrdiff_t>(from), begin + static_cast<std::ptrdiff_t>(to), s) - begin);
+  };
+  std::size_t j = 0;
+  if (s_[seg_] <= s) {
+    j = seg_ + 1;
+    for (int k = 0; k < 8 && j < s_.size() && s_[j] <= s; ++k) ++j;
+    if (j < s_.size() && s_[j] <= s) j = first_after(j, s_.size());
+  } else {
+    j = first_after(0, seg_ + 1);  // s_[seg_] > s: j <= seg_
+  }
+  // s_[j-1] <= s < s_[j]
   const double len = s_[j] - s_[j - 1];
   const double t = len > 0.0 ? (s - s_[j - 1]) / len : 0.0;
   return {pts_[j - 1].x_m + t * (pts_[j].x_m - pts_[j - 1].x_m), pts_[j - 1].y_m + t * (pts_[j].y_m - pts_[j - 1].y_m), 0.0};
@@ -79,6 +96,21 @@ double PathTracker::heading_at(double s) const noexcept {
 }
 
 PathTracker::Target PathTracker::update(const Pose2D& position, double lookahead_m, double search_m) noexcept {
+  if (memo_valid_ && position == memo_position_ && lookahead_m == memo_lookahead_m_ && search_m == memo_search_m_) {
+    return memo_;
+  }
+  const double s_before = s_now_;
+  const std::size_t seg_before = seg_;
+  memo_ = search(position, lookahead_m, search_m);
+  memo_position_ = position;
+  memo_lookahead_m_ = lookahead_m;
+  memo_search_m_ = search_m;
+  // Progress unchanged: the same inputs would search the same window from the same state.
+  memo_valid_ = s_now_ == s_before && seg_ == seg_before;
+  return memo_;
+}
+
+PathTracker::Target PathTracker::search(const Pose2D& position, double lookahead_m, double search_m) noexcept {
   Target t;
   if (pts_.empty()) return t;
   if (pts_.size() == 1) {
@@ -132,6 +164,35 @@ PathTracker::Target PathTracker::update(const Pose2D& position, double lookahead
 // ---------------------------------------------------------------------------------------------
 // CPathFollowingBehavior
 
+struct CPathFollowingBehavior::NearReturns {
+  // What the filtering depends on besides the scan's beam geometry (fixed by the sequence).
+  bool valid = false;
+  std::size_t sequence = 0;
+  Pose2D pose;
+  float rmin = 0.0F, near = 0.0F;
+  const ObstacleMap* map = nullptr;
+  std::vector<Pose2D> points;
+};
+
+namespace {
+
+// One NearReturns per laser resource, alive while a behavior watching that laser is. Called at
+// activation only (allocates); the loop's thread then uses the object without locking, as it
+// reads the resource itself.
+std::shared_ptr<CPathFollowingBehavior::NearReturns> near_returns_of(const LaserResource* laser) {
+  static std::mutex mutex;
+  static std::map<const LaserResource*, std::weak_ptr<CPathFollowingBehavior::NearReturns>> table;
+  std::lock_guard lock(mutex);
+  std::weak_ptr<CPathFollowingBehavior::NearReturns>& entry = table[laser];
+  if (auto shared = entry.lock()) return shared;
+  auto shared = std::make_shared<CPathFollowingBehavior::NearReturns>();
+  shared->points.reserve(kMaxBeams);
+  entry = shared;
+  return shared;
+}
+
+}  // namespace
+
 void CPathFollowingBehavior::configure_following(const ParameterSet& params, const BehaviorContext& context) {
   speed_ = params.number("max_speed_m_s");
   lookahead_m_ = params.number("lookahead_m");
@@ -146,6 +207,7 @@ void CPathFollowingBehavior::configure_following(const ParameterSet& params, con
     laser_ = name.empty() ? context.resources->first<LaserScan>() : context.resources->find<LaserScan>(name);
     bumpers_ = context.resources->first<BumperReading>();
   }
+  shared_ = laser_ != nullptr ? near_returns_of(laser_) : nullptr;
   if (tracker_.capacity() < kMaxPathPoints) tracker_.reserve(kMaxPathPoints);  // once per behavior
   cos_.reserve(kMaxBeams);
   sin_.reserve(kMaxBeams);
@@ -242,6 +304,12 @@ void CPathFollowingBehavior::update_unexpected(const Pose2D& pose, const Behavio
   // a margin; only what the map does not know (a box left in the corridor) stops the robot.
   const ObstacleMap* map = context.navi->map;
   const double c = std::cos(pose.theta_rad), s = std::sin(pose.theta_rad);
+  NearReturns* shared = shared_.get();
+  if (shared != nullptr && shared->valid && shared->sequence == scan_seen_ && shared->pose == pose &&
+      shared->rmin == rmin && shared->near == near && shared->map == map) {
+    unexpected_.assign(shared->points.begin(), shared->points.end());  // within the reserved capacity
+    return;
+  }
   const std::size_t count = std::min(scan.ranges_m.size(), cos_.size());
   const float* ranges = scan.ranges_m.data();
   for (std::size_t i = 0; i < count; ++i) {
@@ -250,6 +318,15 @@ void CPathFollowingBehavior::update_unexpected(const Pose2D& pose, const Behavio
     const double px = r * static_cast<double>(cos_[i]), py = r * static_cast<double>(sin_[i]);
     if (map != nullptr && map->near_obstacle(pose.x_m + c * px - s * py, pose.y_m + s * px + c * py)) continue;
     unexpected_.push_back({px, py, 0.0});  // within the capacity reserved at activation
+  }
+  if (shared != nullptr) {
+    shared->valid = true;
+    shared->sequence = scan_seen_;
+    shared->pose = pose;
+    shared->rmin = rmin;
+    shared->near = near;
+    shared->map = map;
+    shared->points.assign(unexpected_.begin(), unexpected_.end());
   }
 }
 

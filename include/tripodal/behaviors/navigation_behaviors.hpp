@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -34,6 +35,10 @@ class PathTracker {
     double corner_rad = 0.0;   ///< heading change of the path between progress and lookahead
   };
   /// Advances the progress to the closest point near `position`; returns the lookahead target.
+  /// The pose changes only when the sequencing layer publishes one (every few loop periods), so a
+  /// call with the inputs of the previous one, which left the progress where it was, returns that
+  /// call's target without searching again (the same result: the search is a function of the
+  /// progress and the inputs).
   Target update(const Pose2D& position, double lookahead_m, double search_m) noexcept;
   [[nodiscard]] double progress_m() const noexcept { return s_now_; }
   [[nodiscard]] double length_m() const noexcept { return s_.empty() ? 0.0 : s_.back(); }
@@ -45,10 +50,16 @@ class PathTracker {
 
  private:
   [[nodiscard]] double heading_at(double s) const noexcept;
+  [[nodiscard]] Target search(const Pose2D& position, double lookahead_m, double search_m) noexcept;
   std::vector<Pose2D> pts_;
   std::vector<double> s_;
   std::size_t seg_ = 0;
   double s_now_ = 0.0;
+  // The last update's inputs and target, valid while the progress it left is unchanged.
+  bool memo_valid_ = false;
+  Pose2D memo_position_;
+  double memo_lookahead_m_ = 0.0, memo_search_m_ = 0.0;
+  Target memo_;
 };
 
 /// Common part of the path-following behaviors: takes up each new path the sequencing layer
@@ -62,6 +73,10 @@ class CPathFollowingBehavior : public CBehavior {
   /// Longest path taken up (points); the control loop's max_path_points should not exceed it.
   static constexpr std::size_t kMaxPathPoints = 32768;
   [[nodiscard]] const PathTracker& tracker() const noexcept { return tracker_; }
+  /// The last filtering of a scan for unexpected returns, shared by every following behavior
+  /// watching the same laser (BhCleaning, BhAutoMove and BhCleaningTwoWheel active together filter
+  /// the same scan from the same pose: one map lookup per near beam instead of three).
+  struct NearReturns;
 
  protected:
   /// Reads the shared parameters (speeds, lookahead, laser, blocked timeout).
@@ -101,6 +116,7 @@ class CPathFollowingBehavior : public CBehavior {
   /// Once per new scan: its near returns (body frame) that the map does not explain, seen from
   /// `pose` (map frame). The scan changes at the laser's rate, the loop runs far faster.
   void update_unexpected(const Pose2D& pose, const BehaviorContext& context) noexcept;
+  std::shared_ptr<NearReturns> shared_;
   std::vector<Pose2D> unexpected_;
   std::size_t scan_seen_ = 0;
   std::vector<float> cos_, sin_;
