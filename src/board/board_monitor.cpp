@@ -1,0 +1,61 @@
+#include "tripodal/board/board_monitor.hpp"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+#include <string>
+
+namespace tripodal::board {
+
+const ModuleManifest& BoardMonitor::static_manifest() {
+  static const ModuleManifest m =
+      ManifestBuilder("BoardMonitor", ModuleKind::hri, Layer::sequencing)
+          .description("the control board's link and panel as supervisor events (docs/board-protocol.md)")
+          .input("board_link")
+          .outputs({"board.link_lost", "board.link_restored", "board.start", "board.pause", "board.home",
+                    "board.emergency_stop"})
+          .build();
+  return m;
+}
+
+void BoardMonitor::on_start(ModuleContext& context) {
+  host_ = dynamic_cast<BoardHost*>(context.hardware);
+  if (host_ == nullptr) {
+    const std::string type = context.hardware != nullptr ? std::string(context.hardware->manifest().name) : "none";
+    throw ConfigError(where(), fmt::format("module BoardMonitor reads the control board; expected hardware of type "
+                                           "'board' (hardware: {{type: board}}), this robot's is '{}'",
+                                           type));
+  }
+}
+
+void BoardMonitor::on_update(ModuleContext& context) {
+  if (host_ == nullptr) return;
+  BoardLink& link = host_->board().link();
+  std::string fault;
+  if (link.take_link_lost()) {
+    const LinkStats& s = link.stats();
+    fault = fmt::format("link lost at {:.3f} s: no valid response from the board ({} missed, {} error responses so far)",
+                        to_seconds(link.link_lost_at()), s.missed, s.error_responses);
+    context.post("board.link_lost", fault);
+    link_up_ = false;
+  } else if (!link_up_ && link.synchronised()) {
+    if (link.stats().link_losses > 0) context.post("board.link_restored", "SYNC answered again");
+    link_up_ = true;
+  }
+  // Buttons from the DRIVE response of every control period: a press is a held edge.
+  const std::uint8_t held = link.synchronised() && link.has_drive() ? link.drive().buttons : held_;
+  const auto pressed = static_cast<std::uint8_t>(held & ~held_);
+  held_ = held;
+  if ((pressed & kButtonStart) != 0) context.post("board.start", "start button");
+  if ((pressed & kButtonPause) != 0) context.post("board.pause", "pause button");
+  if ((pressed & kButtonHome) != 0) context.post("board.home", "home button");
+  if ((pressed & kButtonEmergencyStop) != 0) {
+    context.post("board.emergency_stop", "emergency stop pressed");
+    if (fault.empty()) fault = "emergency stop pressed: the board braked the wheels";
+  }
+  if (!fault.empty()) throw std::runtime_error(fault);
+}
+
+void register_board_modules(ModuleRegistry& registry) { registry.add<BoardMonitor>(); }
+
+}  // namespace tripodal::board
