@@ -1,6 +1,10 @@
 #include "tripodal/board/board_monitor.hpp"
 
+#include "tripodal/board/actuator_behaviors.hpp"
+
 #include <fmt/format.h>
+
+#include <array>
 
 #include <stdexcept>
 #include <string>
@@ -9,11 +13,12 @@ namespace tripodal::board {
 
 const ModuleManifest& BoardMonitor::static_manifest() {
   static const ModuleManifest m =
-      ManifestBuilder("BoardMonitor", ModuleKind::hri, Layer::sequencing)
+      ManifestBuilder("BoardMonitor", ModuleKind::other, Layer::sequencing)
           .description("the control board's link and panel as supervisor events (docs/board-protocol.md)")
           .input("board_link")
           .outputs({"board.link_lost", "board.link_restored", "board.start", "board.pause", "board.home",
-                    "board.emergency_stop"})
+                    "board.emergency_stop", "board.tank_empty", "board.tank_refilled", "board.battery_low"})
+          .number("battery_low_percent", 15.0, "%", "at or below this the task must end and the robot charge", 0.0, 100.0)
           .build();
   return m;
 }
@@ -26,6 +31,29 @@ void BoardMonitor::on_start(ModuleContext& context) {
                                            "'board' (hardware: {{type: board}}), this robot's is '{}'",
                                            type));
   }
+}
+
+void BoardMonitor::on_configure(const ParameterSet& params) { battery_low_percent_ = params.number("battery_low_percent"); }
+
+void BoardMonitor::on_behavior_activated(const BehaviorActivation& activation, ModuleContext& /*context*/) {
+  if (host_ == nullptr) return;
+  BoardHardware& board = host_->board();
+  if (activation.behavior == BhUvLamp::static_manifest().name) {
+    board.command(Command::uv_lamp, std::array<std::uint8_t, 1>{1});
+  } else if (activation.behavior == BhAtomize::static_manifest().name) {
+    const bool fan = activation.resolved().boolean("fan");
+    board.command(Command::atomizer, std::array<std::uint8_t, 2>{1, static_cast<std::uint8_t>(fan ? 1 : 0)});
+  } else if (activation.behavior == BhVoicePrompt::static_manifest().name) {
+    const auto track = static_cast<std::uint8_t>(activation.resolved().number("track"));
+    board.command(Command::voice, std::array<std::uint8_t, 1>{track});
+  }
+}
+
+void BoardMonitor::on_behavior_deactivated(std::string_view behavior, ModuleContext& /*context*/) {
+  if (host_ == nullptr) return;
+  BoardHardware& board = host_->board();
+  if (behavior == BhUvLamp::static_manifest().name) board.command(Command::uv_lamp, std::array<std::uint8_t, 1>{0});
+  if (behavior == BhAtomize::static_manifest().name) board.command(Command::atomizer, std::array<std::uint8_t, 2>{0, 0});
 }
 
 void BoardMonitor::on_update(ModuleContext& context) {
@@ -52,6 +80,17 @@ void BoardMonitor::on_update(ModuleContext& context) {
   if ((pressed & kButtonEmergencyStop) != 0) {
     context.post("board.emergency_stop", "emergency stop pressed");
     if (fault.empty()) fault = "emergency stop pressed: the board braked the wheels";
+  }
+  if (link.tank_empty() != tank_empty_) {
+    tank_empty_ = link.tank_empty();
+    context.post(tank_empty_ ? "board.tank_empty" : "board.tank_refilled",
+                 fmt::format("disinfectant tank at {} %", link.tank_percent()));
+  }
+  if (link.has_battery()) {
+    const BatteryState& b = link.battery();
+    const bool low = !b.charging && b.percent <= battery_low_percent_;
+    if (low && !battery_low_) context.post("board.battery_low", fmt::format("battery at {} % ({} mV)", b.percent, b.voltage_mv));
+    battery_low_ = low;
   }
   if (!fault.empty()) throw std::runtime_error(fault);
 }

@@ -74,6 +74,10 @@ class BoardHardware final : public CHardware, public HardwareInterface, public B
   BumperResource bumpers_{"bumpers"};
 };
 
+/// The host side's configuration from a profile's hardware entry of type "board" (ConfigError
+/// unless the base controller is differential).
+[[nodiscard]] BoardHardwareConfig board_hardware_config(const HardwareConfig& c);
+
 /// Registers the hardware type "board": opens `port` (a tty, e.g. /dev/ttyUSB0 or the
 /// pseudo-terminal tripodal-board-sim prints) raw 8N1.
 void register_board_hardware(HardwareRegistry& registry);

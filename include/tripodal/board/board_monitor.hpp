@@ -5,6 +5,10 @@
 //   board.link_restored   SYNC answered again after a loss
 //   board.start / board.pause / board.home   a panel button pressed (held edge)
 //   board.emergency_stop  the e-stop pressed: the board has already braked; a fault
+//   board.tank_empty / board.tank_refilled   the liquid level module's empty flag changed
+//   board.battery_low     the battery at or below battery_low_percent (and not charging)
+// and serves the actuator behaviors (actuator_behaviors.hpp): their board commands at activation
+// and deactivation.
 // A fault is also reported as the module's failure ("<module>.fault"), so every running process
 // fails unless its net takes the event, and the planner's recovery rules decide.
 #pragma once
@@ -26,11 +30,17 @@ class BoardMonitor final : public CModule {
   void on_start(ModuleContext& context) override;
   /// Throws std::runtime_error (the module's fault) on a link loss or an emergency stop.
   void on_update(ModuleContext& context) override;
+  void on_configure(const ParameterSet& params) override;
+  void on_behavior_activated(const BehaviorActivation& activation, ModuleContext& context) override;
+  void on_behavior_deactivated(std::string_view behavior, ModuleContext& context) override;
 
  private:
   BoardHost* host_ = nullptr;
   bool link_up_ = false;
   std::uint8_t held_ = 0;
+  bool tank_empty_ = false;
+  bool battery_low_ = false;
+  double battery_low_percent_ = 15.0;
 };
 
 /// Registers the module type "BoardMonitor".
