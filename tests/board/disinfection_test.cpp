@@ -88,3 +88,64 @@ TEST_CASE("the disinfection robot disinfects a room over the board's protocol, b
   CHECK_FALSE(fw.uv_lamp());
   CHECK_FALSE(fw.atomizer());
 }
+
+TEST_CASE("PrDisinfection: an empty tank pauses the fog and asks for disinfectant; a low battery ends it safely", "[board][disinfection]") {
+  DisinfectionRobot r;
+  board::BoardFirmware& fw = r.hw->embedded().firmware();
+  fw.set_tank_l(0.002);  // runs dry after ~12 s of fog
+  REQUIRE(r.robot->command("disinfect the room 2111").accepted);
+  bool fogged = false, prompted = false;
+  r.run_task(60.0, [&] {
+    fogged = fogged || fw.atomizer();
+    prompted = prompted || fw.last_voice_track() == static_cast<std::uint8_t>(board::kTrackAddDisinfectant);
+    if (prompted) r.robot->planner().cancel("stop here");  // checked below, not run to the end
+  });
+  CHECK(fogged);
+  CHECK(prompted);
+  CHECK_FALSE(fw.atomizer());
+  r.robot->run_for(100ms);
+  CHECK_FALSE(fw.uv_lamp());  // cancelled: every behavior deactivated, lamp off
+}
+
+TEST_CASE("PrDisinfection: a low battery ends the task safely, lamp and fog off", "[board][disinfection]") {
+  DisinfectionRobot r;
+  board::BoardFirmware& fw = r.hw->embedded().firmware();
+  REQUIRE(r.robot->command("disinfect the room 2111").accepted);
+  r.run_task(20.0, [] {});
+  REQUIRE(fw.uv_lamp());
+  fw.set_state_of_charge(0.10);  // sampled at the board's next 3 s, polled by the host every 3 s
+  r.run_task(10.0, [] {});
+  const TaskReport& report = r.robot->planner().report();
+  INFO(report.str());
+  CHECK(report.state == TaskState::failed);
+  CHECK_THAT(report.reason, Catch::Contains("battery low: disinfection ended safely"));
+  r.robot->run_for(100ms);
+  CHECK_FALSE(fw.uv_lamp());
+  CHECK_FALSE(fw.atomizer());
+}
+
+TEST_CASE("the disinfection task faults within two periods of a dead board link, and the board stops the motors", "[board][disinfection]") {
+  DisinfectionRobot r;
+  board::BoardFirmware& fw = r.hw->embedded().firmware();
+  REQUIRE(r.robot->command("disinfect the room 2111").accepted);
+  r.run_task(20.0, [] {});
+  REQUIRE(r.robot->planner().busy());
+  const Time cut = r.clock.now();
+  r.hw->embedded().line().host().set_connected(false);  // the cable pulled: no request reaches the board
+  Time failed_at{};
+  r.run_task(1.0, [&] {
+    if (!r.robot->planner().busy() && failed_at == Time{}) failed_at = r.clock.now();
+  });
+  const TaskReport& report = r.robot->planner().report();
+  INFO(report.str());
+  REQUIRE(report.state == TaskState::failed);
+  CHECK_THAT(report.reason, Catch::Contains("module board failed: link lost at"));
+  // The request already on the line at the cut is answered; the first lost one is sent at
+  // cut + 10 ms, missed at the link's cycle 10 ms later, and the process faults 10 ms after that.
+  CHECK(failed_at - cut <= 30ms);
+  r.robot->run_for(300ms);  // the board's watchdog: 200 ms without a valid request
+  CHECK(fw.counters().watchdog_trips == 1);
+  CHECK(fw.link_lost());
+  CHECK(fw.required_m_s(0) == 0.0);
+  CHECK(fw.required_m_s(1) == 0.0);
+}
