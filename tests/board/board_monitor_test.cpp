@@ -8,10 +8,13 @@
 #include "tripodal/board/embedded_board.hpp"
 #include "still_plant.hpp"
 
-using namespace tripodal;
-using namespace tripodal::board;
-using tripodal::board::test::StillPlant;
 using namespace std::chrono_literals;
+using namespace tripodal::board;
+using tripodal::ModuleContext;
+using tripodal::ModuleEvent;
+using tripodal::ResourceTable;
+using tripodal::Time;
+using tripodal::board::test::StillPlant;
 
 namespace {
 

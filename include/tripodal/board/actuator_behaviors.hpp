@@ -10,37 +10,39 @@
 
 namespace tripodal::board {
 
+/// What the actuator behaviors share: no command for the base; BoardMonitor acts on activation.
+class CActuatorBehavior : public CBehavior {
+ protected:
+  void on_activate(const ParameterSet& /*params*/, const BehaviorContext& /*context*/) override {}
+  std::optional<Twist2D> on_step(const BehaviorContext& /*context*/) noexcept override { return std::nullopt; }
+};
+
 /// The UV lamp on while active; never finishes.
-class BhUvLamp final : public CBehavior {
+class BhUvLamp final : public CActuatorBehavior {
  public:
   static const ModuleManifest& static_manifest();
 
  protected:
   const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
-  void on_activate(const ParameterSet& /*params*/, const BehaviorContext& /*context*/) override {}
-  std::optional<Twist2D> on_step(const BehaviorContext& /*context*/) noexcept override { return std::nullopt; }
 };
 
 /// The atomizer (and its fan: parameter fan) on while active; never finishes. The board stops it
 /// when the tank runs dry (BoardMonitor posts board.tank_empty).
-class BhAtomize final : public CBehavior {
+class BhAtomize final : public CActuatorBehavior {
  public:
   static const ModuleManifest& static_manifest();
 
  protected:
   const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
-  void on_activate(const ParameterSet& /*params*/, const BehaviorContext& /*context*/) override {}
-  std::optional<Twist2D> on_step(const BehaviorContext& /*context*/) noexcept override { return std::nullopt; }
 };
 
 /// Plays the WT2003S track `track` once; succeeds at its first step.
-class BhVoicePrompt final : public CBehavior {
+class BhVoicePrompt final : public CActuatorBehavior {
  public:
   static const ModuleManifest& static_manifest();
 
  protected:
   const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
-  void on_activate(const ParameterSet& /*params*/, const BehaviorContext& /*context*/) override {}
   std::optional<Twist2D> on_step(const BehaviorContext& /*context*/) noexcept override {
     succeed();
     return std::nullopt;

@@ -11,8 +11,7 @@
 #include "tripodal/board/board_firmware.hpp"
 #include "tripodal/board/embedded_board.hpp"
 #include "tripodal/hardware/hardware.hpp"
-#include "tripodal/navi/grid_maps.hpp"
-#include "tripodal/navi/localizer.hpp"
+#include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/sim/simulator.hpp"
 #include "tripodal/sim/world.hpp"
 
@@ -47,10 +46,7 @@ class SimBoardPlant final : public board::BoardPlant {
 /// exchange crossing the in-process line byte for byte (board/embedded_board.hpp). Like "sim", it
 /// gives the localizer the ground truth and the maps module the world's map; the world's laser and
 /// gyro (when the world's robot has them) publish as they do on "sim", the rest comes from the board.
-class SimBoardHardware final : public CHardware,
-                               public board::BoardHost,
-                               public navi::GroundTruthSource,
-                               public navi::MapSource {
+class SimBoardHardware final : public CHardware, public board::BoardHost, public SimulatorSources {
  public:
   static const ModuleManifest& static_manifest();
   SimBoardHardware(World world, const ControllerConfig& base, std::uint64_t seed, const board::FirmwareConfig& firmware,
@@ -60,12 +56,8 @@ class SimBoardHardware final : public CHardware,
   [[nodiscard]] board::EmbeddedBoard& embedded() noexcept { return board_; }
   [[nodiscard]] Simulator& simulator() noexcept { return sim_; }
 
-  [[nodiscard]] std::optional<Pose2D> true_pose(Time now) const override { return sim_.true_pose(now); }
-  [[nodiscard]] bool localization_lost(Time now) const noexcept override { return sim_.localization_lost(now); }
-  [[nodiscard]] const navi::OccupancyGrid& world_map() const noexcept override { return sim_.world().grid; }
-  [[nodiscard]] const navi::RegionMap& world_regions() const noexcept override { return sim_.world().regions; }
-
  protected:
+  [[nodiscard]] const Simulator& world_sim() const noexcept override { return sim_; }
   [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
   [[nodiscard]] HardwareInterface& do_wheels() noexcept override { return board_.host().wheels(); }
   void on_add_resources(ResourceTable& table) override;
