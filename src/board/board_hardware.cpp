@@ -124,22 +124,27 @@ void BoardHardware::on_add_resources(ResourceTable& table) {
   table.add(bumpers_);
 }
 
+BoardHardwareConfig board_hardware_config(const HardwareConfig& c) {
+  if (c.base == nullptr || c.base->type != "differential") {
+    throw ConfigError(c.where, "hardware 'board' drives a differential base; expected a base controller of type 'differential'");
+  }
+  BoardHardwareConfig config;
+  config.wheel_radius_m = c.base->differential.wheel_radius_m;
+  config.pulses_per_m = c.parameters.number("pulses_per_m");
+  config.link.response_timeout = from_seconds(c.parameters.number("response_timeout_s"));
+  config.link.max_missed = static_cast<std::uint32_t>(c.parameters.number("max_missed"));
+  return config;
+}
+
 void register_board_hardware(HardwareRegistry& registry) {
   registry.add(BoardHardware::static_manifest(), [](const HardwareConfig& c) -> std::unique_ptr<CHardware> {
-    if (c.base == nullptr || c.base->type != "differential") {
-      throw ConfigError(c.where, "hardware 'board' drives a differential base; expected a base controller of type 'differential'");
-    }
+    const BoardHardwareConfig config = board_hardware_config(c);
     const std::string& port = c.parameters.string("port");
     if (port.empty()) throw ConfigError(c.where, "hardware 'board' needs its port: parameters: {port: /dev/ttyUSB0}");
     // The port's reads are bounded by its own steady clock; the link never waits on them.
     static const SteadyClock port_clock;
     auto stream = std::make_unique<SerialPort>(port, port_clock,
                                                SerialSettings{static_cast<std::uint32_t>(c.parameters.number("baud"))});
-    BoardHardwareConfig config;
-    config.wheel_radius_m = c.base->differential.wheel_radius_m;
-    config.pulses_per_m = c.parameters.number("pulses_per_m");
-    config.link.response_timeout = from_seconds(c.parameters.number("response_timeout_s"));
-    config.link.max_missed = static_cast<std::uint32_t>(c.parameters.number("max_missed"));
     ByteStream& s = *stream;
     return std::make_unique<BoardHardware>(s, config, std::move(stream));
   });

@@ -35,3 +35,44 @@ void SimBoardPlant::sense(Time /*now*/, board::PlantSensors& out) noexcept {
 }
 
 }  // namespace tripodal::sim
+
+namespace tripodal::sim {
+
+SimBoardHardware::SimBoardHardware(World world, const ControllerConfig& base, std::uint64_t seed,
+                                   const board::FirmwareConfig& firmware, const board::BoardHardwareConfig& host)
+    : sim_(std::move(world), base, seed),
+      plant_(sim_, base.differential.wheel_radius_m),
+      board_(firmware, plant_, host) {}
+
+// The real board's type, its parameters, plus what the simulated world adds (the laser, the gyro,
+// the ground truth).
+const ModuleManifest& SimBoardHardware::static_manifest() {
+  static const ModuleManifest m = [] {
+    const ModuleManifest& real = board::BoardHardware::static_manifest();
+    std::vector<std::string> outputs = real.outputs;
+    outputs.insert(outputs.end(), {"laser_scan", "yaw_rate", "ground_truth_pose"});
+    return hardware_manifest("board", "the control board simulated in process in the embedded simulator's world, "
+                                      "every exchange over the line byte for byte (docs/board-protocol.md)",
+                             std::move(outputs), real.parameters);
+  }();
+  return m;
+}
+
+void SimBoardHardware::on_add_resources(ResourceTable& table) {
+  board_.host().add_resources(table);
+  const SimRobotConfig& rc = sim_.world().robot;
+  if (rc.laser.enabled) table.add(sim_.laser());
+  if (rc.gyro.enabled) table.add(sim_.gyro());
+}
+
+void register_sim_board_hardware(HardwareRegistry& registry, std::shared_ptr<const World> world) {
+  registry.add(SimBoardHardware::static_manifest(), [world](const HardwareConfig& c) -> std::unique_ptr<CHardware> {
+    const board::BoardHardwareConfig host = board::board_hardware_config(c);
+    if (!world) throw ConfigError(c.where, "the simulated hardware 'board' needs a world (tripodal run --world FILE)");
+    board::FirmwareConfig firmware;
+    firmware.pulses_per_m = host.pulses_per_m;
+    return std::make_unique<SimBoardHardware>(*world, *c.base, world->seed, firmware, host);
+  });
+}
+
+}  // namespace tripodal::sim

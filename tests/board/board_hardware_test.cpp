@@ -6,28 +6,19 @@
 
 #include "tripodal/board/board_firmware.hpp"
 #include "tripodal/board/serial_line.hpp"
+#include "still_plant.hpp"
 
 using namespace tripodal;
 using namespace tripodal::board;
+using tripodal::board::test::StillPlant;
 using namespace std::chrono_literals;
-
-namespace {
-
-struct StillPlant final : BoardPlant {
-  void drive(Time, double, double) noexcept override {}
-  void sense(Time, PlantSensors& out) noexcept override {
-    out.ultrasonic_m = {0.8F, 1.0F, 1.2F};
-    out.cliff_floor_m = {0.02F, 0.5F, 0.02F};
-    out.bumps = 0x01;
-  }
-};
-
-}  // namespace
 
 TEST_CASE("hardware 'board': wheels through DRIVE, odometry from the encoders, sensors as resources", "[board][hardware]") {
   SimClock clock;
   SerialLine line(clock);
   StillPlant plant;
+  plant.view.cliff_floor_m = {0.02F, 0.5F, 0.02F};
+  plant.view.bumps = 0x01;
   BoardFirmware board(FirmwareConfig{}, line.board(), plant);
   BoardHardware hw(line.host(), BoardHardwareConfig{});
   ResourceTable table;

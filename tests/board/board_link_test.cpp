@@ -4,17 +4,14 @@
 
 #include "tripodal/board/board_firmware.hpp"
 #include "tripodal/board/serial_line.hpp"
+#include "still_plant.hpp"
 
 using namespace tripodal;
 using namespace tripodal::board;
+using tripodal::board::test::StillPlant;
 using namespace std::chrono_literals;
 
 namespace {
-
-struct StillPlant final : BoardPlant {
-  void drive(Time, double, double) noexcept override {}
-  void sense(Time, PlantSensors& out) noexcept override { out.ultrasonic_m = {0.8F, 1.0F, 1.2F}; }
-};
 
 // Host and board on one simulated line and clock: the board ticks every 1 ms, the host's control
 // loop cycles every 10 ms.

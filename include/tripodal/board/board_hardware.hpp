@@ -14,13 +14,23 @@
 
 namespace tripodal::board {
 
+/// What holds the robot's BoardHardware: the hardware itself, or a hardware that embeds one (the
+/// simulated board, embedded_board.hpp). The sequencing loop's BoardMonitor finds the link here.
+class BoardHost {
+ public:
+  [[nodiscard]] virtual class BoardHardware& board() noexcept = 0;
+
+ protected:
+  ~BoardHost() = default;
+};
+
 struct BoardHardwareConfig {
   double wheel_radius_m = 0.09;
   double pulses_per_m = 5000.0;  ///< the board's encoder resolution (FirmwareConfig::pulses_per_m)
   LinkConfig link;
 };
 
-class BoardHardware final : public CHardware, public HardwareInterface {
+class BoardHardware final : public CHardware, public HardwareInterface, public BoardHost {
  public:
   /// Parameters of type "board": port (the tty), baud, pulses_per_m, response_timeout_s, max_missed.
   static const ModuleManifest& static_manifest();
@@ -40,6 +50,7 @@ class BoardHardware final : public CHardware, public HardwareInterface {
   /// True once per link loss: what a module posts as `board.link_lost`.
   [[nodiscard]] bool take_link_lost() noexcept { return link_.take_link_lost(); }
   [[nodiscard]] BoardLink& link() noexcept { return link_; }
+  [[nodiscard]] BoardHardware& board() noexcept override { return *this; }
   /// Queues an actuator command (UV lamp, atomizer, voice, LCD): sent until acknowledged.
   bool command(Command cmd, std::span<const std::uint8_t> payload) noexcept { return link_.queue(cmd, payload); }
 
@@ -62,6 +73,10 @@ class BoardHardware final : public CHardware, public HardwareInterface {
   InfraredResource cliff_{"cliff"};
   BumperResource bumpers_{"bumpers"};
 };
+
+/// The host side's configuration from a profile's hardware entry of type "board" (ConfigError
+/// unless the base controller is differential).
+[[nodiscard]] BoardHardwareConfig board_hardware_config(const HardwareConfig& c);
 
 /// Registers the hardware type "board": opens `port` (a tty, e.g. /dev/ttyUSB0 or the
 /// pseudo-terminal tripodal-board-sim prints) raw 8N1.

@@ -5,8 +5,15 @@
 // and by tripodal-board-sim behind a pseudo-terminal.
 #pragma once
 
+#include <cstdint>
+#include <memory>
+
 #include "tripodal/board/board_firmware.hpp"
+#include "tripodal/board/embedded_board.hpp"
+#include "tripodal/hardware/hardware.hpp"
+#include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/sim/simulator.hpp"
+#include "tripodal/sim/world.hpp"
 
 namespace tripodal::sim {
 
@@ -33,5 +40,38 @@ class SimBoardPlant final : public board::BoardPlant {
   double wheel_radius_m_;
   BoardSensorMounts mounts_;
 };
+
+/// A simulated robot of hardware type "board": the embedded simulator's world moved by the
+/// simulated board's firmware, the robot's wheels and sensors behind the board's host side, every
+/// exchange crossing the in-process line byte for byte (board/embedded_board.hpp). Like "sim", it
+/// gives the localizer the ground truth and the maps module the world's map; the world's laser and
+/// gyro (when the world's robot has them) publish as they do on "sim", the rest comes from the board.
+class SimBoardHardware final : public CHardware, public board::BoardHost, public SimulatorSources {
+ public:
+  static const ModuleManifest& static_manifest();
+  SimBoardHardware(World world, const ControllerConfig& base, std::uint64_t seed, const board::FirmwareConfig& firmware,
+                   const board::BoardHardwareConfig& host);
+
+  [[nodiscard]] board::BoardHardware& board() noexcept override { return board_.host(); }
+  [[nodiscard]] board::EmbeddedBoard& embedded() noexcept { return board_; }
+  [[nodiscard]] Simulator& simulator() noexcept { return sim_; }
+
+ protected:
+  [[nodiscard]] const Simulator& world_sim() const noexcept override { return sim_; }
+  [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  [[nodiscard]] HardwareInterface& do_wheels() noexcept override { return board_.host().wheels(); }
+  void on_add_resources(ResourceTable& table) override;
+  void on_advance_to(Time now) noexcept override { board_.advance_to(now); }
+
+ private:
+  Simulator sim_;
+  SimBoardPlant plant_;
+  board::EmbeddedBoard board_;
+};
+
+/// Registers the hardware type "board" as the simulated board in `world` (what `tripodal run`
+/// registers): the parameters of the real type (board/board_hardware.hpp) except `port` and
+/// `baud`, which the in-process line ignores (115200).
+void register_sim_board_hardware(HardwareRegistry& registry, std::shared_ptr<const World> world);
 
 }  // namespace tripodal::sim

@@ -16,9 +16,23 @@
 
 namespace tripodal::sim {
 
+/// The simulator as the localizer's ground truth and the maps module's map: what every hardware
+/// on the simulator gives (types "sim" and the simulated "board", sim_board.hpp).
+class SimulatorSources : public navi::GroundTruthSource, public navi::MapSource {
+ public:
+  [[nodiscard]] std::optional<Pose2D> true_pose(Time now) const override { return world_sim().true_pose(now); }
+  [[nodiscard]] bool localization_lost(Time now) const noexcept override { return world_sim().localization_lost(now); }
+  [[nodiscard]] const navi::OccupancyGrid& world_map() const noexcept override { return world_sim().world().grid; }
+  [[nodiscard]] const navi::RegionMap& world_regions() const noexcept override { return world_sim().world().regions; }
+
+ protected:
+  ~SimulatorSources() override = default;
+  [[nodiscard]] virtual const Simulator& world_sim() const noexcept = 0;
+};
+
 /// Not final: an application's hardware that adds devices to the simulated base derives from it
 /// (constructed from its HardwareConfig, with the parameters of "sim" in its own manifest).
-class SimHardware : public CHardware, public navi::GroundTruthSource, public navi::MapSource {
+class SimHardware : public CHardware, public SimulatorSources {
  public:
   /// Parameters of type "sim": world (a world file, relative to the profile) and seed (negative:
   /// the world's own).
@@ -33,12 +47,8 @@ class SimHardware : public CHardware, public navi::GroundTruthSource, public nav
   [[nodiscard]] const Simulator& simulator() const noexcept { return sim_; }
   [[nodiscard]] std::uint64_t seed() const noexcept { return seed_; }
 
-  [[nodiscard]] std::optional<Pose2D> true_pose(Time now) const override { return sim_.true_pose(now); }
-  [[nodiscard]] bool localization_lost(Time now) const noexcept override { return sim_.localization_lost(now); }
-  [[nodiscard]] const navi::OccupancyGrid& world_map() const noexcept override { return sim_.world().grid; }
-  [[nodiscard]] const navi::RegionMap& world_regions() const noexcept override { return sim_.world().regions; }
-
  protected:
+  [[nodiscard]] const Simulator& world_sim() const noexcept override { return sim_; }
   [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
   [[nodiscard]] HardwareInterface& do_wheels() noexcept override { return sim_; }
   void on_add_resources(ResourceTable& table) override { sim_.add_resources(table, false); }

@@ -1,0 +1,49 @@
+// BoardMonitor: the sequencing-loop module that turns what the control board's link and panel
+// report into process-supervisor events (seed 001, section 3.3: link monitoring; section 2.5: the
+// buttons). Each sequencing period it reads the robot's BoardHardware (through BoardHost) and posts
+//   board.link_lost       the host missed a response (missing, late or corrupt): a fault
+//   board.link_restored   SYNC answered again after a loss
+//   board.start / board.pause / board.home   a panel button pressed (held edge)
+//   board.emergency_stop  the e-stop pressed: the board has already braked; a fault
+//   board.tank_empty / board.tank_refilled   the liquid level module's empty flag changed
+//   board.battery_low     the battery at or below battery_low_percent (and not charging)
+// and serves the actuator behaviors (actuator_behaviors.hpp): their board commands at activation
+// and deactivation.
+// A fault is also reported as the module's failure ("<module>.fault"), so every running process
+// fails unless its net takes the event, and the planner's recovery rules decide.
+#pragma once
+
+#include <cstdint>
+
+#include "tripodal/board/board_hardware.hpp"
+#include "tripodal/processes/module.hpp"
+
+namespace tripodal::board {
+
+class BoardMonitor final : public CModule {
+ public:
+  static const ModuleManifest& static_manifest();
+
+ protected:
+  [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  /// Throws ConfigError when the robot's hardware is not a board.
+  void on_start(ModuleContext& context) override;
+  /// Throws std::runtime_error (the module's fault) on a link loss or an emergency stop.
+  void on_update(ModuleContext& context) override;
+  void on_configure(const ParameterSet& params) override;
+  void on_behavior_activated(const BehaviorActivation& activation, ModuleContext& context) override;
+  void on_behavior_deactivated(std::string_view behavior, ModuleContext& context) override;
+
+ private:
+  BoardHost* host_ = nullptr;
+  bool link_up_ = false;
+  std::uint8_t held_ = 0;
+  bool tank_empty_ = false;
+  bool battery_low_ = false;
+  double battery_low_percent_ = 15.0;
+};
+
+/// Registers the module type "BoardMonitor".
+void register_board_modules(ModuleRegistry& registry);
+
+}  // namespace tripodal::board

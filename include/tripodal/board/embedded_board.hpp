@@ -1,0 +1,41 @@
+// The simulated control board wired in process to the host side: BoardFirmware and BoardHardware
+// joined by a SerialLine, in simulated time. What a simulated robot of hardware type "board"
+// embeds (sim/sim_board.hpp gives it the simulator's world): every request and response crosses
+// the line byte for byte, at the line's character time.
+#pragma once
+
+#include <cstdint>
+
+#include "tripodal/board/board_firmware.hpp"
+#include "tripodal/board/board_hardware.hpp"
+#include "tripodal/board/serial_line.hpp"
+#include "tripodal/core/clock.hpp"
+
+namespace tripodal::board {
+
+class EmbeddedBoard {
+ public:
+  /// `plant` is the board's world (not owned); power-on at time zero.
+  EmbeddedBoard(const FirmwareConfig& firmware, BoardPlant& plant, const BoardHardwareConfig& host,
+                std::uint32_t baud = 115200);
+  EmbeddedBoard(const EmbeddedBoard&) = delete;
+  EmbeddedBoard& operator=(const EmbeddedBoard&) = delete;
+
+  /// Runs the firmware's 1 ms ticks up to `now`, the line's time moving with each tick: the robot
+  /// only stops at its loops' instants, but a request sent at one control period must be answered
+  /// (bytes travelling at 115200 baud) before the next, as on the real line.
+  void advance_to(Time now) noexcept;
+
+  [[nodiscard]] BoardFirmware& firmware() noexcept { return firmware_; }
+  [[nodiscard]] BoardHardware& host() noexcept { return host_; }
+  [[nodiscard]] SerialLine& line() noexcept { return line_; }
+
+ private:
+  SimClock clock_;  // the line's: moves tick by tick up to the robot's clock
+  Duration tick_;
+  SerialLine line_;
+  BoardFirmware firmware_;
+  BoardHardware host_;
+};
+
+}  // namespace tripodal::board

@@ -1,0 +1,100 @@
+#include "tripodal/board/board_monitor.hpp"
+
+#include "tripodal/board/actuator_behaviors.hpp"
+
+#include <fmt/format.h>
+
+#include <array>
+
+#include <stdexcept>
+#include <string>
+
+namespace tripodal::board {
+
+const ModuleManifest& BoardMonitor::static_manifest() {
+  static const ModuleManifest m =
+      ManifestBuilder("BoardMonitor", ModuleKind::other, Layer::sequencing)
+          .description("the control board's link and panel as supervisor events (docs/board-protocol.md)")
+          .input("board_link")
+          .outputs({"board.link_lost", "board.link_restored", "board.start", "board.pause", "board.home",
+                    "board.emergency_stop", "board.tank_empty", "board.tank_refilled", "board.battery_low"})
+          .number("battery_low_percent", 15.0, "%", "at or below this the task must end and the robot charge", 0.0, 100.0)
+          .build();
+  return m;
+}
+
+void BoardMonitor::on_start(ModuleContext& context) {
+  host_ = dynamic_cast<BoardHost*>(context.hardware);
+  if (host_ == nullptr) {
+    const std::string type = context.hardware != nullptr ? std::string(context.hardware->manifest().name) : "none";
+    throw ConfigError(where(), fmt::format("module BoardMonitor reads the control board; expected hardware of type "
+                                           "'board' (hardware: {{type: board}}), this robot's is '{}'",
+                                           type));
+  }
+}
+
+void BoardMonitor::on_configure(const ParameterSet& params) { battery_low_percent_ = params.number("battery_low_percent"); }
+
+void BoardMonitor::on_behavior_activated(const BehaviorActivation& activation, ModuleContext& /*context*/) {
+  if (host_ == nullptr) return;
+  BoardHardware& board = host_->board();
+  if (activation.behavior == BhUvLamp::static_manifest().name) {
+    board.command(Command::uv_lamp, std::array<std::uint8_t, 1>{1});
+  } else if (activation.behavior == BhAtomize::static_manifest().name) {
+    const bool fan = activation.resolved().boolean("fan");
+    board.command(Command::atomizer, std::array<std::uint8_t, 2>{1, static_cast<std::uint8_t>(fan ? 1 : 0)});
+  } else if (activation.behavior == BhVoicePrompt::static_manifest().name) {
+    const auto track = static_cast<std::uint8_t>(activation.resolved().number("track"));
+    board.command(Command::voice, std::array<std::uint8_t, 1>{track});
+  }
+}
+
+void BoardMonitor::on_behavior_deactivated(std::string_view behavior, ModuleContext& /*context*/) {
+  if (host_ == nullptr) return;
+  BoardHardware& board = host_->board();
+  if (behavior == BhUvLamp::static_manifest().name) board.command(Command::uv_lamp, std::array<std::uint8_t, 1>{0});
+  if (behavior == BhAtomize::static_manifest().name) board.command(Command::atomizer, std::array<std::uint8_t, 2>{0, 0});
+}
+
+void BoardMonitor::on_update(ModuleContext& context) {
+  if (host_ == nullptr) return;
+  BoardLink& link = host_->board().link();
+  std::string fault;
+  if (link.take_link_lost()) {
+    const LinkStats& s = link.stats();
+    fault = fmt::format("link lost at {:.3f} s: no valid response from the board ({} missed, {} error responses so far)",
+                        to_seconds(link.link_lost_at()), s.missed, s.error_responses);
+    context.post("board.link_lost", fault);
+    link_up_ = false;
+  } else if (!link_up_ && link.synchronised()) {
+    if (link.stats().link_losses > 0) context.post("board.link_restored", "SYNC answered again");
+    link_up_ = true;
+  }
+  // Buttons from the DRIVE response of every control period: a press is a held edge.
+  const std::uint8_t held = link.synchronised() && link.has_drive() ? link.drive().buttons : held_;
+  const auto pressed = static_cast<std::uint8_t>(held & ~held_);
+  held_ = held;
+  if ((pressed & kButtonStart) != 0) context.post("board.start", "start button");
+  if ((pressed & kButtonPause) != 0) context.post("board.pause", "pause button");
+  if ((pressed & kButtonHome) != 0) context.post("board.home", "home button");
+  if ((pressed & kButtonEmergencyStop) != 0) {
+    context.post("board.emergency_stop", "emergency stop pressed");
+    if (fault.empty()) fault = "emergency stop pressed: the board braked the wheels";
+  }
+  if (link.tank_empty() != tank_empty_) {
+    tank_empty_ = link.tank_empty();
+    context.post(tank_empty_ ? "board.tank_empty" : "board.tank_refilled",
+                 fmt::format("disinfectant tank at {} %", link.tank_percent()));
+  }
+  if (link.has_battery()) {
+    const BatteryState& b = link.battery();
+    const bool low = !b.charging && b.percent <= battery_low_percent_;
+    if (low && !battery_low_) context.post("board.battery_low", fmt::format("battery at {} % ({} mV)", b.percent, b.voltage_mv));
+    battery_low_ = low;
+  }
+  if (!fault.empty()) throw std::runtime_error(fault);
+}
+
+void register_board_modules(ModuleRegistry& registry) { registry.add<BoardMonitor>(); }
+
+}  // namespace tripodal::board

@@ -1,0 +1,139 @@
+#include "tripodal/board/board_monitor.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <optional>
+#include <string>
+
+#include "tripodal/board/embedded_board.hpp"
+#include "still_plant.hpp"
+
+using namespace std::chrono_literals;
+using namespace tripodal::board;
+using tripodal::ModuleContext;
+using tripodal::ModuleEvent;
+using tripodal::ResourceTable;
+using tripodal::Time;
+using tripodal::board::test::StillPlant;
+
+namespace {
+
+// The robot's order at each instant: the board moves to `now`, the sequencing loop (the monitor),
+// then the reactive loop (the link's exchange, when its resources are polled).
+struct Rig {
+  StillPlant plant;
+  EmbeddedBoard board{FirmwareConfig{}, plant, BoardHardwareConfig{}};
+  ResourceTable table;
+  BoardMonitor monitor;
+  ModuleContext ctx;
+  Time now{};
+
+  Rig() {
+    board.host().add_resources(table);
+    monitor.configure();
+    ctx.hardware = &board.host();
+    monitor.start(ctx);
+  }
+  // One control period; the fault the monitor reported, if any.
+  std::optional<std::string> period() {
+    now += 10ms;
+    board.advance_to(now);
+    ctx.now = now;
+    ctx.events.clear();
+    std::optional<std::string> fault;
+    try {
+      monitor.update(ctx);
+    } catch (const std::runtime_error& e) {
+      fault = e.what();
+    }
+    table.poll_all(now);
+    return fault;
+  }
+  [[nodiscard]] bool posted(const std::string& event) const {
+    for (const ModuleEvent& e : ctx.events) {
+      if (e.name == event) return true;
+    }
+    return false;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("BoardMonitor: a dead link is a fault event within two control periods, and its recovery", "[board][monitor]") {
+  Rig rig;
+  for (int i = 0; i < 50; ++i) REQUIRE_FALSE(rig.period());
+  REQUIRE(rig.board.host().link().synchronised());
+  CHECK(rig.board.host().link().stats().max_round_trip <= 10ms);  // answered by the next period
+
+  // The board stops answering (its transmitter cut) right after the exchange at `cut`.
+  const Time cut = rig.now;
+  rig.board.line().board().set_connected(false);
+  std::optional<std::string> fault;
+  int periods = 0;
+  while (!fault && periods < 10) {
+    fault = rig.period();
+    ++periods;
+  }
+  REQUIRE(fault);
+  CHECK_THAT(*fault, Catch::Contains("link lost at") && Catch::Contains("no valid response from the board"));
+  CHECK(rig.posted("board.link_lost"));
+  CHECK(periods <= 2);  // the request of `cut` unanswered at cut + 10 ms, posted at cut + 20 ms
+  CHECK(rig.now - cut <= 20ms);
+  CHECK(rig.board.host().link().stats().link_losses == 1);
+
+  // The board's watchdog stops the motors; answering again, SYNC restores the link.
+  rig.board.line().board().set_connected(true);
+  bool restored = false;
+  for (int i = 0; i < 50 && !restored; ++i) {
+    REQUIRE_FALSE(rig.period());
+    restored = rig.posted("board.link_restored");
+  }
+  CHECK(restored);
+  CHECK(rig.board.host().link().synchronised());
+}
+
+TEST_CASE("BoardMonitor: the emergency stop brakes at once and is a fault; the other buttons are events", "[board][monitor]") {
+  Rig rig;
+  for (int i = 0; i < 30; ++i) REQUIRE_FALSE(rig.period());
+
+  rig.board.firmware().set_buttons(kButtonStart);
+  bool started = false;
+  for (int i = 0; i < 3 && !started; ++i) {
+    REQUIRE_FALSE(rig.period());
+    started = rig.posted("board.start");
+  }
+  CHECK(started);
+  rig.board.firmware().set_buttons(0);
+  REQUIRE_FALSE(rig.period());
+  CHECK_FALSE(rig.posted("board.start"));  // an edge, posted once
+
+  // Drive, then press the e-stop between two periods: the board brakes on that tick.
+  const std::array<double, 2> wheels{2.0, 2.0};
+  for (int i = 0; i < 50; ++i) {
+    rig.board.host().wheels().write_wheel_velocities(wheels);
+    REQUIRE_FALSE(rig.period());
+  }
+  REQUIRE(rig.board.firmware().required_m_s(0) > 0.1);
+  rig.board.firmware().set_buttons(kButtonEmergencyStop);
+  CHECK(rig.board.firmware().required_m_s(0) == 0.0);
+  std::optional<std::string> fault;
+  int periods = 0;
+  while (!fault && periods < 5) {
+    rig.board.host().wheels().write_wheel_velocities(wheels);
+    fault = rig.period();
+    ++periods;
+  }
+  REQUIRE(fault);
+  CHECK_THAT(*fault, Catch::Contains("emergency stop pressed"));
+  CHECK(rig.posted("board.emergency_stop"));
+  CHECK(periods <= 2);
+  CHECK(rig.board.firmware().required_m_s(0) == 0.0);  // held whatever the host asks
+}
+
+TEST_CASE("BoardMonitor refuses a robot whose hardware is not a board", "[board][monitor]") {
+  BoardMonitor monitor;
+  monitor.configure();
+  ModuleContext ctx;
+  REQUIRE_THROWS_WITH(monitor.start(ctx), Catch::Contains("module BoardMonitor reads the control board") &&
+                                              Catch::Contains("this robot's is 'none'"));
+}
