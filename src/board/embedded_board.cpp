@@ -4,9 +4,25 @@
 
 namespace tripodal::board {
 
+namespace {
+std::unique_ptr<PseudoTerminal> open_carrier(BoardLine carrier, const Clock& clock, std::uint32_t baud) {
+  if (carrier == BoardLine::in_process) return nullptr;
+  return std::make_unique<PseudoTerminal>(clock, SerialSettings{baud});
+}
+}  // namespace
+
 EmbeddedBoard::EmbeddedBoard(const FirmwareConfig& firmware, BoardPlant& plant, const BoardHardwareConfig& host,
-                             std::uint32_t baud)
-    : tick_(firmware.tick), line_(clock_, baud), firmware_(firmware, line_.board(), plant), host_(line_.host(), host) {}
+                             std::uint32_t baud, BoardLine carrier)
+    : tick_(firmware.tick),
+      pty_(open_carrier(carrier, real_clock_, baud)),
+      port_(pty_ ? std::make_unique<SerialPort>(pty_->slave_path(), real_clock_, SerialSettings{baud}) : nullptr),
+      line_(clock_, baud),
+      firmware_(firmware, line_.board(), plant),
+      host_(line_.host(), host) {
+  if (pty_) line_.carry_over(*port_, *pty_, real_clock_);
+}
+
+std::filesystem::path EmbeddedBoard::device() const { return pty_ ? pty_->slave_path() : std::filesystem::path{}; }
 
 void EmbeddedBoard::advance_to(Time now) noexcept {
   while (clock_.now() < now) {

@@ -39,10 +39,21 @@ void SimBoardPlant::sense(Time /*now*/, board::PlantSensors& out) noexcept {
 namespace tripodal::sim {
 
 SimBoardHardware::SimBoardHardware(World world, const ControllerConfig& base, std::uint64_t seed,
-                                   const board::FirmwareConfig& firmware, const board::BoardHardwareConfig& host)
+                                   const board::FirmwareConfig& firmware, const board::BoardHardwareConfig& host,
+                                   board::BoardLine line, UvLamp lamp)
     : sim_(std::move(world), base, seed),
       plant_(sim_, base.differential.wheel_radius_m),
-      board_(firmware, plant_, host) {}
+      board_(firmware, plant_, host, 115200, line),
+      dose_(sim_.world().grid, lamp) {}
+
+// The lamp's state is the firmware's (what the board switched, whatever the host believes); the
+// dose is counted per robot instant, at the pose reached, as the lamp moves a few millimetres
+// between two instants.
+void SimBoardHardware::on_advance_to(Time now) noexcept {
+  const Time before = sim_.now();
+  board_.advance_to(now);
+  if (board_.firmware().uv_lamp()) dose_.expose({sim_.pose().x_m, sim_.pose().y_m}, sim_.now() - before);
+}
 
 // The real board's type, its parameters, plus what the simulated world adds (the laser, the gyro,
 // the ground truth).
@@ -51,9 +62,20 @@ const ModuleManifest& SimBoardHardware::static_manifest() {
     const ModuleManifest& real = board::BoardHardware::static_manifest();
     std::vector<std::string> outputs = real.outputs;
     outputs.insert(outputs.end(), {"laser_scan", "yaw_rate", "ground_truth_pose"});
+    std::vector<ParameterSpec> parameters = real.parameters;
+    const UvLamp lamp;
+    parameters.insert(parameters.end(), {
+        seed_parameter(),
+        ParameterSpec{"line", ValueType::string, Value{std::string("in_process")}, "",
+                      "what carries the bytes: in_process (the simulated line) or pty (a kernel pseudo-terminal)", {}, {}},
+        ParameterSpec{"tank_l", ValueType::number, Value{board::FirmwareConfig{}.tank_initial_l}, "l",
+                      "disinfectant in the tank at power-on", 0.0, board::FirmwareConfig{}.tank_l},
+        ParameterSpec{"uv_power_w", ValueType::number, Value{lamp.uvc_power_w}, "W", "the lamp's UVC output", 0.0, 1000.0, true},
+        ParameterSpec{"uv_height_m", ValueType::number, Value{lamp.height_m}, "m", "the lamp above the floor", 0.0, 1.0, true},
+        ParameterSpec{"uv_radius_m", ValueType::number, Value{lamp.radius_m}, "m", "the lit disc's radius on the floor", 0.0, 5.0, true}});
     return hardware_manifest("board", "the control board simulated in process in the embedded simulator's world, "
                                       "every exchange over the line byte for byte (docs/board-protocol.md)",
-                             std::move(outputs), real.parameters);
+                             std::move(outputs), std::move(parameters));
   }();
   return m;
 }
@@ -71,7 +93,15 @@ void register_sim_board_hardware(HardwareRegistry& registry, std::shared_ptr<con
     if (!world) throw ConfigError(c.where, "the simulated hardware 'board' needs a world (tripodal run --world FILE)");
     board::FirmwareConfig firmware;
     firmware.pulses_per_m = host.pulses_per_m;
-    return std::make_unique<SimBoardHardware>(*world, *c.base, world->seed, firmware, host);
+    firmware.tank_initial_l = c.parameters.number("tank_l");
+    const std::string& line = c.parameters.string("line");
+    if (line != "in_process" && line != "pty") {
+      throw ConfigError(c.where, "parameter 'line' is '" + line + "'; expected in_process or pty");
+    }
+    const UvLamp lamp{c.parameters.number("uv_power_w"), c.parameters.number("uv_height_m"), c.parameters.number("uv_radius_m")};
+    return std::make_unique<SimBoardHardware>(*world, *c.base, seed_of(c, *world), firmware, host,
+                                              line == "pty" ? board::BoardLine::pseudo_terminal : board::BoardLine::in_process,
+                                              lamp);
   });
 }
 

@@ -11,9 +11,18 @@ const ModuleManifest& SimHardware::static_manifest() {
       "sim", "the embedded 2D simulator: simulated base, laser, gyro, bumpers, cliff sensors and battery",
       {"laser_scan", "yaw_rate", "bumpers", "cliff", "battery", "ground_truth_pose"},
       {ParameterSpec{"world", ValueType::string, Value{std::string()}, "", "world file, relative to the robot profile", {}, {}},
-       ParameterSpec{"seed", ValueType::number, Value{-1.0}, "",
-                     "seed of every noise source; negative: the world's own seed", std::nullopt, std::nullopt}});
+       seed_parameter()});
   return m;
+}
+
+ParameterSpec seed_parameter() {
+  return ParameterSpec{"seed", ValueType::number, Value{-1.0}, "", "seed of every noise source; negative: the world's own seed",
+                       std::nullopt, std::nullopt};
+}
+
+std::uint64_t seed_of(const HardwareConfig& c, const World& w) {
+  const double s = c.parameters.number("seed");
+  return s < 0.0 ? w.seed : static_cast<std::uint64_t>(std::llround(s));
 }
 
 namespace {
@@ -24,11 +33,6 @@ World world_of(const HardwareConfig& c, const std::shared_ptr<const World>& worl
   if (!file.empty()) return load_world(c.profile_dir / file);
   if (world) return *world;
   throw ConfigError(c.where, "hardware '" + c.type + "' needs a world: parameters: {world: FILE} (a world file, docs/simulator.md)");
-}
-
-std::uint64_t seed_of(const HardwareConfig& c, const World& w) {
-  const double s = c.parameters.number("seed");
-  return s < 0.0 ? w.seed : static_cast<std::uint64_t>(std::llround(s));
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <termios.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <fstream>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "tripodal/board/frame.hpp"
+#include "tripodal/board/serial_line.hpp"
 
 using namespace tripodal;
 using namespace tripodal::board;
@@ -114,4 +116,79 @@ TEST_CASE("opening a port that is not one fails with the path and the reason", "
   PseudoTerminal pty(clock);
   REQUIRE_THROWS_WITH(SerialPort(pty.slave_path(), clock, SerialSettings{1234}),
                       Catch::Contains("baud 1234 is not supported; expected one of 9600"));
+}
+
+// `tripodal run --board pty`: the simulated line's timing, the bytes through the kernel.
+TEST_CASE("a line carried over a pseudo-terminal delivers what the in-process line does, when it does", "[board][serial]") {
+  SimClock sim;
+  const SteadyClock real;
+  PseudoTerminal pty(real);
+  SerialPort port(pty.slave_path(), real);
+  SerialLine carried(sim);
+  carried.carry_over(port, pty, real);
+  SerialLine plain(sim);
+
+  std::vector<std::uint8_t> request(20);
+  for (std::size_t i = 0; i < request.size(); ++i) request[i] = static_cast<std::uint8_t>(0xA0 + i);
+  REQUIRE(carried.host().write(request));
+  REQUIRE(plain.host().write(request));
+  CHECK(port.bytes_written() == request.size());  // into the kernel's tty, not a copy in memory
+
+  std::array<std::uint8_t, 64> a{};
+  std::array<std::uint8_t, 64> b{};
+  sim.advance(carried.byte_time() * 10);  // ten characters on the wire so far
+  const std::ptrdiff_t na = carried.board().read(a, sim.now());
+  const std::ptrdiff_t nb = plain.board().read(b, sim.now());
+  REQUIRE(na == 10);
+  REQUIRE(nb == 10);
+  CHECK(std::equal(a.begin(), a.begin() + 10, b.begin()));
+  sim.advance(carried.byte_time() * 10);
+  REQUIRE(carried.board().read(a, sim.now()) == 10);
+  CHECK(std::equal(a.begin(), a.begin() + 10, request.begin() + 10));
+
+  const std::array<std::uint8_t, 3> response{0x10, 0x02, 0x81};
+  REQUIRE(carried.board().write(response));
+  CHECK(carried.host().read(a, sim.now()) == 0);  // still on the wire
+  sim.advance(carried.byte_time() * 3);
+  REQUIRE(carried.host().read(a, sim.now()) == 3);
+  CHECK(std::equal(response.begin(), response.end(), a.begin()));
+  CHECK(carried.board().bytes_lost() == 0);
+  CHECK(carried.host().bytes_lost() == 0);
+}
+
+namespace {
+// A carrier that takes bytes and never delivers them; each read costs 1 ms of its clock.
+class DeadCarrier final : public ByteStream {
+ public:
+  explicit DeadCarrier(SimClock& clock) : clock_(clock) {}
+  bool write(std::span<const std::uint8_t>) noexcept override { return true; }
+  std::ptrdiff_t read(std::span<std::uint8_t>, Time) noexcept override {
+    clock_.advance(1ms);
+    ++reads;
+    return 0;
+  }
+  int reads = 0;
+
+ private:
+  SimClock& clock_;
+};
+}  // namespace
+
+TEST_CASE("bytes a stalled carrier owes are counted lost once its time limit passes", "[board][serial]") {
+  SimClock sim;
+  SimClock carrier_clock;
+  DeadCarrier dead(carrier_clock);
+  SerialLine line(sim);
+  line.carry_over(dead, dead, carrier_clock, 20ms);
+  const std::array<std::uint8_t, 5> bytes{1, 2, 3, 4, 5};
+  REQUIRE(line.host().write(bytes));
+  sim.advance(line.byte_time() * 5);
+  std::array<std::uint8_t, 16> out{};
+  CHECK(line.board().read(out, sim.now()) == 0);
+  CHECK(line.board().bytes_lost() == 5);
+  CHECK(dead.reads >= 20);
+  CHECK(dead.reads <= 21);
+  // The line goes on: nothing is owed any more, later bytes are waited for afresh.
+  CHECK(line.board().read(out, sim.now()) == 0);
+  CHECK(line.board().bytes_lost() == 5);
 }

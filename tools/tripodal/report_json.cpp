@@ -31,7 +31,7 @@ std::string RunResult::json() const {
                             {"balloon", stats(sec.balloon, sec.balloon_coverage)},
                             {"boustrophedon", stats(sec.boustrophedon, sec.boustrophedon_coverage)}});
   }
-  const Json report = {{"robot", robot},
+  Json report = {{"robot", robot},
                        {"task", task},
                        {"coverage_pattern", coverage_pattern},
                        {"seed", seed},
@@ -51,6 +51,25 @@ std::string RunResult::json() const {
                        {"faults", faults},
                        {"collisions", collisions},
                        {"robot_steps", robot_steps}};
+  if (disinfection) {
+    const DisinfectionFigures& d = *disinfection;
+    const auto ms = [&](Duration t) { return rounded(to_seconds(t) * 1000.0, 3); };
+    const double mean_rtt_ms = d.link.responses == 0 ? 0.0 : to_seconds(d.link.total_round_trip) * 1000.0 / static_cast<double>(d.link.responses);
+    report["disinfection"] = {
+        {"line", d.line},
+        {"uv_target_dose_j_m2", d.uv_target_dose_j_m2},
+        {"dose_coverage", rounded(d.dose_coverage, 4)},
+        {"median_dose_j_m2", rounded(d.median_dose_j_m2, 2)},
+        {"lamp_on_s", rounded(d.lamp_on_s, 2)},
+        {"disinfectant_used_l", rounded(d.disinfectant_used_l, 4)},
+        {"disinfectant_left_l", rounded(d.disinfectant_left_l, 4)},
+        {"link", {{"requests", d.link.requests}, {"responses", d.link.responses}, {"missed", d.link.missed},
+                  {"error_responses", d.link.error_responses}, {"retries", d.link.retries}, {"link_losses", d.link.link_losses},
+                  {"mean_round_trip_ms", rounded(mean_rtt_ms, 3)}, {"max_round_trip_ms", ms(d.link.max_round_trip)},
+                  {"decoder_errors", d.decoder_errors}, {"board_requests", d.board_requests},
+                  {"watchdog_trips", d.watchdog_trips}, {"bytes_to_board", d.bytes_to_board},
+                  {"bytes_to_host", d.bytes_to_host}, {"bytes_lost", d.bytes_lost}}}};
+  }
   // Task text and names come from the user: bytes that are not UTF-8 are replaced, not thrown on.
   return report.dump(2, ' ', false, Json::error_handler_t::replace) + '\n';
 }

@@ -84,6 +84,12 @@ int run(Args& args, std::ostream& out, std::ostream& err) {
     else out << "no cleaning in this task; ";
     out << "path " << r.total.length_m << " m, " << r.total.turns << " turns; " << r.duration_s << " s simulated; "
         << r.recoveries.size() << " recoveries\n";
+    if (const auto& d = r.disinfection) {
+      out << "disinfection: " << d->dose_coverage * 100.0 << " % of the reachable floor dosed >= " << d->uv_target_dose_j_m2
+          << " J/m2 (median " << d->median_dose_j_m2 << " J/m2, lamp on " << d->lamp_on_s << " s); disinfectant used "
+          << d->disinfectant_used_l << " l; link over " << d->line << ": " << d->link.requests << " requests, "
+          << d->link.missed << " missed, " << d->decoder_errors << " decoder errors, " << d->link.link_losses << " link losses\n";
+    }
     if (!o.out.empty()) out << "wrote " << (o.out / "map.png").string() << ", trajectory.csv, report.json, lifecycle.txt\n";
     return r.succeeded ? kOk : kTaskFailed;
   } catch (const ConfigError& e) {
@@ -112,6 +118,13 @@ cli::Action setup(CLI::App& cmd) {
       ->check(cli::positive_number())
       ->capture_default_str();
   cmd.add_flag("--boustrophedon", o.boustrophedon, "clean along the plough path instead of the balloon");
+  cmd.add_option("--board", o.board_line,
+                 "in_process|pty: on the control board (hardware: {type: board}), what carries the bytes; pty: a "
+                 "kernel pseudo-terminal, the host opening its slave device as it would the board's UART")
+      ->check(CLI::IsMember({"in_process", "pty"}));
+  cmd.add_option("--uv-target-dose", o.uv_target_dose_j_m2, "J/m2: the dose a cell must receive to count as disinfected")
+      ->check(cli::positive_number())
+      ->capture_default_str();
   return [a](std::ostream& out, std::ostream& err) { return run(*a, out, err); };
 }
 

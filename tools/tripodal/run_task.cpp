@@ -20,6 +20,9 @@
 #include "tripodal/planner/lifecycle_recorder.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/robot/robot_profile.hpp"
+#include "tripodal/board/actuator_behaviors.hpp"
+#include "tripodal/board/board_monitor.hpp"
+#include "tripodal/sim/sim_board.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/sim/simulator.hpp"
 #include "tripodal/sim/world.hpp"
@@ -121,6 +124,39 @@ class ReportObserver final : public TaskObserver {
   }
 };
 
+// The dose of each reachable cell (the dose map is on the world's grid, the reachable cells on the
+// robot's map: matched by the cell centre), the tank, and both sides of the link.
+DisinfectionFigures disinfection_figures(sim::SimBoardHardware& hw, const std::vector<char>& reachable, const navi::OccupancyGrid& grid,
+                                         double tank_at_start_l, double target_j_m2) {
+  DisinfectionFigures f;
+  board::EmbeddedBoard& b = hw.embedded();
+  const std::filesystem::path device = b.device();
+  f.line = device.empty() ? "in_process" : "pty " + device.string();
+  f.uv_target_dose_j_m2 = target_j_m2;
+  std::vector<double> doses;
+  for (std::size_t i = 0; i < reachable.size(); ++i) {
+    if (reachable[i] != 0) doses.push_back(hw.uv_dose().dose_at_j_m2(grid.cell_center(grid.cell(i))));
+  }
+  if (!doses.empty()) {
+    const auto dosed = std::count_if(doses.begin(), doses.end(), [&](double d) { return d >= target_j_m2; });
+    f.dose_coverage = static_cast<double>(dosed) / static_cast<double>(doses.size());
+    auto mid = doses.begin() + static_cast<std::ptrdiff_t>(doses.size() / 2);
+    std::nth_element(doses.begin(), mid, doses.end());
+    f.median_dose_j_m2 = *mid;
+  }
+  f.lamp_on_s = to_seconds(hw.uv_dose().lamp_on());
+  f.disinfectant_left_l = b.firmware().tank_l();
+  f.disinfectant_used_l = std::max(0.0, tank_at_start_l - f.disinfectant_left_l);
+  f.link = b.host().link().stats();
+  f.decoder_errors = b.host().link().decoder_stats().errors() + b.firmware().decoder_stats().errors();
+  f.board_requests = b.firmware().counters().requests;
+  f.watchdog_trips = b.firmware().counters().watchdog_trips;
+  f.bytes_to_board = b.line().host().bytes_sent();
+  f.bytes_to_host = b.line().board().bytes_sent();
+  f.bytes_lost = b.line().host().bytes_lost() + b.line().board().bytes_lost();
+  return f;
+}
+
 }  // namespace
 
 
@@ -134,24 +170,35 @@ RunResult run_task(const RunOptions& o) {
   res.coverage_pattern = o.boustrophedon ? "boustrophedon" : "balloon";
   std::vector<navi::LocalizationFault>& faults = world->faults.localization_loss;
   faults.insert(faults.end(), o.faults.begin(), o.faults.end());
-  if (!profile.hardware || profile.hardware->type != "sim") {
+  if (!profile.hardware || (profile.hardware->type != "sim" && profile.hardware->type != "board")) {
     throw ConfigError(profile.hardware ? profile.hardware->where : profile.where,
-                      "`tripodal run` runs the robot on the simulator: its profile needs hardware: {type: sim}");
+                      "`tripodal run` runs the robot on the simulator: its profile needs hardware: {type: sim} "
+                      "(or {type: board}, the control board simulated in the same world)");
+  }
+  const bool on_board = profile.hardware->type == "board";
+  if (!o.board_line.empty() && !on_board) {
+    throw ConfigError(profile.hardware->where, "--board " + o.board_line + " needs a robot on the control board (hardware: {type: board})");
   }
 
-  // The robot, on simulated hardware in this world, with this run's seed and coverage pattern.
+  // The robot, on simulated hardware in this world, with this run's seed and coverage pattern;
+  // the board's modules and actuator behaviors for a robot on the control board.
   RobotPlugins plugins = RobotPlugins::with_builtins();
   sim::register_sim_hardware(plugins.hardware, world);
+  sim::register_sim_board_hardware(plugins.hardware, world);
+  board::register_board_modules(plugins.modules);
+  board::register_board_behaviors(plugins.behaviors);
   RobotOptions ro;
   const std::string seed_text = std::to_string(res.seed);
   ro.parameters.push_back({profile.hardware->name, "seed", seed_text});
+  if (!o.board_line.empty()) ro.parameters.push_back({profile.hardware->name, "line", o.board_line});
   for (const ModuleEntry& e : profile.navigation) {
     if (e.type == navi::CLocalizer::static_manifest().name) ro.parameters.push_back({e.name, "seed", std::to_string(res.seed % (1ULL << 52))});
     if (e.type == navi::CCoverageModule::static_manifest().name && o.boustrophedon) ro.parameters.push_back({e.name, "pattern", "boustrophedon"});
   }
   SimClock clock;
   const auto robot = Robot::assemble(profile, plugins, clock, ro);
-  auto& sim = dynamic_cast<sim::SimHardware&>(*robot->hardware()).simulator();
+  const sim::Simulator& sim = dynamic_cast<sim::SimulatorSources&>(*robot->hardware()).simulation();
+  sim::SimBoardHardware* const board_hw = dynamic_cast<sim::SimBoardHardware*>(robot->hardware());
   Navigation nav{robot->module<navi::CGridMaps>(), robot->module<navi::CSectionSplitter>(), robot->module<navi::CCoverageModule>()};
   if (nav.maps == nullptr || nav.splitter == nullptr || nav.coverage == nullptr) {
     throw ConfigError(profile.where, "`tripodal run` measures cleaning: the robot needs GridMaps, SectionSplitter and CoveragePlanner modules");
@@ -198,6 +245,7 @@ RunResult run_task(const RunOptions& o) {
     return res;
   }
   flush_log();
+  const double tank_at_start_l = board_hw != nullptr ? board_hw->embedded().firmware().tank_l() : 0.0;
 
   // The room's sections and the reachable area, for the measures.
   std::vector<std::string> room_sections;
@@ -324,6 +372,9 @@ RunResult run_task(const RunOptions& o) {
     f.boustrophedon_coverage = p.coverage();
     res.sections.push_back(f);
   }
+
+  if (board_hw != nullptr) res.disinfection = disinfection_figures(*board_hw, reachable, nav.maps->grid(), tank_at_start_l,
+                                                                    o.uv_target_dose_j_m2);
 
   if (!o.out.empty()) {
     std::filesystem::create_directories(o.out);

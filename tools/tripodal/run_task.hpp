@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "tripodal/board/board_link.hpp"
 #include "tripodal/core/time.hpp"
 #include "tripodal/navi/coverage.hpp"
 #include "tripodal/navi/localizer.hpp"
@@ -33,6 +34,11 @@ struct RunOptions {
   /// Follow the boustrophedon path instead of the balloon (the baseline, measured on the robot).
   bool boustrophedon = false;
   double max_duration_s = 4.0 * 3600.0;  ///< the task is cancelled after this much simulated time
+  /// On hardware "board": what carries the simulated board's bytes, "in_process" or "pty" (a
+  /// kernel pseudo-terminal); empty: the profile's choice.
+  std::string board_line;
+  /// The UV dose a cell of the floor must receive to count as disinfected (J/m^2; 10 = 1 mJ/cm^2).
+  double uv_target_dose_j_m2 = 10.0;
   std::ostream* log = nullptr;       ///< task and process life cycle, as it happens
   std::ostream* progress = nullptr;  ///< progress bar
   bool progress_is_terminal = false; ///< redraw the bar in place ('\r') instead of new lines
@@ -54,6 +60,23 @@ struct SectionFigures {
   double boustrophedon_coverage = 0.0;
 };
 
+/// What a run on the simulated control board adds (hardware "board"): the UV dose on the floor,
+/// the disinfectant, and the link.
+struct DisinfectionFigures {
+  std::string line;             ///< "in_process", or "pty /dev/pts/N"
+  double uv_target_dose_j_m2 = 0.0;
+  double dose_coverage = 0.0;   ///< of the reachable cells, those that received the target dose
+  double median_dose_j_m2 = 0.0;  ///< over the reachable cells
+  double lamp_on_s = 0.0;
+  double disinfectant_used_l = 0.0;
+  double disinfectant_left_l = 0.0;
+  board::LinkStats link;        ///< the host's side
+  std::uint64_t decoder_errors = 0;  ///< host and board decoders together
+  std::uint64_t board_requests = 0;  ///< answered by the firmware
+  std::uint64_t watchdog_trips = 0;
+  std::uint64_t bytes_to_board = 0, bytes_to_host = 0, bytes_lost = 0;
+};
+
 struct RunResult {
   bool succeeded = false;
   std::string state;            ///< "succeeded", "failed", "timed out", "refused"
@@ -73,6 +96,7 @@ struct RunResult {
   std::vector<std::string> faults;     ///< injected faults and what happened (simulator events)
   std::size_t collisions = 0;
   std::size_t robot_steps = 0;
+  std::optional<DisinfectionFigures> disinfection;  ///< on hardware "board" only
   [[nodiscard]] std::string json() const;
 };
 

@@ -2,6 +2,8 @@
 // time: each byte arrives one character time (10 bits at the baud rate: 86.8 us at 115200) after
 // the previous one left, so round trips and link utilisation are those of the real line. Both
 // ends are ByteStreams; nothing blocks (a read returns what has arrived by the clock's now).
+// Carried by a real byte stream (a pseudo-terminal: `tripodal run --board pty`), every byte
+// crosses the kernel's tty and the line only keeps the simulated times at which they arrive.
 #pragma once
 
 #include <array>
@@ -23,6 +25,8 @@ class SerialLine {
     /// Cuts the line (a board that stops answering): writes are lost until reconnected.
     void set_connected(bool connected) noexcept { connected_ = connected; }
     [[nodiscard]] std::uint64_t bytes_sent() const noexcept { return sent_; }
+    /// Bytes the carrier failed to deliver in its time limit (dropped from the line).
+    [[nodiscard]] std::uint64_t bytes_lost() const noexcept { return lost_; }
 
    private:
     friend class SerialLine;
@@ -32,6 +36,7 @@ class SerialLine {
       std::array<Time, kCapacity> arrival{};
       std::size_t head = 0;
       std::size_t size = 0;
+      std::size_t filled = 0;  // queued bytes, from head, that have arrived (all without a carrier)
       Time line_free{};  // when the transmitter finishes the last queued byte
     };
     const Clock* clock_ = nullptr;
@@ -40,6 +45,11 @@ class SerialLine {
     Direction* in_ = nullptr;
     bool connected_ = true;
     std::uint64_t sent_ = 0;
+    std::uint64_t lost_ = 0;
+    ByteStream* carrier_ = nullptr;  // this end's side of the real stream, when carried
+    const Clock* carrier_clock_ = nullptr;
+    Duration carrier_timeout_{0};
+    bool fill_from_carrier(Direction& d, std::size_t due) noexcept;
   };
 
   SerialLine(const Clock& clock, std::uint32_t baud = 115200) noexcept;
@@ -48,6 +58,13 @@ class SerialLine {
 
   [[nodiscard]] End& host() noexcept { return host_; }
   [[nodiscard]] End& board() noexcept { return board_; }
+  /// Carries the line over a real byte stream: what the host end writes goes into `host_side` and
+  /// is read from `board_side`, and the reverse. Reads wait (on `real_clock`, at most
+  /// `timeout` per read) for bytes that are due but still in the kernel; bytes that do not come
+  /// in that time are lost (bytes_lost). Both streams must outlive the line.
+  void carry_over(ByteStream& host_side, ByteStream& board_side, const Clock& real_clock,
+                  Duration timeout = std::chrono::seconds(1)) noexcept;
+
   /// One character: start bit, 8 data bits, stop bit.
   [[nodiscard]] Duration byte_time() const noexcept { return host_.byte_time_; }
 

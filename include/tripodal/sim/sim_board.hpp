@@ -13,6 +13,7 @@
 #include "tripodal/hardware/hardware.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/sim/simulator.hpp"
+#include "tripodal/sim/uv_dose.hpp"
 #include "tripodal/sim/world.hpp"
 
 namespace tripodal::sim {
@@ -46,27 +47,34 @@ class SimBoardPlant final : public board::BoardPlant {
 /// exchange crossing the in-process line byte for byte (board/embedded_board.hpp). Like "sim", it
 /// gives the localizer the ground truth and the maps module the world's map; the world's laser and
 /// gyro (when the world's robot has them) publish as they do on "sim", the rest comes from the board.
+/// The UV lamp's dose on the floor is the simulation's ground truth (uv_dose.hpp), accumulated
+/// while the firmware has the lamp on.
 class SimBoardHardware final : public CHardware, public board::BoardHost, public SimulatorSources {
  public:
+  /// The real board's parameters plus the simulation's: line ("in_process" or "pty"), tank_l,
+  /// uv_power_w, uv_height_m, uv_radius_m.
   static const ModuleManifest& static_manifest();
   SimBoardHardware(World world, const ControllerConfig& base, std::uint64_t seed, const board::FirmwareConfig& firmware,
-                   const board::BoardHardwareConfig& host);
+                   const board::BoardHardwareConfig& host, board::BoardLine line = board::BoardLine::in_process,
+                   UvLamp lamp = {});
 
   [[nodiscard]] board::BoardHardware& board() noexcept override { return board_.host(); }
   [[nodiscard]] board::EmbeddedBoard& embedded() noexcept { return board_; }
   [[nodiscard]] Simulator& simulator() noexcept { return sim_; }
+  [[nodiscard]] const UvDoseMap& uv_dose() const noexcept { return dose_; }
 
  protected:
   [[nodiscard]] const Simulator& world_sim() const noexcept override { return sim_; }
   [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
   [[nodiscard]] HardwareInterface& do_wheels() noexcept override { return board_.host().wheels(); }
   void on_add_resources(ResourceTable& table) override;
-  void on_advance_to(Time now) noexcept override { board_.advance_to(now); }
+  void on_advance_to(Time now) noexcept override;
 
  private:
   Simulator sim_;
   SimBoardPlant plant_;
   board::EmbeddedBoard board_;
+  UvDoseMap dose_;
 };
 
 /// Registers the hardware type "board" as the simulated board in `world` (what `tripodal run`

@@ -24,6 +24,8 @@ class SimulatorSources : public navi::GroundTruthSource, public navi::MapSource 
   [[nodiscard]] bool localization_lost(Time now) const noexcept override { return world_sim().localization_lost(now); }
   [[nodiscard]] const navi::OccupancyGrid& world_map() const noexcept override { return world_sim().world().grid; }
   [[nodiscard]] const navi::RegionMap& world_regions() const noexcept override { return world_sim().world().regions; }
+  /// The simulation itself, for what a run measures (true path, collisions, events).
+  [[nodiscard]] const Simulator& simulation() const noexcept { return world_sim(); }
 
  protected:
   ~SimulatorSources() override = default;
@@ -59,6 +61,11 @@ class SimHardware : public CHardware, public SimulatorSources {
   std::uint64_t seed_;
   Simulator sim_;
 };
+
+/// The parameter "seed" of the simulated hardware types, and the seed it gives in world `w`
+/// (negative: the world's own).
+[[nodiscard]] ParameterSpec seed_parameter();
+[[nodiscard]] std::uint64_t seed_of(const HardwareConfig& c, const World& w);
 
 /// Registers the hardware type "sim". With `world`, every robot built from the registry runs in
 /// that world (an application that loaded it, as `tripodal run --world` does) and the parameter
