@@ -24,6 +24,17 @@ bool BoardLink::take_link_lost() noexcept {
 }
 
 void BoardLink::cycle(Time now, WheelSpeeds speeds) noexcept {
+  if (stream_failed_) {
+    // The device went away (unplugged, the board's process killed): every outstanding request
+    // is missed; the device is opened again now and then, and the link resynchronises with SYNC.
+    while (outstanding_size_ > 0) miss(now);
+    if (now < next_reopen_) return;
+    next_reopen_ = now + config_.reopen_period;
+    if (!stream_.reopen()) return;
+    stream_failed_ = false;
+    decoder_.reset();
+    ++stats_.reopens;
+  }
   receive(now);
   while (outstanding_size_ > 0 && now - outstanding_[0].sent >= config_.response_timeout) miss(now);
   if (outstanding_size_ > 0) return;  // still waiting within the period: one exchange at a time
@@ -76,6 +87,8 @@ void BoardLink::receive(Time now) noexcept {
     const std::ptrdiff_t n = stream_.read(rx_, Time{});
     if (n < 0) {
       while (outstanding_size_ > 0) miss(now);
+      stream_failed_ = true;
+      next_reopen_ = now;
       return;
     }
     if (n == 0) return;

@@ -97,17 +97,31 @@ void configure_raw(int fd, std::uint32_t baud, const std::string& what) {
 }
 
 SerialPort::SerialPort(const std::filesystem::path& path, const Clock& clock, SerialSettings settings)
-    : path_(path), clock_(clock) {
-  const std::string what = fmt::format("serial port {}", path.string());
-  fd_ = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
-  if (fd_ < 0) fail_os(what, "open");
+    : path_(path), clock_(clock), settings_(settings), fd_(open_port()) {}
+
+int SerialPort::open_port() const {
+  const std::string what = fmt::format("serial port {}", path_.string());
+  const int fd = ::open(path_.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) fail_os(what, "open");
   try {
-    configure_raw(fd_, settings.baud, what);
-    ::tcflush(fd_, TCIOFLUSH);  // nothing of a previous session
+    configure_raw(fd, settings_.baud, what);
+    ::tcflush(fd, TCIOFLUSH);  // nothing of a previous session
   } catch (...) {
-    ::close(fd_);
+    ::close(fd);
     throw;
   }
+  return fd;
+}
+
+bool SerialPort::reopen() noexcept {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+  try {
+    fd_ = open_port();
+  } catch (const std::exception&) {
+    return false;  // not back yet: the caller tries again later
+  }
+  return true;
 }
 
 SerialPort::~SerialPort() {

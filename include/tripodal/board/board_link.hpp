@@ -26,6 +26,8 @@ struct LinkConfig {
   Duration battery_period{std::chrono::seconds(3)};
   Duration tank_period{std::chrono::seconds(1)};
   Duration ranges_period{std::chrono::milliseconds(100)};  ///< ultrasonic and infrared, alternately
+  /// After the stream failed (the device went away): how often to open it again.
+  Duration reopen_period{std::chrono::milliseconds(500)};
 };
 
 /// Link statistics, for the report and the tests.
@@ -37,6 +39,7 @@ struct LinkStats {
   std::uint64_t retries = 0;          ///< actuator commands sent again
   std::uint64_t link_losses = 0;
   std::uint64_t resyncs = 0;
+  std::uint64_t reopens = 0;          ///< the device opened again after a failure
   Duration max_round_trip{0};
   Duration last_round_trip{0};
   Duration total_round_trip{0};
@@ -107,6 +110,8 @@ class BoardLink {
   std::uint32_t consecutive_missed_ = 0;
   bool synchronised_ = false;
   bool lost_pending_ = false;
+  bool stream_failed_ = false;  // read or write failed: reopen every reopen_period
+  Time next_reopen_{};
   Time lost_at_{};
   Time next_battery_{}, next_tank_{}, next_ranges_{};
   bool ranges_toggle_ = false;

@@ -25,6 +25,9 @@ class ByteStream {
   /// Reads what has arrived into `out`, waiting for a first byte until `deadline` at most; returns
   /// the bytes read (0: none by the deadline) or -1 when the stream failed (closed, I/O error).
   virtual std::ptrdiff_t read(std::span<std::uint8_t> out, Time deadline) noexcept = 0;
+  /// After a failure (-1 from read, false from write): opens the device again, as when a board
+  /// was unplugged or its process restarted. False when it cannot, or the stream has no device.
+  virtual bool reopen() noexcept { return false; }
 };
 
 /// The longest a read waits, whatever its deadline: the control loop's budget on the port.
@@ -51,6 +54,8 @@ class SerialPort final : public ByteStream {
 
   bool write(std::span<const std::uint8_t> bytes) noexcept override;
   std::ptrdiff_t read(std::span<std::uint8_t> out, Time deadline) noexcept override;
+  /// Closes the port and opens `path` again (a symbolic link may now name another device).
+  bool reopen() noexcept override;
 
   [[nodiscard]] const std::filesystem::path& path() const noexcept { return path_; }
   [[nodiscard]] int fd() const noexcept { return fd_; }
@@ -59,8 +64,11 @@ class SerialPort final : public ByteStream {
   [[nodiscard]] std::uint64_t bytes_read() const noexcept { return read_; }
 
  private:
+  // Opens and configures path_ (throws as the constructor says).
+  [[nodiscard]] int open_port() const;
   std::filesystem::path path_;
   const Clock& clock_;
+  SerialSettings settings_;
   int fd_ = -1;
   std::uint64_t written_ = 0;
   std::uint64_t read_ = 0;

@@ -1,0 +1,109 @@
+// A board that stops answering because its process was killed, and comes back (issue 17's fault
+// list): the real tripodal-board-sim behind a pseudo-terminal, the host's BoardLink on the
+// symbolic link the simulator keeps to it, in real time as on the robot. Bounded waits only.
+#include <catch2/catch.hpp>
+
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "tripodal/board/board_link.hpp"
+#include "tripodal/board/serial_port.hpp"
+#include "tripodal/core/clock.hpp"
+
+extern char** environ;
+
+using namespace tripodal;
+using namespace tripodal::board;
+using namespace std::chrono_literals;
+
+namespace {
+
+// tripodal-board-sim on the workspace, its pseudo-terminal also reachable at `link`.
+pid_t start_board(const std::filesystem::path& link) {
+  const std::string exe = TRIPODAL_BOARD_SIM_EXE;
+  const std::string world = std::string(TRIPODAL_SOURCE_DIR) + "/configs/worlds/workspace.yaml";
+  std::vector<std::string> args{exe, "--world", world, "--link", link.string(), "--duration-s", "60", "--link-timeout-s", "2"};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = -1;
+  REQUIRE(::posix_spawn(&pid, exe.c_str(), nullptr, nullptr, argv.data(), environ) == 0);
+  return pid;
+}
+
+void stop_board(pid_t pid) {
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+}
+
+// Runs the host's 100 Hz control cycle until `done` or `max_cycles`; returns the cycles it took
+// (max_cycles + 1 when never).
+template <class Done>
+int cycle_until(BoardLink& link, const SteadyClock& clock, int max_cycles, const Done& done) {
+  Time next = clock.now();
+  for (int i = 1; i <= max_cycles; ++i) {
+    next += 10ms;
+    clock.sleep_until(next);
+    link.cycle(clock.now(), WheelSpeeds{50, 50});
+    if (done()) return i;
+  }
+  return max_cycles + 1;
+}
+
+}  // namespace
+
+TEST_CASE("a board whose process is killed: link lost at once; restarted: the port reopens and resynchronises",
+          "[board][process]") {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("tripodal-board-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path device = dir / "board";
+  const SteadyClock clock;
+
+  pid_t board = start_board(device);
+  // The simulator makes the link before it serves: wait for it (at most 10 s, in 10 ms steps).
+  for (int i = 0; i < 1000 && !std::filesystem::exists(device); ++i) clock.sleep_until(clock.now() + 10ms);
+  REQUIRE(std::filesystem::exists(device));
+
+  SerialPort port(device, clock);
+  // Both processes share two loaded cores without real-time priority: a response may come a few
+  // periods late, which is not what this test is about; the timeout of the robot (10 ms) is
+  // tested on simulated time (board_link_test.cpp), and so is the board's watchdog (2 s here).
+  LinkConfig config;
+  config.response_timeout = 200ms;
+  BoardLink link(port, config);
+  REQUIRE(cycle_until(link, clock, 300, [&] { return link.synchronised() && link.has_drive(); }) <= 300);
+  (void)link.take_link_lost();
+  const std::uint64_t losses_before = link.stats().link_losses;
+
+  stop_board(board);
+  // The master's end is gone: the next read fails, the request is missed and the link lost.
+  const int to_loss = cycle_until(link, clock, 100, [&] { return link.take_link_lost(); });
+  CHECK(to_loss <= 2);
+  CHECK_FALSE(link.synchronised());
+  // While it is away, nothing to open: the link keeps trying (every 0.5 s), posting no new loss.
+  CHECK(cycle_until(link, clock, 60, [&] { return link.synchronised(); }) == 61);
+  CHECK_FALSE(link.take_link_lost());
+
+  board = start_board(device);  // a new pseudo-terminal behind the same link
+  const int to_sync = cycle_until(link, clock, 1000, [&] { return link.synchronised() && link.stats().reopens > 0; });
+  CHECK(to_sync <= 1000);
+  CHECK(link.stats().link_losses == losses_before + 1);
+  CHECK(link.stats().reopens >= 1);
+  const std::uint64_t responses = link.stats().responses;
+  const LinkStats& st = link.stats();
+  INFO("missed " << st.missed << ", error responses " << st.error_responses << ", losses " << st.link_losses << ", reopens "
+                 << st.reopens << ", resyncs " << st.resyncs << ", requests " << st.requests << ", responses " << st.responses);
+  CHECK(cycle_until(link, clock, 20, [] { return false; }) == 21);
+  CHECK(link.stats().responses > responses);  // driving again
+  CHECK(link.synchronised());
+
+  stop_board(board);
+  std::filesystem::remove_all(dir);
+}
