@@ -183,6 +183,8 @@ std::shared_ptr<CPathFollowingBehavior::NearReturns> near_returns_of(const Laser
   static std::mutex mutex;
   static std::map<const LaserResource*, std::weak_ptr<CPathFollowingBehavior::NearReturns>> table;
   std::lock_guard lock(mutex);
+  // Entries of lasers whose behaviors are all gone: a later laser at the same address starts afresh.
+  std::erase_if(table, [](const auto& kv) { return kv.second.expired(); });
   std::weak_ptr<CPathFollowingBehavior::NearReturns>& entry = table[laser];
   if (auto shared = entry.lock()) return shared;
   auto shared = std::make_shared<CPathFollowingBehavior::NearReturns>();

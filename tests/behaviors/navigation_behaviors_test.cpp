@@ -166,6 +166,52 @@ TEST_CASE("PathTracker searches only a short arc ahead, stops the lookahead at c
   CHECK(t.capacity() == 8);
 }
 
+TEST_CASE("PathTracker::at walks from the progress and agrees with interpolating over the whole path",
+          "[behaviors][navigation]") {
+  // A zigzag of 200 segments of uneven lengths, one repeated point (a zero-length segment).
+  std::vector<Pose2D> zig;
+  for (int i = 0; i < 200; ++i) zig.push_back({0.05 * i + 0.01 * (i % 7), (i % 2 == 0 ? 0.0 : 0.2 + 0.01 * (i % 5)), 0.0});
+  zig.insert(zig.begin() + 50, zig[50]);
+  std::vector<double> s{0.0};
+  for (std::size_t i = 1; i < zig.size(); ++i) s.push_back(s.back() + std::hypot(zig[i].x_m - zig[i - 1].x_m, zig[i].y_m - zig[i - 1].y_m));
+  const auto brute = [&](double q) {
+    if (q <= 0.0) return zig.front();
+    if (q >= s.back()) return zig.back();
+    std::size_t j = 1;
+    while (s[j] <= q) ++j;
+    const double t = (q - s[j - 1]) / (s[j] - s[j - 1]);
+    return Pose2D{zig[j - 1].x_m + t * (zig[j].x_m - zig[j - 1].x_m), zig[j - 1].y_m + t * (zig[j].y_m - zig[j - 1].y_m), 0.0};
+  };
+  PathTracker t;
+  t.reserve(512);
+  for (const double start : {0.0, 0.3, s[50], 7.77, s.back() - 0.01}) {
+    t.reset(zig, start);
+    INFO("progress " << start);
+    for (double q = -0.5; q <= s.back() + 0.5; q += 0.0137) {  // behind, around and far ahead of it
+      const Pose2D a = t.at(q);
+      const Pose2D b = brute(q);
+      REQUIRE(a.x_m == Approx(b.x_m).margin(1e-12));
+      REQUIRE(a.y_m == Approx(b.y_m).margin(1e-12));
+    }
+  }
+}
+
+TEST_CASE("PathTracker::update gives the same target for the same inputs, and searches again once they change",
+          "[behaviors][navigation]") {
+  const std::vector<Pose2D> line{{0, 0, 0}, {2, 0, 0}, {4, 0, 0}};
+  PathTracker t;
+  t.reserve(8);
+  t.reset(line);
+  const PathTracker::Target first = t.update({1.0, 0.1, 0.0}, 0.5, 1.0);
+  const PathTracker::Target again = t.update({1.0, 0.1, 0.0}, 0.5, 1.0);
+  CHECK(again.point.x_m == first.point.x_m);
+  CHECK(again.remaining_m == first.remaining_m);
+  CHECK(t.update({1.0, 0.1, 0.0}, 0.8, 1.0).point.x_m == Approx(1.8));  // another lookahead
+  CHECK(t.update({1.5, 0.1, 0.0}, 0.5, 1.0).point.x_m == Approx(2.0));  // moved on
+  t.reset(line, 3.0);                                                    // a new path start
+  CHECK(t.update({1.5, 0.1, 0.0}, 0.5, 1.0).point.x_m == Approx(3.5));
+}
+
 // ---------------------------------------------------------------------------------------------
 // The path-following behaviors against hand-made navigation data
 
