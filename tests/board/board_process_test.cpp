@@ -95,14 +95,14 @@ TEST_CASE("a board whose process is killed: link lost at once; restarted: the po
   const int to_sync = cycle_until(link, clock, 1000, [&] { return link.synchronised() && link.stats().reopens > 0; });
   CHECK(to_sync <= 1000);
   CHECK(link.stats().link_losses == losses_before + 1);
-  CHECK(link.stats().reopens >= 1);
+  // Driving again: DRIVE answered period after period (on a loaded machine a late answer may
+  // cost another resynchronisation on the way; the link comes back each time).
   const std::uint64_t responses = link.stats().responses;
   const LinkStats& st = link.stats();
+  CHECK(cycle_until(link, clock, 500, [&] { return link.synchronised() && st.responses >= responses + 20; }) <= 500);
   INFO("missed " << st.missed << ", error responses " << st.error_responses << ", losses " << st.link_losses << ", reopens "
                  << st.reopens << ", resyncs " << st.resyncs << ", requests " << st.requests << ", responses " << st.responses);
-  CHECK(cycle_until(link, clock, 20, [] { return false; }) == 21);
-  CHECK(link.stats().responses > responses);  // driving again
-  CHECK(link.synchronised());
+  CHECK(st.reopens >= 1);
 
   stop_board(board);
   std::filesystem::remove_all(dir);
