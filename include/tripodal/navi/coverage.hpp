@@ -66,6 +66,11 @@ struct CoverageOptions {
   /// After the passes, visit the reachable cells still uncleaned (points of the medial axis,
   /// narrow places) one by one, nearest first.
   bool touch_up = true;
+  /// hybrid(): neighbouring lanes are cleaning_width - lane_overlap apart (straight lanes on
+  /// grid rows need less overlap than contours; some absorbs the robot's tracking error).
+  double lane_overlap_m = 0.04;
+  /// hybrid(): lanes end this far inside the centre line of the wall round; 0: one cell.
+  double lane_inset_m = 0.0;
   /// hybrid(): a turn weighs like this much travel when the lane direction is chosen.
   double turn_cost_m = 0.5;
 };
