@@ -521,10 +521,16 @@ static long long dist2(CellIndex a, CellIndex b) noexcept {
 void CoveragePlanner::plough(Workspace& ws, const std::vector<std::uint8_t>& mask, bool rows,
                              const std::vector<RoundPiece>& pieces, CellIndex& cur, CoverageResult& r,
                              std::optional<Point2D> start) {
-  const auto [lo, hi] = lane_extent(mask, ws.w, ws.h, rows);
+  // The lanes lie where the offset leaves a lane spacing to the wall round (the first lane's
+  // swath meets the round's); along a lane, its run goes on over `mask`, closer to the round.
+  const double lane_spacing = std::max(grid_.resolution_m(), options_.cleaning_width_m - options_.lane_overlap_m);
+  std::vector<std::uint8_t> far(mask.size());
+  for (std::size_t li = 0; li < mask.size(); ++li) {
+    far[li] = mask[li] != 0 && ws.offset[li] >= static_cast<float>(lane_spacing) ? 1 : 0;
+  }
+  const auto [lo, hi] = lane_extent(far, ws.w, ws.h, rows);
   // Lanes spread evenly from the first to the last lane, at most one spacing apart: no thin
   // last lane that repeats its neighbour.
-  const double lane_spacing = std::max(grid_.resolution_m(), options_.cleaning_width_m - options_.lane_overlap_m);
   const double step = lane_spacing / grid_.resolution_m();
   const int count = lo > hi ? 0 : static_cast<int>(std::ceil(static_cast<double>(hi - lo) / step - 1e-9)) + 1;
   std::vector<int> lanes;
@@ -533,6 +539,14 @@ void CoveragePlanner::plough(Workspace& ws, const std::vector<std::uint8_t>& mas
                                : lo + static_cast<int>(std::lround(static_cast<double>(k) * (hi - lo) / (count - 1))));
   }
   std::vector<LaneRun> runs = lane_runs(mask, ws.w, ws.h, ws.x0, ws.y0, rows, lanes);
+  // a run without a cell a lane spacing from the round lies in the round's swath already
+  std::erase_if(runs, [&](const LaneRun& run) {
+    for (int a = run.lo; a <= run.hi; ++a) {
+      const int l = lanes[static_cast<std::size_t>(run.lane)];
+      if (far[rows ? ws.local(a, l) : ws.local(l, a)] != 0) return false;
+    }
+    return true;
+  });
   // Cells of the boustrophedon decomposition: runs of neighbouring lanes that overlap one to one
   // are swept in one go, lane after lane; a split or a merge (an obstacle, a bay) ends a cell.
   std::vector<std::vector<std::size_t>> up(runs.size()), down(runs.size());
