@@ -67,8 +67,9 @@ struct CoverageOptions {
   /// narrow places) one by one, nearest first.
   bool touch_up = true;
   /// hybrid(): neighbouring lanes are cleaning_width - lane_overlap apart (straight lanes on
-  /// grid rows need less overlap than contours; some absorbs the robot's tracking error).
-  double lane_overlap_m = 0.04;
+  /// grid rows need less overlap than contours; 2 cm absorb the robot's tracking error: demo,
+  /// seeds 1-3, both robots >= 99.70 % driven coverage).
+  double lane_overlap_m = 0.02;
   /// hybrid(): lanes end this far inside the centre line of the wall round; 0: one cell.
   double lane_inset_m = 0.0;
   /// hybrid(): a turn weighs like this much travel when the lane direction is chosen.
