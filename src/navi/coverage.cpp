@@ -539,11 +539,12 @@ void CoveragePlanner::plough(Workspace& ws, const std::vector<std::uint8_t>& mas
                                : lo + static_cast<int>(std::lround(static_cast<double>(k) * (hi - lo) / (count - 1))));
   }
   std::vector<LaneRun> runs = lane_runs(mask, ws.w, ws.h, ws.x0, ws.y0, rows, lanes);
-  // a run without a cell a lane spacing from the round lies in the round's swath already
+  // a run whose cells are all within the footprint radius of the round lies in its swath
+  const auto beyond_round = static_cast<float>(options_.cleaning_width_m / 2.0);
   std::erase_if(runs, [&](const LaneRun& run) {
     for (int a = run.lo; a <= run.hi; ++a) {
       const int l = lanes[static_cast<std::size_t>(run.lane)];
-      if (far[rows ? ws.local(a, l) : ws.local(l, a)] != 0) return false;
+      if (ws.offset[rows ? ws.local(a, l) : ws.local(l, a)] > beyond_round) return false;
     }
     return true;
   });
