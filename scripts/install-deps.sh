@@ -16,6 +16,7 @@ packages=(
   catch2 libbenchmark-dev
   graphviz libxml2-utils
   zlib1g-dev
+  libpng-dev  # tripodal-coverage-eval reads the ipa floor plans (docs/coverage.md)
 )
 
 for group in "$@"; do

@@ -1,6 +1,8 @@
 // Navigation benchmarks on the demo workspace (configs/worlds/workspace_map.yaml: 10.8 m x 32.8 m
 // at 5 cm, 216 x 656 cells): distance field, A* planning, section splitting and ordering, and the
-// two coverage generators. Coverage runs report their path figures as counters.
+// three coverage generators per section and over the whole workspace (the planning-time budget of
+// docs/coverage.md: a section under 20 ms, the workspace under 100 ms). Coverage runs report their
+// path figures as counters.
 #include <benchmark/benchmark.h>
 
 #include <string>
@@ -99,17 +101,31 @@ void BM_OrderSectionsNearestFirst(benchmark::State& state) {
 }
 BENCHMARK(BM_OrderSectionsNearestFirst)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
-// args: section index (0..3 = A..D), touch-up (1) or the passes alone (0)
-template <bool kBalloon>
-void BM_Coverage(benchmark::State& state) {
+enum class Pattern { balloon, boustrophedon, hybrid };
+
+CoverageResult cover(CoveragePlanner& cp, const Section& s, Pattern p) {
+  return p == Pattern::balloon ? cp.balloon(s) : p == Pattern::boustrophedon ? cp.boustrophedon(s) : cp.hybrid(s);
+}
+
+// PSR-2's cleaning tool (configs/robots/psr2.yaml): 0.64 m wide, body radius 0.3 m.
+CoverageOptions psr2_options() {
   CoverageOptions o;
-  o.cleaning_width_m = 0.4;
+  o.cleaning_width_m = 0.64;
+  o.robot_radius_m = 0.3;
+  return o;
+}
+
+// One section (about 76 m2 each) at PSR-2's width. args: section index (0..3 = A..D), touch-up
+// (1) or the passes alone (0).
+template <Pattern kPattern>
+void BM_Coverage(benchmark::State& state) {
+  CoverageOptions o = psr2_options();
   o.touch_up = state.range(1) != 0;
   CoveragePlanner cp(workspace(), o);
   const Section& s = sections().sections.at(static_cast<std::size_t>(state.range(0)));
   CoverageResult r;
   for (auto _ : state) {
-    r = kBalloon ? cp.balloon(s) : cp.boustrophedon(s);
+    r = cover(cp, s, kPattern);
     benchmark::DoNotOptimize(r.path.data());
   }
   state.SetLabel("section " + s.name + (o.touch_up ? "" : " passes only"));
@@ -121,10 +137,34 @@ void BM_Coverage(benchmark::State& state) {
   state.counters["touch_ups"] = static_cast<double>(r.touch_ups);
   state.counters["area_m2"] = s.area_m2;
 }
-void BM_Balloon(benchmark::State& state) { BM_Coverage<true>(state); }
-void BM_Boustrophedon(benchmark::State& state) { BM_Coverage<false>(state); }
+void BM_Balloon(benchmark::State& state) { BM_Coverage<Pattern::balloon>(state); }
+void BM_Boustrophedon(benchmark::State& state) { BM_Coverage<Pattern::boustrophedon>(state); }
+void BM_Hybrid(benchmark::State& state) { BM_Coverage<Pattern::hybrid>(state); }
 BENCHMARK(BM_Balloon)->ArgsProduct({{0, 1, 2, 3}, {1, 0}})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Boustrophedon)->ArgsProduct({{0, 1, 2, 3}, {1, 0}})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Hybrid)->ArgsProduct({{0, 1, 2, 3}, {1, 0}})->Unit(benchmark::kMillisecond);
+
+// The whole workspace (about 300 m2 of reachable floor): the planner built on the map (distance
+// field, A* buffers) and every section's path. arg: 0 balloon, 1 boustrophedon, 2 hybrid.
+void BM_CoverageWorkspace(benchmark::State& state) {
+  const auto pattern = static_cast<Pattern>(state.range(0));
+  double length_m = 0.0, reachable_m2 = 0.0;
+  for (auto _ : state) {
+    CoveragePlanner cp(workspace(), psr2_options());
+    length_m = 0.0;
+    reachable_m2 = 0.0;
+    for (const Section& s : sections().sections) {
+      const CoverageResult r = cover(cp, s, pattern);
+      length_m += r.stats.length_m;
+      reachable_m2 += static_cast<double>(r.reachable_cells) * 0.05 * 0.05;
+      benchmark::DoNotOptimize(r.path.data());
+    }
+  }
+  state.SetLabel(pattern == Pattern::balloon ? "balloon" : pattern == Pattern::boustrophedon ? "boustrophedon" : "hybrid");
+  state.counters["length_m"] = length_m;
+  state.counters["reachable_m2"] = reachable_m2;
+}
+BENCHMARK(BM_CoverageWorkspace)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -203,13 +203,14 @@ void CPathPlanningModule::on_behavior_deactivated(std::string_view behavior, Mod
 const ModuleManifest& CCoverageModule::static_manifest() {
   static const ModuleManifest m = navi_manifest(
       "CoveragePlanner",
-      "gives the cleaning behaviors their section's coverage path (the paper's wall-following balloon, or the "
-      "boustrophedon), resumes where a section stopped, plans detours, records the cleaned cells",
+      "gives the cleaning behaviors their section's coverage path (hybrid: a balloon round along walls and "
+      "obstacles, lanes inside; or the paper's balloon, or the boustrophedon), resumes where a section stopped, plans detours, records the cleaned cells",
       {"grid_map", "sections", "map_from_base", "laser_scan"}, {"coverage_path", "cleaned_cells"},
       {ParameterSpec{"cleaning_width_m", ValueType::number, Value{0.4}, "m", "diameter of the cleaning footprint", 0.01, 5.0},
        ParameterSpec{"overlap_m", ValueType::number, Value{0.05}, "m", "overlap of neighbouring coverage rounds", 0.0, 1.0},
-       ParameterSpec{"pattern", ValueType::string, Value{std::string("balloon")}, "",
-                     "balloon (the paper's wall-following rounds) or boustrophedon (plough lanes)", {}, {}},
+       ParameterSpec{"pattern", ValueType::string, Value{std::string("hybrid")}, "",
+                     "hybrid (a wall-following round, then lanes), balloon (the paper's wall-following rounds) or "
+                     "boustrophedon (plough lanes)", {}, {}},
        ParameterSpec{"serves", ValueType::string, Value{std::string("BhCleaning, BhCleaningTwoWheel")}, "",
                      "the behaviors it gives coverage paths to, comma separated (their parameter `section`)", {}, {}}});
   return m;
@@ -219,10 +220,10 @@ void CCoverageModule::on_configure(const ParameterSet& params) {
   options_.cleaning_width_m = params.number("cleaning_width_m");
   options_.overlap_m = params.number("overlap_m");
   const std::string& pattern = params.string("pattern");
-  if (pattern != "balloon" && pattern != "boustrophedon") {
-    throw ConfigError(where(), "CoveragePlanner: pattern must be balloon or boustrophedon, not '" + pattern + "'");
+  if (pattern != "hybrid" && pattern != "balloon" && pattern != "boustrophedon") {
+    throw ConfigError(where(), "CoveragePlanner: pattern must be hybrid, balloon or boustrophedon, not '" + pattern + "'");
   }
-  boustrophedon_ = pattern == "boustrophedon";
+  pattern_ = pattern;
   serves_ = split_names(params.string("serves"));
   planner_.reset();
 }
@@ -246,7 +247,9 @@ CoveragePlanner& CCoverageModule::planner() {
 }
 
 CoverageResult CCoverageModule::plan(const Section& section, Point2D from) {
-  return boustrophedon_ ? planner().boustrophedon(section, from) : planner().balloon(section, from);
+  if (pattern_ == "boustrophedon") return planner().boustrophedon(section, from);
+  if (pattern_ == "balloon") return planner().balloon(section, from);
+  return planner().hybrid(section, from);
 }
 
 const CoverageResult& CCoverageModule::entry_plan(const Section& section, Point2D from) {

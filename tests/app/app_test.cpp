@@ -112,6 +112,7 @@ TEST_CASE("The run report is JSON with the measured values, strings escaped", "[
   r.recoveries = {"310.000 fault"};
   SectionFigures s;
   s.name = "A";
+  s.hybrid.turns = 5;
   s.balloon.turns = 3;
   s.boustrophedon.turns = 9;
   r.sections.push_back(s);
@@ -119,6 +120,7 @@ TEST_CASE("The run report is JSON with the measured values, strings escaped", "[
   CHECK_THAT(j, Catch::Contains("\"task\": \"clean the \\\"big\\\" room\"") && Catch::Contains("\"coverage\": 0.9877") &&
                     Catch::Contains("\"path\": {\n    \"length_m\": 12.35,\n    \"turns\": 7") &&
                     Catch::Contains("\"recoveries\": [\n    \"310.000 fault\"\n  ]") &&
+                    Catch::Contains("\"hybrid\": {\n        \"length_m\": 0.0,\n        \"turns\": 5") &&
                     Catch::Contains("\"balloon\": {\n        \"length_m\": 0.0,\n        \"turns\": 3") &&
                     Catch::Contains("\"boustrophedon\": {\n        \"length_m\": 0.0,\n        \"turns\": 9") &&
                     Catch::Contains("\"succeeded\": true"));

@@ -512,7 +512,9 @@ TEST_CASE("The coverage planner resumes a section where its coverage stopped, an
   CHECK(m.navigation.path_start_m == 0.0);
   CHECK(m.navigation.path_final);
   const auto& progress = m.coverage->progress().at("A");
-  CHECK(progress.plan.rounds >= 3);
+  // the default pattern, hybrid: one wall round, then lanes
+  CHECK(progress.plan.rounds == 1);
+  CHECK(progress.plan.passes >= 3);
 
   // The behavior reports its progress; the module records it and marks the footprint's cells.
   NavigationFeedback fb;
@@ -681,13 +683,14 @@ TEST_CASE("BhAutoMove pauses while the localizer is lost and goes on when it agr
   CHECK(distance(r.sim().pose(), {5.4, 2.0}) <= 0.1);
 }
 
-TEST_CASE("BhCleaning covers a section with the balloon path on the omni base, keeping its heading",
+TEST_CASE("BhCleaning covers a section with the hybrid path on the omni base, keeping its heading",
           "[navi][modules][robot][cleaning]") {
   NavRobot r(true, world(5.0, 4.0, true, kCorner), {{"BhCleaning", {{"section", "A"}}}});
   const RunOutcome o = r.run(0, 600.0);
   CHECK(o.success);
   const auto& progress = r.coverage().progress().at("A");
-  CHECK(progress.plan.rounds >= 3);
+  CHECK(progress.plan.rounds == 1);  // the wall round; lanes inside it
+  CHECK(progress.plan.passes >= 3);
   CHECK(progress.finished);
   const navi::Section& a = r.section("A");
   CHECK(r.coverage().section_coverage(a) >= 0.99);

@@ -28,6 +28,7 @@ std::string RunResult::json() const {
   for (const SectionFigures& sec : sections) {
     section_list.push_back({{"name", sec.name},
                             {"area_m2", rounded(sec.area_m2, 2)},
+                            {"hybrid", stats(sec.hybrid, sec.hybrid_coverage)},
                             {"balloon", stats(sec.balloon, sec.balloon_coverage)},
                             {"boustrophedon", stats(sec.boustrophedon, sec.boustrophedon_coverage)}});
   }

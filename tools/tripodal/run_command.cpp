@@ -29,12 +29,12 @@ constexpr std::string_view kDescription =
     "\"clean the room 3211\". Prints the task and process life cycle and a progress bar (coverage\n"
     "of the room's reachable free area). With --out, DIR receives map.png (sections, cleaned\n"
     "cells, path), trajectory.csv (true and estimated pose at 10 Hz), report.json (coverage, path\n"
-    "length, turns, duration, faults, recoveries, planned balloon vs boustrophedon paths) and\n"
+    "length, turns, duration, faults, recoveries, planned hybrid, balloon and boustrophedon paths) and\n"
     "lifecycle.txt. The same seed gives the same run. --faults adds localization losses, in\n"
     "seconds of simulated time: \"300-330; 900-905\" (or a file holding that text).\n"
-    "Faster than real time unless --realtime (SPEED times real time, default 1). --boustrophedon\n"
-    "makes the cleaning behaviors follow the plough path instead of the wall-following balloon,\n"
-    "to measure the baseline on the robot.";
+    "Faster than real time unless --realtime (SPEED times real time, default 1). --pattern\n"
+    "makes the cleaning behaviors follow another coverage path (balloon: the paper's wall-following\n"
+    "rounds; boustrophedon: plough lanes) to measure it on the robot.";
 
 constexpr std::string_view kExitCodes =
     "exit codes: 0 task succeeded, 1 bad profile/world/faults, 2 bad command line, 3 I/O error,\n"
@@ -117,7 +117,8 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_option("--max-duration-s", o.max_duration_s, "S: simulated time limit")
       ->check(cli::positive_number())
       ->capture_default_str();
-  cmd.add_flag("--boustrophedon", o.boustrophedon, "clean along the plough path instead of the balloon");
+  cmd.add_option("--pattern", o.pattern, "hybrid|balloon|boustrophedon: the coverage pattern (default: the profile's)")
+      ->check(CLI::IsMember({"hybrid", "balloon", "boustrophedon"}));
   cmd.add_option("--board", o.board_line,
                  "in_process|pty: on the control board (hardware: {type: board}), what carries the bytes; pty: a "
                  "kernel pseudo-terminal, the host opening its slave device as it would the board's UART")

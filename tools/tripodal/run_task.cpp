@@ -167,7 +167,7 @@ RunResult run_task(const RunOptions& o) {
   res.robot = profile.name;
   res.task = o.task;
   res.seed = o.seed.value_or(world->seed);
-  res.coverage_pattern = o.boustrophedon ? "boustrophedon" : "balloon";
+  res.coverage_pattern = o.pattern;
   std::vector<navi::LocalizationFault>& faults = world->faults.localization_loss;
   faults.insert(faults.end(), o.faults.begin(), o.faults.end());
   if (!profile.hardware || (profile.hardware->type != "sim" && profile.hardware->type != "board")) {
@@ -193,13 +193,14 @@ RunResult run_task(const RunOptions& o) {
   if (!o.board_line.empty()) ro.parameters.push_back({profile.hardware->name, "line", o.board_line});
   for (const ModuleEntry& e : profile.navigation) {
     if (e.type == navi::CLocalizer::static_manifest().name) ro.parameters.push_back({e.name, "seed", std::to_string(res.seed % (1ULL << 52))});
-    if (e.type == navi::CCoverageModule::static_manifest().name && o.boustrophedon) ro.parameters.push_back({e.name, "pattern", "boustrophedon"});
+    if (e.type == navi::CCoverageModule::static_manifest().name && !o.pattern.empty()) ro.parameters.push_back({e.name, "pattern", o.pattern});
   }
   SimClock clock;
   const auto robot = Robot::assemble(profile, plugins, clock, ro);
   const sim::Simulator& sim = dynamic_cast<sim::SimulatorSources&>(*robot->hardware()).simulation();
   sim::SimBoardHardware* const board_hw = dynamic_cast<sim::SimBoardHardware*>(robot->hardware());
   Navigation nav{robot->module<navi::CGridMaps>(), robot->module<navi::CSectionSplitter>(), robot->module<navi::CCoverageModule>()};
+  if (nav.coverage != nullptr) res.coverage_pattern = nav.coverage->pattern();
   if (nav.maps == nullptr || nav.splitter == nullptr || nav.coverage == nullptr) {
     throw ConfigError(profile.where, "`tripodal run` measures cleaning: the robot needs GridMaps, SectionSplitter and CoveragePlanner modules");
   }
@@ -357,15 +358,18 @@ RunResult run_task(const RunOptions& o) {
     res.faults.push_back(fixed(to_seconds(e.stamp), 3) + " " + std::string(sim::to_string(e.kind)) + (e.detail.empty() ? "" : " " + e.detail));
   }
 
-  // The planned paths against the boustrophedon of the same sections (same grid and width).
+  // The planned paths of the three patterns over the same sections (same grid and width).
   for (const std::string& name : room_sections) {
     const navi::Section* s = nav.splitter->section(name);
     if (s == nullptr) continue;
     SectionFigures f;
     f.name = name;
     f.area_m2 = s->area_m2;
+    const navi::CoverageResult h = nav.coverage->planner().hybrid(*s);
     const navi::CoverageResult b = nav.coverage->planner().balloon(*s);
     const navi::CoverageResult p = nav.coverage->planner().boustrophedon(*s);
+    f.hybrid = h.stats;
+    f.hybrid_coverage = h.coverage();
     f.balloon = b.stats;
     f.boustrophedon = p.stats;
     f.balloon_coverage = b.coverage();

@@ -31,8 +31,8 @@ struct RunOptions {
   std::filesystem::path out;    ///< folder for map.png, trajectory.csv, report.json (empty: none)
   /// Extra localization losses ("10-20; 35-40", seconds), added to the world's fault schedule.
   std::vector<navi::LocalizationFault> faults;
-  /// Follow the boustrophedon path instead of the balloon (the baseline, measured on the robot).
-  bool boustrophedon = false;
+  /// The CoveragePlanner's pattern (hybrid, balloon, boustrophedon); empty: the profile's.
+  std::string pattern;
   double max_duration_s = 4.0 * 3600.0;  ///< the task is cancelled after this much simulated time
   /// On hardware "board": what carries the simulated board's bytes, "in_process" or "pty" (a
   /// kernel pseudo-terminal); empty: the profile's choice.
@@ -54,8 +54,10 @@ struct PathFigures {
 struct SectionFigures {
   std::string name;
   double area_m2 = 0.0;
+  navi::PathStats hybrid;         ///< the planned hybrid path (a wall round, then lanes)
   navi::PathStats balloon;        ///< the planned balloon (wall-following) path
   navi::PathStats boustrophedon;  ///< the plough path over the same section, grid and width
+  double hybrid_coverage = 0.0;
   double balloon_coverage = 0.0;
   double boustrophedon_coverage = 0.0;
 };
@@ -82,7 +84,7 @@ struct RunResult {
   std::string state;            ///< "succeeded", "failed", "timed out", "refused"
   std::string reason;
   std::string robot, task;
-  std::string coverage_pattern;  ///< "balloon" or "boustrophedon"
+  std::string coverage_pattern;  ///< "hybrid", "balloon" or "boustrophedon"
   std::uint64_t seed = 0;
   double duration_s = 0.0;      ///< simulated
   double coverage = 0.0;        ///< of the reachable free area of the room, from the true path

@@ -1,7 +1,7 @@
 // The planners of the sequencing layer that serve the reactive layer's path-following behaviors:
 // CPathPlanningModule (type "PathPlanner") plans BhAutoMove's path to its goal and replans around
 // obstacles the map does not hold; CCoverageModule (type "CoveragePlanner") gives the cleaning
-// behaviors their section's coverage path (balloon or boustrophedon), resumes a section where its
+// behaviors their section's coverage path (hybrid, balloon or boustrophedon), resumes a section where its
 // coverage stopped, plans detours around unexpected obstacles and records the cleaned cells. Both
 // publish through NavigationData and read the behaviors' NavigationFeedback; planning never runs in
 // the reactive loop.
@@ -122,7 +122,8 @@ class CCoverageModule final : public CNaviModules {
   [[nodiscard]] const CleanedCells& cleaned() const noexcept { return cleaned_; }
   [[nodiscard]] CoveragePlanner& planner();
   [[nodiscard]] double cleaning_width_m() const noexcept { return options_.cleaning_width_m; }
-  [[nodiscard]] bool boustrophedon() const noexcept { return boustrophedon_; }
+  /// "hybrid", "balloon" or "boustrophedon"
+  [[nodiscard]] const std::string& pattern() const noexcept { return pattern_; }
   /// Fraction of the cells its plan can reach in `section` cleaned so far.
   [[nodiscard]] double section_coverage(const Section& section) const;
 
@@ -140,7 +141,7 @@ class CCoverageModule final : public CNaviModules {
 
   std::vector<std::string> serves_;
   CoverageOptions options_;
-  bool boustrophedon_ = false;
+  std::string pattern_ = "hybrid";
   CGridMaps* maps_ = nullptr;
   const CSectionSplitter* splitter_ = nullptr;
   std::optional<CoveragePlanner> planner_;

@@ -1,0 +1,356 @@
+// tripodal-coverage-eval: the coverage planners and the section splitter measured on floor plans
+// (docs/coverage.md). For the demo workspace, the 20 ipa floor plans with a human room
+// segmentation (read from ../shared/data/ipa-maps, never shipped) and seeded random rooms it
+// prints, per map and pattern: coverage of the reachable floor, length / bound (bound = reachable
+// area / cleaning width), turns, total rotation and planning time; for the ipa maps also the
+// precision and recall of the sections against the ground-truth rooms.
+#include <png.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <numbers>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "tripodal/navi/coverage.hpp"
+#include "tripodal/navi/map_io.hpp"
+#include "tripodal/navi/section_splitter.hpp"
+
+using namespace tripodal::navi;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Gray {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> px;  // row 0 at the top
+};
+
+Gray read_png(const fs::path& file) {
+  png_image img{};
+  img.version = PNG_IMAGE_VERSION;
+  if (png_image_begin_read_from_file(&img, file.c_str()) == 0) {
+    throw std::runtime_error(file.string() + ": cannot read the PNG: " + img.message);
+  }
+  img.format = PNG_FORMAT_GRAY;
+  Gray g;
+  g.width = static_cast<int>(img.width);
+  g.height = static_cast<int>(img.height);
+  g.px.resize(PNG_IMAGE_SIZE(img));
+  // transparent pixels composed over white: the plans' background
+  png_color white{255, 255, 255};
+  if (png_image_finish_read(&img, &white, g.px.data(), 0, nullptr) == 0) {
+    throw std::runtime_error(file.string() + ": cannot decode the PNG: " + img.message);
+  }
+  return g;
+}
+
+// A floor plan as a grid: white is free, anything darker a wall (0.05 m per pixel).
+OccupancyGrid grid_of(const Gray& g, double resolution_m) {
+  OccupancyGrid grid(g.width, g.height, resolution_m);
+  for (int r = 0; r < g.height; ++r) {
+    for (int x = 0; x < g.width; ++x) {
+      const bool free = g.px[static_cast<std::size_t>(r) * static_cast<std::size_t>(g.width) + static_cast<std::size_t>(x)] >= 250;
+      grid.set_state({x, g.height - 1 - r}, free ? Occupancy::free : Occupancy::occupied);
+    }
+  }
+  return grid;
+}
+
+// Ground-truth rooms: the white regions of the segmentation image (4-connected), at least
+// min_cells large; label per grid cell (-1: none).
+std::vector<int> rooms_of(const Gray& g, std::size_t min_cells, int& count) {
+  const std::size_t n = g.px.size();
+  std::vector<int> label(n, -1);
+  count = 0;
+  std::vector<std::size_t> stack, comp;
+  std::vector<bool> seen(n, false);
+  for (std::size_t s = 0; s < n; ++s) {
+    if (seen[s] || g.px[s] < 250) continue;
+    comp.clear();
+    stack.push_back(s);
+    seen[s] = true;
+    while (!stack.empty()) {
+      const std::size_t i = stack.back();
+      stack.pop_back();
+      comp.push_back(i);
+      const int x = static_cast<int>(i % static_cast<std::size_t>(g.width));
+      const int r = static_cast<int>(i / static_cast<std::size_t>(g.width));
+      const int nx[4] = {x + 1, x - 1, x, x}, nr[4] = {r, r, r + 1, r - 1};
+      for (int q = 0; q < 4; ++q) {
+        if (nx[q] < 0 || nr[q] < 0 || nx[q] >= g.width || nr[q] >= g.height) continue;
+        const std::size_t k = static_cast<std::size_t>(nr[q]) * static_cast<std::size_t>(g.width) + static_cast<std::size_t>(nx[q]);
+        if (!seen[k] && g.px[k] >= 250) {
+          seen[k] = true;
+          stack.push_back(k);
+        }
+      }
+    }
+    if (comp.size() < min_cells) continue;
+    for (const std::size_t i : comp) {
+      const int x = static_cast<int>(i % static_cast<std::size_t>(g.width));
+      const int r = static_cast<int>(i / static_cast<std::size_t>(g.width));
+      label[static_cast<std::size_t>(g.height - 1 - r) * static_cast<std::size_t>(g.width) + static_cast<std::size_t>(x)] = count;
+    }
+    ++count;
+  }
+  return label;
+}
+
+struct Figures {
+  double reachable_m2 = 0.0, covered_m2 = 0.0, length_m = 0.0, rotation_rad = 0.0, time_ms = 0.0, worst_ms = 0.0;
+  std::size_t turns = 0;
+};
+
+enum class Pattern { balloon, boustrophedon, hybrid };
+const char* name_of(Pattern p) {
+  return p == Pattern::balloon ? "balloon" : p == Pattern::boustrophedon ? "boustrophedon" : "hybrid";
+}
+
+// Every section of the grid covered by one pattern, one after the other from the previous end.
+Figures cover(const OccupancyGrid& grid, const SectionSet& sections, Pattern pattern, const CoverageOptions& o,
+              std::vector<CoverageResult>* results = nullptr) {
+  Figures f;
+  const auto t0 = std::chrono::steady_clock::now();
+  CoveragePlanner cp(grid, o);
+  for (const Section& s : sections.sections) {
+    const auto ts = std::chrono::steady_clock::now();
+    const CoverageResult r = pattern == Pattern::balloon ? cp.balloon(s)
+                             : pattern == Pattern::boustrophedon ? cp.boustrophedon(s)
+                                                                 : cp.hybrid(s);
+    f.worst_ms = std::max(f.worst_ms, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - ts).count());
+    const double cell_m2 = grid.resolution_m() * grid.resolution_m();
+    f.reachable_m2 += static_cast<double>(r.reachable_cells) * cell_m2;
+    f.covered_m2 += static_cast<double>(r.covered_cells) * cell_m2;
+    f.length_m += r.stats.length_m;
+    f.turns += r.stats.turns;
+    f.rotation_rad += r.stats.total_turn_rad;
+    if (results != nullptr) results->push_back(r);
+  }
+  f.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return f;
+}
+
+void print_row(const std::string& map, Pattern p, const Figures& f, double width_m, const std::string& extra = "") {
+  const double bound = f.reachable_m2 / width_m;
+  std::printf("| %s | %s | %.1f | %.2f %% | %.1f | %.2f | %zu | %.0f | %.1f | %.1f |%s\n", map.c_str(), name_of(p),
+              f.reachable_m2, f.reachable_m2 > 0 ? 100.0 * f.covered_m2 / f.reachable_m2 : 100.0, f.length_m,
+              bound > 0 ? f.length_m / bound : 0.0, f.turns, f.rotation_rad * 180.0 / std::numbers::pi, f.time_ms,
+              f.worst_ms, extra.c_str());
+}
+
+void header(bool segmentation) {
+  std::printf("| map | pattern | reachable m2 | coverage | length m | length / bound | turns | rotation deg | plan ms | worst section ms |%s\n",
+              segmentation ? " sections | rooms | precision | recall |" : "");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|%s\n", segmentation ? "---|---|---|---|" : "");
+}
+
+// Sums over maps per pattern, printed last.
+std::map<Pattern, Figures> totals;
+void add(Pattern p, const Figures& f) {
+  Figures& t = totals[p];
+  t.reachable_m2 += f.reachable_m2;
+  t.covered_m2 += f.covered_m2;
+  t.length_m += f.length_m;
+  t.turns += f.turns;
+  t.rotation_rad += f.rotation_rad;
+  t.time_ms += f.time_ms;
+  t.worst_ms = std::max(t.worst_ms, f.worst_ms);
+}
+
+const Pattern kPatterns[] = {Pattern::balloon, Pattern::boustrophedon, Pattern::hybrid};
+
+// Area-weighted precision (each section's best-matching room over the section) and recall (each
+// room's best-matching section over the room), with the counts.
+std::string segmentation(const SectionSet& sections, const std::vector<int>& gt, int rooms) {
+  std::map<std::pair<int, int>, std::size_t> overlap;
+  std::vector<std::size_t> sec_size(sections.sections.size(), 0), room_size(static_cast<std::size_t>(rooms), 0);
+  for (std::size_t i = 0; i < gt.size(); ++i) {
+    const int s = sections.label[i], r = gt[i];
+    if (s >= 0) ++sec_size[static_cast<std::size_t>(s)];
+    if (r >= 0) ++room_size[static_cast<std::size_t>(r)];
+    if (s >= 0 && r >= 0) ++overlap[{s, r}];
+  }
+  std::vector<std::size_t> best_sec(sec_size.size(), 0), best_room(room_size.size(), 0);
+  for (const auto& [key, n] : overlap) {
+    best_sec[static_cast<std::size_t>(key.first)] = std::max(best_sec[static_cast<std::size_t>(key.first)], n);
+    best_room[static_cast<std::size_t>(key.second)] = std::max(best_room[static_cast<std::size_t>(key.second)], n);
+  }
+  std::size_t ps = 0, pn = 0, rs = 0, rn = 0;
+  for (std::size_t k = 0; k < sec_size.size(); ++k) ps += best_sec[k], pn += sec_size[k];
+  for (std::size_t k = 0; k < room_size.size(); ++k) rs += best_room[k], rn += room_size[k];
+  char buf[128];
+  std::snprintf(buf, sizeof buf, " %zu | %d | %.2f | %.2f |", sections.sections.size(), rooms,
+                pn > 0 ? static_cast<double>(ps) / static_cast<double>(pn) : 0.0,
+                rn > 0 ? static_cast<double>(rs) / static_cast<double>(rn) : 0.0);
+  return buf;
+}
+
+// A seeded random room: a rectangle 4-12 m a side with 0-6 boxes and pillars inside.
+OccupancyGrid random_room(unsigned seed, double resolution_m) {
+  std::mt19937 rng(seed);
+  const auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+  const int w = uni(80, 240), h = uni(80, 240);
+  OccupancyGrid g(w, h, resolution_m);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const bool wall = x == 0 || y == 0 || x == w - 1 || y == h - 1;
+      g.set_state({x, y}, wall ? Occupancy::occupied : Occupancy::free);
+    }
+  }
+  const int boxes = uni(0, 6);
+  for (int b = 0; b < boxes; ++b) {
+    const int bw = uni(4, 30), bh = uni(4, 30);
+    const int bx = uni(1, w - bw - 1), by = uni(1, h - bh - 1);
+    for (int y = by; y < by + bh; ++y) {
+      for (int x = bx; x < bx + bw; ++x) g.set_state({x, y}, Occupancy::occupied);
+    }
+  }
+  return g;
+}
+
+// The map (walls black, sections grey), the cleaned cells (light green) and the path (red), as a
+// PNG, row 0 at the top.
+void write_picture(const fs::path& file, const OccupancyGrid& grid, const SectionSet& sections,
+                   const std::vector<CoverageResult>& results, double width_m) {
+  const int w = grid.width(), h = grid.height();
+  std::vector<std::uint8_t> rgb(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 3, 255);
+  const auto put = [&](int x, int y, std::uint8_t r, std::uint8_t g, std::uint8_t b) {
+    if (x < 0 || y < 0 || x >= w || y >= h) return;
+    const std::size_t i = (static_cast<std::size_t>(h - 1 - y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)) * 3;
+    rgb[i] = r, rgb[i + 1] = g, rgb[i + 2] = b;
+  };
+  CleanedCells cleaned(grid);
+  for (const CoverageResult& r : results) cleaned.mark_path(r.path, width_m / 2.0);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = grid.index({x, y});
+      if (grid.state({x, y}) != Occupancy::free) put(x, y, 0, 0, 0);
+      else if (cleaned.cleaned(i)) put(x, y, 200, 240, 200);
+      else if (sections.label[i] >= 0) put(x, y, 255, 200, 200);
+    }
+  }
+  for (const CoverageResult& r : results) {
+    for (std::size_t k = 1; k < r.path.size(); ++k) {
+      const Point2D a = r.path[k - 1], b = r.path[k];
+      const int steps = static_cast<int>(std::ceil(std::hypot(b.x_m - a.x_m, b.y_m - a.y_m) / (grid.resolution_m() / 2))) + 1;
+      for (int t = 0; t <= steps; ++t) {
+        const double f = static_cast<double>(t) / steps;
+        if (const auto c = grid.world_to_cell({a.x_m + f * (b.x_m - a.x_m), a.y_m + f * (b.y_m - a.y_m)})) put(c->x, c->y, 220, 0, 0);
+      }
+    }
+  }
+  png_image img{};
+  img.version = PNG_IMAGE_VERSION;
+  img.width = static_cast<png_uint_32>(w);
+  img.height = static_cast<png_uint_32>(h);
+  img.format = PNG_FORMAT_RGB;
+  if (png_image_write_to_file(&img, file.c_str(), 0, rgb.data(), 0, nullptr) == 0) {
+    throw std::runtime_error(file.string() + ": cannot write the PNG: " + img.message);
+  }
+}
+
+int usage() {
+  std::cerr << "usage: tripodal-coverage-eval [--ipa DIR] [--workspace MAP.yaml] [--random N] [--width M] [--radius M]\n"
+               "  --ipa DIR        the ipa floor plans (NAME.png + NAME_gt_segmentation.png), e.g. ../shared/data/ipa-maps\n"
+               "  --workspace MAP  a map_server map (e.g. configs/worlds/workspace_map.yaml)\n"
+               "  --random N       N seeded random rooms (seeds 1..N)\n"
+               "  --pictures DIR   the workspace's paths per pattern as PNG pictures; --verbose 1: per section figures\n"
+               "  --width M        cleaning width (default 0.64, PSR-2's); --radius M robot radius (default 0.3)\n";
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string ipa, workspace, pictures;
+  bool verbose = false;
+  int random_rooms = 0;
+  CoverageOptions o;
+  o.cleaning_width_m = 0.64;
+  o.robot_radius_m = 0.3;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (i + 1 >= argc) return usage();
+    const std::string v = argv[++i];
+    if (a == "--ipa") ipa = v;
+    else if (a == "--workspace") workspace = v;
+    else if (a == "--random") random_rooms = std::atoi(v.c_str());
+    else if (a == "--width") o.cleaning_width_m = std::atof(v.c_str());
+    else if (a == "--radius") o.robot_radius_m = std::atof(v.c_str());
+    else if (a == "--pictures") pictures = v;
+    else if (a == "--verbose") verbose = v == "1";
+    else return usage();
+  }
+  if (ipa.empty() && workspace.empty() && random_rooms <= 0) return usage();
+  try {
+    if (!workspace.empty()) {
+      const MapFile m = load_map(workspace);
+      const SectionSet sections = CSectionSplitter().split(m.grid);
+      header(false);
+      for (const Pattern p : kPatterns) {
+        std::vector<CoverageResult> results;
+        print_row(fs::path(workspace).stem().string(), p, cover(m.grid, sections, p, o, &results), o.cleaning_width_m);
+        if (!pictures.empty()) {
+          fs::create_directories(pictures);
+          write_picture(fs::path(pictures) / (std::string(name_of(p)) + ".png"), m.grid, sections, results, o.cleaning_width_m);
+        }
+        if (verbose) {
+          for (const CoverageResult& r : results) {
+            std::printf("    %.1f m, %zu turns, %zu passes, %zu touch-ups\n", r.stats.length_m, r.stats.turns, r.passes, r.touch_ups);
+          }
+        }
+      }
+      std::printf("\n");
+    }
+    if (!ipa.empty()) {
+      std::vector<std::string> names;
+      for (const auto& e : fs::directory_iterator(ipa)) {
+        const std::string f = e.path().filename().string();
+        const std::string suffix = "_gt_segmentation.png";
+        if (f.size() > suffix.size() && f.ends_with(suffix)) names.push_back(f.substr(0, f.size() - suffix.size()));
+      }
+      std::sort(names.begin(), names.end());
+      header(true);
+      for (const std::string& name : names) {
+        const Gray plan = read_png(fs::path(ipa) / (name + ".png"));
+        const Gray truth = read_png(fs::path(ipa) / (name + "_gt_segmentation.png"));
+        const OccupancyGrid grid = grid_of(plan, 0.05);
+        const SectionSet sections = CSectionSplitter().split(grid);
+        int rooms = 0;
+        const std::vector<int> gt = rooms_of(truth, 400, rooms);  // rooms of at least 1 m2
+        const std::string seg = truth.width == plan.width && truth.height == plan.height ? segmentation(sections, gt, rooms) : " - | - | - | - |";
+        for (const Pattern p : kPatterns) {
+          const Figures f = cover(grid, sections, p, o);
+          add(p, f);
+          print_row(name, p, f, o.cleaning_width_m, seg);
+        }
+      }
+      for (const Pattern p : kPatterns) print_row("all ipa maps", p, totals[p], o.cleaning_width_m);
+      totals.clear();
+      std::printf("\n");
+    }
+    if (random_rooms > 0) {
+      header(false);
+      for (int s = 1; s <= random_rooms; ++s) {
+        const OccupancyGrid grid = random_room(static_cast<unsigned>(s), 0.05);
+        const SectionSet sections = CSectionSplitter().split(grid);
+        for (const Pattern p : kPatterns) add(p, cover(grid, sections, p, o));
+      }
+      for (const Pattern p : kPatterns) print_row(std::to_string(random_rooms) + " random rooms", p, totals[p], o.cleaning_width_m);
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "tripodal-coverage-eval: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
