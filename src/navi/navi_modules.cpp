@@ -3,6 +3,7 @@
 #include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/navi/localizer.hpp"
 #include "tripodal/navi/planning_modules.hpp"
+#include "tripodal/navi/scan_matching_localizer.hpp"
 #include "tripodal/navi/section_splitter.hpp"
 
 namespace tripodal::navi {
@@ -21,6 +22,7 @@ void register_navigation_modules(ModuleRegistry& registry) {
   registry.add<CGridMaps>();
   registry.add<CSectionSplitter>();
   registry.add<CLocalizer>();
+  registry.add<CScanMatchingLocalizer>();
   registry.add<CPathPlanningModule>();
   registry.add<CCoverageModule>();
 }

@@ -21,8 +21,8 @@ class CNaviModules : public CModule {
 [[nodiscard]] ModuleManifest navi_manifest(std::string name, std::string description, std::vector<std::string> inputs,
                                            std::vector<std::string> outputs, std::vector<ParameterSpec> parameters);
 
-/// Registers the navigation modules: GridMaps, SectionSplitter, Localizer, PathPlanner,
-/// CoveragePlanner.
+/// Registers the navigation modules: GridMaps, SectionSplitter, Localizer, ScanMatchingLocalizer,
+/// PathPlanner, CoveragePlanner.
 void register_navigation_modules(ModuleRegistry& registry);
 
 }  // namespace tripodal::navi
