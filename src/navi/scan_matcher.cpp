@@ -43,9 +43,14 @@ void validate(const ScanMatcherOptions& o, const SourceLocation& where) {
                                                   std::to_string(o.global_max_range_m));
   need(o.global_levels >= 1 && o.global_levels <= 10, "global_levels must be 1..10, got " +
                                                           std::to_string(o.global_levels));
-  if (o.search_xy_m / 0.01 > 500 || o.search_theta_rad / std::max(o.angular_step_rad, 1e-9) > 1000) {
-    d.error(where, "scan matcher: the tracking window is too large for its steps (more than 1000 headings or 500 "
-                   "cells per side)");
+  need(std::isfinite(o.max_search_xy_m) && o.max_search_xy_m >= 0.0 && o.max_search_xy_m <= 5.0,
+       "max_search_xy_m must be 0..5 m, got " + std::to_string(o.max_search_xy_m));
+  need(std::isfinite(o.max_search_theta_rad) && o.max_search_theta_rad >= 0.0 &&
+           o.max_search_theta_rad <= std::numbers::pi,
+       "max_search_theta_rad must be 0..pi, got " + std::to_string(o.max_search_theta_rad));
+  if (std::max(o.search_theta_rad, o.max_search_theta_rad) / std::max(o.angular_step_rad, 1e-9) > 1000) {
+    d.error(where, "scan matcher: the tracking window is too large for its heading step (more than 1000 headings "
+                   "each side)");
   }
   if (d.has_errors()) throw ConfigError(d);
 }
@@ -115,8 +120,9 @@ ScanMatcher::ScanMatcher(const OccupancyGrid& map, ScanMatcherOptions options, c
   range_.reserve(n);
   cx_.resize(n);
   cy_.resize(n);
-  const int nx = static_cast<int>(std::ceil(options_.search_xy_m / cell_m_));
-  const int nt = static_cast<int>(std::ceil(options_.search_theta_rad / options_.angular_step_rad));
+  const int nx = static_cast<int>(std::ceil(std::max(options_.search_xy_m, options_.max_search_xy_m) / cell_m_));
+  const int nt = static_cast<int>(
+      std::ceil(std::max(options_.search_theta_rad, options_.max_search_theta_rad) / options_.angular_step_rad));
   scores_.resize(static_cast<std::size_t>(2 * nt + 1) * static_cast<std::size_t>(2 * nx + 1) *
                  static_cast<std::size_t>(2 * nx + 1));
 }
@@ -232,15 +238,16 @@ double ScanMatcher::quality_at(const Pose2D& pose) const noexcept {
   return px_.empty() ? 0.0 : score_bilinear(to_grid(pose)) / static_cast<double>(px_.size());
 }
 
-ScanMatch ScanMatcher::match(const Pose2D& predicted) noexcept {
+ScanMatch ScanMatcher::match(const Pose2D& predicted, double search_xy_m, double search_theta_rad) noexcept {
   ScanMatch out;
   out.pose = predicted;
   const std::size_t n = px_.size();
   out.points = n;
   if (n == 0) return out;
   const GridPose g0 = to_grid(predicted);
-  const int nx = static_cast<int>(std::ceil(options_.search_xy_m / cell_m_));
-  const int nt = static_cast<int>(std::ceil(options_.search_theta_rad / options_.angular_step_rad));
+  const int nx = static_cast<int>(std::ceil(std::clamp(search_xy_m, 0.0, options_.max_search_xy_m) / cell_m_));
+  const int nt = static_cast<int>(
+      std::ceil(std::clamp(search_theta_rad, 0.0, options_.max_search_theta_rad) / options_.angular_step_rad));
   const double step = options_.angular_step_rad;
   float best = -1.0f;
   int bk = 0, bx = 0, by = 0;

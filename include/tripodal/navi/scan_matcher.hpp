@@ -20,6 +20,9 @@ struct ScanMatcherOptions {
   double search_xy_m = 0.25;         ///< half width of the tracking window around the prediction
   double search_theta_rad = 0.2;     ///< half width of the tracking window in heading
   double angular_step_rad = 0.01;    ///< heading step of the discrete searches
+  /// The largest tracking window a caller may ask for (the score buffer is sized for it).
+  double max_search_xy_m = 1.0;
+  double max_search_theta_rad = 0.8;
   /// Global search: headings step and the farthest point used (farther points would need finer
   /// heading steps to stay within a cell, so the global search drops them).
   double global_angular_step_rad = 0.02;
@@ -59,7 +62,11 @@ class ScanMatcher {
   [[nodiscard]] std::size_t points() const noexcept { return px_.size(); }
 
   /// Best pose within the tracking window around `predicted`.
-  [[nodiscard]] ScanMatch match(const Pose2D& predicted) noexcept;
+  [[nodiscard]] ScanMatch match(const Pose2D& predicted) noexcept {
+    return match(predicted, options_.search_xy_m, options_.search_theta_rad);
+  }
+  /// The same in a window of the given half widths (clipped to max_search_*).
+  [[nodiscard]] ScanMatch match(const Pose2D& predicted, double search_xy_m, double search_theta_rad) noexcept;
   /// Best pose anywhere on the free cells of the map.
   [[nodiscard]] ScanMatch match_global();
   /// Quality (mean likelihood of the points) of the scan at `pose`, without searching.

@@ -23,11 +23,19 @@ struct ScanMatchingLocalizerOptions {
   Pose2D base_from_laser;         ///< the scanner's mounting on the base
   Pose2D initial_pose;            ///< map_from_base at start, unless start_global
   bool start_global = false;      ///< find the start pose by a global search on the first scan
-  double lost_quality = 0.3;      ///< a match below this quality is no evidence of the pose...
+  double lost_quality = 0.7;      ///< a match below this quality is no evidence of the pose...
   int lost_after_scans = 5;       ///< ...and this many in a row make the robot lost
   /// A global search is accepted at or above this quality (higher than lost_quality: a wrong
   /// place that happens to explain part of the scan must not pass).
-  double relocalize_quality = 0.5;
+  double relocalize_quality = 0.75;
+  /// A match below this quality is searched again in the matcher's largest window: the odometry
+  /// sometimes errs by more than the window (a wheel slipping in a turn).
+  double retry_quality = 0.8;
+  /// The odometry errs more the more the robot moves: the tracking window grows by these much
+  /// per metre travelled and per radian turned since the last scan (up to the matcher's max).
+  double window_m_per_m = 0.2;
+  double window_rad_per_rad = 0.3;
+  double window_rad_per_m = 0.1;
 };
 
 /// Type "ScanMatchingLocalizer". As a module of the robot it takes the map of the GridMaps module
