@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "tripodal/navi/map_builder.hpp"
 #include "tripodal/navi/scan_matcher.hpp"
 #include "tripodal/sim/ray_caster.hpp"
 
@@ -252,4 +253,50 @@ TEST_CASE("ScanMatcher and ScanMatchingLocalizer refuse bad options and maps wit
   REQUIRE_THROWS_WITH(loc.start(context), Catch::Contains("robot.yaml:12:5") && Catch::Contains("GridMaps"));
   loc.set_map(g);
   REQUIRE_THROWS_WITH(loc.start(context), Catch::Contains("no laser resource"));
+}
+
+TEST_CASE("MapBuilder: a map from drifting odometry lines up with the world and localizes", "[navi][scan_matching]") {
+  const OccupancyGrid world = room();
+  const sim::SolidMap solid(world);
+  MapBuilder b({-1.5, -2.5}, {9.5, 6.5});
+  DriftingOdometry odo;
+  double worst_step_m = 0.0;
+  Pose2D prev_est, prev_truth;
+  for (int k = 0; k <= 320; k += 2) {
+    const Pose2D truth = true_pose(k);
+    const Pose2D est = b.add(scan_at(solid, truth), odo.read(truth), true_pose(0));
+    if (k > 0) {
+      // relative motion between consecutive scans, against the truth's (Kuemmerle et al.)
+      const Pose2D de = compose(inverse(prev_est), est), dt = compose(inverse(prev_truth), truth);
+      worst_step_m = std::max(worst_step_m, std::hypot(de.x_m - dt.x_m, de.y_m - dt.y_m));
+    }
+    prev_est = est;
+    prev_truth = truth;
+  }
+  CHECK(worst_step_m < 0.05);
+  CHECK(distance(prev_est, true_pose(320)) < 0.1);
+  const OccupancyGrid map = b.grid();
+  // every wall cell the builder marked is on or next to a wall of the world
+  std::size_t marked = 0, on_wall = 0;
+  for (std::size_t i = 0; i < map.size(); ++i) {
+    if (map.state(i) != Occupancy::occupied) continue;
+    ++marked;
+    const Point2D p = map.cell_center(map.cell(i));
+    bool near = false;
+    for (double dy = -0.05; dy <= 0.051 && !near; dy += 0.05) {
+      for (double dx = -0.05; dx <= 0.051 && !near; dx += 0.05) near = world.is_occupied(world.cell_at({p.x_m + dx, p.y_m + dy}));
+    }
+    on_wall += near ? 1 : 0;
+  }
+  REQUIRE(marked > 500);
+  CHECK(static_cast<double>(on_wall) > 0.95 * static_cast<double>(marked));
+  // and the map it made is one the localizer can work on
+  ScanMatcher m(map);
+  m.set_scan(scan_at(solid, true_pose(100)));
+  CHECK(distance(m.match(compose(true_pose(100), Pose2D{0.1, -0.1, 0.05})).pose, true_pose(100)) < 0.08);
+
+  REQUIRE_THROWS_WITH(MapBuilder({0, 0}, {-1, 5}), Catch::Contains("is empty or larger than a map image may be"));
+  MapBuilderOptions bad;
+  bad.resolution_m = 0.0;
+  REQUIRE_THROWS_WITH(MapBuilder({0, 0}, {5, 5}, bad), Catch::Contains("resolution_m must be a number > 0"));
 }

@@ -94,7 +94,9 @@ Log read_log(const std::filesystem::path& file, const std::string& laser_channel
       }
     }
   }
-  if (reader.state() == trace::ReadState::kTruncated) throw ConfigError({}, reader.warning());
+  if (reader.state() == trace::ReadState::kTruncated) {
+    throw ConfigError(SourceLocation{file.string(), 0, 0}, reader.warning() + ": the trace is cut off");
+  }
   if (log.scans.empty()) {
     throw ConfigError(SourceLocation{file.string(), 0, 0}, "no scans on the laser channel '" + laser_channel + "'");
   }
