@@ -17,6 +17,9 @@ namespace {
 // with sigma 0.1 m, so the covariance of a clear match is about a cell, and a corridor (that
 // shifts without loss along its axis) stretches it along the axis as it should.
 constexpr double kQualityScale = 0.05;
+// How far (cells, heading steps) around the best pose the covariance looks: beyond a few cells
+// the weights of a clear match are nil, and a corridor's spread shows within this reach.
+constexpr int kCovarianceReach = 4;
 
 bool positive_finite(double v) { return std::isfinite(v) && v > 0.0; }
 
@@ -118,13 +121,14 @@ ScanMatcher::ScanMatcher(const OccupancyGrid& map, ScanMatcherOptions options, c
   px_.reserve(n);
   py_.reserve(n);
   range_.reserve(n);
-  cx_.resize(n);
-  cy_.resize(n);
   const int nx = static_cast<int>(std::ceil(std::max(options_.search_xy_m, options_.max_search_xy_m) / cell_m_));
   const int nt = static_cast<int>(
       std::ceil(std::max(options_.search_theta_rad, options_.max_search_theta_rad) / options_.angular_step_rad));
-  scores_.resize(static_cast<std::size_t>(2 * nt + 1) * static_cast<std::size_t>(2 * nx + 1) *
-                 static_cast<std::size_t>(2 * nx + 1));
+  const auto headings = static_cast<std::size_t>(2 * nt + 1);
+  cx_.resize(headings * n);
+  cy_.resize(headings * n);
+  const auto side = static_cast<std::size_t>(nx + 1);
+  blocks_.resize(headings * side * side);
 }
 
 std::size_t ScanMatcher::set_scan(const LaserScan& scan, const Pose2D& base_from_laser) noexcept {
@@ -249,35 +253,55 @@ ScanMatch ScanMatcher::match(const Pose2D& predicted, double search_xy_m, double
   const int nt = static_cast<int>(
       std::ceil(std::clamp(search_theta_rad, 0.0, options_.max_search_theta_rad) / options_.angular_step_rad));
   const double step = options_.angular_step_rad;
+  // Branch and bound over one level: every heading's 2 x 2-cell blocks are bounded with the
+  // pooled field, and only blocks whose bound beats the best full score are scored cell by cell.
+  // The answer is the exhaustive search's, at about a quarter of its cost.
+  std::size_t count = 0;
+  for (int k = -nt; k <= nt; ++k) {
+    int* cx = cx_.data() + static_cast<std::size_t>(k + nt) * n;
+    int* cy = cy_.data() + static_cast<std::size_t>(k + nt) * n;
+    rotate_points(g0.theta + k * step, g0.x, g0.y, n, cx, cy);
+    for (int dy = -nx; dy <= nx; dy += 2) {
+      for (int dx = -nx; dx <= nx; dx += 2) blocks_[count++] = {pooled_sum(1, cx, cy, n, dx, dy), k, dx, dy};
+    }
+  }
+  std::sort(blocks_.begin(), blocks_.begin() + static_cast<std::ptrdiff_t>(count),
+            [](const Block& l, const Block& r) { return l.bound > r.bound; });
   float best = -1.0f;
   int bk = 0, bx = 0, by = 0;
-  std::size_t slot = 0;
-  for (int k = -nt; k <= nt; ++k) {
-    rotate_points(g0.theta + k * step, g0.x, g0.y, n, cx_.data(), cy_.data());
-    for (int dy = -nx; dy <= nx; ++dy) {
-      for (int dx = -nx; dx <= nx; ++dx) {
-        const float s = sum_at(cx_.data(), cy_.data(), n, dx, dy);
-        scores_[slot++] = s;
+  auto nearer = [](int k, int x, int y, int k2, int x2, int y2) {
+    return std::abs(k) + std::abs(x) + std::abs(y) < std::abs(k2) + std::abs(x2) + std::abs(y2);
+  };
+  for (std::size_t c = 0; c < count; ++c) {
+    const Block& blk = blocks_[c];
+    if (blk.bound < best) break;
+    const int* cx = cx_.data() + static_cast<std::size_t>(blk.k + nt) * n;
+    const int* cy = cy_.data() + static_cast<std::size_t>(blk.k + nt) * n;
+    for (int dy = blk.dy; dy <= std::min(blk.dy + 1, nx); ++dy) {
+      for (int dx = blk.dx; dx <= std::min(blk.dx + 1, nx); ++dx) {
+        const float sc = sum_at(cx, cy, n, dx, dy);
         // ties go to the pose nearest the prediction (the odometry is the prior)
-        if (s > best || (s == best && std::abs(k) + std::abs(dx) + std::abs(dy) < std::abs(bk) + std::abs(bx) + std::abs(by))) {
-          best = s;
-          bk = k;
+        if (sc > best || (sc == best && nearer(blk.k, dx, dy, bk, bx, by))) {
+          best = sc;
+          bk = blk.k;
           bx = dx;
           by = dy;
         }
       }
     }
   }
-  // Moments of the window's poses weighted by how close their quality comes to the best one.
+  // The covariance from the scores around the best pose, each weighted by how close its quality
+  // comes to the best one.
   double sw = 0.0;
   std::array<double, 3> m1{};
   std::array<double, 6> m2{};  // xx xy xt yy yt tt
-  slot = 0;
   const double inv_n = 1.0 / static_cast<double>(n);
-  for (int k = -nt; k <= nt; ++k) {
-    for (int dy = -nx; dy <= nx; ++dy) {
-      for (int dx = -nx; dx <= nx; ++dx) {
-        const double w = std::exp((scores_[slot++] - best) * inv_n / kQualityScale);
+  for (int k = std::max(-nt, bk - kCovarianceReach); k <= std::min(nt, bk + kCovarianceReach); ++k) {
+    const int* cx = cx_.data() + static_cast<std::size_t>(k + nt) * n;
+    const int* cy = cy_.data() + static_cast<std::size_t>(k + nt) * n;
+    for (int dy = by - kCovarianceReach; dy <= by + kCovarianceReach; ++dy) {
+      for (int dx = bx - kCovarianceReach; dx <= bx + kCovarianceReach; ++dx) {
+        const double w = std::exp((sum_at(cx, cy, n, dx, dy) - best) * inv_n / kQualityScale);
         if (w < 1e-6) continue;
         const double vx = (dx - bx) * cell_m_, vy = (dy - by) * cell_m_, vt = (k - bk) * step;
         sw += w;

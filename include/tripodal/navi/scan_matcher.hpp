@@ -43,10 +43,11 @@ struct ScanMatch {
 };
 
 /// A likelihood-field matcher: each cell holds exp(-d^2 / 2 sigma^2), d the distance to the
-/// nearest occupied cell (navi::DistanceField); a pose scores the sum over the scan's points.
+/// nearest wall surface (navi::DistanceField); a pose scores the sum over the scan's points.
 /// Tracking is a correlative search (every heading step x every cell of the window, the
-/// translations as index offsets of the rotated points) followed by a sub-cell hill climb on the
-/// bilinear field; the covariance comes from the score distribution over the window. The global
+/// translations as index offsets of the rotated points, pruned by a one-level branch and bound
+/// on 2 x 2-cell blocks) followed by a sub-cell hill climb on the bilinear field; the covariance
+/// comes from the score distribution around the best pose. The global
 /// search is a branch and bound over max-pooled fields (as Cartographer's), so its answer is the
 /// best pose of the discretisation, not a sampled guess. Every buffer is sized at construction:
 /// set_scan() and match() do not allocate.
@@ -99,8 +100,12 @@ class ScanMatcher {
   std::vector<std::vector<float>> pooled_;
   int pad_ = 1;
   std::vector<float> px_, py_, range_;       // points in the base frame, metres
-  std::vector<int> cx_, cy_;                 // rotated points, cell offsets (tracking)
-  std::vector<float> scores_;                // the tracking window's scores (covariance)
+  std::vector<int> cx_, cy_;                 // rotated points of every heading of the window, cells
+  struct Block {
+    float bound;
+    int k, dx, dy;
+  };
+  std::vector<Block> blocks_;                // the window's 2 x 2-cell blocks, by heading
   std::vector<int> gcx_, gcy_;               // rotated points for every global heading
 };
 
