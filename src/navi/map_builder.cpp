@@ -81,11 +81,13 @@ void MapBuilder::insert(const LaserScan& scan, const Pose2D& map_from_base, cons
 
 Pose2D MapBuilder::add(const LaserScan& scan, const Pose2D& odom_from_base, const Pose2D& start,
                        const Pose2D& base_from_laser) {
+  Pose2D motion;
   if (!started_) {
     started_ = true;
     pose_ = start;
   } else {
-    pose_ = compose(pose_, compose(inverse(last_odom_), odom_from_base));
+    motion = compose(inverse(last_odom_), odom_from_base);
+    pose_ = compose(pose_, motion);
   }
   last_odom_ = odom_from_base;
   if (!matcher_ || since_refresh_ >= options_.refresh_every_scans) {
@@ -98,10 +100,9 @@ Pose2D MapBuilder::add(const LaserScan& scan, const Pose2D& odom_from_base, cons
   if (matcher_) {
     ++since_refresh_;
     matcher_->set_scan(scan, base_from_laser);
-    const ScanMatch m = matcher_->match(pose_);
+    const ScanMatch m = matcher_->track(pose_, motion, options_.window);
     last_quality_ = m.quality;
-    // a match that explains little of the scan (new ground, clutter) is no better than odometry
-    if (m.quality >= 0.2) pose_ = m.pose;
+    if (m.quality >= options_.min_quality) pose_ = m.pose;
   }
   insert(scan, pose_, base_from_laser);
   return pose_;

@@ -336,6 +336,17 @@ ScanMatch ScanMatcher::match(const Pose2D& predicted, double search_xy_m, double
   return out;
 }
 
+ScanMatch ScanMatcher::track(const Pose2D& predicted, const Pose2D& motion, const TrackingWindow& window) noexcept {
+  const double moved_m = std::hypot(motion.x_m, motion.y_m), turned_rad = std::abs(wrap_angle(motion.theta_rad));
+  ScanMatch m = match(predicted, options_.search_xy_m + window.m_per_m * moved_m,
+                      options_.search_theta_rad + window.rad_per_rad * turned_rad + window.rad_per_m * moved_m);
+  if (m.quality < window.retry_quality) {
+    const ScanMatch wide = match(predicted, options_.max_search_xy_m, options_.max_search_theta_rad);
+    if (wide.quality > m.quality) m = wide;
+  }
+  return m;
+}
+
 ScanMatch ScanMatcher::match_global() {
   // Only the nearer points: a heading step moves a far point by several cells, which the
   // pooled bounds would not cover.

@@ -51,7 +51,7 @@ const ModuleManifest& CScanMatchingLocalizer::static_manifest() {
                      "scans in a row below lost_quality that make the robot lost", 1.0, 100000.0},
        ParameterSpec{"relocalize_quality", ValueType::number, Value{d.relocalize_quality}, "",
                      "quality a global search must reach to be accepted", 0.0, 1.0},
-       ParameterSpec{"retry_quality", ValueType::number, Value{d.retry_quality}, "",
+       ParameterSpec{"retry_quality", ValueType::number, Value{d.window.retry_quality}, "",
                      "below this quality a scan is searched again in the widest window", 0.0, 1.0},
        ParameterSpec{"serves", ValueType::string, Value{std::string("BhGlobalLocalization")}, "",
                      "the behavior during whose activation it runs the global search (its parameter "
@@ -72,7 +72,7 @@ void CScanMatchingLocalizer::on_configure(const ParameterSet& params) {
   o.lost_quality = params.number("lost_quality");
   o.lost_after_scans = static_cast<int>(params.number("lost_after_scans"));
   o.relocalize_quality = params.number("relocalize_quality");
-  o.retry_quality = params.number("retry_quality");
+  o.window.retry_quality = params.number("retry_quality");
   validate(o.matcher, where());
   laser_name_ = params.string("laser");
   odometry_name_ = params.string("odometry");
@@ -137,7 +137,6 @@ void CScanMatchingLocalizer::step(const LaserScan& scan, const Pose2D& odom_from
     pose_ = compose(pose_, motion);
   }
   last_odom_ = odom_from_base;
-  const double moved_m = std::hypot(motion.x_m, motion.y_m), turned_rad = std::abs(motion.theta_rad);
   stamp_ = now;
   matcher_->set_scan(scan, options_.base_from_laser);
   if (need_global_) {
@@ -148,14 +147,7 @@ void CScanMatchingLocalizer::step(const LaserScan& scan, const Pose2D& odom_from
       return;
     }
   }
-  const ScanMatcherOptions& mo = options_.matcher;
-  ScanMatch m = matcher_->match(pose_, mo.search_xy_m + options_.window_m_per_m * moved_m,
-                                mo.search_theta_rad + options_.window_rad_per_rad * turned_rad +
-                                    options_.window_rad_per_m * moved_m);
-  if (m.quality < options_.retry_quality) {
-    const ScanMatch wide = matcher_->match(pose_, mo.max_search_xy_m, mo.max_search_theta_rad);
-    if (wide.quality > m.quality) m = wide;
-  }
+  const ScanMatch m = matcher_->track(pose_, motion, options_.window);
   last_ = m;
   if (m.quality >= options_.lost_quality) {
     pose_ = m.pose;

@@ -25,6 +25,13 @@ struct MapBuilderOptions {
   /// refresh stays bounded however large the map grows.
   double window_m = 15.0;
   ScanMatcherOptions matcher;
+  /// A fixed window, no wide retry: on a map still being made, a poor match is mostly new
+  /// ground, and a wider search there snaps to the wrong wall (on the Intel log, the localizer's
+  /// growing window doubles the relative errors: docs/localization.md).
+  TrackingWindow window{.m_per_m = 0.0, .rad_per_rad = 0.0, .rad_per_m = 0.0, .retry_quality = 0.0};
+  /// A match below this quality (new ground, clutter) is no better than the odometry: the scan
+  /// is inserted at the predicted pose.
+  double min_quality = 0.2;
 };
 
 /// Log-odds occupancy grid over a fixed extent, with scan-to-map matching. Scans are inserted by

@@ -30,6 +30,17 @@ struct ScanMatcherOptions {
   int global_levels = 6;             ///< branch-and-bound tiles of 2^levels cells at the top
 };
 
+/// How a tracker sizes its search: the odometry errs more the more the robot moves, so the window
+/// grows by these much per metre travelled and per radian turned since the last scan (up to the
+/// matcher's max_search_*); a match below retry_quality is searched again in the widest window
+/// (the odometry sometimes errs by more than the window: a wheel slipping in a turn).
+struct TrackingWindow {
+  double m_per_m = 0.2;
+  double rad_per_rad = 0.3;
+  double rad_per_m = 0.1;
+  double retry_quality = 0.8;
+};
+
 /// Throws ConfigError located at where naming every option out of its range.
 void validate(const ScanMatcherOptions& options, const SourceLocation& where = {});
 
@@ -68,6 +79,9 @@ class ScanMatcher {
   }
   /// The same in a window of the given half widths (clipped to max_search_*).
   [[nodiscard]] ScanMatch match(const Pose2D& predicted, double search_xy_m, double search_theta_rad) noexcept;
+  /// Tracking: the best pose around `predicted` in a window sized by the motion (odometry) since
+  /// the last scan, searched again in the widest window when the match is poor.
+  [[nodiscard]] ScanMatch track(const Pose2D& predicted, const Pose2D& motion, const TrackingWindow& window) noexcept;
   /// Best pose anywhere on the free cells of the map.
   [[nodiscard]] ScanMatch match_global();
   /// Quality (mean likelihood of the points) of the scan at `pose`, without searching.

@@ -28,14 +28,7 @@ struct ScanMatchingLocalizerOptions {
   /// A global search is accepted at or above this quality (higher than lost_quality: a wrong
   /// place that happens to explain part of the scan must not pass).
   double relocalize_quality = 0.75;
-  /// A match below this quality is searched again in the matcher's largest window: the odometry
-  /// sometimes errs by more than the window (a wheel slipping in a turn).
-  double retry_quality = 0.8;
-  /// The odometry errs more the more the robot moves: the tracking window grows by these much
-  /// per metre travelled and per radian turned since the last scan (up to the matcher's max).
-  double window_m_per_m = 0.2;
-  double window_rad_per_rad = 0.3;
-  double window_rad_per_m = 0.1;
+  TrackingWindow window;          ///< how the search window follows the odometry
 };
 
 /// Type "ScanMatchingLocalizer". As a module of the robot it takes the map of the GridMaps module
