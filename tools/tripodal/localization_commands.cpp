@@ -318,17 +318,14 @@ int eval_one(const EvalArgs& a, const std::filesystem::path& file, std::ostream&
   return kOk;
 }
 
-int localization_eval(const EvalArgs& a, std::ostream& out, std::ostream& err) {
-  for (const auto& f : a.logs) {
-    if (!std::filesystem::exists(f)) {
-      err << "tripodal localization eval: " << f.string() << ": no such file\n";
-      return kIoError;
-    }
-  }
+// Runs a command's body, mapping its failures to the tools' exit codes: located input errors
+// (the log's, the trace's, the options') to 1, files that cannot be read or written to 3.
+template <class Body>
+int guarded(std::string_view command, std::ostream& err, Body&& body) {
   try {
-    for (const auto& f : a.logs) eval_one(a, f, out);
+    body();
   } catch (const trace::TraceIoError& e) {
-    err << "tripodal localization eval: " << e.what() << '\n';
+    err << command << ": " << e.what() << '\n';
     return kIoError;
   } catch (const trace::TraceFormatError& e) {
     err << e.what() << '\n';
@@ -337,10 +334,22 @@ int localization_eval(const EvalArgs& a, std::ostream& out, std::ostream& err) {
     err << e.what() << '\n';
     return kBadInput;
   } catch (const std::runtime_error& e) {
-    err << "tripodal localization eval: " << e.what() << '\n';
+    err << command << ": " << e.what() << '\n';
     return kIoError;
   }
   return kOk;
+}
+
+int localization_eval(const EvalArgs& a, std::ostream& out, std::ostream& err) {
+  for (const auto& f : a.logs) {
+    if (!std::filesystem::exists(f)) {
+      err << "tripodal localization eval: " << f.string() << ": no such file\n";
+      return kIoError;
+    }
+  }
+  return guarded("tripodal localization eval", err, [&] {
+    for (const auto& f : a.logs) eval_one(a, f, out);
+  });
 }
 
 struct BuildArgs {
@@ -357,7 +366,7 @@ int map_build(const BuildArgs& a, std::ostream& out, std::ostream& err) {
     err << "tripodal map build: " << a.trace.string() << ": no such file\n";
     return kIoError;
   }
-  try {
+  return guarded("tripodal map build", err, [&] {
     const Log log = read_log(a.trace, a.laser_channel, a.odom_channel, a.pose_channel);
     std::vector<Pose2D> odom;
     for (const LoggedScan& s : log.scans) odom.push_back(s.odom);
@@ -394,20 +403,7 @@ int map_build(const BuildArgs& a, std::ostream& out, std::ostream& err) {
         out << "\n";
       }
     }
-  } catch (const trace::TraceIoError& e) {
-    err << "tripodal map build: " << e.what() << '\n';
-    return kIoError;
-  } catch (const trace::TraceFormatError& e) {
-    err << e.what() << '\n';
-    return kBadInput;
-  } catch (const ConfigError& e) {
-    err << e.what() << '\n';
-    return kBadInput;
-  } catch (const std::runtime_error& e) {
-    err << "tripodal map build: " << e.what() << '\n';
-    return kIoError;
-  }
-  return kOk;
+  });
 }
 
 void channel_options(CLI::App& cmd, std::string& laser, std::string& odom, std::string& pose) {
