@@ -15,12 +15,15 @@ namespace tripodal::navi {
 struct MapBuilderOptions {
   double resolution_m = 0.05;
   double max_range_m = 30.0;     ///< beams beyond this (or at the scanner's maximum) are not inserted
-  double hit_log_odds = 0.85;    ///< evidence of an end point
+  /// Evidence of an end point: strong enough that a wall seen once survives the miss of a beam
+  /// grazing it later (with 0.85, a miss turned it back to unknown, and the Intel relative errors
+  /// were twice as large: docs/localization.md).
+  double hit_log_odds = 2.5;
   double miss_log_odds = -0.4;   ///< evidence of a cell a beam crossed
   double clamp_log_odds = 5.0;   ///< bound on the evidence, so that a cell can change its state
   /// The matcher's map is refreshed from the grid every this many scans (a refresh recomputes
-  /// the distance field, O(cells)).
-  int refresh_every_scans = 3;
+  /// the distance field of the window, O(cells)); every scan: the last scan is matched too.
+  int refresh_every_scans = 1;
   /// The matcher sees the map within this distance of the robot (a square): the cost of a
   /// refresh stays bounded however large the map grows.
   double window_m = 15.0;
