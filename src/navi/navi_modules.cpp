@@ -18,6 +18,14 @@ ModuleManifest navi_manifest(std::string name, std::string description, std::vec
       .build();
 }
 
+void GlobalFixAttempts::activated(const BehaviorActivation& activation, Time now) {
+  if (activation.behavior != serves) return;
+  const ParameterSet params = activation.resolved();
+  period_ = from_seconds(params.number("attempt_period_s"));
+  last_ = now;
+  searching_ = true;
+}
+
 void register_navigation_modules(ModuleRegistry& registry) {
   registry.add<CGridMaps>();
   registry.add<CSectionSplitter>();

@@ -76,7 +76,7 @@ void CScanMatchingLocalizer::on_configure(const ParameterSet& params) {
   validate(o.matcher, where());
   laser_name_ = params.string("laser");
   odometry_name_ = params.string("odometry");
-  serves_ = params.string("serves");
+  fix_attempts_.serves = params.string("serves");
   options_ = o;
   pose_ = o.initial_pose;
   need_global_ = o.start_global;
@@ -182,25 +182,18 @@ void CScanMatchingLocalizer::on_update(ModuleContext& context) {
     last_scan_stamp_ = scan.stamp;
     step(scan, odometry_->latest().pose, context.now, context.events);
   }
-  if (searching_ && has_scan_ && context.now - last_attempt_ >= attempt_period_) {
-    last_attempt_ = context.now;
-    if (relocalize()) ++fixes_;
-  }
+  if (has_scan_ && fix_attempts_.due(context.now) && relocalize()) ++fixes_;
   context.heartbeat = true;
   publish(*context.navigation);
   context.navigation->fixes = fixes_;
 }
 
 void CScanMatchingLocalizer::on_behavior_activated(const BehaviorActivation& activation, ModuleContext& context) {
-  if (activation.behavior != serves_) return;
-  const ParameterSet params = activation.resolved();
-  attempt_period_ = from_seconds(params.number("attempt_period_s"));
-  last_attempt_ = context.now;
-  searching_ = true;
+  fix_attempts_.activated(activation, context.now);
 }
 
 void CScanMatchingLocalizer::on_behavior_deactivated(std::string_view behavior, ModuleContext& /*context*/) {
-  if (behavior == serves_) searching_ = false;
+  fix_attempts_.deactivated(behavior);
 }
 
 }  // namespace tripodal::navi

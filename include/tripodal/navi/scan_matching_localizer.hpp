@@ -87,10 +87,7 @@ class CScanMatchingLocalizer final : public CNaviModules {
   bool need_global_ = false;  // start_global before the first scan
   State state_ = State::unknown;
 
-  std::string serves_ = "BhGlobalLocalization";
-  bool searching_ = false;
-  Duration attempt_period_{0};
-  Time last_attempt_{};
+  GlobalFixAttempts fix_attempts_;  // global localization while BhGlobalLocalization is active
   std::uint32_t fixes_ = 0;
 };
 
