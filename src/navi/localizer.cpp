@@ -74,7 +74,7 @@ const ModuleManifest& CLocalizer::static_manifest() {
 }
 
 void CLocalizer::on_configure(const ParameterSet& params) {
-  serves_ = params.string("serves");
+  fix_attempts_.serves = params.string("serves");
   LocalizerOptions o;
   o.noise_xy_m = params.number("noise_xy_m");
   o.noise_theta_rad = params.number("noise_theta_rad");
@@ -120,25 +120,18 @@ void CLocalizer::on_start(ModuleContext& context) {
 
 void CLocalizer::on_update(ModuleContext& context) {
   step(context.now, context.events);
-  if (searching_ && context.now - last_attempt_ >= attempt_period_) {
-    last_attempt_ = context.now;
-    if (relocalize(context.now)) ++fixes_;
-  }
+  if (fix_attempts_.due(context.now) && relocalize(context.now)) ++fixes_;
   context.heartbeat = true;
   publish(*context.navigation);
   context.navigation->fixes = fixes_;
 }
 
 void CLocalizer::on_behavior_activated(const BehaviorActivation& activation, ModuleContext& context) {
-  if (activation.behavior != serves_) return;
-  const ParameterSet params = activation.resolved();
-  attempt_period_ = from_seconds(params.number("attempt_period_s"));
-  last_attempt_ = context.now;
-  searching_ = true;
+  fix_attempts_.activated(activation, context.now);
 }
 
 void CLocalizer::on_behavior_deactivated(std::string_view behavior, ModuleContext& /*context*/) {
-  if (behavior == serves_) searching_ = false;
+  fix_attempts_.deactivated(behavior);
 }
 
 void CLocalizer::step(Time now, std::vector<ModuleEvent>& out) noexcept {

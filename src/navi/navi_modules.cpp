@@ -3,6 +3,7 @@
 #include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/navi/localizer.hpp"
 #include "tripodal/navi/planning_modules.hpp"
+#include "tripodal/navi/scan_matching_localizer.hpp"
 #include "tripodal/navi/section_splitter.hpp"
 
 namespace tripodal::navi {
@@ -17,10 +18,19 @@ ModuleManifest navi_manifest(std::string name, std::string description, std::vec
       .build();
 }
 
+void GlobalFixAttempts::activated(const BehaviorActivation& activation, Time now) {
+  if (activation.behavior != serves) return;
+  const ParameterSet params = activation.resolved();
+  period_ = from_seconds(params.number("attempt_period_s"));
+  last_ = now;
+  searching_ = true;
+}
+
 void register_navigation_modules(ModuleRegistry& registry) {
   registry.add<CGridMaps>();
   registry.add<CSectionSplitter>();
   registry.add<CLocalizer>();
+  registry.add<CScanMatchingLocalizer>();
   registry.add<CPathPlanningModule>();
   registry.add<CCoverageModule>();
 }

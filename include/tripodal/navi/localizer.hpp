@@ -106,10 +106,7 @@ class CLocalizer final : public CNaviModules {
   Time stamp_{};
   double error_m_ = 0.0;
   // Global localization while the behavior it serves (BhGlobalLocalization) is active.
-  std::string serves_ = "BhGlobalLocalization";
-  bool searching_ = false;
-  Duration attempt_period_{0};
-  Time last_attempt_{};
+  GlobalFixAttempts fix_attempts_;  // global localization while BhGlobalLocalization is active
   std::uint32_t fixes_ = 0;
 };
 

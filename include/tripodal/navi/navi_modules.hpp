@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "tripodal/core/manifest.hpp"
@@ -17,12 +18,35 @@ class CNaviModules : public CModule {
   CNaviModules() = default;
 };
 
+/// When a localizer attempts global position fixes (the process PrGlobalLocalization): while the
+/// behavior it serves (BhGlobalLocalization) is active, once every attempt_period_s of that
+/// activation. Shared by the localizers.
+class GlobalFixAttempts {
+ public:
+  std::string serves = "BhGlobalLocalization";
+  void activated(const BehaviorActivation& activation, Time now);
+  void deactivated(std::string_view behavior) noexcept {
+    if (behavior == serves) searching_ = false;
+  }
+  /// Whether an attempt is due at now (then the next one is a period later).
+  [[nodiscard]] bool due(Time now) noexcept {
+    if (!searching_ || now - last_ < period_) return false;
+    last_ = now;
+    return true;
+  }
+
+ private:
+  bool searching_ = false;
+  Duration period_{0};
+  Time last_{};
+};
+
 /// A manifest for a navigation module: layer sequencing, kind navigation.
 [[nodiscard]] ModuleManifest navi_manifest(std::string name, std::string description, std::vector<std::string> inputs,
                                            std::vector<std::string> outputs, std::vector<ParameterSpec> parameters);
 
-/// Registers the navigation modules: GridMaps, SectionSplitter, Localizer, PathPlanner,
-/// CoveragePlanner.
+/// Registers the navigation modules: GridMaps, SectionSplitter, Localizer, ScanMatchingLocalizer,
+/// PathPlanner, CoveragePlanner.
 void register_navigation_modules(ModuleRegistry& registry);
 
 }  // namespace tripodal::navi

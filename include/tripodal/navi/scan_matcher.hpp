@@ -1,0 +1,126 @@
+// The laser scan matcher of the navigation modules (sequencing layer): it places a 2D laser scan on
+// a known occupancy grid, near a predicted pose (tracking) or anywhere on the map (global
+// localization). The scan-matching localizer and the map builder are built on it.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "tripodal/core/diagnostic.hpp"
+#include "tripodal/navi/occupancy_grid.hpp"
+#include "tripodal/resources/readings.hpp"
+
+namespace tripodal::navi {
+
+struct ScanMatcherOptions {
+  double sigma_m = 0.1;              ///< spread of the likelihood field around the walls
+  double max_range_m = 30.0;         ///< returns farther than this are not matched
+  int max_points = 360;              ///< beams beyond this are decimated evenly (bounds the cost)
+  double search_xy_m = 0.25;         ///< half width of the tracking window around the prediction
+  double search_theta_rad = 0.2;     ///< half width of the tracking window in heading
+  double angular_step_rad = 0.01;    ///< heading step of the discrete searches
+  /// The largest tracking window a caller may ask for (the score buffer is sized for it).
+  double max_search_xy_m = 1.0;
+  double max_search_theta_rad = 0.8;
+  /// Global search: headings step and the farthest point used (farther points would need finer
+  /// heading steps to stay within a cell, so the global search drops them).
+  double global_angular_step_rad = 0.02;
+  double global_max_range_m = 12.0;
+  int global_levels = 6;             ///< branch-and-bound tiles of 2^levels cells at the top
+};
+
+/// How a tracker sizes its search: the odometry errs more the more the robot moves, so the window
+/// grows by these much per metre travelled and per radian turned since the last scan (up to the
+/// matcher's max_search_*); a match below retry_quality is searched again in the widest window
+/// (the odometry sometimes errs by more than the window: a wheel slipping in a turn).
+struct TrackingWindow {
+  double m_per_m = 0.2;
+  double rad_per_rad = 0.3;
+  double rad_per_m = 0.1;
+  double retry_quality = 0.8;
+};
+
+/// Throws ConfigError located at where naming every option out of its range.
+void validate(const ScanMatcherOptions& options, const SourceLocation& where = {});
+
+/// A match: the pose (map_from_base), its covariance (x, y, theta; row-major) and the quality, the
+/// mean likelihood of the matched points in [0, 1] (1: every point on a wall of the map).
+struct ScanMatch {
+  Pose2D pose;
+  std::array<double, 9> covariance{};
+  double quality = 0.0;
+  std::size_t points = 0;  ///< points matched
+};
+
+/// A likelihood-field matcher: each cell holds exp(-d^2 / 2 sigma^2), d the distance to the
+/// nearest wall surface (navi::DistanceField); a pose scores the sum over the scan's points.
+/// Tracking is a correlative search (every heading step x every cell of the window, the
+/// translations as index offsets of the rotated points, pruned by a one-level branch and bound
+/// on 2 x 2-cell blocks) followed by a sub-cell hill climb on the bilinear field; the covariance
+/// comes from the score distribution around the best pose. The global
+/// search is a branch and bound over max-pooled fields (as Cartographer's), so its answer is the
+/// best pose of the discretisation, not a sampled guess. Every buffer is sized at construction:
+/// set_scan() and match() do not allocate.
+class ScanMatcher {
+ public:
+  /// Precomputes the fields of `map` (O(cells x levels)). Throws ConfigError located at where
+  /// for options out of range or a map without occupied cells.
+  ScanMatcher(const OccupancyGrid& map, ScanMatcherOptions options = {}, const SourceLocation& where = {});
+
+  /// Takes the points of `scan` as seen from the base (base_from_laser: the scanner's mounting).
+  /// Returns the number of points kept (valid returns within max_range_m, decimated).
+  std::size_t set_scan(const LaserScan& scan, const Pose2D& base_from_laser = {}) noexcept;
+  [[nodiscard]] std::size_t points() const noexcept { return px_.size(); }
+
+  /// Best pose within the tracking window around `predicted`.
+  [[nodiscard]] ScanMatch match(const Pose2D& predicted) noexcept {
+    return match(predicted, options_.search_xy_m, options_.search_theta_rad);
+  }
+  /// The same in a window of the given half widths (clipped to max_search_*).
+  [[nodiscard]] ScanMatch match(const Pose2D& predicted, double search_xy_m, double search_theta_rad) noexcept;
+  /// Tracking: the best pose around `predicted` in a window sized by the motion (odometry) since
+  /// the last scan, searched again in the widest window when the match is poor.
+  [[nodiscard]] ScanMatch track(const Pose2D& predicted, const Pose2D& motion, const TrackingWindow& window) noexcept;
+  /// Best pose anywhere on the free cells of the map.
+  [[nodiscard]] ScanMatch match_global();
+  /// Quality (mean likelihood of the points) of the scan at `pose`, without searching.
+  [[nodiscard]] double quality_at(const Pose2D& pose) const noexcept;
+
+  [[nodiscard]] const ScanMatcherOptions& options() const noexcept { return options_; }
+  [[nodiscard]] const OccupancyGrid& map() const noexcept { return map_; }
+
+ private:
+  struct GridPose {
+    double x = 0.0, y = 0.0, theta = 0.0;  // grid frame, in cells and radians
+  };
+  [[nodiscard]] GridPose to_grid(const Pose2D& p) const noexcept;
+  [[nodiscard]] Pose2D from_grid(const GridPose& g) const noexcept;
+  [[nodiscard]] double score_bilinear(const GridPose& g) const noexcept;
+  [[nodiscard]] GridPose hill_climb(GridPose g, double step_cells, double step_rad) const noexcept;
+  // Rotates the points by theta into integer cell offsets from (x, y) (cells), in cx_/cy_.
+  void rotate_points(double theta, double x, double y, std::size_t count, int* cx, int* cy) const noexcept;
+  [[nodiscard]] float sum_at(const int* cx, const int* cy, std::size_t count, int dx, int dy) const noexcept;
+  [[nodiscard]] float pooled_sum(int level, const int* cx, const int* cy, std::size_t count, int x, int y) const noexcept;
+  ScanMatch finish(const GridPose& best, double sum_w, const std::array<double, 6>& moments) const noexcept;
+
+  OccupancyGrid map_;
+  ScanMatcherOptions options_;
+  double cell_m_ = 0.05;
+  int width_ = 0, height_ = 0;
+  std::vector<float> field_;                 // the likelihood field, width x height
+  // pooled_[h]: max of the field over the 2^h x 2^h cells from (x, y), on the domain extended
+  // by pad_ cells below and left (a tile partly outside the grid still bounds its inside)
+  std::vector<std::vector<float>> pooled_;
+  int pad_ = 1;
+  std::vector<float> px_, py_, range_;       // points in the base frame, metres
+  std::vector<int> cx_, cy_;                 // rotated points of every heading of the window, cells
+  struct Block {
+    float bound;
+    int k, dx, dy;
+  };
+  std::vector<Block> blocks_;                // the window's 2 x 2-cell blocks, by heading
+  std::vector<int> gcx_, gcy_;               // rotated points for every global heading
+};
+
+}  // namespace tripodal::navi

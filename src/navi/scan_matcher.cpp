@@ -1,0 +1,433 @@
+#include "tripodal/navi/scan_matcher.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <utility>
+
+#include "tripodal/navi/distance_field.hpp"
+
+namespace tripodal::navi {
+
+namespace {
+
+// How sharply the covariance weights fall with the match quality: a pose whose quality is lower
+// by this much than the best weighs 1/e. A one-cell shift on a wall costs about 0.05 of quality
+// with sigma 0.1 m, so the covariance of a clear match is about a cell, and a corridor (that
+// shifts without loss along its axis) stretches it along the axis as it should.
+constexpr double kQualityScale = 0.05;
+// How far (cells, heading steps) around the best pose the covariance looks: beyond a few cells
+// the weights of a clear match are nil, and a corridor's spread shows within this reach.
+constexpr int kCovarianceReach = 4;
+
+bool positive_finite(double v) { return std::isfinite(v) && v > 0.0; }
+
+}  // namespace
+
+void validate(const ScanMatcherOptions& o, const SourceLocation& where) {
+  Diagnostics d;
+  auto need = [&](bool ok, const std::string& what) {
+    if (!ok) d.error(where, "scan matcher: " + what);
+  };
+  need(positive_finite(o.sigma_m), "sigma_m must be a number > 0, got " + std::to_string(o.sigma_m));
+  need(positive_finite(o.max_range_m), "max_range_m must be a number > 0, got " + std::to_string(o.max_range_m));
+  need(o.max_points >= 3 && o.max_points <= 100000,
+       "max_points must be 3..100000, got " + std::to_string(o.max_points));
+  need(std::isfinite(o.search_xy_m) && o.search_xy_m >= 0.0 && o.search_xy_m <= 5.0,
+       "search_xy_m must be 0..5 m, got " + std::to_string(o.search_xy_m));
+  need(std::isfinite(o.search_theta_rad) && o.search_theta_rad >= 0.0 && o.search_theta_rad <= std::numbers::pi,
+       "search_theta_rad must be 0..pi, got " + std::to_string(o.search_theta_rad));
+  need(positive_finite(o.angular_step_rad) && o.angular_step_rad <= 0.5,
+       "angular_step_rad must be > 0 and <= 0.5, got " + std::to_string(o.angular_step_rad));
+  need(positive_finite(o.global_angular_step_rad) && o.global_angular_step_rad <= 0.5,
+       "global_angular_step_rad must be > 0 and <= 0.5, got " + std::to_string(o.global_angular_step_rad));
+  need(positive_finite(o.global_max_range_m), "global_max_range_m must be a number > 0, got " +
+                                                  std::to_string(o.global_max_range_m));
+  need(o.global_levels >= 1 && o.global_levels <= 10, "global_levels must be 1..10, got " +
+                                                          std::to_string(o.global_levels));
+  need(std::isfinite(o.max_search_xy_m) && o.max_search_xy_m >= 0.0 && o.max_search_xy_m <= 5.0,
+       "max_search_xy_m must be 0..5 m, got " + std::to_string(o.max_search_xy_m));
+  need(std::isfinite(o.max_search_theta_rad) && o.max_search_theta_rad >= 0.0 &&
+           o.max_search_theta_rad <= std::numbers::pi,
+       "max_search_theta_rad must be 0..pi, got " + std::to_string(o.max_search_theta_rad));
+  if (std::max(o.search_theta_rad, o.max_search_theta_rad) / std::max(o.angular_step_rad, 1e-9) > 1000) {
+    d.error(where, "scan matcher: the tracking window is too large for its heading step (more than 1000 headings "
+                   "each side)");
+  }
+  if (d.has_errors()) throw ConfigError(d);
+}
+
+ScanMatcher::ScanMatcher(const OccupancyGrid& map, ScanMatcherOptions options, const SourceLocation& where)
+    : map_(map), options_(options) {
+  validate(options_, where);
+  if (map.width() < 2 || map.height() < 2) {
+    throw ConfigError(where, "scan matcher: the map is " + std::to_string(map.width()) + " x " +
+                                 std::to_string(map.height()) + " cells, expected at least 2 x 2");
+  }
+  if (map.count(Occupancy::occupied) == 0) {
+    throw ConfigError(where, "scan matcher: the map has no occupied cell, nothing a scan could be matched against");
+  }
+  cell_m_ = map.resolution_m();
+  width_ = map.width();
+  height_ = map.height();
+  const std::size_t cells = map.size();
+  // Distances to the surfaces of the walls: occupied cells beside a cell that is not. A beam
+  // stops at a wall's face; were the whole thickness of a wall a peak, a scan could slide inside
+  // thick walls at no cost. Unknown space and the outside are not walls a beam can hit.
+  std::vector<bool> surface(cells);
+  auto solid = [&](int x, int y) {
+    return x < 0 || y < 0 || x >= width_ || y >= height_ || map.state(map.index({x, y})) == Occupancy::occupied;
+  };
+  for (std::size_t i = 0; i < cells; ++i) {
+    const CellIndex c = map.cell(i);
+    surface[i] = solid(c.x, c.y) &&
+                 (!solid(c.x + 1, c.y) || !solid(c.x - 1, c.y) || !solid(c.x, c.y + 1) || !solid(c.x, c.y - 1));
+  }
+  const DistanceField df(width_, height_, cell_m_, surface, false);
+  field_.resize(cells);
+  const double k = -0.5 / (options_.sigma_m * options_.sigma_m);
+  for (std::size_t i = 0; i < cells; ++i) {
+    const double d = df.distance_m(i);
+    field_[i] = std::isfinite(d) ? static_cast<float>(std::exp(k * d * d)) : 0.0f;
+  }
+
+  // Max-pooled pyramid for the global search, on the domain extended by pad_ below and left.
+  const int levels = options_.global_levels;
+  pad_ = 1 << levels;
+  const int ew = width_ + pad_, eh = height_ + pad_;
+  pooled_.assign(static_cast<std::size_t>(levels) + 1, std::vector<float>(static_cast<std::size_t>(ew) * eh, 0.0f));
+  for (int y = 0; y < height_; ++y) {
+    for (int x = 0; x < width_; ++x) {
+      pooled_[0][static_cast<std::size_t>(y + pad_) * ew + (x + pad_)] = field_[static_cast<std::size_t>(y) * width_ + x];
+    }
+  }
+  for (int h = 1; h <= levels; ++h) {
+    const int half = 1 << (h - 1);
+    const std::vector<float>& lo = pooled_[static_cast<std::size_t>(h) - 1];
+    std::vector<float>& hi = pooled_[static_cast<std::size_t>(h)];
+    auto at = [&](int ex, int ey) -> float {
+      return ex < ew && ey < eh ? lo[static_cast<std::size_t>(ey) * ew + ex] : 0.0f;
+    };
+    for (int ey = 0; ey < eh; ++ey) {
+      for (int ex = 0; ex < ew; ++ex) {
+        hi[static_cast<std::size_t>(ey) * ew + ex] =
+            std::max(std::max(at(ex, ey), at(ex + half, ey)), std::max(at(ex, ey + half), at(ex + half, ey + half)));
+      }
+    }
+  }
+
+  const auto n = static_cast<std::size_t>(options_.max_points);
+  px_.reserve(n);
+  py_.reserve(n);
+  range_.reserve(n);
+  const int nx = static_cast<int>(std::ceil(std::max(options_.search_xy_m, options_.max_search_xy_m) / cell_m_));
+  const int nt = static_cast<int>(
+      std::ceil(std::max(options_.search_theta_rad, options_.max_search_theta_rad) / options_.angular_step_rad));
+  const auto headings = static_cast<std::size_t>(2 * nt + 1);
+  cx_.resize(headings * n);
+  cy_.resize(headings * n);
+  const auto side = static_cast<std::size_t>(nx + 1);
+  blocks_.resize(headings * side * side);
+}
+
+std::size_t ScanMatcher::set_scan(const LaserScan& scan, const Pose2D& base_from_laser) noexcept {
+  px_.clear();
+  py_.clear();
+  range_.clear();
+  const std::size_t n = scan.ranges_m.size();
+  const std::size_t cap = static_cast<std::size_t>(options_.max_points);
+  const std::size_t stride = n <= cap ? 1 : (n + cap - 1) / cap;
+  const double lo = std::max(scan.range_min_m, 1e-3);
+  const double hi = std::min(scan.range_max_m > 0.0 ? scan.range_max_m : options_.max_range_m, options_.max_range_m);
+  const double c0 = std::cos(base_from_laser.theta_rad), s0 = std::sin(base_from_laser.theta_rad);
+  for (std::size_t i = 0; i < n && px_.size() < cap; i += stride) {
+    const double r = scan.ranges_m[i];
+    // a return at the maximum range is the scanner's "nothing seen", not a wall
+    if (!std::isfinite(r) || r < lo || r >= hi) continue;
+    const double a = scan.angle_min_rad + static_cast<double>(i) * scan.angle_increment_rad;
+    const double lx = r * std::cos(a), ly = r * std::sin(a);
+    px_.push_back(static_cast<float>(base_from_laser.x_m + c0 * lx - s0 * ly));
+    py_.push_back(static_cast<float>(base_from_laser.y_m + s0 * lx + c0 * ly));
+    range_.push_back(static_cast<float>(std::hypot(px_.back(), py_.back())));
+  }
+  return px_.size();
+}
+
+ScanMatcher::GridPose ScanMatcher::to_grid(const Pose2D& p) const noexcept {
+  const Point2D g = map_.to_grid_frame({p.x_m, p.y_m});
+  return {g.x_m / cell_m_, g.y_m / cell_m_, p.theta_rad - map_.origin().theta_rad};
+}
+
+Pose2D ScanMatcher::from_grid(const GridPose& g) const noexcept {
+  const Point2D p = map_.from_grid_frame({g.x * cell_m_, g.y * cell_m_});
+  return {p.x_m, p.y_m, wrap_angle(g.theta + map_.origin().theta_rad)};
+}
+
+void ScanMatcher::rotate_points(double theta, double x, double y, std::size_t count, int* cx, int* cy) const noexcept {
+  const double c = std::cos(theta) / cell_m_, s = std::sin(theta) / cell_m_;
+  for (std::size_t i = 0; i < count; ++i) {
+    cx[i] = static_cast<int>(std::floor(x + c * px_[i] - s * py_[i]));
+    cy[i] = static_cast<int>(std::floor(y + s * px_[i] + c * py_[i]));
+  }
+}
+
+float ScanMatcher::sum_at(const int* cx, const int* cy, std::size_t count, int dx, int dy) const noexcept {
+  float s = 0.0f;
+  const auto w = static_cast<unsigned>(width_), h = static_cast<unsigned>(height_);
+  for (std::size_t i = 0; i < count; ++i) {
+    const auto x = static_cast<unsigned>(cx[i] + dx), y = static_cast<unsigned>(cy[i] + dy);
+    if (x < w && y < h) s += field_[static_cast<std::size_t>(y) * w + x];
+  }
+  return s;
+}
+
+float ScanMatcher::pooled_sum(int level, const int* cx, const int* cy, std::size_t count, int x, int y) const noexcept {
+  const std::vector<float>& f = pooled_[static_cast<std::size_t>(level)];
+  const auto w = static_cast<unsigned>(width_ + pad_), h = static_cast<unsigned>(height_ + pad_);
+  float s = 0.0f;
+  for (std::size_t i = 0; i < count; ++i) {
+    const auto ex = static_cast<unsigned>(cx[i] + x + pad_), ey = static_cast<unsigned>(cy[i] + y + pad_);
+    if (ex < w && ey < h) s += f[static_cast<std::size_t>(ey) * w + ex];
+  }
+  return s;
+}
+
+double ScanMatcher::score_bilinear(const GridPose& g) const noexcept {
+  const double c = std::cos(g.theta) / cell_m_, s = std::sin(g.theta) / cell_m_;
+  double total = 0.0;
+  auto at = [&](int x, int y) -> double {
+    return static_cast<unsigned>(x) < static_cast<unsigned>(width_) && static_cast<unsigned>(y) < static_cast<unsigned>(height_)
+               ? field_[static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x)]
+               : 0.0;
+  };
+  for (std::size_t i = 0; i < px_.size(); ++i) {
+    // the field holds cell-centre values: interpolate between the four nearest centres
+    const double u = g.x + c * px_[i] - s * py_[i] - 0.5;
+    const double v = g.y + s * px_[i] + c * py_[i] - 0.5;
+    const double fu = std::floor(u), fv = std::floor(v);
+    const int x = static_cast<int>(fu), y = static_cast<int>(fv);
+    const double a = u - fu, b = v - fv;
+    total += (1 - b) * ((1 - a) * at(x, y) + a * at(x + 1, y)) + b * ((1 - a) * at(x, y + 1) + a * at(x + 1, y + 1));
+  }
+  return total;
+}
+
+ScanMatcher::GridPose ScanMatcher::hill_climb(GridPose g, double step_cells, double step_rad) const noexcept {
+  double best = score_bilinear(g);
+  for (int halvings = 0, moves = 0; halvings < 4 && moves < 60; ++moves) {
+    const GridPose around[6] = {{g.x + step_cells, g.y, g.theta}, {g.x - step_cells, g.y, g.theta},
+                                {g.x, g.y + step_cells, g.theta}, {g.x, g.y - step_cells, g.theta},
+                                {g.x, g.y, g.theta + step_rad},   {g.x, g.y, g.theta - step_rad}};
+    int pick = -1;
+    for (int k = 0; k < 6; ++k) {
+      const double s = score_bilinear(around[k]);
+      if (s > best) {
+        best = s;
+        pick = k;
+      }
+    }
+    if (pick >= 0) {
+      g = around[pick];
+    } else {
+      step_cells *= 0.5;
+      step_rad *= 0.5;
+      ++halvings;
+    }
+  }
+  return g;
+}
+
+double ScanMatcher::quality_at(const Pose2D& pose) const noexcept {
+  return px_.empty() ? 0.0 : score_bilinear(to_grid(pose)) / static_cast<double>(px_.size());
+}
+
+ScanMatch ScanMatcher::match(const Pose2D& predicted, double search_xy_m, double search_theta_rad) noexcept {
+  ScanMatch out;
+  out.pose = predicted;
+  const std::size_t n = px_.size();
+  out.points = n;
+  if (n == 0) return out;
+  const GridPose g0 = to_grid(predicted);
+  const int nx = static_cast<int>(std::ceil(std::clamp(search_xy_m, 0.0, options_.max_search_xy_m) / cell_m_));
+  const int nt = static_cast<int>(
+      std::ceil(std::clamp(search_theta_rad, 0.0, options_.max_search_theta_rad) / options_.angular_step_rad));
+  const double step = options_.angular_step_rad;
+  // Branch and bound over one level: every heading's 2 x 2-cell blocks are bounded with the
+  // pooled field, and only blocks whose bound beats the best full score are scored cell by cell.
+  // The answer is the exhaustive search's, at about a quarter of its cost.
+  std::size_t count = 0;
+  for (int k = -nt; k <= nt; ++k) {
+    int* cx = cx_.data() + static_cast<std::size_t>(k + nt) * n;
+    int* cy = cy_.data() + static_cast<std::size_t>(k + nt) * n;
+    rotate_points(g0.theta + k * step, g0.x, g0.y, n, cx, cy);
+    for (int dy = -nx; dy <= nx; dy += 2) {
+      for (int dx = -nx; dx <= nx; dx += 2) blocks_[count++] = {pooled_sum(1, cx, cy, n, dx, dy), k, dx, dy};
+    }
+  }
+  std::sort(blocks_.begin(), blocks_.begin() + static_cast<std::ptrdiff_t>(count),
+            [](const Block& l, const Block& r) { return l.bound > r.bound; });
+  float best = -1.0f;
+  int bk = 0, bx = 0, by = 0;
+  auto nearer = [](int k, int x, int y, int k2, int x2, int y2) {
+    return std::abs(k) + std::abs(x) + std::abs(y) < std::abs(k2) + std::abs(x2) + std::abs(y2);
+  };
+  for (std::size_t c = 0; c < count; ++c) {
+    const Block& blk = blocks_[c];
+    if (blk.bound < best) break;
+    const int* cx = cx_.data() + static_cast<std::size_t>(blk.k + nt) * n;
+    const int* cy = cy_.data() + static_cast<std::size_t>(blk.k + nt) * n;
+    for (int dy = blk.dy; dy <= std::min(blk.dy + 1, nx); ++dy) {
+      for (int dx = blk.dx; dx <= std::min(blk.dx + 1, nx); ++dx) {
+        const float sc = sum_at(cx, cy, n, dx, dy);
+        // ties go to the pose nearest the prediction (the odometry is the prior)
+        if (sc > best || (sc == best && nearer(blk.k, dx, dy, bk, bx, by))) {
+          best = sc;
+          bk = blk.k;
+          bx = dx;
+          by = dy;
+        }
+      }
+    }
+  }
+  // The covariance from the scores around the best pose, each weighted by how close its quality
+  // comes to the best one.
+  double sw = 0.0;
+  std::array<double, 3> m1{};
+  std::array<double, 6> m2{};  // xx xy xt yy yt tt
+  const double inv_n = 1.0 / static_cast<double>(n);
+  for (int k = std::max(-nt, bk - kCovarianceReach); k <= std::min(nt, bk + kCovarianceReach); ++k) {
+    const int* cx = cx_.data() + static_cast<std::size_t>(k + nt) * n;
+    const int* cy = cy_.data() + static_cast<std::size_t>(k + nt) * n;
+    for (int dy = by - kCovarianceReach; dy <= by + kCovarianceReach; ++dy) {
+      for (int dx = bx - kCovarianceReach; dx <= bx + kCovarianceReach; ++dx) {
+        const double w = std::exp((sum_at(cx, cy, n, dx, dy) - best) * inv_n / kQualityScale);
+        if (w < 1e-6) continue;
+        const double vx = (dx - bx) * cell_m_, vy = (dy - by) * cell_m_, vt = (k - bk) * step;
+        sw += w;
+        m1[0] += w * vx;
+        m1[1] += w * vy;
+        m1[2] += w * vt;
+        m2[0] += w * vx * vx;
+        m2[1] += w * vx * vy;
+        m2[2] += w * vx * vt;
+        m2[3] += w * vy * vy;
+        m2[4] += w * vy * vt;
+        m2[5] += w * vt * vt;
+      }
+    }
+  }
+  const GridPose coarse{g0.x + bx, g0.y + by, g0.theta + bk * step};
+  const GridPose fine = hill_climb(coarse, 0.5, 0.5 * step);
+  out.pose = from_grid(fine);
+  out.quality = score_bilinear(fine) * inv_n;
+  const double mx = m1[0] / sw, my = m1[1] / sw, mt = m1[2] / sw;
+  // the discretisation's own uncertainty (uniform over a step) is the floor
+  const double fx = cell_m_ * cell_m_ / 12.0, ft = step * step / 12.0;
+  const double xx = m2[0] / sw - mx * mx + fx, xy = m2[1] / sw - mx * my, xt = m2[2] / sw - mx * mt;
+  const double yy = m2[3] / sw - my * my + fx, yt = m2[4] / sw - my * mt, tt = m2[5] / sw - mt * mt + ft;
+  // the window is in the grid frame; rotate x, y into the map frame
+  const double c = std::cos(map_.origin().theta_rad), s = std::sin(map_.origin().theta_rad);
+  const double mxx = c * c * xx - 2 * c * s * xy + s * s * yy;
+  const double myy = s * s * xx + 2 * c * s * xy + c * c * yy;
+  const double mxy = c * s * (xx - yy) + (c * c - s * s) * xy;
+  const double mxt = c * xt - s * yt, myt = s * xt + c * yt;
+  out.covariance = {mxx, mxy, mxt, mxy, myy, myt, mxt, myt, tt};
+  return out;
+}
+
+ScanMatch ScanMatcher::track(const Pose2D& predicted, const Pose2D& motion, const TrackingWindow& window) noexcept {
+  const double moved_m = std::hypot(motion.x_m, motion.y_m), turned_rad = std::abs(wrap_angle(motion.theta_rad));
+  ScanMatch m = match(predicted, options_.search_xy_m + window.m_per_m * moved_m,
+                      options_.search_theta_rad + window.rad_per_rad * turned_rad + window.rad_per_m * moved_m);
+  if (m.quality < window.retry_quality) {
+    const ScanMatch wide = match(predicted, options_.max_search_xy_m, options_.max_search_theta_rad);
+    if (wide.quality > m.quality) m = wide;
+  }
+  return m;
+}
+
+ScanMatch ScanMatcher::match_global() {
+  // Only the nearer points: a heading step moves a far point by several cells, which the
+  // pooled bounds would not cover.
+  std::vector<std::size_t> near;
+  near.reserve(px_.size());
+  for (std::size_t i = 0; i < px_.size(); ++i) {
+    if (range_[i] <= options_.global_max_range_m) near.push_back(i);
+  }
+  ScanMatch out;
+  if (near.empty()) return out;
+  const std::size_t m = near.size();
+  const double step = options_.global_angular_step_rad;
+  const int headings = static_cast<int>(std::ceil(2.0 * std::numbers::pi / step));
+  gcx_.resize(static_cast<std::size_t>(headings) * m);
+  gcy_.resize(static_cast<std::size_t>(headings) * m);
+  const double theta0 = -std::numbers::pi;
+  for (int a = 0; a < headings; ++a) {
+    const double t = theta0 + a * step;
+    const double c = std::cos(t) / cell_m_, s = std::sin(t) / cell_m_;
+    int* ox = gcx_.data() + static_cast<std::size_t>(a) * m;
+    int* oy = gcy_.data() + static_cast<std::size_t>(a) * m;
+    for (std::size_t j = 0; j < m; ++j) {
+      const std::size_t i = near[j];
+      // the robot stands at a cell centre: offset of the point's cell from the robot's cell
+      ox[j] = static_cast<int>(std::floor(0.5 + c * px_[i] - s * py_[i]));
+      oy[j] = static_cast<int>(std::floor(0.5 + s * px_[i] + c * py_[i]));
+    }
+  }
+  struct Candidate {
+    float score;
+    int a, x, y;
+  };
+  const int top = options_.global_levels;
+  const int tile = 1 << top;
+  std::vector<Candidate> roots;
+  for (int a = 0; a < headings; ++a) {
+    const int* ox = gcx_.data() + static_cast<std::size_t>(a) * m;
+    const int* oy = gcy_.data() + static_cast<std::size_t>(a) * m;
+    for (int y = 0; y < height_; y += tile) {
+      for (int x = 0; x < width_; x += tile) roots.push_back({pooled_sum(top, ox, oy, m, x, y), a, x, y});
+    }
+  }
+  auto by_score = [](const Candidate& l, const Candidate& r) { return l.score > r.score; };
+  std::sort(roots.begin(), roots.end(), by_score);
+  float best = 0.0f;
+  Candidate winner{-1.0f, 0, 0, 0};
+  // depth-first, best child first: the first leaves found set a high bar that prunes the rest
+  auto branch = [&](auto&& self, const Candidate& c, int level) -> void {
+    if (c.score <= best) return;
+    if (level == 0) {
+      if (map_.is_free({c.x, c.y})) {
+        best = c.score;
+        winner = c;
+      }
+      return;
+    }
+    const int half = 1 << (level - 1);
+    const int* ox = gcx_.data() + static_cast<std::size_t>(c.a) * m;
+    const int* oy = gcy_.data() + static_cast<std::size_t>(c.a) * m;
+    std::array<Candidate, 4> kids;
+    int count = 0;
+    for (int k = 0; k < 4; ++k) {
+      const int x = c.x + (k & 1) * half, y = c.y + (k >> 1) * half;
+      if (x >= width_ || y >= height_) continue;
+      kids[static_cast<std::size_t>(count++)] = {pooled_sum(level - 1, ox, oy, m, x, y), c.a, x, y};
+    }
+    // best first; an insertion sort of at most four (std::sort here trips GCC 12's bounds check)
+    for (int i = 1; i < count; ++i) {
+      for (int j = i; j > 0 && by_score(kids[static_cast<std::size_t>(j)], kids[static_cast<std::size_t>(j) - 1]); --j) {
+        std::swap(kids[static_cast<std::size_t>(j)], kids[static_cast<std::size_t>(j) - 1]);
+      }
+    }
+    for (int k = 0; k < count; ++k) self(self, kids[static_cast<std::size_t>(k)], level - 1);
+  };
+  for (const Candidate& c : roots) {
+    if (c.score <= best) break;
+    branch(branch, c, top);
+  }
+  if (winner.score < 0.0f) return out;
+  const GridPose g{winner.x + 0.5, winner.y + 0.5, theta0 + winner.a * step};
+  return match(from_grid(g));
+}
+
+}  // namespace tripodal::navi

@@ -1,0 +1,302 @@
+#include "tripodal/navi/scan_matching_localizer.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <numbers>
+
+#include "tripodal/navi/map_builder.hpp"
+#include "tripodal/navi/scan_matcher.hpp"
+#include "tripodal/sim/ray_caster.hpp"
+
+using namespace tripodal;
+using namespace tripodal::navi;
+
+namespace {
+
+// A 10 m x 8 m room, 5 cm cells, with an L-shaped partition and two boxes placed so that no
+// rotation or mirror of the room looks like itself (the global search has one answer).
+OccupancyGrid room() {
+  OccupancyGrid g(200, 160, 0.05, Pose2D{-1.0, -2.0, 0.0}, Occupancy::free);
+  auto block = [&](int x0, int y0, int x1, int y1) {
+    for (int y = y0; y <= y1; ++y) {
+      for (int x = x0; x <= x1; ++x) g.set_state({x, y}, Occupancy::occupied);
+    }
+  };
+  block(0, 0, 199, 1);
+  block(0, 158, 199, 159);
+  block(0, 0, 1, 159);
+  block(198, 0, 199, 159);
+  block(120, 60, 121, 159 - 40);  // the partition's long leg
+  block(120, 60, 160, 61);        // its foot
+  block(30, 110, 45, 125);        // a cupboard
+  block(60, 20, 64, 24);          // a bin
+  return g;
+}
+
+// A 180-degree scanner with 181 beams, as the CARMEN logs' SICK.
+LaserScan scan_at(const sim::SolidMap& solid, const Pose2D& pose, double max_range_m = 20.0) {
+  LaserScan s;
+  s.angle_min_rad = -std::numbers::pi / 2;
+  s.angle_increment_rad = std::numbers::pi / 180.0;
+  s.angle_max_rad = std::numbers::pi / 2;
+  s.range_min_m = 0.05;
+  s.range_max_m = max_range_m;
+  s.ranges_m.resize(181);
+  for (std::size_t i = 0; i < s.ranges_m.size(); ++i) {
+    const double a = pose.theta_rad + s.angle_min_rad + static_cast<double>(i) * s.angle_increment_rad;
+    const double r = solid.cast({pose.x_m, pose.y_m}, a, max_range_m);
+    s.ranges_m[i] = static_cast<float>(std::isfinite(r) ? r : max_range_m);
+  }
+  return s;
+}
+
+double distance(const Pose2D& a, const Pose2D& b) { return std::hypot(a.x_m - b.x_m, a.y_m - b.y_m); }
+
+// The true path: a loop through the room, 0.1 m and up to 0.08 rad per scan.
+Pose2D true_pose(int k) {
+  const double t = 0.02 * k;
+  return {2.5 + 1.5 * std::cos(t), 2.0 + 1.2 * std::sin(t), wrap_angle(t + std::numbers::pi / 2)};
+}
+
+// Odometry that drifts: 4 % too long and a heading bias of 0.004 rad per scan.
+struct DriftingOdometry {
+  Pose2D odom{};
+  Pose2D last_truth{};
+  bool started = false;
+  Pose2D read(const Pose2D& truth) {
+    if (!started) {
+      started = true;
+      last_truth = truth;
+      odom = truth;
+      return odom;
+    }
+    Pose2D d = compose(inverse(last_truth), truth);
+    d.x_m *= 1.04;
+    d.y_m *= 1.04;
+    d.theta_rad += 0.004;
+    odom = compose(odom, d);
+    last_truth = truth;
+    return odom;
+  }
+};
+
+Time at(int k) { return time_from_seconds(0.1 * k); }
+
+}  // namespace
+
+TEST_CASE("ScanMatcher: a scan taken at a pose matches back to it, and the covariance follows the geometry",
+          "[navi][scan_matching]") {
+  const OccupancyGrid g = room();
+  const sim::SolidMap solid(g);
+  ScanMatcher m(g);
+  const Pose2D truth{3.0, 1.0, 0.3};
+  REQUIRE(m.set_scan(scan_at(solid, truth)) > 150);
+  CHECK(m.quality_at(truth) > 0.8);
+  const ScanMatch r = m.match({truth.x_m + 0.15, truth.y_m - 0.12, truth.theta_rad + 0.1});
+  // The simulated beams stop at the faces of the wall cells, the field peaks at their centres:
+  // half a cell (2.5 cm) of bias is the model's, the rest the matcher's.
+  CHECK(distance(r.pose, truth) < 0.05);
+  CHECK(std::abs(wrap_angle(r.pose.theta_rad - truth.theta_rad)) < 0.015);
+  CHECK(r.quality > 0.8);
+  CHECK(r.covariance[0] > 0.0);
+  CHECK(r.covariance[4] > 0.0);
+  CHECK(r.covariance[8] > 0.0);
+  CHECK(std::sqrt(r.covariance[0]) < 0.1);
+
+  // a long corridor (walls along x only, open ends beyond the range) leaves x uncertain
+  OccupancyGrid corridor(400, 40, 0.05, {}, Occupancy::free);
+  for (int x = 0; x < 400; ++x) {
+    corridor.set_state({x, 0}, Occupancy::occupied);
+    corridor.set_state({x, 39}, Occupancy::occupied);
+  }
+  const sim::SolidMap csolid(corridor);
+  ScanMatcher cm(corridor);
+  const Pose2D c_truth{10.0, 1.0, 0.0};
+  cm.set_scan(scan_at(csolid, c_truth, 4.0));
+  const ScanMatch cr = cm.match(c_truth);
+  CHECK(cr.covariance[0] > 4.0 * cr.covariance[4]);
+}
+
+TEST_CASE("ScanMatchingLocalizer: tracks a loop on drifting odometry", "[navi][scan_matching]") {
+  const OccupancyGrid g = room();
+  const sim::SolidMap solid(g);
+  ScanMatchingLocalizerOptions o;
+  o.initial_pose = true_pose(0);
+  CScanMatchingLocalizer loc(o);
+  loc.set_map(g);
+  DriftingOdometry odo;
+  std::vector<ModuleEvent> ev;
+  double worst_m = 0.0, worst_rad = 0.0;
+  Pose2D dead_reckoning = true_pose(0);
+  for (int k = 0; k <= 300; ++k) {
+    const Pose2D truth = true_pose(k);
+    const Pose2D odom = odo.read(truth);
+    loc.step(scan_at(solid, truth), odom, at(k), ev);
+    worst_m = std::max(worst_m, distance(loc.estimate(), truth));
+    worst_rad = std::max(worst_rad, std::abs(wrap_angle(loc.estimate().theta_rad - truth.theta_rad)));
+    dead_reckoning = odom;
+  }
+  CHECK(worst_m < 0.05);
+  CHECK(worst_rad < 0.02);
+  CHECK(distance(dead_reckoning, true_pose(300)) > 0.5);  // the odometry alone is far off
+  REQUIRE(ev.size() == 1);
+  CHECK(ev[0].name == "localizer.ok");
+  CHECK(loc.localized());
+  NavigationData nd;
+  loc.publish(nd);
+  CHECK(nd.localized);
+  CHECK(nd.pose_stamp == at(300));
+}
+
+TEST_CASE("ScanMatchingLocalizer: a kidnapped robot is lost, and the global search finds it again",
+          "[navi][scan_matching]") {
+  const OccupancyGrid g = room();
+  const sim::SolidMap solid(g);
+  ScanMatchingLocalizerOptions o;
+  o.initial_pose = true_pose(0);
+  o.lost_after_scans = 3;
+  CScanMatchingLocalizer loc(o);
+  loc.set_map(g);
+  std::vector<ModuleEvent> ev;
+  DriftingOdometry odo;
+  for (int k = 0; k < 20; ++k) loc.step(scan_at(solid, true_pose(k)), odo.read(true_pose(k)), at(k), ev);
+  REQUIRE(ev.size() == 1);
+  CHECK(ev[0].name == "localizer.ok");
+  ev.clear();
+  // carried to the other side of the partition, turned round: the odometry does not see it
+  const Pose2D kidnapped{6.0, 3.5, -2.0};
+  const Pose2D odom_still = odo.odom;
+  int lost_at = -1;
+  for (int k = 20; k < 30 && lost_at < 0; ++k) {
+    loc.step(scan_at(solid, kidnapped), odom_still, at(k), ev);
+    if (!ev.empty()) lost_at = k;
+  }
+  REQUIRE(ev.size() == 1);
+  CHECK(ev[0].name == "localizer.lost");
+  CHECK_THAT(ev[0].message, Catch::Contains("stopped matching"));
+  CHECK(lost_at == 22);  // after lost_after_scans scans, not at the first bad one
+  CHECK_FALSE(loc.localized());
+  CHECK(distance(loc.estimate(), kidnapped) > 1.0);
+  ev.clear();
+  REQUIRE(loc.relocalize());
+  CHECK(distance(loc.estimate(), kidnapped) < 0.08);
+  CHECK(std::abs(wrap_angle(loc.estimate().theta_rad - kidnapped.theta_rad)) < 0.03);
+  loc.step(scan_at(solid, kidnapped), odom_still, at(31), ev);
+  REQUIRE(ev.size() == 1);
+  CHECK(ev[0].name == "localizer.ok");
+  CHECK(loc.localized());
+}
+
+TEST_CASE("ScanMatchingLocalizer: a blinded laser is a loss that heals by itself", "[navi][scan_matching]") {
+  const OccupancyGrid g = room();
+  const sim::SolidMap solid(g);
+  ScanMatchingLocalizerOptions o;
+  o.initial_pose = true_pose(0);
+  CScanMatchingLocalizer loc(o);
+  loc.set_map(g);
+  std::vector<ModuleEvent> ev;
+  DriftingOdometry odo;
+  for (int k = 0; k < 60; ++k) {
+    LaserScan s = scan_at(solid, true_pose(k));
+    if (k >= 20 && k < 30) {
+      for (float& r : s.ranges_m) r = 0.02f;  // covered: every return below range_min
+    }
+    loc.step(s, odo.read(true_pose(k)), at(k), ev);
+  }
+  REQUIRE(ev.size() == 3);
+  CHECK(ev[0].name == "localizer.ok");
+  CHECK(ev[1].name == "localizer.lost");
+  CHECK(ev[1].stamp == at(24));
+  CHECK(ev[2].name == "localizer.ok");
+  CHECK(ev[2].stamp == at(30));
+  CHECK(distance(loc.estimate(), true_pose(59)) < 0.05);
+}
+
+TEST_CASE("ScanMatchingLocalizer: an unknown start is found by the global search on the first scan",
+          "[navi][scan_matching]") {
+  const OccupancyGrid g = room();
+  const sim::SolidMap solid(g);
+  ScanMatchingLocalizerOptions o;
+  o.start_global = true;
+  CScanMatchingLocalizer loc(o);
+  loc.set_map(g);
+  std::vector<ModuleEvent> ev;
+  const Pose2D truth{7.5, 1.0, 2.5};
+  loc.step(scan_at(solid, truth), Pose2D{}, at(0), ev);
+  CHECK(distance(loc.estimate(), truth) < 0.05);
+  REQUIRE(ev.size() == 1);
+  CHECK(ev[0].name == "localizer.ok");
+}
+
+TEST_CASE("ScanMatcher and ScanMatchingLocalizer refuse bad options and maps with locations",
+          "[navi][scan_matching]") {
+  const OccupancyGrid g = room();
+  const SourceLocation where{"robot.yaml", 12, 5};
+  ScanMatcherOptions bad;
+  bad.sigma_m = -0.1;
+  bad.global_levels = 0;
+  REQUIRE_THROWS_WITH(ScanMatcher(g, bad, where), Catch::Contains("robot.yaml:12:5") &&
+                                                      Catch::Contains("sigma_m must be a number > 0") &&
+                                                      Catch::Contains("global_levels must be 1..10"));
+  const OccupancyGrid empty(50, 50, 0.05, {}, Occupancy::free);
+  REQUIRE_THROWS_WITH(ScanMatcher(empty, {}, where),
+                      Catch::Contains("robot.yaml:12:5") && Catch::Contains("no occupied cell"));
+  const OccupancyGrid tiny(1, 1, 0.05, {}, Occupancy::occupied);
+  REQUIRE_THROWS_WITH(ScanMatcher(tiny, {}, where), Catch::Contains("expected at least 2 x 2"));
+
+  CScanMatchingLocalizer loc;
+  REQUIRE_THROWS_WITH(loc.configure({{"sigma_m", Value{0.0}}}, where),
+                      Catch::Contains("robot.yaml:12:5") && Catch::Contains("sigma_m"));
+  loc.configure({}, where);
+  ModuleContext context;
+  REQUIRE_THROWS_WITH(loc.start(context), Catch::Contains("robot.yaml:12:5") && Catch::Contains("GridMaps"));
+  loc.set_map(g);
+  REQUIRE_THROWS_WITH(loc.start(context), Catch::Contains("no laser resource"));
+}
+
+TEST_CASE("MapBuilder: a map from drifting odometry lines up with the world and localizes", "[navi][scan_matching]") {
+  const OccupancyGrid world = room();
+  const sim::SolidMap solid(world);
+  MapBuilder b({-1.5, -2.5}, {9.5, 6.5});
+  DriftingOdometry odo;
+  double worst_step_m = 0.0;
+  Pose2D prev_est, prev_truth;
+  for (int k = 0; k <= 320; k += 2) {
+    const Pose2D truth = true_pose(k);
+    const Pose2D est = b.add(scan_at(solid, truth), odo.read(truth), true_pose(0));
+    if (k > 0) {
+      // relative motion between consecutive scans, against the truth's (Kuemmerle et al.)
+      const Pose2D de = compose(inverse(prev_est), est), dt = compose(inverse(prev_truth), truth);
+      worst_step_m = std::max(worst_step_m, std::hypot(de.x_m - dt.x_m, de.y_m - dt.y_m));
+    }
+    prev_est = est;
+    prev_truth = truth;
+  }
+  CHECK(worst_step_m < 0.05);
+  CHECK(distance(prev_est, true_pose(320)) < 0.1);
+  const OccupancyGrid map = b.grid();
+  // every wall cell the builder marked is on or next to a wall of the world
+  std::size_t marked = 0, on_wall = 0;
+  for (std::size_t i = 0; i < map.size(); ++i) {
+    if (map.state(i) != Occupancy::occupied) continue;
+    ++marked;
+    const Point2D p = map.cell_center(map.cell(i));
+    bool near = false;
+    for (double dy = -0.05; dy <= 0.051 && !near; dy += 0.05) {
+      for (double dx = -0.05; dx <= 0.051 && !near; dx += 0.05) near = world.is_occupied(world.cell_at({p.x_m + dx, p.y_m + dy}));
+    }
+    on_wall += near ? 1 : 0;
+  }
+  REQUIRE(marked > 500);
+  CHECK(static_cast<double>(on_wall) > 0.95 * static_cast<double>(marked));
+  // and the map it made is one the localizer can work on
+  ScanMatcher m(map);
+  m.set_scan(scan_at(solid, true_pose(100)));
+  CHECK(distance(m.match(compose(true_pose(100), Pose2D{0.1, -0.1, 0.05})).pose, true_pose(100)) < 0.08);
+
+  REQUIRE_THROWS_WITH(MapBuilder({0, 0}, {-1, 5}), Catch::Contains("is empty or larger than a map image may be"));
+  MapBuilderOptions bad;
+  bad.resolution_m = 0.0;
+  REQUIRE_THROWS_WITH(MapBuilder({0, 0}, {5, 5}, bad), Catch::Contains("resolution_m must be a number > 0"));
+}
