@@ -67,6 +67,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
   std::map<std::string, std::string, std::less<>> behavior_params;  // behavior -> "a=1, b=2"
   bool nets_changed = true;
   std::uint32_t path_id = ~0U;
+  Time last_scan{Duration{-1}};
   bool map_sent = false;
   std::chrono::steady_clock::time_point last_publish{}, last_cleaned{};
 
@@ -260,7 +261,9 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
       for (const Pose2D& p : nav.path) poses.push_back({{"timestamp", stamp(t)}, {"frame_id", "map"}, {"pose", pose_json(p)}});
       server.publish(ch_path, t, json{{"timestamp", stamp(t)}, {"frame_id", "map"}, {"poses", poses}}.dump());
     }
-    if (const auto* laser = robot.resources().first<LaserScan>(); laser != nullptr && laser->has_reading()) {
+    // A scan once, when it is new (a scanner turns slower than the monitor publishes).
+    if (const auto* laser = robot.resources().first<LaserScan>(); laser != nullptr && laser->has_reading() && laser->stamp() != last_scan) {
+      last_scan = laser->stamp();
       const LaserScan& s = laser->latest();
       json ranges = json::array();
       // Millimetres are all a drawing needs, and the scan is the largest message (shortest decimals).
