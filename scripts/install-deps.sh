@@ -19,8 +19,9 @@ packages=(
   graphviz libxml2-utils
   zlib1g-dev
 )
-# The monitor's protocol test (tests/monitor/protocol_test.py): a WebSocket client in Python.
-packages+=(python3 python3-websockets)
+# The monitor: Graphviz's library lays out the nets it draws (src/monitor/net_drawing.cpp); its
+# protocol test (tests/monitor/protocol_test.py) is a WebSocket client in Python.
+packages+=(libgraphviz-dev python3 python3-websockets)
 
 for group in "$@"; do
   case $group in

@@ -12,6 +12,7 @@
 #include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/navi/section_splitter.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
+#include "net_drawing.hpp"
 
 namespace tripodal::monitor {
 namespace {
@@ -55,6 +56,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
   MonitorServer& server;
   RobotMonitorOptions options;
   LifecycleRecorder life{true};
+  NetDrawing drawing;
   std::size_t life_published = 0;
 
   std::uint32_t ch_pose = 0, ch_path = 0, ch_map = 0, ch_cleaned = 0, ch_laser = 0, ch_nets = 0, ch_markings = 0,
@@ -85,7 +87,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
                                 R"({"type":"object","properties":{"frame_id":{"type":"string"},"pose":{"type":"object"},"start_angle":{"type":"number"},"end_angle":{"type":"number"},"ranges":{"type":"array","items":{"type":"number"}},"intensities":{"type":"array","items":{"type":"number"}}}})",
                                 Delivery::bulk);
     ch_nets = server.advertise("/nets", "tripodal.Nets",
-                               R"({"type":"object","properties":{"nets":{"type":"array","items":{"type":"object","properties":{"run":{"type":"string"},"net":{"type":"string"},"places":{"type":"array"},"transitions":{"type":"array"}}}}}})",
+                               R"({"type":"object","properties":{"nets":{"type":"array","items":{"type":"object","properties":{"run":{"type":"string"},"net":{"type":"string"},"places":{"type":"array"},"transitions":{"type":"array"},"svg":{"type":"string","description":"Graphviz dot layout"}}}}}})",
                                Delivery::state);
     ch_markings = server.advertise("/markings", "tripodal.Markings",
                                    R"({"type":"object","properties":{"nets":{"type":"array","items":{"type":"object","properties":{"run":{"type":"string"},"marked":{"type":"array"},"last_firing":{"type":"string"}}}}}})",
@@ -222,7 +224,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
         for (const ArcRef& a : t.outputs) out.push_back(a.place);
         transitions.push_back({{"id", t.id}, {"name", t.name}, {"event", t.event}, {"in", in}, {"out", out}});
       }
-      j["nets"].push_back({{"run", v.run}, {"net", v.net->id}, {"places", places}, {"transitions", transitions}});
+      j["nets"].push_back({{"run", v.run}, {"net", v.net->id}, {"places", places}, {"transitions", transitions}, {"svg", drawing.svg(*v.net)}});
     }
     server.publish(ch_nets, now_s(), j.dump());
   }

@@ -25,7 +25,7 @@ def main():
     run = MonitoredRun(exe, robot, world, "--start-paused", "--realtime", "10")
     options = webdriver.ChromeOptions()
     options.binary_location = "/usr/bin/chromium"
-    for arg in ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1400,1100"]:
+    for arg in ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1400,1500"]:
         options.add_argument(arg)
     driver = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
     try:
@@ -77,7 +77,7 @@ def main():
         # The robot starts at section A's entry: PrCleaning's P1 (BhCleaning) is marked at once.
         wait.until(lambda d: "breakpoint" in text("paused"))
         check(True, "the breakpoint paused the run: " + text("paused"))
-        marked = driver.find_elements(By.CSS_SELECTOR, 'svg[data-net="PrCleaning"] circle.place.marked[data-place="P1"]')
+        marked = driver.find_elements(By.CSS_SELECTOR, 'div.net[data-net="PrCleaning"] g.place.marked[data-place="P1"]')
         check(len(marked) == 1, "a place of PrCleaning (P1) is marked")
         t1 = text("time")
         time.sleep(1.0)
@@ -90,7 +90,7 @@ def main():
         wait.until(lambda d: xy(text("pose")) != xy(pose_before))
         check(True, "the pose changes on the map: %s -> %s" % (pose_before, text("pose")))
         wait.until(lambda d: float(text("time")) > float(t1) + 20)  # some cleaned cells for the picture
-        check(driver.find_elements(By.CSS_SELECTOR, 'svg[data-net="PrCleaning"] circle.place.marked[data-place="P1"]'),
+        check(driver.find_elements(By.CSS_SELECTOR, 'div.net[data-net="PrCleaning"] g.place.marked[data-place="P1"]'),
               "PrCleaning's P1 stays marked while the section is cleaned")
         driver.save_screenshot(screenshot)
         check(True, "screenshot kept: " + screenshot)
