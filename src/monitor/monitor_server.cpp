@@ -31,6 +31,7 @@ using SteadyTime = std::chrono::steady_clock::time_point;
 
 constexpr std::string_view kFoxglove = "foxglove.websocket.v1";
 constexpr std::size_t kMaxClientFrame = 64 * 1024;
+constexpr std::size_t kMaxOutbox = 4096;  // messages published but not yet taken by the server thread
 
 std::string random_token() {
   std::random_device rd;
@@ -604,6 +605,18 @@ void MonitorServer::stop() noexcept {
 void MonitorServer::publish(std::uint32_t channel, double stamp_s, std::string json) {
   {
     const std::lock_guard lock(impl_->mutex);
+    // A server that is not (or no longer) draining the outbox must not grow it without bound:
+    // bulk messages go oldest first here too (the channels do not change once started).
+    auto& out = impl_->outbox;
+    if (out.size() >= kMaxOutbox) {
+      const auto bulk = [this](const Message& m) {
+        return m.channel >= 1 && m.channel <= impl_->channels.size() && impl_->channels[m.channel - 1].delivery == Delivery::bulk;
+      };
+      if (const auto it = std::find_if(out.begin(), out.end(), bulk); it != out.end()) {
+        out.erase(it);
+        ++impl_->stats.bulk_shed;
+      }
+    }
     impl_->outbox.push_back(Message{channel, stamp_s, std::move(json)});
     ++impl_->stats.published;
   }

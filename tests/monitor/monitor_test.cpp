@@ -361,3 +361,11 @@ TEST_CASE("A robot on simulated time runs the same with a monitor whose client d
   CHECK(stats.slow_disconnects == 0);
   CHECK(stats.published >= 600 * 3 + 60 * 5);  // pose, markings, status at every update; each new scan
 }
+
+TEST_CASE("A server that is not running keeps a bounded outbox of bulk messages", "[monitor][server]") {
+  MonitorServer server;
+  const auto pose = server.advertise("/pose", "foxglove.PoseInFrame", "{}", Delivery::bulk);
+  for (int i = 0; i < 10000; ++i) server.publish(pose, i, "{}");
+  CHECK(server.stats().published == 10000);
+  CHECK(server.stats().bulk_shed == 10000 - 4096);  // the oldest went, 4096 wait
+}
