@@ -1,6 +1,7 @@
 #include "tripodal/monitor/robot_monitor.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -9,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tripodal/behaviors/behavior_registry.hpp"
 #include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/navi/section_splitter.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
@@ -42,6 +44,36 @@ std::string base64_bytes(const std::vector<std::uint8_t>& v) {
   return base64(std::string_view(reinterpret_cast<const char*>(v.data()), v.size()));
 }
 
+// The operator's hand on the robot: the velocity the console sends, submitted through the behavior
+// loop's coordinator on an input of its own ("operator") while a lock of the same name masks the
+// task's behaviors (never the safety inputs above them). Written by the monitor, read by the loop
+// (which may run on its own thread), hence atomics.
+struct DriveCommand {
+  std::atomic<double> vx_m_s{0.0}, vy_m_s{0.0}, wz_rad_s{0.0};
+};
+
+class BhOperatorDrive final : public CBehavior {
+ public:
+  explicit BhOperatorDrive(std::shared_ptr<const DriveCommand> command) : command_(std::move(command)) {}
+  static const ModuleManifest& static_manifest() {
+    static const ModuleManifest m =
+        behavior_manifest("BhOperatorDrive", "the velocity the operator gives on the monitor's console (body frame)", {}, {});
+    return m;
+  }
+
+ protected:
+  const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  void on_activate(const ParameterSet&, const BehaviorContext&) override {}
+  std::optional<Twist2D> on_step(const BehaviorContext&) noexcept override {
+    return Twist2D{command_->vx_m_s.load(), command_->vy_m_s.load(), command_->wz_rad_s.load()};
+  }
+
+ private:
+  std::shared_ptr<const DriveCommand> command_;
+};
+
+constexpr std::string_view kOperator = "operator";
+
 struct NetView {
   std::string run;
   const PetriNet* net = nullptr;
@@ -72,6 +104,9 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
   Time last_scan{Duration{-1}};
   bool map_sent = false;
   std::chrono::steady_clock::time_point last_publish{}, last_cleaned{};
+  std::shared_ptr<DriveCommand> drive = std::make_shared<DriveCommand>();
+  bool driving = false;
+  std::chrono::steady_clock::time_point last_drive{};
 
   Impl(Robot& r, const Clock& c, MonitorServer& s, RobotMonitorOptions o) : robot(r), clock(c), server(s), options(o) {
     ch_pose = server.advertise("/pose", "foxglove.PoseInFrame", pose_schema(), Delivery::bulk);
@@ -98,6 +133,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
     ch_status = server.advertise("/status", "tripodal.Status",
                                  R"({"type":"object","properties":{"time_s":{"type":"number"},"paused":{"type":"boolean"},"task_state":{"type":"string"},"velocity":{"type":"object"},"battery":{"type":["number","null"]},"coverage":{"type":["number","null"]},"behaviors":{"type":"array"},"winner":{"type":"string"}}})",
                                  Delivery::bulk);
+    add_operator_input();
     paused = options.start_paused;
     if (paused) pause_reason = "started paused";
     robot.planner().add_observer(*this);
@@ -107,6 +143,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
   }
 
   ~Impl() override {
+    stop_driving("monitor detached");
     robot.supervisor().remove_observer(life);
     robot.supervisor().remove_observer(*this);
     robot.planner().remove_observer(life);
@@ -116,6 +153,42 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
   Impl& operator=(const Impl&) = delete;
 
   double now_s() const { return to_seconds(clock.now()); }
+
+  // The operator's input ranks just above every normal input of the behavior loop, and its lock
+  // masks exactly those: the task's behaviors stop while the operator drives, safety stays.
+  void add_operator_input() {
+    CBehaviorCoordinator& c = robot.behavior_loop().coordinator();
+    if (c.find_input(kOperator)) return;
+    int top = 0;
+    for (std::size_t i = 0; i < c.input_count(); ++i) {
+      const CoordinatorInputConfig& in = c.input_config(static_cast<InputId>(i));
+      if (in.role == InputRole::normal) top = std::max(top, in.priority);
+    }
+    c.add_input(CoordinatorInputConfig{.name = std::string(kOperator), .priority = top + 1, .timeout = std::chrono::milliseconds(200), .weight = 1.0});
+    c.add_lock(CoordinatorLockConfig{.name = std::string(kOperator), .priority = top});
+  }
+
+  void stop_driving(std::string_view why) {
+    if (!driving) return;
+    driving = false;
+    ControlLoop& loop = robot.behavior_loop();
+    loop.deactivate(kOperator);
+    loop.set_lock(kOperator, false, clock.now());
+    note("operator: manual drive ended (" + std::string(why) + ")");
+  }
+
+  void drive_with(double vx, double vy, double wz) {
+    drive->vx_m_s = vx;
+    drive->vy_m_s = vy;
+    drive->wz_rad_s = wz;
+    last_drive = std::chrono::steady_clock::now();
+    if (driving) return;
+    ControlLoop& loop = robot.behavior_loop();
+    loop.activate(std::make_unique<BhOperatorDrive>(drive), {}, kOperator);
+    loop.set_lock(kOperator, true, clock.now());
+    driving = true;
+    note("operator: manual drive (the task's motion masked)");
+  }
 
   void note(std::string text) { life.note(clock.now(), std::move(text)); }
 
@@ -178,6 +251,21 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
       robot.planner().cancel("cancelled by the operator");
       return reply(200, {{"cancelled", true}});
     }
+    if (op == "drive") {
+      if (body.value("stop", false)) {
+        stop_driving("stopped by the operator");
+        return reply(200, {{"driving", false}});
+      }
+      for (const char* k : {"vx", "vy", "wz"}) {
+        if (body.contains(k) && !body[k].is_number()) return reply(400, {{"error", std::string("drive: \"") + k + "\" must be a number"}});
+      }
+      // Bounds of a hand on a joystick; the controller's limits apply after the coordinator.
+      const double vx = std::clamp(body.value("vx", 0.0), -1.0, 1.0);
+      const double vy = std::clamp(body.value("vy", 0.0), -1.0, 1.0);
+      const double wz = std::clamp(body.value("wz", 0.0), -2.0, 2.0);
+      drive_with(vx, vy, wz);
+      return reply(200, {{"driving", true}, {"deadman_s", options.drive_deadman_s}});
+    }
     if (op == "ack") {
       note("operator: fault acknowledged" + (body.contains("text") && body["text"].is_string() ? ": " + body["text"].get<std::string>() : ""));
       return reply(200, {{"acknowledged", true}});
@@ -193,7 +281,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
       note("monitor: breakpoint " + std::string(on ? "set" : "cleared") + " on place " + place);
       return reply(200, {{"breakpoints", std::vector<std::string>(breakpoints.begin(), breakpoints.end())}});
     }
-    reply(400, {{"error", "unknown op '" + op + "': expected task, pause, resume, cancel, ack or breakpoint"}});
+    reply(400, {{"error", "unknown op '" + op + "': expected task, pause, resume, cancel, ack, breakpoint or drive"}});
   }
 
   // --- topics -------------------------------------------------------------------------------------
@@ -313,6 +401,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
                 {"estimate", {{"x", nav.map_from_base.x_m}, {"y", nav.map_from_base.y_m}, {"theta", nav.map_from_base.theta_rad}}},
                 {"resources", resources},
                 {"breakpoints", std::vector<std::string>(breakpoints.begin(), breakpoints.end())},
+                {"driving", driving},
                 {"battery", nullptr},
                 {"coverage", extras.coverage ? json(*extras.coverage) : json(nullptr)}};
     if (const auto* battery = robot.resources().first<BatteryReading>(); battery != nullptr && battery->has_reading()) {
@@ -324,6 +413,10 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
 
   void update(const MonitorExtras& extras) {
     for (const OperatorRequest& r : server.take_requests()) handle(r);
+    // The dead-man switch: the console repeats the command while a key is held.
+    if (driving && std::chrono::steady_clock::now() - last_drive > std::chrono::duration<double>(options.drive_deadman_s)) {
+      stop_driving("no command for " + std::to_string(static_cast<int>(options.drive_deadman_s * 1000)) + " ms");
+    }
     if (!map_sent) publish_map();
     const double t = now_s();
     const auto& entries = life.entries();

@@ -369,3 +369,50 @@ TEST_CASE("A server that is not running keeps a bounded outbox of bulk messages"
   CHECK(server.stats().published == 10000);
   CHECK(server.stats().bulk_shed == 10000 - 4096);  // the oldest went, 4096 wait
 }
+
+TEST_CASE("Manual drive goes through the coordinator, masks the task's motion and stops at the dead-man timeout", "[monitor][robot]") {
+  const std::filesystem::path configs = std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs";
+  RobotPlugins plugins = RobotPlugins::with_builtins();
+  sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(configs / "worlds/workspace.yaml")));
+  SimClock clock;
+  const auto robot = Robot::assemble(load_robot_profile(configs / "robots/psr2.yaml"), plugins, clock);
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*robot, clock, server, RobotMonitorOptions{.min_interval_s = 0.0, .drive_deadman_s = 0.05});
+  server.start();
+  auto post = [&](const std::string& body) {
+    Client c(server.port());
+    c.send("POST /api/command HTTP/1.1\r\nAuthorization: Bearer t0ken-for-tests\r\nContent-Length: " + std::to_string(body.size()) +
+           "\r\n\r\n" + body);
+    // The robot's thread answers between periods.
+    std::string answer;
+    REQUIRE(wait_for([&] {
+      watch.update();
+      answer = c.read_until([](const std::string& b) { return b.find("\r\n\r\n{") != std::string::npos && b.back() == '}'; },
+                            std::chrono::milliseconds(20));
+      return !answer.empty() && answer.back() == '}';
+    }));
+    return answer;
+  };
+  REQUIRE(robot->command("clean the room 3211").accepted);
+  robot->run_for(std::chrono::seconds(5));
+  CHECK(robot->behavior_active("BhCleaning"));
+
+  CHECK_THAT(post(R"({"op":"drive","vx":"fast"})"), Catch::Contains(R"(drive: \"vx\" must be a number)"));
+  CHECK_THAT(post(R"({"op":"drive","vx":0.0,"wz":1.0})"), Catch::Contains(R"("driving":true)"));
+  const Pose2D before = robot->navigation().map_from_base;
+  robot->run_for(std::chrono::seconds(1));
+  const CycleReport& cycle = robot->behavior_loop().last_cycle();
+  CHECK(cycle.coordinator.locked);
+  CHECK(cycle.coordinator.lock == "operator");
+  CHECK(cycle.coordinator.command.wz_rad_s > 0.5);  // turning on the spot as told, nothing of the cleaning path
+  CHECK(std::abs(cycle.coordinator.command.vx_m_s) < 1e-9);
+  CHECK(std::abs(robot->navigation().map_from_base.theta_rad - before.theta_rad) > 0.3);
+
+  // No further command: the dead-man switch ends the drive at the next update, the task moves on.
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  watch.update();
+  robot->run_for(std::chrono::seconds(1));
+  CHECK_FALSE(robot->behavior_loop().last_cycle().coordinator.locked);
+  CHECK(robot->behavior_active("BhCleaning"));
+  CHECK(robot->planner().busy());
+}

@@ -94,6 +94,8 @@ def main():
         check(status == 401, "a command without the token is refused with 401")
         status, body = run.post({"op": "task", "text": "clean the room 3211"}, token="wrong")
         check(status == 401 and "token" in body["error"], "a command with a wrong token is refused with 401")
+        status, body = run.post({"op": "drive", "vx": 0.3})
+        check(status == 401, "driving by hand without the token is refused with 401")
         status, body = run.post(None, token=run.token, raw=b"x" * 100000)
         check(status == 413, "a body over the limit is refused with 413")
         status, body = run.post({"op": "warp"}, token=run.token)

@@ -25,6 +25,8 @@ struct RobotMonitorOptions {
   double min_interval_s = 0.05;
   /// Least wall time between two maps of cleaned cells (larger than the others).
   double cleaned_interval_s = 0.5;
+  /// Manual drive stops when no drive command came for this long (wall time): the dead-man switch.
+  double drive_deadman_s = 0.5;
 };
 
 /// What the application knows beyond the robot: the simulator's true pose, the measured coverage
@@ -37,8 +39,9 @@ struct MonitorExtras {
 
 class RobotMonitor final {
  public:
-  /// Advertises the topics on `server` (which must not be started yet) and observes the robot's
-  /// planner and supervisor. Robot, clock (the robot's) and server must outlive the monitor.
+  /// Advertises the topics on `server` (which must not be started yet), observes the robot's
+  /// planner and supervisor, and adds the input and lock "operator" to the behavior loop's
+  /// coordinator (so: before the robot's threads start, if they do). Robot, clock (the robot's) and server must outlive the monitor.
   RobotMonitor(Robot& robot, const Clock& clock, MonitorServer& server, RobotMonitorOptions options = {});
   ~RobotMonitor();
   RobotMonitor(const RobotMonitor&) = delete;
