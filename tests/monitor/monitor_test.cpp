@@ -118,6 +118,18 @@ bool wait_for(Pred p) {
   return true;
 }
 
+// The PSR-2 demo robot on the simulator, in the workspace world.
+struct Psr2 {
+  SimClock clock;
+  std::unique_ptr<Robot> robot;
+  Psr2() {
+    const std::filesystem::path configs = std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs";
+    RobotPlugins plugins = RobotPlugins::with_builtins();
+    sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(configs / "worlds/workspace.yaml")));
+    robot = Robot::assemble(load_robot_profile(configs / "robots/psr2.yaml"), plugins, clock);
+  }
+};
+
 }  // namespace
 
 TEST_CASE("SHA-1, base64 and the WebSocket accept key follow their standards", "[monitor][wire]") {
@@ -324,12 +336,10 @@ TEST_CASE("A client that stops reading loses old bulk frames, and is let go rath
 }
 
 TEST_CASE("A robot on simulated time runs the same with a monitor whose client does not read", "[monitor][robot]") {
-  const std::filesystem::path configs = std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs";
   auto run = [&](bool with_monitor, MonitorStats* stats) {
-    RobotPlugins plugins = RobotPlugins::with_builtins();
-    sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(configs / "worlds/workspace.yaml")));
-    SimClock clock;
-    const auto robot = Robot::assemble(load_robot_profile(configs / "robots/psr2.yaml"), plugins, clock);
+    Psr2 psr2;
+    SimClock& clock = psr2.clock;
+    Robot* robot = psr2.robot.get();
     std::unique_ptr<MonitorServer> server;
     std::unique_ptr<RobotMonitor> watch;
     std::unique_ptr<Client> sleeper;
@@ -371,11 +381,9 @@ TEST_CASE("A server that is not running keeps a bounded outbox of bulk messages"
 }
 
 TEST_CASE("Manual drive goes through the coordinator, masks the task's motion and stops at the dead-man timeout", "[monitor][robot]") {
-  const std::filesystem::path configs = std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs";
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(configs / "worlds/workspace.yaml")));
-  SimClock clock;
-  const auto robot = Robot::assemble(load_robot_profile(configs / "robots/psr2.yaml"), plugins, clock);
+  Psr2 psr2;
+  SimClock& clock = psr2.clock;
+  Robot* robot = psr2.robot.get();
   MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
   RobotMonitor watch(*robot, clock, server, RobotMonitorOptions{.min_interval_s = 0.0, .drive_deadman_s = 0.05});
   server.start();
