@@ -502,6 +502,11 @@ struct MonitorServer::Impl {
         c.subscriptions[channel] = s["id"].get<std::uint32_t>();
         const Channel& ch = channels[channel - 1];
         if (ch.has_latest) deliver(c, ch, ch.latest_stamp_s, ch.latest_json);
+        if (ch.delivery == Delivery::event) {  // what happened before the subscription
+          for (const Message& m : history) {
+            if (m.channel == channel) deliver(c, ch, m.stamp_s, m.json);
+          }
+        }
       }
     } else if (op == "unsubscribe" && j.contains("subscriptionIds") && j["subscriptionIds"].is_array()) {
       for (const auto& id : j["subscriptionIds"]) {
