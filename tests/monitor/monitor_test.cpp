@@ -120,11 +120,11 @@ bool wait_for(Pred p) {
 
 // The PSR-2 demo robot on the simulator, in the workspace world.
 struct Psr2 {
+  RobotPlugins plugins = RobotPlugins::with_builtins();  // the robot keeps using them
   SimClock clock;
   std::unique_ptr<Robot> robot;
   Psr2() {
     const std::filesystem::path configs = std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs";
-    RobotPlugins plugins = RobotPlugins::with_builtins();
     sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(configs / "worlds/workspace.yaml")));
     robot = Robot::assemble(load_robot_profile(configs / "robots/psr2.yaml"), plugins, clock);
   }
