@@ -64,6 +64,10 @@ int run(Args& args, std::ostream& out, std::ostream& err) {
     err << "tripodal run: --task is required (without --monitor, where the console may give it)\n";
     return kUsage;
   }
+  if (!o.monitor && (o.start_paused || o.monitor_read_open || !o.monitor_token_file.empty())) {
+    err << "tripodal run: --start-paused, --monitor-read-open and --monitor-token-file need --monitor [ADDR:]PORT\n";
+    return kUsage;
+  }
   if (o.monitor) {
     // The run serves until stopped; the report is still written when it is.
     std::signal(SIGINT, on_stop_signal);
