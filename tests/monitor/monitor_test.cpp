@@ -424,3 +424,19 @@ TEST_CASE("Manual drive goes through the coordinator, masks the task's motion an
   CHECK(robot->behavior_active("BhCleaning"));
   CHECK(robot->planner().busy());
 }
+
+TEST_CASE("Read-only streams may be opened without the token where the operator says so; commands may not", "[monitor][server]") {
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests", .read_without_token = true});
+  server.start();
+  {
+    Client c(server.port());
+    c.send(ws_upgrade("/ws"));
+    const std::string got = c.read_until([](const std::string& b) { return b.find("\"read_only\":true") != std::string::npos; });
+    CHECK_THAT(got, Catch::StartsWith("HTTP/1.1 101 Switching Protocols"));
+    CHECK_THAT(got, Catch::Contains(R"("read_only":true)"));
+  }
+  Client c(server.port());
+  c.send("POST /api/command HTTP/1.1\r\nContent-Length: 14\r\n\r\n{\"op\":\"pause\"}");
+  CHECK_THAT(c.read_all(), Catch::StartsWith("HTTP/1.1 401"));
+  CHECK(server.take_requests().empty());
+}
