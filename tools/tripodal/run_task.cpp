@@ -334,7 +334,8 @@ RunResult run_task(const RunOptions& o) {
 
   const TaskReport tr = robot->planner().report();
   res.succeeded = tr.state == TaskState::succeeded;
-  if (res.state.empty() || (serve && tr.state != TaskState::idle)) res.state = std::string(to_string(tr.state));
+  // With the monitor a task from the console may follow a refused --task: the last task counts.
+  if (res.state.empty() || (serve && res.state == "refused" && tr.state != TaskState::idle)) res.state = std::string(to_string(tr.state));
   if (!serve || tr.state != TaskState::idle) res.reason = tr.reason;
   res.duration_s = to_seconds(clock.now());
   res.cleaned_cells = covered();
