@@ -4,18 +4,31 @@
 #include <graphviz/gvc.h>
 
 #include <map>
+#include <mutex>
 #include <vector>
 
 #include "tripodal/core/net_dot.hpp"
 
 namespace tripodal::monitor {
+namespace {
+
+// One Graphviz context for the process, never freed: libgvc 2.42's text-size code keeps a font
+// name across contexts, so a context made after another was freed reads freed memory (AddressSanitizer
+// shows it in textspan_size). Graphviz is not thread-safe either: one drawing at a time.
+GVC_t* graphviz() {
+  static GVC_t* const context = gvContext();
+  return context;
+}
+std::mutex graphviz_mutex;
+
+}  // namespace
+
 struct NetDrawing::Impl {
-  GVC_t* gvc = gvContext();
   std::map<std::string, std::string, std::less<>> cache;
 };
 
 NetDrawing::NetDrawing() : impl_(std::make_unique<Impl>()) {}
-NetDrawing::~NetDrawing() { gvFreeContext(impl_->gvc); }
+NetDrawing::~NetDrawing() = default;
 
 const std::string& NetDrawing::svg(const PetriNet& net) {
   const std::string key = net.id + "@" + net.where.file.str() + ":" + std::to_string(net.places().size()) + ":" +
@@ -30,17 +43,19 @@ const std::string& NetDrawing::svg(const PetriNet& net) {
   PetriNet untitled = net;
   untitled.description.clear();
   const std::string text = net_to_dot(untitled, empty, DotOptions{.descriptions = false});
+  const std::lock_guard lock(graphviz_mutex);
+  GVC_t* gvc = graphviz();
   if (Agraph_t* g = agmemread(text.c_str())) {
-    if (gvLayout(impl_->gvc, g, "dot") == 0) {
+    if (gvLayout(gvc, g, "dot") == 0) {
       char* data = nullptr;
       unsigned int length = 0;
-      if (gvRenderData(impl_->gvc, g, "svg", &data, &length) == 0 && data != nullptr) {
+      if (gvRenderData(gvc, g, "svg", &data, &length) == 0 && data != nullptr) {
         out.assign(data, length);
         // The page embeds the drawing: the XML prologue and DOCTYPE are not wanted there.
         if (const std::size_t start = out.find("<svg"); start != std::string::npos) out.erase(0, start);
       }
       gvFreeRenderData(data);
-      gvFreeLayout(impl_->gvc, g);
+      gvFreeLayout(gvc, g);
     }
     agclose(g);
   }

@@ -27,6 +27,11 @@
 using namespace tripodal;
 using namespace tripodal::monitor;
 
+// Under LeakSanitizer: the caches Graphviz (libgvc) and fontconfig keep until the process ends are
+// theirs, not leaks of the monitor (their stacks end in those libraries).
+extern "C" const char* __lsan_default_suppressions();
+extern "C" const char* __lsan_default_suppressions() { return "leak:libgvc.so\nleak:libfontconfig.so\n"; }
+
 namespace {
 
 std::string hex(const std::array<std::uint8_t, 20>& d) {
