@@ -5,6 +5,8 @@
 #   scripts/install-deps.sh [GROUP...]   also the packages of the hardening scripts that need them:
 #     fuzz   clang and its runtime (libFuzzer, ASan, UBSan), for scripts/fuzz.sh
 #     tidy   clang-tidy, for scripts/tidy.sh
+#     browser  headless Chromium and Selenium, for the monitor's browser tests
+#              (cmake -DTRIPODAL_BROWSER_TESTS=ON; ctest -L browser)
 #   (ThreadSanitizer, scripts/tsan.sh, needs nothing more: libtsan2 comes with g++.)
 set -euo pipefail
 
@@ -18,13 +20,17 @@ packages=(
   zlib1g-dev
   libpng-dev  # tripodal-coverage-eval reads the ipa floor plans (docs/coverage.md)
 )
+# The monitor: Graphviz's library lays out the nets it draws (src/monitor/net_drawing.cpp); its
+# protocol test (tests/monitor/protocol_test.py) is a WebSocket client in Python.
+packages+=(libgraphviz-dev python3 python3-websockets)
 
 for group in "$@"; do
   case $group in
     # libclang-rt-14-dev holds libFuzzer itself (libclang_rt.fuzzer), which -fsanitize=fuzzer links.
     fuzz) packages+=(clang libclang-rt-14-dev) ;;
     tidy) packages+=(clang-tidy) ;;
-    *) echo "install-deps: unknown group '$group' (expected fuzz or tidy)" >&2; exit 2 ;;
+    browser) packages+=(chromium chromium-driver python3-selenium) ;;
+    *) echo "install-deps: unknown group '$group' (expected fuzz, tidy or browser)" >&2; exit 2 ;;
   esac
 done
 

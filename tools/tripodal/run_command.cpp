@@ -3,6 +3,7 @@
 // progress bar on the terminal, and at the end the map picture, the trajectory and the report.
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <memory>
@@ -34,7 +35,11 @@ constexpr std::string_view kDescription =
     "seconds of simulated time: \"300-330; 900-905\" (or a file holding that text).\n"
     "Faster than real time unless --realtime (SPEED times real time, default 1). --pattern\n"
     "makes the cleaning behaviors follow another coverage path (balloon: the paper's wall-following\n"
-    "rounds; boustrophedon: plough lanes) to measure it on the robot.";
+    "rounds; boustrophedon: plough lanes) to measure it on the robot.\n"
+    "--monitor [ADDR:]PORT serves the live monitor and operator console (docs/monitor.md) on\n"
+    "127.0.0.1 unless ADDR is given, prints its address and token, paces the run to real time\n"
+    "(--realtime SPEED changes the speed) and keeps the robot running after the task (a task may\n"
+    "then come from the console instead of --task) until interrupted (Ctrl-C, SIGTERM).";
 
 constexpr std::string_view kExitCodes =
     "exit codes: 0 task succeeded, 1 bad profile/world/faults, 2 bad command line, 3 I/O error,\n"
@@ -47,11 +52,28 @@ struct Args {
   double realtime_speed = 0.0;      // 0: --realtime without SPEED
 };
 
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void on_stop_signal(int) { g_stop = 1; }
+
 int run(Args& args, std::ostream& out, std::ostream& err) {
   app::RunOptions& o = args.options;
   const std::string& faults = args.faults;
   o.realtime = args.realtime->count() > 0;
   if (args.realtime_speed > 0.0) o.realtime_speed = args.realtime_speed;
+  if (o.task.empty() && !o.monitor) {
+    err << "tripodal run: --task is required (without --monitor, where the console may give it)\n";
+    return kUsage;
+  }
+  if (!o.monitor && (o.start_paused || o.monitor_read_open || !o.monitor_token_file.empty())) {
+    err << "tripodal run: --start-paused, --monitor-read-open and --monitor-token-file need --monitor [ADDR:]PORT\n";
+    return kUsage;
+  }
+  if (o.monitor) {
+    // The run serves until stopped; the report is still written when it is.
+    std::signal(SIGINT, on_stop_signal);
+    std::signal(SIGTERM, on_stop_signal);
+    o.stop = &g_stop;
+  }
   for (const auto& f : {o.robot, o.world}) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(f, ec)) {
@@ -78,6 +100,7 @@ int run(Args& args, std::ostream& out, std::ostream& err) {
     o.progress = &err;
     o.progress_is_terminal = ::isatty(2) != 0;
     out << "tripodal run: robot " << o.robot.string() << ", world " << o.world.string() << ", task \"" << o.task << "\"\n";
+    out.flush();
     const app::RunResult r = app::run_task(o);
     out << "task " << r.state << (r.reason.empty() ? "" : ": " + r.reason) << "; ";
     if (r.reachable_cells > 0) out << "coverage " << r.coverage * 100.0 << " % of " << r.reachable_area_m2 << " m2 reachable; ";
@@ -95,6 +118,9 @@ int run(Args& args, std::ostream& out, std::ostream& err) {
   } catch (const ConfigError& e) {
     err << e.what() << '\n';
     return kBadInput;
+  } catch (const std::invalid_argument& e) {  // --monitor's address or token file
+    err << "tripodal run: --monitor: " << e.what() << '\n';
+    return kUsage;
   } catch (const std::runtime_error& e) {
     err << "tripodal run: " << e.what() << '\n';
     return kIoError;
@@ -106,7 +132,7 @@ cli::Action setup(CLI::App& cmd) {
   app::RunOptions& o = a->options;
   cmd.add_option("--robot", o.robot, "ROBOT.yaml: the robot profile")->required();
   cmd.add_option("--world", o.world, "WORLD.yaml: map, regions, start pose and faults")->required();
-  cmd.add_option("--task", o.task, "\"COMMAND\": the task in plain words")->required();
+  cmd.add_option("--task", o.task, "\"COMMAND\": the task in plain words (optional with --monitor)");
   cmd.add_option("--seed", o.seed, "N: the simulator's seed (default: the world's)");
   cmd.add_option("--out", o.out, "DIR: where map.png, trajectory.csv, report.json and lifecycle.txt go");
   // Without SPEED CLI11 hands the option an empty value, which leaves realtime_speed at 0.
@@ -126,6 +152,10 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_option("--uv-target-dose", o.uv_target_dose_j_m2, "J/m2: the dose a cell must receive to count as disinfected")
       ->check(cli::positive_number())
       ->capture_default_str();
+  cmd.add_option("--monitor", o.monitor, "[ADDR:]PORT: serve the live monitor and console (docs/monitor.md); 0: a free port");
+  cmd.add_option("--monitor-token-file", o.monitor_token_file, "FILE: the console's token (first line; default: generated)");
+  cmd.add_flag("--monitor-read-open", o.monitor_read_open, "let clients without the token watch (not command)");
+  cmd.add_flag("--start-paused", o.start_paused, "with --monitor: hold the run until the operator resumes it");
   return [a](std::ostream& out, std::ostream& err) { return run(*a, out, err); };
 }
 

@@ -13,6 +13,7 @@
 
 #include "run_outputs.hpp"
 #include "tripodal/core/clock.hpp"
+#include "tripodal/monitor/robot_monitor.hpp"
 #include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/navi/localizer.hpp"
 #include "tripodal/navi/planning_modules.hpp"
@@ -219,10 +220,28 @@ RunResult run_task(const RunOptions& o) {
 
   SteadyClock wall;
   std::optional<sim::RealtimePacer> pacer;
-  if (o.realtime) pacer.emplace(wall, o.realtime_speed);
+  if (o.realtime || o.monitor) pacer.emplace(wall, o.realtime ? o.realtime_speed : 1.0);
+
+  // The monitor: its own thread serves the clients; this loop hands it the robot's state and takes
+  // the operator's requests between periods.
+  std::unique_ptr<monitor::MonitorServer> server;
+  std::unique_ptr<monitor::RobotMonitor> watch;
+  if (o.monitor) {
+    monitor::MonitorServerOptions so = monitor::server_options(*o.monitor, o.monitor_token_file);
+    so.read_without_token = o.monitor_read_open;
+    server = std::make_unique<monitor::MonitorServer>(std::move(so));
+    watch = std::make_unique<monitor::RobotMonitor>(*robot, clock, *server, monitor::RobotMonitorOptions{.start_paused = o.start_paused});
+    server->start();
+    if (o.log != nullptr) {
+      *o.log << "monitor: " << server->url() << "  (token " << server->token() << (o.start_paused ? "; paused until resumed" : "")
+             << ")\n";
+      o.log->flush();
+    }
+  }
+  const bool serve = watch != nullptr;
+  auto stopped = [&] { return o.stop != nullptr && *o.stop != 0; };
 
   robot->run_until(clock.now());  // the localizer's first estimate, before the planner asks where to start
-  const CommandAnswer answer = robot->command(o.task);
   std::size_t printed = 0;
   bool bar_shown = false;  // a bar drawn in place on the terminal, to be wiped before a log line
   auto flush_log = [&] {
@@ -239,29 +258,40 @@ RunResult run_task(const RunOptions& o) {
     }
     o.log->flush();
   };
-  if (!answer.accepted) {
-    res.state = "refused";
-    res.reason = answer.text;
-    if (o.log != nullptr) *o.log << answer.text << '\n';
-    return res;
+  if (!o.task.empty()) {
+    const CommandAnswer answer = robot->command(o.task);
+    if (!answer.accepted) {
+      res.state = "refused";
+      res.reason = answer.text;
+      if (o.log != nullptr) *o.log << answer.text << '\n';
+      if (!serve) return res;
+    }
   }
   flush_log();
   const double tank_at_start_l = board_hw != nullptr ? board_hw->embedded().firmware().tank_l() : 0.0;
 
-  // The room's sections and the reachable area, for the measures.
+  // The room's sections and the reachable area, for the measures: of the task running (a task
+  // submitted on the monitor's console is measured from when it starts).
   std::vector<std::string> room_sections;
-  for (const PlanStage& stage : robot->planner().current_plan().stages) {
-    for (const ProcessStep& step : stage.steps) {
-      for (const BindingParam& p : step.params) {
-        if (p.name == "section" && std::find(room_sections.begin(), room_sections.end(), p.value) == room_sections.end()) {
-          room_sections.push_back(p.value);
+  std::vector<char> reachable;
+  navi::PathPlanner reach_planner(nav.maps->grid(), navi::PathPlannerOptions{.robot_radius_m = nav.maps->robot_radius_m()});
+  auto measure_room = [&] {
+    room_sections.clear();
+    for (const PlanStage& stage : robot->planner().current_plan().stages) {
+      for (const ProcessStep& step : stage.steps) {
+        for (const BindingParam& p : step.params) {
+          if (p.name == "section" && std::find(room_sections.begin(), room_sections.end(), p.value) == room_sections.end()) {
+            room_sections.push_back(p.value);
+          }
         }
       }
     }
-  }
-  navi::PathPlanner reach_planner(nav.maps->grid(), navi::PathPlannerOptions{.robot_radius_m = nav.maps->robot_radius_m()});
-  const std::vector<char> reachable = reachable_area(nav, reach_planner, room_sections, start);
-  for (const char c : reachable) res.reachable_cells += c != 0 ? 1 : 0;
+    reachable = reachable_area(nav, reach_planner, room_sections, start);
+    res.reachable_cells = 0;
+    for (const char c : reachable) res.reachable_cells += c != 0 ? 1 : 0;
+  };
+  bool measured_busy = robot->planner().busy();
+  if (measured_busy) measure_room();
 
   navi::CleanedCells cleaned(nav.maps->grid());  // from the true pose, while a cleaning behavior runs
   std::vector<TrajectorySample> traj;
@@ -297,7 +327,23 @@ RunResult run_task(const RunOptions& o) {
   };
 
   std::size_t sim_events_noted = 0;
-  while (robot->planner().busy() && clock.now() < deadline) {
+  auto monitor_update = [&] {
+    if (!watch) return;
+    monitor::MonitorExtras extras;
+    extras.true_pose = sim.pose();
+    if (res.reachable_cells > 0) extras.coverage = static_cast<double>(covered()) / static_cast<double>(res.reachable_cells);
+    extras.cleaned_mask = &cleaned.mask();
+    watch->update(extras);
+  };
+  while (clock.now() < deadline && !stopped() && (serve || robot->planner().busy())) {
+    monitor_update();
+    if (watch && watch->paused()) {
+      wall.sleep_until(wall.now() + std::chrono::milliseconds(20));
+      if (pacer) pacer.emplace(wall, o.realtime ? o.realtime_speed : 1.0);  // no catching up after a pause
+      continue;
+    }
+    if (robot->planner().busy() && !measured_busy) measure_room();
+    measured_busy = robot->planner().busy();
     robot->run_for(tick_period);
     for (; sim_events_noted < sim.events().size(); ++sim_events_noted) {
       const sim::SimEvent& e = sim.events()[sim_events_noted];
@@ -322,22 +368,24 @@ RunResult run_task(const RunOptions& o) {
     }
     if (to_seconds(now) >= next_progress_s) {
       draw_progress(false);
-      next_progress_s += o.progress_is_terminal ? (o.realtime ? 1.0 : 10.0) : 60.0;
+      next_progress_s += o.progress_is_terminal ? (o.realtime || serve ? 1.0 : 10.0) : 60.0;
     }
     if (pacer) pacer->pace(now);
   }
+  monitor_update();
   if (robot->planner().busy()) {
-    robot->planner().cancel("no end within " + fixed(o.max_duration_s, 0) + " s of simulated time");
+    robot->planner().cancel(stopped() ? "the run was stopped" : "no end within " + fixed(o.max_duration_s, 0) + " s of simulated time");
     robot->step_sequencing();
-    res.state = "timed out";
+    res.state = stopped() ? "stopped" : "timed out";
   }
   flush_log();
   draw_progress(true);
 
   const TaskReport tr = robot->planner().report();
   res.succeeded = tr.state == TaskState::succeeded;
-  if (res.state.empty()) res.state = std::string(to_string(tr.state));
-  res.reason = tr.reason;
+  // With the monitor a task from the console may follow a refused --task: the last task counts.
+  if (res.state.empty() || (serve && res.state == "refused" && tr.state != TaskState::idle)) res.state = std::string(to_string(tr.state));
+  if (!serve || tr.state != TaskState::idle) res.reason = tr.reason;
   res.duration_s = to_seconds(clock.now());
   res.cleaned_cells = covered();
   res.coverage = res.reachable_cells == 0 ? 0.0 : static_cast<double>(res.cleaned_cells) / static_cast<double>(res.reachable_cells);

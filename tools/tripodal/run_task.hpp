@@ -7,6 +7,7 @@
 // the `tripodal` tool (tools/tripodal), not of the installed library.
 #pragma once
 
+#include <csignal>
 #include <cstdint>
 #include <filesystem>
 #include <iosfwd>
@@ -39,6 +40,16 @@ struct RunOptions {
   std::string board_line;
   /// The UV dose a cell of the floor must receive to count as disinfected (J/m^2; 10 = 1 mJ/cm^2).
   double uv_target_dose_j_m2 = 10.0;
+  /// The monitor (docs/monitor.md): serve the page, the topics and the operator console on
+  /// ADDRESS:PORT while the run goes on. With a monitor the run is paced to real time (default
+  /// speed 1), the task may come from the console instead of `task`, and the run goes on after
+  /// the task until the monitor is asked to stop (`stop`, set from a signal handler) or
+  /// max_duration_s of simulated time.
+  std::optional<std::string> monitor;  ///< "[ADDR:]PORT"
+  std::filesystem::path monitor_token_file;  ///< the token, read from this file (default: generated)
+  bool monitor_read_open = false;    ///< read-only streams without the token
+  bool start_paused = false;         ///< hold the run until the operator resumes it
+  const volatile std::sig_atomic_t* stop = nullptr;
   std::ostream* log = nullptr;       ///< task and process life cycle, as it happens
   std::ostream* progress = nullptr;  ///< progress bar
   bool progress_is_terminal = false; ///< redraw the bar in place ('\r') instead of new lines

@@ -1,0 +1,67 @@
+// RobotMonitor: attaches a MonitorServer to a Robot (monitor area, above robot). On the thread
+// that drives the robot, between periods, update() answers the operator's requests (a task in
+// plain words, pause, resume, cancel, breakpoints on places) and publishes the topics: pose, path,
+// map and sections, cleaned cells, laser, the running nets and their markings, the task and
+// process life cycle, and a status line (behaviors, coordinator winner, velocity, battery,
+// coverage, resources' age). Publishing copies into the server's outbox; it never waits on a client.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tripodal/core/clock.hpp"
+#include "tripodal/core/geometry.hpp"
+#include "tripodal/monitor/monitor_server.hpp"
+#include "tripodal/robot/robot.hpp"
+
+namespace tripodal::monitor {
+
+struct RobotMonitorOptions {
+  bool start_paused = false;  ///< nothing fires until the operator resumes (attach first)
+  /// Least wall time between two publications of the periodic topics (0: every update()).
+  double min_interval_s = 0.05;
+  /// Least wall time between two maps of cleaned cells (larger than the others).
+  double cleaned_interval_s = 0.5;
+  /// Manual drive stops when no drive command came for this long (wall time): the dead-man switch.
+  double drive_deadman_s = 0.5;
+};
+
+/// What the application knows beyond the robot: the simulator's true pose, the measured coverage
+/// and the cleaned cells (a mask over the map's grid, row-major).
+struct MonitorExtras {
+  std::optional<Pose2D> true_pose;
+  std::optional<double> coverage;
+  const std::vector<std::uint8_t>* cleaned_mask = nullptr;
+};
+
+class RobotMonitor final {
+ public:
+  /// Advertises the topics on `server` (which must not be started yet), observes the robot's
+  /// planner and supervisor, and adds the input and lock "operator" to the behavior loop's
+  /// coordinator (so: before the robot's threads start, if they do). Robot, clock (the robot's) and server must outlive the monitor.
+  RobotMonitor(Robot& robot, const Clock& clock, MonitorServer& server, RobotMonitorOptions options = {});
+  ~RobotMonitor();
+  RobotMonitor(const RobotMonitor&) = delete;
+  RobotMonitor& operator=(const RobotMonitor&) = delete;
+
+  /// On the robot's thread, between periods: operator requests, then the topics that are due.
+  void update(const MonitorExtras& extras = {});
+  /// Whether the run should hold (operator pause, start paused, a breakpoint was reached). The
+  /// driving loop keeps calling update() while paused.
+  [[nodiscard]] bool paused() const noexcept;
+  void pause(std::string reason);
+  void resume();
+  /// Places ("P1" or a place's name in any net, "PrCleaning.P1" in one net) where the run pauses when they become marked.
+  void set_breakpoint(std::string place, bool on);
+  [[nodiscard]] std::vector<std::string> breakpoints() const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace tripodal::monitor

@@ -1,0 +1,474 @@
+#include "tripodal/monitor/robot_monitor.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "tripodal/behaviors/behavior_registry.hpp"
+#include "tripodal/navi/grid_maps.hpp"
+#include "tripodal/navi/section_splitter.hpp"
+#include "tripodal/planner/lifecycle_recorder.hpp"
+#include "net_drawing.hpp"
+
+namespace tripodal::monitor {
+namespace {
+
+using nlohmann::json;
+
+// JSON schemas of the topics (Foxglove reads them to name fields); the foxglove.* shapes are the
+// ones its panels draw.
+constexpr std::string_view kTimeSchema = R"({"type":"object","properties":{"sec":{"type":"integer"},"nsec":{"type":"integer"}}})";
+
+std::string pose_schema() {
+  return std::string(R"({"type":"object","properties":{"timestamp":)") + std::string(kTimeSchema) +
+         R"(,"frame_id":{"type":"string"},"pose":{"type":"object","properties":{"position":{"type":"object"},"orientation":{"type":"object"}}}}})";
+}
+
+json stamp(double t_s) {
+  const double sec = std::floor(std::max(t_s, 0.0));
+  return json{{"sec", static_cast<std::int64_t>(sec)}, {"nsec", static_cast<std::int64_t>((std::max(t_s, 0.0) - sec) * 1e9)}};
+}
+
+json pose_json(const Pose2D& p) {
+  return json{{"position", {{"x", p.x_m}, {"y", p.y_m}, {"z", 0.0}}},
+              {"orientation", {{"x", 0.0}, {"y", 0.0}, {"z", std::sin(p.theta_rad / 2.0)}, {"w", std::cos(p.theta_rad / 2.0)}}}};
+}
+
+std::string base64_bytes(const std::vector<std::uint8_t>& v) {
+  return base64(std::string_view(reinterpret_cast<const char*>(v.data()), v.size()));
+}
+
+// The operator's hand on the robot: the velocity the console sends, submitted through the behavior
+// loop's coordinator on an input of its own ("operator") while a lock of the same name masks the
+// task's behaviors (never the safety inputs above them). Written by the monitor, read by the loop
+// (which may run on its own thread), hence atomics.
+struct DriveCommand {
+  std::atomic<double> vx_m_s{0.0}, vy_m_s{0.0}, wz_rad_s{0.0};
+};
+
+class BhOperatorDrive final : public CBehavior {
+ public:
+  explicit BhOperatorDrive(std::shared_ptr<const DriveCommand> command) : command_(std::move(command)) {}
+  static const ModuleManifest& static_manifest() {
+    static const ModuleManifest m =
+        behavior_manifest("BhOperatorDrive", "the velocity the operator gives on the monitor's console (body frame)", {}, {});
+    return m;
+  }
+
+ protected:
+  const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  void on_activate(const ParameterSet&, const BehaviorContext&) override {}
+  std::optional<Twist2D> on_step(const BehaviorContext&) noexcept override {
+    return Twist2D{command_->vx_m_s.load(), command_->vy_m_s.load(), command_->wz_rad_s.load()};
+  }
+
+ private:
+  std::shared_ptr<const DriveCommand> command_;
+};
+
+constexpr std::string_view kOperator = "operator";
+
+struct NetView {
+  std::string run;
+  const PetriNet* net = nullptr;
+  const Engine* engine = nullptr;
+};
+
+}  // namespace
+
+struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
+  Robot& robot;
+  const Clock& clock;
+  MonitorServer& server;
+  RobotMonitorOptions options;
+  LifecycleRecorder life{true};
+  NetDrawing drawing;
+  std::size_t life_published = 0;
+
+  std::uint32_t ch_pose = 0, ch_path = 0, ch_map = 0, ch_cleaned = 0, ch_laser = 0, ch_nets = 0, ch_markings = 0,
+                ch_lifecycle = 0, ch_status = 0;
+
+  bool paused = false;
+  std::string pause_reason;
+  std::set<std::string, std::less<>> breakpoints;
+  std::map<std::string, std::string, std::less<>> last_firing;  // run -> transition id
+  std::map<std::string, std::string, std::less<>> behavior_params;  // behavior -> "a=1, b=2"
+  bool nets_changed = true;
+  std::uint32_t path_id = ~0U;
+  Time last_scan{Duration{-1}};
+  bool map_sent = false;
+  std::chrono::steady_clock::time_point last_publish{}, last_cleaned{};
+  std::shared_ptr<DriveCommand> drive = std::make_shared<DriveCommand>();
+  bool driving = false;
+  std::chrono::steady_clock::time_point last_drive{};
+
+  Impl(Robot& r, const Clock& c, MonitorServer& s, RobotMonitorOptions o) : robot(r), clock(c), server(s), options(o) {
+    ch_pose = server.advertise("/pose", "foxglove.PoseInFrame", pose_schema(), Delivery::bulk);
+    ch_path = server.advertise("/path", "foxglove.PosesInFrame",
+                               R"({"type":"object","properties":{"frame_id":{"type":"string"},"poses":{"type":"array"}}})", Delivery::state);
+    ch_map = server.advertise("/map", "tripodal.Map",
+                              R"({"type":"object","properties":{"width":{"type":"integer"},"height":{"type":"integer"},"resolution":{"type":"number"},"cells":{"type":"string","contentEncoding":"base64"},"section_of_cell":{"type":"string","contentEncoding":"base64"},"sections":{"type":"array"}}})",
+                              Delivery::state);
+    ch_cleaned = server.advertise("/cleaned", "tripodal.CleanedCells",
+                                  R"({"type":"object","properties":{"width":{"type":"integer"},"height":{"type":"integer"},"mask":{"type":"string","contentEncoding":"base64"}}})",
+                                  Delivery::bulk);
+    ch_laser = server.advertise("/laser", "foxglove.LaserScan",
+                                R"({"type":"object","properties":{"frame_id":{"type":"string"},"pose":{"type":"object"},"start_angle":{"type":"number"},"end_angle":{"type":"number"},"ranges":{"type":"array","items":{"type":"number"}},"intensities":{"type":"array","items":{"type":"number"}}}})",
+                                Delivery::bulk);
+    ch_nets = server.advertise("/nets", "tripodal.Nets",
+                               R"({"type":"object","properties":{"nets":{"type":"array","items":{"type":"object","properties":{"run":{"type":"string"},"net":{"type":"string"},"places":{"type":"array"},"transitions":{"type":"array"},"svg":{"type":"string","description":"Graphviz dot layout"}}}}}})",
+                               Delivery::state);
+    ch_markings = server.advertise("/markings", "tripodal.Markings",
+                                   R"({"type":"object","properties":{"nets":{"type":"array","items":{"type":"object","properties":{"run":{"type":"string"},"marked":{"type":"array"},"last_firing":{"type":"string"}}}}}})",
+                                   Delivery::bulk);
+    ch_lifecycle = server.advertise("/lifecycle", "tripodal.LifecycleEntry",
+                                    R"({"type":"object","properties":{"time_s":{"type":"number"},"kind":{"type":"string"},"text":{"type":"string"}}})",
+                                    Delivery::event);
+    ch_status = server.advertise("/status", "tripodal.Status",
+                                 R"({"type":"object","properties":{"time_s":{"type":"number"},"paused":{"type":"boolean"},"task_state":{"type":"string"},"velocity":{"type":"object"},"battery":{"type":["number","null"]},"coverage":{"type":["number","null"]},"behaviors":{"type":"array"},"winner":{"type":"string"}}})",
+                                 Delivery::bulk);
+    add_operator_input();
+    paused = options.start_paused;
+    if (paused) pause_reason = "started paused";
+    robot.planner().add_observer(*this);
+    robot.planner().add_observer(life);
+    robot.supervisor().add_observer(*this);
+    robot.supervisor().add_observer(life);
+  }
+
+  ~Impl() override {
+    stop_driving("monitor detached");
+    robot.supervisor().remove_observer(life);
+    robot.supervisor().remove_observer(*this);
+    robot.planner().remove_observer(life);
+    robot.planner().remove_observer(*this);
+  }
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+
+  double now_s() const { return to_seconds(clock.now()); }
+
+  // The operator's input ranks just above every normal input of the behavior loop, and its lock
+  // masks exactly those: the task's behaviors stop while the operator drives, safety stays.
+  void add_operator_input() {
+    CBehaviorCoordinator& c = robot.behavior_loop().coordinator();
+    if (c.find_input(kOperator)) return;
+    int top = 0;
+    for (std::size_t i = 0; i < c.input_count(); ++i) {
+      const CoordinatorInputConfig& in = c.input_config(static_cast<InputId>(i));
+      if (in.role == InputRole::normal) top = std::max(top, in.priority);
+    }
+    c.add_input(CoordinatorInputConfig{.name = std::string(kOperator), .priority = top + 1, .timeout = std::chrono::milliseconds(200), .weight = 1.0});
+    c.add_lock(CoordinatorLockConfig{.name = std::string(kOperator), .priority = top});
+  }
+
+  void stop_driving(std::string_view why) {
+    if (!driving) return;
+    driving = false;
+    ControlLoop& loop = robot.behavior_loop();
+    loop.deactivate(kOperator);
+    loop.set_lock(kOperator, false, clock.now());
+    note("operator: manual drive ended (" + std::string(why) + ")");
+  }
+
+  void drive_with(double vx, double vy, double wz) {
+    drive->vx_m_s = vx;
+    drive->vy_m_s = vy;
+    drive->wz_rad_s = wz;
+    last_drive = std::chrono::steady_clock::now();
+    if (driving) return;
+    ControlLoop& loop = robot.behavior_loop();
+    loop.activate(std::make_unique<BhOperatorDrive>(drive), {}, kOperator);
+    loop.set_lock(kOperator, true, clock.now());
+    driving = true;
+    note("operator: manual drive (the task's motion masked)");
+  }
+
+  void note(std::string text) { life.note(clock.now(), std::move(text)); }
+
+  // --- observers --------------------------------------------------------------------------------
+  void on_task_started(const TaskReport&, const Plan&, Time) override { nets_changed = true; }
+  void on_task_succeeded(const TaskReport&) override { nets_changed = true; }
+  void on_task_failed(const TaskReport&) override { nets_changed = true; }
+  void on_run_started(std::string_view, const CProcess&, const ParameterValues&, Time) override { nets_changed = true; }
+  void on_run_finished(const ProcessResult&) override { nets_changed = true; }
+  void on_behavior_activated(std::string_view, std::string_view behavior, const ParameterValues& params, Time) override {
+    std::string text;
+    for (const auto& [k, v] : params) text += (text.empty() ? "" : ", ") + k + "=" + to_string(v);
+    behavior_params[std::string(behavior)] = text;
+  }
+  void on_behavior_deactivated(std::string_view, std::string_view behavior, Time) override {
+    if (const auto it = behavior_params.find(behavior); it != behavior_params.end()) behavior_params.erase(it);
+  }
+  void on_firing(std::string_view run, const PetriNet& net, const Firing& firing) override {
+    last_firing[std::string(run)] = std::string(firing.transition_id);
+    if (breakpoints.empty()) return;
+    for (const PlaceChange& c : firing.changes) {
+      if (c.produced == 0) continue;
+      const Place& p = net.place(c.place);
+      if (breakpoints.contains(p.id) || breakpoints.contains(p.name) || breakpoints.contains(net.id + "." + p.id)) {
+        pause_now("breakpoint: place " + p.id + (p.name != p.id ? " (" + p.name + ")" : "") + " of " + net.id + " (run " +
+                  std::string(run) + ") marked");
+      }
+    }
+  }
+
+  void pause_now(std::string reason) {
+    paused = true;
+    pause_reason = reason;
+    note("monitor: paused, " + reason);
+  }
+
+  // --- operator requests --------------------------------------------------------------------------
+  void handle(const OperatorRequest& r) {
+    const json body = json::parse(r.body, nullptr, false);
+    const std::string op = body.value("op", "");
+    auto reply = [&](int status, json j) { server.answer(r.id, status, j.dump()); };
+    if (op == "task") {
+      if (!body.contains("text") || !body["text"].is_string()) return reply(400, {{"error", "task: expected \"text\": the task in plain words"}});
+      const std::string text = body["text"];
+      const CommandAnswer a = robot.command(text);
+      note(std::string("operator: \"") + text + "\": " + (a.accepted ? "accepted" : "refused") + ": " + a.text);
+      return reply(200, {{"accepted", a.accepted}, {"text", a.text}});
+    }
+    if (op == "pause") {
+      pause_now("by the operator");
+      return reply(200, {{"paused", true}});
+    }
+    if (op == "resume") {
+      paused = false;
+      note("monitor: resumed by the operator");
+      return reply(200, {{"paused", false}});
+    }
+    if (op == "cancel") {
+      if (!robot.planner().busy()) return reply(409, {{"error", "no task is running"}});
+      robot.planner().cancel("cancelled by the operator");
+      return reply(200, {{"cancelled", true}});
+    }
+    if (op == "drive") {
+      if (body.value("stop", false)) {
+        stop_driving("stopped by the operator");
+        return reply(200, {{"driving", false}});
+      }
+      for (const char* k : {"vx", "vy", "wz"}) {
+        if (body.contains(k) && !body[k].is_number()) return reply(400, {{"error", std::string("drive: \"") + k + "\" must be a number"}});
+      }
+      // Bounds of a hand on a joystick; the controller's limits apply after the coordinator.
+      const double vx = std::clamp(body.value("vx", 0.0), -1.0, 1.0);
+      const double vy = std::clamp(body.value("vy", 0.0), -1.0, 1.0);
+      const double wz = std::clamp(body.value("wz", 0.0), -2.0, 2.0);
+      drive_with(vx, vy, wz);
+      return reply(200, {{"driving", true}, {"deadman_s", options.drive_deadman_s}});
+    }
+    if (op == "ack") {
+      note("operator: fault acknowledged" + (body.contains("text") && body["text"].is_string() ? ": " + body["text"].get<std::string>() : ""));
+      return reply(200, {{"acknowledged", true}});
+    }
+    if (op == "breakpoint") {
+      if (!body.contains("place") || !body["place"].is_string() || body["place"].get<std::string>().empty()) {
+        return reply(400, {{"error", "breakpoint: expected \"place\": a place id or name"}});
+      }
+      const bool on = body.value("on", true);
+      const std::string place = body["place"];
+      if (on) breakpoints.insert(place);
+      else breakpoints.erase(place);
+      note("monitor: breakpoint " + std::string(on ? "set" : "cleared") + " on place " + place);
+      return reply(200, {{"breakpoints", std::vector<std::string>(breakpoints.begin(), breakpoints.end())}});
+    }
+    reply(400, {{"error", "unknown op '" + op + "': expected task, pause, resume, cancel, ack, breakpoint or drive"}});
+  }
+
+  // --- topics -------------------------------------------------------------------------------------
+  std::vector<NetView> running_nets() const {
+    std::vector<NetView> out;
+    if (const Engine* e = robot.planner().net_engine()) out.push_back({"task", &e->net(), e});
+    for (const std::string& run : robot.supervisor().running_runs()) {
+      if (const Engine* e = robot.supervisor().engine(run)) out.push_back({run, &e->net(), e});
+    }
+    return out;
+  }
+
+  void publish_nets(const std::vector<NetView>& nets) {
+    json j{{"nets", json::array()}};
+    for (const NetView& v : nets) {
+      json places = json::array(), transitions = json::array();
+      for (const Place& p : v.net->places()) {
+        json jp{{"id", p.id}, {"name", p.name}, {"initial", p.initial_tokens}};
+        if (p.behavior) jp["behavior"] = p.behavior->behavior;
+        if (p.process) jp["process"] = true;
+        if (p.outcome != Outcome::none) jp["outcome"] = p.outcome == Outcome::success ? "success" : "fault";
+        places.push_back(std::move(jp));
+      }
+      for (const Transition& t : v.net->transitions()) {
+        json in = json::array(), out = json::array();
+        for (const ArcRef& a : t.inputs) in.push_back(a.place);
+        for (const ArcRef& a : t.reads) in.push_back(a.place);
+        for (const ArcRef& a : t.outputs) out.push_back(a.place);
+        transitions.push_back({{"id", t.id}, {"name", t.name}, {"event", t.event}, {"in", in}, {"out", out}});
+      }
+      j["nets"].push_back({{"run", v.run}, {"net", v.net->id}, {"places", places}, {"transitions", transitions}, {"svg", drawing.svg(*v.net)}});
+    }
+    server.publish(ch_nets, now_s(), j.dump());
+  }
+
+  void publish_map() {
+    const auto* maps = robot.module<navi::CGridMaps>();
+    if (maps == nullptr) return;
+    const navi::OccupancyGrid& g = maps->grid();
+    if (g.size() == 0) return;
+    std::vector<std::uint8_t> cells(g.size()), section_of(g.size(), 0);
+    for (std::size_t i = 0; i < g.size(); ++i) {
+      const auto s = g.state(i);
+      cells[i] = s == navi::Occupancy::free ? 0 : s == navi::Occupancy::occupied ? 1 : 2;
+    }
+    json sections = json::array();
+    if (const auto* splitter = robot.module<navi::CSectionSplitter>()) {
+      for (const navi::Section& s : splitter->sections().sections) {
+        for (const std::size_t i : s.cells) section_of[i] = static_cast<std::uint8_t>(1 + s.id % 250);
+        sections.push_back({{"name", s.name}, {"index", 1 + s.id % 250}, {"x", s.centroid.x_m}, {"y", s.centroid.y_m}, {"area_m2", s.area_m2}});
+      }
+    }
+    const json j{{"width", g.width()},      {"height", g.height()},       {"resolution", g.resolution_m()},
+                 {"origin", {{"x", g.origin().x_m}, {"y", g.origin().y_m}}}, {"cells", base64_bytes(cells)},
+                 {"section_of_cell", base64_bytes(section_of)}, {"sections", sections}};
+    server.publish(ch_map, now_s(), j.dump());
+    map_sent = true;
+  }
+
+  void publish_periodic(const MonitorExtras& extras) {
+    const double t = now_s();
+    const NavigationData& nav = robot.navigation();
+    server.publish(ch_pose, t, json{{"timestamp", stamp(t)}, {"frame_id", "map"}, {"pose", pose_json(nav.map_from_base)}}.dump());
+    if (nav.path_id != path_id) {
+      path_id = nav.path_id;
+      json poses = json::array();
+      for (const Pose2D& p : nav.path) poses.push_back({{"timestamp", stamp(t)}, {"frame_id", "map"}, {"pose", pose_json(p)}});
+      server.publish(ch_path, t, json{{"timestamp", stamp(t)}, {"frame_id", "map"}, {"poses", poses}}.dump());
+    }
+    // A scan once, when it is new (a scanner turns slower than the monitor publishes).
+    if (const auto* laser = robot.resources().first<LaserScan>(); laser != nullptr && laser->has_reading() && laser->stamp() != last_scan) {
+      last_scan = laser->stamp();
+      const LaserScan& s = laser->latest();
+      json ranges = json::array();
+      // Millimetres are all a drawing needs, and the scan is the largest message (shortest decimals).
+      for (const float r : s.ranges_m) {
+        ranges.push_back(std::isfinite(r) && r >= s.range_min_m && r <= s.range_max_m ? std::round(static_cast<double>(r) * 1000.0) / 1000.0 : 0.0);
+      }
+      server.publish(ch_laser, t,
+                     json{{"timestamp", stamp(to_seconds(s.stamp))}, {"frame_id", "map"}, {"pose", pose_json(nav.map_from_base)},
+                          {"start_angle", s.angle_min_rad}, {"end_angle", s.angle_max_rad}, {"ranges", ranges}, {"intensities", json::array()}}
+                         .dump());
+    }
+    json marked = json::array();
+    for (const NetView& v : running_nets()) {
+      json places = json::array();
+      const auto m = v.engine->marking();
+      for (std::size_t i = 0; i < m.size(); ++i) {
+        if (m[i] > 0) places.push_back({{"place", v.net->places()[i].id}, {"tokens", m[i]}});
+      }
+      const auto lf = last_firing.find(v.run);
+      marked.push_back({{"run", v.run}, {"net", v.net->id}, {"marked", places}, {"last_firing", lf == last_firing.end() ? "" : lf->second}});
+    }
+    server.publish(ch_markings, t, json{{"timestamp", stamp(t)}, {"nets", marked}}.dump());
+
+    const CycleReport& cycle = robot.behavior_loop().last_cycle();
+    json behaviors = json::array();
+    for (const std::string& b : robot.supervisor().active_behaviors()) {
+      const auto it = behavior_params.find(b);
+      behaviors.push_back({{"name", b}, {"params", it == behavior_params.end() ? "" : it->second}});
+    }
+    json resources = json::array();
+    const Time now = clock.now();
+    for (std::size_t i = 0; i < robot.resources().size(); ++i) {
+      const CResource& r = robot.resources().at(i);
+      resources.push_back({{"name", r.name()}, {"age_s", r.has_reading() ? json(to_seconds(now - r.stamp())) : json(nullptr)}});
+    }
+    json status{{"time_s", t},
+                {"paused", paused},
+                {"pause_reason", paused ? pause_reason : ""},
+                {"task_state", std::string(to_string(robot.planner().state()))},
+                {"task", robot.planner().report().command},
+                {"behaviors", behaviors},
+                {"winner", std::string(cycle.coordinator.winner)},
+                {"velocity", {{"vx", cycle.coordinator.command.vx_m_s}, {"vy", cycle.coordinator.command.vy_m_s}, {"wz", cycle.coordinator.command.wz_rad_s}}},
+                {"localized", nav.localized},
+                {"estimate", {{"x", nav.map_from_base.x_m}, {"y", nav.map_from_base.y_m}, {"theta", nav.map_from_base.theta_rad}}},
+                {"resources", resources},
+                {"breakpoints", std::vector<std::string>(breakpoints.begin(), breakpoints.end())},
+                {"driving", driving},
+                {"battery", nullptr},
+                {"coverage", extras.coverage ? json(*extras.coverage) : json(nullptr)}};
+    if (const auto* battery = robot.resources().first<BatteryReading>(); battery != nullptr && battery->has_reading()) {
+      status["battery"] = battery->latest().percentage;
+    }
+    if (extras.true_pose) status["truth"] = {{"x", extras.true_pose->x_m}, {"y", extras.true_pose->y_m}, {"theta", extras.true_pose->theta_rad}};
+    server.publish(ch_status, t, status.dump());
+  }
+
+  void update(const MonitorExtras& extras) {
+    for (const OperatorRequest& r : server.take_requests()) handle(r);
+    // The dead-man switch: the console repeats the command while a key is held.
+    if (driving && std::chrono::steady_clock::now() - last_drive > std::chrono::duration<double>(options.drive_deadman_s)) {
+      stop_driving("no command for " + std::to_string(static_cast<int>(options.drive_deadman_s * 1000)) + " ms");
+    }
+    if (!map_sent) publish_map();
+    const double t = now_s();
+    const auto& entries = life.entries();
+    for (; life_published < entries.size(); ++life_published) {
+      const LifecycleEntry& e = entries[life_published];
+      const bool firing = e.text.find(" fire ") != std::string::npos;
+      if (firing) continue;  // firings travel as markings (last_firing), not as timeline entries
+      const std::string kind = e.text.starts_with("task") ? "task"
+                               : e.text.starts_with("process") ? "process"
+                               : e.text.find("fault") != std::string::npos || e.text.find("failed") != std::string::npos ? "fault"
+                               : e.text.find("recover") != std::string::npos ? "recovery"
+                                                                             : "note";
+      server.publish(ch_lifecycle, to_seconds(e.time), json{{"time_s", to_seconds(e.time)}, {"kind", kind}, {"text", e.text}}.dump());
+    }
+    if (nets_changed) {
+      nets_changed = false;
+      publish_nets(running_nets());
+    }
+    const auto wall = std::chrono::steady_clock::now();
+    if (wall - last_publish >= std::chrono::duration<double>(options.min_interval_s)) {
+      last_publish = wall;
+      publish_periodic(extras);
+    }
+    if (extras.cleaned_mask != nullptr && wall - last_cleaned >= std::chrono::duration<double>(options.cleaned_interval_s)) {
+      last_cleaned = wall;
+      const std::vector<std::uint8_t>& m = *extras.cleaned_mask;
+      std::vector<std::uint8_t> bits((m.size() + 7) / 8, 0);
+      for (std::size_t i = 0; i < m.size(); ++i) {
+        if (m[i] != 0) bits[i / 8] = static_cast<std::uint8_t>(bits[i / 8] | (1U << (i % 8)));
+      }
+      server.publish(ch_cleaned, t, json{{"cells", m.size()}, {"mask", base64_bytes(bits)}}.dump());
+    }
+  }
+};
+
+RobotMonitor::RobotMonitor(Robot& robot, const Clock& clock, MonitorServer& server, RobotMonitorOptions options)
+    : impl_(std::make_unique<Impl>(robot, clock, server, options)) {}
+RobotMonitor::~RobotMonitor() = default;
+
+void RobotMonitor::update(const MonitorExtras& extras) { impl_->update(extras); }
+bool RobotMonitor::paused() const noexcept { return impl_->paused; }
+void RobotMonitor::pause(std::string reason) { impl_->pause_now(std::move(reason)); }
+void RobotMonitor::resume() {
+  impl_->paused = false;
+  impl_->note("monitor: resumed");
+}
+void RobotMonitor::set_breakpoint(std::string place, bool on) {
+  if (on) impl_->breakpoints.insert(std::move(place));
+  else impl_->breakpoints.erase(place);
+}
+std::vector<std::string> RobotMonitor::breakpoints() const {
+  return {impl_->breakpoints.begin(), impl_->breakpoints.end()};
+}
+
+}  // namespace tripodal::monitor

@@ -1,0 +1,447 @@
+// The monitor area: wire formats (HTTP, WebSocket handshake and frames), the server over loopback
+// (page, token, limits, per-client queues) and a robot on simulated time with a client that does
+// not read.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "tripodal/monitor/monitor_server.hpp"
+#include "tripodal/monitor/robot_monitor.hpp"
+#include "tripodal/monitor/wire.hpp"
+#include "tripodal/robot/robot.hpp"
+#include "tripodal/sim/sim_hardware.hpp"
+
+using namespace tripodal;
+using namespace tripodal::monitor;
+
+// Under LeakSanitizer: the caches Graphviz (libgvc) and fontconfig keep until the process ends are
+// theirs, not leaks of the monitor (their stacks end in those libraries).
+extern "C" const char* __lsan_default_suppressions();
+extern "C" const char* __lsan_default_suppressions() { return "leak:libgvc.so\nleak:libfontconfig.so\n"; }
+
+namespace {
+
+std::string hex(const std::array<std::uint8_t, 20>& d) {
+  std::string out;
+  static constexpr char kHex[] = "0123456789abcdef";
+  for (const auto b : d) {
+    out += kHex[b >> 4];
+    out += kHex[b & 0xF];
+  }
+  return out;
+}
+
+// A blocking loopback client: enough to speak HTTP and WebSocket to the server in a test.
+class Client {
+ public:
+  explicit Client(std::uint16_t port, int receive_buffer_bytes = 0) {
+    fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
+    if (receive_buffer_bytes > 0) ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &receive_buffer_bytes, sizeof receive_buffer_bytes);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(port);
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    REQUIRE(::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0);
+  }
+  ~Client() { ::close(fd_); }
+  Client(const Client&) = delete;
+  Client& operator=(const Client&) = delete;
+  void send(const std::string& s) const { REQUIRE(::send(fd_, s.data(), s.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(s.size())); }
+  // Reads until `done` holds for what arrived, the peer closes, or 10 s pass (a hang, not a measure).
+  template <class Done>
+  std::string read_until(Done done, std::chrono::milliseconds patience = std::chrono::seconds(10)) {
+    const auto give_up = std::chrono::steady_clock::now() + patience;
+    while (!done(buf_) && std::chrono::steady_clock::now() < give_up) {
+      pollfd p{fd_, POLLIN, 0};
+      if (::poll(&p, 1, 100) <= 0) continue;
+      char b[65536];
+      const ssize_t n = ::recv(fd_, b, sizeof b, 0);
+      if (n <= 0) break;
+      buf_.append(b, static_cast<std::size_t>(n));
+    }
+    return buf_;
+  }
+  std::string read_all() {
+    return read_until([](const std::string&) { return false; });
+  }
+  void consume(std::size_t n) { buf_.erase(0, n); }
+  int fd() const { return fd_; }
+
+ private:
+  int fd_ = -1;
+  std::string buf_;
+};
+
+std::string ws_upgrade(const std::string& path, const std::string& protocol = {}) {
+  std::string r = "GET " + path + " HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                  "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n";
+  if (!protocol.empty()) r += "Sec-WebSocket-Protocol: " + protocol + "\r\n";
+  return r + "\r\n";
+}
+
+// Server frames (unmasked) in `bytes` after the handshake.
+std::vector<WsFrame> server_frames(std::string_view bytes) {
+  std::vector<WsFrame> out;
+  while (bytes.size() >= 2) {
+    std::uint64_t n = static_cast<std::uint8_t>(bytes[1]) & 0x7FU;
+    std::size_t pos = 2;
+    if (n == 126) {
+      n = (std::uint64_t{static_cast<std::uint8_t>(bytes[2])} << 8) | static_cast<std::uint8_t>(bytes[3]);
+      pos = 4;
+    } else if (n == 127) {
+      n = 0;
+      for (std::size_t i = 2; i < 10; ++i) n = (n << 8) | static_cast<std::uint8_t>(bytes[i]);
+      pos = 10;
+    }
+    if (bytes.size() < pos + n) break;
+    out.push_back(WsFrame{static_cast<WsOpcode>(static_cast<std::uint8_t>(bytes[0]) & 0x0FU), true, std::string(bytes.substr(pos, n))});
+    bytes.remove_prefix(pos + n);
+  }
+  return out;
+}
+
+template <class Pred>
+bool wait_for(Pred p) {
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!p()) {
+    if (std::chrono::steady_clock::now() > give_up) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return true;
+}
+
+// The PSR-2 demo robot on the simulator, in the workspace world.
+struct Psr2 {
+  RobotPlugins plugins = RobotPlugins::with_builtins();  // the robot keeps using them
+  SimClock clock;
+  std::unique_ptr<Robot> robot;
+  Psr2() {
+    const std::filesystem::path configs = std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs";
+    sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(configs / "worlds/workspace.yaml")));
+    robot = Robot::assemble(load_robot_profile(configs / "robots/psr2.yaml"), plugins, clock);
+  }
+};
+
+}  // namespace
+
+TEST_CASE("SHA-1, base64 and the WebSocket accept key follow their standards", "[monitor][wire]") {
+  CHECK(hex(sha1("abc")) == "a9993e364706816aba3e25717850c26c9cd0d89d");
+  CHECK(hex(sha1("")) == "da39a3ee5e6b4b0d3255bfef95601890afd80709");
+  CHECK(hex(sha1(std::string(1000, 'a'))) == "291e9a6c66994949b57ba5e650361e98fc36b1ba");
+  CHECK(base64("foob") == "Zm9vYg==");
+  CHECK(base64("fooba") == "Zm9vYmE=");
+  // RFC 6455 section 1.3.
+  CHECK(websocket_accept("dGhlIHNhbXBsZSBub25jZQ==") == "s3pPLMBiTxaQ9kYGzzhZRbK+xOo=");
+  CHECK(constant_time_equal("abc", "abc"));
+  CHECK_FALSE(constant_time_equal("abc", "abd"));
+  CHECK_FALSE(constant_time_equal("abc", "abcd"));
+}
+
+TEST_CASE("HTTP requests are read with limits and located errors", "[monitor][wire]") {
+  const std::string req = "POST /api/command?token=ab HTTP/1.1\r\nHost: x\r\nContent-Length: 4\r\nX-A:  v \r\n\r\nbody";
+  CHECK(parse_http_request(req.substr(0, 20)).status == HttpParse::Status::incomplete);
+  CHECK(parse_http_request(req.substr(0, req.size() - 1)).status == HttpParse::Status::incomplete);
+  const HttpParse p = parse_http_request(req);
+  REQUIRE(p.status == HttpParse::Status::complete);
+  CHECK(p.consumed == req.size());
+  CHECK(p.request.method == "POST");
+  CHECK(p.request.path == "/api/command");
+  CHECK(p.request.query("token") == std::optional<std::string_view>("ab"));
+  CHECK(p.request.header("x-a") == std::optional<std::string_view>("v"));
+  CHECK(p.request.body == "body");
+
+  HttpLimits small{.max_header_bytes = 64, .max_body_bytes = 3};
+  CHECK(parse_http_request(req, small).status == HttpParse::Status::headers_too_large);
+  CHECK(parse_http_request(std::string(100, 'x'), small).status == HttpParse::Status::headers_too_large);
+  CHECK(parse_http_request(req, HttpLimits{.max_header_bytes = 1024, .max_body_bytes = 3}).status == HttpParse::Status::body_too_large);
+
+  const HttpParse bad = parse_http_request("GARBAGE\r\n\r\n");
+  CHECK(bad.status == HttpParse::Status::bad_request);
+  CHECK_THAT(bad.error, Catch::Contains("request line 'GARBAGE': expected METHOD TARGET HTTP/1.x"));
+  CHECK_THAT(parse_http_request("GET /x HTTP/1.1\r\nContent-Length: -1\r\n\r\n").error,
+             Catch::Contains("Content-Length '-1': expected a decimal byte count"));
+  CHECK_THAT(parse_http_request("GET x HTTP/1.1\r\n\r\n").error, Catch::Contains("target 'x': expected an absolute path"));
+  CHECK_THAT(parse_http_request("GET /x HTTP/1.1\r\nno colon\r\n\r\n").error, Catch::Contains("header 'no colon': expected NAME: VALUE"));
+}
+
+TEST_CASE("WebSocket frames: client frames must be masked and fit the limit", "[monitor][wire]") {
+  for (const std::size_t n : {std::size_t{5}, std::size_t{300}, std::size_t{70000}}) {
+    const std::string payload(n, 'q');
+    const std::string f = ws_client_frame(WsOpcode::text, payload);
+    CHECK(parse_ws_frame(f.substr(0, f.size() - 1), 100000).status == WsParse::Status::incomplete);
+    const WsParse p = parse_ws_frame(f, 100000);
+    REQUIRE(p.status == WsParse::Status::complete);
+    CHECK(p.consumed == f.size());
+    CHECK(p.frame.payload == payload);
+  }
+  const WsParse unmasked = parse_ws_frame(ws_frame(WsOpcode::text, "hi"));
+  CHECK(unmasked.status == WsParse::Status::error);
+  CHECK_THAT(unmasked.error, Catch::Contains("client frame not masked"));
+  const WsParse big = parse_ws_frame(ws_client_frame(WsOpcode::binary, std::string(2000, 'x')), 1000);
+  CHECK_THAT(big.error, Catch::Contains("frame of 2000 bytes: the limit is 1000"));
+}
+
+TEST_CASE("server_options reads [ADDR:]PORT and the token file", "[monitor]") {
+  CHECK(server_options("8765").address == "127.0.0.1");
+  CHECK(server_options("8765").port == 8765);
+  CHECK(server_options("0.0.0.0:80").address == "0.0.0.0");
+  REQUIRE_THROWS_WITH(server_options("http"), Catch::Contains("monitor port 'http' in 'http': expected [ADDR:]PORT"));
+  REQUIRE_THROWS_WITH(server_options("99999"), Catch::Contains("PORT in 0..65535"));
+  REQUIRE_THROWS_WITH(server_options("localhost:80"), Catch::Contains("monitor address 'localhost': expected an IPv4 address"));
+  const auto dir = std::filesystem::temp_directory_path() / "tripodal_monitor_test";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "short") << "abc\n";
+  REQUIRE_THROWS_WITH(server_options("0", dir / "short"), Catch::Contains("short:1:1: monitor token: expected at least 8 printable"));
+  std::ofstream(dir / "good") << "s3cret-token-42\n";
+  CHECK(server_options("0", dir / "good").token == "s3cret-token-42");
+  REQUIRE_THROWS_WITH(server_options("0", dir / "missing"), Catch::Contains("missing': cannot be read"));
+}
+
+TEST_CASE("The server serves the page, refuses without the token and hands commands to the robot's thread", "[monitor][server]") {
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  server.start();
+  REQUIRE(server.port() != 0);
+  CHECK(server.url() == "http://127.0.0.1:" + std::to_string(server.port()) + "/?token=t0ken-for-tests");
+
+  {  // the page
+    Client c(server.port());
+    c.send("GET / HTTP/1.1\r\nHost: x\r\n\r\n");
+    const std::string r = c.read_all();
+    CHECK_THAT(r, Catch::StartsWith("HTTP/1.1 200 OK"));
+    CHECK_THAT(r, Catch::Contains("<title>tripodal monitor</title>"));
+    CHECK_THAT(r, !Catch::Contains("src=\"http"));  // nothing from the network
+  }
+  {  // no file serving
+    Client c(server.port());
+    c.send("GET /../../etc/passwd HTTP/1.1\r\n\r\n");
+    CHECK_THAT(c.read_all(), Catch::StartsWith("HTTP/1.1 404"));
+  }
+  const std::string body = R"({"op":"task","text":"clean the room 3211"})";
+  auto post = [&](const std::string& auth, const std::string& b) {
+    return "POST /api/command HTTP/1.1\r\nContent-Type: application/json\r\n" + auth + "Content-Length: " + std::to_string(b.size()) +
+           "\r\n\r\n" + b;
+  };
+  for (const std::string& auth : {std::string{}, std::string("Authorization: Bearer wrong\r\n")}) {
+    Client c(server.port());
+    c.send(post(auth, body));
+    const std::string r = c.read_all();
+    CHECK_THAT(r, Catch::StartsWith("HTTP/1.1 401 Unauthorized"));
+    CHECK_THAT(r, Catch::Contains("missing or wrong token"));
+  }
+  CHECK(server.take_requests().empty());  // nothing reached the robot
+  CHECK(server.stats().unauthorized == 2);
+  {
+    Client c(server.port());
+    c.send(post("Authorization: Bearer t0ken-for-tests\r\n", std::string(70000, ' ')));
+    CHECK_THAT(c.read_all(), Catch::StartsWith("HTTP/1.1 413"));
+  }
+  {
+    Client c(server.port());
+    c.send(post("Authorization: Bearer t0ken-for-tests\r\n", "[1,2]"));
+    CHECK_THAT(c.read_all(), Catch::Contains("expected a JSON object with a string \\\"op\\\""));
+  }
+  {  // accepted: the robot's thread answers it
+    Client c(server.port());
+    c.send(post("Authorization: Bearer t0ken-for-tests\r\n", body));
+    std::vector<OperatorRequest> requests;
+    REQUIRE(wait_for([&] {
+      auto r = server.take_requests();
+      requests.insert(requests.end(), r.begin(), r.end());
+      return !requests.empty();
+    }));
+    REQUIRE(requests.size() == 1);
+    CHECK(requests[0].body == body);
+    server.answer(requests[0].id, 200, R"({"accepted":true,"text":"ok"})");
+    const std::string r = c.read_all();
+    CHECK_THAT(r, Catch::StartsWith("HTTP/1.1 200 OK"));
+    CHECK_THAT(r, Catch::EndsWith(R"({"accepted":true,"text":"ok"})"));
+  }
+  {  // the stream needs the token too (unless opened read-only by the operator)
+    Client c(server.port());
+    c.send(ws_upgrade("/ws"));
+    CHECK_THAT(c.read_all(), Catch::StartsWith("HTTP/1.1 401"));
+  }
+}
+
+TEST_CASE("Foxglove clients get serverInfo, advertise and binary messageData of their subscriptions", "[monitor][server][foxglove]") {
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  const auto pose = server.advertise("/pose", "foxglove.PoseInFrame", R"({"type":"object"})", Delivery::bulk);
+  server.advertise("/lifecycle", "tripodal.LifecycleEntry", R"({"type":"object"})", Delivery::event);
+  server.start();
+  Client c(server.port());
+  c.send(ws_upgrade("/?token=t0ken-for-tests", "foxglove.websocket.v1"));
+  std::string got = c.read_until([](const std::string& b) { return b.find("\"advertise\"") != std::string::npos && b.find("jsonschema\"}]}") != std::string::npos; });
+  const std::size_t head = got.find("\r\n\r\n");
+  REQUIRE(head != std::string::npos);
+  CHECK_THAT(got.substr(0, head), Catch::Contains("Sec-WebSocket-Protocol: foxglove.websocket.v1"));
+  CHECK_THAT(got.substr(0, head), Catch::Contains("Sec-WebSocket-Accept: s3pPLMBiTxaQ9kYGzzhZRbK+xOo="));
+  auto frames = server_frames(std::string_view(got).substr(head + 4));
+  REQUIRE(frames.size() == 2);
+  const auto info = nlohmann::json::parse(frames[0].payload);
+  CHECK(info["op"] == "serverInfo");
+  CHECK(info["supportedEncodings"][0] == "json");
+  const auto adv = nlohmann::json::parse(frames[1].payload);
+  CHECK(adv["op"] == "advertise");
+  REQUIRE(adv["channels"].size() == 2);
+  CHECK(adv["channels"][0]["topic"] == "/pose");
+  CHECK(adv["channels"][0]["schemaEncoding"] == "jsonschema");
+  c.consume(got.size());
+
+  c.send(ws_client_frame(WsOpcode::text, R"({"op":"subscribe","subscriptions":[{"id":7,"channelId":)" + std::to_string(pose) + "}]}"));
+  // The subscription arrives on the server thread; publish until a message reaches the client.
+  std::string data;
+  REQUIRE(wait_for([&] {
+    server.publish(pose, 1.5, R"({"x":1})");
+    data = c.read_until([](const std::string& b) { return b.size() >= 2 + 13 + 7; }, std::chrono::milliseconds(50));
+    return data.size() >= 2 + 13 + 7;
+  }));
+  const auto f = server_frames(data);
+  REQUIRE(!f.empty());
+  CHECK(f[0].opcode == WsOpcode::binary);
+  REQUIRE(f[0].payload.size() == 13 + 7);
+  CHECK(f[0].payload[0] == 0x01);                  // messageData
+  CHECK(static_cast<std::uint8_t>(f[0].payload[1]) == 7);  // subscription id, little endian
+  std::uint64_t ns = 0;
+  for (int i = 7; i >= 0; --i) ns = (ns << 8) | static_cast<std::uint8_t>(f[0].payload[5 + static_cast<std::size_t>(i)]);
+  CHECK(ns == 1'500'000'000U);
+  CHECK(f[0].payload.substr(13) == R"({"x":1})");
+}
+
+TEST_CASE("A client that stops reading loses old bulk frames, and is let go rather than lose an event", "[monitor][server]") {
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests", .max_bulk_frames = 4, .max_event_bytes = 1U << 20U, .send_buffer_bytes = 16384});
+  const auto scan = server.advertise("/laser", "foxglove.LaserScan", "{}", Delivery::bulk);
+  const auto life = server.advertise("/lifecycle", "tripodal.LifecycleEntry", "{}", Delivery::event);
+  server.start();
+  Client sleeper(server.port(), 4096);
+  sleeper.send(ws_upgrade("/ws?token=t0ken-for-tests"));
+  REQUIRE(wait_for([&] { return server.stats().clients == 1; }));
+  // Bulk: 4000 scans of 16 KiB, far more than the socket buffers hold. publish() only appends.
+  const std::string payload = "\"" + std::string(16 * 1024, 's') + "\"";
+  for (int i = 0; i < 4000; ++i) server.publish(scan, i, payload);
+  REQUIRE(wait_for([&] { return server.stats().bulk_shed > 0; }));
+  CHECK(server.stats().clients == 1);  // still connected: only bulk data was shed
+  CHECK(server.stats().slow_disconnects == 0);
+  // Events: they may not be dropped, so past 1 MiB queued the client goes.
+  for (int i = 0; i < 200; ++i) server.publish(life, i, payload);
+  REQUIRE(wait_for([&] { return server.stats().slow_disconnects == 1; }));
+  CHECK(wait_for([&] { return server.stats().clients == 0; }));
+}
+
+TEST_CASE("A robot on simulated time runs the same with a monitor whose client does not read", "[monitor][robot]") {
+  auto run = [&](bool with_monitor, MonitorStats* stats) {
+    Psr2 psr2;
+    SimClock& clock = psr2.clock;
+    Robot* robot = psr2.robot.get();
+    std::unique_ptr<MonitorServer> server;
+    std::unique_ptr<RobotMonitor> watch;
+    std::unique_ptr<Client> sleeper;
+    if (with_monitor) {
+      server = std::make_unique<MonitorServer>(MonitorServerOptions{.token = "t0ken-for-tests", .max_bulk_frames = 4, .send_buffer_bytes = 16384});
+      watch = std::make_unique<RobotMonitor>(*robot, clock, *server, RobotMonitorOptions{.min_interval_s = 0.0, .cleaned_interval_s = 0.0});
+      server->start();
+      sleeper = std::make_unique<Client>(server->port(), 4096);
+      sleeper->send(ws_upgrade("/ws?token=t0ken-for-tests"));
+      REQUIRE(wait_for([&] { return server->stats().clients == 1; }));
+    }
+    REQUIRE(robot->command("clean the room 3211").accepted);
+    for (int i = 0; i < 600; ++i) {  // 60 s of simulated time, the monitor updated every 100 ms
+      robot->run_for(std::chrono::milliseconds(100));
+      if (watch) watch->update();
+    }
+    if (stats != nullptr) {
+      REQUIRE(wait_for([&] { return server->stats().bulk_shed > 0; }));
+      *stats = server->stats();
+    }
+    return std::make_pair(robot->behavior_loop().cycles(), robot->navigation().map_from_base);
+  };
+  MonitorStats stats;
+  const auto plain = run(false, nullptr);
+  const auto watched = run(true, &stats);
+  CHECK(watched.first == plain.first);      // every reactive cycle ran
+  CHECK(watched.second == plain.second);    // to the same pose: the monitor changed nothing
+  CHECK(stats.bulk_shed > 0);               // the client fell behind and lost old bulk frames
+  CHECK(stats.slow_disconnects == 0);
+  CHECK(stats.published >= 600 * 3 + 60 * 5);  // pose, markings, status at every update; each new scan
+}
+
+TEST_CASE("A server that is not running keeps a bounded outbox of bulk messages", "[monitor][server]") {
+  MonitorServer server;
+  const auto pose = server.advertise("/pose", "foxglove.PoseInFrame", "{}", Delivery::bulk);
+  for (int i = 0; i < 10000; ++i) server.publish(pose, i, "{}");
+  CHECK(server.stats().published == 10000);
+  CHECK(server.stats().bulk_shed == 10000 - 4096);  // the oldest went, 4096 wait
+}
+
+TEST_CASE("Manual drive goes through the coordinator, masks the task's motion and stops at the dead-man timeout", "[monitor][robot]") {
+  Psr2 psr2;
+  SimClock& clock = psr2.clock;
+  Robot* robot = psr2.robot.get();
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*robot, clock, server, RobotMonitorOptions{.min_interval_s = 0.0, .drive_deadman_s = 0.05});
+  server.start();
+  auto post = [&](const std::string& body) {
+    Client c(server.port());
+    c.send("POST /api/command HTTP/1.1\r\nAuthorization: Bearer t0ken-for-tests\r\nContent-Length: " + std::to_string(body.size()) +
+           "\r\n\r\n" + body);
+    // The robot's thread answers between periods.
+    std::string answer;
+    REQUIRE(wait_for([&] {
+      watch.update();
+      answer = c.read_until([](const std::string& b) { return b.find("\r\n\r\n{") != std::string::npos && b.back() == '}'; },
+                            std::chrono::milliseconds(20));
+      return !answer.empty() && answer.back() == '}';
+    }));
+    return answer;
+  };
+  REQUIRE(robot->command("clean the room 3211").accepted);
+  robot->run_for(std::chrono::seconds(5));
+  CHECK(robot->behavior_active("BhCleaning"));
+
+  CHECK_THAT(post(R"({"op":"drive","vx":"fast"})"), Catch::Contains(R"(drive: \"vx\" must be a number)"));
+  CHECK_THAT(post(R"({"op":"drive","vx":0.0,"wz":1.0})"), Catch::Contains(R"("driving":true)"));
+  const Pose2D before = robot->navigation().map_from_base;
+  robot->run_for(std::chrono::seconds(1));
+  const CycleReport& cycle = robot->behavior_loop().last_cycle();
+  CHECK(cycle.coordinator.locked);
+  CHECK(cycle.coordinator.lock == "operator");
+  CHECK(cycle.coordinator.command.wz_rad_s > 0.5);  // turning on the spot as told, nothing of the cleaning path
+  CHECK(std::abs(cycle.coordinator.command.vx_m_s) < 1e-9);
+  CHECK(std::abs(robot->navigation().map_from_base.theta_rad - before.theta_rad) > 0.3);
+
+  // No further command: the dead-man switch ends the drive at the next update, the task moves on.
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  watch.update();
+  robot->run_for(std::chrono::seconds(1));
+  CHECK_FALSE(robot->behavior_loop().last_cycle().coordinator.locked);
+  CHECK(robot->behavior_active("BhCleaning"));
+  CHECK(robot->planner().busy());
+}
+
+TEST_CASE("Read-only streams may be opened without the token where the operator says so; commands may not", "[monitor][server]") {
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests", .read_without_token = true});
+  server.start();
+  {
+    Client c(server.port());
+    c.send(ws_upgrade("/ws"));
+    const std::string got = c.read_until([](const std::string& b) { return b.find("\"read_only\":true") != std::string::npos; });
+    CHECK_THAT(got, Catch::StartsWith("HTTP/1.1 101 Switching Protocols"));
+    CHECK_THAT(got, Catch::Contains(R"("read_only":true)"));
+  }
+  Client c(server.port());
+  c.send("POST /api/command HTTP/1.1\r\nContent-Length: 14\r\n\r\n{\"op\":\"pause\"}");
+  CHECK_THAT(c.read_all(), Catch::StartsWith("HTTP/1.1 401"));
+  CHECK(server.take_requests().empty());
+}
