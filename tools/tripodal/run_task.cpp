@@ -128,7 +128,7 @@ class ReportObserver final : public TaskObserver {
 // The dose of each reachable cell (the dose map is on the world's grid, the reachable cells on the
 // robot's map: matched by the cell centre), the tank, and both sides of the link.
 DisinfectionFigures disinfection_figures(sim::SimBoardHardware& hw, const std::vector<char>& reachable, const navi::OccupancyGrid& grid,
-                                         double tank_at_start_l, double target_j_m2) {
+                                         double target_j_m2) {
   DisinfectionFigures f;
   board::EmbeddedBoard& b = hw.embedded();
   const std::filesystem::path device = b.device();
@@ -147,7 +147,7 @@ DisinfectionFigures disinfection_figures(sim::SimBoardHardware& hw, const std::v
   }
   f.lamp_on_s = to_seconds(hw.uv_dose().lamp_on());
   f.disinfectant_left_l = b.firmware().tank_l();
-  f.disinfectant_used_l = std::max(0.0, tank_at_start_l - f.disinfectant_left_l);
+  f.disinfectant_used_l = b.firmware().disinfectant_used_l();
   f.link = b.host().link().stats();
   f.decoder_errors = b.host().link().decoder_stats().errors() + b.firmware().decoder_stats().errors();
   f.board_requests = b.firmware().counters().requests;
@@ -268,7 +268,6 @@ RunResult run_task(const RunOptions& o) {
     }
   }
   flush_log();
-  const double tank_at_start_l = board_hw != nullptr ? board_hw->embedded().firmware().tank_l() : 0.0;
 
   // The room's sections and the reachable area, for the measures: of the task running (a task
   // submitted on the monitor's console is measured from when it starts).
@@ -425,8 +424,7 @@ RunResult run_task(const RunOptions& o) {
     res.sections.push_back(f);
   }
 
-  if (board_hw != nullptr) res.disinfection = disinfection_figures(*board_hw, reachable, nav.maps->grid(), tank_at_start_l,
-                                                                    o.uv_target_dose_j_m2);
+  if (board_hw != nullptr) res.disinfection = disinfection_figures(*board_hw, reachable, nav.maps->grid(), o.uv_target_dose_j_m2);
 
   if (!o.out.empty()) {
     std::filesystem::create_directories(o.out);
