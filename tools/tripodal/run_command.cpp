@@ -43,7 +43,8 @@ constexpr std::string_view kDescription =
 
 constexpr std::string_view kExitCodes =
     "exit codes: 0 task succeeded, 1 bad profile/world/faults, 2 bad command line, 3 I/O error,\n"
-    "            4 the task failed, was refused or timed out.";
+    "            4 the task failed, was refused or timed out (with --monitor and no task given at all,\n"
+    "            the run ends with 0 when stopped).";
 
 struct Args {
   app::RunOptions options;
@@ -114,7 +115,9 @@ int run(Args& args, std::ostream& out, std::ostream& err) {
           << d->link.missed << " missed, " << d->decoder_errors << " decoder errors, " << d->link.link_losses << " link losses\n";
     }
     if (!o.out.empty()) out << "wrote " << (o.out / "map.png").string() << ", trajectory.csv, report.json, lifecycle.txt\n";
-    return r.succeeded ? kOk : kTaskFailed;
+    // A monitored robot the operator never gave a task: nothing failed.
+    const bool idle_monitor = o.monitor.has_value() && r.state == "idle";
+    return r.succeeded || idle_monitor ? kOk : kTaskFailed;
   } catch (const ConfigError& e) {
     err << e.what() << '\n';
     return kBadInput;
