@@ -11,7 +11,6 @@
 #include <map>
 #include <numbers>
 #include <queue>
-#include <ranges>
 
 namespace tripodal::navi {
 
@@ -31,12 +30,15 @@ constexpr double kUnreachable = std::numeric_limits<double>::infinity();
 
 constexpr std::size_t kNoCell = std::numeric_limits<std::size_t>::max();
 
-// Of `cells`, the one whose centre is closest to p among those `accept` takes; kNoCell if none.
-template <typename Cells, typename Accept>
-std::size_t closest_cell(const OccupancyGrid& grid, Point2D p, const Cells& cells, Accept accept) {
+// Of the cells cell_of(0 .. count-1), the one whose centre is closest to p among those `accept`
+// takes; kNoCell if none. (An index function, not a range: clang 14, the fuzzing build's compiler,
+// cannot compile libstdc++ 12's views::iota.)
+template <typename CellOf, typename Accept>
+std::size_t closest_cell(const OccupancyGrid& grid, Point2D p, std::size_t count, CellOf cell_of, Accept accept) {
   std::size_t best = kNoCell;
   double best_d2 = kUnreachable;
-  for (const std::size_t i : cells) {
+  for (std::size_t k = 0; k < count; ++k) {
+    const std::size_t i = cell_of(k);
     if (!accept(i)) continue;
     const Point2D q = grid.cell_center(grid.cell(i));
     const double d2 = (q.x_m - p.x_m) * (q.x_m - p.x_m) + (q.y_m - p.y_m) * (q.y_m - p.y_m);
@@ -52,7 +54,7 @@ std::size_t closest_cell(const OccupancyGrid& grid, Point2D p, const Cells& cell
 std::size_t nearest_free_cell(const OccupancyGrid& grid, Point2D p) {
   const CellIndex c = grid.cell_at(p);
   if (grid.contains(c) && grid.is_free(c)) return grid.index(c);
-  return closest_cell(grid, p, std::views::iota(std::size_t{0}, grid.size()),
+  return closest_cell(grid, p, grid.size(), [](std::size_t k) { return k; },
                       [&](std::size_t i) { return grid.state(i) == Occupancy::free; });
 }
 
@@ -105,7 +107,8 @@ std::pair<int, double> nearest_section(const OccupancyGrid& grid, const std::vec
 
 // Where the robot is taken to be once a section is cleaned: its cell nearest the centroid.
 std::size_t centre_cell(const OccupancyGrid& grid, const Section& s) {
-  return closest_cell(grid, s.centroid, s.cells, [](std::size_t) { return true; });
+  return closest_cell(grid, s.centroid, s.cells.size(), [&](std::size_t k) { return s.cells[k]; },
+                      [](std::size_t) { return true; });
 }
 
 }  // namespace

@@ -61,7 +61,7 @@ TEST_CASE("Kanban: one place invariant per stage, and two across the synchronise
   CHECK(t.invariants.size() == 5);
 }
 
-TEST_CASE("Weighted arcs give weighted invariants; read arcs change nothing", "[analysis][invariants]") {
+TEST_CASE("Weighted arcs give weighted invariants, read arcs change nothing", "[analysis][invariants]") {
   // t: 2 a -> b, u: b -> 2 a; a reads c.
   PetriNet net;
   net.add_place(Place{.id = "a", .initial_tokens = 4});

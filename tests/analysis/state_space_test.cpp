@@ -118,7 +118,7 @@ TEST_CASE("Engine semantics: an immediate transition is urgent, an event waits f
   CHECK(explore(net, {}).fired() == std::vector<std::uint8_t>{1, 1});
 }
 
-TEST_CASE("Engine semantics: a guard over a fact may be true or false; over a parameter it is decided", "[analysis][explore][engine]") {
+TEST_CASE("Engine semantics: a guard over a fact may be true or false, over a parameter it is decided", "[analysis][explore][engine]") {
   PetriNet net = conflict_net();
   net.facts.push_back(VariableDecl{.name = "battery_low", .type = ValueType::boolean});
   net.parameters.push_back(VariableDecl{.name = "mode", .type = ValueType::string, .default_value = Value{std::string("slow")}});

@@ -38,7 +38,7 @@ TEST_CASE("Priority mode: the live input of highest priority wins and is named")
   CHECK(co.update(Time{30ms}).winner == "BhGoToPose");
 }
 
-TEST_CASE("Per-input timeouts; an explicit zero when every input expired") {
+TEST_CASE("Per-input timeouts, an explicit zero when every input expired") {
   CoordinatorConfig c = three_inputs();
   c.inputs.pop_back();  // no BhStop fallback
   CBehaviorCoordinator co(c);

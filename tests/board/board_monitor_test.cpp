@@ -92,7 +92,7 @@ TEST_CASE("BoardMonitor: a dead link is a fault event within two control periods
   CHECK(rig.board.host().link().synchronised());
 }
 
-TEST_CASE("BoardMonitor: the emergency stop brakes at once and is a fault; the other buttons are events", "[board][monitor]") {
+TEST_CASE("BoardMonitor: the emergency stop brakes at once and is a fault, the other buttons are events", "[board][monitor]") {
   Rig rig;
   for (int i = 0; i < 30; ++i) REQUIRE_FALSE(rig.period());
 

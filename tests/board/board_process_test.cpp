@@ -59,7 +59,7 @@ int cycle_until(BoardLink& link, const SteadyClock& clock, int max_cycles, const
 
 }  // namespace
 
-TEST_CASE("a board whose process is killed: link lost at once; restarted: the port reopens and resynchronises",
+TEST_CASE("a board whose process is killed: link lost at once, restarted: the port reopens and resynchronises",
           "[board][process]") {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("tripodal-board-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);

@@ -103,7 +103,7 @@ TEST_CASE("the disinfection robot disinfects a room over the board's protocol, b
 // for the figures in docs/board-protocol.md.
 TEST_CASE("the disinfection robot disinfects the room 3211", "[.][board][disinfection-3211]") { check_disinfects("3211", 8000.0); }
 
-TEST_CASE("PrDisinfection: an empty tank pauses the fog and asks for disinfectant; a low battery ends it safely", "[board][disinfection]") {
+TEST_CASE("PrDisinfection: an empty tank pauses the fog and asks for disinfectant, a low battery ends it safely", "[board][disinfection]") {
   DisinfectionRobot r;
   board::BoardFirmware& fw = r.hw->embedded().firmware();
   fw.set_tank_l(0.002);  // runs dry after ~12 s of fog

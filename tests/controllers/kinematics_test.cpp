@@ -76,7 +76,7 @@ TEST_CASE("Holonomic kinematics round trip for omni and mecanum bases") {
   }
 }
 
-TEST_CASE("Omni wheel speeds match the textbook formula; mecanum matches the X-arrangement formula") {
+TEST_CASE("Omni wheel speeds match the textbook formula, mecanum matches the X-arrangement formula") {
   const double three[] = {kPi / 2, kPi / 2 + 2 * kPi / 3, kPi / 2 + 4 * kPi / 3};
   IdealWheelHardware hw3(3, 10ms);
   HolonomicController omni(holonomic("omni", omni_base(0.05, 0.2, three)), hw3);

@@ -59,7 +59,7 @@ TEST_CASE("API example: run a two-step net with an event") {
   CHECK(history.transition_ids() == Ids{"start", "finish"});
 }
 
-TEST_CASE("input arcs need their weight and consume it; output arcs produce") {
+TEST_CASE("input arcs need their weight and consume it, output arcs produce") {
   PetriNet net;
   net.add_place(make_place("a", 1));
   net.add_place(make_place("b"));
@@ -402,7 +402,7 @@ PetriNet guarded_net() {
 }
 }  // namespace
 
-TEST_CASE("guards read parameters (defaults applied) and facts; a fact change re-examines") {
+TEST_CASE("guards read parameters (defaults applied) and facts, a fact change re-examines") {
   const PetriNet net = guarded_net();
   Engine e(net, {{"speed_m_s", Value{1.0}}});
   CHECK(std::get<std::string>(e.parameter("mode")) == "auto");
@@ -601,7 +601,7 @@ TEST_CASE("outcome: fault wins over success, lowest place first") {
   CHECK(e.outcome().message == "first fault");
 }
 
-TEST_CASE("observers see every firing until removed; reset restarts the net") {
+TEST_CASE("observers see every firing until removed, reset restarts the net") {
   Engine e(test::ring_net(4, from_seconds(1.0)));
   HistoryRecorder a;
   HistoryRecorder b;

@@ -65,7 +65,7 @@ TEST_CASE("event scripts: errors name line and column, all at once") {
   }
 }
 
-TEST_CASE("event scripts load from files; a missing file is an error naming it") {
+TEST_CASE("event scripts load from files, a missing file is an error naming it") {
   const auto dir = std::filesystem::temp_directory_path() / "tripodal_event_script_test";
   std::filesystem::create_directories(dir);
   const auto file = dir / "run.script";

@@ -20,7 +20,7 @@ bool near(const Pose2D& a, const Pose2D& b, double eps = 1e-12) {
 }
 }  // namespace
 
-TEST_CASE("wrap_angle maps every angle into [-pi, pi)") {
+TEST_CASE("wrap_angle maps every angle into -pi (included) to pi (excluded)") {
   CHECK(wrap_angle(0.0) == 0.0);
   CHECK(wrap_angle(kPi) == Approx(-kPi));
   CHECK(wrap_angle(-kPi) == Approx(-kPi));

@@ -194,7 +194,7 @@ TEST_CASE("WebSocket frames: client frames must be masked and fit the limit", "[
   CHECK_THAT(big.error, Catch::Contains("frame of 2000 bytes: the limit is 1000"));
 }
 
-TEST_CASE("server_options reads [ADDR:]PORT and the token file", "[monitor]") {
+TEST_CASE("server_options reads PORT or ADDR:PORT and the token file", "[monitor]") {
   CHECK(server_options("8765").address == "127.0.0.1");
   CHECK(server_options("8765").port == 8765);
   CHECK(server_options("0.0.0.0:80").address == "0.0.0.0");
@@ -430,7 +430,7 @@ TEST_CASE("Manual drive goes through the coordinator, masks the task's motion an
   CHECK(robot->planner().busy());
 }
 
-TEST_CASE("Read-only streams may be opened without the token where the operator says so; commands may not", "[monitor][server]") {
+TEST_CASE("Read-only streams may be opened without the token where the operator says so, commands may not", "[monitor][server]") {
   MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests", .read_without_token = true});
   server.start();
   {

@@ -118,7 +118,7 @@ TEST_CASE("Coverage: a room with an isolated obstacle", "[navi][coverage]") {
   CHECK(b.passes > b.rounds);
 }
 
-TEST_CASE("Coverage: a bigger robot keeps its radius from walls; unreachable parts are not counted",
+TEST_CASE("Coverage: a bigger robot keeps its radius from walls, unreachable parts are not counted",
           "[navi][coverage]") {
   OccupancyGrid g = test::room(82, 62, 0.05);
   // a closet behind a 0.3 m doorway: the robot (radius 0.3 m) cannot get in

@@ -92,7 +92,7 @@ TEST_CASE("CLocalizer: the same seed gives the same estimates, another seed othe
   CHECK(trace(3) != trace(4));
 }
 
-TEST_CASE("CLocalizer: noise beyond the threshold reads as lost; no truth, no events", "[navi][localizer]") {
+TEST_CASE("CLocalizer: noise beyond the threshold reads as lost, no truth, no events", "[navi][localizer]") {
   Straight truth;
   CLocalizer noisy(&truth);
   noisy.configure({{"noise_xy_m", Value{5.0}}});

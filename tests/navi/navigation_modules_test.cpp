@@ -725,7 +725,7 @@ TEST_CASE("BhCleaningTwoWheel covers the section on the differential base",
 }
 
 TEST_CASE(
-    "The coverage planner detours a cleaning around a box the map does not hold; without replanning it is "
+    "The coverage planner detours a cleaning around a box the map does not hold, without replanning it is "
     "blocked",
     "[navi][modules][robot][cleaning]") {
   const Box box{2.2, 0.05, 2.8, 0.6, {}};  // against the bottom wall, on the first rounds
@@ -756,7 +756,7 @@ TEST_CASE(
   CHECK(r.box_clearance() >= kRadius_m);
 }
 
-TEST_CASE("A cleaning interrupted and activated again resumes where it stopped; lost, it marks nothing",
+TEST_CASE("A cleaning interrupted and activated again resumes where it stopped, lost, it marks nothing",
           "[navi][modules][robot][cleaning]") {
   NavRobot r(true, world(5.0, 4.0, false, kCorner), {{"BhCleaning", {{"section", "A"}}}},
              ", faults: 20-23, recover_at_fault_end: true");

@@ -236,7 +236,7 @@ TEST_CASE("A fault no rule handles, and a skip rule", "[planner]") {
   }
 }
 
-TEST_CASE("The planner runs the processes' module nets; a fault keeps the failing process's message", "[planner]") {
+TEST_CASE("The planner runs the processes' module nets, a fault keeps the failing process's message", "[planner]") {
   World w(true);
   w.behaviors.specs["BhCleaning"].fail = true;
   REQUIRE(w.planner->command("clean room 2111").accepted);
@@ -271,7 +271,7 @@ TEST_CASE("An unknown command is refused and nothing runs", "[planner]") {
   CHECK_THAT(w.life.entries()[0].text, Catch::StartsWith("command refused: \"make me a coffee\": not understood"));
 }
 
-TEST_CASE("A plan naming a process the robot lacks is refused; a busy planner refuses", "[planner]") {
+TEST_CASE("A plan naming a process the robot lacks is refused, a busy planner refuses", "[planner]") {
   SimClock clock;
   FakeBehaviors behaviors;
   behaviors.add("BhAutoMove", 1.0);

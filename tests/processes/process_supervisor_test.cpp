@@ -221,7 +221,7 @@ TEST_CASE("A behavior that stops answering fails after the watchdog timeout", "[
                   "t=0.600 fault BhAutoMove: stopped answering (no step for 0.600 s)") != rig.lines.lines.end());
 }
 
-TEST_CASE("Module watchdog: a silent module posts its event; unhandled module faults fail the processes", "[processes]") {
+TEST_CASE("Module watchdog: a silent module posts its event, unhandled module faults fail the processes", "[processes]") {
   SECTION("the localizer's silence is a localization loss the net handles with its delay") {
     Rig rig;
     rig.supervisor.watch_module("localizer", from_seconds(1.0), "localizer.lost");

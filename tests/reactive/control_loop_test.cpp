@@ -119,7 +119,7 @@ TEST_CASE("Activation, replacement, deactivation and status through the loop") {
   CHECK_THROWS_WITH(loop.set_lock("nope", true, Time{0ms}), Catch::Contains("no coordinator lock named 'nope'"));
 }
 
-TEST_CASE("Behavior outcomes become supervisor events; a failure carries its reason") {
+TEST_CASE("Behavior outcomes become supervisor events, a failure carries its reason") {
   test::ReactiveRig rig(test::omni_base_psr(), CoordinationMode::priority);
   ControlLoop& loop = *rig.loop;
   const BehaviorRegistry& reg = default_behavior_registry();

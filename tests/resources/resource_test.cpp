@@ -72,7 +72,7 @@ TEST_CASE("Publishing a reading of the same size reuses storage") {
   CHECK(laser.sequence() == 3);
 }
 
-TEST_CASE("Drivers publish from poll(); the table finds resources by name and reading type") {
+TEST_CASE("Drivers publish from poll(), the table finds resources by name and reading type") {
   FakeBumperDriver bumpers;
   OdometryResource odom("odom");
   BatteryResource battery("battery", 1s);

@@ -131,7 +131,7 @@ TEST_CASE("Layering rules R1-R5 are enforced with the rule named", "[robot]") {
   }
 }
 
-TEST_CASE("Module types: a registered type's manifest is not declared again; unknown types must be declared", "[robot]") {
+TEST_CASE("Module types: a registered type's manifest is not declared again, unknown types must be declared", "[robot]") {
   Catalog c;
   std::string diag = c.check(profile("  - {name: front_laser, type: LaserScanner, layer: sequencing}\n", kNavigation, kBehaviors));
   CHECK_THAT(diag, Catch::Contains("testbot.yaml:5:5: error: module 'front_laser' re-declares layer of its registered type "
@@ -216,7 +216,7 @@ TEST_CASE("The robot refuses to start with every problem listed", "[robot]") {
   }
 }
 
-TEST_CASE("describe_text lists modules by layer; describe_dot draws clusters and information edges", "[robot]") {
+TEST_CASE("describe_text lists modules by layer, describe_dot draws clusters and information edges", "[robot]") {
   Catalog c;
   RobotDescription r;
   REQUIRE(c.check(profile(kResources, kNavigation, kBehaviors), &r).empty());

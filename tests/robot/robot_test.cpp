@@ -203,7 +203,7 @@ TEST_CASE("PSR-2 refuses an unknown command and runs nothing", "[robot]") {
   CHECK(p.robot->supervisor().active_behaviors().empty());
 }
 
-TEST_CASE("PSR-2: a module that throws becomes a fault; the loop goes on", "[robot]") {
+TEST_CASE("PSR-2: a module that throws becomes a fault, the loop goes on", "[robot]") {
   Psr2 p;
   REQUIRE(p.robot->command("clean the room 3211").accepted);
   REQUIRE_NOTHROW(p.run(200.0, [&](double t) {

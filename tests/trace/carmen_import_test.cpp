@@ -98,7 +98,7 @@ TEST_CASE("FLASER beams follow CARMEN's angle convention and keep their ranges")
   CHECK(first.ranges_m[110] > first.range_max_m);
 }
 
-TEST_CASE("ODOM lines become odometry readings with twist; backwards stamps are clamped") {
+TEST_CASE("ODOM lines become odometry readings with twist, backwards stamps are clamped") {
   const Imported im = import_and_read(kExcerpt);
   // Line 173: ODOM ... 33.1085; line 174: ODOM 0.698035 -0.0132843 -0.460915 0 0 0 32.9068 (backwards);
   // line 175: FLASER at 32.9068; line 176: ODOM 0.600266 -0.0320327 -0.354665 0 0 0 0 (backwards).
