@@ -1,17 +1,18 @@
 #!/usr/bin/env bash
 # Builds the test suites whose tests use threads with ThreadSanitizer (-DTRIPODAL_TSAN=ON, g++) and
 # runs the tests tagged [threads]: LoopRunner, the process supervisor's inbox fed from module
-# threads, Robot::start/stop with a command from another thread, SourceFile interning. A data race
+# threads, Robot::start/stop with a command from another thread, SourceFile interning, the monitor's
+# server thread against the robot's. A data race
 # or a lock-order inversion fails the run (halt_on_error). Build tree: $BUILD_ROOT/tsan.
 #
-# A new threaded component (the monitor server, a DDS transport) joins by tagging its tests
+# A new threaded component (a DDS transport) joins by tagging its tests
 # [threads] and adding its suite to `suites` below.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
 build="${BUILD_ROOT:-$root/build}/tsan"
 jobs=${JOBS:-$(nproc)}
-suites=(tripodal_core_tests tripodal_reactive_tests tripodal_processes_tests tripodal_robot_tests)
+suites=(tripodal_core_tests tripodal_reactive_tests tripodal_processes_tests tripodal_robot_tests tripodal_monitor_tests)
 
 scripts/install-deps.sh
 

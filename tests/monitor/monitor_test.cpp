@@ -210,7 +210,7 @@ TEST_CASE("server_options reads PORT or ADDR:PORT and the token file", "[monitor
   REQUIRE_THROWS_WITH(server_options("0", dir / "missing"), Catch::Contains("missing': cannot be read"));
 }
 
-TEST_CASE("The server serves the page, refuses without the token and hands commands to the robot's thread", "[monitor][server]") {
+TEST_CASE("The server serves the page, refuses without the token and hands commands to the robot's thread", "[monitor][server][threads]") {
   MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
   server.start();
   REQUIRE(server.port() != 0);
@@ -276,7 +276,7 @@ TEST_CASE("The server serves the page, refuses without the token and hands comma
   }
 }
 
-TEST_CASE("Foxglove clients get serverInfo, advertise and binary messageData of their subscriptions", "[monitor][server][foxglove]") {
+TEST_CASE("Foxglove clients get serverInfo, advertise and binary messageData of their subscriptions", "[monitor][server][foxglove][threads]") {
   MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
   const auto pose = server.advertise("/pose", "foxglove.PoseInFrame", R"({"type":"object"})", Delivery::bulk);
   server.advertise("/lifecycle", "tripodal.LifecycleEntry", R"({"type":"object"})", Delivery::event);
@@ -320,7 +320,7 @@ TEST_CASE("Foxglove clients get serverInfo, advertise and binary messageData of 
   CHECK(f[0].payload.substr(13) == R"({"x":1})");
 }
 
-TEST_CASE("A client that stops reading loses old bulk frames, and is let go rather than lose an event", "[monitor][server]") {
+TEST_CASE("A client that stops reading loses old bulk frames, and is let go rather than lose an event", "[monitor][server][threads]") {
   MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests", .max_bulk_frames = 4, .max_event_bytes = 1U << 20U, .send_buffer_bytes = 16384});
   const auto scan = server.advertise("/laser", "foxglove.LaserScan", "{}", Delivery::bulk);
   const auto life = server.advertise("/lifecycle", "tripodal.LifecycleEntry", "{}", Delivery::event);
@@ -340,7 +340,7 @@ TEST_CASE("A client that stops reading loses old bulk frames, and is let go rath
   CHECK(wait_for([&] { return server.stats().clients == 0; }));
 }
 
-TEST_CASE("A robot on simulated time runs the same with a monitor whose client does not read", "[monitor][robot]") {
+TEST_CASE("A robot on simulated time runs the same with a monitor whose client does not read", "[monitor][robot][threads]") {
   auto run = [&](bool with_monitor, MonitorStats* stats) {
     Psr2 psr2;
     SimClock& clock = psr2.clock;
@@ -377,7 +377,7 @@ TEST_CASE("A robot on simulated time runs the same with a monitor whose client d
   CHECK(stats.published >= 600 * 3 + 60 * 5);  // pose, markings, status at every update; each new scan
 }
 
-TEST_CASE("A server that is not running keeps a bounded outbox of bulk messages", "[monitor][server]") {
+TEST_CASE("A server that is not running keeps a bounded outbox of bulk messages", "[monitor][server][threads]") {
   MonitorServer server;
   const auto pose = server.advertise("/pose", "foxglove.PoseInFrame", "{}", Delivery::bulk);
   for (int i = 0; i < 10000; ++i) server.publish(pose, i, "{}");
@@ -430,7 +430,7 @@ TEST_CASE("Manual drive goes through the coordinator, masks the task's motion an
   CHECK(robot->planner().busy());
 }
 
-TEST_CASE("Read-only streams may be opened without the token where the operator says so, commands may not", "[monitor][server]") {
+TEST_CASE("Read-only streams may be opened without the token where the operator says so, commands may not", "[monitor][server][threads]") {
   MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests", .read_without_token = true});
   server.start();
   {
