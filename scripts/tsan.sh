@@ -19,7 +19,7 @@ scripts/install-deps.sh
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTRIPODAL_TSAN=ON -DTRIPODAL_WERROR=ON \
   -DTRIPODAL_BUILD_TESTS=ON -DTRIPODAL_BUILD_TOOLS=OFF -DTRIPODAL_BUILD_BENCH=OFF >/dev/null
 cmake --build "$build" -j "$jobs" --target "${suites[@]}"
-export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1"
+export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$root/scripts/tsan.supp"
 for suite in "${suites[@]}"; do
   exe=$(find "$build/tests" -type f -name "$suite" -perm -u+x | head -n 1)
   echo "== $suite [threads] under ThreadSanitizer"
