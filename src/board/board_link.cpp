@@ -120,11 +120,8 @@ void BoardLink::on_frame(const FrameView& frame, Time now) noexcept {
   if (r->is_error()) {
     ++stats_.error_responses;
     if (front.actuator) ++stats_.retries;  // stays queued: sent again next period
-    if (r->error() == ErrorCode::not_synchronised) {
-      lose(now);  // the board's watchdog tripped: it stopped the motors and wants SYNC
-    } else if (++consecutive_missed_ >= config_.max_missed) {
-      lose(now);
-    }
+    // The board's watchdog tripped (it stopped the motors and wants SYNC), or too many errors.
+    if (r->error() == ErrorCode::not_synchronised || ++consecutive_missed_ >= config_.max_missed) lose(now);
     return;
   }
   ++stats_.responses;

@@ -30,7 +30,7 @@ namespace {
 using SteadyTime = std::chrono::steady_clock::time_point;
 
 constexpr std::string_view kFoxglove = "foxglove.websocket.v1";
-constexpr std::size_t kMaxClientFrame = 64 * 1024;
+constexpr std::size_t kMaxClientFrame = std::size_t{64} * 1024;
 constexpr std::size_t kMaxOutbox = 4096;  // messages published but not yet taken by the server thread
 
 std::string random_token() {
@@ -635,7 +635,7 @@ std::vector<OperatorRequest> MonitorServer::take_requests() {
   return out;
 }
 
-void MonitorServer::answer(std::uint64_t id, int status, std::string json) {
+void MonitorServer::answer(std::uint64_t id, int status, const std::string& json) {
   {
     const std::lock_guard lock(impl_->mutex);
     impl_->answers.emplace_back(id, http_response(status, "application/json", json));

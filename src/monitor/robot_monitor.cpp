@@ -219,7 +219,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
     }
   }
 
-  void pause_now(std::string reason) {
+  void pause_now(const std::string& reason) {
     paused = true;
     pause_reason = reason;
     note("monitor: paused, " + reason);
@@ -229,7 +229,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
   void handle(const OperatorRequest& r) {
     const json body = json::parse(r.body, nullptr, false);
     const std::string op = body.value("op", "");
-    auto reply = [&](int status, json j) { server.answer(r.id, status, j.dump()); };
+    auto reply = [&](int status, const json& j) { server.answer(r.id, status, j.dump()); };
     if (op == "task") {
       if (!body.contains("text") || !body["text"].is_string()) return reply(400, {{"error", "task: expected \"text\": the task in plain words"}});
       const std::string text = body["text"];

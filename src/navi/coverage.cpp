@@ -534,6 +534,7 @@ void CoveragePlanner::plough(Workspace& ws, const std::vector<std::uint8_t>& mas
   const double step = lane_spacing / grid_.resolution_m();
   const int count = lo > hi ? 0 : static_cast<int>(std::ceil(static_cast<double>(hi - lo) / step - 1e-9)) + 1;
   std::vector<int> lanes;
+  lanes.reserve(static_cast<std::size_t>(count));
   for (int k = 0; k < count; ++k) {
     lanes.push_back(count == 1 ? (lo + hi) / 2
                                : lo + static_cast<int>(std::lround(static_cast<double>(k) * (hi - lo) / (count - 1))));

@@ -124,10 +124,10 @@ ScanMatcher::ScanMatcher(const OccupancyGrid& map, ScanMatcherOptions options, c
   const int nx = static_cast<int>(std::ceil(std::max(options_.search_xy_m, options_.max_search_xy_m) / cell_m_));
   const int nt = static_cast<int>(
       std::ceil(std::max(options_.search_theta_rad, options_.max_search_theta_rad) / options_.angular_step_rad));
-  const auto headings = static_cast<std::size_t>(2 * nt + 1);
+  const std::size_t headings = 2 * static_cast<std::size_t>(nt) + 1;
   cx_.resize(headings * n);
   cy_.resize(headings * n);
-  const auto side = static_cast<std::size_t>(nx + 1);
+  const std::size_t side = static_cast<std::size_t>(nx) + 1;
   blocks_.resize(headings * side * side);
 }
 

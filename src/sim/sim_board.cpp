@@ -87,7 +87,7 @@ void SimBoardHardware::on_add_resources(ResourceTable& table) {
   if (rc.gyro.enabled) table.add(sim_.gyro());
 }
 
-void register_sim_board_hardware(HardwareRegistry& registry, std::shared_ptr<const World> world) {
+void register_sim_board_hardware(HardwareRegistry& registry, const std::shared_ptr<const World>& world) {
   registry.add(SimBoardHardware::static_manifest(), [world](const HardwareConfig& c) -> std::unique_ptr<CHardware> {
     const board::BoardHardwareConfig host = board::board_hardware_config(c);
     if (!world) throw ConfigError(c.where, "the simulated hardware 'board' needs a world (tripodal run --world FILE)");

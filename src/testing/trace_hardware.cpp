@@ -75,7 +75,7 @@ ModuleManifest trace_hardware_manifest(std::vector<std::string> outputs) {
 }
 
 void register_trace_hardware(HardwareRegistry& registry, std::vector<std::string> outputs,
-                             std::shared_ptr<const sim::World> world) {
+                             const std::shared_ptr<const sim::World>& world) {
   if (outputs.empty()) outputs = sim::SimHardware::static_manifest().outputs;
   ModuleManifest manifest = trace_hardware_manifest(std::move(outputs));
   registry.add(manifest, [manifest, world](const HardwareConfig& c) -> std::unique_ptr<CHardware> {

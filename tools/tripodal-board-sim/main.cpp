@@ -21,9 +21,9 @@
 namespace {
 std::atomic<bool> g_stop{false};
 void on_signal(int /*sig*/) { g_stop.store(true); }
-}  // namespace
 
-int main(int argc, char** argv) {
+// The tool; main() only keeps what escapes it (CLI11's own errors are answered inside).
+int run(int argc, char** argv) {
   using namespace tripodal;
   CLI::App app{"tripodal-board-sim: the disinfection robot's control board, simulated behind a pseudo-terminal"};
   std::string world_file = "configs/worlds/workspace.yaml";
@@ -79,6 +79,17 @@ int main(int argc, char** argv) {
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "tripodal-board-sim: error: " << e.what() << '\n';
+    return 1;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (...) {
+    std::cerr << "tripodal-board-sim: error: unexpected exception\n";
     return 1;
   }
 }

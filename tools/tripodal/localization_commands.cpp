@@ -369,9 +369,11 @@ int map_build(const BuildArgs& a, std::ostream& out, std::ostream& err) {
   return guarded("tripodal map build", err, [&] {
     const Log log = read_log(a.trace, a.laser_channel, a.odom_channel, a.pose_channel);
     std::vector<Pose2D> odom;
+    odom.reserve(log.scans.size());
     for (const LoggedScan& s : log.scans) odom.push_back(s.odom);
     // the map frame is the odometry frame at the first scan
     std::vector<Pose2D> rel;
+    rel.reserve(odom.size());
     for (const Pose2D& p : odom) rel.push_back(compose(inverse(odom[0]), p));
     Point2D lo, hi;
     // odometry drifts: a generous margin keeps the corrected path inside the grid
@@ -382,6 +384,7 @@ int map_build(const BuildArgs& a, std::ostream& out, std::ostream& err) {
     o.matcher.max_range_m = a.max_range_m;
     navi::MapBuilder b(lo, hi, o);
     std::vector<Pose2D> est;
+    est.reserve(log.scans.size());
     const auto t0 = Clock::now();
     for (const LoggedScan& s : log.scans) est.push_back(b.add(s.scan, s.odom));
     const double ms = ms_since(t0);
@@ -391,8 +394,7 @@ int map_build(const BuildArgs& a, std::ostream& out, std::ostream& err) {
         << " s (" << std::setprecision(2) << ms / static_cast<double>(log.scans.size()) << " ms per scan); map "
         << g.width() << " x " << g.height() << " cells written to " << a.out.string() << "\n";
     if (all_referenced(log)) {
-      std::vector<Pose2D> odo_rel;
-      for (const Pose2D& p : odom) odo_rel.push_back(p);
+      const std::vector<Pose2D>& odo_rel = odom;
       out << "  relative errors vs the corrected poses (Kuemmerle et al. 2009):\n";
       for (const double gap : {0.0, a.gap_s}) {
         out << "    " << (gap == 0.0 ? std::string("consecutive scans") : "scans " + std::to_string(static_cast<int>(gap)) + " s apart")

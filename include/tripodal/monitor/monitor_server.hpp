@@ -80,7 +80,7 @@ class MonitorServer final {
   /// Any thread (the robot's): the operator requests received since the last call.
   [[nodiscard]] std::vector<OperatorRequest> take_requests();
   /// Answers request `id` with an HTTP status and a JSON body.
-  void answer(std::uint64_t id, int status, std::string json);
+  void answer(std::uint64_t id, int status, const std::string& json);
 
   [[nodiscard]] std::uint16_t port() const noexcept;
   [[nodiscard]] const std::string& token() const noexcept;

@@ -80,6 +80,6 @@ class SimBoardHardware final : public CHardware, public board::BoardHost, public
 /// Registers the hardware type "board" as the simulated board in `world` (what `tripodal run`
 /// registers): the parameters of the real type (board/board_hardware.hpp) except `port` and
 /// `baud`, which the in-process line ignores (115200).
-void register_sim_board_hardware(HardwareRegistry& registry, std::shared_ptr<const World> world);
+void register_sim_board_hardware(HardwareRegistry& registry, const std::shared_ptr<const World>& world);
 
 }  // namespace tripodal::sim

@@ -80,6 +80,6 @@ class TraceHardware final : public CHardware, public navi::GroundTruthSource, pu
 /// parameters: trace (file, relative to the profile), localization (channel), world (a world file
 /// for the map, relative to the profile; or `world` given here), max_age_s.
 void register_trace_hardware(HardwareRegistry& registry, std::vector<std::string> outputs = {},
-                             std::shared_ptr<const sim::World> world = nullptr);
+                             const std::shared_ptr<const sim::World>& world = nullptr);
 
 }  // namespace tripodal::testing
