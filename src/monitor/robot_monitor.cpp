@@ -458,7 +458,7 @@ RobotMonitor::~RobotMonitor() = default;
 
 void RobotMonitor::update(const MonitorExtras& extras) { impl_->update(extras); }
 bool RobotMonitor::paused() const noexcept { return impl_->paused; }
-void RobotMonitor::pause(std::string reason) { impl_->pause_now(std::move(reason)); }
+void RobotMonitor::pause(const std::string& reason) { impl_->pause_now(reason); }
 void RobotMonitor::resume() {
   impl_->paused = false;
   impl_->note("monitor: resumed");

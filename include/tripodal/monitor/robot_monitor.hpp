@@ -52,7 +52,7 @@ class RobotMonitor final {
   /// Whether the run should hold (operator pause, start paused, a breakpoint was reached). The
   /// driving loop keeps calling update() while paused.
   [[nodiscard]] bool paused() const noexcept;
-  void pause(std::string reason);
+  void pause(const std::string& reason);
   void resume();
   /// Places ("P1" or a place's name in any net, "PrCleaning.P1" in one net) where the run pauses when they become marked.
   void set_breakpoint(std::string place, bool on);
