@@ -152,9 +152,9 @@ cli::Action setup(CLI::App& cmd) {
                  "in_process|pty: on the control board (hardware: {type: board}), what carries the bytes; pty: a "
                  "kernel pseudo-terminal, the host opening its slave device as it would the board's UART")
       ->check(CLI::IsMember({"in_process", "pty"}));
-  cmd.add_option("--uv-target-dose", o.uv_target_dose_j_m2, "J/m2: the dose a cell must receive to count as disinfected")
-      ->check(cli::positive_number())
-      ->capture_default_str();
+  cmd.add_option("--uv-target-dose", o.uv_target_dose_j_m2,
+                 "J/m2: on the control board, the dose a cell must receive to count as disinfected (default 10)")
+      ->check(cli::positive_number());
   cmd.add_option("--monitor", o.monitor, "[ADDR:]PORT: serve the live monitor and console (docs/monitor.md); 0: a free port");
   cmd.add_option("--monitor-token-file", o.monitor_token_file, "FILE: the console's token (first line; default: generated)");
   cmd.add_flag("--monitor-read-open", o.monitor_read_open, "let clients without the token watch (not command)");

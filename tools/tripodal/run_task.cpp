@@ -180,6 +180,9 @@ RunResult run_task(const RunOptions& o) {
   if (!o.board_line.empty() && !on_board) {
     throw ConfigError(profile.hardware->where, "--board " + o.board_line + " needs a robot on the control board (hardware: {type: board})");
   }
+  if (o.uv_target_dose_j_m2 && !on_board) {
+    throw ConfigError(profile.hardware->where, "--uv-target-dose needs a robot on the control board (hardware: {type: board})");
+  }
 
   // The robot, on simulated hardware in this world, with this run's seed and coverage pattern;
   // the board's modules and actuator behaviors for a robot on the control board.
@@ -424,7 +427,8 @@ RunResult run_task(const RunOptions& o) {
     res.sections.push_back(f);
   }
 
-  if (board_hw != nullptr) res.disinfection = disinfection_figures(*board_hw, reachable, nav.maps->grid(), o.uv_target_dose_j_m2);
+  if (board_hw != nullptr) res.disinfection = disinfection_figures(*board_hw, reachable, nav.maps->grid(),
+                                                                    o.uv_target_dose_j_m2.value_or(kDefaultUvTargetDose));
 
   if (!o.out.empty()) {
     std::filesystem::create_directories(o.out);

@@ -38,8 +38,9 @@ struct RunOptions {
   /// On hardware "board": what carries the simulated board's bytes, "in_process" or "pty" (a
   /// kernel pseudo-terminal); empty: the profile's choice.
   std::string board_line;
-  /// The UV dose a cell of the floor must receive to count as disinfected (J/m^2; 10 = 1 mJ/cm^2).
-  double uv_target_dose_j_m2 = 10.0;
+  /// The UV dose a cell of the floor must receive to count as disinfected (J/m^2; 10 = 1 mJ/cm^2);
+  /// only for a robot on the control board. Default kDefaultUvTargetDose.
+  std::optional<double> uv_target_dose_j_m2;
   /// The monitor (docs/monitor.md): serve the page, the topics and the operator console on
   /// ADDRESS:PORT while the run goes on. With a monitor the run is paced to real time (default
   /// speed 1), the task may come from the console instead of `task`, and the run goes on after
@@ -72,6 +73,8 @@ struct SectionFigures {
   double balloon_coverage = 0.0;
   double boustrophedon_coverage = 0.0;
 };
+
+inline constexpr double kDefaultUvTargetDose = 10.0;  ///< J/m^2 (1 mJ/cm^2)
 
 /// What a run on the simulated control board adds (hardware "board"): the UV dose on the floor,
 /// the disinfectant, and the link.
