@@ -5,8 +5,13 @@
 #
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     default 20 s each (CI), every target
 #   FUZZ_SECONDS=600 scripts/fuzz.sh          the same, by environment
-#   FUZZ_SEED=1 scripts/fuzz.sh               libFuzzer's -seed (default 0: a new one each run);
-#                                             CI fixes it so that a red run is reproducible
+#   FUZZ_SEED=1 scripts/fuzz.sh               libFuzzer's -seed (default 0: a new one each run)
+#   FUZZ_RUNS=40000 FUZZ_SEED=1 scripts/fuzz.sh 30
+#                                             CI: each target runs exactly FUZZ_RUNS inputs from
+#                                             a fresh corpus of the seeds (SECONDS only caps it),
+#                                             so CI explores the same inputs as any machine that
+#                                             ran the same command: a red CI run is reproducible
+#                                             and a green local run predicts a green CI run
 #
 # Stops at the first target that finds a crash, a leak, a timeout or a failed property: the input
 # is kept as build/fuzz/findings/<target>/crash-* (reproduce: build/fuzz/fuzz/fuzz_<target> FILE).
@@ -39,6 +44,13 @@ for t in "${targets[@]}"; do
   exe="$build/fuzz/fuzz_$t"
   [[ -x $exe ]] || { echo "fuzz.sh: no target '$t' (see fuzz/seeds.txt)" >&2; exit 2; }
   corpus="$build/corpus/$t"
+  runs_option=()
+  if [[ -n ${FUZZ_RUNS:-} ]]; then
+    # A fixed sequence: fresh corpus, fixed seed and count. A time cap can only cut it short.
+    corpus="$build/fixed-corpus/$t"
+    rm -rf "$corpus"
+    runs_option=(-runs="$FUZZ_RUNS")
+  fi
   findings="$build/findings/$t"
   mkdir -p "$corpus" "$findings"
   # Seeds: the files fuzz/seeds.txt lists for the target (missing optional ones are skipped).
@@ -46,12 +58,12 @@ for t in "${targets[@]}"; do
   for g in $globs; do
     for f in $g; do [[ -f $f ]] && cp "$f" "$corpus/seed-$(basename "$f")"; done
   done
-  echo "== fuzz_$t: ${seconds} s on $(ls "$corpus" | wc -l) inputs"
+  echo "== fuzz_$t: ${FUZZ_RUNS:+$FUZZ_RUNS runs, at most }${seconds} s on $(ls "$corpus" | wc -l) inputs"
   log="$findings/last-run.log"
   # -malloc_limit_mb: any single allocation past 512 MiB is a finding (limits before allocation);
   # -timeout: one input taking 10 s is a finding (quadratic parsing, endless loops).
   if ! ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
-      "$exe" "$corpus" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=512 \
+      "$exe" "$corpus" -max_total_time="$seconds" "${runs_option[@]}" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=512 \
       -seed="${FUZZ_SEED:-0}" -artifact_prefix="$findings/" -print_final_stats=1 >"$log" 2>&1; then
     tail -n 60 "$log"
     echo "fuzz.sh: fuzz_$t found a problem; input kept in $findings/" >&2
@@ -64,5 +76,5 @@ for t in "${targets[@]}"; do
   summary+=("$line")
 done
 
-echo "== fuzz summary (${seconds} s per target)"
+echo "== fuzz summary (${FUZZ_RUNS:+$FUZZ_RUNS runs, at most }${seconds} s per target)"
 printf '%s\n' "${summary[@]}"

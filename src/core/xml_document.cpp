@@ -113,6 +113,7 @@ bool declared_latin1(std::string_view s) {
   const std::size_t start = s.starts_with("\xEF\xBB\xBF") ? 3 : 0;
   if (s.compare(start, 5, "<?xml") != 0) return false;
   const std::size_t end = s.find("?>", start);
+  if (end == std::string_view::npos) return false;  // an unclosed declaration: tinyxml2 refuses it
   const std::size_t key = s.substr(0, end).find("encoding", start);
   if (key == std::string_view::npos) return false;
   std::size_t i = key + 8;
