@@ -78,9 +78,9 @@ TEST_CASE("dds: the type names are those ROS 2 registers", "[dds]") {
   CHECK(MessageType<msg::Event>::dds == "tripodal_msgs::msg::dds_::Event_");
   CHECK(ros_topic("cmd_vel") == "rt/cmd_vel");
   CHECK(ros_topic("/cmd_vel", "/robot1/") == "rt/robot1/cmd_vel");
-  CHECK(to_seconds(to_time(-1.25)) == Approx(-1.25));
-  CHECK(to_time(-1.25).sec == -2);
-  CHECK(to_time(-1.25).nanosec == 750000000U);
+  CHECK(ros_seconds(ros_time(-1.25)) == Approx(-1.25));
+  CHECK(ros_time(-1.25).sec == -2);
+  CHECK(ros_time(-1.25).nanosec == 750000000U);
 }
 
 TEST_CASE("dds: golden CDR bytes of every message type", "[dds]") {

@@ -173,7 +173,7 @@ concept Message = requires {
 };
 
 // The time of a message from seconds (ROS 2's convention: nanosec in [0, 1e9)).
-msg::Time to_time(double seconds);
-double to_seconds(const msg::Time& t);
+msg::Time ros_time(double seconds);
+double ros_seconds(const msg::Time& t);
 
 }  // namespace tripodal::dds
