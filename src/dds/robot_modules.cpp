@@ -2,6 +2,7 @@
 #include "tripodal/dds/robot_modules.hpp"
 
 #include <cmath>
+#include <numbers>
 
 namespace tripodal::dds {
 
@@ -134,7 +135,7 @@ ControlStatus DdsCmdVelController::on_update(Time now, Duration period, const Tw
   const double s = std::sin(odometry.pose.theta_rad);
   odometry.pose.x_m += (limited.vx_m_s * c - limited.vy_m_s * s) * dt;
   odometry.pose.y_m += (limited.vx_m_s * s + limited.vy_m_s * c) * dt;
-  odometry.pose.theta_rad = std::remainder(odometry.pose.theta_rad + limited.wz_rad_s * dt, 2.0 * M_PI);
+  odometry.pose.theta_rad = std::remainder(odometry.pose.theta_rad + limited.wz_rad_s * dt, 2.0 * std::numbers::pi);
   odometry.twist = limited;
   odometry.stamp = now;
   if (!written) return ControlStatus::hardware_fault;

@@ -46,7 +46,11 @@ int run(int argc, char** argv) {
   if (mode == "cmd-vel" && argc == 5) {
     options.participant_lease = 1s;
     Participant p(options);
-    Publisher<msg::Twist> pub(p, ros_topic("cmd_vel", ns), {.kind = TopicKind::command});
+    // The command QoS keeps only the latest sample, which a writer cannot resend once replaced;
+    // the test checks that every one of its samples arrives, so it keeps them all.
+    Qos keep_all = qos_for(TopicKind::command, Role::publisher);
+    keep_all.depth = 16;
+    Publisher<msg::Twist> pub(p, ros_topic("cmd_vel", ns), {.qos = keep_all});
     if (!pub.wait_for_subscribers(1, 10s)) return 3;
     const int count = std::stoi(argv[4]);
     for (int i = 1; i <= count; ++i) pub.publish({{0.1 * i, 0.0, 0.0}, {0.0, 0.0, -0.1 * i}});

@@ -2,6 +2,7 @@
 // resource fed by a LaserScan topic, a controller publishing cmd_vel.
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <thread>
 
 #include "dds_test_support.hpp"
@@ -15,6 +16,13 @@ using namespace tripodal::dds::test;
 using namespace std::chrono_literals;
 
 namespace {
+// The modules' participants have the default options; a participant of the test in the same
+// process and domain must have the same (one Cyclone domain per process and id).
+ParticipantOptions module_options(std::uint32_t domain) {
+  ParticipantOptions o;
+  o.domain_id = domain;
+  return o;
+}
 ParameterValues binding(std::uint32_t domain) {
   return {{"namespace", Value{test_namespace()}}, {"domain_id", Value{static_cast<double>(domain)}}};
 }
@@ -34,7 +42,7 @@ TEST_CASE("dds: the DdsLaser resource holds the scans of its topic", "[dds]") {
   auto& laser = dynamic_cast<DdsLaserResource&>(*resource);
   CHECK(laser.topic() == ros_topic("scan", test_namespace()));
 
-  Participant p(test_options(20));
+  Participant p(module_options(test_domain(20)));
   Publisher<msg::LaserScan> scans(p, ros_topic("scan", test_namespace()), {.kind = TopicKind::scan});
   REQUIRE(scans.wait_for_subscribers(1, 5s));
   const auto sent = sample_scan();
@@ -67,16 +75,17 @@ TEST_CASE("dds: the dds_cmd_vel controller publishes its limited command", "[dds
 
   ControllerConfig config;
   config.type = "dds_cmd_vel";
-  config.period = 100ms;
   config.limits.vx.max_velocity = 0.5;
-  config.parameters = ParameterSet::resolve(plugins.controllers.manifest("dds_cmd_vel"), binding(test_domain(21)));
+  auto given = binding(test_domain(21));
+  given["period_s"] = Value{0.1};
+  config.parameters = ParameterSet::resolve(plugins.controllers.manifest("dds_cmd_vel"), given);
   apply_parameters(config);
   IdealWheelHardware no_wheels(2, config.period);
   auto controller = plugins.controllers.create(config, no_wheels);
   CHECK(controller->capabilities().max_vy_m_s == 0.0);
   CHECK(controller->capabilities().max_vx_m_s == 0.5);
 
-  Participant p(test_options(21));
+  Participant p(module_options(test_domain(21)));
   Subscriber<msg::Twist> base(p, ros_topic("cmd_vel", test_namespace()), {.kind = TopicKind::command});
   REQUIRE(base.wait_for_publishers(1, 5s));
 
@@ -90,6 +99,8 @@ TEST_CASE("dds: the dds_cmd_vel controller publishes its limited command", "[dds
   CHECK(got->angular.z == Approx(0.3));
   controller->update(t0 + 100ms);
   REQUIRE(base.take_one(5s).has_value());
-  CHECK(controller->odometry().pose.x_m == Approx(0.05));  // dead reckoning: 0.5 m/s for 0.1 s
+  // Dead reckoning: 0.5 m/s for two periods of 0.1 s, turning at 0.3 rad/s.
+  CHECK(controller->odometry().pose.x_m == Approx(0.05 + 0.05 * std::cos(0.03)));
+  CHECK(controller->odometry().pose.theta_rad == Approx(0.06));
   CHECK(controller->wheel_commands().empty());
 }

@@ -78,7 +78,11 @@ void echo_round_trip(Participant& p, const T& message, TopicKind kind) {
 
 TEST_CASE("dds: cmd_vel published by another process is received on loopback", "[dds][process]") {
   Participant p(test_options(10));
-  Subscriber<msg::Twist> cmd_vel(p, ros_topic("cmd_vel", test_namespace()), {.kind = TopicKind::command});
+  // A command subscriber keeps only the latest sample (the base wants the newest command); this
+  // one keeps them all, to check that each of the ten arrives, in order.
+  Qos keep_all = qos_for(TopicKind::command, Role::subscriber);
+  keep_all.depth = 16;
+  Subscriber<msg::Twist> cmd_vel(p, ros_topic("cmd_vel", test_namespace()), {.qos = keep_all});
   Peer peer({"cmd-vel", std::to_string(test_domain(10)), test_namespace(), "10"});
   std::vector<msg::Twist> got;
   const auto until = std::chrono::steady_clock::now() + 15s;
