@@ -9,7 +9,8 @@
 # Every violation is reported with file:line:col before the script fails.
 #
 #   cmake -DGRAPH=<build>/tripodal_area_graph.cmake -DSOURCE_DIR=<tree> -P check_layers.cmake
-# GRAPH sets TRIPODAL_AREAS and TRIPODAL_AREA_<area>_PUBLIC / _PRIVATE (tripodal_write_area_graph).
+# GRAPH sets TRIPODAL_AREAS and TRIPODAL_AREA_<area>_PUBLIC / _PRIVATE (tripodal_write_area_graph),
+# and TRIPODAL_DISABLED_AREAS: optional areas this build leaves out, whose folders are skipped.
 # SOURCE_DIR holds include/tripodal/<area>/ (public headers) and src/<area>/ (sources).
 cmake_minimum_required(VERSION 3.25)
 
