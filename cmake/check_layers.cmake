@@ -9,7 +9,8 @@
 # Every violation is reported with file:line:col before the script fails.
 #
 #   cmake -DGRAPH=<build>/tripodal_area_graph.cmake -DSOURCE_DIR=<tree> -P check_layers.cmake
-# GRAPH sets TRIPODAL_AREAS and TRIPODAL_AREA_<area>_PUBLIC / _PRIVATE (tripodal_write_area_graph).
+# GRAPH sets TRIPODAL_AREAS and TRIPODAL_AREA_<area>_PUBLIC / _PRIVATE (tripodal_write_area_graph),
+# and TRIPODAL_DISABLED_AREAS: optional areas this build leaves out, whose folders are skipped.
 # SOURCE_DIR holds include/tripodal/<area>/ (public headers) and src/<area>/ (sources).
 cmake_minimum_required(VERSION 3.25)
 
@@ -176,6 +177,10 @@ macro(check_tree dir kind)
       string(REGEX REPLACE "/.*" "" area "${sub}")
     else()
       set(area core)
+    endif()
+    if(area IN_LIST TRIPODAL_DISABLED_AREAS)
+      # An optional area this build leaves out (TRIPODAL_DDS=OFF); checked by the builds that have it.
+      continue()
     endif()
     if(NOT area IN_LIST TRIPODAL_AREAS)
       layer_error("${rel}:1:1: error: ${dir}/${area}/ belongs to no area library; declare it with tripodal_add_area(${area} ...) in src/${area}/CMakeLists.txt")

@@ -3,10 +3,10 @@
 #   1. a Release build with -Werror and the whole test suite (ctest),
 #   2. the example consumer, the behavior tutorial's test (examples/behavior_test) and the
 #      application robot (examples/custom_robot) built against the *installed* package
-#      (find_package(tripodal)),
+#      (find_package(tripodal)), and the DDS consumer (examples/dds_consumer) when the package has dds,
 #   3. the test suite again under AddressSanitizer + UndefinedBehaviorSanitizer,
 # Build trees go to build/release, build/sanitize, build/consumer,
-# build/behavior_test, build/custom_robot (override with BUILD_ROOT).
+# build/behavior_test, build/custom_robot, build/dds_consumer (override with BUILD_ROOT).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
@@ -43,6 +43,14 @@ cmake -S examples/custom_robot -B "$build_root/custom_robot" "${generator[@]}" \
   -DCMAKE_PREFIX_PATH="$build_root/install" -DCMAKE_COMPILE_WARNING_AS_ERROR=ON
 cmake --build "$build_root/custom_robot" -j "$jobs"
 "$build_root/custom_robot/custom_robot"
+
+if [ -d "$build_root/install/include/tripodal/dds" ]; then
+  echo "== Build and run the DDS consumer (find_package(tripodal COMPONENTS dds)) against the installed package"
+  cmake -S examples/dds_consumer -B "$build_root/dds_consumer" "${generator[@]}" \
+    -DCMAKE_PREFIX_PATH="$build_root/install" -DCMAKE_COMPILE_WARNING_AS_ERROR=ON
+  cmake --build "$build_root/dds_consumer" -j "$jobs"
+  "$build_root/dds_consumer/tripodal_dds_consumer"
+fi
 
 echo "== AddressSanitizer + UndefinedBehaviorSanitizer build"
 cmake -S . -B "$build_root/sanitize" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \

@@ -1,0 +1,179 @@
+// The messages tripodal exchanges over DDS, as plain C++ values (tripodal::dds area, optional;
+// docs/distribution.md): the ROS 2 messages it speaks and its own event and task topics.
+#pragma once
+
+#include <array>
+#include <concepts>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace tripodal::dds {
+
+// Field names, order and types follow the ROS 2 message definitions (the CDR bytes depend on
+// order and types only). Defaults are ROS 2's (zero, identity quaternion).
+namespace msg {
+
+struct Time {  // builtin_interfaces/Time
+  std::int32_t sec = 0;
+  std::uint32_t nanosec = 0;
+  bool operator==(const Time&) const = default;
+};
+
+struct Header {  // std_msgs/Header
+  Time stamp;
+  std::string frame_id;
+  bool operator==(const Header&) const = default;
+};
+
+struct String {  // std_msgs/String
+  std::string data;
+  bool operator==(const String&) const = default;
+};
+
+struct Vector3 {  // geometry_msgs/Vector3
+  double x = 0.0;
+  double y = 0.0;
+  double z = 0.0;
+  bool operator==(const Vector3&) const = default;
+};
+
+struct Point {  // geometry_msgs/Point
+  double x = 0.0;
+  double y = 0.0;
+  double z = 0.0;
+  bool operator==(const Point&) const = default;
+};
+
+struct Quaternion {  // geometry_msgs/Quaternion
+  double x = 0.0;
+  double y = 0.0;
+  double z = 0.0;
+  double w = 1.0;
+  bool operator==(const Quaternion&) const = default;
+};
+
+struct Pose {  // geometry_msgs/Pose
+  Point position;
+  Quaternion orientation;
+  bool operator==(const Pose&) const = default;
+};
+
+struct PoseWithCovariance {  // geometry_msgs/PoseWithCovariance; row-major 6x6 (x y z rotX rotY rotZ)
+  Pose pose;
+  std::array<double, 36> covariance{};
+  bool operator==(const PoseWithCovariance&) const = default;
+};
+
+struct PoseWithCovarianceStamped {  // geometry_msgs/PoseWithCovarianceStamped
+  Header header;
+  PoseWithCovariance pose;
+  bool operator==(const PoseWithCovarianceStamped&) const = default;
+};
+
+struct Twist {  // geometry_msgs/Twist
+  Vector3 linear;
+  Vector3 angular;
+  bool operator==(const Twist&) const = default;
+};
+
+struct TwistWithCovariance {  // geometry_msgs/TwistWithCovariance
+  Twist twist;
+  std::array<double, 36> covariance{};
+  bool operator==(const TwistWithCovariance&) const = default;
+};
+
+struct Odometry {  // nav_msgs/Odometry
+  Header header;
+  std::string child_frame_id;
+  PoseWithCovariance pose;
+  TwistWithCovariance twist;
+  bool operator==(const Odometry&) const = default;
+};
+
+struct LaserScan {  // sensor_msgs/LaserScan
+  Header header;
+  float angle_min = 0.0F;
+  float angle_max = 0.0F;
+  float angle_increment = 0.0F;
+  float time_increment = 0.0F;
+  float scan_time = 0.0F;
+  float range_min = 0.0F;
+  float range_max = 0.0F;
+  std::vector<float> ranges;
+  std::vector<float> intensities;
+  bool operator==(const LaserScan&) const = default;
+};
+
+struct MapMetaData {  // nav_msgs/MapMetaData
+  Time map_load_time;
+  float resolution = 0.0F;
+  std::uint32_t width = 0;
+  std::uint32_t height = 0;
+  Pose origin;
+  bool operator==(const MapMetaData&) const = default;
+};
+
+struct OccupancyGrid {  // nav_msgs/OccupancyGrid; data row-major from origin, -1 unknown, 0..100
+  Header header;
+  MapMetaData info;
+  std::vector<std::int8_t> data;
+  bool operator==(const OccupancyGrid&) const = default;
+};
+
+// tripodal_msgs/Event: something that happened in a robot (a fault, a silent peer, a task's end).
+struct Event {
+  Time stamp;
+  std::string robot;
+  std::string source;
+  std::string kind;
+  std::string detail;
+  std::uint8_t severity = 0;  // 0 info, 1 warning, 2 error
+  bool operator==(const Event&) const = default;
+};
+
+// tripodal_msgs/TaskCommand: a task given to a robot's planner.
+struct TaskCommand {
+  Time stamp;
+  std::string robot;  // empty: any robot
+  std::uint32_t id = 0;
+  std::string command;  // start, cancel, pause, resume
+  std::string task;
+  bool operator==(const TaskCommand&) const = default;
+};
+
+}  // namespace msg
+
+// The names a message type has: `ros` as ROS 2 tools print it, `dds` as ROS 2 registers it with
+// DDS (what a topic's type name must be for a ROS 2 node to match it).
+template <class T>
+struct MessageType;
+
+#define TRIPODAL_DDS_MESSAGE_TYPE(Type, package, name)                              \
+  template <>                                                                       \
+  struct MessageType<msg::Type> {                                                   \
+    static constexpr std::string_view ros = package "/msg/" name;                   \
+    static constexpr std::string_view dds = package "::msg::dds_::" name "_";       \
+  }
+TRIPODAL_DDS_MESSAGE_TYPE(String, "std_msgs", "String");
+TRIPODAL_DDS_MESSAGE_TYPE(Twist, "geometry_msgs", "Twist");
+TRIPODAL_DDS_MESSAGE_TYPE(PoseWithCovarianceStamped, "geometry_msgs", "PoseWithCovarianceStamped");
+TRIPODAL_DDS_MESSAGE_TYPE(Odometry, "nav_msgs", "Odometry");
+TRIPODAL_DDS_MESSAGE_TYPE(OccupancyGrid, "nav_msgs", "OccupancyGrid");
+TRIPODAL_DDS_MESSAGE_TYPE(LaserScan, "sensor_msgs", "LaserScan");
+TRIPODAL_DDS_MESSAGE_TYPE(Event, "tripodal_msgs", "Event");
+TRIPODAL_DDS_MESSAGE_TYPE(TaskCommand, "tripodal_msgs", "TaskCommand");
+#undef TRIPODAL_DDS_MESSAGE_TYPE
+
+// A type that can be published: one of the above (the transport instantiates exactly these).
+template <class T>
+concept Message = requires {
+  { MessageType<T>::dds } -> std::convertible_to<std::string_view>;
+};
+
+// The time of a message from seconds (ROS 2's convention: nanosec in [0, 1e9)).
+msg::Time ros_time(double seconds);
+double ros_seconds(const msg::Time& t);
+
+}  // namespace tripodal::dds

@@ -1,0 +1,94 @@
+// Robot modules on DDS (tripodal::dds area): a laser resource fed by a sensor_msgs/LaserScan topic
+// and a controller type that publishes its limited command as geometry_msgs/Twist on cmd_vel for a
+// base driven by another process (ROS 2 or tripodal); both registered by name like any plugin.
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "tripodal/controllers/controller_config.hpp"
+#include "tripodal/dds/endpoint.hpp"
+#include "tripodal/resources/resource.hpp"
+
+namespace tripodal::dds {
+
+// Where a module's topic is: read from the parameters `topic`, `namespace`, `domain_id`,
+// `loopback` that both module types declare.
+struct TopicBinding {
+  std::string topic;  // the DDS topic name, "rt/<namespace>/<topic>"
+  ParticipantOptions participant;
+};
+TopicBinding topic_binding(const ParameterSet& parameters, std::string_view default_topic);
+
+// Type "DdsLaser": the latest sensor_msgs/LaserScan of a topic as a laser resource. Scans arrive on
+// a Cyclone DDS thread and are handed to the control loop in poll(), stamped with the loop's time
+// of that poll (the sender's stamp is on another clock), so max_age_s measures how long ago the
+// robot last heard of the laser.
+class DdsLaserResource final : public LaserResource {
+ public:
+  static const ModuleManifest& static_manifest();
+  // `parameters` resolved against static_manifest() (a robot profile's resource entry).
+  DdsLaserResource(std::string name, const ParameterSet& parameters);
+  ~DdsLaserResource() override;
+  DdsLaserResource(const DdsLaserResource&) = delete;
+  DdsLaserResource& operator=(const DdsLaserResource&) = delete;
+
+  const std::string& topic() const noexcept;
+  std::size_t matched_publishers() const;
+
+ private:
+  void on_poll(Time now) noexcept override;
+
+  std::unique_ptr<Participant> participant_;
+  std::mutex mutex_;  // guards pending_ between the DDS thread and the loop
+  LaserScan pending_;
+  std::atomic<bool> has_pending_{false};
+  std::unique_ptr<Subscriber<msg::LaserScan>> subscriber_;
+};
+
+// Type "dds_cmd_vel": a controller for a base that another process drives. Each period it limits
+// the command like every controller and publishes it as geometry_msgs/Twist (linear x, y; angular
+// z) with the command QoS. It has no wheels: its odometry integrates what it commanded (dead
+// reckoning, no feedback), and a write that fails reports hardware_fault. Publishing goes through
+// Cyclone DDS, which allocates: unlike the wheel controllers, update() is not allocation-free.
+class DdsCmdVelController final : public CController {
+ public:
+  static const ModuleManifest& static_manifest();
+  // The hardware interface is not used (no wheels here); config.parameters may be empty (defaults).
+  DdsCmdVelController(const ControllerConfig& config, HardwareInterface& hardware);
+  ~DdsCmdVelController() override;
+  DdsCmdVelController(const DdsCmdVelController&) = delete;
+  DdsCmdVelController& operator=(const DdsCmdVelController&) = delete;
+
+  const std::string& topic() const noexcept;
+  std::size_t matched_subscribers() const;
+
+ private:
+  const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  BaseCapabilities do_capabilities() const noexcept override;
+  std::span<const double> do_wheel_commands() const noexcept override { return {}; }
+  ControlStatus on_update(Time now, Duration period, const Twist2D& command, bool timed_out, Twist2D& limited,
+                          OdometryReading& odometry) noexcept override;
+  Duration command_timeout() const noexcept override { return config_.cmd_timeout; }
+
+  ControllerConfig config_;
+  bool holonomic_ = false;
+  TwistLimiter limiter_;
+  std::unique_ptr<Participant> participant_;
+  std::unique_ptr<Publisher<msg::Twist>> publisher_;
+};
+
+// Adds "DdsLaser" to a robot's resource registry (RobotPlugins::resources) and "dds_cmd_vel" to its
+// controller registry. A template over the resource registry so that this area needs not link the
+// robot's, whose ResourceConfig is read for its name and parameters only.
+template <class ResourceRegistry>
+void register_dds_modules(ResourceRegistry& resources, ControllerRegistry& controllers) {
+  resources.add(DdsLaserResource::static_manifest(), [](const auto& config) -> std::unique_ptr<CResource> {
+    return std::make_unique<DdsLaserResource>(config.name, config.parameters);
+  });
+  controllers.template add<DdsCmdVelController>();
+}
+
+}  // namespace tripodal::dds

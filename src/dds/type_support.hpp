@@ -1,0 +1,181 @@
+// Private to the dds area: how each C++ message of messages.hpp maps onto the C type idlc
+// generated from the IDL, in both directions.
+#pragma once
+
+#include <dds/dds.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "ros2_messages.h"
+#include "tripodal/dds/messages.hpp"
+#include "tripodal_messages.h"
+
+namespace tripodal::dds::detail {
+
+// Writing builds a C view of the C++ message, pointing into its strings and vectors: dds_write
+// only reads the sample, so nothing is copied before serialisation. The const_casts only satisfy
+// the C types' non-const pointers.
+inline char* view(const std::string& s) { return const_cast<char*>(s.c_str()); }
+inline std::string text(const char* s) { return s != nullptr ? std::string(s) : std::string(); }
+
+template <class Seq, class V>
+Seq view_sequence(const std::vector<V>& v) {
+  Seq s{};
+  s._maximum = static_cast<uint32_t>(v.size());
+  s._length = static_cast<uint32_t>(v.size());
+  s._buffer = const_cast<V*>(v.data());
+  s._release = false;
+  return s;
+}
+template <class V, class Seq>
+std::vector<V> copy_sequence(const Seq& s) {
+  if (s._buffer == nullptr) return {};
+  return std::vector<V>(s._buffer, s._buffer + s._length);
+}
+
+inline builtin_interfaces_msg_dds__Time_ to_c(const msg::Time& t) { return {t.sec, t.nanosec}; }
+inline msg::Time from_c(const builtin_interfaces_msg_dds__Time_& t) { return {t.sec, t.nanosec}; }
+
+inline std_msgs_msg_dds__Header_ to_c(const msg::Header& h) { return {to_c(h.stamp), view(h.frame_id)}; }
+inline msg::Header from_c(const std_msgs_msg_dds__Header_& h) { return {from_c(h.stamp), text(h.frame_id)}; }
+
+inline geometry_msgs_msg_dds__Vector3_ to_c(const msg::Vector3& v) { return {v.x, v.y, v.z}; }
+inline msg::Vector3 from_c(const geometry_msgs_msg_dds__Vector3_& v) { return {v.x, v.y, v.z}; }
+
+inline geometry_msgs_msg_dds__Pose_ to_c(const msg::Pose& p) {
+  return {{p.position.x, p.position.y, p.position.z},
+          {p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w}};
+}
+inline msg::Pose from_c(const geometry_msgs_msg_dds__Pose_& p) {
+  return {{p.position.x, p.position.y, p.position.z},
+          {p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w}};
+}
+
+inline geometry_msgs_msg_dds__PoseWithCovariance_ to_c(const msg::PoseWithCovariance& p) {
+  geometry_msgs_msg_dds__PoseWithCovariance_ c{};
+  c.pose = to_c(p.pose);
+  std::copy(p.covariance.begin(), p.covariance.end(), c.covariance);
+  return c;
+}
+inline msg::PoseWithCovariance from_c(const geometry_msgs_msg_dds__PoseWithCovariance_& c) {
+  msg::PoseWithCovariance p;
+  p.pose = from_c(c.pose);
+  std::copy(std::begin(c.covariance), std::end(c.covariance), p.covariance.begin());
+  return p;
+}
+
+inline geometry_msgs_msg_dds__Twist_ to_c(const msg::Twist& t) { return {to_c(t.linear), to_c(t.angular)}; }
+inline msg::Twist from_c(const geometry_msgs_msg_dds__Twist_& t) { return {from_c(t.linear), from_c(t.angular)}; }
+
+inline geometry_msgs_msg_dds__TwistWithCovariance_ to_c(const msg::TwistWithCovariance& t) {
+  geometry_msgs_msg_dds__TwistWithCovariance_ c{};
+  c.twist = to_c(t.twist);
+  std::copy(t.covariance.begin(), t.covariance.end(), c.covariance);
+  return c;
+}
+inline msg::TwistWithCovariance from_c(const geometry_msgs_msg_dds__TwistWithCovariance_& c) {
+  msg::TwistWithCovariance t;
+  t.twist = from_c(c.twist);
+  std::copy(std::begin(c.covariance), std::end(c.covariance), t.covariance.begin());
+  return t;
+}
+
+// TypeSupport<T>: the generated C type and descriptor of a message, and its conversions.
+template <class T>
+struct TypeSupport;
+
+template <>
+struct TypeSupport<msg::String> {
+  using C = std_msgs_msg_dds__String_;
+  static const dds_topic_descriptor_t* descriptor() { return &std_msgs_msg_dds__String__desc; }
+  static C to_c(const msg::String& m) { return {view(m.data)}; }
+  static msg::String from_c(const C& c) { return {text(c.data)}; }
+};
+
+template <>
+struct TypeSupport<msg::Twist> {
+  using C = geometry_msgs_msg_dds__Twist_;
+  static const dds_topic_descriptor_t* descriptor() { return &geometry_msgs_msg_dds__Twist__desc; }
+  static C to_c(const msg::Twist& m) { return detail::to_c(m); }
+  static msg::Twist from_c(const C& c) { return detail::from_c(c); }
+};
+
+template <>
+struct TypeSupport<msg::PoseWithCovarianceStamped> {
+  using C = geometry_msgs_msg_dds__PoseWithCovarianceStamped_;
+  static const dds_topic_descriptor_t* descriptor() { return &geometry_msgs_msg_dds__PoseWithCovarianceStamped__desc; }
+  static C to_c(const msg::PoseWithCovarianceStamped& m) { return {detail::to_c(m.header), detail::to_c(m.pose)}; }
+  static msg::PoseWithCovarianceStamped from_c(const C& c) { return {detail::from_c(c.header), detail::from_c(c.pose)}; }
+};
+
+template <>
+struct TypeSupport<msg::Odometry> {
+  using C = nav_msgs_msg_dds__Odometry_;
+  static const dds_topic_descriptor_t* descriptor() { return &nav_msgs_msg_dds__Odometry__desc; }
+  static C to_c(const msg::Odometry& m) {
+    return {detail::to_c(m.header), view(m.child_frame_id), detail::to_c(m.pose), detail::to_c(m.twist)};
+  }
+  static msg::Odometry from_c(const C& c) {
+    return {detail::from_c(c.header), text(c.child_frame_id), detail::from_c(c.pose), detail::from_c(c.twist)};
+  }
+};
+
+template <>
+struct TypeSupport<msg::LaserScan> {
+  using C = sensor_msgs_msg_dds__LaserScan_;
+  static const dds_topic_descriptor_t* descriptor() { return &sensor_msgs_msg_dds__LaserScan__desc; }
+  static C to_c(const msg::LaserScan& m) {
+    return {detail::to_c(m.header), m.angle_min, m.angle_max, m.angle_increment, m.time_increment,
+            m.scan_time, m.range_min, m.range_max, view_sequence<dds_sequence_float>(m.ranges),
+            view_sequence<dds_sequence_float>(m.intensities)};
+  }
+  static msg::LaserScan from_c(const C& c) {
+    return {detail::from_c(c.header), c.angle_min, c.angle_max, c.angle_increment, c.time_increment,
+            c.scan_time, c.range_min, c.range_max, copy_sequence<float>(c.ranges),
+            copy_sequence<float>(c.intensities)};
+  }
+};
+
+template <>
+struct TypeSupport<msg::OccupancyGrid> {
+  using C = nav_msgs_msg_dds__OccupancyGrid_;
+  static const dds_topic_descriptor_t* descriptor() { return &nav_msgs_msg_dds__OccupancyGrid__desc; }
+  static C to_c(const msg::OccupancyGrid& m) {
+    nav_msgs_msg_dds__MapMetaData_ info{detail::to_c(m.info.map_load_time), m.info.resolution, m.info.width,
+                                        m.info.height, detail::to_c(m.info.origin)};
+    return {detail::to_c(m.header), info, view_sequence<dds_sequence_int8>(m.data)};
+  }
+  static msg::OccupancyGrid from_c(const C& c) {
+    msg::MapMetaData info{detail::from_c(c.info.map_load_time), c.info.resolution, c.info.width, c.info.height,
+                          detail::from_c(c.info.origin)};
+    return {detail::from_c(c.header), info, copy_sequence<std::int8_t>(c.data)};
+  }
+};
+
+template <>
+struct TypeSupport<msg::Event> {
+  using C = tripodal_msgs_msg_dds__Event_;
+  static const dds_topic_descriptor_t* descriptor() { return &tripodal_msgs_msg_dds__Event__desc; }
+  static C to_c(const msg::Event& m) {
+    return {detail::to_c(m.stamp), view(m.robot), view(m.source), view(m.kind), view(m.detail), m.severity};
+  }
+  static msg::Event from_c(const C& c) {
+    return {detail::from_c(c.stamp), text(c.robot), text(c.source), text(c.kind), text(c.detail), c.severity};
+  }
+};
+
+template <>
+struct TypeSupport<msg::TaskCommand> {
+  using C = tripodal_msgs_msg_dds__TaskCommand_;
+  static const dds_topic_descriptor_t* descriptor() { return &tripodal_msgs_msg_dds__TaskCommand__desc; }
+  static C to_c(const msg::TaskCommand& m) {
+    return {detail::to_c(m.stamp), view(m.robot), m.id, view(m.command), view(m.task)};
+  }
+  static msg::TaskCommand from_c(const C& c) {
+    return {detail::from_c(c.stamp), text(c.robot), c.id, text(c.command), text(c.task)};
+  }
+};
+
+}  // namespace tripodal::dds::detail

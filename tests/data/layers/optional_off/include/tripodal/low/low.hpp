@@ -1,0 +1,2 @@
+// Fixture: an area at the bottom.
+#pragma once

@@ -1,0 +1,2 @@
+// Fixture: a source of low.
+#include "tripodal/low/low.hpp"

@@ -1,0 +1,2 @@
+// Fixture: a source of the optional area.
+#include "tripodal/opt/opt.hpp"
