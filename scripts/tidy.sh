@@ -10,9 +10,14 @@ jobs=${JOBS:-$(nproc)}
 
 scripts/install-deps.sh tidy
 
-# Only the compile commands are needed: nothing is built.
+# Only the compile commands are needed: nothing is built but generated headers (below).
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DTRIPODAL_BUILD_TESTS=OFF \
   -DTRIPODAL_BUILD_BENCH=OFF >/dev/null
+# Headers generated at build time (the dds area's idlc output) must exist for the sources that
+# include them.
+if ninja -C "$build" -t targets all | grep -q '^tripodal_dds_idl:'; then
+  cmake --build "$build" --target tripodal_dds_idl >/dev/null
+fi
 log="$build/tidy.log"
 # -Wno-unknown-warning-option: the commands are g++'s, whose -Wno-restrict clang does not know.
 run-clang-tidy -quiet -j "$jobs" -p "$build" -extra-arg=-Wno-unknown-warning-option \

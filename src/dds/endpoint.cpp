@@ -166,12 +166,12 @@ template <class T>
 std::vector<T> take_samples(const EndpointCore& core, std::size_t max) {
   using C = typename TypeSupport<T>::C;
   std::vector<T> out;
-  constexpr std::size_t batch = 16;
-  std::array<void*, batch> samples{};
-  std::array<dds_sample_info_t, batch> infos{};
+  constexpr std::size_t kBatch = 16;
+  std::array<void*, kBatch> samples{};
+  std::array<dds_sample_info_t, kBatch> infos{};
   while (out.size() < max) {
     samples.fill(nullptr);  // null: Cyclone lends its own samples, returned below
-    const auto wanted = static_cast<uint32_t>(std::min(batch, max - out.size()));
+    const auto wanted = static_cast<uint32_t>(std::min(kBatch, max - out.size()));
     const dds_return_t n = dds_take(core.entity, samples.data(), infos.data(), wanted, wanted);
     check(n, core.where("dds_take"));
     for (dds_return_t i = 0; i < n; ++i) {
@@ -192,8 +192,8 @@ std::vector<T> take_samples(const EndpointCore& core, std::size_t max) {
 // --- Publisher -----------------------------------------------------------------------------
 
 template <Message T>
-Publisher<T>::Publisher(Participant& participant, std::string topic, EndpointOptions options)
-    : core_(detail::make_core(participant, std::move(topic), detail::TypeSupport<T>::descriptor(), options,
+Publisher<T>::Publisher(Participant& participant, const std::string& topic, const EndpointOptions& options)
+    : core_(detail::make_core(participant, topic, detail::TypeSupport<T>::descriptor(), options,
                               Role::publisher, false)) {}
 
 template <Message T>
@@ -243,9 +243,10 @@ const Qos& Publisher<T>::qos() const noexcept { return core_->qos; }
 // --- Subscriber ----------------------------------------------------------------------------
 
 template <Message T>
-Subscriber<T>::Subscriber(Participant& participant, std::string topic, EndpointOptions options, DataCallback on_data) {
+Subscriber<T>::Subscriber(Participant& participant, const std::string& topic, const EndpointOptions& options,
+                          DataCallback on_data) {
   const bool with_callback = static_cast<bool>(on_data);
-  core_ = detail::make_core(participant, std::move(topic), detail::TypeSupport<T>::descriptor(), options,
+  core_ = detail::make_core(participant, topic, detail::TypeSupport<T>::descriptor(), options,
                             Role::subscriber, false);
   if (with_callback) {
     // Installed after creation, then the listener enabled: the reader was made without a data
@@ -302,11 +303,11 @@ std::optional<T> Subscriber<T>::take_one(std::chrono::milliseconds timeout) {
 template <Message T>
 std::vector<std::vector<std::uint8_t>> Subscriber<T>::take_serialized(std::size_t max) {
   std::vector<std::vector<std::uint8_t>> out;
-  constexpr std::size_t batch = 16;
-  std::array<ddsi_serdata*, batch> data{};
-  std::array<dds_sample_info_t, batch> infos{};
+  constexpr std::size_t kBatch = 16;
+  std::array<ddsi_serdata*, kBatch> data{};
+  std::array<dds_sample_info_t, kBatch> infos{};
   while (out.size() < max) {
-    const auto wanted = static_cast<uint32_t>(std::min(batch, max - out.size()));
+    const auto wanted = static_cast<uint32_t>(std::min(kBatch, max - out.size()));
     const dds_return_t n = dds_takecdr(core_->entity, data.data(), wanted, infos.data(), DDS_ANY_STATE);
     detail::check(n, core_->where("dds_takecdr"));
     for (dds_return_t i = 0; i < n; ++i) {

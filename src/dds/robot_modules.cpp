@@ -15,7 +15,7 @@ std::vector<ParameterSpec> topic_parameters(std::string default_topic) {
           parameter::flag("loopback", true, "stay on 127.0.0.1 (false: Cyclone DDS's own network configuration)")};
 }
 
-std::string text_or(const ParameterSet& p, std::string_view name, std::string fallback) {
+std::string text_or(const ParameterSet& p, std::string_view name, const std::string& fallback) {
   return p.contains(name) ? p.string(name) : fallback;
 }
 

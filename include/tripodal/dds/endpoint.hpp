@@ -57,7 +57,7 @@ struct EndpointCore;  // the Cyclone entities, listener and type support of one 
 template <Message T>
 class Publisher {
  public:
-  Publisher(Participant& participant, std::string topic, EndpointOptions options = {});
+  Publisher(Participant& participant, const std::string& topic, const EndpointOptions& options = {});
   ~Publisher();
   Publisher(Publisher&&) noexcept;
   Publisher& operator=(Publisher&&) noexcept;
@@ -84,7 +84,7 @@ class Subscriber {
   // With on_data, every sample is handed to it on a Cyclone DDS thread as it arrives, and take()
   // finds nothing; without, samples wait in the reader's history (qos depth) for take().
   using DataCallback = std::function<void(const T&)>;
-  Subscriber(Participant& participant, std::string topic, EndpointOptions options = {},
+  Subscriber(Participant& participant, const std::string& topic, const EndpointOptions& options = {},
              DataCallback on_data = {});
   ~Subscriber();
   Subscriber(Subscriber&&) noexcept;
