@@ -475,16 +475,19 @@ nlohmann::json next_status(MonitorServer& server, RobotMonitor& watch) {
   Client c(server.port());
   c.send(ws_upgrade("/ws?token=t0ken-for-tests"));
   nlohmann::json status;
-  REQUIRE(wait_for([&] {
-    watch.update();
-    const std::string bytes = c.read_until([](const std::string& b) { return b.find("\"topic\":\"/status\"") != std::string::npos; },
-                                           std::chrono::milliseconds(20));
+  // Whether `bytes` hold a whole /status frame (kept in `status`).
+  auto complete = [&](const std::string& bytes) {
     const std::size_t body = bytes.find("\r\n\r\n");
     if (body == std::string::npos) return false;
     for (const WsFrame& f : server_frames(std::string_view(bytes).substr(body + 4))) {
       const auto j = nlohmann::json::parse(f.payload, nullptr, false);
       if (j.is_object() && j.value("topic", "") == "/status") status = j["data"];
     }
+    return status.is_object();
+  };
+  REQUIRE(wait_for([&] {
+    watch.update();
+    c.read_until(complete, std::chrono::milliseconds(20));
     return status.is_object();
   }));
   return status;
