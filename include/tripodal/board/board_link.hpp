@@ -113,7 +113,6 @@ class BoardLink {
   std::array<ActuatorCommand, 8> queue_{};
   std::size_t queue_head_ = 0;
   std::size_t queue_size_ = 0;
-  bool actuator_in_flight_ = false;
   std::uint32_t consecutive_missed_ = 0;
   bool synchronised_ = false;
   bool lost_pending_ = false;
