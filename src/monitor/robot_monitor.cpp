@@ -183,7 +183,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
                                     R"({"type":"object","properties":{"time_s":{"type":"number"},"kind":{"type":"string"},"text":{"type":"string"}}})",
                                     Delivery::event);
     ch_status = server.advertise("/status", "tripodal.Status",
-                                 R"({"type":"object","properties":{"time_s":{"type":"number"},"paused":{"type":"boolean"},"task_state":{"type":"string"},"velocity":{"type":"object"},"battery":{"type":["number","null"]},"coverage":{"type":["number","null"]},"behaviors":{"type":"array"},"winner":{"type":"string"}}})",
+                                 R"({"type":"object","properties":{"time_s":{"type":"number"},"paused":{"type":"boolean"},"task_state":{"type":"string"},"velocity":{"type":"object"},"battery":{"type":["number","null"]},"coverage":{"type":["number","null"]},"behaviors":{"type":"array"},"winner":{"type":"string"},"board":{"type":"object","description":"the control board's link as the host sees it; only on hardware board"}}})",
                                  Delivery::bulk);
     add_operator_input();
     paused = options.start_paused;
