@@ -12,6 +12,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <regex>
 #include <string>
@@ -454,12 +455,15 @@ namespace {
 
 // Posts a command and keeps the robot's side answering (update() between tries) until the answer
 // is complete; returns the whole HTTP response.
+// `between` runs before each update(): the robot's periods, for a request that waits for one.
 std::string post_command(MonitorServer& server, RobotMonitor& watch, const std::string& body,
-                         const std::string& auth = "Authorization: Bearer t0ken-for-tests\r\n") {
+                         const std::string& auth = "Authorization: Bearer t0ken-for-tests\r\n",
+                         const std::function<void()>& between = {}) {
   Client c(server.port());
   c.send("POST /api/command HTTP/1.1\r\n" + auth + "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body);
   std::string answer;
   REQUIRE(wait_for([&] {
+    if (between) between();
     watch.update();
     answer = c.read_until([](const std::string& b) { return b.find("\r\n\r\n{") != std::string::npos && b.back() == '}'; },
                           std::chrono::milliseconds(20));
@@ -545,6 +549,29 @@ TEST_CASE("The console reloads an edited net at a quiet marking, and refuses one
     CHECK_FALSE(a["accepted"].get<bool>());
     CHECK_THAT(a["diagnostics"].dump(), Catch::Contains("place P3 holds 1 token in the running net"));
     CHECK(robot->supervisor().engine(run) == running);
+  }
+  SECTION("not quiet: the reload waits for the next quiet point, or is refused with the reasons when none comes in time") {
+    robot->supervisor().post_event("localizer.lost");  // P3 -> P4: t5 times its 10 s
+    robot->run_for(std::chrono::milliseconds(100));
+    REQUIRE_FALSE(robot->supervisor().why_not_quiet(run).empty());
+    running = robot->supervisor().engine(run);
+    // The robot stands still (only update() runs): no quiet point within reload_wait_s.
+    const auto t0 = std::chrono::steady_clock::now();
+    const nlohmann::json refused = answer_json(post_command(server, watch, reload));
+    CHECK(std::chrono::steady_clock::now() - t0 >= std::chrono::milliseconds(500));
+    CHECK_FALSE(refused["accepted"].get<bool>());
+    CHECK_THAT(refused["diagnostics"].dump(), Catch::Contains("is not at a quiet marking: transition t5 is timing its delay of 10 s"));
+    CHECK(robot->supervisor().engine(run) == running);
+    // Localization comes back while the request waits: the next period is quiet, the reload goes through.
+    int periods = 0;
+    const nlohmann::json accepted = answer_json(post_command(server, watch, reload, "Authorization: Bearer t0ken-for-tests\r\n", [&] {
+      if (++periods == 3) robot->supervisor().post_event("localizer.ok");
+      robot->run_for(std::chrono::milliseconds(10));
+    }));
+    INFO(accepted.dump());
+    CHECK(accepted["accepted"].get<bool>());
+    CHECK(periods >= 3);
+    CHECK(robot->supervisor().engine(run)->net().find_place("P99").has_value());
   }
   SECTION("an edited net that loads replaces the running one, marking carried over, the task goes on") {
     const nlohmann::json a = answer_json(post_command(server, watch, reload));
