@@ -78,6 +78,7 @@ bool BoardLink::send(Command cmd, std::span<const std::uint8_t> payload, Time no
   }
   outstanding_[outstanding_size_++] = Outstanding{cmd, now, actuator};
   ++stats_.requests;
+  stats_.bytes_sent += n;
   return true;
 }
 
@@ -92,6 +93,7 @@ void BoardLink::receive(Time now) noexcept {
       return;
     }
     if (n == 0) return;
+    stats_.bytes_received += static_cast<std::uint64_t>(n);
     decoder_.feed(std::span<const std::uint8_t>(rx_.data(), static_cast<std::size_t>(n)),
                   [&](const FrameView& f) { on_frame(f, now); });
   }
@@ -121,6 +123,7 @@ void BoardLink::on_frame(const FrameView& frame, Time now) noexcept {
     ++stats_.error_responses;
     if (front.actuator) ++stats_.retries;  // stays queued: sent again next period
     // The board's watchdog tripped (it stopped the motors and wants SYNC), or too many errors.
+    if (r->error() == ErrorCode::not_synchronised && synchronised_) ++stats_.watchdog_trips;
     if (r->error() == ErrorCode::not_synchronised || ++consecutive_missed_ >= config_.max_missed) lose(now);
     return;
   }
@@ -152,6 +155,7 @@ void BoardLink::on_frame(const FrameView& frame, Time now) noexcept {
       if (r->payload.size() == 2) {
         tank_percent_ = r->payload[0];
         tank_empty_ = r->payload[1] != 0;
+        has_tank_ = true;
       }
       break;
     case Command::ultrasonic: {

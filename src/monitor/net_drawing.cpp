@@ -31,9 +31,6 @@ NetDrawing::NetDrawing() : impl_(std::make_unique<Impl>()) {}
 NetDrawing::~NetDrawing() = default;
 
 const std::string& NetDrawing::svg(const PetriNet& net) {
-  const std::string key = net.id + "@" + net.where.file.str() + ":" + std::to_string(net.places().size()) + ":" +
-                          std::to_string(net.transitions().size());
-  if (const auto it = impl_->cache.find(key); it != impl_->cache.end()) return it->second;
   std::string out;
   // The drawing of `tripodal-net dot` without its legend, every place empty: the page marks the
   // places of the live marking.
@@ -43,6 +40,9 @@ const std::string& NetDrawing::svg(const PetriNet& net) {
   PetriNet untitled = net;
   untitled.description.clear();
   const std::string text = net_to_dot(untitled, empty, DotOptions{.descriptions = false});
+  // Keyed by the drawing's text, not the net's id: an edited net reloaded under the same id and
+  // file name is drawn anew. Writing the text costs little next to Graphviz's layout.
+  if (const auto it = impl_->cache.find(text); it != impl_->cache.end()) return it->second;
   const std::lock_guard lock(graphviz_mutex);
   GVC_t* gvc = graphviz();
   if (Agraph_t* g = agmemread(text.c_str())) {
@@ -59,7 +59,7 @@ const std::string& NetDrawing::svg(const PetriNet& net) {
     }
     agclose(g);
   }
-  return impl_->cache.emplace(key, std::move(out)).first->second;
+  return impl_->cache.emplace(text, std::move(out)).first->second;
 }
 
 }  // namespace tripodal::monitor

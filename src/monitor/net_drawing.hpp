@@ -17,7 +17,7 @@ class NetDrawing final {
   NetDrawing(const NetDrawing&) = delete;
   NetDrawing& operator=(const NetDrawing&) = delete;
 
-  /// The SVG of `net`; nets drawn before (same id and source) come from this drawing's cache.
+  /// The SVG of `net`; nets drawn before (the same drawing text) come from this drawing's cache.
   /// Drawings in several threads take turns (Graphviz is not thread-safe).
   const std::string& svg(const PetriNet& net);
 

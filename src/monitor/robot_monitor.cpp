@@ -11,6 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "tripodal/behaviors/behavior_registry.hpp"
+#include "tripodal/board/board_hardware.hpp"
+#include "tripodal/core/net_loader.hpp"
 #include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/navi/section_splitter.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
@@ -74,6 +76,48 @@ class BhOperatorDrive final : public CBehavior {
 
 constexpr std::string_view kOperator = "operator";
 
+// The control board's link as the host sees it (hardware type "board", real or simulated): the
+// panel of the page. Everything here is what the board reported over the line or the host counted.
+json board_json(board::BoardLink& link, Time now) {
+  const board::LinkStats& s = link.stats();
+  const double answered = static_cast<double>(s.responses + s.error_responses);
+  json j{{"connected", link.synchronised()},
+         {"requests", s.requests},
+         {"responses", s.responses},
+         {"missed", s.missed},
+         {"error_responses", s.error_responses},
+         {"link_losses", s.link_losses},
+         {"resyncs", s.resyncs},
+         {"reopens", s.reopens},
+         {"retries", s.retries},
+         {"watchdog_trips", s.watchdog_trips},
+         {"decoder_errors", link.decoder_stats().errors()},
+         {"bytes_sent", s.bytes_sent},
+         {"bytes_received", s.bytes_received},
+         {"round_trip_ms", {{"last", to_seconds(s.last_round_trip) * 1e3},
+                            {"max", to_seconds(s.max_round_trip) * 1e3},
+                            {"mean", answered > 0 ? to_seconds(s.total_round_trip) * 1e3 / answered : 0.0}}},
+         {"pending_actuator_commands", link.pending_actuator_commands()},
+         {"battery", nullptr},
+         {"tank", nullptr},
+         {"status", nullptr}};
+  if (!link.synchronised()) j["lost_for_s"] = to_seconds(now - link.link_lost_at());
+  if (link.has_battery()) {
+    const board::BatteryState& b = link.battery();
+    j["battery"] = {{"percent", b.percent}, {"charging", b.charging}, {"voltage_v", b.voltage_mv / 1000.0}};
+  }
+  if (link.has_tank()) j["tank"] = {{"percent", link.tank_percent()}, {"empty", link.tank_empty()}};
+  if (link.has_drive()) {
+    const std::uint8_t f = link.drive().status;
+    j["status"] = {{"uv_lamp", (f & board::kStatusUvLamp) != 0},
+                   {"atomizer", (f & board::kStatusAtomizer) != 0},
+                   {"emergency_stop", (f & board::kStatusEmergencyStop) != 0},
+                   {"watchdog_latched", (f & board::kStatusLinkLost) != 0},
+                   {"age_s", to_seconds(now - link.drive_stamp())}};
+  }
+  return j;
+}
+
 struct NetView {
   std::string run;
   const PetriNet* net = nullptr;
@@ -104,6 +148,14 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
   Time last_scan{Duration{-1}};
   bool map_sent = false;
   std::chrono::steady_clock::time_point last_publish{}, last_cleaned{};
+  // A reload that was valid but came while its run was not quiet: retried between periods (the
+  // supervisor's quiet points) until it goes through, fails otherwise, or its time is up.
+  struct PendingReload {
+    std::uint64_t request = 0;
+    std::string run, text, source;
+    std::chrono::steady_clock::time_point deadline{};
+  };
+  std::optional<PendingReload> pending_reload;
   std::shared_ptr<DriveCommand> drive = std::make_shared<DriveCommand>();
   bool driving = false;
   std::chrono::steady_clock::time_point last_drive{};
@@ -131,7 +183,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
                                     R"({"type":"object","properties":{"time_s":{"type":"number"},"kind":{"type":"string"},"text":{"type":"string"}}})",
                                     Delivery::event);
     ch_status = server.advertise("/status", "tripodal.Status",
-                                 R"({"type":"object","properties":{"time_s":{"type":"number"},"paused":{"type":"boolean"},"task_state":{"type":"string"},"velocity":{"type":"object"},"battery":{"type":["number","null"]},"coverage":{"type":["number","null"]},"behaviors":{"type":"array"},"winner":{"type":"string"}}})",
+                                 R"({"type":"object","properties":{"time_s":{"type":"number"},"paused":{"type":"boolean"},"task_state":{"type":"string"},"velocity":{"type":"object"},"battery":{"type":["number","null"]},"coverage":{"type":["number","null"]},"behaviors":{"type":"array"},"winner":{"type":"string"},"board":{"type":"object","description":"the control board's link as the host sees it; only on hardware board"}}})",
                                  Delivery::bulk);
     add_operator_input();
     paused = options.start_paused;
@@ -198,6 +250,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
   void on_task_failed(const TaskReport&) override { nets_changed = true; }
   void on_run_started(std::string_view, const CProcess&, const ParameterValues&, Time) override { nets_changed = true; }
   void on_run_finished(const ProcessResult&) override { nets_changed = true; }
+  void on_net_reloaded(std::string_view, const CProcess&, std::string_view, Time) override { nets_changed = true; }
   void on_behavior_activated(std::string_view, std::string_view behavior, const ParameterValues& params, Time) override {
     std::string text;
     for (const auto& [k, v] : params) text += (text.empty() ? "" : ", ") + k + "=" + to_string(v);
@@ -223,6 +276,63 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
     paused = true;
     pause_reason = reason;
     note("monitor: paused, " + reason);
+  }
+
+  // --- reloading an edited net ----------------------------------------------------------------------
+  static json diagnostics_json(const Diagnostics& d) {
+    json out = json::array();
+    for (const Diagnostic& x : d.all()) {
+      out.push_back({{"severity", x.severity == Severity::error ? "error" : x.severity == Severity::warning ? "warning" : "note"},
+                     {"where", x.where.str()},
+                     {"message", x.message},
+                     {"text", x.str()}});
+    }
+    return out;
+  }
+
+  // One attempt; true when the request is answered (accepted, or refused for good).
+  bool try_reload(std::uint64_t request, const std::string& run, const std::string& text, const std::string& source, bool last_chance) {
+    const ReloadResult res = robot.supervisor().reload(run, text, source);
+    if (!res.accepted && res.not_quiet && !last_chance) return false;
+    if (res.accepted) {
+      note("operator: net of " + run + " reloaded (" + source + ")");
+    } else {
+      const std::string first = res.diagnostics.all().empty() ? std::string() : res.diagnostics.all().front().str();
+      note("operator: reload of " + run + " refused: " + first);
+    }
+    server.answer(request, 200,
+                  json{{"accepted", res.accepted}, {"run", run}, {"marking", res.marking}, {"diagnostics", diagnostics_json(res.diagnostics)}}
+                      .dump());
+    return true;
+  }
+
+  void retry_pending_reload() {
+    if (!pending_reload) return;
+    const bool last = paused || std::chrono::steady_clock::now() >= pending_reload->deadline;
+    if (try_reload(pending_reload->request, pending_reload->run, pending_reload->text, pending_reload->source, last)) pending_reload.reset();
+  }
+
+  void reload(const OperatorRequest& r, const json& body) {
+    auto reply = [&](int status, const json& j) { server.answer(r.id, status, j.dump()); };
+    if (!body.contains("run") || !body["run"].is_string() || !body.contains("xml") || !body["xml"].is_string()) {
+      return reply(400, {{"error", "reload: expected \"run\": a running process's run id and \"xml\": its edited net"}});
+    }
+    const std::string run = body["run"];
+    if (run == "task") {
+      return reply(409, {{"error", "reload: the task's net is composed by the planner from the process modules; reload a process net"}});
+    }
+    if (pending_reload) {
+      return reply(409, {{"error", "reload: the reload of " + pending_reload->run + " is waiting for a quiet marking"}});
+    }
+    const CProcess* process = robot.supervisor().process(run);
+    // The name diagnostics give the edited text: the process's own file name, marked as edited.
+    const std::string source = (process != nullptr ? process->name() : run) + ".edited.xml";
+    const std::string text = body["xml"];
+    // Paused, nothing steps: a run that is not quiet now will not become quiet, so no waiting.
+    if (try_reload(r.id, run, text, source, paused)) return;
+    pending_reload = PendingReload{r.id, run, text, source,
+                                   std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                                          std::chrono::duration<double>(options.reload_wait_s))};
   }
 
   // --- operator requests --------------------------------------------------------------------------
@@ -270,6 +380,14 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
       note("operator: fault acknowledged" + (body.contains("text") && body["text"].is_string() ? ": " + body["text"].get<std::string>() : ""));
       return reply(200, {{"acknowledged", true}});
     }
+    if (op == "net") {
+      const std::string run = body.value("run", "");
+      if (run == "task") return reply(409, {{"error", "net: the task's net is composed by the planner; only process nets are edited"}});
+      const CProcess* process = robot.supervisor().process(run);
+      if (process == nullptr) return reply(404, {{"error", "net: no process is running as '" + run + "'"}});
+      return reply(200, {{"run", run}, {"process", process->name()}, {"xml", net_to_string(process->net(), NetFormat::native_xml)}});
+    }
+    if (op == "reload") return reload(r, body);
     if (op == "breakpoint") {
       if (!body.contains("place") || !body["place"].is_string() || body["place"].get<std::string>().empty()) {
         return reply(400, {{"error", "breakpoint: expected \"place\": a place id or name"}});
@@ -281,7 +399,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
       note("monitor: breakpoint " + std::string(on ? "set" : "cleared") + " on place " + place);
       return reply(200, {{"breakpoints", std::vector<std::string>(breakpoints.begin(), breakpoints.end())}});
     }
-    reply(400, {{"error", "unknown op '" + op + "': expected task, pause, resume, cancel, ack, breakpoint or drive"}});
+    reply(400, {{"error", "unknown op '" + op + "': expected task, pause, resume, cancel, ack, breakpoint, drive, net or reload"}});
   }
 
   // --- topics -------------------------------------------------------------------------------------
@@ -407,11 +525,13 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
     if (const auto* battery = robot.resources().first<BatteryReading>(); battery != nullptr && battery->has_reading()) {
       status["battery"] = battery->latest().percentage;
     }
+    if (auto* host = dynamic_cast<board::BoardHost*>(robot.hardware())) status["board"] = board_json(host->board().link(), now);
     if (extras.true_pose) status["truth"] = {{"x", extras.true_pose->x_m}, {"y", extras.true_pose->y_m}, {"theta", extras.true_pose->theta_rad}};
     server.publish(ch_status, t, status.dump());
   }
 
   void update(const MonitorExtras& extras) {
+    retry_pending_reload();
     for (const OperatorRequest& r : server.take_requests()) handle(r);
     // The dead-man switch: the console repeats the command while a key is held.
     if (driving && std::chrono::steady_clock::now() - last_drive > std::chrono::duration<double>(options.drive_deadman_s)) {

@@ -65,4 +65,9 @@ void LifecycleRecorder::on_fault(std::string_view source, std::string_view reaso
   if (details_) add(now, "  fault " + std::string(source) + ": " + std::string(reason));
 }
 
+void LifecycleRecorder::on_net_reloaded(std::string_view run, const CProcess& process, std::string_view marking, Time now) {
+  add(now, "process " + std::string(run) + " " + process.name() + " net reloaded from " + process.net().where.file.str() +
+               " at a quiet marking (" + std::string(marking) + ")");
+}
+
 }  // namespace tripodal

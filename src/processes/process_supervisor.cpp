@@ -6,12 +6,19 @@
 
 #include <spdlog/spdlog.h>
 
+#include "tripodal/core/net_loader.hpp"
+
 namespace tripodal {
 
 namespace {
 
 std::string done_event(std::string_view behavior) { return done_event_name(behavior); }
 std::string failed_event(std::string_view behavior) { return failed_event_name(behavior); }
+
+bool same_binding(const std::vector<BindingParam>& a, const std::vector<BindingParam>& b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+                    [](const BindingParam& x, const BindingParam& y) { return x.name == y.name && x.value == y.value; });
+}
 
 }  // namespace
 
@@ -45,6 +52,8 @@ struct CProcessSupervisor::Run {
   std::map<std::string, std::string, std::less<>> failure_messages;  // failure event -> message
   Forwarder forwarder;
   bool finished = false;
+  std::unique_ptr<CProcess> reloaded;      // the edited process after a reload (`process` points at it)
+  std::vector<std::string> pending_events;  // behavior failures of a reload's activations, for the next step
 };
 
 struct CProcessSupervisor::Inbox {
@@ -234,6 +243,11 @@ std::vector<std::string> CProcessSupervisor::step_run(Run& run, std::vector<std:
 }
 
 void CProcessSupervisor::step() {
+  stepping_ = true;
+  struct Done {
+    bool& flag;
+    ~Done() { flag = false; }
+  } done{stepping_};
   const Time now = clock_.now();
   std::vector<std::string> module_events;
   std::vector<std::pair<std::string, Value>> facts;
@@ -282,6 +296,8 @@ void CProcessSupervisor::step() {
     if (run.finished) continue;
     // Module events were queued before this step; behavior status is read now, so it comes after.
     std::vector<std::string> events = module_events;
+    events.insert(events.end(), run.pending_events.begin(), run.pending_events.end());
+    run.pending_events.clear();
     std::vector<std::string> done_offered;
     // Behavior status becomes events of the run that holds the behavior, once per change.
     for (auto& a : run.active) {
@@ -404,6 +420,207 @@ const Engine* CProcessSupervisor::engine(std::string_view run) const noexcept {
     if (r->id == run) return r->engine.get();
   }
   return nullptr;
+}
+
+const CProcess* CProcessSupervisor::process(std::string_view run) const noexcept {
+  for (const auto& r : runs_) {
+    if (r->id == run) return r->process;
+  }
+  return nullptr;
+}
+
+std::vector<std::string> CProcessSupervisor::why_not_quiet(std::string_view run) const {
+  const auto it = std::find_if(runs_.begin(), runs_.end(), [&](const auto& r) { return r->id == run; });
+  if (it == runs_.end() || (*it)->finished) return {"no process is running as '" + std::string(run) + "'"};
+  if (stepping_) return {"the supervisor is inside a step (a firing in progress): reload between steps"};
+  const Run& r = **it;
+  const Engine& e = *r.engine;
+  std::vector<std::string> why;
+  if (const OutcomeState o = e.outcome(); o.outcome != Outcome::none) {
+    why.push_back("the net has reached its outcome place " + std::string(o.place_id));
+  }
+  const PetriNet& net = e.net();
+  for (TransitionIndex t = 0; t < net.transitions().size(); ++t) {
+    const Transition& tr = net.transition(t);
+    if (!tr.event.empty() || !e.is_enabled(t)) continue;  // waiting for its event is the quiet state
+    if (tr.delay > Duration{0}) {
+      why.push_back("transition " + tr.id + " is timing its delay of " + format_seconds(tr.delay, kExactDigits) +
+                    " s: a new net would start it again");
+    } else {
+      why.push_back("transition " + tr.id + " is enabled and has not fired yet (the net has not settled)");
+    }
+  }
+  for (const Run::Active& a : r.active) {
+    BehaviorReport rep;
+    try {
+      rep = behaviors_.report(a.behavior);
+    } catch (...) {
+      rep.state = BehaviorStatus::failed;
+    }
+    if (rep.state == BehaviorStatus::succeeded && !a.done_posted) {
+      why.push_back("behavior " + a.behavior + " (place " + net.place(a.place).id + ") has completed and the net has not taken " +
+                    done_event(a.behavior) + " yet (a transition mid-action)");
+    } else if (rep.state == BehaviorStatus::failed && !a.failure_posted) {
+      why.push_back("behavior " + a.behavior + " (place " + net.place(a.place).id + ") has failed and the net has not taken " +
+                    failed_event(a.behavior) + " yet (a transition mid-action)");
+    }
+  }
+  if (!r.pending_events.empty()) why.push_back("events of the last reload wait for the next step");
+  return why;
+}
+
+ReloadResult CProcessSupervisor::reload(std::string_view run, std::string_view text, std::string_view source_name) {
+  ReloadResult res;
+  LoadOptions lo;
+  lo.is_known_behavior = [this](std::string_view b) { return behaviors_.has(b); };
+  std::optional<PetriNet> net = load_net_from_string(text, source_name, res.diagnostics, lo);
+  if (!net) return res;
+  Diagnostics warnings = std::move(res.diagnostics);
+  res = reload(run, std::move(*net));
+  // The loader's warnings come first, as a reader of the file expects them.
+  warnings.append(res.diagnostics);
+  res.diagnostics = std::move(warnings);
+  return res;
+}
+
+ReloadResult CProcessSupervisor::reload(std::string_view run, PetriNet net) {
+  ReloadResult res;
+  const SourceLocation net_where = net.where;
+  const auto it = std::find_if(runs_.begin(), runs_.end(), [&](const auto& r) { return r->id == run && !r->finished; });
+  if (it == runs_.end()) {
+    std::string running;
+    for (const auto& r : runs_) running += (running.empty() ? "" : ", ") + r->id;
+    res.diagnostics.error(net_where, "no process is running as '" + std::string(run) + "' (running: " +
+                                         (running.empty() ? std::string("none") : running) + ")");
+    return res;
+  }
+  Run& r = **it;
+  const Time now = clock_.now();
+
+  // The edited process: the same module in every respect but its net (name, type, configured
+  // parameters, recovery rules), checked as configuration is.
+  ProcessDefinition d;
+  d.name = r.process->name();
+  d.type = r.process->type();
+  d.net = std::move(net);
+  if (const PetriNet* m = r.process->module()) d.module = *m;
+  d.parameters = r.process->configured_parameters();
+  d.recovery = r.process->recovery();
+  d.where = net_where;
+  std::unique_ptr<CProcess> edited;
+  try {
+    edited = std::make_unique<CProcess>(std::move(d));
+  } catch (const ConfigError& e) {
+    res.diagnostics.append(e.diagnostics());
+    return res;
+  }
+
+  // The marking, by place id. The new net's initial marking does not count: the instance goes on.
+  const Engine& old = *r.engine;
+  const PetriNet& old_net = old.net();
+  PetriNet carried = edited->net();
+  for (PlaceIndex p = 0; p < carried.places().size(); ++p) carried.place(p).initial_tokens = 0;
+  const auto marking = old.marking();
+  for (PlaceIndex p = 0; p < marking.size(); ++p) {
+    if (marking[p] == 0) continue;
+    const Place& was = old_net.place(p);
+    const auto to = carried.find_place(was.id);
+    const std::string tokens = std::to_string(marking[p]) + (marking[p] == 1 ? " token" : " tokens");
+    if (!to) {
+      res.diagnostics.error(net_where, "place " + was.id + " holds " + tokens + " in the running net (run " + r.id +
+                                           ") but is not in the new net: its marking cannot be carried over");
+      continue;
+    }
+    Place& now_place = carried.place(*to);
+    if (now_place.capacity && marking[p] > *now_place.capacity) {
+      res.diagnostics.error(now_place.where, "place " + was.id + " holds " + tokens + " in the running net, more than its new capacity " +
+                                                 std::to_string(*now_place.capacity));
+      continue;
+    }
+    now_place.initial_tokens = marking[p];
+    if (!res.marking.empty()) res.marking += ", ";
+    res.marking += was.id + "=" + std::to_string(marking[p]);
+    if (now_place.outcome != Outcome::none) {
+      res.diagnostics.error(now_place.where, "place " + was.id + " is an outcome place in the new net: carrying its marking over would end the process at once");
+    }
+  }
+  if (res.diagnostics.has_errors()) return res;
+
+  EngineOptions eo = options_.engine;
+  eo.start_time = now;
+  std::unique_ptr<Engine> engine;
+  try {
+    engine = std::make_unique<Engine>(carried, r.params, eo);
+  } catch (const ConfigError& e) {
+    res.diagnostics.append(e.diagnostics());
+    return res;
+  } catch (const std::exception& e) {
+    res.diagnostics.error(net_where, std::string("the engine refused the new net: ") + e.what());
+    return res;
+  }
+  // Facts keep their values where the new net declares them with the same type.
+  for (const VariableDecl& f : old_net.facts) {
+    const auto from = old.fact_id(f.name);
+    const auto to = engine->fact_id(f.name);
+    if (!from || !to) continue;
+    if (const Value* v = old.fact(*from)) {
+      try {
+        engine->set_fact(*to, *v);
+      } catch (const std::exception& e) {
+        res.diagnostics.warning(net_where, "fact " + f.name + " starts unknown in the new net: " + e.what());
+      }
+    }
+  }
+  const PetriNet& new_net = engine->net();
+  for (TransitionIndex t = 0; t < new_net.transitions().size(); ++t) {
+    const Transition& tr = new_net.transition(t);
+    if (tr.event.empty() && tr.delay == Duration{0} && engine->is_enabled(t)) {
+      res.diagnostics.error(tr.where, "transition " + tr.id + " is enabled by the carried marking (" + res.marking +
+                                          ") and would fire at once: the marking is not quiet in the new net");
+    }
+  }
+  if (res.diagnostics.has_errors()) return res;
+  for (const std::string& why : why_not_quiet(run)) res.diagnostics.error(net_where, "run " + r.id + " is not at a quiet marking: " + why);
+  if (res.diagnostics.has_errors()) {
+    res.not_quiet = true;
+    return res;
+  }
+
+  // Settle the new engine at the reload's instant: nothing fires (checked above); its first step
+  // reports the bound places of the carried marking, which are matched with the running behaviors.
+  const StepResult& first = engine->step(now);
+  const std::vector<PlaceIndex> bound = first.activated;
+  std::vector<Run::Active> kept;
+  std::vector<PlaceIndex> to_activate;
+  for (const PlaceIndex p : bound) {
+    const Place& np = new_net.place(p);
+    if (!np.behavior) continue;
+    const auto same = std::find_if(r.active.begin(), r.active.end(), [&](const Run::Active& a) {
+      const Place& op = old_net.place(a.place);
+      return op.id == np.id && op.behavior && a.behavior == np.behavior->behavior && same_binding(op.behavior->params, np.behavior->params);
+    });
+    if (same == r.active.end()) {
+      to_activate.push_back(p);
+      continue;
+    }
+    Run::Active a = *same;
+    a.place = p;
+    kept.push_back(std::move(a));
+    r.active.erase(same);
+  }
+  // The behaviors the edited net no longer holds (or holds with another binding) stop first.
+  while (!r.active.empty()) deactivate(r, r.active.back().place, now);
+  r.active = std::move(kept);
+  r.engine->remove_observer(r.forwarder);
+  r.engine = std::move(engine);
+  r.engine->add_observer(r.forwarder);
+  r.reloaded = std::move(edited);
+  r.process = r.reloaded.get();
+  for (const PlaceIndex p : to_activate) activate(r, p, now, r.pending_events);
+  res.accepted = true;
+  spdlog::info("process {} ({}) net reloaded at a quiet marking: {}", r.process->name(), r.id, res.marking);
+  for (SupervisorObserver* o : observers_) o->on_net_reloaded(r.id, *r.process, res.marking, now);
+  return res;
 }
 
 std::optional<Time> CProcessSupervisor::next_deadline() const noexcept {

@@ -2,9 +2,13 @@
 python3-selenium, against a running `tripodal run --monitor --start-paused`. A wrong token is
 refused (401) and nothing runs; an unknown task shows the planner's answer; "clean the room 3211"
 starts the task; the pose changes on the map; a place of PrCleaning becomes marked; a breakpoint
-on it pauses the run. The page's screenshot is kept as the test's artifact.
+on it pauses the run; an edited PrCleaning net that does not load is refused with the loader's
+located diagnostics on the page, one that loads is reloaded at the quiet marking and drawn; the
+board link panel stays hidden (the PSR-2 has no control board). The page's screenshot is kept as
+the test's artifact.
 
 usage: browser_test.py TRIPODAL ROBOT.yaml WORLD.yaml SCREENSHOT.png"""
+import re
 import sys
 import time
 
@@ -82,6 +86,37 @@ def main():
         t1 = text("time")
         time.sleep(1.0)
         check(text("time") == t1, "paused: the robot's time stands still (%s s)" % t1)
+        check(not driver.find_element(By.ID, "board-panel").is_displayed(), "no board link panel for the PSR-2")
+
+        # Edit the running PrCleaning net: its text from the robot, a broken edit refused with the
+        # diagnostics, a good one reloaded at the quiet marking (paused at the breakpoint).
+        wait.until(lambda d: any("PrCleaning" in o.text for o in d.find_elements(By.CSS_SELECTOR, "#edit-run option")))
+        for o in driver.find_elements(By.CSS_SELECTOR, "#edit-run option"):
+            if "PrCleaning" in o.text:
+                o.click()
+                run_id = o.get_attribute("value")
+        driver.find_element(By.ID, "edit-load").click()
+        wait.until(lambda d: "<net" in d.find_element(By.ID, "edit-xml").get_attribute("value"))
+        check(True, "the text of PrCleaning's net (run %s) is in the editor" % run_id)
+        edit = lambda js: driver.execute_script("const e = document.getElementById('edit-xml'); e.value = " + js + ";")
+        original = driver.find_element(By.ID, "edit-xml").get_attribute("value")
+        edit("e.value.replace('</place>', '')")
+        driver.find_element(By.ID, "edit-reload").click()
+        wait.until(lambda d: text("edit-result").startswith("refused"))
+        result = text("edit-result")
+        check(re.search(r"PrCleaning\.edited\.xml:\d+:\d+: error: ", result) is not None,
+              "a net that does not load is refused with located diagnostics: " + result.replace("\n", " | "))
+        check(driver.find_element(By.ID, "edit-result").get_attribute("class") == "refused", "shown as refused")
+        driver.execute_script("document.getElementById('edit-xml').value = arguments[0];",
+                              original.replace("</net>", '  <place id="P99" description="operator note"/>\n</net>'))
+        driver.find_element(By.ID, "edit-reload").click()
+        wait.until(lambda d: text("edit-result").startswith("reloaded") or text("edit-result").startswith("refused:"))
+        result = text("edit-result")
+        check(result.startswith("reloaded " + run_id + " at a quiet marking (") and "P1=1" in result,
+              "an edited net that loads is reloaded with the marking carried over: " + result.replace("\n", " | "))
+        wait.until(lambda d: d.find_elements(By.CSS_SELECTOR, 'div.net[data-net="PrCleaning"] g.place[data-place="P99"]'))
+        check(driver.find_elements(By.CSS_SELECTOR, 'div.net[data-net="PrCleaning"] g.place.marked[data-place="P1"]'),
+              "the edited net is drawn, P1 still marked")
 
         driver.find_element(By.ID, "bp-clear").click()
         wait.until(lambda d: "PrCleaning.P1" not in text("bps"))
@@ -98,6 +133,7 @@ def main():
         driver.quit()
         out = run.stop()
     check("activate BhCleaning(section=A)" in out or "PrCleaning(section=A)" in out, "the run's log shows the cleaning")
+    check("net reloaded from PrCleaning.edited.xml at a quiet marking" in out, "the life cycle records the reload")
 
 
 if __name__ == "__main__":

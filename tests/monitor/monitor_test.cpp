@@ -12,16 +12,21 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
+#include <regex>
 #include <string>
 #include <thread>
 
 #include <nlohmann/json.hpp>
 
+#include "tripodal/board/actuator_behaviors.hpp"
+#include "tripodal/board/board_monitor.hpp"
 #include "tripodal/monitor/monitor_server.hpp"
 #include "tripodal/monitor/robot_monitor.hpp"
 #include "tripodal/monitor/wire.hpp"
 #include "tripodal/robot/robot.hpp"
+#include "tripodal/sim/sim_board.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
 
 using namespace tripodal;
@@ -444,4 +449,192 @@ TEST_CASE("Read-only streams may be opened without the token where the operator 
   c.send("POST /api/command HTTP/1.1\r\nContent-Length: 14\r\n\r\n{\"op\":\"pause\"}");
   CHECK_THAT(c.read_all(), Catch::StartsWith("HTTP/1.1 401"));
   CHECK(server.take_requests().empty());
+}
+
+namespace {
+
+// Posts a command and keeps the robot's side answering (update() between tries) until the answer
+// is complete; returns the whole HTTP response.
+// `between` runs before each update(): the robot's periods, for a request that waits for one.
+std::string post_command(MonitorServer& server, RobotMonitor& watch, const std::string& body,
+                         const std::string& auth = "Authorization: Bearer t0ken-for-tests\r\n",
+                         const std::function<void()>& between = {}) {
+  Client c(server.port());
+  c.send("POST /api/command HTTP/1.1\r\n" + auth + "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body);
+  std::string answer;
+  REQUIRE(wait_for([&] {
+    if (between) between();
+    watch.update();
+    answer = c.read_until([](const std::string& b) { return b.find("\r\n\r\n{") != std::string::npos && b.back() == '}'; },
+                          std::chrono::milliseconds(20));
+    return !answer.empty() && answer.back() == '}';
+  }));
+  return answer;
+}
+
+nlohmann::json answer_json(const std::string& http) { return nlohmann::json::parse(http.substr(http.find("\r\n\r\n") + 4)); }
+
+// The next /status a page client receives (the monitor publishes at every update()).
+nlohmann::json next_status(MonitorServer& server, RobotMonitor& watch) {
+  Client c(server.port());
+  c.send(ws_upgrade("/ws?token=t0ken-for-tests"));
+  nlohmann::json status;
+  // Whether `bytes` hold a whole /status frame (kept in `status`).
+  auto complete = [&](const std::string& bytes) {
+    const std::size_t body = bytes.find("\r\n\r\n");
+    if (body == std::string::npos) return false;
+    for (const WsFrame& f : server_frames(std::string_view(bytes).substr(body + 4))) {
+      const auto j = nlohmann::json::parse(f.payload, nullptr, false);
+      if (j.is_object() && j.value("topic", "") == "/status") status = j["data"];
+    }
+    return status.is_object();
+  };
+  REQUIRE(wait_for([&] {
+    watch.update();
+    c.read_until(complete, std::chrono::milliseconds(20));
+    return status.is_object();
+  }));
+  return status;
+}
+
+std::string cleaning_run(Robot& robot) {
+  for (const std::string& run : robot.supervisor().running_runs()) {
+    if (const CProcess* p = robot.supervisor().process(run); p != nullptr && p->name() == "PrCleaning") return run;
+  }
+  return {};
+}
+
+}  // namespace
+
+TEST_CASE("The console reloads an edited net at a quiet marking, and refuses one that does not load with its diagnostics", "[monitor][robot][reload]") {
+  Psr2 psr2;
+  Robot* robot = psr2.robot.get();
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0, .reload_wait_s = 0.5});
+  server.start();
+  REQUIRE(robot->command("clean the room 3211").accepted);
+  robot->run_for(std::chrono::seconds(5));
+  const std::string run = cleaning_run(*robot);
+  REQUIRE_FALSE(run.empty());
+  REQUIRE(robot->behavior_active("BhCleaning"));
+  const Engine* running = robot->supervisor().engine(run);
+  const std::vector<Tokens> marking(running->marking().begin(), running->marking().end());
+
+  // The page fetches the running net's text to edit it.
+  const nlohmann::json net = answer_json(post_command(server, watch, nlohmann::json{{"op", "net"}, {"run", run}}.dump()));
+  REQUIRE(net.value("process", "") == "PrCleaning");
+  const std::string xml = net["xml"];
+  REQUIRE(xml.find("<net") != std::string::npos);
+  CHECK_THAT(post_command(server, watch, R"({"op":"net","run":"task"})"), Catch::Contains("409"));
+
+  // Without the token nothing reaches the supervisor.
+  const std::string edited = std::regex_replace(xml, std::regex("</net>"), "  <place id=\"P99\" description=\"operator's note\"/>\n</net>");
+  const std::string reload = nlohmann::json{{"op", "reload"}, {"run", run}, {"xml", edited}}.dump();
+  CHECK_THAT(post_command(server, watch, reload, ""), Catch::StartsWith("HTTP/1.1 401"));
+  CHECK(robot->supervisor().engine(run) == running);
+
+  SECTION("a net that does not load is refused with located diagnostics, nothing changed") {
+    std::string broken = xml;
+    broken.erase(broken.find("</place>"), 8);
+    const nlohmann::json a = answer_json(post_command(server, watch, nlohmann::json{{"op", "reload"}, {"run", run}, {"xml", broken}}.dump()));
+    CHECK_FALSE(a["accepted"].get<bool>());
+    REQUIRE_FALSE(a["diagnostics"].empty());
+    CHECK(std::regex_search(a["diagnostics"][0]["text"].get<std::string>(), std::regex(R"(^PrCleaning\.edited\.xml:\d+:\d+: error: )")));
+    CHECK(a["diagnostics"][0]["severity"] == "error");
+    CHECK(robot->supervisor().engine(run) == running);
+  }
+  SECTION("a net missing a marked place is refused naming it") {
+    const std::string renamed = std::regex_replace(xml, std::regex("\"P3\""), "\"P3b\"");
+    const nlohmann::json a = answer_json(post_command(server, watch, nlohmann::json{{"op", "reload"}, {"run", run}, {"xml", renamed}}.dump()));
+    CHECK_FALSE(a["accepted"].get<bool>());
+    CHECK_THAT(a["diagnostics"].dump(), Catch::Contains("place P3 holds 1 token in the running net"));
+    CHECK(robot->supervisor().engine(run) == running);
+  }
+  SECTION("not quiet: the reload waits for the next quiet point, or is refused with the reasons when none comes in time") {
+    robot->supervisor().post_event("localizer.lost");  // P3 -> P4: t5 times its 10 s
+    robot->run_for(std::chrono::milliseconds(100));
+    REQUIRE_FALSE(robot->supervisor().why_not_quiet(run).empty());
+    running = robot->supervisor().engine(run);
+    // The robot stands still (only update() runs): no quiet point within reload_wait_s.
+    const auto t0 = std::chrono::steady_clock::now();
+    const nlohmann::json refused = answer_json(post_command(server, watch, reload));
+    CHECK(std::chrono::steady_clock::now() - t0 >= std::chrono::milliseconds(500));
+    CHECK_FALSE(refused["accepted"].get<bool>());
+    CHECK_THAT(refused["diagnostics"].dump(), Catch::Contains("is not at a quiet marking: transition t5 is timing its delay of 10 s"));
+    CHECK(robot->supervisor().engine(run) == running);
+    // Localization comes back while the request waits: the next period is quiet, the reload goes through.
+    int periods = 0;
+    const nlohmann::json accepted = answer_json(post_command(server, watch, reload, "Authorization: Bearer t0ken-for-tests\r\n", [&] {
+      if (++periods == 3) robot->supervisor().post_event("localizer.ok");
+      robot->run_for(std::chrono::milliseconds(10));
+    }));
+    INFO(accepted.dump());
+    CHECK(accepted["accepted"].get<bool>());
+    CHECK(periods >= 3);
+    CHECK(robot->supervisor().engine(run)->net().find_place("P99").has_value());
+  }
+  SECTION("an edited net that loads replaces the running one, marking carried over, the task goes on") {
+    const nlohmann::json a = answer_json(post_command(server, watch, reload));
+    INFO(a.dump());
+    REQUIRE(a["accepted"].get<bool>());
+    const Engine* now = robot->supervisor().engine(run);
+    REQUIRE(now != nullptr);
+    CHECK(now->net().find_place("P99").has_value());
+    CHECK(std::vector<Tokens>(now->marking().begin(), now->marking().begin() + static_cast<std::ptrdiff_t>(marking.size())) == marking);
+    CHECK(robot->supervisor().process(run)->net().where.file.str() == "PrCleaning.edited.xml");
+    // The loader's warning about the unreachable place travels with the acceptance.
+    CHECK_THAT(a["diagnostics"].dump(), Catch::Contains("P99"));
+    CHECK(robot->behavior_active("BhCleaning"));
+    robot->run_for(std::chrono::seconds(2));
+    CHECK(robot->planner().busy());
+    CHECK(robot->behavior_active("BhCleaning"));
+  }
+}
+
+TEST_CASE("The status carries the control board's link for a board robot and nothing of it for the simulated PSR-2", "[monitor][robot][board]") {
+  SECTION("PSR-2 on the simulator: no board section") {
+    Psr2 psr2;
+    MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+    RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
+    server.start();
+    psr2.robot->run_for(std::chrono::seconds(1));
+    const nlohmann::json status = next_status(server, watch);
+    CHECK(status.contains("task_state"));
+    CHECK_FALSE(status.contains("board"));
+  }
+  SECTION("the disinfection robot on the simulated board: the link as the host sees it") {
+    const std::filesystem::path configs = std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs";
+    RobotPlugins plugins = RobotPlugins::with_builtins();
+    SimClock clock;
+    sim::register_sim_board_hardware(plugins.hardware, std::make_shared<const sim::World>(sim::load_world(configs / "worlds/workspace.yaml")));
+    board::register_board_modules(plugins.modules);
+    board::register_board_behaviors(plugins.behaviors);
+    const auto robot = Robot::assemble(load_robot_profile(configs / "robots/disinfection.yaml"), plugins, clock);
+    MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+    RobotMonitor watch(*robot, clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
+    server.start();
+    robot->run_for(std::chrono::seconds(4));  // SYNC, DRIVE every period, the battery (3 s) and the tank (1 s) polled
+    const board::LinkStats& link = dynamic_cast<board::BoardHost&>(*robot->hardware()).board().link().stats();
+    const nlohmann::json status = next_status(server, watch);
+    REQUIRE(status.contains("board"));
+    const nlohmann::json& b = status["board"];
+    INFO(b.dump());
+    CHECK(b["connected"].get<bool>());
+    CHECK(b["requests"].get<std::uint64_t>() == link.requests);
+    CHECK(b["requests"].get<std::uint64_t>() > 300);  // a DRIVE each 10 ms period, and the polls
+    CHECK(b["missed"].get<std::uint64_t>() == 0);
+    CHECK(b["decoder_errors"].get<std::uint64_t>() == 0);
+    CHECK(b["watchdog_trips"].get<std::uint64_t>() == 0);
+    CHECK(b["bytes_sent"].get<std::uint64_t>() == link.bytes_sent);
+    CHECK(b["bytes_sent"].get<std::uint64_t>() > 0);
+    CHECK(b["bytes_received"].get<std::uint64_t>() > 0);
+    CHECK(b["round_trip_ms"]["max"].get<double>() > 0.0);
+    CHECK(b["round_trip_ms"]["max"].get<double>() <= 10.0);  // within the response timeout
+    REQUIRE(b["battery"].is_object());
+    CHECK(b["battery"]["percent"].get<int>() > 0);
+    REQUIRE(b["tank"].is_object());
+    CHECK(b["tank"]["percent"].get<int>() > 0);
+    REQUIRE(b["status"].is_object());
+    CHECK_FALSE(b["status"]["uv_lamp"].get<bool>());  // no task: the lamp is off
+  }
 }

@@ -40,6 +40,11 @@ struct LinkStats {
   std::uint64_t link_losses = 0;
   std::uint64_t resyncs = 0;
   std::uint64_t reopens = 0;          ///< the device opened again after a failure
+  /// The board answered "not synchronised" while the host held the link: its watchdog had stopped
+  /// the motors (the board's own count is not on the wire; this is what the host learns of it).
+  std::uint64_t watchdog_trips = 0;
+  std::uint64_t bytes_sent = 0;      ///< written to the line by the host
+  std::uint64_t bytes_received = 0;  ///< read from the line by the host
   Duration max_round_trip{0};
   Duration last_round_trip{0};
   Duration total_round_trip{0};
@@ -75,6 +80,8 @@ class BoardLink {
   [[nodiscard]] bool has_battery() const noexcept { return has_battery_; }
   [[nodiscard]] std::uint8_t tank_percent() const noexcept { return tank_percent_; }
   [[nodiscard]] bool tank_empty() const noexcept { return tank_empty_; }
+  /// Whether the liquid level module has answered yet (before that the tank reads 0 %).
+  [[nodiscard]] bool has_tank() const noexcept { return has_tank_; }
   [[nodiscard]] std::span<const std::uint16_t> ultrasonic_mm() const noexcept { return {ultrasonic_.data(), ultrasonic_count_}; }
   [[nodiscard]] std::span<const std::uint16_t> infrared_mm() const noexcept { return {infrared_.data(), infrared_count_}; }
   [[nodiscard]] std::size_t cliff_count() const noexcept { return cliff_count_; }
@@ -106,7 +113,6 @@ class BoardLink {
   std::array<ActuatorCommand, 8> queue_{};
   std::size_t queue_head_ = 0;
   std::size_t queue_size_ = 0;
-  bool actuator_in_flight_ = false;
   std::uint32_t consecutive_missed_ = 0;
   bool synchronised_ = false;
   bool lost_pending_ = false;
@@ -122,6 +128,7 @@ class BoardLink {
   bool has_battery_ = false;
   std::uint8_t tank_percent_ = 0;
   bool tank_empty_ = false;
+  bool has_tank_ = false;
   std::array<std::uint16_t, kMaxUltrasonic> ultrasonic_{};
   std::size_t ultrasonic_count_ = 0;
   std::array<std::uint16_t, 2 * kMaxInfrared> infrared_{};

@@ -27,6 +27,10 @@ struct RobotMonitorOptions {
   double cleaned_interval_s = 0.5;
   /// Manual drive stops when no drive command came for this long (wall time): the dead-man switch.
   double drive_deadman_s = 0.5;
+  /// A reload of an edited net that is valid but comes while its run is not quiet is tried again
+  /// at each update() (between periods) for this long (wall time), then refused. Less than the
+  /// server's answer_timeout_s.
+  double reload_wait_s = 2.0;
 };
 
 /// What the application knows beyond the robot: the simulator's true pose, the measured coverage

@@ -45,6 +45,8 @@ class LifecycleRecorder final : public TaskObserver, public SupervisorObserver {
   void on_behavior_deactivated(std::string_view run, std::string_view behavior, Time now) override;
   void on_firing(std::string_view run, const PetriNet& net, const Firing& firing) override;
   void on_fault(std::string_view source, std::string_view reason, Time now) override;
+  /// Recorded with or without details: the operator changed what a process does.
+  void on_net_reloaded(std::string_view run, const CProcess& process, std::string_view marking, Time now) override;
 
  private:
   void add(Time t, std::string text) { entries_.push_back(LifecycleEntry{t, std::move(text)}); }

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "tripodal/core/clock.hpp"
+#include "tripodal/core/diagnostic.hpp"
 #include "tripodal/core/engine.hpp"
 #include "tripodal/processes/behavior_host.hpp"
 #include "tripodal/processes/process.hpp"
@@ -41,6 +42,22 @@ class SupervisorObserver {
   virtual void on_event_dropped(std::string_view /*event*/, Time /*now*/) {}
   /// A module or behavior failed at run time (threw, reported failure, stopped answering).
   virtual void on_fault(std::string_view /*source*/, std::string_view /*reason*/, Time /*now*/) {}
+  /// The net of a running process was replaced by an edited one at a quiet marking
+  /// (CProcessSupervisor::reload); `marking` is the carried marking, "P1=1, P3=1".
+  virtual void on_net_reloaded(std::string_view /*run*/, const CProcess& /*process*/, std::string_view /*marking*/,
+                               Time /*now*/) {}
+};
+
+/// What CProcessSupervisor::reload did, or why it refused.
+struct ReloadResult {
+  bool accepted = false;
+  /// Refused only because the run is not at a quiet marking now (it may be at a later step).
+  bool not_quiet = false;
+  /// Refused: every reason, located (FILE:LINE:COL of the edited net where there is one).
+  /// Accepted: the loader's warnings, if any.
+  Diagnostics diagnostics;
+  /// Accepted: the marking carried over, by place id ("P1=1, P3=1").
+  std::string marking;
 };
 
 struct SupervisorOptions {
@@ -69,6 +86,29 @@ class CProcessSupervisor final {
   /// Stops a running process: its behaviors are deactivated and it ends with a fault "stopped:
   /// <reason>" (reported like any other result). False when no such run is running.
   bool stop(std::string_view run, std::string_view reason = "stopped by the planner");
+
+  /// Replaces the net of the running process `run` by an edited one, carrying the marking over by
+  /// place id, and records it (SupervisorObserver::on_net_reloaded). Call it between steps (the
+  /// thread that steps). Refused, with located diagnostics and nothing changed, when: no such run;
+  /// the net does not load (load_net_from_string, `source_name` in the diagnostics; behavior names
+  /// checked against the host) or is not a valid process net (CProcess) or does not take the run's
+  /// parameters (Engine); a marked place of the running net is missing from the new net or holds
+  /// more than the new place's capacity; the carried marking marks an outcome place or enables an
+  /// immediate transition in the new net; the run is not quiet (why_not_quiet). The run keeps its
+  /// id, bound parameters, start time and the facts both nets declare; the new net's initial
+  /// marking is ignored; a delayed transition enabled in the carried marking counts its delay from
+  /// the reload. A behavior whose place stays marked with the same binding keeps running (it is not
+  /// restarted); the others are deactivated, and the newly bound ones activated.
+  ReloadResult reload(std::string_view run, std::string_view text, std::string_view source_name);
+  /// The same with a net already loaded.
+  ReloadResult reload(std::string_view run, PetriNet net);
+  /// Why `run` is not at a quiet marking now, one reason each; empty when quiet. A run is quiet
+  /// between steps when nothing is under way that a swap of its net would lose or repeat: no
+  /// immediate transition is enabled (the net has settled), no delayed transition is timing its
+  /// delay, and no behavior of a marked place has completed or failed without the net having
+  /// taken its event yet (a transition mid-action). Inside a step (an observer calling back) a
+  /// firing is in progress: never quiet. A run that is not running is not quiet either.
+  [[nodiscard]] std::vector<std::string> why_not_quiet(std::string_view run) const;
 
   /// One supervision step at the clock's time: drains queued module events and facts, checks the
   /// watchdogs, polls the active behaviors, steps every running net (in start order) and
@@ -101,6 +141,8 @@ class CProcessSupervisor final {
   [[nodiscard]] std::vector<std::string> active_behaviors() const;
   /// The engine of a running process (for monitors and tests); nullptr when not running.
   [[nodiscard]] const Engine* engine(std::string_view run) const noexcept;
+  /// The process a run executes (after a reload, the edited one); nullptr when not running.
+  [[nodiscard]] const CProcess* process(std::string_view run) const noexcept;
   /// The earliest delay deadline of any running net.
   [[nodiscard]] std::optional<Time> next_deadline() const noexcept;
 
@@ -125,6 +167,7 @@ class CProcessSupervisor final {
   std::vector<ProcessResult> results_;
   std::vector<SupervisorObserver*> observers_;
   std::unique_ptr<Inbox> inbox_;
+  bool stepping_ = false;  // inside step(): an observer calling reload() would swap a net mid-firing
 };
 
 }  // namespace tripodal
