@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -72,18 +73,15 @@ ScanMatcher::ScanMatcher(const OccupancyGrid& map, ScanMatcherOptions options, c
   width_ = map.width();
   height_ = map.height();
   const std::size_t cells = map.size();
-  // The likelihood of a return is a function of its distance to the surface of a wall, and a
-  // wall's surface is the face between an occupied cell and one that is not: an occupied cell is
-  // an obstacle filling the cell, so a beam stops at its face (the simulator's ray caster does
-  // exactly that, and a real wall mapped into a cell lies anywhere in it). Measuring from the
-  // surface cell's centre instead put the field's peak half a cell (2.5 cm) behind the face, and
-  // pulled every match that much towards the nearer walls. The face lies half a cell from the
-  // centres of the two cells it separates: outside a wall, the distance is the one to the nearest
-  // surface cell minus half a cell; inside, the one to the nearest open cell beside a wall minus
-  // half a cell. A wall's whole thickness must not be a peak either (a scan would slide inside
-  // thick walls at no cost), and this field falls off inside walls as outside them. Unknown space
-  // is not a wall a beam can hit: open, for this purpose; the outside of the map is solid (no
-  // beam comes from there).
+  // The likelihood of a return is a function of its distance to the surface of a wall, measured
+  // from the wall's boundary cells: occupied cells beside one that is not (were the whole
+  // thickness of a wall a peak, a scan could slide inside thick walls at no cost). Unknown space
+  // is not a wall a beam can hit: open, for this purpose; the outside of the map is solid (no beam
+  // comes from there). In a map built from scans the surface lies inside the boundary cells, at
+  // their centre on average: the distance is the one between cell centres. In a map drawn as
+  // solid cells it is the face between a boundary cell and its open neighbour, half a cell from
+  // the centres of both: outside a wall, the distance to the nearest boundary cell minus half a
+  // cell; inside, the one to the nearest open cell beside a wall minus half a cell.
   std::vector<bool> surface(cells), facing(cells), inside(cells);
   auto solid = [&](int x, int y) {
     return x < 0 || y < 0 || x >= width_ || y >= height_ || map.state(map.index({x, y})) == Occupancy::occupied;
@@ -98,14 +96,15 @@ ScanMatcher::ScanMatcher(const OccupancyGrid& map, ScanMatcherOptions options, c
     facing[i] = !s && solid_neighbours > 0;
   }
   const DistanceField to_surface(width_, height_, cell_m_, surface, false);
-  const DistanceField to_facing(width_, height_, cell_m_, facing, false);
+  std::optional<DistanceField> to_facing;
+  if (options_.surface_at_cell_face) to_facing.emplace(width_, height_, cell_m_, facing, false);
   field_.resize(cells);
   const double k = -0.5 / (options_.sigma_m * options_.sigma_m);
   const double half_cell = 0.5 * cell_m_;
   for (std::size_t i = 0; i < cells; ++i) {
-    const double centre = inside[i] ? to_facing.distance_m(i) : to_surface.distance_m(i);
-    const double d = std::max(0.0, centre - half_cell);
-    field_[i] = std::isfinite(centre) ? static_cast<float>(std::exp(k * d * d)) : 0.0f;
+    double d = to_surface.distance_m(i);
+    if (to_facing) d = std::max(0.0, (inside[i] ? to_facing->distance_m(i) : d) - half_cell);
+    field_[i] = std::isfinite(d) ? static_cast<float>(std::exp(k * d * d)) : 0.0f;
   }
 
   // Max-pooled pyramid for the global search, on the domain extended by pad_ below and left.

@@ -99,7 +99,8 @@ class TestLocalizer final : public navi::CNaviModules {
         module_manifest("ScanMatchingLocalizer", {"laser_scan", "odometry", "grid_map"}, {"map_from_base"},
                         {ParameterSpec{"initial_x_m", ValueType::number, Value{0.0}, "m", "", {}, {}},
                          ParameterSpec{"initial_y_m", ValueType::number, Value{0.0}, "m", "", {}, {}},
-                         ParameterSpec{"initial_theta_rad", ValueType::number, Value{0.0}, "rad", "", {}, {}}});
+                         ParameterSpec{"initial_theta_rad", ValueType::number, Value{0.0}, "rad", "", {}, {}},
+                         ParameterSpec{"surface_at_cell_face", ValueType::boolean, Value{false}, "", "", {}, {}}});
     return m;
   }
 

@@ -28,6 +28,13 @@ struct ScanMatcherOptions {
   double global_angular_step_rad = 0.02;
   double global_max_range_m = 12.0;
   int global_levels = 6;             ///< branch-and-bound tiles of 2^levels cells at the top
+  /// Where a wall's surface lies in the map's cells. A map built from scans (SLAM, MapBuilder, the
+  /// CARMEN logs) marks the cell a return fell in: the surface lies inside the wall's boundary
+  /// cells, at their centre on average (false). A map drawn as solid cells (a floor plan, the
+  /// simulator's world, whose beams stop at an occupied cell's face) has it on the face between
+  /// an occupied cell and an open one (true). Matching with the wrong one biases every match by
+  /// half a cell towards the nearer walls (docs/localization.md).
+  bool surface_at_cell_face = false;
 };
 
 /// How a tracker sizes its search: the odometry errs more the more the robot moves, so the window
