@@ -156,6 +156,8 @@ std::size_t ScanMatcher::set_scan(const LaserScan& scan, const Pose2D& base_from
   const double lo = std::max(scan.range_min_m, 1e-3);
   const double hi = std::min(scan.range_max_m > 0.0 ? scan.range_max_m : options_.max_range_m, options_.max_range_m);
   const double c0 = std::cos(base_from_laser.theta_rad), s0 = std::sin(base_from_laser.theta_rad);
+  origin_x_ = base_from_laser.x_m;
+  origin_y_ = base_from_laser.y_m;
   for (std::size_t i = 0; i < n && px_.size() < cap; i += stride) {
     const double r = scan.ranges_m[i];
     // a return at the maximum range is the scanner's "nothing seen", not a wall
@@ -255,6 +257,55 @@ ScanMatcher::GridPose ScanMatcher::hill_climb(GridPose g, double step_cells, dou
 
 double ScanMatcher::quality_at(const Pose2D& pose) const noexcept {
   return px_.empty() ? 0.0 : score_bilinear(to_grid(pose)) / static_cast<double>(px_.size());
+}
+
+double ScanMatcher::explained_quality(const Pose2D& pose) const noexcept {
+  if (px_.empty()) return 0.0;
+  const GridPose g = to_grid(pose);
+  const double c = std::cos(g.theta) / cell_m_, s = std::sin(g.theta) / cell_m_;
+  auto field_at = [&](int x, int y) -> double {
+    return static_cast<unsigned>(x) < static_cast<unsigned>(width_) && static_cast<unsigned>(y) < static_cast<unsigned>(height_)
+               ? field_[static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x)]
+               : 0.0;
+  };
+  auto wall_at = [&](double u, double v) {
+    const int x = static_cast<int>(std::floor(u)), y = static_cast<int>(std::floor(v));
+    return x < 0 || y < 0 || x >= width_ || y >= height_ || map_.state(map_.index({x, y})) == Occupancy::occupied;
+  };
+  // Two sigmas from every wall: the field is below exp(-2) there.
+  const double far = std::exp(-2.0);
+  const double ou = g.x + c * origin_x_ - s * origin_y_, ov = g.y + s * origin_x_ + c * origin_y_;
+  double all = 0.0, kept = 0.0;
+  std::size_t left_out = 0;
+  for (std::size_t i = 0; i < px_.size(); ++i) {
+    const double pu = g.x + c * px_[i] - s * py_[i], pv = g.y + s * px_[i] + c * py_[i];
+    const double u = pu - 0.5, v = pv - 0.5;
+    const double fu = std::floor(u), fv = std::floor(v);
+    const int x = static_cast<int>(fu), y = static_cast<int>(fv);
+    const double a = u - fu, b = v - fv;
+    const double f = (1 - b) * ((1 - a) * field_at(x, y) + a * field_at(x + 1, y)) +
+                     b * ((1 - a) * field_at(x, y + 1) + a * field_at(x + 1, y + 1));
+    all += f;
+    if (f < far) {
+      // Walk the beam by half cells: a beam that crossed a wall of the map contradicts the pose
+      // (it should have stopped there) and counts; one through open space only is left out.
+      const double du = pu - ou, dv = pv - ov;
+      const int steps = static_cast<int>(2.0 * std::hypot(du, dv));
+      bool crossed = false;
+      for (int k = 1; k < steps && !crossed; ++k) {
+        const double t = static_cast<double>(k) / steps;
+        crossed = wall_at(ou + t * du, ov + t * dv);
+      }
+      if (!crossed) {
+        ++left_out;
+        continue;
+      }
+    }
+    kept += f;
+  }
+  const std::size_t n = px_.size();
+  if (2 * left_out > n) return all / static_cast<double>(n);
+  return kept / static_cast<double>(n - left_out);
 }
 
 ScanMatch ScanMatcher::match(const Pose2D& predicted, double search_xy_m, double search_theta_rad) noexcept {

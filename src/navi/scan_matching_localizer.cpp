@@ -152,7 +152,11 @@ void CScanMatchingLocalizer::step(const LaserScan& scan, const Pose2D& odom_from
       return;
     }
   }
-  const ScanMatch m = matcher_->track(pose_, motion, options_.window);
+  ScanMatch m = matcher_->track(pose_, motion, options_.window);
+  // Judged on what the map can explain: a cart beside the robot hides a quarter of its scan and
+  // is no sign of a wrong pose (the pose itself comes from the match, the cart's points pull
+  // nowhere).
+  m.quality = matcher_->explained_quality(m.pose);
   last_ = m;
   if (m.quality >= options_.lost_quality) {
     pose_ = m.pose;
@@ -166,7 +170,8 @@ void CScanMatchingLocalizer::step(const LaserScan& scan, const Pose2D& odom_from
 
 bool CScanMatchingLocalizer::relocalize() {
   if (!matcher_ || matcher_->points() == 0) return false;
-  const ScanMatch m = matcher_->match_global();
+  ScanMatch m = matcher_->match_global();
+  m.quality = matcher_->explained_quality(m.pose);
   if (m.quality < options_.relocalize_quality) return false;
   pose_ = m.pose;
   last_ = m;

