@@ -259,6 +259,10 @@ double ScanMatcher::quality_at(const Pose2D& pose) const noexcept {
   return px_.empty() ? 0.0 : score_bilinear(to_grid(pose)) / static_cast<double>(px_.size());
 }
 
+namespace {
+constexpr double kClutterRange = 2.0;  // metres from the base
+}  // namespace
+
 double ScanMatcher::explained_quality(const Pose2D& pose) const noexcept {
   if (px_.empty()) return 0.0;
   const GridPose g = to_grid(pose);
@@ -286,7 +290,9 @@ double ScanMatcher::explained_quality(const Pose2D& pose) const noexcept {
     const double f = (1 - b) * ((1 - a) * field_at(x, y) + a * field_at(x + 1, y)) +
                      b * ((1 - a) * field_at(x, y + 1) + a * field_at(x + 1, y + 1));
     all += f;
-    if (f < far) {
+    // Only near returns: what the map does not hold and matters is beside the robot (a cart, a
+    // person), and a wrong pose puts returns in open space at every range.
+    if (f < far && range_[i] < kClutterRange) {
       // Walk the beam by half cells: a beam that crossed a wall of the map contradicts the pose
       // (it should have stopped there) and counts; one through open space only is left out.
       const double du = pu - ou, dv = pv - ov;
@@ -304,7 +310,7 @@ double ScanMatcher::explained_quality(const Pose2D& pose) const noexcept {
     kept += f;
   }
   const std::size_t n = px_.size();
-  if (2 * left_out > n) return all / static_cast<double>(n);
+  if (3 * left_out > n) return all / static_cast<double>(n);
   return kept / static_cast<double>(n - left_out);
 }
 

@@ -94,10 +94,11 @@ class ScanMatcher {
   /// Quality (mean likelihood of the points) of the scan at `pose`, without searching.
   [[nodiscard]] double quality_at(const Pose2D& pose) const noexcept;
   /// The quality of the evidence at `pose`: the mean likelihood of the points the map can
-  /// explain. A point far from every wall whose beam crosses no wall of the map stopped on
-  /// something the map does not hold (a cart, a person): it says nothing about the pose and is
-  /// left out. At most half the points are left out (more would leave too little of the map to
-  /// vouch for the pose): beyond, this is quality_at(). Never below quality_at().
+  /// explain. A point within 2 m, far from every wall, whose beam crosses no wall of the map
+  /// stopped on something the map does not hold (a cart, a person): it says nothing about the
+  /// pose and is left out. At most a third of the points are left out (more would leave too
+  /// little of the map to vouch for the pose): beyond, this is quality_at(). Never below
+  /// quality_at().
   [[nodiscard]] double explained_quality(const Pose2D& pose) const noexcept;
 
   [[nodiscard]] const ScanMatcherOptions& options() const noexcept { return options_; }
