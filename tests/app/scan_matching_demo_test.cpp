@@ -77,7 +77,7 @@ struct TempDir {
 }  // namespace
 
 TEST_CASE("The demo robots' profiles localize from the laser", "[app][scan_matching]") {
-  for (const char* robot : {"psr2.yaml", "jinny_differential.yaml", "disinfection.yaml"}) {
+  for (const char* robot : {"psr2.yaml", "jinny_differential.yaml"}) {
     const RobotProfile p = load_robot_profile(kSource / "configs/robots" / robot);
     const ModuleEntry* localizer = nullptr;
     for (const ModuleEntry& e : p.navigation) {
