@@ -139,6 +139,9 @@ void CScanMatchingLocalizer::step(const LaserScan& scan, const Pose2D& odom_from
   Pose2D motion;
   if (last_odom_) {
     motion = compose(inverse(*last_odom_), odom_from_base);
+    // More than the widest tracking window between two scans is no motion the base made: the
+    // odometry was reset (as `tripodal run` does to the start pose after the first reading).
+    if (!plausible(motion)) motion = Pose2D{};
     pose_ = compose(pose_, motion);
   }
   last_odom_ = odom_from_base;
@@ -166,6 +169,11 @@ void CScanMatchingLocalizer::step(const LaserScan& scan, const Pose2D& odom_from
   }
   // No evidence: keep dead reckoning, and after enough scans in a row say so.
   if (++low_scans_ >= options_.lost_after_scans) post(State::lost, now, out);
+}
+
+bool CScanMatchingLocalizer::plausible(const Pose2D& motion) const noexcept {
+  return std::hypot(motion.x_m, motion.y_m) <= options_.matcher.max_search_xy_m &&
+         std::abs(wrap_angle(motion.theta_rad)) <= options_.matcher.max_search_theta_rad;
 }
 
 bool CScanMatchingLocalizer::relocalize() {
@@ -199,8 +207,11 @@ void CScanMatchingLocalizer::on_update(ModuleContext& context) {
   // goes on with the odometry since the last one (else the estimate lags the robot by up to a
   // scan period, centimetres at cleaning speed).
   if (last_odom_ && odometry_->has_reading()) {
-    context.navigation->map_from_base = compose(pose_, compose(inverse(*last_odom_), odometry_->latest().pose));
-    context.navigation->pose_stamp = context.now;
+    const Pose2D since_scan = compose(inverse(*last_odom_), odometry_->latest().pose);
+    if (plausible(since_scan)) {
+      context.navigation->map_from_base = compose(pose_, since_scan);
+      context.navigation->pose_stamp = context.now;
+    }
   }
   context.navigation->fixes = fixes_;
 }
