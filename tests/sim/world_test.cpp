@@ -59,7 +59,7 @@ TEST_CASE("load_world: the demo workspace", "[sim][world]") {
   CHECK(f.faults.localization_loss[0] == navi::LocalizationFault{time_from_seconds(60.0), time_from_seconds(64.0)});
   REQUIRE(f.faults.kidnappings.size() == 1);
   CHECK(f.faults.kidnappings[0].at == time_from_seconds(150.0));
-  CHECK(f.faults.kidnappings[0].to == Pose2D{2.5, 6.0, 2.0});
+  CHECK(f.faults.kidnappings[0].to == Pose2D{3.5, 2.0, 2.0});
   REQUIRE(f.faults.dead_sensors.size() == 1);
   CHECK(f.faults.dead_sensors[0].sensor == SensorKind::laser);
   CHECK(f.faults.dead_sensors[0].start == time_from_seconds(90.0));
