@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -72,23 +73,37 @@ ScanMatcher::ScanMatcher(const OccupancyGrid& map, ScanMatcherOptions options, c
   width_ = map.width();
   height_ = map.height();
   const std::size_t cells = map.size();
-  // Distances to the surfaces of the walls: occupied cells beside a cell that is not. A beam
-  // stops at a wall's face; were the whole thickness of a wall a peak, a scan could slide inside
-  // thick walls at no cost. Unknown space and the outside are not walls a beam can hit.
-  std::vector<bool> surface(cells);
+  // The likelihood of a return is a function of its distance to the surface of a wall, measured
+  // from the wall's boundary cells: occupied cells beside one that is not (were the whole
+  // thickness of a wall a peak, a scan could slide inside thick walls at no cost). Unknown space
+  // is not a wall a beam can hit: open, for this purpose; the outside of the map is solid (no beam
+  // comes from there). In a map built from scans the surface lies inside the boundary cells, at
+  // their centre on average: the distance is the one between cell centres. In a map drawn as
+  // solid cells it is the face between a boundary cell and its open neighbour, half a cell from
+  // the centres of both: outside a wall, the distance to the nearest boundary cell minus half a
+  // cell; inside, the one to the nearest open cell beside a wall minus half a cell.
+  std::vector<bool> surface(cells), facing(cells), inside(cells);
   auto solid = [&](int x, int y) {
     return x < 0 || y < 0 || x >= width_ || y >= height_ || map.state(map.index({x, y})) == Occupancy::occupied;
   };
   for (std::size_t i = 0; i < cells; ++i) {
     const CellIndex c = map.cell(i);
-    surface[i] = solid(c.x, c.y) &&
-                 (!solid(c.x + 1, c.y) || !solid(c.x - 1, c.y) || !solid(c.x, c.y + 1) || !solid(c.x, c.y - 1));
+    const bool s = solid(c.x, c.y);
+    inside[i] = s;
+    const int solid_neighbours = static_cast<int>(solid(c.x + 1, c.y)) + static_cast<int>(solid(c.x - 1, c.y)) +
+                                 static_cast<int>(solid(c.x, c.y + 1)) + static_cast<int>(solid(c.x, c.y - 1));
+    surface[i] = s && solid_neighbours < 4;
+    facing[i] = !s && solid_neighbours > 0;
   }
-  const DistanceField df(width_, height_, cell_m_, surface, false);
+  const DistanceField to_surface(width_, height_, cell_m_, surface, false);
+  std::optional<DistanceField> to_facing;
+  if (options_.surface_at_cell_face) to_facing.emplace(width_, height_, cell_m_, facing, false);
   field_.resize(cells);
   const double k = -0.5 / (options_.sigma_m * options_.sigma_m);
+  const double half_cell = 0.5 * cell_m_;
   for (std::size_t i = 0; i < cells; ++i) {
-    const double d = df.distance_m(i);
+    double d = to_surface.distance_m(i);
+    if (to_facing) d = std::max(0.0, (inside[i] ? to_facing->distance_m(i) : d) - half_cell);
     field_[i] = std::isfinite(d) ? static_cast<float>(std::exp(k * d * d)) : 0.0f;
   }
 
@@ -141,6 +156,8 @@ std::size_t ScanMatcher::set_scan(const LaserScan& scan, const Pose2D& base_from
   const double lo = std::max(scan.range_min_m, 1e-3);
   const double hi = std::min(scan.range_max_m > 0.0 ? scan.range_max_m : options_.max_range_m, options_.max_range_m);
   const double c0 = std::cos(base_from_laser.theta_rad), s0 = std::sin(base_from_laser.theta_rad);
+  origin_x_ = base_from_laser.x_m;
+  origin_y_ = base_from_laser.y_m;
   for (std::size_t i = 0; i < n && px_.size() < cap; i += stride) {
     const double r = scan.ranges_m[i];
     // a return at the maximum range is the scanner's "nothing seen", not a wall
@@ -240,6 +257,61 @@ ScanMatcher::GridPose ScanMatcher::hill_climb(GridPose g, double step_cells, dou
 
 double ScanMatcher::quality_at(const Pose2D& pose) const noexcept {
   return px_.empty() ? 0.0 : score_bilinear(to_grid(pose)) / static_cast<double>(px_.size());
+}
+
+namespace {
+constexpr double kClutterRange = 2.0;  // metres from the base
+}  // namespace
+
+double ScanMatcher::explained_quality(const Pose2D& pose) const noexcept {
+  if (px_.empty()) return 0.0;
+  const GridPose g = to_grid(pose);
+  const double c = std::cos(g.theta) / cell_m_, s = std::sin(g.theta) / cell_m_;
+  auto field_at = [&](int x, int y) -> double {
+    return static_cast<unsigned>(x) < static_cast<unsigned>(width_) && static_cast<unsigned>(y) < static_cast<unsigned>(height_)
+               ? field_[static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x)]
+               : 0.0;
+  };
+  auto wall_at = [&](double u, double v) {
+    const int x = static_cast<int>(std::floor(u)), y = static_cast<int>(std::floor(v));
+    return x < 0 || y < 0 || x >= width_ || y >= height_ || map_.state(map_.index({x, y})) == Occupancy::occupied;
+  };
+  // Two sigmas from every wall: the field is below exp(-2) there.
+  const double far = std::exp(-2.0);
+  const double ou = g.x + c * origin_x_ - s * origin_y_, ov = g.y + s * origin_x_ + c * origin_y_;
+  double all = 0.0, kept = 0.0;
+  std::size_t left_out = 0;
+  for (std::size_t i = 0; i < px_.size(); ++i) {
+    const double pu = g.x + c * px_[i] - s * py_[i], pv = g.y + s * px_[i] + c * py_[i];
+    const double u = pu - 0.5, v = pv - 0.5;
+    const double fu = std::floor(u), fv = std::floor(v);
+    const int x = static_cast<int>(fu), y = static_cast<int>(fv);
+    const double a = u - fu, b = v - fv;
+    const double f = (1 - b) * ((1 - a) * field_at(x, y) + a * field_at(x + 1, y)) +
+                     b * ((1 - a) * field_at(x, y + 1) + a * field_at(x + 1, y + 1));
+    all += f;
+    // Only near returns: what the map does not hold and matters is beside the robot (a cart, a
+    // person), and a wrong pose puts returns in open space at every range.
+    if (f < far && range_[i] < kClutterRange) {
+      // Walk the beam by half cells: a beam that crossed a wall of the map contradicts the pose
+      // (it should have stopped there) and counts; one through open space only is left out.
+      const double du = pu - ou, dv = pv - ov;
+      const int steps = static_cast<int>(2.0 * std::hypot(du, dv));
+      bool crossed = false;
+      for (int k = 1; k < steps && !crossed; ++k) {
+        const double t = static_cast<double>(k) / steps;
+        crossed = wall_at(ou + t * du, ov + t * dv);
+      }
+      if (!crossed) {
+        ++left_out;
+        continue;
+      }
+    }
+    kept += f;
+  }
+  const std::size_t n = px_.size();
+  if (3 * left_out > n) return all / static_cast<double>(n);
+  return kept / static_cast<double>(n - left_out);
 }
 
 ScanMatch ScanMatcher::match(const Pose2D& predicted, double search_xy_m, double search_theta_rad) noexcept {

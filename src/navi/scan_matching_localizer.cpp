@@ -44,6 +44,10 @@ const ModuleManifest& CScanMatchingLocalizer::static_manifest() {
                      "half width of the tracking window", 0.0, 5.0},
        ParameterSpec{"search_theta_rad", ValueType::number, Value{d.matcher.search_theta_rad}, "rad",
                      "half width of the tracking window in heading", 0.0, 3.15},
+       ParameterSpec{"surface_at_cell_face", ValueType::boolean, Value{d.matcher.surface_at_cell_face}, "",
+                     "the map's walls are solid cells (a drawn map, the simulator's world): a wall's surface is an "
+                     "occupied cell's face; false: inside the cell, at its centre on average (a map built from scans)",
+                     {}, {}},
        ParameterSpec{"lost_quality", ValueType::number, Value{d.lost_quality}, "",
                      "match quality (mean likelihood of the points, 0..1) below which a scan is no evidence", 0.0,
                      1.0},
@@ -69,6 +73,7 @@ void CScanMatchingLocalizer::on_configure(const ParameterSet& params) {
   o.matcher.max_points = static_cast<int>(params.number("max_points"));
   o.matcher.search_xy_m = params.number("search_xy_m");
   o.matcher.search_theta_rad = params.number("search_theta_rad");
+  o.matcher.surface_at_cell_face = params.boolean("surface_at_cell_face");
   o.lost_quality = params.number("lost_quality");
   o.lost_after_scans = static_cast<int>(params.number("lost_after_scans"));
   o.relocalize_quality = params.number("relocalize_quality");
@@ -134,6 +139,9 @@ void CScanMatchingLocalizer::step(const LaserScan& scan, const Pose2D& odom_from
   Pose2D motion;
   if (last_odom_) {
     motion = compose(inverse(*last_odom_), odom_from_base);
+    // More than the widest tracking window between two scans is no motion the base made: the
+    // odometry was reset (as `tripodal run` does to the start pose after the first reading).
+    if (!plausible(motion)) motion = Pose2D{};
     pose_ = compose(pose_, motion);
   }
   last_odom_ = odom_from_base;
@@ -147,7 +155,11 @@ void CScanMatchingLocalizer::step(const LaserScan& scan, const Pose2D& odom_from
       return;
     }
   }
-  const ScanMatch m = matcher_->track(pose_, motion, options_.window);
+  ScanMatch m = matcher_->track(pose_, motion, options_.window);
+  // Judged on what the map can explain: a cart beside the robot hides a quarter of its scan and
+  // is no sign of a wrong pose (the pose itself comes from the match, the cart's points pull
+  // nowhere).
+  m.quality = matcher_->explained_quality(m.pose);
   last_ = m;
   if (m.quality >= options_.lost_quality) {
     pose_ = m.pose;
@@ -159,9 +171,15 @@ void CScanMatchingLocalizer::step(const LaserScan& scan, const Pose2D& odom_from
   if (++low_scans_ >= options_.lost_after_scans) post(State::lost, now, out);
 }
 
+bool CScanMatchingLocalizer::plausible(const Pose2D& motion) const noexcept {
+  return std::hypot(motion.x_m, motion.y_m) <= options_.matcher.max_search_xy_m &&
+         std::abs(wrap_angle(motion.theta_rad)) <= options_.matcher.max_search_theta_rad;
+}
+
 bool CScanMatchingLocalizer::relocalize() {
   if (!matcher_ || matcher_->points() == 0) return false;
-  const ScanMatch m = matcher_->match_global();
+  ScanMatch m = matcher_->match_global();
+  m.quality = matcher_->explained_quality(m.pose);
   if (m.quality < options_.relocalize_quality) return false;
   pose_ = m.pose;
   last_ = m;
@@ -185,6 +203,16 @@ void CScanMatchingLocalizer::on_update(ModuleContext& context) {
   if (has_scan_ && fix_attempts_.due(context.now) && relocalize()) ++fixes_;
   context.heartbeat = true;
   publish(*context.navigation);
+  // The scans come at a few hertz, the sequencing loop runs at 20: between two scans the pose
+  // goes on with the odometry since the last one (else the estimate lags the robot by up to a
+  // scan period, centimetres at cleaning speed).
+  if (last_odom_ && odometry_->has_reading()) {
+    const Pose2D since_scan = compose(inverse(*last_odom_), odometry_->latest().pose);
+    if (plausible(since_scan)) {
+      context.navigation->map_from_base = compose(pose_, since_scan);
+      context.navigation->pose_stamp = context.now;
+    }
+  }
   context.navigation->fixes = fixes_;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 
 #include "tripodal/controllers/holonomic_controller.hpp"
@@ -50,6 +51,7 @@ std::string_view to_string(SimEvent::Kind kind) noexcept {
     case SimEvent::Kind::sensor_restored: return "sensor_restored";
     case SimEvent::Kind::localization_loss_start: return "localization_loss_start";
     case SimEvent::Kind::localization_loss_end: return "localization_loss_end";
+    case SimEvent::Kind::kidnapped: return "kidnapped";
     case SimEvent::Kind::fell: return "fell";
     case SimEvent::Kind::battery_empty: return "battery_empty";
   }
@@ -308,6 +310,17 @@ void Simulator::update_faults() noexcept {
       log(active ? SimEvent::Kind::localization_loss_start : SimEvent::Kind::localization_loss_end, {});
     }
   }
+  // The world carries the robot off (someone lifts it): its wheels do not turn, so the odometry
+  // goes on from where it was. set_pose refuses a place its footprint does not fit (the world file
+  // checks the static map; a box may stand there now): the robot then stays.
+  while (next_kidnapping_ < world_.faults.kidnappings.size() && now_ >= world_.faults.kidnappings[next_kidnapping_].at) {
+    const Kidnapping& k = world_.faults.kidnappings[next_kidnapping_++];
+    const bool moved = set_pose(k.to);
+    char text[96];
+    std::snprintf(text, sizeof text, "%s (%.2f, %.2f, %.2f)", moved ? "to" : "refused, stays; to", k.to.x_m, k.to.y_m,
+                  k.to.theta_rad);
+    log(SimEvent::Kind::kidnapped, text);
+  }
 }
 
 void Simulator::set_obstacle(std::size_t index, bool present) noexcept {
@@ -394,7 +407,11 @@ void Simulator::update_bumpers() noexcept {
 void Simulator::sample_sensors() noexcept {
   const SimRobotConfig& rc = world_.robot;
   if (due(laser_due_) && !sensor_dead(SensorKind::laser, now_)) {
-    laser_model_.scan(solid_, pose_, now_, laser_.edit());
+    LaserScan& scan = laser_.edit();
+    laser_model_.scan(solid_, pose_, now_, scan);
+    // A localization loss is the scanner dazzled: it still publishes, without a return (after
+    // drawing the beams' noise, so the noise stream is the same as without the fault).
+    if (localization_lost(now_)) std::fill(scan.ranges_m.begin(), scan.ranges_m.end(), std::numeric_limits<float>::infinity());
     laser_.commit();
   }
   if (due(odom_due_) && !sensor_dead(SensorKind::odometry, now_)) {

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <initializer_list>
@@ -288,7 +289,26 @@ std::optional<SensorKind> sensor_of(const std::string& s) {
 }
 
 void read_faults(Reader& r, const YAML::Node& n, FaultSchedule& f) {
-  if (!r.check_map(n, "faults", {"localization_loss", "dead_sensors"})) return;
+  if (!r.check_map(n, "faults", {"localization_loss", "dead_sensors", "kidnap"})) return;
+  if (const YAML::Node k = n["kidnap"]) {
+    if (!k.IsSequence()) {
+      r.error(k, "faults.kidnap must be a list of {at_s: S, to: [x, y, theta]}, got " + Reader::kind(k));
+    } else {
+      for (const auto& item : k) {
+        if (!r.check_map(item, "a kidnap entry", {"at_s", "to"})) continue;
+        if (!item["at_s"] || !item["to"]) {
+          r.error(item, "a kidnap entry needs at_s (seconds, >= 0) and to: [x, y, theta] (map frame)");
+          continue;
+        }
+        const auto at = r.number(item["at_s"], "kidnap.at_s");
+        const auto to = r.pose(item["to"], "kidnap.to");
+        if (at && *at < 0.0) r.error(item["at_s"], "kidnap.at_s must be >= 0");
+        if (at && to && *at >= 0.0) f.kidnappings.push_back({time_from_seconds(*at), *to, r.at(item)});
+      }
+      std::stable_sort(f.kidnappings.begin(), f.kidnappings.end(),
+                       [](const Kidnapping& a, const Kidnapping& b) { return a.at < b.at; });
+    }
+  }
   if (const YAML::Node l = n["localization_loss"]) {
     if (l.IsScalar()) {
       // The navi localizer's own schedule syntax, "10-20; 35.5-40".
@@ -491,6 +511,12 @@ World parse_world(std::string_view text, const std::filesystem::path& file) {
     } else if (solid.disc_overlaps({w.start_pose.x_m, w.start_pose.y_m}, w.robot.radius_m)) {
       r.error(start, "at start_pose the robot's footprint (radius " + std::to_string(w.robot.radius_m) +
                          " m) overlaps an occupied cell or leaves the map");
+    }
+    for (const Kidnapping& k : w.faults.kidnappings) {
+      if (solid.disc_overlaps({k.to.x_m, k.to.y_m}, w.robot.radius_m)) {
+        r.diagnostics().error(k.where, "kidnap.to: there the robot's footprint (radius " + std::to_string(w.robot.radius_m) +
+                                           " m) overlaps an occupied cell or leaves the map");
+      }
     }
   }
   if (r.diagnostics().has_errors()) throw ConfigError(std::move(r.diagnostics()));

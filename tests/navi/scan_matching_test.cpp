@@ -94,8 +94,9 @@ TEST_CASE("ScanMatcher: a scan taken at a pose matches back to it, and the covar
   REQUIRE(m.set_scan(scan_at(solid, truth)) > 150);
   CHECK(m.quality_at(truth) > 0.8);
   const ScanMatch r = m.match({truth.x_m + 0.15, truth.y_m - 0.12, truth.theta_rad + 0.1});
-  // The simulated beams stop at the faces of the wall cells, the field peaks at their centres:
-  // half a cell (2.5 cm) of bias is the model's, the rest the matcher's.
+  // The test room's map is one of solid cells, matched here with the default surface model of
+  // scanned maps (the cell centre): half a cell (2.5 cm) of bias is the model's, the rest the
+  // matcher's. The next test has the face model.
   CHECK(distance(r.pose, truth) < 0.05);
   CHECK(std::abs(wrap_angle(r.pose.theta_rad - truth.theta_rad)) < 0.015);
   CHECK(r.quality > 0.8);
@@ -116,6 +117,43 @@ TEST_CASE("ScanMatcher: a scan taken at a pose matches back to it, and the covar
   cm.set_scan(scan_at(csolid, c_truth, 4.0));
   const ScanMatch cr = cm.match(c_truth);
   CHECK(cr.covariance[0] > 4.0 * cr.covariance[4]);
+}
+
+TEST_CASE("ScanMatcher: on a map of solid cells, no bias towards the nearer walls", "[navi][scan_matching]") {
+  // Poses close to one wall, far from the others: most points lie on the near wall. The ray
+  // caster stops a beam at the face of the first occupied cell; a field peaking at that cell's
+  // centre (the surface model of maps built from scans) pulls such matches half a cell (2.5 cm)
+  // towards the near wall, the face model does not.
+  const OccupancyGrid g = room();
+  const sim::SolidMap solid(g);
+  const auto mean_error = [&](bool at_face) {
+    ScanMatcherOptions o;
+    o.surface_at_cell_face = at_face;
+    ScanMatcher m(g, o);
+    double sum = 0.0;
+    int n = 0;
+    for (const Pose2D truth : {Pose2D{0.4, 2.0, std::numbers::pi}, Pose2D{3.0, -1.3, -std::numbers::pi / 2},
+                               Pose2D{4.0, 5.5, std::numbers::pi / 2}, Pose2D{8.6, 0.5, 0.0},
+                               Pose2D{0.35, 4.5, 2.8}, Pose2D{6.0, -1.4, -1.2}}) {
+      REQUIRE(m.set_scan(scan_at(solid, truth)) > 150);
+      const ScanMatch r = m.match({truth.x_m + 0.04, truth.y_m - 0.03, truth.theta_rad + 0.02});
+      const double e = distance(r.pose, truth);
+      INFO("at face " << at_face << ", pose (" << truth.x_m << ", " << truth.y_m << ", " << truth.theta_rad
+                      << "): off by " << e << " m");
+      CHECK(std::abs(wrap_angle(r.pose.theta_rad - truth.theta_rad)) < 0.01);
+      if (at_face) CHECK(e < 0.035);
+      sum += e;
+      ++n;
+    }
+    return sum / n;
+  };
+  const double face = mean_error(true), centre = mean_error(false);
+  INFO("mean error: face model " << face << " m, centre model " << centre << " m");
+  // Measured: 0.018 m against 0.032 m. The face model does not reach the matcher's resolution:
+  // the face lies between two cell centres, where the field is sampled, and the bilinear field
+  // is flat over that cell.
+  CHECK(face < 0.022);
+  CHECK(centre > face + 0.01);
 }
 
 TEST_CASE("ScanMatchingLocalizer: tracks a loop on drifting odometry", "[navi][scan_matching]") {

@@ -29,7 +29,7 @@ std::string profile(const std::string& resources, const std::string& navigation,
 const std::string kResources = "  - {name: front_laser, type: LaserScanner}\n";
 const std::string kNavigation =
     "  - {name: maps, type: GridMaps}\n"
-    "  - {name: localizer, type: Localizer}\n"
+    "  - {name: localizer, type: ScanMatchingLocalizer}\n"
     "  - {name: section_splitter, type: SectionSplitter}\n";
 const std::string kBehaviors = "  - BhAutoMove\n  - BhCleaning\n";
 
@@ -61,7 +61,7 @@ TEST_CASE("Missing providers are refused with the consumer and the information n
   Catalog c;
   // No section splitter: the clean task asks sections(room); no map: the localizer needs grid_map.
   const std::string diag = c.check(profile(kResources,
-                                           "  - {name: localizer, type: Localizer}\n", kBehaviors));
+                                           "  - {name: localizer, type: ScanMatchingLocalizer}\n", kBehaviors));
   CHECK_THAT(diag, Catch::Contains("testbot.yaml:1:8: error: missing provider: deliberate core component 'planner' needs "
                                    "'sections', but no module provides it"));
   CHECK_THAT(diag, Catch::Contains("testbot.yaml:7:5: error: missing provider: sequencing navigation 'localizer' needs "
@@ -183,7 +183,7 @@ TEST_CASE("The robot refuses to start with every problem listed", "[robot]") {
       CHECK_THAT(m, Catch::Contains("psr2.yaml:13:3: error: unknown hardware type 'sim'; known: none; register it"));
       CHECK_THAT(m, Catch::Contains("psr2.yaml:16:5: error: unknown controller type 'omni'; known: none; register it"));
       CHECK_THAT(m, Catch::Contains("psr2.yaml:26:5: error: unknown navigation type 'GridMaps'; known: none; register it"));
-      CHECK_THAT(m, Catch::Contains("psr2.yaml:47:13: error: unknown behavior type 'BhAutoMove'; known: none; register it"));
+      CHECK_THAT(m, Catch::Contains("psr2.yaml:51:13: error: unknown behavior type 'BhAutoMove'; known: none; register it"));
     }
   }
   SECTION("a process binding a behavior the robot lacks; a task naming a process it lacks") {
@@ -223,7 +223,7 @@ TEST_CASE("describe_text lists modules by layer, describe_dot draws clusters and
   const std::string text = describe_text(r);
   CHECK_THAT(text, Catch::StartsWith("robot testbot\n\ndeliberate layer\n  planner (core, CPlanner)\n      in:  sections, process_result\n"));
   CHECK_THAT(text, Catch::Contains("sequencing layer\n  process_supervisor (core, CProcessSupervisor)\n"));
-  CHECK_THAT(text, Catch::Contains("  localizer (navigation, Localizer)\n      in:  laser_scan, odometry, grid_map\n      out: map_from_base\n"));
+  CHECK_THAT(text, Catch::Contains("  localizer (navigation, ScanMatchingLocalizer)\n      in:  laser_scan, odometry, grid_map\n      out: map_from_base\n"));
   CHECK_THAT(text, Catch::Contains("  configurations (core): PrAutoMove\n"));
   CHECK_THAT(text, Catch::Contains("reactive layer\n  behavior_coordinator (core, CBehaviorCoordinator)\n      in:  behavior_command*\n"));
   const std::string dot = describe_dot(r);

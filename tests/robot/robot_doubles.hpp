@@ -96,9 +96,11 @@ class TestLocalizer final : public navi::CNaviModules {
   static TestWorld* world;
   static const ModuleManifest& static_manifest() {
     static const ModuleManifest m =
-        module_manifest("Localizer", {"laser_scan", "odometry", "grid_map"}, {"map_from_base"},
-                        {ParameterSpec{"noise_xy_m", ValueType::number, Value{0.0}, "m", "", {}, {}},
-                         ParameterSpec{"noise_theta_rad", ValueType::number, Value{0.0}, "rad", "", {}, {}}});
+        module_manifest("ScanMatchingLocalizer", {"laser_scan", "odometry", "grid_map"}, {"map_from_base"},
+                        {ParameterSpec{"initial_x_m", ValueType::number, Value{0.0}, "m", "", {}, {}},
+                         ParameterSpec{"initial_y_m", ValueType::number, Value{0.0}, "m", "", {}, {}},
+                         ParameterSpec{"initial_theta_rad", ValueType::number, Value{0.0}, "rad", "", {}, {}},
+                         ParameterSpec{"surface_at_cell_face", ValueType::boolean, Value{false}, "", "", {}, {}}});
     return m;
   }
 

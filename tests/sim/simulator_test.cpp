@@ -278,6 +278,48 @@ TEST_CASE("Simulator: localization loss windows drive the navi localizer from gr
   CHECK(sim.events()[1].kind == SimEvent::Kind::localization_loss_end);
 }
 
+TEST_CASE("Simulator: a localization loss dazzles the laser, which keeps publishing scans without a return",
+          "[sim][faults]") {
+  World world = room_world(81, 81, {2.0, 2.0, 0.0});
+  world.faults.localization_loss = navi::parse_fault_schedule("1-2");
+  Simulator sim(std::move(world), omni3_base(), 1);
+  const auto returns = [&] {
+    std::size_t n = 0;
+    for (float r : sim.laser().latest().ranges_m) n += std::isfinite(r) ? 1 : 0;
+    return n;
+  };
+  run(sim, 0.5);
+  CHECK(returns() > 0);
+  run(sim, 1.0);  // t = 1.5
+  const Time blinded = sim.laser().latest().stamp;
+  CHECK(to_seconds(blinded) > 1.0);
+  CHECK(returns() == 0);
+  run(sim, 1.0);  // t = 2.5
+  CHECK(sim.laser().latest().stamp > blinded);
+  CHECK(returns() > 0);
+}
+
+TEST_CASE("Simulator: a kidnapping moves the robot, not its odometry", "[sim][faults]") {
+  World world = room_world(81, 81, {2.0, 2.0, 0.0});
+  world.faults.kidnappings.push_back({time_from_seconds(1.0), Pose2D{1.0, 3.0, 1.0}, {}});
+  // Into the wall: refused, the robot stays where it is.
+  world.faults.kidnappings.push_back({time_from_seconds(2.0), Pose2D{0.0, 0.0, 0.0}, {}});
+  Simulator sim(std::move(world), omni3_base(), 1);
+  run(sim, 0.95);
+  const Pose2D odom_before = sim.odometry().latest().pose;
+  CHECK(sim.pose().x_m == Approx(2.0));
+  run(sim, 0.1);
+  CHECK(sim.pose() == Pose2D{1.0, 3.0, 1.0});
+  CHECK(std::abs(sim.odometry().latest().pose.x_m - odom_before.x_m) < 1e-6);
+  CHECK(std::abs(sim.odometry().latest().pose.y_m - odom_before.y_m) < 1e-6);
+  run(sim, 1.0);
+  CHECK(sim.pose() == Pose2D{1.0, 3.0, 1.0});
+  REQUIRE(sim.events().size() == 2);
+  CHECK(sim.events()[0].kind == SimEvent::Kind::kidnapped);
+  CHECK(sim.events()[0].detail == "to (1.00, 3.00, 1.00)");
+  CHECK(sim.events()[1].detail == "refused, stays; to (0.00, 0.00, 0.00)");
+}
+
 TEST_CASE("Simulator: cliff sensors see a drop ahead, a robot driving into it falls", "[sim][cliff]") {
   World world = room_world(81, 81, {2.0, 2.0, 0.0});
   world.drops.push_back({"stairs", {{3.0, 1.0}, {3.5, 1.0}, {3.5, 3.0}, {3.0, 3.0}}, {}});

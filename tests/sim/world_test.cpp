@@ -56,7 +56,10 @@ TEST_CASE("load_world: the demo workspace", "[sim][world]") {
   CHECK(f.obstacles[0].disappear == time_from_seconds(400.0));
   CHECK(f.obstacles[0].polygon.size() == 4);
   REQUIRE(f.faults.localization_loss.size() == 1);
-  CHECK(f.faults.localization_loss[0] == navi::LocalizationFault{time_from_seconds(60.0), time_from_seconds(70.0)});
+  CHECK(f.faults.localization_loss[0] == navi::LocalizationFault{time_from_seconds(60.0), time_from_seconds(64.0)});
+  REQUIRE(f.faults.kidnappings.size() == 1);
+  CHECK(f.faults.kidnappings[0].at == time_from_seconds(150.0));
+  CHECK(f.faults.kidnappings[0].to == Pose2D{3.5, 2.0, 2.0});
   REQUIRE(f.faults.dead_sensors.size() == 1);
   CHECK(f.faults.dead_sensors[0].sensor == SensorKind::laser);
   CHECK(f.faults.dead_sensors[0].start == time_from_seconds(90.0));
@@ -219,4 +222,27 @@ obstacles:
     CHECK_THROWS_WITH(load_world("/nonexistent/world.yaml"), Catch::Contains("/nonexistent/world.yaml") &&
                                                                   Catch::Contains("cannot read the file"));
   }
+}
+
+TEST_CASE("parse_world: kidnappings, in time order, refused with their location where the robot cannot be", "[sim][world]") {
+  TempDir dir("world_kidnap");
+  write_file(dir / "world.yaml", head() + "faults:\n  kidnap:\n    - {at_s: 90, to: [2.5, 6.0, 2.0]}\n"
+                                          "    - {at_s: 30, to: [7.0, 2.0]}\n");
+  const World w = load_world(dir / "world.yaml");
+  REQUIRE(w.faults.kidnappings.size() == 2);
+  CHECK(w.faults.kidnappings[0].at == time_from_seconds(30.0));
+  CHECK(w.faults.kidnappings[0].to == Pose2D{7.0, 2.0, 0.0});
+  CHECK(w.faults.kidnappings[1].at == time_from_seconds(90.0));
+  CHECK(w.faults.kidnappings[1].where.line == 6);
+
+  // Into a wall (the obstacle at x 4.2-5.6, y 4.2-4.8), at a negative time, without a pose.
+  CHECK_THAT(error_of(head() + "faults:\n  kidnap:\n    - {at_s: 10, to: [4.9, 4.5, 0.0]}\n"),
+             Catch::Contains("world.yaml:6:7: error: kidnap.to: there the robot's footprint"));
+  const std::string e = error_of(head() + "faults:\n  kidnap:\n    - {at_s: 10, to: [2.5, 6.0]}\n"
+                                          "    - {at_s: -1, to: [2.5, 6.0]}\n    - {at_s: 5}\n    - {at: 5, to: [1, 1]}\n");
+  CHECK_THAT(e, Catch::Contains("world.yaml:7:14: error: kidnap.at_s must be >= 0"));
+  CHECK_THAT(e, Catch::Contains("world.yaml:8:7: error: a kidnap entry needs at_s"));
+  CHECK_THAT(e, Catch::Contains("world.yaml:9:"));
+  CHECK_THAT(e, !Catch::Contains("world.yaml:6:"));
+  CHECK_THAT(error_of(head() + "faults:\n  kidnap: {at_s: 1}\n"), Catch::Contains("faults.kidnap must be a list"));
 }

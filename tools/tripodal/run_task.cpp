@@ -17,6 +17,7 @@
 #include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/navi/localizer.hpp"
 #include "tripodal/navi/planning_modules.hpp"
+#include "tripodal/navi/scan_matching_localizer.hpp"
 #include "tripodal/navi/section_splitter.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
 #include "tripodal/robot/robot.hpp"
@@ -197,6 +198,18 @@ RunResult run_task(const RunOptions& o) {
   if (!o.board_line.empty()) ro.parameters.push_back({profile.hardware->name, "line", o.board_line});
   for (const ModuleEntry& e : profile.navigation) {
     if (e.type == navi::CLocalizer::static_manifest().name) ro.parameters.push_back({e.name, "seed", std::to_string(res.seed % (1ULL << 52))});
+    if (e.type == navi::CScanMatchingLocalizer::static_manifest().name) {
+      // The robot starts on its charger, whose place in the map it knows: the world's start pose
+      // (the profile's initial pose is the workspace's charger; another world starts elsewhere).
+      const auto text = [](double v) {
+        std::ostringstream out;
+        out << std::setprecision(17) << v;
+        return out.str();
+      };
+      ro.parameters.push_back({e.name, "initial_x_m", text(world->start_pose.x_m)});
+      ro.parameters.push_back({e.name, "initial_y_m", text(world->start_pose.y_m)});
+      ro.parameters.push_back({e.name, "initial_theta_rad", text(world->start_pose.theta_rad)});
+    }
     if (e.type == navi::CCoverageModule::static_manifest().name && !o.pattern.empty()) ro.parameters.push_back({e.name, "pattern", o.pattern});
   }
   SimClock clock;

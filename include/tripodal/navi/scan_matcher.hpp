@@ -28,6 +28,13 @@ struct ScanMatcherOptions {
   double global_angular_step_rad = 0.02;
   double global_max_range_m = 12.0;
   int global_levels = 6;             ///< branch-and-bound tiles of 2^levels cells at the top
+  /// Where a wall's surface lies in the map's cells. A map built from scans (SLAM, MapBuilder, the
+  /// CARMEN logs) marks the cell a return fell in: the surface lies inside the wall's boundary
+  /// cells, at their centre on average (false). A map drawn as solid cells (a floor plan, the
+  /// simulator's world, whose beams stop at an occupied cell's face) has it on the face between
+  /// an occupied cell and an open one (true). Matching with the wrong one biases every match by
+  /// half a cell towards the nearer walls (docs/localization.md).
+  bool surface_at_cell_face = false;
 };
 
 /// How a tracker sizes its search: the odometry errs more the more the robot moves, so the window
@@ -86,6 +93,13 @@ class ScanMatcher {
   [[nodiscard]] ScanMatch match_global();
   /// Quality (mean likelihood of the points) of the scan at `pose`, without searching.
   [[nodiscard]] double quality_at(const Pose2D& pose) const noexcept;
+  /// The quality of the evidence at `pose`: the mean likelihood of the points the map can
+  /// explain. A point within 2 m, far from every wall, whose beam crosses no wall of the map
+  /// stopped on something the map does not hold (a cart, a person): it says nothing about the
+  /// pose and is left out. At most a third of the points are left out (more would leave too
+  /// little of the map to vouch for the pose): beyond, this is quality_at(). Never below
+  /// quality_at().
+  [[nodiscard]] double explained_quality(const Pose2D& pose) const noexcept;
 
   [[nodiscard]] const ScanMatcherOptions& options() const noexcept { return options_; }
   [[nodiscard]] const OccupancyGrid& map() const noexcept { return map_; }
@@ -114,6 +128,7 @@ class ScanMatcher {
   std::vector<std::vector<float>> pooled_;
   int pad_ = 1;
   std::vector<float> px_, py_, range_;       // points in the base frame, metres
+  double origin_x_ = 0.0, origin_y_ = 0.0;   // the scanner in the base frame, metres
   std::vector<int> cx_, cy_;                 // rotated points of every heading of the window, cells
   struct Block {
     float bound;

@@ -70,6 +70,8 @@ class CScanMatchingLocalizer final : public CNaviModules {
  private:
   enum class State { unknown, ok, lost };
   void post(State next, Time now, std::vector<ModuleEvent>& out);
+  // Whether an odometry increment between two scans is motion the tracker can follow (not a reset).
+  [[nodiscard]] bool plausible(const Pose2D& motion) const noexcept;
 
   ScanMatchingLocalizerOptions options_;
   std::unique_ptr<ScanMatcher> matcher_;

@@ -38,8 +38,9 @@ struct SimEvent {
     obstacle_removed,
     sensor_dead,              ///< a SensorOutage started
     sensor_restored,
-    localization_loss_start,  ///< a localization fault window started (the localizer acts on it)
+    localization_loss_start,  ///< a localization loss window started: the laser is blinded
     localization_loss_end,
+    kidnapped,                ///< the world moved the robot (detail: "to (x, y, theta)")
     fell,                     ///< the robot's centre entered a drop area
     battery_empty,
   };
@@ -112,7 +113,7 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   [[nodiscard]] bool charging() const noexcept { return charging_; }
   /// Whether `sensor` is silenced by the fault schedule at time t.
   [[nodiscard]] bool sensor_dead(SensorKind sensor, Time t) const noexcept;
-  /// Whether a localization fault window covers t.
+  /// Whether a localization loss window covers t (the laser returns nothing then).
   [[nodiscard]] bool localization_lost(Time t) const noexcept override;
 
   [[nodiscard]] const World& world() const noexcept { return world_; }
@@ -158,6 +159,7 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   std::vector<std::uint8_t> obstacle_present_;
   std::vector<std::uint8_t> outage_active_;
   std::vector<std::uint8_t> loss_active_;
+  std::size_t next_kidnapping_ = 0;
 
   Time now_{};
   Pose2D pose_;

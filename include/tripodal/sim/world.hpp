@@ -146,12 +146,23 @@ struct SensorOutage {
   SourceLocation where;
 };
 
-/// The faults injected in a run. Localization losses are the navi localizer's own type
-/// (navi::LocalizationFault): hand them to CLocalizer::add_fault(); the simulator logs them.
-/// Blocked paths are World::obstacles with an appearance time.
+/// A kidnapping: at `at` the world moves the robot to `to` (map_from_base) without a wheel
+/// turning, so the odometry does not see it; the localizer must find out from its laser.
+struct Kidnapping {
+  Time at{};
+  Pose2D to;
+  SourceLocation where;
+};
+
+/// The faults injected in a run. A localization loss window blinds the laser (it keeps
+/// publishing scans, with no return: the scanner dazzled), the physical cause a laser localizer
+/// detects from its match quality; the windows are the navi localizer's own type
+/// (navi::LocalizationFault), so the ground-truth test double CLocalizer can take them as flags
+/// (CLocalizer::add_fault()). Blocked paths are World::obstacles with an appearance time.
 struct FaultSchedule {
   std::vector<navi::LocalizationFault> localization_loss;
   std::vector<SensorOutage> dead_sensors;
+  std::vector<Kidnapping> kidnappings;  ///< in time order
 };
 
 /// A world file, loaded: everything the simulator needs.
