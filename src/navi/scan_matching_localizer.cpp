@@ -48,6 +48,9 @@ const ModuleManifest& CScanMatchingLocalizer::static_manifest() {
                      "the map's walls are solid cells (a drawn map, the simulator's world): a wall's surface is an "
                      "occupied cell's face; false: inside the cell, at its centre on average (a map built from scans)",
                      {}, {}},
+       ParameterSpec{"odometry_reset_m", ValueType::number, Value{d.odometry_reset_m}, "m",
+                     "an odometry increment longer than this between two scans is a reset, not motion (0: never)",
+                     0.0, 100.0},
        ParameterSpec{"lost_quality", ValueType::number, Value{d.lost_quality}, "",
                      "match quality (mean likelihood of the points, 0..1) below which a scan is no evidence", 0.0,
                      1.0},
@@ -74,6 +77,7 @@ void CScanMatchingLocalizer::on_configure(const ParameterSet& params) {
   o.matcher.search_xy_m = params.number("search_xy_m");
   o.matcher.search_theta_rad = params.number("search_theta_rad");
   o.matcher.surface_at_cell_face = params.boolean("surface_at_cell_face");
+  o.odometry_reset_m = params.number("odometry_reset_m");
   o.lost_quality = params.number("lost_quality");
   o.lost_after_scans = static_cast<int>(params.number("lost_after_scans"));
   o.relocalize_quality = params.number("relocalize_quality");
@@ -172,8 +176,8 @@ void CScanMatchingLocalizer::step(const LaserScan& scan, const Pose2D& odom_from
 }
 
 bool CScanMatchingLocalizer::plausible(const Pose2D& motion) const noexcept {
-  return std::hypot(motion.x_m, motion.y_m) <= options_.matcher.max_search_xy_m &&
-         std::abs(wrap_angle(motion.theta_rad)) <= options_.matcher.max_search_theta_rad;
+  // Translation only: a base turns fast between scans, while a reset moves the origin by metres.
+  return options_.odometry_reset_m <= 0.0 || std::hypot(motion.x_m, motion.y_m) <= options_.odometry_reset_m;
 }
 
 bool CScanMatchingLocalizer::relocalize() {

@@ -29,6 +29,10 @@ struct ScanMatchingLocalizerOptions {
   /// place that happens to explain part of the scan must not pass).
   double relocalize_quality = 0.75;
   TrackingWindow window;          ///< how the search window follows the odometry
+  /// An odometry increment longer than this between two scans is a reset of the odometry's
+  /// origin (the simulator's, when `tripodal run` puts the robot on its start pose), not motion;
+  /// 0: every increment is motion (logs whose scans are far apart, `localization eval`).
+  double odometry_reset_m = 1.0;
 };
 
 /// Type "ScanMatchingLocalizer". As a module of the robot it takes the map of the GridMaps module
