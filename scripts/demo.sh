@@ -23,7 +23,7 @@ echo "== PSR-2 (omni): clean the room 3211"
 "$tool" run --robot configs/robots/psr2.yaml --world "$world" --task "clean the room 3211" --seed 1 --out "$out/psr2"
 
 echo
-echo "== PSR-2 in the faults world: a cart on its path, a localization loss at 60-70 s, a dead laser at 90-92 s"
+echo "== PSR-2 in the faults world: a cart on its path, the laser dazzled at 60-64 s and dead at 90-92 s, the robot kidnapped at 150 s"
 "$tool" run --robot configs/robots/psr2.yaml --world configs/worlds/workspace_faults.yaml --task "clean the room 3211" \
   --seed 1 --out "$out/psr2-faults"
 
