@@ -7,11 +7,10 @@
 #   FUZZ_SECONDS=600 scripts/fuzz.sh          the same, by environment
 #   FUZZ_SEED=1 scripts/fuzz.sh               libFuzzer's -seed (default 0: a new one each run)
 #   FUZZ_RUNS=40000 FUZZ_SEED=1 scripts/fuzz.sh 30
-#                                             CI: each target runs exactly FUZZ_RUNS inputs from
-#                                             a fresh corpus of the seeds (SECONDS only caps it),
-#                                             so CI explores the same inputs as any machine that
-#                                             ran the same command: a red CI run is reproducible
-#                                             and a green local run predicts a green CI run
+#                                             CI: each target runs FUZZ_RUNS inputs from a fresh
+#                                             corpus of the seeds (SECONDS only caps it); the same
+#                                             seed replays the same inputs on one machine and
+#                                             binary only (docs/fuzzing.md "Fuzzing in CI")
 #
 # Stops at the first target that finds a crash, a leak, a timeout or a failed property: the input
 # is kept as build/fuzz/findings/<target>/crash-* (reproduce: build/fuzz/fuzz/fuzz_<target> FILE).
@@ -46,7 +45,7 @@ for t in "${targets[@]}"; do
   corpus="$build/corpus/$t"
   runs_option=()
   if [[ -n ${FUZZ_RUNS:-} ]]; then
-    # A fixed sequence: fresh corpus, fixed seed and count. A time cap can only cut it short.
+    # A bounded run: fresh corpus, given seed and count. A time cap can only cut it short.
     corpus="$build/fixed-corpus/$t"
     rm -rf "$corpus"
     # FUZZ_RUNS_<target> overrides the count for one slow target (CI: carmen, whose seed is a 9 MB

@@ -88,6 +88,12 @@ YAML::Node Reader::require(const YAML::Node& map, std::string_view key, std::str
   return value;
 }
 
+std::optional<std::string> Reader::key(const YAML::Node& key, std::string_view what) {
+  if (key.IsScalar()) return key.Scalar();
+  error(key, fmt::format("{}: a key must be text, got {}", what, kind(key)));
+  return std::nullopt;
+}
+
 std::optional<std::string> Reader::text(const YAML::Node& node, std::string_view what, bool non_empty) {
   if (!node.IsScalar() || (non_empty && node.Scalar().empty())) {
     error(node, fmt::format("{}: expected {}, got {}", what, non_empty ? "a non-empty text" : "text",

@@ -28,6 +28,18 @@ using KeyList = std::initializer_list<std::string_view>;
 /// Parses YAML text; a syntax error becomes a ConfigError at FILE:LINE:COL.
 [[nodiscard]] YAML::Node parse(std::string_view text, const std::string& file);
 
+/// Runs a loader's walk over its parsed nodes. The typed reads below never throw, but yaml-cpp
+/// still does on a shape no read expected (a subscript of a text, a list as a key): that becomes
+/// a ConfigError at the node's FILE:LINE:COL instead of a YAML exception without the file's name.
+template <class Walk>
+decltype(auto) guarded(const std::string& file, Walk&& walk) {
+  try {
+    return walk();
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(SourceLocation{file, e.mark.line + 1, e.mark.column + 1}, "unexpected YAML structure: " + e.msg);
+  }
+}
+
 /// What a node is, for messages: "a map", "a list", "'text'" (the scalar itself), "nothing".
 [[nodiscard]] std::string kind(const YAML::Node& node);
 
@@ -56,6 +68,12 @@ class Reader {
   /// map[key], or "WHAT: missing 'KEY' (EXPECTED)" at the map and an undefined node.
   YAML::Node require(const YAML::Node& map, std::string_view key, std::string_view what, std::string_view expected);
 
+  /// A map key's text. Keys a map does not constrain (parameters, process names) may be written
+  /// as lists or maps (`? [a]: b`): "WHAT: a key must be text, got a list" at the key.
+  std::optional<std::string> key(const YAML::Node& key, std::string_view what);
+  /// The text of a key already checked by expect_keys, which reported a non-text key as
+  /// unknown: "" for such a key, so the caller's dispatch skips it.
+  [[nodiscard]] static std::string checked_key(const YAML::Node& key) { return key.IsScalar() ? key.Scalar() : std::string(); }
   /// A scalar's text ("WHAT: expected text, got a list"); non_empty also refuses "".
   std::optional<std::string> text(const YAML::Node& node, std::string_view what, bool non_empty = false);
   /// A finite number ("WHAT: expected a number, got 'fast'").

@@ -163,7 +163,9 @@ void write_pgm(const std::filesystem::path& file, const GrayImage& image) {
   if (!out) throw std::runtime_error("cannot write " + file.string());
 }
 
-MapMetadata parse_map_yaml(std::string_view text, const std::filesystem::path& file) {
+namespace {
+
+MapMetadata walk_map_yaml(std::string_view text, const std::filesystem::path& file) {
   const std::string name = file.string();
   const YAML::Node root = yaml::parse(text, name);
   Diagnostics d;
@@ -211,6 +213,12 @@ MapMetadata parse_map_yaml(std::string_view text, const std::filesystem::path& f
   }
   if (d.has_errors()) throw ConfigError(d);
   return m;
+}
+
+}  // namespace
+
+MapMetadata parse_map_yaml(std::string_view text, const std::filesystem::path& file) {
+  return yaml::guarded(file.string(), [&] { return walk_map_yaml(text, file); });
 }
 
 MapMetadata load_map_yaml(const std::filesystem::path& file) {

@@ -181,7 +181,7 @@ std::vector<std::string> RegionMap::room_names() const {
 }
 
 RegionMap parse_regions(std::string_view text, const std::string& file) {
-  return RegionLoader(file).load(yaml::parse(text, file));
+  return yaml::guarded(file, [&] { return RegionLoader(file).load(yaml::parse(text, file)); });
 }
 
 RegionMap load_regions(const std::filesystem::path& file) {

@@ -18,8 +18,8 @@ bool iequals(std::string_view a, std::string_view b) {
          });
 }
 
-RecoveryPolicy parse(const std::string& text, const std::string& file,
-                     const std::function<bool(std::string_view)>& is_known_process) {
+RecoveryPolicy walk(const std::string& text, const std::string& file,
+                    const std::function<bool(std::string_view)>& is_known_process) {
   const YAML::Node root = yaml::parse(text, file);
   Diagnostics d;
   yaml::Reader r(file, d);
@@ -53,12 +53,15 @@ RecoveryPolicy parse(const std::string& text, const std::string& file,
           continue;
         }
         const auto step_kv = *s.begin();
-        ProcessStep step{step_kv.first.as<std::string>(), {}};
+        const auto process = r.key(step_kv.first, "an inserted step (the process name)");
+        if (!process) continue;
+        ProcessStep step{*process, {}};
         if (is_known_process && !is_known_process(step.process)) r.error(step_kv.first, "unknown process '" + step.process + "'");
         if (step_kv.second.IsMap()) {
           for (const auto& p : step_kv.second) {
-            const std::string name = p.first.as<std::string>();
-            if (auto value = r.text(p.second, "parameter '" + name + "'")) step.params.push_back({name, *value, r.at(p.second)});
+            const auto name = r.key(p.first, "the parameters of '" + step.process + "'");
+            if (!name) continue;
+            if (auto value = r.text(p.second, "parameter '" + *name + "'")) step.params.push_back({*name, *value, r.at(p.second)});
           }
         } else if (!step_kv.second.IsNull()) {
           r.expect_map(step_kv.second, "the parameters of '" + step.process + "'");
@@ -71,6 +74,11 @@ RecoveryPolicy parse(const std::string& text, const std::string& file,
   }
   if (d.has_errors()) throw ConfigError(d);
   return RecoveryPolicy(std::move(rules));
+}
+
+RecoveryPolicy parse(const std::string& text, const std::string& file,
+                     const std::function<bool(std::string_view)>& is_known_process) {
+  return yaml::guarded(file, [&] { return walk(text, file, is_known_process); });
 }
 
 }  // namespace

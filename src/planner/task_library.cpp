@@ -168,14 +168,15 @@ class Loader {
     TemplateNode node;
     node.kind = TemplateNode::Kind::process;
     node.where = r_.at(key);
-    node.process = key.as<std::string>();
+    node.process = key.Scalar();  // parse_node has checked that the key is text
     if (options_.is_known_process && !options_.is_known_process(node.process)) {
       diags_.error(node.where, "unknown process '" + node.process + "'");
     }
     if (value.IsMap()) {
       for (const auto& kv : value) {
-        BindingParam param{kv.first.as<std::string>(), scalar(kv.second, "parameter '" + kv.first.as<std::string>() + "'"),
-                           r_.at(kv.second)};
+        const auto name = r_.key(kv.first, "the parameters of '" + node.process + "'");
+        if (!name) continue;
+        BindingParam param{*name, scalar(kv.second, "parameter '" + *name + "'"), r_.at(kv.second)};
         check_refs(param.value, bound, param.where);
         node.params.push_back(std::move(param));
       }
@@ -191,7 +192,9 @@ class Loader {
       return {};
     }
     const auto kv = *n.begin();
-    const auto key = kv.first.as<std::string>();
+    const auto key_text = r_.key(kv.first, "a plan step (a process name, 'foreach' or 'parallel')");
+    if (!key_text) return {};
+    const std::string& key = *key_text;
     if (key == "foreach" || key == "parallel") {
       if (!allow_groups) {
         diags_.error(r_.at(kv.first), "'" + key + "' is not allowed inside a parallel group");
@@ -240,7 +243,7 @@ class Loader {
 };
 
 std::vector<TaskTemplate> load_templates(const std::string& text, const std::string& name, const TaskLoadOptions& options) {
-  return Loader(name, options).load(yaml::parse(text, name));
+  return yaml::guarded(name, [&] { return Loader(name, options).load(yaml::parse(text, name)); });
 }
 
 // ---------------------------------------------------------------- matching

@@ -348,7 +348,9 @@ LoopConfig read_loop(Reader& r, const YAML::Node& node, std::size_t index) {
 
 }  // namespace
 
-ReactiveConfig parse_reactive_config(std::string_view text, const std::string& file, const ControllerRegistry& registry) {
+namespace {
+
+ReactiveConfig walk_reactive_config(std::string_view text, const std::string& file, const ControllerRegistry& registry) {
   Diagnostics diags;
   Reader r(file, diags);
   const YAML::Node root = yaml::parse(text, file);
@@ -386,6 +388,12 @@ ReactiveConfig parse_reactive_config(std::string_view text, const std::string& f
   }
   if (diags.has_errors()) throw ConfigError(std::move(diags));
   return out;
+}
+
+}  // namespace
+
+ReactiveConfig parse_reactive_config(std::string_view text, const std::string& file, const ControllerRegistry& registry) {
+  return yaml::guarded(file, [&] { return walk_reactive_config(text, file, registry); });
 }
 
 ReactiveConfig load_reactive_config(const std::string& path, const ControllerRegistry& registry) {

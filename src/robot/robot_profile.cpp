@@ -53,7 +53,7 @@ struct Parser {
     e.kind = kind;
     e.where = at(n);
     if (n.IsScalar()) {  // "- BhCleaning": a registered type under its own name
-      e.name = e.type = n.as<std::string>();
+      e.name = e.type = n.Scalar();
       out.push_back(std::move(e));
       return;
     }
@@ -62,7 +62,7 @@ struct Parser {
       return;
     }
     for (const auto& kv : n) {
-      const std::string key = kv.first.as<std::string>();
+      const std::string key = yaml::Reader::checked_key(kv.first);
       const YAML::Node v = kv.second;
       if (key == "name") {
         scalar(v, e.name, "name");
@@ -83,8 +83,9 @@ struct Parser {
       } else if (key == "parameters") {
         if (!r.expect_map(v, "parameters")) continue;
         for (const auto& p : v) {
+          const auto name = r.key(p.first, "parameters");
           std::string val;
-          if (scalar(p.second, val, "parameter '" + p.first.as<std::string>() + "'")) e.parameters[p.first.as<std::string>()] = val;
+          if (name && scalar(p.second, val, "parameter '" + *name + "'")) e.parameters[*name] = val;
         }
       } else if (key == "watchdog") {
         if (!r.expect_keys(v, {"timeout_s", "event"}, "watchdog")) continue;
@@ -113,7 +114,7 @@ struct Parser {
     if (!r.expect_keys(n, {"name", "type", "net", "module", "parameters", "recovery"}, "a process entry")) return;
     bool has_net = false;
     for (const auto& kv : n) {
-      const std::string key = kv.first.as<std::string>();
+      const std::string key = yaml::Reader::checked_key(kv.first);
       const YAML::Node v = kv.second;
       if (key == "name") {
         scalar(v, p.name, "name");
@@ -130,8 +131,9 @@ struct Parser {
       } else if (key == "parameters") {
         if (!r.expect_map(v, "parameters")) continue;
         for (const auto& q : v) {
+          const auto name = r.key(q.first, "parameters");
           std::string val;
-          if (scalar(q.second, val, "parameter")) p.parameters.push_back(BindingParam{q.first.as<std::string>(), val, at(q.second)});
+          if (name && scalar(q.second, val, "parameter '" + *name + "'")) p.parameters.push_back(BindingParam{*name, val, at(q.second)});
         }
       }
     }
@@ -152,7 +154,7 @@ struct Parser {
       throw ConfigError(d);
     }
     for (const auto& kv : root) {
-      const std::string key = kv.first.as<std::string>();
+      const std::string key = yaml::Reader::checked_key(kv.first);
       const YAML::Node v = kv.second;
       if (key == "robot") {
         if (!r.expect_keys(v, {"name", "description", "sequencing_period_s"}, "robot")) continue;
@@ -238,7 +240,7 @@ RobotProfile load_robot_profile(const std::filesystem::path& file) {
 
 RobotProfile load_robot_profile_from_string(std::string_view yaml, std::string_view name, const std::filesystem::path& base_dir) {
   Parser p(std::string(name), base_dir);
-  return p.parse(std::string(yaml));
+  return yaml::guarded(p.file, [&] { return p.parse(std::string(yaml)); });
 }
 
 }  // namespace tripodal

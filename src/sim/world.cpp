@@ -360,9 +360,7 @@ void read_faults(Reader& r, const YAML::Node& n, FaultSchedule& f) {
   }
 }
 
-}  // namespace
-
-World parse_world(std::string_view text, const std::filesystem::path& file) {
+World walk_world(std::string_view text, const std::filesystem::path& file) {
   const std::string fname = file.string();
   const YAML::Node root = yaml::parse(text, fname);
   Reader r(fname);
@@ -521,6 +519,12 @@ World parse_world(std::string_view text, const std::filesystem::path& file) {
   }
   if (r.diagnostics().has_errors()) throw ConfigError(std::move(r.diagnostics()));
   return w;
+}
+
+}  // namespace
+
+World parse_world(std::string_view text, const std::filesystem::path& file) {
+  return yaml::guarded(file.string(), [&] { return walk_world(text, file); });
 }
 
 World load_world(const std::filesystem::path& file) {

@@ -90,6 +90,28 @@ TEST_CASE("yaml::Reader typed reads accept good values and locate bad ones", "[y
   CHECK_THAT(e, Catch::Contains("name: expected text, got a list"));
 }
 
+TEST_CASE("yaml::Reader::key refuses a list or a map as a key, at the key", "[yaml]") {
+  Fixture f("params:\n  speed: 1\n  [a, b]: 2\n  {c: 3}: 4\n");
+  std::vector<std::string> keys;
+  for (const auto& kv : f.root["params"]) {
+    if (auto k = f.r.key(kv.first, "params")) keys.push_back(*k);
+  }
+  CHECK(keys == std::vector<std::string>{"speed"});
+  CHECK_THAT(f.errors(), Catch::Contains("t.yaml:3:3: error: params: a key must be text, got a list") &&
+                             Catch::Contains("t.yaml:4:3: error: params: a key must be text, got a map"));
+  CHECK(yaml::Reader::checked_key(f.root["params"].begin()->first) == "speed");
+}
+
+TEST_CASE("yaml::guarded turns what yaml-cpp throws into an error located in the file", "[yaml]") {
+  const YAML::Node root = yaml::parse("a: text\nb: [1, 2]\n", "g.yaml");
+  CHECK(yaml::guarded("g.yaml", [&] { return root["a"].Scalar(); }) == "text");
+  // A subscript of a text throws yaml-cpp's BadSubscript; the file's name and the node's line come with it.
+  REQUIRE_THROWS_WITH(yaml::guarded("g.yaml", [&] { return root["a"]["x"].Scalar(); }),
+                      Catch::StartsWith("g.yaml:1:4: error: unexpected YAML structure:"));
+  REQUIRE_THROWS_WITH(yaml::guarded("g.yaml", [&] { return root["b"].as<std::string>(); }),
+                      Catch::StartsWith("g.yaml:2:4: error: unexpected YAML structure:"));
+}
+
 TEST_CASE("yaml::Reader locates the empty document at 1:1") {
   // Found by fuzz_robot_profile: an empty profile's "expected a map, got nothing" had no line.
   Diagnostics d;

@@ -73,6 +73,19 @@ TEST_CASE("malformed recovery rules are located") {
   }
 }
 
+TEST_CASE("recovery rules whose process or parameter keys are not text are located") {
+  const char* yaml = "recovery:\n  - fault: x\n    insert:\n      - {[PrA]: {}}\n      - PrB: {[k]: v, n: 1}\n";
+  try {
+    (void)RecoveryPolicy::load_from_string(yaml, "k.yaml");
+    FAIL("expected ConfigError");
+  } catch (const ConfigError& e) {
+    const std::string w = e.what();
+    CHECK_THAT(w, Catch::Contains("k.yaml:4:10: error: an inserted step (the process name): a key must be text, got a list"));
+    CHECK_THAT(w, Catch::Contains("k.yaml:5:15: error: the parameters of 'PrB': a key must be text, got a list"));
+    CHECK(e.diagnostics().error_count() == 2);
+  }
+}
+
 namespace {
 
 PetriNet shipped_net(const char* file) { return load_net_or_throw(std::string(TRIPODAL_SOURCE_DIR "/configs/petri/") + file); }

@@ -104,6 +104,24 @@ TEST_CASE("malformed task templates are refused with every error located") {
   }
 }
 
+TEST_CASE("plan steps and parameters whose keys are not text are located") {
+  const char* yaml = R"(tasks:
+  - name: clean
+    commands: ["clean {room}"]
+    plan:
+      - {[PrCleaning]: {}}
+      - PrAutoMove: {{to: x}: "{room}"}
+)";
+  try {
+    (void)TaskLibrary::load_from_string(yaml, "tasks.yaml");
+    FAIL("expected a ConfigError");
+  } catch (const ConfigError& e) {
+    const std::string what = e.what();
+    CHECK_THAT(what, Catch::Contains("tasks.yaml:5:10: error: a plan step (a process name, 'foreach' or 'parallel'): a key must be text, got a list"));
+    CHECK_THAT(what, Catch::Contains("tasks.yaml:6:22: error: the parameters of 'PrAutoMove': a key must be text, got a map"));
+  }
+}
+
 TEST_CASE("unknown process names are refused when a registry is given") {
   TaskLoadOptions options;
   options.is_known_process = [](std::string_view p) { return p == "PrAutoMove"; };

@@ -171,6 +171,27 @@ TEST_CASE("Profile load errors are all reported, located", "[robot]") {
   }
 }
 
+// A list or a map as a key (`? [a]: b`, `{a: 1}: b`) is valid YAML; it once escaped the loader as a
+// yaml-cpp conversion exception without the file's name (found by fuzz_robot_profile in CI).
+TEST_CASE("Profile keys that are not text are refused, located", "[robot]") {
+  const std::string bad =
+      "robot: {name: bad}\n"
+      "? [colour]\n: red\n"
+      "behaviors:\n  - name: BhX\n    {a: 1}: 2\n    parameters: {[speed]: 3, gain: 4}\n"
+      "processes:\n  - {name: PrX, net: nowhere.xml, parameters: {{k: v}: 1}}\n";
+  try {
+    (void)load_robot_profile_from_string(bad, "keys.yaml", kRobots);
+    FAIL("no error");
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    CHECK_THAT(m, Catch::Contains("keys.yaml:2:3: error: unknown key 'a list' in the robot profile"));
+    CHECK_THAT(m, Catch::Contains("keys.yaml:6:5: error: unknown key 'a map' in a behavior entry"));
+    CHECK_THAT(m, Catch::Contains("keys.yaml:7:18: error: parameters: a key must be text, got a list"));
+    CHECK_THAT(m, Catch::Contains("keys.yaml:9:48: error: parameters: a key must be text, got a map"));
+    CHECK_THAT(m, !Catch::Contains("yaml-cpp"));
+  }
+}
+
 TEST_CASE("The robot refuses to start with every problem listed", "[robot]") {
   SimClock clock;
   SECTION("modules without implementations") {
