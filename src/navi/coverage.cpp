@@ -520,7 +520,7 @@ static long long dist2(CellIndex a, CellIndex b) noexcept {
 
 void CoveragePlanner::plough(Workspace& ws, const std::vector<std::uint8_t>& mask, bool rows,
                              const std::vector<RoundPiece>& pieces, CellIndex& cur, CoverageResult& r,
-                             std::optional<Point2D> start) {
+                             std::optional<Point2D> start, std::optional<Point2D> finish_near) {
   // The lanes lie where the offset leaves a lane spacing to the wall round (the first lane's
   // swath meets the round's); along a lane, its run goes on over `mask`, closer to the round.
   const double lane_spacing = std::max(grid_.resolution_m(), options_.cleaning_width_m - options_.lane_overlap_m);
@@ -591,58 +591,316 @@ void CoveragePlanner::plough(Workspace& ws, const std::vector<std::uint8_t>& mas
     }
     cur = to;
   };
-  std::vector<bool> swept(cells.size(), false), walked(pieces.size(), false);
-  for (std::size_t left = cells.size() + pieces.size(); left > 0; --left) {
-    long long best_d = std::numeric_limits<long long>::max();
-    std::size_t best_cell = none, best_piece = none, entry = 0;
-    bool from_top = false;
-    const auto d2 = [&](CellIndex c) { return cur.x < 0 ? 0 : dist2(cur, c); };
-    for (std::size_t c = 0; c < cells.size(); ++c) {
-      if (swept[c]) continue;
-      const LaneRun& f = runs[cells[c].front()];
-      const LaneRun& l = runs[cells[c].back()];
-      const long long df = std::min(d2(f.a), d2(f.b));
-      const long long dl = std::min(d2(l.a), d2(l.b));
-      if (df < best_d) best_d = df, best_cell = c, from_top = false;
-      if (dl < best_d) best_d = dl, best_cell = c, from_top = true;
+  // The closed pieces (rounds around obstacles inside the section) are left out of the tour and
+  // inserted afterwards where it passes nearest (insert_round): the greedy tour would otherwise
+  // jump to one as soon as it is the nearest thing and jump back, several metres each way.
+  // The tour's items: the lane cells (entered at the first or the last run, that run swept one
+  // way or the other: 4 ways) and the open pieces of the round (from either end: 2 ways).
+  struct Way {
+    CellIndex entry, exit;
+    double inside_m = 0.0;  // travel within the item (lanes and the steps between them)
+  };
+  const double res = grid_.resolution_m();
+  const auto metres = [&](CellIndex p, CellIndex q) { return std::sqrt(static_cast<double>(dist2(p, q))) * res; };
+  const auto sweep_order = [&](std::size_t c, bool from_top, bool first_flipped, auto&& visit) {
+    std::vector<std::size_t> order = cells[c];
+    if (from_top) std::reverse(order.begin(), order.end());
+    CellIndex at{-1, -1};
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      const LaneRun& run = runs[order[k]];
+      const bool flip = k == 0 ? first_flipped : dist2(at, run.b) < dist2(at, run.a);
+      visit(flip ? run.b : run.a, flip ? run.a : run.b);
+      at = flip ? run.a : run.b;
     }
-    for (std::size_t p = 0; p < pieces.size(); ++p) {
-      if (walked[p]) continue;
-      const std::vector<CellIndex>& pc = pieces[p].cells;
-      if (pieces[p].closed) {
-        for (std::size_t k = 0; k < pc.size(); ++k) {
-          if (d2(pc[k]) < best_d) best_d = d2(pc[k]), best_piece = p, best_cell = none, entry = k;
+  };
+  std::vector<std::vector<Way>> ways;
+  constexpr std::size_t kLaneCell = std::numeric_limits<std::size_t>::max();
+  std::vector<std::size_t> item_piece;  // the piece of an item; kLaneCell for a lane cell
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    ways.emplace_back();
+    for (const int w : {0, 1, 2, 3}) {
+      Way way;
+      bool first = true;
+      CellIndex at{};
+      sweep_order(c, (w & 2) != 0, (w & 1) != 0, [&](CellIndex from, CellIndex to) {
+        if (first) way.entry = from;
+        else way.inside_m += metres(at, from);
+        way.inside_m += metres(from, to);
+        at = to;
+        first = false;
+      });
+      way.exit = at;
+      ways.back().push_back(way);
+    }
+    item_piece.push_back(kLaneCell);
+  }
+  for (std::size_t p = 0; p < pieces.size(); ++p) {
+    if (pieces[p].closed) continue;  // inserted afterwards (insert_round)
+    const auto& pc = pieces[p].cells;
+    const double len = static_cast<double>(pc.size()) * res;
+    ways.push_back({Way{pc.front(), pc.back(), len}, Way{pc.back(), pc.front(), len}});
+    item_piece.push_back(p);
+  }
+  const std::size_t items = ways.size();
+  // The order: exact (Held-Karp over items and ways, straight-line links) for the few items of
+  // a room-sized section, nearest-next beyond. With `finish_near`, the distance from the tour's
+  // end to it counts too: the next section's path starts there.
+  std::vector<std::pair<std::size_t, std::size_t>> tour;  // (item, way)
+  const auto end_cost = [&](CellIndex exit) {
+    return finish_near ? std::hypot(grid_.cell_center(exit).x_m - finish_near->x_m, grid_.cell_center(exit).y_m - finish_near->y_m)
+                       : 0.0;
+  };
+  const CellIndex first_at = cur;
+  const auto link_m = [&](CellIndex from, CellIndex to) { return from.x < 0 ? 0.0 : metres(from, to); };
+  if (items > 0 && items <= kExactTourItems) {
+    const std::size_t masks = std::size_t{1} << items, kWays = 4;
+    const auto at = [&](std::size_t set, std::size_t i, std::size_t w) { return (set * items + i) * kWays + w; };
+    std::vector<double> cost(masks * items * kWays, std::numeric_limits<double>::infinity());
+    std::vector<std::uint32_t> parent(cost.size(), 0);
+    // exit of (i, w) to entry of (j, v) plus the inside of (j, v), once
+    std::vector<double> leg_m(items * kWays * items * kWays, std::numeric_limits<double>::infinity());
+    const auto leg_at = [&](std::size_t i, std::size_t w, std::size_t j, std::size_t v) {
+      return ((i * kWays + w) * items + j) * kWays + v;
+    };
+    for (std::size_t i = 0; i < items; ++i) {
+      for (std::size_t w = 0; w < ways[i].size(); ++w) {
+        for (std::size_t j = 0; j < items; ++j) {
+          for (std::size_t v = 0; v < ways[j].size(); ++v) {
+            leg_m[leg_at(i, w, j, v)] = metres(ways[i][w].exit, ways[j][v].entry) + ways[j][v].inside_m;
+          }
         }
-      } else {
-        if (d2(pc.front()) < best_d) best_d = d2(pc.front()), best_piece = p, best_cell = none, entry = 0;
-        if (d2(pc.back()) < best_d) best_d = d2(pc.back()), best_piece = p, best_cell = none, entry = pc.size() - 1;
       }
     }
-    if (best_cell == none) {
-      walked[best_piece] = true;
-      RoundPiece piece = pieces[best_piece];
-      if (piece.closed) {
-        std::rotate(piece.cells.begin(), piece.cells.begin() + static_cast<std::ptrdiff_t>(entry), piece.cells.end());
-      } else if (entry != 0) {
-        std::reverse(piece.cells.begin(), piece.cells.end());
+    for (std::size_t i = 0; i < items; ++i) {
+      for (std::size_t w = 0; w < ways[i].size(); ++w) {
+        cost[at(std::size_t{1} << i, i, w)] = link_m(first_at, ways[i][w].entry) + ways[i][w].inside_m;
       }
+    }
+    for (std::size_t set = 1; set < masks; ++set) {
+      for (std::size_t i = 0; i < items; ++i) {
+        if ((set & (std::size_t{1} << i)) == 0) continue;
+        for (std::size_t w = 0; w < ways[i].size(); ++w) {
+          const double c = cost[at(set, i, w)];
+          if (!std::isfinite(c)) continue;
+          for (std::size_t j = 0; j < items; ++j) {
+            if ((set & (std::size_t{1} << j)) != 0) continue;
+            const std::size_t grown = set | (std::size_t{1} << j);
+            for (std::size_t v = 0; v < ways[j].size(); ++v) {
+              const double nc = c + leg_m[leg_at(i, w, j, v)];
+              if (nc < cost[at(grown, j, v)]) {
+                cost[at(grown, j, v)] = nc;
+                parent[at(grown, j, v)] = static_cast<std::uint32_t>(i * kWays + w);
+              }
+            }
+          }
+        }
+      }
+    }
+    const std::size_t full = masks - 1;
+    double best = std::numeric_limits<double>::infinity();
+    std::size_t bi = 0, bw = 0;
+    for (std::size_t i = 0; i < items; ++i) {
+      for (std::size_t w = 0; w < ways[i].size(); ++w) {
+        const double c = cost[at(full, i, w)] + end_cost(ways[i][w].exit);
+        if (c < best) best = c, bi = i, bw = w;
+      }
+    }
+    for (std::size_t set = full;;) {
+      tour.emplace_back(bi, bw);
+      const std::size_t before = set & ~(std::size_t{1} << bi);
+      if (before == 0) break;
+      const std::uint32_t p = parent[at(set, bi, bw)];
+      set = before;
+      bi = p / kWays;
+      bw = p % kWays;
+    }
+    std::reverse(tour.begin(), tour.end());
+  } else {
+    std::vector<bool> used(items, false);
+    CellIndex at = first_at;
+    for (std::size_t left = items; left > 0; --left) {
+      double best = std::numeric_limits<double>::infinity();
+      std::size_t bi = 0, bw = 0;
+      for (std::size_t i = 0; i < items; ++i) {
+        if (used[i]) continue;
+        for (std::size_t w = 0; w < ways[i].size(); ++w) {
+          const double d = link_m(at, ways[i][w].entry);
+          if (d < best) best = d, bi = i, bw = w;
+        }
+      }
+      used[bi] = true;
+      tour.emplace_back(bi, bw);
+      at = ways[bi][bw].exit;
+    }
+  }
+  const std::size_t tour_begin = r.path.size();
+  for (const auto& [item, way] : tour) {
+    if (item_piece[item] != kLaneCell) {
+      RoundPiece piece = pieces[item_piece[item]];
+      if (way == 1) std::reverse(piece.cells.begin(), piece.cells.end());
       append_piece(r, cur, piece, start);
       continue;
     }
-    swept[best_cell] = true;
-    std::vector<std::size_t> order = cells[best_cell];
-    if (from_top) std::reverse(order.begin(), order.end());
-    for (const std::size_t i : order) {
-      const LaneRun& run = runs[i];
-      const bool flip = cur.x >= 0 && dist2(cur, run.b) < dist2(cur, run.a);
-      go_to(flip ? run.b : run.a);
-      go_to(flip ? run.a : run.b);
+    sweep_order(item, (way & 2) != 0, (way & 1) != 0, [&](CellIndex from, CellIndex to) {
+      go_to(from);
+      go_to(to);
       ++r.passes;
+    });
+  }
+  for (const RoundPiece& piece : pieces) {
+    if (piece.closed) insert_round(r, cur, piece, tour_begin, start);
+  }
+}
+
+void CoveragePlanner::join_pieces(std::vector<RoundPiece>& pieces) {
+  // round_pieces breaks a chain where it would turn by more than a right angle, so the round
+  // around a box comes as its four sides. Ends a few cells apart with a clear line between them
+  // are one walk: sides joined at the corners, and a chain whose ends meet is closed.
+  constexpr int kGap = 6;  // cells, Chebyshev: around the corner of a box, a quarter of a pillar
+  std::vector<CellIndex> between;  // the cells that join two ends, when they are near
+  const auto near = [&](CellIndex a, CellIndex b) {
+    between.clear();
+    if (std::abs(a.x - b.x) > kGap || std::abs(a.y - b.y) > kGap) return false;
+    if (planner_.line_of_sight(a, b)) return true;
+    return local_path(a, b, kGap, between);
+  };
+  for (bool merged = true; merged;) {
+    merged = false;
+    for (std::size_t i = 0; i < pieces.size() && !merged; ++i) {
+      if (pieces[i].closed) continue;
+      for (std::size_t j = i + 1; j < pieces.size() && !merged; ++j) {
+        if (pieces[j].closed) continue;
+        auto& a = pieces[i].cells;
+        auto b = pieces[j].cells;
+        if (near(a.back(), b.back()) || near(a.front(), b.front())) std::reverse(b.begin(), b.end());
+        if (near(a.back(), b.front())) {
+          a.insert(a.end(), between.begin(), between.end());
+          a.insert(a.end(), b.begin(), b.end());
+        } else if (near(b.back(), a.front())) {
+          b.insert(b.end(), between.begin(), between.end());
+          b.insert(b.end(), a.begin(), a.end());
+          a = std::move(b);
+        } else {
+          continue;
+        }
+        pieces.erase(pieces.begin() + static_cast<std::ptrdiff_t>(j));
+        merged = true;
+      }
+    }
+  }
+  for (RoundPiece& p : pieces) {
+    if (!p.closed && p.cells.size() > 2 * kGap && near(p.cells.back(), p.cells.front())) {
+      p.cells.insert(p.cells.end(), between.begin(), between.end());
+      p.closed = true;
     }
   }
 }
 
-CoverageResult CoveragePlanner::hybrid(const Section& section, std::optional<Point2D> start) {
+bool CoveragePlanner::local_path(CellIndex a, CellIndex b, int margin, std::vector<CellIndex>& between) const {
+  // Breadth-first over the traversable cells of the box around a and b (8-connected, a diagonal
+  // never cutting a corner, as A* moves): the planner's A* would search the whole map before
+  // failing for ends that a wall separates.
+  const int x0 = std::min(a.x, b.x) - margin, y0 = std::min(a.y, b.y) - margin;
+  const int w = std::abs(a.x - b.x) + 2 * margin + 1, h = std::abs(a.y - b.y) + 2 * margin + 1;
+  const auto index = [&](CellIndex c) { return static_cast<std::size_t>((c.y - y0) * w + (c.x - x0)); };
+  const auto open = [&](CellIndex c) {
+    return c.x >= x0 && c.y >= y0 && c.x < x0 + w && c.y < y0 + h && grid_.contains(c) && planner_.traversable(c);
+  };
+  std::vector<int> from(static_cast<std::size_t>(w * h), -1);
+  std::vector<CellIndex> queue{a};
+  from[index(a)] = static_cast<int>(index(a));
+  for (std::size_t q = 0; q < queue.size(); ++q) {
+    const CellIndex c = queue[q];
+    if (c == b) break;
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const CellIndex n{c.x + dx, c.y + dy};
+        if ((dx == 0 && dy == 0) || !open(n) || from[index(n)] >= 0) continue;
+        if (dx != 0 && dy != 0 && (!open({c.x + dx, c.y}) || !open({c.x, c.y + dy}))) continue;
+        from[index(n)] = static_cast<int>(index(c));
+        queue.push_back(n);
+      }
+    }
+  }
+  if (!open(b) || from[index(b)] < 0) return false;
+  between.clear();
+  for (std::size_t i = static_cast<std::size_t>(from[index(b)]); i != index(a); i = static_cast<std::size_t>(from[i])) {
+    between.push_back({x0 + static_cast<int>(i) % w, y0 + static_cast<int>(i) / w});
+  }
+  std::reverse(between.begin(), between.end());
+  return between.size() <= static_cast<std::size_t>(2 * margin);
+}
+
+void CoveragePlanner::insert_round(CoverageResult& r, CellIndex& cur, const RoundPiece& piece, std::size_t tour_begin,
+                                   std::optional<Point2D> start) {
+  // The cheapest place: a point S of a leg of the tour (a lane passing by, usually) from which
+  // the round is entered at its nearest cell and left again at S: 2 |S c| of travel added. The
+  // other choice is after the tour's end, |end c|, with no way back.
+  const auto& path = r.path;
+  std::vector<Point2D> centres;
+  centres.reserve(piece.cells.size());
+  for (const CellIndex& c : piece.cells) centres.push_back(grid_.cell_center(c));
+  double best2 = std::numeric_limits<double>::infinity();  // |S c|^2
+  std::size_t best_leg = 0, best_cell = 0;
+  CellIndex split{};
+  for (std::size_t k = tour_begin; k + 1 < path.size(); ++k) {
+    const Point2D a = path[k], b = path[k + 1];
+    const double dx = b.x_m - a.x_m, dy = b.y_m - a.y_m, len2 = dx * dx + dy * dy;
+    for (std::size_t i = 0; i < centres.size(); ++i) {
+      const Point2D c = centres[i];
+      const double t = len2 > 0.0 ? std::clamp(((c.x_m - a.x_m) * dx + (c.y_m - a.y_m) * dy) / len2, 0.0, 1.0) : 0.0;
+      const Point2D s{a.x_m + t * dx, a.y_m + t * dy};
+      const double d2 = (c.x_m - s.x_m) * (c.x_m - s.x_m) + (c.y_m - s.y_m) * (c.y_m - s.y_m);
+      if (d2 >= best2) continue;
+      // S on a cell centre of the leg (legs of lanes run along cell rows or columns)
+      const CellIndex sc = grid_.cell_at(s);
+      if (!grid_.contains(sc) || !planner_.traversable(sc)) continue;
+      // snapped to a cell centre, S may leave the leg: both halves must stay in plain sight
+      if (!planner_.line_of_sight(grid_.cell_at(a), sc) || !planner_.line_of_sight(sc, grid_.cell_at(b))) continue;
+      best2 = d2, best_leg = k, best_cell = i, split = sc;
+    }
+  }
+  if (path.size() > tour_begin) {
+    const Point2D end = path.back();
+    for (const Point2D c : centres) {
+      // after the end: |end c| against 2 |S c| there and back
+      if ((c.x_m - end.x_m) * (c.x_m - end.x_m) + (c.y_m - end.y_m) * (c.y_m - end.y_m) < 4.0 * best2) {
+        return append_from(r, cur, piece, start);
+      }
+    }
+  }
+  if (!std::isfinite(best2)) return append_from(r, cur, piece, start);
+  const CellIndex entry = piece.cells[best_cell];
+  std::vector<Point2D> detour;
+  detour.push_back(grid_.cell_center(split));
+  link(detour, split, entry);
+  for (std::size_t j = 1; j <= piece.cells.size(); ++j) {
+    detour.push_back(grid_.cell_center(piece.cells[(best_cell + j) % piece.cells.size()]));
+  }
+  link(detour, entry, split);
+  // S itself is on the leg; it is not repeated where it coincides with the leg's ends
+  const auto same = [](Point2D p, Point2D q) { return std::hypot(p.x_m - q.x_m, p.y_m - q.y_m) < 1e-9; };
+  if (same(detour.back(), path[best_leg + 1])) detour.pop_back();
+  if (same(detour.front(), path[best_leg])) detour.erase(detour.begin());
+  r.path.insert(r.path.begin() + static_cast<std::ptrdiff_t>(best_leg + 1), detour.begin(), detour.end());
+  ++r.passes;
+}
+
+void CoveragePlanner::append_from(CoverageResult& r, CellIndex& cur, const RoundPiece& piece, std::optional<Point2D> start) {
+  // a closed piece entered at its cell nearest to the robot
+  std::size_t entry = 0;
+  long long best = std::numeric_limits<long long>::max();
+  for (std::size_t k = 0; k < piece.cells.size(); ++k) {
+    const long long d = cur.x < 0 ? 0 : dist2(cur, piece.cells[k]);
+    if (d < best) best = d, entry = k;
+  }
+  RoundPiece rotated = piece;
+  std::rotate(rotated.cells.begin(), rotated.cells.begin() + static_cast<std::ptrdiff_t>(entry), rotated.cells.end());
+  append_piece(r, cur, rotated, start);
+}
+
+CoverageResult CoveragePlanner::hybrid(const Section& section, std::optional<Point2D> start,
+                                       std::optional<Point2D> finish_near) {
   Workspace ws = prepare(section);
   if (ws.stand_cells_global.empty()) {
     CoverageResult r;
@@ -668,13 +926,19 @@ CoverageResult CoveragePlanner::hybrid(const Section& section, std::optional<Poi
     Workspace w = ws;
     CoverageResult res;
     CellIndex cur = start_cell(start);
-    const auto pieces = round_pieces(w, wall, cur);
-    if (pieces) res.rounds = 1;
-    plough(w, inner, rows, pieces ? *pieces : std::vector<RoundPiece>{}, cur, res, start);
+    auto pieces = round_pieces(w, wall, cur);
+    if (pieces) {
+      res.rounds = 1;
+      join_pieces(*pieces);
+    }
+    plough(w, inner, rows, pieces ? *pieces : std::vector<RoundPiece>{}, cur, res, start, finish_near);
     finish(res, w, cur);
     // Lanes across the shorter way cost turns and lane ends: keep the direction whose path is
-    // cheaper, a turn counted as options_.turn_cost_m of travel.
-    const double cost = res.stats.length_m + options_.turn_cost_m * static_cast<double>(res.stats.turns);
+    // cheaper, a turn counted as options_.turn_cost_m of travel, and the way on to finish_near.
+    double cost = res.stats.length_m + options_.turn_cost_m * static_cast<double>(res.stats.turns);
+    if (finish_near && !res.path.empty()) {
+      cost += std::hypot(res.path.back().x_m - finish_near->x_m, res.path.back().y_m - finish_near->y_m);
+    }
     if (cost < best_cost) {
       best_cost = cost;
       best = std::move(res);

@@ -208,6 +208,12 @@ const ModuleManifest& CCoverageModule::static_manifest() {
       {"grid_map", "sections", "map_from_base", "laser_scan"}, {"coverage_path", "cleaned_cells"},
       {ParameterSpec{"cleaning_width_m", ValueType::number, Value{0.4}, "m", "diameter of the cleaning footprint", 0.01, 5.0},
        ParameterSpec{"overlap_m", ValueType::number, Value{0.05}, "m", "overlap of neighbouring coverage rounds", 0.0, 1.0},
+       ParameterSpec{"lane_overlap_m", ValueType::number, Value{CoverageOptions{}.lane_overlap_m}, "m",
+                     "hybrid: overlap of neighbouring lanes (absorbs the robot's tracking and localization error)", 0.0, 1.0},
+       ParameterSpec{"lane_inset_m", ValueType::number, Value{CoverageOptions{}.lane_inset_m}, "m",
+                     "hybrid: how far inside the wall round's centre line the lanes end (0: one cell)", 0.0, 5.0},
+       ParameterSpec{"turn_cost_m", ValueType::number, Value{CoverageOptions{}.turn_cost_m}, "m",
+                     "hybrid: the travel a turn weighs when the lane direction is chosen", 0.0, 100.0},
        ParameterSpec{"pattern", ValueType::string, Value{std::string("hybrid")}, "",
                      "hybrid (a wall-following round, then lanes), balloon (the paper's wall-following rounds) or "
                      "boustrophedon (plough lanes)", {}, {}},
@@ -219,6 +225,9 @@ const ModuleManifest& CCoverageModule::static_manifest() {
 void CCoverageModule::on_configure(const ParameterSet& params) {
   options_.cleaning_width_m = params.number("cleaning_width_m");
   options_.overlap_m = params.number("overlap_m");
+  options_.lane_overlap_m = params.number("lane_overlap_m");
+  options_.turn_cost_m = params.number("turn_cost_m");
+  options_.lane_inset_m = params.number("lane_inset_m");
   const std::string& pattern = params.string("pattern");
   if (pattern != "hybrid" && pattern != "balloon" && pattern != "boustrophedon") {
     throw ConfigError(where(), "CoveragePlanner: pattern must be hybrid, balloon or boustrophedon, not '" + pattern + "'");
@@ -249,7 +258,25 @@ CoveragePlanner& CCoverageModule::planner() {
 CoverageResult CCoverageModule::plan(const Section& section, Point2D from) {
   if (pattern_ == "boustrophedon") return planner().boustrophedon(section, from);
   if (pattern_ == "balloon") return planner().balloon(section, from);
-  return planner().hybrid(section, from);
+  return planner().hybrid(section, from, next_section_centroid(section));
+}
+
+std::optional<Point2D> CCoverageModule::next_section_centroid(const Section& section) const {
+  // The planner visits a room's sections nearest first (CSectionSplitter::on_answer), so the
+  // next one is most likely the nearest section not cleaned yet; a path that ends on its side
+  // saves the walk across this one.
+  std::optional<Point2D> next;
+  double best = std::numeric_limits<double>::infinity();
+  for (const Section& s : splitter_->sections().sections) {
+    if (s.name == section.name) continue;
+    if (const auto p = progress_.find(s.name); p != progress_.end() && p->second.finished) continue;
+    const double d = std::hypot(s.centroid.x_m - section.centroid.x_m, s.centroid.y_m - section.centroid.y_m);
+    if (d < best) {
+      best = d;
+      next = s.centroid;
+    }
+  }
+  return next;
 }
 
 const CoverageResult& CCoverageModule::entry_plan(const Section& section, Point2D from) {

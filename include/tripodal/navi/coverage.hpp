@@ -129,13 +129,18 @@ class CoveragePlanner final {
   [[nodiscard]] CoverageResult boustrophedon(const Section& section, std::optional<Point2D> start = std::nullopt);
 
   /// Walls by balloon, floor by plough: round 0 of the balloon (tangent to every wall, obstacle
-  /// and virtual wall, pieces nearest first), then straight lanes over the region whose offset
-  /// leaves a full spacing to that round, spread evenly at most one spacing apart. Lanes that
-  /// overlap one to one from lane to lane form the cells of a boustrophedon decomposition, each
-  /// swept in one go, nearest end first; the direction (rows or columns) whose path costs less
-  /// (length + turn_cost_m per turn) is kept. Links go around obstacles (the planner); the
-  /// touch-up then visits what is left, nearest first.
-  [[nodiscard]] CoverageResult hybrid(const Section& section, std::optional<Point2D> start = std::nullopt);
+  /// and virtual wall; its pieces joined where their ends meet, so the round around an obstacle
+  /// is one loop), then straight lanes over the region whose offset leaves a full spacing to
+  /// that round, spread evenly at most one spacing apart. Lanes that overlap one to one from lane
+  /// to lane form the cells of a boustrophedon decomposition, each swept in one go. The lane
+  /// cells and the open pieces of the round are toured in the order of least travel (exact up to
+  /// kExactTourItems items, nearest-next beyond), ending near `finish_near` when given (where the
+  /// robot goes next); each closed loop is walked from the point of the tour nearest to it. The
+  /// direction (rows or columns) whose path costs less (length + turn_cost_m per turn + the way
+  /// on to finish_near) is kept. Links go around obstacles (the planner); the touch-up then
+  /// visits what is left, nearest first.
+  [[nodiscard]] CoverageResult hybrid(const Section& section, std::optional<Point2D> start = std::nullopt,
+                                      std::optional<Point2D> finish_near = std::nullopt);
 
   [[nodiscard]] const CoverageOptions& options() const noexcept { return options_; }
   [[nodiscard]] PathPlanner& planner() noexcept { return planner_; }
@@ -154,12 +159,26 @@ class CoveragePlanner final {
   /// `cur` takes them (nearest piece next); nullopt if it has no boundary.
   [[nodiscard]] std::optional<std::vector<RoundPiece>> round_pieces(Workspace& ws, const std::vector<std::uint8_t>& in_round,
                                                                     CellIndex cur) const;
+  /// Joins pieces whose ends are a few cells apart in plain sight; marks closed the ones whose
+  /// ends meet (hybrid: the round around an obstacle as one loop, not four sides).
+  void join_pieces(std::vector<RoundPiece>& pieces);
+  /// The shortest way from a to b over traversable cells within `margin` cells of both, at most
+  /// 2 * margin cells between them (filled in `between`, a and b excluded); false when none.
+  [[nodiscard]] bool local_path(CellIndex a, CellIndex b, int margin, std::vector<CellIndex>& between) const;
   /// Links to the piece's first cell and walks it (the start, if the path is empty).
   void append_piece(CoverageResult& r, CellIndex& cur, const RoundPiece& piece, std::optional<Point2D> start);
   /// Lanes over `mask` (window rows or columns), swept cell by cell of the decomposition, and the
   /// round's pieces, in one nearest-next tour.
   void plough(Workspace& ws, const std::vector<std::uint8_t>& mask, bool rows, const std::vector<RoundPiece>& pieces,
-              CellIndex& cur, CoverageResult& r, std::optional<Point2D> start);
+              CellIndex& cur, CoverageResult& r, std::optional<Point2D> start, std::optional<Point2D> finish_near);
+  /// Up to this many lane cells and open round pieces, plough orders them exactly.
+  static constexpr std::size_t kExactTourItems = 10;
+  /// Walks a closed piece (the round around an obstacle) from the point of the path since
+  /// `tour_begin` nearest to it and back, or after the path's end when that is cheaper.
+  void insert_round(CoverageResult& r, CellIndex& cur, const RoundPiece& piece, std::size_t tour_begin,
+                    std::optional<Point2D> start);
+  /// Links to a closed piece's cell nearest to `cur` and walks it round.
+  void append_from(CoverageResult& r, CellIndex& cur, const RoundPiece& piece, std::optional<Point2D> start);
   [[nodiscard]] CellIndex start_cell(std::optional<Point2D> start) const noexcept;
 
   OccupancyGrid grid_;

@@ -137,6 +137,8 @@ class CCoverageModule final : public CNaviModules {
 
  private:
   [[nodiscard]] CoverageResult plan(const Section& section, Point2D from);
+  /// The centroid of the nearest section not cleaned yet (where the hybrid path should end).
+  [[nodiscard]] std::optional<Point2D> next_section_centroid(const Section& section) const;
   void plan_detour(const Pose2D& pose, ModuleContext& context);
 
   std::vector<std::string> serves_;
