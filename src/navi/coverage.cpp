@@ -653,7 +653,8 @@ void CoveragePlanner::plough(Workspace& ws, const std::vector<std::uint8_t>& mas
   const CellIndex first_at = cur;
   const auto link_m = [&](CellIndex from, CellIndex to) { return from.x < 0 ? 0.0 : metres(from, to); };
   if (items > 0 && items <= kExactTourItems) {
-    const std::size_t masks = std::size_t{1} << items, kWays = 4;
+    constexpr std::size_t kWays = 4;
+    const std::size_t masks = std::size_t{1} << items;
     const auto at = [&](std::size_t set, std::size_t i, std::size_t w) { return (set * items + i) * kWays + w; };
     std::vector<double> cost(masks * items * kWays, std::numeric_limits<double>::infinity());
     std::vector<std::uint32_t> parent(cost.size(), 0);
@@ -789,7 +790,7 @@ void CoveragePlanner::join_pieces(std::vector<RoundPiece>& pieces) {
     }
   }
   for (RoundPiece& p : pieces) {
-    if (!p.closed && p.cells.size() > 2 * kGap && near(p.cells.back(), p.cells.front())) {
+    if (!p.closed && p.cells.size() > std::size_t{2} * kGap && near(p.cells.back(), p.cells.front())) {
       p.cells.insert(p.cells.end(), between.begin(), between.end());
       p.closed = true;
     }
@@ -802,11 +803,13 @@ bool CoveragePlanner::local_path(CellIndex a, CellIndex b, int margin, std::vect
   // failing for ends that a wall separates.
   const int x0 = std::min(a.x, b.x) - margin, y0 = std::min(a.y, b.y) - margin;
   const int w = std::abs(a.x - b.x) + 2 * margin + 1, h = std::abs(a.y - b.y) + 2 * margin + 1;
-  const auto index = [&](CellIndex c) { return static_cast<std::size_t>((c.y - y0) * w + (c.x - x0)); };
+  const auto index = [&](CellIndex c) {
+    return static_cast<std::size_t>(c.y - y0) * static_cast<std::size_t>(w) + static_cast<std::size_t>(c.x - x0);
+  };
   const auto open = [&](CellIndex c) {
     return c.x >= x0 && c.y >= y0 && c.x < x0 + w && c.y < y0 + h && grid_.contains(c) && planner_.traversable(c);
   };
-  std::vector<int> from(static_cast<std::size_t>(w * h), -1);
+  std::vector<int> from(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), -1);
   std::vector<CellIndex> queue{a};
   from[index(a)] = static_cast<int>(index(a));
   for (std::size_t q = 0; q < queue.size(); ++q) {
@@ -828,7 +831,7 @@ bool CoveragePlanner::local_path(CellIndex a, CellIndex b, int margin, std::vect
     between.push_back({x0 + static_cast<int>(i) % w, y0 + static_cast<int>(i) / w});
   }
   std::reverse(between.begin(), between.end());
-  return between.size() <= static_cast<std::size_t>(2 * margin);
+  return between.size() <= 2 * static_cast<std::size_t>(margin);
 }
 
 void CoveragePlanner::insert_round(CoverageResult& r, CellIndex& cur, const RoundPiece& piece, std::size_t tour_begin,
