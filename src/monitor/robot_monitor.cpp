@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <mutex>
 #include <set>
@@ -14,6 +16,7 @@
 #include "tripodal/board/board_hardware.hpp"
 #include "tripodal/core/net_loader.hpp"
 #include "tripodal/navi/grid_maps.hpp"
+#include "tripodal/navi/mapping_module.hpp"
 #include "tripodal/navi/section_splitter.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
 #include "net_drawing.hpp"
@@ -312,6 +315,51 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
     if (try_reload(pending_reload->request, pending_reload->run, pending_reload->text, pending_reload->source, last)) pending_reload.reset();
   }
 
+  // Live mapping (navi::CMappingModule): begin, end, status, save NAME into options.map_dir.
+  void map_request(const OperatorRequest& r, const json& body) {
+    auto reply = [&](int status, const json& j) { server.answer(r.id, status, j.dump()); };
+    auto* mapper = robot.module<navi::CMappingModule>();
+    if (mapper == nullptr) return reply(404, {{"error", "map: the robot has no MapBuilder module (add one to its profile's navigation)"}});
+    const std::string action = body.value("action", "");
+    const auto status = [&] {
+      return json{{"mapping", mapper->mapping()}, {"scans", mapper->scans()}, {"quality", mapper->last_quality()}};
+    };
+    if (action == "begin") {
+      // in the frame of the robot's current estimate, so a new map overlays the one it runs on
+      mapper->begin(robot.navigation().map_from_base);
+      note("operator: mapping begun");
+      return reply(200, status());
+    }
+    if (action == "end") {
+      mapper->end();
+      note("operator: mapping ended after " + std::to_string(mapper->scans()) + " scans");
+      return reply(200, status());
+    }
+    if (action == "status") return reply(200, status());
+    if (action == "save") {
+      if (options.map_dir.empty()) return reply(403, {{"error", "map: saving is off (the application sets the monitor's map folder)"}});
+      const std::string name = body.contains("name") && body["name"].is_string() ? body["name"].get<std::string>() : "";
+      // a bare file name: the operator chooses the name, never the folder
+      const bool plain = !name.empty() && name.size() <= 64 && name.front() != '.' &&
+                         std::all_of(name.begin(), name.end(), [](char c) {
+                           return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-' || c == '.';
+                         });
+      if (!plain) return reply(400, {{"error", "map: expected \"name\": letters, digits, '_', '-' or '.', at most 64, not starting with '.'"}});
+      const std::filesystem::path file = options.map_dir / (name + ".yaml");
+      try {
+        std::filesystem::create_directories(options.map_dir);
+        mapper->save(file);
+      } catch (const std::exception& e) {
+        return reply(409, {{"error", std::string("map: ") + e.what()}});
+      }
+      note("operator: map saved to " + file.string());
+      json j = status();
+      j["saved"] = file.string();
+      return reply(200, j);
+    }
+    reply(400, {{"error", "map: expected \"action\": begin, end, status or save"}});
+  }
+
   void reload(const OperatorRequest& r, const json& body) {
     auto reply = [&](int status, const json& j) { server.answer(r.id, status, j.dump()); };
     if (!body.contains("run") || !body["run"].is_string() || !body.contains("xml") || !body["xml"].is_string()) {
@@ -388,6 +436,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
       return reply(200, {{"run", run}, {"process", process->name()}, {"xml", net_to_string(process->net(), NetFormat::native_xml)}});
     }
     if (op == "reload") return reload(r, body);
+    if (op == "map") return map_request(r, body);
     if (op == "breakpoint") {
       if (!body.contains("place") || !body["place"].is_string() || body["place"].get<std::string>().empty()) {
         return reply(400, {{"error", "breakpoint: expected \"place\": a place id or name"}});
@@ -399,7 +448,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
       note("monitor: breakpoint " + std::string(on ? "set" : "cleared") + " on place " + place);
       return reply(200, {{"breakpoints", std::vector<std::string>(breakpoints.begin(), breakpoints.end())}});
     }
-    reply(400, {{"error", "unknown op '" + op + "': expected task, pause, resume, cancel, ack, breakpoint, drive, net or reload"}});
+    reply(400, {{"error", "unknown op '" + op + "': expected task, pause, resume, cancel, ack, breakpoint, drive, net, reload or map"}});
   }
 
   // --- topics -------------------------------------------------------------------------------------

@@ -118,6 +118,13 @@ OccupancyGrid MapBuilder::grid_around(Point2D center) const {
                  clip(std::ceil(cy + r), height_));
 }
 
+OccupancyGrid MapBuilder::grid_within(Point2D lower, Point2D upper) const {
+  const double res = options_.resolution_m;
+  auto clip = [](double v, int hi) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(hi))); };
+  return grid_of(clip(std::floor((lower.x_m - origin_.x_m) / res), width_), clip(std::floor((lower.y_m - origin_.y_m) / res), height_),
+                 clip(std::ceil((upper.x_m - origin_.x_m) / res), width_), clip(std::ceil((upper.y_m - origin_.y_m) / res), height_));
+}
+
 OccupancyGrid MapBuilder::grid_of(int x0, int y0, int x1, int y1) const {
   const double res = options_.resolution_m;
   OccupancyGrid g(x1 - x0, y1 - y0, res, Pose2D{origin_.x_m + x0 * res, origin_.y_m + y0 * res, 0.0}, Occupancy::unknown);

@@ -2,6 +2,7 @@
 
 #include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/navi/localizer.hpp"
+#include "tripodal/navi/mapping_module.hpp"
 #include "tripodal/navi/planning_modules.hpp"
 #include "tripodal/navi/scan_matching_localizer.hpp"
 #include "tripodal/navi/section_splitter.hpp"
@@ -31,6 +32,7 @@ void register_navigation_modules(ModuleRegistry& registry) {
   registry.add<CSectionSplitter>();
   registry.add<CLocalizer>();
   registry.add<CScanMatchingLocalizer>();
+  registry.add<CMappingModule>();
   registry.add<CPathPlanningModule>();
   registry.add<CCoverageModule>();
 }

@@ -25,6 +25,7 @@
 #include "tripodal/monitor/monitor_server.hpp"
 #include "tripodal/monitor/robot_monitor.hpp"
 #include "tripodal/monitor/wire.hpp"
+#include "tripodal/navi/map_io.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_board.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
@@ -637,4 +638,83 @@ TEST_CASE("The status carries the control board's link for a board robot and not
     REQUIRE(b["status"].is_object());
     CHECK_FALSE(b["status"]["uv_lamp"].get<bool>());  // no task: the lamp is off
   }
+}
+
+TEST_CASE("Live mapping from the console: begin, drive by hand, save a map that lines up with the world", "[monitor][robot][mapping]") {
+  Psr2 psr2;
+  Robot* robot = psr2.robot.get();
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "tripodal_monitor_mapping";
+  std::filesystem::remove_all(dir);
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0, .drive_deadman_s = 5.0, .map_dir = dir});
+  server.start();
+  auto post = [&](const std::string& body) {
+    Client c(server.port());
+    c.send("POST /api/command HTTP/1.1\r\nAuthorization: Bearer t0ken-for-tests\r\nContent-Length: " + std::to_string(body.size()) +
+           "\r\n\r\n" + body);
+    std::string answer;
+    REQUIRE(wait_for([&] {
+      watch.update();
+      answer = c.read_until([](const std::string& b) { return b.find("\r\n\r\n{") != std::string::npos && b.back() == '}'; },
+                            std::chrono::milliseconds(20));
+      return !answer.empty() && answer.back() == '}';
+    }));
+    return answer;
+  };
+  robot->run_for(std::chrono::seconds(1));  // the first scans: the localizer settles
+  CHECK_THAT(post(R"({"op":"map","action":"save","name":"early"})"), Catch::Contains("no map to save yet"));
+  CHECK_THAT(post(R"({"op":"map","action":"begin"})"), Catch::Contains(R"("mapping":true)"));
+  // a slow curve through section A, as an operator would drive it with the console's joystick
+  for (int k = 0; k < 12; ++k) {
+    CHECK_THAT(post(R"({"op":"drive","vx":0.3,"wz":)" + std::string(k < 6 ? "0.15" : "-0.15") + "}"), Catch::Contains(R"("driving":true)"));
+    robot->run_for(std::chrono::seconds(2));
+  }
+  CHECK_THAT(post(R"({"op":"drive","stop":true})"), Catch::Contains(R"("driving":false)"));
+  const std::string status = post(R"({"op":"map","action":"status"})");
+  CHECK_THAT(status, Catch::Contains(R"("mapping":true)"));
+  CHECK_THAT(post(R"({"op":"map","action":"save","name":"../escape"})"), Catch::Contains("expected \\\"name\\\""));
+  CHECK_THAT(post(R"({"op":"map","action":"fly"})"), Catch::Contains("expected \\\"action\\\": begin, end, status or save"));
+  CHECK_THAT(post(R"({"op":"map","action":"save","name":"hall-1"})"), Catch::Contains(R"("saved")"));
+  CHECK_THAT(post(R"({"op":"map","action":"end"})"), Catch::Contains(R"("mapping":false)"));
+
+  const navi::MapFile built = navi::load_map(dir / "hall-1.yaml");
+  const navi::MapFile truth =
+      navi::load_map(std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs" / "worlds" / "workspace_map.yaml");
+  std::size_t marked = 0, on_wall = 0;
+  for (std::size_t i = 0; i < built.grid.size(); ++i) {
+    if (built.grid.state(i) != navi::Occupancy::occupied) continue;
+    ++marked;
+    const Point2D p = built.grid.cell_center(built.grid.cell(i));
+    bool near = false;
+    for (double dy = -0.05; dy <= 0.051 && !near; dy += 0.05) {
+      for (double dx = -0.05; dx <= 0.051 && !near; dx += 0.05) {
+        const auto c = truth.grid.world_to_cell({p.x_m + dx, p.y_m + dy});
+        near = c && truth.grid.is_occupied(*c);
+      }
+    }
+    on_wall += near ? 1 : 0;
+  }
+  INFO(marked << " occupied cells, " << on_wall << " on a wall of the world");
+  REQUIRE(marked > 300);
+  CHECK(static_cast<double>(on_wall) > 0.9 * static_cast<double>(marked));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("Map requests without a map folder or a MapBuilder are refused", "[monitor][robot][mapping]") {
+  Psr2 psr2;
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
+  server.start();
+  Client c(server.port());
+  const std::string body = R"({"op":"map","action":"save","name":"x"})";
+  c.send("POST /api/command HTTP/1.1\r\nAuthorization: Bearer t0ken-for-tests\r\nContent-Length: " + std::to_string(body.size()) +
+         "\r\n\r\n" + body);
+  std::string answer;
+  REQUIRE(wait_for([&] {
+    watch.update();
+    answer = c.read_until([](const std::string& b) { return b.find("\r\n\r\n{") != std::string::npos && b.back() == '}'; },
+                          std::chrono::milliseconds(20));
+    return !answer.empty() && answer.back() == '}';
+  }));
+  CHECK_THAT(answer, Catch::Contains("403") && Catch::Contains("saving is off"));
 }

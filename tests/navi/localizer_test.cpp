@@ -126,7 +126,7 @@ TEST_CASE("CLocalizer: bad parameters and fault schedules are reported", "[navi]
 TEST_CASE("Navigation modules: every one is created by name and configured with defaults", "[navi][modules]") {
   ModuleRegistry reg("module type");
   register_navigation_modules(reg);
-  REQUIRE(reg.names() == std::vector<std::string>{"CoveragePlanner", "GridMaps", "Localizer", "PathPlanner", "ScanMatchingLocalizer",
+  REQUIRE(reg.names() == std::vector<std::string>{"CoveragePlanner", "GridMaps", "Localizer", "MapBuilder", "PathPlanner", "ScanMatchingLocalizer",
                                                   "SectionSplitter"});
   for (const std::string& name : reg.names()) {
     std::unique_ptr<CModule> m = reg.create(name);

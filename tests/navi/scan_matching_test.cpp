@@ -3,9 +3,12 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <filesystem>
 #include <numbers>
 
 #include "tripodal/navi/map_builder.hpp"
+#include "tripodal/navi/map_io.hpp"
+#include "tripodal/navi/mapping_module.hpp"
 #include "tripodal/navi/scan_matcher.hpp"
 #include "tripodal/sim/ray_caster.hpp"
 
@@ -337,4 +340,56 @@ TEST_CASE("MapBuilder: a map from drifting odometry lines up with the world and 
   MapBuilderOptions bad;
   bad.resolution_m = 0.0;
   REQUIRE_THROWS_WITH(MapBuilder({0, 0}, {5, 5}, bad), Catch::Contains("resolution_m must be a number > 0"));
+}
+
+TEST_CASE("MapBuilder module: maps only between begin and end, crops to what the beams reached, saves a map_server map",
+          "[navi][scan_matching][mapping]") {
+  const OccupancyGrid world = room();
+  const sim::SolidMap solid(world);
+  MappingOptions o;
+  o.size_m = 30.0;
+  CMappingModule mapper(o);
+  DriftingOdometry odo;
+  CHECK_FALSE(mapper.map().has_value());
+  mapper.add(scan_at(solid, true_pose(0)), odo.read(true_pose(0)));  // not mapping yet: ignored
+  CHECK(mapper.scans() == 0);
+  CHECK_THROWS_WITH(mapper.save(std::filesystem::temp_directory_path() / "tripodal_no_map.yaml"),
+                    Catch::Contains("no map to save yet"));
+
+  mapper.begin(true_pose(0));
+  for (int k = 0; k <= 200; k += 2) mapper.add(scan_at(solid, true_pose(k)), odo.read(true_pose(k)));
+  CHECK(mapper.scans() == 101);
+  CHECK(distance(mapper.pose(), true_pose(200)) < 0.1);
+  mapper.end();
+  CHECK_FALSE(mapper.mapping());
+  mapper.add(scan_at(solid, true_pose(202)), odo.read(true_pose(202)));
+  CHECK(mapper.scans() == 101);
+
+  const std::optional<OccupancyGrid> map = mapper.map();
+  REQUIRE(map.has_value());
+  // cropped to the room (10 m x 8 m and the scanner's reach within it), not the 30 m square
+  CHECK(map->width() * map->resolution_m() < 11.0);
+  CHECK(map->height() * map->resolution_m() < 9.0);
+  std::size_t marked = 0, on_wall = 0;
+  for (std::size_t i = 0; i < map->size(); ++i) {
+    if (map->state(i) != Occupancy::occupied) continue;
+    ++marked;
+    const Point2D p = map->cell_center(map->cell(i));
+    bool near = false;
+    for (double dy = -0.05; dy <= 0.051 && !near; dy += 0.05) {
+      for (double dx = -0.05; dx <= 0.051 && !near; dx += 0.05) near = world.is_occupied(world.cell_at({p.x_m + dx, p.y_m + dy}));
+    }
+    on_wall += near ? 1 : 0;
+  }
+  REQUIRE(marked > 500);
+  CHECK(static_cast<double>(on_wall) > 0.95 * static_cast<double>(marked));
+
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "tripodal_mapping_test";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  mapper.save(dir / "room.yaml");
+  const MapFile saved = load_map(dir / "room.yaml");
+  CHECK(saved.grid.width() == map->width());
+  CHECK(saved.grid.count(Occupancy::occupied) == map->count(Occupancy::occupied));
+  std::filesystem::remove_all(dir);
 }

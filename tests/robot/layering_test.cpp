@@ -204,7 +204,7 @@ TEST_CASE("The robot refuses to start with every problem listed", "[robot]") {
       CHECK_THAT(m, Catch::Contains("psr2.yaml:13:3: error: unknown hardware type 'sim'; known: none; register it"));
       CHECK_THAT(m, Catch::Contains("psr2.yaml:16:5: error: unknown controller type 'omni'; known: none; register it"));
       CHECK_THAT(m, Catch::Contains("psr2.yaml:26:5: error: unknown navigation type 'GridMaps'; known: none; register it"));
-      CHECK_THAT(m, Catch::Contains("psr2.yaml:51:13: error: unknown behavior type 'BhAutoMove'; known: none; register it"));
+      CHECK_THAT(m, Catch::Contains("psr2.yaml:55:13: error: unknown behavior type 'BhAutoMove'; known: none; register it"));
     }
   }
   SECTION("a process binding a behavior the robot lacks; a task naming a process it lacks") {

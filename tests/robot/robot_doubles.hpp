@@ -189,12 +189,15 @@ inline RobotPlugins test_plugins(TestWorld& world) {
   static ModuleManifest coverage = module_manifest(
       "CoveragePlanner", {"grid_map", "sections"}, {"coverage_path"},
       {ParameterSpec{"cleaning_width_m", ValueType::number, Value{0.4}, "m", "", {}, {}}});
+  static ModuleManifest mapping = module_manifest("MapBuilder", {"laser_scan", "odometry"}, {"built_map"});
   PassiveModule<0>::manifest_of = &maps;
   PassiveModule<1>::manifest_of = &planner;
   PassiveModule<2>::manifest_of = &coverage;
+  PassiveModule<3>::manifest_of = &mapping;
   p.modules.add<PassiveModule<0>>();
   p.modules.add<PassiveModule<1>>();
   p.modules.add<PassiveModule<2>>();
+  p.modules.add<PassiveModule<3>>();
   static const ModuleManifest laser = [] {
     ModuleManifest m = resource_manifest<LaserScan>();
     m.name = "LaserScanner";

@@ -60,7 +60,8 @@ TEST_CASE("PSR-2 assembles from its profile with the paper's nets", "[robot]") {
   CHECK(p.robot->processes().names() == std::vector<std::string>{"PrAutoMove", "PrCleaning", "PrGlobalLocalization", "PrWait"});
   CHECK(p.robot->module("localizer") != nullptr);
   CHECK(p.robot->module("BhCleaning") == nullptr);
-  CHECK(p.robot->modules().size() == 5);
+  CHECK(p.robot->modules().size() == 6);
+  CHECK(p.robot->module("mapping") != nullptr);
   CHECK(p.robot->hardware() != nullptr);
   REQUIRE(p.robot->loop("motion") != nullptr);
   CHECK(&p.robot->behavior_loop() == p.robot->loop("motion"));
@@ -68,8 +69,8 @@ TEST_CASE("PSR-2 assembles from its profile with the paper's nets", "[robot]") {
   CHECK(p.robot->behavior_loop().controller() != nullptr);
   CHECK(p.robot->behavior_loop().period() == std::chrono::milliseconds(10));
   const auto& mods = p.robot->description().modules;
-  // core components, hardware, controller, five navigation modules, four behaviors
-  REQUIRE(mods.size() == 3 + 1 + 1 + 5 + 4);
+  // core components, hardware, controller, six navigation modules (with the live mapper), four behaviors
+  REQUIRE(mods.size() == 3 + 1 + 1 + 6 + 4);
   CHECK(mods[0].name == "planner");
   CHECK(mods[0].inputs == std::vector<std::string>{"sections", "process_result"});
 }

@@ -246,7 +246,9 @@ RunResult run_task(const RunOptions& o) {
     monitor::MonitorServerOptions so = monitor::server_options(*o.monitor, o.monitor_token_file);
     so.read_without_token = o.monitor_read_open;
     server = std::make_unique<monitor::MonitorServer>(std::move(so));
-    watch = std::make_unique<monitor::RobotMonitor>(*robot, clock, *server, monitor::RobotMonitorOptions{.start_paused = o.start_paused});
+    // the operator's live maps go beside the run's own outputs
+    watch = std::make_unique<monitor::RobotMonitor>(*robot, clock, *server,
+                                                    monitor::RobotMonitorOptions{.start_paused = o.start_paused, .map_dir = o.out});
     server->start();
     if (o.log != nullptr) {
       *o.log << "monitor: " << server->url() << "  (token " << server->token() << (o.start_paused ? "; paused until resumed" : "")

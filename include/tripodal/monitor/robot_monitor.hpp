@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -31,6 +32,9 @@ struct RobotMonitorOptions {
   /// at each update() (between periods) for this long (wall time), then refused. Less than the
   /// server's answer_timeout_s.
   double reload_wait_s = 2.0;
+  /// Where the operator's "map save NAME" writes NAME.yaml and NAME.pgm (live mapping, a
+  /// MapBuilder module); empty: saving is refused.
+  std::filesystem::path map_dir;
 };
 
 /// What the application knows beyond the robot: the simulator's true pose, the measured coverage

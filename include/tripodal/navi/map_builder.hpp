@@ -60,6 +60,8 @@ class MapBuilder {
   [[nodiscard]] OccupancyGrid grid() const;
   /// The same over the cells within window_m of `center` (clipped to the grid).
   [[nodiscard]] OccupancyGrid grid_around(Point2D center) const;
+  /// The same over the cells of the box [lower, upper] (map frame, clipped to the grid).
+  [[nodiscard]] OccupancyGrid grid_within(Point2D lower, Point2D upper) const;
 
  private:
   [[nodiscard]] OccupancyGrid grid_of(int x0, int y0, int x1, int y1) const;
