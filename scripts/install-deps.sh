@@ -27,6 +27,8 @@ packages+=(libgraphviz-dev python3 python3-websockets)
 # compiler idlc, which generates the message types at build time. Without them the build leaves
 # the dds area out (TRIPODAL_DDS=OFF).
 packages+=(cyclonedds-dev cyclonedds-tools)
+# The HRI (tripodal::hri, docs/hri.md): Xapian ranks the knowledge base (BM25, English stemming).
+packages+=(libxapian-dev)
 
 for group in "$@"; do
   case $group in
