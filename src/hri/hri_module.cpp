@@ -43,7 +43,9 @@ RetrievalOptions retrieval_options(const TaskLibrary& tasks) {
 // Polite openings and closings around a command ("could you please guide me to node 1"): the
 // task templates are written without them.
 std::vector<std::string> without_politeness(std::vector<std::string> ws) {
-  static const std::array<std::vector<std::string_view>, 10> kLeads = {{
+  static const std::array<std::vector<std::string_view>, 12> kLeads = {{
+      {"let", "s"},
+      {"let", "us"},
       {"i", "would", "like", "you", "to"},
       {"i", "want", "you", "to"},
       {"can", "you"},
@@ -222,7 +224,9 @@ HriReply HriModule::handle(std::string_view utterance) {
   const bool confident = !r.hits.empty() && r.hits.front().confidence >= options_.confidence_threshold;
   const bool starts_like_command = !command_words.empty() && std::find(command_words_.begin(), command_words_.end(),
                                                                        command_words.front()) != command_words_.end();
-  if (!u.task.empty() || (starts_like_command && !(confident && !entries_[r.hits.front().entry].action.empty()))) {
+  const bool action_covers = !r.hits.empty() && r.hits.front().confidence >= options_.command_confidence_threshold &&
+                             !entries_[r.hits.front().entry].action.empty();
+  if (!u.task.empty() || (starts_like_command && !action_covers)) {
     reply.kind = HriReply::Kind::task_refused;
     reply.task = u.task;
     reply.text = plain_refusal(u.explanation);

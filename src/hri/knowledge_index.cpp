@@ -19,6 +19,8 @@ namespace {
 constexpr Xapian::termcount kKeywordWdf = 3;
 constexpr Xapian::termcount kTopicWdf = 2;
 constexpr Xapian::termcount kQuestionWdf = 1;
+// How much a stop word of the utterance counts in the ranking, relative to a content word.
+constexpr double kStopWordScale = 0.2;
 
 }  // namespace
 
@@ -35,17 +37,16 @@ struct KnowledgeIndex::Impl {
 
   void index_text(Xapian::Document& doc, std::string_view text, Xapian::termcount wdf, std::set<std::string>& words_seen) {
     const std::vector<std::string> ws = hri::words(text);
-    const bool all_stop = std::all_of(ws.begin(), ws.end(), [](const std::string& w) { return hri::is_stop_word(w); });
     for (const auto& w : ws) {
       words_seen.insert(w);
-      // A question made of stop words only ("what is that?") still says something.
-      if (hri::is_stop_word(w) && !all_stop) continue;
+      // Stop words are indexed too: the query weighs them little, but they tell apart entries
+      // whose telling words are the same ("what can you do" vs "how are you").
       doc.add_term(term(w), wdf);
     }
   }
 
   [[nodiscard]] std::string corrected_word(const std::string& w) const {
-    if (known.count(w) != 0 || hri::has_digit(w) || db.term_exists(term(w))) return w;
+    if (known.count(w) != 0 || hri::is_stop_word(w) || hri::has_digit(w) || db.term_exists(term(w))) return w;
     const std::size_t limit = w.size() >= 7 ? 2 : (w.size() >= 4 ? 1 : 0);
     if (limit == 0) return w;
     std::string best;
@@ -110,13 +111,17 @@ Retrieval KnowledgeIndex::search(std::string_view utterance) const {
   for (auto& w : ws) w = x.corrected_word(w);
   for (const auto& w : ws) r.corrected += (r.corrected.empty() ? "" : " ") + w;
 
-  std::vector<std::string> content;
-  for (const auto& w : ws) {
-    if (!hri::is_stop_word(w)) content.push_back(w);
-  }
-  if (content.empty()) content = ws;
+  // Content words decide the confidence; stop words only break ties between entries (weighed
+  // kStopWordScale), unless the utterance has nothing else ("who are you" without "who"...).
   std::set<std::string> terms;
-  for (const auto& w : content) terms.insert(x.term(w));
+  std::set<std::string> stop_terms;
+  for (const auto& w : ws) {
+    if (!hri::is_stop_word(w)) terms.insert(x.term(w));
+  }
+  for (const auto& w : ws) {
+    if (hri::is_stop_word(w) && terms.count(x.term(w)) == 0) stop_terms.insert(x.term(w));
+  }
+  if (terms.empty()) terms.swap(stop_terms);
   if (terms.empty() || x.db.get_doccount() == 0) return r;
 
   // The confidence weighs each term by its inverse document frequency, so a match on a rare,
@@ -133,7 +138,14 @@ Retrieval KnowledgeIndex::search(std::string_view utterance) const {
   }
 
   Xapian::Enquire enquire(x.db);
-  enquire.set_query(Xapian::Query(Xapian::Query::OP_OR, terms.begin(), terms.end()));
+  Xapian::Query query(Xapian::Query::OP_OR, terms.begin(), terms.end());
+  if (!stop_terms.empty()) {
+    query = Xapian::Query(Xapian::Query::OP_OR, query,
+                          Xapian::Query(Xapian::Query::OP_SCALE_WEIGHT,
+                                        Xapian::Query(Xapian::Query::OP_OR, stop_terms.begin(), stop_terms.end()),
+                                        kStopWordScale));
+  }
+  enquire.set_query(query);
   const Xapian::MSet mset = enquire.get_mset(0, static_cast<Xapian::doccount>(x.options.max_results));
   for (auto it = mset.begin(); it != mset.end(); ++it) {
     RetrievalHit hit;

@@ -9,8 +9,12 @@ namespace tripodal::hri {
 std::vector<std::string> words(std::string_view text) {
   std::vector<std::string> out;
   std::string word;
-  for (const char c : text) {
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
     const auto u = static_cast<unsigned char>(c);
+    // "PSR-1" is one name, "psr1": a hyphen before a digit joins (the digit would otherwise match
+    // every other "1" of the base).
+    if (c == '-' && !word.empty() && i + 1 < text.size() && text[i + 1] >= '0' && text[i + 1] <= '9') continue;
     if ((u >= 'a' && u <= 'z') || (u >= '0' && u <= '9') || u >= 0x80) {
       word += c;
     } else if (u >= 'A' && u <= 'Z') {
@@ -27,13 +31,12 @@ std::vector<std::string> words(std::string_view text) {
 bool is_stop_word(std::string_view word) noexcept {
   // Sorted for binary search. Kept short on purpose: "who", "where", "how" and "you" stay out
   // because entries are told apart by them ("who are you" vs "where are you").
-  static constexpr std::array<std::string_view, 64> kStop = {
-      "a",     "about", "am",   "an",    "and",  "any",   "are",    "at",    "be",   "can",   "could",
-      "d",     "do",    "does", "for",   "give", "i",     "in",     "is",    "it",   "just",  "kindly",
-      "know",  "let",   "ll",   "m",     "me",   "might", "my",     "now",   "of",   "on",    "or",
-      "please", "pls",  "re",   "s",     "say",  "shall", "should", "so",    "some", "t",     "tell",
-      "than",  "that",  "the",  "there", "this", "to",    "too",    "us",    "ve",   "very",  "want",
-      "was",   "we",    "what", "whats", "will", "with",  "would",  "yes",   "your"};
+  static constexpr std::array<std::string_view, 66> kStop = {
+      "a", "about", "am", "an", "and", "any", "anything", "are", "at", "be", "can", "could", "d", "do",
+      "does", "for", "give", "i", "in", "is", "it", "just", "kindly", "know", "let", "ll", "m", "me", "might",
+      "my", "now", "of", "on", "or", "please", "pls", "re", "s", "say", "shall", "should", "so", "some",
+      "something", "t", "tell", "than", "that", "the", "there", "this", "to", "too", "us", "ve", "very",
+      "want", "was", "we", "what", "whats", "will", "with", "would", "yes", "your"};
   return std::binary_search(kStop.begin(), kStop.end(), word);
 }
 

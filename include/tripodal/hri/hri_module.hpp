@@ -21,6 +21,10 @@ struct HriOptions {
   /// Below this confidence (KnowledgeIndex's coverage of the utterance) the HRI says it did not
   /// understand and offers the closest topics.
   double confidence_threshold = 0.5;
+  /// An input that starts like a command ("take me to ...") but that the planner refuses is
+  /// answered from the RKMS instead only when an entry with an action covers it this well
+  /// ("take me to PSR-2"); otherwise the planner's refusal is spoken ("take me to node").
+  double command_confidence_threshold = 0.75;
   /// How many topics a "did not understand" offers.
   std::size_t offered_topics = 3;
   /// The longest utterance considered (bytes); a longer one is refused unread.
