@@ -117,7 +117,7 @@ TEST_CASE("answers fill their placeholders from the providers, which follow the 
   CHECK(jinny.started.empty());
 }
 
-TEST_CASE("a command input becomes a plan for the planner; an entry's action starts one after the answer") {
+TEST_CASE("a command input becomes a plan for the planner, and an entry's action starts one after the answer") {
   Jinny jinny;
   const HriReply guide = jinny.hri.handle("Could you guide me to node 1, please?");
   CHECK(guide.kind == HriReply::Kind::task_started);

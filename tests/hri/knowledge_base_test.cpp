@@ -96,7 +96,7 @@ TEST_CASE("a knowledge base written by to_xml reads back the same") {
   CHECK(again.entries() == kb.entries());
 }
 
-TEST_CASE("placeholders: names of lower-case letters, digits and '_'; doubled braces are literal") {
+TEST_CASE("placeholders: names of lower-case letters, digits and '_', doubled braces are literal") {
   CHECK(scan_placeholders("It is {time}, {battery_2}. {{not}} }}").placeholders.size() == 2);
   CHECK(scan_placeholders("It is {time").error == "unclosed '{' at byte 6; expected {provider} or '{{' for a brace");
   CHECK(scan_placeholders("a } b").error == "'}' at byte 2 closes nothing; write '}}' for a brace");
@@ -167,7 +167,7 @@ TEST_CASE("malformed knowledge files: each error located at FILE:LINE:COL") {
   }
 }
 
-TEST_CASE("save writes the next version atomically; a stale copy is refused and the file is unchanged") {
+TEST_CASE("save writes the next version atomically, a stale copy is refused and the file is unchanged") {
   const TempDir dir;
   const fs::path file = dir.path / "kb.xml";
   write(file, kSmall);
