@@ -29,6 +29,9 @@ packages+=(libgraphviz-dev python3 python3-websockets)
 packages+=(cyclonedds-dev cyclonedds-tools)
 # The HRI (tripodal::hri, docs/hri.md): Xapian ranks the knowledge base (BM25, English stemming).
 packages+=(libxapian-dev)
+# Its voice (optional, TRIPODAL_VOICE): espeak-ng synthesises, pocketsphinx recognises with the
+# US English acoustic model.
+packages+=(libespeak-ng-dev libpocketsphinx-dev pocketsphinx-en-us)
 
 for group in "$@"; do
   case $group in

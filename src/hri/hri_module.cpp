@@ -196,6 +196,17 @@ HriReply HriModule::answer(const KnowledgeEntry& entry, double confidence) {
   return reply;
 }
 
+HriReply HriModule::handle_heard(const SpeechRecognizer::Result& heard) {
+  if (!heard.words.empty() && heard.confidence < options_.min_recognition_confidence) {
+    HriReply reply;
+    reply.kind = HriReply::Kind::not_understood;
+    reply.confidence = heard.confidence;
+    reply.text = "Sorry, I did not catch that. Could you say it again?";
+    return reply;
+  }
+  return handle(typed_form(heard.words));
+}
+
 HriReply HriModule::handle(std::string_view utterance) {
   HriReply reply;
   reply.kind = HriReply::Kind::refused_input;

@@ -13,6 +13,7 @@
 #include "tripodal/hri/answer_providers.hpp"
 #include "tripodal/hri/knowledge_base.hpp"
 #include "tripodal/hri/knowledge_index.hpp"
+#include "tripodal/hri/speech.hpp"
 #include "tripodal/planner/task_library.hpp"
 
 namespace tripodal {
@@ -29,6 +30,10 @@ struct HriOptions {
   std::size_t offered_topics = 3;
   /// The longest utterance considered (bytes); a longer one is refused unread.
   std::size_t max_utterance_bytes = 500;
+  /// A recognised utterance less sure than this (SpeechRecognizer::Result::confidence) is not
+  /// acted on: "Sorry, I did not catch that." A recognizer with a closed language model hears
+  /// any sound as one of its sentences; the posterior is low when the sound was something else.
+  double min_recognition_confidence = 0.002;
 };
 
 /// What the HRI did with one input.
@@ -65,6 +70,10 @@ class HriModule {
 
   /// Classifies and handles one typed or recognised input. Never throws for any input.
   HriReply handle(std::string_view utterance);
+  /// A spoken input: below min_recognition_confidence it is not understood ("Sorry, I did not
+  /// catch that. Could you say it again?"); otherwise its words, in typed form ("node one" ->
+  /// "node 1"), are handled as typed.
+  HriReply handle_heard(const SpeechRecognizer::Result& heard);
 
   /// The robot's internal state as the HRI shows it ("task guide: running", set by the robot).
   void set_status(std::string status) { status_ = std::move(status); }
