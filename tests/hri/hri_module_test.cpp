@@ -213,3 +213,16 @@ TEST_CASE("typo correction maps unknown words to the nearest known word and keep
   // Too far from any word: kept as it is.
   CHECK(jinny.hri.index().correct("xylophone") == "xylophone");
 }
+
+TEST_CASE("a heard utterance is handled in typed form, and not at all when the recognizer is unsure") {
+  Jinny jinny;
+  const HriReply sure = jinny.hri.handle_heard({"guide me to node one", 0.3});
+  CHECK(sure.kind == HriReply::Kind::task_started);
+  CHECK(to_string(sure.plan) == "PrAutoMove(goal=node1)");
+  const HriReply unsure = jinny.hri.handle_heard({"guide me to node one", 0.0005});
+  CHECK(unsure.kind == HriReply::Kind::not_understood);
+  CHECK(unsure.text == "Sorry, I did not catch that. Could you say it again?");
+  CHECK(jinny.started.size() == 1);
+  CHECK(jinny.hri.handle_heard({"tell me about p s r two", 0.1}).entry_id == "node1_robot");
+  CHECK(jinny.hri.handle_heard({"", 0.0}).kind == HriReply::Kind::refused_input);
+}
