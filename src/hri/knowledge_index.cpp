@@ -105,6 +105,16 @@ std::string KnowledgeIndex::correct(std::string_view text) const {
 }
 
 Retrieval KnowledgeIndex::search(std::string_view utterance) const {
+  try {
+    return search_unguarded(utterance);
+  } catch (const Xapian::Error&) {
+    // Xapian documents errors for I/O and corrupt databases, which an in-memory index built here
+    // should never meet; if it does, the utterance is simply not understood.
+    return {};
+  }
+}
+
+Retrieval KnowledgeIndex::search_unguarded(std::string_view utterance) const {
   const Impl& x = *impl_;
   Retrieval r;
   std::vector<std::string> ws = hri::words(utterance);

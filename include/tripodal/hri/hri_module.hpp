@@ -60,6 +60,7 @@ struct HriReply {
 /// task started, otherwise the reason it could not (spoken back).
 using TaskStarter = std::function<std::string(const Understanding&)>;
 
+/// One input at a time (the HRI's own thread or the robot's deliberate loop): not thread-safe.
 class HriModule {
  public:
   /// `tasks`, `knowledge` and `providers` must outlive the module; the base is indexed now (a

@@ -34,6 +34,7 @@ struct Retrieval {
   std::string corrected;           ///< the utterance's words after typo correction (lower case)
 };
 
+/// Not thread-safe (Xapian's objects are not): one search at a time.
 class KnowledgeIndex {
  public:
   /// Indexes `base`'s entries (a copy of each entry's terms is kept; the base itself is not
@@ -53,6 +54,8 @@ class KnowledgeIndex {
   [[nodiscard]] std::string correct(std::string_view text) const;
 
  private:
+  [[nodiscard]] Retrieval search_unguarded(std::string_view utterance) const;
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
