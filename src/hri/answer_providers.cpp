@@ -25,7 +25,7 @@ std::vector<std::string> AnswerProviders::names() const {
 
 namespace {
 
-constexpr std::int64_t kSecondsPerDay = 24 * 3600;
+constexpr std::int64_t kSecondsPerDay = std::int64_t{24} * 3600;
 
 // Seconds since the midnight before the clock's epoch.
 std::int64_t seconds_of(const Clock& clock, std::chrono::seconds start_of_day) {

@@ -43,7 +43,7 @@ RetrievalOptions retrieval_options(const TaskLibrary& tasks) {
 // Polite openings and closings around a command ("could you please guide me to node 1"): the
 // task templates are written without them.
 std::vector<std::string> without_politeness(std::vector<std::string> ws) {
-  static const std::array<std::vector<std::string_view>, 12> kLeads = {{
+  static const std::array<std::vector<std::string_view>, 12> leads = {{
       {"let", "s"},
       {"let", "us"},
       {"i", "would", "like", "you", "to"},
@@ -60,7 +60,7 @@ std::vector<std::string> without_politeness(std::vector<std::string> ws) {
   bool stripped = true;
   while (stripped && !ws.empty()) {
     stripped = false;
-    for (const auto& lead : kLeads) {
+    for (const auto& lead : leads) {
       if (ws.size() > lead.size() && std::equal(lead.begin(), lead.end(), ws.begin())) {
         ws.erase(ws.begin(), ws.begin() + static_cast<std::ptrdiff_t>(lead.size()));
         stripped = true;

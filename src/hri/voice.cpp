@@ -85,6 +85,7 @@ class PocketsphinxRecognizer final : public SpeechRecognizer {
       args.push_back(value);
     }
     std::vector<char*> argv;
+    argv.reserve(args.size());
     for (auto& a : args) argv.push_back(a.data());
     config_ = cmd_ln_parse_r(nullptr, ps_args(), static_cast<int32>(argv.size()), argv.data(), TRUE);
     if (config_ == nullptr && !lm_file_.empty()) ::unlink(lm_file_.c_str());
@@ -136,8 +137,8 @@ class PocketsphinxRecognizer final : public SpeechRecognizer {
 
 }  // namespace
 
-std::unique_ptr<SpeechSynthesizer> make_espeak_synthesizer(EspeakOptions options) {
-  return std::make_unique<EspeakSynthesizer>(std::move(options));
+std::unique_ptr<SpeechSynthesizer> make_espeak_synthesizer(const EspeakOptions& options) {
+  return std::make_unique<EspeakSynthesizer>(options);
 }
 
 std::unique_ptr<SpeechRecognizer> make_pocketsphinx_recognizer(const PocketsphinxOptions& options) {

@@ -8,7 +8,7 @@ namespace tripodal {
 
 bool voice_available() noexcept { return false; }
 
-std::unique_ptr<SpeechSynthesizer> make_espeak_synthesizer(EspeakOptions) {
+std::unique_ptr<SpeechSynthesizer> make_espeak_synthesizer(const EspeakOptions&) {
   throw std::runtime_error("this build of tripodal has no espeak-ng (TRIPODAL_VOICE=OFF; install libespeak-ng-dev)");
 }
 

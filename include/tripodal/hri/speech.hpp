@@ -100,7 +100,7 @@ struct EspeakOptions {
 /// espeak-ng, synthesising in the calling thread (its engine is one per process: calls from
 /// several synthesizers are serialised). Throws std::runtime_error when the build has no
 /// espeak-ng or its data cannot be found.
-[[nodiscard]] std::unique_ptr<SpeechSynthesizer> make_espeak_synthesizer(EspeakOptions options = {});
+[[nodiscard]] std::unique_ptr<SpeechSynthesizer> make_espeak_synthesizer(const EspeakOptions& options = {});
 
 struct PocketsphinxOptions {
   /// The acoustic model and dictionary (Debian pocketsphinx-en-us).
