@@ -226,9 +226,12 @@ HriReply HriModule::handle(std::string_view utterance) {
   }
 
   // A command input: the planner understands it, or it starts with a command's verb.
+  // The words as typed first: typo correction knows only the base's and the commands' words, and
+  // could bend a slot's value ("carry the kettle ...") towards one of them.
+  const Understanding as_typed = tasks_.understand(joined(without_politeness(hri::words(utterance))), knowledge_);
+  if (as_typed.understood) return command(as_typed);
   const std::vector<std::string> command_words = without_politeness(hri::words(corrected));
-  const std::string command_text = joined(command_words);
-  const Understanding u = tasks_.understand(command_text, knowledge_);
+  const Understanding u = tasks_.understand(joined(command_words), knowledge_);
   if (u.understood) return command(u);
 
   const Retrieval r = index_.search(utterance);
