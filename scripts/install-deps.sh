@@ -27,6 +27,11 @@ packages+=(libgraphviz-dev python3 python3-websockets)
 # compiler idlc, which generates the message types at build time. Without them the build leaves
 # the dds area out (TRIPODAL_DDS=OFF).
 packages+=(cyclonedds-dev cyclonedds-tools)
+# The HRI (tripodal::hri, docs/hri.md): Xapian ranks the knowledge base (BM25, English stemming).
+packages+=(libxapian-dev)
+# Its voice (optional, TRIPODAL_VOICE): espeak-ng synthesises, pocketsphinx recognises with the
+# US English acoustic model.
+packages+=(libespeak-ng-dev libpocketsphinx-dev pocketsphinx-en-us)
 
 for group in "$@"; do
   case $group in

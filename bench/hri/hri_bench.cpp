@@ -1,0 +1,105 @@
+// Answer latency of the HRI (issue 19): one typed utterance through HriModule::handle (the
+// planner's matching, typo correction, Xapian BM25 ranking, the answer with its providers) on
+// Jinny's base grown to 1,000 entries with generated ones. Target: < 10 ms median. Also the time
+// to index such a base (done once, when the module starts or the base changes).
+//
+//   build/rel/bench/hri/tripodal_hri_bench --benchmark_repetitions=10 --benchmark_report_aggregates_only=true
+#include <benchmark/benchmark.h>
+
+#include <random>
+#include <string>
+#include <vector>
+
+#include "tripodal/hri/hri_module.hpp"
+
+namespace {
+
+using namespace tripodal;
+using namespace std::chrono_literals;
+
+// Pronounceable made-up words (seeded): a generated base shares no vocabulary with English, so
+// the ranking really searches it rather than matching a few common words.
+std::vector<std::string> vocabulary(std::size_t n, std::mt19937& rng) {
+  static const char* const kOnsets[] = {"b", "k", "d", "f", "g", "l", "m", "n", "p", "r", "s", "t", "v", "z", "br", "st", "kr"};
+  static const char* const kVowels[] = {"a", "e", "i", "o", "u", "ai", "ou"};
+  std::vector<std::string> out;
+  std::uniform_int_distribution<int> syllables(2, 4);
+  std::uniform_int_distribution<std::size_t> onset(0, std::size(kOnsets) - 1);
+  std::uniform_int_distribution<std::size_t> vowel(0, std::size(kVowels) - 1);
+  while (out.size() < n) {
+    std::string w;
+    for (int s = syllables(rng); s > 0; --s) w += std::string(kOnsets[onset(rng)]) + kVowels[vowel(rng)];
+    out.push_back(w);
+  }
+  return out;
+}
+
+KnowledgeBase generated_base(std::size_t entries) {
+  KnowledgeBase base = KnowledgeBase::load(TRIPODAL_SOURCE_DIR "/configs/hri/jinny.xml");
+  std::mt19937 rng(19);
+  const std::vector<std::string> words = vocabulary(4000, rng);
+  std::uniform_int_distribution<std::size_t> pick(0, words.size() - 1);
+  for (std::size_t i = base.entries().size(); i < entries; ++i) {
+    KnowledgeEntry e;
+    e.id = "generated" + std::to_string(i);
+    e.topic = "the " + words[pick(rng)] + " " + words[pick(rng)];
+    for (int k = 0; k < 5; ++k) e.keywords.push_back(words[pick(rng)]);
+    e.questions.push_back("What is the " + words[pick(rng)] + " of the " + words[pick(rng)] + "?");
+    e.questions.push_back("Where can I see the " + words[pick(rng)] + " " + words[pick(rng)] + "?");
+    e.questions.push_back("Tell me about " + e.keywords[0] + " and " + words[pick(rng)] + ".");
+    e.answer = "The " + e.keywords[0] + " is shown at stand " + std::to_string(i) + "; it is {time} now.";
+    base.put(std::move(e));
+  }
+  return base;
+}
+
+class Hall final : public TaskKnowledge {
+ public:
+  ListResult list(std::string_view, std::string_view argument) const override {
+    return {true, {"node" + std::string(argument)}, {}};
+  }
+};
+
+void BM_HriAnswer(benchmark::State& state) {
+  const KnowledgeBase base = generated_base(static_cast<std::size_t>(state.range(0)));
+  const TaskLibrary tasks = TaskLibrary::load(TRIPODAL_SOURCE_DIR "/configs/tasks/jinny_guide.yaml");
+  const Hall hall;
+  const SimClock clock;
+  AnswerProviders providers;
+  providers.add("time", std::make_unique<ClockTimeProvider>(clock, 10h));
+  providers.add("battery", std::make_unique<BatteryProvider>([] { return 0.8; }));
+  providers.add("weather", std::make_unique<FixedProvider>("sunny"));
+  HriModule hri(base, tasks, hall, providers, [](const Understanding&) { return std::string(); });
+  // A mix as visitors type it: questions of the base, generated entries' keywords, typos,
+  // commands, and something the base does not know.
+  std::vector<std::string> utterances = {"Introduce yourself.", "How is the wether today?", "guide me to node 1",
+                                         "what time is it", "Where is the restroom?", "what is the capital of France",
+                                         "show me the cleaning robot", "how much batery do you have"};
+  for (std::size_t i = 30; i < base.entries().size(); i += 97) {
+    utterances.push_back("tell me about " + base.entries()[i].keywords[1] + " " + base.entries()[i].keywords[2]);
+  }
+  std::size_t next = 0;
+  std::size_t answered = 0;
+  for (auto _ : state) {
+    const HriReply r = hri.handle(utterances[next]);
+    answered += r.kind == HriReply::Kind::answered ? 1 : 0;
+    benchmark::DoNotOptimize(r.text.data());
+    next = (next + 1) % utterances.size();
+  }
+  state.counters["entries"] = static_cast<double>(base.entries().size());
+  state.counters["answered_share"] = static_cast<double>(answered) / static_cast<double>(state.iterations());
+}
+BENCHMARK(BM_HriAnswer)->Arg(1000)->Arg(100)->Unit(benchmark::kMicrosecond);
+
+void BM_KnowledgeIndexBuild(benchmark::State& state) {
+  const KnowledgeBase base = generated_base(static_cast<std::size_t>(state.range(0)));
+  for (auto _ : state) {
+    KnowledgeIndex index(base);
+    benchmark::DoNotOptimize(&index);
+  }
+}
+BENCHMARK(BM_KnowledgeIndexBuild)->Arg(1000)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

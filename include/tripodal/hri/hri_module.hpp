@@ -1,0 +1,105 @@
+// The HRI module of the deliberate layer (paper, section 4, CHri): every user input is a
+// *reaction input*, answered by the HRI alone from the RKMS knowledge base, or a *command input*,
+// handed to the planner as a task; when the planner refuses, its reason is spoken back in plain
+// words. Inputs that are empty, too long or not text get a polite refusal and nothing runs.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tripodal/hri/answer_providers.hpp"
+#include "tripodal/hri/knowledge_base.hpp"
+#include "tripodal/hri/knowledge_index.hpp"
+#include "tripodal/hri/speech.hpp"
+#include "tripodal/planner/task_library.hpp"
+
+namespace tripodal {
+
+struct HriOptions {
+  /// Below this confidence (KnowledgeIndex's coverage of the utterance) the HRI says it did not
+  /// understand and offers the closest topics.
+  double confidence_threshold = 0.5;
+  /// An input that starts like a command ("take me to ...") but that the planner refuses is
+  /// answered from the RKMS instead only when an entry with an action covers it this well
+  /// ("take me to PSR-2"); otherwise the planner's refusal is spoken ("take me to node").
+  double command_confidence_threshold = 0.75;
+  /// How many topics a "did not understand" offers.
+  std::size_t offered_topics = 3;
+  /// The longest utterance considered (bytes); a longer one is refused unread.
+  std::size_t max_utterance_bytes = 500;
+  /// A recognised utterance less sure than this (SpeechRecognizer::Result::confidence) is not
+  /// acted on: "Sorry, I did not catch that." A recognizer with a closed language model hears
+  /// any sound as one of its sentences; the posterior is low when the sound was something else.
+  double min_recognition_confidence = 0.002;
+};
+
+/// What the HRI did with one input.
+struct HriReply {
+  enum class Kind {
+    answered,         ///< a reaction input answered from the RKMS (entry; maybe a task too)
+    task_started,     ///< a command input the planner accepted
+    task_refused,     ///< a command input the planner refused (text says why)
+    not_understood,   ///< nothing matched well enough (text offers the closest topics)
+    refused_input,    ///< empty, too long or not text: nothing ran
+  };
+  Kind kind = Kind::not_understood;
+  std::string text;      ///< what the robot says
+  std::string entry_id;  ///< answered: the RKMS entry
+  std::string task;      ///< the task the planner started (also for an entry's action)
+  Plan plan;             ///< when a task started
+  double confidence = 0.0;
+  std::vector<std::string> closest_topics;  ///< not_understood
+};
+
+[[nodiscard]] std::string_view to_string(HriReply::Kind kind) noexcept;
+
+/// Where accepted tasks go: the planner of the running robot. Returns an empty string when the
+/// task started, otherwise the reason it could not (spoken back).
+using TaskStarter = std::function<std::string(const Understanding&)>;
+
+/// One input at a time (the HRI's own thread or the robot's deliberate loop): not thread-safe.
+class HriModule {
+ public:
+  /// `tasks`, `knowledge` and `providers` must outlive the module; the base is indexed now (a
+  /// changed base needs a new module). Throws ConfigError, at each entry's location, when an
+  /// answer names a provider that `providers` does not have.
+  HriModule(const KnowledgeBase& base, const TaskLibrary& tasks, const TaskKnowledge& knowledge,
+            const AnswerProviders& providers, TaskStarter start_task, HriOptions options = {});
+
+  /// Classifies and handles one typed or recognised input. Never throws for any input.
+  HriReply handle(std::string_view utterance);
+  /// A spoken input: below min_recognition_confidence it is not understood ("Sorry, I did not
+  /// catch that. Could you say it again?"); otherwise its words, in typed form ("node one" ->
+  /// "node 1"), are handled as typed.
+  HriReply handle_heard(const SpeechRecognizer::Result& heard);
+
+  /// The robot's internal state as the HRI shows it ("task guide: running", set by the robot).
+  void set_status(std::string status) { status_ = std::move(status); }
+  [[nodiscard]] const std::string& status() const noexcept { return status_; }
+
+  [[nodiscard]] const KnowledgeIndex& index() const noexcept { return index_; }
+
+ private:
+  HriReply answer(const KnowledgeEntry& entry, double confidence);
+  HriReply command(const Understanding& understanding);
+  [[nodiscard]] std::string fill(std::string_view answer) const;
+
+  std::vector<KnowledgeEntry> entries_;
+  const TaskLibrary& tasks_;
+  const TaskKnowledge& knowledge_;
+  const AnswerProviders& providers_;
+  TaskStarter start_task_;
+  HriOptions options_;
+  KnowledgeIndex index_;
+  std::vector<std::string> command_words_;  // the first word of each command form ("guide", "clean")
+  std::string status_;
+};
+
+/// The planner's explanation of a refused command in plain words, for speaking: "I cannot do
+/// that: ..." without the list of command forms.
+[[nodiscard]] std::string plain_refusal(std::string_view explanation);
+
+}  // namespace tripodal

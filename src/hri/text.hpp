@@ -1,0 +1,29 @@
+// Internal: the words of an utterance as the HRI compares them (lower case, split at anything
+// that is not a letter or digit), English stop words, edit distance for typo correction, and the
+// check that an input is text at all.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace tripodal::hri {
+
+/// Lower-case words of `text`: runs of ASCII letters and digits and of bytes beyond ASCII (kept
+/// as they are); everything else separates.
+[[nodiscard]] std::vector<std::string> words(std::string_view text);
+
+/// Words that tell nothing about a topic ("the", "is", "what", "please", "robot's" clitics).
+[[nodiscard]] bool is_stop_word(std::string_view word) noexcept;
+
+/// Optimal-string-alignment distance (insertions, deletions, substitutions, transpositions of
+/// neighbours), or `limit` + 1 as soon as it must exceed `limit`.
+[[nodiscard]] std::size_t edit_distance(std::string_view a, std::string_view b, std::size_t limit);
+
+/// Valid UTF-8 without control characters other than tab, line feed and carriage return.
+[[nodiscard]] bool is_text(std::string_view bytes) noexcept;
+
+[[nodiscard]] bool has_digit(std::string_view word) noexcept;
+
+}  // namespace tripodal::hri

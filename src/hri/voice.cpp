@@ -1,0 +1,148 @@
+// The voice engines, built when CMake found espeak-ng and pocketsphinx (TRIPODAL_VOICE).
+#include <espeak-ng/speak_lib.h>
+#include <pocketsphinx.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <mutex>
+#include <stdexcept>
+
+#include "tripodal/hri/speech.hpp"
+
+namespace tripodal {
+
+bool voice_available() noexcept { return true; }
+
+namespace {
+
+// espeak-ng keeps one engine per process: it is initialised once and every synthesis holds this.
+std::mutex& espeak_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+int on_samples(short* wav, int count, espeak_EVENT* events) {
+  if (wav != nullptr && count > 0 && events != nullptr && events->user_data != nullptr) {
+    auto* out = static_cast<std::vector<std::int16_t>*>(events->user_data);
+    out->insert(out->end(), wav, wav + count);
+  }
+  return 0;  // continue
+}
+
+class EspeakSynthesizer final : public SpeechSynthesizer {
+ public:
+  explicit EspeakSynthesizer(EspeakOptions options) : options_(std::move(options)) {
+    const std::lock_guard lock(espeak_mutex());
+    static const int rate = espeak_Initialize(AUDIO_OUTPUT_SYNCHRONOUS, 0, nullptr, espeakINITIALIZE_DONT_EXIT);
+    if (rate <= 0) throw std::runtime_error("espeak-ng: cannot initialise (is espeak-ng-data installed?)");
+    rate_hz_ = rate;
+  }
+
+  AudioClip synthesize(std::string_view text) override {
+    const std::lock_guard lock(espeak_mutex());
+    if (espeak_SetVoiceByName(options_.voice.c_str()) != EE_OK) {
+      throw std::runtime_error("espeak-ng: no voice '" + options_.voice + "'");
+    }
+    espeak_SetParameter(espeakRATE, options_.words_per_minute, 0);
+    espeak_SetSynthCallback(on_samples);
+    AudioClip clip;
+    clip.sample_rate_hz = rate_hz_;
+    const std::string z(text);
+    const espeak_ERROR e = espeak_Synth(z.c_str(), z.size() + 1, 0, POS_CHARACTER, 0, espeakCHARS_UTF8, nullptr, &clip.samples);
+    if (e != EE_OK || espeak_Synchronize() != EE_OK) throw std::runtime_error("espeak-ng: synthesis failed");
+    return clip;
+  }
+
+ private:
+  EspeakOptions options_;
+  int rate_hz_ = 22050;
+};
+
+class PocketsphinxRecognizer final : public SpeechRecognizer {
+ public:
+  explicit PocketsphinxRecognizer(const PocketsphinxOptions& options) {
+    const std::string hmm = (options.model_dir / "en-us").string();
+    const std::string dict = (options.model_dir / "cmudict-en-us.dict").string();
+    std::string lm = (options.model_dir / "en-us.lm.bin").string();
+    if (!options.language_model.empty()) {
+      // pocketsphinx reads a model from a file only.
+      char name[] = "/tmp/tripodal_lm_XXXXXX";
+      const int fd = ::mkstemp(name);
+      if (fd < 0) throw std::runtime_error("pocketsphinx: cannot create a temporary language model file");
+      ::close(fd);
+      lm_file_ = name;
+      std::ofstream(lm_file_) << options.language_model;
+      lm = lm_file_;
+    }
+    // argv[0] is the program's name, as for main().
+    std::vector<std::string> args = {"tripodal", "-hmm", hmm, "-lm", lm, "-dict", dict, "-logfn", "/dev/null",
+                                     // Synthesised and clipped audio has runs of exact zeros, whose
+                                     // log energy is -inf in the cepstra: a little noise keeps them finite.
+                                     "-dither", "yes"};
+    for (const auto& [name, value] : options.arguments) {
+      args.push_back(name);
+      args.push_back(value);
+    }
+    std::vector<char*> argv;
+    argv.reserve(args.size());
+    for (auto& a : args) argv.push_back(a.data());
+    config_ = cmd_ln_parse_r(nullptr, ps_args(), static_cast<int32>(argv.size()), argv.data(), TRUE);
+    if (config_ == nullptr && !lm_file_.empty()) ::unlink(lm_file_.c_str());
+    if (config_ == nullptr) throw std::runtime_error("pocketsphinx: bad configuration (model in " + options.model_dir.string() + ")");
+    decoder_ = ps_init(config_);
+    if (decoder_ == nullptr) {
+      cmd_ln_free_r(config_);
+      if (!lm_file_.empty()) ::unlink(lm_file_.c_str());
+      throw std::runtime_error("pocketsphinx: cannot load the model in " + options.model_dir.string());
+    }
+  }
+  PocketsphinxRecognizer(const PocketsphinxRecognizer&) = delete;
+  PocketsphinxRecognizer& operator=(const PocketsphinxRecognizer&) = delete;
+  ~PocketsphinxRecognizer() override {
+    ps_free(decoder_);
+    cmd_ln_free_r(config_);
+    if (!lm_file_.empty()) ::unlink(lm_file_.c_str());
+  }
+
+  int sample_rate_hz() const noexcept override { return 16000; }
+
+  Result recognize(const AudioClip& audio) override {
+    AudioClip clip = audio.sample_rate_hz == 16000 ? audio : resample(audio, 16000);
+    // Cepstral mean normalisation and the silence model need a little silence around the words;
+    // a clip cut tight around them (as a synthesiser makes) is padded with a quarter second.
+    const std::vector<std::int16_t> pad(4000, 0);
+    clip.samples.insert(clip.samples.begin(), pad.begin(), pad.end());
+    clip.samples.insert(clip.samples.end(), pad.begin(), pad.end());
+    if (ps_start_utt(decoder_) < 0) throw std::runtime_error("pocketsphinx: cannot start an utterance");
+    if (!clip.samples.empty() && ps_process_raw(decoder_, clip.samples.data(), clip.samples.size(), FALSE, TRUE) < 0) {
+      ps_end_utt(decoder_);
+      throw std::runtime_error("pocketsphinx: cannot process the audio");
+    }
+    ps_end_utt(decoder_);
+    std::int32_t score = 0;
+    const char* hyp = ps_get_hyp(decoder_, &score);
+    Result r;
+    if (hyp == nullptr) return {std::string(), 0.0};
+    r.words = hyp;
+    r.confidence = logmath_exp(ps_get_logmath(decoder_), ps_get_prob(decoder_));
+    return r;
+  }
+
+ private:
+  cmd_ln_t* config_ = nullptr;
+  ps_decoder_t* decoder_ = nullptr;
+  std::string lm_file_;
+};
+
+}  // namespace
+
+std::unique_ptr<SpeechSynthesizer> make_espeak_synthesizer(const EspeakOptions& options) {
+  return std::make_unique<EspeakSynthesizer>(options);
+}
+
+std::unique_ptr<SpeechRecognizer> make_pocketsphinx_recognizer(const PocketsphinxOptions& options) {
+  return std::make_unique<PocketsphinxRecognizer>(options);
+}
+
+}  // namespace tripodal

@@ -1,0 +1,228 @@
+#include "tripodal/hri/hri_module.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <catch2/catch.hpp>
+#include <iostream>
+#include <string>
+
+using namespace tripodal;
+
+namespace {
+
+using namespace std::chrono_literals;
+
+// The exhibit hall of the paper's section 5.2: node 0 and node 1.
+class ExhibitHall final : public TaskKnowledge {
+ public:
+  ListResult list(std::string_view function, std::string_view argument) const override {
+    if (function != "node") return {false, {}, "no list named '" + std::string(function) + "'"};
+    if (argument == "0" || argument == "1") return {true, {"node" + std::string(argument)}, {}};
+    return {false, {}, "unknown node '" + std::string(argument) + "' (known: 0, 1)"};
+  }
+};
+
+// Jinny's HRI over the shipped knowledge and tasks, with fixed local providers and a planner
+// double that records what it was asked to start.
+struct Jinny {
+  SimClock clock;
+  KnowledgeBase base = KnowledgeBase::load(TRIPODAL_SOURCE_DIR "/configs/hri/jinny.xml");
+  TaskLibrary tasks = TaskLibrary::load(TRIPODAL_SOURCE_DIR "/configs/tasks/jinny_guide.yaml");
+  ExhibitHall hall;
+  AnswerProviders providers;
+  double battery = 0.82;
+  std::vector<std::string> started;
+  std::string refuse_with;  // what the planner double answers; empty: it starts the task
+  HriModule hri;
+
+  static AnswerProviders make_providers(const SimClock& clock, const double& battery) {
+    AnswerProviders p;
+    p.add("time", std::make_unique<ClockTimeProvider>(clock, 14h + 5min));
+    p.add("battery", std::make_unique<BatteryProvider>([&battery] { return battery; }));
+    p.add("weather", std::make_unique<WeatherTableProvider>(clock, 14h + 5min,
+                                                            std::vector<std::string>{"sunny, 27 degrees", "light rain, 22 degrees"}));
+    return p;
+  }
+
+  Jinny()
+      : providers(make_providers(clock, battery)),
+        hri(base, tasks, hall, providers, [this](const Understanding& u) {
+          if (!refuse_with.empty()) return refuse_with;
+          started.push_back(to_string(u.plan));
+          return std::string();
+        }) {}
+};
+
+struct Expected {
+  std::string say;
+  std::string outcome;
+  std::string entry;
+  std::string task;
+};
+
+std::vector<Expected> utterance_set() {
+  const YAML::Node doc = YAML::LoadFile(TRIPODAL_TEST_DATA_DIR "/hri/utterances.yaml");
+  std::vector<Expected> out;
+  for (const auto& u : doc["utterances"]) {
+    out.push_back({u["say"].as<std::string>(), u["outcome"].as<std::string>(),
+                   u["entry"] ? u["entry"].as<std::string>() : std::string(),
+                   u["task"] ? u["task"].as<std::string>() : std::string()});
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("the typed utterance set is classified and answered right at least 95 % of the time") {
+  Jinny jinny;
+  const std::vector<Expected> set = utterance_set();
+  REQUIRE(set.size() >= 60);
+  std::size_t right = 0;
+  std::string misses;
+  for (const auto& e : set) {
+    const HriReply r = jinny.hri.handle(e.say);
+    const bool ok = to_string(r.kind) == e.outcome && r.entry_id == e.entry && r.task == e.task;
+    if (e.outcome == "not_understood") {
+      std::cout << "  (not understood as expected: \"" << e.say << "\", best confidence " << r.confidence << ")\n";
+    }
+    if (ok) {
+      ++right;
+    } else {
+      misses += "  \"" + e.say + "\": expected " + e.outcome + " " + e.entry + " " + e.task + ", got " +
+                std::string(to_string(r.kind)) + " " + r.entry_id + " " + r.task + " (confidence " +
+                std::to_string(r.confidence) + "): " + r.text + "\n";
+    }
+  }
+  const double accuracy = static_cast<double>(right) / static_cast<double>(set.size());
+  std::cout << "HRI typed utterance set: " << right << "/" << set.size() << " right, accuracy "
+            << accuracy * 100.0 << " %\n" << misses;
+  CHECK(accuracy >= 0.95);
+}
+
+TEST_CASE("answers fill their placeholders from the providers, which follow the injected clock") {
+  Jinny jinny;
+  HriReply r = jinny.hri.handle("What time is it?");
+  CHECK(r.kind == HriReply::Kind::answered);
+  CHECK(r.text == "It is 14:05.");
+  jinny.clock.advance(1h + 30s);
+  CHECK(jinny.hri.handle("what time is it").text == "It is 15:05.");
+  CHECK(jinny.hri.handle("How's weather today?").text == "The weather today: sunny, 27 degrees.");
+  jinny.clock.advance(24h);
+  CHECK(jinny.hri.handle("How's weather today?").text == "The weather today: light rain, 22 degrees.");
+  CHECK(jinny.hri.handle("how much battery do you have").text == "My battery is at 82 percent.");
+  jinny.battery = 0.305;
+  CHECK(jinny.hri.handle("how much battery do you have").text == "My battery is at 31 percent.");
+  jinny.battery = -1.0;
+  CHECK(jinny.hri.handle("how much battery do you have").text == "My battery is at unknown.");
+  CHECK(jinny.started.empty());
+}
+
+TEST_CASE("a command input becomes a plan for the planner, and an entry's action starts one after the answer") {
+  Jinny jinny;
+  const HriReply guide = jinny.hri.handle("Could you guide me to node 1, please?");
+  CHECK(guide.kind == HriReply::Kind::task_started);
+  CHECK(guide.task == "guide");
+  CHECK(to_string(guide.plan) == "PrAutoMove(goal=node1)");
+  CHECK(guide.text == "All right, I am starting the guide task.");
+
+  const HriReply show = jinny.hri.handle("Show me the cleaning robot");
+  CHECK(show.kind == HriReply::Kind::answered);
+  CHECK(show.entry_id == "show_node1");
+  CHECK_THAT(show.text, Catch::StartsWith("Follow me, I will take you to PSR-2"));
+  CHECK(to_string(show.plan) == "PrAutoMove(goal=node1)");
+  CHECK(jinny.started == std::vector<std::string>{"PrAutoMove(goal=node1)", "PrAutoMove(goal=node1)"});
+}
+
+TEST_CASE("the planner's refusal is spoken back in plain words, without the list of command forms") {
+  Jinny jinny;
+  const HriReply unknown_node = jinny.hri.handle("guide me to node 7");
+  CHECK(unknown_node.kind == HriReply::Kind::task_refused);
+  CHECK(unknown_node.text == "Sorry, I cannot do the guide task: unknown node '7' (known: 0, 1).");
+
+  const HriReply kitchen = jinny.hri.handle("guide me to the kitchen");
+  CHECK(kitchen.kind == HriReply::Kind::task_refused);
+  CHECK(kitchen.text ==
+        "Sorry, I did not understand that command: I understood \"guide me to the\", then \"kitchen\" where I expected \"node\".");
+  CHECK_THAT(kitchen.text, !Catch::Contains("Possible commands"));
+
+  // The planner itself may refuse a task it understood (busy, faulted): its reason is spoken.
+  jinny.refuse_with = "the robot is charging";
+  const HriReply busy = jinny.hri.handle("dance for us");
+  CHECK(busy.kind == HriReply::Kind::task_refused);
+  CHECK(busy.text == "Sorry, I cannot start the dance task now: the robot is charging.");
+  const HriReply show = jinny.hri.handle("Show me the cleaning robot");
+  CHECK(show.kind == HriReply::Kind::answered);
+  CHECK_THAT(show.text, Catch::EndsWith("But I cannot do it now: the robot is charging."));
+  CHECK(show.task.empty());
+  CHECK(jinny.started.empty());
+}
+
+TEST_CASE("below the confidence threshold the HRI says it did not understand and offers the closest topics") {
+  Jinny jinny;
+  const HriReply r = jinny.hri.handle("What is the capital of France?");
+  CHECK(r.kind == HriReply::Kind::not_understood);
+  CHECK(r.closest_topics.size() == 3);
+  CHECK_THAT(r.text, Catch::StartsWith("Sorry, I did not understand that. I can tell you about "));
+  // A question sharing a word with an entry but about something else: the closest topic offered.
+  const HriReply r2 = jinny.hri.handle("what time does the football match on tv start tonight");
+  CHECK(r2.kind == HriReply::Kind::not_understood);
+  REQUIRE_FALSE(r2.closest_topics.empty());
+  CHECK(r2.closest_topics.front() == "the time");
+}
+
+TEST_CASE("empty, huge and binary utterances get a polite refusal and nothing runs") {
+  Jinny jinny;
+  const std::string huge(1 << 20, 'a');
+  std::string binary = "guide me to node 1";
+  binary[5] = '\0';
+  const std::string bad_utf8 = "guide me to node 1 \xC3\x28";
+  std::string long_command;
+  while (long_command.size() < 600) long_command += "guide me to node 1 ";
+  for (const std::string& input : {std::string(), std::string("  \t\n "), std::string("?!..."), huge, binary, bad_utf8, long_command}) {
+    const HriReply r = jinny.hri.handle(input);
+    CHECK(r.kind == HriReply::Kind::refused_input);
+    CHECK_THAT(r.text, Catch::StartsWith("Sorry") || Catch::StartsWith("I did not catch anything"));
+    CHECK(r.task.empty());
+    CHECK(r.entry_id.empty());
+  }
+  CHECK(jinny.hri.handle(huge).text == "Sorry, that is too long for me. Please ask me in a sentence or two.");
+  CHECK(jinny.hri.handle(binary).text == "Sorry, I can only understand words. Please type or say your question again.");
+  CHECK(jinny.started.empty());
+}
+
+TEST_CASE("an answer naming a provider the application did not plug in is refused at the entry") {
+  const KnowledgeBase base = KnowledgeBase::load_from_string(R"(<knowledge version="1">
+  <entry id="stock" topic="stocks">
+    <keywords>stock</keywords>
+    <answer>Today: {stocks}.</answer>
+  </entry>
+</knowledge>
+)",
+                                                             "kb.xml");
+  const TaskLibrary tasks = TaskLibrary::load(TRIPODAL_SOURCE_DIR "/configs/tasks/jinny_guide.yaml");
+  const ExhibitHall hall;
+  AnswerProviders providers;
+  providers.add("time", std::make_unique<FixedProvider>("noon"));
+  CHECK_THROWS_WITH(HriModule(base, tasks, hall, providers, {}),
+                    "kb.xml:2:3: error: entry 'stock': the answer names {stocks}, which no provider gives; providers: time\n");
+}
+
+TEST_CASE("typo correction maps unknown words to the nearest known word and keeps numbers") {
+  Jinny jinny;
+  CHECK(jinny.hri.index().correct("Gide me to node 12, whats the wether") == "guide me to node 12 whats the weather");
+  // Too far from any word: kept as it is.
+  CHECK(jinny.hri.index().correct("xylophone") == "xylophone");
+}
+
+TEST_CASE("a heard utterance is handled in typed form, and not at all when the recognizer is unsure") {
+  Jinny jinny;
+  const HriReply sure = jinny.hri.handle_heard({"guide me to node one", 0.3});
+  CHECK(sure.kind == HriReply::Kind::task_started);
+  CHECK(to_string(sure.plan) == "PrAutoMove(goal=node1)");
+  const HriReply unsure = jinny.hri.handle_heard({"guide me to node one", 0.0005});
+  CHECK(unsure.kind == HriReply::Kind::not_understood);
+  CHECK(unsure.text == "Sorry, I did not catch that. Could you say it again?");
+  CHECK(jinny.started.size() == 1);
+  CHECK(jinny.hri.handle_heard({"tell me about p s r two", 0.1}).entry_id == "node1_robot");
+  CHECK(jinny.hri.handle_heard({"", 0.0}).kind == HriReply::Kind::refused_input);
+}
