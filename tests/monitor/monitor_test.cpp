@@ -25,6 +25,7 @@
 #include "tripodal/monitor/monitor_server.hpp"
 #include "tripodal/monitor/robot_monitor.hpp"
 #include "tripodal/monitor/wire.hpp"
+#include "../navi/navi_test_util.hpp"
 #include "tripodal/navi/map_io.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_board.hpp"
@@ -140,6 +141,25 @@ struct Psr2 {
     robot = Robot::assemble(load_robot_profile(configs / "robots/psr2.yaml"), plugins, clock);
   }
 };
+
+// An operator's command (with the test token unless `auth` says otherwise); the robot's thread
+// (here: the test's, through watch.update(), after `between`) answers between periods. Returns
+// the whole HTTP answer.
+std::string post_command(MonitorServer& server, RobotMonitor& watch, const std::string& body,
+                         const std::string& auth = "Authorization: Bearer t0ken-for-tests\r\n",
+                         const std::function<void()>& between = {}) {
+  Client c(server.port());
+  c.send("POST /api/command HTTP/1.1\r\n" + auth + "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body);
+  std::string answer;
+  REQUIRE(wait_for([&] {
+    if (between) between();
+    watch.update();
+    answer = c.read_until([](const std::string& b) { return b.find("\r\n\r\n{") != std::string::npos && b.back() == '}'; },
+                          std::chrono::milliseconds(20));
+    return !answer.empty() && answer.back() == '}';
+  }));
+  return answer;
+}
 
 }  // namespace
 
@@ -398,20 +418,7 @@ TEST_CASE("Manual drive goes through the coordinator, masks the task's motion an
   MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
   RobotMonitor watch(*robot, clock, server, RobotMonitorOptions{.min_interval_s = 0.0, .drive_deadman_s = 0.05});
   server.start();
-  auto post = [&](const std::string& body) {
-    Client c(server.port());
-    c.send("POST /api/command HTTP/1.1\r\nAuthorization: Bearer t0ken-for-tests\r\nContent-Length: " + std::to_string(body.size()) +
-           "\r\n\r\n" + body);
-    // The robot's thread answers between periods.
-    std::string answer;
-    REQUIRE(wait_for([&] {
-      watch.update();
-      answer = c.read_until([](const std::string& b) { return b.find("\r\n\r\n{") != std::string::npos && b.back() == '}'; },
-                            std::chrono::milliseconds(20));
-      return !answer.empty() && answer.back() == '}';
-    }));
-    return answer;
-  };
+  auto post = [&](const std::string& body) { return post_command(server, watch, body); };
   REQUIRE(robot->command("clean the room 3211").accepted);
   robot->run_for(std::chrono::seconds(5));
   CHECK(robot->behavior_active("BhCleaning"));
@@ -453,25 +460,6 @@ TEST_CASE("Read-only streams may be opened without the token where the operator 
 }
 
 namespace {
-
-// Posts a command and keeps the robot's side answering (update() between tries) until the answer
-// is complete; returns the whole HTTP response.
-// `between` runs before each update(): the robot's periods, for a request that waits for one.
-std::string post_command(MonitorServer& server, RobotMonitor& watch, const std::string& body,
-                         const std::string& auth = "Authorization: Bearer t0ken-for-tests\r\n",
-                         const std::function<void()>& between = {}) {
-  Client c(server.port());
-  c.send("POST /api/command HTTP/1.1\r\n" + auth + "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body);
-  std::string answer;
-  REQUIRE(wait_for([&] {
-    if (between) between();
-    watch.update();
-    answer = c.read_until([](const std::string& b) { return b.find("\r\n\r\n{") != std::string::npos && b.back() == '}'; },
-                          std::chrono::milliseconds(20));
-    return !answer.empty() && answer.back() == '}';
-  }));
-  return answer;
-}
 
 nlohmann::json answer_json(const std::string& http) { return nlohmann::json::parse(http.substr(http.find("\r\n\r\n") + 4)); }
 
@@ -648,19 +636,7 @@ TEST_CASE("Live mapping from the console: begin, drive by hand, save a map that 
   MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
   RobotMonitor watch(*robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0, .drive_deadman_s = 5.0, .map_dir = dir});
   server.start();
-  auto post = [&](const std::string& body) {
-    Client c(server.port());
-    c.send("POST /api/command HTTP/1.1\r\nAuthorization: Bearer t0ken-for-tests\r\nContent-Length: " + std::to_string(body.size()) +
-           "\r\n\r\n" + body);
-    std::string answer;
-    REQUIRE(wait_for([&] {
-      watch.update();
-      answer = c.read_until([](const std::string& b) { return b.find("\r\n\r\n{") != std::string::npos && b.back() == '}'; },
-                            std::chrono::milliseconds(20));
-      return !answer.empty() && answer.back() == '}';
-    }));
-    return answer;
-  };
+  auto post = [&](const std::string& body) { return post_command(server, watch, body); };
   robot->run_for(std::chrono::seconds(1));  // the first scans: the localizer settles
   CHECK_THAT(post(R"({"op":"map","action":"save","name":"early"})"), Catch::Contains("no map to save yet"));
   CHECK_THAT(post(R"({"op":"map","action":"begin"})"), Catch::Contains(R"("mapping":true)"));
@@ -680,23 +656,10 @@ TEST_CASE("Live mapping from the console: begin, drive by hand, save a map that 
   const navi::MapFile built = navi::load_map(dir / "hall-1.yaml");
   const navi::MapFile truth =
       navi::load_map(std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs" / "worlds" / "workspace_map.yaml");
-  std::size_t marked = 0, on_wall = 0;
-  for (std::size_t i = 0; i < built.grid.size(); ++i) {
-    if (built.grid.state(i) != navi::Occupancy::occupied) continue;
-    ++marked;
-    const Point2D p = built.grid.cell_center(built.grid.cell(i));
-    bool near = false;
-    for (double dy = -0.05; dy <= 0.051 && !near; dy += 0.05) {
-      for (double dx = -0.05; dx <= 0.051 && !near; dx += 0.05) {
-        const auto c = truth.grid.world_to_cell({p.x_m + dx, p.y_m + dy});
-        near = c && truth.grid.is_occupied(*c);
-      }
-    }
-    on_wall += near ? 1 : 0;
-  }
-  INFO(marked << " occupied cells, " << on_wall << " on a wall of the world");
-  REQUIRE(marked > 300);
-  CHECK(static_cast<double>(on_wall) > 0.9 * static_cast<double>(marked));
+  const navi::test::WallAgreement walls = navi::test::wall_agreement(built.grid, truth.grid);
+  INFO(walls.marked << " occupied cells, " << walls.on_wall << " on a wall of the world");
+  REQUIRE(walls.marked > 300);
+  CHECK(walls.fraction() > 0.9);
   std::filesystem::remove_all(dir);
 }
 
@@ -705,16 +668,6 @@ TEST_CASE("Map requests without a map folder or a MapBuilder are refused", "[mon
   MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
   RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
   server.start();
-  Client c(server.port());
-  const std::string body = R"({"op":"map","action":"save","name":"x"})";
-  c.send("POST /api/command HTTP/1.1\r\nAuthorization: Bearer t0ken-for-tests\r\nContent-Length: " + std::to_string(body.size()) +
-         "\r\n\r\n" + body);
-  std::string answer;
-  REQUIRE(wait_for([&] {
-    watch.update();
-    answer = c.read_until([](const std::string& b) { return b.find("\r\n\r\n{") != std::string::npos && b.back() == '}'; },
-                          std::chrono::milliseconds(20));
-    return !answer.empty() && answer.back() == '}';
-  }));
-  CHECK_THAT(answer, Catch::Contains("403") && Catch::Contains("saving is off"));
+  CHECK_THAT(post_command(server, watch, R"({"op":"map","action":"save","name":"x"})"),
+             Catch::Contains("403") && Catch::Contains("saving is off"));
 }

@@ -70,4 +70,33 @@ inline OccupancyGrid room(int w, int h, double resolution_m = 0.05) {
   return g;
 }
 
+/// How many of `built`'s occupied cells there are, and how many lie on or beside (one cell) an
+/// occupied cell of `world`: a built map lines up with the world when nearly all do.
+struct WallAgreement {
+  std::size_t marked = 0;
+  std::size_t on_wall = 0;
+  [[nodiscard]] double fraction() const noexcept {
+    return marked == 0 ? 0.0 : static_cast<double>(on_wall) / static_cast<double>(marked);
+  }
+};
+
+inline WallAgreement wall_agreement(const OccupancyGrid& built, const OccupancyGrid& world) {
+  WallAgreement a;
+  const double step = world.resolution_m();
+  for (std::size_t i = 0; i < built.size(); ++i) {
+    if (built.state(i) != Occupancy::occupied) continue;
+    ++a.marked;
+    const Point2D p = built.cell_center(built.cell(i));
+    bool near = false;
+    for (int dy = -1; dy <= 1 && !near; ++dy) {
+      for (int dx = -1; dx <= 1 && !near; ++dx) {
+        const auto c = world.world_to_cell({p.x_m + dx * step, p.y_m + dy * step});
+        near = c && world.is_occupied(*c);
+      }
+    }
+    a.on_wall += near ? 1 : 0;
+  }
+  return a;
+}
+
 }  // namespace tripodal::navi::test

@@ -10,6 +10,7 @@
 #include "tripodal/navi/map_io.hpp"
 #include "tripodal/navi/mapping_module.hpp"
 #include "tripodal/navi/scan_matcher.hpp"
+#include "navi_test_util.hpp"
 #include "tripodal/sim/ray_caster.hpp"
 
 using namespace tripodal;
@@ -318,19 +319,9 @@ TEST_CASE("MapBuilder: a map from drifting odometry lines up with the world and 
   CHECK(distance(prev_est, true_pose(320)) < 0.1);
   const OccupancyGrid map = b.grid();
   // every wall cell the builder marked is on or next to a wall of the world
-  std::size_t marked = 0, on_wall = 0;
-  for (std::size_t i = 0; i < map.size(); ++i) {
-    if (map.state(i) != Occupancy::occupied) continue;
-    ++marked;
-    const Point2D p = map.cell_center(map.cell(i));
-    bool near = false;
-    for (double dy = -0.05; dy <= 0.051 && !near; dy += 0.05) {
-      for (double dx = -0.05; dx <= 0.051 && !near; dx += 0.05) near = world.is_occupied(world.cell_at({p.x_m + dx, p.y_m + dy}));
-    }
-    on_wall += near ? 1 : 0;
-  }
-  REQUIRE(marked > 500);
-  CHECK(static_cast<double>(on_wall) > 0.95 * static_cast<double>(marked));
+  const test::WallAgreement walls = test::wall_agreement(map, world);
+  REQUIRE(walls.marked > 500);
+  CHECK(walls.fraction() > 0.95);
   // and the map it made is one the localizer can work on
   ScanMatcher m(map);
   m.set_scan(scan_at(solid, true_pose(100)));
@@ -370,26 +361,13 @@ TEST_CASE("MapBuilder module: maps only between begin and end, crops to what the
   // cropped to the room (10 m x 8 m and the scanner's reach within it), not the 30 m square
   CHECK(map->width() * map->resolution_m() < 11.0);
   CHECK(map->height() * map->resolution_m() < 9.0);
-  std::size_t marked = 0, on_wall = 0;
-  for (std::size_t i = 0; i < map->size(); ++i) {
-    if (map->state(i) != Occupancy::occupied) continue;
-    ++marked;
-    const Point2D p = map->cell_center(map->cell(i));
-    bool near = false;
-    for (double dy = -0.05; dy <= 0.051 && !near; dy += 0.05) {
-      for (double dx = -0.05; dx <= 0.051 && !near; dx += 0.05) near = world.is_occupied(world.cell_at({p.x_m + dx, p.y_m + dy}));
-    }
-    on_wall += near ? 1 : 0;
-  }
-  REQUIRE(marked > 500);
-  CHECK(static_cast<double>(on_wall) > 0.95 * static_cast<double>(marked));
+  const test::WallAgreement walls = test::wall_agreement(*map, world);
+  REQUIRE(walls.marked > 500);
+  CHECK(walls.fraction() > 0.95);
 
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "tripodal_mapping_test";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  mapper.save(dir / "room.yaml");
-  const MapFile saved = load_map(dir / "room.yaml");
+  const test::TempDir dir("mapping");
+  mapper.save(dir.path() / "room.yaml");
+  const MapFile saved = load_map(dir.path() / "room.yaml");
   CHECK(saved.grid.width() == map->width());
   CHECK(saved.grid.count(Occupancy::occupied) == map->count(Occupancy::occupied));
-  std::filesystem::remove_all(dir);
 }
