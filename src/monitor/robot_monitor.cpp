@@ -9,6 +9,7 @@
 #include <map>
 #include <mutex>
 #include <set>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -163,7 +164,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
   bool driving = false;
   std::chrono::steady_clock::time_point last_drive{};
 
-  Impl(Robot& r, const Clock& c, MonitorServer& s, RobotMonitorOptions o) : robot(r), clock(c), server(s), options(o) {
+  Impl(Robot& r, const Clock& c, MonitorServer& s, RobotMonitorOptions o) : robot(r), clock(c), server(s), options(std::move(o)) {
     ch_pose = server.advertise("/pose", "foxglove.PoseInFrame", pose_schema(), Delivery::bulk);
     ch_path = server.advertise("/path", "foxglove.PosesInFrame",
                                R"({"type":"object","properties":{"frame_id":{"type":"string"},"poses":{"type":"array"}}})", Delivery::state);
@@ -622,7 +623,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
 };
 
 RobotMonitor::RobotMonitor(Robot& robot, const Clock& clock, MonitorServer& server, RobotMonitorOptions options)
-    : impl_(std::make_unique<Impl>(robot, clock, server, options)) {}
+    : impl_(std::make_unique<Impl>(robot, clock, server, std::move(options))) {}
 RobotMonitor::~RobotMonitor() = default;
 
 void RobotMonitor::update(const MonitorExtras& extras) { impl_->update(extras); }
