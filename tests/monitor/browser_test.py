@@ -2,14 +2,18 @@
 python3-selenium, against a running `tripodal run --monitor --start-paused`. A wrong token is
 refused (401) and nothing runs; an unknown task shows the planner's answer; "clean the room 3211"
 starts the task; the pose changes on the map; a place of PrCleaning becomes marked; a breakpoint
-on it pauses the run; an edited PrCleaning net that does not load is refused with the loader's
+on it pauses the run; live mapping begins from the console and saves a map beside the run's
+outputs (a name with a folder in it refused); an edited PrCleaning net that does not load is refused with the loader's
 located diagnostics on the page, one that loads is reloaded at the quiet marking and drawn; the
 board link panel stays hidden (the PSR-2 has no control board). The page's screenshot is kept as
 the test's artifact.
 
 usage: browser_test.py TRIPODAL ROBOT.yaml WORLD.yaml SCREENSHOT.png"""
+import os
 import re
+import shutil
 import sys
+import tempfile
 import time
 
 try:
@@ -26,7 +30,8 @@ from monitor_support import MonitoredRun, check
 
 def main():
     exe, robot, world, screenshot = sys.argv[1:5]
-    run = MonitoredRun(exe, robot, world, "--start-paused", "--realtime", "10")
+    out_dir = tempfile.mkdtemp(prefix="tripodal_browser_")
+    run = MonitoredRun(exe, robot, world, "--start-paused", "--realtime", "10", "--out", out_dir)
     options = webdriver.ChromeOptions()
     options.binary_location = "/usr/bin/chromium"
     for arg in ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1400,1500"]:
@@ -124,7 +129,20 @@ def main():
         xy = lambda pose: [round(float(v), 1) for v in pose.split()[:2]]
         wait.until(lambda d: xy(text("pose")) != xy(pose_before))
         check(True, "the pose changes on the map: %s -> %s" % (pose_before, text("pose")))
+        driver.find_element(By.ID, "map-begin").click()
+        wait.until(lambda d: text("map-state").startswith("mapping"))
+        check(True, "live mapping begun from the console: " + text("map-state"))
         wait.until(lambda d: float(text("time")) > float(t1) + 20)  # some cleaned cells for the picture
+        driver.find_element(By.ID, "map-name").send_keys("../elsewhere")
+        driver.find_element(By.ID, "map-save").click()
+        wait.until(lambda d: "expected" in text("map-state"))
+        check(True, "a map name with a folder in it is refused: " + text("map-state"))
+        driver.find_element(By.ID, "map-name").clear()
+        driver.find_element(By.ID, "map-name").send_keys("hall")
+        driver.find_element(By.ID, "map-save").click()
+        wait.until(lambda d: text("map-state").startswith("saved"))
+        check(os.path.isfile(os.path.join(out_dir, "hall.yaml")) and os.path.isfile(os.path.join(out_dir, "hall.pgm")),
+              "the map is saved beside the run's outputs: " + text("map-state"))
         check(driver.find_elements(By.CSS_SELECTOR, 'div.net[data-net="PrCleaning"] g.place.marked[data-place="P1"]'),
               "PrCleaning's P1 stays marked while the section is cleaned")
         driver.save_screenshot(screenshot)
@@ -132,6 +150,7 @@ def main():
     finally:
         driver.quit()
         out = run.stop()
+        shutil.rmtree(out_dir, ignore_errors=True)
     check("activate BhCleaning(section=A)" in out or "PrCleaning(section=A)" in out, "the run's log shows the cleaning")
     check("net reloaded from PrCleaning.edited.xml at a quiet marking" in out, "the life cycle records the reload")
 
