@@ -51,19 +51,8 @@ void CMappingModule::on_configure(const ParameterSet& params) {
 }
 
 void CMappingModule::on_start(ModuleContext& context) {
-  if (context.resources != nullptr) {
-    laser_ = laser_name_.empty() ? context.resources->first<LaserScan>() : context.resources->find<LaserScan>(laser_name_);
-    odometry_ = odometry_name_.empty() ? context.resources->first<OdometryReading>()
-                                       : context.resources->find<OdometryReading>(odometry_name_);
-  }
-  if (laser_ == nullptr) {
-    throw ConfigError(where(), laser_name_.empty() ? std::string("MapBuilder needs a laser scanner, and the robot has no laser resource")
-                                                   : "MapBuilder: no laser resource named '" + laser_name_ + "'");
-  }
-  if (odometry_ == nullptr) {
-    throw ConfigError(where(), odometry_name_.empty() ? std::string("MapBuilder needs odometry, and the robot has no odometry resource")
-                                                      : "MapBuilder: no odometry resource named '" + odometry_name_ + "'");
-  }
+  laser_ = &sensor_of<LaserScan>(context, laser_name_, "MapBuilder", "a laser scanner", "laser", where());
+  odometry_ = &sensor_of<OdometryReading>(context, odometry_name_, "MapBuilder", "odometry", "odometry", where());
   if (options_.begin_at_start) begin();
 }
 

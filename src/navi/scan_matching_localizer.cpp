@@ -108,22 +108,8 @@ void CScanMatchingLocalizer::on_start(ModuleContext& context) {
     }
     set_map(maps->grid());
   }
-  if (context.resources != nullptr) {
-    laser_ = laser_name_.empty() ? context.resources->first<LaserScan>() : context.resources->find<LaserScan>(laser_name_);
-    odometry_ = odometry_name_.empty() ? context.resources->first<OdometryReading>()
-                                       : context.resources->find<OdometryReading>(odometry_name_);
-  }
-  if (laser_ == nullptr) {
-    throw ConfigError(where(), laser_name_.empty() ? std::string("ScanMatchingLocalizer needs a laser scanner, and the "
-                                                                 "robot has no laser resource")
-                                                   : "ScanMatchingLocalizer: no laser resource named '" + laser_name_ + "'");
-  }
-  if (odometry_ == nullptr) {
-    throw ConfigError(where(), odometry_name_.empty()
-                                   ? std::string("ScanMatchingLocalizer needs odometry, and the robot has no odometry "
-                                                 "resource")
-                                   : "ScanMatchingLocalizer: no odometry resource named '" + odometry_name_ + "'");
-  }
+  laser_ = &sensor_of<LaserScan>(context, laser_name_, "ScanMatchingLocalizer", "a laser scanner", "laser", where());
+  odometry_ = &sensor_of<OdometryReading>(context, odometry_name_, "ScanMatchingLocalizer", "odometry", "odometry", where());
 }
 
 void CScanMatchingLocalizer::post(State next, Time now, std::vector<ModuleEvent>& out) {

@@ -371,3 +371,18 @@ TEST_CASE("MapBuilder module: maps only between begin and end, crops to what the
   CHECK(saved.grid.width() == map->width());
   CHECK(saved.grid.count(Occupancy::occupied) == map->count(Occupancy::occupied));
 }
+
+TEST_CASE("MapBuilder and ScanMatchingLocalizer refuse to start without their sensors, naming what is missing",
+          "[navi][scan_matching][mapping]") {
+  ModuleContext none;  // a robot without resources
+  CMappingModule mapper;
+  mapper.configure({}, SourceLocation{"robot.yaml", 40, 5});
+  CHECK_THROWS_WITH(mapper.start(none), Catch::Contains("robot.yaml:40:5: error: MapBuilder needs a laser scanner, and the robot has no laser resource"));
+  CMappingModule named;
+  named.configure({{"laser", Value{std::string("front")}}}, SourceLocation{"robot.yaml", 44, 5});
+  CHECK_THROWS_WITH(named.start(none), Catch::Contains("robot.yaml:44:5: error: MapBuilder: no laser resource named 'front'"));
+  CScanMatchingLocalizer localizer;
+  localizer.configure({}, SourceLocation{"robot.yaml", 32, 5});
+  localizer.set_map(room());
+  CHECK_THROWS_WITH(localizer.start(none), Catch::Contains("robot.yaml:32:5: error: ScanMatchingLocalizer needs a laser scanner"));
+}

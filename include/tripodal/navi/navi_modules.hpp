@@ -8,8 +8,10 @@
 #include <string_view>
 #include <vector>
 
+#include "tripodal/core/diagnostic.hpp"
 #include "tripodal/core/manifest.hpp"
 #include "tripodal/processes/module.hpp"
+#include "tripodal/resources/resource.hpp"
 
 namespace tripodal::navi {
 
@@ -45,8 +47,21 @@ class GlobalFixAttempts {
 [[nodiscard]] ModuleManifest navi_manifest(std::string name, std::string description, std::vector<std::string> inputs,
                                            std::vector<std::string> outputs, std::vector<ParameterSpec> parameters);
 
+/// The robot's sensor of type T that a navigation module reads: the resource named `name`, or the
+/// first of its type when `name` is empty. Otherwise a ConfigError at `where`: "WHO needs NEEDS,
+/// and the robot has no KIND resource" or "WHO: no KIND resource named 'NAME'".
+template <class T>
+[[nodiscard]] const TypedResource<T>& sensor_of(const ModuleContext& context, const std::string& name, std::string_view who,
+                                                std::string_view needs, std::string_view kind, const SourceLocation& where) {
+  const TypedResource<T>* r = nullptr;
+  if (context.resources != nullptr) r = name.empty() ? context.resources->first<T>() : context.resources->find<T>(name);
+  if (r != nullptr) return *r;
+  throw ConfigError(where, name.empty() ? std::string(who) + " needs " + std::string(needs) + ", and the robot has no " + std::string(kind) + " resource"
+                                        : std::string(who) + ": no " + std::string(kind) + " resource named '" + name + "'");
+}
+
 /// Registers the navigation modules: GridMaps, SectionSplitter, Localizer, ScanMatchingLocalizer,
-/// PathPlanner, CoveragePlanner.
+/// MapBuilder, PathPlanner, CoveragePlanner.
 void register_navigation_modules(ModuleRegistry& registry);
 
 }  // namespace tripodal::navi
