@@ -18,7 +18,7 @@ scripts/install-deps.sh
 
 # -O1 -g1 as in the ASan+UBSan build of scripts/test.sh: reports with file:line, half the compile time.
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG" \
-  -DTRIPODAL_TSAN=ON -DTRIPODAL_WERROR=ON \
+  -DTRIPODAL_TSAN=ON -DTRIPODAL_WERROR=ON -DTRIPODAL_TEST_CXX_FLAGS=-O0 \
   -DTRIPODAL_BUILD_TESTS=ON -DTRIPODAL_BUILD_TOOLS=OFF -DTRIPODAL_BUILD_BENCH=OFF >/dev/null
 cmake --build "$build" -j "$jobs" --target "${suites[@]}"
 export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$root/scripts/tsan.supp"

@@ -9,10 +9,19 @@
 
 namespace tripodal::navi {
 
-MapBuilder::MapBuilder(Point2D lower, Point2D upper, MapBuilderOptions options) : options_(options) {
-  options_.matcher.global_levels = 1;  // the builder never searches globally: no pyramid
+MapBuilder::MapBuilder(Point2D lower, Point2D upper, MapBuilderOptions options)
+    : options_(options), closure_matcher_(options.matcher) {
+  options_.matcher.global_levels = 1;  // the tracker never searches globally: no pyramid
   validate(options_.matcher);
+  validate(closure_matcher_);
   Diagnostics d;
+  const LoopClosureOptions& loop = options_.loop;
+  if (!(loop.keyframe_m > 0.0 && loop.keyframe_rad > 0.0 && loop.every_keyframes >= 1 && loop.min_travel_m >= 0.0 &&
+        loop.search_radius_m > 0.0 && loop.submap_keyframes >= 1 && loop.min_quality > 0.0 && loop.min_quality <= 1.0 &&
+        loop.settled_m >= 0.0 && loop.settled_rad >= 0.0)) {
+    d.error({}, "map builder: loop closure options out of range (keyframe_m, keyframe_rad, search_radius_m > 0; "
+                "every_keyframes, submap_keyframes >= 1; min_quality in (0, 1])");
+  }
   if (!(std::isfinite(options_.resolution_m) && options_.resolution_m > 0.0)) {
     d.error({}, "map builder: resolution_m must be a number > 0, got " + std::to_string(options_.resolution_m));
   }
@@ -97,15 +106,109 @@ Pose2D MapBuilder::add(const LaserScan& scan, const Pose2D& odom_from_base, cons
       since_refresh_ = 0;
     }
   }
+  bool matched = false;
   if (matcher_) {
     ++since_refresh_;
     matcher_->set_scan(scan, base_from_laser);
     const ScanMatch m = matcher_->track(pose_, motion, options_.window);
     last_quality_ = m.quality;
-    if (m.quality >= options_.min_quality) pose_ = m.pose;
+    matched = m.quality >= options_.min_quality;
+    if (matched) pose_ = m.pose;
   }
+  travel_m_ += std::hypot(motion.x_m, motion.y_m);
   insert(scan, pose_, base_from_laser);
+  const LoopClosureOptions& loop = options_.loop;
+  if (keyframes_.empty()) {
+    add_keyframe(scan, base_from_laser, true);
+  } else {
+    const Pose2D since = compose(inverse(graph_.poses().back()), pose_);
+    if (std::hypot(since.x_m, since.y_m) >= loop.keyframe_m || std::abs(since.theta_rad) >= loop.keyframe_rad) {
+      add_keyframe(scan, base_from_laser, matched);
+    }
+  }
+  scans_.push_back({keyframes_.size() - 1, compose(inverse(graph_.poses().back()), pose_)});
   return pose_;
+}
+
+void MapBuilder::add_keyframe(const LaserScan& scan, const Pose2D& base_from_laser, bool matched) {
+  const LoopClosureOptions& loop = options_.loop;
+  const std::size_t node = graph_.add_node(pose_);
+  if (node > 0) {
+    // a poor match is the odometry's word only: a looser edge, which a closure bends first
+    graph_.add_edge(node - 1, node, compose(inverse(graph_.pose(node - 1)), pose_),
+                    matched ? loop.match_noise : loop.odometry_noise);
+  }
+  Keyframe k{scan, base_from_laser, travel_m_};
+  k.scan.intensities.clear();
+  keyframes_.push_back(std::move(k));
+  ++stats_.keyframes;
+  if (loop.enabled && node > 0 && node % static_cast<std::size_t>(loop.every_keyframes) == 0) try_closure();
+}
+
+void MapBuilder::try_closure() {
+  const LoopClosureOptions& loop = options_.loop;
+  const std::size_t c = keyframes_.size() - 1;
+  const Pose2D& here = graph_.pose(c);
+  const double horizon_m = keyframes_[c].travel_m - loop.min_travel_m;
+  // the candidate: the nearest key scan passed long enough ago
+  std::size_t j = c;
+  double best_m = loop.search_radius_m;
+  for (std::size_t k = 0; k < c && keyframes_[k].travel_m <= horizon_m; ++k) {
+    const double d = std::hypot(graph_.pose(k).x_m - here.x_m, graph_.pose(k).y_m - here.y_m);
+    if (d <= best_m) {
+      best_m = d;
+      j = k;
+    }
+  }
+  if (j == c) return;
+  ++stats_.attempts;
+  // its local map: the key scans around it, none from the recent past
+  const auto span = static_cast<std::size_t>(loop.submap_keyframes);
+  const std::size_t first = j > span ? j - span : 0;
+  std::size_t last = std::min(j + span, c);
+  while (last > j && keyframes_[last].travel_m > horizon_m) --last;
+  const double reach_m = std::min(options_.max_range_m, closure_matcher_.global_max_range_m) + 1.0;
+  Point2D lo{here.x_m - reach_m, here.y_m - reach_m}, hi{here.x_m + reach_m, here.y_m + reach_m};
+  for (std::size_t k = first; k <= last; ++k) {
+    lo = {std::min(lo.x_m, graph_.pose(k).x_m - reach_m), std::min(lo.y_m, graph_.pose(k).y_m - reach_m)};
+    hi = {std::max(hi.x_m, graph_.pose(k).x_m + reach_m), std::max(hi.y_m, graph_.pose(k).y_m + reach_m)};
+  }
+  MapBuilderOptions local_options = options_;
+  local_options.loop.enabled = false;
+  local_options.resolution_m = std::max(options_.resolution_m, loop.submap_resolution_m);
+  MapBuilder local(lo, hi, local_options);
+  for (std::size_t k = first; k <= last; ++k) local.insert(keyframes_[k].scan, graph_.pose(k), keyframes_[k].base_from_laser);
+  const OccupancyGrid submap = local.grid();
+  if (submap.count(Occupancy::occupied) == 0) return;
+  ScanMatcher matcher(submap, closure_matcher_);
+  if (matcher.set_scan(keyframes_[c].scan, keyframes_[c].base_from_laser) == 0) return;
+  const ScanMatch m = matcher.match_global();
+  if (m.quality < loop.min_quality || std::hypot(m.pose.x_m - here.x_m, m.pose.y_m - here.y_m) > loop.search_radius_m) return;
+  const Pose2D j_to_c = compose(inverse(graph_.pose(j)), m.pose);
+  const Pose2D off = compose(inverse(j_to_c), compose(inverse(graph_.pose(j)), here));
+  graph_.add_edge(j, c, j_to_c, loop.closure_noise, true);
+  ++stats_.closures;
+  if (std::hypot(off.x_m, off.y_m) <= loop.settled_m && std::abs(off.theta_rad) <= loop.settled_rad) return;
+  const PoseGraphReport report = graph_.optimize();
+  ++stats_.solves;
+  stats_.rejected += report.rejected;
+  stats_.closures -= report.rejected;
+  if (report.rejected > 0 && graph_.rejected(graph_.edge_count() - 1) && report.rejected == 1) return;
+  redraw();
+  pose_ = graph_.pose(c);
+  matcher_.reset();  // the tracker's window is refreshed from the redrawn map at the next scan
+}
+
+void MapBuilder::redraw() {
+  std::fill(log_odds_.begin(), log_odds_.end(), 0.0f);
+  for (std::size_t k = 0; k < keyframes_.size(); ++k) insert(keyframes_[k].scan, graph_.pose(k), keyframes_[k].base_from_laser);
+}
+
+std::vector<Pose2D> MapBuilder::trajectory() const {
+  std::vector<Pose2D> out;
+  out.reserve(scans_.size());
+  for (const ScanRef& s : scans_) out.push_back(compose(graph_.pose(s.keyframe), s.keyframe_from_base));
+  return out;
 }
 
 OccupancyGrid MapBuilder::grid() const { return grid_of(0, 0, width_, height_); }

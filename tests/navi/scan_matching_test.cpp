@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <memory>
 #include <numbers>
 
 #include "tripodal/navi/map_builder.hpp"
@@ -331,6 +332,47 @@ TEST_CASE("MapBuilder: a map from drifting odometry lines up with the world and 
   MapBuilderOptions bad;
   bad.resolution_m = 0.0;
   REQUIRE_THROWS_WITH(MapBuilder({0, 0}, {5, 5}, bad), Catch::Contains("resolution_m must be a number > 0"));
+}
+
+TEST_CASE("MapBuilder: loop closure undoes the drift of a map made on odometry alone", "[navi][scan_matching][pose_graph]") {
+  const OccupancyGrid world = room();
+  const sim::SolidMap solid(world);
+  // three times round the loop (about 26 m) trusting no match: the odometry's heading bias alone
+  // would leave the robot far off; the closures against the first round bring it back
+  auto run = [&](bool closing) {
+    MapBuilderOptions o;
+    o.min_quality = 1.0;  // no scan-to-map correction: odometry alone between closures
+    o.loop.enabled = closing;
+    o.loop.min_travel_m = 6.0;
+    auto b = std::make_unique<MapBuilder>(Point2D{-6.5, -7.5}, Point2D{14.5, 11.5}, o);
+    DriftingOdometry odo;
+    for (int k = 0; k <= 960; k += 2) b->add(scan_at(solid, true_pose(k)), odo.read(true_pose(k)), true_pose(0));
+    return b;
+  };
+  const auto open = run(false);
+  const auto closed = run(true);
+  CHECK(open->loop_stats().closures == 0);
+  CHECK(closed->loop_stats().closures >= 3);
+  CHECK(closed->loop_stats().solves >= 1);
+  const std::vector<Pose2D> drifted = open->trajectory(), corrected = closed->trajectory();
+  REQUIRE(corrected.size() == 481);
+  const Pose2D end = true_pose(960);
+  CHECK(distance(drifted.back(), end) > 1.0);
+  CHECK(distance(corrected.back(), end) < 0.25);
+  // the whole path: the closures tie every later round to the first (whose own bend only its
+  // closure at the start straightens: a map from odometry alone stays bent, less so)
+  double open_sum_m = 0.0, closed_sum_m = 0.0;
+  for (std::size_t i = 0; i < corrected.size(); ++i) {
+    open_sum_m += distance(drifted[i], true_pose(static_cast<int>(2 * i)));
+    closed_sum_m += distance(corrected[i], true_pose(static_cast<int>(2 * i)));
+  }
+  CHECK(closed_sum_m < open_sum_m / 4.0);
+  // and the map drawn again at the solved poses has its walls where the world has them at least
+  // twice as often
+  const double closed_walls = test::wall_agreement(closed->grid(), world).fraction();
+  const double open_walls = test::wall_agreement(open->grid(), world).fraction();
+  INFO("wall agreement: closed " << closed_walls << ", open " << open_walls);
+  CHECK(closed_walls > 2.0 * open_walls);
 }
 
 TEST_CASE("MapBuilder module: maps only between begin and end, crops to what the beams reached, saves a map_server map",

@@ -360,6 +360,7 @@ struct BuildArgs {
   double resolution_m = 0.05;
   double max_range_m = 30.0;
   double gap_s = 10.0;
+  bool no_loop_closure = false;
   std::string laser_channel = "front_laser", odom_channel = "odom", pose_channel = "laser_pose";
 };
 
@@ -384,17 +385,24 @@ int map_build(const BuildArgs& a, std::ostream& out, std::ostream& err) {
     o.resolution_m = a.resolution_m;
     o.max_range_m = a.max_range_m;
     o.matcher.max_range_m = a.max_range_m;
+    o.loop.enabled = !a.no_loop_closure;
     navi::MapBuilder b(lo, hi, o);
     std::vector<Pose2D> est;
     est.reserve(log.scans.size());
     const auto t0 = Clock::now();
-    for (const LoggedScan& s : log.scans) est.push_back(b.add(s.scan, s.odom));
+    for (const LoggedScan& s : log.scans) b.add(s.scan, s.odom);
     const double ms = ms_since(t0);
+    // scored on the poses as the graph places them at the end (a closure moves past poses too)
+    est = b.trajectory();
     const OccupancyGrid g = b.grid();
     navi::save_map(g, a.out);
     out << log.name << ": " << log.scans.size() << " scans mapped in " << std::fixed << std::setprecision(1) << ms / 1000.0
         << " s (" << std::setprecision(2) << ms / static_cast<double>(log.scans.size()) << " ms per scan); map "
         << g.width() << " x " << g.height() << " cells written to " << a.out.string() << "\n";
+    const navi::LoopClosureStats& loop = b.loop_stats();
+    out << "  loop closure: " << (o.loop.enabled ? "" : "off; ") << loop.keyframes << " key scans, " << loop.attempts
+        << " local matches tried, " << loop.closures << " closures kept, " << loop.rejected << " rejected, " << loop.solves
+        << " graph solves\n";
     if (all_referenced(log)) {
       const std::vector<Pose2D>& odo_rel = odom;
       out << "  relative errors vs the corrected poses (Kuemmerle et al. 2009):\n";
@@ -441,6 +449,7 @@ cli::Action setup_build(CLI::App& cmd) {
   cmd.add_option("--resolution", a->resolution_m, "M: cell side")->capture_default_str()->check(positive_number());
   cmd.add_option("--max-range", a->max_range_m, "M: returns beyond are not mapped")->capture_default_str()->check(positive_number());
   cmd.add_option("--gap", a->gap_s, "S: time between the far pairs of the relative errors")->capture_default_str()->check(positive_number());
+  cmd.add_flag("--no-loop-closure", a->no_loop_closure, "scan to map only: no pose graph, no closures");
   channel_options(cmd, a->laser_channel, a->odom_channel, a->pose_channel);
   return [a](std::ostream& out, std::ostream& err) { return map_build(*a, out, err); };
 }
