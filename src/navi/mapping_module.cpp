@@ -29,7 +29,9 @@ const ModuleManifest& CMappingModule::static_manifest() {
        ParameterSpec{"max_range_m", ValueType::number, Value{d.builder.max_range_m}, "m",
                      "beams beyond this are not inserted", 0.5, 100.0},
        ParameterSpec{"begin_at_start", ValueType::boolean, Value{d.begin_at_start}, "",
-                     "map from the first period (else when the operator asks)", {}, {}}});
+                     "map from the first period (else when the operator asks)", {}, {}},
+       ParameterSpec{"loop_closure", ValueType::boolean, Value{d.builder.loop.enabled}, "",
+                     "close loops while mapping (each attempt holds the sequencing loop for 50-250 ms)", {}, {}}});
   return m;
 }
 
@@ -40,6 +42,7 @@ void CMappingModule::on_configure(const ParameterSet& params) {
   o.builder.max_range_m = params.number("max_range_m");
   o.size_m = params.number("size_m");
   o.begin_at_start = params.boolean("begin_at_start");
+  o.builder.loop.enabled = params.boolean("loop_closure");
   const double cells = o.size_m / o.builder.resolution_m;
   if (cells * cells > static_cast<double>(kMaxPgmPixels)) {
     throw ConfigError(where(), "MapBuilder: size_m / resolution_m gives a map of " + std::to_string(static_cast<long long>(cells)) +
