@@ -110,10 +110,10 @@ def main():
               "the page's stale edit is refused: " + m.replace("\n", " | "))
         check("entrance D." in disk() and "entrance E." not in disk(), "the file keeps the API's change")
         check(el("f-answer").get_attribute("value") == "The car park is at entrance E.", "the editor's text stays in the form")
+        driver.save_screenshot(os.path.join(artifacts, "rkms.png"))
         el("reload-entry-btn").click()
         wait.until(lambda d: el("f-version").get_attribute("value") == "4")
         check(el("f-answer").get_attribute("value") == "Park at entrance D.", "'reload this entry' shows the saved version 4")
-        driver.save_screenshot(os.path.join(artifacts, "rkms.png"))
 
         # Delete it (the page asks first).
         driver.execute_script("document.getElementById('msg').textContent = ''")
