@@ -851,7 +851,7 @@ TEST_CASE("RKMS administration needs the token: refused without it and nothing c
   server.stop();
 }
 
-TEST_CASE("The RKMS and touch pages are served; the touch screen's questions are answered by the HRI", "[monitor][robot][rkms]") {
+TEST_CASE("The RKMS and touch pages are served, and the touch screen's questions are answered by the HRI", "[monitor][robot][rkms]") {
   Psr2WithHri psr2;
   MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
   RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
