@@ -5,12 +5,14 @@
 
 #include <catch2/catch.hpp>
 
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include "tripodal/hri/hri_service.hpp"
 
@@ -352,4 +354,30 @@ TEST_CASE("StoreBackedHri answers from an edit at once and refuses a provider th
 
   REQUIRE(store.remove("parking", 2, "x").ok());
   CHECK(hri.ask("where can I park my car").kind == HriReply::Kind::not_understood);
+}
+
+TEST_CASE("store: changes from two threads are all saved, each under a version of its own") {
+  Folder f;
+  KnowledgeStore store(f.file);
+  // Catch2's assertions are not thread-safe: the threads count, the test thread checks.
+  std::atomic<int> saved{0};
+  const auto writer = [&store, &saved](const std::string& prefix) {
+    for (int i = 0; i < 10; ++i) {
+      KnowledgeEntry e = parking();
+      e.id = prefix + std::to_string(i);
+      if (store.add(e, prefix).ok()) ++saved;
+      (void)store.search("car");  // readers in between
+    }
+  };
+  std::thread a(writer, "a");
+  std::thread b(writer, "b");
+  a.join();
+  b.join();
+  REQUIRE(saved == 20);
+  const auto h = store.history();
+  REQUIRE(h.size() == 20);
+  for (std::size_t i = 0; i < h.size(); ++i) CHECK(h[i].version == i + 2);
+  CHECK(store.version() == 21);
+  CHECK(store.entries().size() == 45);
+  require_disk_equals_store(store);
 }

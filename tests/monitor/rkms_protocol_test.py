@@ -9,6 +9,8 @@ usage: rkms_protocol_test.py SERVER SOURCE_DIR"""
 import json
 import os
 import re
+import shutil
+import subprocess
 import sys
 import urllib.request
 
@@ -74,17 +76,34 @@ def main():
         check(status == 400 and "expected \"version\"" in j["error"], "an edit without a version: 400")
         check(read(srv.knowledge) == before, "the refused entries changed nothing on disk")
 
+        odd = {"id": "odd.entry-1", "topic": "<R&D> \"quotes\"", "keywords": ["a<b", "R&D"],
+               "questions": ["Is 1 < 2 & \"so\"?\r\nReally?"], "answer": "Line one,\nline two & {{braces}} at {time}.",
+               "action": "guide me to node 1"}
+        status, j = srv.op("rkms.add", entry=odd)
+        check(status == 200, "an entry with markup characters, quotes and line breaks is added")
+        xmllint = shutil.which("xmllint")
+        if xmllint:
+            r = subprocess.run([xmllint, "--noout", "--schema", os.path.join(source, "configs/hri/rkms.xsd"), srv.knowledge],
+                               capture_output=True, text=True)
+            check(r.returncode == 0, "the saved file validates against configs/hri/rkms.xsd: " + r.stderr.strip())
+        status, j = srv.op("rkms.get", id="odd.entry-1")
+        check(j["entry"]["questions"] == ["Is 1 < 2 & \"so\"?\nReally?"] and j["entry"]["topic"] == "<R&D> \"quotes\"",
+              "it reads back as saved (line breaks as \\n)")
+        status, j = srv.op("rkms.delete", id="odd.entry-1", version=j["entry"]["version"])
+        check(status == 200, "and is deleted")
+
         status, j = srv.op("rkms.list", query="PARKING entrance")
         check([e["id"] for e in j["entries"]] == ["parking"] and j["entries"][0]["version"] == 3, "search finds the edited entry")
         status, j = srv.op("rkms.delete", id="parking", version=3, author="dave")
-        check(status == 200 and j["version"] == 4, "rkms.delete: version 4")
+        check(status == 200 and j["version"] == 6, "rkms.delete: version 6")
         status, j = srv.op("rkms.history")
         ops = [(c["op"], c["id"], c["author"], c["version"]) for c in j["changes"]]
-        check(ops == [("add", "parking", "alice", 2), ("edit", "parking", "bob", 3), ("delete", "parking", "dave", 4)],
+        check(ops == [("add", "parking", "alice", 2), ("edit", "parking", "bob", 3), ("add", "odd.entry-1", "operator", 4),
+                      ("delete", "odd.entry-1", "operator", 5), ("delete", "parking", "dave", 6)],
               "the history: %s" % ops)
         check(re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ", j["changes"][0]["time"]) is not None, "changes carry their UTC time")
         with open(srv.knowledge + ".history") as f:
-            check(len(f.read().splitlines()) == 3, "the history file beside the knowledge has a line per change")
+            check(len(f.read().splitlines()) == 5, "the history file beside the knowledge has a line per change")
 
         status, j = srv.op("touch")
         check(status == 200 and len(j["questions"]) == 8 and isinstance(j["voice"], bool), "touch: 8 questions, voice %s" % j["voice"])
