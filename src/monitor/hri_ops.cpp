@@ -205,7 +205,7 @@ HriOpResult handle_hri_op(HriService* hri, std::string_view op, const json& body
   }
   if (op == "rkms.add" || op == "rkms.edit") {
     std::vector<KnowledgeFieldError> errors;
-    const auto entry = entry_from(body.contains("entry") ? body["entry"] : json(nullptr), errors);
+    auto entry = entry_from(body.contains("entry") ? body["entry"] : json(nullptr), errors);
     if (!entry) {
       HriOpResult r = bad(std::string(op) + ": the entry is not valid; nothing was saved");
       r.body["status"] = "invalid";
@@ -219,6 +219,7 @@ HriOpResult handle_hri_op(HriService* hri, std::string_view op, const json& body
       const auto version = version_of(body);
       if (!version) return bad("rkms.edit: expected \"version\": the entry's version you edited (from rkms.list)");
       const std::string id = body.contains("id") && body["id"].is_string() ? body["id"].get<std::string>() : entry->id;
+      if (entry->id.empty()) entry->id = id;  // the entry of the id the request names
       r = store.edit(id, *entry, *version, author_of(body));
     }
     const bool changed = r.ok() && r.message.find("unchanged") == std::string::npos;

@@ -47,9 +47,10 @@ class StoreBackedHri final : public HriService {
   HriReply ask(std::string_view utterance) override;
   [[nodiscard]] SpeechSynthesizer* voice() noexcept override { return voice_.get(); }
 
-  /// The module as of the store's current version (indexed anew if needed). An edit that names a
-  /// provider the application lacks keeps the previous module answering and is reported in
-  /// index_error().
+  /// The module as of the store's current version (indexed anew if needed), for the inputs ask()
+  /// does not cover (handle_heard). Not locked: call it from the thread that calls ask(). A base
+  /// that cannot be indexed (a hand-edited file naming a provider the application lacks) keeps the
+  /// previous module answering and is reported in index_error().
   HriModule& module();
   /// The version the current module was indexed at.
   [[nodiscard]] std::uint64_t indexed_version() const noexcept { return indexed_version_; }
