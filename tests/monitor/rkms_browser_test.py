@@ -135,6 +135,8 @@ def main():
         driver.get(srv.base + "/touch?token=" + srv.token)
         wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#buttons button.question")) == 8)
         check(text("title").startswith("Hello, I am Jinny!"), "the touch page shows 8 big buttons")
+        wait.until(lambda d: el("state").get_attribute("data-task-state") == "idle")
+        check(text("state") == "the robot's state: no task (idle), paused", "the robot's state is shown: " + text("state"))
         voice = text("voice").startswith("voice is on")
         driver.find_element(By.XPATH, '//button[text()="Introduce yourself."]').click()
         wait.until(lambda d: el("answer").get_attribute("data-kind") == "answered")
