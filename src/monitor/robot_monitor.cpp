@@ -646,6 +646,7 @@ void RobotMonitor::set_breakpoint(std::string place, bool on) {
   if (on) impl_->breakpoints.insert(std::move(place));
   else impl_->breakpoints.erase(place);
 }
+void RobotMonitor::set_hri(HriService* hri) noexcept { impl_->hri = hri; }
 std::vector<std::string> RobotMonitor::breakpoints() const {
   return {impl_->breakpoints.begin(), impl_->breakpoints.end()};
 }

@@ -896,3 +896,27 @@ TEST_CASE("RKMS ops on a robot without an HRI module are refused with 404", "[mo
   CHECK_THAT(r.body["error"].get<std::string>(), Catch::Contains("this robot has no HRI knowledge store"));
   server.stop();
 }
+
+TEST_CASE("An HRI built by the application outside the robot's modules is given to the monitor with set_hri", "[monitor][robot][rkms]") {
+  Psr2WithHri with;  // only for its knowledge file and Jinny's tasks
+  Psr2 psr2;         // a robot without an HRI module
+  KnowledgeStore store(with.file);
+  const TaskLibrary tasks = TaskLibrary::load(TRIPODAL_SOURCE_DIR "/configs/tasks/jinny_guide.yaml");
+  const testing_hri::NoNodes nodes;
+  AnswerProviders providers;
+  providers.add("time", std::make_unique<FixedProvider>("14:05"));
+  providers.add("battery", std::make_unique<FixedProvider>("82 percent"));
+  providers.add("weather", std::make_unique<FixedProvider>("rain"));
+  StoreBackedHri hri(store, tasks, nodes, providers, [](const Understanding&) { return std::string("no"); });
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
+  server.start();
+  CHECK(json_command(server, watch, {{"op", "ask"}, {"text", "will it rain"}}).status == 404);
+  watch.set_hri(&hri);
+  const JsonAnswer r = json_command(server, watch, {{"op", "ask"}, {"text", "will it rain"}});
+  CHECK(r.status == 200);
+  CHECK(r.body["entry"] == "weather");
+  CHECK(r.body["text"] == "The weather today: rain.");
+  watch.set_hri(nullptr);
+  server.stop();
+}

@@ -71,6 +71,10 @@ class RobotMonitor final {
   /// Places ("P1" or a place's name in any net, "PrCleaning.P1" in one net) where the run pauses when they become marked.
   void set_breakpoint(std::string place, bool on);
   [[nodiscard]] std::vector<std::string> breakpoints() const;
+  /// The HRI the RKMS and touch ops reach, when the application builds it after the monitor
+  /// (RobotMonitorOptions::hri otherwise); nullptr: none (those ops answer 404). Call it from the
+  /// thread that calls update(); `hri` must outlive the monitor or be replaced first.
+  void set_hri(HriService* hri) noexcept;
 
   struct Impl;
 
