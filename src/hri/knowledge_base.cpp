@@ -48,36 +48,6 @@ std::vector<std::string> split_keywords(std::string_view text) {
   return out;
 }
 
-// The checks an entry must pass however it was made (loaded or put): each problem as a message,
-// with what was expected.
-std::vector<std::string> entry_problems(const KnowledgeEntry& e) {
-  std::vector<std::string> out;
-  if (e.id.empty()) {
-    out.emplace_back("an entry needs an id");
-  } else if (!std::all_of(e.id.begin(), e.id.end(), id_char)) {
-    out.push_back("entry id '" + e.id + "': expected letters, digits, '_', '-' or '.'");
-  }
-  if (trimmed(e.topic).empty()) out.push_back("entry '" + e.id + "': the topic is empty; expected a few words");
-  if (e.keywords.empty() && e.questions.empty()) {
-    out.push_back("entry '" + e.id + "' has neither keywords nor questions; expected at least one");
-  }
-  for (const auto& k : e.keywords) {
-    if (trimmed(k).empty() || k.find(',') != std::string::npos) {
-      out.push_back("entry '" + e.id + "': keyword '" + k + "' is empty or holds a comma");
-    }
-  }
-  for (const auto& q : e.questions) {
-    if (trimmed(q).empty()) out.push_back("entry '" + e.id + "': a question is empty");
-  }
-  if (trimmed(e.answer).empty()) {
-    out.push_back("entry '" + e.id + "': the answer is empty; expected what the robot says");
-  } else {
-    const PlaceholderScan scan = scan_placeholders(e.answer);
-    if (!scan.error.empty()) out.push_back("entry '" + e.id + "': answer: " + scan.error);
-  }
-  return out;
-}
-
 struct Reader {
   const XmlLocator& at;
   Diagnostics& d;
@@ -229,6 +199,36 @@ KnowledgeBase parse(std::string_view text, std::string_view name, std::uint64_t&
 
 }  // namespace
 
+std::vector<KnowledgeFieldError> knowledge_entry_errors(const KnowledgeEntry& e) {
+  std::vector<KnowledgeFieldError> out;
+  const std::string who = "entry '" + e.id + "'";
+  if (e.id.empty()) {
+    out.push_back({"id", "an entry needs an id: letters, digits, '_', '-' or '.'"});
+  } else if (!std::all_of(e.id.begin(), e.id.end(), id_char)) {
+    out.push_back({"id", "entry id '" + e.id + "': expected letters, digits, '_', '-' or '.'"});
+  }
+  if (trimmed(e.topic).empty()) out.push_back({"topic", who + ": the topic is empty; expected a few words"});
+  if (e.keywords.empty() && e.questions.empty()) {
+    out.push_back({"keywords", who + " has neither keywords nor questions; expected at least one"});
+  }
+  for (std::size_t i = 0; i < e.keywords.size(); ++i) {
+    const std::string& k = e.keywords[i];
+    if (trimmed(k).empty() || k.find(',') != std::string::npos) {
+      out.push_back({"keywords[" + std::to_string(i) + "]", who + ": keyword '" + k + "' is empty or holds a comma"});
+    }
+  }
+  for (std::size_t i = 0; i < e.questions.size(); ++i) {
+    if (trimmed(e.questions[i]).empty()) out.push_back({"questions[" + std::to_string(i) + "]", who + ": a question is empty"});
+  }
+  if (trimmed(e.answer).empty()) {
+    out.push_back({"answer", who + ": the answer is empty; expected what the robot says"});
+  } else {
+    const PlaceholderScan scan = scan_placeholders(e.answer);
+    if (!scan.error.empty()) out.push_back({"answer", who + ": answer: " + scan.error});
+  }
+  return out;
+}
+
 PlaceholderScan scan_placeholders(std::string_view answer) {
   PlaceholderScan scan;
   std::size_t i = 0;
@@ -298,10 +298,10 @@ const KnowledgeEntry* KnowledgeBase::find(std::string_view id) const noexcept {
 }
 
 void KnowledgeBase::put(KnowledgeEntry entry) {
-  const std::vector<std::string> problems = entry_problems(entry);
+  const std::vector<KnowledgeFieldError> problems = knowledge_entry_errors(entry);
   if (!problems.empty()) {
     std::string text;
-    for (const auto& p : problems) text += (text.empty() ? "" : "; ") + p;
+    for (const auto& p : problems) text += (text.empty() ? "" : "; ") + p.message;
     throw std::invalid_argument(text);
   }
   const auto it = std::find_if(entries_.begin(), entries_.end(), [&](const KnowledgeEntry& e) { return e.id == entry.id; });

@@ -405,9 +405,15 @@ struct MonitorServer::Impl {
       return;
     }
     if (r.method != "GET") return refuse(c, 405, "only GET is served here");
-    if (r.path == "/" || r.path == "/index.html") {
-      enqueue(c, http_response(200, "text/html; charset=utf-8", page,
-                               "Content-Security-Policy: default-src 'self' 'unsafe-inline'; connect-src 'self' ws: wss:\r\n"),
+    const std::string_view html = r.path == "/" || r.path == "/index.html" ? std::string_view(page)
+                                  : r.path == "/rkms"                         ? embedded_rkms_page()
+                                  : r.path == "/touch"                        ? embedded_touch_page()
+                                                                              : std::string_view();
+    if (!html.empty()) {
+      // Pages carry no secret (the token comes with the address or is typed): served to anyone.
+      // Audio the touch page plays is a data: URL of the answer, hence media-src data:.
+      enqueue(c, http_response(200, "text/html; charset=utf-8", html,
+                               "Content-Security-Policy: default-src 'self' 'unsafe-inline'; connect-src 'self' ws: wss:; media-src data:\r\n"),
               false);
       c.close_after_write = true;
       return;
@@ -418,7 +424,8 @@ struct MonitorServer::Impl {
       c.close_after_write = true;
       return;
     }
-    refuse(c, 404, "not found: the monitor serves / (the page), /ws (WebSocket) and /api/command");
+    refuse(c, 404, "not found: the monitor serves / (the page), /rkms (the RKMS administration), /touch (the touch screen), "
+                   "/ws (WebSocket) and /api/command");
   }
 
   void upgrade_ws(Connection& c, const HttpRequest& r) {

@@ -20,6 +20,7 @@
 #include "tripodal/navi/mapping_module.hpp"
 #include "tripodal/navi/section_splitter.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
+#include "hri_ops.hpp"
 #include "net_drawing.hpp"
 
 namespace tripodal::monitor {
@@ -163,8 +164,11 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
   std::shared_ptr<DriveCommand> drive = std::make_shared<DriveCommand>();
   bool driving = false;
   std::chrono::steady_clock::time_point last_drive{};
+  // The robot's HRI, found once: the modules do not change after assembly.
+  HriService* hri = nullptr;
 
   Impl(Robot& r, const Clock& c, MonitorServer& s, RobotMonitorOptions o) : robot(r), clock(c), server(s), options(std::move(o)) {
+    hri = options.hri != nullptr ? options.hri : robot.module<HriService>();
     ch_pose = server.advertise("/pose", "foxglove.PoseInFrame", pose_schema(), Delivery::bulk);
     ch_path = server.advertise("/path", "foxglove.PosesInFrame",
                                R"({"type":"object","properties":{"frame_id":{"type":"string"},"poses":{"type":"array"}}})", Delivery::state);
@@ -437,6 +441,10 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
       return reply(200, {{"run", run}, {"process", process->name()}, {"xml", net_to_string(process->net(), NetFormat::native_xml)}});
     }
     if (op == "reload") return reload(r, body);
+    if (is_hri_op(op)) {
+      const HriOpResult result = handle_hri_op(hri, op, body, [this](std::string text) { note(std::move(text)); });
+      return reply(result.status, result.body);
+    }
     if (op == "map") return map_request(r, body);
     if (op == "breakpoint") {
       if (!body.contains("place") || !body["place"].is_string() || body["place"].get<std::string>().empty()) {
@@ -449,7 +457,8 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
       note("monitor: breakpoint " + std::string(on ? "set" : "cleared") + " on place " + place);
       return reply(200, {{"breakpoints", std::vector<std::string>(breakpoints.begin(), breakpoints.end())}});
     }
-    reply(400, {{"error", "unknown op '" + op + "': expected task, pause, resume, cancel, ack, breakpoint, drive, net, reload or map"}});
+    reply(400, {{"error", "unknown op '" + op + "': expected task, pause, resume, cancel, ack, breakpoint, drive, net, reload, map, "
+                                          "rkms.list, rkms.get, rkms.add, rkms.edit, rkms.delete, rkms.history, touch or ask"}});
   }
 
   // --- topics -------------------------------------------------------------------------------------
@@ -637,6 +646,7 @@ void RobotMonitor::set_breakpoint(std::string place, bool on) {
   if (on) impl_->breakpoints.insert(std::move(place));
   else impl_->breakpoints.erase(place);
 }
+void RobotMonitor::set_hri(HriService* hri) noexcept { impl_->hri = hri; }
 std::vector<std::string> RobotMonitor::breakpoints() const {
   return {impl_->breakpoints.begin(), impl_->breakpoints.end()};
 }

@@ -12,7 +12,10 @@ import urllib.request
 
 class MonitoredRun:
     def __init__(self, exe, robot, world, *extra):
-        self.cmd = [exe, "run", "--robot", robot, "--world", world, "--monitor", "0", *extra]
+        self._start([exe, "run", "--robot", robot, "--world", world, "--monitor", "0", *extra])
+
+    def _start(self, cmd):
+        self.cmd = cmd
         self.proc = subprocess.Popen(self.cmd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
         self.lines = []
         deadline = time.monotonic() + 60
@@ -26,7 +29,7 @@ class MonitoredRun:
                 self.base, self.port, self.token = m.group(1), int(m.group(2)), m.group(3)
                 return
         self.stop()
-        raise RuntimeError("tripodal run did not print the monitor's address: " + "".join(self.lines))
+        raise RuntimeError(" ".join(self.cmd[:2]) + " did not print the monitor's address: " + "".join(self.lines))
 
     def post(self, body, token=None, raw=None):
         """POST /api/command; returns (status, parsed JSON)."""
@@ -53,6 +56,28 @@ class MonitoredRun:
         rest = self.proc.stdout.read() if self.proc.stdout else ""
         self.lines.append(rest)
         return "".join(self.lines)
+
+
+class HriMonitorServer(MonitoredRun):
+    """tripodal_hri_monitor_server: the PSR-2 with an HRI module on a copy of `knowledge` in a
+    fresh folder (self.knowledge), served by the monitor, paused."""
+
+    def __init__(self, exe, source_dir, knowledge):
+        import shutil
+        import tempfile
+        self.dir = tempfile.mkdtemp(prefix="tripodal_rkms_")
+        self.knowledge = os.path.join(self.dir, os.path.basename(knowledge))
+        shutil.copyfile(knowledge, self.knowledge)
+        self._start([exe, source_dir, self.knowledge])
+
+    def op(self, op, **fields):
+        return self.post(dict(op=op, **fields), token=self.token)
+
+    def stop(self):
+        import shutil
+        out = super().stop()
+        shutil.rmtree(self.dir, ignore_errors=True)
+        return out
 
 
 def check(cond, what):

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <memory>
 #include <regex>
 #include <string>
@@ -30,6 +31,7 @@
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_board.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
+#include "test_hri_module.hpp"
 
 using namespace tripodal;
 using namespace tripodal::monitor;
@@ -670,4 +672,251 @@ TEST_CASE("Map requests without a map folder or a MapBuilder are refused", "[mon
   server.start();
   CHECK_THAT(post_command(server, watch, R"({"op":"map","action":"save","name":"x"})"),
              Catch::Contains("403") && Catch::Contains("saving is off"));
+}
+
+namespace {
+
+// The PSR-2 with an HRI module (TestHri) on a copy of Jinny's knowledge in a fresh folder: the
+// monitor finds the knowledge through the robot's modules.
+struct Psr2WithHri {
+  std::filesystem::path dir;
+  std::filesystem::path file;
+  RobotPlugins plugins = RobotPlugins::with_builtins();
+  SimClock clock;
+  std::unique_ptr<Robot> robot;
+  Psr2WithHri() {
+    const std::filesystem::path source = TRIPODAL_SOURCE_DIR;
+    dir = std::filesystem::temp_directory_path() / ("tripodal_rkms_monitor_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    file = dir / "jinny.xml";
+    std::filesystem::copy_file(source / "configs/hri/jinny.xml", file);
+    plugins.modules.add<testing_hri::TestHri>();
+    sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(source / "configs/worlds/workspace.yaml")));
+    RobotProfile profile = load_robot_profile(source / "configs/robots/psr2.yaml");
+    testing_hri::add_test_hri(profile, file, source);
+    robot = Robot::assemble(profile, plugins, clock);
+  }
+  ~Psr2WithHri() {
+    robot.reset();
+    std::error_code ec;
+    std::filesystem::remove_all(dir, ec);
+  }
+  Psr2WithHri(const Psr2WithHri&) = delete;
+  Psr2WithHri& operator=(const Psr2WithHri&) = delete;
+};
+
+struct JsonAnswer {
+  int status = 0;
+  nlohmann::json body;
+};
+
+JsonAnswer json_command(MonitorServer& server, RobotMonitor& watch, const nlohmann::json& body,
+                        const std::string& auth = "Authorization: Bearer t0ken-for-tests\r\n") {
+  const std::string a = post_command(server, watch, body.dump(), auth);
+  JsonAnswer out;
+  out.status = std::stoi(a.substr(9, 3));
+  out.body = nlohmann::json::parse(a.substr(a.find("\r\n\r\n") + 4));
+  return out;
+}
+
+std::string file_text(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+}  // namespace
+
+TEST_CASE("RKMS administration: list, add, edit, delete and history through the robot's HRI module", "[monitor][robot][rkms]") {
+  Psr2WithHri psr2;
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
+  server.start();
+
+  JsonAnswer r = json_command(server, watch, {{"op", "rkms.list"}});
+  REQUIRE(r.status == 200);
+  CHECK(r.body["version"] == 1);
+  CHECK(r.body["file"] == "jinny.xml");
+  CHECK(r.body["entries"].size() == 25);
+  r = json_command(server, watch, {{"op", "rkms.list"}, {"query", "umbrella"}});
+  REQUIRE(r.body["entries"].size() == 1);
+  CHECK(r.body["entries"][0]["id"] == "weather");
+  CHECK(r.body["entries"][0]["version"] == 1);
+
+  const nlohmann::json parking{{"id", "parking"},
+                               {"topic", "the parking"},
+                               {"keywords", {"parking", "car"}},
+                               {"questions", {"Where can I park my car?"}},
+                               {"answer", "The car park is behind the hall."}};
+  CHECK(json_command(server, watch, {{"op", "ask"}, {"text", "where can I park my car"}}).body["kind"] == "not_understood");
+  r = json_command(server, watch, {{"op", "rkms.add"}, {"entry", parking}, {"author", "alice"}});
+  REQUIRE(r.status == 200);
+  CHECK(r.body["version"] == 2);
+  CHECK(r.body["entry_version"] == 2);
+  // Answered at once, from the file's next version.
+  r = json_command(server, watch, {{"op", "ask"}, {"text", "where can I park my car"}});
+  CHECK(r.body["kind"] == "answered");
+  CHECK(r.body["entry"] == "parking");
+  CHECK(r.body["text"] == "The car park is behind the hall.");
+  CHECK(KnowledgeBase::load(psr2.file).find("parking") != nullptr);
+
+  nlohmann::json edited = parking;
+  edited["answer"] = "Behind the hall, entrance B.";
+  r = json_command(server, watch, {{"op", "rkms.edit"}, {"id", "parking"}, {"version", 2}, {"entry", edited}, {"author", "bob"}});
+  REQUIRE(r.status == 200);
+  CHECK(r.body["version"] == 3);
+  // A second editor who read version 2: refused, and nothing changes.
+  const std::string before = file_text(psr2.file);
+  nlohmann::json other = parking;
+  other["answer"] = "Nowhere.";
+  r = json_command(server, watch, {{"op", "rkms.edit"}, {"id", "parking"}, {"version", 2}, {"entry", other}, {"author", "carol"}});
+  CHECK(r.status == 409);
+  CHECK(r.body["status"] == "stale");
+  CHECK(r.body["entry_version"] == 3);
+  CHECK(r.body["current"]["answer"] == "Behind the hall, entrance B.");
+  CHECK_THAT(r.body["error"].get<std::string>(), Catch::Contains("was changed since you read it"));
+  CHECK(json_command(server, watch, {{"op", "rkms.delete"}, {"id", "parking"}, {"version", 2}}).status == 409);
+  CHECK(file_text(psr2.file) == before);
+
+  // Invalid: the field is named.
+  nlohmann::json bad = parking;
+  bad["id"] = "car park";
+  bad["answer"] = "It is {time";
+  r = json_command(server, watch, {{"op", "rkms.add"}, {"entry", bad}});
+  CHECK(r.status == 400);
+  CHECK(r.body["errors"][0]["field"] == "id");
+  CHECK(r.body["errors"][1]["field"] == "answer");
+  CHECK_THAT(r.body["errors"][1]["message"].get<std::string>(), Catch::Contains("unclosed '{' at byte 6"));
+  bad = parking;
+  bad["keywords"] = nlohmann::json::array({"car", 7});
+  r = json_command(server, watch, {{"op", "rkms.add"}, {"entry", bad}});
+  CHECK(r.status == 400);
+  CHECK(r.body["errors"][0]["field"] == "keywords[1]");
+  // Oversize and binary fields: a polite refusal.
+  bad = parking;
+  bad["id"] = "big";
+  bad["answer"] = std::string(5000, 'a');
+  r = json_command(server, watch, {{"op", "rkms.add"}, {"entry", bad}});
+  CHECK(r.status == 400);
+  CHECK(r.body["errors"][0]["message"] == "answer is 5000 bytes long; expected at most 4000");
+  bad["answer"] = std::string("bell\x07", 5);
+  r = json_command(server, watch, {{"op", "rkms.add"}, {"entry", bad}});
+  CHECK(r.status == 400);
+  CHECK(r.body["errors"][0]["message"] == "answer is not text: expected UTF-8 without control characters");
+  CHECK(file_text(psr2.file) == before);
+
+  r = json_command(server, watch, {{"op", "rkms.delete"}, {"id", "parking"}, {"version", 3}, {"author", "dave"}});
+  REQUIRE(r.status == 200);
+  CHECK(r.body["version"] == 4);
+  CHECK(json_command(server, watch, {{"op", "rkms.get"}, {"id", "parking"}}).status == 404);
+
+  r = json_command(server, watch, {{"op", "rkms.history"}});
+  REQUIRE(r.status == 200);
+  REQUIRE(r.body["changes"].size() == 3);
+  CHECK(r.body["changes"][0]["op"] == "add");
+  CHECK(r.body["changes"][0]["author"] == "alice");
+  CHECK(r.body["changes"][1]["op"] == "edit");
+  CHECK(r.body["changes"][1]["before"]["answer"] == "The car park is behind the hall.");
+  CHECK(r.body["changes"][1]["after"]["answer"] == "Behind the hall, entrance B.");
+  CHECK(r.body["changes"][2]["op"] == "delete");
+  CHECK(r.body["changes"][2]["after"].is_null());
+  CHECK(json_command(server, watch, {{"op", "rkms.history"}, {"limit", 1}}).body["changes"].size() == 1);
+  server.stop();
+}
+
+TEST_CASE("RKMS administration needs the token: refused without it and nothing changes", "[monitor][robot][rkms]") {
+  Psr2WithHri psr2;
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
+  server.start();
+  const std::string before = file_text(psr2.file);
+  const nlohmann::json add{{"op", "rkms.add"},
+                           {"entry", {{"id", "x"}, {"topic", "x"}, {"keywords", {"x"}}, {"answer", "x"}}}};
+  for (const std::string auth : {"", "Authorization: Bearer wrong-token\r\n", "X-Tripodal-Token: t0ken\r\n"}) {
+    Client c(server.port());
+    const std::string body = add.dump();
+    c.send("POST /api/command HTTP/1.1\r\n" + auth + "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body);
+    const std::string a = c.read_all();
+    CHECK(a.starts_with("HTTP/1.1 401"));
+    watch.update();
+  }
+  const nlohmann::json del{{"op", "rkms.delete"}, {"id", "weather"}, {"version", 1}};
+  Client c(server.port());
+  c.send("POST /api/command HTTP/1.1\r\nContent-Length: " + std::to_string(del.dump().size()) + "\r\n\r\n" + del.dump());
+  CHECK(c.read_all().starts_with("HTTP/1.1 401"));
+  watch.update();
+  CHECK(file_text(psr2.file) == before);
+  CHECK_FALSE(std::filesystem::exists(psr2.file.string() + ".history"));
+  CHECK(json_command(server, watch, {{"op", "rkms.list"}}).body["entries"].size() == 25);
+  server.stop();
+}
+
+TEST_CASE("The RKMS and touch pages are served, and the touch screen's questions are answered by the HRI", "[monitor][robot][rkms]") {
+  Psr2WithHri psr2;
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
+  server.start();
+  for (const auto& [path, marker] : {std::pair{"/rkms", "RKMS: the robot's knowledge"}, std::pair{"/touch", "Type your question here"}}) {
+    Client c(server.port());
+    c.send(std::string("GET ") + path + " HTTP/1.1\r\nHost: x\r\n\r\n");
+    const std::string page = c.read_all();
+    CHECK(page.starts_with("HTTP/1.1 200"));
+    CHECK(page.find(marker) != std::string::npos);
+  }
+  JsonAnswer r = json_command(server, watch, {{"op", "touch"}});
+  REQUIRE(r.status == 200);
+  CHECK(r.body["robot"] == "jinny");
+  CHECK(r.body["voice"] == voice_available());
+  REQUIRE(r.body["questions"].size() == 8);
+  CHECK(r.body["questions"][0] == "Introduce yourself.");
+  r = json_command(server, watch, {{"op", "ask"}, {"text", "Introduce yourself."}, {"speak", true}});
+  CHECK(r.body["kind"] == "answered");
+  CHECK(r.body["entry"] == "introduce");
+  if (voice_available()) {
+    // A RIFF WAVE of the spoken answer: a second or more at espeak-ng's 22,050 Hz.
+    REQUIRE(r.body.contains("audio"));
+    const std::string b64 = r.body["audio"];
+    CHECK(b64.starts_with(base64("RIFF").substr(0, 4)));
+    CHECK(b64.size() * 3 / 4 > 44 + 22050 * 2);
+  } else {
+    CHECK_FALSE(r.body.contains("audio"));
+  }
+  r = json_command(server, watch, {{"op", "ask"}, {"text", std::string(600, 'a')}});
+  CHECK(r.body["kind"] == "refused_input");
+  server.stop();
+}
+
+TEST_CASE("RKMS ops on a robot without an HRI module are refused with 404", "[monitor][robot][rkms]") {
+  Psr2 psr2;
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
+  server.start();
+  const JsonAnswer r = json_command(server, watch, {{"op", "rkms.list"}});
+  CHECK(r.status == 404);
+  CHECK_THAT(r.body["error"].get<std::string>(), Catch::Contains("this robot has no HRI knowledge store"));
+  server.stop();
+}
+
+TEST_CASE("An HRI built by the application outside the robot's modules is given to the monitor with set_hri", "[monitor][robot][rkms]") {
+  Psr2WithHri with;  // only for its knowledge file and Jinny's tasks
+  Psr2 psr2;         // a robot without an HRI module
+  KnowledgeStore store(with.file);
+  const TaskLibrary tasks = TaskLibrary::load(TRIPODAL_SOURCE_DIR "/configs/tasks/jinny_guide.yaml");
+  const testing_hri::NoNodes nodes;
+  AnswerProviders providers;
+  providers.add("time", std::make_unique<FixedProvider>("14:05"));
+  providers.add("battery", std::make_unique<FixedProvider>("82 percent"));
+  providers.add("weather", std::make_unique<FixedProvider>("rain"));
+  StoreBackedHri hri(store, tasks, nodes, providers, [](const Understanding&) { return std::string("no"); });
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
+  server.start();
+  CHECK(json_command(server, watch, {{"op", "ask"}, {"text", "will it rain"}}).status == 404);
+  watch.set_hri(&hri);
+  const JsonAnswer r = json_command(server, watch, {{"op", "ask"}, {"text", "will it rain"}});
+  CHECK(r.status == 200);
+  CHECK(r.body["entry"] == "weather");
+  CHECK(r.body["text"] == "The weather today: rain.");
+  watch.set_hri(nullptr);
+  server.stop();
 }

@@ -49,6 +49,19 @@ struct PlaceholderScan {
 };
 [[nodiscard]] PlaceholderScan scan_placeholders(std::string_view answer);
 
+/// A problem of one field of an entry: `field` is "id", "topic", "keywords[2]", "questions[0]",
+/// "answer" or "action", so an editor can put the message beside the field that is wrong.
+struct KnowledgeFieldError {
+  std::string field;
+  std::string message;
+  friend bool operator==(const KnowledgeFieldError&, const KnowledgeFieldError&) = default;
+};
+
+/// The rules the loader (and configs/hri/rkms.xsd) apply to an entry, however it was made: an id
+/// of letters, digits, '_', '-', '.'; a topic; at least one keyword or question, none empty and no
+/// keyword holding a comma; an answer with well-formed placeholders. Empty when the entry is valid.
+[[nodiscard]] std::vector<KnowledgeFieldError> knowledge_entry_errors(const KnowledgeEntry& entry);
+
 /// Thrown by KnowledgeBase::save when the file changed since this copy was loaded: the version
 /// on disk is not the one the copy was read at. The file is left as it was.
 class StaleVersionError : public std::runtime_error {
@@ -77,7 +90,8 @@ class KnowledgeBase {
   void set_robot(std::string robot) { robot_ = std::move(robot); }
 
   /// Adds `entry`, or replaces the entry of the same id. Throws std::invalid_argument (saying
-  /// what is wrong) for an entry the loader would refuse; the base is then unchanged.
+  /// what is wrong, field by field: knowledge_entry_errors) for an entry the loader would refuse;
+  /// the base is then unchanged.
   void put(KnowledgeEntry entry);
   /// Removes the entry `id`; false when there is none.
   bool remove(std::string_view id);

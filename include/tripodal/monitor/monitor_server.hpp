@@ -101,5 +101,8 @@ class MonitorServer final {
 
 /// The embedded page (assets compiled into the binary).
 [[nodiscard]] std::string_view embedded_page() noexcept;
+/// The RKMS administration page (served at /rkms) and the visitors' touch page (/touch).
+[[nodiscard]] std::string_view embedded_rkms_page() noexcept;
+[[nodiscard]] std::string_view embedded_touch_page() noexcept;
 
 }  // namespace tripodal::monitor

@@ -1,6 +1,7 @@
 // RobotMonitor: attaches a MonitorServer to a Robot (monitor area, above robot). On the thread
 // that drives the robot, between periods, update() answers the operator's requests (a task in
-// plain words, pause, resume, cancel, breakpoints on places) and publishes the topics: pose, path,
+// plain words, pause, resume, cancel, breakpoints on places; the RKMS administration and the
+// touch screen's questions when the robot has an HRI) and publishes the topics: pose, path,
 // map and sections, cleaned cells, laser, the running nets and their markings, the task and
 // process life cycle, and a status line (behaviors, coordinator winner, velocity, battery,
 // coverage, resources' age). Publishing copies into the server's outbox; it never waits on a client.
@@ -15,6 +16,7 @@
 
 #include "tripodal/core/clock.hpp"
 #include "tripodal/core/geometry.hpp"
+#include "tripodal/hri/hri_service.hpp"
 #include "tripodal/monitor/monitor_server.hpp"
 #include "tripodal/robot/robot.hpp"
 
@@ -35,6 +37,10 @@ struct RobotMonitorOptions {
   /// Where the operator's "map save NAME" writes NAME.yaml and NAME.pgm (live mapping, a
   /// MapBuilder module); empty: saving is refused.
   std::filesystem::path map_dir;
+  /// The robot's HRI for the RKMS administration and the touch page (docs/monitor.md); nullptr:
+  /// the first module of the robot that implements HriService (the HRI module of its profile,
+  /// which names the knowledge file), if any. Must outlive the monitor.
+  HriService* hri = nullptr;
 };
 
 /// What the application knows beyond the robot: the simulator's true pose, the measured coverage
@@ -65,6 +71,10 @@ class RobotMonitor final {
   /// Places ("P1" or a place's name in any net, "PrCleaning.P1" in one net) where the run pauses when they become marked.
   void set_breakpoint(std::string place, bool on);
   [[nodiscard]] std::vector<std::string> breakpoints() const;
+  /// The HRI the RKMS and touch ops reach, when the application builds it after the monitor
+  /// (RobotMonitorOptions::hri otherwise); nullptr: none (those ops answer 404). Call it from the
+  /// thread that calls update(); `hri` must outlive the monitor or be replaced first.
+  void set_hri(HriService* hri) noexcept;
 
   struct Impl;
 

@@ -1,0 +1,33 @@
+// Internal (monitor area): the operator requests that reach the robot's HRI — the RKMS
+// administration (rkms.list, rkms.get, rkms.add, rkms.edit, rkms.delete, rkms.history) and the
+// touch screen (touch, ask). RobotMonitor hands them over on the robot's thread; the store's rules
+// are the hri area's (KnowledgeStore), this file only turns JSON into calls and back.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <string_view>
+
+#include <nlohmann/json.hpp>
+
+#include "tripodal/hri/hri_service.hpp"
+
+namespace tripodal::monitor {
+
+struct HriOpResult {
+  int status = 200;
+  nlohmann::json body;
+};
+
+/// Whether `op` is one of this file's.
+[[nodiscard]] bool is_hri_op(std::string_view op) noexcept;
+
+/// Handles an HRI op; `hri` nullptr: 404 (the robot has no HriService module). `note` receives a
+/// line for the life cycle for every change made.
+[[nodiscard]] HriOpResult handle_hri_op(HriService* hri, std::string_view op, const nlohmann::json& body,
+                                        const std::function<void(std::string)>& note);
+
+/// A RIFF WAVE file (PCM 16 bit, mono) of `clip`, in memory: the touch page plays it.
+[[nodiscard]] std::string wav_bytes(const AudioClip& clip);
+
+}  // namespace tripodal::monitor
