@@ -191,6 +191,16 @@ Errors relative_errors(const Log& log, const std::vector<Pose2D>& est, double ga
   return e;
 }
 
+// The whole path's consistency, which relative errors over short pairs cannot show: each pose
+// against the reference, the two frames joined at the first scan (both start there).
+Errors absolute_errors(const Log& log, const std::vector<Pose2D>& est) {
+  Errors e;
+  if (est.empty()) return e;
+  const Pose2D first_ref = inverse(log.scans[0].reference);
+  for (std::size_t i = 0; i < est.size(); ++i) e.add(compose(inverse(est[0]), est[i]), compose(first_ref, log.scans[i].reference));
+  return e;
+}
+
 OccupancyGrid reference_map(const Log& log, double resolution_m, double max_range_m) {
   std::vector<Pose2D> ref;
   for (const LoggedScan& s : log.scans) ref.push_back(s.reference);
@@ -360,7 +370,8 @@ struct BuildArgs {
   double resolution_m = 0.05;
   double max_range_m = 30.0;
   double gap_s = 10.0;
-  bool no_loop_closure = false;
+  bool loop_closure = false;
+  double closure_quality = navi::LoopClosureOptions{}.min_quality;
   std::string laser_channel = "front_laser", odom_channel = "odom", pose_channel = "laser_pose";
 };
 
@@ -385,7 +396,8 @@ int map_build(const BuildArgs& a, std::ostream& out, std::ostream& err) {
     o.resolution_m = a.resolution_m;
     o.max_range_m = a.max_range_m;
     o.matcher.max_range_m = a.max_range_m;
-    o.loop.enabled = !a.no_loop_closure;
+    o.loop.enabled = a.loop_closure;
+    o.loop.min_quality = a.closure_quality;
     navi::MapBuilder b(lo, hi, o);
     std::vector<Pose2D> est;
     est.reserve(log.scans.size());
@@ -414,6 +426,11 @@ int map_build(const BuildArgs& a, std::ostream& out, std::ostream& err) {
         relative_errors(log, odo_rel, gap).print(out);
         out << "\n";
       }
+      out << "    whole path, frames joined at the first scan: mapping ";
+      absolute_errors(log, est).print(out);
+      out << "; odometry ";
+      absolute_errors(log, odo_rel).print(out);
+      out << "\n";
     }
   });
 }
@@ -449,7 +466,9 @@ cli::Action setup_build(CLI::App& cmd) {
   cmd.add_option("--resolution", a->resolution_m, "M: cell side")->capture_default_str()->check(positive_number());
   cmd.add_option("--max-range", a->max_range_m, "M: returns beyond are not mapped")->capture_default_str()->check(positive_number());
   cmd.add_option("--gap", a->gap_s, "S: time between the far pairs of the relative errors")->capture_default_str()->check(positive_number());
-  cmd.add_flag("--no-loop-closure", a->no_loop_closure, "scan to map only: no pose graph, no closures");
+  cmd.add_flag("--loop-closure", a->loop_closure, "keep a pose graph of key scans and close loops (docs/localization.md)");
+  cmd.add_option("--closure-quality", a->closure_quality, "Q: with --loop-closure, the match quality a closure needs, in (0, 1]")
+      ->capture_default_str()->check(CLI::Range(0.01, 1.0));
   channel_options(cmd, a->laser_channel, a->odom_channel, a->pose_channel);
   return [a](std::ostream& out, std::ostream& err) { return map_build(*a, out, err); };
 }

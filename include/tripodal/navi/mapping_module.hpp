@@ -18,9 +18,9 @@
 namespace tripodal::navi {
 
 struct MappingOptions {
-  /// Loop closure is off on the robot by default: an attempt (a local map and a global search)
-  /// takes 50-250 ms, several sequencing periods, and the module runs in the sequencing loop.
-  /// `tripodal map build` closes loops offline on a recorded trace.
+  /// Loop closure is off unless the profile asks for it (loop_closure): an attempt (a local map
+  /// and a global search) takes 50-250 ms, several sequencing periods, and the module runs in the
+  /// sequencing loop (`tripodal map build --loop-closure` closes loops on a recorded trace).
   MapBuilderOptions builder{.loop = {.enabled = false}};
   /// The map covers a square this wide centred on the pose mapping begins at (the grid is
   /// allocated at begin(), so the side bounds its memory: 60 m at 5 cm is 1.44 M cells).
