@@ -271,15 +271,21 @@ VisitResult run_visit(const VisitOptions& o) {
     x.mismatch = m;
   };
 
-  const std::optional<std::size_t> neck = sim.joint_index("neck");
-  std::string shown;
+  // The display shows the internal state when it changes; the joints are shown where they stop.
+  std::optional<InternalState> shown;
+  std::vector<double> joints_shown;
+  for (const sim::JointState& j : sim.joints()) joints_shown.push_back(j.position_rad);
   auto display = [&] {
     hri.set_internal_state(observer.state);
-    std::string line = hri.status();
-    if (neck) line += " | neck " + fixed(sim.joints()[*neck].position_rad * 180.0 / std::numbers::pi, 0) + " deg";
-    if (line != shown) {
-      shown = line;
-      say("display: " + line);
+    if (!shown || *shown != hri.internal_state()) {
+      shown = hri.internal_state();
+      say("display: " + hri.status());
+    }
+    for (std::size_t i = 0; i < sim.joints().size(); ++i) {
+      const sim::JointState& j = sim.joints()[i];
+      if (j.velocity_rad_s != 0.0 || j.position_rad == joints_shown[i]) continue;
+      joints_shown[i] = j.position_rad;
+      say("gesture: " + world->robot.joints[i].name + " at " + fixed(j.position_rad * 180.0 / std::numbers::pi, 0) + " deg");
     }
   };
 
