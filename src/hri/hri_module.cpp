@@ -136,7 +136,7 @@ HriModule::HriModule(const KnowledgeBase& base, const TaskLibrary& tasks, const 
       knowledge_(knowledge),
       providers_(providers),
       start_task_(std::move(start_task)),
-      options_(options),
+      options_(std::move(options)),
       index_(base, retrieval_options(tasks)) {
   Diagnostics d;
   std::string available;

@@ -296,6 +296,7 @@ VisitResult run_visit(const VisitOptions& o) {
   Time ready_at = clock.now();
   std::optional<std::size_t> waiting;  // the exchange whose task is running
   std::size_t pending_button = 0;      // button presses on their way to the HRI
+  std::vector<char> giving_way(sim.visitors().size(), 0);
   display();
   while (clock.now() < deadline) {
     // The task of the last request ended: its outcome, and the next step's time.
@@ -376,6 +377,11 @@ VisitResult run_visit(const VisitOptions& o) {
       break;
     }
     robot->run_for(period);
+    for (std::size_t i = 0; i < sim.visitors().size(); ++i) {
+      const bool waits = sim.visitors()[i].giving_way;
+      if (waits && giving_way[i] == 0) ++res.visitor_waits;
+      giving_way[i] = waits ? 1 : 0;
+    }
     flush_life();
     display();
   }
@@ -410,6 +416,7 @@ std::string VisitResult::json() const {
   j["collisions"] = collisions;
   j["visitor_collisions"] = visitor_collisions;
   j["min_visitor_clearance_m"] = std::isfinite(min_visitor_clearance_m) ? Json(std::round(min_visitor_clearance_m * 1000.0) / 1000.0) : Json();
+  j["visitor_waits"] = visitor_waits;
   j["mismatches"] = mismatches;
   Json xs = Json::array();
   for (const VisitExchange& x : exchanges) {

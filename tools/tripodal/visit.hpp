@@ -80,6 +80,7 @@ struct VisitResult {
   std::uint64_t collisions = 0;  ///< of the robot's footprint (walls, exhibits, visitors)
   std::uint64_t visitor_collisions = 0;
   double min_visitor_clearance_m = 0.0;
+  std::size_t visitor_waits = 0;  ///< times a walking visitor stopped to let the robot pass
   std::vector<VisitExchange> exchanges;
   std::vector<std::string> processes;  ///< "12.300-40.100 X0 PrAutoMove(goal=node1) succeeded"
   std::size_t mismatches = 0;
