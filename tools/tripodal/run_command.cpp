@@ -85,7 +85,8 @@ int run_visit(const Args& args, std::ostream& out, std::ostream& err) {
     out << "visit " << (r.completed ? "completed" : "not completed") << " (seed " << r.seed << "): " << r.exchanges.size()
         << " exchanges, " << r.mismatches << " not as expected; " << r.duration_s << " s simulated; path " << r.distance_m << " m; "
         << r.collisions << " collisions (" << r.visitor_collisions << " with visitors); closest to a visitor "
-        << r.min_visitor_clearance_m << " m; visitors stopped " << r.visitor_waits << " times to let the robot pass\n";
+        << r.min_visitor_clearance_m << " m; visitors stopped " << r.visitor_waits << " times to let the robot pass, the robot waited "
+        << r.robot_waited_s << " s for visitors\n";
     if (!o.out.empty()) out << "wrote " << (o.out / "dialogue.txt").string() << ", report.json" << (r.voice ? ", audio/*.wav" : "") << "\n";
     return r.completed && r.mismatches == 0 && r.collisions == 0 ? kOk : kTaskFailed;
   } catch (const ConfigError& e) {

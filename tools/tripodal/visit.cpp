@@ -377,10 +377,17 @@ VisitResult run_visit(const VisitOptions& o) {
       break;
     }
     robot->run_for(period);
+    bool visitor_near = false;
     for (std::size_t i = 0; i < sim.visitors().size(); ++i) {
+      const navi::Point2D v = sim.visitors()[i].position;
+      visitor_near = visitor_near || std::hypot(v.x_m - sim.pose().x_m, v.y_m - sim.pose().y_m) < 1.2;
       const bool waits = sim.visitors()[i].giving_way;
       if (waits && giving_way[i] == 0) ++res.visitor_waits;
       giving_way[i] = waits ? 1 : 0;
+    }
+    if (visitor_near && robot->behavior_active("BhAutoMove") && std::hypot(sim.velocity().vx_m_s, sim.velocity().vy_m_s) < 0.02 &&
+        std::abs(sim.velocity().wz_rad_s) < 0.05) {
+      res.robot_waited_s += to_seconds(period);
     }
     flush_life();
     display();
@@ -417,6 +424,7 @@ std::string VisitResult::json() const {
   j["visitor_collisions"] = visitor_collisions;
   j["min_visitor_clearance_m"] = std::isfinite(min_visitor_clearance_m) ? Json(std::round(min_visitor_clearance_m * 1000.0) / 1000.0) : Json();
   j["visitor_waits"] = visitor_waits;
+  j["robot_waited_s"] = std::round(robot_waited_s * 100.0) / 100.0;
   j["mismatches"] = mismatches;
   Json xs = Json::array();
   for (const VisitExchange& x : exchanges) {

@@ -81,6 +81,9 @@ struct VisitResult {
   std::uint64_t visitor_collisions = 0;
   double min_visitor_clearance_m = 0.0;
   std::size_t visitor_waits = 0;  ///< times a walking visitor stopped to let the robot pass
+  /// Time the robot stood still on its way (BhAutoMove active) with a visitor within 1.2 m: it
+  /// waited for a visitor (sampled every 50 ms).
+  double robot_waited_s = 0.0;
   std::vector<VisitExchange> exchanges;
   std::vector<std::string> processes;  ///< "12.300-40.100 X0 PrAutoMove(goal=node1) succeeded"
   std::size_t mismatches = 0;
