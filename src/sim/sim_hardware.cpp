@@ -9,7 +9,7 @@ namespace tripodal::sim {
 const ModuleManifest& SimHardware::static_manifest() {
   static const ModuleManifest m = hardware_manifest(
       "sim", "the embedded 2D simulator: simulated base, laser, gyro, bumpers, cliff sensors and battery",
-      {"laser_scan", "yaw_rate", "bumpers", "cliff", "battery", "ground_truth_pose", "joint_state"},
+      {"laser_scan", "yaw_rate", "bumpers", "cliff", "battery", "joint_state", "ground_truth_pose"},
       {ParameterSpec{"world", ValueType::string, Value{std::string()}, "", "world file, relative to the robot profile", {}, {}},
        seed_parameter()});
   return m;

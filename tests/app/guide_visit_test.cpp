@@ -122,7 +122,7 @@ TEST_CASE("guide visit, seed 3: no collision, the dialogue as expected", "[app][
 TEST_CASE("guide visit, seed 4: no collision, the dialogue as expected", "[app][visit][e2e]") { check_visit(4, false); }
 TEST_CASE("guide visit, seed 5: no collision, the dialogue as expected", "[app][visit][e2e]") { check_visit(5, false); }
 
-TEST_CASE("guide visit: a seed repeats its run; visitors walk differently with another", "[app][visit][e2e]") {
+TEST_CASE("guide visit: a seed repeats its run, and visitors walk differently with another", "[app][visit][e2e]") {
   const VisitResult a = visit(6, false), b = visit(6, false);
   CHECK(a.json() == b.json());
   const VisitResult c = visit(7, false);

@@ -106,7 +106,7 @@ TEST_CASE("BhFaceVisitor ignores what the map holds: a wall nearer than the pers
   CHECK(scene.pose.theta_rad == Approx(std::atan2(-1.0, 0.5)).margin(0.1));
 }
 
-TEST_CASE("BhFaceVisitor: nobody within reach is nobody to face; no laser fails", "[behaviors][gestures]") {
+TEST_CASE("BhFaceVisitor: nobody within reach is nobody to face, and no laser fails", "[behaviors][gestures]") {
   Scene scene;
   scene.person_x = 5.0;  // beyond max_range_m (2.5 m)
   BhFaceVisitor face;

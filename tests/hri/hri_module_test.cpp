@@ -227,7 +227,7 @@ TEST_CASE("a heard utterance is handled in typed form, and not at all when the r
   CHECK(jinny.hri.handle_heard({"", 0.0}).kind == HriReply::Kind::refused_input);
 }
 
-TEST_CASE("LED buttons: a press is the request bound to the button; an unbound button does nothing") {
+TEST_CASE("LED buttons: a press is the request bound to the button, an unbound button does nothing") {
   HriOptions options;
   options.buttons = {{"hello", "Introduce yourself."}, {"tour", "Guide me to node 1"}};
   Jinny jinny(options);

@@ -116,7 +116,7 @@ visitors:
              Contains(":4:") && Contains("visitor 'wall'") && Contains("overlaps an occupied cell or leaves the map"));
 }
 
-TEST_CASE("visitors: a seed gives one walk; another seed another", "[sim][visitors]") {
+TEST_CASE("visitors: a seed gives one walk, another seed another", "[sim][visitors]") {
   const auto a = walk(7, 20.0), b = walk(7, 20.0), c = walk(8, 20.0);
   CHECK(a == b);
   CHECK(a != c);
