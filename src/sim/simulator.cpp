@@ -158,7 +158,7 @@ Simulator::Simulator(World world, const ControllerConfig& base, std::uint64_t se
       st.speed_m_s = uniform(walk.rng, v.speed_min_m_s, v.speed_max_m_s);
     }
     visitors_.push_back(st);
-    walks_.push_back(std::move(walk));
+    walks_.push_back(walk);
   }
   for (const JointConfig& j : world_.robot.joints) {
     joints_.push_back({j.initial_rad, j.initial_rad, 0.0, false});

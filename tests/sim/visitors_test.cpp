@@ -22,16 +22,7 @@ namespace {
 
 const std::string kWorlds = std::string(TRIPODAL_SOURCE_DIR) + "/configs/worlds/";
 
-std::string error_of(const std::string& text) {
-  TempDir dir("visitors");
-  write_file(dir / "world.yaml", text);
-  try {
-    (void)load_world(dir / "world.yaml");
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return {};
-}
+std::string error_of(const std::string& text) { return world_error_of(text); }
 
 const std::string kHead = "map: " + kWorlds + "exhibit_hall_map.yaml\nstart_pose: [1.5, 4.0, 0.0]\n";
 
