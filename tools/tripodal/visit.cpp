@@ -252,10 +252,8 @@ VisitResult run_visit(const VisitOptions& o) {
   auto record = [&](VisitExchange& x, const HriReply& r) {
     x.reply_kind = std::string(to_string(r.kind));
     x.entry = r.entry_id;
-    x.task = r.task.empty() && r.kind == HriReply::Kind::task_started ? started_task : r.task;
-    if (x.task.empty() && !started_task.empty() && (r.kind == HriReply::Kind::answered || r.kind == HriReply::Kind::task_started)) {
-      x.task = started_task;
-    }
+    // The task the planner started for this input (an entry's action too), or the one it refused.
+    x.task = !started_task.empty() ? started_task : r.task;
     x.reply = r.text;
     x.wav = speak(r.text);
     say("Jinny [" + x.reply_kind + (x.entry.empty() ? "" : " " + x.entry) + (x.task.empty() ? "" : ", task " + x.task) + "]: " + r.text +
