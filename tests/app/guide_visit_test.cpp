@@ -7,7 +7,8 @@
 #include <fstream>
 #include <string>
 
-#include "tripodal/hri/speech.hpp"
+#include <spdlog/spdlog.h>
+
 #include "visit.hpp"
 
 using namespace tripodal;
@@ -28,6 +29,7 @@ std::string error_of(const std::string& text) {
 }
 
 VisitResult visit(std::uint64_t seed, bool voice) {
+  spdlog::set_level(spdlog::level::warn);  // the planner's life cycle: in the result, not the test log
   VisitOptions o;
   o.robot = kConfigs / "robots/jinny.yaml";
   o.world = kConfigs / "worlds/exhibit_hall.yaml";

@@ -100,7 +100,8 @@ class HriModule {
   /// The names of the bound buttons, for a display or a page.
   [[nodiscard]] std::vector<std::string> buttons() const;
 
-  /// The robot's internal state the HRI displays (set by the robot program).
+  /// The robot's internal state the HRI displays (set by the robot program). Like every method,
+  /// on the HRI's thread: a monitor on another thread copies it there (e.g. between periods).
   void set_internal_state(InternalState state) { state_ = std::move(state); }
   [[nodiscard]] const InternalState& internal_state() const noexcept { return state_; }
   /// display_text(internal_state()).
