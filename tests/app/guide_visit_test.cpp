@@ -3,12 +3,15 @@
 // expected outcomes, for five seeds; a seed repeats its run.
 #include <catch2/catch.hpp>
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <string>
 
 #include <spdlog/spdlog.h>
 
+#include "tripodal/hri/speech.hpp"
 #include "visit.hpp"
 
 using namespace tripodal;
@@ -28,9 +31,10 @@ std::string error_of(const std::string& text) {
   return {};
 }
 
-VisitResult visit(std::uint64_t seed, bool voice) {
+VisitResult visit(std::uint64_t seed, bool voice, const std::filesystem::path& out = {}) {
   spdlog::set_level(spdlog::level::warn);  // the planner's life cycle: in the result, not the test log
   VisitOptions o;
+  o.out = out;
   o.robot = kConfigs / "robots/jinny.yaml";
   o.world = kConfigs / "worlds/exhibit_hall.yaml";
   o.visit = kConfigs / "visits/exhibit_hall.yaml";
@@ -39,8 +43,8 @@ VisitResult visit(std::uint64_t seed, bool voice) {
   return run_visit(o);
 }
 
-void check_visit(std::uint64_t seed, bool voice) {
-  const VisitResult r = visit(seed, voice);
+void check_visit(std::uint64_t seed, bool voice, const std::filesystem::path& out = {}) {
+  const VisitResult r = visit(seed, voice, out);
   INFO("seed " << seed << ": " << r.json());
   CHECK(r.completed);
   CHECK(r.collisions == 0);
@@ -118,7 +122,20 @@ TEST_CASE("visit file: every mistake located, all in one report", "[app][visit][
 
 // One test case per seed keeps each under a few seconds (Release); the first hears its spoken
 // requests through espeak-ng and pocketsphinx when the build has voice.
-TEST_CASE("guide visit, seed 1: no collision, the dialogue as expected", "[app][visit][e2e]") { check_visit(1, true); }
+TEST_CASE("guide visit, seed 1: no collision, the dialogue as expected", "[app][visit][e2e]") {
+  const std::filesystem::path out = std::filesystem::temp_directory_path() / ("tripodal_guide_" + std::to_string(::getpid()));
+  check_visit(1, true, out);
+  CHECK(std::filesystem::is_regular_file(out / "dialogue.txt"));
+  CHECK(std::filesystem::is_regular_file(out / "report.json"));
+  // The answers' audio: the introduction is a few seconds of speech when the build has voice.
+  if (voice_available()) {
+    const AudioClip intro = read_wav(out / "audio/answer_03.wav");
+    CHECK(intro.duration_s() > 3.0);
+  } else {
+    CHECK_FALSE(std::filesystem::exists(out / "audio/answer_01.wav"));
+  }
+  std::filesystem::remove_all(out);
+}
 TEST_CASE("guide visit, seed 2: no collision, the dialogue as expected", "[app][visit][e2e]") { check_visit(2, false); }
 TEST_CASE("guide visit, seed 3: no collision, the dialogue as expected", "[app][visit][e2e]") { check_visit(3, false); }
 TEST_CASE("guide visit, seed 4: no collision, the dialogue as expected", "[app][visit][e2e]") { check_visit(4, false); }
