@@ -160,6 +160,8 @@ Simulator::Simulator(World world, const ControllerConfig& base, std::uint64_t se
     visitors_.push_back(st);
     walks_.push_back(walk);
   }
+  trail_.assign(4096, {});
+  follower_next_.assign(world_.visitors.size(), 0);
   for (const JointConfig& j : world_.robot.joints) {
     joints_.push_back({j.initial_rad, j.initial_rad, 0.0, false});
   }
@@ -200,12 +202,43 @@ void Simulator::next_leg(std::size_t index) noexcept {
 
 void Simulator::move_visitors(double h) noexcept {
   const navi::Point2D robot{pose_.x_m, pose_.y_m};
+  constexpr double kTrailStepM = 0.2;
+  if (trail_size_ == 0 || distance(trail_[(trail_head_ + trail_size_ - 1) % trail_.size()], robot) >= kTrailStepM) {
+    trail_[(trail_head_ + trail_size_) % trail_.size()] = robot;
+    if (trail_size_ < trail_.size()) {
+      ++trail_size_;
+    } else {
+      trail_head_ = (trail_head_ + 1) % trail_.size();
+    }
+    ++trail_count_;
+  }
   for (std::size_t i = 0; i < visitors_.size(); ++i) {
     const Visitor& v = world_.visitors[i];
     VisitorState& st = visitors_[i];
     VisitorWalk& w = walks_[i];
     st.giving_way = false;
-    if (v.path.size() > 1 && now_ >= w.pause_until) {
+    if (v.follow_robot && now_ >= w.pause_until) {
+      // Along the robot's trail, the next point not yet reached, until follow_gap_m from it.
+      st.speed_m_s = 0.0;
+      const std::uint64_t oldest = trail_count_ - trail_size_;
+      follower_next_[i] = std::max(follower_next_[i], oldest);
+      double budget = v.speed_max_m_s * h;
+      while (budget > 0.0 && follower_next_[i] < trail_count_ &&
+             distance(st.position, robot) - v.radius_m - world_.robot.radius_m > v.follow_gap_m) {
+        const navi::Point2D target = trail_[(trail_head_ + (follower_next_[i] - oldest)) % trail_.size()];
+        const double left = distance(st.position, target);
+        if (left <= budget) {
+          st.position = target;
+          budget -= left;
+          ++follower_next_[i];
+        } else {
+          st.position = {st.position.x_m + (target.x_m - st.position.x_m) * budget / left,
+                         st.position.y_m + (target.y_m - st.position.y_m) * budget / left};
+          budget = 0.0;
+        }
+        st.speed_m_s = v.speed_max_m_s;
+      }
+    } else if (v.path.size() > 1 && now_ >= w.pause_until) {
       const navi::Point2D target = v.path[w.next];
       const double left = distance(st.position, target);
       const double step = st.speed_m_s * h;

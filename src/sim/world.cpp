@@ -370,7 +370,8 @@ void read_visitors(Reader& r, const YAML::Node& n, std::vector<Visitor>& out) {
   std::set<std::string> names;
   for (const auto& item : n) {
     if (!r.check_map(item, "a visitors entry",
-                     {"name", "path", "speed_m_s", "pause_s", "loop", "radius_m", "give_way_m", "start_s"})) {
+                     {"name", "path", "speed_m_s", "pause_s", "loop", "radius_m", "give_way_m", "start_s", "follow_robot",
+                      "follow_gap_m"})) {
       continue;
     }
     Visitor v;
@@ -395,6 +396,12 @@ void read_visitors(Reader& r, const YAML::Node& n, std::vector<Visitor>& out) {
     ok = read_range(r, item, "speed_m_s", v.speed_min_m_s, v.speed_max_m_s, w, true) && ok;
     ok = read_range(r, item, "pause_s", v.pause_min_s, v.pause_max_s, w, false) && ok;
     r.boolean(item, "loop", v.loop, w);
+    r.boolean(item, "follow_robot", v.follow_robot, w);
+    r.number_at_least(item, "follow_gap_m", v.follow_gap_m, 0.0, true, w);
+    if (v.follow_robot && v.path.size() > 1) {
+      r.error(path, w + ": a visitor following the robot starts from one waypoint, got " + std::to_string(v.path.size()));
+      ok = false;
+    }
     r.number_at_least(item, "radius_m", v.radius_m, 0.0, true, w);
     r.number_at_least(item, "give_way_m", v.give_way_m, 0.0, false, w);
     double start = 0.0;

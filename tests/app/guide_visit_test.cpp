@@ -56,6 +56,9 @@ void check_visit(std::uint64_t seed, bool voice, const std::filesystem::path& ou
   CHECK(r.exchanges[3].entry == "weather");
   CHECK(r.exchanges[4].task == "guide");
   CHECK(r.exchanges[4].task_end == "succeeded");
+  // The guest followed Jinny across the hall: at node 1 it stands behind it (gap 0.8 m + bodies).
+  CHECK(r.exchanges[4].follower_distance_m > 1.0);
+  CHECK(r.exchanges[4].follower_distance_m < 1.8);
   CHECK(r.exchanges[5].task == "explain_here");
   CHECK(r.exchanges[5].task_end == "succeeded");
   CHECK(r.exchanges[6].kind == "button");

@@ -66,6 +66,8 @@ visitors:
     start_s: 4
   - name: bob
     path: [[9.0, 3.0]]
+    follow_robot: true
+    follow_gap_m: 1.2
 )");
   const World w = load_world(dir / "world.yaml");
   REQUIRE(w.visitors.size() == 2);
@@ -78,6 +80,8 @@ visitors:
   CHECK(w.visitors[0].pause_max_s == 2.0);
   CHECK(w.visitors[0].start == time_from_seconds(4.0));
   CHECK(w.visitors[1].path.size() == 1);
+  CHECK(w.visitors[1].follow_robot);
+  CHECK(w.visitors[1].follow_gap_m == 1.2);
   REQUIRE(w.robot.joints.size() == 1);
   CHECK(w.robot.joints[0].min_rad == Approx(-45.0 * std::numbers::pi / 180.0));
   CHECK(w.robot.joints[0].initial_rad == Approx(5.0 * std::numbers::pi / 180.0));
@@ -201,4 +205,34 @@ TEST_CASE("joints: limits, speed, and the state a JointResource shows", "[sim][j
   CHECK(hw.simulator().set_led("hello", true));
   CHECK(hw.simulator().led("hello"));
   CHECK_FALSE(hw.simulator().set_led("nope", true));
+}
+
+TEST_CASE("visitors: a guided visitor follows the robot along its trail and keeps its gap", "[sim][visitors]") {
+  World w = room_world(120, 80, {1.0, 2.0, 0.0});
+  Visitor g;
+  g.name = "guest";
+  g.path = {{0.4, 2.0}};
+  g.follow_robot = true;
+  g.follow_gap_m = 0.5;
+  g.speed_min_m_s = g.speed_max_m_s = 0.8;
+  w.visitors.push_back(g);
+  Simulator sim(w, differential_base(), 1);
+  // An L-shaped drive: 3 m along x, a quarter turn, 1 m along y.
+  sim.command_twist({0.5, 0.0, 0.0});
+  sim.step(std::chrono::seconds(6));
+  sim.command_twist({0.0, 0.0, std::numbers::pi / 4.0});
+  sim.step(std::chrono::seconds(2));
+  sim.command_twist({0.5, 0.0, 0.0});
+  sim.step(std::chrono::seconds(2));
+  sim.command_twist({});
+  sim.step(std::chrono::seconds(3));
+  const navi::Point2D p = sim.visitors()[0].position;
+  const double gap = std::hypot(p.x_m - sim.pose().x_m, p.y_m - sim.pose().y_m) - 0.5;
+  CHECK(gap == Approx(0.5).margin(0.05));
+  // Behind the robot on its trail, at the corner (trail points are 0.2 m apart: it cuts the corner
+  // by at most that), not on the straight line through the room.
+  CHECK(p.x_m > 3.75);
+  CHECK(p.x_m < 4.05);
+  CHECK(p.y_m < sim.pose().y_m - 0.6);
+  CHECK(sim.collisions() == 0);
 }

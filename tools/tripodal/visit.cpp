@@ -301,6 +301,12 @@ VisitResult run_visit(const VisitOptions& o) {
     if (waiting && !robot->planner().busy() && !observer.last_task_end.empty()) {
       VisitExchange& x = res.exchanges[*waiting];
       x.task_end = observer.last_task_end;
+      for (std::size_t i = 0; i < sim.visitors().size(); ++i) {
+        if (!world->visitors[i].follow_robot) continue;
+        const navi::Point2D p = sim.visitors()[i].position;
+        x.follower_distance_m = std::hypot(p.x_m - sim.pose().x_m, p.y_m - sim.pose().y_m);
+        say(world->visitors[i].name + ", following Jinny, stands " + fixed(x.follower_distance_m, 2) + " m from it");
+      }
       check(visit.steps[x.step], x);
       waiting.reset();
       ready_at = clock.now() + from_seconds(visit.steps[next - 1].after_s);
@@ -428,7 +434,8 @@ std::string VisitResult::json() const {
   for (const VisitExchange& x : exchanges) {
     xs.push_back({{"time_s", std::round(x.time_s * 10.0) / 10.0}, {"kind", x.kind}, {"request", x.request}, {"heard", x.heard},
                   {"reply_kind", x.reply_kind}, {"entry", x.entry}, {"task", x.task}, {"task_end", x.task_end}, {"reply", x.reply},
-                  {"wav", x.wav}, {"as_expected", x.as_expected}, {"mismatch", x.mismatch}});
+                  {"wav", x.wav}, {"follower_distance_m", std::round(x.follower_distance_m * 100.0) / 100.0},
+                  {"as_expected", x.as_expected}, {"mismatch", x.mismatch}});
   }
   j["dialogue"] = xs;
   j["processes"] = processes;

@@ -66,6 +66,9 @@ struct VisitExchange {
   std::string reply_kind, entry, task, reply;
   std::string task_end;  ///< how the task it started ended ("" when none)
   std::string wav;       ///< the answer's audio file ("" without voice or --out)
+  /// When the task ended: how far the visitor following the robot (World visitor follow_robot)
+  /// stood from it, centre to centre (m; negative when nobody follows).
+  double follower_distance_m = -1.0;
   bool as_expected = true;
   std::string mismatch;  ///< what differed from the visit file's expect
 };

@@ -247,6 +247,12 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   std::vector<SimEvent> events_;
 
   std::vector<VisitorState> visitors_;
+  // The robot's trail for visitors following it: a point every kTrailStepM, oldest dropped first
+  // when full (fixed capacity: no allocation while stepping); each follower's next point in it.
+  std::vector<navi::Point2D> trail_;
+  std::size_t trail_head_ = 0, trail_size_ = 0;
+  std::uint64_t trail_count_ = 0;              // points ever laid
+  std::vector<std::uint64_t> follower_next_;   // per visitor: the trail point (by count) walked to
   std::vector<VisitorWalk> walks_;
   std::uint64_t visitor_collisions_ = 0;
   double min_visitor_clearance_m_ = std::numeric_limits<double>::infinity();

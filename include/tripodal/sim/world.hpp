@@ -162,6 +162,11 @@ struct Visitor {
   double pause_max_s = 0.0;
   double give_way_m = 0.15;
   Time start{};  ///< stands at its starting point until then
+  /// A visitor being guided: from its one waypoint it follows the robot along the robot's own
+  /// trail (clear of the map for a body no wider than the robot's), at speed_max, and stops when
+  /// it is follow_gap_m from the robot's footprint.
+  bool follow_robot = false;
+  double follow_gap_m = 0.8;
   SourceLocation where;
 };
 
