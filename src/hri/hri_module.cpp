@@ -105,6 +105,30 @@ std::string plain_refusal(std::string_view explanation) {
   return detail.empty() ? "Sorry, I did not understand that command." : "Sorry, I did not understand that command: " + detail + ".";
 }
 
+std::string display_text(const InternalState& state) {
+  std::string out = state.task.empty() ? "idle" : "task " + state.task + ": " + (state.task_state.empty() ? "running" : state.task_state);
+  out += state.process.empty() ? " | no process" : " | process " + state.process;
+  out += state.fault.empty() ? " | no fault" : " | fault: " + state.fault;
+  return out;
+}
+
+HriReply HriModule::handle_button(std::string_view button) {
+  const auto it = options_.buttons.find(button);
+  if (it == options_.buttons.end()) {
+    HriReply reply;
+    reply.kind = HriReply::Kind::not_understood;
+    reply.text = "Sorry, that button does nothing here.";
+    return reply;
+  }
+  return handle(it->second);
+}
+
+std::vector<std::string> HriModule::buttons() const {
+  std::vector<std::string> out;
+  for (const auto& [name, request] : options_.buttons) out.push_back(name);
+  return out;
+}
+
 HriModule::HriModule(const KnowledgeBase& base, const TaskLibrary& tasks, const TaskKnowledge& knowledge,
                      const AnswerProviders& providers, TaskStarter start_task, HriOptions options)
     : entries_(base.entries()),
@@ -112,7 +136,7 @@ HriModule::HriModule(const KnowledgeBase& base, const TaskLibrary& tasks, const 
       knowledge_(knowledge),
       providers_(providers),
       start_task_(std::move(start_task)),
-      options_(options),
+      options_(std::move(options)),
       index_(base, retrieval_options(tasks)) {
   Diagnostics d;
   std::string available;

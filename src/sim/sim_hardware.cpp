@@ -9,7 +9,7 @@ namespace tripodal::sim {
 const ModuleManifest& SimHardware::static_manifest() {
   static const ModuleManifest m = hardware_manifest(
       "sim", "the embedded 2D simulator: simulated base, laser, gyro, bumpers, cliff sensors and battery",
-      {"laser_scan", "yaw_rate", "bumpers", "cliff", "battery", "ground_truth_pose"},
+      {"laser_scan", "yaw_rate", "bumpers", "cliff", "battery", "joint_state", "ground_truth_pose"},
       {ParameterSpec{"world", ValueType::string, Value{std::string()}, "", "world file, relative to the robot profile", {}, {}},
        seed_parameter()});
   return m;
@@ -38,14 +38,44 @@ World world_of(const HardwareConfig& c, const std::shared_ptr<const World>& worl
 }  // namespace
 
 SimHardware::SimHardware(World world, const ControllerConfig& base, std::uint64_t seed)
-    : seed_(seed), sim_(std::move(world), base, seed) {}
+    : seed_(seed), sim_(std::move(world), base, seed) {
+  make_joints();
+}
 
 SimHardware::SimHardware(const HardwareConfig& config, const std::shared_ptr<const World>& world)
     : SimHardware(world_of(config, world), config) {}
 
 // world_of checked config.base; seed_ is initialised before sim_.
 SimHardware::SimHardware(World world, const HardwareConfig& config)
-    : seed_(seed_of(config, world)), sim_(std::move(world), *config.base, seed_) {}
+    : seed_(seed_of(config, world)), sim_(std::move(world), *config.base, seed_) {
+  make_joints();
+}
+
+void SimHardware::make_joints() {
+  for (const JointConfig& j : sim_.world().robot.joints) {
+    joints_.push_back(std::make_unique<JointResource>(j.name, 3 * from_seconds(1.0 / j.rate_hz)));
+  }
+  on_advance_to(sim_.now());  // a first state at the start
+}
+
+void SimHardware::on_add_resources(ResourceTable& table) {
+  sim_.add_resources(table, false);
+  for (auto& j : joints_) table.add(*j);
+}
+
+void SimHardware::on_advance_to(Time now) noexcept {
+  for (std::size_t i = 0; i < joints_.size(); ++i) {
+    if (const auto c = joints_[i]->take_command()) sim_.command_joint(i, *c);
+  }
+  sim_.step_until(now);
+  for (std::size_t i = 0; i < joints_.size(); ++i) {
+    const JointConfig& c = sim_.world().robot.joints[i];
+    const JointState& s = sim_.joints()[i];
+    JointReading& r = joints_[i]->edit();
+    r = {sim_.now(), s.position_rad, s.velocity_rad_s, s.target_rad, c.min_rad, c.max_rad};
+    joints_[i]->commit();
+  }
+}
 
 void register_sim_hardware(HardwareRegistry& registry, std::shared_ptr<const World> world) {
   registry.add(SimHardware::static_manifest(), [world = std::move(world)](const HardwareConfig& c) -> std::unique_ptr<CHardware> {

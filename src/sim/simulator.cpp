@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 #include <numbers>
+#include <utility>
 
 #include "tripodal/controllers/holonomic_controller.hpp"
 #include "tripodal/controllers/ideal_hardware.hpp"
@@ -21,6 +22,27 @@ std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t stream) noexcept {
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
   return z ^ (z >> 31);
+}
+
+// Uniform in [lo, hi] from the top 53 bits: the same on every standard library, unlike
+// std::uniform_real_distribution, so a seed walks the visitors the same way everywhere.
+double uniform(std::mt19937_64& rng, double lo, double hi) noexcept {
+  const double u = static_cast<double>(rng() >> 11) * 0x1.0p-53;
+  return lo + (hi - lo) * u;
+}
+
+double distance(navi::Point2D a, navi::Point2D b) noexcept { return std::hypot(a.x_m - b.x_m, a.y_m - b.y_m); }
+
+// Range along a ray from `o` at unit direction (c, s) to the circle (centre, radius): the nearer
+// crossing in front of the origin, or +inf.
+double ray_circle(navi::Point2D o, double c, double s, navi::Point2D centre, double radius) noexcept {
+  const double dx = centre.x_m - o.x_m, dy = centre.y_m - o.y_m;
+  const double along = dx * c + dy * s;
+  const double across2 = dx * dx + dy * dy - along * along;
+  const double r2 = radius * radius;
+  if (across2 > r2) return std::numeric_limits<double>::infinity();
+  const double t = along - std::sqrt(r2 - across2);
+  return t >= 0.0 ? t : std::numeric_limits<double>::infinity();
 }
 
 Duration period_of(double rate_hz) noexcept {
@@ -54,6 +76,7 @@ std::string_view to_string(SimEvent::Kind kind) noexcept {
     case SimEvent::Kind::kidnapped: return "kidnapped";
     case SimEvent::Kind::fell: return "fell";
     case SimEvent::Kind::battery_empty: return "battery_empty";
+    case SimEvent::Kind::button_pressed: return "button_pressed";
   }
   return "?";
 }
@@ -121,11 +144,204 @@ Simulator::Simulator(World world, const ControllerConfig& base, std::uint64_t se
   bumpers_.edit().count = rc.bumpers.sectors;
   cliff_.edit().cliff.assign(rc.cliff.positions.size(), 0);
 
+  // Visitors: each its own stream, after the sensors' streams, so adding a visitor changes no
+  // sensor noise. The seed places it on its first leg and draws its first speed.
+  for (std::size_t i = 0; i < world_.visitors.size(); ++i) {
+    const Visitor& v = world_.visitors[i];
+    VisitorWalk walk{std::mt19937_64(stream_seed(seed, 100 + i)), 0, 1, v.start};
+    VisitorState st;
+    st.position = v.path.front();
+    if (v.path.size() > 1) {
+      const double f = uniform(walk.rng, 0.0, 1.0);
+      st.position = {v.path[0].x_m + f * (v.path[1].x_m - v.path[0].x_m), v.path[0].y_m + f * (v.path[1].y_m - v.path[0].y_m)};
+      walk.next = 1;
+      st.speed_m_s = uniform(walk.rng, v.speed_min_m_s, v.speed_max_m_s);
+    }
+    visitors_.push_back(st);
+    walks_.push_back(walk);
+  }
+  trail_.assign(4096, {});
+  follower_next_.assign(world_.visitors.size(), 0);
+  for (const JointConfig& j : world_.robot.joints) {
+    joints_.push_back({j.initial_rad, j.initial_rad, 0.0, false});
+  }
+  leds_.assign(world_.robot.buttons.size(), 0);
+
   update_faults();
   sample_sensors();
 }
 
 Simulator::~Simulator() = default;
+
+// --- visitors, joints, buttons ---------------------------------------------------------------
+
+std::optional<std::size_t> Simulator::visitor_hit(const Pose2D& p) const noexcept {
+  for (std::size_t i = 0; i < visitors_.size(); ++i) {
+    if (distance({p.x_m, p.y_m}, visitors_[i].position) < world_.visitors[i].radius_m + world_.robot.radius_m) return i;
+  }
+  return std::nullopt;
+}
+
+bool Simulator::footprint_blocked(const Pose2D& p) const noexcept {
+  return solid_.disc_overlaps({p.x_m, p.y_m}, world_.robot.radius_m) || visitor_hit(p).has_value();
+}
+
+void Simulator::next_leg(std::size_t index) noexcept {
+  const Visitor& v = world_.visitors[index];
+  VisitorWalk& w = walks_[index];
+  const std::size_t n = v.path.size();
+  if (v.loop) {
+    w.next = (w.next + 1) % n;
+  } else {
+    if ((w.direction > 0 && w.next + 1 >= n) || (w.direction < 0 && w.next == 0)) w.direction = -w.direction;
+    w.next = w.direction > 0 ? w.next + 1 : w.next - 1;
+  }
+  visitors_[index].speed_m_s = uniform(w.rng, v.speed_min_m_s, v.speed_max_m_s);
+  w.pause_until = now_ + from_seconds(uniform(w.rng, v.pause_min_s, v.pause_max_s));
+}
+
+void Simulator::move_visitors(double h) noexcept {
+  const navi::Point2D robot{pose_.x_m, pose_.y_m};
+  constexpr double kTrailStepM = 0.2;
+  if (trail_size_ == 0 || distance(trail_[(trail_head_ + trail_size_ - 1) % trail_.size()], robot) >= kTrailStepM) {
+    trail_[(trail_head_ + trail_size_) % trail_.size()] = robot;
+    if (trail_size_ < trail_.size()) {
+      ++trail_size_;
+    } else {
+      trail_head_ = (trail_head_ + 1) % trail_.size();
+    }
+    ++trail_count_;
+  }
+  for (std::size_t i = 0; i < visitors_.size(); ++i) {
+    const Visitor& v = world_.visitors[i];
+    VisitorState& st = visitors_[i];
+    VisitorWalk& w = walks_[i];
+    st.giving_way = false;
+    if (v.follow_robot && now_ >= w.pause_until) {
+      // Along the robot's trail, the next point not yet reached, until follow_gap_m from it.
+      st.speed_m_s = 0.0;
+      const std::uint64_t oldest = trail_count_ - trail_size_;
+      follower_next_[i] = std::max(follower_next_[i], oldest);
+      double budget = v.speed_max_m_s * h;
+      while (budget > 0.0 && follower_next_[i] < trail_count_ &&
+             distance(st.position, robot) - v.radius_m - world_.robot.radius_m > v.follow_gap_m) {
+        const navi::Point2D target = trail_[(trail_head_ + (follower_next_[i] - oldest)) % trail_.size()];
+        const double left = distance(st.position, target);
+        if (left <= budget) {
+          st.position = target;
+          budget -= left;
+          ++follower_next_[i];
+        } else {
+          st.position = {st.position.x_m + (target.x_m - st.position.x_m) * budget / left,
+                         st.position.y_m + (target.y_m - st.position.y_m) * budget / left};
+          budget = 0.0;
+        }
+        st.speed_m_s = v.speed_max_m_s;
+      }
+    } else if (v.path.size() > 1 && now_ >= w.pause_until) {
+      const navi::Point2D target = v.path[w.next];
+      const double left = distance(st.position, target);
+      const double step = st.speed_m_s * h;
+      const navi::Point2D candidate =
+          step >= left ? target
+                       : navi::Point2D{st.position.x_m + (target.x_m - st.position.x_m) * step / left,
+                                       st.position.y_m + (target.y_m - st.position.y_m) * step / left};
+      // People give way to a robot: no step that brings them closer than give_way_m to its body.
+      const double keep = v.radius_m + world_.robot.radius_m + v.give_way_m;
+      const double now_d = distance(st.position, robot), next_d = distance(candidate, robot);
+      if (next_d < keep && next_d < now_d) {
+        st.giving_way = true;
+      } else {
+        st.position = candidate;
+        if (step >= left) next_leg(i);
+      }
+    }
+    const double clearance = distance(st.position, robot) - v.radius_m - world_.robot.radius_m;
+    min_visitor_clearance_m_ = std::min(min_visitor_clearance_m_, clearance);
+  }
+}
+
+void Simulator::move_joints(double h) noexcept {
+  for (std::size_t i = 0; i < joints_.size(); ++i) {
+    JointState& j = joints_[i];
+    const double gap = j.target_rad - j.position_rad;
+    const double max_step = world_.robot.joints[i].speed_rad_s * h;
+    const double step = std::clamp(gap, -max_step, max_step);
+    // Landing exactly on the target: the joint then reads as stopped (velocity 0).
+    j.position_rad = std::abs(gap) <= max_step ? j.target_rad : j.position_rad + step;
+    j.velocity_rad_s = h > 0.0 ? step / h : 0.0;
+  }
+}
+
+std::optional<std::size_t> Simulator::joint_index(std::string_view name) const noexcept {
+  for (std::size_t i = 0; i < world_.robot.joints.size(); ++i) {
+    if (world_.robot.joints[i].name == name) return i;
+  }
+  return std::nullopt;
+}
+
+bool Simulator::command_joint(std::size_t index, double target_rad) noexcept {
+  if (index >= joints_.size() || !std::isfinite(target_rad)) return false;
+  const JointConfig& c = world_.robot.joints[index];
+  const double clamped = std::clamp(target_rad, c.min_rad, c.max_rad);
+  joints_[index].target_rad = clamped;
+  joints_[index].at_limit = clamped != target_rad;
+  return clamped == target_rad;
+}
+
+bool Simulator::press_button(std::string_view name) {
+  for (const ButtonConfig& b : world_.robot.buttons) {
+    if (b.name != name) continue;
+    presses_.emplace_back(name);
+    log(SimEvent::Kind::button_pressed, name);
+    return true;
+  }
+  return false;
+}
+
+std::vector<std::string> Simulator::take_button_presses() { return std::exchange(presses_, {}); }
+
+bool Simulator::set_led(std::string_view name, bool on) noexcept {
+  for (std::size_t i = 0; i < world_.robot.buttons.size(); ++i) {
+    if (world_.robot.buttons[i].name != name) continue;
+    leds_[i] = on ? 1 : 0;
+    return true;
+  }
+  return false;
+}
+
+bool Simulator::led(std::string_view name) const noexcept {
+  for (std::size_t i = 0; i < world_.robot.buttons.size(); ++i) {
+    if (world_.robot.buttons[i].name == name) return leds_[i] != 0;
+  }
+  return false;
+}
+
+void Simulator::add_visitors_to_scan(LaserScan& scan) const noexcept {
+  if (visitors_.empty()) return;
+  const LaserConfig& lc = world_.robot.laser;
+  const double c = std::cos(pose_.theta_rad), s = std::sin(pose_.theta_rad);
+  const navi::Point2D origin{pose_.x_m + c * lc.mount.x_m - s * lc.mount.y_m, pose_.y_m + s * lc.mount.x_m + c * lc.mount.y_m};
+  const double heading = pose_.theta_rad + lc.mount.theta_rad;
+  const double reach = scan.range_max_m;
+  for (std::size_t k = 0; k < visitors_.size(); ++k) {
+    const navi::Point2D p = visitors_[k].position;
+    const double r = world_.visitors[k].radius_m;
+    const double d = distance(origin, p);
+    if (d - r > reach) continue;
+    // Only the beams within the visitor's angular extent can hit it.
+    const double centre = std::atan2(p.y_m - origin.y_m, p.x_m - origin.x_m) - heading;
+    const double half = d > r ? std::asin(r / d) : std::numbers::pi;
+    for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
+      const double a = scan.angle_min_rad + static_cast<double>(i) * scan.angle_increment_rad;
+      if (std::abs(wrap_angle(a - centre)) > half + 1e-9) continue;
+      const double range = ray_circle(origin, std::cos(heading + a), std::sin(heading + a), p, r);
+      if (range < scan.range_min_m || range > reach) continue;
+      const auto f = static_cast<float>(range);
+      if (!(scan.ranges_m[i] <= f)) scan.ranges_m[i] = f;  // an inf or a farther wall: the visitor
+    }
+  }
+}
 
 // --- kinematics ------------------------------------------------------------------------------
 
@@ -172,7 +388,7 @@ bool Simulator::read_wheel_states(std::span<double> velocity_rad_s, std::span<do
 std::optional<Pose2D> Simulator::true_pose(Time /*now*/) const { return pose_; }
 
 bool Simulator::set_pose(const Pose2D& map_from_base) noexcept {
-  if (solid_.disc_overlaps({map_from_base.x_m, map_from_base.y_m}, world_.robot.radius_m)) return false;
+  if (footprint_blocked(map_from_base)) return false;
   pose_ = map_from_base;
   pose_.theta_rad = wrap_angle(pose_.theta_rad);
   blocked_ = false;
@@ -208,21 +424,27 @@ void Simulator::substep(Duration dt) noexcept {
     const double dx = cmd.vx_m_s * h, dy = cmd.vy_m_s * h, dth = cmd.wz_rad_s * h;
     const Pose2D candidate = integrate_body_displacement(pose_, dx, dy, dth);
     double frac = 1.0;
-    if (solid_.disc_overlaps({candidate.x_m, candidate.y_m}, rc.radius_m)) {
+    if (footprint_blocked(candidate)) {
       // Contact inside this substep: bisect the fraction of the motion that stays clear, so the
       // robot stops against the obstacle rather than a whole substep short of it.
       double lo = 0.0, hi = 1.0;
       for (int k = 0; k < 16; ++k) {
         const double mid = 0.5 * (lo + hi);
         const Pose2D p = integrate_body_displacement(pose_, dx * mid, dy * mid, dth * mid);
-        (solid_.disc_overlaps({p.x_m, p.y_m}, rc.radius_m) ? hi : lo) = mid;
+        (footprint_blocked(p) ? hi : lo) = mid;
       }
       frac = lo;
       pose_ = integrate_body_displacement(pose_, dx * lo, dy * lo, dth * lo);
       if (!blocked_) {
         ++collisions_;
-        char where[64];
-        std::snprintf(where, sizeof where, "at (%.2f, %.2f)", pose_.x_m, pose_.y_m);
+        char where[96];
+        const Pose2D touching = integrate_body_displacement(pose_, dx * hi, dy * hi, dth * hi);
+        if (const auto v = visitor_hit(touching); v && !solid_.disc_overlaps({touching.x_m, touching.y_m}, rc.radius_m)) {
+          ++visitor_collisions_;
+          std::snprintf(where, sizeof where, "with %s at (%.2f, %.2f)", world_.visitors[*v].name.c_str(), pose_.x_m, pose_.y_m);
+        } else {
+          std::snprintf(where, sizeof where, "at (%.2f, %.2f)", pose_.x_m, pose_.y_m);
+        }
         log(SimEvent::Kind::collision, where);
       }
       blocked_ = true;
@@ -235,6 +457,8 @@ void Simulator::substep(Duration dt) noexcept {
     rotation_rad_ += std::abs(actual.wz_rad_s) * h;
   }
   velocity_ = blocked_ ? Twist2D{} : actual;
+  move_visitors(h);
+  move_joints(h);
 
   // Encoders: the wheels' actual rotation, each read with a relative error (odometry drift
   // proportional to the distance) and its constant scale error.
@@ -398,6 +622,18 @@ void Simulator::update_bumpers() noexcept {
       mask |= 1U << s;
     }
   }
+  // Visitors press the sector facing them when within the margin of the footprint.
+  for (std::size_t i = 0; i < visitors_.size(); ++i) {
+    const navi::Point2D p = visitors_[i].position;
+    const double gap = distance(p, {pose_.x_m, pose_.y_m}) - world_.visitors[i].radius_m - world_.robot.radius_m;
+    if (gap >= bc.contact_margin_m) continue;
+    const double a = std::atan2(p.y_m - pose_.y_m, p.x_m - pose_.x_m) - pose_.theta_rad + 0.5 * sector;
+    double wrapped = std::fmod(a, 2.0 * std::numbers::pi);
+    if (wrapped < 0.0) wrapped += 2.0 * std::numbers::pi;
+    auto k = static_cast<std::uint32_t>(wrapped / sector);
+    if (k >= bc.sectors) k = bc.sectors - 1;
+    mask |= 1U << k;
+  }
   BumperReading& b = bumpers_.edit();
   b.stamp = now_;
   b.count = bc.sectors;
@@ -409,6 +645,7 @@ void Simulator::sample_sensors() noexcept {
   if (due(laser_due_) && !sensor_dead(SensorKind::laser, now_)) {
     LaserScan& scan = laser_.edit();
     laser_model_.scan(solid_, pose_, now_, scan);
+    add_visitors_to_scan(scan);
     // A localization loss is the scanner dazzled: it still publishes, without a return (after
     // drawing the beams' noise, so the noise stream is the same as without the fault).
     if (localization_lost(now_)) std::fill(scan.ranges_m.begin(), scan.ranges_m.end(), std::numeric_limits<float>::infinity());

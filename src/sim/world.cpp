@@ -187,8 +187,12 @@ void read_laser(Reader& r, const YAML::Node& n, LaserConfig& c) {
   }
 }
 
+void read_joints(Reader& r, const YAML::Node& n, std::vector<JointConfig>& out);
+void read_buttons(Reader& r, const YAML::Node& n, std::vector<ButtonConfig>& out);
+
 void read_robot(Reader& r, const YAML::Node& n, SimRobotConfig& rc) {
-  if (!r.check_map(n, "robot", {"radius_m", "max_substep_s", "laser", "odometry", "gyro", "bumpers", "cliff", "battery"})) {
+  if (!r.check_map(n, "robot", {"radius_m", "max_substep_s", "laser", "odometry", "gyro", "bumpers", "cliff", "battery", "joints",
+                                "buttons"})) {
     return;
   }
   r.number_at_least(n, "radius_m", rc.radius_m, 0.0, true, "robot");
@@ -202,6 +206,8 @@ void read_robot(Reader& r, const YAML::Node& n, SimRobotConfig& rc) {
     }
   }
   if (const YAML::Node l = n["laser"]) read_laser(r, l, rc.laser);
+  if (const YAML::Node j = n["joints"]) read_joints(r, j, rc.joints);
+  if (const YAML::Node b = n["buttons"]) read_buttons(r, b, rc.buttons);
   if (const YAML::Node o = n["odometry"]) {
     if (r.check_map(o, "robot.odometry", {"name", "noise_ratio", "scale_error_stddev", "rate_hz"})) {
       r.text(o, "name", rc.odometry.name, "robot.odometry");
@@ -277,6 +283,131 @@ void read_robot(Reader& r, const YAML::Node& n, SimRobotConfig& rc) {
       r.number_at_least(b, "charge_per_s", bc.charge_per_s, 0.0, false, w);
       r.number_at_least(b, "rate_hz", bc.rate_hz, 0.0, true, w);
     }
+  }
+}
+
+void read_joints(Reader& r, const YAML::Node& n, std::vector<JointConfig>& out) {
+  if (!n.IsSequence()) {
+    r.error(n, "robot.joints must be a list of {name, min_deg, max_deg, speed_deg_s, initial_deg, rate_hz}, got " + Reader::kind(n));
+    return;
+  }
+  std::set<std::string> names;
+  for (const auto& item : n) {
+    const std::string w = "robot.joints entry";
+    if (!r.check_map(item, w, {"name", "min_deg", "max_deg", "speed_deg_s", "initial_deg", "rate_hz"})) continue;
+    JointConfig j;
+    j.where = r.at(item);
+    r.text(item, "name", j.name, w);
+    if (j.name.empty()) {
+      r.error(item, "a robot.joints entry needs name: the resource of its state (e.g. neck)");
+      continue;
+    }
+    if (!names.insert(j.name).second) r.error(item["name"], "duplicate joint name '" + j.name + "'");
+    double min_deg = j.min_rad / kDegToRad, max_deg = j.max_rad / kDegToRad, speed = j.speed_rad_s / kDegToRad, init = 0.0;
+    const std::string jw = "joint '" + j.name + "'";
+    if (const YAML::Node v = item["min_deg"]) min_deg = r.number(v, jw + ".min_deg").value_or(min_deg);
+    if (const YAML::Node v = item["max_deg"]) max_deg = r.number(v, jw + ".max_deg").value_or(max_deg);
+    r.number_at_least(item, "speed_deg_s", speed, 0.0, true, jw);
+    if (const YAML::Node v = item["initial_deg"]) init = r.number(v, jw + ".initial_deg").value_or(init);
+    r.number_at_least(item, "rate_hz", j.rate_hz, 0.0, true, jw);
+    if (max_deg <= min_deg) {
+      r.error(item["max_deg"] ? item["max_deg"] : item, fmt::format("{}: expected min_deg < max_deg, got {} and {}", jw, min_deg, max_deg));
+    } else if (init < min_deg || init > max_deg) {
+      r.error(item["initial_deg"], fmt::format("{}.initial_deg must be within [{}, {}], got {}", jw, min_deg, max_deg, init));
+    }
+    j.min_rad = min_deg * kDegToRad;
+    j.max_rad = max_deg * kDegToRad;
+    j.speed_rad_s = speed * kDegToRad;
+    j.initial_rad = init * kDegToRad;
+    out.push_back(std::move(j));
+  }
+}
+
+void read_buttons(Reader& r, const YAML::Node& n, std::vector<ButtonConfig>& out) {
+  if (!n.IsSequence()) {
+    r.error(n, "robot.buttons must be a list of button names, got " + Reader::kind(n));
+    return;
+  }
+  std::set<std::string> names;
+  for (const auto& item : n) {
+    if (!item.IsScalar() || item.Scalar().empty()) {
+      r.error(item, "a robot.buttons entry must be a button name, got " + Reader::kind(item));
+      continue;
+    }
+    if (!names.insert(item.Scalar()).second) r.error(item, "duplicate button name '" + item.Scalar() + "'");
+    out.push_back({item.Scalar(), r.at(item)});
+  }
+}
+
+// A [lo, hi] range or one number (lo = hi) of a visitor entry.
+bool read_range(Reader& r, const YAML::Node& entry, const char* key, double& lo, double& hi, const std::string& what,
+                bool positive) {
+  const YAML::Node n = entry[key];
+  if (!n) return true;
+  std::optional<std::vector<double>> v;
+  if (n.IsScalar()) {
+    if (auto x = r.number(n, what + "." + key)) v = std::vector<double>{*x, *x};
+  } else {
+    v = r.numbers(n, what + "." + key, 2, 0, "N or [min, max]");
+  }
+  if (!v) return false;
+  const double a = (*v)[0], b = (*v)[1];
+  if (a > b || (positive ? a <= 0.0 : a < 0.0)) {
+    r.error(n, fmt::format("{}.{}: expected {} min <= max, got [{}, {}]", what, key, positive ? "0 <" : "0 <=", a, b));
+    return false;
+  }
+  lo = a;
+  hi = b;
+  return true;
+}
+
+void read_visitors(Reader& r, const YAML::Node& n, std::vector<Visitor>& out) {
+  if (!n.IsSequence()) {
+    r.error(n, "visitors must be a list of {name, path, speed_m_s, pause_s, loop, radius_m, give_way_m, start_s}, got " +
+                   Reader::kind(n));
+    return;
+  }
+  std::set<std::string> names;
+  for (const auto& item : n) {
+    if (!r.check_map(item, "a visitors entry",
+                     {"name", "path", "speed_m_s", "pause_s", "loop", "radius_m", "give_way_m", "start_s", "follow_robot",
+                      "follow_gap_m"})) {
+      continue;
+    }
+    Visitor v;
+    v.where = r.at(item);
+    r.text(item, "name", v.name, "visitors entry");
+    if (v.name.empty()) v.name = "visitor " + std::to_string(out.size() + 1);
+    if (!names.insert(v.name).second) r.error(item["name"] ? item["name"] : item, "duplicate visitor name '" + v.name + "'");
+    const std::string w = "visitor '" + v.name + "'";
+    bool ok = true;
+    const YAML::Node path = item["path"];
+    if (!path || !path.IsSequence() || path.size() == 0) {
+      r.error(path ? path : item, w + " needs path: a list of [x, y] waypoints (map frame, metres), got " +
+                                      (path ? Reader::kind(path) : std::string("nothing")));
+      ok = false;
+    } else {
+      for (const auto& c : path) {
+        auto p = r.numbers(c, w + ".path waypoint", 2, 0, "[x, y]");
+        ok = ok && p.has_value();
+        if (p) v.path.push_back({(*p)[0], (*p)[1]});
+      }
+    }
+    ok = read_range(r, item, "speed_m_s", v.speed_min_m_s, v.speed_max_m_s, w, true) && ok;
+    ok = read_range(r, item, "pause_s", v.pause_min_s, v.pause_max_s, w, false) && ok;
+    r.boolean(item, "loop", v.loop, w);
+    r.boolean(item, "follow_robot", v.follow_robot, w);
+    r.number_at_least(item, "follow_gap_m", v.follow_gap_m, 0.0, true, w);
+    if (v.follow_robot && v.path.size() > 1) {
+      r.error(path, w + ": a visitor following the robot starts from one waypoint, got " + std::to_string(v.path.size()));
+      ok = false;
+    }
+    r.number_at_least(item, "radius_m", v.radius_m, 0.0, true, w);
+    r.number_at_least(item, "give_way_m", v.give_way_m, 0.0, false, w);
+    double start = 0.0;
+    r.number_at_least(item, "start_s", start, 0.0, false, w);
+    v.start = time_from_seconds(start);
+    if (ok) out.push_back(std::move(v));
   }
 }
 
@@ -366,7 +497,8 @@ World walk_world(std::string_view text, const std::filesystem::path& file) {
   Reader r(fname);
   World w;
   w.file = file;
-  if (!r.check_map(root, "the world file", {"map", "regions", "start_pose", "seed", "robot", "drops", "obstacles", "faults"})) {
+  if (!r.check_map(root, "the world file", {"map", "regions", "start_pose", "seed", "robot", "drops", "obstacles", "visitors",
+                                              "faults"})) {
     throw ConfigError(std::move(r.diagnostics()));
   }
   const std::filesystem::path dir = file.parent_path();
@@ -498,6 +630,7 @@ World walk_world(std::string_view text, const std::filesystem::path& file) {
   }
 
   if (const YAML::Node f = root["faults"]) read_faults(r, f, w.faults);
+  if (const YAML::Node v = root["visitors"]) read_visitors(r, v, w.visitors);
 
   if (have_map && start && !r.diagnostics().has_errors()) {
     const SolidMap solid(w.grid);
@@ -509,6 +642,28 @@ World walk_world(std::string_view text, const std::filesystem::path& file) {
     } else if (solid.disc_overlaps({w.start_pose.x_m, w.start_pose.y_m}, w.robot.radius_m)) {
       r.error(start, "at start_pose the robot's footprint (radius " + std::to_string(w.robot.radius_m) +
                          " m) overlaps an occupied cell or leaves the map");
+    }
+    // A visitor walks only where the map is open: its waypoints and the legs between them, sampled
+    // every 5 cm, must leave its disc clear of the static map.
+    for (const Visitor& v : w.visitors) {
+      const std::size_t n = v.path.size();
+      const std::size_t legs = n == 1 ? 1 : (v.loop ? n : n - 1);
+      for (std::size_t i = 0; i < legs; ++i) {
+        const navi::Point2D a = v.path[i], b = v.path[(i + 1) % n];
+        const double len = std::hypot(b.x_m - a.x_m, b.y_m - a.y_m);
+        const int samples = std::max(1, static_cast<int>(std::ceil(len / 0.05)));
+        for (int k = 0; k <= samples; ++k) {
+          const double f = static_cast<double>(k) / samples;
+          const navi::Point2D p{a.x_m + f * (b.x_m - a.x_m), a.y_m + f * (b.y_m - a.y_m)};
+          if (solid.disc_overlaps(p, v.radius_m)) {
+            r.diagnostics().error(v.where, fmt::format("visitor '{}': at ({:.2f}, {:.2f}), on its path from waypoint {} to {}, its "
+                                                       "disc (radius {} m) overlaps an occupied cell or leaves the map",
+                                                       v.name, p.x_m, p.y_m, i + 1, (i + 1) % n + 1, v.radius_m));
+            k = samples + 1;
+            i = legs;
+          }
+        }
+      }
     }
     for (const Kidnapping& k : w.faults.kidnappings) {
       if (solid.disc_overlaps({k.to.x_m, k.to.y_m}, w.robot.radius_m)) {

@@ -44,13 +44,13 @@ struct Jinny {
     return p;
   }
 
-  Jinny()
+  explicit Jinny(HriOptions options = {})
       : providers(make_providers(clock, battery)),
         hri(base, tasks, hall, providers, [this](const Understanding& u) {
           if (!refuse_with.empty()) return refuse_with;
           started.push_back(to_string(u.plan));
           return std::string();
-        }) {}
+        }, std::move(options)) {}
 };
 
 struct Expected {
@@ -225,4 +225,32 @@ TEST_CASE("a heard utterance is handled in typed form, and not at all when the r
   CHECK(jinny.started.size() == 1);
   CHECK(jinny.hri.handle_heard({"tell me about p s r two", 0.1}).entry_id == "node1_robot");
   CHECK(jinny.hri.handle_heard({"", 0.0}).kind == HriReply::Kind::refused_input);
+}
+
+TEST_CASE("LED buttons: a press is the request bound to the button, an unbound button does nothing") {
+  HriOptions options;
+  options.buttons = {{"hello", "Introduce yourself."}, {"tour", "Guide me to node 1"}};
+  Jinny jinny(options);
+  CHECK(jinny.hri.buttons() == std::vector<std::string>{"hello", "tour"});
+  const HriReply hello = jinny.hri.handle_button("hello");
+  CHECK(hello.kind == HriReply::Kind::answered);
+  CHECK(hello.entry_id == "introduce");
+  const HriReply tour = jinny.hri.handle_button("tour");
+  CHECK(tour.kind == HriReply::Kind::task_started);
+  CHECK(jinny.started == std::vector<std::string>{"PrAutoMove(goal=node1)"});
+  const HriReply other = jinny.hri.handle_button("panic");
+  CHECK(other.kind == HriReply::Kind::not_understood);
+  CHECK(other.text == "Sorry, that button does nothing here.");
+  CHECK(jinny.started.size() == 1);
+}
+
+TEST_CASE("the internal state the HRI displays: task, process, fault") {
+  Jinny jinny;
+  CHECK(jinny.hri.status() == "idle | no process | no fault");
+  jinny.hri.set_internal_state({"guide", "running", "PrAutoMove(goal=node1)", ""});
+  CHECK(jinny.hri.internal_state().process == "PrAutoMove(goal=node1)");
+  CHECK(jinny.hri.status() == "task guide: running | process PrAutoMove(goal=node1) | no fault");
+  jinny.hri.set_internal_state({"guide", "failed", "", "path blocked"});
+  CHECK(jinny.hri.status() == "task guide: failed | no process | fault: path blocked");
+  CHECK(display_text({}) == "idle | no process | no fault");
 }

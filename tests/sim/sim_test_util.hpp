@@ -90,4 +90,17 @@ inline void write_file(const std::filesystem::path& p, const std::string& text) 
   f << text;
 }
 
+/// The message of the ConfigError that loading `text` as a world file DIR/world.yaml throws ("" if
+/// none).
+inline std::string world_error_of(const std::string& text) {
+  TempDir dir("world");
+  write_file(dir / "world.yaml", text);
+  try {
+    (void)load_world(dir / "world.yaml");
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return {};
+}
+
 }  // namespace tripodal::sim::test

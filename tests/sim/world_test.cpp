@@ -18,17 +18,7 @@ const std::string kWorlds = std::string(TRIPODAL_SOURCE_DIR) + "/configs/worlds/
 const std::string kMap = kWorlds + "workspace_map.yaml";
 const std::string kRegions = kWorlds + "workspace_regions.yaml";
 
-// The message of the ConfigError that loading `text` as DIR/world.yaml throws ("" if none).
-std::string error_of(const std::string& text) {
-  TempDir dir("world");
-  write_file(dir / "world.yaml", text);
-  try {
-    (void)load_world(dir / "world.yaml");
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return {};
-}
+std::string error_of(const std::string& text) { return world_error_of(text); }
 
 std::string head() { return "map: " + kMap + "\nregions: " + kRegions + "\nstart_pose: [0.8, 0.8, 0.0]\n"; }
 

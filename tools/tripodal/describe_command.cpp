@@ -6,6 +6,8 @@
 #include <ostream>
 
 #include "cli_tool.hpp"
+#include "guide_hri.hpp"
+#include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/behaviors/behavior_registry.hpp"
 #include "tripodal/controllers/controller_config.hpp"
 #include "tripodal/planner/task_library.hpp"
@@ -58,9 +60,12 @@ int describe(const Args& args, std::ostream& out, std::ostream& err) {
         d.append(e.diagnostics());
       }
     }
-    // The types this program knows: the framework's own and the simulator's hardware.
+    // The types this program knows: the framework's own, the simulator's hardware, and the guide
+    // robot's gestures and HRI (the types `tripodal run` registers).
     RobotPlugins plugins = RobotPlugins::with_builtins();
     sim::register_sim_hardware(plugins.hardware);
+    register_gesture_behaviors(plugins.behaviors);
+    app::register_guide_modules(plugins.modules);
     const RobotDescription r = describe_robot(profile, plugins, knowledge_inputs(tasks), d);
     if (d.has_errors()) {
       err << d.str() << '\n' << "robot '" << profile.name << "' would refuse to start: " << d.error_count() << " error(s)\n";

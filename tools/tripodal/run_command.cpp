@@ -13,6 +13,7 @@
 
 #include "cli_tool.hpp"
 #include "run_task.hpp"
+#include "visit.hpp"
 #include "tripodal/core/diagnostic.hpp"
 
 #include <spdlog/spdlog.h>
@@ -39,15 +40,21 @@ constexpr std::string_view kDescription =
     "--monitor [ADDR:]PORT serves the live monitor and operator console (docs/monitor.md) on\n"
     "127.0.0.1 unless ADDR is given, prints its address and token, paces the run to real time\n"
     "(--realtime SPEED changes the speed) and keeps the robot running after the task (a task may\n"
-    "then come from the console instead of --task) until interrupted (Ctrl-C, SIGTERM).";
+    "then come from the console instead of --task) until interrupted (Ctrl-C, SIGTERM).\n"
+    "--visit VISIT.yaml runs the guide robot's scripted visit instead of a task (docs/guide.md): the\n"
+    "dialogue, the life cycle and the collisions; with --out, dialogue.txt, report.json and the\n"
+    "answers' audio (audio/*.wav, when the build has voice).";
 
 constexpr std::string_view kExitCodes =
     "exit codes: 0 task succeeded, 1 bad profile/world/faults, 2 bad command line, 3 I/O error,\n"
     "            4 the task failed, was refused or timed out (with --monitor and no task given at all,\n"
-    "            the run ends with 0 when stopped).";
+    "            the run ends with 0 when stopped); with --visit: a collision, an outcome not as\n"
+    "            expected, or the visit not completed.";
 
 struct Args {
   app::RunOptions options;
+  std::filesystem::path visit;  // --visit: the guide demo instead of a task
+  bool no_voice = false;
   std::string faults;
   CLI::Option* realtime = nullptr;  // given at all (with or without SPEED)
   double realtime_speed = 0.0;      // 0: --realtime without SPEED
@@ -56,7 +63,43 @@ struct Args {
 volatile std::sig_atomic_t g_stop = 0;
 extern "C" void on_stop_signal(int) { g_stop = 1; }
 
+// `--visit FILE`: the guide robot's scripted visit (docs/guide.md).
+int run_visit(const Args& args, std::ostream& out, std::ostream& err) {
+  const app::RunOptions& o = args.options;
+  if (!o.task.empty() || o.monitor || o.realtime) {
+    err << "tripodal run: --visit runs the visit file's requests: it takes no --task, --monitor or --realtime\n";
+    return kUsage;
+  }
+  for (const auto& f : {o.robot, o.world, args.visit}) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(f, ec)) {
+      err << "tripodal run: cannot read '" << f.string() << "'\n";
+      return kIoError;
+    }
+  }
+  try {
+    spdlog::set_level(spdlog::level::warn);
+    app::VisitOptions vo{o.robot, o.world, args.visit, o.seed, o.out, !args.no_voice, &out};
+    out << "tripodal run: robot " << o.robot.string() << ", world " << o.world.string() << ", visit " << args.visit.string() << "\n";
+    const app::VisitResult r = app::run_visit(vo);
+    out << "visit " << (r.completed ? "completed" : "not completed") << " (seed " << r.seed << "): " << r.exchanges.size()
+        << " exchanges, " << r.mismatches << " not as expected; " << r.duration_s << " s simulated; path " << r.distance_m << " m; "
+        << r.collisions << " collisions (" << r.visitor_collisions << " with visitors); closest to a visitor "
+        << r.min_visitor_clearance_m << " m; visitors stopped " << r.visitor_waits << " times to let the robot pass, the robot waited "
+        << r.robot_waited_s << " s for visitors\n";
+    if (!o.out.empty()) out << "wrote " << (o.out / "dialogue.txt").string() << ", report.json" << (r.voice ? ", audio/*.wav" : "") << "\n";
+    return r.completed && r.mismatches == 0 && r.collisions == 0 ? kOk : kTaskFailed;
+  } catch (const ConfigError& e) {
+    err << e.what() << '\n';
+    return kBadInput;
+  } catch (const std::runtime_error& e) {
+    err << "tripodal run: " << e.what() << '\n';
+    return kIoError;
+  }
+}
+
 int run(Args& args, std::ostream& out, std::ostream& err) {
+  if (!args.visit.empty()) return run_visit(args, out, err);
   app::RunOptions& o = args.options;
   const std::string& faults = args.faults;
   o.realtime = args.realtime->count() > 0;
@@ -136,6 +179,9 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_option("--robot", o.robot, "ROBOT.yaml: the robot profile")->required();
   cmd.add_option("--world", o.world, "WORLD.yaml: map, regions, start pose and faults")->required();
   cmd.add_option("--task", o.task, "\"COMMAND\": the task in plain words (optional with --monitor)");
+  cmd.add_option("--visit", a->visit,
+                 "VISIT.yaml: the guide robot's scripted visit (typed and spoken requests, buttons; docs/guide.md) instead of a task");
+  cmd.add_flag("--no-voice", a->no_voice, "with --visit: read spoken requests as typed, write no audio");
   cmd.add_option("--seed", o.seed, "N: the simulator's seed (default: the world's)");
   cmd.add_option("--out", o.out, "DIR: where map.png, trajectory.csv, report.json and lifecycle.txt go");
   // Without SPEED CLI11 hands the option an empty value, which leaves realtime_speed at 0.

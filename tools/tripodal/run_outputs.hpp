@@ -14,6 +14,9 @@
 #include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/navi/planning_modules.hpp"
 #include "tripodal/navi/section_splitter.hpp"
+#include "tripodal/robot/robot.hpp"
+#include "tripodal/robot/robot_profile.hpp"
+#include "tripodal/sim/world.hpp"
 
 namespace tripodal::app {
 
@@ -32,6 +35,10 @@ struct TrajectorySample {
   bool localized = false;
   bool cleaning = false;
 };
+
+/// The parameters a run on the simulator sets in the robot's profile: the hardware's seed, the
+/// test-double localizer's seed, the scan-matching localizer's initial pose (the world's start).
+std::vector<ParameterOverride> simulation_overrides(const RobotProfile& profile, const sim::World& world, std::uint64_t seed);
 
 /// `v` with `digits` decimals.
 std::string fixed(double v, int digits);

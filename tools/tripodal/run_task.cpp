@@ -162,6 +162,27 @@ DisinfectionFigures disinfection_figures(sim::SimBoardHardware& hw, const std::v
 }  // namespace
 
 
+std::vector<ParameterOverride> simulation_overrides(const RobotProfile& profile, const sim::World& world, std::uint64_t seed) {
+  std::vector<ParameterOverride> out;
+  if (profile.hardware) out.push_back({profile.hardware->name, "seed", std::to_string(seed)});
+  for (const ModuleEntry& e : profile.navigation) {
+    if (e.type == navi::CLocalizer::static_manifest().name) out.push_back({e.name, "seed", std::to_string(seed % (1ULL << 52))});
+    if (e.type == navi::CScanMatchingLocalizer::static_manifest().name) {
+      // The robot starts on its charger, whose place in the map it knows: the world's start pose
+      // (the profile's initial pose is the workspace's charger; another world starts elsewhere).
+      const auto text = [](double v) {
+        std::ostringstream s;
+        s << std::setprecision(17) << v;
+        return s.str();
+      };
+      out.push_back({e.name, "initial_x_m", text(world.start_pose.x_m)});
+      out.push_back({e.name, "initial_y_m", text(world.start_pose.y_m)});
+      out.push_back({e.name, "initial_theta_rad", text(world.start_pose.theta_rad)});
+    }
+  }
+  return out;
+}
+
 RunResult run_task(const RunOptions& o) {
   const RobotProfile profile = load_robot_profile(o.robot);
   auto world = std::make_shared<sim::World>(sim::load_world(o.world));
@@ -193,23 +214,9 @@ RunResult run_task(const RunOptions& o) {
   board::register_board_modules(plugins.modules);
   board::register_board_behaviors(plugins.behaviors);
   RobotOptions ro;
-  const std::string seed_text = std::to_string(res.seed);
-  ro.parameters.push_back({profile.hardware->name, "seed", seed_text});
+  ro.parameters = simulation_overrides(profile, *world, res.seed);
   if (!o.board_line.empty()) ro.parameters.push_back({profile.hardware->name, "line", o.board_line});
   for (const ModuleEntry& e : profile.navigation) {
-    if (e.type == navi::CLocalizer::static_manifest().name) ro.parameters.push_back({e.name, "seed", std::to_string(res.seed % (1ULL << 52))});
-    if (e.type == navi::CScanMatchingLocalizer::static_manifest().name) {
-      // The robot starts on its charger, whose place in the map it knows: the world's start pose
-      // (the profile's initial pose is the workspace's charger; another world starts elsewhere).
-      const auto text = [](double v) {
-        std::ostringstream out;
-        out << std::setprecision(17) << v;
-        return out.str();
-      };
-      ro.parameters.push_back({e.name, "initial_x_m", text(world->start_pose.x_m)});
-      ro.parameters.push_back({e.name, "initial_y_m", text(world->start_pose.y_m)});
-      ro.parameters.push_back({e.name, "initial_theta_rad", text(world->start_pose.theta_rad)});
-    }
     if (e.type == navi::CCoverageModule::static_manifest().name && !o.pattern.empty()) ro.parameters.push_back({e.name, "pattern", o.pattern});
   }
   SimClock clock;

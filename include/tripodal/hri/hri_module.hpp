@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <map>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -34,7 +35,24 @@ struct HriOptions {
   /// acted on: "Sorry, I did not catch that." A recognizer with a closed language model hears
   /// any sound as one of its sentences; the posterior is low when the sound was something else.
   double min_recognition_confidence = 0.002;
+  /// LED buttons (Table 3): each button's name and the request a press stands for ("hello" ->
+  /// "Introduce yourself."). A press is handled as that input was typed.
+  std::map<std::string, std::string, std::less<>> buttons;
 };
+
+/// The robot's internal state as the HRI displays it to the visitor and the operator (paper,
+/// section 4): the current task and its state, the process running, the last fault. Set by the
+/// robot program from the planner's life cycle; read by the demo and the monitor.
+struct InternalState {
+  std::string task;        ///< "guide" ("" when idle)
+  std::string task_state;  ///< "running", "succeeded", "failed", "cancelled"
+  std::string process;     ///< "PrAutoMove(goal=node1)" ("" when none runs)
+  std::string fault;       ///< the last fault message ("path blocked"; "" when none)
+  friend bool operator==(const InternalState&, const InternalState&) = default;
+};
+
+/// One line for a display: "task guide: running | process PrAutoMove(goal=node1) | no fault".
+[[nodiscard]] std::string display_text(const InternalState& state);
 
 /// What the HRI did with one input.
 struct HriReply {
@@ -76,9 +94,18 @@ class HriModule {
   /// "node 1"), are handled as typed.
   HriReply handle_heard(const SpeechRecognizer::Result& heard);
 
-  /// The robot's internal state as the HRI shows it ("task guide: running", set by the robot).
-  void set_status(std::string status) { status_ = std::move(status); }
-  [[nodiscard]] const std::string& status() const noexcept { return status_; }
+  /// An LED button was pressed: handled as the request HriOptions::buttons binds to it; an
+  /// unbound button is not understood ("Sorry, that button does nothing here.").
+  HriReply handle_button(std::string_view button);
+  /// The names of the bound buttons, for a display or a page.
+  [[nodiscard]] std::vector<std::string> buttons() const;
+
+  /// The robot's internal state the HRI displays (set by the robot program). Like every method,
+  /// on the HRI's thread: a monitor on another thread copies it there (e.g. between periods).
+  void set_internal_state(InternalState state) { state_ = std::move(state); }
+  [[nodiscard]] const InternalState& internal_state() const noexcept { return state_; }
+  /// display_text(internal_state()).
+  [[nodiscard]] std::string status() const { return display_text(state_); }
 
   [[nodiscard]] const KnowledgeIndex& index() const noexcept { return index_; }
 
@@ -95,7 +122,7 @@ class HriModule {
   HriOptions options_;
   KnowledgeIndex index_;
   std::vector<std::string> command_words_;  // the first word of each command form ("guide", "clean")
-  std::string status_;
+  InternalState state_;
 };
 
 /// The planner's explanation of a refused command in plain words, for speaking: "I cannot do

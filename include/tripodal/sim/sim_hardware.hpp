@@ -7,7 +7,9 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <vector>
 
+#include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/hardware/hardware.hpp"
 #include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/navi/localizer.hpp"
@@ -53,13 +55,16 @@ class SimHardware : public CHardware, public SimulatorSources {
   [[nodiscard]] const Simulator& world_sim() const noexcept override { return sim_; }
   [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
   [[nodiscard]] HardwareInterface& do_wheels() noexcept override { return sim_; }
-  void on_add_resources(ResourceTable& table) override { sim_.add_resources(table, false); }
-  void on_advance_to(Time now) noexcept override { sim_.step_until(now); }
+  void on_add_resources(ResourceTable& table) override;
+  /// Takes the joints' commands, steps the simulator, publishes the joints' states.
+  void on_advance_to(Time now) noexcept override;
 
  private:
   SimHardware(World world, const HardwareConfig& config);
+  void make_joints();
   std::uint64_t seed_;
   Simulator sim_;
+  std::vector<std::unique_ptr<JointResource>> joints_;  // World robot.joints, same order
 };
 
 /// The parameter "seed" of the simulated hardware types, and the seed it gives in world `w`

@@ -7,6 +7,8 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
+#include <string_view>
 #include <memory>
 #include <optional>
 #include <random>
@@ -43,12 +45,28 @@ struct SimEvent {
     kidnapped,                ///< the world moved the robot (detail: "to (x, y, theta)")
     fell,                     ///< the robot's centre entered a drop area
     battery_empty,
+    button_pressed,           ///< an LED button was pressed (detail: its name)
   };
   Kind kind = Kind::collision;
   Time stamp{};
   std::string detail;  ///< obstacle or sensor name; "at (x, y)" of a collision
 };
 [[nodiscard]] std::string_view to_string(SimEvent::Kind kind) noexcept;
+
+/// Where a visitor (World::visitors) is now.
+struct VisitorState {
+  navi::Point2D position;
+  double speed_m_s = 0.0;  ///< of the leg it walks (0 while paused, waiting or giving way)
+  bool giving_way = false; ///< it would come closer to the robot than give_way_m: it waits
+};
+
+/// A simulated joint (World robot.joints) now.
+struct JointState {
+  double position_rad = 0.0;
+  double target_rad = 0.0;     ///< the last command, clamped to the limits
+  double velocity_rad_s = 0.0;
+  bool at_limit = false;       ///< the last command was beyond a limit (clamped)
+};
 
 /// The simulator. Threading: one thread calls everything (the SimRunner's caller).
 class Simulator final : public HardwareInterface, public navi::GroundTruthSource {
@@ -119,6 +137,30 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   [[nodiscard]] const World& world() const noexcept { return world_; }
   /// The static map plus the boxes present now.
   [[nodiscard]] const SolidMap& solid_map() const noexcept { return solid_; }
+  /// The visitors now, in World::visitors order.
+  [[nodiscard]] const std::vector<VisitorState>& visitors() const noexcept { return visitors_; }
+  /// Contacts of the robot's footprint with a visitor (counted in collisions() too).
+  [[nodiscard]] std::uint64_t visitor_collisions() const noexcept { return visitor_collisions_; }
+  /// The smallest distance between the robot's footprint and a visitor's disc so far (m; +inf
+  /// without visitors).
+  [[nodiscard]] double min_visitor_clearance_m() const noexcept { return min_visitor_clearance_m_; }
+
+  /// The joints now, in World robot.joints order; index_of_joint(name) or nullopt.
+  [[nodiscard]] const std::vector<JointState>& joints() const noexcept { return joints_; }
+  [[nodiscard]] std::optional<std::size_t> joint_index(std::string_view name) const noexcept;
+  /// Commands joint `index` toward `target_rad`, clamped to its limits (false when clamped or
+  /// when there is no such joint or the target is not finite: then nothing changes).
+  bool command_joint(std::size_t index, double target_rad) noexcept;
+
+  /// Presses LED button `name` now (a visitor's finger; tests and the visit script): logged as a
+  /// button_pressed event and queued for take_button_presses(). False for an unknown button.
+  bool press_button(std::string_view name);
+  /// The presses since the last call (button names, in order).
+  [[nodiscard]] std::vector<std::string> take_button_presses();
+  /// Lights or darkens a button's LED; false for an unknown button.
+  bool set_led(std::string_view name, bool on) noexcept;
+  [[nodiscard]] bool led(std::string_view name) const noexcept;
+
   /// What happened so far, in time order.
   [[nodiscard]] const std::vector<SimEvent>& events() const noexcept { return events_; }
 
@@ -144,6 +186,18 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   void sample_sensors() noexcept;
   void update_bumpers() noexcept;
   void set_obstacle(std::size_t index, bool present) noexcept;
+  void move_visitors(double h) noexcept;
+  void move_joints(double h) noexcept;
+  void add_visitors_to_scan(LaserScan& scan) const noexcept;
+  [[nodiscard]] bool footprint_blocked(const Pose2D& p) const noexcept;
+  [[nodiscard]] std::optional<std::size_t> visitor_hit(const Pose2D& p) const noexcept;
+  struct VisitorWalk {
+    std::mt19937_64 rng;
+    std::size_t next = 0;  // waypoint walked to
+    int direction = 1;     // along the path (+1) or back (-1)
+    Time pause_until{};
+  };
+  void next_leg(std::size_t index) noexcept;
   void log(SimEvent::Kind kind, std::string_view detail) noexcept;
   [[nodiscard]] bool due(Schedule& s) const noexcept;
 
@@ -191,6 +245,20 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   InfraredResource cliff_;
   BatteryResource battery_;
   std::vector<SimEvent> events_;
+
+  std::vector<VisitorState> visitors_;
+  // The robot's trail for visitors following it: a point every kTrailStepM, oldest dropped first
+  // when full (fixed capacity: no allocation while stepping); each follower's next point in it.
+  std::vector<navi::Point2D> trail_;
+  std::size_t trail_head_ = 0, trail_size_ = 0;
+  std::uint64_t trail_count_ = 0;              // points ever laid
+  std::vector<std::uint64_t> follower_next_;   // per visitor: the trail point (by count) walked to
+  std::vector<VisitorWalk> walks_;
+  std::uint64_t visitor_collisions_ = 0;
+  double min_visitor_clearance_m_ = std::numeric_limits<double>::infinity();
+  std::vector<JointState> joints_;
+  std::vector<std::uint8_t> leds_;
+  std::vector<std::string> presses_;
 };
 
 /// Paces a simulation to wall time (for --realtime): pace(t) sleeps on `wall` until the wall

@@ -99,6 +99,25 @@ struct BatteryConfig {
   double rate_hz = 1.0;
 };
 
+/// A joint of the robot's head or arm (Jinny's neck): it turns toward its commanded position at
+/// speed_rad_s and never leaves [min_rad, max_rad]; a command beyond a limit is clamped to it.
+struct JointConfig {
+  std::string name;  ///< resource name of its state ("neck")
+  double min_rad = -1.0;
+  double max_rad = 1.0;
+  double speed_rad_s = 1.0;
+  double initial_rad = 0.0;
+  double rate_hz = 50.0;  ///< state published at this rate
+  SourceLocation where;
+};
+
+/// An LED button on the robot's body (Table 3's interaction elements): pressing it is an event;
+/// its LED is lit by the robot.
+struct ButtonConfig {
+  std::string name;
+  SourceLocation where;
+};
+
 /// The simulated robot: a round footprint, its sensors, and the physics step. The wheel geometry
 /// is not here: it is the base controller's configuration (ControllerConfig), so the simulated
 /// base and the controller always agree.
@@ -110,6 +129,8 @@ struct SimRobotConfig {
   BumperConfig bumpers;
   CliffConfig cliff;
   BatteryConfig battery;
+  std::vector<JointConfig> joints;
+  std::vector<ButtonConfig> buttons;
   /// Longest physics substep: a step(dt) is cut into equal substeps no longer than this.
   Duration max_substep{std::chrono::milliseconds(5)};
 };
@@ -122,6 +143,30 @@ struct DynamicObstacle {
   std::vector<navi::Point2D> polygon;  ///< map frame; a rectangle is stored as its 4 corners
   Time appear{};
   std::optional<Time> disappear;
+  SourceLocation where;
+};
+
+/// A person walking in the world: a disc moving along its waypoints, seen by the laser and the
+/// bumpers and stopping the robot's footprint like a wall. The run's seed draws where on its first
+/// leg it starts, its speed on each leg within [speed_min, speed_max] and its pause at each
+/// waypoint within [pause_min, pause_max]. A visitor gives way: it does not step closer than
+/// `give_way_m` to the robot's footprint (it waits), so a contact is always the robot's doing.
+struct Visitor {
+  std::string name;
+  double radius_m = 0.25;
+  std::vector<navi::Point2D> path;  ///< map frame; one point: someone standing there
+  bool loop = false;  ///< after the last point, on to the first; otherwise back along the path
+  double speed_min_m_s = 0.5;
+  double speed_max_m_s = 1.0;
+  double pause_min_s = 0.0;
+  double pause_max_s = 0.0;
+  double give_way_m = 0.15;
+  Time start{};  ///< stands at its starting point until then
+  /// A visitor being guided: from its one waypoint it follows the robot along the robot's own
+  /// trail (clear of the map for a body no wider than the robot's), at speed_max, and stops when
+  /// it is follow_gap_m from the robot's footprint.
+  bool follow_robot = false;
+  double follow_gap_m = 0.8;
   SourceLocation where;
 };
 
@@ -177,6 +222,7 @@ struct World {
   SimRobotConfig robot;
   std::vector<DropArea> drops;
   std::vector<DynamicObstacle> obstacles;
+  std::vector<Visitor> visitors;
   FaultSchedule faults;
 };
 

@@ -1,0 +1,99 @@
+// The guide demo (docs/guide.md): a scripted visit of the exhibit hall. A visit file lists what a
+// visitor types, says or presses, in sequence or at times; `tripodal run --visit FILE` puts Jinny
+// (configs/robots/jinny.yaml) in the hall among walking visitors, hands each request to its HRI,
+// and prints the dialogue and the task and process life cycle, the collisions and the figures;
+// with --out it writes the audio of the answers (voice built) and a report. Application layer,
+// part of the `tripodal` tool, not installed.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tripodal/core/diagnostic.hpp"
+
+namespace tripodal::app {
+
+/// One thing the visitor does.
+struct VisitStep {
+  enum class Kind { typed, spoken, button };
+  Kind kind = Kind::typed;
+  std::string text;  ///< the request, or the button's name
+  /// Not before this simulated time (s); otherwise after_s after the previous step is over (its
+  /// answer given and the task it started ended).
+  std::optional<double> at_s;
+  double after_s = 1.0;
+  /// What should happen, checked and reported (empty: anything): the HRI's reply kind
+  /// ("answered", "task_started", ...), the RKMS entry, the task started, and how it ends.
+  std::string expect_outcome, expect_entry, expect_task, expect_task_end;
+  SourceLocation where;
+};
+
+struct Visit {
+  std::filesystem::path file;
+  std::string name;
+  double max_duration_s = 900.0;  ///< the visit is cut off after this much simulated time
+  std::vector<VisitStep> steps;
+};
+
+[[nodiscard]] std::string_view to_string(VisitStep::Kind kind) noexcept;
+
+/// Parses a visit file's text (`file` names it in messages). Every problem is collected and thrown
+/// as one ConfigError, FILE:LINE:COL each: unknown keys, a step with none or two of type / say /
+/// press, an empty request, a negative time, an unknown expected outcome or task end.
+[[nodiscard]] Visit parse_visit(std::string_view text, const std::filesystem::path& file);
+[[nodiscard]] Visit load_visit(const std::filesystem::path& file);
+
+struct VisitOptions {
+  std::filesystem::path robot, world, visit;
+  std::optional<std::uint64_t> seed;  ///< default: the world's
+  std::filesystem::path out;          ///< dialogue.txt, report.json, answers' WAV files (empty: none)
+  bool voice = true;                  ///< false: treat spoken requests as typed even if voice is built
+  std::ostream* log = nullptr;        ///< the dialogue and the life cycle as they happen
+};
+
+/// One exchange of the dialogue.
+struct VisitExchange {
+  std::size_t step = 0;  ///< of the visit file, from 0
+  double time_s = 0.0;
+  std::string kind;    ///< typed, spoken, button
+  std::string request; ///< as typed, the words heard, or the button
+  std::string heard;   ///< spoken: the recognizer's words ("" otherwise)
+  std::string reply_kind, entry, task, reply;
+  std::string task_end;  ///< how the task it started ended ("" when none)
+  std::string wav;       ///< the answer's audio file ("" without voice or --out)
+  /// When the task ended: how far the visitor following the robot (World visitor follow_robot)
+  /// stood from it, centre to centre (m; negative when nobody follows).
+  double follower_distance_m = -1.0;
+  bool as_expected = true;
+  std::string mismatch;  ///< what differed from the visit file's expect
+};
+
+struct VisitResult {
+  std::string visit;
+  std::uint64_t seed = 0;
+  bool voice = false;
+  bool completed = false;        ///< every step ran within max_duration_s
+  double duration_s = 0.0;       ///< simulated
+  double distance_m = 0.0;       ///< ground truth
+  std::uint64_t collisions = 0;  ///< of the robot's footprint (walls, exhibits, visitors)
+  std::uint64_t visitor_collisions = 0;
+  double min_visitor_clearance_m = 0.0;
+  std::size_t visitor_waits = 0;  ///< times a walking visitor stopped to let the robot pass
+  /// Time the robot stood still on its way (BhAutoMove active) with a visitor within 1.2 m: it
+  /// waited for a visitor (sampled every 50 ms).
+  double robot_waited_s = 0.0;
+  std::vector<VisitExchange> exchanges;
+  std::vector<std::string> processes;  ///< "12.300-40.100 X0 PrAutoMove(goal=node1) succeeded"
+  std::size_t mismatches = 0;
+  [[nodiscard]] std::string json() const;
+};
+
+/// Runs the visit. Throws ConfigError for a bad profile, world or visit file (located).
+[[nodiscard]] VisitResult run_visit(const VisitOptions& options);
+
+}  // namespace tripodal::app
