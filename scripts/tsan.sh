@@ -2,7 +2,7 @@
 # Builds the test suites whose tests use threads with ThreadSanitizer (-DTRIPODAL_TSAN=ON, g++) and
 # runs the tests tagged [threads]: LoopRunner, the process supervisor's inbox fed from module
 # threads, Robot::start/stop with a command from another thread, SourceFile interning, the monitor's
-# server thread against the robot's. A data race
+# server thread against the robot's, the RKMS store written from two threads. A data race
 # or a lock-order inversion fails the run (halt_on_error). Build tree: $BUILD_ROOT/tsan.
 #
 # A new threaded component (a DDS transport) joins by tagging its tests
@@ -12,7 +12,7 @@ cd "$(dirname "$0")/.."
 root=$(pwd)
 build="${BUILD_ROOT:-$root/build}/tsan"
 jobs=${JOBS:-$(nproc)}
-suites=(tripodal_core_tests tripodal_reactive_tests tripodal_processes_tests tripodal_robot_tests tripodal_monitor_tests)
+suites=(tripodal_core_tests tripodal_reactive_tests tripodal_processes_tests tripodal_robot_tests tripodal_monitor_tests tripodal_hri_tests)
 
 scripts/install-deps.sh
 

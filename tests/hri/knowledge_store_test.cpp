@@ -356,7 +356,7 @@ TEST_CASE("StoreBackedHri answers from an edit at once and refuses a provider th
   CHECK(hri.ask("where can I park my car").kind == HriReply::Kind::not_understood);
 }
 
-TEST_CASE("store: changes from two threads are all saved, each under a version of its own") {
+TEST_CASE("store: changes from two threads are all saved, each under a version of its own", "[hri][store][threads]") {
   Folder f;
   KnowledgeStore store(f.file);
   // Catch2's assertions are not thread-safe: the threads count, the test thread checks.
