@@ -37,7 +37,7 @@ std::uint16_t get_u16(std::string_view s, std::size_t at) {
 
 }  // namespace
 
-void write_wav(const std::filesystem::path& file, const AudioClip& clip) {
+std::string wav_bytes(const AudioClip& clip) {
   const auto data_bytes = static_cast<std::uint32_t>(clip.samples.size() * 2);
   std::string out;
   out.reserve(44 + data_bytes);
@@ -54,6 +54,11 @@ void write_wav(const std::filesystem::path& file, const AudioClip& clip) {
   out += "data";
   put_u32(out, data_bytes);
   for (const std::int16_t s : clip.samples) put_u16(out, static_cast<std::uint16_t>(s));
+  return out;
+}
+
+void write_wav(const std::filesystem::path& file, const AudioClip& clip) {
+  const std::string out = wav_bytes(clip);
   std::ofstream f(file, std::ios::binary);
   f.write(out.data(), static_cast<std::streamsize>(out.size()));
   if (!f) throw std::runtime_error(file.string() + ": cannot write the WAV file");

@@ -133,37 +133,8 @@ std::string_view kind_text(HriReply::Kind k) {
   return "?";
 }
 
-void put_u16(std::string& out, std::uint16_t v) {
-  out += static_cast<char>(v & 0xFFU);
-  out += static_cast<char>((v >> 8U) & 0xFFU);
-}
-void put_u32(std::string& out, std::uint32_t v) {
-  put_u16(out, static_cast<std::uint16_t>(v & 0xFFFFU));
-  put_u16(out, static_cast<std::uint16_t>(v >> 16U));
-}
-
 }  // namespace
 
-std::string wav_bytes(const AudioClip& clip) {
-  const auto data_bytes = static_cast<std::uint32_t>(clip.samples.size() * 2);
-  const auto rate = static_cast<std::uint32_t>(clip.sample_rate_hz);
-  std::string out;
-  out.reserve(44 + data_bytes);
-  out += "RIFF";
-  put_u32(out, 36 + data_bytes);
-  out += "WAVEfmt ";
-  put_u32(out, 16);
-  put_u16(out, 1);  // PCM
-  put_u16(out, 1);  // mono
-  put_u32(out, rate);
-  put_u32(out, rate * 2);
-  put_u16(out, 2);
-  put_u16(out, 16);
-  out += "data";
-  put_u32(out, data_bytes);
-  for (const std::int16_t s : clip.samples) put_u16(out, static_cast<std::uint16_t>(s));
-  return out;
-}
 
 bool is_hri_op(std::string_view op) noexcept {
   return op == "rkms.list" || op == "rkms.get" || op == "rkms.add" || op == "rkms.edit" || op == "rkms.delete" ||

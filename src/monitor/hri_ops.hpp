@@ -27,7 +27,4 @@ struct HriOpResult {
 [[nodiscard]] HriOpResult handle_hri_op(HriService* hri, std::string_view op, const nlohmann::json& body,
                                         const std::function<void(std::string)>& note);
 
-/// A RIFF WAVE file (PCM 16 bit, mono) of `clip`, in memory: the touch page plays it.
-[[nodiscard]] std::string wav_bytes(const AudioClip& clip);
-
 }  // namespace tripodal::monitor

@@ -50,6 +50,9 @@ class SpeechRecognizer {
   [[nodiscard]] virtual Result recognize(const AudioClip& audio) = 0;
 };
 
+/// The bytes of a RIFF WAVE file (PCM, 16 bit, mono) holding `clip`: what write_wav writes, and
+/// what the monitor sends a touch page to play.
+[[nodiscard]] std::string wav_bytes(const AudioClip& clip);
 /// Writes a RIFF WAVE file (PCM, 16 bit, mono). Throws std::runtime_error when it cannot.
 void write_wav(const std::filesystem::path& file, const AudioClip& clip);
 /// Reads a RIFF WAVE file of 16-bit PCM, mono (or the first channel of several). Throws
