@@ -12,7 +12,7 @@ StoreBackedHri::StoreBackedHri(KnowledgeStore& store, const TaskLibrary& tasks, 
       knowledge_(knowledge),
       providers_(providers),
       start_task_(std::move(start_task)),
-      options_(options),
+      options_(std::move(options)),
       voice_(std::move(voice)) {
   // An answer naming a provider the robot lacks would make the next index refuse the whole base:
   // the store refuses such an entry when it is edited, at its field.
