@@ -138,7 +138,8 @@ void MapBuilder::add_keyframe(const LaserScan& scan, const Pose2D& base_from_las
     graph_.add_edge(node - 1, node, compose(inverse(graph_.pose(node - 1)), pose_),
                     matched ? loop.match_noise : loop.odometry_noise);
   }
-  Keyframe k{scan, base_from_laser, travel_m_};
+  // the scan is kept only to draw the map again after a solve: without loop closure, no copy
+  Keyframe k{loop.enabled ? scan : LaserScan{}, base_from_laser, travel_m_};
   k.scan.intensities.clear();
   keyframes_.push_back(std::move(k));
   ++stats_.keyframes;
