@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "tripodal/behaviors/behavior_registry.hpp"
+#include "stale_watch.hpp"
 
 namespace tripodal {
 
@@ -22,18 +23,7 @@ const OdometryResource* find_odometry(const ParameterSet& params, const Behavior
                       : context.resources->find<OdometryReading>(name);
 }
 
-// Tracks how long a resource has been stale; true once that exceeds `timeout`.
-bool stale_too_long(bool fresh, Time now, Duration timeout, bool& stale, Time& since) noexcept {
-  if (fresh) {
-    stale = false;
-    return false;
-  }
-  if (!stale) {
-    stale = true;
-    since = now;
-  }
-  return now - since > timeout;
-}
+using detail::stale_too_long;
 
 // Body-frame translation toward a target at (dx, dy) in the body frame with speed `speed` (>= 0),
 // as the base can execute it: straight on a holonomic base; on a base without sideways motion,

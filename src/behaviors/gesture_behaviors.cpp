@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "stale_watch.hpp"
+
 namespace tripodal {
 
 namespace {
@@ -63,16 +65,9 @@ void BhFaceVisitor::on_activate(const ParameterSet& params, const BehaviorContex
 
 std::optional<Twist2D> BhFaceVisitor::on_step(const BehaviorContext& context) noexcept {
   const bool fresh = laser_->is_fresh(context.now);
-  if (!fresh) {
-    if (!stale_) {
-      stale_ = true;
-      stale_since_ = context.now;
-    } else if (context.now - stale_since_ > stale_timeout_) {
-      fail("no laser");
-      return Twist2D{};
-    }
-  } else {
-    stale_ = false;
+  if (detail::stale_too_long(fresh, context.now, stale_timeout_, stale_, stale_since_)) {
+    fail("no laser");
+    return Twist2D{};
   }
   const double yaw = odom_ != nullptr && odom_->has_reading() ? odom_->latest().pose.theta_rad : 0.0;
   if (fresh && laser_->sequence() != scan_seen_) {
