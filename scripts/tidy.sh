@@ -14,8 +14,11 @@ scripts/install-deps.sh tidy
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DTRIPODAL_BUILD_TESTS=OFF \
   -DTRIPODAL_BUILD_BENCH=OFF >/dev/null
 # Headers generated at build time (the dds area's idlc output) must exist for the sources that
-# include them.
-if ninja -C "$build" -t targets all | grep -q '^tripodal_dds_idl:'; then
+# include them. The target list is read whole first: `ninja ... | grep -q` under pipefail fails
+# whenever grep exits before ninja has written everything (SIGPIPE), and the headers were then
+# silently not generated.
+targets=$(ninja -C "$build" -t targets all)
+if grep -q '^tripodal_dds_idl:' <<<"$targets"; then
   cmake --build "$build" --target tripodal_dds_idl >/dev/null
 fi
 log="$build/tidy.log"
