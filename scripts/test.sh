@@ -10,6 +10,8 @@
 # build/behavior_test, build/custom_robot, build/dds_consumer (override with BUILD_ROOT).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# Each step prints the wall time since the start: CI's budget is read from these lines.
+stage() { echo "== $* [$(date -u +%T), ${SECONDS} s]"; }
 root=$(pwd)
 build_root=${BUILD_ROOT:-$root/build}
 jobs=${JOBS:-$(nproc)}
@@ -19,41 +21,41 @@ scripts/install-deps.sh
 generator=()
 if command -v ninja >/dev/null; then generator=(-G Ninja); fi
 
-echo "== Release build (-Werror)"
+stage "Release build (-Werror)"
 cmake -S . -B "$build_root/release" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
   -DTRIPODAL_WERROR=ON -DTRIPODAL_BUILD_TESTS=ON -DTRIPODAL_BUILD_BENCH=ON \
   -DTRIPODAL_TEST_CXX_FLAGS=-O1 -DCMAKE_INSTALL_PREFIX="$build_root/install"
 cmake --build "$build_root/release" -j "$jobs"
-echo "== Release tests"
+stage "Release tests"
 ctest --test-dir "$build_root/release" --output-on-failure -j "$jobs"
 
-echo "== Install and build the example consumer against the installed package"
+stage "Install and build the example consumer against the installed package"
 rm -rf "$build_root/install"
 cmake --install "$build_root/release" >/dev/null
 cmake -S examples/consumer -B "$build_root/consumer" "${generator[@]}" \
   -DCMAKE_PREFIX_PATH="$build_root/install" -DCMAKE_COMPILE_WARNING_AS_ERROR=ON
 cmake --build "$build_root/consumer" -j "$jobs"
 "$build_root/consumer/tripodal_consumer"
-echo "== Build and run the behavior tutorial's trace test against the installed package"
+stage "Build and run the behavior tutorial's trace test against the installed package"
 cmake -S examples/behavior_test -B "$build_root/behavior_test" "${generator[@]}" \
   -DCMAKE_PREFIX_PATH="$build_root/install" -DCMAKE_COMPILE_WARNING_AS_ERROR=ON
 cmake --build "$build_root/behavior_test" -j "$jobs"
 "$build_root/behavior_test/bh_approach_test"
-echo "== Build and run the application robot (examples/custom_robot) against the installed package"
+stage "Build and run the application robot (examples/custom_robot) against the installed package"
 cmake -S examples/custom_robot -B "$build_root/custom_robot" "${generator[@]}" \
   -DCMAKE_PREFIX_PATH="$build_root/install" -DCMAKE_COMPILE_WARNING_AS_ERROR=ON
 cmake --build "$build_root/custom_robot" -j "$jobs"
 "$build_root/custom_robot/custom_robot"
 
 if [ -d "$build_root/install/include/tripodal/dds" ]; then
-  echo "== Build and run the DDS consumer (find_package(tripodal COMPONENTS dds)) against the installed package"
+  stage "Build and run the DDS consumer (find_package(tripodal COMPONENTS dds)) against the installed package"
   cmake -S examples/dds_consumer -B "$build_root/dds_consumer" "${generator[@]}" \
     -DCMAKE_PREFIX_PATH="$build_root/install" -DCMAKE_COMPILE_WARNING_AS_ERROR=ON
   cmake --build "$build_root/dds_consumer" -j "$jobs"
   "$build_root/dds_consumer/tripodal_dds_consumer"
 fi
 
-echo "== AddressSanitizer + UndefinedBehaviorSanitizer build"
+stage "AddressSanitizer + UndefinedBehaviorSanitizer build"
 # -O1 -g1 (line tables): the sanitizers' reports keep their file:line, and the tree compiles in half
 # the time of -O2 -g (27 s against 13 s for robot_monitor.cpp), which CI's budget needs. The tests'
 # own sources at -O0 halve their share again (TRIPODAL_TEST_CXX_FLAGS in CMakeLists.txt).
@@ -62,7 +64,7 @@ cmake -S . -B "$build_root/sanitize" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWit
   -DTRIPODAL_WERROR=ON -DTRIPODAL_SANITIZE=ON -DTRIPODAL_BUILD_TESTS=ON -DTRIPODAL_BUILD_BENCH=OFF \
   -DTRIPODAL_TEST_CXX_FLAGS=-O0
 cmake --build "$build_root/sanitize" -j "$jobs"
-echo "== Sanitizer tests"
+stage "Sanitizer tests"
 # -LE long: the whole-workspace runs that repeat code another run drives (tests/app/CMakeLists.txt).
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir "$build_root/sanitize" --output-on-failure -j "$jobs" -LE long

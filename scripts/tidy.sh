@@ -28,7 +28,7 @@ run-clang-tidy -quiet -j "$jobs" -p "$build" -extra-arg=-Wno-unknown-warning-opt
 warnings=$(grep -cE '^/.*: (warning|error): ' "$log" || true)
 if [[ $warnings -ne 0 ]]; then
   grep -E '^/.*: (warning|error): ' "$log" | sort -u
-  echo "tidy: $warnings findings (full output: $log)" >&2
+  echo "tidy: $warnings findings (full output: $log; ${SECONDS} s)" >&2
   exit 1
 fi
-echo "tidy: clean ($(grep -c '"file"' "$build/compile_commands.json") translation units)"
+echo "tidy: clean ($(grep -c '"file"' "$build/compile_commands.json") translation units, ${SECONDS} s)"
