@@ -1,6 +1,7 @@
 #include "tripodal/navi/regions.hpp"
 
 #include <catch2/catch.hpp>
+#include <filesystem>
 
 #include "navi_test_util.hpp"
 #include "tripodal/navi/map_io.hpp"
@@ -98,9 +99,9 @@ TEST_CASE("regions: restricting a map to a room", "[navi][regions]") {
 }
 
 TEST_CASE("the demo world: map, regions, splitter and planner agree", "[navi][regions][workspace]") {
-  const std::string dir = std::string(TRIPODAL_SOURCE_DIR) + "/configs/worlds/";
-  const MapFile m = load_map(dir + "workspace_map.yaml");
-  const RegionMap regions = load_regions(dir + "workspace_regions.yaml");
+  const std::filesystem::path dir = std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs" / "worlds";
+  const MapFile m = load_map(dir / "workspace_map.yaml");
+  const RegionMap regions = load_regions(dir / "workspace_regions.yaml");
   for (const char* name : {"3211", "2111", "2133"}) REQUIRE(regions.room(name) != nullptr);
   CHECK(regions.room("3211")->area_m2() == Approx(320.0));
   // the whole workspace is room 3211: four sections, as in the paper's experiment
