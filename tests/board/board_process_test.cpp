@@ -27,7 +27,7 @@ namespace {
 // tripodal-board-sim on the workspace, its pseudo-terminal also reachable at `link`.
 pid_t start_board(const std::filesystem::path& link) {
   const std::string exe = TRIPODAL_BOARD_SIM_EXE;
-  const std::string world = std::string(TRIPODAL_SOURCE_DIR) + "/configs/worlds/workspace.yaml";
+  const std::string world = (std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs" / "worlds" / "workspace.yaml").string();
   std::vector<std::string> args{exe, "--world", world, "--link", link.string(), "--duration-s", "60", "--link-timeout-s", "2"};
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
