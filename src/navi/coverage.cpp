@@ -108,9 +108,12 @@ struct CoveragePlanner::Workspace {
 
 CoveragePlanner::CoveragePlanner(const OccupancyGrid& grid, CoverageOptions options)
     : grid_(grid), options_(options),
-      planner_(grid, PathPlannerOptions{options.robot_radius_m > 0.0 ? options.robot_radius_m
-                                                                      : options.cleaning_width_m / 2.0,
-                                        true, true}) {
+      planner_(grid, [&] {
+        PathPlannerOptions o{options.robot_radius_m > 0.0 ? options.robot_radius_m : options.cleaning_width_m / 2.0,
+                             true, true};
+        if (options.link_margin_m > 0.0) o.preferred_clearance_m = o.robot_radius_m + options.link_margin_m;
+        return o;
+      }()) {
   if (options_.robot_radius_m <= 0.0) options_.robot_radius_m = options_.cleaning_width_m / 2.0;
   if (options_.simplify_tolerance_m <= 0.0) options_.simplify_tolerance_m = 0.75 * grid.resolution_m();
 }
@@ -209,11 +212,12 @@ CoveragePlanner::Workspace CoveragePlanner::prepare(const Section& section) {
 
 void CoveragePlanner::link(std::vector<Point2D>& path, CellIndex from, CellIndex to) {
   if (from == to) return;
-  if (planner_.line_of_sight(from, to)) {
+  const double keep = planner_.leg_clearance_m(from, to);
+  if (planner_.line_of_sight(from, to, keep)) {
     path.push_back(grid_.cell_center(to));
     return;
   }
-  const PlannedPath p = planner_.plan(from, to);
+  const PlannedPath p = planner_.plan(from, to, keep);
   if (!p.ok()) return;  // cannot happen for cells of linked components; leave a jump rather than fail
   path.insert(path.end(), p.waypoints.begin() + 1, p.waypoints.end());
 }

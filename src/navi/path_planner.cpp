@@ -41,25 +41,39 @@ PathPlanner::PathPlanner(const OccupancyGrid& grid, PathPlannerOptions options)
       open_cell_[padded_index(x, y)] = traversable_[grid_.index({x, y})];
     }
   }
+  clearance_.assign(padded, 0.0F);
+  for (int y = 0; y < grid_.height(); ++y) {
+    for (int x = 0; x < grid_.width(); ++x) {
+      clearance_[padded_index(x, y)] = static_cast<float>(field_.clearance_m(grid_.index({x, y})));
+    }
+  }
   g_.resize(padded);
   parent_.resize(padded);
   stamp_.assign(padded, 0);
   closed_.resize(padded);
 }
 
-bool PathPlanner::line_of_sight(CellIndex a, CellIndex b) const noexcept {
+double PathPlanner::leg_clearance_m(CellIndex a, CellIndex b) const noexcept {
+  if (options_.preferred_clearance_m <= options_.robot_radius_m) return 0.0;
+  return std::min({options_.preferred_clearance_m, clearance_m(a), clearance_m(b)});
+}
+
+bool PathPlanner::line_of_sight(CellIndex a, CellIndex b, double min_clearance_m) const noexcept {
   // Supercover walk: every cell the segment between the two centres passes through.
   int x = a.x, y = a.y;
   const int dx = std::abs(b.x - a.x), dy = std::abs(b.y - a.y);
   const int sx = b.x > a.x ? 1 : -1, sy = b.y > a.y ? 1 : -1;
-  if (!traversable({x, y})) return false;
+  const auto open = [&](CellIndex c) {
+    return traversable(c) && (min_clearance_m <= 0.0 || field_.clearance_m(grid_.index(c)) >= min_clearance_m);
+  };
+  if (!open({x, y})) return false;
   int ix = 0, iy = 0;
   while (ix < dx || iy < dy) {
     // compare (0.5 + ix) / dx with (0.5 + iy) / dy without division
     const long long lhs = static_cast<long long>(1 + 2 * ix) * dy;
     const long long rhs = static_cast<long long>(1 + 2 * iy) * dx;
     if (lhs == rhs) {  // through a corner: both side cells must be free
-      if (!traversable({x + sx, y}) || !traversable({x, y + sy})) return false;
+      if (!open({x + sx, y}) || !open({x, y + sy})) return false;
       x += sx;
       y += sy;
       ++ix;
@@ -71,7 +85,7 @@ bool PathPlanner::line_of_sight(CellIndex a, CellIndex b) const noexcept {
       y += sy;
       ++iy;
     }
-    if (!traversable({x, y})) return false;
+    if (!open({x, y})) return false;
   }
   return true;
 }
@@ -144,7 +158,7 @@ PlannedPath PathPlanner::plan_around(Point2D start, Point2D goal, std::span<cons
   return plan(start, goal);
 }
 
-PlannedPath PathPlanner::plan(CellIndex start, CellIndex goal) {
+PlannedPath PathPlanner::plan(CellIndex start, CellIndex goal, double keep_clearance_m) {
   PlannedPath out;
   std::ostringstream msg;
   const auto describe = [&](const char* what, CellIndex c) {
@@ -212,6 +226,11 @@ PlannedPath PathPlanner::plan(CellIndex start, CellIndex goal) {
   const std::int32_t steps[8] = {1, -1, pw, -pw, pw + 1, -pw + 1, pw - 1, -pw - 1};
   static constexpr int kSide[8][2] = {{0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 2}, {0, 3}, {1, 2}, {1, 3}};
   const std::uint8_t* cell_open = open_cell_.data();
+  // Steps onto cells nearer than the clearance kept cost up to 1 + kClearanceWeight times more.
+  const bool keep_clear = keep_clearance_m > options_.robot_radius_m;
+  const auto keep = static_cast<float>(keep_clearance_m);
+  const float per_m = keep_clear ? kClearanceWeight / static_cast<float>(keep_clearance_m - options_.robot_radius_m) : 0.0F;
+  const float* clearance = clearance_.data();
   bool found = false;
   while (!open.empty()) {
     const Node n = open.top();
@@ -232,7 +251,8 @@ PlannedPath PathPlanner::plan(CellIndex start, CellIndex goal) {
         const auto s1 = static_cast<std::uint32_t>(static_cast<std::int32_t>(n.i) + steps[kSide[k][1]]);
         if (cell_open[s0] == 0 || cell_open[s1] == 0) continue;
       }
-      const float ng = gn + (k >= 4 ? kSqrt2 : 1.0F);
+      const float penalty = keep_clear ? std::min(kClearanceWeight, std::max(0.0F, keep - clearance[ni]) * per_m) : 0.0F;
+      const float ng = gn + (k >= 4 ? kSqrt2 : 1.0F) * (1.0F + penalty);
       if (stamp_[ni] != search_id_) {
         stamp_[ni] = search_id_;
         closed_[ni] = 0;
@@ -263,13 +283,21 @@ PlannedPath PathPlanner::plan(CellIndex start, CellIndex goal) {
   std::vector<CellIndex> kept;
   if (options_.shortcut) {
     // String pulling: extend each straight leg while the next path cell stays visible. Done from
-    // both ends, the shorter result kept: the greedy pull depends on its direction.
+    // both ends, the shorter result kept: the greedy pull depends on its direction. With a
+    // clearance to keep a leg keeps it, or at least the least clearance of the cells it
+    // replaces: a shortcut does not undo the way A* took around a corner.
     const auto pull = [&](const std::vector<CellIndex>& cells) {
       std::vector<CellIndex> k{cells[0]};
       std::size_t i = 0;
       while (i + 1 < cells.size()) {
         std::size_t j = i + 1;
-        while (j + 1 < cells.size() && line_of_sight(cells[i], cells[j + 1])) ++j;
+        double least = keep_clear ? std::min({keep_clearance_m, clearance_m(cells[i]), clearance_m(cells[j])}) : 0.0;
+        while (j + 1 < cells.size()) {
+          const double with_next = keep_clear ? std::min(least, clearance_m(cells[j + 1])) : 0.0;
+          if (!line_of_sight(cells[i], cells[j + 1], with_next)) break;
+          least = with_next;
+          ++j;
+        }
         k.push_back(cells[j]);
         i = j;
       }

@@ -214,6 +214,9 @@ const ModuleManifest& CCoverageModule::static_manifest() {
                      "hybrid: how far inside the wall round's centre line the lanes end (0: one cell)", 0.0, 5.0},
        ParameterSpec{"turn_cost_m", ValueType::number, Value{CoverageOptions{}.turn_cost_m}, "m",
                      "hybrid: the travel a turn weighs when the lane direction is chosen", 0.0, 100.0},
+       ParameterSpec{"link_margin_m", ValueType::number, Value{CoverageOptions{}.link_margin_m}, "m",
+                     "links between passes keep this much more than the robot radius from obstacles where the way "
+                     "allows (0: the robot radius)", 0.0, 1.0},
        ParameterSpec{"pattern", ValueType::string, Value{std::string("hybrid")}, "",
                      "hybrid (a wall-following round, then lanes), balloon (the paper's wall-following rounds) or "
                      "boustrophedon (plough lanes)", {}, {}},
@@ -228,6 +231,7 @@ void CCoverageModule::on_configure(const ParameterSet& params) {
   options_.lane_overlap_m = params.number("lane_overlap_m");
   options_.turn_cost_m = params.number("turn_cost_m");
   options_.lane_inset_m = params.number("lane_inset_m");
+  options_.link_margin_m = params.number("link_margin_m");
   const std::string& pattern = params.string("pattern");
   if (pattern != "hybrid" && pattern != "balloon" && pattern != "boustrophedon") {
     throw ConfigError(where(), "CoveragePlanner: pattern must be hybrid, balloon or boustrophedon, not '" + pattern + "'");
@@ -324,6 +328,29 @@ void CCoverageModule::on_behavior_activated(const BehaviorActivation& activation
   }
   active_ = &it->second;
   coverage_path_.publish(active_->plan.path, active_->done_m, true, context);
+  rejoin(from, context);
+}
+
+void CCoverageModule::rejoin(Point2D from, ModuleContext& context) {
+  // The follower steers straight at the path's next point: from where a kidnapping (or a
+  // recovery that moved the robot) left it, that line may pass an obstacle of the map at any
+  // distance, and the laser watch ignores what the map holds. The way back goes round it.
+  const Point2D back = coverage_path_.at(active_->done_m);
+  PathPlanner& pp = planner().planner();
+  const auto a = pp.grid().world_to_cell(from);
+  const auto b = pp.grid().world_to_cell(back);
+  if (!a || !b || (*a == *b)) return;
+  const double keep = pp.leg_clearance_m(*a, *b);
+  if (pp.line_of_sight(*a, *b, keep)) return;
+  PlannedPath plan = pp.plan(*a, *b, keep);
+  if (plan.ok()) {
+    plan.waypoints.front() = from;
+    plan.waypoints.back() = back;
+  }
+  if (!plan.ok()) return;  // the follower's straight line, as before
+  detour_.publish(plan.waypoints, 0.0, false, context);
+  detouring_ = true;
+  resume_m_ = active_->done_m;
 }
 
 void CCoverageModule::on_update(ModuleContext& context) {

@@ -558,6 +558,75 @@ TEST_CASE("The coverage planner resumes a section where its coverage stopped, an
   CHECK(m.navigation.path_failure == "unknown section");
 }
 
+TEST_CASE("A section taken up again from the far side of a pillar is rejoined by a planned way",
+          "[navi][modules][cleaning]") {
+  // The faults world's kidnapping: the robot is carried off, found again, and its cleaning goes
+  // on from where it stopped. The follower would steer straight at that point, through what
+  // the map holds between (its laser watch ignores mapped obstacles).
+  Modules m(6.0, 4.0, true);  // the pillar: x 2.7-3.3 m, y 1.2-2.8 m
+  m.navigation.map_from_base = kCorner;
+  const ModuleManifest& bh = BhCleaning::static_manifest();
+  const ParameterValues section_a{{"section", Value{std::string("A")}}};
+  m.activated(bh, section_a, Time{});
+  const std::vector<Pose2D> path(m.navigation.path.begin(), m.navigation.path.end());
+  // a point of the path west of the pillar, level with it (sampled every 5 cm along the legs)
+  double s = 0.0, done_m = -1.0;
+  Pose2D stop;
+  for (std::size_t i = 1; i < path.size() && done_m < 0.0; ++i) {
+    const double len = std::hypot(path[i].x_m - path[i - 1].x_m, path[i].y_m - path[i - 1].y_m);
+    for (double d = 0.0; d < len; d += 0.05) {
+      const double t = d / len;
+      const Pose2D p{path[i - 1].x_m + t * (path[i].x_m - path[i - 1].x_m),
+                     path[i - 1].y_m + t * (path[i].y_m - path[i - 1].y_m), 0.0};
+      if (p.x_m > 1.2 && p.x_m < 2.2 && std::abs(p.y_m - 2.0) < 0.3) {
+        done_m = s + d;
+        stop = p;
+        break;
+      }
+    }
+    s += len;
+  }
+  REQUIRE(done_m > 0.0);
+  NavigationFeedback fb;
+  fb.path_id = m.navigation.path_id;
+  fb.progress_m = done_m;
+  m.update(time_from_seconds(1.0), fb);
+  m.deactivated("BhCleaning", time_from_seconds(2.0));
+
+  // found again east of the pillar, mirrored: the straight line back crosses it
+  const Point2D found{6.0 - stop.x_m, stop.y_m};
+  m.navigation.map_from_base = {found.x_m, found.y_m, 0.0};
+  const navi::PathPlanner& pp = m.maps->planner();
+  REQUIRE(pp.traversable(m.maps->grid().cell_at(found)));
+  REQUIRE_FALSE(pp.line_of_sight(m.maps->grid().cell_at(found), m.maps->grid().cell_at({stop.x_m, stop.y_m})));
+  m.activated(bh, section_a, time_from_seconds(3.0));
+  const std::vector<Pose2D> way(m.navigation.path.begin(), m.navigation.path.end());
+  REQUIRE(way.size() >= 3);  // round the pillar
+  CHECK_FALSE(m.navigation.path_final);
+  CHECK(way.front().x_m == Approx(found.x_m));
+  CHECK(way.back().x_m == Approx(stop.x_m).margin(1e-6));
+  CHECK(way.back().y_m == Approx(stop.y_m).margin(1e-6));
+  for (std::size_t i = 1; i < way.size(); ++i) {
+    CHECK(pp.line_of_sight(m.maps->grid().cell_at({way[i - 1].x_m, way[i - 1].y_m}),
+                           m.maps->grid().cell_at({way[i].x_m, way[i].y_m})));
+  }
+  // at its end the coverage path is given again, from where the section stopped
+  NavigationFeedback back;
+  back.path_id = m.navigation.path_id;
+  back.reached_end = true;
+  m.navigation.map_from_base = stop;
+  m.update(time_from_seconds(20.0), back);
+  CHECK(m.navigation.path_final);
+  CHECK(m.navigation.path_start_m == Approx(done_m));
+  CHECK(m.navigation.path.size() == path.size());
+
+  // taken up again where it stopped: no way to plan, the coverage path at once
+  m.deactivated("BhCleaning", time_from_seconds(21.0));
+  m.activated(bh, section_a, time_from_seconds(22.0));
+  CHECK(m.navigation.path_final);
+  CHECK(m.navigation.path_start_m == Approx(done_m));
+}
+
 // ---------------------------------------------------------------------------------------------
 // A whole robot: the modules plan, the behaviors track, the simulator moves the body.
 

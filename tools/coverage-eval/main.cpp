@@ -266,7 +266,8 @@ int usage() {
                "  --random N       N seeded random rooms (seeds 1..N)\n"
                "  --pictures DIR   the workspace's paths per pattern as PNG pictures; --verbose 1: per section figures\n"
                "  --width M        cleaning width (default 0.64, PSR-2's); --radius M robot radius (default 0.3)\n"
-               "  --lane-overlap M, --lane-inset M, --turn-cost M   the hybrid's CoverageOptions of the same names\n";
+               "  --lane-overlap M, --lane-inset M, --turn-cost M   the hybrid's CoverageOptions of the same names\n"
+               "  --link-margin M   CoverageOptions::link_margin_m (the clearance links keep beyond the robot radius)\n";
   return 2;
 }
 
@@ -291,6 +292,7 @@ int main(int argc, char** argv) {
     else if (a == "--lane-overlap") o.lane_overlap_m = std::atof(v.c_str());
     else if (a == "--lane-inset") o.lane_inset_m = std::atof(v.c_str());
     else if (a == "--turn-cost") o.turn_cost_m = std::atof(v.c_str());
+    else if (a == "--link-margin") o.link_margin_m = std::atof(v.c_str());
     else if (a == "--pictures") pictures = v;
     else if (a == "--verbose") verbose = v == "1";
     else return usage();

@@ -70,10 +70,18 @@ struct CoverageOptions {
   /// grid rows need less overlap than contours; 2 cm absorb the robot's tracking error: demo,
   /// seeds 1-3, both robots >= 99.70 % driven coverage).
   double lane_overlap_m = 0.02;
-  /// hybrid(): lanes end this far inside the centre line of the wall round; 0: one cell.
-  double lane_inset_m = 0.0;
+  /// hybrid(): lanes end this far inside the centre line of the wall round; 0: one cell. 0.1 m:
+  /// the driven robot still turns on the round's swath, and the lane ends repeat less of it
+  /// (demo, seeds 1-3, both robots: 1.29-1.30x the bound, safe at corners with link_margin_m).
+  double lane_inset_m = 0.1;
   /// hybrid(): a turn weighs like this much travel when the lane direction is chosen.
   double turn_cost_m = 0.5;
+  /// Links between passes keep this much more than the robot radius from physical obstacles
+  /// where the way allows (PathPlannerOptions::preferred_clearance_m), or at least the
+  /// clearance of their own ends: a link that cut by an obstacle corner at the robot radius left
+  /// the driven robot no room for its tracking error (the demo's differential base hit box
+  /// corners with lanes ending 0.1 m inside the round). 0: links only need to be traversable.
+  double link_margin_m = 0.05;
 };
 
 /// Length and turns of a path.

@@ -18,6 +18,11 @@ struct PathPlannerOptions {
   double robot_radius_m = 0.25;     ///< obstacles are inflated by this much (footprint disc)
   bool unknown_is_obstacle = true;  ///< plan only through cells known to be free
   bool shortcut = true;             ///< drop waypoints joined by a collision-free straight line
+  /// Clearance kept where the way allows (0 or at most robot_radius_m: none). A path that
+  /// passes an obstacle corner at just the robot radius leaves the follower no room for its
+  /// tracking error: A* cells nearer than this cost more (up to 1 + kClearanceWeight times a
+  /// step at the robot radius), and a shortcut never comes nearer than the cells it replaces.
+  double preferred_clearance_m = 0.0;
 };
 
 enum class PlanStatus { ok, start_outside_map, goal_outside_map, start_in_collision, goal_in_collision, unreachable };
@@ -47,7 +52,11 @@ class PathPlanner final {
   /// Plans from start to goal (map frame, metres).
   [[nodiscard]] PlannedPath plan(Point2D start, Point2D goal);
   /// Plans between two cells.
-  [[nodiscard]] PlannedPath plan(CellIndex start, CellIndex goal);
+  [[nodiscard]] PlannedPath plan(CellIndex start, CellIndex goal) { return plan(start, goal, options_.preferred_clearance_m); }
+  /// Plans between two cells keeping this clearance where the way allows (as the option
+  /// preferred_clearance_m, for this plan: a link between two cells along a wall keeps theirs,
+  /// leg_clearance_m, rather than stepping out to the preferred clearance and back).
+  [[nodiscard]] PlannedPath plan(CellIndex start, CellIndex goal, double keep_clearance_m);
   /// Plans from start to goal around obstacles the map does not hold (points seen by a laser,
   /// map frame), for this plan only: the cells within the robot radius of a point are closed,
   /// and those within the radius plus margin_m too, except near the start (a robot stopped
@@ -61,7 +70,21 @@ class PathPlanner final {
     return grid_.contains(c) && traversable_[grid_.index(c)] != 0;
   }
   /// Whether every cell on the straight segment a-b (supercover line) is traversable.
-  [[nodiscard]] bool line_of_sight(CellIndex a, CellIndex b) const noexcept;
+  [[nodiscard]] bool line_of_sight(CellIndex a, CellIndex b) const noexcept { return line_of_sight(a, b, 0.0); }
+  /// Whether every cell on the segment a-b is traversable and has at least this clearance.
+  [[nodiscard]] bool line_of_sight(CellIndex a, CellIndex b, double min_clearance_m) const noexcept;
+  /// Clearance of the cell's centre from the nearest obstacle (0 outside the grid).
+  [[nodiscard]] double clearance_m(CellIndex c) const noexcept {
+    return grid_.contains(c) ? field_.clearance_m(grid_.index(c)) : 0.0;
+  }
+  /// The clearance a straight leg between a and b keeps where the way allows: the preferred
+  /// clearance, or less where an end of the leg itself is nearer an obstacle (a lane end, a
+  /// contour along a wall). Without a preferred clearance: 0 (traversable is enough).
+  [[nodiscard]] double leg_clearance_m(CellIndex a, CellIndex b) const noexcept;
+
+  /// Extra cost of a step onto a cell at the robot radius, relative to a step at the clearance
+  /// kept (falls linearly to 0 there).
+  static constexpr float kClearanceWeight = 4.0F;
 
   [[nodiscard]] const OccupancyGrid& grid() const noexcept { return grid_; }
   [[nodiscard]] const DistanceField& distance_field() const noexcept { return field_; }
@@ -79,6 +102,8 @@ class PathPlanner final {
     return static_cast<std::size_t>(y + 1) * static_cast<std::size_t>(padded_width_) + static_cast<std::size_t>(x + 1);
   }
   std::vector<std::uint8_t> open_cell_;
+  // Per padded cell: the clearance (0 on the padding), for the cost of steps near obstacles.
+  std::vector<float> clearance_;
   // A* scratch (padded indices), reused across plans; valid where stamp_ == search_id_.
   std::vector<float> g_;
   std::vector<std::uint32_t> parent_;

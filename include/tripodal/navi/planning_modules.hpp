@@ -140,6 +140,8 @@ class CCoverageModule final : public CNaviModules {
   /// The centroid of the nearest section not cleaned yet (where the hybrid path should end).
   [[nodiscard]] std::optional<Point2D> next_section_centroid(const Section& section) const;
   void plan_detour(const Pose2D& pose, ModuleContext& context);
+  /// A section taken up again away from where it stopped: the way back to the path, planned.
+  void rejoin(Point2D from, ModuleContext& context);
 
   std::vector<std::string> serves_;
   CoverageOptions options_;
