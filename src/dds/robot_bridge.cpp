@@ -11,6 +11,7 @@
 
 #include "tripodal/dds/endpoint.hpp"
 #include "tripodal/navi/grid_maps.hpp"
+#include "tripodal/planner/plan.hpp"
 #include "tripodal/planner/planner.hpp"
 #include "tripodal/processes/process_supervisor.hpp"
 
@@ -24,13 +25,8 @@ msg::Quaternion yaw_quaternion(double theta_rad) {
 
 msg::Pose pose_of(const Pose2D& p) { return {{p.x_m, p.y_m, 0.0}, yaw_quaternion(p.theta_rad)}; }
 
-std::string step_text(const ProcessStep& s) {
-  std::string out = s.process;
-  if (s.params.empty()) return out;
-  out += '(';
-  for (std::size_t i = 0; i < s.params.size(); ++i) out += (i == 0 ? "" : ", ") + s.params[i].name + "=" + s.params[i].value;
-  return out + ')';
-}
+// "PrCleaning(section=A)": a plan of one step in the planner's own words (planner/plan.hpp).
+std::string step_text(const ProcessStep& s) { return to_string(Plan{{}, {}, {PlanStage{{s}}}}); }
 
 enum Severity : std::uint8_t { kInfo = 0, kWarning = 1, kError = 2 };
 

@@ -202,9 +202,9 @@ TEST_CASE("dds: a malformed dds: section is refused, located", "[dds]") {
     }
     return "no error";
   };
-  CHECK_THAT(errors_of("{domain_id: 300}"), Catch::Contains("bot.yaml:2:19: error: dds domain_id: expected a whole number from 0 to 232, got 300"));
+  CHECK_THAT(errors_of("{domain_id: 300}"), Catch::Contains("bot.yaml:2:18: error: dds domain_id: expected a whole number from 0 to 232, got '300'"));
   CHECK_THAT(errors_of("{namespace: 1st/robot}"),
-             Catch::Contains("bot.yaml:2:19: error: dds namespace '1st/robot' is not a ROS 2 namespace"));
+             Catch::Contains("bot.yaml:2:18: error: dds namespace '1st/robot' is not a ROS 2 namespace"));
   CHECK_THAT(errors_of("{namespace: 'a b'}"), Catch::Contains("dds namespace 'a b' is not a ROS 2 namespace"));
   CHECK_THAT(errors_of("{publish: [odom, scans]}"),
              Catch::Contains("bot.yaml:2:23: error: dds publish: expected one of odom, pose, map, events, markings; got 'scans'"));
