@@ -13,6 +13,7 @@
 #include "tripodal/dds/endpoint.hpp"
 #include "tripodal/dds/robot_bridge.hpp"
 #include "tripodal/dds/robot_modules.hpp"
+#include "tripodal/resources/resource_faults.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/sim/world.hpp"
@@ -51,6 +52,19 @@ struct FaultLog final : SupervisorObserver {
     faults.push_back(std::string(source) + ": " + std::string(reason));
   }
   void on_event_dropped(std::string_view event, Time) override { dropped.emplace_back(event); }
+};
+
+// A resource of a remote device whose faults the test injects (as DdsLaser's come from DDS).
+class RemoteDevice final : public TypedResource<GyroReading>, public ResourceFaultSource {
+ public:
+  static const ModuleManifest& static_manifest() {
+    static const ModuleManifest m =
+        ManifestBuilder("RemoteDevice", ModuleKind::resource).description("a device behind a link").output("remote_status").build();
+    return m;
+  }
+  explicit RemoteDevice(std::string name) : TypedResource<GyroReading>(std::move(name), Duration{0}, static_manifest()) {}
+  std::vector<std::string> take_faults() override { return faults.take(); }
+  ResourceFaultQueue faults;
 };
 
 }  // namespace
@@ -303,4 +317,66 @@ TEST_CASE("dds: a DdsLaser whose publisher leaves is the resource's fault, a fau
   robot->run_for(500ms);
   CHECK(log.faults.size() == 1);
   robot->supervisor().remove_observer(log);
+}
+
+// The rest of the way of a resource's fault: a running process fails with it, and the planner's
+// recovery rules decide; the bridge tells a peer each step.
+TEST_CASE("dds: a resource's fault during a task fails its process and the planner's recovery runs", "[dds]") {
+  const std::uint32_t domain = test_domain(33);
+  const std::string ns = test_namespace();
+  const std::string message = "module remote failed: link lost";
+  const std::filesystem::path rules = std::filesystem::temp_directory_path() / ("tripodal_dds_recovery_" + ns + ".yaml");
+  {
+    std::ofstream out(rules);
+    out << read_text(kConfigs / "tasks/recovery.yaml") << "  - fault: \"" << message << "\"\n    insert:\n      - PrWait: {}\n"
+        << "    then: retry\n    max_retries: 1\n";
+  }
+  std::string yaml = read_text(kConfigs / "robots/psr2.yaml");
+  const std::string shipped = "recovery: ../tasks/recovery.yaml";
+  REQUIRE(yaml.find(shipped) != std::string::npos);
+  yaml.replace(yaml.find(shipped), shipped.size(), "recovery: " + rules.string());
+  yaml += "resources:\n  - {name: remote, type: RemoteDevice}\ndds: {domain_id: " + std::to_string(domain) + ", namespace: " + ns +
+          ", participant_lease_s: 1, publish: [events]}\n";
+  const RobotProfile profile = load_robot_profile_from_string(yaml, "psr2-remote.yaml", kConfigs / "robots");
+
+  RobotPlugins plugins = RobotPlugins::with_builtins();
+  sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml")));
+  plugins.resources.add(RemoteDevice::static_manifest(),
+                        [](const ResourceConfig& c) -> std::unique_ptr<CResource> { return std::make_unique<RemoteDevice>(c.name); });
+  SimClock clock;
+  const auto robot = Robot::assemble(profile, plugins, clock);
+  std::filesystem::remove(rules);  // read by assemble()
+  auto* remote = dynamic_cast<RemoteDevice*>(robot->resources().find("remote"));
+  REQUIRE(remote != nullptr);
+
+  Participant peer(test_options(33));
+  Subscriber<msg::Event> events(peer, ros_topic("tripodal/events", ns), {.kind = TopicKind::event});
+  RobotBridge bridge(*robot, clock, *profile.dds);
+  REQUIRE(events.wait_for_publishers(1, 5s));
+  std::vector<msg::Event> seen;
+  auto run_until = [&](auto done, int max_steps) {
+    for (int i = 0; i < max_steps; ++i) {
+      robot->run_for(100ms);
+      bridge.update();
+      std::this_thread::sleep_for(2ms);
+      for (auto& e : events.take()) seen.push_back(e);
+      if (done()) return true;
+    }
+    return false;
+  };
+
+  REQUIRE(robot->command("clean the room 3211").accepted);
+  REQUIRE(run_until([&] { return has_event(seen, "process_started"); }, 50));
+  remote->faults.report("link lost");  // as a middleware's thread would
+  const bool recovered = run_until([&] { return has_event(seen, "recovery"); }, 50);
+  INFO(events_text(seen));
+  REQUIRE(recovered);
+  CHECK(has_event(seen, "fault", "remote"));
+  CHECK(has_event(seen, "process_failed"));
+  const auto failed = std::find_if(seen.begin(), seen.end(), [](const msg::Event& e) { return e.kind == "process_failed"; });
+  CHECK_THAT(failed->detail, Catch::Contains(message));
+  const auto recovery = std::find_if(seen.begin(), seen.end(), [](const msg::Event& e) { return e.kind == "recovery"; });
+  CHECK_THAT(recovery->detail, Catch::Contains("PrWait"));
+  REQUIRE_FALSE(robot->planner().report().recoveries.empty());
+  CHECK(robot->planner().busy());  // the task goes on with the new plan
 }
