@@ -28,6 +28,9 @@ class RobotBridge final {
   /// On the thread that drives the robot, between periods (as RobotMonitor::update): the task
   /// commands received since the last call, then odometry, pose and markings when a period of
   /// the section is due, the map when it is first available or changes size.
+  /// The observers run on the thread of the robot's sequencing loop, so the robot is driven from
+  /// the thread that calls update() (run_until(), as `tripodal run` does), not with
+  /// Robot::start()'s threads.
   void update();
   /// Whether a "pause" command holds the run (until "resume"); the driving loop keeps calling
   /// update() while paused.
