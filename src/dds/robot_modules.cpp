@@ -37,6 +37,10 @@ const ModuleManifest& DdsLaserResource::static_manifest() {
                                       .output("laser_scan")
                                       .parameters(topic_parameters("scan"))
                                       .number("max_age_s", 0.5, "s", "older than this the scan is stale; 0: never", 0.0)
+                                      .number("deadline_s", 0.0, "s",
+                                              "a fault when no scan comes within this (DDS deadline; the publisher must "
+                                              "offer one at least as short); 0: none",
+                                              0.0)
                                       .build();
   return m;
 }
@@ -47,8 +51,14 @@ DdsLaserResource::DdsLaserResource(std::string name, const ParameterSet& paramet
                     static_manifest()) {
   const TopicBinding b = topic_binding(parameters, "scan");
   participant_ = std::make_unique<Participant>(b.participant);
+  EndpointOptions options{.kind = TopicKind::scan, .on_status = [this](const StatusEvent& e) { on_status(e); }};
+  if (parameters.contains("deadline_s") && parameters.number("deadline_s") > 0.0) {
+    Qos q = qos_for(TopicKind::scan, Role::subscriber);
+    q.deadline = std::chrono::duration_cast<std::chrono::nanoseconds>(from_seconds(parameters.number("deadline_s")));
+    options.qos = q;
+  }
   subscriber_ = std::make_unique<Subscriber<msg::LaserScan>>(
-      *participant_, b.topic, EndpointOptions{.kind = TopicKind::scan}, [this](const msg::LaserScan& s) {
+      *participant_, b.topic, options, [this](const msg::LaserScan& s) {
         std::lock_guard lock(mutex_);
         pending_.angle_min_rad = s.angle_min;
         pending_.angle_max_rad = s.angle_max;
@@ -60,11 +70,24 @@ DdsLaserResource::DdsLaserResource(std::string name, const ParameterSet& paramet
         pending_.ranges_m.assign(s.ranges.begin(), s.ranges.end());
         pending_.intensities.assign(s.intensities.begin(), s.intensities.end());
         has_pending_.store(true, std::memory_order_release);
+        silent_.store(false, std::memory_order_relaxed);
       });
 }
 
 // The subscriber goes first: its callback uses the members below it.
 DdsLaserResource::~DdsLaserResource() { subscriber_.reset(); }
+
+// On a Cyclone DDS thread. A lost publisher while another still sends is no fault: only the
+// laser's silence is.
+void DdsLaserResource::on_status(const StatusEvent& e) {
+  if (e.kind == StatusKind::liveliness_lost && e.current_count == 0) {
+    silent_.store(true, std::memory_order_relaxed);
+    faults_.report("the publisher of " + e.topic + " went silent (DDS liveliness lost: its process died, its lease ran out or it left)");
+  } else if (e.kind == StatusKind::deadline_missed && !silent_.exchange(true, std::memory_order_relaxed)) {
+    // Once per silence: the deadline is missed again every period until a scan comes.
+    faults_.report("no scan on " + e.topic + " within its deadline (missed " + std::to_string(e.total_count) + " times)");
+  }
+}
 
 const std::string& DdsLaserResource::topic() const noexcept { return subscriber_->topic(); }
 std::size_t DdsLaserResource::matched_publishers() const { return subscriber_->matched_publishers(); }

@@ -12,6 +12,7 @@
 #include "tripodal/core/net_loader.hpp"
 #include "tripodal/navi/navi_modules.hpp"
 #include "tripodal/reactive/reactive_config.hpp"
+#include "tripodal/resources/resource_faults.hpp"
 
 namespace tripodal {
 
@@ -89,6 +90,8 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
   std::unique_ptr<CHardware> hardware;
   std::vector<ControllerConfig> controller_configs;
   std::vector<std::unique_ptr<CResource>> own_resources;
+  // The resources that detect faults of their own (ResourceFaultSource), by instance name.
+  std::vector<std::pair<std::string, ResourceFaultSource*>> fault_sources;
   OdometryResource odometry{"odometry"};
   ResourceTable resources;
   std::vector<std::unique_ptr<ControlLoop>> loops;
@@ -231,6 +234,10 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
     std::vector<std::unique_ptr<ControlLoop::ChangeBatch>> batches;
     for (auto& loop : loops) batches.push_back(std::make_unique<ControlLoop::ChangeBatch>(*loop));
     collect_loop_reports();
+    // A resource's own faults (a silent peer) go the way of a module's: "<resource>.fault".
+    for (auto& [name, source] : fault_sources) {
+      for (std::string& why : source->take_faults()) supervisor->report_module_fault(name, std::move(why));
+    }
     ModuleContext ctx = context(now);
     for_each_module(ctx, [&](CModule& m) { m.update(ctx); });
     if (planner->busy()) {
@@ -347,6 +354,9 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
                         e.where, m->hardware.get()};
       m->own_resources.push_back(plugins.resources.create_at(e.where, e.type, rc));
       m->resources.add(*m->own_resources.back());
+      if (auto* faults = dynamic_cast<ResourceFaultSource*>(m->own_resources.back().get())) {
+        m->fault_sources.emplace_back(e.name, faults);
+      }
     });
   }
   if (d.has_errors()) throw ConfigError(d);

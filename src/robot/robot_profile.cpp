@@ -2,6 +2,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -21,6 +23,7 @@ struct Parser {
   std::filesystem::path base;
   Diagnostics d;
   yaml::Reader r;
+  bool dds_namespace_given = false;  // an explicit "" puts the topics at the root
 
   SourceLocation at(const YAML::Node& n) const { return r.at(n); }
 
@@ -142,6 +145,75 @@ struct Parser {
     if (!p.name.empty()) out.push_back(std::move(p));
   }
 
+  // `dds:` — every value checked where it is written; a namespace must be one ROS 2 accepts, since
+  // a ROS 2 node on the same domain would otherwise see none of the robot's topics.
+  void dds_section(const YAML::Node& n, RobotProfile& prof) {
+    DdsSection s;
+    s.where = at(n);
+    if (!r.expect_keys(n, {"domain_id", "namespace", "loopback", "participant_lease_s", "period_s", "publish", "tasks"}, "dds")) {
+      return;
+    }
+    if (const YAML::Node v = n["domain_id"]) {
+      if (auto id = r.integer(v, "dds domain_id", 0, 232)) s.domain_id = static_cast<std::uint32_t>(*id);
+    }
+    if (const YAML::Node v = n["namespace"]) {
+      if (auto ns = r.text(v, "dds namespace")) {
+        dds_namespace_given = true;
+        s.ros_namespace = *ns;
+        if (!valid_ros_namespace(*ns)) {
+          d.error(at(v), "dds namespace '" + *ns + "' is not a ROS 2 namespace: names of letters, digits and '_', "
+                         "not starting with a digit, separated by '/'");
+        }
+      }
+    }
+    if (const YAML::Node v = n["loopback"]) {
+      if (auto b = r.boolean(v, "dds loopback")) s.loopback = *b;
+    }
+    if (const YAML::Node v = n["participant_lease_s"]) {
+      if (auto l = positive_seconds(v, "dds participant_lease_s")) s.participant_lease = from_seconds(*l);
+    }
+    if (const YAML::Node v = n["period_s"]) {
+      if (auto p = positive_seconds(v, "dds period_s")) s.period = from_seconds(*p);
+    }
+    if (const YAML::Node v = n["tasks"]) {
+      if (auto b = r.boolean(v, "dds tasks")) s.tasks = *b;
+    }
+    if (const YAML::Node v = n["publish"]) {
+      if (r.expect_list(v, "dds publish")) {
+        std::map<std::string, SourceLocation> seen;
+        for (const auto& item : v) {
+          auto topic = r.choice(item, "dds publish", {"odom", "pose", "map", "events", "markings"});
+          if (!topic) continue;
+          auto [it, fresh] = seen.emplace(*topic, at(item));
+          if (!fresh) {
+            d.error(at(item), "dds publish lists '" + *topic + "' twice (first at " + it->second.str() + ")");
+            continue;
+          }
+          s.publish.push_back(*topic);
+        }
+      }
+    } else {
+      s.publish.assign(std::begin(kDdsTopics), std::end(kDdsTopics));
+    }
+    prof.dds = std::move(s);
+  }
+
+  static bool valid_ros_namespace(std::string_view ns) {
+    if (!ns.empty() && ns.front() == '/') ns.remove_prefix(1);
+    if (ns.empty()) return true;  // none: the topics are at the root ("rt/odom")
+    std::size_t start = 0;
+    while (start <= ns.size()) {
+      const std::size_t end = std::min(ns.find('/', start), ns.size());
+      const std::string_view token = ns.substr(start, end - start);
+      if (token.empty() || std::isdigit(static_cast<unsigned char>(token.front())) != 0) return false;
+      for (const char c : token) {
+        if (std::isalnum(static_cast<unsigned char>(c)) == 0 && c != '_') return false;
+      }
+      start = end + 1;
+    }
+    return true;
+  }
+
   RobotProfile parse(const std::string& text) {
     RobotProfile prof;
     prof.file = file;
@@ -149,7 +221,7 @@ struct Parser {
     const YAML::Node root = yaml::parse(text, file);
     prof.where = SourceLocation{file, 1, 1};
     if (!r.expect_keys(root, {"robot", "hardware", "controllers", "loops", "resources", "navigation", "hri", "modules", "behaviors",
-                              "processes", "tasks", "recovery"},
+                              "processes", "tasks", "recovery", "dds"},
                        "the robot profile")) {
       throw ConfigError(d);
     }
@@ -200,9 +272,18 @@ struct Parser {
         prof.tasks = path_of(v, "tasks file", prof.tasks_where);
       } else if (key == "recovery") {
         prof.recovery = path_of(v, "recovery file", prof.recovery_where);
+      } else if (key == "dds") {
+        dds_section(v, prof);
       }
     }
     if (prof.name.empty()) d.error(prof.where, "the profile needs robot: {name: ...}");
+    if (prof.dds && !dds_namespace_given) {
+      prof.dds->ros_namespace = prof.name;
+      if (!valid_ros_namespace(prof.name)) {
+        d.error(prof.dds->where, "dds: the robot's name '" + prof.name + "' is not a ROS 2 namespace (letters, digits and '_'); "
+                                 "give dds: {namespace: ...}");
+      }
+    }
     // Names are unique across every kind of module: they identify providers in the checks.
     std::map<std::string, SourceLocation> seen;
     for (const ModuleEntry* m : prof.all_modules()) {

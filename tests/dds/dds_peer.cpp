@@ -2,6 +2,7 @@
 //   tripodal_dds_peer cmd-vel <domain> <namespace> <count>  publishes <count> cmd_vel, linear.x = 0.1 * i
 //   tripodal_dds_peer echo <domain> <namespace>             returns every message type: <type>_ping -> <type>_pong
 //   tripodal_dds_peer alive <domain> <namespace> <lease_ms> a live event publisher, until killed
+//   tripodal_dds_peer scan <domain> <namespace> <lease_ms>  a laser: a LaserScan on scan at 10 Hz, until killed
 // Exits 0 when done, 2 on a usage error, 3 when no subscriber came, 4 on a DDS error.
 #include <csignal>
 #include <cstdio>
@@ -84,6 +85,19 @@ int run(int argc, char** argv) {
     wait_until_stopped(120s);
     return 0;
   }
+  if (mode == "scan" && argc == 5) {
+    options.participant_lease = std::chrono::milliseconds(std::stoi(argv[4]));
+    Participant p(options);
+    Publisher<msg::LaserScan> pub(p, ros_topic("scan", ns), {.kind = TopicKind::scan});
+    if (!pub.wait_for_subscribers(1, 10s)) return 3;
+    msg::LaserScan scan{{}, -1.5F, 1.5F, 0.5F, 0.0F, 0.1F, 0.05F, 10.0F, {2.0F, 2.0F, 2.0F, 2.0F, 2.0F, 2.0F, 2.0F}, {}};
+    const auto until = std::chrono::steady_clock::now() + 120s;
+    while (stop == 0 && std::chrono::steady_clock::now() < until) {
+      pub.publish(scan);
+      std::this_thread::sleep_for(100ms);
+    }
+    return 0;
+  }
   return 2;
 }
 
@@ -94,7 +108,7 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, on_signal);
   try {
     const int rc = run(argc, argv);
-    if (rc == 2) std::fprintf(stderr, "usage: tripodal_dds_peer cmd-vel|echo|alive <domain> <namespace> [count|lease_ms]\n");
+    if (rc == 2) std::fprintf(stderr, "usage: tripodal_dds_peer cmd-vel|echo|alive|scan <domain> <namespace> [count|lease_ms]\n");
     return rc;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "tripodal_dds_peer: %s\n", e.what());

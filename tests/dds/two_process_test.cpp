@@ -12,9 +12,12 @@
 
 #include "dds_test_support.hpp"
 #include "tripodal/dds/endpoint.hpp"
+#include "tripodal/dds/robot_modules.hpp"
+#include "tripodal/robot/robot.hpp"
 
 extern char** environ;
 
+using namespace tripodal;
 using namespace tripodal::dds;
 using namespace tripodal::dds::test;
 using namespace std::chrono_literals;
@@ -140,4 +143,51 @@ TEST_CASE("dds: a killed process is reported silent within its lease", "[dds][pr
   const auto after = std::chrono::duration_cast<std::chrono::milliseconds>(*lost - killed);
   INFO("a killed peer reported silent " << after.count() << " ms after SIGKILL (lease 500 ms)");
   CHECK(after <= lease + 200ms);
+}
+
+// The laser of a robot in another process: killed, its DdsLaser resource is the robot's fault once
+// the peer's participant lease runs out (the robot's supervisor sees it, "laser.fault" is posted).
+TEST_CASE("dds: a robot's DdsLaser whose process is killed is a fault within the lease", "[dds][process]") {
+  const std::uint32_t domain = test_domain(13);
+  const RobotProfile profile = load_robot_profile_from_string(
+      "robot: {name: lidar}\nresources:\n  - {name: laser, type: DdsLaser, parameters: {namespace: " + test_namespace() +
+          ", domain_id: " + std::to_string(domain) + "}}\n",
+      "lidar.yaml", ".");
+  RobotPlugins plugins = RobotPlugins::with_builtins();
+  register_dds_modules(plugins.resources, plugins.controllers);
+  SimClock clock;
+  const auto robot = Robot::assemble(profile, plugins, clock);
+  struct Faults final : SupervisorObserver {
+    std::vector<std::string> seen;
+    void on_fault(std::string_view source, std::string_view reason, Time) override {
+      seen.push_back(std::string(source) + ": " + std::string(reason));
+    }
+  } faults;
+  robot->supervisor().add_observer(faults);
+  auto* laser = dynamic_cast<DdsLaserResource*>(robot->resources().find("laser"));
+  REQUIRE(laser != nullptr);
+
+  constexpr auto lease = 500ms;
+  Peer peer({"scan", std::to_string(domain), test_namespace(), std::to_string(lease.count())});
+  for (int i = 0; i < 1000 && !laser->has_reading(); ++i) {
+    std::this_thread::sleep_for(5ms);
+    laser->poll(clock.now());
+  }
+  REQUIRE(laser->has_reading());
+  robot->run_for(200ms);
+  CHECK(faults.seen.empty());
+
+  peer.kill(SIGKILL);
+  const auto killed = std::chrono::steady_clock::now();
+  CHECK(peer.wait(5s) == 128 + SIGKILL);
+  while (faults.seen.empty() && std::chrono::steady_clock::now() - killed < 5s) {
+    robot->run_for(50ms);  // one sequencing period: the resource's faults taken and reported
+    std::this_thread::sleep_for(5ms);
+  }
+  const auto after = std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - killed);
+  INFO("the killed laser was the robot's fault " << after.count() << " ms after SIGKILL (lease 500 ms)");
+  REQUIRE(faults.seen.size() == 1);
+  CHECK_THAT(faults.seen.front(), Catch::StartsWith("laser: the publisher of " + ros_topic("scan", test_namespace()) + " went silent"));
+  CHECK(after <= lease + 300ms);
+  robot->supervisor().remove_observer(faults);
 }

@@ -15,6 +15,7 @@
 #include "run_task.hpp"
 #include "visit.hpp"
 #include "tripodal/core/diagnostic.hpp"
+#include "tripodal/robot/robot_profile.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -41,13 +42,16 @@ constexpr std::string_view kDescription =
     "127.0.0.1 unless ADDR is given, prints its address and token, paces the run to real time\n"
     "(--realtime SPEED changes the speed) and keeps the robot running after the task (a task may\n"
     "then come from the console instead of --task) until interrupted (Ctrl-C, SIGTERM).\n"
+    "A robot whose profile has a dds: section is on DDS while it runs (docs/distribution.md): its\n"
+    "odometry, pose, map, events and markings are published and it takes task commands; without\n"
+    "--task (and dds: tasks on) it is paced to real time and waits for a task from a peer.\n"
     "--visit VISIT.yaml runs the guide robot's scripted visit instead of a task (docs/guide.md): the\n"
     "dialogue, the life cycle and the collisions; with --out, dialogue.txt, report.json and the\n"
     "answers' audio (audio/*.wav, when the build has voice).";
 
 constexpr std::string_view kExitCodes =
     "exit codes: 0 task succeeded, 1 bad profile/world/faults, 2 bad command line, 3 I/O error,\n"
-    "            4 the task failed, was refused or timed out (with --monitor and no task given at all,\n"
+    "            4 the task failed, was refused or timed out (with --monitor or dds: and no task given at all,\n"
     "            the run ends with 0 when stopped); with --visit: a collision, an outcome not as\n"
     "            expected, or the visit not completed.";
 
@@ -98,14 +102,26 @@ int run_visit(const Args& args, std::ostream& out, std::ostream& err) {
   }
 }
 
+// Whether the robot takes its task over DDS (its profile's dds: tasks), so --task may be left out.
+// A profile that does not load counts as yes: the run reports its errors, located.
+bool takes_dds_tasks(const std::filesystem::path& robot) {
+  try {
+    const RobotProfile p = load_robot_profile(robot);
+    return p.dds && p.dds->tasks;
+  } catch (const std::exception&) {
+    return true;
+  }
+}
+
 int run(Args& args, std::ostream& out, std::ostream& err) {
   if (!args.visit.empty()) return run_visit(args, out, err);
   app::RunOptions& o = args.options;
   const std::string& faults = args.faults;
   o.realtime = args.realtime->count() > 0;
   if (args.realtime_speed > 0.0) o.realtime_speed = args.realtime_speed;
-  if (o.task.empty() && !o.monitor) {
-    err << "tripodal run: --task is required (without --monitor, where the console may give it)\n";
+  if (o.task.empty() && !o.monitor && !takes_dds_tasks(o.robot)) {
+    err << "tripodal run: --task is required (without --monitor, where the console may give it, or a profile "
+           "with dds: {tasks: true}, where a DDS peer may)\n";
     return kUsage;
   }
   if (!o.monitor && (o.start_paused || o.monitor_read_open || !o.monitor_token_file.empty())) {
@@ -159,7 +175,7 @@ int run(Args& args, std::ostream& out, std::ostream& err) {
     }
     if (!o.out.empty()) out << "wrote " << (o.out / "map.png").string() << ", trajectory.csv, report.json, lifecycle.txt\n";
     // A monitored robot the operator never gave a task: nothing failed.
-    const bool idle_monitor = o.monitor.has_value() && r.state == "idle";
+    const bool idle_monitor = (o.monitor.has_value() || o.task.empty()) && r.state == "idle";
     return r.succeeded || idle_monitor ? kOk : kTaskFailed;
   } catch (const ConfigError& e) {
     err << e.what() << '\n';

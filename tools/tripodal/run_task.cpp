@@ -28,6 +28,9 @@
 #include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/sim/simulator.hpp"
 #include "tripodal/sim/world.hpp"
+#ifdef TRIPODAL_HAVE_DDS
+#include "tripodal/dds/robot_bridge.hpp"
+#endif
 
 namespace tripodal::app {
 
@@ -183,6 +186,28 @@ std::vector<ParameterOverride> simulation_overrides(const RobotProfile& profile,
   return out;
 }
 
+// The robot on DDS when its profile has a `dds:` section (docs/distribution.md); a tool built
+// without the dds area refuses such a profile rather than run a robot its peers cannot see.
+#ifdef TRIPODAL_HAVE_DDS
+using DdsBridge = dds::RobotBridge;
+std::unique_ptr<DdsBridge> make_dds_bridge(Robot& robot, const Clock& clock, const RobotProfile& profile) {
+  return profile.dds ? std::make_unique<DdsBridge>(robot, clock, *profile.dds) : nullptr;
+}
+#else
+struct DdsBridge {
+  void update() {}
+  [[nodiscard]] bool paused() const noexcept { return false; }
+  [[nodiscard]] std::string topic(std::string_view) const { return {}; }
+};
+std::unique_ptr<DdsBridge> make_dds_bridge(Robot&, const Clock&, const RobotProfile& profile) {
+  if (profile.dds) {
+    throw ConfigError(profile.dds->where, "dds: this tripodal was built without DDS (TRIPODAL_DDS=OFF or Cyclone DDS not found); "
+                                          "remove the section or build with Cyclone DDS");
+  }
+  return nullptr;
+}
+#endif
+
 RunResult run_task(const RunOptions& o) {
   const RobotProfile profile = load_robot_profile(o.robot);
   auto world = std::make_shared<sim::World>(sim::load_world(o.world));
@@ -241,9 +266,18 @@ RunResult run_task(const RunOptions& o) {
   robot->supervisor().add_observer(life);
   robot->planner().add_observer(report);
 
+  // On DDS without a task given here, the run waits for one from a peer: paced like the monitor's.
+  const std::unique_ptr<DdsBridge> bridge = make_dds_bridge(*robot, clock, profile);
+  const bool serve_dds = bridge != nullptr && o.task.empty();
+  if (bridge && o.log != nullptr) {
+    *o.log << "dds: domain " << profile.dds->domain_id << ", namespace '" << profile.dds->ros_namespace << "' ("
+           << bridge->topic("events") << (profile.dds->tasks ? ", tasks on " + bridge->topic("task") : std::string()) << ")\n";
+    o.log->flush();
+  }
+
   SteadyClock wall;
   std::optional<sim::RealtimePacer> pacer;
-  if (o.realtime || o.monitor) pacer.emplace(wall, o.realtime ? o.realtime_speed : 1.0);
+  if (o.realtime || o.monitor || serve_dds) pacer.emplace(wall, o.realtime ? o.realtime_speed : 1.0);
 
   // The monitor: its own thread serves the clients; this loop hands it the robot's state and takes
   // the operator's requests between periods.
@@ -263,7 +297,7 @@ RunResult run_task(const RunOptions& o) {
       o.log->flush();
     }
   }
-  const bool serve = watch != nullptr;
+  const bool serve = watch != nullptr || serve_dds;
   auto stopped = [&] { return o.stop != nullptr && *o.stop != 0; };
 
   robot->run_until(clock.now());  // the localizer's first estimate, before the planner asks where to start
@@ -352,6 +386,7 @@ RunResult run_task(const RunOptions& o) {
 
   std::size_t sim_events_noted = 0;
   auto monitor_update = [&] {
+    if (bridge) bridge->update();
     if (!watch) return;
     monitor::MonitorExtras extras;
     extras.true_pose = sim.pose();
@@ -361,7 +396,7 @@ RunResult run_task(const RunOptions& o) {
   };
   while (clock.now() < deadline && !stopped() && (serve || robot->planner().busy())) {
     monitor_update();
-    if (watch && watch->paused()) {
+    if ((watch && watch->paused()) || (bridge && bridge->paused())) {
       wall.sleep_until(wall.now() + std::chrono::milliseconds(20));
       if (pacer) pacer.emplace(wall, o.realtime ? o.realtime_speed : 1.0);  // no catching up after a pause
       continue;

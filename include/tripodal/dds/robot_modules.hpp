@@ -11,6 +11,7 @@
 #include "tripodal/controllers/controller_config.hpp"
 #include "tripodal/dds/endpoint.hpp"
 #include "tripodal/resources/resource.hpp"
+#include "tripodal/resources/resource_faults.hpp"
 
 namespace tripodal::dds {
 
@@ -25,8 +26,11 @@ TopicBinding topic_binding(const ParameterSet& parameters, std::string_view defa
 // Type "DdsLaser": the latest sensor_msgs/LaserScan of a topic as a laser resource. Scans arrive on
 // a Cyclone DDS thread and are handed to the control loop in poll(), stamped with the loop's time
 // of that poll (the sender's stamp is on another clock), so max_age_s measures how long ago the
-// robot last heard of the laser.
-class DdsLaserResource final : public LaserResource {
+// robot last heard of the laser. A silent laser is also a fault of the resource (ResourceFaultSource,
+// so the robot posts "<name>.fault" and the planner's recovery runs): when the last alive publisher
+// loses its liveliness (its process died, its lease ran out, it was deleted), and, with deadline_s,
+// when no scan came within it.
+class DdsLaserResource final : public LaserResource, public ResourceFaultSource {
  public:
   static const ModuleManifest& static_manifest();
   // `parameters` resolved against static_manifest() (a robot profile's resource entry).
@@ -37,14 +41,18 @@ class DdsLaserResource final : public LaserResource {
 
   const std::string& topic() const noexcept;
   std::size_t matched_publishers() const;
+  [[nodiscard]] std::vector<std::string> take_faults() override { return faults_.take(); }
 
  private:
   void on_poll(Time now) noexcept override;
+  void on_status(const StatusEvent& e);
 
+  ResourceFaultQueue faults_;
   std::unique_ptr<Participant> participant_;
   std::mutex mutex_;  // guards pending_ between the DDS thread and the loop
   LaserScan pending_;
   std::atomic<bool> has_pending_{false};
+  std::atomic<bool> silent_{false};  // a fault was reported and no scan came since
   std::unique_ptr<Subscriber<msg::LaserScan>> subscriber_;
 };
 

@@ -4,6 +4,7 @@
 // reference in docs/processes.md.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -56,6 +57,30 @@ struct ProcessEntry {
   SourceLocation module_where;
 };
 
+/// The topics a robot on DDS can publish (its `dds: publish:` list), in the order the profile
+/// reference lists them (docs/distribution.md).
+inline constexpr std::string_view kDdsTopics[] = {"odom", "pose", "map", "events", "markings"};
+
+/// The robot on DDS: `dds: {domain_id, namespace, loopback, participant_lease_s, period_s, publish,
+/// tasks}`. Plain data read by the dds area's RobotBridge (docs/distribution.md); the robot itself
+/// does not use it, so the core builds and runs without DDS.
+struct DdsSection {
+  std::uint32_t domain_id = 0;       ///< ROS 2's ROS_DOMAIN_ID, 0..232
+  std::string ros_namespace;         ///< of every topic ("rt/<ns>/odom"); default: the robot's name
+  bool loopback = true;              ///< 127.0.0.1 only; false: Cyclone DDS's own configuration
+  std::optional<Duration> participant_lease;  ///< how long peers wait for this process; default Cyclone's 10 s
+  Duration period{std::chrono::milliseconds(100)};  ///< odometry, pose and markings at most this often
+  std::vector<std::string> publish;  ///< of kDdsTopics; default: all of them
+  bool tasks = true;                 ///< take tripodal_msgs/TaskCommand on tripodal/task
+  SourceLocation where;
+  [[nodiscard]] bool publishes(std::string_view topic) const noexcept {
+    for (const std::string& t : publish) {
+      if (t == topic) return true;
+    }
+    return false;
+  }
+};
+
 struct RobotProfile {
   std::string name;
   std::string description;
@@ -79,6 +104,8 @@ struct RobotProfile {
   std::filesystem::path recovery;  ///< recovery rules (empty: none)
   SourceLocation tasks_where;
   SourceLocation recovery_where;
+  /// The robot on DDS; none: the robot speaks no DDS.
+  std::optional<DdsSection> dds;
 
   /// Every module entry, in profile order: controllers, resources, navigation, hri, modules, behaviors.
   [[nodiscard]] std::vector<const ModuleEntry*> all_modules() const;
