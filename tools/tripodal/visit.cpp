@@ -91,6 +91,12 @@ VisitResult run_visit(const VisitOptions& o) {
     visit.name = "the monitor's visitors";
     visit.max_duration_s = o.max_duration_s;
   }
+  // A bad monitor address or token file is refused before anything is built.
+  std::optional<monitor::MonitorServerOptions> server_options;
+  if (o.monitor) {
+    server_options = monitor::server_options(*o.monitor, o.monitor_token_file);
+    server_options->read_without_token = o.monitor_read_open;
+  }
   const RobotProfile profile = load_robot_profile(o.robot);
   auto world = std::make_shared<sim::World>(sim::load_world(o.world));
   if (o.visitors_give_way_m) {
@@ -140,10 +146,8 @@ VisitResult run_visit(const VisitOptions& o) {
   std::unique_ptr<monitor::RobotMonitor> watch;
   SteadyClock wall;
   std::optional<sim::RealtimePacer> pacer;
-  if (o.monitor) {
-    monitor::MonitorServerOptions so = monitor::server_options(*o.monitor, o.monitor_token_file);
-    so.read_without_token = o.monitor_read_open;
-    server = std::make_unique<monitor::MonitorServer>(std::move(so));
+  if (server_options) {
+    server = std::make_unique<monitor::MonitorServer>(std::move(*server_options));
     watch = std::make_unique<monitor::RobotMonitor>(*robot, clock, *server, monitor::RobotMonitorOptions{.start_paused = o.start_paused});
     watch->set_hri(&guide.service());
     server->start();
