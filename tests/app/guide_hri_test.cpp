@@ -167,6 +167,17 @@ class BhPush final : public CBehavior {
   std::optional<Twist2D> on_step(const BehaviorContext&) noexcept override { return Twist2D{0.5, 0.0, 0.0}; }
 };
 
+// BhAvoidObstacle as a safety behavior, as docs/guide.md shows it for Jinny's profile.
+ModuleEntry safety_entry() {
+  ModuleEntry e;
+  e.kind = ModuleKind::behavior;
+  e.name = e.type = "BhAvoidObstacle";
+  e.safety = true;
+  e.parameters = {{"robot_radius_m", "0.25"}, {"stop_distance_m", "0.15"}, {"slow_distance_m", "0.9"}};
+  e.where = SourceLocation{"test profile", 1, 1};
+  return e;
+}
+
 // Jinny at the entrance facing +x, one visitor standing 1.1 m ahead (0.6 m between the bodies),
 // pushed towards it for 4 s; with or without the profile's safety behavior.
 struct PushResult {
@@ -184,7 +195,7 @@ PushResult push_towards_visitor(bool with_safety) {
   standing.radius_m = 0.25;
   world->visitors = {standing};
   RobotProfile profile = load_robot_profile(kConfigs / "robots/jinny.yaml");
-  if (!with_safety) std::erase_if(profile.behaviors, [](const ModuleEntry& b) { return b.safety; });
+  if (with_safety) profile.behaviors.push_back(safety_entry());
   RobotPlugins plugins = RobotPlugins::with_builtins();
   sim::register_sim_hardware(plugins.hardware, world);
   register_gesture_behaviors(plugins.behaviors);
@@ -205,10 +216,11 @@ PushResult push_towards_visitor(bool with_safety) {
 
 }  // namespace
 
-TEST_CASE("Jinny's BhAvoidObstacle (safety: true) stops a behavior that drives into a visitor who does not give way",
+TEST_CASE("BhAvoidObstacle as Jinny's safety behavior (safety: true) stops a behavior that drives into a visitor who does not give way",
           "[app][guide][safety]") {
   {
-    const RobotProfile profile = load_robot_profile(kConfigs / "robots/jinny.yaml");
+    RobotProfile profile = load_robot_profile(kConfigs / "robots/jinny.yaml");
+    profile.behaviors.push_back(safety_entry());
     SimClock clock;
     auto world = std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/exhibit_hall.yaml"));
     RobotPlugins plugins = RobotPlugins::with_builtins();
@@ -253,7 +265,7 @@ TEST_CASE("A safety behavior: safety takes true or false, behaviors only, and no
 
   // BhAutoMove made a safety behavior: PrAutoMove's net binds it, which the robot refuses.
   RobotProfile profile = load_robot_profile(kConfigs / "robots/jinny.yaml");
-  for (ModuleEntry& b : profile.behaviors) b.safety = b.safety || b.name == "BhAutoMove";
+  for (ModuleEntry& b : profile.behaviors) b.safety = b.name == "BhAutoMove";
   auto world = std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/exhibit_hall.yaml"));
   RobotPlugins plugins = RobotPlugins::with_builtins();
   sim::register_sim_hardware(plugins.hardware, world);
