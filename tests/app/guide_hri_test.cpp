@@ -173,7 +173,7 @@ ModuleEntry safety_entry() {
   e.kind = ModuleKind::behavior;
   e.name = e.type = "BhAvoidObstacle";
   e.safety = true;
-  e.parameters = {{"robot_radius_m", "0.25"}, {"stop_distance_m", "0.15"}, {"slow_distance_m", "0.9"}};
+  e.parameters = {{"robot_radius_m", "0.25"}, {"stop_distance_m", "0.15"}, {"slow_distance_m", "0.9"}, {"max_speed_m_s", "0.8"}};
   e.where = SourceLocation{"test profile", 1, 1};
   return e;
 }
