@@ -383,6 +383,21 @@ std::optional<Twist2D> BhAvoidObstacle::on_step(const BehaviorContext& context) 
       if (y > 0.0) left = std::min(left, y - r);
       else right = std::min(right, -y - r);
     }
+    // Outside those corridors too: a base that turns while it moves (a differential drive on a
+    // curve) sweeps beyond the straight corridor, and a person walks into it from the side. A
+    // return at bearing a from an axis closes on the footprint at cos(a) of the speed along that
+    // axis: its clearance along the axis counts as gap / cos(a). Returns nearly abeam (cos(a) <=
+    // 0.1, within about 6 degrees of the axis's normal) leave that axis free.
+    const double d = std::hypot(x, y);
+    const double gap = d - r;
+    if (gap < slow_m_ && d > 0.0) {
+      constexpr double kAbeam = 0.1;
+      const double cx = x / d, cy = y / d;
+      if (cx > kAbeam) front = std::min(front, std::max(gap, 0.0) / cx);
+      if (cx < -kAbeam) back = std::min(back, std::max(gap, 0.0) / -cx);
+      if (cy > kAbeam) left = std::min(left, std::max(gap, 0.0) / cy);
+      if (cy < -kAbeam) right = std::min(right, std::max(gap, 0.0) / -cy);
+    }
   };
   // Blocks of kLanes beams are tested at once (SIMD compare) and skipped when none is near.
   using Lanes = float __attribute__((vector_size(4 * sizeof(float))));

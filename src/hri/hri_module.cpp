@@ -118,9 +118,9 @@ HriReply HriModule::handle_button(std::string_view button) {
     HriReply reply;
     reply.kind = HriReply::Kind::not_understood;
     reply.text = "Sorry, that button does nothing here.";
-    return reply;
+    return remember("button", std::string(button.substr(0, 64)), std::move(reply));
   }
-  return handle(it->second);
+  return remember("button", it->first, classify(it->second));
 }
 
 std::vector<std::string> HriModule::buttons() const {
@@ -226,12 +226,27 @@ HriReply HriModule::handle_heard(const SpeechRecognizer::Result& heard) {
     reply.kind = HriReply::Kind::not_understood;
     reply.confidence = heard.confidence;
     reply.text = "Sorry, I did not catch that. Could you say it again?";
-    return reply;
+    return remember("heard", heard.words, std::move(reply));
   }
-  return handle(typed_form(heard.words));
+  const std::string typed = typed_form(heard.words);
+  return remember("heard", heard.words, classify(typed));
 }
 
 HriReply HriModule::handle(std::string_view utterance) {
+  HriReply reply = classify(utterance);
+  // What the display may show of the input: the text itself, unless it was refused unread.
+  std::string shown = utterance.size() > options_.max_utterance_bytes ? "(" + std::to_string(utterance.size()) + " bytes: too long)"
+                      : !hri::is_text(utterance)                       ? "(" + std::to_string(utterance.size()) + " bytes: not text)"
+                                                                       : std::string(utterance);
+  return remember("typed", std::move(shown), std::move(reply));
+}
+
+HriReply HriModule::remember(std::string source, std::string input, HriReply reply) {
+  last_ = HriExchange{std::move(source), std::move(input), reply.kind, reply.text, reply.entry_id, reply.task};
+  return reply;
+}
+
+HriReply HriModule::classify(std::string_view utterance) {
   HriReply reply;
   reply.kind = HriReply::Kind::refused_input;
   // Checked before anything reads the words: a huge or binary input costs nothing more.

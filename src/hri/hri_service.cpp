@@ -38,7 +38,9 @@ HriModule& StoreBackedHri::module() {
     tried_version_ = now;
     const KnowledgeBase base = store_.base();
     try {
-      module_ = std::make_unique<HriModule>(base, tasks_, knowledge_, providers_, start_task_, options_);
+      auto next = std::make_unique<HriModule>(base, tasks_, knowledge_, providers_, start_task_, options_);
+      next->restore_display(module_->display());
+      module_ = std::move(next);
       indexed_version_ = base.version();
       index_error_.clear();
     } catch (const std::exception& e) {
@@ -48,6 +50,11 @@ HriModule& StoreBackedHri::module() {
     }
   }
   return *module_;
+}
+
+HriDisplay StoreBackedHri::display() {
+  const std::lock_guard lock(mutex_);
+  return module_->display();
 }
 
 HriReply StoreBackedHri::ask(std::string_view utterance) {

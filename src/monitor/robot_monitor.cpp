@@ -123,6 +123,21 @@ json board_json(board::BoardLink& link, Time now) {
   return j;
 }
 
+// What the robot's HRI displays (paper, section 4: its internal state), and the last exchange.
+json hri_display_json(const HriDisplay& d) {
+  json j{{"task", d.state.task},
+         {"task_state", d.state.task_state},
+         {"process", d.state.process},
+         {"fault", d.state.fault},
+         {"status", display_text(d.state)},
+         {"last", nullptr}};
+  if (d.last) {
+    j["last"] = {{"source", d.last->source}, {"input", d.last->input}, {"kind", std::string(to_string(d.last->kind))},
+                 {"reply", d.last->reply},   {"entry", d.last->entry}, {"task", d.last->task}};
+  }
+  return j;
+}
+
 struct NetView {
   std::string run;
   const PetriNet* net = nullptr;
@@ -191,7 +206,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
                                     R"({"type":"object","properties":{"time_s":{"type":"number"},"kind":{"type":"string"},"text":{"type":"string"}}})",
                                     Delivery::event);
     ch_status = server.advertise("/status", "tripodal.Status",
-                                 R"({"type":"object","properties":{"time_s":{"type":"number"},"paused":{"type":"boolean"},"task_state":{"type":"string"},"velocity":{"type":"object"},"battery":{"type":["number","null"]},"coverage":{"type":["number","null"]},"behaviors":{"type":"array"},"winner":{"type":"string"},"board":{"type":"object","description":"the control board's link as the host sees it; only on hardware board"}}})",
+                                 R"({"type":"object","properties":{"time_s":{"type":"number"},"paused":{"type":"boolean"},"task_state":{"type":"string"},"velocity":{"type":"object"},"battery":{"type":["number","null"]},"coverage":{"type":["number","null"]},"behaviors":{"type":"array"},"winner":{"type":"string"},"board":{"type":"object","description":"the control board's link as the host sees it; only on hardware board"},"hri":{"type":["object","null"],"description":"what the robot's HRI displays: task, task_state, process, fault, status, and the last input with its answer (last); null without an HRI"}}})",
                                  Delivery::bulk);
     add_operator_input();
     paused = options.start_paused;
@@ -585,6 +600,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
       status["battery"] = battery->latest().percentage;
     }
     if (auto* host = dynamic_cast<board::BoardHost*>(robot.hardware())) status["board"] = board_json(host->board().link(), now);
+    status["hri"] = hri != nullptr ? hri_display_json(hri->display()) : json(nullptr);
     if (extras.true_pose) status["truth"] = {{"x", extras.true_pose->x_m}, {"y", extras.true_pose->y_m}, {"theta", extras.true_pose->theta_rad}};
     server.publish(ch_status, t, status.dump());
   }

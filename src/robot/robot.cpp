@@ -270,7 +270,13 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
   std::vector<std::string> process_names;
   for (const ProcessEntry& p : profile.processes) process_names.push_back(p.name);
   auto is_process = [&](std::string_view n) { return std::find(process_names.begin(), process_names.end(), n) != process_names.end(); };
-  for (const ModuleEntry& b : profile.behaviors) m->behavior_types.emplace(b.name, b.type);
+  // Safety behaviors are the loop's own, active from the start: the nets do not activate them.
+  for (const ModuleEntry& b : profile.behaviors) {
+    if (!b.safety) m->behavior_types.emplace(b.name, b.type);
+  }
+  auto is_safety = [&](std::string_view n) {
+    return std::any_of(profile.behaviors.begin(), profile.behaviors.end(), [&](const ModuleEntry& b) { return b.safety && b.name == n; });
+  };
   auto is_behavior = [&](std::string_view n) { return m->behavior_types.count(n) != 0; };
 
   if (!profile.tasks.empty()) {
@@ -286,7 +292,8 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
   if (!load) {
     load = [&](const std::filesystem::path& f) {
       LoadOptions lo;
-      lo.is_known_behavior = is_behavior;
+      // A safety behavior is known, so that a net binding it is refused below with the reason.
+      lo.is_known_behavior = [&](std::string_view n) { return is_behavior(n) || is_safety(n); };
       lo.structural_warnings = false;
       return load_net_or_throw(f, lo);
     };
@@ -305,7 +312,11 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
       }
       if (!p.recovery.empty()) def.recovery = RecoveryPolicy::load(p.recovery, is_process).rules();
       for (const Place& place : def.net.places()) {
-        if (place.behavior && !is_behavior(place.behavior->behavior)) {
+        if (place.behavior && is_safety(place.behavior->behavior)) {
+          d.error(p.net_where.line > 0 ? p.net_where : p.where,
+                  "process '" + p.name + "': place '" + place.id + "' of " + p.net.filename().string() + " binds behavior '" +
+                      place.behavior->behavior + "', which the robot runs as a safety behavior (safety: true: always active, never a net's)");
+        } else if (place.behavior && !is_behavior(place.behavior->behavior)) {
           d.error(p.net_where.line > 0 ? p.net_where : p.where,
                   "process '" + p.name + "': place '" + place.id + "' of " + p.net.filename().string() + " binds behavior '" +
                       place.behavior->behavior + "', which the robot does not list under behaviors");
@@ -376,7 +387,16 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
       CoordinatorConfig cc;
       if (first) {
         int priority = static_cast<int>(profile.behaviors.size());
-        for (const ModuleEntry& b : profile.behaviors) cc.inputs.push_back(CoordinatorInputConfig{b.name, priority--});
+        // Safety inputs rank above every other input (the monitor's operator too), so no lock
+        // below the emergency stop masks them.
+        const int safety_priority = priority + 1000;
+        for (const ModuleEntry& b : profile.behaviors) {
+          if (b.safety) {
+            cc.inputs.push_back(CoordinatorInputConfig{.name = b.name, .priority = safety_priority, .role = InputRole::safety});
+          } else {
+            cc.inputs.push_back(CoordinatorInputConfig{b.name, priority--});
+          }
+        }
       }
       ControlLoopOptions lo;
       lo.name = l.name;
@@ -390,6 +410,11 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
   }
   if (m->loops.empty() && !profile.behaviors.empty()) {
     d.error(profile.where, "the robot lists behaviors but no loop to run them: add loops: [{name, period_s, controller}]");
+  }
+  // The safety behaviors run from the start, with the parameters the profile gives them.
+  for (const ModuleEntry& b : profile.behaviors) {
+    if (!b.safety || m->loops.empty() || !plugins.behaviors.contains(b.type)) continue;
+    collect([&] { m->loops.front()->activate(plugins.behaviors.create(b.type), parameters_of(b, m->options.parameters), b.name, b.where); });
   }
 
   // The modules of the sequencing loop.

@@ -61,9 +61,10 @@ struct Parser {
       return;
     }
     const std::string entry = "a " + std::string(to_string(kind)) + " entry";
-    if (!r.expect_keys(n, {"name", "type", "description", "layer", "inputs", "outputs", "parameters", "watchdog"}, entry)) {
-      return;
-    }
+    const bool known = kind == ModuleKind::behavior
+                           ? r.expect_keys(n, {"name", "type", "description", "layer", "inputs", "outputs", "parameters", "watchdog", "safety"}, entry)
+                           : r.expect_keys(n, {"name", "type", "description", "layer", "inputs", "outputs", "parameters", "watchdog"}, entry);
+    if (!known) return;
     for (const auto& kv : n) {
       const std::string key = yaml::Reader::checked_key(kv.first);
       const YAML::Node v = kv.second;
@@ -89,6 +90,12 @@ struct Parser {
           const auto name = r.key(p.first, "parameters");
           std::string val;
           if (name && scalar(p.second, val, "parameter '" + *name + "'")) e.parameters[*name] = val;
+        }
+      } else if (key == "safety") {
+        std::string flag;
+        if (scalar(v, flag, "safety")) {
+          if (flag == "true") e.safety = true;
+          else if (flag != "false") d.error(at(v), "safety: expected true or false, got '" + flag + "'");
         }
       } else if (key == "watchdog") {
         if (!r.expect_keys(v, {"timeout_s", "event"}, "watchdog")) continue;

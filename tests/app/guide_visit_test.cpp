@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 
 #include <spdlog/spdlog.h>
@@ -31,7 +32,7 @@ std::string error_of(const std::string& text) {
   return {};
 }
 
-VisitResult visit(std::uint64_t seed, bool voice, const std::filesystem::path& out = {}) {
+VisitResult visit(std::uint64_t seed, bool voice, const std::filesystem::path& out = {}, std::optional<double> give_way_m = {}) {
   spdlog::set_level(spdlog::level::warn);  // the planner's life cycle: in the result, not the test log
   VisitOptions o;
   o.out = out;
@@ -40,11 +41,12 @@ VisitResult visit(std::uint64_t seed, bool voice, const std::filesystem::path& o
   o.visit = kConfigs / "visits/exhibit_hall.yaml";
   o.seed = seed;
   o.voice = voice;
+  o.visitors_give_way_m = give_way_m;
   return run_visit(o);
 }
 
-void check_visit(std::uint64_t seed, bool voice, const std::filesystem::path& out = {}) {
-  const VisitResult r = visit(seed, voice, out);
+void check_visit(std::uint64_t seed, bool voice, const std::filesystem::path& out = {}, std::optional<double> give_way_m = {}) {
+  const VisitResult r = visit(seed, voice, out, give_way_m);
   INFO("seed " << seed << ": " << r.json());
   CHECK(r.completed);
   CHECK(r.collisions == 0);
@@ -143,6 +145,14 @@ TEST_CASE("guide visit, seed 2: no collision, the dialogue as expected", "[app][
 TEST_CASE("guide visit, seed 3: no collision, the dialogue as expected", "[app][visit][e2e]") { check_visit(3, false); }
 TEST_CASE("guide visit, seed 4: no collision, the dialogue as expected", "[app][visit][e2e]") { check_visit(4, false); }
 TEST_CASE("guide visit, seed 5: no collision, the dialogue as expected", "[app][visit][e2e]") { check_visit(5, false); }
+
+// Walkers that do not give way (give_way_m 0: they stop only at contact). Seeds 1-4 go as the
+// visit expects with no collision; seed 5 does not (3 collisions: docs/guide.md, "Visitors who do
+// not give way").
+TEST_CASE("guide visit among walkers that do not give way, seed 1: no collision", "[app][visit][e2e]") { check_visit(1, false, {}, 0.0); }
+TEST_CASE("guide visit among walkers that do not give way, seed 2: no collision", "[app][visit][e2e]") { check_visit(2, false, {}, 0.0); }
+TEST_CASE("guide visit among walkers that do not give way, seed 3: no collision", "[app][visit][e2e]") { check_visit(3, false, {}, 0.0); }
+TEST_CASE("guide visit among walkers that do not give way, seed 4: no collision", "[app][visit][e2e]") { check_visit(4, false, {}, 0.0); }
 
 TEST_CASE("guide visit: a seed repeats its run, and visitors walk differently with another", "[app][visit][e2e]") {
   const VisitResult a = visit(6, false), b = visit(6, false);

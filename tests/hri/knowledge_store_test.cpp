@@ -324,6 +324,15 @@ class NoPlaces final : public TaskKnowledge {
   ListResult list(std::string_view, std::string_view) const override { return {false, {}, "none"}; }
 };
 
+// Jinny's three placeholders, from fixed text.
+AnswerProviders fixed_providers() {
+  AnswerProviders providers;
+  providers.add("time", std::make_unique<FixedProvider>("14:05"));
+  providers.add("battery", std::make_unique<FixedProvider>("82 percent"));
+  providers.add("weather", std::make_unique<FixedProvider>("sunny"));
+  return providers;
+}
+
 }  // namespace
 
 TEST_CASE("StoreBackedHri answers from an edit at once and refuses a provider the robot lacks") {
@@ -331,10 +340,7 @@ TEST_CASE("StoreBackedHri answers from an edit at once and refuses a provider th
   KnowledgeStore store(f.file);
   const TaskLibrary tasks = TaskLibrary::load(TRIPODAL_SOURCE_DIR "/configs/tasks/jinny_guide.yaml");
   const NoPlaces places;
-  AnswerProviders providers;
-  providers.add("time", std::make_unique<FixedProvider>("14:05"));
-  providers.add("battery", std::make_unique<FixedProvider>("82 percent"));
-  providers.add("weather", std::make_unique<FixedProvider>("sunny"));
+  const AnswerProviders providers = fixed_providers();
   StoreBackedHri hri(store, tasks, places, providers, [](const Understanding&) { return std::string(); });
 
   CHECK(hri.ask("where can I park my car").kind == HriReply::Kind::not_understood);
@@ -354,6 +360,56 @@ TEST_CASE("StoreBackedHri answers from an edit at once and refuses a provider th
 
   REQUIRE(store.remove("parking", 2, "x").ok());
   CHECK(hri.ask("where can I park my car").kind == HriReply::Kind::not_understood);
+}
+
+TEST_CASE("StoreBackedHri displays the internal state and the last exchange, kept when an edit re-indexes it", "[hri][store][display]") {
+  Folder f;
+  KnowledgeStore store(f.file);
+  const TaskLibrary tasks = TaskLibrary::load(TRIPODAL_SOURCE_DIR "/configs/tasks/jinny_guide.yaml");
+  const NoPlaces places;
+  const AnswerProviders providers = fixed_providers();
+  StoreBackedHri hri(store, tasks, places, providers, [](const Understanding&) { return std::string("the robot is charging"); });
+
+  CHECK_FALSE(hri.display().last.has_value());
+  CHECK(display_text(hri.display().state) == "idle | no process | no fault");
+  hri.module().set_internal_state({"guide", "running", "PrAutoMove(goal=node1)", ""});
+  (void)hri.ask("How's the weather today?");
+  HriDisplay d = hri.display();
+  REQUIRE(d.last.has_value());
+  CHECK(d.last->source == "typed");
+  CHECK(d.last->input == "How's the weather today?");
+  CHECK(d.last->kind == HriReply::Kind::answered);
+  CHECK(d.last->entry == "weather");
+  CHECK(d.last->reply == "The weather today: sunny.");
+  CHECK(display_text(d.state) == "task guide: running | process PrAutoMove(goal=node1) | no fault");
+
+  // A command the planner refuses: its reason, in plain words, is what the display shows.
+  (void)hri.ask("dance for us");
+  d = hri.display();
+  CHECK(d.last->kind == HriReply::Kind::task_refused);
+  CHECK(d.last->task == "dance");
+  CHECK(d.last->reply == "Sorry, I cannot start the dance task now: the robot is charging.");
+
+  // An edit makes the next input re-index: the new module shows what the old one showed.
+  REQUIRE(store.add(parking(), "alice").ok());
+  (void)hri.module();
+  CHECK(hri.indexed_version() == 2);
+  d = hri.display();
+  CHECK(d.last->input == "dance for us");
+  CHECK(d.state.process == "PrAutoMove(goal=node1)");
+
+  // Inputs refused unread are described, never copied; a button and a recognition name theirs.
+  (void)hri.ask(std::string(1 << 20, 'x'));
+  CHECK(hri.display().last->input == "(1048576 bytes: too long)");
+  (void)hri.ask(std::string("ab\0cd", 5));
+  CHECK(hri.display().last->input == "(5 bytes: not text)");
+  CHECK(hri.display().last->kind == HriReply::Kind::refused_input);
+  (void)hri.module().handle_button("nothing");
+  CHECK(hri.display().last->source == "button");
+  CHECK(hri.display().last->reply == "Sorry, that button does nothing here.");
+  (void)hri.module().handle_heard({"where can i park my car", 0.5});
+  CHECK(hri.display().last->source == "heard");
+  CHECK(hri.display().last->entry == "parking");
 }
 
 TEST_CASE("store: changes from two threads are all saved, each under a version of its own", "[hri][store][threads]") {

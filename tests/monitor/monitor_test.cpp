@@ -889,6 +889,43 @@ TEST_CASE("The RKMS and touch pages are served, and the touch screen's questions
   server.stop();
 }
 
+TEST_CASE("/status carries what the HRI displays: the internal state and the last input with its answer", "[monitor][robot][rkms][display]") {
+  Psr2WithHri psr2;
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
+  server.start();
+  nlohmann::json status = next_status(server, watch);
+  REQUIRE(status["hri"].is_object());
+  CHECK(status["hri"]["status"] == "idle | no process | no fault");
+  CHECK(status["hri"]["task"] == "");
+  CHECK(status["hri"]["last"].is_null());
+  REQUIRE(json_command(server, watch, {{"op", "ask"}, {"text", "How is the weather today?"}}).status == 200);
+  status = next_status(server, watch);
+  const nlohmann::json& last = status["hri"]["last"];
+  CHECK(last["source"] == "typed");
+  CHECK(last["input"] == "How is the weather today?");
+  CHECK(last["kind"] == "answered");
+  CHECK(last["entry"] == "weather");
+  CHECK(last["reply"] == "The weather today: sunny, 27 degrees.");
+  // A command the planner refuses: the refusal in plain words.
+  REQUIRE(json_command(server, watch, {{"op", "ask"}, {"text", "dance for us"}}).status == 200);
+  status = next_status(server, watch);
+  CHECK(status["hri"]["last"]["kind"] == "task_refused");
+  CHECK(status["hri"]["last"]["reply"] == "Sorry, I cannot start the dance task now: this test robot runs no guide tasks.");
+  server.stop();
+}
+
+TEST_CASE("/status of a robot without an HRI has hri null", "[monitor][robot][display]") {
+  Psr2 psr2;
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
+  server.start();
+  const nlohmann::json status = next_status(server, watch);
+  REQUIRE(status.contains("hri"));
+  CHECK(status["hri"].is_null());
+  server.stop();
+}
+
 TEST_CASE("RKMS ops on a robot without an HRI module are refused with 404", "[monitor][robot][rkms]") {
   Psr2 psr2;
   MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});

@@ -5,7 +5,7 @@ entry is added (an invalid one first, refused with the field's message beside it
 refused as stale when it was changed through the API between the page's load and its save (the
 file keeps the API's text), reloaded, and deleted; the history lists the changes. On /touch: the
 big buttons ask the robot, the answer is shown, and spoken when the build has a voice (else the
-page says the voice is off). Screenshots: <build>/artifacts/rkms.png and touch.png.
+page says the voice is off). On /: the HRI panel shows the HRI's display and the last exchange. Screenshots: <build>/artifacts/rkms.png and touch.png.
 
 usage: rkms_browser_test.py SERVER SOURCE_DIR ARTIFACT_DIR"""
 import os
@@ -136,7 +136,8 @@ def main():
         wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#buttons button.question")) == 8)
         check(text("title").startswith("Hello, I am Jinny!"), "the touch page shows 8 big buttons")
         wait.until(lambda d: el("state").get_attribute("data-task-state") == "idle")
-        check(text("state") == "the robot's state: no task (idle), paused", "the robot's state is shown: " + text("state"))
+        check(text("state") == "the robot's state: idle | no process | no fault, paused",
+              "the robot's state as the HRI displays it: " + text("state"))
         voice = text("voice").startswith("voice is on")
         driver.find_element(By.XPATH, '//button[text()="Introduce yourself."]').click()
         wait.until(lambda d: el("answer").get_attribute("data-kind") == "answered")
@@ -151,6 +152,13 @@ def main():
         wait.until(lambda d: "sunny" in text("answer"))
         check(el("answer").get_attribute("data-entry") == "weather", "a typed question with a typo is answered: " + text("answer"))
         driver.save_screenshot(os.path.join(artifacts, "touch.png"))
+
+        # The monitor's page shows what the HRI displays: its state and the last exchange.
+        driver.get(srv.base + "/?token=" + srv.token)
+        wait.until(lambda d: el("hri-panel").is_displayed() and "wether" in text("hri"))
+        check(text("hri-status") == "idle | no process | no fault", "the HRI panel shows the display line: " + text("hri-status"))
+        check("typed: \u201chows the wether today\u201d" in text("hri") and "answered (weather)" in text("hri"),
+              "the HRI panel shows the last input and its answer: " + text("hri").replace("\n", " | "))
     finally:
         driver.quit()
         out = srv.stop()

@@ -36,6 +36,7 @@ class TestHri final : public CModule, public HriService {
     return hri_->ask(utterance);
   }
   SpeechSynthesizer* voice() noexcept override { return hri_->voice(); }
+  HriDisplay display() override { return hri_->display(); }
   [[nodiscard]] int asked() const noexcept { return asked_; }
 
  protected:

@@ -3,11 +3,13 @@
 // progress bar on the terminal, and at the end the map picture, the trajectory and the report.
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <memory>
 #include <iostream>
+#include <optional>
 #include <ostream>
 #include <sstream>
 
@@ -47,7 +49,9 @@ constexpr std::string_view kDescription =
     "--task (and dds: tasks on) it is paced to real time and waits for a task from a peer.\n"
     "--visit VISIT.yaml runs the guide robot's scripted visit instead of a task (docs/guide.md): the\n"
     "dialogue, the life cycle and the collisions; with --out, dialogue.txt, report.json and the\n"
-    "answers' audio (audio/*.wav, when the build has voice).";
+    "answers' audio (audio/*.wav, when the build has voice). With --monitor (and a visit or not) the\n"
+    "guide robot's monitor also serves its knowledge base (/rkms, administered with the token) and\n"
+    "its touch screen (/touch), answered by the robot's own HRI.";
 
 constexpr std::string_view kExitCodes =
     "exit codes: 0 task succeeded, 1 bad profile/world/faults, 2 bad command line, 3 I/O error,\n"
@@ -59,6 +63,7 @@ struct Args {
   app::RunOptions options;
   std::filesystem::path visit;  // --visit: the guide demo instead of a task
   bool no_voice = false;
+  std::optional<double> give_way_m;  // --visitors-give-way-m
   std::string faults;
   CLI::Option* realtime = nullptr;  // given at all (with or without SPEED)
   double realtime_speed = 0.0;      // 0: --realtime without SPEED
@@ -67,35 +72,72 @@ struct Args {
 volatile std::sig_atomic_t g_stop = 0;
 extern "C" void on_stop_signal(int) { g_stop = 1; }
 
-// `--visit FILE`: the guide robot's scripted visit (docs/guide.md).
-int run_visit(const Args& args, std::ostream& out, std::ostream& err) {
+// The guide robot's runs (docs/guide.md): `--visit FILE`, the scripted visit, and `--monitor` on a
+// robot whose HRI is the guide's (type Hri), its RKMS and touch page served with or without a visit.
+int run_guide(const Args& args, std::ostream& out, std::ostream& err) {
   const app::RunOptions& o = args.options;
-  if (!o.task.empty() || o.monitor || o.realtime) {
-    err << "tripodal run: --visit runs the visit file's requests: it takes no --task, --monitor or --realtime\n";
+  if (!o.task.empty()) {
+    err << "tripodal run: the guide robot takes its requests from --visit or the monitor's touch page, not --task\n";
     return kUsage;
   }
-  for (const auto& f : {o.robot, o.world, args.visit}) {
+  if (o.realtime && !o.monitor) {
+    err << "tripodal run: --visit runs as fast as it can; --realtime goes with --monitor\n";
+    return kUsage;
+  }
+  if (!o.monitor && (o.start_paused || o.monitor_read_open || !o.monitor_token_file.empty())) {
+    err << "tripodal run: --start-paused, --monitor-read-open and --monitor-token-file need --monitor [ADDR:]PORT\n";
+    return kUsage;
+  }
+  std::vector<std::filesystem::path> files{o.robot, o.world};
+  if (!args.visit.empty()) files.push_back(args.visit);
+  for (const auto& f : files) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(f, ec)) {
       err << "tripodal run: cannot read '" << f.string() << "'\n";
       return kIoError;
     }
   }
+  if (o.monitor) {
+    std::signal(SIGINT, on_stop_signal);
+    std::signal(SIGTERM, on_stop_signal);
+  }
   try {
     spdlog::set_level(spdlog::level::warn);
-    app::VisitOptions vo{o.robot, o.world, args.visit, o.seed, o.out, !args.no_voice, &out};
-    out << "tripodal run: robot " << o.robot.string() << ", world " << o.world.string() << ", visit " << args.visit.string() << "\n";
+    app::VisitOptions vo;
+    vo.robot = o.robot;
+    vo.world = o.world;
+    vo.visit = args.visit;
+    vo.seed = o.seed;
+    vo.out = o.out;
+    vo.voice = !args.no_voice;
+    vo.visitors_give_way_m = args.give_way_m;
+    vo.log = &out;
+    vo.monitor = o.monitor;
+    vo.monitor_token_file = o.monitor_token_file;
+    vo.monitor_read_open = o.monitor_read_open;
+    vo.start_paused = o.start_paused;
+    vo.realtime_speed = o.realtime && args.realtime_speed > 0.0 ? args.realtime_speed : 1.0;
+    vo.max_duration_s = o.max_duration_s;
+    vo.stop = o.monitor ? &g_stop : nullptr;
+    out << "tripodal run: robot " << o.robot.string() << ", world " << o.world.string()
+        << (args.visit.empty() ? std::string(", no visit file: the monitor's visitors") : ", visit " + args.visit.string()) << "\n";
+    out.flush();
     const app::VisitResult r = app::run_visit(vo);
-    out << "visit " << (r.completed ? "completed" : "not completed") << " (seed " << r.seed << "): " << r.exchanges.size()
-        << " exchanges, " << r.mismatches << " not as expected; " << r.duration_s << " s simulated; path " << r.distance_m << " m; "
-        << r.collisions << " collisions (" << r.visitor_collisions << " with visitors); closest to a visitor "
+    out << (args.visit.empty() ? "run ended" : std::string("visit ") + (r.completed ? "completed" : "not completed")) << " (seed " << r.seed
+        << "): " << r.exchanges.size() << " exchanges, " << r.mismatches << " not as expected; " << r.duration_s << " s simulated; path "
+        << r.distance_m << " m; " << r.collisions << " collisions (" << r.visitor_collisions << " with visitors); closest to a visitor "
         << r.min_visitor_clearance_m << " m; visitors stopped " << r.visitor_waits << " times to let the robot pass, the robot waited "
         << r.robot_waited_s << " s for visitors\n";
     if (!o.out.empty()) out << "wrote " << (o.out / "dialogue.txt").string() << ", report.json" << (r.voice ? ", audio/*.wav" : "") << "\n";
-    return r.completed && r.mismatches == 0 && r.collisions == 0 ? kOk : kTaskFailed;
+    // A monitored run stopped by the operator after (or without) its visit: nothing failed.
+    const bool visit_ok = args.visit.empty() || (r.completed && r.mismatches == 0);
+    return visit_ok && r.collisions == 0 ? kOk : kTaskFailed;
   } catch (const ConfigError& e) {
     err << e.what() << '\n';
     return kBadInput;
+  } catch (const std::invalid_argument& e) {  // --monitor's address or token file
+    err << "tripodal run: --monitor: " << e.what() << '\n';
+    return kUsage;
   } catch (const std::runtime_error& e) {
     err << "tripodal run: " << e.what() << '\n';
     return kIoError;
@@ -113,12 +155,27 @@ bool takes_dds_tasks(const std::filesystem::path& robot) {
   }
 }
 
+// Whether the profile's HRI is the guide robot's (a module of type Hri): its monitor runs serve the
+// robot's RKMS and touch page (run_guide). A profile that does not load is left to run_task's errors.
+bool is_guide_robot(const std::filesystem::path& robot) {
+  try {
+    const RobotProfile profile = load_robot_profile(robot);
+    return std::any_of(profile.hri.begin(), profile.hri.end(), [](const ModuleEntry& e) { return e.type == "Hri"; });
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
 int run(Args& args, std::ostream& out, std::ostream& err) {
-  if (!args.visit.empty()) return run_visit(args, out, err);
   app::RunOptions& o = args.options;
   const std::string& faults = args.faults;
   o.realtime = args.realtime->count() > 0;
   if (args.realtime_speed > 0.0) o.realtime_speed = args.realtime_speed;
+  if (!args.visit.empty() || (o.monitor && o.task.empty() && is_guide_robot(o.robot))) return run_guide(args, out, err);
+  if (args.give_way_m || args.no_voice) {
+    err << "tripodal run: --no-voice and --visitors-give-way-m go with the guide robot's runs (--visit, or --monitor on a robot with an Hri module)\n";
+    return kUsage;
+  }
   if (o.task.empty() && !o.monitor && !takes_dds_tasks(o.robot)) {
     err << "tripodal run: --task is required (without --monitor, where the console may give it, or a profile "
            "with dds: {tasks: true}, where a DDS peer may)\n";
@@ -198,6 +255,10 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_option("--visit", a->visit,
                  "VISIT.yaml: the guide robot's scripted visit (typed and spoken requests, buttons; docs/guide.md) instead of a task");
   cmd.add_flag("--no-voice", a->no_voice, "with --visit: read spoken requests as typed, write no audio");
+  cmd.add_option("--visitors-give-way-m", a->give_way_m,
+                 "M: the guide robot's runs: every visitor keeps M from the robot (the world's give_way_m); 0: walkers that do "
+                 "not yield")
+      ->check(CLI::NonNegativeNumber);
   cmd.add_option("--seed", o.seed, "N: the simulator's seed (default: the world's)");
   cmd.add_option("--out", o.out, "DIR: where map.png, trajectory.csv, report.json and lifecycle.txt go");
   // Without SPEED CLI11 hands the option an empty value, which leaves realtime_speed at 0.

@@ -16,8 +16,8 @@
 #include "run_outputs.hpp"
 #include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/core/clock.hpp"
-#include "tripodal/hri/answer_providers.hpp"
 #include "tripodal/hri/hri_module.hpp"
+#include "tripodal/monitor/robot_monitor.hpp"
 #include "tripodal/hri/speech.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
 #include "tripodal/planner/task_library.hpp"
@@ -31,110 +31,34 @@ namespace tripodal::app {
 
 namespace {
 
-// The HRI's knowledge of the hall: the planner's functions as the robot's Hri module answers them
-// from where the robot stands now.
-class HallKnowledge final : public TaskKnowledge {
- public:
-  HallKnowledge(const CHri& hri, Robot& robot) : hri_(hri), robot_(robot) {}
-  [[nodiscard]] ListResult list(std::string_view function, std::string_view argument) const override {
-    const auto a = hri_.answer(function, argument, robot_.navigation());
-    if (!a) return {false, {}, "I know nothing of " + std::string(function) + "()"};
-    return {a->ok, a->items, a->error};
-  }
-
- private:
-  const CHri& hri_;
-  Robot& robot_;
-};
-
-// The words of the task's first command form with the slots the HRI understood: what the robot's
-// planner is told ("guide me to node 1").
-std::string command_text(const TaskLibrary& tasks, const Understanding& u) {
-  for (const TaskTemplate& t : tasks.templates()) {
-    if (t.name != u.task || t.commands.empty()) continue;
-    std::string out;
-    for (const PatternToken& tok : t.commands.front().tokens) {
-      if (tok.kind == PatternToken::Kind::optional_word) continue;
-      std::string word = tok.text;
-      if (tok.kind != PatternToken::Kind::word) {
-        const auto it = u.slots.find(tok.text);
-        word = it != u.slots.end() ? it->second : std::string();
-      }
-      if (!word.empty()) out += (out.empty() ? "" : " ") + word;
-    }
-    return out;
-  }
-  return u.task;
-}
-
-std::string step_text(const ProcessStep& s) {
-  std::string out = s.process + "(";
-  for (std::size_t i = 0; i < s.params.size(); ++i) out += (i ? ", " : "") + s.params[i].name + "=" + s.params[i].value;
-  return out + ")";
-}
-
-// Keeps the internal state the HRI displays, and the explanations PrExplain asks for.
-class StateObserver final : public TaskObserver {
- public:
-  InternalState state;
-  std::deque<std::string> explain;  // topics of PrExplain runs started, for the HRI to speak
-  std::vector<std::string> processes;
-  std::string last_task_end;
-
-  void on_task_started(const TaskReport& task, const Plan& /*plan*/, Time /*now*/) override {
-    state = {task.task, "running", "", ""};
-    last_task_end.clear();
-  }
-  void on_process_started(const ProcessRecord& p) override {
-    state.process = step_text(p.step);
-    if (p.step.process == "PrExplain") {
-      for (const BindingParam& b : p.step.params) {
-        if (b.name == "topic") explain.push_back(b.value);
-      }
-    }
-  }
-  void on_process_succeeded(const ProcessRecord& p) override { finished(p, "succeeded"); }
-  void on_process_failed(const ProcessRecord& p) override {
-    state.fault = p.message;
-    finished(p, "failed: " + p.message);
-  }
-  void on_task_succeeded(const TaskReport& /*task*/) override { ended("succeeded"); }
-  void on_task_failed(const TaskReport& task) override {
-    if (!task.reason.empty()) state.fault = task.reason;
-    ended("failed");
-  }
-
- private:
-  void finished(const ProcessRecord& p, const std::string& how) {
-    processes.push_back(fixed(to_seconds(p.started), 3) + "-" + fixed(to_seconds(p.finished.value_or(p.started)), 3) + " " + p.run +
-                        " " + step_text(p.step) + " " + how);
-    state.process.clear();
-  }
-  void ended(const std::string& how) {
-    state.task_state = how;
-    state.process.clear();
-    last_task_end = how;
-  }
-};
-
-// The voices: the visitor's (espeak-ng klatt, which pocketsphinx hears best, docs/hri.md), the
-// robot's (espeak-ng en-us) and the recognizer with a language model of what the robot knows.
+// The voices: the visitor's (espeak-ng klatt, which pocketsphinx hears best, docs/hri.md) and the
+// recognizer with a language model of what the robot knows; the robot's own (espeak-ng en-us) is
+// the HRI's (GuideHri), which the touch page speaks with too.
 struct Voice {
-  std::unique_ptr<SpeechSynthesizer> visitor, robot;
+  std::unique_ptr<SpeechSynthesizer> visitor;
   std::unique_ptr<SpeechRecognizer> ears;
   std::string off_reason;
 };
 
-Voice make_voice(bool wanted, const KnowledgeBase& base, const TaskLibrary& tasks, const navi::RegionMap& regions) {
-  Voice v;
+std::unique_ptr<SpeechSynthesizer> make_robot_voice(bool wanted, std::string& off_reason) {
   if (!wanted) {
-    v.off_reason = "off (--no-voice)";
-    return v;
+    off_reason = "off (--no-voice)";
+    return nullptr;
   }
   if (!voice_available()) {
-    v.off_reason = "off: this build has no espeak-ng and pocketsphinx (TRIPODAL_VOICE)";
-    return v;
+    off_reason = "off: this build has no espeak-ng and pocketsphinx (TRIPODAL_VOICE)";
+    return nullptr;
   }
+  try {
+    return make_espeak_synthesizer();
+  } catch (const std::exception& e) {
+    off_reason = std::string("off: ") + e.what();
+    return nullptr;
+  }
+}
+
+Voice make_voice(const KnowledgeBase& base, const TaskLibrary& tasks, const navi::RegionMap& regions) {
+  Voice v;
   try {
     std::vector<std::string> nodes;
     for (const navi::MapNode& n : regions.nodes) {
@@ -147,7 +71,6 @@ Voice make_voice(bool wanted, const KnowledgeBase& base, const TaskLibrary& task
                                                [&](std::string_view w) { return std::binary_search(dict.begin(), dict.end(), w); });
     v.ears = make_pocketsphinx_recognizer(options);
     v.visitor = make_espeak_synthesizer({"en-us+klatt", 170});
-    v.robot = make_espeak_synthesizer();
   } catch (const std::exception& e) {
     v = Voice{};
     v.off_reason = std::string("off: ") + e.what();
@@ -160,9 +83,25 @@ std::string in_quotes(std::string_view s) { return "\"" + std::string(s) + "\"";
 }  // namespace
 
 VisitResult run_visit(const VisitOptions& o) {
-  const Visit visit = load_visit(o.visit);
+  if (o.visit.empty() && !o.monitor) throw std::invalid_argument("run_visit: without a visit file there must be a monitor to serve");
+  Visit visit;
+  if (!o.visit.empty()) {
+    visit = load_visit(o.visit);
+  } else {
+    visit.name = "the monitor's visitors";
+    visit.max_duration_s = o.max_duration_s;
+  }
+  // A bad monitor address or token file is refused before anything is built.
+  std::optional<monitor::MonitorServerOptions> server_options;
+  if (o.monitor) {
+    server_options = monitor::server_options(*o.monitor, o.monitor_token_file);
+    server_options->read_without_token = o.monitor_read_open;
+  }
   const RobotProfile profile = load_robot_profile(o.robot);
   auto world = std::make_shared<sim::World>(sim::load_world(o.world));
+  if (o.visitors_give_way_m) {
+    for (sim::Visitor& v : world->visitors) v.give_way_m = *o.visitors_give_way_m;
+  }
   if (!profile.hardware || profile.hardware->type != "sim") {
     throw ConfigError(profile.hardware ? profile.hardware->where : profile.where,
                       "`tripodal run --visit` runs the robot on the simulator: its profile needs hardware: {type: sim}");
@@ -186,32 +125,35 @@ VisitResult run_visit(const VisitOptions& o) {
   if (profile.tasks.empty()) throw ConfigError(profile.where, "`tripodal run --visit` needs the robot's tasks (tasks: FILE)");
   if (CController* c = robot->behavior_loop().controller()) c->reset_odometry(world->start_pose);
 
-  // The HRI on the robot: the RKMS of its Hri module, its task templates, answers from local
-  // providers (the hall has no internet), commands to the robot's planner.
-  const TaskLibrary tasks = TaskLibrary::load(profile.tasks);
-  const HallKnowledge hall(*hri_module, *robot);
-  AnswerProviders providers;
-  providers.add("time", std::make_unique<ClockTimeProvider>(clock, std::chrono::hours(14)));
-  providers.add("battery", std::make_unique<BatteryProvider>([&sim] { return sim.battery_charge(); }));
-  providers.add("weather", std::make_unique<WeatherTableProvider>(
-                               clock, std::chrono::hours(14), std::vector<std::string>{"sunny and mild, 22 degrees", "cloudy, 18 degrees"}));
-  std::string started_task;
-  const TaskStarter starter = [&](const Understanding& u) -> std::string {
-    const CommandAnswer a = robot->command(command_text(tasks, u));
-    if (a.accepted) started_task = u.task;
-    return a.accepted ? std::string() : a.text;
-  };
-  HriOptions hri_options;
-  hri_options.buttons = hri_module->buttons();
-  HriModule hri(hri_module->knowledge(), tasks, hall, providers, starter, hri_options);
-  Voice voice = make_voice(o.voice, hri_module->knowledge(), tasks, world->regions);
+  // The HRI on the robot (GuideHri): the RKMS of its Hri module, its task templates, answers from
+  // local providers (the hall has no internet), commands to the robot's planner. The same object
+  // answers the visit's requests and the monitor's touch page.
+  std::string voice_off;
+  std::unique_ptr<SpeechSynthesizer> robot_voice = make_robot_voice(o.voice, voice_off);
+  const bool robot_speaks = robot_voice != nullptr;
+  GuideHri guide(*robot, *hri_module, clock, profile.tasks,
+                 GuideHri::Options{[&sim] { return sim.battery_charge(); }, std::move(robot_voice)});
+  Voice voice = robot_speaks ? make_voice(hri_module->knowledge_store().base(), guide.tasks(), world->regions) : Voice{{}, {}, voice_off};
   res.voice = voice.ears != nullptr;
 
   LifecycleRecorder life(false);
-  StateObserver observer;
   robot->planner().add_observer(life);
   robot->supervisor().add_observer(life);
-  robot->planner().add_observer(observer);
+
+  // The monitor (--monitor): its own thread serves the clients; this loop hands it the robot's
+  // state and the operator's and visitors' requests between periods, paced to real time.
+  std::unique_ptr<monitor::MonitorServer> server;
+  std::unique_ptr<monitor::RobotMonitor> watch;
+  SteadyClock wall;
+  std::optional<sim::RealtimePacer> pacer;
+  if (server_options) {
+    server = std::make_unique<monitor::MonitorServer>(std::move(*server_options));
+    watch = std::make_unique<monitor::RobotMonitor>(*robot, clock, *server, monitor::RobotMonitorOptions{.start_paused = o.start_paused});
+    watch->set_hri(&guide.service());
+    server->start();
+    pacer.emplace(wall, o.realtime_speed);
+  }
+  auto stopped = [&] { return o.stop != nullptr && *o.stop != 0; };
 
   std::ostream* log = o.log;
   std::ostringstream dialogue;
@@ -239,23 +181,30 @@ VisitResult run_visit(const VisitOptions& o) {
     audio_dir = o.out / "audio";
     std::filesystem::create_directories(audio_dir);
   }
+  if (server) say("monitor: " + server->url() + "  (token " + server->token() + (o.start_paused ? "; paused until resumed" : "") +
+                  "; RKMS at /rkms, touch screen at /touch)");
   say(std::string("voice ") + (res.voice ? "on: requests spoken by espeak-ng and heard by pocketsphinx, answers synthesised" : voice.off_reason) +
       (res.voice && audio_dir.empty() ? " (no --out: answers not written)" : ""));
   std::size_t clip = 0;
   auto speak = [&](const std::string& text) -> std::string {
-    if (!res.voice || audio_dir.empty() || text.empty()) return {};
+    SpeechSynthesizer* robot_voice_now = guide.service().voice();
+    if (!res.voice || robot_voice_now == nullptr || audio_dir.empty() || text.empty()) return {};
     char name[32];
     std::snprintf(name, sizeof name, "answer_%02zu.wav", ++clip);
-    write_wav(audio_dir / name, voice.robot->synthesize(text));
+    write_wav(audio_dir / name, robot_voice_now->synthesize(text));
     return (std::filesystem::path("audio") / name).string();
   };
+  // The last exchange the HRI displays that this loop knows of: another one came from the touch page.
+  std::optional<HriExchange> seen;
   auto record = [&](VisitExchange& x, const HriReply& r) {
     x.reply_kind = std::string(to_string(r.kind));
     x.entry = r.entry_id;
     // The task the planner started for this input (an entry's action too), or the one it refused.
-    x.task = !started_task.empty() ? started_task : r.task;
+    const std::string started = guide.take_started_task();
+    x.task = !started.empty() ? started : r.task;
     x.reply = r.text;
     x.wav = speak(r.text);
+    seen = guide.service().display().last;
     say("Jinny [" + x.reply_kind + (x.entry.empty() ? "" : " " + x.entry) + (x.task.empty() ? "" : ", task " + x.task) + "]: " + r.text +
         (x.wav.empty() ? "" : "  (" + x.wav + ")"));
   };
@@ -269,15 +218,20 @@ VisitResult run_visit(const VisitOptions& o) {
     x.mismatch = m;
   };
 
-  // The display shows the internal state when it changes; the joints are shown where they stop.
+  // The display shows the internal state when it changes; the joints are shown where they stop;
+  // the HRI speaks the explanation of an exhibit when PrExplain starts.
   std::optional<InternalState> shown;
   std::vector<double> joints_shown;
   for (const sim::JointState& j : sim.joints()) joints_shown.push_back(j.position_rad);
   auto display = [&] {
-    hri.set_internal_state(observer.state);
-    if (!shown || *shown != hri.internal_state()) {
-      shown = hri.internal_state();
-      say("display: " + hri.status());
+    for (const HriReply& r : guide.update()) {
+      const std::string wav = speak(r.text);
+      seen = guide.service().display().last;
+      say("Jinny [explaining" + (r.entry_id.empty() ? std::string() : " " + r.entry_id) + "]: " + r.text + (wav.empty() ? "" : "  (" + wav + ")"));
+    }
+    if (!shown || *shown != guide.state()) {
+      shown = guide.state();
+      say("display: " + display_text(guide.state()));
     }
     for (std::size_t i = 0; i < sim.joints().size(); ++i) {
       const sim::JointState& j = sim.joints()[i];
@@ -286,21 +240,42 @@ VisitResult run_visit(const VisitOptions& o) {
       say("gesture: " + world->robot.joints[i].name + " at " + fixed(j.position_rad * 180.0 / std::numbers::pi, 0) + " deg");
     }
   };
+  // Between periods: the monitor's requests (an input typed on the touch page is answered there
+  // and shown here), then its topics.
+  auto monitor_update = [&] {
+    if (!watch) return;
+    watch->update(monitor::MonitorExtras{.true_pose = sim.pose()});
+    const std::optional<HriExchange> last = guide.service().display().last;
+    if (last && last != seen) {
+      seen = last;
+      const std::string started = guide.take_started_task();
+      say("touch screen: " + in_quotes(last->input) + " -> Jinny [" + std::string(to_string(last->kind)) +
+          (last->entry.empty() ? "" : " " + last->entry) + (started.empty() ? "" : ", task " + started) + "]: " + last->reply);
+    }
+  };
 
   robot->run_until(clock.now());
   const Duration period = std::chrono::milliseconds(50);
   const Time deadline = time_from_seconds(visit.max_duration_s);
   std::size_t next = 0;
   Time ready_at = clock.now();
-  std::optional<std::size_t> waiting;  // the exchange whose task is running
+  // The exchange whose task is running (a plain index: GCC 12 sees an optional here as maybe unset).
+  constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  std::size_t waiting = kNone;
   std::size_t pending_button = 0;      // button presses on their way to the HRI
   std::vector<char> giving_way(sim.visitors().size(), 0);
   display();
-  while (clock.now() < deadline) {
+  while (clock.now() < deadline && !stopped()) {
+    monitor_update();
+    if (watch && watch->paused()) {
+      wall.sleep_until(wall.now() + std::chrono::milliseconds(20));
+      pacer.emplace(wall, o.realtime_speed);  // no catching up after a pause
+      continue;
+    }
     // The task of the last request ended: its outcome, and the next step's time.
-    if (waiting && !robot->planner().busy() && !observer.last_task_end.empty()) {
-      VisitExchange& x = res.exchanges[*waiting];
-      x.task_end = observer.last_task_end;
+    if (waiting != kNone && !robot->planner().busy() && !guide.last_task_end().empty()) {
+      VisitExchange& x = res.exchanges[waiting];
+      x.task_end = guide.last_task_end();
       for (std::size_t i = 0; i < sim.visitors().size(); ++i) {
         if (!world->visitors[i].follow_robot) continue;
         const navi::Point2D p = sim.visitors()[i].position;
@@ -308,15 +283,8 @@ VisitResult run_visit(const VisitOptions& o) {
         say(world->visitors[i].name + ", following Jinny, stands " + fixed(x.follower_distance_m, 2) + " m from it");
       }
       check(visit.steps[x.step], x);
-      waiting.reset();
+      waiting = kNone;
       ready_at = clock.now() + from_seconds(visit.steps[next - 1].after_s);
-    }
-    // The HRI speaks the explanation of an exhibit when PrExplain starts.
-    while (!observer.explain.empty()) {
-      const HriReply r = hri.handle(observer.explain.front());
-      observer.explain.pop_front();
-      const std::string wav = speak(r.text);
-      say("Jinny [explaining" + (r.entry_id.empty() ? std::string() : " " + r.entry_id) + "]: " + r.text + (wav.empty() ? "" : "  (" + wav + ")"));
     }
     for (const std::string& b : hri_module->take_presses()) {
       VisitExchange x;
@@ -325,24 +293,25 @@ VisitResult run_visit(const VisitOptions& o) {
       x.kind = "button";
       x.request = b;
       say("visitor presses the LED button " + in_quotes(b) + " (event button." + b + ")");
-      started_task.clear();
-      observer.last_task_end.clear();
-      record(x, hri.handle_button(b));
+      (void)guide.take_started_task();
+      guide.clear_task_end();
+      record(x, guide.module().handle_button(b));
       res.exchanges.push_back(x);
       if (pending_button > 0) --pending_button;
+      if (next == 0) continue;  // pressed on the simulator, not by the visit
       const VisitStep& s = visit.steps[next - 1];
       check(s, res.exchanges.back());
       if (!x.task.empty()) waiting = res.exchanges.size() - 1;
       else ready_at = clock.now() + from_seconds(s.after_s);
     }
-    const bool idle = !waiting && pending_button == 0;
+    const bool idle = waiting == kNone && pending_button == 0;
     if (idle && next < visit.steps.size()) {
       const VisitStep& s = visit.steps[next];
       const Time at = s.at_s ? std::max(ready_at, time_from_seconds(*s.at_s)) : ready_at;
       if (clock.now() >= at) {
         ++next;
-        started_task.clear();
-        observer.last_task_end.clear();
+        (void)guide.take_started_task();
+        guide.clear_task_end();
         if (s.kind == VisitStep::Kind::button) {
           if (hri_module->simulator() != nullptr && hri_module->simulator()->press_button(s.text)) {
             ++pending_button;
@@ -362,11 +331,11 @@ VisitResult run_visit(const VisitOptions& o) {
             const SpeechRecognizer::Result heard = voice.ears->recognize(resample(audio, voice.ears->sample_rate_hz()));
             x.heard = heard.words;
             say("visitor (spoken): " + in_quotes(s.text) + "  heard: " + in_quotes(heard.words));
-            r = hri.handle_heard(heard);
+            r = guide.module().handle_heard(heard);
           } else {
             say(std::string("visitor (") + (s.kind == VisitStep::Kind::spoken ? "spoken, voice off: read as typed" : "typed") +
                 "): " + in_quotes(s.text));
-            r = hri.handle(s.text);
+            r = guide.module().handle(s.text);
           }
           record(x, r);
           res.exchanges.push_back(x);
@@ -376,9 +345,11 @@ VisitResult run_visit(const VisitOptions& o) {
         }
       }
     }
-    if (next >= visit.steps.size() && !waiting && pending_button == 0 && !robot->planner().busy()) {
+    if (next >= visit.steps.size() && waiting == kNone && pending_button == 0 && !robot->planner().busy()) {
+      // The visit is over; a monitored robot goes on serving its pages until stopped.
+      if (!res.completed && !o.visit.empty()) say("the visit is over" + std::string(watch ? "; the monitor goes on serving until stopped" : ""));
       res.completed = true;
-      break;
+      if (!watch) break;
     }
     robot->run_for(period);
     bool visitor_near = false;
@@ -395,7 +366,9 @@ VisitResult run_visit(const VisitOptions& o) {
     }
     flush_life();
     display();
+    if (pacer) pacer->pace(clock.now());
   }
+  monitor_update();
   flush_life();
   for (const sim::SimEvent& e : sim.events()) {
     if (e.kind == sim::SimEvent::Kind::collision) say("simulator: collision " + e.detail + " at " + fixed(to_seconds(e.stamp), 1) + " s");
@@ -405,9 +378,9 @@ VisitResult run_visit(const VisitOptions& o) {
   res.collisions = sim.collisions();
   res.visitor_collisions = sim.visitor_collisions();
   res.min_visitor_clearance_m = sim.min_visitor_clearance_m();
-  res.processes = observer.processes;
+  res.processes = guide.processes();
   for (const VisitExchange& x : res.exchanges) res.mismatches += x.as_expected ? 0 : 1;
-  if (!res.completed) say("the visit did not end within " + fixed(visit.max_duration_s, 0) + " s");
+  if (!res.completed) say(stopped() ? std::string("the run was stopped") : "the visit did not end within " + fixed(visit.max_duration_s, 0) + " s");
   if (!o.out.empty()) {
     write_text(o.out / "dialogue.txt", dialogue.str());
     write_text(o.out / "report.json", res.json());

@@ -6,6 +6,7 @@
 // part of the `tripodal` tool, not installed.
 #pragma once
 
+#include <csignal>
 #include <cstdint>
 #include <filesystem>
 #include <iosfwd>
@@ -49,11 +50,26 @@ struct Visit {
 [[nodiscard]] Visit load_visit(const std::filesystem::path& file);
 
 struct VisitOptions {
-  std::filesystem::path robot, world, visit;
+  std::filesystem::path robot, world;
+  std::filesystem::path visit;        ///< the visit file; empty: none (the monitor's visitors only)
   std::optional<std::uint64_t> seed;  ///< default: the world's
   std::filesystem::path out;          ///< dialogue.txt, report.json, answers' WAV files (empty: none)
   bool voice = true;                  ///< false: treat spoken requests as typed even if voice is built
+  /// Overrides every visitor's give_way_m (world file, docs/simulator.md): 0 makes walkers that do
+  /// not yield (they stop only at contact). Empty: the world's.
+  std::optional<double> visitors_give_way_m;
   std::ostream* log = nullptr;        ///< the dialogue and the life cycle as they happen
+  /// The monitor (docs/monitor.md, docs/guide.md): "[ADDR:]PORT" to serve the page, the robot's
+  /// RKMS (/rkms) and its touch screen (/touch) while the visit runs, paced to real time; the run
+  /// then goes on after the visit until `stop` is set (a signal) or max_duration_s. Empty: none.
+  std::optional<std::string> monitor;
+  std::filesystem::path monitor_token_file;  ///< the token, read from this file (default: generated)
+  bool monitor_read_open = false;            ///< read-only streams without the token
+  bool start_paused = false;                 ///< hold the run until the operator resumes it
+  double realtime_speed = 1.0;               ///< with the monitor: SPEED times real time
+  /// Simulated time limit of a monitored run without a visit file (a visit file has its own).
+  double max_duration_s = 4.0 * 3600.0;
+  const volatile std::sig_atomic_t* stop = nullptr;
 };
 
 /// One exchange of the dialogue.
@@ -93,7 +109,9 @@ struct VisitResult {
   [[nodiscard]] std::string json() const;
 };
 
-/// Runs the visit. Throws ConfigError for a bad profile, world or visit file (located).
+/// Runs the visit (and serves the monitor when asked). Throws ConfigError for a bad profile, world
+/// or visit file (located), std::invalid_argument for a bad monitor address or token file, or for
+/// neither a visit nor a monitor.
 [[nodiscard]] VisitResult run_visit(const VisitOptions& options);
 
 }  // namespace tripodal::app

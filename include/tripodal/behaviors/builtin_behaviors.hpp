@@ -101,7 +101,10 @@ class BhBackOff final : public CBehavior {
 /// robot_radius_m and imposes a velocity envelope: speed toward an obstacle falls linearly from
 /// max_speed_m_s at slow_distance_m to 0 at stop_distance_m (clearances from the footprint);
 /// beyond slow_distance_m and in directions without returns nothing is restricted; rotation is
-/// never restricted. With a stale or missing scan it blocks all translation. Never
+/// never restricted. A return outside the straight corridors counts too, its clearance along an
+/// axis being its gap to the footprint divided by the cosine of its bearing from that axis (a base
+/// turning on a curve sweeps beyond the corridor, a person steps into it from the side); returns
+/// nearly abeam (within about 6 degrees) leave the axis free. With a stale or missing scan it blocks all translation. Never
 /// finishes; commands nothing itself (step returns nothing, envelope() carries the limits).
 class BhAvoidObstacle final : public CBehavior {
  public:

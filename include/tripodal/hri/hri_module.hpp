@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -74,6 +75,26 @@ struct HriReply {
 
 [[nodiscard]] std::string_view to_string(HriReply::Kind kind) noexcept;
 
+/// The last input the HRI handled and what it said, for its display (the monitor's HRI panel).
+struct HriExchange {
+  /// "typed" (handle), "heard" (handle_heard: the words recognised) or "button" (handle_button).
+  std::string source;
+  /// What came in: the text, the words heard, the button's name. An input the HRI refused unread
+  /// (too long, not text) is described instead ("(1048576 bytes: too long)"), never copied.
+  std::string input;
+  HriReply::Kind kind = HriReply::Kind::not_understood;
+  std::string reply;  ///< what the robot said
+  std::string entry;  ///< the RKMS entry that answered ("" when none)
+  std::string task;   ///< the task started or refused ("" when none)
+  friend bool operator==(const HriExchange&, const HriExchange&) = default;
+};
+
+/// Everything the HRI displays: the robot's internal state and the last exchange.
+struct HriDisplay {
+  InternalState state;
+  std::optional<HriExchange> last;  ///< none before the first input
+};
+
 /// Where accepted tasks go: the planner of the running robot. Returns an empty string when the
 /// task started, otherwise the reason it could not (spoken back).
 using TaskStarter = std::function<std::string(const Understanding&)>;
@@ -106,10 +127,21 @@ class HriModule {
   [[nodiscard]] const InternalState& internal_state() const noexcept { return state_; }
   /// display_text(internal_state()).
   [[nodiscard]] std::string status() const { return display_text(state_); }
+  /// The last input handled (handle, handle_heard, handle_button) and the reply; none before.
+  [[nodiscard]] const std::optional<HriExchange>& last_exchange() const noexcept { return last_; }
+  /// The internal state and the last exchange. A module indexed anew for an edited base takes
+  /// them over from the one it replaces (restore_display), so the display does not blink.
+  [[nodiscard]] HriDisplay display() const { return {state_, last_}; }
+  void restore_display(HriDisplay display) {
+    state_ = std::move(display.state);
+    last_ = std::move(display.last);
+  }
 
   [[nodiscard]] const KnowledgeIndex& index() const noexcept { return index_; }
 
  private:
+  HriReply classify(std::string_view utterance);
+  HriReply remember(std::string source, std::string input, HriReply reply);
   HriReply answer(const KnowledgeEntry& entry, double confidence);
   HriReply command(const Understanding& understanding);
   [[nodiscard]] std::string fill(std::string_view answer) const;
@@ -123,6 +155,7 @@ class HriModule {
   KnowledgeIndex index_;
   std::vector<std::string> command_words_;  // the first word of each command form ("guide", "clean")
   InternalState state_;
+  std::optional<HriExchange> last_;
 };
 
 /// The planner's explanation of a refused command in plain words, for speaking: "I cannot do

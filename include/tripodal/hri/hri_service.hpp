@@ -30,6 +30,9 @@ class HriService {
   virtual HriReply ask(std::string_view utterance) = 0;
   /// The robot's voice; nullptr when it has none (a build without TRIPODAL_VOICE).
   [[nodiscard]] virtual SpeechSynthesizer* voice() noexcept = 0;
+  /// What the HRI displays now: the robot's internal state (task, process, fault) and the last
+  /// input with its answer (the monitor's HRI panel). Call it from the thread that calls ask().
+  [[nodiscard]] virtual HriDisplay display() = 0;
 };
 
 /// An HriModule over a KnowledgeStore: ask() first compares the store's version with the one the
@@ -46,6 +49,7 @@ class StoreBackedHri final : public HriService {
   [[nodiscard]] KnowledgeStore& knowledge_store() override { return store_; }
   HriReply ask(std::string_view utterance) override;
   [[nodiscard]] SpeechSynthesizer* voice() noexcept override { return voice_.get(); }
+  [[nodiscard]] HriDisplay display() override;
 
   /// The module as of the store's current version (indexed anew if needed), for the inputs ask()
   /// does not cover (handle_heard). Not locked: call it from the thread that calls ask(). A base

@@ -34,6 +34,10 @@ struct ModuleEntry {
   std::map<std::string, std::string, std::less<>> parameters;
   std::optional<Duration> watchdog_timeout;  ///< supervisor watchdog on the module's heartbeat
   std::string watchdog_event;                ///< posted on silence; default "<name>.fault"
+  /// Behaviors only (`safety: true`): a safety input of the behavior loop's coordinator, active
+  /// from the robot's start and never activated by a net; its envelope restricts whatever command
+  /// wins (BhAvoidObstacle: no motion toward an obstacle the laser sees, whoever drives).
+  bool safety = false;
   SourceLocation where;
 };
 
