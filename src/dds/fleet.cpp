@@ -169,6 +169,7 @@ struct FleetPlanner::Robot {
   std::optional<std::size_t> current;  // the unit in hand
   std::uint32_t command_id = 0;
   bool answered = false;
+  bool paused = false;  // we asked it to pause (nothing to do: its simulation need not run)
   double sent_s = 0.0;   // the last (re)send of the command
   double given_s = 0.0;  // when the unit in hand was given
 };
@@ -352,7 +353,15 @@ std::vector<FleetCommand> FleetPlanner::poll() {
   for (auto& rp : robots_) {
     Robot& r = *rp;
     if (!r.alive || !r.ready) continue;
-    if (!r.current && !r.queue.empty()) {
+    if (!r.current && r.queue.empty() && !r.paused && options_.pause_idle) {
+      r.paused = true;
+      note(r.name + " has nothing left to do: paused");
+      out.push_back({r.name, next_id_++, "pause", {}, {}});
+    } else if (!r.current && !r.queue.empty()) {
+      if (r.paused) {
+        r.paused = false;
+        out.push_back({r.name, next_id_++, "resume", {}, {}});
+      }
       r.current = r.queue.front();
       r.queue.erase(r.queue.begin());
       r.command_id = next_id_++;
@@ -457,7 +466,11 @@ struct DdsFleet::Impl {
     for (std::size_t i = 0; i < robots.size(); ++i) {
       auto l = std::make_unique<Link>();
       l->name = robots[i].name;
-      l->task.emplace(*participant, ros_topic("tripodal/task", l->name), EndpointOptions{.kind = TopicKind::command});
+      // A resume and a start go together: a history of one could drop the first before it is
+      // acknowledged. (The robot's reader hands each sample to a callback as it arrives.)
+      Qos q = qos_for(TopicKind::command, Role::publisher);
+      q.depth = 16;
+      l->task.emplace(*participant, ros_topic("tripodal/task", l->name), EndpointOptions{.kind = TopicKind::command, .qos = q});
       EndpointOptions eo{.kind = TopicKind::event};
       eo.on_status = [this, i](const StatusEvent& s) {
         if (s.kind != StatusKind::liveliness_lost || s.current_count > 0) return;

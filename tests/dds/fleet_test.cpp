@@ -174,10 +174,16 @@ TEST_CASE("fleet: refusals and failures are the unit's result; answers to other 
   p.robot_event(a.robot, "command_refused", "task_command/" + std::to_string(a.id), "start: not understood");
   accept(p, b);
   p.robot_event(b.robot, "task_failed", "planner", "clean the section B: no recovery rule for fault \"path blocked\" of PrAutoMove");
-  cmds = p.poll();
-  REQUIRE(cmds.size() == 1);  // C to one of them, the other has nothing left
-  accept(p, cmds[0]);
-  succeed(p, cmds[0].robot, "clean the section C");
+  cmds = p.poll();  // robot1 has nothing left: paused; robot2 goes on with C
+  REQUIRE(cmds.size() == 2);
+  CHECK(cmds[0].robot == a.robot);
+  CHECK(cmds[0].command == "pause");
+  CHECK(cmds[1].robot == b.robot);
+  CHECK(cmds[1].command == "start");
+  CHECK(cmds[1].unit == "C");
+  accept(p, cmds[1]);
+  CHECK(p.poll().empty());  // paused once
+  succeed(p, cmds[1].robot, "clean the section C");
   CHECK(p.finished());
   const FleetResult r = p.result();
   CHECK_FALSE(r.succeeded);
@@ -218,6 +224,27 @@ TEST_CASE("fleet: an unanswered start goes again with its id; a robot that never
   CHECK(p.result().silent[0] == "robot2 at 30.0 s: not on DDS within 30.0 s");
 }
 
+TEST_CASE("fleet: an idle robot is paused, and resumed before a unit reassigned to it") {
+  SimClock clock;
+  FleetPlanner p(robots_at_origin(2), {unit("A", 2), unit("B", 1)}, clock);
+  p.robot_ready("robot1");
+  p.robot_ready("robot2");
+  for (const FleetCommand& c : p.poll()) accept(p, c);
+  succeed(p, "robot2", "clean the section B");
+  std::vector<FleetCommand> cmds = p.poll();
+  REQUIRE(cmds.size() == 1);
+  CHECK(cmds[0].robot == "robot2");
+  CHECK(cmds[0].command == "pause");
+  p.robot_silent("robot1", "liveliness lost");
+  cmds = p.poll();
+  REQUIRE(cmds.size() == 2);
+  CHECK(cmds[0].command == "resume");
+  CHECK(cmds[1].command == "start");
+  CHECK(cmds[1].unit == "A");
+  CHECK(cmds[1].robot == "robot2");
+  CHECK(cmds[1].id > cmds[0].id);
+}
+
 TEST_CASE("fleet: when every robot is silent the fleet ends without the rest") {
   SimClock clock;
   FleetPlanner p(robots_at_origin(2), {unit("A", 1), unit("B", 1)}, clock);
@@ -252,13 +279,14 @@ struct FakeRobot {
         got.push_back(c);
       }
       events->publish({{}, "psr2", "task_command/" + std::to_string(c.id), "command_accepted", c.command + ": ok", 0});
+      if (c.command != "start") return;
       events->publish({{}, "psr2", "planner", "task_started", c.task + " (plan ...)", 0});
       if (finish) events->publish({{}, "psr2", "planner", "task_succeeded", c.task, 0});
     });
   }
-  std::size_t received() {
+  std::size_t starts() {
     std::lock_guard lock(m);
-    return got.size();
+    return static_cast<std::size_t>(std::count_if(got.begin(), got.end(), [](const msg::TaskCommand& c) { return c.command == "start"; }));
   }
 };
 
@@ -277,7 +305,7 @@ TEST_CASE("fleet: on DDS, stand-in robots get their units, and one that leaves m
   bool left = false;
   while (!planner.finished() && std::chrono::steady_clock::now() < until) {
     fleet.update();
-    if (!left && r2->received() > 0) {
+    if (!left && r2->starts() > 0) {
       std::this_thread::sleep_for(100ms);
       r2->events.reset();  // its event writer leaves: liveliness lost at once
       left = true;
@@ -295,7 +323,7 @@ TEST_CASE("fleet: on DDS, stand-in robots get their units, and one that leaves m
   CHECK(r.reassignments[0].unit == "B");
   CHECK(r.reassignments[0].from == robots[1].name);
   CHECK(r.reassignments[0].reason == robots[1].name + " went silent (liveliness lost)");
-  CHECK(r1.received() == 2);
+  CHECK(r1.starts() == 2);
 }
 
 }  // namespace

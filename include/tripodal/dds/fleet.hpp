@@ -45,7 +45,7 @@ struct FleetRobot {
 struct FleetCommand {
   std::string robot;
   std::uint32_t id = 0;
-  std::string command;  ///< "start"
+  std::string command;  ///< "start", "pause" or "resume"
   std::string task;
   std::string unit;
 };
@@ -85,6 +85,9 @@ struct FleetOptions {
   /// A start command without an answer this long is sent again (same id: the robot answers a
   /// command it already took only once).
   Duration answer_timeout{std::chrono::seconds(5)};
+  /// A ready robot with nothing left to do is sent "pause" (its simulation stops spending CPU the
+  /// others need), and "resume" before a unit reassigned to it.
+  bool pause_idle = true;
 };
 
 /// The fleet's logic, fed by its caller (DdsFleet, or a test): which robot is ready, what each
@@ -105,8 +108,9 @@ class FleetPlanner {
   /// had not begun go to the robots still alive.
   void robot_silent(std::string_view robot, std::string_view reason);
 
-  /// The commands to send now: the next unit of each ready robot without one in hand, and those
-  /// not answered within answer_timeout. Also applies the startup timeout.
+  /// The commands to send now: the next unit of each ready robot without one in hand (after a
+  /// "resume" when it was paused), a start not answered within answer_timeout again, "pause" to a
+  /// robot with nothing left (FleetOptions::pause_idle). Also applies the startup timeout.
   [[nodiscard]] std::vector<FleetCommand> poll();
   /// Every unit done or failed, or no robot left alive to do the rest.
   [[nodiscard]] bool finished() const noexcept;
