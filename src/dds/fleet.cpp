@@ -118,6 +118,7 @@ std::string FleetResult::text() const {
     s << "unit " << u.name << " (" << u.task << "): " << u.state;
     if (u.state == "done") s << " by " << u.robot;
     if (u.state == "failed") s << " on " << u.robot << ": " << u.detail;
+    if (u.state == "not done" && !u.robot.empty()) s << " (" << u.robot << " had it)";
     if (u.started_s >= 0.0) s << ", " << fixed1(u.started_s) << "-" << (u.finished_s >= 0.0 ? fixed1(u.finished_s) : "?") << " s";
     if (u.assigned.size() > 1) s << "; given to " << join(u.assigned, ", then ");
     s << '\n';

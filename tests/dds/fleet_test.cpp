@@ -64,7 +64,7 @@ TEST_CASE("fleet: on equal loads the nearest robot takes the unit") {
   CHECK(plan[1] == std::vector<std::size_t>{0});
 }
 
-TEST_CASE("fleet: robots that are not eligible get nothing; bad input is refused") {
+TEST_CASE("fleet: robots that are not eligible get nothing, and bad input is refused") {
   const std::vector<FleetUnit> units{unit("A", 1), unit("B", 1), unit("C", 1)};
   const bool eligible[] = {false, true, true};
   const auto plan = assign_units(units, robots_at_origin(3), eligible);
@@ -160,7 +160,7 @@ TEST_CASE("fleet: a silent robot's unit in hand and its queue go to the others, 
   CHECK(p.take_log().empty());
 }
 
-TEST_CASE("fleet: refusals and failures are the unit's result; answers to other commands are ignored") {
+TEST_CASE("fleet: refusals and failures are the unit's result, and answers to other commands are ignored") {
   SimClock clock;
   FleetPlanner p(robots_at_origin(2), {unit("A", 2), unit("B", 1), unit("C", 1)}, clock);
   p.robot_ready("robot1");
@@ -196,7 +196,7 @@ TEST_CASE("fleet: refusals and failures are the unit's result; answers to other 
   CHECK_THAT(r.text(), Catch::Contains("fleet did not finish: 1 of 3 units done"));
 }
 
-TEST_CASE("fleet: an unanswered start goes again with its id; a robot that never comes is silent") {
+TEST_CASE("fleet: an unanswered start goes again with its id, and a robot that never comes is silent") {
   SimClock clock;
   FleetOptions o;
   o.startup_timeout = 30s;

@@ -339,7 +339,10 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
         << " units:";
     for (const std::string& n : names) out << " " << n;
     out << "\n";
-    if (units.size() < robots.size()) out << "(" << robots.size() - units.size() << " robots get no unit at first: more robots than units)\n";
+    if (units.size() < robots.size()) {
+      const std::size_t idle = robots.size() - units.size();
+      out << "(" << idle << (idle == 1 ? " robot gets" : " robots get") << " no unit at first: more robots than units)\n";
+    }
     out.flush();
 
     SteadyClock clock;
