@@ -82,8 +82,8 @@ struct FleetOptions {
   /// A robot whose task topic has no reader this long after the start never came: it counts as
   /// silent and its units go to the others.
   Duration startup_timeout{std::chrono::seconds(60)};
-  /// A start command without an answer this long is sent again (same id: the robot answers a
-  /// command it already took only once).
+  /// A start command without an answer this long is sent again, with the same id (the first
+  /// answer to an id counts, later ones are ignored).
   Duration answer_timeout{std::chrono::seconds(5)};
   /// A ready robot with nothing left to do is sent "pause" (its simulation stops spending CPU the
   /// others need), and "resume" before a unit reassigned to it.
