@@ -308,6 +308,7 @@ void FleetPlanner::redistribute(std::vector<std::size_t> units, const std::strin
   }
   if (!any) {
     std::vector<std::string> names;
+    names.reserve(units.size());
     for (const std::size_t u : units) names.push_back(unit_info_[u].name);
     note("no robot left for " + join(names, ", "));
     return;

@@ -224,6 +224,7 @@ class Children {
     posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     posix_spawn_file_actions_adddup2(&fa, 1, 2);
     std::vector<char*> args;
+    args.reserve(argv.size() + 1);
     for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);
     pid_t pid = -1;
@@ -334,6 +335,7 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
     std::vector<dds::FleetRobot> robots;
     for (int k = 1; k <= a.robots; ++k) robots.push_back({"robot" + std::to_string(k), world.start_pose.x_m, world.start_pose.y_m});
     std::vector<std::string> names;
+    names.reserve(units.size());
     for (const dds::FleetUnit& u : units) names.push_back(u.name + " (" + fixed1(u.area_m2) + " m2)");
     out << "tripodal fleet: " << a.robots << " robots, world " << a.world.string() << ", task \"" << a.task << "\": " << units.size()
         << " units:";
