@@ -344,6 +344,25 @@ void FleetPlanner::robot_silent(std::string_view robot, std::string_view reason)
   redistribute(std::move(left), r->name, why);
 }
 
+void FleetPlanner::take_queued(Robot& idle) {
+  Robot* from = nullptr;
+  double most_m2 = 0.0;
+  for (auto& rp : robots_) {
+    if (rp.get() == &idle || !rp->alive || rp->queue.empty()) continue;
+    double queued_m2 = 0.0;
+    for (const std::size_t u : rp->queue) queued_m2 += unit_info_[u].area_m2;
+    if (queued_m2 > most_m2) from = rp.get(), most_m2 = queued_m2;
+  }
+  if (from == nullptr) return;
+  const std::size_t u = from->queue.back();  // the one it would have begun last
+  from->queue.pop_back();
+  idle.queue.push_back(u);
+  units_[u].assigned.push_back(idle.name);
+  const std::string why = idle.name + " had nothing left to do";
+  reassignments_.push_back({unit_info_[u].name, from->name, idle.name, seconds(), why});
+  note("reassigned " + unit_info_[u].name + " from " + from->name + " to " + idle.name + ": " + why);
+}
+
 std::vector<FleetCommand> FleetPlanner::poll() {
   std::vector<FleetCommand> out;
   const double now = seconds();
@@ -355,6 +374,7 @@ std::vector<FleetCommand> FleetPlanner::poll() {
   for (auto& rp : robots_) {
     Robot& r = *rp;
     if (!r.alive || !r.ready) continue;
+    if (!r.current && r.queue.empty() && options_.take_when_idle) take_queued(r);
     if (!r.current && r.queue.empty() && !r.paused && options_.pause_idle) {
       r.paused = true;
       note(r.name + " has nothing left to do: paused");

@@ -174,16 +174,18 @@ TEST_CASE("fleet: refusals and failures are the unit's result, and answers to ot
   p.robot_event(a.robot, "command_refused", "task_command/" + std::to_string(a.id), "start: not understood");
   accept(p, b);
   p.robot_event(b.robot, "task_failed", "planner", "clean the section B: no recovery rule for fault \"path blocked\" of PrAutoMove");
-  cmds = p.poll();  // robot1 has nothing left: paused; robot2 goes on with C
+  // robot1 (A refused) has nothing left: it takes C from robot2's queue; robot2, with nothing left
+  // to take, is paused
+  cmds = p.poll();
   REQUIRE(cmds.size() == 2);
   CHECK(cmds[0].robot == a.robot);
-  CHECK(cmds[0].command == "pause");
+  CHECK(cmds[0].command == "start");
+  CHECK(cmds[0].unit == "C");
   CHECK(cmds[1].robot == b.robot);
-  CHECK(cmds[1].command == "start");
-  CHECK(cmds[1].unit == "C");
-  accept(p, cmds[1]);
+  CHECK(cmds[1].command == "pause");
+  accept(p, cmds[0]);
   CHECK(p.poll().empty());  // paused once
-  succeed(p, cmds[1].robot, "clean the section C");
+  succeed(p, cmds[0].robot, "clean the section C");
   CHECK(p.finished());
   const FleetResult r = p.result();
   CHECK_FALSE(r.succeeded);
@@ -193,6 +195,12 @@ TEST_CASE("fleet: refusals and failures are the unit's result, and answers to ot
   CHECK(r.units[1].detail == "no recovery rule for fault \"path blocked\" of PrAutoMove");
   CHECK(r.units[2].state == "done");
   CHECK(r.reason == "failed: A, B");
+  REQUIRE(r.reassignments.size() == 1);
+  CHECK(r.reassignments[0].unit == "C");
+  CHECK(r.reassignments[0].from == b.robot);
+  CHECK(r.reassignments[0].to == a.robot);
+  CHECK(r.reassignments[0].reason == a.robot + " had nothing left to do");
+  CHECK(r.units[2].assigned == std::vector<std::string>{b.robot, a.robot});
   CHECK_THAT(r.text(), Catch::Contains("fleet did not finish: 1 of 3 units done"));
 }
 

@@ -88,6 +88,10 @@ struct FleetOptions {
   /// A ready robot with nothing left to do is sent "pause" (its simulation stops spending CPU the
   /// others need), and "resume" before a unit reassigned to it.
   bool pause_idle = true;
+  /// A ready robot with nothing left to do takes, before it is paused, the last unit not begun of
+  /// the robot with the most area not begun (a reassignment too): the balance made at the start
+  /// or at a silence is by area, not by how fast each robot turns out to be.
+  bool take_when_idle = true;
 };
 
 /// The fleet's logic, fed by its caller (DdsFleet, or a test): which robot is ready, what each
@@ -109,7 +113,8 @@ class FleetPlanner {
   void robot_silent(std::string_view robot, std::string_view reason);
 
   /// The commands to send now: the next unit of each ready robot without one in hand (after a
-  /// "resume" when it was paused), a start not answered within answer_timeout again, "pause" to a
+  /// "resume" when it was paused; one taken from another's queue when it has none,
+  /// FleetOptions::take_when_idle), a start not answered within answer_timeout again, "pause" to a
   /// robot with nothing left (FleetOptions::pause_idle). Also applies the startup timeout.
   [[nodiscard]] std::vector<FleetCommand> poll();
   /// Every unit done or failed, or no robot left alive to do the rest.
@@ -136,6 +141,7 @@ class FleetPlanner {
   void note(std::string line);
   void finish_unit(Robot& r, bool ok, std::string_view detail);
   void redistribute(std::vector<std::size_t> units, const std::string& from, const std::string& reason);
+  void take_queued(Robot& idle);
 
   const Clock& clock_;
   FleetOptions options_;
