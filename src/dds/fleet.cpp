@@ -251,6 +251,11 @@ bool FleetPlanner::alive(std::string_view robot) const {
   return r != nullptr && r->alive;
 }
 
+bool FleetPlanner::ready(std::string_view robot) const {
+  const Robot* r = find(robot);
+  return r != nullptr && r->ready;
+}
+
 void FleetPlanner::robot_ready(std::string_view robot) {
   Robot* r = find(robot);
   if (r == nullptr || !r->alive || r->ready) return;

@@ -211,6 +211,8 @@ TEST_CASE("fleet: an unanswered start goes again with its id, and a robot that n
   o.answer_timeout = 5s;
   FleetPlanner p(robots_at_origin(2), {unit("A", 1), unit("B", 1)}, clock, o);
   p.robot_ready("robot1");
+  CHECK(p.ready("robot1"));
+  CHECK_FALSE(p.ready("robot2"));
   std::vector<FleetCommand> cmds = p.poll();
   REQUIRE(cmds.size() == 1);
   const FleetCommand first = cmds[0];

@@ -234,16 +234,19 @@ class Children {
     children_.push_back({name, pid});
   }
 
-  /// Reaps those that ended; returns a line for each ("robot2 ended: killed by signal 9").
-  std::vector<std::string> reap() {
-    std::vector<std::string> out;
+  struct Ended {
+    std::string name, how;  // "robot2", "killed by signal 9"
+  };
+  /// Reaps those that ended.
+  std::vector<Ended> reap() {
+    std::vector<Ended> out;
     for (Child& c : children_) {
       if (c.exited) continue;
       int st = 0;
       if (waitpid(c.pid, &st, WNOHANG) == c.pid) {
         c.exited = true;
         c.status = st;
-        out.push_back(c.name + " ended: " + describe(st));
+        out.push_back({c.name, describe(st)});
       }
     }
     return out;
@@ -281,6 +284,17 @@ class Children {
   }
   std::vector<Child> children_;
 };
+
+// The end of a robot's log, for a robot that failed before it could say anything on DDS.
+std::vector<std::string> last_lines(const std::filesystem::path& file, std::size_t n) {
+  std::ifstream f(file);
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(f, l);) {
+    if (!l.empty()) lines.push_back(l);
+  }
+  if (lines.size() > n) lines.erase(lines.begin(), lines.end() - static_cast<std::ptrdiff_t>(n));
+  return lines;
+}
 
 std::string fixed1(double v) {
   std::ostringstream s;
@@ -386,9 +400,15 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
               << " s into its unit\n";
         }
       }
-      std::vector<std::string> ended = children.reap();
-      for (std::string& l : ended) l = fixed1(planner.elapsed_s()) + " s  " + l;
-      print(ended);
+      for (const Children::Ended& e : children.reap()) {
+        out << fixed1(planner.elapsed_s()) << " s  " << e.name << " ended: " << e.how << '\n';
+        // One that never came on DDS will not: no need to wait for the startup timeout. (A robot
+        // that was on DDS is declared silent by its lost liveliness, the fleet's DDS path.)
+        if (!planner.ready(e.name)) {
+          planner.robot_silent(e.name, "its process ended before it was on DDS: " + e.how);
+          for (const std::string& l : last_lines(dir / (e.name + ".log"), 3)) out << "    " << e.name << ".log: " << l << '\n';
+        }
+      }
       if (planner.elapsed_s() >= a.timeout_s) {
         timed_out = true;
         break;

@@ -127,6 +127,8 @@ class FleetPlanner {
   /// The units a robot has still to do (in hand first), by name; for tests and the log.
   [[nodiscard]] std::vector<std::string> queue_of(std::string_view robot) const;
   [[nodiscard]] bool alive(std::string_view robot) const;
+  /// Whether robot_ready() came for it.
+  [[nodiscard]] bool ready(std::string_view robot) const;
   /// When the robot was sent the unit it has in hand (elapsed_s()), nullopt when it has none.
   [[nodiscard]] std::optional<double> busy_since_s(std::string_view robot) const;
   /// Seconds on the clock since construction.
