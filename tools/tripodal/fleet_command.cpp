@@ -1,0 +1,472 @@
+// `tripodal fleet --robots 4 --world WORLD.yaml --task "clean the room 3211"`: a fleet on one
+// machine over loopback DDS (docs/distribution.md, "A fleet"). Each robot is a `tripodal run`
+// process of its own, on a copy of the profile with its own dds: namespace; the fleet planner
+// (tripodal/dds/fleet.hpp) shares the task's units among them, reassigns the work of a robot that
+// goes silent and prints one result. Built only with the dds area.
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <ostream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "cli_tool.hpp"
+#include "tripodal/core/clock.hpp"
+#include "tripodal/core/diagnostic.hpp"
+#include "tripodal/dds/fleet.hpp"
+#include "tripodal/dds/participant.hpp"
+#include "tripodal/navi/section_splitter.hpp"
+#include "tripodal/robot/robot_profile.hpp"
+#include "tripodal/sim/world.hpp"
+
+extern char** environ;
+
+namespace tripodal::tool {
+namespace {
+
+using namespace cli;
+
+constexpr int kFleetFailed = 4;
+
+constexpr std::string_view kDescription =
+    "Runs a fleet of N robots on one machine over loopback DDS: each robot is a `tripodal run`\n"
+    "process of its own (the same profile, a copy per robot with the dds: namespace robotK, task\n"
+    "commands on, participant lease --lease-s), each in its own copy of the simulated world. The\n"
+    "fleet planner divides the task into units, \"clean the room R\" into the room's sections\n"
+    "(\"clean the section A\", ...) and \"clean the rooms R1, R2 and R3\" into the rooms, gives each\n"
+    "robot a balanced share (by area, then nearest), sends each robot its next unit as a\n"
+    "TaskCommand when the last one is done, and when a robot goes silent (its DDS liveliness lost:\n"
+    "its process died) gives the unit it had in hand and the ones it had not begun to the others.\n"
+    "Prints what happens and one result: which units were done by whom, the reassignments, the\n"
+    "failures. With --out, DIR receives fleet.json, fleet.txt, the robots' profiles and their logs\n"
+    "(robotK.log); without, they go to a temporary folder that is removed. The robots run at\n"
+    "--speed times real time. --kill-robot K --kill-after-s S kills robot K with SIGKILL S seconds\n"
+    "after it was given its first unit (the test of a robot lost mid-task). The robots are stopped\n"
+    "when the fleet ends, fails or is interrupted (Ctrl-C, SIGTERM).";
+
+constexpr std::string_view kExitCodes =
+    "exit codes: 0 every unit done, 1 bad profile/world/task, 2 bad command line, 3 I/O error (a file,\n"
+    "            a robot process, DDS), 4 a unit failed or was not done (no robot left, timeout, stopped).";
+
+struct Args {
+  int robots = 0;
+  std::filesystem::path world, robot, out;
+  std::string task;
+  double speed = 50.0;
+  unsigned domain = 0;
+  double lease_s = 5.0;
+  double timeout_s = 900.0;
+  std::optional<double> kill_after_s;
+  std::optional<int> kill_robot;
+  std::optional<std::uint64_t> seed;
+};
+
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void on_fleet_stop_signal(int) { g_stop = 1; }
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+std::vector<std::string> words_of(std::string_view text) {
+  std::string t(text);
+  while (!t.empty() && (t.back() == '.' || t.back() == '!' || t.back() == '?' || std::isspace(static_cast<unsigned char>(t.back())))) {
+    t.pop_back();
+  }
+  std::replace(t.begin(), t.end(), ',', ' ');
+  std::istringstream s(t);
+  std::vector<std::string> out;
+  for (std::string w; s >> w;) out.push_back(w);
+  return out;
+}
+
+// The robot's section splitter, with the profile's parameters: the same split the robots make of
+// the same map.
+navi::SectionSplitterOptions splitter_options(const RobotProfile& profile) {
+  navi::SectionSplitterOptions o;
+  for (const ModuleEntry& e : profile.navigation) {
+    if (e.type != navi::CSectionSplitter::static_manifest().name) continue;
+    const auto number = [&](const char* key, double& v) {
+      if (const auto it = e.parameters.find(key); it != e.parameters.end()) v = std::stod(it->second);
+    };
+    number("min_obstacle_area_m2", o.min_obstacle_area_m2);
+    number("min_gap_m", o.min_gap_m);
+    number("min_section_height_m", o.min_section_height_m);
+    number("min_section_area_m2", o.min_section_area_m2);
+    return o;
+  }
+  throw ConfigError(profile.where, "tripodal fleet: sharing a room by sections needs the robot's SectionSplitter module");
+}
+
+constexpr std::string_view kForms =
+    "the fleet shares \"clean [the] room ROOM\" (by its sections) and \"clean [the] rooms ROOM1, ROOM2 and ROOM3\" (by room)";
+
+// The units of the task: a room's sections, or the rooms named. Throws ConfigError (located at
+// --task) when the task does not divide or names an unknown room.
+std::vector<dds::FleetUnit> units_of(const std::string& task, const sim::World& world, const RobotProfile& profile) {
+  const SourceLocation where{"--task", 1, 1};
+  std::vector<std::string> w = words_of(lower(task));
+  if (w.empty() || w[0] != "clean") throw ConfigError(where, "\"" + task + "\" does not divide among robots: " + std::string(kForms));
+  w.erase(w.begin());
+  if (!w.empty() && w[0] == "the") w.erase(w.begin());
+  const auto known = [&] {
+    std::string k;
+    for (const std::string& n : world.regions.room_names()) k += " " + n;
+    return "(known:" + k + ")";
+  };
+  std::vector<dds::FleetUnit> units;
+  if (!w.empty() && w[0] == "rooms") {
+    std::vector<std::string> rooms;
+    for (std::size_t i = 1; i < w.size(); ++i) {
+      if (w[i] != "and") rooms.push_back(w[i]);
+    }
+    if (rooms.empty()) throw ConfigError(where, "\"" + task + "\" names no room: " + std::string(kForms));
+    for (const std::string& name : rooms) {
+      const navi::Region* r = world.regions.room(name);
+      if (r == nullptr) throw ConfigError(where, "unknown room '" + name + "' in \"" + task + "\" " + known());
+      if (std::any_of(units.begin(), units.end(), [&](const dds::FleetUnit& u) { return u.name == name; })) {
+        throw ConfigError(where, "room '" + name + "' is named twice in \"" + task + "\"");
+      }
+      double cx = 0.0, cy = 0.0;
+      for (const navi::Point2D& p : r->polygon) cx += p.x_m, cy += p.y_m;
+      const double n = static_cast<double>(std::max<std::size_t>(r->polygon.size(), 1));
+      units.push_back({name, "clean the room " + name, std::max(r->area_m2(), 1e-3), cx / n, cy / n});
+    }
+    return units;
+  }
+  if (!w.empty() && w[0] == "room") w.erase(w.begin());
+  if (w.size() != 1) throw ConfigError(where, "\"" + task + "\" does not divide among robots: " + std::string(kForms));
+  navi::CSectionSplitter splitter(splitter_options(profile));
+  splitter.split_map(world.grid, world.regions);
+  const KnowledgeAnswer a = splitter.sections_of_room(w[0]);
+  if (!a.ok) throw ConfigError(where, a.error);
+  if (a.items.empty()) throw ConfigError(where, "room '" + w[0] + "' has no section with free floor to clean");
+  for (const std::string& name : a.items) {
+    const navi::Section* s = splitter.section(name);
+    units.push_back({name, "clean the section " + name, std::max(s->area_m2, 1e-3), s->centroid.x_m, s->centroid.y_m});
+  }
+  return units;
+}
+
+// Relative paths of the profile (nets, tasks, module parameters) made absolute, so that the copy
+// may live anywhere: a scalar that names an existing file or folder beside the profile.
+void absolutize(YAML::Node node, const std::filesystem::path& dir) {
+  if (node.IsMap()) {
+    for (auto it = node.begin(); it != node.end(); ++it) absolutize(it->second, dir);
+  } else if (node.IsSequence()) {
+    for (std::size_t i = 0; i < node.size(); ++i) absolutize(node[i], dir);
+  } else if (node.IsScalar()) {
+    const std::string v = node.Scalar();
+    if (v.empty() || v.find('/') == std::string::npos || std::filesystem::path(v).is_absolute()) return;
+    std::error_code ec;
+    if (std::filesystem::exists(dir / v, ec)) node = std::filesystem::weakly_canonical(dir / v).string();
+  }
+}
+
+// The profile of robot `ns`: the given one with a dds: section of its own (any dds: section of the
+// original is replaced).
+std::string fleet_profile(const std::filesystem::path& profile, const std::string& ns, unsigned domain, double lease_s) {
+  YAML::Node root = YAML::LoadFile(profile.string());
+  absolutize(root, std::filesystem::absolute(profile).parent_path());
+  root.remove("dds");
+  YAML::Node d(YAML::NodeType::Map);
+  d["domain_id"] = domain;
+  d["namespace"] = ns;
+  d["loopback"] = true;
+  d["participant_lease_s"] = lease_s;
+  d["tasks"] = true;
+  YAML::Node publish(YAML::NodeType::Sequence);
+  publish.push_back("events");  // the fleet follows the events only; the rest would cost CPU
+  d["publish"] = publish;
+  root["dds"] = d;
+  YAML::Emitter e;
+  e << root;
+  return "# Generated by tripodal fleet from " + std::filesystem::absolute(profile).string() + "\n" + e.c_str() + "\n";
+}
+
+// The robots' processes: stopped (SIGTERM, then SIGKILL) and reaped when the fleet ends, however.
+class Children {
+ public:
+  struct Child {
+    std::string name;
+    pid_t pid = -1;
+    bool exited = false;
+    int status = 0;
+  };
+  ~Children() { stop(); }
+  Children() = default;
+  Children(const Children&) = delete;
+  Children& operator=(const Children&) = delete;
+
+  void spawn(const std::string& name, const std::vector<std::string>& argv, const std::filesystem::path& log) {
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+    posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&fa, 1, 2);
+    std::vector<char*> args;
+    args.reserve(argv.size() + 1);
+    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    pid_t pid = -1;
+    const int rc = posix_spawn(&pid, args[0], &fa, nullptr, args.data(), environ);
+    posix_spawn_file_actions_destroy(&fa);
+    if (rc != 0) throw std::runtime_error("cannot start " + name + " (" + argv[0] + "): " + std::strerror(rc));
+    children_.push_back({name, pid});
+  }
+
+  struct Ended {
+    std::string name, how;  // "robot2", "killed by signal 9"
+  };
+  /// Reaps those that ended.
+  std::vector<Ended> reap() {
+    std::vector<Ended> out;
+    for (Child& c : children_) {
+      if (c.exited) continue;
+      int st = 0;
+      if (waitpid(c.pid, &st, WNOHANG) == c.pid) {
+        c.exited = true;
+        c.status = st;
+        out.push_back({c.name, describe(st)});
+      }
+    }
+    return out;
+  }
+
+  void kill_one(std::size_t i) {
+    if (i < children_.size() && !children_[i].exited) ::kill(children_[i].pid, SIGKILL);
+  }
+
+  void stop() {
+    for (const Child& c : children_) {
+      if (!c.exited) ::kill(c.pid, SIGTERM);
+    }
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+    while (std::chrono::steady_clock::now() < until && !all_exited()) {
+      reap();
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    for (Child& c : children_) {
+      if (c.exited) continue;
+      ::kill(c.pid, SIGKILL);
+      waitpid(c.pid, &c.status, 0);
+      c.exited = true;
+    }
+  }
+
+ private:
+  static std::string describe(int st) {
+    if (WIFEXITED(st)) return "exit code " + std::to_string(WEXITSTATUS(st));
+    if (WIFSIGNALED(st)) return "killed by signal " + std::to_string(WTERMSIG(st));
+    return "status " + std::to_string(st);
+  }
+  [[nodiscard]] bool all_exited() const {
+    return std::all_of(children_.begin(), children_.end(), [](const Child& c) { return c.exited; });
+  }
+  std::vector<Child> children_;
+};
+
+// The end of a robot's log, for a robot that failed before it could say anything on DDS.
+std::vector<std::string> last_lines(const std::filesystem::path& file, std::size_t n) {
+  std::ifstream f(file);
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(f, l);) {
+    if (!l.empty()) lines.push_back(l);
+  }
+  if (lines.size() > n) lines.erase(lines.begin(), lines.end() - static_cast<std::ptrdiff_t>(n));
+  return lines;
+}
+
+std::string fixed1(double v) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(1);
+  s << v;
+  return s.str();
+}
+
+int run(const Args& a, std::ostream& out, std::ostream& err) {
+  if (a.kill_robot.has_value() != a.kill_after_s.has_value()) {
+    err << "tripodal fleet: --kill-robot and --kill-after-s go together\n";
+    return kUsage;
+  }
+  if (a.kill_robot && (*a.kill_robot < 1 || *a.kill_robot > a.robots)) {
+    err << "tripodal fleet: --kill-robot " << *a.kill_robot << ": expected a robot from 1 to " << a.robots << "\n";
+    return kUsage;
+  }
+  const std::filesystem::path robot =
+      a.robot.empty() ? std::filesystem::absolute(a.world).parent_path().parent_path() / "robots" / "psr2.yaml" : a.robot;
+  for (const auto& f : {a.world, robot}) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(f, ec)) {
+      err << "tripodal fleet: cannot read '" << f.string() << "'" << (a.robot.empty() && f == robot ? " (the default --robot)" : "")
+          << "\n";
+      return kIoError;
+    }
+  }
+  std::filesystem::path dir = a.out;
+  bool temporary = false;
+  try {
+    const RobotProfile profile = load_robot_profile(robot);
+    const sim::World world = sim::load_world(a.world);
+    const std::vector<dds::FleetUnit> units = units_of(a.task, world, profile);
+
+    if (dir.empty()) {
+      std::string tmpl = (std::filesystem::temp_directory_path() / "tripodal-fleet-XXXXXX").string();
+      if (::mkdtemp(tmpl.data()) == nullptr) throw std::runtime_error("cannot create a temporary folder: " + std::string(std::strerror(errno)));
+      dir = tmpl;
+      temporary = true;
+    }
+    std::filesystem::create_directories(dir);
+    struct RemoveTemporary {
+      const std::filesystem::path& dir;
+      bool on;
+      ~RemoveTemporary() {
+        std::error_code ec;
+        if (on) std::filesystem::remove_all(dir, ec);
+      }
+    } remove_temporary{dir, temporary};
+
+    std::vector<dds::FleetRobot> robots;
+    for (int k = 1; k <= a.robots; ++k) robots.push_back({"robot" + std::to_string(k), world.start_pose.x_m, world.start_pose.y_m});
+    std::vector<std::string> names;
+    names.reserve(units.size());
+    for (const dds::FleetUnit& u : units) names.push_back(u.name + " (" + fixed1(u.area_m2) + " m2)");
+    out << "tripodal fleet: " << a.robots << " robots, world " << a.world.string() << ", task \"" << a.task << "\": " << units.size()
+        << " units:";
+    for (const std::string& n : names) out << " " << n;
+    out << "\n";
+    if (units.size() < robots.size()) {
+      const std::size_t idle = robots.size() - units.size();
+      out << "(" << idle << (idle == 1 ? " robot gets" : " robots get") << " no unit at first: more robots than units)\n";
+    }
+    out.flush();
+
+    SteadyClock clock;
+    dds::FleetPlanner planner(robots, units, clock);
+    dds::DdsFleet fleet(planner, robots,
+                        dds::DdsFleetOptions{.domain_id = a.domain, .network = dds::Network::loopback,
+                                             .participant_lease = std::chrono::milliseconds(static_cast<long>(a.lease_s * 1000.0))});
+
+    const std::string exe = std::filesystem::read_symlink("/proc/self/exe").string();
+    Children children;
+    for (const dds::FleetRobot& r : robots) {
+      const std::filesystem::path p = dir / (r.name + ".yaml");
+      std::ofstream f(p);
+      f << fleet_profile(robot, r.name, a.domain, a.lease_s);
+      if (!f) throw std::runtime_error("cannot write '" + p.string() + "'");
+      f.close();
+      std::vector<std::string> argv{exe, "run", "--robot", p.string(), "--world", std::filesystem::absolute(a.world).string(),
+                                    "--realtime", fixed1(a.speed), "--max-duration-s", fixed1(a.timeout_s * a.speed + 60.0)};
+      if (a.seed) argv.insert(argv.end(), {"--seed", std::to_string(*a.seed)});
+      children.spawn(r.name, argv, dir / (r.name + ".log"));
+    }
+
+    std::signal(SIGINT, on_fleet_stop_signal);
+    std::signal(SIGTERM, on_fleet_stop_signal);
+    bool killed = false, timed_out = false;
+    auto print = [&](const std::vector<std::string>& lines) {
+      for (const std::string& l : lines) out << l << '\n';
+      out.flush();
+    };
+    while (!planner.finished() && g_stop == 0) {
+      fleet.update();
+      print(planner.take_log());
+      if (a.kill_robot && !killed) {
+        const std::string& victim = robots[static_cast<std::size_t>(*a.kill_robot - 1)].name;
+        if (const auto since = planner.busy_since_s(victim); since && planner.elapsed_s() - *since >= *a.kill_after_s) {
+          children.kill_one(static_cast<std::size_t>(*a.kill_robot - 1));
+          killed = true;
+          out << fixed1(planner.elapsed_s()) << " s  killed " << victim << " (SIGKILL), " << fixed1(*a.kill_after_s)
+              << " s into its unit\n";
+        }
+      }
+      for (const Children::Ended& e : children.reap()) {
+        out << fixed1(planner.elapsed_s()) << " s  " << e.name << " ended: " << e.how << '\n';
+        // One that never came on DDS will not: no need to wait for the startup timeout. (A robot
+        // that was on DDS is declared silent by its lost liveliness, the fleet's DDS path.)
+        if (!planner.ready(e.name)) {
+          planner.robot_silent(e.name, "its process ended before it was on DDS: " + e.how);
+          for (const std::string& l : last_lines(dir / (e.name + ".log"), 3)) out << "    " << e.name << ".log: " << l << '\n';
+        }
+      }
+      if (planner.elapsed_s() >= a.timeout_s) {
+        timed_out = true;
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    fleet.update();
+    print(planner.take_log());
+    dds::FleetResult result = planner.result();
+    if (timed_out) result.reason += (result.reason.empty() ? "" : "; ") + std::string("timed out after ") + fixed1(a.timeout_s) + " s";
+    if (g_stop != 0) result.reason += (result.reason.empty() ? "" : "; ") + std::string("stopped");
+    if (timed_out || g_stop != 0) result.succeeded = false;
+    children.stop();
+    out << result.text();
+    if (!temporary) {
+      std::ofstream(dir / "fleet.json") << result.json();
+      std::ofstream(dir / "fleet.txt") << result.text();
+      out << "wrote " << (dir / "fleet.json").string() << ", fleet.txt, robotK.yaml and robotK.log\n";
+    }
+    return result.succeeded ? kOk : kFleetFailed;
+  } catch (const ConfigError& e) {
+    err << e.what() << '\n';
+    return kBadInput;
+  } catch (const YAML::Exception& e) {
+    err << "tripodal fleet: " << robot.string() << ": " << e.what() << '\n';
+    return kBadInput;
+  } catch (const std::invalid_argument& e) {
+    err << "tripodal fleet: " << e.what() << '\n';
+    return kBadInput;
+  } catch (const std::exception& e) {  // files, processes, DDS
+    err << "tripodal fleet: " << e.what() << '\n';
+    return kIoError;
+  }
+}
+
+cli::Action setup(CLI::App& cmd) {
+  auto a = std::make_shared<Args>();
+  cmd.add_option("--robots", a->robots, "N: how many robots (processes), 1 to 16")->required()->check(CLI::Range(1, 16));
+  cmd.add_option("--world", a->world, "WORLD.yaml: the world every robot runs in (its own copy)")->required();
+  cmd.add_option("--task", a->task, "\"COMMAND\": \"clean the room 3211\" (by sections) or \"clean the rooms 2111 and 2133\"")->required();
+  cmd.add_option("--robot", a->robot, "ROBOT.yaml: the robots' profile (default: robots/psr2.yaml beside the world's folder)");
+  cmd.add_option("--out", a->out, "DIR: fleet.json, fleet.txt, the robots' profiles and logs");
+  cmd.add_option("--speed", a->speed, "X: the robots run at X times real time")->check(cli::positive_number())->capture_default_str();
+  cmd.add_option("--domain", a->domain, "ID: the DDS domain (ROS_DOMAIN_ID)")->check(CLI::Range(0, 232))->capture_default_str();
+  cmd.add_option("--lease-s", a->lease_s, "S: the robots' participant lease: a dead robot is seen silent after S")
+      ->check(cli::positive_number())
+      ->capture_default_str();
+  cmd.add_option("--timeout-s", a->timeout_s, "S: wall time after which the fleet gives up")->check(cli::positive_number())->capture_default_str();
+  cmd.add_option("--seed", a->seed, "N: the simulators' seed (default: the world's)");
+  cmd.add_option("--kill-robot", a->kill_robot, "K: kill robot K (1..N) with SIGKILL, with --kill-after-s");
+  cmd.add_option("--kill-after-s", a->kill_after_s, "S: that many seconds after robot K was given its first unit")
+      ->check(CLI::NonNegativeNumber);
+  return [a](std::ostream& out, std::ostream& err) { return run(*a, out, err); };
+}
+
+}  // namespace
+
+TRIPODAL_CLI_COMMAND("", "fleet", "run a fleet of robot processes on DDS sharing a task (clean the room 3211)", kDescription, kExitCodes,
+                     &setup);
+
+}  // namespace tripodal::tool
