@@ -4,7 +4,8 @@
 // the pacing, is the limit. Reports the simulated seconds of the robots' tasks (from their logs),
 // the wall and CPU seconds of the whole command (robots' start and stop included), and their ratio.
 //   tripodal_fleet_bench [--domain BASE] [benchmark options]
-//   (BM_FleetThroughput/N on DDS domain BASE + N; BASE 210 unless given)
+//   (BM_FleetThroughput/N on DDS domain BASE + N; BASE 210 unless given). A fleet that does not
+//   exit 0 is an error of its benchmark, and the program exits 1.
 #include <benchmark/benchmark.h>
 #include <fcntl.h>
 #include <spawn.h>
@@ -28,8 +29,9 @@ extern char** environ;
 namespace {
 
 std::uint32_t domain_base = 210;
+bool failed = false;  // a fleet that did not succeed: the program's exit code says so too
 
-// The robots run paced at this many times real time: a robot simulates about 60 to 80 s per CPU
+// The robots run paced at this many times real time: a robot simulates about 60 s per CPU
 // second (docs/distribution.md), so the pacing never waits.
 constexpr const char* kSpeed = "10000";
 
@@ -64,11 +66,12 @@ RobotTasks read_robot_log(const std::filesystem::path& log) {
   return out;
 }
 
+// The last non-empty line holding `what` ("": any).
 std::string last_line_with(const std::filesystem::path& file, const std::string& what) {
   std::ifstream f(file);
   std::string found;
   for (std::string l; std::getline(f, l);) {
-    if (l.find(what) != std::string::npos) found = l;
+    if (!l.empty() && l.find(what) != std::string::npos) found = l;
   }
   return found;
 }
@@ -77,17 +80,22 @@ void BM_FleetThroughput(benchmark::State& state) {
   const int robots = static_cast<int>(state.range(0));
   std::string tmpl = (std::filesystem::temp_directory_path() / "tripodal-fleet-bench-XXXXXX").string();
   if (::mkdtemp(tmpl.data()) == nullptr) {
+    failed = true;
     state.SkipWithError("cannot create a temporary folder");
     return;
   }
   const std::filesystem::path dir = tmpl;
   const std::filesystem::path out = dir / "fleet.out";
   for (auto _ : state) {
-    const std::vector<std::string> argv{TRIPODAL_TOOL_EXE, "fleet",   "--robots", std::to_string(robots),
-                                        "--world",         TRIPODAL_FLEET_WORLD, "--robot", TRIPODAL_FLEET_ROBOT,
-                                        "--task",          kTask,    "--speed",  kSpeed,
-                                        "--domain",        std::to_string(domain_base + static_cast<std::uint32_t>(robots)),
-                                        "--out",           dir.string()};
+    const std::vector<std::string> argv{
+        TRIPODAL_TOOL_EXE, "fleet",
+        "--robots",        std::to_string(robots),
+        "--world",         TRIPODAL_FLEET_WORLD,
+        "--robot",         TRIPODAL_FLEET_ROBOT,
+        "--task",          kTask,
+        "--speed",         kSpeed,
+        "--domain",        std::to_string(domain_base + static_cast<std::uint32_t>(robots)),
+        "--out",           dir.string()};
     std::vector<char*> args;
     for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);
@@ -100,7 +108,9 @@ void BM_FleetThroughput(benchmark::State& state) {
     const int rc = posix_spawn(&pid, args[0], &fa, nullptr, args.data(), environ);
     posix_spawn_file_actions_destroy(&fa);
     if (rc != 0) {
-      state.SkipWithError((std::string("cannot start ") + TRIPODAL_TOOL_EXE + ": " + std::strerror(rc)).c_str());
+      failed = true;
+      state.SkipWithError(
+          (std::string("cannot start ") + TRIPODAL_TOOL_EXE + ": " + std::strerror(rc)).c_str());
       return;
     }
     int status = 0;
@@ -109,10 +119,12 @@ void BM_FleetThroughput(benchmark::State& state) {
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     state.SetIterationTime(wall_s);
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+      failed = true;
       const std::string how = WIFEXITED(status) ? "exit code " + std::to_string(WEXITSTATUS(status))
                                                 : "status " + std::to_string(status);
-      state.SkipWithError(("tripodal fleet --robots " + std::to_string(robots) + " ended with " + how + ": \"" +
-                           last_line_with(out, "fleet ") + "\" (its output and the robots' logs are in " + dir.string() + ")")
+      state.SkipWithError(("tripodal fleet --robots " + std::to_string(robots) + " ended with " + how +
+                           ": \"" + last_line_with(out, "") + "\" (its output and the robots' logs are in " +
+                           dir.string() + ")")
                               .c_str());
       return;
     }
@@ -124,7 +136,9 @@ void BM_FleetThroughput(benchmark::State& state) {
       all.ended += r.ended;
       idle += r.started == 0 ? 1 : 0;
     }
-    const auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_usec) * 1e-6; };
+    const auto seconds = [](const timeval& t) {
+      return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_usec) * 1e-6;
+    };
     const double cpu_s = seconds(usage.ru_utime) + seconds(usage.ru_stime);
     state.counters["robots"] = robots;
     state.counters["idle_robots"] = idle;
@@ -165,5 +179,5 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&count, args.data());
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
-  return 0;
+  return failed ? 1 : 0;
 }
