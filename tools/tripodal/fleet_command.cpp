@@ -29,6 +29,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "cli_tool.hpp"
+#include "run_outputs.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/dds/fleet.hpp"
@@ -99,20 +100,16 @@ std::vector<std::string> words_of(std::string_view text) {
   return out;
 }
 
-// The robot's section splitter, with the profile's parameters: the same split the robots make of
-// the same map.
-navi::SectionSplitterOptions splitter_options(const RobotProfile& profile) {
-  navi::SectionSplitterOptions o;
+// The robot's section splitter, configured from the profile's entry as the robot configures it
+// (the module's manifest: defaults, types, ranges, errors located in the profile): the same split
+// the robots make of the same map.
+void configure_from_profile(navi::CSectionSplitter& splitter, const RobotProfile& profile) {
   for (const ModuleEntry& e : profile.navigation) {
     if (e.type != navi::CSectionSplitter::static_manifest().name) continue;
-    const auto number = [&](const char* key, double& v) {
-      if (const auto it = e.parameters.find(key); it != e.parameters.end()) v = std::stod(it->second);
-    };
-    number("min_obstacle_area_m2", o.min_obstacle_area_m2);
-    number("min_gap_m", o.min_gap_m);
-    number("min_section_height_m", o.min_section_height_m);
-    number("min_section_area_m2", o.min_section_area_m2);
-    return o;
+    ParameterValues given;
+    for (const auto& [k, v] : e.parameters) given.emplace(k, Value{v});
+    splitter.configure(given, e.where);
+    return;
   }
   throw ConfigError(profile.where, "tripodal fleet: sharing a room by sections needs the robot's SectionSplitter module");
 }
@@ -155,7 +152,8 @@ std::vector<dds::FleetUnit> units_of(const std::string& task, const sim::World& 
   }
   if (!w.empty() && w[0] == "room") w.erase(w.begin());
   if (w.size() != 1) throw ConfigError(where, "\"" + task + "\" does not divide among robots: " + std::string(kForms));
-  navi::CSectionSplitter splitter(splitter_options(profile));
+  navi::CSectionSplitter splitter;
+  configure_from_profile(splitter, profile);
   splitter.split_map(world.grid, world.regions);
   const KnowledgeAnswer a = splitter.sections_of_room(w[0]);
   if (!a.ok) throw ConfigError(where, a.error);
@@ -296,13 +294,6 @@ std::vector<std::string> last_lines(const std::filesystem::path& file, std::size
   return lines;
 }
 
-std::string fixed1(double v) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(1);
-  s << v;
-  return s.str();
-}
 
 int run(const Args& a, std::ostream& out, std::ostream& err) {
   if (a.kill_robot.has_value() != a.kill_after_s.has_value()) {
@@ -350,7 +341,7 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
     for (int k = 1; k <= a.robots; ++k) robots.push_back({"robot" + std::to_string(k), world.start_pose.x_m, world.start_pose.y_m});
     std::vector<std::string> names;
     names.reserve(units.size());
-    for (const dds::FleetUnit& u : units) names.push_back(u.name + " (" + fixed1(u.area_m2) + " m2)");
+    for (const dds::FleetUnit& u : units) names.push_back(u.name + " (" + app::fixed(u.area_m2, 1) + " m2)");
     out << "tripodal fleet: " << a.robots << " robots, world " << a.world.string() << ", task \"" << a.task << "\": " << units.size()
         << " units:";
     for (const std::string& n : names) out << " " << n;
@@ -376,13 +367,15 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
       if (!f) throw std::runtime_error("cannot write '" + p.string() + "'");
       f.close();
       std::vector<std::string> argv{exe, "run", "--robot", p.string(), "--world", std::filesystem::absolute(a.world).string(),
-                                    "--realtime", fixed1(a.speed), "--max-duration-s", fixed1(a.timeout_s * a.speed + 60.0)};
+                                    "--realtime", app::fixed(a.speed, 3), "--max-duration-s", app::fixed(a.timeout_s * a.speed + 60.0, 1)};
       if (a.seed) argv.insert(argv.end(), {"--seed", std::to_string(*a.seed)});
       children.spawn(r.name, argv, dir / (r.name + ".log"));
     }
 
-    std::signal(SIGINT, on_fleet_stop_signal);
-    std::signal(SIGTERM, on_fleet_stop_signal);
+    // Every way the fleet may be told to end stops its robots first: a closed output (`| head`,
+    // SIGPIPE) or a closed terminal (SIGHUP) too, which would otherwise end the fleet and leave
+    // its robots running to their own limit.
+    for (const int sig : {SIGINT, SIGTERM, SIGPIPE, SIGHUP}) std::signal(sig, on_fleet_stop_signal);
     bool killed = false, timed_out = false;
     auto print = [&](const std::vector<std::string>& lines) {
       for (const std::string& l : lines) out << l << '\n';
@@ -396,12 +389,12 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
         if (const auto since = planner.busy_since_s(victim); since && planner.elapsed_s() - *since >= *a.kill_after_s) {
           children.kill_one(static_cast<std::size_t>(*a.kill_robot - 1));
           killed = true;
-          out << fixed1(planner.elapsed_s()) << " s  killed " << victim << " (SIGKILL), " << fixed1(*a.kill_after_s)
+          out << app::fixed(planner.elapsed_s(), 1) << " s  killed " << victim << " (SIGKILL), " << app::fixed(*a.kill_after_s, 1)
               << " s into its unit\n";
         }
       }
       for (const Children::Ended& e : children.reap()) {
-        out << fixed1(planner.elapsed_s()) << " s  " << e.name << " ended: " << e.how << '\n';
+        out << app::fixed(planner.elapsed_s(), 1) << " s  " << e.name << " ended: " << e.how << '\n';
         // One that never came on DDS will not: no need to wait for the startup timeout. (A robot
         // that was on DDS is declared silent by its lost liveliness, the fleet's DDS path.)
         if (!planner.ready(e.name)) {
@@ -418,7 +411,7 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
     fleet.update();
     print(planner.take_log());
     dds::FleetResult result = planner.result();
-    if (timed_out) result.reason += (result.reason.empty() ? "" : "; ") + std::string("timed out after ") + fixed1(a.timeout_s) + " s";
+    if (timed_out) result.reason += (result.reason.empty() ? "" : "; ") + std::string("timed out after ") + app::fixed(a.timeout_s, 1) + " s";
     if (g_stop != 0) result.reason += (result.reason.empty() ? "" : "; ") + std::string("stopped");
     if (timed_out || g_stop != 0) result.succeeded = false;
     children.stop();
