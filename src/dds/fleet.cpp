@@ -12,6 +12,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <nlohmann/json.hpp>
+
 #include "tripodal/dds/endpoint.hpp"
 
 namespace tripodal::dds {
@@ -22,27 +24,6 @@ std::string fixed1(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.1f", v);
   return buf;
-}
-
-std::string json_string(std::string_view s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
-          out += buf;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
 }
 
 std::string join(const std::vector<std::string>& items, std::string_view sep) {
@@ -100,7 +81,7 @@ std::vector<std::vector<std::size_t>> assign_units(std::span<const FleetUnit> un
   std::iota(order.begin(), order.end(), std::size_t{0});
   std::vector<Spot> at;
   for (const FleetRobot& r : robots) at.push_back({r.x_m, r.y_m});
-  const std::unique_ptr<bool[]> flags(new bool[ok.size()]);
+  const auto flags = std::make_unique<bool[]>(ok.size());  // std::vector<bool> has no span
   for (std::size_t i = 0; i < ok.size(); ++i) flags[i] = ok[i];
   return balance(std::move(order), units, std::vector<double>(robots.size(), 0.0), std::move(at), {flags.get(), ok.size()}, tie_m2);
 }
@@ -135,27 +116,20 @@ std::string FleetResult::text() const {
 }
 
 std::string FleetResult::json() const {
-  std::ostringstream s;
-  s << "{\n  \"succeeded\": " << (succeeded ? "true" : "false") << ",\n  \"reason\": " << json_string(reason)
-    << ",\n  \"duration_s\": " << duration_s << ",\n  \"units\": [";
-  for (std::size_t i = 0; i < units.size(); ++i) {
-    const FleetUnitResult& u = units[i];
-    std::vector<std::string> given;
-    for (const std::string& a : u.assigned) given.push_back(json_string(a));
-    s << (i ? "," : "") << "\n    {\"name\": " << json_string(u.name) << ", \"task\": " << json_string(u.task) << ", \"state\": "
-      << json_string(u.state) << ", \"robot\": " << json_string(u.robot) << ", \"assigned\": [" << join(given, ", ")
-      << "], \"started_s\": " << u.started_s << ", \"finished_s\": " << u.finished_s << ", \"detail\": " << json_string(u.detail) << "}";
+  // ordered_json: the keys in the order a reader expects them (the result first, then the units).
+  using Json = nlohmann::ordered_json;
+  Json out{{"succeeded", succeeded}, {"reason", reason}, {"duration_s", duration_s}};
+  Json& list = out["units"] = Json::array();
+  for (const FleetUnitResult& u : units) {
+    list.push_back(Json{{"name", u.name}, {"task", u.task}, {"state", u.state}, {"robot", u.robot}, {"assigned", u.assigned},
+                        {"started_s", u.started_s}, {"finished_s", u.finished_s}, {"detail", u.detail}});
   }
-  s << "\n  ],\n  \"reassignments\": [";
-  for (std::size_t i = 0; i < reassignments.size(); ++i) {
-    const FleetReassignment& r = reassignments[i];
-    s << (i ? "," : "") << "\n    {\"unit\": " << json_string(r.unit) << ", \"from\": " << json_string(r.from) << ", \"to\": "
-      << json_string(r.to) << ", \"at_s\": " << r.at_s << ", \"reason\": " << json_string(r.reason) << "}";
+  Json& moves = out["reassignments"] = Json::array();
+  for (const FleetReassignment& r : reassignments) {
+    moves.push_back(Json{{"unit", r.unit}, {"from", r.from}, {"to", r.to}, {"at_s", r.at_s}, {"reason", r.reason}});
   }
-  s << "\n  ],\n  \"silent\": [";
-  for (std::size_t i = 0; i < silent.size(); ++i) s << (i ? ", " : "") << json_string(silent[i]);
-  s << "]\n}\n";
-  return s.str();
+  out["silent"] = silent;
+  return out.dump(2) + "\n";
 }
 
 // ---------------------------------------------------------------------------------------------
