@@ -2,6 +2,7 @@
 #include "tripodal/dds/robot_bridge.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <map>
@@ -198,6 +199,12 @@ struct RobotBridge::Impl final : TaskObserver, SupervisorObserver {
     msg::PoseWithCovarianceStamped m;
     m.header = {stamp(nav.pose_stamp), "map"};
     m.pose.pose = pose_of(nav.map_from_base);
+    // The planar (x, y, theta) covariance into ROS's 6 x 6 over (x, y, z, roll, pitch, yaw), row
+    // major: theta is yaw (index 5); the rest stays zero, as amcl leaves it.
+    constexpr std::array<std::size_t, 3> kRosIndex{0, 1, 5};
+    for (std::size_t r = 0; r < 3; ++r) {
+      for (std::size_t c = 0; c < 3; ++c) m.pose.covariance[kRosIndex[r] * 6 + kRosIndex[c]] = nav.pose_covariance[r * 3 + c];
+    }
     pose->publish(m);
     ++n_pose;
   }

@@ -180,6 +180,7 @@ bool CScanMatchingLocalizer::relocalize() {
 void CScanMatchingLocalizer::publish(NavigationData& data) const noexcept {
   data.map_from_base = pose_;
   data.pose_stamp = stamp_;
+  data.pose_covariance = last_.covariance;
   data.localized = localized();
 }
 

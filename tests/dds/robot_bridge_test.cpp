@@ -151,7 +151,23 @@ TEST_CASE("dds: a robot with a dds: section publishes its state and takes a task
   REQUIRE(run_until([&] { return has_event(marks, "marking", "task"); }, 50));
   // The localizer's estimate, once it trusts it.
   CHECK(run_until([&] { return !poses.empty(); }, 100));
-  if (!poses.empty()) CHECK(poses.back().header.frame_id == "map");
+  if (!poses.empty()) {
+    const msg::PoseWithCovarianceStamped& p = poses.back();
+    CHECK(p.header.frame_id == "map");
+    // The scan-matching localizer's covariance, on ROS's (x, y, z, roll, pitch, yaw) axes: the
+    // planar variances positive (a clear match: a standard deviation under 10 cm), symmetric, and
+    // nothing on the axes a ground robot does not move along.
+    const auto& c = p.pose.covariance;
+    CHECK(c[0] > 0.0);
+    CHECK(c[7] > 0.0);
+    CHECK(c[35] > 0.0);
+    CHECK(c[0] < 0.1 * 0.1);
+    CHECK(c[7] < 0.1 * 0.1);
+    CHECK(c[1] == c[6]);
+    CHECK(c[5] == c[30]);
+    CHECK(c[11] == c[31]);
+    for (const std::size_t i : {2, 3, 4, 12, 14, 21, 28}) CHECK(c[i] == 0.0);
+  }
 
   // A command for another robot, an unknown one, then cancel: each answered on the events topic.
   tasks.publish({ros_time(2.0), "psr9", 42, "start", "clean the room 3212"});

@@ -5,6 +5,7 @@
 // "<BehaviorName>.failed".
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -36,6 +37,9 @@ class ObstacleMap {
 struct NavigationData {
   Pose2D map_from_base;      ///< pose estimate in the map frame
   Time pose_stamp{};
+  /// Covariance of map_from_base over (x, y, theta), row-major (m², m·rad, rad²), as the
+  /// localizer estimates it; all zero when it does not (the ground-truth test double).
+  std::array<double, 9> pose_covariance{};
   bool localized = false;    ///< the localizer trusts map_from_base
   std::uint32_t fixes = 0;   ///< global position fixes accepted so far (BhGlobalLocalization)
   bool has_goal = false;
