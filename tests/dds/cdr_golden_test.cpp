@@ -84,6 +84,11 @@ TEST_CASE("dds: the type names are those ROS 2 registers", "[dds]") {
   CHECK(ros_seconds(ros_time(-1.25)) == Approx(-1.25));
   CHECK(ros_time(-1.25).sec == -2);
   CHECK(ros_time(-1.25).nanosec == 750000000U);
+  // A tripodal Time converts to the nanosecond, both ways.
+  const tripodal::Time t{std::chrono::nanoseconds(-1'250'000'001)};
+  CHECK(ros_time(t) == msg::Time{-2, 749'999'999});
+  CHECK(tripodal_time(ros_time(t)) == t);
+  CHECK(tripodal_time(msg::Time{78, 900'000'000}) == tripodal::Time{std::chrono::milliseconds(78'900)});
 }
 
 TEST_CASE("dds: golden CDR bytes of every message type", "[dds]") {

@@ -9,6 +9,8 @@
 #include <string_view>
 #include <vector>
 
+#include "tripodal/core/time.hpp"
+
 namespace tripodal::dds {
 
 // Field names, order and types follow the ROS 2 message definitions (the CDR bytes depend on
@@ -211,5 +213,8 @@ concept Message = requires {
 // The time of a message from seconds (ROS 2's convention: nanosec in [0, 1e9)).
 msg::Time ros_time(double seconds);
 double ros_seconds(const msg::Time& t);
+// The same to and from a tripodal Time, to the nanosecond (lock-step co-simulation compares them).
+msg::Time ros_time(Time t);
+Time tripodal_time(const msg::Time& t);
 
 }  // namespace tripodal::dds
