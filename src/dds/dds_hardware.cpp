@@ -85,8 +85,8 @@ DdsHardware::DdsHardware(const HardwareConfig& config)
     std::lock_guard lock(mutex_);
     if (simulator_silent_) return;
     simulator_silent_ = true;
-    silent_why_ = "the publisher of " + e.topic + " went silent (DDS " + std::string(to_string(e.kind)) +
-                  ": its process died, its lease ran out or it left)";
+    silent_why_ = "the publisher of " + e.topic + " is gone (DDS " + std::string(to_string(e.kind)) +
+                  ", no publisher left: its process died, its lease ran out or it stopped)";
     cv_.notify_all();
   };
   joint_states_ = std::make_unique<Subscriber<msg::JointState>>(

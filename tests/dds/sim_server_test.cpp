@@ -1,0 +1,157 @@
+// `tripodal sim-server` and a robot on hardware "dds" (`tripodal run --hardware dds`): two processes
+// on loopback DDS in lock-step, against the same robot on the in-process simulator; and the server
+// killed mid-task, which the robot must report as a fault and end on, not hang.
+#include <catch2/catch.hpp>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "dds_test_support.hpp"
+
+extern char** environ;
+
+using namespace tripodal::dds::test;
+using namespace std::chrono_literals;
+
+namespace {
+
+const std::string kTool = TRIPODAL_TOOL;
+const std::string kRobot = std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/psr2.yaml";
+const std::string kWorld = std::string(TRIPODAL_SOURCE_DIR) + "/configs/worlds/workspace.yaml";
+
+// A `tripodal` process, its output (stdout and stderr) in a file; killed and reaped on destruction.
+class Tool {
+ public:
+  Tool(std::vector<std::string> args, std::string log) : log_(std::move(log)) {
+    args.insert(args.begin(), kTool);
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t files;
+    posix_spawn_file_actions_init(&files);
+    posix_spawn_file_actions_addopen(&files, 1, log_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&files, 1, 2);
+    const int rc = posix_spawn(&pid_, kTool.c_str(), &files, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&files);
+    REQUIRE(rc == 0);
+  }
+  Tool(const Tool&) = delete;
+  Tool& operator=(const Tool&) = delete;
+  ~Tool() {
+    if (pid_ > 0) {
+      ::kill(pid_, SIGKILL);
+      ::waitpid(pid_, nullptr, 0);
+    }
+  }
+  void kill(int signal) const { ::kill(pid_, signal); }
+  // The exit code, 128 + signal, or -1 if it did not end within the timeout.
+  int wait(std::chrono::milliseconds timeout) {
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < until) {
+      int status = 0;
+      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+        pid_ = 0;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      }
+      std::this_thread::sleep_for(10ms);
+    }
+    return -1;
+  }
+  [[nodiscard]] std::string output() const {
+    std::ifstream f(log_);
+    std::ostringstream s;
+    s << f.rdbuf();
+    return s.str();
+  }
+
+ private:
+  std::string log_;
+  pid_t pid_ = 0;
+};
+
+std::string log_file(const std::string& name) { return "/tmp/" + test_namespace() + "_" + name + ".log"; }
+
+// "78.25 s simulated" of `tripodal run`'s last line.
+double simulated_s(const std::string& out) {
+  std::smatch m;
+  REQUIRE(std::regex_search(out, m, std::regex(R"(; ([0-9.]+) s simulated;)")));
+  return std::stod(m[1].str());
+}
+
+}  // namespace
+
+TEST_CASE("dds: a robot runs its task against tripodal sim-server as on the in-process simulator", "[dds][sim_server]") {
+  const std::string ns = test_namespace();
+  const std::string domain = std::to_string(test_domain(40));
+  const std::string task = "patrol rooms 2111 and 2133";
+  Tool server({"sim-server", "--robot", kRobot, "--world", kWorld, "--namespace", ns, "--domain", domain, "--seed", "1", "--wait-s", "60"},
+              log_file("server"));
+  const auto start = std::chrono::steady_clock::now();
+  Tool robot({"run", "--robot", kRobot, "--world", kWorld, "--task", task, "--seed", "1", "--hardware", "dds", "--hardware-param",
+              "namespace=" + ns, "--hardware-param", "domain_id=" + domain},
+             log_file("robot"));
+  const int robot_exit = robot.wait(60s);
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const std::string out = robot.output();
+  INFO(out);
+  REQUIRE(robot_exit == 0);
+  CHECK(out.find("task patrol succeeded") != std::string::npos);
+  // The robot leaving ends the server, with its report.
+  REQUIRE(server.wait(15s) == 0);
+  const std::string served = server.output();
+  INFO(served);
+  CHECK(std::regex_search(served, std::regex(R"(sim-server ended: the robot left.*; [0-9]+ steps served; [0-9.]+ s simulated; distance [0-9.]+ m; 0 collisions)")));
+
+  // The same robot and seed in one process: the same task, about the same time.
+  Tool local({"run", "--robot", kRobot, "--world", kWorld, "--task", task, "--seed", "1"}, log_file("local"));
+  REQUIRE(local.wait(60s) == 0);
+  const std::string local_out = local.output();
+  CHECK(local_out.find("task patrol succeeded") != std::string::npos);
+  const double remote_s = simulated_s(out);
+  const double local_s = simulated_s(local_out);
+  CHECK(remote_s == Approx(local_s).margin(1.0));
+  WARN("over DDS: " << remote_s << " s simulated in " << wall_s << " s of wall time (robot and server started); in process: " << local_s
+                    << " s simulated");
+}
+
+TEST_CASE("dds: a sim-server killed mid-task is a fault of the robot's hardware, which ends the task", "[dds][sim_server]") {
+  const std::string ns = test_namespace();
+  const std::string domain = std::to_string(test_domain(41));
+  Tool server({"sim-server", "--robot", kRobot, "--world", kWorld, "--namespace", ns, "--domain", domain, "--lease-s", "1", "--wait-s", "60"},
+              log_file("server_killed"));
+  Tool robot({"run", "--robot", kRobot, "--world", kWorld, "--task", "clean the room 2111", "--hardware", "dds", "--hardware-param",
+              "namespace=" + ns, "--hardware-param", "domain_id=" + domain, "--hardware-param", "step_timeout_s=5"},
+             log_file("robot_killed"));
+  // Killed once the robot is cleaning (its life cycle says so).
+  const auto until = std::chrono::steady_clock::now() + 30s;
+  while (robot.output().find("activate BhCleaning") == std::string::npos && std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(20ms);
+  }
+  REQUIRE(robot.output().find("activate BhCleaning") != std::string::npos);
+  std::this_thread::sleep_for(300ms);
+  server.kill(SIGKILL);
+  const auto killed = std::chrono::steady_clock::now();
+  REQUIRE(server.wait(5s) == 128 + SIGKILL);
+  const int robot_exit = robot.wait(20s);
+  const double after_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - killed).count();
+  const std::string out = robot.output();
+  INFO(out);
+  CHECK(robot_exit == 4);  // the task failed: no hang, no crash
+  CHECK(out.find("fault hardware: ") != std::string::npos);
+  CHECK(out.find("PrCleaning failed: module hardware failed: ") != std::string::npos);
+  CHECK(out.find("task clean failed") != std::string::npos);
+  // Seen within the server's 1 s lease (or the 5 s step timeout), and the run ends at once after.
+  CHECK(after_s < 6.0);
+  WARN("the robot ended " << after_s << " s after the server was killed");
+}
