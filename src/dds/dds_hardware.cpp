@@ -12,6 +12,7 @@ BaseTopics::BaseTopics(const std::string& ns)
     : cmd_vel(ros_topic("cmd_vel", ns)),
       joint_states(ros_topic("joint_states", ns)),
       scan(ros_topic("scan", ns)),
+      clock(ros_topic("clock")),  // ROS 2 nodes follow /clock, whatever their namespace
       sim_step(ros_topic("tripodal/sim_step", ns)),
       sim_state(ros_topic("tripodal/sim_state", ns)) {}
 

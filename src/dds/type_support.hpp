@@ -160,6 +160,14 @@ struct TypeSupport<msg::JointState> {
 };
 
 template <>
+struct TypeSupport<msg::Clock> {
+  using C = rosgraph_msgs_msg_dds__Clock_;
+  static const dds_topic_descriptor_t* descriptor() { return &rosgraph_msgs_msg_dds__Clock__desc; }
+  static C to_c(const msg::Clock& m) { return {detail::to_c(m.clock)}; }
+  static msg::Clock from_c(const C& c) { return {detail::from_c(c.clock)}; }
+};
+
+template <>
 struct TypeSupport<msg::OccupancyGrid> {
   using C = nav_msgs_msg_dds__OccupancyGrid_;
   static const dds_topic_descriptor_t* descriptor() { return &nav_msgs_msg_dds__OccupancyGrid__desc; }

@@ -77,6 +77,7 @@ TEST_CASE("dds: the type names are those ROS 2 registers", "[dds]") {
   CHECK(MessageType<msg::String>::dds == "std_msgs::msg::dds_::String_");
   CHECK(MessageType<msg::Event>::dds == "tripodal_msgs::msg::dds_::Event_");
   CHECK(MessageType<msg::JointState>::dds == "sensor_msgs::msg::dds_::JointState_");
+  CHECK(MessageType<msg::Clock>::dds == "rosgraph_msgs::msg::dds_::Clock_");
   CHECK(MessageType<msg::SimStep>::dds == "tripodal_msgs::msg::dds_::SimStep_");
   CHECK(MessageType<msg::SimState>::dds == "tripodal_msgs::msg::dds_::SimState_");
   CHECK(ros_topic("cmd_vel") == "rt/cmd_vel");
@@ -150,6 +151,10 @@ TEST_CASE("dds: golden CDR bytes of every message type", "[dds]") {
     for (const std::string& n : m.name) w.str(n);
     for (const auto* v : {&m.position, &m.velocity, &m.effort}) w.u32(static_cast<std::uint32_t>(v->size())).f64s(*v);
     check_golden(p, m, w.bytes());
+  }
+  SECTION("rosgraph_msgs/Clock") {
+    const msg::Clock m{{78, 900000000}};
+    check_golden(p, m, CdrWriter().time(m.clock).bytes());
   }
   SECTION("nav_msgs/OccupancyGrid") {
     const auto m = sample_grid();

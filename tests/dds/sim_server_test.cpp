@@ -18,6 +18,8 @@
 #include <vector>
 
 #include "dds_test_support.hpp"
+#include "tripodal/dds/dds_hardware.hpp"
+#include "tripodal/dds/endpoint.hpp"
 
 extern char** environ;
 
@@ -154,4 +156,45 @@ TEST_CASE("dds: a sim-server killed mid-task is a fault of the robot's hardware,
   // Seen within the server's 1 s lease (or the 5 s step timeout), and the run ends at once after.
   CHECK(after_s < 6.0);
   WARN("the robot ended " << after_s << " s after the server was killed");
+}
+
+TEST_CASE("dds: sim-server --realtime runs on its own, driven by cmd_vel, publishing clock", "[dds][sim_server]") {
+  const std::string ns = test_namespace();
+  const std::uint32_t domain = test_domain(44);
+  Tool server({"sim-server", "--robot", kRobot, "--world", kWorld, "--namespace", ns, "--domain", std::to_string(domain), "--realtime", "5"},
+              log_file("server_realtime"));
+  tripodal::dds::ParticipantOptions po;
+  po.domain_id = domain;
+  tripodal::dds::Participant p(po);
+  const tripodal::dds::BaseTopics topics(ns);
+  tripodal::dds::Publisher<tripodal::dds::msg::Twist> cmd_vel(p, topics.cmd_vel, {.kind = tripodal::dds::TopicKind::command});
+  tripodal::dds::Subscriber<tripodal::dds::msg::Clock> clock(p, topics.clock, {.kind = tripodal::dds::TopicKind::state});
+  tripodal::dds::Subscriber<tripodal::dds::msg::SimState> state(p, topics.sim_state, {.kind = tripodal::dds::TopicKind::state});
+  REQUIRE(cmd_vel.wait_for_subscribers(1, 10s));
+  REQUIRE(clock.wait_for_publishers(1, 10s));
+  REQUIRE(state.wait_for_publishers(1, 10s));
+  // Forward at 0.2 m/s for a second of wall time (about 5 s simulated at 5x).
+  double start_x = -1.0;
+  double last_x = 0.0;
+  const auto until = std::chrono::steady_clock::now() + 1s;
+  while (std::chrono::steady_clock::now() < until) {
+    cmd_vel.publish({{0.2, 0.0, 0.0}, {0.0, 0.0, 0.0}});
+    for (const auto& s : state.take()) {
+      if (start_x < 0.0) start_x = s.x;
+      last_x = s.x;
+    }
+    std::this_thread::sleep_for(50ms);
+  }
+  const auto ticks = clock.take(1000);
+  REQUIRE(!ticks.empty());
+  const double simulated_s = tripodal::dds::ros_seconds(ticks.back().clock);
+  server.kill(SIGTERM);
+  REQUIRE(server.wait(10s) == 0);
+  const std::string out = server.output();
+  INFO(out);
+  CHECK(simulated_s > 0.5);   // it runs by itself (5 s at 5x on a quiet machine; a loaded one lags)
+  CHECK(simulated_s < 10.0);  // and no faster than asked
+  CHECK(last_x - start_x > 0.05);  // cmd_vel drove it (the start pose faces +x)
+  CHECK(std::regex_search(out, std::regex(R"(sim-server ended: stopped; [0-9]+ periods; [0-9.]+ s simulated; distance [0-9.]+ m; 0 collisions)")));
+  WARN("--realtime 5: " << simulated_s << " s simulated in about 1 s of wall time; moved " << last_x - start_x << " m");
 }

@@ -16,6 +16,7 @@
 
 #include "cli_tool.hpp"
 #include "run_outputs.hpp"
+#include "tripodal/core/clock.hpp"
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/dds/dds_hardware.hpp"
 #include "tripodal/dds/endpoint.hpp"
@@ -40,7 +41,10 @@ constexpr std::string_view kDescription =
     "robot is the same profile with its hardware of type dds: `tripodal run --robot ROBOT.yaml\n"
     "--world WORLD.yaml --hardware dds --hardware-param namespace=NS ...`. Serves one robot until\n"
     "it leaves or the server is stopped (Ctrl-C, SIGTERM), then prints what the simulation measured:\n"
-    "simulated time, distance, collisions and the world's events.";
+    "simulated time, distance, collisions and the world's events. With --realtime [SPEED] it runs on\n"
+    "its own at SPEED times real time instead, driven by plain cmd_vel (geometry_msgs/Twist; none for\n"
+    "0.5 s: the base stops) and publishing /clock (rosgraph_msgs/Clock), as ROS 2 tools expect,\n"
+    "until stopped.";
 
 constexpr std::string_view kExitCodes =
     "exit codes: 0 served until the robot left or the server was stopped, 1 bad profile/world, 2 bad\n"
@@ -54,6 +58,8 @@ struct Args {
   double lease_s = 2.0;
   double wait_s = 0.0;
   bool system_network = false;
+  CLI::Option* realtime = nullptr;  // given at all (with or without SPEED)
+  double realtime_speed = 0.0;      // 0: --realtime without SPEED
 };
 
 volatile std::sig_atomic_t g_stop = 0;
@@ -62,6 +68,8 @@ extern "C" void on_sim_server_stop_signal(int) { g_stop = 1; }
 // The step requests and the client's comings and goings, from Cyclone DDS threads.
 struct Inbox {
   std::mutex mutex;
+  std::optional<dds::msg::Twist> cmd_vel;  // --realtime: the latest, and when it came
+  std::chrono::steady_clock::time_point cmd_vel_at;
   std::condition_variable cv;
   std::deque<dds::msg::SimStep> steps;
   bool had_client = false;
@@ -117,13 +125,26 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
       }
       inbox.cv.notify_all();
     };
-    dds::Subscriber<dds::msg::SimStep> steps(participant, topics.sim_step,
-                                             {.kind = dds::TopicKind::state, .on_status = on_status},
-                                             [&inbox](const dds::msg::SimStep& s) {
-                                               std::lock_guard lock(inbox.mutex);
-                                               inbox.steps.push_back(s);
-                                               inbox.cv.notify_all();
-                                             });
+    const bool realtime = a.realtime->count() > 0;
+    std::optional<dds::Subscriber<dds::msg::SimStep>> steps;
+    std::optional<dds::Subscriber<dds::msg::Twist>> cmd_vel;
+    std::optional<dds::Publisher<dds::msg::Clock>> clock;
+    if (realtime) {
+      cmd_vel.emplace(participant, topics.cmd_vel, dds::EndpointOptions{.kind = dds::TopicKind::command},
+                      [&inbox](const dds::msg::Twist& t) {
+                        std::lock_guard lock(inbox.mutex);
+                        inbox.cmd_vel = t;
+                        inbox.cmd_vel_at = std::chrono::steady_clock::now();
+                      });
+      clock.emplace(participant, topics.clock, dds::EndpointOptions{.kind = dds::TopicKind::state});
+    } else {
+      steps.emplace(participant, topics.sim_step, dds::EndpointOptions{.kind = dds::TopicKind::state, .on_status = on_status},
+                    [&inbox](const dds::msg::SimStep& s) {
+                      std::lock_guard lock(inbox.mutex);
+                      inbox.steps.push_back(s);
+                      inbox.cv.notify_all();
+                    });
+    }
     // Reliable scans: a lock-step robot counts on every one (ROS 2's best-effort readers match too).
     dds::Qos scan_qos = dds::qos_for(dds::TopicKind::scan, dds::Role::publisher);
     scan_qos.reliability = dds::Reliability::reliable;
@@ -135,7 +156,11 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
     std::signal(SIGTERM, on_sim_server_stop_signal);
     out << "tripodal sim-server: robot " << profile.name << " (" << base->type << " base, " << sim.wheel_count() << " wheels), world "
         << a.world.string() << ", seed " << seed << "; domain " << a.domain << ", serving " << topics.scan << ", "
-        << topics.joint_states << ", " << topics.sim_state << "; steps on " << topics.sim_step << "\n";
+        << topics.joint_states << ", " << topics.sim_state
+        << (realtime ? ", " + topics.clock + " at " + app::fixed(a.realtime_speed > 0.0 ? a.realtime_speed : 1.0, 1) +
+                           " times real time; commands on " + topics.cmd_vel
+                     : "; steps on " + topics.sim_step)
+        << "\n";
     out.flush();
 
     const std::size_t n = sim.wheel_count();
@@ -150,10 +175,8 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
     const auto started = std::chrono::steady_clock::now();
     std::string ended = "stopped";
     int code = kOk;
-    // One step: the command over it, the world advanced, what the sensors gave, then the state.
-    auto serve = [&](const dds::msg::SimStep& s) {
-      sim.command_twist(Twist2D{s.cmd_vel.linear.x, s.cmd_vel.linear.y, s.cmd_vel.angular.z});
-      sim.step_until(dds::tripodal_time(s.until));
+    // After a step: what the sensors gave, then the state (and with --realtime the clock).
+    auto publish = [&](std::uint32_t step) {
       const LaserResource& laser = sim.laser();
       if (laser.sequence() != laser_seen && laser.has_reading()) {
         laser_seen = laser.sequence();
@@ -181,12 +204,42 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
       }
       joints.publish(js);
       ++joint_states;
-      last_step = s.step;
+      last_step = step;
       const Pose2D& p = sim.pose();
       state.publish(dds::msg::SimState{dds::ros_time(sim.now()), p.x_m, p.y_m, p.theta_rad, sim.distance_m(), last_step, scans,
                                        joint_states, static_cast<std::uint32_t>(sim.collisions())});
+      if (clock) clock->publish(dds::msg::Clock{dds::ros_time(sim.now())});
     };
-    while (g_stop == 0) {
+    // Lock-step: the command over the step, the world advanced to its end, then what it gave.
+    auto serve = [&](const dds::msg::SimStep& s) {
+      sim.command_twist(Twist2D{s.cmd_vel.linear.x, s.cmd_vel.linear.y, s.cmd_vel.angular.z});
+      sim.step_until(dds::tripodal_time(s.until));
+      publish(s.step);
+    };
+    // Real time: a physics period at a time, paced to the wall clock, with the latest cmd_vel
+    // (none within kCmdTimeout: the base stops, as a ROS 2 base driver does).
+    if (realtime) {
+      constexpr auto kPeriod = std::chrono::milliseconds(10);
+      constexpr auto kCmdTimeout = std::chrono::milliseconds(500);
+      SteadyClock wall;
+      sim::RealtimePacer pacer(wall, a.realtime_speed > 0.0 ? a.realtime_speed : 1.0);
+      std::uint32_t periods = 0;
+      publish(periods);
+      while (g_stop == 0) {
+        Twist2D command{};
+        {
+          std::lock_guard lock(inbox.mutex);
+          if (inbox.cmd_vel && std::chrono::steady_clock::now() - inbox.cmd_vel_at < kCmdTimeout) {
+            command = {inbox.cmd_vel->linear.x, inbox.cmd_vel->linear.y, inbox.cmd_vel->angular.z};
+          }
+        }
+        sim.command_twist(command);
+        sim.step(kPeriod);
+        publish(++periods);
+        pacer.pace(sim.now());
+      }
+    }
+    while (!realtime && g_stop == 0) {
       std::unique_lock lock(inbox.mutex);
       // Wakes for a request or a departure, and every 100 ms to see a signal.
       inbox.cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return !inbox.steps.empty() || inbox.client_left; });
@@ -208,7 +261,7 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
         break;
       }
     }
-    out << "sim-server ended: " << ended << "; " << last_step << " steps served; " << app::fixed(to_seconds(sim.now()), 2)
+    out << "sim-server ended: " << ended << "; " << last_step << (realtime ? " periods" : " steps served") << "; " << app::fixed(to_seconds(sim.now()), 2)
         << " s simulated; distance " << app::fixed(sim.distance_m(), 2) << " m; " << sim.collisions() << " collisions\n";
     for (const sim::SimEvent& e : sim.events()) {
       out << app::fixed(to_seconds(e.stamp), 3) << " s  simulator: " << sim::to_string(e.kind) << (e.detail.empty() ? "" : " " + e.detail)
@@ -237,6 +290,12 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_option("--wait-s", a->wait_s, "S: give up (exit 4) when no robot came within S of wall time; 0: wait until stopped")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  // Without SPEED CLI11 hands the option an empty value, which leaves realtime_speed at 0.
+  a->realtime = cmd.add_option("--realtime", a->realtime_speed,
+                               "[SPEED]: free-running at SPEED times real time (default 1), driven by cmd_vel, publishing clock "
+                               "(for ROS 2 tools; no lock-step)")
+                    ->expected(0, 1)
+                    ->check(cli::positive_number() | CLI::IsMember({"", "true"}));
   cmd.add_flag("--system-network", a->system_network, "Cyclone DDS's own network configuration instead of loopback only");
   return [a](std::ostream& out, std::ostream& err) { return run(*a, out, err); };
 }

@@ -23,7 +23,7 @@ namespace tripodal::dds {
 
 // The topics of a base on DDS under namespace `ns` (shared by DdsHardware and the sim-server).
 struct BaseTopics {
-  std::string cmd_vel, joint_states, scan, sim_step, sim_state;
+  std::string cmd_vel, joint_states, scan, clock, sim_step, sim_state;
   explicit BaseTopics(const std::string& ns);
 };
 

@@ -117,6 +117,11 @@ struct JointState {  // sensor_msgs/JointState; position, velocity, effort empty
   bool operator==(const JointState&) const = default;
 };
 
+struct Clock {  // rosgraph_msgs/Clock: the simulated time (ROS 2's use_sim_time)
+  Time clock;
+  bool operator==(const Clock&) const = default;
+};
+
 struct MapMetaData {  // nav_msgs/MapMetaData
   Time map_load_time;
   float resolution = 0.0F;
@@ -198,6 +203,7 @@ TRIPODAL_DDS_MESSAGE_TYPE(Odometry, "nav_msgs", "Odometry");
 TRIPODAL_DDS_MESSAGE_TYPE(OccupancyGrid, "nav_msgs", "OccupancyGrid");
 TRIPODAL_DDS_MESSAGE_TYPE(LaserScan, "sensor_msgs", "LaserScan");
 TRIPODAL_DDS_MESSAGE_TYPE(JointState, "sensor_msgs", "JointState");
+TRIPODAL_DDS_MESSAGE_TYPE(Clock, "rosgraph_msgs", "Clock");
 TRIPODAL_DDS_MESSAGE_TYPE(Event, "tripodal_msgs", "Event");
 TRIPODAL_DDS_MESSAGE_TYPE(TaskCommand, "tripodal_msgs", "TaskCommand");
 TRIPODAL_DDS_MESSAGE_TYPE(SimStep, "tripodal_msgs", "SimStep");
