@@ -3,25 +3,18 @@
 // killed mid-task, which the robot must report as a fault and end on, not hang.
 #include <catch2/catch.hpp>
 
-#include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
-#include <fstream>
 #include <regex>
-#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "child_process.hpp"
 #include "dds_test_support.hpp"
 #include "tripodal/dds/dds_hardware.hpp"
 #include "tripodal/dds/endpoint.hpp"
-
-extern char** environ;
 
 using namespace tripodal::dds::test;
 using namespace std::chrono_literals;
@@ -32,54 +25,10 @@ const std::string kTool = TRIPODAL_TOOL;
 const std::string kRobot = std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/psr2.yaml";
 const std::string kWorld = std::string(TRIPODAL_SOURCE_DIR) + "/configs/worlds/workspace.yaml";
 
-// A `tripodal` process, its output (stdout and stderr) in a file; killed and reaped on destruction.
-class Tool {
+// A `tripodal` process, its output (stdout and stderr) in a file.
+class Tool : public ChildProcess {
  public:
-  Tool(std::vector<std::string> args, std::string log) : log_(std::move(log)) {
-    args.insert(args.begin(), kTool);
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t files;
-    posix_spawn_file_actions_init(&files);
-    posix_spawn_file_actions_addopen(&files, 1, log_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&files, 1, 2);
-    const int rc = posix_spawn(&pid_, kTool.c_str(), &files, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&files);
-    REQUIRE(rc == 0);
-  }
-  Tool(const Tool&) = delete;
-  Tool& operator=(const Tool&) = delete;
-  ~Tool() {
-    if (pid_ > 0) {
-      ::kill(pid_, SIGKILL);
-      ::waitpid(pid_, nullptr, 0);
-    }
-  }
-  void kill(int signal) const { ::kill(pid_, signal); }
-  // The exit code, 128 + signal, or -1 if it did not end within the timeout.
-  int wait(std::chrono::milliseconds timeout) {
-    const auto until = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < until) {
-      int status = 0;
-      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-        pid_ = 0;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      }
-      std::this_thread::sleep_for(10ms);
-    }
-    return -1;
-  }
-  [[nodiscard]] std::string output() const {
-    std::ifstream f(log_);
-    std::ostringstream s;
-    s << f.rdbuf();
-    return s.str();
-  }
-
- private:
-  std::string log_;
-  pid_t pid_ = 0;
+  Tool(std::vector<std::string> args, std::string log) : ChildProcess(kTool, std::move(args), std::move(log)) {}
 };
 
 std::string log_file(const std::string& name) { return "/tmp/" + test_namespace() + "_" + name + ".log"; }
