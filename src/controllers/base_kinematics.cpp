@@ -12,7 +12,8 @@ namespace {
 const ControllerConfig& checked_base(const ControllerConfig& base) {
   Diagnostics d = validate(base);
   if (base.type != "differential" && base.type != "omni" && base.type != "mecanum") {
-    d.error(base.where, "the base must be of type \"differential\", \"omni\" or \"mecanum\", got \"" + base.type + "\"");
+    d.error(base.where,
+            "the base must be of type \"differential\", \"omni\" or \"mecanum\", got \"" + base.type + "\"");
   }
   if (d.has_errors()) throw ConfigError(std::move(d));
   return base;
@@ -38,16 +39,16 @@ void BaseKinematics::inverse(const Twist2D& twist, std::span<double> wheel_rad_s
   if (holonomic_) {
     holonomic_->inverse(twist, wheel_rad_s);
   } else {
-    differential_inverse(base_.differential.wheel_separation_m, base_.differential.wheel_radius_m, twist, wheel_rad_s[0],
-                         wheel_rad_s[1]);
+    differential_inverse(base_.differential.wheel_separation_m, base_.differential.wheel_radius_m, twist,
+                         wheel_rad_s[0], wheel_rad_s[1]);
   }
 }
 
 Twist2D BaseKinematics::forward(std::span<const double> wheel_rad_s) const noexcept {
   if (wheel_rad_s.size() != wheels_) return {};
   if (holonomic_) return holonomic_->forward(wheel_rad_s);
-  return differential_forward(base_.differential.wheel_separation_m, base_.differential.wheel_radius_m, wheel_rad_s[0],
-                              wheel_rad_s[1]);
+  return differential_forward(base_.differential.wheel_separation_m, base_.differential.wheel_radius_m,
+                              wheel_rad_s[0], wheel_rad_s[1]);
 }
 
 }  // namespace tripodal

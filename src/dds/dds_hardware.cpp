@@ -18,18 +18,24 @@ BaseTopics::BaseTopics(const std::string& ns)
 
 const ModuleManifest& DdsHardware::static_manifest() {
   static const ModuleManifest m = hardware_manifest(
-      "dds", "a base and its laser behind DDS (ROS 2 topics cmd_vel, joint_states, scan): tripodal sim-server or a base driver",
+      "dds",
+      "a base and its laser behind DDS (ROS 2 topics cmd_vel, joint_states, scan): tripodal sim-server or a "
+      "base driver",
       {"laser_scan"},
-      {parameter::text("namespace", "", "ROS 2 namespace of the base's topics (the sim-server's --namespace); empty: none"),
+      {parameter::text("namespace", "",
+                       "ROS 2 namespace of the base's topics (the sim-server's --namespace); empty: none"),
        parameter::number("domain_id", 0.0, "", "DDS domain (ROS_DOMAIN_ID)", 0.0, 232.0),
-       parameter::flag("loopback", true, "stay on 127.0.0.1 (false: Cyclone DDS's own network configuration)"),
+       parameter::flag("loopback", true,
+                       "stay on 127.0.0.1 (false: Cyclone DDS's own network configuration)"),
        parameter::flag("lock_step", true,
-                       "the base is a simulator (tripodal sim-server) that advances with the robot's clock; false: a real "
+                       "the base is a simulator (tripodal sim-server) that advances with the robot's clock; "
+                       "false: a real "
                        "base on its own time"),
-       parameter::number("step_timeout_s", 5.0, "s", "lock-step: the longest wait for the simulator's answer (wall time)",
-                         0.001, 3600.0),
-       parameter::number("connect_timeout_s", 10.0, "s", "lock-step: the longest wait for the simulator at the start (wall time)",
-                         0.001, 3600.0)});
+       parameter::number("step_timeout_s", 5.0, "s",
+                         "lock-step: the longest wait for the simulator's answer (wall time)", 0.001, 3600.0),
+       parameter::number("connect_timeout_s", 10.0, "s",
+                         "lock-step: the longest wait for the simulator at the start (wall time)", 0.001,
+                         3600.0)});
   return m;
 }
 
@@ -38,11 +44,13 @@ namespace {
 // Checks what the manifest cannot: the base, and the namespace as ROS 2 would take it.
 const ControllerConfig& base_of(const HardwareConfig& c) {
   Diagnostics d;
-  if (c.base == nullptr) d.error(c.where, "hardware '" + c.type + "' needs the robot's base controller (its wheel geometry)");
+  if (c.base == nullptr)
+    d.error(c.where, "hardware '" + c.type + "' needs the robot's base controller (its wheel geometry)");
   const std::string& ns = c.parameters.string("namespace");
   if (!is_ros_namespace(ns)) {
     d.error(c.where, "hardware '" + c.type + "' namespace '" + ns +
-                         "' is not a ROS 2 namespace: names of letters, digits and '_', not starting with a digit, separated by '/'");
+                         "' is not a ROS 2 namespace: names of letters, digits and '_', not starting with a "
+                         "digit, separated by '/'");
   }
   if (d.has_errors()) throw ConfigError(std::move(d));
   return *c.base;
@@ -80,8 +88,8 @@ DdsHardware::DdsHardware(const HardwareConfig& config)
 
   // A simulator (or base driver) that goes away is the hardware's fault.
   auto on_status = [this](const StatusEvent& e) {
-    const bool gone = (e.kind == StatusKind::liveliness_lost || e.kind == StatusKind::publication_matched) && e.current_count == 0 &&
-                      e.total_count > 0;
+    const bool gone = (e.kind == StatusKind::liveliness_lost || e.kind == StatusKind::publication_matched) &&
+                      e.current_count == 0 && e.total_count > 0;
     if (!gone) return;
     std::lock_guard lock(mutex_);
     if (simulator_silent_) return;
@@ -91,7 +99,8 @@ DdsHardware::DdsHardware(const HardwareConfig& config)
     cv_.notify_all();
   };
   joint_states_ = std::make_unique<Subscriber<msg::JointState>>(
-      *participant_, topics_.joint_states, EndpointOptions{.kind = TopicKind::state, .on_status = lock_step_ ? StatusCallback{} : on_status},
+      *participant_, topics_.joint_states,
+      EndpointOptions{.kind = TopicKind::state, .on_status = lock_step_ ? StatusCallback{} : on_status},
       [this](const msg::JointState& m) {
         std::lock_guard lock(mutex_);
         ++joint_states_received_;
@@ -102,13 +111,14 @@ DdsHardware::DdsHardware(const HardwareConfig& config)
         }
         cv_.notify_all();
       });
-  cmd_vel_ = std::make_unique<Publisher<msg::Twist>>(*participant_, topics_.cmd_vel, EndpointOptions{.kind = TopicKind::command});
+  cmd_vel_ = std::make_unique<Publisher<msg::Twist>>(*participant_, topics_.cmd_vel,
+                                                     EndpointOptions{.kind = TopicKind::command});
   if (lock_step_) {
     // One request at a time, each answered before the next: keep the last one only.
     Qos step_qos = qos_for(TopicKind::state, Role::publisher);
     step_qos.depth = 1;
-    sim_step_ = std::make_unique<Publisher<msg::SimStep>>(*participant_, topics_.sim_step,
-                                                          EndpointOptions{.kind = TopicKind::state, .qos = step_qos});
+    sim_step_ = std::make_unique<Publisher<msg::SimStep>>(
+        *participant_, topics_.sim_step, EndpointOptions{.kind = TopicKind::state, .qos = step_qos});
     sim_state_ = std::make_unique<Subscriber<msg::SimState>>(
         *participant_, topics_.sim_state, EndpointOptions{.kind = TopicKind::state, .on_status = on_status},
         [this](const msg::SimState& s) {
@@ -126,9 +136,13 @@ DdsHardware::~DdsHardware() {
   laser_.reset();
 }
 
-void DdsHardware::on_add_resources(ResourceTable& table) { table.add(*laser_); }
+void DdsHardware::on_add_resources(ResourceTable& table) {
+  table.add(*laser_);
+}
 
-Twist2D DdsHardware::commanded_twist() const noexcept { return kinematics_.forward(command_); }
+Twist2D DdsHardware::commanded_twist() const noexcept {
+  return kinematics_.forward(command_);
+}
 
 bool DdsHardware::write_wheel_velocities(std::span<const double> wheel_rad_s) noexcept {
   if (wheel_rad_s.size() != command_.size() || lost_) return false;
@@ -146,8 +160,10 @@ bool DdsHardware::write_wheel_velocities(std::span<const double> wheel_rad_s) no
   return true;
 }
 
-bool DdsHardware::read_wheel_states(std::span<double> velocity_rad_s, std::span<double> position_rad) noexcept {
-  if (velocity_rad_s.size() != command_.size() || position_rad.size() != command_.size() || lost_) return false;
+bool DdsHardware::read_wheel_states(std::span<double> velocity_rad_s,
+                                    std::span<double> position_rad) noexcept {
+  if (velocity_rad_s.size() != command_.size() || position_rad.size() != command_.size() || lost_)
+    return false;
   std::lock_guard lock(mutex_);
   if (!has_wheels_) return false;
   std::copy(wheel_velocity_.begin(), wheel_velocity_.end(), velocity_rad_s.begin());
@@ -173,7 +189,8 @@ bool DdsHardware::connect() noexcept {
                                                            until - std::chrono::steady_clock::now())) &&
                     laser_->matched_publishers() > 0 && joint_states_->matched_publishers() > 0;
     if (!ok) {
-      fail("no simulator answers on " + topics_.sim_step + " within " + std::to_string(connect_timeout_.count()) +
+      fail("no simulator answers on " + topics_.sim_step + " within " +
+           std::to_string(connect_timeout_.count()) +
            " ms (is `tripodal sim-server` running with this namespace and domain?)");
       return false;
     }
@@ -203,7 +220,8 @@ void DdsHardware::advance(Time now) {
   const Twist2D t = commanded_twist();
   const std::uint32_t step = ++step_;
   try {
-    sim_step_->publish(msg::SimStep{ros_time(now), {{t.vx_m_s, t.vy_m_s, 0.0}, {0.0, 0.0, t.wz_rad_s}}, step});
+    sim_step_->publish(
+        msg::SimStep{ros_time(now), {{t.vx_m_s, t.vy_m_s, 0.0}, {0.0, 0.0, t.wz_rad_s}}, step});
   } catch (const std::exception& e) {
     fail(std::string("the step request could not be sent: ") + e.what());
     return;
@@ -215,8 +233,8 @@ void DdsHardware::advance(Time now) {
   };
   if (!cv_.wait_for(lock, step_timeout_, answered)) {
     lock.unlock();
-    fail("the simulator did not answer step " + std::to_string(step) + " (to " + std::to_string(to_seconds(now)) + " s) within " +
-         std::to_string(step_timeout_.count()) + " ms");
+    fail("the simulator did not answer step " + std::to_string(step) + " (to " +
+         std::to_string(to_seconds(now)) + " s) within " + std::to_string(step_timeout_.count()) + " ms");
     return;
   }
   if (simulator_silent_) {
@@ -231,8 +249,9 @@ void DdsHardware::advance(Time now) {
 }
 
 void register_dds_hardware(HardwareRegistry& registry) {
-  registry.add(DdsHardware::static_manifest(),
-               [](const HardwareConfig& c) -> std::unique_ptr<CHardware> { return std::make_unique<DdsHardware>(c); });
+  registry.add(DdsHardware::static_manifest(), [](const HardwareConfig& c) -> std::unique_ptr<CHardware> {
+    return std::make_unique<DdsHardware>(c);
+  });
 }
 
 }  // namespace tripodal::dds

@@ -9,7 +9,6 @@
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
-
 #include <chrono>
 #include <fstream>
 #include <sstream>
@@ -24,7 +23,8 @@ namespace tripodal::dds::test {
 class ChildProcess {
  public:
   // `args` without the program; with `log`, its stdout and stderr go to that file.
-  ChildProcess(const std::string& program, std::vector<std::string> args, std::string log = {}) : log_(std::move(log)) {
+  ChildProcess(const std::string& program, std::vector<std::string> args, std::string log = {})
+      : log_(std::move(log)) {
     args.insert(args.begin(), program);
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());

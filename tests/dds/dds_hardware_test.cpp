@@ -1,14 +1,14 @@
 // The hardware type "dds" through the library: created by name, its wheel commands out on cmd_vel by
 // the base's kinematics, no simulator a fault rather than a hang, its bad parameters located. The
 // lock-step with `tripodal sim-server` is tests/dds/sim_server_test.cpp (two processes).
-#include <catch2/catch.hpp>
+#include "tripodal/dds/dds_hardware.hpp"
 
 #include <array>
+#include <catch2/catch.hpp>
 #include <chrono>
 
 #include "dds_test_support.hpp"
 #include "tripodal/controllers/base_kinematics.hpp"
-#include "tripodal/dds/dds_hardware.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/robot/robot_profile.hpp"
 
@@ -20,7 +20,8 @@ using namespace std::chrono_literals;
 namespace {
 
 ControllerConfig psr2_base() {
-  const auto base = base_controller_config(load_robot_profile(std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/psr2.yaml"));
+  const auto base = base_controller_config(
+      load_robot_profile(std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/psr2.yaml"));
   REQUIRE(base.has_value());
   return *base;
 }
@@ -36,7 +37,8 @@ HardwareConfig dds_config(const ControllerConfig* base, ParameterValues given) {
 
 }  // namespace
 
-TEST_CASE("dds: hardware dds sends the wheels' command as cmd_vel; no simulator is its fault, not a hang", "[dds]") {
+TEST_CASE("dds: hardware dds sends the wheels' command as cmd_vel; no simulator is its fault, not a hang",
+          "[dds]") {
   const ControllerConfig base = psr2_base();
   const std::uint32_t domain = test_domain(42);
   HardwareRegistry registry{"hardware type"};
@@ -79,7 +81,8 @@ TEST_CASE("dds: hardware dds sends the wheels' command as cmd_vel; no simulator 
   CHECK(std::chrono::steady_clock::now() - t0 < 3s);
   const auto reported = faults.take_faults();
   REQUIRE(reported.size() == 1);
-  CHECK_THAT(reported[0], Catch::Contains("no simulator answers on rt/" + test_namespace() + "/tripodal/sim_step within 300 ms"));
+  CHECK_THAT(reported[0], Catch::Contains("no simulator answers on rt/" + test_namespace() +
+                                          "/tripodal/sim_step within 300 ms"));
   CHECK_FALSE(dds_hw.link_up());
   t0 = std::chrono::steady_clock::now();
   hw->advance_to(Time{std::chrono::milliseconds(10)});
@@ -89,12 +92,17 @@ TEST_CASE("dds: hardware dds sends the wheels' command as cmd_vel; no simulator 
   CHECK_FALSE(hw->wheels().read_wheel_states(velocity, position));
 }
 
-TEST_CASE("dds: hardware dds refuses a namespace ROS 2 would not take and a robot without a base, located", "[dds]") {
+TEST_CASE("dds: hardware dds refuses a namespace ROS 2 would not take and a robot without a base, located",
+          "[dds]") {
   const ControllerConfig base = psr2_base();
-  CHECK_THROWS_WITH(DdsHardware(dds_config(&base, {{"namespace", Value{std::string("9lives")}}, {"domain_id", Value{43.0}}})),
-                    Catch::Contains("robot.yaml:12:3: error: hardware 'dds' namespace '9lives' is not a ROS 2 namespace"));
-  CHECK_THROWS_WITH(DdsHardware(dds_config(nullptr, {{"domain_id", Value{43.0}}})),
-                    Catch::Contains("robot.yaml:12:3: error: hardware 'dds' needs the robot's base controller"));
-  CHECK_THROWS_WITH(ParameterSet::resolve(DdsHardware::static_manifest(), {{"step_timeout_s", Value{0.0}}}, SourceLocation{"robot.yaml", 12, 3}),
+  CHECK_THROWS_WITH(
+      DdsHardware(
+          dds_config(&base, {{"namespace", Value{std::string("9lives")}}, {"domain_id", Value{43.0}}})),
+      Catch::Contains("robot.yaml:12:3: error: hardware 'dds' namespace '9lives' is not a ROS 2 namespace"));
+  CHECK_THROWS_WITH(
+      DdsHardware(dds_config(nullptr, {{"domain_id", Value{43.0}}})),
+      Catch::Contains("robot.yaml:12:3: error: hardware 'dds' needs the robot's base controller"));
+  CHECK_THROWS_WITH(ParameterSet::resolve(DdsHardware::static_manifest(), {{"step_timeout_s", Value{0.0}}},
+                                          SourceLocation{"robot.yaml", 12, 3}),
                     Catch::Contains("step_timeout_s"));
 }

@@ -63,7 +63,9 @@ struct Args {
 };
 
 volatile std::sig_atomic_t g_stop = 0;
-extern "C" void on_sim_server_stop_signal(int) { g_stop = 1; }
+extern "C" void on_sim_server_stop_signal(int) {
+  g_stop = 1;
+}
 
 // The step requests and the client's comings and goings, from Cyclone DDS threads.
 struct Inbox {
@@ -94,13 +96,17 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
   }
   if (!is_ros_namespace(a.ros_namespace)) {
     err << "tripodal sim-server: --namespace '" << a.ros_namespace
-        << "' is not a ROS 2 namespace: names of letters, digits and '_', not starting with a digit, separated by '/'\n";
+        << "' is not a ROS 2 namespace: names of letters, digits and '_', not starting with a digit, "
+           "separated by '/'\n";
     return kUsage;
   }
   try {
     const RobotProfile profile = load_robot_profile(a.robot);
     const std::optional<ControllerConfig> base = base_controller_config(profile);
-    if (!base) throw ConfigError(profile.where, "tripodal sim-server simulates the robot's base: the profile needs a loop with a controller");
+    if (!base)
+      throw ConfigError(
+          profile.where,
+          "tripodal sim-server simulates the robot's base: the profile needs a loop with a controller");
     sim::World world = sim::load_world(a.world);
     const std::uint64_t seed = a.seed.value_or(world.seed);
     sim::Simulator sim(std::move(world), *base, seed);
@@ -115,13 +121,15 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
     Inbox inbox;
     // The robot's step writer: its requests, and the robot leaving (its process ended or died).
     auto on_status = [&inbox](const dds::StatusEvent& e) {
-      if (e.kind != dds::StatusKind::publication_matched && e.kind != dds::StatusKind::liveliness_lost) return;
+      if (e.kind != dds::StatusKind::publication_matched && e.kind != dds::StatusKind::liveliness_lost)
+        return;
       std::lock_guard lock(inbox.mutex);
       if (e.current_count > 0) {
         inbox.had_client = true;
       } else if (inbox.had_client && !inbox.client_left) {
         inbox.client_left = true;
-        inbox.left_why = e.kind == dds::StatusKind::liveliness_lost ? "left or went silent (DDS liveliness lost)" : "left";
+        inbox.left_why =
+            e.kind == dds::StatusKind::liveliness_lost ? "left or went silent (DDS liveliness lost)" : "left";
       }
       inbox.cv.notify_all();
     };
@@ -138,7 +146,8 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
                       });
       clock.emplace(participant, topics.clock, dds::EndpointOptions{.kind = dds::TopicKind::state});
     } else {
-      steps.emplace(participant, topics.sim_step, dds::EndpointOptions{.kind = dds::TopicKind::state, .on_status = on_status},
+      steps.emplace(participant, topics.sim_step,
+                    dds::EndpointOptions{.kind = dds::TopicKind::state, .on_status = on_status},
                     [&inbox](const dds::msg::SimStep& s) {
                       std::lock_guard lock(inbox.mutex);
                       inbox.steps.push_back(s);
@@ -148,16 +157,19 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
     // Reliable scans: a lock-step robot counts on every one (ROS 2's best-effort readers match too).
     dds::Qos scan_qos = dds::qos_for(dds::TopicKind::scan, dds::Role::publisher);
     scan_qos.reliability = dds::Reliability::reliable;
-    dds::Publisher<dds::msg::LaserScan> scan(participant, topics.scan, {.kind = dds::TopicKind::scan, .qos = scan_qos});
-    dds::Publisher<dds::msg::JointState> joints(participant, topics.joint_states, {.kind = dds::TopicKind::state});
+    dds::Publisher<dds::msg::LaserScan> scan(participant, topics.scan,
+                                             {.kind = dds::TopicKind::scan, .qos = scan_qos});
+    dds::Publisher<dds::msg::JointState> joints(participant, topics.joint_states,
+                                                {.kind = dds::TopicKind::state});
     dds::Publisher<dds::msg::SimState> state(participant, topics.sim_state, {.kind = dds::TopicKind::state});
 
     std::signal(SIGINT, on_sim_server_stop_signal);
     std::signal(SIGTERM, on_sim_server_stop_signal);
-    out << "tripodal sim-server: robot " << profile.name << " (" << base->type << " base, " << sim.wheel_count() << " wheels), world "
-        << a.world.string() << ", seed " << seed << "; domain " << a.domain << ", serving " << topics.scan << ", "
-        << topics.joint_states << ", " << topics.sim_state
-        << (realtime ? ", " + topics.clock + " at " + app::fixed(a.realtime_speed > 0.0 ? a.realtime_speed : 1.0, 1) +
+    out << "tripodal sim-server: robot " << profile.name << " (" << base->type << " base, "
+        << sim.wheel_count() << " wheels), world " << a.world.string() << ", seed " << seed << "; domain "
+        << a.domain << ", serving " << topics.scan << ", " << topics.joint_states << ", " << topics.sim_state
+        << (realtime ? ", " + topics.clock + " at " +
+                           app::fixed(a.realtime_speed > 0.0 ? a.realtime_speed : 1.0, 1) +
                            " times real time; commands on " + topics.cmd_vel
                      : "; steps on " + topics.sim_step)
         << "\n";
@@ -206,8 +218,9 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
       ++joint_states;
       last_step = step;
       const Pose2D& p = sim.pose();
-      state.publish(dds::msg::SimState{dds::ros_time(sim.now()), p.x_m, p.y_m, p.theta_rad, sim.distance_m(), last_step, scans,
-                                       joint_states, static_cast<std::uint32_t>(sim.collisions())});
+      state.publish(dds::msg::SimState{dds::ros_time(sim.now()), p.x_m, p.y_m, p.theta_rad, sim.distance_m(),
+                                       last_step, scans, joint_states,
+                                       static_cast<std::uint32_t>(sim.collisions())});
       if (clock) clock->publish(dds::msg::Clock{dds::ros_time(sim.now())});
     };
     // Lock-step: the command over the step, the world advanced to its end, then what it gave.
@@ -242,7 +255,8 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
     while (!realtime && g_stop == 0) {
       std::unique_lock lock(inbox.mutex);
       // Wakes for a request or a departure, and every 100 ms to see a signal.
-      inbox.cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return !inbox.steps.empty() || inbox.client_left; });
+      inbox.cv.wait_for(lock, std::chrono::milliseconds(100),
+                        [&] { return !inbox.steps.empty() || inbox.client_left; });
       if (!inbox.steps.empty()) {
         const dds::msg::SimStep s = inbox.steps.front();
         inbox.steps.pop_front();
@@ -261,11 +275,12 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
         break;
       }
     }
-    out << "sim-server ended: " << ended << "; " << last_step << (realtime ? " periods" : " steps served") << "; " << app::fixed(to_seconds(sim.now()), 2)
-        << " s simulated; distance " << app::fixed(sim.distance_m(), 2) << " m; " << sim.collisions() << " collisions\n";
+    out << "sim-server ended: " << ended << "; " << last_step << (realtime ? " periods" : " steps served")
+        << "; " << app::fixed(to_seconds(sim.now()), 2) << " s simulated; distance "
+        << app::fixed(sim.distance_m(), 2) << " m; " << sim.collisions() << " collisions\n";
     for (const sim::SimEvent& e : sim.events()) {
-      out << app::fixed(to_seconds(e.stamp), 3) << " s  simulator: " << sim::to_string(e.kind) << (e.detail.empty() ? "" : " " + e.detail)
-          << '\n';
+      out << app::fixed(to_seconds(e.stamp), 3) << " s  simulator: " << sim::to_string(e.kind)
+          << (e.detail.empty() ? "" : " " + e.detail) << '\n';
     }
     return code;
   } catch (const ConfigError& e) {
@@ -280,29 +295,37 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
 cli::Action setup(CLI::App& cmd) {
   auto a = std::make_shared<Args>();
   cmd.add_option("--robot", a->robot, "ROBOT.yaml: the robot profile whose base is simulated")->required();
-  cmd.add_option("--world", a->world, "WORLD.yaml: map, start pose, sensors and faults of the simulation")->required();
-  cmd.add_option("--namespace", a->ros_namespace, "NS: the ROS 2 namespace of the topics (the robot's hardware parameter namespace)");
-  cmd.add_option("--domain", a->domain, "ID: the DDS domain (ROS_DOMAIN_ID)")->check(CLI::Range(0, 232))->capture_default_str();
+  cmd.add_option("--world", a->world, "WORLD.yaml: map, start pose, sensors and faults of the simulation")
+      ->required();
+  cmd.add_option("--namespace", a->ros_namespace,
+                 "NS: the ROS 2 namespace of the topics (the robot's hardware parameter namespace)");
+  cmd.add_option("--domain", a->domain, "ID: the DDS domain (ROS_DOMAIN_ID)")
+      ->check(CLI::Range(0, 232))
+      ->capture_default_str();
   cmd.add_option("--seed", a->seed, "N: the simulator's seed (default: the world's)");
   cmd.add_option("--lease-s", a->lease_s, "S: the participant lease: a killed server is seen silent after S")
       ->check(cli::positive_number())
       ->capture_default_str();
-  cmd.add_option("--wait-s", a->wait_s, "S: give up (exit 4) when no robot came within S of wall time; 0: wait until stopped")
+  cmd.add_option("--wait-s", a->wait_s,
+                 "S: give up (exit 4) when no robot came within S of wall time; 0: wait until stopped")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   // Without SPEED CLI11 hands the option an empty value, which leaves realtime_speed at 0.
   a->realtime = cmd.add_option("--realtime", a->realtime_speed,
-                               "[SPEED]: free-running at SPEED times real time (default 1), driven by cmd_vel, publishing clock "
+                               "[SPEED]: free-running at SPEED times real time (default 1), driven by "
+                               "cmd_vel, publishing clock "
                                "(for ROS 2 tools; no lock-step)")
                     ->expected(0, 1)
                     ->check(cli::positive_number() | CLI::IsMember({"", "true"}));
-  cmd.add_flag("--system-network", a->system_network, "Cyclone DDS's own network configuration instead of loopback only");
+  cmd.add_flag("--system-network", a->system_network,
+               "Cyclone DDS's own network configuration instead of loopback only");
   return [a](std::ostream& out, std::ostream& err) { return run(*a, out, err); };
 }
 
 }  // namespace
 
-TRIPODAL_CLI_COMMAND("", "sim-server", "serve the simulator of a world to a robot over DDS (tripodal run --hardware dds)", kDescription,
-                     kExitCodes, &setup);
+TRIPODAL_CLI_COMMAND("", "sim-server",
+                     "serve the simulator of a world to a robot over DDS (tripodal run --hardware dds)",
+                     kDescription, kExitCodes, &setup);
 
 }  // namespace tripodal::tool

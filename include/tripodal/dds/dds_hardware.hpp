@@ -21,7 +21,8 @@
 
 namespace tripodal::dds {
 
-// The topics of a base on DDS under namespace `ns` (shared by DdsHardware and the sim-server).
+// The topics of a base on DDS under namespace `ns` (shared by DdsHardware and the sim-server);
+// `clock` is ROS 2's /clock, which no namespace changes.
 struct BaseTopics {
   std::string cmd_vel, joint_states, scan, clock, sim_step, sim_state;
   explicit BaseTopics(const std::string& ns);
