@@ -37,7 +37,7 @@ HardwareConfig dds_config(const ControllerConfig* base, ParameterValues given) {
 
 }  // namespace
 
-TEST_CASE("dds: hardware dds sends the wheels' command as cmd_vel; no simulator is its fault, not a hang",
+TEST_CASE("dds: hardware dds sends the wheels' command as cmd_vel, and no simulator is its fault, not a hang",
           "[dds]") {
   const ControllerConfig base = psr2_base();
   const std::uint32_t domain = test_domain(42);
