@@ -56,6 +56,10 @@ const ControllerConfig& base_of(const HardwareConfig& c) {
   return *c.base;
 }
 
+SimTruth truth_of(const msg::SimState& s) {
+  return {tripodal_time(s.stamp), Pose2D{s.x, s.y, s.theta}, s.distance, s.collisions};
+}
+
 std::chrono::milliseconds millis(double seconds) {
   return std::chrono::milliseconds(static_cast<std::int64_t>(std::ceil(seconds * 1000.0)));
 }
@@ -119,14 +123,17 @@ DdsHardware::DdsHardware(const HardwareConfig& config)
     step_qos.depth = 1;
     sim_step_ = std::make_unique<Publisher<msg::SimStep>>(
         *participant_, topics_.sim_step, EndpointOptions{.kind = TopicKind::state, .qos = step_qos});
-    sim_state_ = std::make_unique<Subscriber<msg::SimState>>(
-        *participant_, topics_.sim_state, EndpointOptions{.kind = TopicKind::state, .on_status = on_status},
-        [this](const msg::SimState& s) {
-          std::lock_guard lock(mutex_);
-          state_ = s;
-          cv_.notify_all();
-        });
   }
+  // Without lock-step, a free-running sim-server's state is the run's ground truth all the same (a
+  // real base has none).
+  sim_state_ = std::make_unique<Subscriber<msg::SimState>>(
+      *participant_, topics_.sim_state,
+      EndpointOptions{.kind = TopicKind::state, .on_status = lock_step_ ? on_status : StatusCallback{}},
+      [this](const msg::SimState& s) {
+        std::lock_guard lock(mutex_);
+        state_ = s;
+        cv_.notify_all();
+      });
 }
 
 // The endpoints go first: their callbacks use the members below them.
@@ -214,6 +221,7 @@ void DdsHardware::advance(Time now) {
   if (!lock_step_) {
     std::lock_guard lock(mutex_);
     if (simulator_silent_ && !lost_) fail(silent_why_);
+    if (state_) truth_ = truth_of(*state_);
     return;
   }
   if (lost_ || (!connected_ && !connect())) return;
@@ -243,9 +251,7 @@ void DdsHardware::advance(Time now) {
     fail(why);
     return;
   }
-  const msg::SimState s = *state_;
-  lock.unlock();
-  truth_ = SimTruth{tripodal_time(s.stamp), Pose2D{s.x, s.y, s.theta}, s.distance, s.collisions};
+  truth_ = truth_of(*state_);
 }
 
 void register_dds_hardware(HardwareRegistry& registry) {

@@ -28,7 +28,7 @@ struct BaseTopics {
   explicit BaseTopics(const std::string& ns);
 };
 
-// The simulator's ground truth after the last step (lock-step only), for a run's measures.
+// The simulator's ground truth (tripodal_msgs/SimState), for a run's measures.
 struct SimTruth {
   Time stamp{};
   Pose2D map_from_base;
@@ -64,7 +64,8 @@ class DdsHardware : public CHardware, public HardwareInterface, public ResourceF
   [[nodiscard]] bool lock_step() const noexcept { return lock_step_; }
   // False once the link to the simulator is down (a fault was reported).
   [[nodiscard]] bool link_up() const noexcept { return !lost_; }
-  // The simulator's ground truth after the last step; nullopt before the first or without lock-step.
+  // The simulator's ground truth after the last step (without lock-step: the latest a free-running
+  // sim-server sent); nullopt before the first, or on a real base.
   [[nodiscard]] const std::optional<SimTruth>& truth() const noexcept { return truth_; }
   [[nodiscard]] std::uint32_t steps() const noexcept { return step_; }
 
