@@ -112,6 +112,8 @@ DdsHardware::DdsHardware(const HardwareConfig& config)
           std::copy(m.position.begin(), m.position.end(), wheel_position_.begin());
           std::copy(m.velocity.begin(), m.velocity.end(), wheel_velocity_.begin());
           has_wheels_ = true;
+        } else {
+          has_wheels_ = false;  // no values (a dead encoder) or another base: the read fails
         }
         cv_.notify_all();
       });
