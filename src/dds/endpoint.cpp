@@ -205,8 +205,15 @@ Publisher<T>& Publisher<T>::operator=(Publisher&&) noexcept = default;
 
 template <Message T>
 void Publisher<T>::publish(const T& message) {
-  const auto sample = detail::TypeSupport<T>::to_c(message);
-  detail::check(dds_write(core_->entity, &sample), core_->where("dds_write"));
+  using Support = detail::TypeSupport<T>;
+  if constexpr (requires { typename Support::Scratch; }) {
+    typename Support::Scratch scratch;  // what the C view points into (a string sequence's pointers)
+    const auto sample = Support::to_c(message, scratch);
+    detail::check(dds_write(core_->entity, &sample), core_->where("dds_write"));
+  } else {
+    const auto sample = Support::to_c(message);
+    detail::check(dds_write(core_->entity, &sample), core_->where("dds_write"));
+  }
 }
 
 template <Message T>
@@ -350,8 +357,12 @@ TRIPODAL_DDS_INSTANTIATE(PoseWithCovarianceStamped);
 TRIPODAL_DDS_INSTANTIATE(Odometry);
 TRIPODAL_DDS_INSTANTIATE(OccupancyGrid);
 TRIPODAL_DDS_INSTANTIATE(LaserScan);
+TRIPODAL_DDS_INSTANTIATE(JointState);
+TRIPODAL_DDS_INSTANTIATE(Clock);
 TRIPODAL_DDS_INSTANTIATE(Event);
 TRIPODAL_DDS_INSTANTIATE(TaskCommand);
+TRIPODAL_DDS_INSTANTIATE(SimStep);
+TRIPODAL_DDS_INSTANTIATE(SimState);
 #undef TRIPODAL_DDS_INSTANTIATE
 
 }  // namespace tripodal::dds

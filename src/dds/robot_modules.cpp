@@ -1,6 +1,7 @@
 // The DDS laser resource and the cmd_vel controller.
 #include "tripodal/dds/robot_modules.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -45,32 +46,50 @@ const ModuleManifest& DdsLaserResource::static_manifest() {
   return m;
 }
 
+namespace {
+
+DdsLaserOptions laser_options(const ParameterSet& p) {
+  DdsLaserOptions o;
+  o.binding = topic_binding(p, "scan");
+  o.max_age = from_seconds(p.contains("max_age_s") ? p.number("max_age_s") : 0.5);
+  if (p.contains("deadline_s")) o.deadline = from_seconds(p.number("deadline_s"));
+  return o;
+}
+
+}  // namespace
+
 DdsLaserResource::DdsLaserResource(std::string name, const ParameterSet& parameters)
-    : LaserResource(std::move(name),
-                    from_seconds(parameters.contains("max_age_s") ? parameters.number("max_age_s") : 0.5),
-                    static_manifest()) {
-  const TopicBinding b = topic_binding(parameters, "scan");
-  participant_ = std::make_unique<Participant>(b.participant);
+    : DdsLaserResource(std::move(name), laser_options(parameters)) {}
+
+DdsLaserResource::DdsLaserResource(std::string name, DdsLaserOptions o)
+    : LaserResource(std::move(name), o.max_age, static_manifest()), sender_stamp_(o.lock_step), on_scan_(std::move(o.on_scan)) {
+  participant_ = std::make_unique<Participant>(o.binding.participant);
   EndpointOptions options{.kind = TopicKind::scan, .on_status = [this](const StatusEvent& e) { on_status(e); }};
-  if (parameters.contains("deadline_s") && parameters.number("deadline_s") > 0.0) {
+  if (o.deadline > Duration{0} || o.lock_step) {
     Qos q = qos_for(TopicKind::scan, Role::subscriber);
-    q.deadline = std::chrono::duration_cast<std::chrono::nanoseconds>(from_seconds(parameters.number("deadline_s")));
+    if (o.deadline > Duration{0}) q.deadline = o.deadline;
+    if (o.lock_step) q.reliability = Reliability::reliable;
     options.qos = q;
   }
   subscriber_ = std::make_unique<Subscriber<msg::LaserScan>>(
-      *participant_, b.topic, options, [this](const msg::LaserScan& s) {
-        std::lock_guard lock(mutex_);
-        pending_.angle_min_rad = s.angle_min;
-        pending_.angle_max_rad = s.angle_max;
-        pending_.angle_increment_rad = s.angle_increment;
-        pending_.time_increment_s = s.time_increment;
-        pending_.scan_time_s = s.scan_time;
-        pending_.range_min_m = s.range_min;
-        pending_.range_max_m = s.range_max;
-        pending_.ranges_m.assign(s.ranges.begin(), s.ranges.end());
-        pending_.intensities.assign(s.intensities.begin(), s.intensities.end());
-        has_pending_.store(true, std::memory_order_release);
-        silent_.store(false, std::memory_order_relaxed);
+      *participant_, o.binding.topic, options, [this](const msg::LaserScan& s) {
+        {
+          std::lock_guard lock(mutex_);
+          pending_.angle_min_rad = s.angle_min;
+          pending_.angle_max_rad = s.angle_max;
+          pending_.angle_increment_rad = s.angle_increment;
+          pending_.time_increment_s = s.time_increment;
+          pending_.scan_time_s = s.scan_time;
+          pending_.range_min_m = s.range_min;
+          pending_.range_max_m = s.range_max;
+          pending_.ranges_m.assign(s.ranges.begin(), s.ranges.end());
+          pending_.intensities.assign(s.intensities.begin(), s.intensities.end());
+          pending_stamp_ = tripodal_time(s.header.stamp);
+          has_pending_.store(true, std::memory_order_release);
+          silent_.store(false, std::memory_order_relaxed);
+        }
+        received_.fetch_add(1, std::memory_order_acq_rel);
+        if (on_scan_) on_scan_();
       });
 }
 
@@ -98,7 +117,9 @@ void DdsLaserResource::on_poll(Time now) noexcept {
   // Swapping keeps both buffers' capacity: no allocation once the beam count is steady.
   LaserScan& latest = edit();
   std::swap(latest, pending_);
-  latest.stamp = now;
+  // Another process's clock is not the loop's: the scan is as old as the news of it, unless the
+  // sender's clock is the robot's own (lock-step).
+  latest.stamp = sender_stamp_ ? std::min(pending_stamp_, now) : now;
   has_pending_.store(false, std::memory_order_relaxed);
   commit();
 }

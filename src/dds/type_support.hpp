@@ -139,6 +139,35 @@ struct TypeSupport<msg::LaserScan> {
 };
 
 template <>
+struct TypeSupport<msg::JointState> {
+  using C = sensor_msgs_msg_dds__JointState_;
+  using Scratch = std::vector<char*>;  // the names' pointers, alive until the write returns
+  static const dds_topic_descriptor_t* descriptor() { return &sensor_msgs_msg_dds__JointState__desc; }
+  static C to_c(const msg::JointState& m, Scratch& names) {
+    names.clear();
+    for (const std::string& n : m.name) names.push_back(view(n));
+    return {detail::to_c(m.header), view_sequence<dds_sequence_string>(names), view_sequence<dds_sequence_double>(m.position),
+            view_sequence<dds_sequence_double>(m.velocity), view_sequence<dds_sequence_double>(m.effort)};
+  }
+  static msg::JointState from_c(const C& c) {
+    msg::JointState m{detail::from_c(c.header), {}, copy_sequence<double>(c.position), copy_sequence<double>(c.velocity),
+                      copy_sequence<double>(c.effort)};
+    if (c.name._buffer != nullptr) {
+      for (std::uint32_t i = 0; i < c.name._length; ++i) m.name.push_back(text(c.name._buffer[i]));
+    }
+    return m;
+  }
+};
+
+template <>
+struct TypeSupport<msg::Clock> {
+  using C = rosgraph_msgs_msg_dds__Clock_;
+  static const dds_topic_descriptor_t* descriptor() { return &rosgraph_msgs_msg_dds__Clock__desc; }
+  static C to_c(const msg::Clock& m) { return {detail::to_c(m.clock)}; }
+  static msg::Clock from_c(const C& c) { return {detail::from_c(c.clock)}; }
+};
+
+template <>
 struct TypeSupport<msg::OccupancyGrid> {
   using C = nav_msgs_msg_dds__OccupancyGrid_;
   static const dds_topic_descriptor_t* descriptor() { return &nav_msgs_msg_dds__OccupancyGrid__desc; }
@@ -175,6 +204,26 @@ struct TypeSupport<msg::TaskCommand> {
   }
   static msg::TaskCommand from_c(const C& c) {
     return {detail::from_c(c.stamp), text(c.robot), c.id, text(c.command), text(c.task)};
+  }
+};
+
+template <>
+struct TypeSupport<msg::SimStep> {
+  using C = tripodal_msgs_msg_dds__SimStep_;
+  static const dds_topic_descriptor_t* descriptor() { return &tripodal_msgs_msg_dds__SimStep__desc; }
+  static C to_c(const msg::SimStep& m) { return {detail::to_c(m.until), detail::to_c(m.cmd_vel), m.step}; }
+  static msg::SimStep from_c(const C& c) { return {detail::from_c(c.until), detail::from_c(c.cmd_vel), c.step}; }
+};
+
+template <>
+struct TypeSupport<msg::SimState> {
+  using C = tripodal_msgs_msg_dds__SimState_;
+  static const dds_topic_descriptor_t* descriptor() { return &tripodal_msgs_msg_dds__SimState__desc; }
+  static C to_c(const msg::SimState& m) {
+    return {detail::to_c(m.stamp), m.x, m.y, m.theta, m.distance, m.step, m.scans, m.joint_states, m.collisions};
+  }
+  static msg::SimState from_c(const C& c) {
+    return {detail::from_c(c.stamp), c.x, c.y, c.theta, c.distance, c.step, c.scans, c.joint_states, c.collisions};
   }
 };
 

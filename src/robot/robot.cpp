@@ -75,6 +75,16 @@ ControllerConfig controller_config(const RobotProfile& p, const ModuleEntry& e) 
 
 }  // namespace
 
+std::optional<ControllerConfig> base_controller_config(const RobotProfile& profile) {
+  for (const LoopEntry& l : profile.loops) {
+    if (l.controller.empty()) continue;
+    for (const ModuleEntry& c : profile.controllers) {
+      if (c.name == l.controller) return controller_config(profile, c);
+    }
+  }
+  return std::nullopt;
+}
+
 struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
   Clock& clock;
   const RobotPlugins& plugins;
@@ -353,6 +363,8 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
       hc.profile_dir = profile.dir;
       m->hardware = plugins.hardware.create_at(h.where, h.type, hc);
       m->hardware->add_resources(m->resources);
+      // Hardware whose link detects faults of its own (a base on DDS) reports them like a resource.
+      if (auto* faults = dynamic_cast<ResourceFaultSource*>(m->hardware.get())) m->fault_sources.emplace_back(h.name, faults);
     });
   }
   for (const ModuleEntry& e : profile.resources) {

@@ -13,6 +13,22 @@
 
 namespace tripodal {
 
+bool is_ros_namespace(std::string_view ns) {
+  if (!ns.empty() && ns.front() == '/') ns.remove_prefix(1);
+  if (ns.empty()) return true;  // none: the topics are at the root ("rt/odom")
+  std::size_t start = 0;
+  while (start <= ns.size()) {
+    const std::size_t end = std::min(ns.find('/', start), ns.size());
+    const std::string_view token = ns.substr(start, end - start);
+    if (token.empty() || std::isdigit(static_cast<unsigned char>(token.front())) != 0) return false;
+    for (const char c : token) {
+      if (std::isalnum(static_cast<unsigned char>(c)) == 0 && c != '_') return false;
+    }
+    start = end + 1;
+  }
+  return true;
+}
+
 namespace {
 
 struct Parser {
@@ -167,7 +183,7 @@ struct Parser {
       if (auto ns = r.text(v, "dds namespace")) {
         dds_namespace_given = true;
         s.ros_namespace = *ns;
-        if (!valid_ros_namespace(*ns)) {
+        if (!is_ros_namespace(*ns)) {
           d.error(at(v), "dds namespace '" + *ns + "' is not a ROS 2 namespace: names of letters, digits and '_', "
                          "not starting with a digit, separated by '/'");
         }
@@ -203,22 +219,6 @@ struct Parser {
       s.publish.assign(std::begin(kDdsTopics), std::end(kDdsTopics));
     }
     prof.dds = std::move(s);
-  }
-
-  static bool valid_ros_namespace(std::string_view ns) {
-    if (!ns.empty() && ns.front() == '/') ns.remove_prefix(1);
-    if (ns.empty()) return true;  // none: the topics are at the root ("rt/odom")
-    std::size_t start = 0;
-    while (start <= ns.size()) {
-      const std::size_t end = std::min(ns.find('/', start), ns.size());
-      const std::string_view token = ns.substr(start, end - start);
-      if (token.empty() || std::isdigit(static_cast<unsigned char>(token.front())) != 0) return false;
-      for (const char c : token) {
-        if (std::isalnum(static_cast<unsigned char>(c)) == 0 && c != '_') return false;
-      }
-      start = end + 1;
-    }
-    return true;
   }
 
   RobotProfile parse(const std::string& text) {
@@ -286,7 +286,7 @@ struct Parser {
     if (prof.name.empty()) d.error(prof.where, "the profile needs robot: {name: ...}");
     if (prof.dds && !dds_namespace_given) {
       prof.dds->ros_namespace = prof.name;
-      if (!valid_ros_namespace(prof.name)) {
+      if (!is_ros_namespace(prof.name)) {
         d.error(prof.dds->where, "dds: the robot's name '" + prof.name + "' is not a ROS 2 namespace (letters, digits and '_'); "
                                  "give dds: {namespace: ...}");
       }

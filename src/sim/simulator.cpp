@@ -7,8 +7,6 @@
 #include <numbers>
 #include <utility>
 
-#include "tripodal/controllers/holonomic_controller.hpp"
-#include "tripodal/controllers/ideal_hardware.hpp"
 #include "tripodal/controllers/kinematics.hpp"
 
 namespace tripodal::sim {
@@ -52,16 +50,6 @@ Duration period_of(double rate_hz) noexcept {
 // Readings go stale after three missed periods: a dead sensor is detectable, jitter is not.
 Duration max_age_of(double rate_hz) noexcept { return 3 * period_of(rate_hz); }
 
-const ControllerConfig& checked_base(const ControllerConfig& base) {
-  Diagnostics d = validate(base);
-  if (base.type != "differential" && base.type != "omni" && base.type != "mecanum") {
-    d.error(base.where, "the simulated base must be of type \"differential\", \"omni\" or \"mecanum\", got \"" +
-                            base.type + "\"");
-  }
-  if (d.has_errors()) throw ConfigError(std::move(d));
-  return base;
-}
-
 }  // namespace
 
 std::string_view to_string(SimEvent::Kind kind) noexcept {
@@ -83,7 +71,7 @@ std::string_view to_string(SimEvent::Kind kind) noexcept {
 
 Simulator::Simulator(World world, const ControllerConfig& base, std::uint64_t seed, Time start)
     : world_(std::move(world)),
-      base_(checked_base(base)),
+      kinematics_(base),
       now_(start),
       laser_model_(world_.robot.laser, stream_seed(seed, 1)),
       odom_rng_(stream_seed(seed, 2)),
@@ -96,15 +84,8 @@ Simulator::Simulator(World world, const ControllerConfig& base, std::uint64_t se
       bumpers_(world_.robot.bumpers.name, max_age_of(world_.robot.bumpers.rate_hz)),
       cliff_(world_.robot.cliff.name, max_age_of(world_.robot.cliff.rate_hz)),
       battery_(world_.robot.battery.name, max_age_of(world_.robot.battery.rate_hz)) {
-  if (base_.type == "differential") {
-    wheels_ = 2;
-  } else {
-    wheels_ = base_.holonomic.wheels.size();
-    // The controller's own Jacobian and pseudo-inverse are the base's kinematics: the simulated
-    // wheels and the controller can never disagree about the geometry.
-    model_hw_ = std::make_unique<IdealWheelHardware>(wheels_, base_.period);
-    holonomic_ = std::make_unique<HolonomicController>(base_, *model_hw_);
-  }
+  // The controller's own kinematics: the simulated wheels and the controller never disagree.
+  wheels_ = kinematics_.wheel_count();
   wheel_cmd_.assign(wheels_, 0.0);
   wheel_vel_.assign(wheels_, 0.0);
   wheel_pos_.assign(wheels_, 0.0);
@@ -346,20 +327,11 @@ void Simulator::add_visitors_to_scan(LaserScan& scan) const noexcept {
 // --- kinematics ------------------------------------------------------------------------------
 
 void Simulator::inverse_kinematics(const Twist2D& twist, std::span<double> wheel_rad_s) const noexcept {
-  if (wheel_rad_s.size() != wheels_) return;
-  if (holonomic_) {
-    holonomic_->inverse(twist, wheel_rad_s);
-  } else {
-    differential_inverse(base_.differential.wheel_separation_m, base_.differential.wheel_radius_m, twist,
-                         wheel_rad_s[0], wheel_rad_s[1]);
-  }
+  kinematics_.inverse(twist, wheel_rad_s);
 }
 
 Twist2D Simulator::forward_kinematics(std::span<const double> wheel_rad_s) const noexcept {
-  if (wheel_rad_s.size() != wheels_) return {};
-  if (holonomic_) return holonomic_->forward(wheel_rad_s);
-  return differential_forward(base_.differential.wheel_separation_m, base_.differential.wheel_radius_m,
-                              wheel_rad_s[0], wheel_rad_s[1]);
+  return kinematics_.forward(wheel_rad_s);
 }
 
 void Simulator::command_twist(const Twist2D& twist) noexcept {

@@ -76,11 +76,20 @@ TEST_CASE("dds: the type names are those ROS 2 registers", "[dds]") {
   CHECK(MessageType<msg::PoseWithCovarianceStamped>::dds == "geometry_msgs::msg::dds_::PoseWithCovarianceStamped_");
   CHECK(MessageType<msg::String>::dds == "std_msgs::msg::dds_::String_");
   CHECK(MessageType<msg::Event>::dds == "tripodal_msgs::msg::dds_::Event_");
+  CHECK(MessageType<msg::JointState>::dds == "sensor_msgs::msg::dds_::JointState_");
+  CHECK(MessageType<msg::Clock>::dds == "rosgraph_msgs::msg::dds_::Clock_");
+  CHECK(MessageType<msg::SimStep>::dds == "tripodal_msgs::msg::dds_::SimStep_");
+  CHECK(MessageType<msg::SimState>::dds == "tripodal_msgs::msg::dds_::SimState_");
   CHECK(ros_topic("cmd_vel") == "rt/cmd_vel");
   CHECK(ros_topic("/cmd_vel", "/robot1/") == "rt/robot1/cmd_vel");
   CHECK(ros_seconds(ros_time(-1.25)) == Approx(-1.25));
   CHECK(ros_time(-1.25).sec == -2);
   CHECK(ros_time(-1.25).nanosec == 750000000U);
+  // A tripodal Time converts to the nanosecond, both ways.
+  const tripodal::Time t{std::chrono::nanoseconds(-1'250'000'001)};
+  CHECK(ros_time(t) == msg::Time{-2, 749'999'999});
+  CHECK(tripodal_time(ros_time(t)) == t);
+  CHECK(tripodal_time(msg::Time{78, 900'000'000}) == tripodal::Time{std::chrono::milliseconds(78'900)});
 }
 
 TEST_CASE("dds: golden CDR bytes of every message type", "[dds]") {
@@ -134,6 +143,19 @@ TEST_CASE("dds: golden CDR bytes of every message type", "[dds]") {
     for (float r : m.intensities) w.f32(r);
     check_golden(p, m, w.bytes());
   }
+  SECTION("sensor_msgs/JointState") {
+    const auto m = sample_joint_state();
+    // "base" ends at 17; the names' count aligns to 20, each name to 4; the doubles to 8
+    CdrWriter w;
+    w.header(m.header).u32(static_cast<std::uint32_t>(m.name.size()));
+    for (const std::string& n : m.name) w.str(n);
+    for (const auto* v : {&m.position, &m.velocity, &m.effort}) w.u32(static_cast<std::uint32_t>(v->size())).f64s(*v);
+    check_golden(p, m, w.bytes());
+  }
+  SECTION("rosgraph_msgs/Clock") {
+    const msg::Clock m{{78, 900000000}};
+    check_golden(p, m, CdrWriter().time(m.clock).bytes());
+  }
   SECTION("nav_msgs/OccupancyGrid") {
     const auto m = sample_grid();
     CdrWriter w;
@@ -148,5 +170,14 @@ TEST_CASE("dds: golden CDR bytes of every message type", "[dds]") {
                  CdrWriter().time(e.stamp).str(e.robot).str(e.source).str(e.kind).str(e.detail).u8(e.severity).bytes());
     const auto t = sample_task();
     check_golden(p, t, CdrWriter().time(t.stamp).str(t.robot).u32(t.id).str(t.command).str(t.task).bytes());
+  }
+  SECTION("tripodal_msgs/SimStep and SimState") {
+    const auto s = sample_sim_step();
+    // the twist's doubles align to 8 right after the 8-byte time
+    check_golden(p, s, CdrWriter().time(s.until).twist(s.cmd_vel).u32(s.step).bytes());
+    const auto t = sample_sim_state();
+    check_golden(p, t,
+                 CdrWriter().time(t.stamp).f64(t.x).f64(t.y).f64(t.theta).f64(t.distance).u32(t.step).u32(t.scans)
+                     .u32(t.joint_states).u32(t.collisions).bytes());
   }
 }

@@ -77,9 +77,14 @@ TEST_CASE("dds: every message type makes a round trip between two participants",
   round_trip(a, b, sample_grid(), TopicKind::map);
   round_trip(a, b, sample_event(), TopicKind::event);
   round_trip(a, b, sample_task(), TopicKind::command);
+  round_trip(a, b, sample_joint_state(), TopicKind::state);
+  round_trip(a, b, msg::Clock{{78, 900000000}}, TopicKind::state);
+  round_trip(a, b, sample_sim_step(), TopicKind::state);
+  round_trip(a, b, sample_sim_state(), TopicKind::state);
   // Empty strings and sequences travel as well (a zero length, no buffer).
   round_trip(a, b, msg::LaserScan{}, TopicKind::scan);
   round_trip(a, b, msg::OccupancyGrid{}, TopicKind::map);
+  round_trip(a, b, msg::JointState{}, TopicKind::state);
 }
 
 TEST_CASE("dds: QoS per kind of topic", "[dds]") {

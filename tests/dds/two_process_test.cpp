@@ -1,21 +1,15 @@
 // Two processes on loopback: this one and tests/dds/dds_peer.cpp, started with posix_spawn.
 #include <catch2/catch.hpp>
 
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <condition_variable>
 #include <mutex>
 #include <thread>
 
+#include "child_process.hpp"
 #include "dds_test_support.hpp"
 #include "tripodal/dds/endpoint.hpp"
 #include "tripodal/dds/robot_modules.hpp"
 #include "tripodal/robot/robot.hpp"
-
-extern char** environ;
 
 using namespace tripodal;
 using namespace tripodal::dds;
@@ -24,42 +18,10 @@ using namespace std::chrono_literals;
 
 namespace {
 
-// The peer process; killed and reaped on destruction if still running.
-class Peer {
+// The peer process (tests/dds/dds_peer.cpp).
+class Peer : public ChildProcess {
  public:
-  explicit Peer(std::vector<std::string> args) {
-    args.insert(args.begin(), TRIPODAL_DDS_PEER);
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    const int rc = posix_spawn(&pid_, TRIPODAL_DDS_PEER, nullptr, nullptr, argv.data(), environ);
-    REQUIRE(rc == 0);
-  }
-  Peer(const Peer&) = delete;
-  Peer& operator=(const Peer&) = delete;
-  ~Peer() {
-    if (pid_ > 0) {
-      ::kill(pid_, SIGKILL);
-      ::waitpid(pid_, nullptr, 0);
-    }
-  }
-  void kill(int signal) { ::kill(pid_, signal); }
-  // The exit code, or -1 if it did not exit within the timeout, or 128 + signal.
-  int wait(std::chrono::milliseconds timeout) {
-    const auto until = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < until) {
-      int status = 0;
-      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-        pid_ = 0;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      }
-      std::this_thread::sleep_for(5ms);
-    }
-    return -1;
-  }
-
- private:
-  pid_t pid_ = 0;
+  explicit Peer(std::vector<std::string> args) : ChildProcess(TRIPODAL_DDS_PEER, std::move(args)) {}
 };
 
 template <class T>

@@ -47,6 +47,9 @@ constexpr std::string_view kDescription =
     "A robot whose profile has a dds: section is on DDS while it runs (docs/distribution.md): its\n"
     "odometry, pose, map, events and markings are published and it takes task commands; without\n"
     "--task (and dds: tasks on) it is paced to real time and waits for a task from a peer.\n"
+    "--hardware dds runs the same robot against a simulator in another process (`tripodal sim-server`,\n"
+    "docs/distribution.md), in lock-step with it; --hardware-param KEY=VALUE sets its namespace,\n"
+    "domain_id, step_timeout_s ...\n"
     "--visit VISIT.yaml runs the guide robot's scripted visit instead of a task (docs/guide.md): the\n"
     "dialogue, the life cycle and the collisions; with --out, dialogue.txt, report.json and the\n"
     "answers' audio (audio/*.wav, when the build has voice). With --monitor (and a visit or not) the\n"
@@ -65,6 +68,7 @@ struct Args {
   bool no_voice = false;
   std::optional<double> give_way_m;  // --visitors-give-way-m
   std::string faults;
+  std::vector<std::string> hardware_params;  // --hardware-param KEY=VALUE
   CLI::Option* realtime = nullptr;  // given at all (with or without SPEED)
   double realtime_speed = 0.0;      // 0: --realtime without SPEED
 };
@@ -176,6 +180,14 @@ int run(Args& args, std::ostream& out, std::ostream& err) {
     err << "tripodal run: --no-voice and --visitors-give-way-m go with the guide robot's runs (--visit, or --monitor on a robot with an Hri module)\n";
     return kUsage;
   }
+  for (const std::string& kv : args.hardware_params) {
+    const std::size_t eq = kv.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      err << "tripodal run: --hardware-param " << kv << ": expected KEY=VALUE (namespace=psr2)\n";
+      return kUsage;
+    }
+    o.hardware_parameters.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
+  }
   if (o.task.empty() && !o.monitor && !takes_dds_tasks(o.robot)) {
     err << "tripodal run: --task is required (without --monitor, where the console may give it, or a profile "
            "with dds: {tasks: true}, where a DDS peer may)\n";
@@ -216,7 +228,8 @@ int run(Args& args, std::ostream& out, std::ostream& err) {
     o.log = &out;
     o.progress = &err;
     o.progress_is_terminal = ::isatty(2) != 0;
-    out << "tripodal run: robot " << o.robot.string() << ", world " << o.world.string() << ", task \"" << o.task << "\"\n";
+    out << "tripodal run: robot " << o.robot.string() << ", world " << o.world.string() << ", task \"" << o.task << "\""
+        << (o.hardware.empty() ? std::string() : ", hardware " + o.hardware) << "\n";
     out.flush();
     const app::RunResult r = app::run_task(o);
     out << "task " << r.state << (r.reason.empty() ? "" : ": " + r.reason) << "; ";
@@ -260,6 +273,11 @@ cli::Action setup(CLI::App& cmd) {
                  "not yield")
       ->check(CLI::NonNegativeNumber);
   cmd.add_option("--seed", o.seed, "N: the simulator's seed (default: the world's)");
+  cmd.add_option("--hardware", o.hardware,
+                 "TYPE: instead of the profile's hardware: dds, the simulator in another process (tripodal sim-server; "
+                 "docs/distribution.md), the world still giving the map and regions");
+  cmd.add_option("--hardware-param", a->hardware_params,
+                 "KEY=VALUE: a parameter of the hardware slot (repeatable): namespace=NS, domain_id=N, step_timeout_s=S");
   cmd.add_option("--out", o.out, "DIR: where map.png, trajectory.csv, report.json and lifecycle.txt go");
   // Without SPEED CLI11 hands the option an empty value, which leaves realtime_speed at 0.
   a->realtime = cmd.add_option("--realtime", a->realtime_speed, "[SPEED]: SPEED times real time (default 1)")

@@ -29,6 +29,7 @@
 #include "tripodal/sim/simulator.hpp"
 #include "tripodal/sim/world.hpp"
 #ifdef TRIPODAL_HAVE_DDS
+#include "tripodal/dds/dds_hardware.hpp"
 #include "tripodal/dds/robot_bridge.hpp"
 #endif
 
@@ -167,7 +168,10 @@ DisinfectionFigures disinfection_figures(sim::SimBoardHardware& hw, const std::v
 
 std::vector<ParameterOverride> simulation_overrides(const RobotProfile& profile, const sim::World& world, std::uint64_t seed) {
   std::vector<ParameterOverride> out;
-  if (profile.hardware) out.push_back({profile.hardware->name, "seed", std::to_string(seed)});
+  // A simulator in this process takes the seed (a sim-server has its own --seed).
+  if (profile.hardware && (profile.hardware->type == "sim" || profile.hardware->type == "board")) {
+    out.push_back({profile.hardware->name, "seed", std::to_string(seed)});
+  }
   for (const ModuleEntry& e : profile.navigation) {
     if (e.type == navi::CLocalizer::static_manifest().name) out.push_back({e.name, "seed", std::to_string(seed % (1ULL << 52))});
     if (e.type == navi::CScanMatchingLocalizer::static_manifest().name) {
@@ -208,8 +212,92 @@ std::unique_ptr<DdsBridge> make_dds_bridge(Robot&, const Clock&, const RobotProf
 }
 #endif
 
+// Hardware "dds" for `tripodal run`: the base in another process, the map the world's, as a real
+// robot loads its map while its base is elsewhere.
+#ifdef TRIPODAL_HAVE_DDS
+class WorldDdsHardware final : public dds::DdsHardware, public navi::MapSource {
+ public:
+  WorldDdsHardware(const HardwareConfig& c, std::shared_ptr<const sim::World> world) : DdsHardware(c), world_(std::move(world)) {}
+  [[nodiscard]] const navi::OccupancyGrid& world_map() const noexcept override { return world_->grid; }
+  [[nodiscard]] const navi::RegionMap& world_regions() const noexcept override { return world_->regions; }
+
+ private:
+  std::shared_ptr<const sim::World> world_;
+};
+void register_remote_hardware(HardwareRegistry& registry, const std::shared_ptr<const sim::World>& world) {
+  registry.add(dds::DdsHardware::static_manifest(), [world](const HardwareConfig& c) -> std::unique_ptr<CHardware> {
+    return std::make_unique<WorldDdsHardware>(c, world);
+  });
+}
+#else
+void register_remote_hardware(HardwareRegistry&, const std::shared_ptr<const sim::World>&) {}
+#endif
+
+// What a run measures itself by: the simulator's ground truth, in this process, or in the
+// sim-server's, as its lock-step answers carry it (before the first: the world's start).
+class GroundTruth {
+ public:
+  GroundTruth(CHardware* hw, Pose2D start) : start_(start) {
+    if (auto* s = dynamic_cast<sim::SimulatorSources*>(hw)) local_ = &s->simulation();
+#ifdef TRIPODAL_HAVE_DDS
+    remote_ = dynamic_cast<const dds::DdsHardware*>(hw);
+#endif
+  }
+  [[nodiscard]] const sim::Simulator* local() const noexcept { return local_; }
+  [[nodiscard]] Pose2D pose() const {
+    if (local_ != nullptr) return local_->pose();
+#ifdef TRIPODAL_HAVE_DDS
+    if (remote_ != nullptr && remote_->truth()) return remote_->truth()->map_from_base;
+#endif
+    return start_;
+  }
+  [[nodiscard]] double distance_m() const {
+    if (local_ != nullptr) return local_->distance_m();
+#ifdef TRIPODAL_HAVE_DDS
+    if (remote_ != nullptr && remote_->truth()) return remote_->truth()->distance_m;
+#endif
+    return 0.0;
+  }
+  [[nodiscard]] std::size_t collisions() const {
+    if (local_ != nullptr) return local_->collisions();
+#ifdef TRIPODAL_HAVE_DDS
+    if (remote_ != nullptr && remote_->truth()) return remote_->truth()->collisions;
+#endif
+    return 0;
+  }
+  /// Of the body, absolute (rad): the simulator's own, or summed from the poses sampled here.
+  [[nodiscard]] double rotation_rad() const { return local_ != nullptr ? local_->rotation_rad() : sampled_rotation_rad_; }
+  void sample() {
+    const Pose2D p = pose();
+    sampled_rotation_rad_ += std::abs(wrap_angle(p.theta_rad - last_.theta_rad));
+    last_ = p;
+  }
+
+ private:
+  Pose2D start_;
+  Pose2D last_ = start_;
+  double sampled_rotation_rad_ = 0.0;
+  const sim::Simulator* local_ = nullptr;
+#ifdef TRIPODAL_HAVE_DDS
+  const dds::DdsHardware* remote_ = nullptr;
+#endif
+};
+
 RunResult run_task(const RunOptions& o) {
-  const RobotProfile profile = load_robot_profile(o.robot);
+  RobotProfile profile = load_robot_profile(o.robot);
+  if (!o.hardware.empty()) {
+    if (!profile.hardware) {
+      profile.hardware = ModuleEntry{};
+      profile.hardware->name = "hardware";
+      profile.hardware->where = profile.where;
+    }
+    if (profile.hardware->type != o.hardware) profile.hardware->parameters.clear();  // the profile's were for its own type
+    profile.hardware->type = o.hardware;
+  }
+  if (!o.hardware_parameters.empty() && !profile.hardware) {
+    throw ConfigError(profile.where, "--hardware-param: the profile has no hardware slot (hardware: {type: ...}) and no --hardware is given");
+  }
+  for (const auto& [key, value] : o.hardware_parameters) profile.hardware->parameters.insert_or_assign(key, value);
   auto world = std::make_shared<sim::World>(sim::load_world(o.world));
   RunResult res;
   res.robot = profile.name;
@@ -218,10 +306,21 @@ RunResult run_task(const RunOptions& o) {
   res.coverage_pattern = o.pattern;
   std::vector<navi::LocalizationFault>& faults = world->faults.localization_loss;
   faults.insert(faults.end(), o.faults.begin(), o.faults.end());
-  if (!profile.hardware || (profile.hardware->type != "sim" && profile.hardware->type != "board")) {
+  if (!profile.hardware ||
+      (profile.hardware->type != "sim" && profile.hardware->type != "board" && profile.hardware->type != "dds")) {
     throw ConfigError(profile.hardware ? profile.hardware->where : profile.where,
                       "`tripodal run` runs the robot on the simulator: its profile needs hardware: {type: sim} "
-                      "(or {type: board}, the control board simulated in the same world)");
+                      "(or {type: board}, the control board simulated in the same world, or {type: dds}, the simulator "
+                      "in another process: tripodal sim-server)");
+  }
+  const bool remote = profile.hardware->type == "dds";
+#ifndef TRIPODAL_HAVE_DDS
+  if (remote) {
+    throw ConfigError(profile.hardware->where, "hardware dds: this tripodal was built without DDS (TRIPODAL_DDS=OFF or Cyclone DDS not found)");
+  }
+#endif
+  if (remote && !o.faults.empty()) {
+    throw ConfigError(SourceLocation{"--faults", 1, 1}, "the simulator is in another process (hardware dds): give the faults to its world");
   }
   const bool on_board = profile.hardware->type == "board";
   if (!o.board_line.empty() && !on_board) {
@@ -236,6 +335,7 @@ RunResult run_task(const RunOptions& o) {
   RobotPlugins plugins = RobotPlugins::with_builtins();
   sim::register_sim_hardware(plugins.hardware, world);
   sim::register_sim_board_hardware(plugins.hardware, world);
+  register_remote_hardware(plugins.hardware, world);
   board::register_board_modules(plugins.modules);
   board::register_board_behaviors(plugins.behaviors);
   RobotOptions ro;
@@ -246,7 +346,7 @@ RunResult run_task(const RunOptions& o) {
   }
   SimClock clock;
   const auto robot = Robot::assemble(profile, plugins, clock, ro);
-  const sim::Simulator& sim = dynamic_cast<sim::SimulatorSources&>(*robot->hardware()).simulation();
+  GroundTruth truth(robot->hardware(), world->start_pose);
   sim::SimBoardHardware* const board_hw = dynamic_cast<sim::SimBoardHardware*>(robot->hardware());
   Navigation nav{robot->module<navi::CGridMaps>(), robot->module<navi::CSectionSplitter>(), robot->module<navi::CCoverageModule>()};
   if (nav.coverage != nullptr) res.coverage_pattern = nav.coverage->pattern();
@@ -358,7 +458,7 @@ RunResult run_task(const RunOptions& o) {
   const Duration tick_period = robot->behavior_loop().period();
   const Time deadline = time_from_seconds(o.max_duration_s);
   bool was_cleaning = false;
-  Pose2D last_truth = sim.pose();
+  Pose2D last_truth = truth.pose();
   double next_progress_s = 0.0;
   Time next_sample = clock.now();
   auto is_cleaning = [&] { return robot->behavior_active("BhCleaning") || robot->behavior_active("BhCleaningTwoWheel"); };
@@ -389,7 +489,7 @@ RunResult run_task(const RunOptions& o) {
     if (bridge) bridge->update();
     if (!watch) return;
     monitor::MonitorExtras extras;
-    extras.true_pose = sim.pose();
+    extras.true_pose = truth.pose();
     if (res.reachable_cells > 0) extras.coverage = static_cast<double>(covered()) / static_cast<double>(res.reachable_cells);
     extras.cleaned_mask = &cleaned.mask();
     watch->update(extras);
@@ -404,26 +504,27 @@ RunResult run_task(const RunOptions& o) {
     if (robot->planner().busy() && !measured_busy) measure_room();
     measured_busy = robot->planner().busy();
     robot->run_for(tick_period);
-    for (; sim_events_noted < sim.events().size(); ++sim_events_noted) {
-      const sim::SimEvent& e = sim.events()[sim_events_noted];
+    for (; truth.local() != nullptr && sim_events_noted < truth.local()->events().size(); ++sim_events_noted) {
+      const sim::SimEvent& e = truth.local()->events()[sim_events_noted];
       life.note(e.stamp, "simulator: " + std::string(sim::to_string(e.kind)) + (e.detail.empty() ? "" : " " + e.detail));
     }
     const Time now = clock.now();
-    const Pose2D truth = sim.pose();
+    truth.sample();
+    const Pose2D true_pose = truth.pose();
     const bool cleaning = is_cleaning();
     if (cleaning) {
-      if (was_cleaning) cleaned.mark_segment({last_truth.x_m, last_truth.y_m}, {truth.x_m, truth.y_m}, half_width);
-      else cleaned.mark_disc({truth.x_m, truth.y_m}, half_width);
+      if (was_cleaning) cleaned.mark_segment({last_truth.x_m, last_truth.y_m}, {true_pose.x_m, true_pose.y_m}, half_width);
+      else cleaned.mark_disc({true_pose.x_m, true_pose.y_m}, half_width);
     }
     was_cleaning = cleaning;
-    last_truth = truth;
+    last_truth = true_pose;
     flush_log();
     if (now >= next_sample) {  // 10 Hz trajectory
       next_sample += std::chrono::milliseconds(100);
       const NavigationData& navi = robot->navigation();
-      traj.push_back({now, truth, navi.map_from_base, navi.localized, cleaning});
-      path_all.push_back({truth.x_m, truth.y_m});
-      if (cleaning) path_cleaning.push_back({truth.x_m, truth.y_m});
+      traj.push_back({now, true_pose, navi.map_from_base, navi.localized, cleaning});
+      path_all.push_back({true_pose.x_m, true_pose.y_m});
+      if (cleaning) path_cleaning.push_back({true_pose.x_m, true_pose.y_m});
     }
     if (to_seconds(now) >= next_progress_s) {
       draw_progress(false);
@@ -451,17 +552,17 @@ RunResult run_task(const RunOptions& o) {
   const double res_m = nav.maps->grid().resolution_m();
   res.reachable_area_m2 = static_cast<double>(res.reachable_cells) * res_m * res_m;
   res.total = path_figures(path_all);
-  res.total.length_m = sim.distance_m();
-  res.total.rotation_rad = sim.rotation_rad();
+  res.total.length_m = truth.distance_m();
+  res.total.rotation_rad = truth.rotation_rad();
   res.cleaning = path_figures(path_cleaning);
   res.processes = report.processes;
   res.recoveries = report.recoveries;
-  res.collisions = sim.collisions();
+  res.collisions = truth.collisions();
   res.robot_steps = robot->behavior_loop().cycles();
   for (const navi::LocalizationFault& f : faults) {
     res.faults.push_back("localization loss " + fixed(to_seconds(f.start), 1) + "-" + fixed(to_seconds(f.end), 1) + " s");
   }
-  for (const sim::SimEvent& e : sim.events()) {
+  for (const sim::SimEvent& e : truth.local() != nullptr ? truth.local()->events() : std::vector<sim::SimEvent>{}) {
     res.faults.push_back(fixed(to_seconds(e.stamp), 3) + " " + std::string(sim::to_string(e.kind)) + (e.detail.empty() ? "" : " " + e.detail));
   }
 

@@ -13,6 +13,7 @@
 #include <iosfwd>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tripodal/board/board_link.hpp"
@@ -26,6 +27,12 @@ struct RunOptions {
   std::filesystem::path robot;  ///< robot profile (YAML)
   std::filesystem::path world;  ///< world file (sim::load_world)
   std::string task;             ///< the command in plain words
+  /// Overrides the type of the profile's hardware slot (its parameters then start empty): "dds",
+  /// the simulator in another process (`tripodal sim-server`, docs/distribution.md). Empty: the
+  /// profile's own.
+  std::string hardware;
+  /// Parameters of the hardware slot (KEY, VALUE), over the profile's: "namespace", "psr2".
+  std::vector<std::pair<std::string, std::string>> hardware_parameters;
   std::optional<std::uint64_t> seed;  ///< default: the world's seed
   bool realtime = false;        ///< pace the simulation to wall time
   double realtime_speed = 1.0;

@@ -9,6 +9,8 @@
 #include <string_view>
 #include <vector>
 
+#include "tripodal/core/time.hpp"
+
 namespace tripodal::dds {
 
 // Field names, order and types follow the ROS 2 message definitions (the CDR bytes depend on
@@ -106,6 +108,20 @@ struct LaserScan {  // sensor_msgs/LaserScan
   bool operator==(const LaserScan&) const = default;
 };
 
+struct JointState {  // sensor_msgs/JointState; position, velocity, effort empty or as long as name
+  Header header;
+  std::vector<std::string> name;
+  std::vector<double> position;
+  std::vector<double> velocity;
+  std::vector<double> effort;
+  bool operator==(const JointState&) const = default;
+};
+
+struct Clock {  // rosgraph_msgs/Clock: the simulated time (ROS 2's use_sim_time)
+  Time clock;
+  bool operator==(const Clock&) const = default;
+};
+
 struct MapMetaData {  // nav_msgs/MapMetaData
   Time map_load_time;
   float resolution = 0.0F;
@@ -143,6 +159,30 @@ struct TaskCommand {
   bool operator==(const TaskCommand&) const = default;
 };
 
+// tripodal_msgs/SimStep: lock-step co-simulation, the robot's request to advance the simulator to
+// `until` with the base driven by `cmd_vel` (tripodal sim-server).
+struct SimStep {
+  Time until;
+  Twist cmd_vel;
+  std::uint32_t step = 0;  // from 1
+  bool operator==(const SimStep&) const = default;
+};
+
+// tripodal_msgs/SimState: the simulator after a step: its time, its ground truth for the run's
+// measures, the last step done and the samples published so far on scan and joint_states.
+struct SimState {
+  Time stamp;
+  double x = 0.0;  // true map_from_base (m, m, rad)
+  double y = 0.0;
+  double theta = 0.0;
+  double distance = 0.0;  // driven so far (m)
+  std::uint32_t step = 0;
+  std::uint32_t scans = 0;
+  std::uint32_t joint_states = 0;
+  std::uint32_t collisions = 0;
+  bool operator==(const SimState&) const = default;
+};
+
 }  // namespace msg
 
 // The names a message type has: `ros` as ROS 2 tools print it, `dds` as ROS 2 registers it with
@@ -162,8 +202,12 @@ TRIPODAL_DDS_MESSAGE_TYPE(PoseWithCovarianceStamped, "geometry_msgs", "PoseWithC
 TRIPODAL_DDS_MESSAGE_TYPE(Odometry, "nav_msgs", "Odometry");
 TRIPODAL_DDS_MESSAGE_TYPE(OccupancyGrid, "nav_msgs", "OccupancyGrid");
 TRIPODAL_DDS_MESSAGE_TYPE(LaserScan, "sensor_msgs", "LaserScan");
+TRIPODAL_DDS_MESSAGE_TYPE(JointState, "sensor_msgs", "JointState");
+TRIPODAL_DDS_MESSAGE_TYPE(Clock, "rosgraph_msgs", "Clock");
 TRIPODAL_DDS_MESSAGE_TYPE(Event, "tripodal_msgs", "Event");
 TRIPODAL_DDS_MESSAGE_TYPE(TaskCommand, "tripodal_msgs", "TaskCommand");
+TRIPODAL_DDS_MESSAGE_TYPE(SimStep, "tripodal_msgs", "SimStep");
+TRIPODAL_DDS_MESSAGE_TYPE(SimState, "tripodal_msgs", "SimState");
 #undef TRIPODAL_DDS_MESSAGE_TYPE
 
 // A type that can be published: one of the above (the transport instantiates exactly these).
@@ -175,5 +219,8 @@ concept Message = requires {
 // The time of a message from seconds (ROS 2's convention: nanosec in [0, 1e9)).
 msg::Time ros_time(double seconds);
 double ros_seconds(const msg::Time& t);
+// The same to and from a tripodal Time, to the nanosecond (lock-step co-simulation compares them).
+msg::Time ros_time(Time t);
+Time tripodal_time(const msg::Time& t);
 
 }  // namespace tripodal::dds

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <atomic>
+#include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -23,6 +25,18 @@ struct TopicBinding {
 };
 TopicBinding topic_binding(const ParameterSet& parameters, std::string_view default_topic);
 
+// How a DdsLaserResource reads its topic, when built in code rather than from a profile's entry
+// (the laser of DdsHardware).
+struct DdsLaserOptions {
+  TopicBinding binding;
+  Duration max_age{};       // older than this the scan is stale; 0: never
+  Duration deadline{};      // a fault when no scan comes within this; 0: none
+  // Lock-step co-simulation: every scan must arrive (a reliable reader, which matches only reliable
+  // publishers) and its stamp is the robot's own time (the simulator's clock is the robot's).
+  bool lock_step = false;
+  std::function<void()> on_scan;  // after a scan was received (on a Cyclone DDS thread)
+};
+
 // Type "DdsLaser": the latest sensor_msgs/LaserScan of a topic as a laser resource. Scans arrive on
 // a Cyclone DDS thread and are handed to the control loop in poll(), stamped with the loop's time
 // of that poll (the sender's stamp is on another clock), so max_age_s measures how long ago the
@@ -35,12 +49,15 @@ class DdsLaserResource final : public LaserResource, public ResourceFaultSource 
   static const ModuleManifest& static_manifest();
   // `parameters` resolved against static_manifest() (a robot profile's resource entry).
   DdsLaserResource(std::string name, const ParameterSet& parameters);
+  DdsLaserResource(std::string name, DdsLaserOptions options);
   ~DdsLaserResource() override;
   DdsLaserResource(const DdsLaserResource&) = delete;
   DdsLaserResource& operator=(const DdsLaserResource&) = delete;
 
   const std::string& topic() const noexcept;
   std::size_t matched_publishers() const;
+  // Scans received so far (any thread).
+  std::uint64_t received() const noexcept { return received_.load(std::memory_order_acquire); }
   [[nodiscard]] std::vector<std::string> take_faults() override { return faults_.take(); }
 
  private:
@@ -53,6 +70,10 @@ class DdsLaserResource final : public LaserResource, public ResourceFaultSource 
   LaserScan pending_;
   std::atomic<bool> has_pending_{false};
   std::atomic<bool> silent_{false};  // a fault was reported and no scan came since
+  std::atomic<std::uint64_t> received_{0};
+  bool sender_stamp_ = false;
+  Time pending_stamp_{};
+  std::function<void()> on_scan_;
   std::unique_ptr<Subscriber<msg::LaserScan>> subscriber_;
 };
 

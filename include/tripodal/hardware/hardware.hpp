@@ -28,6 +28,9 @@ struct HardwareConfig {
   std::filesystem::path profile_dir;       ///< relative file parameters are relative to it
 };
 
+/// A hardware whose link can fail on its own (a base behind DDS) also implements
+/// ResourceFaultSource (resources/resource_faults.hpp): the robot reports its faults like a
+/// resource's, as the module fault "<hardware name>.fault".
 class CHardware {
  public:
   virtual ~CHardware() = default;

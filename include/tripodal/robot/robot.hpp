@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -44,6 +45,12 @@ struct RobotOptions {
   /// Loads a process net; default: load_net_or_throw checking behavior names against the profile.
   std::function<PetriNet(const std::filesystem::path&)> load_net;
 };
+
+/// The configuration of the base controller the profile's hardware drives (the controller of the
+/// first loop that has one, read from the reactive configuration its entry names), as the robot
+/// gives it to its hardware (HardwareConfig::base): what a simulator of the base in another process
+/// needs. nullopt when no loop drives a controller; throws ConfigError (located) for a bad entry.
+[[nodiscard]] std::optional<ControllerConfig> base_controller_config(const RobotProfile& profile);
 
 class Robot final {
  public:

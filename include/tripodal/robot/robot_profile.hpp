@@ -65,6 +65,10 @@ struct ProcessEntry {
 /// reference lists them (docs/distribution.md).
 inline constexpr std::string_view kDdsTopics[] = {"odom", "pose", "map", "events", "markings"};
 
+/// Whether ROS 2 takes `ns` as a namespace: names of letters, digits and '_', not starting with a
+/// digit, separated by '/' (a leading '/' allowed); empty is none.
+[[nodiscard]] bool is_ros_namespace(std::string_view ns);
+
 /// The robot on DDS: `dds: {domain_id, namespace, loopback, participant_lease_s, period_s, publish,
 /// tasks}`. Plain data read by the dds area's RobotBridge (docs/distribution.md); the robot itself
 /// does not use it, so the core builds and runs without DDS.

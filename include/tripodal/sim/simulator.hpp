@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "tripodal/controllers/base_kinematics.hpp"
 #include "tripodal/controllers/controller.hpp"
 #include "tripodal/controllers/controller_config.hpp"
 #include "tripodal/core/clock.hpp"
@@ -24,11 +25,6 @@
 #include "tripodal/resources/resource.hpp"
 #include "tripodal/sim/ray_caster.hpp"
 #include "tripodal/sim/world.hpp"
-
-namespace tripodal {
-class HolonomicController;
-class IdealWheelHardware;
-}  // namespace tripodal
 
 namespace tripodal::sim {
 
@@ -202,10 +198,8 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   [[nodiscard]] bool due(Schedule& s) const noexcept;
 
   World world_;
-  ControllerConfig base_;
+  BaseKinematics kinematics_;
   std::size_t wheels_ = 0;
-  std::unique_ptr<IdealWheelHardware> model_hw_;
-  std::unique_ptr<HolonomicController> holonomic_;  // kinematics model of a holonomic base
   SolidMap solid_;
   std::vector<std::uint8_t> static_solid_;
   std::vector<std::uint8_t> drop_;

@@ -1,0 +1,331 @@
+// `tripodal sim-server --robot ROBOT.yaml --world WORLD.yaml`: the embedded simulator in a process
+// of its own, serving the robot's base and laser over DDS (docs/distribution.md, "The simulator in
+// another process") to a robot whose hardware is of type "dds" (`tripodal run --hardware dds`), in
+// lock-step with the robot's clock. Built only with the dds area.
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <csignal>
+#include <deque>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <ostream>
+#include <string>
+
+#include "cli_tool.hpp"
+#include "run_outputs.hpp"
+#include "tripodal/core/clock.hpp"
+#include "tripodal/core/diagnostic.hpp"
+#include "tripodal/dds/dds_hardware.hpp"
+#include "tripodal/dds/endpoint.hpp"
+#include "tripodal/robot/robot.hpp"
+#include "tripodal/robot/robot_profile.hpp"
+#include "tripodal/sim/simulator.hpp"
+#include "tripodal/sim/world.hpp"
+
+namespace tripodal::tool {
+namespace {
+
+using namespace cli;
+
+constexpr int kNoRobot = 4;
+
+constexpr std::string_view kDescription =
+    "Runs the embedded simulator of a world with the base of a robot profile (its base\n"
+    "controller's wheels) in a process of its own and serves it over DDS under --namespace: the\n"
+    "laser on scan (sensor_msgs/LaserScan), the wheels on joint_states (sensor_msgs/JointState),\n"
+    "and, in lock-step with the robot's clock, each step the robot asks for on tripodal/sim_step\n"
+    "(tripodal_msgs/SimStep: advance to t with this cmd_vel) answered on tripodal/sim_state. The\n"
+    "robot is the same profile with its hardware of type dds: `tripodal run --robot ROBOT.yaml\n"
+    "--world WORLD.yaml --hardware dds --hardware-param namespace=NS ...`. Serves one robot until\n"
+    "it leaves or the server is stopped (Ctrl-C, SIGTERM), then prints what the simulation measured:\n"
+    "simulated time, distance, collisions and the world's events. With --realtime [SPEED] it runs on\n"
+    "its own at SPEED times real time instead, driven by plain cmd_vel (geometry_msgs/Twist; none for\n"
+    "0.5 s: the base stops) and publishing /clock (rosgraph_msgs/Clock), as ROS 2 tools expect,\n"
+    "until stopped.";
+
+constexpr std::string_view kExitCodes =
+    "exit codes: 0 served until the robot left or the server was stopped, 1 bad profile/world, 2 bad\n"
+    "            command line, 3 I/O error (a file, DDS), 4 no robot came within --wait-s.";
+
+struct Args {
+  std::filesystem::path robot, world;
+  std::string ros_namespace;
+  unsigned domain = 0;
+  std::optional<std::uint64_t> seed;
+  double lease_s = 2.0;
+  double wait_s = 0.0;
+  bool system_network = false;
+  CLI::Option* realtime = nullptr;  // given at all (with or without SPEED)
+  double realtime_speed = 0.0;      // 0: --realtime without SPEED
+};
+
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void on_sim_server_stop_signal(int) {
+  g_stop = 1;
+}
+
+// The step requests and the client's comings and goings, from Cyclone DDS threads.
+struct Inbox {
+  std::mutex mutex;
+  std::optional<dds::msg::Twist> cmd_vel;  // --realtime: the latest, and when it came
+  std::chrono::steady_clock::time_point cmd_vel_at;
+  std::condition_variable cv;
+  std::deque<dds::msg::SimStep> steps;
+  bool had_client = false;
+  bool client_left = false;
+  std::string left_why;
+};
+
+std::vector<std::string> wheel_names(std::size_t n) {
+  if (n == 2) return {"left_wheel", "right_wheel"};
+  std::vector<std::string> names;
+  for (std::size_t i = 1; i <= n; ++i) names.push_back("wheel_" + std::to_string(i));
+  return names;
+}
+
+int run(const Args& a, std::ostream& out, std::ostream& err) {
+  for (const auto& f : {a.robot, a.world}) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(f, ec)) {
+      err << "tripodal sim-server: cannot read '" << f.string() << "'\n";
+      return kIoError;
+    }
+  }
+  if (!is_ros_namespace(a.ros_namespace)) {
+    err << "tripodal sim-server: --namespace '" << a.ros_namespace
+        << "' is not a ROS 2 namespace: names of letters, digits and '_', not starting with a digit, "
+           "separated by '/'\n";
+    return kUsage;
+  }
+  try {
+    const RobotProfile profile = load_robot_profile(a.robot);
+    const std::optional<ControllerConfig> base = base_controller_config(profile);
+    if (!base)
+      throw ConfigError(
+          profile.where,
+          "tripodal sim-server simulates the robot's base: the profile needs a loop with a controller");
+    sim::World world = sim::load_world(a.world);
+    const std::uint64_t seed = a.seed.value_or(world.seed);
+    sim::Simulator sim(std::move(world), *base, seed);
+
+    dds::ParticipantOptions po;
+    po.domain_id = a.domain;
+    po.network = a.system_network ? dds::Network::system : dds::Network::loopback;
+    po.participant_lease = std::chrono::milliseconds(static_cast<std::int64_t>(a.lease_s * 1000.0));
+    dds::Participant participant(po);
+    const dds::BaseTopics topics(a.ros_namespace);
+
+    Inbox inbox;
+    // The robot's step writer: its requests, and the robot leaving (its process ended or died).
+    auto on_status = [&inbox](const dds::StatusEvent& e) {
+      if (e.kind != dds::StatusKind::publication_matched && e.kind != dds::StatusKind::liveliness_lost)
+        return;
+      std::lock_guard lock(inbox.mutex);
+      if (e.current_count > 0) {
+        inbox.had_client = true;
+      } else if (inbox.had_client && !inbox.client_left) {
+        inbox.client_left = true;
+        inbox.left_why =
+            e.kind == dds::StatusKind::liveliness_lost ? "left or went silent (DDS liveliness lost)" : "left";
+      }
+      inbox.cv.notify_all();
+    };
+    const bool realtime = a.realtime->count() > 0;
+    std::optional<dds::Subscriber<dds::msg::SimStep>> steps;
+    std::optional<dds::Subscriber<dds::msg::Twist>> cmd_vel;
+    std::optional<dds::Publisher<dds::msg::Clock>> clock;
+    if (realtime) {
+      cmd_vel.emplace(participant, topics.cmd_vel, dds::EndpointOptions{.kind = dds::TopicKind::command},
+                      [&inbox](const dds::msg::Twist& t) {
+                        std::lock_guard lock(inbox.mutex);
+                        inbox.cmd_vel = t;
+                        inbox.cmd_vel_at = std::chrono::steady_clock::now();
+                      });
+      clock.emplace(participant, topics.clock, dds::EndpointOptions{.kind = dds::TopicKind::state});
+    } else {
+      steps.emplace(participant, topics.sim_step,
+                    dds::EndpointOptions{.kind = dds::TopicKind::state, .on_status = on_status},
+                    [&inbox](const dds::msg::SimStep& s) {
+                      std::lock_guard lock(inbox.mutex);
+                      inbox.steps.push_back(s);
+                      inbox.cv.notify_all();
+                    });
+    }
+    // Reliable scans: a lock-step robot counts on every one (ROS 2's best-effort readers match too).
+    dds::Qos scan_qos = dds::qos_for(dds::TopicKind::scan, dds::Role::publisher);
+    scan_qos.reliability = dds::Reliability::reliable;
+    dds::Publisher<dds::msg::LaserScan> scan(participant, topics.scan,
+                                             {.kind = dds::TopicKind::scan, .qos = scan_qos});
+    dds::Publisher<dds::msg::JointState> joints(participant, topics.joint_states,
+                                                {.kind = dds::TopicKind::state});
+    dds::Publisher<dds::msg::SimState> state(participant, topics.sim_state, {.kind = dds::TopicKind::state});
+
+    std::signal(SIGINT, on_sim_server_stop_signal);
+    std::signal(SIGTERM, on_sim_server_stop_signal);
+    out << "tripodal sim-server: robot " << profile.name << " (" << base->type << " base, "
+        << sim.wheel_count() << " wheels), world " << a.world.string() << ", seed " << seed << "; domain "
+        << a.domain << ", serving " << topics.scan << ", " << topics.joint_states << ", " << topics.sim_state
+        << (realtime ? ", " + topics.clock + " at " +
+                           app::fixed(a.realtime_speed > 0.0 ? a.realtime_speed : 1.0, 1) +
+                           " times real time; commands on " + topics.cmd_vel
+                     : "; steps on " + topics.sim_step)
+        << "\n";
+    out.flush();
+
+    const std::size_t n = sim.wheel_count();
+    dds::msg::JointState js;
+    js.header.frame_id = "base_link";
+    js.name = wheel_names(n);
+    dds::msg::LaserScan ls;
+    ls.header.frame_id = "laser";
+    std::vector<double> velocity(n), position(n);
+    std::uint32_t scans = 0, joint_states = 0, last_step = 0;
+    std::size_t laser_seen = 0;
+    const auto started = std::chrono::steady_clock::now();
+    std::string ended = "stopped";
+    int code = kOk;
+    // After a step: what the sensors gave, then the state (and with --realtime the clock).
+    auto publish = [&](std::uint32_t step) {
+      const LaserResource& laser = sim.laser();
+      if (laser.sequence() != laser_seen && laser.has_reading()) {
+        laser_seen = laser.sequence();
+        const LaserScan& l = laser.latest();
+        ls.header.stamp = dds::ros_time(l.stamp);
+        ls.angle_min = static_cast<float>(l.angle_min_rad);
+        ls.angle_max = static_cast<float>(l.angle_max_rad);
+        ls.angle_increment = static_cast<float>(l.angle_increment_rad);
+        ls.time_increment = static_cast<float>(l.time_increment_s);
+        ls.scan_time = static_cast<float>(l.scan_time_s);
+        ls.range_min = static_cast<float>(l.range_min_m);
+        ls.range_max = static_cast<float>(l.range_max_m);
+        ls.ranges = l.ranges_m;
+        ls.intensities = l.intensities;
+        scan.publish(ls);
+        ++scans;
+      }
+      js.header.stamp = dds::ros_time(sim.now());
+      if (sim.read_wheel_states(velocity, position)) {
+        js.position = position;
+        js.velocity = velocity;
+      } else {  // the odometry is dead: states without values, as the in-process read fails
+        js.position.clear();
+        js.velocity.clear();
+      }
+      joints.publish(js);
+      ++joint_states;
+      last_step = step;
+      const Pose2D& p = sim.pose();
+      state.publish(dds::msg::SimState{dds::ros_time(sim.now()), p.x_m, p.y_m, p.theta_rad, sim.distance_m(),
+                                       last_step, scans, joint_states,
+                                       static_cast<std::uint32_t>(sim.collisions())});
+      if (clock) clock->publish(dds::msg::Clock{dds::ros_time(sim.now())});
+    };
+    // Lock-step: the command over the step, the world advanced to its end, then what it gave.
+    auto serve = [&](const dds::msg::SimStep& s) {
+      sim.command_twist(Twist2D{s.cmd_vel.linear.x, s.cmd_vel.linear.y, s.cmd_vel.angular.z});
+      sim.step_until(dds::tripodal_time(s.until));
+      publish(s.step);
+    };
+    // Real time: a physics period at a time, paced to the wall clock, with the latest cmd_vel
+    // (none within kCmdTimeout: the base stops, as a ROS 2 base driver does).
+    if (realtime) {
+      constexpr auto kPeriod = std::chrono::milliseconds(10);
+      constexpr auto kCmdTimeout = std::chrono::milliseconds(500);
+      SteadyClock wall;
+      sim::RealtimePacer pacer(wall, a.realtime_speed > 0.0 ? a.realtime_speed : 1.0);
+      std::uint32_t periods = 0;
+      publish(periods);
+      while (g_stop == 0) {
+        Twist2D command{};
+        {
+          std::lock_guard lock(inbox.mutex);
+          if (inbox.cmd_vel && std::chrono::steady_clock::now() - inbox.cmd_vel_at < kCmdTimeout) {
+            command = {inbox.cmd_vel->linear.x, inbox.cmd_vel->linear.y, inbox.cmd_vel->angular.z};
+          }
+        }
+        sim.command_twist(command);
+        sim.step(kPeriod);
+        publish(++periods);
+        pacer.pace(sim.now());
+      }
+    }
+    while (!realtime && g_stop == 0) {
+      std::unique_lock lock(inbox.mutex);
+      // Wakes for a request or a departure, and every 100 ms to see a signal.
+      inbox.cv.wait_for(lock, std::chrono::milliseconds(100),
+                        [&] { return !inbox.steps.empty() || inbox.client_left; });
+      if (!inbox.steps.empty()) {
+        const dds::msg::SimStep s = inbox.steps.front();
+        inbox.steps.pop_front();
+        lock.unlock();
+        serve(s);
+        continue;
+      }
+      if (inbox.client_left) {
+        ended = "the robot " + inbox.left_why;
+        break;
+      }
+      if (!inbox.had_client && a.wait_s > 0.0 &&
+          std::chrono::steady_clock::now() - started > std::chrono::duration<double>(a.wait_s)) {
+        ended = "no robot came within " + app::fixed(a.wait_s, 1) + " s";
+        code = kNoRobot;
+        break;
+      }
+    }
+    out << "sim-server ended: " << ended << "; " << last_step << (realtime ? " periods" : " steps served")
+        << "; " << app::fixed(to_seconds(sim.now()), 2) << " s simulated; distance "
+        << app::fixed(sim.distance_m(), 2) << " m; " << sim.collisions() << " collisions\n";
+    for (const sim::SimEvent& e : sim.events()) {
+      out << app::fixed(to_seconds(e.stamp), 3) << " s  simulator: " << sim::to_string(e.kind)
+          << (e.detail.empty() ? "" : " " + e.detail) << '\n';
+    }
+    return code;
+  } catch (const ConfigError& e) {
+    err << e.what() << '\n';
+    return kBadInput;
+  } catch (const std::exception& e) {  // files, DDS
+    err << "tripodal sim-server: " << e.what() << '\n';
+    return kIoError;
+  }
+}
+
+cli::Action setup(CLI::App& cmd) {
+  auto a = std::make_shared<Args>();
+  cmd.add_option("--robot", a->robot, "ROBOT.yaml: the robot profile whose base is simulated")->required();
+  cmd.add_option("--world", a->world, "WORLD.yaml: map, start pose, sensors and faults of the simulation")
+      ->required();
+  cmd.add_option("--namespace", a->ros_namespace,
+                 "NS: the ROS 2 namespace of the topics (the robot's hardware parameter namespace)");
+  cmd.add_option("--domain", a->domain, "ID: the DDS domain (ROS_DOMAIN_ID)")
+      ->check(CLI::Range(0, 232))
+      ->capture_default_str();
+  cmd.add_option("--seed", a->seed, "N: the simulator's seed (default: the world's)");
+  cmd.add_option("--lease-s", a->lease_s, "S: the participant lease: a killed server is seen silent after S")
+      ->check(cli::positive_number())
+      ->capture_default_str();
+  cmd.add_option("--wait-s", a->wait_s,
+                 "S: give up (exit 4) when no robot came within S of wall time; 0: wait until stopped")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  // Without SPEED CLI11 hands the option an empty value, which leaves realtime_speed at 0.
+  a->realtime = cmd.add_option("--realtime", a->realtime_speed,
+                               "[SPEED]: free-running at SPEED times real time (default 1), driven by "
+                               "cmd_vel, publishing clock "
+                               "(for ROS 2 tools; no lock-step)")
+                    ->expected(0, 1)
+                    ->check(cli::positive_number() | CLI::IsMember({"", "true"}));
+  cmd.add_flag("--system-network", a->system_network,
+               "Cyclone DDS's own network configuration instead of loopback only");
+  return [a](std::ostream& out, std::ostream& err) { return run(*a, out, err); };
+}
+
+}  // namespace
+
+TRIPODAL_CLI_COMMAND("", "sim-server",
+                     "serve the simulator of a world to a robot over DDS (tripodal run --hardware dds)",
+                     kDescription, kExitCodes, &setup);
+
+}  // namespace tripodal::tool
