@@ -1,5 +1,7 @@
 #include "tripodal/behaviors/behavior.hpp"
 
+#include <cmath>
+
 namespace tripodal {
 
 std::string_view to_string(BehaviorStatus status) noexcept {
@@ -11,6 +13,9 @@ std::string_view to_string(BehaviorStatus status) noexcept {
   }
   return "?";
 }
+
+double SafetyFeedback::requested_speed_m_s() const noexcept { return std::hypot(requested.vx_m_s, requested.vy_m_s); }
+double SafetyFeedback::allowed_speed_m_s() const noexcept { return std::hypot(allowed.vx_m_s, allowed.vy_m_s); }
 
 std::string done_event_name(std::string_view behavior_name) { return std::string(behavior_name) + ".done"; }
 std::string failed_event_name(std::string_view behavior_name) { return std::string(behavior_name) + ".failed"; }

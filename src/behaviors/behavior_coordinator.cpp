@@ -181,6 +181,8 @@ const CoordinatorOutput& CBehaviorCoordinator::update(Time now) noexcept {
   out.all_expired = out.live_inputs == 0;
   if (out.all_expired) fused = Twist2D{};
 
+  out.requested = fused;
+
   // Safety override: intersect the envelopes of the live safety inputs, clamp into it.
   VelocityEnvelope env;
   bool any_safety = false;

@@ -34,6 +34,10 @@ std::vector<ParameterSpec> following_parameters(double speed, double lookahead) 
       number("replan_after_s", 2.0, "s",
              "Stopped this long by an obstacle the map does not hold, plan a way around it (0: never)", 0.0, 3600.0),
       number("max_replans", 5.0, "", "Plans around unexpected obstacles allowed per activation", 0.0, 1000.0),
+      number("safety_hold_s", 1.0, "s",
+             "Held still this long by a safety input (the commanded translation clamped to zero) counts as blocked, "
+             "as before an obstacle on the path (0: at once)",
+             0.0, 3600.0),
       text("laser", "", "Laser resource watched for obstacles (empty: the first laser)"),
   };
 }
@@ -202,6 +206,8 @@ void CPathFollowingBehavior::configure_following(const ParameterSet& params, con
   stop_distance_m_ = params.number("stop_distance_m");
   slow_distance_m_ = std::max(params.number("slow_distance_m"), stop_distance_m_);
   blocked_timeout_ = from_seconds(params.number("blocked_timeout_s"));
+  safety_hold_ = from_seconds(params.number("safety_hold_s"));
+  held_ = false;
   laser_ = nullptr;
   bumpers_ = nullptr;
   if (context.resources != nullptr) {
@@ -264,7 +270,7 @@ Twist2D CPathFollowingBehavior::drive_toward(const Pose2D& pose, const PathTrack
   update_unexpected(pose, context);
   bool blocked = false;
   const Twist2D cmd = command_toward(pose, target, context, blocked);
-  const bool too_long = blocked_too_long(blocked, context.now);
+  const bool too_long = blocked_too_long(blocked || held_by_safety(context), context.now);
   if (context.feedback != nullptr) {
     context.feedback->blocked = blocked_;
     context.feedback->blocked_since = blocked_since_;
@@ -396,6 +402,23 @@ Twist2D CPathFollowingBehavior::command_toward(const Pose2D& pose, const PathTra
     }
   }
   return cmd;
+}
+
+bool CPathFollowingBehavior::held_by_safety(const BehaviorContext& context) noexcept {
+  // Held: the last command asked to move and the safety override let it crawl at most. Turning is
+  // never held (a safety input leaves rotation free), so a turn in place toward a new path is not.
+  const SafetyFeedback* safety = context.safety;
+  const bool holding = safety != nullptr && safety->limited && safety->requested_speed_m_s() >= kCrawl_m_s &&
+                       safety->allowed_speed_m_s() < kCrawl_m_s;
+  if (!holding) {
+    held_ = false;
+    return false;
+  }
+  if (!held_) {
+    held_ = true;
+    held_since_ = context.now;
+  }
+  return context.now - held_since_ >= safety_hold_;
 }
 
 bool CPathFollowingBehavior::blocked_too_long(bool blocked, Time now) noexcept {

@@ -251,11 +251,19 @@ const CycleReport& ControlLoop::step(Time now) noexcept {
   context.base = base_;
   feedback_ = NavigationFeedback{};
   context.feedback = &feedback_;
+  // The previous cycle's fusion (report_ still holds it): what the safety override did to the
+  // winner's command goes to the winner alone, so a behavior learns that it is held still.
+  const CoordinatorOutput& last = report_.coordinator;
+  safety_.limited = last.safety_limited;
+  safety_.requested = last.requested;
+  safety_.allowed = last.command;
+  safety_.limited_by = last.limited_by;
 
   std::uint32_t active = 0;
   for (Slot& slot : slots_) {
     if (!slot.active) continue;
     CBehavior& b = *slot.behavior;
+    context.safety = last.winner_id && *last.winner_id == slot.input ? &safety_ : nullptr;
     const std::optional<Twist2D> command = b.step(context);
     if (b.envelope()) {
       coordinator_.submit_envelope(slot.input, *b.envelope(), now);

@@ -5,6 +5,8 @@
 // the HRI displays following the planner's life cycle.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+
 #include <unistd.h>
 
 #include <filesystem>
@@ -167,15 +169,11 @@ class BhPush final : public CBehavior {
   std::optional<Twist2D> on_step(const BehaviorContext&) noexcept override { return Twist2D{0.5, 0.0, 0.0}; }
 };
 
-// BhAvoidObstacle as a safety behavior, as docs/guide.md shows it for Jinny's profile.
-ModuleEntry safety_entry() {
-  ModuleEntry e;
-  e.kind = ModuleKind::behavior;
-  e.name = e.type = "BhAvoidObstacle";
-  e.safety = true;
-  e.parameters = {{"robot_radius_m", "0.25"}, {"stop_distance_m", "0.15"}, {"slow_distance_m", "0.9"}, {"max_speed_m_s", "0.8"}};
-  e.where = SourceLocation{"test profile", 1, 1};
-  return e;
+// Jinny's shipped profile, with its safety behavior (BhAvoidObstacle, safety: true) or without it.
+RobotProfile jinny_profile(bool with_safety) {
+  RobotProfile profile = load_robot_profile(kConfigs / "robots/jinny.yaml");
+  if (!with_safety) std::erase_if(profile.behaviors, [](const ModuleEntry& e) { return e.safety; });
+  return profile;
 }
 
 // Jinny at the entrance facing +x, one visitor standing 1.1 m ahead (0.6 m between the bodies),
@@ -194,8 +192,7 @@ PushResult push_towards_visitor(bool with_safety) {
   standing.give_way_m = 0.0;
   standing.radius_m = 0.25;
   world->visitors = {standing};
-  RobotProfile profile = load_robot_profile(kConfigs / "robots/jinny.yaml");
-  if (with_safety) profile.behaviors.push_back(safety_entry());
+  RobotProfile profile = jinny_profile(with_safety);
   RobotPlugins plugins = RobotPlugins::with_builtins();
   sim::register_sim_hardware(plugins.hardware, world);
   register_gesture_behaviors(plugins.behaviors);
@@ -219,8 +216,8 @@ PushResult push_towards_visitor(bool with_safety) {
 TEST_CASE("BhAvoidObstacle as Jinny's safety behavior (safety: true) stops a behavior that drives into a visitor who does not give way",
           "[app][guide][safety]") {
   {
-    RobotProfile profile = load_robot_profile(kConfigs / "robots/jinny.yaml");
-    profile.behaviors.push_back(safety_entry());
+    const RobotProfile profile = jinny_profile(true);  // as shipped
+    REQUIRE(std::count_if(profile.behaviors.begin(), profile.behaviors.end(), [](const ModuleEntry& e) { return e.safety; }) == 1);
     SimClock clock;
     auto world = std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/exhibit_hall.yaml"));
     RobotPlugins plugins = RobotPlugins::with_builtins();

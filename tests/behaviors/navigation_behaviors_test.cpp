@@ -424,3 +424,69 @@ TEST_CASE("register_navigation_behaviors registers the four behaviors by name", 
   REQUIRE_THROWS_WITH(reg.create("BhClean"), Catch::Contains("unknown behavior type 'BhClean'; known: BhAutoMove, BhCleaning, "
                                                              "BhCleaningTwoWheel, BhGlobalLocalization; did you mean 'BhCleaning'?"));
 }
+
+TEST_CASE(
+    "A path-following behavior held still by a safety input reports itself blocked after safety_hold_s, not "
+    "before, and not once released",
+    "[behaviors][navigation][safety]") {
+  Bench bench(false);
+  BhAutoMove b;
+  b.activate(params({{"goal", "door"}, {"safety_hold_s", "1"}, {"blocked_timeout_s", "3"}}), bench.ctx);
+  bench.publish({{0.6, 2.0, 0}, {5.4, 2.0, 0}}, 1);
+  // What the loop hands over: the safety override of the previous period's command. The base
+  // stands still (no laser return: the behavior itself sees nothing in the way).
+  SafetyFeedback safety;
+  bench.ctx.safety = &safety;
+  const auto step = [&](bool held, double allowed_fraction = 0.0) {
+    bench.ctx.now = bench.now;
+    bench.feedback = NavigationFeedback{};
+    const Twist2D cmd = b.step(bench.ctx).value_or(Twist2D{});
+    safety.limited = held;
+    safety.requested = cmd;
+    safety.allowed = held ? Twist2D{allowed_fraction * cmd.vx_m_s, 0.0, cmd.wz_rad_s} : cmd;
+    safety.limited_by = held ? "BhAvoidObstacle" : "";
+    bench.now += bench.ctx.period;
+    return cmd;
+  };
+  for (int i = 0; i < 10; ++i) CHECK(step(false).vx_m_s > 0.1);  // free: it drives on
+  CHECK_FALSE(bench.feedback.blocked);
+
+  // Slowed (to half) but not held: never blocked.
+  for (int i = 0; i < 40; ++i) step(true, 0.5);
+  CHECK_FALSE(bench.feedback.blocked);
+
+  // Held: the first step that sees the hold starts the timer; blocked from 1 s on, not before.
+  (void)step(true);
+  const Time held_from = bench.now;
+  std::optional<Time> blocked_at;
+  while (bench.now - held_from < 1500ms) {
+    (void)step(true);
+    if (bench.feedback.blocked && !blocked_at) blocked_at = bench.ctx.now;
+    if (!blocked_at) CHECK_FALSE(bench.feedback.blocked);
+  }
+  REQUIRE(blocked_at);
+  CHECK(to_seconds(*blocked_at - held_from) == Approx(1.0).margin(0.051));
+  CHECK(bench.feedback.blocked_since == *blocked_at);
+  CHECK(b.running());
+
+  // Released: not blocked once the release reaches the behavior (the step after the one whose
+  // command was let through), and the hold starts again from zero.
+  (void)step(false);
+  CHECK(step(false).vx_m_s > 0.1);
+  CHECK_FALSE(bench.feedback.blocked);
+  for (int i = 0; i < 10; ++i) (void)step(true);  // 0.5 s held: under safety_hold_s
+  CHECK_FALSE(bench.feedback.blocked);
+  // A hold that reaches another behavior's command (context.safety null) is not this one's.
+  bench.ctx.safety = nullptr;
+  for (int i = 0; i < 40; ++i) (void)step(true);
+  CHECK_FALSE(bench.feedback.blocked);
+
+  // Held for good: blocked after 1 s, then "path blocked" after blocked_timeout_s (3 s) more, as
+  // before an obstacle on the path (the replanning and the recovery rules take it from there).
+  bench.ctx.safety = &safety;
+  const Time from = bench.now;
+  while (b.running() && bench.now - from < 10s) (void)step(true);
+  CHECK(b.status() == BehaviorStatus::failed);
+  CHECK(b.failure_reason() == "path blocked");
+  CHECK(to_seconds(bench.now - from) == Approx(4.1).margin(0.15));
+}

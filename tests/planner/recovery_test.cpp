@@ -5,7 +5,9 @@
 #include <string>
 #include <vector>
 
+#include "tripodal/core/event_script.hpp"
 #include "tripodal/core/net_loader.hpp"
+#include "tripodal/core/net_simulation.hpp"
 
 using namespace tripodal;
 
@@ -126,10 +128,14 @@ TEST_CASE("the fault messages a net can post: its fault places that can be marke
 
 TEST_CASE("every shipped recovery rule matches a fault a shipped net posts, and inserts a process that has a net") {
   const PetriNet automove = shipped_net("PrAutoMove.xml"), cleaning = shipped_net("PrCleaning.xml"),
-                 global = shipped_net("PrGlobalLocalization.xml"), wait = shipped_net("PrWait.xml");
-  const std::vector<ProcessNet> nets{
-      {"PrAutoMove", &automove}, {"PrCleaning", &cleaning}, {"PrGlobalLocalization", &global}, {"PrWait", &wait}};
-  for (const char* file : {"recovery.yaml"}) {
+                 global = shipped_net("PrGlobalLocalization.xml"), wait = shipped_net("PrWait.xml"),
+                 back_off = shipped_net("PrBackOff.xml");
+  const std::vector<ProcessNet> nets{{"PrAutoMove", &automove},
+                                     {"PrCleaning", &cleaning},
+                                     {"PrGlobalLocalization", &global},
+                                     {"PrWait", &wait},
+                                     {"PrBackOff", &back_off}};
+  for (const char* file : {"recovery.yaml", "jinny_recovery.yaml"}) {
     INFO(file);
     Diagnostics d;
     check_recovery_rules(RecoveryPolicy::load(std::string(TRIPODAL_SOURCE_DIR "/configs/tasks/") + file), nets, d);
@@ -183,4 +189,37 @@ TEST_CASE("recovery rules that can never match are reported at the rule, with wh
   CHECK(is_supervisor_fault_message("stopped: cancelled"));
   CHECK_FALSE(is_supervisor_fault_message("path blocked"));
   CHECK_FALSE(is_supervisor_fault_message("behavior failed"));
+}
+
+TEST_CASE("Jinny backs off, then waits, then retries PrAutoMove after 'path blocked'", "[safety]") {
+  const auto policy = RecoveryPolicy::load(TRIPODAL_SOURCE_DIR "/configs/tasks/jinny_recovery.yaml");
+  Plan plan;
+  plan.task = "explain";
+  plan.stages.push_back({{{"PrAutoMove", {{"goal", "node0", {}}}}}});
+  plan.stages.push_back({{{"PrExplain", {{"topic", "the robot at node 0", {}}}}}});
+  const auto d = policy.decide(plan.stages[0].steps[0], "path blocked", 0);
+  CHECK(d.action == RecoveryAction::retry);
+  CHECK(d.reason == "fault \"path blocked\" of PrAutoMove: insert PrBackOff, PrWait, then retry (1/3)");
+  CHECK(to_string(RecoveryPolicy::remaining_plan(plan, 0, d)) ==
+        "PrBackOff() -> PrWait() -> PrAutoMove(goal=node0) -> PrExplain(topic=the robot at node 0)");
+  CHECK(policy.decide(plan.stages[0].steps[0], "path blocked", 3).action == RecoveryAction::abort);
+}
+
+TEST_CASE("PrBackOff succeeds when BhBackOff is done or failed, and after 8 s when held", "[safety]") {
+  const PetriNet net = shipped_net("PrBackOff.xml");
+  CHECK(postable_fault_messages(net).empty());  // a best effort: it never fails the task
+  const auto run = [&](const char* script) {
+    NetSimulation sim(net, {});
+    return sim.run(parse_event_script(script, "back_off.script"));
+  };
+  const SimulationResult done = run("1.5 BhBackOff.done\n");
+  CHECK(done.outcome == Outcome::success);
+  CHECK(to_seconds(done.end_time) == Approx(1.5));
+  const SimulationResult failed = run("0.2 BhBackOff.failed\n");
+  CHECK(failed.outcome == Outcome::success);
+  CHECK(to_seconds(failed.end_time) == Approx(0.2));
+  // Held by the safety behavior (something behind as well): nothing comes, the delay ends it.
+  const SimulationResult held = run("");
+  CHECK(held.outcome == Outcome::success);
+  CHECK(to_seconds(held.end_time) == Approx(8.0));
 }

@@ -327,3 +327,77 @@ TEST_CASE("Loop statistics quantiles are histogram bin edges") {
   CHECK(s.jitter_quantile(1.0) == 20000us);
   CHECK(s.max_jitter() == 1s);
 }
+
+namespace {
+
+// Drives forward at 0.3 m/s and keeps what the loop told it of the safety override.
+class BhSafetyWitness final : public CBehavior {
+ public:
+  static const ModuleManifest& static_manifest() {
+    static const ModuleManifest m = [] {
+      ModuleManifest x;
+      x.name = "BhSafetyWitness";
+      x.kind = ModuleKind::behavior;
+      return x;
+    }();
+    return m;
+  }
+  bool told = false;  ///< context.safety was set in the last step
+  SafetyFeedback seen;
+
+ protected:
+  const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  void on_activate(const ParameterSet&, const BehaviorContext&) override {}
+  std::optional<Twist2D> on_step(const BehaviorContext& context) noexcept override {
+    told = context.safety != nullptr;
+    if (told) seen = *context.safety;
+    return Twist2D{0.3, 0.0, 0.2};
+  }
+};
+
+}  // namespace
+
+TEST_CASE("The loop tells the behavior that won the last fusion what the safety override did to its command",
+          "[safety]") {
+  ResourceTable resources;
+  CoordinatorConfig cc;
+  cc.inputs = {{"drive", 10, 0ms}, {"other", 0, 0ms}, {"guard", 0, 0ms, 1.0, InputRole::safety}};
+  ControlLoop loop({}, resources, CBehaviorCoordinator(cc), nullptr);
+  auto drive_owned = std::make_unique<BhSafetyWitness>();
+  auto other_owned = std::make_unique<BhSafetyWitness>();
+  BhSafetyWitness& drive = *drive_owned;
+  BhSafetyWitness& other = *other_owned;
+  loop.activate(std::move(drive_owned), {}, "drive");
+  loop.activate(std::move(other_owned), {}, "other");
+  Time now{};
+  const auto cycle = [&] {
+    loop.step(now);
+    now += 10ms;
+  };
+  cycle();
+  cycle();
+  REQUIRE(drive.told);  // it won: it hears of the fusion, unrestricted so far
+  CHECK_FALSE(drive.seen.limited);
+  CHECK(drive.seen.allowed == Twist2D{0.3, 0.0, 0.2});
+  CHECK_FALSE(other.told);  // it lost: the command restricted was not its own
+
+  // A safety input commanding a stop (envelope [0, 0] on every axis) holds the winner still.
+  const BehaviorHandle guard = loop.activate(default_behavior_registry().create("BhStop"), {}, "guard");
+  cycle();  // the guard joins and clamps this fusion
+  cycle();  // the winner hears of it
+  REQUIRE(drive.told);
+  CHECK(drive.seen.limited);
+  CHECK(drive.seen.limited_by == "guard");
+  CHECK(drive.seen.requested == Twist2D{0.3, 0.0, 0.2});
+  CHECK(drive.seen.allowed == Twist2D{});
+  CHECK(drive.seen.requested_speed_m_s() == Approx(0.3));
+  CHECK(drive.seen.allowed_speed_m_s() == 0.0);
+  CHECK_FALSE(other.told);
+
+  loop.deactivate(guard);
+  cycle();
+  cycle();
+  REQUIRE(drive.told);
+  CHECK_FALSE(drive.seen.limited);
+  CHECK(loop.last_cycle().coordinator.requested == loop.last_cycle().coordinator.command);
+}

@@ -82,6 +82,21 @@ struct VelocityEnvelope {
   friend bool operator==(const VelocityEnvelope&, const VelocityEnvelope&) = default;
 };
 
+/// What the behavior coordinator's safety override did to the command of the previous period, as
+/// the control loop hands it to the behavior whose input won that fusion (docs/guide.md, "Visitors
+/// who do not give way"). A safety input restricts whatever wins without the winner knowing; a
+/// path-following behavior reads this to learn that it is held still (its translation clamped to
+/// zero) and counts itself blocked, as before an obstacle on its path.
+struct SafetyFeedback {
+  bool limited = false;         ///< a safety input changed the fused command
+  Twist2D requested;            ///< the fused command before the safety override
+  Twist2D allowed;              ///< the command after it (what the controller was given)
+  std::string_view limited_by;  ///< the first live safety input, when limited
+  /// Translation (m/s) asked for and allowed, along the body axes together.
+  [[nodiscard]] double requested_speed_m_s() const noexcept;
+  [[nodiscard]] double allowed_speed_m_s() const noexcept;
+};
+
 /// What a behavior can see during activation and each step. Built by the control loop; holds
 /// references only, so building and passing it allocates nothing.
 struct BehaviorContext {
@@ -93,6 +108,9 @@ struct BehaviorContext {
   /// Where path-following behaviors report (nullptr outside a loop); the loop resets it to
   /// "no path" before every cycle.
   NavigationFeedback* feedback = nullptr;
+  /// The safety override's effect on this behavior's command of the previous period; nullptr when
+  /// that command did not win the fusion (or outside a loop).
+  const SafetyFeedback* safety = nullptr;
 };
 
 enum class BehaviorStatus : std::uint8_t {

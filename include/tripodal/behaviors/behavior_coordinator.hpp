@@ -58,6 +58,7 @@ using LockId = std::uint32_t;
 struct CoordinatorOutput {
   Time stamp{};
   Twist2D command;               ///< explicit zero when nothing is live
+  Twist2D requested;             ///< the fused command before the safety override
   std::string_view winner;       ///< priority: winning input; weighted: "weighted_sum"; "" if none
   std::optional<InputId> winner_id;
   bool all_expired = false;      ///< no normal input was live and unmasked: command is zero

@@ -66,7 +66,8 @@ class PathTracker {
 /// publishes, looks ahead with the laser (counting only returns the map does not explain), keeps
 /// the blocked timer, reports progress and blockage, and commands an omni or differential base
 /// toward the lookahead point. Fails "path blocked" when stopped for blocked_timeout_s (the
-/// sequencing layer's replans, each a new path, restart the timer), "no path" when none arrives
+/// sequencing layer's replans, each a new path, restart the timer; being held still by a safety
+/// input for safety_hold_s counts as stopped), "no path" when none arrives
 /// within blocked_timeout_s, or with the reason the sequencing layer gives (path_failure).
 class CPathFollowingBehavior : public CBehavior {
  public:
@@ -96,7 +97,8 @@ class CPathFollowingBehavior : public CBehavior {
   [[nodiscard]] Twist2D command_toward(const Pose2D& pose, const PathTracker::Target& target,
                                        const BehaviorContext& context, bool& blocked) noexcept;
   /// command_toward() with the blocked bookkeeping: fails "path blocked" (zero command) when
-  /// blocked longer than blocked_timeout_s; reports the blockage in the feedback.
+  /// blocked longer than blocked_timeout_s; reports the blockage in the feedback. Held still by a
+  /// safety input for safety_hold_s (BehaviorContext::safety) counts as blocked too.
   [[nodiscard]] Twist2D drive_toward(const Pose2D& pose, const PathTracker::Target& target,
                                      const BehaviorContext& context) noexcept;
 
@@ -110,6 +112,8 @@ class CPathFollowingBehavior : public CBehavior {
 
  private:
   [[nodiscard]] bool blocked_too_long(bool blocked, Time now) noexcept;
+  /// Keeps the timer of the safety input holding the robot still; true once held for safety_hold_s.
+  [[nodiscard]] bool held_by_safety(const BehaviorContext& context) noexcept;
   /// The beams' directions in the body frame, computed once per scan geometry (a cycle reads
   /// every beam: cos and sin per beam would dominate it).
   void update_beam_table(const LaserScan& scan) noexcept;
@@ -125,6 +129,9 @@ class CPathFollowingBehavior : public CBehavior {
   Time waiting_since_{};      ///< activation, for the "no path" timeout
   bool blocked_ = false;
   Time blocked_since_{};
+  Duration safety_hold_{0};
+  bool held_ = false;  ///< the safety input holds the robot still since held_since_
+  Time held_since_{};
 };
 
 /// Moves to a named goal (parameter goal: "<section>.entry", a map node, a room or a section)

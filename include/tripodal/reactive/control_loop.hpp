@@ -186,6 +186,7 @@ class ControlLoop final {
   NavigationData navi_;
   std::vector<Pose2D> path_;
   NavigationFeedback feedback_;
+  SafetyFeedback safety_;  // the last fusion's safety override, for the behavior that won it
   CycleReport report_;
   bool controller_faulted_ = false;
   std::vector<LoopEvent> local_events_;  // ring buffer of events not yet handed over
