@@ -1,7 +1,6 @@
 #include "tripodal/hri/hri_module.hpp"
 
 #include <algorithm>
-#include <array>
 
 #include "text.hpp"
 
@@ -34,41 +33,9 @@ RetrievalOptions retrieval_options(const TaskLibrary& tasks) {
   RetrievalOptions o;
   o.extra_vocabulary = command_vocabulary(tasks);
   // Politeness the command path strips must survive the typo correction.
-  for (const char* w : {"please", "could", "would", "will", "can", "you", "jinny", "hey", "hello", "like"}) {
-    o.extra_vocabulary.emplace_back(w);
-  }
+  for (const auto& opening : hri::polite_openings()) o.extra_vocabulary.insert(o.extra_vocabulary.end(), opening.begin(), opening.end());
+  for (const auto& closing : hri::polite_closings()) o.extra_vocabulary.emplace_back(closing);
   return o;
-}
-
-// Polite openings and closings around a command ("could you please guide me to node 1"): the
-// task templates are written without them.
-std::vector<std::string> without_politeness(std::vector<std::string> ws) {
-  static const std::array<std::vector<std::string_view>, 12> leads = {{
-      {"let", "s"},
-      {"let", "us"},
-      {"i", "would", "like", "you", "to"},
-      {"i", "want", "you", "to"},
-      {"can", "you"},
-      {"could", "you"},
-      {"would", "you"},
-      {"will", "you"},
-      {"please"},
-      {"jinny"},
-      {"hey"},
-      {"ok"},
-  }};
-  bool stripped = true;
-  while (stripped && !ws.empty()) {
-    stripped = false;
-    for (const auto& lead : leads) {
-      if (ws.size() > lead.size() && std::equal(lead.begin(), lead.end(), ws.begin())) {
-        ws.erase(ws.begin(), ws.begin() + static_cast<std::ptrdiff_t>(lead.size()));
-        stripped = true;
-      }
-    }
-  }
-  while (ws.size() > 1 && (ws.back() == "please" || ws.back() == "jinny" || ws.back() == "now")) ws.pop_back();
-  return ws;
 }
 
 std::string joined(const std::vector<std::string>& ws) {
@@ -228,8 +195,18 @@ HriReply HriModule::handle_heard(const SpeechRecognizer::Result& heard) {
     reply.text = "Sorry, I did not catch that. Could you say it again?";
     return remember("heard", heard.words, std::move(reply));
   }
-  const std::string typed = typed_form(heard.words);
-  return remember("heard", heard.words, classify(typed));
+  const Decision best = decide(typed_form(heard.words));
+  // Only a command is taken from the alternatives: the task grammar is strict, so a sentence
+  // misheard into a full command is rare, while retrieval finds some entry in almost anything.
+  if (!best.understood()) {
+    for (const auto& alt : heard.alternatives) {
+      if (alt.log_score < -options_.max_alternative_log_gap) continue;
+      if (Decision d = decide(typed_form(alt.words)); d.what == Decision::What::command) {
+        return remember("heard", alt.words, carry_out(d));
+      }
+    }
+  }
+  return remember("heard", heard.words, carry_out(best));
 }
 
 HriReply HriModule::handle(std::string_view utterance) {
@@ -246,48 +223,72 @@ HriReply HriModule::remember(std::string source, std::string input, HriReply rep
   return reply;
 }
 
-HriReply HriModule::classify(std::string_view utterance) {
-  HriReply reply;
-  reply.kind = HriReply::Kind::refused_input;
+HriModule::Decision HriModule::decide(std::string_view utterance) const {
+  Decision d;
+  d.what = Decision::What::refuse_input;
   // Checked before anything reads the words: a huge or binary input costs nothing more.
   if (utterance.size() > options_.max_utterance_bytes) {
-    reply.text = "Sorry, that is too long for me. Please ask me in a sentence or two.";
-    return reply;
+    d.text = "Sorry, that is too long for me. Please ask me in a sentence or two.";
+    return d;
   }
   if (!hri::is_text(utterance)) {
-    reply.text = "Sorry, I can only understand words. Please type or say your question again.";
-    return reply;
+    d.text = "Sorry, I can only understand words. Please type or say your question again.";
+    return d;
   }
   const std::string corrected = index_.correct(utterance);
   if (corrected.empty()) {
-    reply.text = "I did not catch anything. How can I help you?";
-    return reply;
+    d.text = "I did not catch anything. How can I help you?";
+    return d;
   }
 
   // A command input: the planner understands it, or it starts with a command's verb.
   // The words as typed first: typo correction knows only the base's and the commands' words, and
   // could bend a slot's value ("carry the kettle ...") towards one of them.
-  const Understanding as_typed = tasks_.understand(joined(without_politeness(hri::words(utterance))), knowledge_);
-  if (as_typed.understood) return command(as_typed);
-  const std::vector<std::string> command_words = without_politeness(hri::words(corrected));
-  const Understanding u = tasks_.understand(joined(command_words), knowledge_);
-  if (u.understood) return command(u);
+  d.what = Decision::What::command;
+  const std::vector<std::string> typed_words = hri::without_politeness(hri::words(utterance));
+  d.understanding = tasks_.understand(joined(typed_words), knowledge_);
+  if (d.understanding.understood) return d;
+  d.understanding = tasks_.understand(joined(hri::without_politeness(hri::words(corrected))), knowledge_);
+  if (d.understanding.understood) return d;
 
-  const Retrieval r = index_.search(utterance);
+  d.retrieval = index_.search(utterance);
+  const Retrieval& r = d.retrieval;
   const bool confident = !r.hits.empty() && r.hits.front().confidence >= options_.confidence_threshold;
-  const bool starts_like_command = !command_words.empty() && std::find(command_words_.begin(), command_words_.end(),
-                                                                       command_words.front()) != command_words_.end();
+  // The verb as typed: a correction that made one ("cook pasta" -> "look") is no command.
+  const bool starts_like_command = !typed_words.empty() && std::find(command_words_.begin(), command_words_.end(),
+                                                                     typed_words.front()) != command_words_.end();
   const bool action_covers = !r.hits.empty() && r.hits.front().confidence >= options_.command_confidence_threshold &&
                              !entries_[r.hits.front().entry].action.empty();
-  if (!u.task.empty() || (starts_like_command && !action_covers)) {
-    reply.kind = HriReply::Kind::task_refused;
-    reply.task = u.task;
-    reply.text = plain_refusal(u.explanation);
-    return reply;
+  if (!d.understanding.task.empty() || (starts_like_command && !action_covers)) {
+    d.what = Decision::What::refuse_command;
+    d.text = plain_refusal(d.understanding.explanation);
+    return d;
   }
-
   // A reaction input: answered from the RKMS.
-  if (confident) return answer(entries_[r.hits.front().entry], r.hits.front().confidence);
+  d.what = confident ? Decision::What::answer : Decision::What::not_understood;
+  return d;
+}
+
+HriReply HriModule::carry_out(const Decision& d) {
+  HriReply reply;
+  const Retrieval& r = d.retrieval;
+  switch (d.what) {
+    case Decision::What::refuse_input:
+      reply.kind = HriReply::Kind::refused_input;
+      reply.text = d.text;
+      return reply;
+    case Decision::What::command:
+      return command(d.understanding);
+    case Decision::What::refuse_command:
+      reply.kind = HriReply::Kind::task_refused;
+      reply.task = d.understanding.task;
+      reply.text = d.text;
+      return reply;
+    case Decision::What::answer:
+      return answer(entries_[r.hits.front().entry], r.hits.front().confidence);
+    case Decision::What::not_understood:
+      break;
+  }
 
   reply.kind = HriReply::Kind::not_understood;
   reply.confidence = r.hits.empty() ? 0.0 : r.hits.front().confidence;

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -299,6 +300,8 @@ std::string arpa_bigram_model(const std::vector<std::string>& sentences, const s
     if (w != "<s>") total += c;
   }
   // Unigrams add one to every count so that no word is impossible after an unseen history.
+  // (Kneser-Ney continuation counts instead lowered the word error rate but let out-of-domain
+  // sentences through the confidence threshold more often: docs/hri.md, "Voice".)
   const double vocab = static_cast<double>(unigram.size());
   std::map<std::string, double> p1;
   for (const auto& [w, c] : unigram) p1[w] = (c + 1.0) / (total + vocab);
@@ -375,7 +378,15 @@ std::vector<std::string> speech_corpus(const KnowledgeBase& base, const std::vec
     std::vector<std::string> tokens;
     std::istringstream s(form);
     for (std::string t; s >> t;) tokens.push_back(t);
+    const std::size_t first = out.size();
     expand_form(tokens, 0, {}, slot_values, out);
+    if (out.size() == first) continue;
+    // "please" before and after a command, once per form: enough for the bigrams ("<s> please",
+    // "please guide", "one please") without outweighing the questions. The HRI strips more
+    // politeness ("could you ..."), but in the model those put "you" before every command's verb,
+    // and the spoken round trip lost more than it gained (docs/hri.md, "Voice").
+    out.push_back("please " + out[first]);
+    out.push_back(out[first] + " please");
   }
   return out;
 }
@@ -391,6 +402,68 @@ std::vector<std::string> pocketsphinx_dictionary_words(const std::filesystem::pa
   }
   std::sort(out.begin(), out.end());
   return out;
+}
+
+std::optional<std::string> arpabet_from_espeak(std::string_view mnemonics) {
+  // espeak-ng's English mnemonics (docs/phonemes of espeak-ng, US variant), longest first where
+  // one is the start of another ("aI@" before "aI", "tS" before "t").
+  struct Phone {
+    std::string_view espeak;
+    std::string_view arpabet;
+  };
+  static constexpr std::array<Phone, 59> kPhones = {{
+      {"aI@", "AY ER"}, {"aI3", "AY ER"}, {"aU@", "AW ER"}, {"aU3", "AW ER"}, {"i@3", "IY R"}, {"A@", "AA R"},  {"e@", "EH R"},
+      {"i@", "IY R"},   {"U@", "UH R"},   {"o@", "AO R"},   {"O@", "AO R"},   {"3:", "ER"},    {"@L", "AH L"},  {"@2", "AH"},
+      {"@5", "AH"},     {"I#", "IH"},     {"I2", "IH"},     {"i:", "IY"},     {"u:", "UW"},    {"A:", "AA"},    {"O:", "AO"},
+      {"eI", "EY"},     {"aI", "AY"},     {"aU", "AW"},     {"oU", "OW"},     {"OI", "OY"},    {"tS", "CH"},    {"dZ", "JH"},
+      {"t#", "T"},      {"n-", "N"},      {"l-", "L"},      {"r-", "R"},      {"a#", "AH"},    {"a", "AE"},     {"@", "AH"},
+      {"3", "ER"},      {"E", "EH"},      {"i", "IY"},      {"I", "IH"},      {"0", "AA"},     {"O", "AO"},     {"U", "UH"},
+      {"V", "AH"},      {"u", "UW"},      {"e", "EH"},      {"o", "OW"},      {"A", "AA"},     {"T", "TH"},     {"D", "DH"},
+      {"S", "SH"},      {"Z", "ZH"},      {"N", "NG"},      {"j", "Y"},       {"h", "HH"},     {"x", "K"},      {"?", "T"},
+      {"C", "HH"},      {"w", "W"},       {"r", "R"},
+  }};
+  static constexpr std::string_view kPlain = "pbtdkgfvszmnl";  // the same letter, upper case
+  std::string out;
+  const auto add = [&](std::string_view phones) {
+    if (!out.empty()) out += ' ';
+    out += phones;
+  };
+  std::size_t i = 0;
+  while (i < mnemonics.size()) {
+    const char c = mnemonics[i];
+    if (c == '\'' || c == ',' || c == '_' || c == '|' || c == '%' || c == '=' || c == ' ' || c == ':') {
+      ++i;  // stress, syllable and word marks; a lone length mark
+      continue;
+    }
+    const auto phone = std::find_if(kPhones.begin(), kPhones.end(), [&](const Phone& p) { return mnemonics.substr(i).starts_with(p.espeak); });
+    if (phone != kPhones.end()) {
+      add(phone->arpabet);
+      i += phone->espeak.size();
+    } else if (kPlain.find(c) != std::string_view::npos) {
+      add(std::string(1, static_cast<char>(std::toupper(static_cast<unsigned char>(c)))));
+      ++i;
+    } else {
+      return std::nullopt;
+    }
+  }
+  if (out.empty()) return std::nullopt;
+  return out;
+}
+
+PocketsphinxOptions recognizer_options(const std::vector<std::string>& corpus, PocketsphinxOptions base) {
+  const std::vector<std::string> dict = pocketsphinx_dictionary_words(base.model_dir);
+  const auto in_dictionary = [&](std::string_view w) { return std::binary_search(dict.begin(), dict.end(), w); };
+  for (const auto& sentence : corpus) {
+    std::istringstream s(spoken_form(sentence));
+    for (std::string w; s >> w;) {
+      if (in_dictionary(w) || base.extra_pronunciations.count(w) != 0) continue;
+      if (auto phones = espeak_pronunciation(w)) base.extra_pronunciations.emplace(w, std::move(*phones));
+    }
+  }
+  base.language_model = arpa_bigram_model(corpus, [&](std::string_view w) {
+    return in_dictionary(w) || base.extra_pronunciations.count(std::string(w)) != 0;
+  });
+  return base;
 }
 
 }  // namespace tripodal

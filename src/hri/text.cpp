@@ -106,4 +106,34 @@ bool has_digit(std::string_view word) noexcept {
   return std::any_of(word.begin(), word.end(), [](char c) { return c >= '0' && c <= '9'; });
 }
 
+const std::vector<std::vector<std::string_view>>& polite_openings() {
+  static const std::vector<std::vector<std::string_view>> openings = {
+      {"let", "s"},   {"let", "us"},    {"i", "would", "like", "you", "to"}, {"i", "want", "you", "to"},
+      {"can", "you"}, {"could", "you"}, {"would", "you"},                    {"will", "you"},
+      {"please"},     {"jinny"},        {"hey"},                             {"ok"},
+  };
+  return openings;
+}
+
+const std::vector<std::string_view>& polite_closings() {
+  static const std::vector<std::string_view> closings = {"please", "jinny", "now"};
+  return closings;
+}
+
+std::vector<std::string> without_politeness(std::vector<std::string> ws) {
+  bool stripped = true;
+  while (stripped && !ws.empty()) {
+    stripped = false;
+    for (const auto& opening : polite_openings()) {
+      if (ws.size() > opening.size() && std::equal(opening.begin(), opening.end(), ws.begin())) {
+        ws.erase(ws.begin(), ws.begin() + static_cast<std::ptrdiff_t>(opening.size()));
+        stripped = true;
+      }
+    }
+  }
+  const auto& closings = polite_closings();
+  while (ws.size() > 1 && std::find(closings.begin(), closings.end(), ws.back()) != closings.end()) ws.pop_back();
+  return ws;
+}
+
 }  // namespace tripodal::hri

@@ -26,4 +26,14 @@ namespace tripodal::hri {
 
 [[nodiscard]] bool has_digit(std::string_view word) noexcept;
 
+/// Polite openings a visitor puts before a command ("could you", "please", "jinny") and closings
+/// after it ("please"): the task templates are written without them, so the HRI strips them
+/// before asking the planner (and typo correction must keep them).
+[[nodiscard]] const std::vector<std::vector<std::string_view>>& polite_openings();
+[[nodiscard]] const std::vector<std::string_view>& polite_closings();
+
+/// `ws` without polite openings (repeatedly: "jinny could you please ...") and closings; a
+/// command's own words are never all stripped.
+[[nodiscard]] std::vector<std::string> without_politeness(std::vector<std::string> ws);
+
 }  // namespace tripodal::hri

@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <fstream>
 #include <mutex>
+#include <optional>
+#include <set>
 #include <stdexcept>
 
 #include "tripodal/hri/speech.hpp"
@@ -30,13 +32,18 @@ int on_samples(short* wav, int count, espeak_EVENT* events) {
   return 0;  // continue
 }
 
+// The engine, initialised once for the process; its sample rate. Call with espeak_mutex() held.
+int espeak_engine() {
+  static const int rate = espeak_Initialize(AUDIO_OUTPUT_SYNCHRONOUS, 0, nullptr, espeakINITIALIZE_DONT_EXIT);
+  if (rate <= 0) throw std::runtime_error("espeak-ng: cannot initialise (is espeak-ng-data installed?)");
+  return rate;
+}
+
 class EspeakSynthesizer final : public SpeechSynthesizer {
  public:
   explicit EspeakSynthesizer(EspeakOptions options) : options_(std::move(options)) {
     const std::lock_guard lock(espeak_mutex());
-    static const int rate = espeak_Initialize(AUDIO_OUTPUT_SYNCHRONOUS, 0, nullptr, espeakINITIALIZE_DONT_EXIT);
-    if (rate <= 0) throw std::runtime_error("espeak-ng: cannot initialise (is espeak-ng-data installed?)");
-    rate_hz_ = rate;
+    rate_hz_ = espeak_engine();
   }
 
   AudioClip synthesize(std::string_view text) override {
@@ -60,6 +67,9 @@ class EspeakSynthesizer final : public SpeechSynthesizer {
 };
 
 class PocketsphinxRecognizer final : public SpeechRecognizer {
+  static constexpr std::size_t kAlternatives = 8;
+  static constexpr int kNbestVisits = 40;
+
  public:
   explicit PocketsphinxRecognizer(const PocketsphinxOptions& options) {
     const std::string hmm = (options.model_dir / "en-us").string();
@@ -75,11 +85,32 @@ class PocketsphinxRecognizer final : public SpeechRecognizer {
       std::ofstream(lm_file_) << options.language_model;
       lm = lm_file_;
     }
+    std::string dict_path = dict;
+    if (!options.extra_pronunciations.empty()) {
+      // The model's dictionary and the extra words, in a file of our own (pocketsphinx reads one).
+      char name[] = "/tmp/tripodal_dict_XXXXXX";
+      const int fd = ::mkstemp(name);
+      if (fd < 0) throw std::runtime_error("pocketsphinx: cannot create a temporary dictionary file");
+      ::close(fd);
+      dict_file_ = name;
+      std::ifstream in(dict);
+      std::ofstream out(dict_file_);
+      out << in.rdbuf();
+      for (const auto& [word, phones] : options.extra_pronunciations) out << word << ' ' << phones << '\n';
+      if (!in || !out) {
+        remove_files();
+        throw std::runtime_error("pocketsphinx: cannot copy the dictionary " + dict);
+      }
+      dict_path = dict_file_;
+    }
     // argv[0] is the program's name, as for main().
-    std::vector<std::string> args = {"tripodal", "-hmm", hmm, "-lm", lm, "-dict", dict, "-logfn", "/dev/null",
+    std::vector<std::string> args = {"tripodal", "-hmm", hmm, "-lm", lm, "-dict", dict_path, "-logfn", "/dev/null",
                                      // Synthesised and clipped audio has runs of exact zeros, whose
                                      // log energy is -inf in the cepstra: a little noise keeps them finite.
-                                     "-dither", "yes"};
+                                     "-dither", "yes",
+                                     // pocketsphinx's random generator is one per process: seeded
+                                     // here, a recognition does not depend on what ran before.
+                                     "-seed", "1"};
     for (const auto& [name, value] : options.arguments) {
       args.push_back(name);
       args.push_back(value);
@@ -88,12 +119,12 @@ class PocketsphinxRecognizer final : public SpeechRecognizer {
     argv.reserve(args.size());
     for (auto& a : args) argv.push_back(a.data());
     config_ = cmd_ln_parse_r(nullptr, ps_args(), static_cast<int32>(argv.size()), argv.data(), TRUE);
-    if (config_ == nullptr && !lm_file_.empty()) ::unlink(lm_file_.c_str());
+    if (config_ == nullptr) remove_files();
     if (config_ == nullptr) throw std::runtime_error("pocketsphinx: bad configuration (model in " + options.model_dir.string() + ")");
     decoder_ = ps_init(config_);
     if (decoder_ == nullptr) {
       cmd_ln_free_r(config_);
-      if (!lm_file_.empty()) ::unlink(lm_file_.c_str());
+      remove_files();
       throw std::runtime_error("pocketsphinx: cannot load the model in " + options.model_dir.string());
     }
   }
@@ -102,7 +133,7 @@ class PocketsphinxRecognizer final : public SpeechRecognizer {
   ~PocketsphinxRecognizer() override {
     ps_free(decoder_);
     cmd_ln_free_r(config_);
-    if (!lm_file_.empty()) ::unlink(lm_file_.c_str());
+    remove_files();
   }
 
   int sample_rate_hz() const noexcept override { return 16000; }
@@ -125,17 +156,60 @@ class PocketsphinxRecognizer final : public SpeechRecognizer {
     Result r;
     if (hyp == nullptr) return {std::string(), 0.0};
     r.words = hyp;
-    r.confidence = logmath_exp(ps_get_logmath(decoder_), ps_get_prob(decoder_));
+    logmath_t* lmath = ps_get_logmath(decoder_);
+    r.confidence = logmath_exp(lmath, ps_get_prob(decoder_));
+    // The n-best list by A* over the lattice: a few distinct sentences, the search bounded so a
+    // long utterance's lattice cannot cost more than a fraction of its own decoding.
+    std::set<std::string> seen{r.words};
+    int visited = 0;
+    std::optional<std::int32_t> top;  // the A* search's own score of its first sentence
+    for (ps_nbest_t* nb = ps_nbest(decoder_); nb != nullptr; nb = ps_nbest_next(nb)) {
+      std::int32_t alt_score = 0;
+      const char* alt = ps_nbest_hyp(nb, &alt_score);
+      if (alt == nullptr || ++visited > kNbestVisits || r.alternatives.size() >= kAlternatives) {
+        ps_nbest_free(nb);
+        break;
+      }
+      if (!top) top = alt_score;
+      if (!seen.insert(alt).second) continue;
+      r.alternatives.push_back({alt, logmath_log_to_ln(lmath, alt_score - *top)});
+    }
     return r;
   }
 
  private:
+  void remove_files() noexcept {
+    if (!lm_file_.empty()) ::unlink(lm_file_.c_str());
+    if (!dict_file_.empty()) ::unlink(dict_file_.c_str());
+  }
+
   cmd_ln_t* config_ = nullptr;
   ps_decoder_t* decoder_ = nullptr;
   std::string lm_file_;
+  std::string dict_file_;
 };
 
 }  // namespace
+
+std::optional<std::string> espeak_pronunciation(std::string_view word) {
+  const std::lock_guard lock(espeak_mutex());
+  try {
+    espeak_engine();
+  } catch (const std::runtime_error&) {
+    return std::nullopt;
+  }
+  if (espeak_SetVoiceByName("en-us") != EE_OK) return std::nullopt;
+  const std::string text(word);
+  const void* at = text.c_str();
+  std::string mnemonics;
+  // One clause at a time; a word is one clause, but the loop keeps to the documented contract.
+  while (at != nullptr) {
+    const char* phonemes = espeak_TextToPhonemes(&at, espeakCHARS_UTF8, 0);
+    if (phonemes == nullptr) break;
+    mnemonics += std::string(phonemes) + " ";
+  }
+  return arpabet_from_espeak(mnemonics);
+}
 
 std::unique_ptr<SpeechSynthesizer> make_espeak_synthesizer(const EspeakOptions& options) {
   return std::make_unique<EspeakSynthesizer>(options);

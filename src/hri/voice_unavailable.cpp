@@ -8,6 +8,8 @@ namespace tripodal {
 
 bool voice_available() noexcept { return false; }
 
+std::optional<std::string> espeak_pronunciation(std::string_view) { return std::nullopt; }
+
 std::unique_ptr<SpeechSynthesizer> make_espeak_synthesizer(const EspeakOptions&) {
   throw std::runtime_error("this build of tripodal has no espeak-ng (TRIPODAL_VOICE=OFF; install libespeak-ng-dev)");
 }

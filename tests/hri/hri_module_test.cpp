@@ -60,8 +60,8 @@ struct Expected {
   std::string task;
 };
 
-std::vector<Expected> utterance_set() {
-  const YAML::Node doc = YAML::LoadFile(TRIPODAL_TEST_DATA_DIR "/hri/utterances.yaml");
+std::vector<Expected> utterance_set(const std::string& file) {
+  const YAML::Node doc = YAML::LoadFile(TRIPODAL_TEST_DATA_DIR "/hri/" + file);
   std::vector<Expected> out;
   for (const auto& u : doc["utterances"]) {
     out.push_back({u["say"].as<std::string>(), u["outcome"].as<std::string>(),
@@ -73,10 +73,12 @@ std::vector<Expected> utterance_set() {
 
 }  // namespace
 
-TEST_CASE("the typed utterance set is classified and answered right at least 95 % of the time") {
+namespace {
+
+// The share of `file`'s utterances typed to Jinny that get the expected outcome; prints the misses.
+double typed_accuracy(const std::string& file) {
   Jinny jinny;
-  const std::vector<Expected> set = utterance_set();
-  REQUIRE(set.size() >= 60);
+  const std::vector<Expected> set = utterance_set(file);
   std::size_t right = 0;
   std::string misses;
   for (const auto& e : set) {
@@ -93,10 +95,28 @@ TEST_CASE("the typed utterance set is classified and answered right at least 95 
                 std::to_string(r.confidence) + "): " + r.text + "\n";
     }
   }
-  const double accuracy = static_cast<double>(right) / static_cast<double>(set.size());
-  std::cout << "HRI typed utterance set: " << right << "/" << set.size() << " right, accuracy "
+  const double accuracy = set.empty() ? 0.0 : static_cast<double>(right) / static_cast<double>(set.size());
+  std::cout << "HRI typed utterance set " << file << ": " << right << "/" << set.size() << " right, accuracy "
             << accuracy * 100.0 << " %\n" << misses;
-  CHECK(accuracy >= 0.95);
+  return accuracy;
+}
+
+}  // namespace
+
+TEST_CASE("the typed utterance set is classified and answered right at least 95 % of the time") {
+  REQUIRE(utterance_set("utterances.yaml").size() >= 60);
+  CHECK(typed_accuracy("utterances.yaml") >= 0.95);
+}
+
+TEST_CASE("the development typed utterance set is answered right at least 90 % of the time") {
+  REQUIRE(utterance_set("utterances_dev.yaml").size() >= 40);
+  CHECK(typed_accuracy("utterances_dev.yaml") >= 0.90);
+}
+
+TEST_CASE("the held-out typed utterance set is answered right at least 85 % of the time") {
+  // Phrasings nothing was tuned on: measured 90 % (36/40) when they were first run.
+  REQUIRE(utterance_set("utterances_heldout.yaml").size() >= 40);
+  CHECK(typed_accuracy("utterances_heldout.yaml") >= 0.85);
 }
 
 TEST_CASE("answers fill their placeholders from the providers, which follow the injected clock") {
@@ -225,6 +245,55 @@ TEST_CASE("a heard utterance is handled in typed form, and not at all when the r
   CHECK(jinny.started.size() == 1);
   CHECK(jinny.hri.handle_heard({"tell me about p s r two", 0.1}).entry_id == "node1_robot");
   CHECK(jinny.hri.handle_heard({"", 0.0}).kind == HriReply::Kind::refused_input);
+}
+
+TEST_CASE("a heard sentence that is not understood gives way to the first alternative that is a command") {
+  using Alternative = SpeechRecognizer::Result::Alternative;
+  Jinny jinny;
+  // The best sentence misheard one word ("to" for "at"); the second alternative is the command.
+  SpeechRecognizer::Result heard{"explain the robot to node one", 0.01, {}};
+  heard.alternatives = {Alternative{"explain the robot at to node one", -0.1}, Alternative{"explain the robot at node one", -0.2}};
+  const HriReply r = jinny.hri.handle_heard(heard);
+  CHECK(r.kind == HriReply::Kind::task_started);
+  CHECK(r.task == "explain");
+  CHECK(jinny.started == std::vector<std::string>{"PrAutoMove(goal=node1) -> PrExplain(topic=the robot at node 1)"});
+  REQUIRE(jinny.hri.last_exchange().has_value());
+  CHECK(jinny.hri.last_exchange()->input == "explain the robot at node one");
+
+  // Too far behind the best (max_alternative_log_gap): the best is answered as heard.
+  heard.alternatives = {Alternative{"explain the robot at node one", -3.0}};
+  CHECK(jinny.hri.handle_heard(heard).kind == HriReply::Kind::task_refused);
+  CHECK(jinny.started.size() == 1);
+
+  // Only commands are taken from the alternatives: retrieval finds some entry in almost anything.
+  SpeechRecognizer::Result question{"what is the me to node eyes", 0.05, {Alternative{"what is the robot at node one", -0.1}}};
+  CHECK(jinny.hri.handle_heard(question).kind == HriReply::Kind::not_understood);
+
+  // A best sentence that is understood is acted on, whatever the alternatives say.
+  SpeechRecognizer::Result clear{"what time is it", 0.4, {Alternative{"guide me to node one", -0.01}}};
+  CHECK(jinny.hri.handle_heard(clear).entry_id == "time");
+  CHECK(jinny.started.size() == 1);
+
+  // An unsure recognition is not acted on, alternatives or not; a gap of 0 turns them off.
+  CHECK(jinny.hri.handle_heard({"explain the robot to node one", 0.0001, {Alternative{"explain the robot at node one", -0.1}}}).kind ==
+        HriReply::Kind::not_understood);
+  HriOptions off;
+  off.max_alternative_log_gap = 0.0;
+  Jinny strict(off);
+  heard.alternatives = {Alternative{"explain the robot at node one", -0.2}};
+  CHECK(strict.hri.handle_heard(heard).kind == HriReply::Kind::task_refused);
+  CHECK(strict.started.empty());
+}
+
+TEST_CASE("a word corrected into a command's verb does not make a question a command") {
+  Jinny jinny;
+  // "cook" is one letter from "look" (look at me): the question is not a refused command.
+  const HriReply r = jinny.hri.handle("Can you cook pasta?");
+  CHECK(r.kind == HriReply::Kind::not_understood);
+  CHECK(jinny.started.empty());
+  // A misspelt verb of a whole command is still understood, and a real verb still refused.
+  CHECK(jinny.hri.handle("gide me to node 1").kind == HriReply::Kind::task_started);
+  CHECK(jinny.hri.handle("take me to node").kind == HriReply::Kind::task_refused);
 }
 
 TEST_CASE("LED buttons: a press is the request bound to the button, an unbound button does nothing") {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -116,8 +117,93 @@ TEST_CASE("the speech corpus expands optional words and slots of the command for
   kb.put({"time", "the time", {"clock"}, {"What time is it?"}, "It is {time}.", "", {}});
   const auto corpus = speech_corpus(kb, {"guide me to [the] node {node}", "patrol {rooms...}"}, {{"node", {"0", "1"}}});
   CHECK(corpus == std::vector<std::string>{"What time is it?", "clock", "guide me to node 0", "guide me to node 1",
-                                           "guide me to the node 0", "guide me to the node 1"});
+                                           "guide me to the node 0", "guide me to the node 1",
+                                           // the politeness the HRI strips, once per command form
+                                           "please guide me to node 0", "guide me to node 0 please"});
 }
+
+TEST_CASE("espeak-ng's phoneme mnemonics become the dictionary's ARPAbet phones") {
+  CHECK(arpabet_from_espeak("dZ'Ini") == "JH IH N IY");
+  CHECK(arpabet_from_espeak("tr'aIp0d@L") == "T R AY P AA D AH L");
+  CHECK(arpabet_from_espeak("T'aNks") == "TH AE NG K S");
+  CHECK(arpabet_from_espeak("tS'3:tS") == "CH ER CH");
+  CHECK(arpabet_from_espeak("b'V?n-") == "B AH T N");            // glottal stop, syllabic n
+  CHECK(arpabet_from_espeak("j'i@3") == "Y IY R");               // r-coloured vowels: vowel and R
+  CHECK(arpabet_from_espeak("'A@kI2t,EktS3") == "AA R K IH T EH K CH ER");
+  CHECK(arpabet_from_espeak("d,Vb@Lj,u: s'i:") == "D AH B AH L Y UW S IY");  // "wc", spelled
+  CHECK_FALSE(arpabet_from_espeak("k'a~").has_value());           // a mnemonic with no counterpart
+  CHECK_FALSE(arpabet_from_espeak("'  ,").has_value());           // marks only
+  CHECK_FALSE(arpabet_from_espeak("").has_value());
+}
+
+TEST_CASE("the recognizer's options pronounce the corpus words the dictionary lacks, with espeak-ng", "[voice]") {
+  if (!voice_available()) {
+    CHECK_FALSE(espeak_pronunciation("jinny").has_value());
+    return;
+  }
+  CHECK(espeak_pronunciation("jinny") == "JH IH N IY");
+  CHECK(espeak_pronunciation("tripodal") == "T R AY P AA D AH L");
+  const PocketsphinxOptions o = recognizer_options({"Hello Jinny", "tell me about the tripodal architecture", "guide me to node 1"});
+  // Dictionary words are not repeated; the robot's name and the architecture's are added.
+  CHECK(o.extra_pronunciations == std::map<std::string, std::string>{{"jinny", "JH IH N IY"}, {"tripodal", "T R AY P AA D AH L"}});
+  CHECK_THAT(o.language_model, Catch::Contains(" hello jinny\n"));
+  CHECK_THAT(o.language_model, Catch::Contains(" the tripodal\n"));
+  CHECK_THAT(o.language_model, Catch::Contains(" node one\n"));
+  // The recognizer loads the extended dictionary (a word it lacks would make pocketsphinx drop
+  // it from the model) and hears the robot's name.
+  const auto recognizer = make_pocketsphinx_recognizer(o);
+  const auto voice = make_espeak_synthesizer({"en-us+klatt", 170});
+  CHECK_THAT(recognizer->recognize(resample(voice->synthesize("hello jinny"), 16000)).words, Catch::EndsWith("jinny"));
+}
+
+namespace {
+
+struct RoundTrip {
+  std::size_t total = 0;
+  std::size_t right = 0;
+  std::size_t word_errors = 0;
+  std::size_t words = 0;
+  [[nodiscard]] double accuracy() const { return total == 0 ? 0.0 : static_cast<double>(right) / static_cast<double>(total); }
+};
+
+// Speaks each utterance of `file` (its `spoken` text, else `say`), recognises it, hands what was
+// heard to the HRI and compares the reply with the expected outcome; prints the figures and misses.
+RoundTrip spoken_round_trip(const std::string& file, SpeechSynthesizer& synthesizer, SpeechRecognizer& recognizer, HriModule& hri) {
+  const YAML::Node doc = YAML::LoadFile(TRIPODAL_TEST_DATA_DIR "/hri/" + file);
+  RoundTrip rt;
+  std::string misses;
+  for (const auto& u : doc["utterances"]) {
+    const std::string text = u["spoken"] ? u["spoken"].as<std::string>() : u["say"].as<std::string>();
+    const AudioClip audio = synthesizer.synthesize(text);
+    REQUIRE(audio.duration_s() > 0.3);
+    const SpeechRecognizer::Result result = recognizer.recognize(resample(audio, recognizer.sample_rate_hz()));
+    const std::string& heard = result.words;
+    const WordErrors e = word_errors(spoken_form(text), heard);
+    rt.word_errors += e.errors;
+    rt.words += e.reference_words;
+    const HriReply r = hri.handle_heard(result);
+    const bool ok = to_string(r.kind) == u["outcome"].as<std::string>() &&
+                    r.entry_id == (u["entry"] ? u["entry"].as<std::string>() : std::string()) &&
+                    r.task == (u["task"] ? u["task"].as<std::string>() : std::string());
+    ++rt.total;
+    if (ok) {
+      ++rt.right;
+    } else {
+      const std::string acted_on = hri.last_exchange() ? hri.last_exchange()->input : heard;
+      misses += "  \"" + text + "\" heard \"" + heard + "\" (" + std::to_string(result.confidence) + ")" +
+                (acted_on != heard ? ", acted on \"" + acted_on + "\"" : std::string()) + ": " + std::string(to_string(r.kind)) + " " +
+                r.entry_id + "\n";
+    }
+  }
+  const double wer = rt.words == 0 ? 0.0 : static_cast<double>(rt.word_errors) / static_cast<double>(rt.words);
+  std::cout << "HRI spoken round trip of " << file << " (espeak-ng -> 16 kHz -> pocketsphinx): " << rt.total
+            << " utterances, word error rate " << wer * 100.0 << " % (" << rt.word_errors << "/" << rt.words
+            << " words), answers right " << rt.right << "/" << rt.total << " = " << rt.accuracy() * 100.0 << " %\n"
+            << misses;
+  return rt;
+}
+
+}  // namespace
 
 TEST_CASE("spoken round trip: espeak-ng speaks the utterance set, pocketsphinx recognises it, the HRI answers",
           "[voice]") {
@@ -144,54 +230,27 @@ TEST_CASE("spoken round trip: espeak-ng speaks the utterance set, pocketsphinx r
 
   // The recognizer's language model is what the robot knows about (its knowledge and its
   // commands), not the test set.
-  const PocketsphinxOptions defaults;
-  const std::vector<std::string> dict = pocketsphinx_dictionary_words(defaults.model_dir);
-  PocketsphinxOptions options;
-  options.language_model =
-      arpa_bigram_model(speech_corpus(base, tasks.command_forms(), {{"node", {"0", "1"}}}),
-                        [&](std::string_view w) { return std::binary_search(dict.begin(), dict.end(), w); });
+  const PocketsphinxOptions options = recognizer_options(speech_corpus(base, tasks.command_forms(), {{"node", {"0", "1"}}}));
   const auto recognizer = make_pocketsphinx_recognizer(options);
   // The visitor's voice: of five espeak-ng variants at two rates, tried on every third utterance
   // of the set, pocketsphinx's US English model hears klatt at 170 words a minute best (WER 18 %
   // there; the default en-us voice 39 %): synthetic speech is far from the model's training data.
   const auto synthesizer = make_espeak_synthesizer({"en-us+klatt", 170});
 
-  const YAML::Node doc = YAML::LoadFile(TRIPODAL_TEST_DATA_DIR "/hri/utterances.yaml");
-  std::size_t errors = 0;
-  std::size_t words = 0;
-  std::size_t right = 0;
-  std::size_t total = 0;
-  std::string misses;
-  for (const auto& u : doc["utterances"]) {
-    const std::string text = u["spoken"] ? u["spoken"].as<std::string>() : u["say"].as<std::string>();
-    const AudioClip audio = synthesizer->synthesize(text);
-    REQUIRE(audio.duration_s() > 0.3);
-    const SpeechRecognizer::Result result = recognizer->recognize(resample(audio, recognizer->sample_rate_hz()));
-    const std::string& heard = result.words;
-    const WordErrors e = word_errors(spoken_form(text), heard);
-    errors += e.errors;
-    words += e.reference_words;
-    const HriReply r = hri.handle_heard(result);
-    const bool ok = to_string(r.kind) == u["outcome"].as<std::string>() &&
-                    r.entry_id == (u["entry"] ? u["entry"].as<std::string>() : std::string()) &&
-                    r.task == (u["task"] ? u["task"].as<std::string>() : std::string());
-    ++total;
-    if (ok) {
-      ++right;
-    } else {
-      misses += "  \"" + text + "\" heard \"" + heard + "\" (" + std::to_string(result.confidence) + "): " + std::string(to_string(r.kind)) + " " + r.entry_id + "\n";
-    }
-  }
-  const double wer = static_cast<double>(errors) / static_cast<double>(words);
-  const double accuracy = static_cast<double>(right) / static_cast<double>(total);
-  std::cout << "HRI spoken round trip (espeak-ng -> 16 kHz -> pocketsphinx): " << total << " utterances, word error rate "
-            << wer * 100.0 << " % (" << errors << "/" << words << " words), answers right " << right << "/" << total << " = "
-            << accuracy * 100.0 << " %\n"
-            << misses;
-  CHECK(total >= 60);
-  // Measured 84.3 % (75/89, WER 24.4 %) on Debian 12's espeak-ng 1.51 and pocketsphinx
-  // 5prealpha: just under issue 19's 85 % target. The floor guards against regressions.
-  CHECK(accuracy >= 0.80);
+  const RoundTrip main_set = spoken_round_trip("utterances.yaml", *synthesizer, *recognizer, hri);
+  CHECK(main_set.total >= 60);
+  // Measured 85.4 % (76/89, WER 21.1 %) on Debian 12's espeak-ng 1.51 and pocketsphinx
+  // 5prealpha, in a process of its own (espeak-ng's state moves it by about two utterances:
+  // docs/hri.md). The floors guard against regressions.
+  CHECK(main_set.accuracy() >= 0.80);
+  const RoundTrip dev_set = spoken_round_trip("utterances_dev.yaml", *synthesizer, *recognizer, hri);
+  CHECK(dev_set.total >= 40);
+  // The development set, whose misses guided the changes: 87.5 % (35/40, WER 19.0 %).
+  CHECK(dev_set.accuracy() >= 0.75);
+  // The held-out set (phrasings nothing was tuned on) measured 65 % (26/40, WER 32.9 %).
+  const RoundTrip held_out = spoken_round_trip("utterances_heldout.yaml", *synthesizer, *recognizer, hri);
+  CHECK(held_out.total >= 40);
+  CHECK(held_out.accuracy() >= 0.55);
 
   // The answer itself, spoken and written as a WAV file a visitor's speaker would play.
   const fs::path wav = temp_file("answer.wav");

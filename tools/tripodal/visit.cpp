@@ -64,12 +64,7 @@ Voice make_voice(const KnowledgeBase& base, const TaskLibrary& tasks, const navi
     for (const navi::MapNode& n : regions.nodes) {
       if (n.name.starts_with("node")) nodes.push_back(n.name.substr(4));
     }
-    const PocketsphinxOptions defaults;
-    const std::vector<std::string> dict = pocketsphinx_dictionary_words(defaults.model_dir);
-    PocketsphinxOptions options;
-    options.language_model = arpa_bigram_model(speech_corpus(base, tasks.command_forms(), {{"node", nodes}}),
-                                               [&](std::string_view w) { return std::binary_search(dict.begin(), dict.end(), w); });
-    v.ears = make_pocketsphinx_recognizer(options);
+    v.ears = make_pocketsphinx_recognizer(recognizer_options(speech_corpus(base, tasks.command_forms(), {{"node", nodes}})));
     v.visitor = make_espeak_synthesizer({"en-us+klatt", 170});
   } catch (const std::exception& e) {
     v = Voice{};

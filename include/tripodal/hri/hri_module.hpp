@@ -36,6 +36,10 @@ struct HriOptions {
   /// acted on: "Sorry, I did not catch that." A recognizer with a closed language model hears
   /// any sound as one of its sentences; the posterior is low when the sound was something else.
   double min_recognition_confidence = 0.002;
+  /// When the recognizer's best sentence is not understood, its alternatives at most this much
+  /// less likely (natural log of the path score ratio) are tried in order, and the first one
+  /// understood is acted on. 0 turns the n-best list off.
+  double max_alternative_log_gap = 1.0;
   /// LED buttons (Table 3): each button's name and the request a press stands for ("hello" ->
   /// "Introduce yourself."). A press is handled as that input was typed.
   std::map<std::string, std::string, std::less<>> buttons;
@@ -112,7 +116,8 @@ class HriModule {
   HriReply handle(std::string_view utterance);
   /// A spoken input: below min_recognition_confidence it is not understood ("Sorry, I did not
   /// catch that. Could you say it again?"); otherwise its words, in typed form ("node one" ->
-  /// "node 1"), are handled as typed.
+  /// "node 1"), are handled as typed, unless they are not understood and one of the recognizer's
+  /// alternatives within max_alternative_log_gap is: then the first such alternative is.
   HriReply handle_heard(const SpeechRecognizer::Result& heard);
 
   /// An LED button was pressed: handled as the request HriOptions::buttons binds to it; an
@@ -140,7 +145,18 @@ class HriModule {
   [[nodiscard]] const KnowledgeIndex& index() const noexcept { return index_; }
 
  private:
-  HriReply classify(std::string_view utterance);
+  // What an input is, decided without acting on it (so that a recogniser's alternatives can be
+  // weighed), then carried out: a task started, an answer given.
+  struct Decision {
+    enum class What { refuse_input, command, refuse_command, answer, not_understood } what = What::not_understood;
+    std::string text;             // refuse_input, refuse_command: what to say
+    Understanding understanding;  // command, refuse_command
+    Retrieval retrieval;          // answer, not_understood
+    [[nodiscard]] bool understood() const noexcept { return what == What::command || what == What::answer; }
+  };
+  [[nodiscard]] Decision decide(std::string_view utterance) const;
+  HriReply carry_out(const Decision& decision);
+  HriReply classify(std::string_view utterance) { return carry_out(decide(utterance)); }
   HriReply remember(std::string source, std::string input, HriReply reply);
   HriReply answer(const KnowledgeEntry& entry, double confidence);
   HriReply command(const Understanding& understanding);

@@ -9,9 +9,10 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <map>
+#include <optional>
 #include <string>
 #include <string_view>
-#include <map>
 #include <vector>
 
 #include "tripodal/hri/knowledge_base.hpp"
@@ -45,6 +46,16 @@ class SpeechRecognizer {
     /// best path. A closed language model hears any sound as some of its sentences; this is what
     /// tells a visitor's question about something else from one it knows.
     double confidence = 1.0;
+    /// Other sentences the recognizer found almost as likely, best first, without `words`
+    /// itself: each with the natural log of its path score relative to the best path (<= 0 in
+    /// principle; the A* search of a lattice may rank them slightly out of order). The HRI acts on
+    /// one of them when the best is a sentence it cannot understand (an n-best list read by the
+    /// language understanding, as spoken dialogue systems do). Empty when the recognizer gives none.
+    struct Alternative {
+      std::string words;
+      double log_score = 0.0;
+    };
+    std::vector<Alternative> alternatives;
   };
   /// What was heard in `audio`.
   [[nodiscard]] virtual Result recognize(const AudioClip& audio) = 0;
@@ -93,6 +104,16 @@ struct WordErrors {
 [[nodiscard]] std::vector<std::string> speech_corpus(const KnowledgeBase& base, const std::vector<std::string>& command_forms,
                                                      const std::map<std::string, std::vector<std::string>>& slot_values);
 
+/// espeak-ng's phoneme mnemonics of a word (US English: "dZ'Ini" for "jinny") as the CMU
+/// dictionary's ARPAbet phones ("JH IH N IY"); stress and syllable marks are dropped, flaps and
+/// glottal stops become T, r-coloured vowels their vowel and R. Nullopt for a mnemonic without
+/// a counterpart, or no phone at all.
+[[nodiscard]] std::optional<std::string> arpabet_from_espeak(std::string_view mnemonics);
+
+/// How espeak-ng's US English rules pronounce `word`, in ARPAbet (arpabet_from_espeak); nullopt
+/// when the build has no espeak-ng or the word has no pronunciation in those phones.
+[[nodiscard]] std::optional<std::string> espeak_pronunciation(std::string_view word);
+
 /// True when this build has espeak-ng and pocketsphinx (CMake option TRIPODAL_VOICE).
 [[nodiscard]] bool voice_available() noexcept;
 
@@ -112,10 +133,19 @@ struct PocketsphinxOptions {
   std::string language_model;
   /// Further decoder options, name and value ("-lw", "10"), after the defaults.
   std::vector<std::pair<std::string, std::string>> arguments;
+  /// Words the dictionary lacks and their pronunciations in its phones ("jinny" -> "JH IH N IY"),
+  /// added to it: a robot's name, its exhibits', its architecture's.
+  std::map<std::string, std::string> extra_pronunciations;
 };
 /// pocketsphinx at 16 kHz. Throws std::runtime_error when the build has no pocketsphinx or the
 /// model cannot be loaded.
 [[nodiscard]] std::unique_ptr<SpeechRecognizer> make_pocketsphinx_recognizer(const PocketsphinxOptions& options = {});
+
+/// A recognizer's options for what visitors may say (`corpus`, e.g. speech_corpus): the bigram
+/// model of it over the dictionary's words and the words the dictionary lacks that espeak-ng can
+/// pronounce ("jinny", "tripodal"), which are added to the dictionary; other words are left out.
+/// Reads `base.model_dir`'s dictionary; throws std::runtime_error when it cannot.
+[[nodiscard]] PocketsphinxOptions recognizer_options(const std::vector<std::string>& corpus, PocketsphinxOptions base = {});
 
 /// The words of the pocketsphinx dictionary in `model_dir` (cmudict-en-us.dict), for
 /// arpa_bigram_model's `known`.
