@@ -8,6 +8,7 @@
 #include <mutex>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
 #include "tripodal/hri/speech.hpp"
@@ -66,6 +67,22 @@ class EspeakSynthesizer final : public SpeechSynthesizer {
   int rate_hz_ = 22050;
 };
 
+// pocketsphinx reads its models from files only: `contents` in a new temporary file, its name.
+std::string temporary_file(const std::string& contents, const std::string& what) {
+  char name[] = "/tmp/tripodal_ps_XXXXXX";
+  const int fd = ::mkstemp(name);
+  if (fd < 0) throw std::runtime_error("pocketsphinx: cannot create a temporary " + what + " file");
+  ::close(fd);
+  std::ofstream out(name);
+  out << contents;
+  out.close();
+  if (!out) {
+    ::unlink(name);
+    throw std::runtime_error("pocketsphinx: cannot write the temporary " + what + " file " + name);
+  }
+  return name;
+}
+
 class PocketsphinxRecognizer final : public SpeechRecognizer {
   static constexpr std::size_t kAlternatives = 8;
   static constexpr int kNbestVisits = 40;
@@ -76,30 +93,23 @@ class PocketsphinxRecognizer final : public SpeechRecognizer {
     const std::string dict = (options.model_dir / "cmudict-en-us.dict").string();
     std::string lm = (options.model_dir / "en-us.lm.bin").string();
     if (!options.language_model.empty()) {
-      // pocketsphinx reads a model from a file only.
-      char name[] = "/tmp/tripodal_lm_XXXXXX";
-      const int fd = ::mkstemp(name);
-      if (fd < 0) throw std::runtime_error("pocketsphinx: cannot create a temporary language model file");
-      ::close(fd);
-      lm_file_ = name;
-      std::ofstream(lm_file_) << options.language_model;
+      lm_file_ = temporary_file(options.language_model, "language model");
       lm = lm_file_;
     }
     std::string dict_path = dict;
     if (!options.extra_pronunciations.empty()) {
-      // The model's dictionary and the extra words, in a file of our own (pocketsphinx reads one).
-      char name[] = "/tmp/tripodal_dict_XXXXXX";
-      const int fd = ::mkstemp(name);
-      if (fd < 0) throw std::runtime_error("pocketsphinx: cannot create a temporary dictionary file");
-      ::close(fd);
-      dict_file_ = name;
-      std::ifstream in(dict);
-      std::ofstream out(dict_file_);
-      out << in.rdbuf();
-      for (const auto& [word, phones] : options.extra_pronunciations) out << word << ' ' << phones << '\n';
-      if (!in || !out) {
+      // The model's dictionary and the extra words.
+      std::ostringstream text;
+      if (std::ifstream in(dict); !(text << in.rdbuf())) {
         remove_files();
-        throw std::runtime_error("pocketsphinx: cannot copy the dictionary " + dict);
+        throw std::runtime_error("pocketsphinx: cannot read the dictionary " + dict);
+      }
+      for (const auto& [word, phones] : options.extra_pronunciations) text << word << ' ' << phones << '\n';
+      try {
+        dict_file_ = temporary_file(text.str(), "dictionary");
+      } catch (const std::runtime_error&) {
+        remove_files();
+        throw;
       }
       dict_path = dict_file_;
     }
@@ -108,8 +118,7 @@ class PocketsphinxRecognizer final : public SpeechRecognizer {
                                      // Synthesised and clipped audio has runs of exact zeros, whose
                                      // log energy is -inf in the cepstra: a little noise keeps them finite.
                                      "-dither", "yes",
-                                     // pocketsphinx's random generator is one per process: seeded
-                                     // here, a recognition does not depend on what ran before.
+                                     // A fixed seed, so that the dither is the same in every run.
                                      "-seed", "1"};
     for (const auto& [name, value] : options.arguments) {
       args.push_back(name);
