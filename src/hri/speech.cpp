@@ -381,11 +381,12 @@ std::vector<std::string> speech_corpus(const KnowledgeBase& base, const std::vec
     const std::size_t first = out.size();
     expand_form(tokens, 0, {}, slot_values, out);
     if (out.size() == first) continue;
-    // "please" before and after a command, once per form: enough for the bigrams ("<s> please",
-    // "please guide", "one please") without outweighing the questions. The HRI strips more
-    // politeness ("could you ..."), but in the model those put "you" before every command's verb,
-    // and the spoken round trip lost more than it gained (docs/hri.md, "Voice").
-    out.push_back("please " + out[first]);
+    // Polite requests, once per form: enough for the bigrams ("<s> please", "please guide",
+    // "one please", "could you guide") without outweighing the questions. The HRI strips more
+    // politeness ("can you", "i want you to"), but in the model those put a question's words
+    // before every command's verb, and the spoken round trip lost more than it gained
+    // (docs/hri.md, "Voice").
+    for (const char* opening : {"please", "could you", "would you"}) out.push_back(std::string(opening) + " " + out[first]);
     out.push_back(out[first] + " please");
   }
   return out;

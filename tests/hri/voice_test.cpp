@@ -118,8 +118,9 @@ TEST_CASE("the speech corpus expands optional words and slots of the command for
   const auto corpus = speech_corpus(kb, {"guide me to [the] node {node}", "patrol {rooms...}"}, {{"node", {"0", "1"}}});
   CHECK(corpus == std::vector<std::string>{"What time is it?", "clock", "guide me to node 0", "guide me to node 1",
                                            "guide me to the node 0", "guide me to the node 1",
-                                           // the politeness the HRI strips, once per command form
-                                           "please guide me to node 0", "guide me to node 0 please"});
+                                           // polite requests, once per command form
+                                           "please guide me to node 0", "could you guide me to node 0",
+                                           "would you guide me to node 0", "guide me to node 0 please"});
 }
 
 TEST_CASE("espeak-ng's phoneme mnemonics become the dictionary's ARPAbet phones") {
@@ -239,18 +240,19 @@ TEST_CASE("spoken round trip: espeak-ng speaks the utterance set, pocketsphinx r
 
   const RoundTrip main_set = spoken_round_trip("utterances.yaml", *synthesizer, *recognizer, hri);
   CHECK(main_set.total >= 60);
-  // Measured 85.4 % (76/89, WER 21.1 %) on Debian 12's espeak-ng 1.51 and pocketsphinx
+  // Measured 85.4 % (76/89, WER 20.9 %) on Debian 12's espeak-ng 1.51 and pocketsphinx
   // 5prealpha, in a process of its own (espeak-ng's state moves it by about two utterances:
   // docs/hri.md). The floors guard against regressions.
   CHECK(main_set.accuracy() >= 0.80);
   const RoundTrip dev_set = spoken_round_trip("utterances_dev.yaml", *synthesizer, *recognizer, hri);
   CHECK(dev_set.total >= 40);
-  // The development set, whose misses guided the changes: 87.5 % (35/40, WER 19.0 %).
+  // The development set, whose misses guided the changes: 81.3 % (65/80, WER 23.8 %).
   CHECK(dev_set.accuracy() >= 0.75);
-  // The held-out set (phrasings nothing was tuned on) measured 65 % (26/40, WER 32.9 %).
+  // The held-out set (phrasings nothing was tuned on) measured 72.5 % (29/40, WER 28.3 %) when
+  // first run.
   const RoundTrip held_out = spoken_round_trip("utterances_heldout.yaml", *synthesizer, *recognizer, hri);
   CHECK(held_out.total >= 40);
-  CHECK(held_out.accuracy() >= 0.55);
+  CHECK(held_out.accuracy() >= 0.60);
 
   // The answer itself, spoken and written as a WAV file a visitor's speaker would play.
   const fs::path wav = temp_file("answer.wav");
