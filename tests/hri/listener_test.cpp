@@ -5,6 +5,7 @@
 #include <numbers>
 #include <random>
 
+#include "spoken_jinny.hpp"
 #include "tripodal/hri/hri_module.hpp"
 
 using namespace tripodal;
@@ -202,10 +203,9 @@ TEST_CASE("a stream of spoken questions: each one is recognised and answered", "
     WARN("built without espeak-ng and pocketsphinx (TRIPODAL_VOICE=OFF): nothing to test");
     return;
   }
-  const KnowledgeBase base = KnowledgeBase::load(TRIPODAL_SOURCE_DIR "/configs/hri/jinny.xml");
-  const TaskLibrary tasks = TaskLibrary::load(TRIPODAL_SOURCE_DIR "/configs/tasks/jinny_guide.yaml");
-  const auto recognizer = make_pocketsphinx_recognizer(recognizer_options(speech_corpus(base, tasks.command_forms(), {{"node", {"0", "1"}}})));
-  const auto voice = make_espeak_synthesizer({"en-us+klatt", 170});
+  testing::SpokenJinny jinny;
+  const auto recognizer = jinny.recognizer();
+  const auto voice = testing::SpokenJinny::visitor();
 
   // One recording: room noise, three requests with pauses of various lengths between them.
   Recording r;
@@ -219,25 +219,6 @@ TEST_CASE("a stream of spoken questions: each one is recognised and answered", "
     r.room(0.8 + 0.3 * static_cast<double>(starts.size()));
   }
 
-  class Hall final : public TaskKnowledge {
-   public:
-    ListResult list(std::string_view, std::string_view a) const override {
-      if (a == "0" || a == "1") return {true, {"node" + std::string(a)}, {}};
-      return {false, {}, "unknown node"};
-    }
-  };
-  const Hall hall;
-  const SimClock clock;
-  AnswerProviders providers;
-  providers.add("time", std::make_unique<ClockTimeProvider>(clock, std::chrono::hours(14)));
-  providers.add("battery", std::make_unique<BatteryProvider>([] { return 0.8; }));
-  providers.add("weather", std::make_unique<FixedProvider>("sunny"));
-  std::vector<std::string> started;
-  HriModule hri(base, tasks, hall, providers, [&](const Understanding& u) {
-    started.push_back(u.task);
-    return std::string();
-  });
-
   SpeechListener listener(*recognizer, kRate);
   std::vector<HeardUtterance> heard;
   // Fed as a microphone would: 20 ms at a time.
@@ -249,8 +230,8 @@ TEST_CASE("a stream of spoken questions: each one is recognised and answered", "
 
   REQUIRE(heard.size() == 3);
   for (std::size_t i = 0; i < heard.size(); ++i) CHECK(heard[i].start_s == Approx(starts[i]).margin(0.1));
-  CHECK(hri.handle_heard(heard[0].result).entry_id == "time");
-  CHECK(hri.handle_heard(heard[1].result).entry_id == "introduce");
-  CHECK(hri.handle_heard(heard[2].result).kind == HriReply::Kind::task_started);
-  CHECK(started == std::vector<std::string>{"guide"});
+  CHECK(jinny.hri.handle_heard(heard[0].result).entry_id == "time");
+  CHECK(jinny.hri.handle_heard(heard[1].result).entry_id == "introduce");
+  CHECK(jinny.hri.handle_heard(heard[2].result).kind == HriReply::Kind::task_started);
+  CHECK(jinny.started == std::vector<std::string>{"guide"});
 }

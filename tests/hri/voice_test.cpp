@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -12,6 +11,8 @@
 
 #include "tripodal/hri/hri_module.hpp"
 #include "tripodal/hri/speech.hpp"
+
+#include "spoken_jinny.hpp"
 
 using namespace tripodal;
 
@@ -212,32 +213,10 @@ TEST_CASE("spoken round trip: espeak-ng speaks the utterance set, pocketsphinx r
     WARN("built without espeak-ng and pocketsphinx (TRIPODAL_VOICE=OFF): nothing to test");
     return;
   }
-  class Hall final : public TaskKnowledge {
-   public:
-    ListResult list(std::string_view, std::string_view a) const override {
-      if (a == "0" || a == "1") return {true, {"node" + std::string(a)}, {}};
-      return {false, {}, "unknown node '" + std::string(a) + "' (known: 0, 1)"};
-    }
-  };
-  const KnowledgeBase base = KnowledgeBase::load(TRIPODAL_SOURCE_DIR "/configs/hri/jinny.xml");
-  const TaskLibrary tasks = TaskLibrary::load(TRIPODAL_SOURCE_DIR "/configs/tasks/jinny_guide.yaml");
-  const Hall hall;
-  const SimClock clock;
-  AnswerProviders providers;
-  providers.add("time", std::make_unique<ClockTimeProvider>(clock, std::chrono::hours(14)));
-  providers.add("battery", std::make_unique<BatteryProvider>([] { return 0.8; }));
-  providers.add("weather", std::make_unique<FixedProvider>("sunny"));
-  HriModule hri(base, tasks, hall, providers, [](const Understanding&) { return std::string(); });
-
-  // The recognizer's language model is what the robot knows about (its knowledge and its
-  // commands), not the test set.
-  const PocketsphinxOptions options = recognizer_options(speech_corpus(base, tasks.command_forms(), {{"node", {"0", "1"}}}));
-  const auto recognizer = make_pocketsphinx_recognizer(options);
-  // The visitor's voice: of five espeak-ng variants at two rates, tried on every third utterance
-  // of the set, pocketsphinx's US English model hears klatt at 170 words a minute best (WER 18 %
-  // there; the default en-us voice 39 %): synthetic speech is far from the model's training data.
-  const auto synthesizer = make_espeak_synthesizer({"en-us+klatt", 170});
-
+  testing::SpokenJinny jinny;
+  HriModule& hri = jinny.hri;
+  const auto recognizer = jinny.recognizer();
+  const auto synthesizer = testing::SpokenJinny::visitor();
   const RoundTrip main_set = spoken_round_trip("utterances.yaml", *synthesizer, *recognizer, hri);
   CHECK(main_set.total >= 60);
   // Measured 85.4 % (76/89, WER 20.9 %) on Debian 12's espeak-ng 1.51 and pocketsphinx
