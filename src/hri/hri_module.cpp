@@ -13,6 +13,8 @@ std::string_view to_string(HriReply::Kind kind) noexcept {
     case HriReply::Kind::task_refused: return "task_refused";
     case HriReply::Kind::not_understood: return "not_understood";
     case HriReply::Kind::refused_input: return "refused_input";
+    case HriReply::Kind::confirm_task: return "confirm_task";
+    case HriReply::Kind::task_cancelled: return "task_cancelled";
   }
   return "unknown";
 }
@@ -80,6 +82,7 @@ std::string display_text(const InternalState& state) {
 }
 
 HriReply HriModule::handle_button(std::string_view button) {
+  asked_.reset();
   const auto it = options_.buttons.find(button);
   if (it == options_.buttons.end()) {
     HriReply reply;
@@ -195,22 +198,60 @@ HriReply HriModule::handle_heard(const SpeechRecognizer::Result& heard) {
     reply.text = "Sorry, I did not catch that. Could you say it again?";
     return remember("heard", heard.words, std::move(reply));
   }
-  const Decision best = decide(typed_form(heard.words));
+  if (auto reply = answer_to_question(heard.words)) return remember("heard", heard.words, std::move(*reply));
+  Decision chosen = decide(typed_form(heard.words));
+  std::string words = heard.words;
+  bool from_alternative = false;
   // Only a command is taken from the alternatives: the task grammar is strict, so a sentence
   // misheard into a full command is rare, while retrieval finds some entry in almost anything.
-  if (!best.understood()) {
+  if (!chosen.understood()) {
     for (const auto& alt : heard.alternatives) {
       if (alt.log_score < -options_.max_alternative_log_gap) continue;
       if (Decision d = decide(typed_form(alt.words)); d.what == Decision::What::command) {
-        return remember("heard", alt.words, carry_out(d));
+        chosen = std::move(d);
+        words = alt.words;
+        from_alternative = true;
+        break;
       }
     }
   }
-  return remember("heard", heard.words, carry_out(best));
+  if (chosen.what == Decision::What::command && (from_alternative || heard.confidence < options_.confirm_heard_tasks_below)) {
+    HriReply reply;
+    reply.kind = HriReply::Kind::confirm_task;
+    reply.task = chosen.understanding.task;
+    reply.confidence = heard.confidence;
+    reply.text = "Did you ask me to " + typed_form(words) + "? Please say yes or no.";
+    asked_ = std::move(chosen.understanding);
+    return remember("heard", words, std::move(reply));
+  }
+  return remember("heard", words, carry_out(chosen));
+}
+
+std::optional<HriReply> HriModule::answer_to_question(std::string_view input) {
+  if (!asked_) return std::nullopt;
+  const Understanding asked = std::move(*asked_);
+  asked_.reset();
+  switch (hri::yes_or_no(hri::without_politeness(hri::words(input)))) {
+    case hri::Answer::yes:
+      return command(asked);
+    case hri::Answer::no: {
+      HriReply reply;
+      reply.kind = HriReply::Kind::task_cancelled;
+      reply.task = asked.task;
+      reply.text = "All right, I will not start the " + asked.task + " task.";
+      return reply;
+    }
+    case hri::Answer::neither:
+      break;
+  }
+  return std::nullopt;
 }
 
 HriReply HriModule::handle(std::string_view utterance) {
-  HriReply reply = classify(utterance);
+  std::optional<HriReply> answered = utterance.size() <= options_.max_utterance_bytes && hri::is_text(utterance)
+                                         ? answer_to_question(utterance)
+                                         : std::nullopt;
+  HriReply reply = answered ? std::move(*answered) : classify(utterance);
   // What the display may show of the input: the text itself, unless it was refused unread.
   std::string shown = utterance.size() > options_.max_utterance_bytes ? "(" + std::to_string(utterance.size()) + " bytes: too long)"
                       : !hri::is_text(utterance)                       ? "(" + std::to_string(utterance.size()) + " bytes: not text)"

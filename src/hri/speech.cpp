@@ -389,6 +389,12 @@ std::vector<std::string> speech_corpus(const KnowledgeBase& base, const std::vec
     for (const char* opening : {"please", "could you", "would you"}) out.push_back(std::string(opening) + " " + out[first]);
     out.push_back(out[first] + " please");
   }
+  // The answers to the HRI's "Did you ask me to ...? Please say yes or no."
+  for (const auto& answers : {hri::yes_answers(), hri::no_answers()}) {
+    for (const auto a : answers) out.emplace_back(a == "don t" ? std::string_view("don't") : a);
+  }
+  out.emplace_back("yes please");
+  out.emplace_back("no thanks");
   return out;
 }
 

@@ -136,4 +136,26 @@ std::vector<std::string> without_politeness(std::vector<std::string> ws) {
   return ws;
 }
 
+const std::vector<std::string_view>& yes_answers() {
+  static const std::vector<std::string_view> yes = {"yes", "yeah", "yep", "sure", "ok", "okay", "correct", "right", "go ahead", "do it", "please do"};
+  return yes;
+}
+
+const std::vector<std::string_view>& no_answers() {
+  static const std::vector<std::string_view> no = {"no", "nope", "cancel", "wrong", "stop", "don t", "do not"};
+  return no;
+}
+
+Answer yes_or_no(const std::vector<std::string>& ws) {
+  const auto starts_with = [&](std::string_view phrase) {
+    const std::vector<std::string> p = words(phrase);
+    return !p.empty() && ws.size() >= p.size() && std::equal(p.begin(), p.end(), ws.begin());
+  };
+  // "ok" is also a polite opening; a bare "please" is the politeness itself, a yes.
+  if (ws.size() == 1 && ws.front() == "please") return Answer::yes;
+  if (std::any_of(no_answers().begin(), no_answers().end(), starts_with)) return Answer::no;
+  if (std::any_of(yes_answers().begin(), yes_answers().end(), starts_with)) return Answer::yes;
+  return Answer::neither;
+}
+
 }  // namespace tripodal::hri

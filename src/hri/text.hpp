@@ -32,6 +32,14 @@ namespace tripodal::hri {
 [[nodiscard]] const std::vector<std::vector<std::string_view>>& polite_openings();
 [[nodiscard]] const std::vector<std::string_view>& polite_closings();
 
+/// Words that answer a yes-or-no question ("yes please", "sure", "go ahead"; "no", "cancel",
+/// "don't"), for the HRI's confirmation and the recognizer's corpus.
+[[nodiscard]] const std::vector<std::string_view>& yes_answers();
+[[nodiscard]] const std::vector<std::string_view>& no_answers();
+enum class Answer { yes, no, neither };
+/// Yes when `ws` start with a yes answer's words, no with a no answer's, neither otherwise.
+[[nodiscard]] Answer yes_or_no(const std::vector<std::string>& ws);
+
 /// `ws` without polite openings (repeatedly: "jinny could you please ...") and closings; a
 /// command's own words are never all stripped.
 [[nodiscard]] std::vector<std::string> without_politeness(std::vector<std::string> ws);

@@ -122,17 +122,6 @@ json change_json(const KnowledgeChange& c) {
               {"after", c.after ? entry_json(*c.after) : json(nullptr)}};
 }
 
-std::string_view kind_text(HriReply::Kind k) {
-  switch (k) {
-    case HriReply::Kind::answered: return "answered";
-    case HriReply::Kind::task_started: return "task_started";
-    case HriReply::Kind::task_refused: return "task_refused";
-    case HriReply::Kind::not_understood: return "not_understood";
-    case HriReply::Kind::refused_input: return "refused_input";
-  }
-  return "?";
-}
-
 }  // namespace
 
 
@@ -217,14 +206,14 @@ HriOpResult handle_hri_op(HriService* hri, std::string_view op, const json& body
   // ask
   if (!body.contains("text") || !body["text"].is_string()) return bad("ask: expected \"text\": what the visitor typed");
   const HriReply reply = hri->ask(body["text"].get<std::string>());
-  json j{{"kind", std::string(kind_text(reply.kind))},
+  json j{{"kind", std::string(to_string(reply.kind))},
          {"text", reply.text},
          {"entry", reply.entry_id},
          {"task", reply.task},
          {"confidence", reply.confidence},
          {"topics", reply.closest_topics},
          {"voice", hri->voice() != nullptr}};
-  if (reply.kind == HriReply::Kind::task_started || !reply.task.empty()) note("hri: touch screen: task " + reply.task + " started");
+  if (reply.kind == HriReply::Kind::task_started || (reply.kind == HriReply::Kind::answered && !reply.task.empty())) note("hri: touch screen: task " + reply.task + " started");
   if (body.contains("speak") && body["speak"].is_boolean() && body["speak"].get<bool>()) {
     if (SpeechSynthesizer* voice = hri->voice()) {
       try {

@@ -253,12 +253,16 @@ TEST_CASE("a heard sentence that is not understood gives way to the first altern
   // The best sentence misheard one word ("to" for "at"); the second alternative is the command.
   SpeechRecognizer::Result heard{"explain the robot to node one", 0.01, {}};
   heard.alternatives = {Alternative{"explain the robot at to node one", -0.1}, Alternative{"explain the robot at node one", -0.2}};
+  // Not what was heard best: asked about first, started on a yes.
   const HriReply r = jinny.hri.handle_heard(heard);
-  CHECK(r.kind == HriReply::Kind::task_started);
+  CHECK(r.kind == HriReply::Kind::confirm_task);
   CHECK(r.task == "explain");
-  CHECK(jinny.started == std::vector<std::string>{"PrAutoMove(goal=node1) -> PrExplain(topic=the robot at node 1)"});
+  CHECK(r.text == "Did you ask me to explain the robot at node 1? Please say yes or no.");
   REQUIRE(jinny.hri.last_exchange().has_value());
   CHECK(jinny.hri.last_exchange()->input == "explain the robot at node one");
+  CHECK(jinny.started.empty());
+  CHECK(jinny.hri.handle_heard({"yes", 0.3, {}}).kind == HriReply::Kind::task_started);
+  CHECK(jinny.started == std::vector<std::string>{"PrAutoMove(goal=node1) -> PrExplain(topic=the robot at node 1)"});
 
   // Too far behind the best (max_alternative_log_gap): the best is answered as heard.
   heard.alternatives = {Alternative{"explain the robot at node one", -3.0}};
@@ -281,8 +285,56 @@ TEST_CASE("a heard sentence that is not understood gives way to the first altern
   off.max_alternative_log_gap = 0.0;
   Jinny strict(off);
   heard.alternatives = {Alternative{"explain the robot at node one", -0.2}};
+  heard.confidence = 0.3;
   CHECK(strict.hri.handle_heard(heard).kind == HriReply::Kind::task_refused);
   CHECK(strict.started.empty());
+}
+
+TEST_CASE("a command heard with little confidence is asked about and started only on a yes") {
+  Jinny jinny;
+  // "thank you jinny" misheard as a command: asked, not started; "no" cancels it.
+  HriReply r = jinny.hri.handle_heard({"dance to jinny", 0.008, {}});
+  CHECK(r.kind == HriReply::Kind::confirm_task);
+  CHECK(r.task == "dance");
+  CHECK(r.text == "Did you ask me to dance to jinny? Please say yes or no.");
+  CHECK(jinny.started.empty());
+  r = jinny.hri.handle_heard({"no", 0.4, {}});
+  CHECK(r.kind == HriReply::Kind::task_cancelled);
+  CHECK(r.text == "All right, I will not start the dance task.");
+  CHECK(jinny.started.empty());
+  // The question is answered once: a second "no" is an input of its own.
+  CHECK(jinny.hri.handle("no").kind == HriReply::Kind::not_understood);
+
+  // A yes, spoken or typed, in any of its forms, starts the task asked about.
+  for (const char* yes : {"yes", "yes please", "Sure!", "ok", "go ahead", "please", "jinny yes"}) {
+    CHECK(jinny.hri.handle_heard({"guide me to node one", 0.01, {}}).kind == HriReply::Kind::confirm_task);
+    CHECK(jinny.hri.handle(yes).kind == HriReply::Kind::task_started);
+  }
+  CHECK(jinny.started.size() == 7);
+  for (const char* no : {"no", "No thanks.", "don't", "cancel that", "nope"}) {
+    CHECK(jinny.hri.handle_heard({"guide me to node one", 0.01, {}}).kind == HriReply::Kind::confirm_task);
+    CHECK(jinny.hri.handle(no).kind == HriReply::Kind::task_cancelled);
+  }
+  CHECK(jinny.started.size() == 7);
+
+  // Anything else drops the question and is handled as itself; so does a button press.
+  CHECK(jinny.hri.handle_heard({"guide me to node one", 0.01, {}}).kind == HriReply::Kind::confirm_task);
+  CHECK(jinny.hri.handle("What time is it?").entry_id == "time");
+  CHECK(jinny.hri.handle("yes").kind != HriReply::Kind::task_started);
+  CHECK(jinny.hri.handle_heard({"guide me to node one", 0.01, {}}).kind == HriReply::Kind::confirm_task);
+  CHECK(jinny.hri.handle_button("nothing bound").kind == HriReply::Kind::not_understood);
+  CHECK(jinny.hri.handle("yes").kind != HriReply::Kind::task_started);
+  CHECK(jinny.started.size() == 7);
+
+  // Heard surely enough, a command starts at once; typed commands never ask.
+  CHECK(jinny.hri.handle_heard({"guide me to node one", 0.06, {}}).kind == HriReply::Kind::task_started);
+  CHECK(jinny.hri.handle("guide me to node 1").kind == HriReply::Kind::task_started);
+  CHECK(jinny.started.size() == 9);
+  // A threshold of 0 never asks.
+  HriOptions never;
+  never.confirm_heard_tasks_below = 0.0;
+  Jinny trusting(never);
+  CHECK(trusting.hri.handle_heard({"dance to jinny", 0.008, {}}).kind == HriReply::Kind::task_started);
 }
 
 TEST_CASE("a word corrected into a command's verb does not make a question a command") {

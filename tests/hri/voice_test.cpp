@@ -121,7 +121,11 @@ TEST_CASE("the speech corpus expands optional words and slots of the command for
                                            "guide me to the node 0", "guide me to the node 1",
                                            // polite requests, once per command form
                                            "please guide me to node 0", "could you guide me to node 0",
-                                           "would you guide me to node 0", "guide me to node 0 please"});
+                                           "would you guide me to node 0", "guide me to node 0 please",
+                                           // the answers to "did you ask me to ...?"
+                                           "yes", "yeah", "yep", "sure", "ok", "okay", "correct", "right", "go ahead",
+                                           "do it", "please do", "no", "nope", "cancel", "wrong", "stop", "don't", "do not",
+                                           "yes please", "no thanks"});
 }
 
 TEST_CASE("espeak-ng's phoneme mnemonics become the dictionary's ARPAbet phones") {
@@ -165,6 +169,7 @@ struct RoundTrip {
   std::size_t right = 0;
   std::size_t word_errors = 0;
   std::size_t words = 0;
+  std::size_t confirmed = 0;  // right, after the visitor confirmed the task asked about
   [[nodiscard]] double accuracy() const { return total == 0 ? 0.0 : static_cast<double>(right) / static_cast<double>(total); }
 };
 
@@ -184,14 +189,23 @@ RoundTrip spoken_round_trip(const std::string& file, SpeechSynthesizer& synthesi
     rt.word_errors += e.errors;
     rt.words += e.reference_words;
     const HriReply r = hri.handle_heard(result);
-    const bool ok = to_string(r.kind) == u["outcome"].as<std::string>() &&
-                    r.entry_id == (u["entry"] ? u["entry"].as<std::string>() : std::string()) &&
-                    r.task == (u["task"] ? u["task"].as<std::string>() : std::string());
+    const std::string acted_on = hri.last_exchange() ? hri.last_exchange()->input : heard;
+    const std::string expected = u["outcome"].as<std::string>();
+    const std::string expected_task = u["task"] ? u["task"].as<std::string>() : std::string();
+    // A command asked about before it starts (heard with little confidence) is understood: the
+    // visitor's yes starts it. Counted right, and counted apart.
+    const bool confirmed = expected == "task_started" && r.kind == HriReply::Kind::confirm_task && r.task == expected_task;
+    const bool ok = confirmed || (to_string(r.kind) == expected &&
+                                  r.entry_id == (u["entry"] ? u["entry"].as<std::string>() : std::string()) && r.task == expected_task);
+    if (confirmed) ++rt.confirmed;
+    if (r.kind == HriReply::Kind::confirm_task) {
+      // The visitor answers the question: yes when the task is the one meant, no otherwise.
+      (void)hri.handle(confirmed ? "yes" : "no");
+    }
     ++rt.total;
     if (ok) {
       ++rt.right;
     } else {
-      const std::string acted_on = hri.last_exchange() ? hri.last_exchange()->input : heard;
       misses += "  \"" + text + "\" heard \"" + heard + "\" (" + std::to_string(result.confidence) + ")" +
                 (acted_on != heard ? ", acted on \"" + acted_on + "\"" : std::string()) + ": " + std::string(to_string(r.kind)) + " " +
                 r.entry_id + "\n";
@@ -200,7 +214,8 @@ RoundTrip spoken_round_trip(const std::string& file, SpeechSynthesizer& synthesi
   const double wer = rt.words == 0 ? 0.0 : static_cast<double>(rt.word_errors) / static_cast<double>(rt.words);
   std::cout << "HRI spoken round trip of " << file << " (espeak-ng -> 16 kHz -> pocketsphinx): " << rt.total
             << " utterances, word error rate " << wer * 100.0 << " % (" << rt.word_errors << "/" << rt.words
-            << " words), answers right " << rt.right << "/" << rt.total << " = " << rt.accuracy() * 100.0 << " %\n"
+            << " words), answers right " << rt.right << "/" << rt.total << " = " << rt.accuracy() * 100.0 << " % ("
+            << rt.confirmed << " of them a task asked about first)\n"
             << misses;
   return rt;
 }
@@ -219,16 +234,15 @@ TEST_CASE("spoken round trip: espeak-ng speaks the utterance set, pocketsphinx r
   const auto synthesizer = testing::SpokenJinny::visitor();
   const RoundTrip main_set = spoken_round_trip("utterances.yaml", *synthesizer, *recognizer, hri);
   CHECK(main_set.total >= 60);
-  // Measured 85.4 % (76/89, WER 20.9 %) on Debian 12's espeak-ng 1.51 and pocketsphinx
+  // Measured 86.5 % (77/89, WER 20.9 %; two of them commands asked about first) on Debian 12's espeak-ng 1.51 and pocketsphinx
   // 5prealpha, in a process of its own (espeak-ng's state moves it by about two utterances:
   // docs/hri.md). The floors guard against regressions.
   CHECK(main_set.accuracy() >= 0.80);
   const RoundTrip dev_set = spoken_round_trip("utterances_dev.yaml", *synthesizer, *recognizer, hri);
   CHECK(dev_set.total >= 40);
-  // The development set, whose misses guided the changes: 81.3 % (65/80, WER 23.8 %).
+  // The development set, whose misses guided the changes: 82.5 % (66/80, WER 23.5 %).
   CHECK(dev_set.accuracy() >= 0.75);
-  // The held-out set (phrasings nothing was tuned on) measured 72.5 % (29/40, WER 28.3 %) when
-  // first run.
+  // The held-out set (phrasings nothing was tuned on) measured 72.5 % (29/40, WER 28.3 %).
   const RoundTrip held_out = spoken_round_trip("utterances_heldout.yaml", *synthesizer, *recognizer, hri);
   CHECK(held_out.total >= 40);
   CHECK(held_out.accuracy() >= 0.60);

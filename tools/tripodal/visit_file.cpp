@@ -21,7 +21,7 @@ namespace {
 
 void read_expect(yaml::Reader& r, const YAML::Node& n, VisitStep& step) {
   if (!r.expect_keys(n, {"outcome", "entry", "task", "task_end"}, "a step's expect")) return;
-  if (const YAML::Node v = n["outcome"]) step.expect_outcome = r.choice(v, "expect.outcome", {"answered", "task_started", "task_refused", "not_understood", "refused_input"}).value_or("");
+  if (const YAML::Node v = n["outcome"]) step.expect_outcome = r.choice(v, "expect.outcome", {"answered", "task_started", "task_refused", "not_understood", "refused_input", "confirm_task", "task_cancelled"}).value_or("");
   if (const YAML::Node v = n["entry"]) step.expect_entry = r.text(v, "expect.entry", true).value_or("");
   if (const YAML::Node v = n["task"]) step.expect_task = r.text(v, "expect.task", true).value_or("");
   if (const YAML::Node v = n["task_end"]) step.expect_task_end = r.choice(v, "expect.task_end", {"succeeded", "failed"}).value_or("");

@@ -40,6 +40,11 @@ struct HriOptions {
   /// less likely (natural log of the path score ratio) are tried in order, and the first one
   /// understood is acted on. 0 turns the n-best list off.
   double max_alternative_log_gap = 1.0;
+  /// A command heard less surely than this (SpeechRecognizer::Result::confidence), or taken from
+  /// the recognizer's alternatives, is not started at once: the HRI asks "Did you ask me to ...?
+  /// Please say yes or no." and starts it on a yes (confirm_task, then task_started or
+  /// task_cancelled). A robot must not drive off on a misheard thanks. 0 never asks.
+  double confirm_heard_tasks_below = 0.05;
   /// LED buttons (Table 3): each button's name and the request a press stands for ("hello" ->
   /// "Introduce yourself."). A press is handled as that input was typed.
   std::map<std::string, std::string, std::less<>> buttons;
@@ -67,11 +72,13 @@ struct HriReply {
     task_refused,     ///< a command input the planner refused (text says why)
     not_understood,   ///< nothing matched well enough (text offers the closest topics)
     refused_input,    ///< empty, too long or not text: nothing ran
+    confirm_task,     ///< a command heard with too little confidence: task is asked about, not started
+    task_cancelled,   ///< the visitor said no to the task asked about
   };
   Kind kind = Kind::not_understood;
   std::string text;      ///< what the robot says
   std::string entry_id;  ///< answered: the RKMS entry
-  std::string task;      ///< the task the planner started (also for an entry's action)
+  std::string task;      ///< the task the planner started (also for an entry's action); confirm_task: the one asked about
   Plan plan;             ///< when a task started
   double confidence = 0.0;
   std::vector<std::string> closest_topics;  ///< not_understood
@@ -157,6 +164,9 @@ class HriModule {
   [[nodiscard]] Decision decide(std::string_view utterance) const;
   HriReply carry_out(const Decision& decision);
   HriReply classify(std::string_view utterance) { return carry_out(decide(utterance)); }
+  // The visitor's answer to a confirm_task question: a reply when `words` say yes or no; nullopt
+  // (and the question dropped) otherwise.
+  std::optional<HriReply> answer_to_question(std::string_view words);
   HriReply remember(std::string source, std::string input, HriReply reply);
   HriReply answer(const KnowledgeEntry& entry, double confidence);
   HriReply command(const Understanding& understanding);
@@ -172,6 +182,7 @@ class HriModule {
   std::vector<std::string> command_words_;  // the first word of each command form ("guide", "clean")
   InternalState state_;
   std::optional<HriExchange> last_;
+  std::optional<Understanding> asked_;  // the task a confirm_task asked about
 };
 
 /// The planner's explanation of a refused command in plain words, for speaking: "I cannot do
