@@ -171,10 +171,10 @@ std::vector<HeardUtterance> SpeechListener::feed(std::span<const std::int16_t> s
 
 std::vector<HeardUtterance> SpeechListener::finish() { return recognise(segmenter_.finish()); }
 
-std::vector<HeardUtterance> SpeechListener::recognise(std::vector<SegmentedUtterance> utterances) {
+std::vector<HeardUtterance> SpeechListener::recognise(const std::vector<SegmentedUtterance>& utterances) {
   std::vector<HeardUtterance> out;
   out.reserve(utterances.size());
-  for (auto& u : utterances) {
+  for (const auto& u : utterances) {
     out.push_back({u.start_s, u.end_s, u.truncated, recognizer_.recognize(u.clip)});
   }
   return out;

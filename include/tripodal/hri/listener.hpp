@@ -110,7 +110,7 @@ class SpeechListener {
   [[nodiscard]] const UtteranceSegmenter& segmenter() const noexcept { return segmenter_; }
 
  private:
-  std::vector<HeardUtterance> recognise(std::vector<SegmentedUtterance> utterances);
+  std::vector<HeardUtterance> recognise(const std::vector<SegmentedUtterance>& utterances);
 
   SpeechRecognizer& recognizer_;
   UtteranceSegmenter segmenter_;
