@@ -215,13 +215,22 @@ HriReply HriModule::handle_heard(const SpeechRecognizer::Result& heard) {
       }
     }
   }
-  if (chosen.what == Decision::What::command && (from_alternative || heard.confidence < options_.confirm_heard_tasks_below)) {
+  // A task heard unsurely (a command, or an answer whose entry starts one) waits for a yes.
+  const bool starts_task = chosen.what == Decision::What::command ||
+                           (chosen.what == Decision::What::answer && !entries_[chosen.retrieval.hits.front().entry].action.empty());
+  if (starts_task && (from_alternative || heard.confidence < options_.confirm_heard_tasks_below)) {
     HriReply reply;
     reply.kind = HriReply::Kind::confirm_task;
-    reply.task = chosen.understanding.task;
+    if (chosen.what == Decision::What::command) {
+      reply.task = chosen.understanding.task;
+    } else {
+      const KnowledgeEntry& e = entries_[chosen.retrieval.hits.front().entry];
+      reply.entry_id = e.id;
+      reply.task = tasks_.understand(e.action, knowledge_).task;
+    }
     reply.confidence = heard.confidence;
-    reply.text = "Did you ask me to " + typed_form(words) + "? Please say yes or no.";
-    asked_ = std::move(chosen.understanding);
+    reply.text = "Did you say \"" + typed_form(words) + "\"? Please say yes or no.";
+    asked_ = std::move(chosen);
     return remember("heard", words, std::move(reply));
   }
   return remember("heard", words, carry_out(chosen));
@@ -229,16 +238,16 @@ HriReply HriModule::handle_heard(const SpeechRecognizer::Result& heard) {
 
 std::optional<HriReply> HriModule::answer_to_question(std::string_view input) {
   if (!asked_) return std::nullopt;
-  const Understanding asked = std::move(*asked_);
+  const Decision asked = std::move(*asked_);
   asked_.reset();
   switch (hri::yes_or_no(hri::without_politeness(hri::words(input)))) {
     case hri::Answer::yes:
-      return command(asked);
+      return carry_out(asked);
     case hri::Answer::no: {
       HriReply reply;
       reply.kind = HriReply::Kind::task_cancelled;
-      reply.task = asked.task;
-      reply.text = "All right, I will not start the " + asked.task + " task.";
+      reply.text = "All right, I will not do that.";
+      if (asked.what == Decision::What::command) reply.task = asked.understanding.task;
       return reply;
     }
     case hri::Answer::neither:

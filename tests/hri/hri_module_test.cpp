@@ -257,7 +257,7 @@ TEST_CASE("a heard sentence that is not understood gives way to the first altern
   const HriReply r = jinny.hri.handle_heard(heard);
   CHECK(r.kind == HriReply::Kind::confirm_task);
   CHECK(r.task == "explain");
-  CHECK(r.text == "Did you ask me to explain the robot at node 1? Please say yes or no.");
+  CHECK(r.text == "Did you say \"explain the robot at node 1\"? Please say yes or no.");
   REQUIRE(jinny.hri.last_exchange().has_value());
   CHECK(jinny.hri.last_exchange()->input == "explain the robot at node one");
   CHECK(jinny.started.empty());
@@ -296,11 +296,12 @@ TEST_CASE("a command heard with little confidence is asked about and started onl
   HriReply r = jinny.hri.handle_heard({"dance to jinny", 0.008, {}});
   CHECK(r.kind == HriReply::Kind::confirm_task);
   CHECK(r.task == "dance");
-  CHECK(r.text == "Did you ask me to dance to jinny? Please say yes or no.");
+  CHECK(r.text == "Did you say \"dance to jinny\"? Please say yes or no.");
   CHECK(jinny.started.empty());
   r = jinny.hri.handle_heard({"no", 0.4, {}});
   CHECK(r.kind == HriReply::Kind::task_cancelled);
-  CHECK(r.text == "All right, I will not start the dance task.");
+  CHECK(r.task == "dance");
+  CHECK(r.text == "All right, I will not do that.");
   CHECK(jinny.started.empty());
   // The question is answered once: a second "no" is an input of its own.
   CHECK(jinny.hri.handle("no").kind == HriReply::Kind::not_understood);
@@ -330,6 +331,19 @@ TEST_CASE("a command heard with little confidence is asked about and started onl
   CHECK(jinny.hri.handle_heard({"guide me to node one", 0.06, {}}).kind == HriReply::Kind::task_started);
   CHECK(jinny.hri.handle("guide me to node 1").kind == HriReply::Kind::task_started);
   CHECK(jinny.started.size() == 9);
+  // An answer whose entry starts a task is asked about too; a yes gives the answer and starts it.
+  r = jinny.hri.handle_heard({"i want to see p s r one", 0.01, {}});
+  CHECK(r.kind == HriReply::Kind::confirm_task);
+  CHECK(r.entry_id == "show_node0");
+  CHECK(r.task == "guide");
+  CHECK(jinny.started.size() == 9);
+  r = jinny.hri.handle("yes");
+  CHECK(r.kind == HriReply::Kind::answered);
+  CHECK(r.entry_id == "show_node0");
+  CHECK(r.task == "guide");
+  CHECK(jinny.started.size() == 10);
+  // An answer without an action is given at once, however unsure.
+  CHECK(jinny.hri.handle_heard({"what time is it", 0.01, {}}).entry_id == "time");
   // A threshold of 0 never asks.
   HriOptions never;
   never.confirm_heard_tasks_below = 0.0;

@@ -192,11 +192,12 @@ RoundTrip spoken_round_trip(const std::string& file, SpeechSynthesizer& synthesi
     const std::string acted_on = hri.last_exchange() ? hri.last_exchange()->input : heard;
     const std::string expected = u["outcome"].as<std::string>();
     const std::string expected_task = u["task"] ? u["task"].as<std::string>() : std::string();
-    // A command asked about before it starts (heard with little confidence) is understood: the
+    // A task asked about before it starts (heard with little confidence) is understood: the
     // visitor's yes starts it. Counted right, and counted apart.
-    const bool confirmed = expected == "task_started" && r.kind == HriReply::Kind::confirm_task && r.task == expected_task;
-    const bool ok = confirmed || (to_string(r.kind) == expected &&
-                                  r.entry_id == (u["entry"] ? u["entry"].as<std::string>() : std::string()) && r.task == expected_task);
+    const std::string expected_entry = u["entry"] ? u["entry"].as<std::string>() : std::string();
+    const bool confirmed = (expected == "task_started" || (expected == "answered" && !expected_task.empty())) &&
+                           r.kind == HriReply::Kind::confirm_task && r.task == expected_task && r.entry_id == expected_entry;
+    const bool ok = confirmed || (to_string(r.kind) == expected && r.entry_id == expected_entry && r.task == expected_task);
     if (confirmed) ++rt.confirmed;
     if (r.kind == HriReply::Kind::confirm_task) {
       // The visitor answers the question: yes when the task is the one meant, no otherwise.

@@ -41,9 +41,10 @@ struct HriOptions {
   /// understood is acted on. 0 turns the n-best list off.
   double max_alternative_log_gap = 1.0;
   /// A command heard less surely than this (SpeechRecognizer::Result::confidence), or taken from
-  /// the recognizer's alternatives, is not started at once: the HRI asks "Did you ask me to ...?
-  /// Please say yes or no." and starts it on a yes (confirm_task, then task_started or
-  /// task_cancelled). A robot must not drive off on a misheard thanks. 0 never asks.
+  /// the recognizer's alternatives, and an answer whose entry starts a task heard less surely, are
+  /// not carried out at once: the HRI asks 'Did you say "..."? Please say yes or no.' and carries
+  /// it out on a yes (confirm_task, then task_started or answered; task_cancelled on a no). A robot
+  /// must not drive off on a misheard thanks. 0 never asks.
   double confirm_heard_tasks_below = 0.05;
   /// LED buttons (Table 3): each button's name and the request a press stands for ("hello" ->
   /// "Introduce yourself."). A press is handled as that input was typed.
@@ -72,7 +73,7 @@ struct HriReply {
     task_refused,     ///< a command input the planner refused (text says why)
     not_understood,   ///< nothing matched well enough (text offers the closest topics)
     refused_input,    ///< empty, too long or not text: nothing ran
-    confirm_task,     ///< a command heard with too little confidence: task is asked about, not started
+    confirm_task,     ///< a task heard with too little confidence: asked about (task; entry for an answer), not started
     task_cancelled,   ///< the visitor said no to the task asked about
   };
   Kind kind = Kind::not_understood;
@@ -182,7 +183,8 @@ class HriModule {
   std::vector<std::string> command_words_;  // the first word of each command form ("guide", "clean")
   InternalState state_;
   std::optional<HriExchange> last_;
-  std::optional<Understanding> asked_;  // the task a confirm_task asked about
+  // What a confirm_task asked about: a command, or an answer whose entry starts a task.
+  std::optional<Decision> asked_;
 };
 
 /// The planner's explanation of a refused command in plain words, for speaking: "I cannot do
