@@ -257,9 +257,9 @@ std::optional<HriReply> HriModule::answer_to_question(std::string_view input) {
 }
 
 HriReply HriModule::handle(std::string_view utterance) {
-  std::optional<HriReply> answered = utterance.size() <= options_.max_utterance_bytes && hri::is_text(utterance)
-                                         ? answer_to_question(utterance)
-                                         : std::nullopt;
+  const bool readable = utterance.size() <= options_.max_utterance_bytes && hri::is_text(utterance);
+  if (!readable) asked_.reset();  // refused unread: not an answer, and the question is dropped
+  std::optional<HriReply> answered = readable ? answer_to_question(utterance) : std::nullopt;
   HriReply reply = answered ? std::move(*answered) : classify(utterance);
   // What the display may show of the input: the text itself, unless it was refused unread.
   std::string shown = utterance.size() > options_.max_utterance_bytes ? "(" + std::to_string(utterance.size()) + " bytes: too long)"

@@ -43,8 +43,8 @@ struct HriOptions {
   /// A command heard less surely than this (SpeechRecognizer::Result::confidence), or taken from
   /// the recognizer's alternatives, and an answer whose entry starts a task heard less surely, are
   /// not carried out at once: the HRI asks 'Did you say "..."? Please say yes or no.' and carries
-  /// it out on a yes (confirm_task, then task_started or answered; task_cancelled on a no). A robot
-  /// must not drive off on a misheard thanks. 0 never asks.
+  /// it out on a yes (confirm_task, then task_started or answered; task_cancelled on a no); any
+  /// other input drops the question. A robot must not drive off on a misheard thanks. 0 never asks.
   double confirm_heard_tasks_below = 0.05;
   /// LED buttons (Table 3): each button's name and the request a press stands for ("hello" ->
   /// "Introduce yourself."). A press is handled as that input was typed.
