@@ -391,7 +391,7 @@ std::vector<std::string> speech_corpus(const KnowledgeBase& base, const std::vec
   }
   // The answers to the HRI's "Did you ask me to ...? Please say yes or no."
   for (const auto& answers : {hri::yes_answers(), hri::no_answers()}) {
-    for (const auto a : answers) out.emplace_back(a == "don t" ? std::string_view("don't") : a);
+    out.insert(out.end(), answers.begin(), answers.end());
   }
   out.emplace_back("yes please");
   out.emplace_back("no thanks");

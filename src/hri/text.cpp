@@ -142,7 +142,7 @@ const std::vector<std::string_view>& yes_answers() {
 }
 
 const std::vector<std::string_view>& no_answers() {
-  static const std::vector<std::string_view> no = {"no", "nope", "cancel", "wrong", "stop", "don t", "do not"};
+  static const std::vector<std::string_view> no = {"no", "nope", "cancel", "wrong", "stop", "don't", "do not"};
   return no;
 }
 
