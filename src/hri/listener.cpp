@@ -61,6 +61,8 @@ std::vector<SegmentedUtterance> UtteranceSegmenter::finish() {
     utterance_.insert(utterance_.end(), frame_.begin(), frame_.end());
     close_utterance(out, false);
   }
+  // The partial frame still counts in the timeline, should the stream be fed on after this.
+  samples_seen_ += frame_.size();
   frame_.clear();
   history_.clear();
   in_speech_ = false;

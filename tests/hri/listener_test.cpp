@@ -124,6 +124,18 @@ TEST_CASE("an utterance longer than max_utterance_s is cut and the rest goes on,
   CHECK_FALSE(found[3].truncated);
   CHECK(found[3].start_s == Approx(4.0).margin(0.02));
   CHECK(found[3].end_s == Approx(4.5).margin(0.02));
+
+  // Fed on after finish(), the timeline goes on from the last sample, the partial frame included.
+  UtteranceSegmenter s(kRate);
+  const std::vector<std::int16_t> odd(4159, 0);  // 25 frames of 160 and 159 samples
+  CHECK(s.feed(odd).empty());
+  CHECK(s.finish().empty());
+  Recording more;
+  more.voice(0.5);
+  more.room(0.6);
+  const std::vector<SegmentedUtterance> later = s.feed(more.clip.samples);
+  REQUIRE(later.size() == 1);
+  CHECK(later[0].start_s == Approx(4159.0 / kRate).margin(0.001));
 }
 
 TEST_CASE("the noise floor follows a room getting louder, and a voice above it is still found") {
