@@ -12,6 +12,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config
+  ccache  # every tree compiles through it (CMakeLists.txt, TRIPODAL_CCACHE)
   libeigen3-dev libyaml-cpp-dev libspdlog-dev
   libfmt-dev nlohmann-json3-dev libcli11-dev
   libtinyxml2-dev  # the net loaders read XML with it

@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
-# The README's test command: installs dependencies, then
+# The README's test command, the quick path a newcomer runs: installs dependencies, then
 #   1. a Release build with -Werror and the whole test suite (ctest; the tests' own sources at -O1,
 #      36 % less compile time than -O3 for no run time: the library keeps -O3),
 #   2. the example consumer, the behavior tutorial's test (examples/behavior_test) and the
 #      application robot (examples/custom_robot) built against the *installed* package
-#      (find_package(tripodal)), and the DDS consumer (examples/dds_consumer) when the package has dds,
-#   3. the test suite again under AddressSanitizer + UndefinedBehaviorSanitizer,
-# Build trees go to build/release, build/sanitize, build/consumer,
-# build/behavior_test, build/custom_robot, build/dds_consumer (override with BUILD_ROOT).
+#      (find_package(tripodal)), and the DDS consumer (examples/dds_consumer) when the package has dds.
+# The slower passes are their own scripts, which .ci/run runs after this one: scripts/sanitize.sh
+# (the suite under AddressSanitizer + UndefinedBehaviorSanitizer), scripts/fuzz.sh, scripts/tsan.sh
+# and scripts/tidy.sh. Every tree compiles through ccache when it is installed (CMakeLists.txt).
+# Build trees go to build/release, build/consumer, build/behavior_test, build/custom_robot,
+# build/dds_consumer (override with BUILD_ROOT).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # Each step prints the wall time since the start: CI's budget is read from these lines.
@@ -54,17 +56,3 @@ if [ -d "$build_root/install/include/tripodal/dds" ]; then
   cmake --build "$build_root/dds_consumer" -j "$jobs"
   "$build_root/dds_consumer/tripodal_dds_consumer"
 fi
-
-stage "AddressSanitizer + UndefinedBehaviorSanitizer build"
-# -O1 -g1 (line tables): the sanitizers' reports keep their file:line, and the tree compiles in half
-# the time of -O2 -g (27 s against 13 s for robot_monitor.cpp), which CI's budget needs. The tests'
-# own sources at -O0 halve their share again (TRIPODAL_TEST_CXX_FLAGS in CMakeLists.txt).
-cmake -S . -B "$build_root/sanitize" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG" \
-  -DTRIPODAL_WERROR=ON -DTRIPODAL_SANITIZE=ON -DTRIPODAL_BUILD_TESTS=ON -DTRIPODAL_BUILD_BENCH=OFF \
-  -DTRIPODAL_TEST_CXX_FLAGS=-O0
-cmake --build "$build_root/sanitize" -j "$jobs"
-stage "Sanitizer tests"
-# -LE long: the whole-workspace runs that repeat code another run drives (tests/app/CMakeLists.txt).
-ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir "$build_root/sanitize" --output-on-failure -j "$jobs" -LE long
