@@ -64,7 +64,11 @@ void BoardFirmware::receive() noexcept {
   while (true) {
     // Deadline 0: the firmware's loop polls the UART, it never waits on it.
     const std::ptrdiff_t n = link_.read(rx_, Time{});
-    if (n <= 0) return;
+    if (n <= 0) {
+      if (decoder_.partial() && now_ - last_byte_ >= config_.frame_idle_timeout) abandon_idle_frame();
+      return;
+    }
+    last_byte_ = now_;
     std::span<const std::uint8_t> in(rx_.data(), static_cast<std::size_t>(n));
     while (true) {
       const FrameDecoder::Result r = decoder_.decode(in);
@@ -81,6 +85,17 @@ void BoardFirmware::receive() noexcept {
       if (!r.frame && in.empty()) break;
     }
   }
+}
+
+// A truncated frame gets no answer (the host times its request out); the frames found in its bytes
+// are answered as usual, and the errors found on the way are not answered late.
+void BoardFirmware::abandon_idle_frame() noexcept {
+  FrameDecoder::Result r = decoder_.abandon_partial();
+  while (r.frame) {
+    handle(decoder_.frame());
+    r = decoder_.decode({});
+  }
+  decoder_errors_seen_ = decoder_.stats().checksum + decoder_.stats().oversize;
 }
 
 void BoardFirmware::handle(const FrameView& frame) noexcept {

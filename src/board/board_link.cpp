@@ -23,7 +23,31 @@ bool BoardLink::take_link_lost() noexcept {
   return lost;
 }
 
+void BoardLink::fail_stream(Time now) noexcept {
+  while (outstanding_size_ > 0) miss(now);
+  stream_failed_ = true;
+  next_reopen_ = now;
+}
+
+// The port's settings are the link's too: a line switched to canonical mode or echo under the
+// host swallows or mirrors bytes for good, so the port is reopened and configured again.
+void BoardLink::check_port(Time now) noexcept {
+  check_port_now_ = false;
+  next_port_check_ = now + config_.port_check_period;
+  ++stats_.port_checks;
+  const std::string_view fault = stream_.check();
+  if (fault.empty()) return;
+  last_port_fault_ = fault;
+  if (fault == kDeviceGone) {
+    ++stats_.port_failures;
+  } else {
+    ++stats_.settings_changed;
+  }
+  fail_stream(now);
+}
+
 void BoardLink::cycle(Time now, WheelSpeeds speeds) noexcept {
+  if (!stream_failed_ && (check_port_now_ || now >= next_port_check_)) check_port(now);
   if (stream_failed_) {
     // The device went away (unplugged, the board's process killed): every outstanding request
     // is missed; the device is opened again now and then, and the link resynchronises with SYNC.
@@ -87,9 +111,8 @@ void BoardLink::receive(Time now) noexcept {
     // Deadline 0 (passed): take what has arrived, never wait in the control loop.
     const std::ptrdiff_t n = stream_.read(rx_, Time{});
     if (n < 0) {
-      while (outstanding_size_ > 0) miss(now);
-      stream_failed_ = true;
-      next_reopen_ = now;
+      ++stats_.port_failures;
+      fail_stream(now);
       return;
     }
     if (n == 0) return;
@@ -121,6 +144,7 @@ void BoardLink::on_frame(const FrameView& frame, Time now) noexcept {
   stats_.total_round_trip += rtt;
   if (r->is_error()) {
     ++stats_.error_responses;
+    check_port_now_ = true;
     if (front.actuator) ++stats_.retries;  // stays queued: sent again next period
     // The board's watchdog tripped (it stopped the motors and wants SYNC), or too many errors.
     if (r->error() == ErrorCode::not_synchronised && synchronised_) ++stats_.watchdog_trips;
@@ -184,6 +208,7 @@ void BoardLink::miss(Time now, bool rescan) noexcept {
     --outstanding_size_;
   }
   ++stats_.missed;
+  check_port_now_ = true;
   // A frame cut short by the loss would hold up the next one: give it up and re-scan.
   if (rescan && decoder_.partial()) (void)decoder_.abandon_partial();
   if (++consecutive_missed_ >= config_.max_missed) lose(now);

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <pty.h>
+#include <sys/ioctl.h>
 #include <termios.h>
 #include <unistd.h>
 
@@ -29,6 +30,61 @@ constexpr std::array<BaudRate, 8> kBaudRates{{{9600, B9600},
                                                {230400, B230400},
                                                {460800, B460800},
                                                {921600, B921600}}};
+
+const BaudRate* find_rate(std::uint32_t baud) noexcept {
+  const auto rate = std::find_if(kBaudRates.begin(), kBaudRates.end(), [&](const BaudRate& r) { return r.baud == baud; });
+  return rate == kBaudRates.end() ? nullptr : &*rate;
+}
+
+// One flag of the raw settings: where it lives, whether configure_raw sets or clears it, and the
+// message when it is found otherwise (stty's name for it).
+enum class Field { input, output, control, local };
+struct FlagRule {
+  Field field;
+  tcflag_t mask;
+  bool on;
+  std::string_view mismatch;
+};
+constexpr std::array<FlagRule, 22> kRawRules{{
+    {Field::local, ICANON, false, "icanon on, expected off"},
+    {Field::local, ECHO, false, "echo on, expected off"},
+    {Field::local, ECHONL, false, "echonl on, expected off"},
+    {Field::local, ISIG, false, "isig on, expected off"},
+    {Field::local, IEXTEN, false, "iexten on, expected off"},
+    {Field::input, IGNBRK, false, "ignbrk on, expected off"},
+    {Field::input, BRKINT, false, "brkint on, expected off"},
+    {Field::input, PARMRK, false, "parmrk on, expected off"},
+    {Field::input, ISTRIP, false, "istrip on, expected off"},
+    {Field::input, INLCR, false, "inlcr on, expected off"},
+    {Field::input, IGNCR, false, "igncr on, expected off"},
+    {Field::input, ICRNL, false, "icrnl on, expected off"},
+    {Field::input, IXON, false, "ixon on, expected off"},
+    {Field::input, IXOFF, false, "ixoff on, expected off"},
+    {Field::input, IXANY, false, "ixany on, expected off"},
+    {Field::output, OPOST, false, "opost on, expected off"},
+    {Field::control, PARENB, false, "parenb on, expected off (no parity)"},
+    {Field::control, CSTOPB, false, "cstopb on, expected off (one stop bit)"},
+    {Field::control, CRTSCTS, false, "crtscts on, expected off (no flow control)"},
+    {Field::control, CREAD, true, "cread off, expected on"},
+    {Field::control, CLOCAL, true, "clocal off, expected on"},
+    {Field::control, CSIZE, true, "cs8 off, expected 8 data bits"},  // checked as CS8 below
+}};
+
+std::string_view mismatch_of(const termios& t, const BaudRate& rate) noexcept {
+  for (const FlagRule& r : kRawRules) {
+    const tcflag_t flags = r.field == Field::input    ? t.c_iflag
+                           : r.field == Field::output ? t.c_oflag
+                           : r.field == Field::control ? t.c_cflag
+                                                       : t.c_lflag;
+    const bool ok = r.mask == CSIZE ? (flags & CSIZE) == CS8 : ((flags & r.mask) != 0) == r.on;
+    if (!ok) return r.mismatch;
+  }
+  if (t.c_cc[VMIN] != 0) return "min not 0 (reads would block)";
+  if (t.c_cc[VTIME] != 0) return "time not 0 (reads would wait)";
+  if (::cfgetispeed(&t) != rate.speed) return "ispeed differs from the configured baud";
+  if (::cfgetospeed(&t) != rate.speed) return "ospeed differs from the configured baud";
+  return {};
+}
 
 [[noreturn]] void fail_os(const std::string& what, const char* step) {
   throw std::runtime_error(fmt::format("{}: {}: {}", what, step, std::strerror(errno)));
@@ -77,9 +133,17 @@ Duration read_wait(Time now, Time deadline) noexcept {
   return std::clamp(deadline - now, Duration{0}, kMaxReadWait);
 }
 
+std::string_view raw_settings_mismatch(int fd, std::uint32_t baud) noexcept {
+  const BaudRate* rate = find_rate(baud);
+  if (rate == nullptr) return "baud not supported";
+  termios t{};
+  if (::tcgetattr(fd, &t) != 0) return kDeviceGone;
+  return mismatch_of(t, *rate);
+}
+
 void configure_raw(int fd, std::uint32_t baud, const std::string& what) {
-  const auto rate = std::find_if(kBaudRates.begin(), kBaudRates.end(), [&](const BaudRate& r) { return r.baud == baud; });
-  if (rate == kBaudRates.end()) {
+  const BaudRate* rate = find_rate(baud);
+  if (rate == nullptr) {
     throw std::runtime_error(fmt::format("{}: baud {} is not supported; expected one of 9600, 19200, 38400, 57600, "
                                          "115200, 230400, 460800, 921600",
                                          what, baud));
@@ -94,6 +158,11 @@ void configure_raw(int fd, std::uint32_t baud, const std::string& what) {
   t.c_cc[VTIME] = 0;
   if (::cfsetispeed(&t, rate->speed) != 0 || ::cfsetospeed(&t, rate->speed) != 0) fail_os(what, "cfsetspeed");
   if (::tcsetattr(fd, TCSANOW, &t) != 0) fail_os(what, "tcsetattr");
+  // tcsetattr succeeds when any one change took: read them back, as a driver may refuse some.
+  termios back{};
+  if (::tcgetattr(fd, &back) != 0) fail_os(what, "tcgetattr (read back)");
+  const std::string_view mismatch = mismatch_of(back, *rate);
+  if (!mismatch.empty()) throw std::runtime_error(fmt::format("{}: settings read back differ: {}", what, mismatch));
 }
 
 SerialPort::SerialPort(const std::filesystem::path& path, const Clock& clock, SerialSettings settings)
@@ -102,9 +171,15 @@ SerialPort::SerialPort(const std::filesystem::path& path, const Clock& clock, Se
 int SerialPort::open_port() const {
   const std::string what = fmt::format("serial port {}", path_.string());
   const int fd = ::open(path_.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0 && errno == EBUSY) {
+    throw std::runtime_error(fmt::format("{}: open: {} (another process holds the port exclusively)", what, std::strerror(errno)));
+  }
   if (fd < 0) fail_os(what, "open");
   try {
-    configure_raw(fd, settings_.baud, what);
+    configure_raw(fd, settings_.baud, what);  // first: a file that is no tty fails at tcgetattr
+    // Ours alone: a second opener (a terminal program, a stray stty) would share the line and its
+    // settings; TIOCEXCL makes its open fail with EBUSY instead (root with CAP_SYS_ADMIN excepted).
+    if (::ioctl(fd, TIOCEXCL) != 0) fail_os(what, "ioctl TIOCEXCL");
     ::tcflush(fd, TCIOFLUSH);  // nothing of a previous session
   } catch (...) {
     ::close(fd);
@@ -113,20 +188,39 @@ int SerialPort::open_port() const {
   return fd;
 }
 
+namespace {
+// The exclusive flag belongs to the tty, not to our descriptor: it outlives a close while anyone
+// else holds the device (the pseudo-terminal's keeper), so clear it or our own reopen is refused.
+void close_port(int fd) noexcept {
+  if (fd < 0) return;
+  (void)::ioctl(fd, TIOCNXCL);
+  ::close(fd);
+}
+}  // namespace
+
 bool SerialPort::reopen() noexcept {
-  if (fd_ >= 0) ::close(fd_);
+  close_port(fd_);
   fd_ = -1;
   try {
     fd_ = open_port();
-  } catch (const std::exception&) {
+    reopen_error_.clear();
+  } catch (const std::exception& e) {
+    try {
+      reopen_error_ = e.what();
+    } catch (...) {
+      reopen_error_.clear();
+    }
     return false;  // not back yet: the caller tries again later
   }
   return true;
 }
 
-SerialPort::~SerialPort() {
-  if (fd_ >= 0) ::close(fd_);
+std::string_view SerialPort::check() noexcept {
+  if (fd_ < 0) return kDeviceGone;
+  return raw_settings_mismatch(fd_, settings_.baud);
 }
+
+SerialPort::~SerialPort() { close_port(fd_); }
 
 bool SerialPort::write(std::span<const std::uint8_t> bytes) noexcept {
   const bool ok = write_fd(fd_, bytes);

@@ -286,3 +286,16 @@ TEST_CASE("sensors, buttons, voice and LCD over the protocol", "[board][firmware
   CHECK(b.board->lcd_line(1) == "Hi");
   CHECK(b.exchange(Command::lcd_text, {9, 'x'}) == Bytes{0x10, 0x03, 0xEE, 0x06, 0x33, 0x0D});
 }
+
+TEST_CASE("a frame whose bytes stop coming is given up on the idle line, so the next request is answered", "[board][firmware]") {
+  Bench b;
+  // A SYNC whose Length was corrupted from 2 to 0xA2 (162): the board would take the next 159
+  // bytes as its body, swallowing every request the host sends meanwhile.
+  const Bytes corrupt{0x10, 0xA2, 0xA8, 0x00, 0x01};
+  REQUIRE(b.line.host().write(corrupt));
+  b.run_for(b.config.frame_idle_timeout + 2ms);  // the line idle past the timeout
+  CHECK(b.board->decoder_stats().truncated == 1);
+  const Bytes sync{0x10, 0x02, 0xA8, 0x00, 0x01};
+  CHECK(b.exchange_raw(sync) == sync);  // echoed: the board listened again
+  CHECK(b.board->synchronised());
+}

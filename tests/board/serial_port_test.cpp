@@ -2,11 +2,17 @@
 
 #include <catch2/catch.hpp>
 
+#include <fcntl.h>
+#include <linux/capability.h>
+#include <sys/syscall.h>
+#include <sys/wait.h>
 #include <termios.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <memory>
 #include <vector>
@@ -116,6 +122,140 @@ TEST_CASE("opening a port that is not one fails with the path and the reason", "
   PseudoTerminal pty(clock);
   REQUIRE_THROWS_WITH(SerialPort(pty.slave_path(), clock, SerialSettings{1234}),
                       Catch::Contains("baud 1234 is not supported; expected one of 9600"));
+}
+
+namespace {
+// Another process opens `path` as a terminal program would: its errno (0 when it opened). It
+// drops CAP_SYS_ADMIN first, as the tests run as root and an administrator may open an exclusive
+// tty all the same.
+int open_from_another_process(const std::filesystem::path& path) {
+  const pid_t pid = ::fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    __user_cap_header_struct header{_LINUX_CAPABILITY_VERSION_3, 0};
+    std::array<__user_cap_data_struct, 2> caps{};
+    if (::syscall(SYS_capget, &header, caps.data()) != 0) ::_exit(250);
+    caps[CAP_SYS_ADMIN / 32].effective &= ~(1U << (CAP_SYS_ADMIN % 32));
+    if (::syscall(SYS_capset, &header, caps.data()) != 0) ::_exit(251);
+    const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
+    ::_exit(fd >= 0 ? 0 : errno);
+  }
+  int status = 0;
+  REQUIRE(::waitpid(pid, &status, 0) == pid);
+  REQUIRE(WIFEXITED(status));
+  return WEXITSTATUS(status);
+}
+}  // namespace
+
+TEST_CASE("the port is opened exclusively: another process's open fails with EBUSY", "[board][serial]") {
+  SimClock clock;
+  PseudoTerminal pty(clock);
+  CHECK(open_from_another_process(pty.slave_path()) == 0);  // free before the host takes it
+  {
+    SerialPort port(pty.slave_path(), clock);
+    CHECK(open_from_another_process(pty.slave_path()) == EBUSY);
+    REQUIRE(port.reopen());  // our own reopen is not refused: the flag is cleared before closing
+    CHECK(open_from_another_process(pty.slave_path()) == EBUSY);
+  }
+  // Closed: the tty lives on (the pseudo-terminal holds it) and is free again.
+  CHECK(open_from_another_process(pty.slave_path()) == 0);
+}
+
+TEST_CASE("the settings are read back and a change under the port names the setting", "[board][serial]") {
+  SimClock clock;
+  PseudoTerminal pty(clock);
+  // A neighbour that had the line open before the host took it.
+  const int other = ::open(pty.slave_path().c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+  REQUIRE(other >= 0);
+  SerialPort port(pty.slave_path(), clock);
+  CHECK(port.check().empty());
+  CHECK(raw_settings_mismatch(other, 115200).empty());
+  CHECK(raw_settings_mismatch(other, 9600) == "ispeed differs from the configured baud");
+
+  const auto change = [&](auto&& edit) {
+    termios t{};
+    REQUIRE(::tcgetattr(other, &t) == 0);
+    edit(t);
+    const int rc = ::tcsetattr(other, TCSANOW, &t);
+    INFO("tcsetattr: " << std::strerror(errno));
+    REQUIRE(rc == 0);
+  };
+  change([](termios& t) { t.c_lflag |= ICANON | ECHO; });  // `stty icanon echo`
+  CHECK(port.check() == "icanon on, expected off");
+  REQUIRE(port.reopen());
+  CHECK(port.check().empty());
+  change([](termios& t) { t.c_lflag |= ECHO; });
+  CHECK(port.check() == "echo on, expected off");
+  REQUIRE(port.reopen());
+  change([](termios& t) { t.c_iflag |= IXON; });  // (a pseudo-terminal refuses parity: no cflag case)
+  CHECK(port.check() == "ixon on, expected off");
+  REQUIRE(port.reopen());
+  change([](termios& t) { t.c_oflag |= OPOST; });
+  CHECK(port.check() == "opost on, expected off");
+  REQUIRE(port.reopen());
+  change([](termios& t) { t.c_cc[VMIN] = 1; });
+  CHECK(port.check() == "min not 0 (reads would block)");
+  REQUIRE(port.reopen());
+  change([](termios& t) {
+    ::cfsetispeed(&t, B9600);
+    ::cfsetospeed(&t, B9600);
+  });
+  CHECK(port.check() == "ispeed differs from the configured baud");
+  REQUIRE(port.reopen());
+  CHECK(port.check().empty());
+  ::close(other);
+  CHECK(raw_settings_mismatch(-1, 115200) == kDeviceGone);
+}
+
+TEST_CASE("a port that cannot be reopened says why", "[board][serial]") {
+  SimClock clock;
+  const std::filesystem::path link = std::filesystem::temp_directory_path() / "tripodal_serial_reopen_link";
+  std::filesystem::remove(link);
+  auto pty = std::make_unique<PseudoTerminal>(clock);
+  std::filesystem::create_symlink(pty->slave_path(), link);
+  SerialPort port(link, clock);
+  std::filesystem::remove(link);
+  CHECK_FALSE(port.reopen());
+  CHECK_THAT(port.last_reopen_error(), Catch::Contains("tripodal_serial_reopen_link: open: No such file or directory"));
+  CHECK(port.check() == kDeviceGone);
+  std::filesystem::create_symlink(pty->slave_path(), link);
+  CHECK(port.reopen());
+  CHECK(port.last_reopen_error().empty());
+  std::filesystem::remove(link);
+}
+
+TEST_CASE("a noisy line corrupts, drops and duplicates bytes at its rates, repeatably by seed", "[board][serial][noise]") {
+  const auto carry = [](const LineNoise& noise, std::vector<std::uint8_t>& got) {
+    SimClock clock;
+    SerialLine line(clock);
+    line.host().set_noise(noise);
+    std::vector<std::uint8_t> chunk(1000);
+    for (std::size_t i = 0; i < chunk.size(); ++i) chunk[i] = static_cast<std::uint8_t>(i * 7);
+    std::array<std::uint8_t, 4096> buf{};
+    for (int k = 0; k < 100; ++k) {
+      REQUIRE(line.host().write(chunk));
+      clock.advance(line.byte_time() * 3000);
+      const std::ptrdiff_t n = line.board().read(buf, clock.now());
+      REQUIRE(n >= 0);
+      got.insert(got.end(), buf.begin(), buf.begin() + n);
+    }
+    return std::array<std::uint64_t, 4>{line.host().bytes_sent(), line.host().bytes_corrupted(), line.host().bytes_dropped(),
+                                        line.host().bytes_duplicated()};
+  };
+  std::vector<std::uint8_t> a, b, c, clean;
+  const auto counts = carry(LineNoise{0.01, 0.01, 0.01, 7}, a);
+  CHECK(counts[0] == 100'000);
+  CHECK(counts[1] == Approx(1000).epsilon(0.15));  // 1 % of 100 000, 3 sigma about 10 %
+  CHECK(counts[2] == Approx(1000).epsilon(0.15));
+  CHECK(counts[3] == Approx(1000).epsilon(0.15));
+  CHECK(a.size() == counts[0] - counts[2] + counts[3]);
+  (void)carry(LineNoise{0.01, 0.01, 0.01, 7}, b);
+  CHECK(a == b);  // the same seed, the same line
+  (void)carry(LineNoise{0.01, 0.01, 0.01, 8}, c);
+  CHECK(a != c);
+  const auto none = carry(LineNoise{}, clean);
+  CHECK(none[1] + none[2] + none[3] == 0);
+  CHECK(clean.size() == 100'000);
 }
 
 // `tripodal run --board pty`: the simulated line's timing, the bytes through the kernel.

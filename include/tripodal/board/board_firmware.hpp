@@ -55,6 +55,9 @@ struct FirmwareConfig {
   Duration tick{std::chrono::milliseconds(1)};            ///< the timer interrupt
   Duration motor_period{std::chrono::milliseconds(10)};   ///< encoder speed and PID refresh
   Duration link_timeout{std::chrono::milliseconds(200)};  ///< no valid request this long: motors stop
+  /// The UART's idle line: a frame whose bytes stop coming this long (a byte dropped on the line,
+  /// a corrupt Length) is given up, so the next request is not swallowed as its body.
+  Duration frame_idle_timeout{std::chrono::milliseconds(5)};
   Duration battery_period{std::chrono::seconds(3)};       ///< section 3.4.1
   double pulses_per_m = 5000.0;    ///< encoder pulses per metre of wheel travel
   double max_wheel_speed_m_s = 1.0;  ///< at 100 % duty and a full pack (16.8 V)
@@ -146,6 +149,7 @@ class BoardFirmware {
   };
   void tick() noexcept;
   void receive() noexcept;
+  void abandon_idle_frame() noexcept;
   void handle(const FrameView& frame) noexcept;
   void answer(std::uint8_t resp, std::span<const std::uint8_t> payload) noexcept;
   void answer_error(ErrorCode code, std::uint8_t cmd) noexcept;
@@ -168,6 +172,7 @@ class BoardFirmware {
   Time now_{};
   std::uint32_t tick_ms_ = 0;
   Time last_request_{};
+  Time last_byte_{};  // the latest byte received: the idle line's start
   Time next_motor_{};
   Time next_battery_{};
   Time link_lost_at_{};

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string_view>
 
 #include "tripodal/board/commands.hpp"
 #include "tripodal/board/frame.hpp"
@@ -28,6 +29,10 @@ struct LinkConfig {
   Duration ranges_period{std::chrono::milliseconds(100)};  ///< ultrasonic and infrared, alternately
   /// After the stream failed (the device went away): how often to open it again.
   Duration reopen_period{std::chrono::milliseconds(500)};
+  /// How often the port's settings are read back and verified while all is well (another process
+  /// may reconfigure the line under the host); they are also verified after every missed or
+  /// erroneous response. A mismatch reopens the port (settings applied again) and resynchronises.
+  Duration port_check_period{std::chrono::seconds(1)};
 };
 
 /// Link statistics, for the report and the tests.
@@ -40,6 +45,13 @@ struct LinkStats {
   std::uint64_t link_losses = 0;
   std::uint64_t resyncs = 0;
   std::uint64_t reopens = 0;          ///< the device opened again after a failure
+  /// The device failed: a read failed, or its settings could not be read back (closed under the
+  /// host, hung up, gone).
+  std::uint64_t port_failures = 0;
+  /// The port's settings read back differed from those it was opened with (`stty icanon echo`
+  /// by another process): the port was reopened and configured again.
+  std::uint64_t settings_changed = 0;
+  std::uint64_t port_checks = 0;      ///< settings read back and verified while running
   /// The board answered "not synchronised" while the host held the link: its watchdog had stopped
   /// the motors (the board's own count is not on the wire; this is what the host learns of it).
   std::uint64_t watchdog_trips = 0;
@@ -88,6 +100,8 @@ class BoardLink {
   [[nodiscard]] std::size_t pending_actuator_commands() const noexcept { return queue_size_; }
   [[nodiscard]] const LinkStats& stats() const noexcept { return stats_; }
   [[nodiscard]] const DecoderStats& decoder_stats() const noexcept { return decoder_.stats(); }
+  /// What the latest port check found wrong ("icanon on, expected off"); empty if none yet.
+  [[nodiscard]] std::string_view last_port_fault() const noexcept { return last_port_fault_; }
 
  private:
   struct Outstanding {
@@ -99,6 +113,8 @@ class BoardLink {
   void on_frame(const FrameView& frame, Time now) noexcept;
   void miss(Time now, bool rescan = true) noexcept;
   void lose(Time now) noexcept;
+  void fail_stream(Time now) noexcept;
+  void check_port(Time now) noexcept;
   bool send(Command cmd, std::span<const std::uint8_t> payload, Time now, bool actuator) noexcept;
 
   ByteStream& stream_;
@@ -118,6 +134,9 @@ class BoardLink {
   bool lost_pending_ = false;
   bool stream_failed_ = false;  // read or write failed: reopen every reopen_period
   Time next_reopen_{};
+  Time next_port_check_{};
+  bool check_port_now_ = false;  // a response was missed: verify the port before going on
+  std::string_view last_port_fault_;
   Time lost_at_{};
   Time next_battery_{}, next_tank_{}, next_ranges_{};
   bool ranges_toggle_ = false;

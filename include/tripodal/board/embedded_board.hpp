@@ -40,6 +40,8 @@ class EmbeddedBoard {
   [[nodiscard]] SerialLine& line() noexcept { return line_; }
   /// The pseudo-terminal's slave device the host side opened (empty in process).
   [[nodiscard]] std::filesystem::path device() const;
+  /// The host's port on that device (nullptr in process): the one the link reopens.
+  [[nodiscard]] SerialPort* port() noexcept { return port_.get(); }
 
  private:
   SimClock clock_;  // the line's: moves tick by tick up to the robot's clock

@@ -9,11 +9,16 @@
 #include <filesystem>
 #include <span>
 #include <string>
+#include <string_view>
 
 #include "tripodal/core/clock.hpp"
 #include "tripodal/core/time.hpp"
 
 namespace tripodal::board {
+
+/// What ByteStream::check says when the settings cannot be read at all: the device is gone, was
+/// closed under its owner, or is not a tty.
+inline constexpr std::string_view kDeviceGone = "tcgetattr failed: the device is gone or not a tty";
 
 /// A byte pipe to the other end of the link: the serial port, or an in-memory line in simulation.
 /// One thread reads, one writes (may be the same).
@@ -28,6 +33,11 @@ class ByteStream {
   /// After a failure (-1 from read, false from write): opens the device again, as when a board
   /// was unplugged or its process restarted. False when it cannot, or the stream has no device.
   virtual bool reopen() noexcept { return false; }
+  /// Reads the device's settings back and compares them with those it was opened with (another
+  /// process may have run `stty icanon echo` on the line, or the device gone): empty while they
+  /// match, else what differs, named as stty names it ("icanon on, expected off"), or kDeviceGone.
+  /// A static string; no allocation.
+  [[nodiscard]] virtual std::string_view check() noexcept { return {}; }
 };
 
 /// The longest a read waits, whatever its deadline: the control loop's budget on the port.
@@ -40,13 +50,17 @@ struct SerialSettings {
   std::uint32_t baud = 115200;  ///< one of the standard rates 9600..921600
 };
 
-/// A tty opened raw: 8 data bits, no parity, 1 stop bit, no flow control, no echo, no line
-/// editing, no character translation; non-blocking, reads bounded by read_wait.
+/// A tty opened exclusively (TIOCEXCL: another process's open fails with EBUSY, unless it has
+/// CAP_SYS_ADMIN) and raw: 8 data bits, no parity, 1 stop bit, no flow control, no echo, no line
+/// editing, no character translation; non-blocking, reads bounded by read_wait. The settings are
+/// read back after every (re)open and verified; check() verifies them again while running.
 class SerialPort final : public ByteStream {
  public:
   /// Opens and configures `path`. Throws std::runtime_error naming the path, the step that failed
-  /// and the OS error ("serial port /dev/ttyS9: open: No such file or directory"), or an
-  /// unsupported baud rate ("baud 1234 is not supported; expected one of 9600, ...").
+  /// and the OS error ("serial port /dev/ttyS9: open: No such file or directory", "...: open:
+  /// Device or resource busy (another process holds the port exclusively)"), an unsupported baud
+  /// rate ("baud 1234 is not supported; expected one of 9600, ..."), or a setting the device did
+  /// not take ("settings read back differ: crtscts on, expected off").
   SerialPort(const std::filesystem::path& path, const Clock& clock, SerialSettings settings = {});
   ~SerialPort() override;
   SerialPort(const SerialPort&) = delete;
@@ -54,8 +68,13 @@ class SerialPort final : public ByteStream {
 
   bool write(std::span<const std::uint8_t> bytes) noexcept override;
   std::ptrdiff_t read(std::span<std::uint8_t> out, Time deadline) noexcept override;
-  /// Closes the port and opens `path` again (a symbolic link may now name another device).
+  /// Closes the port and opens `path` again (a symbolic link may now name another device), with
+  /// the settings applied and verified as by the constructor. False when it cannot (the reason:
+  /// last_reopen_error()).
   bool reopen() noexcept override;
+  [[nodiscard]] std::string_view check() noexcept override;
+  /// Why the latest reopen failed (empty after a success).
+  [[nodiscard]] const std::string& last_reopen_error() const noexcept { return reopen_error_; }
 
   [[nodiscard]] const std::filesystem::path& path() const noexcept { return path_; }
   [[nodiscard]] int fd() const noexcept { return fd_; }
@@ -72,11 +91,19 @@ class SerialPort final : public ByteStream {
   int fd_ = -1;
   std::uint64_t written_ = 0;
   std::uint64_t read_ = 0;
+  std::string reopen_error_;
 };
 
 /// Configures an open tty raw 8N1 at `baud` (what SerialPort does; the pseudo-terminal's master
-/// side uses it too). Throws std::runtime_error with `what` and the OS error.
+/// side uses it too), then reads the settings back and verifies them. Throws std::runtime_error
+/// with `what` and the OS error, or the first setting that did not take.
 void configure_raw(int fd, std::uint32_t baud, const std::string& what);
+
+/// Reads a tty's settings (tcgetattr) and compares them with what configure_raw sets: empty when
+/// they match, else the first that differs, named as stty does ("icanon on, expected off",
+/// "ispeed differs from the configured baud"), or kDeviceGone when they cannot be read.
+/// A static string; noexcept and allocation-free, so the control loop may call it.
+[[nodiscard]] std::string_view raw_settings_mismatch(int fd, std::uint32_t baud) noexcept;
 
 /// A pseudo-terminal (openpty): the master end, held by the simulated board, and the slave
 /// device's path, which the host opens as its SerialPort. Both configured raw at 115200.
