@@ -1,10 +1,13 @@
 // State-space exploration speed: states per second and bytes per stored state on Kanban (N
 // kanbans per stage), token rings and dining philosophers, under interleaving semantics (all of
-// these are plain P/T nets, as the published state counts assume). Bounds from the place
+// these are plain P/T nets, as the published state counts assume); and check/analyze time
+// against the size of a net with a linear state space (chains of 1,000 to 100,000 places). Bounds from the place
 // invariants are given, as `tripodal-net analyze` does, so markings are packed to the bit.
 #include <benchmark/benchmark.h>
 
 #include "../../tests/analysis/analysis_test_nets.hpp"
+#include "tripodal/analysis/analyzer.hpp"
+#include "tripodal/core/diagnostic.hpp"
 #include "tripodal/analysis/invariants.hpp"
 #include "tripodal/analysis/state_space.hpp"
 
@@ -59,6 +62,41 @@ void BM_Philosophers(benchmark::State& state) {
   run(state, test::philosophers_net(static_cast<std::size_t>(state.range(0))), 0);
 }
 BENCHMARK(BM_Philosophers)->Arg(10)->Arg(13)->Unit(benchmark::kMillisecond);
+
+// What `tripodal-net check` runs on a loaded net (check_behaviour: Karp–Miller where the net is
+// small enough, exploration with edges, the outcome check), on chains of n places: n states, so
+// the time should grow linearly with n (issue 32: 10,000 places in well under a second).
+void BM_CheckChain(benchmark::State& state) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  const PetriNet net = test::chain_net(n);
+  BehaviourCheckOptions options;
+  options.max_states = n;  // above the default of 200,000 for the largest size
+  for (auto _ : state) {
+    Diagnostics d;
+    if (!check_behaviour(net, d, options)) state.SkipWithError("the chain did not pass the check");
+    benchmark::DoNotOptimize(d);
+  }
+  state.SetComplexityN(state.range(0));
+  state.counters["places"] = static_cast<double>(n);
+  state.counters["us_per_place"] = benchmark::Counter(static_cast<double>(state.iterations()) * static_cast<double>(n),
+                                                      benchmark::Counter::kIsRate | benchmark::Counter::kInvert,
+                                                      benchmark::Counter::kIs1000);
+}
+BENCHMARK(BM_CheckChain)->Arg(1'000)->Arg(10'000)->Arg(100'000)->Unit(benchmark::kMillisecond)->Complexity();
+
+// The full analysis (report included) of the same chains: invariants and Karp–Miller run up to
+// AnalysisOptions::max_structural_size places + transitions, then are skipped.
+void BM_AnalyzeChain(benchmark::State& state) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  const PetriNet net = test::chain_net(n);
+  for (auto _ : state) {
+    const AnalysisReport r = analyze(net);
+    if (!r.ok() || r.states != n) state.SkipWithError("unexpected analysis of the chain");
+    benchmark::DoNotOptimize(r.states);
+  }
+  state.counters["places"] = static_cast<double>(n);
+}
+BENCHMARK(BM_AnalyzeChain)->Arg(1'000)->Arg(10'000)->Arg(100'000)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -103,10 +103,13 @@ AnalysisReport analyze(const PetriNet& net, const AnalysisOptions& options) {
   r.semantics = options.semantics;
   r.parameters = options.parameters;
   r.max_states = options.max_states;
+  r.max_memory_bytes = options.max_memory_bytes;
+  r.max_structural_size = options.max_structural_size;
+  r.structure_skipped = r.places + r.transitions > options.max_structural_size;
 
   // Structure first: invariants give place bounds that size the packed fields.
   std::vector<std::optional<Tokens>> known(r.places);
-  if (options.invariants) {
+  if (options.invariants && !r.structure_skipped) {
     r.invariants_computed = true;
     r.p_invariants = place_invariants(net, {.max_rows = options.max_invariant_rows});
     r.t_invariants = transition_invariants(net, {.max_rows = options.max_invariant_rows});
@@ -121,7 +124,7 @@ AnalysisReport analyze(const PetriNet& net, const AnalysisOptions& options) {
   const bool structurally_bounded = std::all_of(known.begin(), known.end(), [](const auto& b) { return b.has_value(); });
 
   // Karp–Miller only where the structure does not already bound every place.
-  if (!structurally_bounded) {
+  if (!structurally_bounded && !r.structure_skipped) {
     r.coverability_ran = true;
     r.coverability = karp_miller(net, {.parameters = options.parameters, .max_nodes = options.max_coverability_nodes});
     if (r.coverability.complete) {
@@ -274,20 +277,40 @@ std::vector<Value> candidate_values(const PetriNet& net, const VariableDecl& p) 
 
 enum class CheckResult { passed, failed, not_decided };
 
+}  // namespace
+
+std::string incomplete_reason(const AnalysisReport& r) {
+  const std::string after = " after " + std::to_string(r.states) + " states";
+  switch (r.stop) {
+    case StopReason::complete: return "the exploration is complete";
+    case StopReason::max_states:
+      return "more than " + std::to_string(r.max_states) + " reachable states: the exploration stopped at the limit of " +
+             std::to_string(r.max_states) + " states; raise it with --max-states N";
+    case StopReason::max_memory:
+      return "the state store would exceed the memory limit of " + std::to_string(r.max_memory_bytes >> 20) +
+             " MiB" + after + "; raise it with --max-memory-mb N";
+    case StopReason::token_overflow:
+      return "a place would hold more than 4294967295 tokens" + after + " (the net is probably unbounded)";
+  }
+  return "?";
+}
+
+namespace {
+
 CheckResult check_once(const PetriNet& net, Diagnostics& diagnostics, const BehaviourCheckOptions& options,
                        const ParameterValues& parameters, const std::string& prefix) {
   AnalysisOptions o;
   o.semantics = options.semantics;
   o.parameters = parameters;
   o.max_states = options.max_states;
+  o.max_memory_bytes = options.max_memory_bytes;
   o.max_examples = 3;
   o.invariants = false;
   o.max_coverability_nodes = options.max_states;
   const AnalysisReport r = analyze(net, o);
   if (!r.complete()) {
-    diagnostics.note(net.where, prefix + "behaviour not checked: more than " + std::to_string(options.max_states) +
-                                    " reachable states (" + std::string(to_string(r.stop)) +
-                                    "); run tripodal-net analyze for the full analysis");
+    diagnostics.note(net.where, prefix + "behaviour not checked: " + incomplete_reason(r) +
+                                    " (or run tripodal-net analyze for the full analysis)");
     return CheckResult::not_decided;
   }
   for (const Witness& w : r.deadlocks) {

@@ -1,6 +1,8 @@
 #include "compiled_net.hpp"
 
 #include <algorithm>
+#include <string_view>
+#include <unordered_map>
 
 #include "tripodal/core/diagnostic.hpp"
 
@@ -94,7 +96,7 @@ CompiledNet::CompiledNet(const PetriNet& net, const ParameterValues& parameters,
 
   // Conflict order as in the engine.
   const std::vector<TransitionIndex> order = tripodal::detail::conflict_order(net);
-  std::vector<std::string> event_names;
+  std::unordered_map<std::string_view, std::size_t> event_index;
   std::vector<std::vector<TransitionIndex>> by_event;
   for (const TransitionIndex t : order) {
     const Transition& tr = net.transition(t);
@@ -105,12 +107,11 @@ CompiledNet::CompiledNet(const PetriNet& net, const ParameterValues& parameters,
       if (kind[t] == Kind::immediate && guard[t] == GuardState::always) decisive[t] = 1;
       continue;
     }
-    const auto it = std::find(event_names.begin(), event_names.end(), tr.event);
-    if (it == event_names.end()) {
-      event_names.push_back(tr.event);
+    const auto [it, added] = event_index.try_emplace(tr.event, by_event.size());
+    if (added) {
       by_event.push_back({t});
     } else {
-      by_event[static_cast<std::size_t>(it - event_names.begin())].push_back(t);
+      by_event[it->second].push_back(t);
     }
     // A listener without delay and with a certain guard takes its event whenever it is enabled.
     if (tr.delay.count() == 0 && guard[t] == GuardState::always) decisive[t] = 1;
@@ -119,6 +120,40 @@ CompiledNet::CompiledNet(const PetriNet& net, const ParameterValues& parameters,
   for (const auto& l : by_event) {
     listeners.insert(listeners.end(), l.begin(), l.end());
     event_begin.push_back(static_cast<std::uint32_t>(listeners.size()));
+  }
+
+  rank.assign(transitions, 0);
+  group.assign(transitions, kNoGroup);
+  if (semantics == Semantics::interleaving) {
+    for (TransitionIndex t = 0; t < transitions; ++t) rank[t] = static_cast<std::uint32_t>(t);
+  } else {
+    std::uint32_t next = 0;
+    for (const TransitionIndex t : urgent_order) rank[t] = next++;
+    for (std::size_t e = 0; e + 1 < event_begin.size(); ++e) {
+      for (std::uint32_t i = event_begin[e]; i < event_begin[e + 1]; ++i) {
+        rank[listeners[i]] = next++;
+        group[listeners[i]] = static_cast<std::uint32_t>(e);
+      }
+    }
+  }
+  std::vector<std::uint32_t> watched(transitions, 0xFFFFFFFFU);
+  watch_begin.assign(places + 1, 0);
+  for (TransitionIndex t = 0; t < transitions; ++t) {
+    if (guard[t] == GuardState::never) continue;
+    for (std::uint32_t i = check_begin[t]; i < check_begin[t + 1]; ++i) {
+      if (checks[i].lo > 0) {
+        watched[t] = checks[i].place;
+        ++watch_begin[checks[i].place + 1];
+        break;
+      }
+    }
+    if (watched[t] == 0xFFFFFFFFU) unwatched.push_back(t);
+  }
+  for (std::size_t p = 0; p < places; ++p) watch_begin[p + 1] += watch_begin[p];
+  watchers.resize(watch_begin[places]);
+  std::vector<std::uint32_t> fill(watch_begin.begin(), watch_begin.end() - 1);
+  for (TransitionIndex t = 0; t < transitions; ++t) {
+    if (watched[t] != 0xFFFFFFFFU) watchers[fill[watched[t]]++] = t;
   }
 }
 

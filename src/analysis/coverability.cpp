@@ -24,6 +24,16 @@ struct MarkingHash {
 
 constexpr std::uint32_t kRoot = 0xFFFFFFFFU;
 
+// Bit p % 64 for every marked place p: a marking covers another only if its signature contains
+// the other's, so most ancestors are passed over without comparing the markings place by place.
+std::uint64_t signature(const Marking& m) noexcept {
+  std::uint64_t s = 0;
+  for (std::size_t p = 0; p < m.size(); ++p) {
+    if (m[p] != 0) s |= std::uint64_t{1} << (p % 64);
+  }
+  return s;
+}
+
 }  // namespace
 
 bool CoverabilityResult::bounded() const noexcept {
@@ -41,10 +51,12 @@ CoverabilityResult karp_miller(const PetriNet& net, const CoverabilityOptions& o
   std::vector<Marking> nodes;
   std::vector<std::uint32_t> parent;
   std::vector<TransitionIndex> via;
+  std::vector<std::uint64_t> sig;
   std::unordered_map<Marking, std::uint32_t, MarkingHash> index;
   nodes.push_back(net.initial_marking());
   parent.push_back(kRoot);
   via.push_back(0);
+  sig.push_back(signature(nodes[0]));
   index.emplace(nodes[0], 0);
   bool found_pump = false;
 
@@ -67,7 +79,9 @@ CoverabilityResult karp_miller(const PetriNet& net, const CoverabilityOptions& o
         const std::uint64_t after = std::uint64_t{v} - c.consumed + c.produced;
         v = after >= kOmega ? kOmega : static_cast<Tokens>(after);
       }
+      const std::uint64_t next_sig = signature(next);  // acceleration only turns marked places into omega
       for (std::uint32_t a = n; a != kRoot; a = parent[a]) {
+        if ((sig[a] & ~next_sig) != 0) continue;
         const Marking& old = nodes[a];
         bool covers = true;
         bool strictly = false;
@@ -100,6 +114,7 @@ CoverabilityResult karp_miller(const PetriNet& net, const CoverabilityOptions& o
       nodes.push_back(std::move(next));
       parent.push_back(n);
       via.push_back(t);
+      sig.push_back(next_sig);
     }
     if (!result.complete) break;
   }

@@ -176,7 +176,7 @@ std::string format_text(const AnalysisReport& r, const PetriNet& net) {
     out << " (complete, " << buf << ")\n";
   } else {
     out << " -- INCOMPLETE: stopped by " << to_string(r.stop) << " after expanding " << r.expanded << " states ("
-        << buf << "); the verdicts below cover only what was explored\n";
+        << buf << "); the verdicts below cover only what was explored\n  " << incomplete_reason(r) << '\n';
   }
   std::snprintf(buf, sizeof buf, "%.1f", r.bytes_per_state);
   out << "memory: " << bytes_text(r.memory_bytes) << " (" << buf << " bytes per state, packed marking "
@@ -244,6 +244,11 @@ std::string format_text(const AnalysisReport& r, const PetriNet& net) {
       break;
   }
 
+  if (r.structure_skipped) {
+    out << "\ninvariants and coverability: not computed: " << r.places << " places + " << r.transitions
+        << " transitions exceed the limit of " << r.max_structural_size
+        << " (both grow faster than the net; raise it with --max-structural-size N)\n";
+  }
   if (r.invariants_computed) {
     out << "\nplace invariants (" << r.p_invariants.invariants.size()
         << (r.p_invariants.complete ? "" : ", incomplete") << "):\n";
@@ -257,7 +262,17 @@ std::string format_text(const AnalysisReport& r, const PetriNet& net) {
         << (r.t_invariants.complete ? "" : ", incomplete") << "):\n";
     for (const Invariant& inv : r.t_invariants.invariants) out << "  " << invariant_text(net, inv, false) << '\n';
   }
-  out << "\nverdict: " << (r.ok() ? "OK" : "PROBLEMS FOUND") << '\n';
+  // A cut search never says OK: it says what was found so far and that the rest is unknown.
+  out << "\nverdict: ";
+  if (r.ok()) {
+    out << "OK\n";
+  } else if (!r.complete()) {
+    const bool found = r.deadlock_count > 0 || r.bounded == Verdict::fail;
+    out << (found ? "PROBLEMS FOUND; " : "") << "INCOMPLETE: not every reachable marking was explored ("
+        << incomplete_reason(r) << ")\n";
+  } else {
+    out << "PROBLEMS FOUND\n";
+  }
   return out.str();
 }
 
@@ -308,6 +323,7 @@ std::string format_json(const AnalysisReport& r, const PetriNet& net) {
         {"complete", r.complete()},
         {"stop_reason", to_string(r.stop)},
         {"max_states", r.max_states},
+        {"max_memory_bytes", r.max_memory_bytes},
         {"exploration_s", r.exploration_s},
         {"states_per_s", rate(r)},
         {"memory_bytes", r.memory_bytes},
@@ -316,6 +332,7 @@ std::string format_json(const AnalysisReport& r, const PetriNet& net) {
       {"deadlocks", {{"count", r.deadlock_count}, {"examples", std::move(deadlocks)}}},
       {"bounds", {{"bounded", to_string(r.bounded)}, {"safe", to_string(r.safe)}, {"places", std::move(places)}}},
       {"coverability", std::move(coverability)},
+      {"structure", {{"max_size", r.max_structural_size}, {"skipped", r.structure_skipped}}},
       {"dead_transitions", ids_json(net, r.dead_transitions, false)},
       {"never_marked_places", ids_json(net, r.never_marked, true)},
       {"outcome",

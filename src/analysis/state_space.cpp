@@ -8,6 +8,10 @@
 //    only touches the arena when the tags agree.
 //  - A place whose bound is unknown starts narrow; a firing that would overflow its field stops
 //    the search, the field is doubled and the search restarts (at most 3 times per place).
+//  - Large nets (a dense marking over 64 bytes, few places marked) use the sparse store instead:
+//    a state is its marked places as (place << 32 | count) words in place order, and a state
+//    costs O(marked places + the transitions watching them), not O(places + transitions). A
+//    chain of n places then takes O(n) time and memory instead of O(n^2).
 #include "tripodal/analysis/state_space.hpp"
 
 #include <algorithm>
@@ -41,6 +45,7 @@ namespace {
 
 constexpr StateId kNoState = 0xFFFFFFFFU;
 constexpr std::size_t kMaxWords = 1U << 20;
+constexpr std::size_t kDenseWordsAlways = 8;  // up to 64 bytes a marking is always stored dense
 
 struct WordDelta {
   std::uint32_t word = 0;
@@ -80,6 +85,10 @@ struct StateSpace::Impl {
   std::vector<StateId> edge_targets;
   std::size_t max_states = 0;
   std::size_t max_memory = 0;
+  // The sparse store: state s is entries[entry_begin[s] .. entry_begin[s + 1]).
+  bool sparse = false;
+  std::vector<std::uint64_t> entries;
+  std::vector<std::uint64_t> entry_begin;
 
   // --- results ------------------------------------------------------------------------------
   std::size_t expanded = 0;
@@ -95,6 +104,7 @@ struct StateSpace::Impl {
   std::vector<std::uint64_t> batch_words;
   std::vector<TransitionIndex> batch_t;
   std::vector<std::uint64_t> batch_hash;
+  std::vector<std::size_t> batch_begin;  // sparse: batch_words[batch_begin[i] .. batch_begin[i + 1])
 
   void layout(const std::vector<std::uint8_t>& b) {
     bits = b;
@@ -123,7 +133,8 @@ struct StateSpace::Impl {
   [[nodiscard]] std::size_t memory() const noexcept {
     return arena.capacity() + table.capacity() * sizeof(std::uint64_t) + parent.capacity() * sizeof(StateId) +
            via.capacity() * sizeof(TransitionIndex) + edge_begin.capacity() * sizeof(std::uint64_t) +
-           edge_targets.capacity() * sizeof(StateId);
+           edge_targets.capacity() * sizeof(StateId) + entries.capacity() * sizeof(std::uint64_t) +
+           entry_begin.capacity() * sizeof(std::uint64_t);
   }
 
   void pack(const Tokens* m, std::uint64_t* w) const noexcept {
@@ -163,6 +174,27 @@ struct StateSpace::Impl {
     return true;
   }
 
+  [[nodiscard]] static std::uint64_t hash_sparse(const std::uint64_t* e, std::size_t n) noexcept {
+    std::uint64_t h = 0x9E3779B97F4A7C15ULL * (n + 1);
+    for (std::size_t i = 0; i < n; ++i) h = mix(h ^ e[i]) + i;
+    return h;
+  }
+
+  [[nodiscard]] StateId lookup_sparse(const std::uint64_t* e, std::size_t n, std::uint64_t h) const noexcept {
+    if (table.empty()) return kNoState;
+    const std::size_t mask = table.size() - 1;
+    const std::uint64_t tag = h >> 32;
+    for (std::size_t i = slot_of(tag);; i = (i + 1) & mask) {
+      const std::uint64_t x = table[i];
+      if (x == 0) return kNoState;
+      if ((x >> 32) == tag) {
+        const StateId s = static_cast<StateId>((x & 0xFFFFFFFFULL) - 1);
+        const std::uint64_t b = entry_begin[s];
+        if (entry_begin[s + 1] - b == n && std::equal(e, e + n, entries.data() + b)) return s;
+      }
+    }
+  }
+
   [[nodiscard]] StateId lookup(const std::uint64_t* w, std::uint64_t h) const noexcept {
     if (table.empty()) return kNoState;
     const std::size_t mask = table.size() - 1;
@@ -199,14 +231,45 @@ struct StateSpace::Impl {
     if (count == parent.capacity()) {
       const std::size_t cap = std::min(std::max<std::size_t>(parent.capacity() * 2, 64), max_states);
       const std::size_t per_state = stride + sizeof(StateId) + sizeof(TransitionIndex) +
-                                    (keep_edges ? sizeof(std::uint64_t) : 0);
+                                    (keep_edges ? sizeof(std::uint64_t) : 0) + (sparse ? sizeof(std::uint64_t) : 0);
       if (memory() + cap * per_state > max_memory) return false;
       arena.reserve(cap * stride);
       parent.reserve(cap);
       via.reserve(cap);
       if (keep_edges) edge_begin.reserve(cap + 1);
+      if (sparse) entry_begin.reserve(cap + 1);
     }
     return true;
+  }
+
+  // The sparse counterpart of insert().
+  std::pair<StateId, bool> insert_sparse(const std::uint64_t* e, std::size_t n, std::uint64_t h, StateId from,
+                                         TransitionIndex t) {
+    const StateId found = lookup_sparse(e, n, h);
+    if (found != kNoState) return {found, false};
+    if (count >= max_states) {
+      stop = StopReason::max_states;
+      return {kNoState, false};
+    }
+    if (!make_room()) {
+      stop = StopReason::max_memory;
+      return {kNoState, false};
+    }
+    if (entries.size() + n > entries.capacity()) {
+      const std::size_t cap = std::max({entries.capacity() * 2, entries.size() + n, std::size_t{4096}});
+      if (memory() + cap * sizeof(std::uint64_t) > max_memory) {
+        stop = StopReason::max_memory;
+        return {kNoState, false};
+      }
+      entries.reserve(cap);
+    }
+    const auto s = static_cast<StateId>(count++);
+    entries.insert(entries.end(), e, e + n);
+    entry_begin.push_back(entries.size());
+    parent.push_back(from);
+    via.push_back(t);
+    place_entry(((h >> 32) << 32) | (std::uint64_t{s} + 1));
+    return {s, true};
   }
 
   // Returns the state and whether it is new; kNoState with `stop` set when a limit is hit.
@@ -238,6 +301,8 @@ struct StateSpace::Impl {
     via = {};
     edge_begin = {};
     edge_targets = {};
+    entries = {};
+    entry_begin = {};
     count = expanded = edges = 0;
     stop = StopReason::complete;
     max_tokens.assign(places, 0);
@@ -333,17 +398,9 @@ struct StateSpace::Impl {
             abort = true;
             break;
           }
-          if (keep_edges) {
-            if (edge_targets.size() == edge_targets.capacity()) {
-              const std::size_t cap = std::max<std::size_t>(edge_targets.capacity() * 2, 4096);
-              if (memory() + cap * sizeof(StateId) > max_memory) {
-                stop = StopReason::max_memory;
-                abort = true;
-                break;
-              }
-              edge_targets.reserve(cap);
-            }
-            edge_targets.push_back(target);
+          if (!add_edge(target)) {
+            abort = true;
+            break;
           }
           ++successors;
           fired[t] = 1;
@@ -367,6 +424,115 @@ struct StateSpace::Impl {
     }
     return std::nullopt;
   }
+
+  // The search over the sparse store. A place holds up to 2^32 - 1 tokens; no field to widen.
+  void run_sparse(const detail::CompiledNet& net, const Marking& initial, bool stop_at_outcome) {
+    reset();
+    fired.assign(net.transitions, 0);
+    entry_begin.push_back(0);
+    std::vector<std::uint64_t> cur;
+    for (std::size_t p = 0; p < places; ++p) {
+      if (initial[p] != 0) cur.push_back((std::uint64_t{p} << 32) | initial[p]);
+    }
+    if (insert_sparse(cur.data(), cur.size(), hash_sparse(cur.data(), cur.size()), kNoState, 0).first == kNoState) {
+      return;
+    }
+    if (keep_edges) edge_begin.push_back(0);
+
+    std::vector<Tokens> m(std::max<std::size_t>(places, 1), 0);  // the expanded marking; zero between states
+    std::vector<TransitionIndex> candidates;
+    const auto by_rank = [&](TransitionIndex a, TransitionIndex b) { return net.rank[a] < net.rank[b]; };
+    while (expanded < count) {
+      const auto s = static_cast<StateId>(expanded);
+      cur.assign(entries.begin() + static_cast<std::ptrdiff_t>(entry_begin[s]),
+                 entries.begin() + static_cast<std::ptrdiff_t>(entry_begin[s + 1]));
+      bool outcome = false;
+      candidates.clear();
+      for (const std::uint64_t e : cur) {
+        const auto p = static_cast<std::size_t>(e >> 32);
+        const auto k = static_cast<Tokens>(e);
+        m[p] = k;
+        max_tokens[p] = std::max(max_tokens[p], k);
+        outcome = outcome || net.is_outcome[p] != 0;
+        candidates.insert(candidates.end(), net.watchers.begin() + net.watch_begin[p],
+                          net.watchers.begin() + net.watch_begin[p + 1]);
+      }
+      if (outcome) outcome_states.push_back(s);
+      bool abort = false;
+      batch_t.clear();
+      batch_begin.assign(1, 0);
+      if (!(outcome && stop_at_outcome)) {
+        candidates.insert(candidates.end(), net.unwatched.begin(), net.unwatched.end());
+        std::sort(candidates.begin(), candidates.end(), by_rank);
+        net.successors_among(m.data(), candidates, [&](TransitionIndex t) {
+          if (abort) return;
+          // The successor: the marked places merged with the places t changes.
+          std::size_t out = batch_begin.back();
+          const std::size_t need = out + cur.size() + (net.change_begin[t + 1] - net.change_begin[t]);
+          if (batch_words.size() < need) batch_words.resize(need * 2);
+          std::size_t i = 0;
+          for (std::uint32_t c = net.change_begin[t]; c < net.change_begin[t + 1]; ++c) {
+            const detail::Change& d = net.changes[c];
+            for (; i < cur.size() && (cur[i] >> 32) < d.place; ++i) batch_words[out++] = cur[i];
+            if (i < cur.size() && (cur[i] >> 32) == d.place) ++i;
+            const std::uint64_t after = std::uint64_t{m[d.place]} - d.consumed + d.produced;
+            if (after > 0xFFFFFFFFULL) {
+              stop = StopReason::token_overflow;
+              abort = true;
+              return;
+            }
+            if (after != 0) batch_words[out++] = (std::uint64_t{d.place} << 32) | after;
+          }
+          for (; i < cur.size(); ++i) batch_words[out++] = cur[i];
+          batch_t.push_back(t);
+          batch_begin.push_back(out);
+        });
+      }
+      for (const std::uint64_t e : cur) m[static_cast<std::size_t>(e >> 32)] = 0;
+      std::size_t successors = 0;
+      if (!abort) {
+        const std::size_t k = batch_t.size();
+        batch_hash.resize(k);
+        for (std::size_t i = 0; i < k; ++i) {
+          batch_hash[i] = hash_sparse(batch_words.data() + batch_begin[i], batch_begin[i + 1] - batch_begin[i]);
+        }
+        for (std::size_t i = 0; i < k && !abort; ++i) {
+          const TransitionIndex t = batch_t[i];
+          const auto [target, inserted] = insert_sparse(batch_words.data() + batch_begin[i],
+                                                        batch_begin[i + 1] - batch_begin[i], batch_hash[i], s, t);
+          if (target == kNoState || !add_edge(target)) {
+            abort = true;
+            break;
+          }
+          ++successors;
+          fired[t] = 1;
+        }
+      }
+      if (abort) {
+        if (keep_edges) edge_targets.resize(edge_begin.back());
+        return;  // a limit: `stop` says which
+      }
+      edges += successors;
+      if (successors == 0 && !outcome) deadlocks.push_back(s);
+      if (keep_edges) edge_begin.push_back(edge_targets.size());
+      ++expanded;
+    }
+  }
+
+  // Records an edge when edges are kept; false when the memory cap forbids it.
+  bool add_edge(StateId target) {
+    if (!keep_edges) return true;
+    if (edge_targets.size() == edge_targets.capacity()) {
+      const std::size_t cap = std::max<std::size_t>(edge_targets.capacity() * 2, 4096);
+      if (memory() + cap * sizeof(StateId) > max_memory) {
+        stop = StopReason::max_memory;
+        return false;
+      }
+      edge_targets.reserve(cap);
+    }
+    edge_targets.push_back(target);
+    return true;
+  }
 };
 
 StateSpace::StateSpace() : impl_(std::make_unique<Impl>()) {}
@@ -382,7 +548,12 @@ const std::vector<Tokens>& StateSpace::max_tokens() const noexcept { return impl
 const std::vector<std::uint8_t>& StateSpace::fired() const noexcept { return impl_->fired; }
 const std::vector<StateId>& StateSpace::deadlocks() const noexcept { return impl_->deadlocks; }
 const std::vector<StateId>& StateSpace::outcome_states() const noexcept { return impl_->outcome_states; }
-std::size_t StateSpace::bytes_per_marking() const noexcept { return impl_->stride; }
+std::size_t StateSpace::bytes_per_marking() const noexcept {
+  if (!impl_->sparse) return impl_->stride;
+  const std::size_t n = std::max<std::size_t>(impl_->count, 1);
+  return (impl_->entries.size() * sizeof(std::uint64_t) + n - 1) / n;
+}
+bool StateSpace::sparse() const noexcept { return impl_->sparse; }
 std::size_t StateSpace::memory_bytes() const noexcept { return impl_->memory(); }
 const std::vector<std::uint8_t>& StateSpace::bits_per_place() const noexcept { return impl_->bits; }
 std::size_t StateSpace::restarts() const noexcept { return impl_->restarts; }
@@ -393,6 +564,7 @@ double StateSpace::bytes_per_state() const noexcept {
   // What the stored states occupy (not the reserve of the vectors' last doubling).
   const std::size_t used = impl_->count * (impl_->stride + sizeof(StateId) + sizeof(TransitionIndex)) +
                            impl_->table.size() * sizeof(std::uint64_t) +
+                           (impl_->entries.size() + impl_->entry_begin.size()) * sizeof(std::uint64_t) +
                            impl_->edge_begin.size() * sizeof(std::uint64_t) +
                            impl_->edge_targets.size() * sizeof(StateId);
   return static_cast<double>(used) / static_cast<double>(n);
@@ -400,9 +572,15 @@ double StateSpace::bytes_per_state() const noexcept {
 
 Marking StateSpace::marking(StateId s) const {
   if (s >= impl_->count) throw std::out_of_range("no state " + std::to_string(s));
+  Marking m(impl_->places);
+  if (impl_->sparse) {
+    for (std::uint64_t i = impl_->entry_begin[s]; i < impl_->entry_begin[s + 1]; ++i) {
+      m[static_cast<std::size_t>(impl_->entries[i] >> 32)] = static_cast<Tokens>(impl_->entries[i]);
+    }
+    return m;
+  }
   std::vector<std::uint64_t> w(impl_->words);
   impl_->load(s, w.data());
-  Marking m(impl_->places);
   impl_->unpack(w.data(), m.data());
   return m;
 }
@@ -423,6 +601,15 @@ std::span<const StateId> StateSpace::successors(StateId s) const {
 
 std::optional<StateId> StateSpace::find(const Marking& m) const {
   if (m.size() != impl_->places) return std::nullopt;
+  if (impl_->sparse) {
+    std::vector<std::uint64_t> e;
+    for (std::size_t p = 0; p < m.size(); ++p) {
+      if (m[p] != 0) e.push_back((std::uint64_t{p} << 32) | m[p]);
+    }
+    const StateId s = impl_->lookup_sparse(e.data(), e.size(), Impl::hash_sparse(e.data(), e.size()));
+    if (s == kNoState) return std::nullopt;
+    return s;
+  }
   for (std::size_t p = 0; p < m.size(); ++p) {
     if (m[p] > impl_->field_max[p]) return std::nullopt;
   }
@@ -449,6 +636,18 @@ StateSpace explore(const PetriNet& net, const ExploreOptions& options) {
   impl.keep_edges = options.keep_edges;
   impl.max_states = std::max<std::size_t>(options.max_states, 1);
   impl.max_memory = options.max_memory_bytes;
+  impl.layout(bits);
+  std::size_t marked = 0;
+  for (const Tokens k : initial) marked += k != 0 ? 1 : 0;
+  impl.sparse = options.store == MarkingStore::sparse ||
+                (options.store == MarkingStore::automatic && impl.words > kDenseWordsAlways &&
+                 16 * (marked + 1) < impl.stride);
+  if (impl.sparse) {
+    impl.bits.assign(initial.size(), 32);
+    impl.stride = 0;
+    impl.run_sparse(compiled, initial, options.stop_at_outcome);
+    return result;
+  }
   for (;;) {
     impl.layout(bits);
     const auto overflow = impl.run(compiled, initial, options.stop_at_outcome);

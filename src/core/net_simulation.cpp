@@ -11,10 +11,17 @@ namespace {
 
 std::string time_column(Time t) { return fmt::format("{:>10} s", format_seconds(t)); }
 
-// Turns firings into trace entries while a run lasts.
+// Turns firings into trace entries while a run lasts. The marked places are kept up to date from
+// each firing's changes, so an entry costs O(marked places), not O(places): simulating a net of a
+// million places must not copy its marking per firing.
 class TraceObserver final : public EngineObserver {
  public:
-  TraceObserver(const PetriNet& net, std::vector<TraceEntry>& trace) : net_(net), trace_(trace) {}
+  TraceObserver(const PetriNet& net, std::span<const Tokens> marking, std::vector<TraceEntry>& trace)
+      : net_(net), trace_(trace) {
+    for (PlaceIndex p = 0; p < marking.size(); ++p) {
+      if (marking[p] != 0) marked_.emplace_back(p, marking[p]);
+    }
+  }
 
  protected:
   void on_firing(const Firing& f) override {
@@ -25,13 +32,28 @@ class TraceObserver final : public EngineObserver {
     e.name = std::string(f.transition_id);
     e.detail = net_.transition(f.transition).description;
     e.event = std::string(f.event);
-    e.marking_after.assign(f.marking_after.begin(), f.marking_after.end());
+    for (const PlaceChange& c : f.changes) {
+      const Tokens now = f.marking_after[c.place];
+      const auto at = std::lower_bound(marked_.begin(), marked_.end(), c.place,
+                                       [](const auto& m, PlaceIndex p) { return m.first < p; });
+      if (at != marked_.end() && at->first == c.place) {
+        if (now == 0) {
+          marked_.erase(at);
+        } else {
+          at->second = now;
+        }
+      } else if (now != 0) {
+        marked_.insert(at, {c.place, now});
+      }
+    }
+    e.marked_after = marked_;
     trace_.push_back(std::move(e));
   }
 
  private:
   const PetriNet& net_;
   std::vector<TraceEntry>& trace_;
+  std::vector<std::pair<PlaceIndex, Tokens>> marked_;
 };
 
 class ObserverGuard {
@@ -47,6 +69,16 @@ class ObserverGuard {
   Engine& engine_;
   EngineObserver& observer_;
 };
+
+std::string format_marked(const PetriNet& net, const std::vector<std::pair<PlaceIndex, Tokens>>& marked) {
+  std::string out;
+  for (const auto& [p, k] : marked) {
+    if (!out.empty()) out += ' ';
+    out += net.place(p).id;
+    if (k > 1) out += ':' + std::to_string(k);
+  }
+  return out.empty() ? std::string("(empty)") : out;
+}
 
 }  // namespace
 
@@ -70,7 +102,7 @@ std::string SimulationResult::str(const PetriNet& net) const {
         out += "  fire " + e.name;
         if (!e.event.empty()) out += " [" + e.event + "]";
         if (!e.detail.empty()) out += "  " + e.detail;
-        out += "  -> " + format_marking(net, e.marking_after);
+        out += "  -> " + format_marked(net, e.marked_after);
         break;
       case TraceEntry::Kind::fact_set: out += "  set " + e.name + " = " + e.detail; break;
       case TraceEntry::Kind::event_dropped:
@@ -121,7 +153,7 @@ SimulationResult NetSimulation::run(const EventScript& script) {
   validate(script);
   SimulationResult result;
   engine_.reset(Time{});
-  TraceObserver observer(engine_.net(), result.trace);
+  TraceObserver observer(engine_.net(), engine_.marking(), result.trace);
   const ObserverGuard guard(engine_, observer);
 
   // Records what a step reports besides firings; false when the simulation must stop on error.

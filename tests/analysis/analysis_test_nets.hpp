@@ -1,6 +1,6 @@
 // Generated nets with known state spaces, shared by the analysis tests and benchmarks:
-// Kanban (the structure of Kanban2-test001.pnml with N tokens per stage), token rings and
-// dining philosophers.
+// Kanban (the structure of Kanban2-test001.pnml with N tokens per stage), token rings, dining
+// philosophers and chains (one long sequence, for scaling).
 #pragma once
 
 #include <string>
@@ -93,6 +93,27 @@ inline PetriNet philosophers_net(std::size_t n) {
     net.add_arc("release" + s, "think" + s);
     net.add_arc("release" + s, "fork" + s);
     net.add_arc("release" + s, right);
+  }
+  return net;
+}
+
+/// A process that is one long sequence: `places` places p0..p(n-1), a token on p0, immediate
+/// transitions t_i moving it from p_i to p_(i+1), and p(n-1) the success outcome. Its state
+/// space is linear (n states, n - 1 edges, no deadlock, the outcome reached from every state),
+/// so the work to verify it should be too: the scaling benchmark and tests use it.
+inline PetriNet chain_net(std::size_t places) {
+  PetriNet net;
+  net.id = "chain" + std::to_string(places);
+  for (std::size_t i = 0; i < places; ++i) {
+    net.add_place(Place{.id = "p" + std::to_string(i),
+                        .initial_tokens = i == 0 ? Tokens{1} : Tokens{0},
+                        .outcome = i + 1 == places ? Outcome::success : Outcome::none});
+  }
+  for (std::size_t i = 0; i + 1 < places; ++i) {
+    const std::string t = "t" + std::to_string(i);
+    net.add_transition(Transition{.id = t});
+    net.add_arc("p" + std::to_string(i), t);
+    net.add_arc(t, "p" + std::to_string(i + 1));
   }
   return net;
 }

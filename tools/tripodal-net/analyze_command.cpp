@@ -78,6 +78,10 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_option("--max-memory-mb", a->max_memory_mb, "stop before the state store exceeds N MiB")
       ->check(cli::positive_count())
       ->capture_default_str();
+  cmd.add_option("--max-structural-size", a->options.max_structural_size,
+                 "places + transitions above which invariants and Karp-Miller are skipped")
+      ->check(cli::positive_count())
+      ->capture_default_str();
   cmd.add_flag("--json", a->json, "the report as JSON (schema in docs/analysis.md)");
   cmd.add_option("--param", a->params, "K=V: value of process parameter K for guards (default: declared defaults)")
       ->allow_extra_args(false);

@@ -24,8 +24,10 @@ constexpr std::string_view kDescription =
     "file. A directory stands for its *.xml and *.pnml files (not recursive).\n"
     "A net that loads is then explored with its default parameters, every event order included\n"
     "(docs/analysis.md): a reachable deadlock, or a reachable marking from which no outcome place\n"
-    "can be reached, is an error. Nets with more than 200000 reachable states, or parameters\n"
-    "without defaults, get a note instead (use tripodal-net analyze).\n"
+    "can be reached, is an error. A net with more reachable states than --max-states (200000), or\n"
+    "whose states would not fit in --max-memory-mb, or with too many combinations of parameters\n"
+    "without defaults, gets a note naming the limit instead, and its summary says the behaviour was\n"
+    "not checked (raise the limit, or use tripodal-net analyze).\n"
     "With --recovery RULES.yaml, the recovery rules are checked against the low-level nets given\n"
     "(a net's id is its process name): a rule whose fault message none of them can post, or that\n"
     "names or inserts a process without a net, is an error.";
@@ -39,6 +41,8 @@ struct Args {
   std::vector<std::filesystem::path> recovery_files;
   bool no_warnings = false;
   bool no_behaviour = false;
+  std::size_t max_states = analysis::kCheckStateLimit;
+  std::size_t max_memory_mb = 2048;
 };
 
 enum class FileStatus { valid, invalid, unreadable };
@@ -52,8 +56,9 @@ std::string file_head(const std::filesystem::path& file) {
 }
 
 // Checks one net file: the loader's diagnostics, then the behavioural checks on a net that loaded.
-FileStatus check_file(const std::filesystem::path& file, const LoadOptions& options, bool behaviour,
+FileStatus check_file(const std::filesystem::path& file, const LoadOptions& options, const Args& args,
                       std::vector<PetriNet>& loaded, std::ostream& out, std::ostream& err) {
+  const bool behaviour = !args.no_behaviour;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec)) {
     err << file.string() << ": error: cannot open file\n";
@@ -71,6 +76,8 @@ FileStatus check_file(const std::filesystem::path& file, const LoadOptions& opti
   if (behaviour) {
     analysis::BehaviourCheckOptions check;
     check.semantics = analysis::default_semantics_for(file.string(), file_head(file));
+    check.max_states = args.max_states;
+    check.max_memory_bytes = args.max_memory_mb << 20;
     try {
       checked = analysis::check_behaviour(*net, diagnostics, check);
     } catch (const ConfigError& e) {
@@ -85,10 +92,11 @@ FileStatus check_file(const std::filesystem::path& file, const LoadOptions& opti
   }
   std::size_t arcs = 0;
   for (const auto& t : net->transitions()) arcs += t.inputs.size() + t.outputs.size() + t.reads.size() + t.inhibitors.size();
-  out << file.string() << ": ok (" << net->places().size() << " places, " << net->transitions().size()
-      << " transitions, " << arcs << " arcs";
+  // "ok" only when everything asked for was checked: a cut search is reported as such.
+  out << file.string() << (!behaviour || checked ? ": ok (" : ": valid, behaviour NOT CHECKED (") << net->places().size()
+      << " places, " << net->transitions().size() << " transitions, " << arcs << " arcs";
   if (warnings > 0) out << ", " << warnings << " warning(s)";
-  if (behaviour) out << (checked ? "; no deadlock, no marking that cannot reach an outcome" : "; behaviour not checked");
+  if (behaviour) out << (checked ? "; no deadlock, no marking that cannot reach an outcome" : "; see the note");
   out << ")\n";
   loaded.push_back(*net);
   return FileStatus::valid;
@@ -107,7 +115,6 @@ FileStatus check_recovery(const std::filesystem::path& file, const std::vector<P
 int run_check(const Args& args, std::ostream& out, std::ostream& err) {
   LoadOptions options;
   options.structural_warnings = !args.no_warnings;
-  const bool behaviour = !args.no_behaviour;
   std::vector<std::filesystem::path> files;
   bool unreadable = false;
   for (const auto& a : args.inputs) {
@@ -135,7 +142,7 @@ int run_check(const Args& args, std::ostream& out, std::ostream& err) {
   bool invalid = false;
   std::vector<PetriNet> loaded;
   for (const auto& f : files) {
-    const FileStatus s = check_file(f, options, behaviour, loaded, out, err);
+    const FileStatus s = check_file(f, options, args, loaded, out, err);
     unreadable = unreadable || s == FileStatus::unreadable;
     invalid = invalid || s == FileStatus::invalid;
   }
@@ -150,6 +157,13 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_flag("--no-warnings", a->no_warnings,
                "leave out the structural warnings (places never marked, transitions never enabled)");
   cmd.add_flag("--no-behaviour", a->no_behaviour, "skip the deadlock and outcome checks");
+  cmd.add_option("--max-states", a->max_states,
+                 "explore at most N states per net and parameter combination; a net with more gets a note")
+      ->check(cli::positive_count())
+      ->capture_default_str();
+  cmd.add_option("--max-memory-mb", a->max_memory_mb, "stop a net's exploration before its state store exceeds N MiB")
+      ->check(cli::positive_count())
+      ->capture_default_str();
   cmd.add_option("--recovery", a->recovery_files,
                  "RULES.yaml: also check these recovery rules against the low-level nets given (repeatable)")
       ->allow_extra_args(false);

@@ -18,6 +18,9 @@
 
 namespace tripodal::analysis {
 
+/// Default of AnalysisOptions::max_structural_size (`--max-structural-size`).
+inline constexpr std::size_t kMaxStructuralSize = 1'000;
+
 struct AnalysisOptions {
   Semantics semantics = Semantics::engine;
   ParameterValues parameters;           ///< process parameters (defaults applied for the rest)
@@ -27,6 +30,11 @@ struct AnalysisOptions {
   std::size_t max_examples = 10;        ///< deadlocks / stuck markings listed with their paths
   std::size_t max_invariant_rows = 20'000;
   std::size_t max_coverability_nodes = 200'000;
+  /// Places + transitions above which invariants and the Karp–Miller search are skipped (a note in
+  /// the report): both are superlinear in the net's size (Farkas' rows hold a place and a
+  /// transition column each; Karp–Miller compares every node with its ancestors), while the
+  /// exploration alone is linear in the states times the marked places.
+  std::size_t max_structural_size = kMaxStructuralSize;
   bool invariants = true;               ///< compute place and transition invariants
   const Clock* clock = nullptr;         ///< times the exploration; nullptr: a SteadyClock
 };
@@ -68,6 +76,7 @@ struct AnalysisReport {
   std::size_t expanded = 0;
   StopReason stop = StopReason::complete;
   std::size_t max_states = 0;
+  std::size_t max_memory_bytes = 0;
   double exploration_s = 0.0;
   std::size_t memory_bytes = 0;
   double bytes_per_state = 0.0;
@@ -94,6 +103,8 @@ struct AnalysisReport {
   std::vector<Witness> stuck;      ///< the first max_examples
 
   // structure
+  std::size_t max_structural_size = 0;
+  bool structure_skipped = false;  ///< the net exceeds max_structural_size: no invariants, no Karp–Miller
   bool invariants_computed = false;
   InvariantBasis p_invariants;
   InvariantBasis t_invariants;
@@ -105,6 +116,11 @@ struct AnalysisReport {
 
 /// Runs every analysis. Throws ConfigError for bad parameters or guards reading undeclared names.
 [[nodiscard]] AnalysisReport analyze(const PetriNet& net, const AnalysisOptions& options = {});
+
+/// Why an exploration stopped short, naming the limit and the option that raises it
+/// ("more than 200000 reachable states: the exploration stopped at the limit of 200000 states;
+/// raise it with --max-states N").
+[[nodiscard]] std::string incomplete_reason(const AnalysisReport& report);
 
 /// The report for a person: sections in a fixed order, paths as transition ids with events.
 [[nodiscard]] std::string format_text(const AnalysisReport& report, const PetriNet& net);
@@ -120,7 +136,8 @@ struct AnalysisReport {
 namespace tripodal::analysis {
 
 /// The state limit of the behavioural part of `tripodal-net check`: larger nets are reported as
-/// not checked (a note), never as failing; `tripodal-net analyze` has no such limit by default.
+/// not checked (a note naming the limit and --max-states), never as failing; `tripodal-net
+/// analyze` has a larger default.
 inline constexpr std::size_t kCheckStateLimit = 200'000;
 /// Parameters without defaults are checked with every combination of the values their guards
 /// name, up to this many combinations (more: a note, not checked).
@@ -128,7 +145,8 @@ inline constexpr std::size_t kCheckParameterCombinations = 16;
 
 struct BehaviourCheckOptions {
   Semantics semantics = Semantics::engine;
-  std::size_t max_states = kCheckStateLimit;
+  std::size_t max_states = kCheckStateLimit;            ///< `tripodal-net check --max-states`
+  std::size_t max_memory_bytes = std::size_t{2} << 30;  ///< `tripodal-net check --max-memory-mb`
 };
 
 /// What `tripodal-net check` runs on a net that loaded: reachable deadlocks and markings from

@@ -40,6 +40,14 @@ enum class StopReason {
 
 using StateId = std::uint32_t;
 
+/// How stored markings are laid out (docs/analysis.md, "Reachability graph").
+enum class MarkingStore {
+  automatic,  ///< dense for small nets; sparse when a dense marking would be larger than 64 bytes
+              ///< and a sparse one much smaller
+  dense,      ///< every place a bit field: cheapest for small nets, O(places) work per state
+  sparse,     ///< only the marked places: O(marked places + their transitions) per state
+};
+
 struct ExploreOptions {
   Semantics semantics = Semantics::engine;
   ParameterValues parameters;   ///< process parameters guards are evaluated with
@@ -50,6 +58,7 @@ struct ExploreOptions {
   /// Known upper bounds per place (from invariants, capacities or coverability) used to size the
   /// packed fields; empty or nullopt: start narrow and widen (re-exploring) when exceeded.
   std::vector<std::optional<Tokens>> place_bounds;
+  MarkingStore store = MarkingStore::automatic;
 };
 
 /// The explored graph. States are numbered in breadth-first order from 0 (the initial marking),
@@ -83,7 +92,9 @@ class StateSpace {
   /// Stored states where an outcome place is marked.
   [[nodiscard]] const std::vector<StateId>& outcome_states() const noexcept;
 
-  [[nodiscard]] std::size_t bytes_per_marking() const noexcept;  ///< packed marking in the arena
+  /// The packed marking in the arena; with the sparse store, the average over the stored states.
+  [[nodiscard]] std::size_t bytes_per_marking() const noexcept;
+  [[nodiscard]] bool sparse() const noexcept;  ///< the sparse store was used
   [[nodiscard]] std::size_t memory_bytes() const noexcept;       ///< arena, hash set, parents, edges
   [[nodiscard]] double bytes_per_state() const noexcept;
   [[nodiscard]] const std::vector<std::uint8_t>& bits_per_place() const noexcept;

@@ -5,6 +5,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tripodal/core/engine.hpp"
@@ -29,7 +30,8 @@ struct TraceEntry {
   std::string name;                ///< transition id, fact name or event name
   std::string detail;              ///< firing: description; fact_set: value; error: message
   std::string event;               ///< firing: the event it consumed
-  Marking marking_after;           ///< firing
+  /// firing: the marked places after it, ascending (a trace of a large net keeps only these).
+  std::vector<std::pair<PlaceIndex, Tokens>> marked_after;
 };
 
 struct SimulationResult {
