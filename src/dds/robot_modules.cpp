@@ -51,6 +51,9 @@ const ModuleManifest& DdsLaserResource::static_manifest() {
                                               "a fault when no scan comes within this (DDS deadline; the publisher must "
                                               "offer one at least as short); 0: none",
                                               0.0)
+                                      .flag("reliable", false,
+                                            "a reliable reader: every scan, the first too, but only reliable publishers "
+                                            "match (false: best effort, ROS 2's sensor-data QoS, any publisher)")
                                       .build();
   return m;
 }
@@ -62,6 +65,7 @@ DdsLaserOptions laser_options(const ParameterSet& p) {
   o.binding = topic_binding(p, "scan");
   o.max_age = from_seconds(p.contains("max_age_s") ? p.number("max_age_s") : 0.5);
   if (p.contains("deadline_s")) o.deadline = from_seconds(p.number("deadline_s"));
+  o.reliable = p.contains("reliable") && p.boolean("reliable");
   return o;
 }
 
@@ -76,10 +80,10 @@ DdsLaserResource::DdsLaserResource(std::string name, DdsLaserOptions o)
     : LaserResource(std::move(name), o.max_age, static_manifest()), sender_stamp_(o.lock_step), on_scan_(std::move(o.on_scan)) {
   participant_ = std::make_unique<Participant>(o.binding.participant);
   EndpointOptions options{.kind = TopicKind::scan, .on_status = [this](const StatusEvent& e) { on_status(e); }};
-  if (o.deadline > Duration{0} || o.lock_step) {
+  if (o.deadline > Duration{0} || o.lock_step || o.reliable) {
     Qos q = qos_for(TopicKind::scan, Role::subscriber);
     if (o.deadline > Duration{0}) q.deadline = o.deadline;
-    if (o.lock_step) q.reliability = Reliability::reliable;
+    if (o.lock_step || o.reliable) q.reliability = Reliability::reliable;
     options.qos = q;
   }
   subscriber_ = std::make_unique<Subscriber<msg::LaserScan>>(
@@ -203,6 +207,9 @@ const ModuleManifest& DdsReadingResource<Reading, Msg>::static_manifest() {
                                       .output(std::string(Traits::output))
                                       .parameters(topic_parameters(std::string(Traits::topic)))
                                       .number("max_age_s", 0.5, "s", "older than this the reading is stale; 0: never", 0.0)
+                                      .flag("reliable", Traits::kind != TopicKind::scan,
+                                            "a reliable reader (only reliable publishers match); false: best effort, any "
+                                            "publisher, a sample lost is not repaired")
                                       .build();
   return m;
 }
@@ -220,6 +227,10 @@ DdsReadingResource<Reading, Msg>::DdsReadingResource(std::string name, const Par
                               faults_.report("the publisher of " + e.topic + " went silent (DDS liveliness lost)");
                             }
                           }};
+  Qos q = qos_for(Traits::kind, Role::subscriber);
+  q.reliability = (p.contains("reliable") ? p.boolean("reliable") : Traits::kind != TopicKind::scan) ? Reliability::reliable
+                                                                                                    : Reliability::best_effort;
+  options.qos = q;
   subscriber_ = std::make_unique<Subscriber<Msg>>(*participant_, b.topic, options, [this](const Msg& m) {
     {
       std::lock_guard lock(mutex_);

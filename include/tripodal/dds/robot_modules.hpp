@@ -36,6 +36,11 @@ struct DdsLaserOptions {
   // Lock-step co-simulation: every scan must arrive (a reliable reader, which matches only reliable
   // publishers) and its stamp is the robot's own time (the simulator's clock is the robot's).
   bool lock_step = false;
+  // A reliable reader (matches only reliable publishers, as rplidar_ros's default QoS is): a lost
+  // sample is repaired, the first one too. Best effort (the default, ROS 2's sensor-data profile)
+  // matches every publisher but loses for good the samples a publisher writes before this
+  // reader's discovery of it completes (docs/distribution.md, "First samples").
+  bool reliable = false;
   std::function<void()> on_scan;  // after a scan was received (on a Cyclone DDS thread)
 };
 
