@@ -7,6 +7,8 @@
 #     tidy   clang-tidy, for scripts/tidy.sh
 #     browser  headless Chromium and Selenium, for the monitor's browser tests
 #              (cmake -DTRIPODAL_BROWSER_TESTS=ON; ctest -L browser)
+#     ros2-peer  Fast DDS (ROS 2's default middleware), the independent peer of the ROS 2 graph
+#                tests (tests/dds/ros2_peer_test.cpp; without it they are not built)
 #   (ThreadSanitizer, scripts/tsan.sh, needs nothing more: libtsan2 comes with g++.)
 set -euo pipefail
 
@@ -40,7 +42,8 @@ for group in "$@"; do
     fuzz) packages+=(clang libclang-rt-14-dev) ;;
     tidy) packages+=(clang-tidy) ;;
     browser) packages+=(chromium chromium-driver python3-selenium) ;;
-    *) echo "install-deps: unknown group '$group' (expected fuzz, tidy or browser)" >&2; exit 2 ;;
+    ros2-peer) packages+=(libfastrtps-dev libfastcdr-dev) ;;
+    *) echo "install-deps: unknown group '$group' (expected fuzz, tidy, browser or ros2-peer)" >&2; exit 2 ;;
   esac
 done
 

@@ -9,6 +9,7 @@
 #include <thread>
 #include <utility>
 
+#include "node_graph.hpp"
 #include "qos_c.hpp"
 #include "type_support.hpp"
 
@@ -59,6 +60,7 @@ struct EndpointCore {
   dds_entity_t entity = 0;  // the writer or the reader
   dds_entity_t waitset = 0;
   dds_entity_t read_condition = 0;
+  std::shared_ptr<NodeGraph> graph;  // told of the endpoint, for ros_discovery_info
 
   EndpointCore() = default;
   EndpointCore(const EndpointCore&) = delete;
@@ -66,6 +68,7 @@ struct EndpointCore {
   ~EndpointCore() {
     // Deleting the reader or writer waits for its listener callbacks in progress, which use this
     // object: so it goes first.
+    if (graph && entity > 0) graph->remove(entity);
     if (waitset > 0) dds_delete(waitset);
     if (entity > 0) dds_delete(entity);
     if (topic > 0) dds_delete(topic);
@@ -148,6 +151,8 @@ std::unique_ptr<EndpointCore> make_core(Participant& participant, std::string to
     core->entity = dds_create_writer(participant.handle(), core->topic, qos.get(), listener.get());
     check(core->entity, core->where("dds_create_writer"));
   }
+  core->graph = participant.graph();
+  core->graph->add(core->entity, role == Role::subscriber);
   return core;
 }
 
@@ -344,6 +349,11 @@ bool Subscriber<T>::wait_for_publishers(std::size_t count, std::chrono::millisec
 }
 
 template <Message T>
+msg::Gid Publisher<T>::gid() const { return detail::gid_of(core_->entity); }
+template <Message T>
+msg::Gid Subscriber<T>::gid() const { return detail::gid_of(core_->entity); }
+
+template <Message T>
 const std::string& Subscriber<T>::topic() const noexcept { return core_->topic_name; }
 template <Message T>
 const Qos& Subscriber<T>::qos() const noexcept { return core_->qos; }
@@ -359,6 +369,9 @@ TRIPODAL_DDS_INSTANTIATE(OccupancyGrid);
 TRIPODAL_DDS_INSTANTIATE(LaserScan);
 TRIPODAL_DDS_INSTANTIATE(JointState);
 TRIPODAL_DDS_INSTANTIATE(Clock);
+TRIPODAL_DDS_INSTANTIATE(TFMessage);
+TRIPODAL_DDS_INSTANTIATE(Imu);
+TRIPODAL_DDS_INSTANTIATE(ParticipantEntitiesInfo);
 TRIPODAL_DDS_INSTANTIATE(Event);
 TRIPODAL_DDS_INSTANTIATE(TaskCommand);
 TRIPODAL_DDS_INSTANTIATE(SimStep);

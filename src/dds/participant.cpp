@@ -3,10 +3,13 @@
 
 #include <dds/dds.h>
 
+#include <algorithm>
 #include <map>
+#include <stdexcept>
 #include <mutex>
 #include <string>
 
+#include "node_graph.hpp"
 #include "qos_c.hpp"
 
 namespace tripodal::dds {
@@ -83,15 +86,52 @@ Participant::Participant(const ParticipantOptions& options) : options_(options) 
       slot = created;
     }
   }
-  handle_ = dds_create_participant(options.domain_id, nullptr, nullptr);
+  // rmw's user data: the security enclave of the participant's nodes, "/" without security.
+  const detail::QosPtr qos(dds_create_qos());
+  static constexpr std::string_view kEnclave = "enclave=/;";
+  dds_qset_userdata(qos.get(), kEnclave.data(), kEnclave.size());
+  handle_ = dds_create_participant(options.domain_id, qos.get(), nullptr);
   detail::check(handle_, where + ": dds_create_participant");
+  graph_ = std::make_shared<detail::NodeGraph>(handle_);
 }
 
 Participant::~Participant() {
+  if (graph_) graph_->close();
   if (handle_ > 0) dds_delete(handle_);
   // The domain (and Cyclone's threads and sockets for it) goes with its last participant.
   std::lock_guard lock(domains_mutex);
   domain_.reset();
 }
+
+bool is_ros_node_name(std::string_view name) noexcept {
+  if (name.empty() || name.size() > 255 || (name.front() >= '0' && name.front() <= '9')) return false;
+  return std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+  });
+}
+
+msg::Gid Participant::gid() const noexcept { return graph_->participant_gid(); }
+
+void Participant::declare_node(std::string_view name, std::string_view ns) {
+  if (!is_ros_node_name(name)) {
+    throw std::invalid_argument("dds: '" + std::string(name) + "' is not a ROS 2 node name (letters, digits and '_', "
+                                "not starting with a digit, at most 255 characters)");
+  }
+  while (!ns.empty() && ns.back() == '/') ns.remove_suffix(1);
+  while (!ns.empty() && ns.front() == '/') ns.remove_prefix(1);
+  const std::string full_ns = "/" + std::string(ns);
+  std::size_t start = 1;
+  while (start < full_ns.size()) {  // each part of a/b must be a name
+    const std::size_t end = std::min(full_ns.find('/', start), full_ns.size());
+    if (!is_ros_node_name(std::string_view(full_ns).substr(start, end - start)) || full_ns.size() > 256) {
+      throw std::invalid_argument("dds: '" + full_ns + "' is not a ROS 2 namespace (names of letters, digits and '_', "
+                                  "separated by '/', at most 256 characters)");
+    }
+    start = end + 1;
+  }
+  graph_->declare(full_ns, std::string(name));
+}
+
+msg::ParticipantEntitiesInfo Participant::graph_info() const { return graph_->info(); }
 
 }  // namespace tripodal::dds

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 #include <mutex>
+#include <typeinfo>
 #include <optional>
 #include <vector>
 
@@ -31,12 +32,26 @@ std::string step_text(const ProcessStep& s) { return to_string(Plan{{}, {}, {Pla
 
 enum Severity : std::uint8_t { kInfo = 0, kWarning = 1, kError = 2 };
 
+msg::Transform transform_of(const Pose2D& p) { return {{p.x_m, p.y_m, 0.0}, yaw_quaternion(p.theta_rad)}; }
+
+// amcl_pose as Nav2's AMCL offers it: its subscribers (Nav2, rviz2's default for the topic) ask
+// for transient local and are refused by a volatile writer.
+constexpr Qos kPoseQos{Reliability::reliable, Durability::transient_local, 1, {}, Liveliness::automatic, {}};
+// tf2's static broadcaster: every static transform in one latched sample.
+constexpr Qos kStaticTfQos{Reliability::reliable, Durability::transient_local, 1, {}, Liveliness::automatic, {}};
+// tf2's dynamic broadcaster: ROS 2's default profile.
+constexpr Qos kTfQos{Reliability::reliable, Durability::volatile_, 100, {}, Liveliness::automatic, {}};
+// /clock: a reliable writer serves the readers of rclcpp's clock QoS (best effort, keep last 1)
+// and reliable ones alike; only the latest time matters.
+constexpr Qos kClockQos{Reliability::reliable, Durability::volatile_, 1, {}, Liveliness::automatic, {}};
+
 }  // namespace
 
 struct RobotBridge::Impl final : TaskObserver, SupervisorObserver {
   Robot& robot;
   const Clock& clock;
   DdsSection section;
+  RobotBridgeOptions options;
   std::string robot_name;
 
   std::unique_ptr<Participant> participant;
@@ -46,12 +61,17 @@ struct RobotBridge::Impl final : TaskObserver, SupervisorObserver {
   std::optional<Publisher<msg::Event>> events;
   std::optional<Publisher<msg::Event>> markings;
   std::optional<Subscriber<msg::TaskCommand>> tasks;
+  std::optional<Publisher<msg::TFMessage>> tf;
+  std::optional<Publisher<msg::TFMessage>> tf_static;
+  std::optional<Publisher<msg::Clock>> clock_out;
 
   // Commands arrive on a Cyclone DDS thread and are carried out on the robot's, in update().
   std::mutex inbox_mutex;
   std::vector<msg::TaskCommand> inbox;
 
-  std::atomic<std::uint64_t> n_odom{0}, n_pose{0}, n_map{0}, n_events{0}, n_markings{0}, n_tasks{0};
+  std::atomic<std::uint64_t> n_odom{0}, n_pose{0}, n_map{0}, n_events{0}, n_markings{0}, n_tasks{0}, n_tf{0}, n_tf_static{0},
+      n_clock{0};
+  std::optional<Time> last_clock;
   bool paused = false;
   std::optional<Time> next_periodic;
   Time last_pose_stamp{Duration{-1}};
@@ -59,14 +79,23 @@ struct RobotBridge::Impl final : TaskObserver, SupervisorObserver {
   bool markings_changed = true;
   std::map<std::string, std::string, std::less<>> last_firing;  // run -> transition id
 
-  Impl(Robot& r, const Clock& c, const DdsSection& s) : robot(r), clock(c), section(s), robot_name(r.description().name) {
+  Impl(Robot& r, const Clock& c, const DdsSection& s, const RobotBridgeOptions& o)
+      : robot(r), clock(c), section(s), options(o), robot_name(r.description().name) {
     ParticipantOptions po;
     po.domain_id = s.domain_id;
     po.network = s.loopback ? Network::loopback : Network::system;
     if (s.participant_lease) po.participant_lease = std::chrono::duration_cast<std::chrono::milliseconds>(*s.participant_lease);
     participant = std::make_unique<Participant>(po);
+    participant->declare_node("tripodal", s.ros_namespace);
     if (s.publishes("odom")) odom.emplace(*participant, name("odom"), EndpointOptions{.kind = TopicKind::state});
-    if (s.publishes("pose")) pose.emplace(*participant, name("pose"), EndpointOptions{.kind = TopicKind::state});
+    if (s.publishes("pose")) pose.emplace(*participant, name("pose"), EndpointOptions{.kind = TopicKind::state, .qos = kPoseQos});
+    if (s.publishes("tf")) {
+      tf.emplace(*participant, name("tf"), EndpointOptions{.kind = TopicKind::state, .qos = kTfQos});
+      tf_static.emplace(*participant, name("tf_static"), EndpointOptions{.kind = TopicKind::map, .qos = kStaticTfQos});
+    }
+    if (s.publishes("clock") && o.simulated_time) {
+      clock_out.emplace(*participant, name("clock"), EndpointOptions{.kind = TopicKind::state, .qos = kClockQos});
+    }
     if (s.publishes("map")) map.emplace(*participant, name("map"), EndpointOptions{.kind = TopicKind::map});
     if (s.publishes("events")) events.emplace(*participant, name("events"), EndpointOptions{.kind = TopicKind::event});
     if (s.publishes("markings")) markings.emplace(*participant, name("markings"), EndpointOptions{.kind = TopicKind::state});
@@ -78,6 +107,7 @@ struct RobotBridge::Impl final : TaskObserver, SupervisorObserver {
     }
     robot.planner().add_observer(*this);
     robot.supervisor().add_observer(*this);
+    if (tf_static) publish_static_frames();
   }
 
   ~Impl() override {
@@ -96,8 +126,40 @@ struct RobotBridge::Impl final : TaskObserver, SupervisorObserver {
     if (which == "events") return ros_topic("tripodal/events", ns);
     if (which == "markings") return ros_topic("tripodal/markings", ns);
     if (which == "task") return ros_topic("tripodal/task", ns);
+    // tf and the clock are global in ROS 2: the robot's frames carry its namespace instead.
+    if (which == "tf") return ros_topic("tf");
+    if (which == "tf_static") return ros_topic("tf_static");
+    if (which == "clock") return ros_topic("clock");
     throw std::invalid_argument("RobotBridge: no topic '" + std::string(which) +
-                                "'; expected odom, pose, map, events, markings or task");
+                                "'; expected odom, pose, map, events, markings, task, tf, tf_static or clock");
+  }
+
+  [[nodiscard]] std::string frame(std::string_view f) const {
+    std::string_view ns = section.ros_namespace;
+    while (!ns.empty() && ns.front() == '/') ns.remove_prefix(1);
+    while (!ns.empty() && ns.back() == '/') ns.remove_suffix(1);
+    return ns.empty() ? std::string(f) : std::string(ns) + "/" + std::string(f);
+  }
+
+  // base_link -> each sensor of the profile: the section's frames (their mounts), then every laser
+  // resource not among them at the base's origin, named after the resource.
+  void publish_static_frames() {
+    msg::TFMessage m;
+    const msg::Time t = stamp(clock.now());
+    std::vector<std::string> named;
+    for (const DdsFrame& f : section.frames) {
+      m.transforms.push_back({{t, frame("base_link")}, frame(f.name), transform_of(f.base_from_frame)});
+      named.push_back(f.name);
+    }
+    const ResourceTable& table = robot.resources();
+    for (std::size_t i = 0; i < table.size(); ++i) {
+      const CResource& r = table.at(i);
+      if (r.reading_type() != typeid(LaserScan)) continue;
+      if (std::find(named.begin(), named.end(), r.name()) != named.end()) continue;
+      m.transforms.push_back({{t, frame("base_link")}, frame(r.name()), transform_of(Pose2D{})});
+    }
+    tf_static->publish(m);
+    ++n_tf_static;
   }
 
   [[nodiscard]] msg::Time stamp(Time t) const { return ros_time(to_seconds(t)); }
@@ -183,8 +245,8 @@ struct RobotBridge::Impl final : TaskObserver, SupervisorObserver {
     if (r == nullptr || !r->has_reading()) return;
     const OdometryReading& o = r->latest();
     msg::Odometry m;
-    m.header = {stamp(now), "odom"};
-    m.child_frame_id = "base_link";
+    m.header = {stamp(now), frame("odom")};
+    m.child_frame_id = frame("base_link");
     m.pose.pose = pose_of(o.pose);
     m.twist.twist = {{o.twist.vx_m_s, o.twist.vy_m_s, 0.0}, {0.0, 0.0, o.twist.wz_rad_s}};
     odom->publish(m);
@@ -197,7 +259,7 @@ struct RobotBridge::Impl final : TaskObserver, SupervisorObserver {
     if (!nav.localized || nav.pose_stamp == last_pose_stamp) return;
     last_pose_stamp = nav.pose_stamp;
     msg::PoseWithCovarianceStamped m;
-    m.header = {stamp(nav.pose_stamp), "map"};
+    m.header = {stamp(nav.pose_stamp), frame("map")};
     m.pose.pose = pose_of(nav.map_from_base);
     // The planar (x, y, theta) covariance into ROS's 6 x 6 over (x, y, z, roll, pitch, yaw), row
     // major: theta is yaw (index 5); the rest stays zero, as amcl leaves it.
@@ -221,7 +283,7 @@ struct RobotBridge::Impl final : TaskObserver, SupervisorObserver {
     if (g->size() == 0 || std::pair{g->width(), g->height()} == map_size) return;
     map_size = {g->width(), g->height()};
     msg::OccupancyGrid m;
-    m.header = {stamp(now), "map"};
+    m.header = {stamp(now), frame("map")};
     m.info.map_load_time = stamp(now);
     m.info.resolution = static_cast<float>(g->resolution_m());
     m.info.width = static_cast<std::uint32_t>(g->width());
@@ -253,6 +315,31 @@ struct RobotBridge::Impl final : TaskObserver, SupervisorObserver {
     }
   }
 
+  // odom -> base_link from the odometry, and map -> odom when the localizer trusts its estimate
+  // (map_from_odom = map_from_base * inverse(odom_from_base)), both stamped with the odometry's time.
+  void publish_tf(Time now) {
+    const ResourceTable& table = robot.resources();
+    const TypedResource<OdometryReading>* r = table.find<OdometryReading>("odometry");
+    if (r == nullptr) r = table.first<OdometryReading>();
+    if (r == nullptr || !r->has_reading()) return;
+    const OdometryReading& o = r->latest();
+    msg::TFMessage m;
+    const NavigationData& nav = robot.navigation();
+    if (nav.localized) {
+      m.transforms.push_back({{stamp(now), frame("map")}, frame("odom"), transform_of(compose(nav.map_from_base, inverse(o.pose)))});
+    }
+    m.transforms.push_back({{stamp(now), frame("odom")}, frame("base_link"), transform_of(o.pose)});
+    tf->publish(m);
+    ++n_tf;
+  }
+
+  void publish_clock(Time now) {
+    if (last_clock && *last_clock == now) return;
+    last_clock = now;
+    clock_out->publish(msg::Clock{stamp(now)});
+    ++n_clock;
+  }
+
   void update() {
     std::vector<msg::TaskCommand> commands;
     {
@@ -261,23 +348,27 @@ struct RobotBridge::Impl final : TaskObserver, SupervisorObserver {
     }
     for (const msg::TaskCommand& c : commands) carry_out(c);
     const Time now = clock.now();
+    // Every update: a use_sim_time node's timers and tf lookups run on it.
+    if (clock_out) publish_clock(now);
     if (map) publish_map(now);
     if (next_periodic && now < *next_periodic) return;
     next_periodic = now + section.period;
     if (odom) publish_odometry(now);
+    if (tf) publish_tf(now);
     if (pose) publish_pose();
     if (markings) publish_markings(now);
   }
 };
 
-RobotBridge::RobotBridge(Robot& robot, const Clock& clock, const DdsSection& section)
-    : impl_(std::make_unique<Impl>(robot, clock, section)) {}
+RobotBridge::RobotBridge(Robot& robot, const Clock& clock, const DdsSection& section, const RobotBridgeOptions& options)
+    : impl_(std::make_unique<Impl>(robot, clock, section, options)) {}
 
 RobotBridge::~RobotBridge() = default;
 
 void RobotBridge::update() { impl_->update(); }
 bool RobotBridge::paused() const noexcept { return impl_->paused; }
 std::string RobotBridge::topic(std::string_view which) const { return impl_->name(which); }
+std::string RobotBridge::frame(std::string_view name) const { return impl_->frame(name); }
 
 std::uint64_t RobotBridge::count(std::string_view which) const noexcept {
   if (which == "odom") return impl_->n_odom;
@@ -286,6 +377,9 @@ std::uint64_t RobotBridge::count(std::string_view which) const noexcept {
   if (which == "events") return impl_->n_events;
   if (which == "markings") return impl_->n_markings;
   if (which == "task") return impl_->n_tasks;
+  if (which == "tf") return impl_->n_tf;
+  if (which == "tf_static") return impl_->n_tf_static;
+  if (which == "clock") return impl_->n_clock;
   return 0;
 }
 

@@ -2,6 +2,7 @@
 #include "tripodal/dds/robot_modules.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <numbers>
 
@@ -18,6 +19,14 @@ std::vector<ParameterSpec> topic_parameters(std::string default_topic) {
 
 std::string text_or(const ParameterSet& p, std::string_view name, const std::string& fallback) {
   return p.contains(name) ? p.string(name) : fallback;
+}
+
+// A module's participant is a ROS 2 node, "tripodal_<module name>" in its topic's namespace, so
+// that `ros2 node list` and `ros2 topic info -v` show who reads the driver's topic.
+void declare_module_node(Participant& participant, std::string_view module, const ParameterSet& p) {
+  std::string name = "tripodal_";
+  for (const char c : module) name += (std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_') ? c : '_';
+  participant.declare_node(name, text_or(p, "namespace", ""));
 }
 
 }  // namespace
@@ -42,6 +51,9 @@ const ModuleManifest& DdsLaserResource::static_manifest() {
                                               "a fault when no scan comes within this (DDS deadline; the publisher must "
                                               "offer one at least as short); 0: none",
                                               0.0)
+                                      .flag("reliable", false,
+                                            "a reliable reader: every scan, the first too, but only reliable publishers "
+                                            "match (false: best effort, ROS 2's sensor-data QoS, any publisher)")
                                       .build();
   return m;
 }
@@ -53,22 +65,25 @@ DdsLaserOptions laser_options(const ParameterSet& p) {
   o.binding = topic_binding(p, "scan");
   o.max_age = from_seconds(p.contains("max_age_s") ? p.number("max_age_s") : 0.5);
   if (p.contains("deadline_s")) o.deadline = from_seconds(p.number("deadline_s"));
+  o.reliable = p.contains("reliable") && p.boolean("reliable");
   return o;
 }
 
 }  // namespace
 
 DdsLaserResource::DdsLaserResource(std::string name, const ParameterSet& parameters)
-    : DdsLaserResource(std::move(name), laser_options(parameters)) {}
+    : DdsLaserResource(std::move(name), laser_options(parameters)) {
+  declare_module_node(*participant_, this->name(), parameters);
+}
 
 DdsLaserResource::DdsLaserResource(std::string name, DdsLaserOptions o)
     : LaserResource(std::move(name), o.max_age, static_manifest()), sender_stamp_(o.lock_step), on_scan_(std::move(o.on_scan)) {
   participant_ = std::make_unique<Participant>(o.binding.participant);
   EndpointOptions options{.kind = TopicKind::scan, .on_status = [this](const StatusEvent& e) { on_status(e); }};
-  if (o.deadline > Duration{0} || o.lock_step) {
+  if (o.deadline > Duration{0} || o.lock_step || o.reliable) {
     Qos q = qos_for(TopicKind::scan, Role::subscriber);
     if (o.deadline > Duration{0}) q.deadline = o.deadline;
-    if (o.lock_step) q.reliability = Reliability::reliable;
+    if (o.lock_step || o.reliable) q.reliability = Reliability::reliable;
     options.qos = q;
   }
   subscriber_ = std::make_unique<Subscriber<msg::LaserScan>>(
@@ -124,6 +139,137 @@ void DdsLaserResource::on_poll(Time now) noexcept {
   commit();
 }
 
+// --- DdsReadingResource ------------------------------------------------------------------------
+
+namespace {
+
+double yaw_of(const msg::Quaternion& q) {
+  return std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
+}
+Pose2D pose2d_of(const msg::Pose& p) { return {p.position.x, p.position.y, yaw_of(p.orientation)}; }
+
+// What each reading type takes from its message, and its type's name, topic and QoS.
+template <class Reading, class Msg>
+struct ReadingTraits;
+
+template <>
+struct ReadingTraits<OdometryReading, msg::Odometry> {
+  static constexpr std::string_view type = "DdsOdometry";
+  static constexpr std::string_view topic = "odom";
+  static constexpr std::string_view output = "odometry";
+  static constexpr std::string_view description = "the latest nav_msgs/Odometry of a DDS topic (a ROS 2 base driver's odom)";
+  static constexpr TopicKind kind = TopicKind::state;
+  static void convert(const msg::Odometry& m, OdometryReading& r) {
+    r.pose = pose2d_of(m.pose.pose);
+    r.twist = {m.twist.twist.linear.x, m.twist.twist.linear.y, m.twist.twist.angular.z};
+  }
+};
+
+template <>
+struct ReadingTraits<GyroReading, msg::Imu> {
+  static constexpr std::string_view type = "DdsImu";
+  static constexpr std::string_view topic = "imu";
+  static constexpr std::string_view output = "gyro";
+  static constexpr std::string_view description = "the yaw rate and yaw of the latest sensor_msgs/Imu of a DDS topic";
+  static constexpr TopicKind kind = TopicKind::scan;  // sensor data: best effort
+  static void convert(const msg::Imu& m, GyroReading& r) {
+    r.yaw_rate_rad_s = m.angular_velocity.z;
+    // orientation_covariance[0] = -1: the IMU gives no orientation (ROS's convention)
+    r.yaw_rad = m.orientation_covariance[0] < 0.0 ? 0.0 : yaw_of(m.orientation);
+  }
+};
+
+template <>
+struct ReadingTraits<PoseEstimate, msg::PoseWithCovarianceStamped> {
+  static constexpr std::string_view type = "DdsPose";
+  static constexpr std::string_view topic = "amcl_pose";
+  static constexpr std::string_view output = "pose_estimate";
+  static constexpr std::string_view description =
+      "the latest geometry_msgs/PoseWithCovarianceStamped of a DDS topic (a ROS 2 localizer's amcl_pose)";
+  // Reliable, volatile: matches AMCL's transient local writer too, and gets its last pose at once.
+  static constexpr TopicKind kind = TopicKind::state;
+  static void convert(const msg::PoseWithCovarianceStamped& m, PoseEstimate& r) {
+    r.map_from_base = pose2d_of(m.pose.pose);
+    constexpr std::array<std::size_t, 3> kRosIndex{0, 1, 5};  // x, y, yaw of ROS's 6 x 6
+    for (std::size_t i = 0; i < 3; ++i) {
+      for (std::size_t j = 0; j < 3; ++j) r.covariance[i * 3 + j] = m.pose.covariance[kRosIndex[i] * 6 + kRosIndex[j]];
+    }
+  }
+};
+
+}  // namespace
+
+template <class Reading, class Msg>
+const ModuleManifest& DdsReadingResource<Reading, Msg>::static_manifest() {
+  using Traits = ReadingTraits<Reading, Msg>;
+  static const ModuleManifest m = ManifestBuilder(std::string(Traits::type), ModuleKind::resource)
+                                      .description(std::string(Traits::description))
+                                      .output(std::string(Traits::output))
+                                      .parameters(topic_parameters(std::string(Traits::topic)))
+                                      .number("max_age_s", 0.5, "s", "older than this the reading is stale; 0: never", 0.0)
+                                      .flag("reliable", Traits::kind != TopicKind::scan,
+                                            "a reliable reader (only reliable publishers match); false: best effort, any "
+                                            "publisher, a sample lost is not repaired")
+                                      .build();
+  return m;
+}
+
+template <class Reading, class Msg>
+DdsReadingResource<Reading, Msg>::DdsReadingResource(std::string name, const ParameterSet& p)
+    : TypedResource<Reading>(std::move(name), from_seconds(p.contains("max_age_s") ? p.number("max_age_s") : 0.5),
+                             static_manifest()) {
+  using Traits = ReadingTraits<Reading, Msg>;
+  const TopicBinding b = topic_binding(p, Traits::topic);
+  participant_ = std::make_unique<Participant>(b.participant);
+  declare_module_node(*participant_, this->name(), p);
+  EndpointOptions options{.kind = Traits::kind, .on_status = [this](const StatusEvent& e) {
+                            if (e.kind == StatusKind::liveliness_lost && e.current_count == 0) {
+                              faults_.report("the publisher of " + e.topic + " went silent (DDS liveliness lost)");
+                            }
+                          }};
+  Qos q = qos_for(Traits::kind, Role::subscriber);
+  q.reliability = (p.contains("reliable") ? p.boolean("reliable") : Traits::kind != TopicKind::scan) ? Reliability::reliable
+                                                                                                    : Reliability::best_effort;
+  options.qos = q;
+  subscriber_ = std::make_unique<Subscriber<Msg>>(*participant_, b.topic, options, [this](const Msg& m) {
+    {
+      std::lock_guard lock(mutex_);
+      Traits::convert(m, pending_);
+      has_pending_.store(true, std::memory_order_release);
+    }
+    received_.fetch_add(1, std::memory_order_acq_rel);
+  });
+}
+
+template <class Reading, class Msg>
+DdsReadingResource<Reading, Msg>::~DdsReadingResource() {
+  subscriber_.reset();
+}
+
+template <class Reading, class Msg>
+const std::string& DdsReadingResource<Reading, Msg>::topic() const noexcept {
+  return subscriber_->topic();
+}
+template <class Reading, class Msg>
+std::size_t DdsReadingResource<Reading, Msg>::matched_publishers() const {
+  return subscriber_->matched_publishers();
+}
+
+template <class Reading, class Msg>
+void DdsReadingResource<Reading, Msg>::on_poll(Time now) noexcept {
+  if (!has_pending_.load(std::memory_order_acquire)) return;
+  std::lock_guard lock(mutex_);
+  Reading& latest = this->edit();
+  latest = pending_;
+  latest.stamp = now;  // the sender's clock is not the loop's
+  has_pending_.store(false, std::memory_order_relaxed);
+  this->commit();
+}
+
+template class DdsReadingResource<OdometryReading, msg::Odometry>;
+template class DdsReadingResource<GyroReading, msg::Imu>;
+template class DdsReadingResource<PoseEstimate, msg::PoseWithCovarianceStamped>;
+
 // --- DdsCmdVelController -----------------------------------------------------------------------
 
 const ModuleManifest& DdsCmdVelController::static_manifest() {
@@ -144,6 +290,7 @@ DdsCmdVelController::DdsCmdVelController(const ControllerConfig& config, Hardwar
   holonomic_ = config.parameters.contains("holonomic") && config.parameters.boolean("holonomic");
   const TopicBinding b = topic_binding(config.parameters, "cmd_vel");
   participant_ = std::make_unique<Participant>(b.participant);
+  declare_module_node(*participant_, config.name, config.parameters);
   publisher_ = std::make_unique<Publisher<msg::Twist>>(*participant_, b.topic, EndpointOptions{.kind = TopicKind::command});
 }
 

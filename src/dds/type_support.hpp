@@ -5,6 +5,7 @@
 #include <dds/dds.h>
 
 #include <algorithm>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -165,6 +166,133 @@ struct TypeSupport<msg::Clock> {
   static const dds_topic_descriptor_t* descriptor() { return &rosgraph_msgs_msg_dds__Clock__desc; }
   static C to_c(const msg::Clock& m) { return {detail::to_c(m.clock)}; }
   static msg::Clock from_c(const C& c) { return {detail::from_c(c.clock)}; }
+};
+
+inline geometry_msgs_msg_dds__Quaternion_ to_c(const msg::Quaternion& q) { return {q.x, q.y, q.z, q.w}; }
+inline msg::Quaternion from_c(const geometry_msgs_msg_dds__Quaternion_& q) { return {q.x, q.y, q.z, q.w}; }
+
+inline geometry_msgs_msg_dds__TransformStamped_ to_c(const msg::TransformStamped& t) {
+  return {detail::to_c(t.header), view(t.child_frame_id),
+          {detail::to_c(t.transform.translation), detail::to_c(t.transform.rotation)}};
+}
+inline msg::TransformStamped from_c(const geometry_msgs_msg_dds__TransformStamped_& c) {
+  return {detail::from_c(c.header), text(c.child_frame_id),
+          {detail::from_c(c.transform.translation), detail::from_c(c.transform.rotation)}};
+}
+
+template <>
+struct TypeSupport<msg::TFMessage> {
+  using C = tf2_msgs_msg_dds__TFMessage_;
+  using Scratch = std::vector<geometry_msgs_msg_dds__TransformStamped_>;
+  static const dds_topic_descriptor_t* descriptor() { return &tf2_msgs_msg_dds__TFMessage__desc; }
+  static C to_c(const msg::TFMessage& m, Scratch& transforms) {
+    transforms.clear();
+    for (const msg::TransformStamped& t : m.transforms) transforms.push_back(detail::to_c(t));
+    return {view_sequence<dds_sequence_geometry_msgs_msg_dds__TransformStamped_>(transforms)};
+  }
+  static msg::TFMessage from_c(const C& c) {
+    msg::TFMessage m;
+    if (c.transforms._buffer != nullptr) {
+      for (std::uint32_t i = 0; i < c.transforms._length; ++i) m.transforms.push_back(detail::from_c(c.transforms._buffer[i]));
+    }
+    return m;
+  }
+};
+
+template <>
+struct TypeSupport<msg::Imu> {
+  using C = sensor_msgs_msg_dds__Imu_;
+  static const dds_topic_descriptor_t* descriptor() { return &sensor_msgs_msg_dds__Imu__desc; }
+  static C to_c(const msg::Imu& m) {
+    C c{};
+    c.header = detail::to_c(m.header);
+    c.orientation = detail::to_c(m.orientation);
+    std::copy(m.orientation_covariance.begin(), m.orientation_covariance.end(), c.orientation_covariance);
+    c.angular_velocity = detail::to_c(m.angular_velocity);
+    std::copy(m.angular_velocity_covariance.begin(), m.angular_velocity_covariance.end(), c.angular_velocity_covariance);
+    c.linear_acceleration = detail::to_c(m.linear_acceleration);
+    std::copy(m.linear_acceleration_covariance.begin(), m.linear_acceleration_covariance.end(), c.linear_acceleration_covariance);
+    return c;
+  }
+  static msg::Imu from_c(const C& c) {
+    msg::Imu m;
+    m.header = detail::from_c(c.header);
+    m.orientation = detail::from_c(c.orientation);
+    std::copy(std::begin(c.orientation_covariance), std::end(c.orientation_covariance), m.orientation_covariance.begin());
+    m.angular_velocity = detail::from_c(c.angular_velocity);
+    std::copy(std::begin(c.angular_velocity_covariance), std::end(c.angular_velocity_covariance), m.angular_velocity_covariance.begin());
+    m.linear_acceleration = detail::from_c(c.linear_acceleration);
+    std::copy(std::begin(c.linear_acceleration_covariance), std::end(c.linear_acceleration_covariance),
+              m.linear_acceleration_covariance.begin());
+    return m;
+  }
+};
+
+// The graph's message holds fixed-size names and gid structs: copied into the scratch, which
+// lives until the write returns.
+template <>
+struct TypeSupport<msg::ParticipantEntitiesInfo> {
+  using C = rmw_dds_common_msg_dds__ParticipantEntitiesInfo_;
+  using CGid = rmw_dds_common_msg_dds__Gid_;
+  using CNode = rmw_dds_common_msg_dds__NodeEntitiesInfo_;
+  struct Scratch {
+    std::vector<CNode> nodes;
+    std::vector<std::vector<CGid>> gids;
+  };
+  static const dds_topic_descriptor_t* descriptor() { return &rmw_dds_common_msg_dds__ParticipantEntitiesInfo__desc; }
+  static CGid gid_to_c(const msg::Gid& g) {
+    CGid c{};
+    std::copy(g.begin(), g.end(), c.data);
+    return c;
+  }
+  static msg::Gid gid_from_c(const CGid& c) {
+    msg::Gid g{};
+    std::copy(std::begin(c.data), std::end(c.data), g.begin());
+    return g;
+  }
+  template <std::size_t N>
+  static void copy_name(char (&to)[N], const std::string& from) {
+    const std::size_t n = std::min(from.size(), N - 1);  // names are checked to fit before
+    std::memcpy(to, from.data(), n);
+    to[n] = '\0';
+  }
+  static dds_sequence_rmw_dds_common_msg_dds__Gid_ gids_to_c(const std::vector<msg::Gid>& from, Scratch& scratch) {
+    std::vector<CGid>& held = scratch.gids.emplace_back();
+    for (const msg::Gid& g : from) held.push_back(gid_to_c(g));
+    return view_sequence<dds_sequence_rmw_dds_common_msg_dds__Gid_>(held);
+  }
+  static std::vector<msg::Gid> gids_from_c(const dds_sequence_rmw_dds_common_msg_dds__Gid_& c) {
+    std::vector<msg::Gid> out;
+    if (c._buffer != nullptr) {
+      for (std::uint32_t i = 0; i < c._length; ++i) out.push_back(gid_from_c(c._buffer[i]));
+    }
+    return out;
+  }
+  static C to_c(const msg::ParticipantEntitiesInfo& m, Scratch& scratch) {
+    scratch.nodes.clear();
+    scratch.gids.clear();
+    scratch.gids.reserve(2 * m.node_entities_info_seq.size());  // the views point into these vectors
+    for (const msg::NodeEntitiesInfo& n : m.node_entities_info_seq) {
+      CNode& c = scratch.nodes.emplace_back();
+      copy_name(c.node_namespace, n.node_namespace);
+      copy_name(c.node_name, n.node_name);
+      c.reader_gid_seq = gids_to_c(n.reader_gid_seq, scratch);
+      c.writer_gid_seq = gids_to_c(n.writer_gid_seq, scratch);
+    }
+    return {gid_to_c(m.gid), view_sequence<dds_sequence_rmw_dds_common_msg_dds__NodeEntitiesInfo_>(scratch.nodes)};
+  }
+  static msg::ParticipantEntitiesInfo from_c(const C& c) {
+    msg::ParticipantEntitiesInfo m;
+    m.gid = gid_from_c(c.gid);
+    if (c.node_entities_info_seq._buffer != nullptr) {
+      for (std::uint32_t i = 0; i < c.node_entities_info_seq._length; ++i) {
+        const CNode& n = c.node_entities_info_seq._buffer[i];
+        m.node_entities_info_seq.push_back({text(n.node_namespace), text(n.node_name), gids_from_c(n.reader_gid_seq),
+                                            gids_from_c(n.writer_gid_seq)});
+      }
+    }
+    return m;
+  }
 };
 
 template <>

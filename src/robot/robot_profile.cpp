@@ -173,7 +173,7 @@ struct Parser {
   void dds_section(const YAML::Node& n, RobotProfile& prof) {
     DdsSection s;
     s.where = at(n);
-    if (!r.expect_keys(n, {"domain_id", "namespace", "loopback", "participant_lease_s", "period_s", "publish", "tasks"}, "dds")) {
+    if (!r.expect_keys(n, {"domain_id", "namespace", "loopback", "participant_lease_s", "period_s", "publish", "tasks", "frames"}, "dds")) {
       return;
     }
     if (const YAML::Node v = n["domain_id"]) {
@@ -201,11 +201,25 @@ struct Parser {
     if (const YAML::Node v = n["tasks"]) {
       if (auto b = r.boolean(v, "dds tasks")) s.tasks = *b;
     }
+    if (const YAML::Node v = n["frames"]) {
+      if (r.expect_map(v, "dds frames")) {
+        for (const auto& kv : v) {
+          const auto frame = r.key(kv.first, "dds frames");
+          if (!frame) continue;
+          if (!is_ros_namespace(*frame) || frame->find('/') != std::string::npos || frame->empty()) {
+            d.error(at(kv.first), "dds frames: '" + *frame + "' is not a frame name (letters, digits and '_')");
+            continue;
+          }
+          const auto xyt = r.numbers(kv.second, "dds frames " + *frame, 3, 3, "[x_m, y_m, theta_rad]");
+          if (xyt) s.frames.push_back({*frame, Pose2D{(*xyt)[0], (*xyt)[1], (*xyt)[2]}, at(kv.first)});
+        }
+      }
+    }
     if (const YAML::Node v = n["publish"]) {
       if (r.expect_list(v, "dds publish")) {
         std::map<std::string, SourceLocation> seen;
         for (const auto& item : v) {
-          auto topic = r.choice(item, "dds publish", {"odom", "pose", "map", "events", "markings"});
+          auto topic = r.choice(item, "dds publish", {"odom", "pose", "map", "events", "markings", "tf", "clock"});
           if (!topic) continue;
           auto [it, fresh] = seen.emplace(*topic, at(item));
           if (!fresh) {

@@ -80,6 +80,9 @@ TEST_CASE("dds: the type names are those ROS 2 registers", "[dds]") {
   CHECK(MessageType<msg::Clock>::dds == "rosgraph_msgs::msg::dds_::Clock_");
   CHECK(MessageType<msg::SimStep>::dds == "tripodal_msgs::msg::dds_::SimStep_");
   CHECK(MessageType<msg::SimState>::dds == "tripodal_msgs::msg::dds_::SimState_");
+  CHECK(MessageType<msg::TFMessage>::dds == "tf2_msgs::msg::dds_::TFMessage_");
+  CHECK(MessageType<msg::Imu>::dds == "sensor_msgs::msg::dds_::Imu_");
+  CHECK(MessageType<msg::ParticipantEntitiesInfo>::dds == "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_");
   CHECK(ros_topic("cmd_vel") == "rt/cmd_vel");
   CHECK(ros_topic("/cmd_vel", "/robot1/") == "rt/robot1/cmd_vel");
   CHECK(ros_seconds(ros_time(-1.25)) == Approx(-1.25));
@@ -155,6 +158,49 @@ TEST_CASE("dds: golden CDR bytes of every message type", "[dds]") {
   SECTION("rosgraph_msgs/Clock") {
     const msg::Clock m{{78, 900000000}};
     check_golden(p, m, CdrWriter().time(m.clock).bytes());
+  }
+  SECTION("tf2_msgs/TFMessage") {
+    msg::TFMessage m;
+    m.transforms.push_back({{{12, 5}, "psr2/odom"}, "psr2/base_link", {{1.5, -2.0, 0.0}, {0.0, 0.0, 0.6, 0.8}}});
+    m.transforms.push_back({{{12, 5}, "psr2/map"}, "psr2/odom", {{0.25, 0.0, 0.0}, {}}});
+    // the count, then per transform: header, child frame, translation and rotation (doubles at 8)
+    CdrWriter w;
+    w.u32(2);
+    for (const auto& t : m.transforms) {
+      w.header(t.header).str(t.child_frame_id);
+      w.f64(t.transform.translation.x).f64(t.transform.translation.y).f64(t.transform.translation.z);
+      w.f64(t.transform.rotation.x).f64(t.transform.rotation.y).f64(t.transform.rotation.z).f64(t.transform.rotation.w);
+    }
+    check_golden(p, m, w.bytes());
+  }
+  SECTION("sensor_msgs/Imu") {
+    msg::Imu m;
+    m.header = {{3, 7}, "imu_link"};
+    m.orientation = {0.0, 0.0, 0.6, 0.8};
+    m.orientation_covariance[0] = 0.01;
+    m.angular_velocity = {0.0, 0.0, 0.5};
+    m.linear_acceleration = {0.1, 0.0, 9.81};
+    m.linear_acceleration_covariance[8] = -1.0;
+    CdrWriter w;
+    w.header(m.header).f64(m.orientation.x).f64(m.orientation.y).f64(m.orientation.z).f64(m.orientation.w);
+    w.f64s(m.orientation_covariance).f64(0.0).f64(0.0).f64(0.5).f64s(m.angular_velocity_covariance);
+    w.f64(0.1).f64(0.0).f64(9.81).f64s(m.linear_acceleration_covariance);
+    check_golden(p, m, w.bytes());
+  }
+  SECTION("rmw_dds_common/ParticipantEntitiesInfo") {
+    msg::ParticipantEntitiesInfo m;
+    for (std::uint8_t i = 0; i < 16; ++i) m.gid[i] = i;
+    msg::Gid reader{};
+    reader.fill(0xaa);
+    m.node_entities_info_seq.push_back({"/psr2", "tripodal", {reader}, {}});
+    // the gid's 16 bytes, the node count, the two names (bounded strings are written as strings),
+    // one reader gid, no writer gid
+    CdrWriter w;
+    for (const auto b : m.gid) w.u8(b);
+    w.u32(1).str("/psr2").str("tripodal").u32(1);
+    for (const auto b : reader) w.u8(b);
+    w.u32(0);
+    check_golden(p, m, w.bytes());
   }
   SECTION("nav_msgs/OccupancyGrid") {
     const auto m = sample_grid();

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <optional>
 #include <sstream>
@@ -78,7 +79,7 @@ TEST_CASE("dds: a robot with a dds: section publishes its state and takes a task
                            "\n  namespace: " + ns + "\n  participant_lease_s: 1\n  period_s: 0.1\n";
   const RobotProfile profile = load_robot_profile_from_string(yaml, "psr2-dds.yaml", kConfigs / "robots");
   REQUIRE(profile.dds);
-  CHECK(profile.dds->publish == std::vector<std::string>{"odom", "pose", "map", "events", "markings"});
+  CHECK(profile.dds->publish == std::vector<std::string>{"odom", "pose", "map", "events", "markings", "tf", "clock"});
 
   RobotPlugins plugins = RobotPlugins::with_builtins();
   sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml")));
@@ -123,8 +124,9 @@ TEST_CASE("dds: a robot with a dds: section publishes its state and takes a task
   };
 
   REQUIRE(run_until([&] { return odoms.size() >= 5; }, 100));
-  CHECK(odoms.back().header.frame_id == "odom");
-  CHECK(odoms.back().child_frame_id == "base_link");
+  // Frames carry the namespace as a tf prefix, as on /tf.
+  CHECK(odoms.back().header.frame_id == ns + "/odom");
+  CHECK(odoms.back().child_frame_id == ns + "/base_link");
   CHECK(ros_seconds(odoms.back().header.stamp) > ros_seconds(odoms.front().header.stamp));  // the robot's clock
   CHECK_FALSE(robot->planner().busy());
 
@@ -132,7 +134,7 @@ TEST_CASE("dds: a robot with a dds: section publishes its state and takes a task
   Subscriber<msg::OccupancyGrid> map(peer, ros_topic("map", ns), {.kind = TopicKind::map});
   const std::optional<msg::OccupancyGrid> grid = map.take_one(5s);
   REQUIRE(grid);
-  CHECK(grid->header.frame_id == "map");
+  CHECK(grid->header.frame_id == ns + "/map");
   CHECK(grid->info.width > 0);
   CHECK(grid->data.size() == static_cast<std::size_t>(grid->info.width) * grid->info.height);
   CHECK(bridge.count("map") == 1);
@@ -153,7 +155,7 @@ TEST_CASE("dds: a robot with a dds: section publishes its state and takes a task
   CHECK(run_until([&] { return !poses.empty(); }, 100));
   if (!poses.empty()) {
     const msg::PoseWithCovarianceStamped& p = poses.back();
-    CHECK(p.header.frame_id == "map");
+    CHECK(p.header.frame_id == ns + "/map");
     // The scan-matching localizer's covariance, on ROS's (x, y, z, roll, pitch, yaw) axes: the
     // planar variances positive (a clear match: a standard deviation under 10 cm), symmetric, and
     // nothing on the axes a ground robot does not move along.
@@ -181,6 +183,86 @@ TEST_CASE("dds: a robot with a dds: section publishes its state and takes a task
   CHECK(cancelled);
   CHECK(has_event(seen, "command_accepted", "task_command/44"));
   CHECK_FALSE(robot->planner().busy());
+}
+
+TEST_CASE("dds: the robot's frames on /tf and /tf_static, its time on /clock, amcl_pose latched", "[dds]") {
+  const std::uint32_t domain = test_domain(34);
+  const std::string ns = test_namespace();
+  const std::string yaml = read_text(kConfigs / "robots/psr2.yaml") + "\ndds:\n  domain_id: " + std::to_string(domain) +
+                           "\n  namespace: " + ns + "\n  participant_lease_s: 1\n  period_s: 0.1\n  tasks: false\n" +
+                           "  frames: {front_laser: [0.2, 0.0, 0.0]}\n";
+  const RobotProfile profile = load_robot_profile_from_string(yaml, "psr2-dds.yaml", kConfigs / "robots");
+  RobotPlugins plugins = RobotPlugins::with_builtins();
+  sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml")));
+  SimClock clock;
+  const auto robot = Robot::assemble(profile, plugins, clock);
+
+  Participant peer(test_options(34));
+  const Qos latched{Reliability::reliable, Durability::transient_local, 1, {}, Liveliness::automatic, {}};
+  Subscriber<msg::TFMessage> tf(peer, "rt/tf", {.kind = TopicKind::state});
+  Subscriber<msg::Clock> clock_in(peer, "rt/clock", {.qos = qos_for(TopicKind::scan, Role::subscriber)});
+  RobotBridge bridge(*robot, clock, *profile.dds, RobotBridgeOptions{.simulated_time = true});
+  REQUIRE(tf.wait_for_publishers(1, 5s));
+  REQUIRE(clock_in.wait_for_publishers(1, 5s));
+
+  std::vector<msg::TFMessage> tfs;
+  std::vector<msg::Clock> clocks;
+  bool localized = false;
+  for (int i = 0; i < 200 && !(localized && tfs.size() >= 3); ++i) {
+    robot->run_for(100ms);
+    bridge.update();
+    std::this_thread::sleep_for(2ms);
+    for (auto& m : tf.take()) tfs.push_back(m);
+    for (auto& c : clock_in.take()) clocks.push_back(c);
+    localized = robot->navigation().localized;
+  }
+  REQUIRE(localized);
+  // The samples of the last update, on their way.
+  for (int i = 0; i < 100 && (clocks.empty() || tfs.empty() || clocks.back().clock != ros_time(clock.now())); ++i) {
+    std::this_thread::sleep_for(5ms);
+    for (auto& m : tf.take()) tfs.push_back(m);
+    for (auto& c : clock_in.take()) clocks.push_back(c);
+  }
+  REQUIRE_FALSE(clocks.empty());
+  CHECK(clocks.back().clock == ros_time(clock.now()));  // the robot's simulated time
+  CHECK(bridge.count("clock") >= clocks.size());
+
+  // The last /tf: map -> odom -> base_link composes to the localizer's map_from_base, odom ->
+  // base_link is the odometry.
+  REQUIRE_FALSE(tfs.empty());
+  const msg::TFMessage& last = tfs.back();
+  REQUIRE(last.transforms.size() == 2);
+  const msg::TransformStamped& map_odom = last.transforms[0];
+  const msg::TransformStamped& odom_base = last.transforms[1];
+  CHECK(map_odom.header.frame_id == ns + "/map");
+  CHECK(map_odom.child_frame_id == ns + "/odom");
+  CHECK(odom_base.header.frame_id == ns + "/odom");
+  CHECK(odom_base.child_frame_id == ns + "/base_link");
+  auto pose_of = [](const msg::Transform& t) {
+    return Pose2D{t.translation.x, t.translation.y, 2.0 * std::atan2(t.rotation.z, t.rotation.w)};
+  };
+  const Pose2D odom_from_base = robot->resources().first<OdometryReading>()->latest().pose;
+  CHECK(pose_of(odom_base.transform).x_m == Approx(odom_from_base.x_m).margin(1e-9));
+  CHECK(pose_of(odom_base.transform).y_m == Approx(odom_from_base.y_m).margin(1e-9));
+  const Pose2D map_from_base = compose(pose_of(map_odom.transform), pose_of(odom_base.transform));
+  const Pose2D expected = robot->navigation().map_from_base;
+  CHECK(map_from_base.x_m == Approx(expected.x_m).margin(1e-9));
+  CHECK(map_from_base.y_m == Approx(expected.y_m).margin(1e-9));
+  CHECK(wrap_angle(map_from_base.theta_rad - expected.theta_rad) == Approx(0.0).margin(1e-9));
+
+  // Latched, as tf2's static broadcaster and Nav2's AMCL: subscribers that come late, asking for
+  // transient local, get the sensors' frames and the last pose (a volatile writer refuses them).
+  Subscriber<msg::TFMessage> tf_static(peer, "rt/tf_static", {.qos = latched});
+  const auto statics = tf_static.take_one(5s);
+  REQUIRE(statics);
+  REQUIRE(statics->transforms.size() == 1);
+  CHECK(statics->transforms[0].header.frame_id == ns + "/base_link");
+  CHECK(statics->transforms[0].child_frame_id == ns + "/front_laser");
+  CHECK(statics->transforms[0].transform.translation.x == 0.2);
+  Subscriber<msg::PoseWithCovarianceStamped> amcl(peer, ros_topic("amcl_pose", ns), {.qos = latched});
+  const auto pose = amcl.take_one(5s);
+  REQUIRE(pose);
+  CHECK(pose->header.frame_id == ns + "/map");
 }
 
 TEST_CASE("dds: a pause command holds the run until resume", "[dds]") {
@@ -237,7 +319,10 @@ TEST_CASE("dds: a malformed dds: section is refused, located", "[dds]") {
              Catch::Contains("bot.yaml:2:18: error: dds namespace '1st/robot' is not a ROS 2 namespace"));
   CHECK_THAT(errors_of("{namespace: 'a b'}"), Catch::Contains("dds namespace 'a b' is not a ROS 2 namespace"));
   CHECK_THAT(errors_of("{publish: [odom, scans]}"),
-             Catch::Contains("bot.yaml:2:23: error: dds publish: expected one of odom, pose, map, events, markings; got 'scans'"));
+             Catch::Contains("bot.yaml:2:23: error: dds publish: expected one of odom, pose, map, events, markings, tf, clock; got 'scans'"));
+  CHECK_THAT(errors_of("{frames: {laser: [0.1, 0]}}"),
+             Catch::Contains("bot.yaml:2:23: error: dds frames laser: expected [x_m, y_m, theta_rad], got a list of 2 items"));
+  CHECK_THAT(errors_of("{frames: {'a/b': [0, 0, 0]}}"), Catch::Contains("bot.yaml:2:16: error: dds frames: 'a/b' is not a frame name"));
   CHECK_THAT(errors_of("{publish: [odom, map, odom]}"),
              Catch::Contains("bot.yaml:2:28: error: dds publish lists 'odom' twice (first at bot.yaml:2:17)"));
   CHECK_THAT(errors_of("{domain: 3}"), Catch::Contains("bot.yaml:2:7: error: unknown key 'domain' in dds; expected one of: domain_id"));
@@ -258,7 +343,8 @@ TEST_CASE("dds: a malformed dds: section is refused, located", "[dds]") {
     CHECK_THAT(e.what(), Catch::Contains("psr.yaml:2:6: error: dds: the robot's name 'PSR-2' is not a ROS 2 namespace"));
   }
   const RobotProfile ok = load_robot_profile_from_string(
-      "robot: {name: bot}\ndds: {domain_id: 7, namespace: /fleet/bot_1, loopback: false, publish: [events], tasks: false}\n", "ok.yaml",
+      "robot: {name: bot}\ndds: {domain_id: 7, namespace: /fleet/bot_1, loopback: false, publish: [events], tasks: false,\n"
+      "      frames: {laser: [0.2, -0.1, 3.14], sonar_1: [0, 0, 0]}}\n", "ok.yaml",
       kConfigs / "robots");
   REQUIRE(ok.dds);
   CHECK(ok.dds->domain_id == 7);
@@ -267,6 +353,10 @@ TEST_CASE("dds: a malformed dds: section is refused, located", "[dds]") {
   CHECK(ok.dds->publish == std::vector<std::string>{"events"});
   CHECK_FALSE(ok.dds->tasks);
   CHECK(ok.dds->where.line == 2);
+  REQUIRE(ok.dds->frames.size() == 2);
+  CHECK(ok.dds->frames[0].name == "laser");
+  CHECK(ok.dds->frames[0].base_from_frame == Pose2D{0.2, -0.1, 3.14});
+  CHECK(ok.dds->frames[1].name == "sonar_1");
   CHECK_FALSE(load_robot_profile_from_string("robot: {name: bot}\n", "none.yaml", kConfigs / "robots").dds);
 }
 

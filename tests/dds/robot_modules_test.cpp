@@ -104,3 +104,74 @@ TEST_CASE("dds: the dds_cmd_vel controller publishes its limited command", "[dds
   CHECK(controller->odometry().pose.theta_rad == Approx(0.06));
   CHECK(controller->wheel_commands().empty());
 }
+
+TEST_CASE("dds: DdsPose, DdsImu and DdsOdometry hold a ROS 2 node's pose, IMU and odometry", "[dds]") {
+  RobotPlugins plugins = RobotPlugins::with_builtins();
+  register_dds_modules(plugins.resources, plugins.controllers);
+  const std::uint32_t domain = test_domain(22);
+  auto create = [&](const std::string& type, const std::string& name) {
+    ResourceConfig config{name, ParameterSet::resolve(plugins.resources.manifest(type), binding(domain)), {}, nullptr};
+    return plugins.resources.create(type, config);
+  };
+  auto pose_r = create("DdsPose", "amcl");
+  auto imu_r = create("DdsImu", "imu");
+  auto odom_r = create("DdsOdometry", "wheels");
+  auto& pose = dynamic_cast<DdsPoseResource&>(*pose_r);
+  auto& imu = dynamic_cast<DdsImuResource&>(*imu_r);
+  auto& odom = dynamic_cast<DdsOdometryResource&>(*odom_r);
+  CHECK(pose.topic() == ros_topic("amcl_pose", test_namespace()));
+  CHECK(imu.topic() == ros_topic("imu", test_namespace()));
+  CHECK(odom.topic() == ros_topic("odom", test_namespace()));
+
+  Participant p(module_options(domain));
+  // AMCL's QoS (reliable, transient local): the resource's reliable volatile reader matches it.
+  Publisher<msg::PoseWithCovarianceStamped> amcl(
+      p, ros_topic("amcl_pose", test_namespace()),
+      {.qos = Qos{Reliability::reliable, Durability::transient_local, 1, {}, Liveliness::automatic, {}}});
+  Publisher<msg::Imu> imu_pub(p, ros_topic("imu", test_namespace()), {.kind = TopicKind::scan});
+  Publisher<msg::Odometry> odom_pub(p, ros_topic("odom", test_namespace()), {.kind = TopicKind::state});
+  REQUIRE(amcl.wait_for_subscribers(1, 5s));
+  REQUIRE(imu_pub.wait_for_subscribers(1, 5s));
+  REQUIRE(odom_pub.wait_for_subscribers(1, 5s));
+
+  const double yaw = 0.7;
+  const msg::Quaternion q{0.0, 0.0, std::sin(yaw / 2.0), std::cos(yaw / 2.0)};
+  msg::PoseWithCovarianceStamped a;
+  a.pose.pose = {{1.5, -2.0, 0.0}, q};
+  a.pose.covariance[0] = 0.04;   // x x
+  a.pose.covariance[1] = 0.01;   // x y
+  a.pose.covariance[35] = 0.09;  // yaw yaw
+  amcl.publish(a);
+  msg::Imu m;
+  m.orientation = q;
+  m.angular_velocity.z = -0.25;
+  imu_pub.publish(m);
+  msg::Odometry o;
+  o.pose.pose = {{3.0, 4.0, 0.0}, q};
+  o.twist.twist = {{0.2, 0.1, 0.0}, {0.0, 0.0, 0.3}};
+  odom_pub.publish(o);
+
+  const Time t0 = time_from_seconds(5.0);
+  for (int i = 0; i < 1000 && (pose.received() == 0 || imu.received() == 0 || odom.received() == 0); ++i) std::this_thread::sleep_for(2ms);
+  pose.poll(t0);
+  imu.poll(t0);
+  odom.poll(t0);
+  REQUIRE(pose.has_reading());
+  REQUIRE(imu.has_reading());
+  REQUIRE(odom.has_reading());
+  CHECK(pose.latest().stamp == t0);
+  CHECK(pose.latest().map_from_base.x_m == 1.5);
+  CHECK(pose.latest().map_from_base.y_m == -2.0);
+  CHECK(pose.latest().map_from_base.theta_rad == Approx(yaw));
+  // ROS's 6 x 6 over (x, y, z, roll, pitch, yaw) to the planar 3 x 3 over (x, y, yaw).
+  CHECK(pose.latest().covariance == std::array<double, 9>{0.04, 0.01, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.09});
+  CHECK(imu.latest().yaw_rate_rad_s == -0.25);
+  CHECK(imu.latest().yaw_rad == Approx(yaw));
+  CHECK(odom.latest().pose.x_m == 3.0);
+  CHECK(odom.latest().pose.theta_rad == Approx(yaw));
+  CHECK(odom.latest().twist.vy_m_s == 0.1);
+  CHECK(odom.latest().twist.wz_rad_s == 0.3);
+  // Profile parameters are checked by the manifest: reliable is a flag.
+  CHECK_THROWS_WITH(ParameterSet::resolve(plugins.resources.manifest("DdsPose"), {{"reliable", Value{2.0}}}),
+                    Catch::Contains("reliable"));
+}

@@ -7,6 +7,7 @@
 
 #include "cli_tool.hpp"
 #include "guide_hri.hpp"
+#include "run_task.hpp"
 #include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/behaviors/behavior_registry.hpp"
 #include "tripodal/controllers/controller_config.hpp"
@@ -64,6 +65,7 @@ int describe(const Args& args, std::ostream& out, std::ostream& err) {
     // robot's gestures and HRI (the types `tripodal run` registers).
     RobotPlugins plugins = RobotPlugins::with_builtins();
     sim::register_sim_hardware(plugins.hardware);
+    app::register_dds_robot_modules(plugins);
     register_gesture_behaviors(plugins.behaviors);
     app::register_guide_modules(plugins.modules);
     const RobotDescription r = describe_robot(profile, plugins, knowledge_inputs(tasks), d);

@@ -31,6 +31,7 @@
 #ifdef TRIPODAL_HAVE_DDS
 #include "tripodal/dds/dds_hardware.hpp"
 #include "tripodal/dds/robot_bridge.hpp"
+#include "tripodal/dds/robot_modules.hpp"
 #endif
 
 namespace tripodal::app {
@@ -190,12 +191,19 @@ std::vector<ParameterOverride> simulation_overrides(const RobotProfile& profile,
   return out;
 }
 
+#ifdef TRIPODAL_HAVE_DDS
+void register_dds_robot_modules(RobotPlugins& plugins) { dds::register_dds_modules(plugins.resources, plugins.controllers); }
+#else
+void register_dds_robot_modules(RobotPlugins&) {}
+#endif
+
 // The robot on DDS when its profile has a `dds:` section (docs/distribution.md); a tool built
 // without the dds area refuses such a profile rather than run a robot its peers cannot see.
 #ifdef TRIPODAL_HAVE_DDS
 using DdsBridge = dds::RobotBridge;
 std::unique_ptr<DdsBridge> make_dds_bridge(Robot& robot, const Clock& clock, const RobotProfile& profile) {
-  return profile.dds ? std::make_unique<DdsBridge>(robot, clock, *profile.dds) : nullptr;
+  // The run's clock is the simulation's, never the wall's: it goes out on /clock.
+  return profile.dds ? std::make_unique<DdsBridge>(robot, clock, *profile.dds, dds::RobotBridgeOptions{.simulated_time = true}) : nullptr;
 }
 #else
 struct DdsBridge {
@@ -336,6 +344,7 @@ RunResult run_task(const RunOptions& o) {
   sim::register_sim_hardware(plugins.hardware, world);
   sim::register_sim_board_hardware(plugins.hardware, world);
   register_remote_hardware(plugins.hardware, world);
+  register_dds_robot_modules(plugins);
   board::register_board_modules(plugins.modules);
   board::register_board_behaviors(plugins.behaviors);
   RobotOptions ro;

@@ -21,7 +21,16 @@
 #include "tripodal/navi/coverage.hpp"
 #include "tripodal/navi/localizer.hpp"
 
+namespace tripodal {
+struct RobotPlugins;
+}
+
 namespace tripodal::app {
+
+/// With the dds area: its resource and controller types (DdsLaser, DdsOdometry, DdsImu, DdsPose,
+/// dds_cmd_vel), so that any robot profile can name them; without it, nothing (such a profile is
+/// then refused as naming an unknown type).
+void register_dds_robot_modules(RobotPlugins& plugins);
 
 struct RunOptions {
   std::filesystem::path robot;  ///< robot profile (YAML)

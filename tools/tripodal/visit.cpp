@@ -14,6 +14,7 @@
 
 #include "guide_hri.hpp"
 #include "run_outputs.hpp"
+#include "run_task.hpp"
 #include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/hri/hri_module.hpp"
@@ -107,6 +108,7 @@ VisitResult run_visit(const VisitOptions& o) {
 
   RobotPlugins plugins = RobotPlugins::with_builtins();
   sim::register_sim_hardware(plugins.hardware, world);
+  register_dds_robot_modules(plugins);
   register_gesture_behaviors(plugins.behaviors);
   register_guide_modules(plugins.modules);
   RobotOptions ro;

@@ -73,6 +73,8 @@ class Publisher {
   bool wait_for_subscribers(std::size_t count, std::chrono::milliseconds timeout) const;
   const std::string& topic() const noexcept;
   const Qos& qos() const noexcept;
+  // The writer's GUID (ROS 2's gid: what ros_discovery_info lists for its node).
+  msg::Gid gid() const;
 
  private:
   std::unique_ptr<detail::EndpointCore> core_;
@@ -100,6 +102,8 @@ class Subscriber {
   bool wait_for_publishers(std::size_t count, std::chrono::milliseconds timeout) const;
   const std::string& topic() const noexcept;
   const Qos& qos() const noexcept;
+  // The reader's GUID (ROS 2's gid).
+  msg::Gid gid() const;
 
  private:
   std::unique_ptr<detail::EndpointCore> core_;
@@ -116,6 +120,9 @@ TRIPODAL_DDS_EXTERN(OccupancyGrid);
 TRIPODAL_DDS_EXTERN(LaserScan);
 TRIPODAL_DDS_EXTERN(JointState);
 TRIPODAL_DDS_EXTERN(Clock);
+TRIPODAL_DDS_EXTERN(TFMessage);
+TRIPODAL_DDS_EXTERN(Imu);
+TRIPODAL_DDS_EXTERN(ParticipantEntitiesInfo);
 TRIPODAL_DDS_EXTERN(Event);
 TRIPODAL_DDS_EXTERN(TaskCommand);
 TRIPODAL_DDS_EXTERN(SimStep);

@@ -86,6 +86,54 @@ struct TwistWithCovariance {  // geometry_msgs/TwistWithCovariance
   bool operator==(const TwistWithCovariance&) const = default;
 };
 
+struct Transform {  // geometry_msgs/Transform
+  Vector3 translation;
+  Quaternion rotation;
+  bool operator==(const Transform&) const = default;
+};
+
+// geometry_msgs/TransformStamped: parent_from_child, the parent being header.frame_id (tf2's way).
+struct TransformStamped {
+  Header header;
+  std::string child_frame_id;
+  Transform transform;
+  bool operator==(const TransformStamped&) const = default;
+};
+
+struct TFMessage {  // tf2_msgs/TFMessage: what /tf and /tf_static carry
+  std::vector<TransformStamped> transforms;
+  bool operator==(const TFMessage&) const = default;
+};
+
+struct Imu {  // sensor_msgs/Imu; covariance row-major 3x3, element 0 = -1: that field is not given
+  Header header;
+  Quaternion orientation;
+  std::array<double, 9> orientation_covariance{};
+  Vector3 angular_velocity;  // rad/s
+  std::array<double, 9> angular_velocity_covariance{};
+  Vector3 linear_acceleration;  // m/s^2
+  std::array<double, 9> linear_acceleration_covariance{};
+  bool operator==(const Imu&) const = default;
+};
+
+// rmw_dds_common/Gid: a DDS entity's GUID (16 bytes; ROS 2 Iron and later).
+using Gid = std::array<std::uint8_t, 16>;
+
+struct NodeEntitiesInfo {  // rmw_dds_common/NodeEntitiesInfo; names at most 256 characters
+  std::string node_namespace;
+  std::string node_name;
+  std::vector<Gid> reader_gid_seq;
+  std::vector<Gid> writer_gid_seq;
+  bool operator==(const NodeEntitiesInfo&) const = default;
+};
+
+// rmw_dds_common/ParticipantEntitiesInfo: the ROS 2 nodes of one DDS participant (ros_discovery_info).
+struct ParticipantEntitiesInfo {
+  Gid gid{};
+  std::vector<NodeEntitiesInfo> node_entities_info_seq;
+  bool operator==(const ParticipantEntitiesInfo&) const = default;
+};
+
 struct Odometry {  // nav_msgs/Odometry
   Header header;
   std::string child_frame_id;
@@ -204,6 +252,9 @@ TRIPODAL_DDS_MESSAGE_TYPE(OccupancyGrid, "nav_msgs", "OccupancyGrid");
 TRIPODAL_DDS_MESSAGE_TYPE(LaserScan, "sensor_msgs", "LaserScan");
 TRIPODAL_DDS_MESSAGE_TYPE(JointState, "sensor_msgs", "JointState");
 TRIPODAL_DDS_MESSAGE_TYPE(Clock, "rosgraph_msgs", "Clock");
+TRIPODAL_DDS_MESSAGE_TYPE(TFMessage, "tf2_msgs", "TFMessage");
+TRIPODAL_DDS_MESSAGE_TYPE(Imu, "sensor_msgs", "Imu");
+TRIPODAL_DDS_MESSAGE_TYPE(ParticipantEntitiesInfo, "rmw_dds_common", "ParticipantEntitiesInfo");
 TRIPODAL_DDS_MESSAGE_TYPE(Event, "tripodal_msgs", "Event");
 TRIPODAL_DDS_MESSAGE_TYPE(TaskCommand, "tripodal_msgs", "TaskCommand");
 TRIPODAL_DDS_MESSAGE_TYPE(SimStep, "tripodal_msgs", "SimStep");

@@ -7,6 +7,9 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <string_view>
+
+#include "tripodal/dds/messages.hpp"
 
 namespace tripodal::dds {
 
@@ -33,8 +36,13 @@ struct ParticipantOptions {
 };
 
 namespace detail {
-struct Domain;  // a Cyclone domain created with our configuration, shared by its participants
+struct Domain;     // a Cyclone domain created with our configuration, shared by its participants
+class NodeGraph;   // the participant's ros_discovery_info
 }
+
+// Whether ROS 2 accepts `name` as a node name: letters, digits and '_', not starting with a digit,
+// at most 255 characters.
+bool is_ros_node_name(std::string_view name) noexcept;
 
 // The Cyclone DDS XML configuration of a loopback participant: the loopback interface only,
 // multicast off, unicast discovery of the participants of this host. Exposed for the documentation
@@ -56,10 +64,25 @@ class Participant {
   const ParticipantOptions& options() const noexcept { return options_; }
   // Cyclone's entity handle (dds_entity_t), for the transport's own use.
   std::int32_t handle() const noexcept { return handle_; }
+  // The participant's GUID, which ROS 2 calls its gid.
+  msg::Gid gid() const noexcept;
+
+  // Makes this participant a ROS 2 node (`ros2 node list` shows "<ns>/<name>"): as rmw does, it
+  // publishes rmw_dds_common/ParticipantEntitiesInfo on the DDS topic "ros_discovery_info"
+  // (reliable, transient local, keep last 1) with the node and the gids of every reader and
+  // writer of the participant, again whenever one is created or deleted. Called again: renames.
+  // `ns` is "/" or "/a/b" ("" and "a/b" are taken as "/" and "/a/b"). Throws std::invalid_argument
+  // naming the bad name, DdsError when the writer cannot be created.
+  void declare_node(std::string_view name, std::string_view ns = "/");
+  // What the participant publishes on ros_discovery_info (no node until declare_node).
+  msg::ParticipantEntitiesInfo graph_info() const;
+  // For the endpoints, which register with it.
+  const std::shared_ptr<detail::NodeGraph>& graph() const noexcept { return graph_; }
 
  private:
   ParticipantOptions options_;
   std::shared_ptr<detail::Domain> domain_;
+  std::shared_ptr<detail::NodeGraph> graph_;
   std::int32_t handle_ = 0;
 };
 

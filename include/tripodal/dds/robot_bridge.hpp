@@ -15,12 +15,19 @@
 
 namespace tripodal::dds {
 
+struct RobotBridgeOptions {
+  /// The robot's clock is not the wall clock (a simulation, a replay): its time goes out on /clock
+  /// for ROS 2 nodes with use_sim_time.
+  bool simulated_time = false;
+};
+
 class RobotBridge final {
  public:
-  /// Creates the participant and the topics `section` names, and observes the robot's planner and
-  /// supervisor (the observers the monitor uses). Robot and clock (the robot's) must outlive the
-  /// bridge. Throws DdsError when the participant or a topic cannot be created.
-  RobotBridge(Robot& robot, const Clock& clock, const DdsSection& section);
+  /// Creates the participant (the ROS 2 node "<ns>/tripodal" in ros_discovery_info) and the topics
+  /// `section` names, and observes the robot's planner and supervisor (the observers the monitor
+  /// uses). Robot and clock (the robot's) must outlive the bridge. Throws DdsError when the
+  /// participant or a topic cannot be created.
+  RobotBridge(Robot& robot, const Clock& clock, const DdsSection& section, const RobotBridgeOptions& options = {});
   ~RobotBridge();
   RobotBridge(const RobotBridge&) = delete;
   RobotBridge& operator=(const RobotBridge&) = delete;
@@ -38,10 +45,14 @@ class RobotBridge final {
 
   /// The DDS name of one of the bridge's topics: "odom" -> "rt/<ns>/odom"; also "pose"
   /// (rt/<ns>/amcl_pose), "map", "events" (rt/<ns>/tripodal/events), "markings"
-  /// (rt/<ns>/tripodal/markings), "task" (rt/<ns>/tripodal/task).
+  /// (rt/<ns>/tripodal/markings), "task" (rt/<ns>/tripodal/task), and the global ones: "tf"
+  /// (rt/tf), "tf_static" (rt/tf_static), "clock" (rt/clock).
   [[nodiscard]] std::string topic(std::string_view which) const;
   /// Samples written so far on topic `which` (as topic() names them); task: commands taken.
   [[nodiscard]] std::uint64_t count(std::string_view which) const noexcept;
+  /// A frame of this robot as tf names it: "base_link" -> "<ns>/base_link" (no prefix without a
+  /// namespace), so that several robots share /tf.
+  [[nodiscard]] std::string frame(std::string_view name) const;
 
   struct Impl;
 

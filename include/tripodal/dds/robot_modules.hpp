@@ -3,6 +3,7 @@
 // base driven by another process (ROS 2 or tripodal); both registered by name like any plugin.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -12,6 +13,7 @@
 
 #include "tripodal/controllers/controller_config.hpp"
 #include "tripodal/dds/endpoint.hpp"
+#include "tripodal/resources/readings.hpp"
 #include "tripodal/resources/resource.hpp"
 #include "tripodal/resources/resource_faults.hpp"
 
@@ -34,6 +36,11 @@ struct DdsLaserOptions {
   // Lock-step co-simulation: every scan must arrive (a reliable reader, which matches only reliable
   // publishers) and its stamp is the robot's own time (the simulator's clock is the robot's).
   bool lock_step = false;
+  // A reliable reader (matches only reliable publishers, as rplidar_ros's default QoS is): a lost
+  // sample is repaired, the first one too. Best effort (the default, ROS 2's sensor-data profile)
+  // matches every publisher but loses for good the samples a publisher writes before this
+  // reader's discovery of it completes (docs/distribution.md, "First samples").
+  bool reliable = false;
   std::function<void()> on_scan;  // after a scan was received (on a Cyclone DDS thread)
 };
 
@@ -77,6 +84,52 @@ class DdsLaserResource final : public LaserResource, public ResourceFaultSource 
   std::unique_ptr<Subscriber<msg::LaserScan>> subscriber_;
 };
 
+// A planar pose estimate of another process's localizer (a ROS 2 AMCL's amcl_pose), as DdsPose
+// holds it: map_from_base and its (x, y, theta) covariance, row-major 3 x 3.
+struct PoseEstimate {
+  Time stamp{};
+  Pose2D map_from_base;
+  std::array<double, 9> covariance{};
+  friend bool operator==(const PoseEstimate&, const PoseEstimate&) = default;
+};
+
+// The latest message of a topic as a typed resource: "DdsOdometry" (nav_msgs/Odometry on odom, an
+// odometry reading), "DdsImu" (sensor_msgs/Imu on imu, a gyro reading: the yaw rate and the yaw of
+// the orientation), "DdsPose" (geometry_msgs/PoseWithCovarianceStamped on amcl_pose, a
+// PoseEstimate). As DdsLaser: received on a Cyclone DDS thread, handed over in poll() stamped with
+// the loop's time; a publisher that loses its liveliness is the resource's fault.
+template <class Reading, class Msg>
+class DdsReadingResource final : public TypedResource<Reading>, public ResourceFaultSource {
+ public:
+  static const ModuleManifest& static_manifest();
+  DdsReadingResource(std::string name, const ParameterSet& parameters);
+  ~DdsReadingResource() override;
+  DdsReadingResource(const DdsReadingResource&) = delete;
+  DdsReadingResource& operator=(const DdsReadingResource&) = delete;
+
+  const std::string& topic() const noexcept;
+  std::size_t matched_publishers() const;
+  std::uint64_t received() const noexcept { return received_.load(std::memory_order_acquire); }
+  [[nodiscard]] std::vector<std::string> take_faults() override { return faults_.take(); }
+
+ private:
+  void on_poll(Time now) noexcept override;
+
+  ResourceFaultQueue faults_;
+  std::unique_ptr<Participant> participant_;
+  std::mutex mutex_;
+  Reading pending_{};
+  std::atomic<bool> has_pending_{false};
+  std::atomic<std::uint64_t> received_{0};
+  std::unique_ptr<Subscriber<Msg>> subscriber_;
+};
+using DdsOdometryResource = DdsReadingResource<OdometryReading, msg::Odometry>;
+using DdsImuResource = DdsReadingResource<GyroReading, msg::Imu>;
+using DdsPoseResource = DdsReadingResource<PoseEstimate, msg::PoseWithCovarianceStamped>;
+extern template class DdsReadingResource<OdometryReading, msg::Odometry>;
+extern template class DdsReadingResource<GyroReading, msg::Imu>;
+extern template class DdsReadingResource<PoseEstimate, msg::PoseWithCovarianceStamped>;
+
 // Type "dds_cmd_vel": a controller for a base that another process drives. Each period it limits
 // the command like every controller and publishes it as geometry_msgs/Twist (linear x, y; angular
 // z) with the command QoS. It has no wheels: its odometry integrates what it commanded (dead
@@ -109,13 +162,22 @@ class DdsCmdVelController final : public CController {
   std::unique_ptr<Publisher<msg::Twist>> publisher_;
 };
 
-// Adds "DdsLaser" to a robot's resource registry (RobotPlugins::resources) and "dds_cmd_vel" to its
-// controller registry. A template over the resource registry so that this area needs not link the
+// Adds "DdsLaser", "DdsOdometry", "DdsImu" and "DdsPose" to a robot's resource registry
+// (RobotPlugins::resources) and "dds_cmd_vel" to its controller registry. A template over the resource registry so that this area needs not link the
 // robot's, whose ResourceConfig is read for its name and parameters only.
 template <class ResourceRegistry>
 void register_dds_modules(ResourceRegistry& resources, ControllerRegistry& controllers) {
   resources.add(DdsLaserResource::static_manifest(), [](const auto& config) -> std::unique_ptr<CResource> {
     return std::make_unique<DdsLaserResource>(config.name, config.parameters);
+  });
+  resources.add(DdsOdometryResource::static_manifest(), [](const auto& config) -> std::unique_ptr<CResource> {
+    return std::make_unique<DdsOdometryResource>(config.name, config.parameters);
+  });
+  resources.add(DdsImuResource::static_manifest(), [](const auto& config) -> std::unique_ptr<CResource> {
+    return std::make_unique<DdsImuResource>(config.name, config.parameters);
+  });
+  resources.add(DdsPoseResource::static_manifest(), [](const auto& config) -> std::unique_ptr<CResource> {
+    return std::make_unique<DdsPoseResource>(config.name, config.parameters);
   });
   controllers.template add<DdsCmdVelController>();
 }

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "tripodal/core/diagnostic.hpp"
+#include "tripodal/core/geometry.hpp"
 #include "tripodal/core/manifest.hpp"
 #include "tripodal/core/petri_net.hpp"
 #include "tripodal/core/time.hpp"
@@ -63,7 +64,14 @@ struct ProcessEntry {
 
 /// The topics a robot on DDS can publish (its `dds: publish:` list), in the order the profile
 /// reference lists them (docs/distribution.md).
-inline constexpr std::string_view kDdsTopics[] = {"odom", "pose", "map", "events", "markings"};
+inline constexpr std::string_view kDdsTopics[] = {"odom", "pose", "map", "events", "markings", "tf", "clock"};
+
+/// A sensor's frame for tf_static: where it sits on the base (base_from_frame: x_m, y_m, theta_rad).
+struct DdsFrame {
+  std::string name;
+  Pose2D base_from_frame;
+  SourceLocation where;
+};
 
 /// Whether ROS 2 takes `ns` as a namespace: names of letters, digits and '_', not starting with a
 /// digit, separated by '/' (a leading '/' allowed); empty is none.
@@ -80,6 +88,9 @@ struct DdsSection {
   Duration period{std::chrono::milliseconds(100)};  ///< odometry, pose and markings at most this often
   std::vector<std::string> publish;  ///< of kDdsTopics; default: all of them
   bool tasks = true;                 ///< take tripodal_msgs/TaskCommand on tripodal/task
+  /// `frames: {laser: [x_m, y_m, theta_rad]}`: the sensors' mounts on tf_static (laser resources
+  /// not listed go there at the base's origin).
+  std::vector<DdsFrame> frames;
   SourceLocation where;
   [[nodiscard]] bool publishes(std::string_view topic) const noexcept {
     for (const std::string& t : publish) {
