@@ -135,10 +135,12 @@ def main():
         driver.find_element(By.ID, "resume").click()
         wait.until(lambda d: text("paused") == "running")
         check(True, "the monitor's own page resumes the run")
+        wait.until(lambda d: text("answer") != "")  # the resume's answer, then the task's
+        driver.execute_script("document.getElementById('answer').textContent = ''")
         box = driver.find_element(By.ID, "task-input")
         box.send_keys("fly to the moon")
         driver.find_element(By.ID, "task-submit").click()
-        wait.until(lambda d: text("answer") != "")
+        wait.until(lambda d: text("answer").startswith("refused") or text("answer").startswith("accepted"))
         check(text("answer").startswith("refused: "), "the own page's task is answered by the planner: " + text("answer"))
     finally:
         driver.quit()
