@@ -6,7 +6,8 @@ can: fetch() with the token header (a CORS preflight), a no-cors fetch with the 
 a form posted as text/plain into a hidden frame, and WebSockets with and without the token. A page
 reached through a DNS name that resolves to the robot (Chromium's --host-resolver-rules maps
 rebound.test to 127.0.0.1: DNS rebinding) is refused with 421. The run stays paused throughout;
-then the monitor's own page resumes it and has a task answered (docs/monitor.md, "Host and Origin").
+then the monitor's own page resumes it and has a task answered. A run started with
+--monitor-allow-host rebound.test serves its page under that name (docs/monitor.md, "Host and Origin").
 
 usage: cross_origin_browser_test.py TRIPODAL ROBOT.yaml WORLD.yaml"""
 import http.server
@@ -142,6 +143,16 @@ def main():
         driver.find_element(By.ID, "task-submit").click()
         wait.until(lambda d: text("answer").startswith("refused") or text("answer").startswith("accepted"))
         check(text("answer").startswith("refused: "), "the own page's task is answered by the planner: " + text("answer"))
+        run.stop()
+
+        # The operator names the robot's host: then the page is served under that name too.
+        named = MonitoredRun(exe, robot, world, "--start-paused", "--monitor-allow-host", "rebound.test")
+        try:
+            driver.get("http://rebound.test:%d/?token=%s" % (named.port, named.token))
+            wait.until(lambda d: text("conn") == "connected")
+            check(True, "with --monitor-allow-host rebound.test the page is served under that name and connects")
+        finally:
+            named.stop()
     finally:
         driver.quit()
         site.shutdown()

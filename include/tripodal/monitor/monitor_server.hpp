@@ -3,7 +3,9 @@
 // thread only appends to a briefly locked outbox and takes operator requests when it is ready, so
 // no client can slow a control or sequencing loop. It serves the embedded page, a stream of topics
 // to page clients and to Foxglove clients (subprotocol foxglove.websocket.v1), and operator
-// commands (POST /api/command) that need the token. docs/monitor.md describes protocol and limits.
+// commands (POST /api/command) that need the token. Every request's Host and Origin are checked, so
+// a page of another site cannot use the operator's browser against the robot, and everything a
+// client can make it keep has a budget. docs/monitor.md describes protocol, checks and budgets.
 #pragma once
 
 #include <cstddef>
