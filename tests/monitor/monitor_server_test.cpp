@@ -56,7 +56,7 @@ TEST_CASE("Half-open connections without the token cannot lock the operator out,
           "[monitor][server][budgets][threads]") {
   // Finding 4: 40 half-open tokenless connections (more than the 32 clients of the old shared
   // pool) answered every operator request with 503.
-  MonitorServer server(MonitorServerOptions{.token = kToken, .header_timeout_s = 0.5, .max_unauthenticated = 8});
+  MonitorServer server(MonitorServerOptions{.token = kToken, .header_timeout_s = 1.0, .max_unauthenticated = 8});
   server.start();
   const std::string half = "GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: ";
   std::vector<std::unique_ptr<Client>> slow;
