@@ -16,7 +16,9 @@
 #include <deque>
 #include <fstream>
 #include <algorithm>
+#include <array>
 #include <map>
+#include <optional>
 #include <mutex>
 #include <random>
 #include <stdexcept>
@@ -44,7 +46,11 @@ std::string random_token() {
   return out;
 }
 
-std::string error_json(std::string_view message) { return nlohmann::json{{"error", message}}.dump(); }
+// Messages may quote what a client sent (a request line, a header): bytes that are not UTF-8 are
+// replaced rather than thrown on.
+std::string error_json(std::string_view message) {
+  return nlohmann::json{{"error", message}}.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
 
 void append_le(std::string& out, std::uint64_t v, int bytes) {
   for (int i = 0; i < bytes; ++i) out += static_cast<char>((v >> (8 * i)) & 0xFFU);
@@ -72,9 +78,16 @@ struct OutFrame {
 
 enum class Kind { http, page, foxglove };
 
+// Which budget a connection counts against (docs/monitor.md, "Budgets"): one that has not shown the
+// token may not take the place of one that has.
+enum class Pool { unauthenticated, authenticated, reader };
+
 struct Connection {
   int fd = -1;
   Kind kind = Kind::http;
+  Pool pool = Pool::unauthenticated;
+  SteadyTime accepted{};
+  SteadyTime deadline = SteadyTime::max();  // closed then (unauthenticated, or an answer unread)
   std::string in;
   std::deque<OutFrame> out;
   std::size_t out_offset = 0;  // bytes of out.front() already sent
@@ -83,7 +96,6 @@ struct Connection {
   bool close_after_write = false;
   bool dead = false;
   std::uint64_t waiting_for = 0;  // an operator request this HTTP connection waits on
-  SteadyTime since{};
   std::map<std::uint32_t, std::uint32_t> subscriptions;  // foxglove: channel id -> subscription id
 };
 
@@ -96,6 +108,7 @@ struct MonitorServer::Impl {
   int wake_fd = -1;
   std::uint16_t port = 0;
   std::vector<Channel> channels;
+  std::string session_id = random_token().substr(0, 16);  // Foxglove's sessionId: nothing of the token
   std::thread thread;
   std::atomic<bool> running{false};
 
@@ -109,6 +122,7 @@ struct MonitorServer::Impl {
   // The server thread's own.
   std::vector<std::unique_ptr<Connection>> connections;
   std::deque<Message> history;
+  std::size_t history_bytes = 0;  // as framed for a page client (what a joining client is sent)
   std::uint64_t next_request = 1;
   std::map<std::uint64_t, SteadyTime> pending;  // requests handed to the robot, by id
 
@@ -188,10 +202,29 @@ struct MonitorServer::Impl {
         ch.latest_stamp_s = m.stamp_s;
         ch.has_latest = true;
       } else if (ch.delivery == Delivery::event) {
-        history.push_back(std::move(m));
-        if (history.size() > options.history) history.pop_front();
+        keep(ch, std::move(m));
       }
     }
+  }
+
+  // The history replayed to clients that join is budgeted in count and in bytes, so that the
+  // replay always fits a client's event queue (max_history_bytes <= max_event_bytes / 2).
+  void keep(const Channel& ch, Message m) {
+    const std::size_t bytes = page_frame(ch, m.stamp_s, m.json).size();
+    if (bytes > options.max_history_bytes || options.history == 0) {
+      count(&MonitorStats::history_not_kept);
+    } else {
+      history.push_back(std::move(m));
+      history_bytes += bytes;
+    }
+    while (history.size() > options.history || history_bytes > options.max_history_bytes) {
+      const Message& old = history.front();
+      history_bytes -= page_frame(channels[old.channel - 1], old.stamp_s, old.json).size();
+      history.pop_front();
+    }
+    const std::lock_guard lock(mutex);
+    stats.history_entries = history.size();
+    stats.history_bytes = history_bytes;
   }
 
   // --- the thread --------------------------------------------------------------------------------
@@ -243,23 +276,46 @@ struct MonitorServer::Impl {
       for (auto& c : connections) {
         if (c->waiting_for == id) {
           c->waiting_for = 0;
-          enqueue(*c, std::move(response), false);
-          c->close_after_write = true;
+          answer_now(*c, std::move(response));
           break;
         }
       }
     }
   }
 
+  // An answer to an operator's request: the client has header_timeout_s to read it.
+  void answer_now(Connection& c, std::string response) {
+    enqueue(c, std::move(response), false);
+    c.close_after_write = true;
+    if (c.pool != Pool::unauthenticated) c.deadline = std::chrono::steady_clock::now() + seconds(options.header_timeout_s);
+  }
+
+  static std::chrono::steady_clock::duration seconds(double s) {
+    return std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(s));
+  }
+
+  [[nodiscard]] std::size_t in_pool(Pool pool) const noexcept {
+    return static_cast<std::size_t>(
+        std::count_if(connections.begin(), connections.end(), [pool](const auto& c) { return !c->dead && c->pool == pool; }));
+  }
+
   void accept_clients() {
-    for (;;) {
+    // At most half the unauthenticated pool per round: a connection accepted in this round has its
+    // request read in the next one before it could be evicted by newer connections.
+    const std::size_t per_round = std::max<std::size_t>(1, options.max_unauthenticated / 2);
+    for (std::size_t accepted = 0; accepted < per_round; ++accepted) {
       const int fd = ::accept4(listen_fd, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
       if (fd < 0) return;
-      if (connections.size() >= options.max_clients) {
-        const std::string r = http_response(503, "application/json", error_json("too many clients"));
-        [[maybe_unused]] const auto w = ::send(fd, r.data(), r.size(), MSG_NOSIGNAL);
-        ::close(fd);
-        continue;
+      if (in_pool(Pool::unauthenticated) >= options.max_unauthenticated) {
+        // Half-open connections (slowloris) must not lock the operator out: the oldest goes.
+        Connection* oldest = nullptr;
+        for (auto& c : connections) {
+          if (!c->dead && c->pool == Pool::unauthenticated && (oldest == nullptr || c->accepted < oldest->accepted)) oldest = c.get();
+        }
+        if (oldest != nullptr) {
+          oldest->dead = true;
+          count(&MonitorStats::evicted);
+        }
       }
       const int one = 1;
       ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
@@ -268,18 +324,20 @@ struct MonitorServer::Impl {
       if (sndbuf > 0) ::setsockopt(fd, SOL_SOCKET, SO_SNDBUF, &sndbuf, sizeof sndbuf);
       auto c = std::make_unique<Connection>();
       c->fd = fd;
-      c->since = std::chrono::steady_clock::now();
+      c->accepted = std::chrono::steady_clock::now();
+      c->deadline = c->accepted + seconds(options.header_timeout_s);
       connections.push_back(std::move(c));
     }
   }
 
   void expire() {
     const auto now = std::chrono::steady_clock::now();
-    const auto idle = std::chrono::duration<double>(options.idle_timeout_s);
     for (auto& c : connections) {
-      if (c->kind == Kind::http && c->waiting_for == 0 && c->out.empty() && now - c->since > idle) c->dead = true;
+      if (c->dead || c->kind != Kind::http || now < c->deadline) continue;
+      c->dead = true;
+      if (c->pool == Pool::unauthenticated) count(&MonitorStats::header_timeouts);
     }
-    const auto limit = std::chrono::duration<double>(options.answer_timeout_s);
+    const auto limit = seconds(options.answer_timeout_s);
     for (auto it = pending.begin(); it != pending.end();) {
       if (now - it->second <= limit) {
         ++it;
@@ -288,8 +346,7 @@ struct MonitorServer::Impl {
       for (auto& c : connections) {
         if (c->waiting_for == it->first) {
           c->waiting_for = 0;
-          enqueue(*c, http_response(503, "application/json", error_json("the robot did not answer in time")), false);
-          c->close_after_write = true;
+          answer_now(*c, http_response(503, "application/json", error_json("the robot did not answer in time")));
         }
       }
       it = pending.erase(it);
@@ -298,17 +355,20 @@ struct MonitorServer::Impl {
 
   void reap() {
     std::size_t clients = 0;
+    std::size_t unauthenticated = 0;
     for (auto it = connections.begin(); it != connections.end();) {
       if ((*it)->dead) {
         ::close((*it)->fd);
         it = connections.erase(it);
       } else {
         clients += (*it)->kind != Kind::http ? 1 : 0;
+        unauthenticated += (*it)->pool == Pool::unauthenticated ? 1 : 0;
         ++it;
       }
     }
     const std::lock_guard lock(mutex);
     stats.clients = clients;
+    stats.unauthenticated = unauthenticated;
   }
 
   void write_to(Connection& c) {
@@ -358,17 +418,61 @@ struct MonitorServer::Impl {
 
   void refuse(Connection& c, int status, std::string_view message) {
     if (status == 401) count(&MonitorStats::unauthorized);
-    enqueue(c, http_response(status, "application/json", error_json(message)), false);
-    c.close_after_write = true;
+    if (status == 503) count(&MonitorStats::busy);
+    if (status == 421) count(&MonitorStats::refused_host);
+    if (status == 403) count(&MonitorStats::refused_origin);
+    answer_now(c, http_response(status, "application/json", error_json(message)));
     c.in.clear();
   }
 
-  [[nodiscard]] bool token_ok(const HttpRequest& r) const {
+  // The token from a header; commands take it from nothing else, so that a cross-site form or
+  // "simple" request cannot carry it (a custom header needs a CORS preflight, never answered).
+  [[nodiscard]] bool header_token_ok(const HttpRequest& r) const {
     std::string_view given;
     if (const auto a = r.header("authorization"); a && a->starts_with("Bearer ")) given = a->substr(7);
     else if (const auto t = r.header("x-tripodal-token")) given = *t;
-    else if (const auto q = r.query("token")) given = *q;
     return !given.empty() && constant_time_equal(given, options.token);
+  }
+
+  // Streams and GETs also take it from the address (?token=): a browser's WebSocket cannot send a
+  // header. The Origin check keeps other pages from using it.
+  [[nodiscard]] bool token_ok(const HttpRequest& r) const {
+    if (r.header("authorization") || r.header("x-tripodal-token")) return header_token_ok(r);
+    const auto q = r.query("token");
+    return q && !q->empty() && constant_time_equal(*q, options.token);
+  }
+
+  // Moves `c` into the authenticated or reader pool; false (and 503) when that pool is full.
+  bool admit(Connection& c, Pool pool) {
+    const std::size_t limit = pool == Pool::authenticated ? options.max_clients : options.max_open_readers;
+    if (in_pool(pool) >= limit) {
+      refuse(c, 503, pool == Pool::authenticated ? "too many clients" : "too many read-only clients without the token");
+      return false;
+    }
+    c.pool = pool;
+    c.deadline = SteadyTime::max();
+    return true;
+  }
+
+  // Browser-grade checks (docs/monitor.md, "Host and Origin"): a page of another site may make the
+  // browser send a request here, with a DNS name rebound to this address or from its own origin.
+  [[nodiscard]] std::string_view browser_refusal(const HttpRequest& r, int& status) const {
+    const auto host = r.header("host");
+    if (host && !host_allowed(*host, options.allowed_hosts)) {
+      status = 421;
+      return "Host is not this server's name: loopback names and IP addresses are served, other names only when "
+             "allowed (MonitorServerOptions::allowed_hosts)";
+    }
+    if (const auto origin = r.header("origin")) {
+      const bool own = host && same_origin(*origin, *host);
+      const bool allowed = std::find(options.allowed_origins.begin(), options.allowed_origins.end(), *origin) != options.allowed_origins.end();
+      if (!own && !allowed) {
+        status = 403;
+        return "Origin is not this server's page: streams and commands are served to the monitor's own pages and to "
+               "clients that are not browsers";
+      }
+    }
+    return {};
   }
 
   void handle_http(Connection& c) {
@@ -388,15 +492,21 @@ struct MonitorServer::Impl {
     }
     c.in.erase(0, p.consumed);
     const HttpRequest& r = p.request;
+    int status = 0;
+    if (const std::string_view why = browser_refusal(r, status); !why.empty()) return refuse(c, status, why);
     const auto upgrade = r.header("upgrade");
     if (upgrade && (*upgrade == "websocket" || *upgrade == "WebSocket")) return upgrade_ws(c, r);
     if (r.path == "/api/command") {
       if (r.method != "POST") return refuse(c, 405, "POST a JSON command to /api/command");
-      if (!token_ok(r)) return refuse(c, 401, "missing or wrong token (Authorization: Bearer TOKEN)");
+      if (const auto type = r.header("content-type"); type && media_type(*type) != "application/json") {
+        return refuse(c, 415, "Content-Type '" + std::string(type->substr(0, 60)) + "': commands are application/json");
+      }
+      if (!header_token_ok(r)) return refuse(c, 401, "missing or wrong token (Authorization: Bearer TOKEN)");
       const nlohmann::json body = nlohmann::json::parse(r.body, nullptr, false);
       if (body.is_discarded() || !body.is_object() || !body.contains("op") || !body["op"].is_string()) {
         return refuse(c, 400, "body: expected a JSON object with a string \"op\"");
       }
+      if (!admit(c, Pool::authenticated)) return;
       const std::uint64_t id = next_request++;
       c.waiting_for = id;
       pending.emplace(id, std::chrono::steady_clock::now());
@@ -412,16 +522,14 @@ struct MonitorServer::Impl {
     if (!html.empty()) {
       // Pages carry no secret (the token comes with the address or is typed): served to anyone.
       // Audio the touch page plays is a data: URL of the answer, hence media-src data:.
-      enqueue(c, http_response(200, "text/html; charset=utf-8", html,
-                               "Content-Security-Policy: default-src 'self' 'unsafe-inline'; connect-src 'self' ws: wss:; media-src data:\r\n"),
-              false);
-      c.close_after_write = true;
+      answer_now(c, http_response(200, "text/html; charset=utf-8", html,
+                                  "Content-Security-Policy: default-src 'self' 'unsafe-inline'; connect-src 'self' ws: wss:; media-src data:\r\n"));
       return;
     }
     if (r.path == "/api/ping") {
       if (!token_ok(r)) return refuse(c, 401, "missing or wrong token");
-      enqueue(c, http_response(200, "application/json", R"({"ok":true})"), false);
-      c.close_after_write = true;
+      if (!admit(c, Pool::authenticated)) return;
+      answer_now(c, http_response(200, "application/json", R"({"ok":true})"));
       return;
     }
     refuse(c, 404, "not found: the monitor serves / (the page), /rkms (the RKMS administration), /touch (the touch screen), "
@@ -431,7 +539,9 @@ struct MonitorServer::Impl {
   void upgrade_ws(Connection& c, const HttpRequest& r) {
     const auto key = r.header("sec-websocket-key");
     if (!key || key->empty()) return refuse(c, 400, "WebSocket upgrade without Sec-WebSocket-Key");
-    if (!options.read_without_token && !token_ok(r)) return refuse(c, 401, "missing or wrong token (?token=TOKEN)");
+    const bool with_token = token_ok(r);
+    if (!options.read_without_token && !with_token) return refuse(c, 401, "missing or wrong token (?token=TOKEN)");
+    if (!admit(c, with_token ? Pool::authenticated : Pool::reader)) return;
     bool foxglove = false;
     if (const auto proto = r.header("sec-websocket-protocol")) foxglove = proto->find(kFoxglove) != std::string_view::npos;
     std::string response = "HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Accept: " +
@@ -446,7 +556,7 @@ struct MonitorServer::Impl {
                                 {"capabilities", nlohmann::json::array()},
                                 {"supportedEncodings", {"json"}},
                                 {"metadata", nlohmann::json::object()},
-                                {"sessionId", options.token.substr(0, 4) + std::to_string(port)}};
+                                {"sessionId", session_id}};
       enqueue(c, ws_frame(WsOpcode::text, info.dump()), false);
       nlohmann::json adv{{"op", "advertise"}, {"channels", nlohmann::json::array()}};
       for (const Channel& ch : channels) {
@@ -459,7 +569,7 @@ struct MonitorServer::Impl {
       }
       enqueue(c, ws_frame(WsOpcode::text, adv.dump()), false);
     } else {
-      nlohmann::json hello{{"topics", nlohmann::json::array()}, {"read_only", !token_ok(r)}};
+      nlohmann::json hello{{"topics", nlohmann::json::array()}, {"read_only", !with_token}};
       for (const Channel& ch : channels) hello["topics"].push_back(ch.topic);
       enqueue(c, ws_frame(WsOpcode::text, R"({"topic":"hello","t":0,"data":)" + hello.dump() + "}"), false);
       for (const Channel& ch : channels) {
@@ -470,58 +580,147 @@ struct MonitorServer::Impl {
     if (!c.in.empty()) handle_ws(c);
   }
 
+  void protocol_error(Connection& c, std::string_view why) {
+    std::string reason = "\x03\xEA" + std::string(why.substr(0, 100));  // 1002 protocol error
+    enqueue(c, ws_frame(WsOpcode::close, reason), false);
+    c.close_after_write = true;
+    c.in.clear();
+  }
+
   void handle_ws(Connection& c) {
-    for (;;) {
+    while (!c.close_after_write) {
       WsParse p = parse_ws_frame(c.in, kMaxClientFrame);
       if (p.status == WsParse::Status::incomplete) return;
-      if (p.status == WsParse::Status::error) {
-        std::string reason = "\x03\xEA" + p.error.substr(0, 100);  // 1002 protocol error
-        enqueue(c, ws_frame(WsOpcode::close, reason), false);
-        c.close_after_write = true;
-        c.in.clear();
-        return;
-      }
+      if (p.status == WsParse::Status::error) return protocol_error(c, p.error);
       c.in.erase(0, p.consumed);
+      const auto op = static_cast<std::uint8_t>(p.frame.opcode);
+      const bool control = (op & 0x8U) != 0;
+      if (control && (!p.frame.fin || p.frame.payload.size() > 125)) {
+        return protocol_error(c, "control frame fragmented or over 125 bytes (RFC 6455 5.5)");
+      }
       switch (p.frame.opcode) {
         case WsOpcode::close:
           enqueue(c, ws_frame(WsOpcode::close, p.frame.payload.substr(0, 2)), false);
           c.close_after_write = true;
           return;
         case WsOpcode::ping: enqueue(c, ws_frame(WsOpcode::pong, p.frame.payload), false); break;
+        case WsOpcode::pong: break;
         case WsOpcode::text:
-          if (c.kind == Kind::foxglove) foxglove_request(c, p.frame.payload);
+        case WsOpcode::binary:
+        case WsOpcode::continuation:
+          // Page clients only listen (commands go through POST /api/command): what they send is
+          // counted and dropped. Foxglove clients are answered.
+          if (c.kind != Kind::foxglove) {
+            count(&MonitorStats::client_errors);
+          } else if (p.frame.opcode != WsOpcode::text) {
+            foxglove_status(c, "binary client messages (publishing, service calls) are not offered by this server");
+          } else if (!p.frame.fin) {
+            foxglove_status(c, "fragmented messages are not accepted: send each operation in one frame");
+          } else {
+            foxglove_request(c, p.frame.payload);
+          }
           break;
-        default: break;  // page clients only listen; commands go through POST /api/command
+        default: return protocol_error(c, "unknown opcode " + std::to_string(op));
       }
     }
   }
 
+  // Foxglove's status message, level 2 (error): what a client sent that the server refused.
+  void foxglove_status(Connection& c, const std::string& message) {
+    count(&MonitorStats::client_errors);
+    const nlohmann::json status{{"op", "status"}, {"level", 2}, {"message", message}};
+    enqueue(c, ws_frame(WsOpcode::text, status.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)), false);
+  }
+
+  // A subscription or channel id: a whole number that fits 32 bits.
+  static std::optional<std::uint32_t> u32(const nlohmann::json& v) {
+    if (!v.is_number_unsigned() || v.get<std::uint64_t>() > 0xFFFFFFFFU) return std::nullopt;
+    return static_cast<std::uint32_t>(v.get<std::uint64_t>());
+  }
+
+  static std::string type_of(const nlohmann::json& v) {
+    if (v.is_number_integer() && !v.is_number_unsigned()) return "a negative number";
+    if (v.is_number_unsigned()) return "a number over 4294967295";
+    return std::string(v.type_name());
+  }
+
+  // Client operations of foxglove.websocket.v1. Anything malformed or wrong-typed is answered with
+  // a status naming the field and what was expected; nothing throws.
   void foxglove_request(Connection& c, const std::string& text) {
     const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
-    if (j.is_discarded() || !j.is_object() || !j.contains("op") || !j["op"].is_string()) return;
-    const std::string op = j["op"];
-    if (op == "subscribe" && j.contains("subscriptions") && j["subscriptions"].is_array()) {
-      for (const auto& s : j["subscriptions"]) {
-        if (!s.is_object() || !s.contains("id") || !s.contains("channelId")) continue;
-        if (!s["id"].is_number_unsigned() || !s["channelId"].is_number_unsigned()) continue;
-        const auto channel = s["channelId"].get<std::uint32_t>();
-        if (channel == 0 || channel > channels.size()) continue;
-        c.subscriptions[channel] = s["id"].get<std::uint32_t>();
-        const Channel& ch = channels[channel - 1];
-        if (ch.has_latest) deliver(c, ch, ch.latest_stamp_s, ch.latest_json);
-        if (ch.delivery == Delivery::event) {  // what happened before the subscription
-          for (const Message& m : history) {
-            if (m.channel == channel) deliver(c, ch, m.stamp_s, m.json);
-          }
+    if (j.is_discarded()) return foxglove_status(c, "not JSON: expected an object {\"op\": ...}");
+    if (!j.is_object()) return foxglove_status(c, "expected a JSON object {\"op\": ...}, got " + std::string(j.type_name()));
+    const auto op_it = j.find("op");
+    if (op_it == j.end() || !op_it->is_string()) {
+      return foxglove_status(c, "\"op\": expected a string, got " + (op_it == j.end() ? std::string("nothing") : std::string(op_it->type_name())));
+    }
+    const std::string& op = op_it->get_ref<const std::string&>();
+    if (op == "subscribe") return subscribe(c, j);
+    if (op == "unsubscribe") return unsubscribe(c, j);
+    static constexpr std::array<std::string_view, 11> kNotOffered = {
+        "advertise", "unadvertise", "getParameters", "setParameters", "subscribeParameterUpdates", "unsubscribeParameterUpdates",
+        "callService", "subscribeConnectionGraph", "unsubscribeConnectionGraph", "fetchAsset", "serviceCallRequest"};
+    if (std::find(kNotOffered.begin(), kNotOffered.end(), op) != kNotOffered.end()) {
+      return foxglove_status(c, "op '" + op + "' is not offered: this server advertises no capabilities (subscribe and unsubscribe only)");
+    }
+    foxglove_status(c, "unknown op '" + op.substr(0, 60) + "': expected subscribe or unsubscribe");
+  }
+
+  void subscribe(Connection& c, const nlohmann::json& j) {
+    const auto subs = j.find("subscriptions");
+    if (subs == j.end() || !subs->is_array()) {
+      return foxglove_status(c, "subscribe: \"subscriptions\": expected an array of {id, channelId}, got " +
+                                    (subs == j.end() ? std::string("nothing") : std::string(subs->type_name())));
+    }
+    for (std::size_t i = 0; i < subs->size(); ++i) {
+      const nlohmann::json& s = (*subs)[i];
+      const std::string where = "subscribe: subscriptions[" + std::to_string(i) + "]";
+      if (!s.is_object()) {
+        foxglove_status(c, where + ": expected an object {id, channelId}, got " + std::string(s.type_name()));
+        continue;
+      }
+      const auto id_it = s.find("id");
+      const auto ch_it = s.find("channelId");
+      const auto id = id_it == s.end() ? std::nullopt : u32(*id_it);
+      const auto channel = ch_it == s.end() ? std::nullopt : u32(*ch_it);
+      if (!id) {
+        foxglove_status(c, where + ".id: expected a whole number 0..4294967295, got " + (id_it == s.end() ? std::string("nothing") : type_of(*id_it)));
+        continue;
+      }
+      if (!channel) {
+        foxglove_status(c, where + ".channelId: expected a whole number 0..4294967295, got " +
+                               (ch_it == s.end() ? std::string("nothing") : type_of(*ch_it)));
+        continue;
+      }
+      if (*channel == 0 || *channel > channels.size()) {
+        foxglove_status(c, where + ".channelId: no channel " + std::to_string(*channel) + " was advertised");
+        continue;
+      }
+      c.subscriptions[*channel] = *id;
+      const Channel& ch = channels[*channel - 1];
+      if (ch.has_latest) deliver(c, ch, ch.latest_stamp_s, ch.latest_json);
+      if (ch.delivery == Delivery::event) {  // what happened before the subscription
+        for (const Message& m : history) {
+          if (m.channel == *channel) deliver(c, ch, m.stamp_s, m.json);
         }
       }
-    } else if (op == "unsubscribe" && j.contains("subscriptionIds") && j["subscriptionIds"].is_array()) {
-      for (const auto& id : j["subscriptionIds"]) {
-        if (!id.is_number_unsigned()) continue;
-        for (auto it = c.subscriptions.begin(); it != c.subscriptions.end();) {
-          it = it->second == id.get<std::uint32_t>() ? c.subscriptions.erase(it) : std::next(it);
-        }
+    }
+  }
+
+  void unsubscribe(Connection& c, const nlohmann::json& j) {
+    const auto ids = j.find("subscriptionIds");
+    if (ids == j.end() || !ids->is_array()) {
+      return foxglove_status(c, "unsubscribe: \"subscriptionIds\": expected an array of whole numbers, got " +
+                                    (ids == j.end() ? std::string("nothing") : std::string(ids->type_name())));
+    }
+    for (std::size_t i = 0; i < ids->size(); ++i) {
+      const auto id = u32((*ids)[i]);
+      if (!id) {
+        foxglove_status(c, "unsubscribe: subscriptionIds[" + std::to_string(i) + "]: expected a whole number 0..4294967295, got " +
+                               type_of((*ids)[i]));
+        continue;
       }
+      std::erase_if(c.subscriptions, [&id](const auto& kv) { return kv.second == *id; });
     }
   }
 };
@@ -561,6 +760,20 @@ MonitorServer::MonitorServer(MonitorServerOptions options) : impl_(std::make_uni
   Impl& m = *impl_;
   m.options = std::move(options);
   if (m.options.token.empty()) m.options.token = random_token();
+  const MonitorServerOptions& o = m.options;
+  const auto refuse = [](const std::string& what) { throw std::invalid_argument("monitor: " + what); };
+  if (o.max_clients == 0 || o.max_unauthenticated == 0) {
+    refuse("max_clients and max_unauthenticated: expected at least 1 (got " + std::to_string(o.max_clients) + " and " +
+           std::to_string(o.max_unauthenticated) + ")");
+  }
+  if (o.max_history_bytes > o.max_event_bytes / 2) {
+    refuse("max_history_bytes " + std::to_string(o.max_history_bytes) + ": expected at most half of max_event_bytes (" +
+           std::to_string(o.max_event_bytes) + "), so that the history replayed to a client that joins fits its queue");
+  }
+  if (!(o.header_timeout_s > 0.0) || !(o.answer_timeout_s > 0.0) || o.header_timeout_s > 3600.0 || o.answer_timeout_s > 3600.0) {
+    refuse("header_timeout_s and answer_timeout_s: expected seconds in (0, 3600] (got " + std::to_string(o.header_timeout_s) + " and " +
+           std::to_string(o.answer_timeout_s) + ")");
+  }
   const std::string where = m.options.address + ":" + std::to_string(m.options.port);
   sockaddr_in addr{};
   addr.sin_family = AF_INET;

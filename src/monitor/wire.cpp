@@ -1,5 +1,8 @@
 #include "tripodal/monitor/wire.hpp"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+
 #include <algorithm>
 #include <cctype>
 
@@ -167,10 +170,13 @@ std::string_view http_reason(int status) noexcept {
     case 200: return "OK";
     case 400: return "Bad Request";
     case 401: return "Unauthorized";
+    case 403: return "Forbidden";
     case 404: return "Not Found";
     case 405: return "Method Not Allowed";
     case 409: return "Conflict";
     case 413: return "Payload Too Large";
+    case 415: return "Unsupported Media Type";
+    case 421: return "Misdirected Request";
     case 431: return "Request Header Fields Too Large";
     case 503: return "Service Unavailable";
     default: return "Error";
@@ -254,6 +260,54 @@ std::string ws_client_frame(WsOpcode opcode, std::string_view payload, std::uint
   for (std::size_t i = 0; i < payload.size(); ++i) out[header + 4 + i] = static_cast<char>(payload[i] ^ m[i % 4]);
   return out;
 }
+
+bool host_allowed(std::string_view host, const std::vector<std::string>& allowed_hosts) {
+  std::string_view name = host;
+  std::string_view port;
+  if (name.starts_with('[')) {  // [IPv6]:port
+    const std::size_t close = name.find(']');
+    if (close == std::string_view::npos) return false;
+    port = name.substr(close + 1);
+    name = name.substr(1, close - 1);
+    if (!port.empty() && !port.starts_with(':')) return false;
+    in6_addr probe{};
+    if (::inet_pton(AF_INET6, std::string(name).c_str(), &probe) != 1) return false;
+  } else {
+    const std::size_t colon = name.find(':');
+    if (colon != std::string_view::npos) {
+      port = name.substr(colon);
+      name = name.substr(0, colon);
+    }
+  }
+  if (!port.empty()) {
+    port.remove_prefix(1);
+    if (port.empty() || port.size() > 5 || !std::all_of(port.begin(), port.end(), [](char c) { return c >= '0' && c <= '9'; })) return false;
+  }
+  if (host.starts_with('[')) return true;  // an IPv6 literal, checked above
+  if (name.empty()) return false;
+  // An address literal cannot be rebound: a page that names it is served from that very origin.
+  in_addr v4{};
+  if (::inet_pton(AF_INET, std::string(name).c_str(), &v4) == 1) return true;
+  const std::string n = lower(name);
+  if (n == "localhost") return true;
+  return std::any_of(allowed_hosts.begin(), allowed_hosts.end(), [&n](const std::string& a) { return lower(a) == n; });
+}
+
+bool same_origin(std::string_view origin, std::string_view host) noexcept {
+  if (host.empty()) return false;
+  for (const std::string_view scheme : {std::string_view("http://"), std::string_view("https://")}) {
+    if (origin.size() != scheme.size() + host.size()) continue;
+    bool equal = true;
+    for (std::size_t i = 0; i < origin.size() && equal; ++i) {
+      const char expected = i < scheme.size() ? scheme[i] : host[i - scheme.size()];
+      equal = std::tolower(static_cast<unsigned char>(origin[i])) == std::tolower(static_cast<unsigned char>(expected));
+    }
+    if (equal) return true;
+  }
+  return false;
+}
+
+std::string media_type(std::string_view content_type) { return lower(trim(content_type.substr(0, content_type.find(';')))); }
 
 bool constant_time_equal(std::string_view a, std::string_view b) noexcept {
   unsigned char diff = a.size() == b.size() ? 0 : 1;

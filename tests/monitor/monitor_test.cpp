@@ -31,10 +31,12 @@
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_board.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
+#include "loopback_client.hpp"
 #include "test_hri_module.hpp"
 
 using namespace tripodal;
 using namespace tripodal::monitor;
+using namespace tripodal::monitor::test;
 
 // Under LeakSanitizer: the caches Graphviz (libgvc) and fontconfig keep until the process ends are
 // theirs, not leaks of the monitor (their stacks end in those libraries).
@@ -51,85 +53,6 @@ std::string hex(const std::array<std::uint8_t, 20>& d) {
     out += kHex[b & 0xF];
   }
   return out;
-}
-
-// A blocking loopback client: enough to speak HTTP and WebSocket to the server in a test.
-class Client {
- public:
-  explicit Client(std::uint16_t port, int receive_buffer_bytes = 0) {
-    fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
-    if (receive_buffer_bytes > 0) ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &receive_buffer_bytes, sizeof receive_buffer_bytes);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_port = htons(port);
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    REQUIRE(::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0);
-  }
-  ~Client() { ::close(fd_); }
-  Client(const Client&) = delete;
-  Client& operator=(const Client&) = delete;
-  void send(const std::string& s) const { REQUIRE(::send(fd_, s.data(), s.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(s.size())); }
-  // Reads until `done` holds for what arrived, the peer closes, or 10 s pass (a hang, not a measure).
-  template <class Done>
-  std::string read_until(Done done, std::chrono::milliseconds patience = std::chrono::seconds(10)) {
-    const auto give_up = std::chrono::steady_clock::now() + patience;
-    while (!done(buf_) && std::chrono::steady_clock::now() < give_up) {
-      pollfd p{fd_, POLLIN, 0};
-      if (::poll(&p, 1, 100) <= 0) continue;
-      char b[65536];
-      const ssize_t n = ::recv(fd_, b, sizeof b, 0);
-      if (n <= 0) break;
-      buf_.append(b, static_cast<std::size_t>(n));
-    }
-    return buf_;
-  }
-  std::string read_all() {
-    return read_until([](const std::string&) { return false; });
-  }
-  void consume(std::size_t n) { buf_.erase(0, n); }
-  int fd() const { return fd_; }
-
- private:
-  int fd_ = -1;
-  std::string buf_;
-};
-
-std::string ws_upgrade(const std::string& path, const std::string& protocol = {}) {
-  std::string r = "GET " + path + " HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
-                  "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n";
-  if (!protocol.empty()) r += "Sec-WebSocket-Protocol: " + protocol + "\r\n";
-  return r + "\r\n";
-}
-
-// Server frames (unmasked) in `bytes` after the handshake.
-std::vector<WsFrame> server_frames(std::string_view bytes) {
-  std::vector<WsFrame> out;
-  while (bytes.size() >= 2) {
-    std::uint64_t n = static_cast<std::uint8_t>(bytes[1]) & 0x7FU;
-    std::size_t pos = 2;
-    if (n == 126) {
-      n = (std::uint64_t{static_cast<std::uint8_t>(bytes[2])} << 8) | static_cast<std::uint8_t>(bytes[3]);
-      pos = 4;
-    } else if (n == 127) {
-      n = 0;
-      for (std::size_t i = 2; i < 10; ++i) n = (n << 8) | static_cast<std::uint8_t>(bytes[i]);
-      pos = 10;
-    }
-    if (bytes.size() < pos + n) break;
-    out.push_back(WsFrame{static_cast<WsOpcode>(static_cast<std::uint8_t>(bytes[0]) & 0x0FU), true, std::string(bytes.substr(pos, n))});
-    bytes.remove_prefix(pos + n);
-  }
-  return out;
-}
-
-template <class Pred>
-bool wait_for(Pred p) {
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-  while (!p()) {
-    if (std::chrono::steady_clock::now() > give_up) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  return true;
 }
 
 // The PSR-2 demo robot on the simulator, in the workspace world.
@@ -179,7 +102,7 @@ TEST_CASE("SHA-1, base64 and the WebSocket accept key follow their standards", "
 }
 
 TEST_CASE("HTTP requests are read with limits and located errors", "[monitor][wire]") {
-  const std::string req = "POST /api/command?token=ab HTTP/1.1\r\nHost: x\r\nContent-Length: 4\r\nX-A:  v \r\n\r\nbody";
+  const std::string req = "POST /api/command?token=ab HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 4\r\nX-A:  v \r\n\r\nbody";
   CHECK(parse_http_request(req.substr(0, 20)).status == HttpParse::Status::incomplete);
   CHECK(parse_http_request(req.substr(0, req.size() - 1)).status == HttpParse::Status::incomplete);
   const HttpParse p = parse_http_request(req);
@@ -246,7 +169,7 @@ TEST_CASE("The server serves the page, refuses without the token and hands comma
 
   {  // the page
     Client c(server.port());
-    c.send("GET / HTTP/1.1\r\nHost: x\r\n\r\n");
+    c.send("GET / HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n");
     const std::string r = c.read_all();
     CHECK_THAT(r, Catch::StartsWith("HTTP/1.1 200 OK"));
     CHECK_THAT(r, Catch::Contains("<title>tripodal monitor</title>"));
@@ -349,7 +272,7 @@ TEST_CASE("Foxglove clients get serverInfo, advertise and binary messageData of 
 }
 
 TEST_CASE("A client that stops reading loses old bulk frames, and is let go rather than lose an event", "[monitor][server][threads]") {
-  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests", .max_bulk_frames = 4, .max_event_bytes = 1U << 20U, .send_buffer_bytes = 16384});
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests", .max_bulk_frames = 4, .max_event_bytes = 1U << 20U, .send_buffer_bytes = 16384, .max_history_bytes = 256U << 10U});
   const auto scan = server.advertise("/laser", "foxglove.LaserScan", "{}", Delivery::bulk);
   const auto life = server.advertise("/lifecycle", "tripodal.LifecycleEntry", "{}", Delivery::event);
   server.start();
@@ -861,7 +784,7 @@ TEST_CASE("The RKMS and touch pages are served, and the touch screen's questions
   server.start();
   for (const auto& [path, marker] : {std::pair{"/rkms", "RKMS: the robot's knowledge"}, std::pair{"/touch", "Type your question here"}}) {
     Client c(server.port());
-    c.send(std::string("GET ") + path + " HTTP/1.1\r\nHost: x\r\n\r\n");
+    c.send(std::string("GET ") + path + " HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n");
     const std::string page = c.read_all();
     CHECK(page.starts_with("HTTP/1.1 200"));
     CHECK(page.find(marker) != std::string::npos);

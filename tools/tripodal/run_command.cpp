@@ -88,8 +88,10 @@ int run_guide(const Args& args, std::ostream& out, std::ostream& err) {
     err << "tripodal run: --visit runs as fast as it can; --realtime goes with --monitor\n";
     return kUsage;
   }
-  if (!o.monitor && (o.start_paused || o.monitor_read_open || !o.monitor_token_file.empty())) {
-    err << "tripodal run: --start-paused, --monitor-read-open and --monitor-token-file need --monitor [ADDR:]PORT\n";
+  if (!o.monitor && (o.start_paused || o.monitor_read_open || !o.monitor_token_file.empty() || !o.monitor_allowed_hosts.empty() ||
+                     !o.monitor_allowed_origins.empty())) {
+    err << "tripodal run: --start-paused, --monitor-read-open, --monitor-token-file, --monitor-allow-host and "
+           "--monitor-allow-origin need --monitor [ADDR:]PORT\n";
     return kUsage;
   }
   std::vector<std::filesystem::path> files{o.robot, o.world};
@@ -119,6 +121,8 @@ int run_guide(const Args& args, std::ostream& out, std::ostream& err) {
     vo.monitor = o.monitor;
     vo.monitor_token_file = o.monitor_token_file;
     vo.monitor_read_open = o.monitor_read_open;
+    vo.monitor_allowed_hosts = o.monitor_allowed_hosts;
+    vo.monitor_allowed_origins = o.monitor_allowed_origins;
     vo.start_paused = o.start_paused;
     vo.realtime_speed = o.realtime && args.realtime_speed > 0.0 ? args.realtime_speed : 1.0;
     vo.max_duration_s = o.max_duration_s;
@@ -193,8 +197,10 @@ int run(Args& args, std::ostream& out, std::ostream& err) {
            "with dds: {tasks: true}, where a DDS peer may)\n";
     return kUsage;
   }
-  if (!o.monitor && (o.start_paused || o.monitor_read_open || !o.monitor_token_file.empty())) {
-    err << "tripodal run: --start-paused, --monitor-read-open and --monitor-token-file need --monitor [ADDR:]PORT\n";
+  if (!o.monitor && (o.start_paused || o.monitor_read_open || !o.monitor_token_file.empty() || !o.monitor_allowed_hosts.empty() ||
+                     !o.monitor_allowed_origins.empty())) {
+    err << "tripodal run: --start-paused, --monitor-read-open, --monitor-token-file, --monitor-allow-host and "
+           "--monitor-allow-origin need --monitor [ADDR:]PORT\n";
     return kUsage;
   }
   if (o.monitor) {
@@ -299,6 +305,10 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_option("--monitor", o.monitor, "[ADDR:]PORT: serve the live monitor and console (docs/monitor.md); 0: a free port");
   cmd.add_option("--monitor-token-file", o.monitor_token_file, "FILE: the console's token (first line; default: generated)");
   cmd.add_flag("--monitor-read-open", o.monitor_read_open, "let clients without the token watch (not command)");
+  cmd.add_option("--monitor-allow-host", o.monitor_allowed_hosts,
+                 "NAME: also serve requests that name this host (the robot's DNS name; loopback and addresses always are)");
+  cmd.add_option("--monitor-allow-origin", o.monitor_allowed_origins,
+                 "ORIGIN: also take streams and commands from pages of this origin (https://app.foxglove.dev)");
   cmd.add_flag("--start-paused", o.start_paused, "with --monitor: hold the run until the operator resumes it");
   return [a](std::ostream& out, std::ostream& err) { return run(*a, out, err); };
 }

@@ -395,6 +395,8 @@ RunResult run_task(const RunOptions& o) {
   if (o.monitor) {
     monitor::MonitorServerOptions so = monitor::server_options(*o.monitor, o.monitor_token_file);
     so.read_without_token = o.monitor_read_open;
+    so.allowed_hosts = o.monitor_allowed_hosts;
+    so.allowed_origins = o.monitor_allowed_origins;
     server = std::make_unique<monitor::MonitorServer>(std::move(so));
     // the operator's live maps go beside the run's own outputs
     watch = std::make_unique<monitor::RobotMonitor>(*robot, clock, *server,

@@ -65,6 +65,8 @@ struct RunOptions {
   std::optional<std::string> monitor;  ///< "[ADDR:]PORT"
   std::filesystem::path monitor_token_file;  ///< the token, read from this file (default: generated)
   bool monitor_read_open = false;    ///< read-only streams without the token
+  std::vector<std::string> monitor_allowed_hosts;    ///< Host names served besides loopback and addresses
+  std::vector<std::string> monitor_allowed_origins;  ///< Origins served besides the page's own
   bool start_paused = false;         ///< hold the run until the operator resumes it
   const volatile std::sig_atomic_t* stop = nullptr;
   std::ostream* log = nullptr;       ///< task and process life cycle, as it happens

@@ -92,6 +92,8 @@ VisitResult run_visit(const VisitOptions& o) {
   if (o.monitor) {
     server_options = monitor::server_options(*o.monitor, o.monitor_token_file);
     server_options->read_without_token = o.monitor_read_open;
+    server_options->allowed_hosts = o.monitor_allowed_hosts;
+    server_options->allowed_origins = o.monitor_allowed_origins;
   }
   const RobotProfile profile = load_robot_profile(o.robot);
   auto world = std::make_shared<sim::World>(sim::load_world(o.world));

@@ -65,6 +65,8 @@ struct VisitOptions {
   std::optional<std::string> monitor;
   std::filesystem::path monitor_token_file;  ///< the token, read from this file (default: generated)
   bool monitor_read_open = false;            ///< read-only streams without the token
+  std::vector<std::string> monitor_allowed_hosts;    ///< Host names served besides loopback and addresses
+  std::vector<std::string> monitor_allowed_origins;  ///< Origins served besides the page's own
   bool start_paused = false;                 ///< hold the run until the operator resumes it
   double realtime_speed = 1.0;               ///< with the monitor: SPEED times real time
   /// Simulated time limit of a monitored run without a visit file (a visit file has its own).

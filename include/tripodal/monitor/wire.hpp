@@ -79,6 +79,18 @@ struct WsParse {
 /// Encodes a client frame (masked with `mask`), for tests and the benchmark's clients.
 [[nodiscard]] std::string ws_client_frame(WsOpcode opcode, std::string_view payload, std::uint32_t mask = 0x12345678U);
 
+/// Whether a request's `Host` value ("name[:port]") names this server from a browser's point of
+/// view: an IP literal (IPv4, or IPv6 in brackets), `localhost`, or one of `allowed_hosts` (names
+/// compared without case). Any other name may be a DNS-rebinding page's: refused.
+[[nodiscard]] bool host_allowed(std::string_view host, const std::vector<std::string>& allowed_hosts);
+
+/// Whether `origin` (an `Origin` header) is the origin of a page served by the server the request
+/// names in `host`: "http://HOST" or "https://HOST", compared without case. "null" is not.
+[[nodiscard]] bool same_origin(std::string_view origin, std::string_view host) noexcept;
+
+/// The media type of a Content-Type value, lower case, without parameters ("application/json").
+[[nodiscard]] std::string media_type(std::string_view content_type);
+
 /// Whether two secrets are equal, in time independent of where they differ.
 [[nodiscard]] bool constant_time_equal(std::string_view a, std::string_view b) noexcept;
 
