@@ -223,7 +223,7 @@ TEST_CASE("run_task: the order of the processes follows the start (section D fir
   CHECK_THAT(a.processes[1], Catch::Contains("X1 PrCleaning(section=A) failed: stopped"));
 }
 
-TEST_CASE("run_task: a run without a task writes a valid map and report; a signal stops a task in order", "[app][run][shutdown]") {
+TEST_CASE("run_task: a run without a task writes a valid map and report, a signal stops a task in order", "[app][run][shutdown]") {
   // Before, a run that never had a task drew the map from an empty vector of reachable cells
   // (a segfault: exit 139 and no report), and a refused task wrote nothing at all.
   const std::filesystem::path out = std::filesystem::temp_directory_path() / ("tripodal_app_empty_" + std::to_string(::getpid()));
@@ -236,6 +236,7 @@ TEST_CASE("run_task: a run without a task writes a valid map and report; a signa
   o.task = "clean the kitchen now";
   const RunResult refused = run_task(o);
   CHECK(refused.state == "refused");
+  CHECK_THAT(refused.reason, Catch::Contains("not understood"));
   CHECK(refused.reachable_cells == 0);
   CHECK(refused.sections.empty());
   CHECK(refused.base_at_rest);

@@ -563,7 +563,9 @@ RunResult run_task(const RunOptions& o) {
   res.succeeded = tr.state == TaskState::succeeded;
   // With the monitor a task from the console may follow a refused --task: the last task counts.
   if (res.state.empty() || (serve && res.state == "refused" && tr.state != TaskState::idle)) res.state = std::string(to_string(tr.state));
-  if (!serve || tr.state != TaskState::idle) res.reason = tr.reason;
+  // A refused task leaves the planner idle: the refusal's words stay the reason.
+  const bool only_refused = res.state == "refused" && tr.state == TaskState::idle;
+  if (!only_refused && (!serve || tr.state != TaskState::idle)) res.reason = tr.reason;
   res.duration_s = to_seconds(clock.now());
   res.cleaned_cells = covered();
   res.coverage = res.reachable_cells == 0 ? 0.0 : static_cast<double>(res.cleaned_cells) / static_cast<double>(res.reachable_cells);
