@@ -5,8 +5,8 @@ was idle), report.json valid JSON naming the stop ("interrupted by SIGTERM"), th
 zero at the end, and map.png a PNG (also when the run had no task: no cells, no path, no sections).
 
 usage: shutdown_test.py TRIPODAL SOURCE_DIR MODE SIGNAL
-MODE: task, monitor_idle, monitor_task, board_pty, dds_profile, visit. Exit 77: skipped (a build
-without DDS for dds_profile)."""
+MODE: task, monitor_idle, monitor_task, board_pty, dds_profile, hardware_dds (the simulator in a
+`tripodal sim-server` of its own), visit. Exit 77: skipped (a build without DDS for the DDS modes)."""
 import json
 import os
 import re
@@ -61,11 +61,17 @@ def run(exe, source, mode, sig, sig_name, work):
         cmd = ["run", "--robot", os.path.join(robots, "disinfection.yaml"), "--world", workspace, "--task", "disinfect the room 2111",
                "--seed", "1", "--board", "pty"]
         ready, cut = running_task, True
-    elif mode == "dds_profile":
-        probe = subprocess.run([exe, "fleet", "--help"], capture_output=True, text=True)
-        if probe.returncode != 0:  # `tripodal fleet` is built with the dds area only
-            print("skipped: this tripodal was built without DDS")
-            sys.exit(SKIP)
+    elif mode in ("dds_profile", "hardware_dds") and subprocess.run([exe, "sim-server", "--help"], capture_output=True).returncode != 0:
+        print("skipped: this tripodal was built without DDS")  # sim-server is built with the dds area only
+        sys.exit(SKIP)
+    elif mode == "hardware_dds":
+        ns, domain = "shutdown_hw_%d" % os.getpid(), str(100 + os.getpid() % 50)
+        server = subprocess.Popen([exe, "sim-server", "--robot", psr2, "--world", workspace, "--namespace", ns, "--domain", domain,
+                                   "--seed", "1", "--wait-s", "60"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        cmd = ["run", "--robot", psr2, "--world", workspace, "--task", "clean the room 2111", "--seed", "1", "--hardware", "dds",
+               "--hardware-param", "namespace=" + ns, "--hardware-param", "domain_id=" + domain]
+        ready, cut = running_task, True
+    if mode == "dds_profile":
         # A copy of configs/ (the profile's files are relative to it) whose PSR-2 is on DDS, on a
         # domain of its own.
         copy = os.path.join(work, "configs")
@@ -80,7 +86,7 @@ def run(exe, source, mode, sig, sig_name, work):
         cmd = ["run", "--robot", os.path.join(robots, "jinny.yaml"), "--world", os.path.join(worlds, "exhibit_hall.yaml"), "--visit",
                os.path.join(configs, "visits", "exhibit_hall.yaml"), "--no-voice", "--monitor", "0", "--realtime", "2"]
         ready, cut = r"PrAutoMove\(goal=node1\) started", True
-    else:
+    elif mode not in ("task", "monitor_idle", "monitor_task", "board_pty", "hardware_dds"):
         fail("unknown mode " + mode)
     cmd = [exe] + cmd + ["--out", out]
 
@@ -119,6 +125,12 @@ def run(exe, source, mode, sig, sig_name, work):
     for t in readers:
         t.join(timeout=10)
 
+    if mode == "hardware_dds":  # the robot gone, the server ends by itself; bounded all the same
+        try:
+            server.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            server.kill()
+            server.wait()
     expected_rc = 128 + int(sig) if cut else 0
     if rc != expected_rc:
         fail("exit code %d after %s, expected %d" % (rc, sig_name, expected_rc), output())
