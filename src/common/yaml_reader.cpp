@@ -2,7 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <yaml-cpp/eventhandler.h>
+
 #include <cmath>
+#include <sstream>
+#include <unordered_map>
 
 namespace tripodal::yaml {
 
@@ -25,13 +29,74 @@ std::optional<double> finite(const YAML::Node& node) {
   return v;
 }
 
+// YAML says a mapping's keys are unique, but yaml-cpp keeps both pairs and `map["k"]` answers the
+// first: a profile that sets `period_s` twice would run with the value its author did not read
+// last. The parser's events see every key where it is written (an alias is one event, so a
+// document of aliases is scanned in its length, never expanded).
+class DuplicateKeys final : public YAML::EventHandler {
+ public:
+  DuplicateKeys(const std::string& file, Diagnostics& d) : file_(file), d_(d) {}
+
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override { leaf(); }
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override { leaf(); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t, const std::string& value) override {
+    if (in_key_position()) {
+      const auto [first, inserted] = frames_.back().keys.try_emplace(value, mark);
+      if (!inserted) {
+        d_.error(located(mark), fmt::format("duplicate key '{}' (first at {}:{}:{}); a key may appear once in a map", value, file_,
+                                            first->second.line + 1, first->second.column + 1));
+      }
+    }
+    leaf();
+  }
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    frames_.push_back({});
+  }
+  void OnSequenceEnd() override { close(); }
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    frames_.push_back({true, 0, {}});
+  }
+  void OnMapEnd() override { close(); }
+
+ private:
+  struct Frame {
+    bool map = false;
+    std::size_t children = 0;  // in a map, keys and values alternate: an even count is a key next
+    std::unordered_map<std::string, YAML::Mark> keys;
+  };
+  [[nodiscard]] bool in_key_position() const { return !frames_.empty() && frames_.back().map && frames_.back().children % 2 == 0; }
+  void leaf() {
+    if (!frames_.empty()) ++frames_.back().children;
+  }
+  void close() {
+    frames_.pop_back();
+    leaf();
+  }
+  [[nodiscard]] SourceLocation located(const YAML::Mark& m) const { return {file_, m.line + 1, m.column + 1}; }
+
+  const std::string& file_;
+  Diagnostics& d_;
+  std::vector<Frame> frames_;
+};
+
 }  // namespace
 
 std::string read_file(const std::filesystem::path& file) { return read_config_file(file); }
 
 YAML::Node parse(std::string_view text, const std::string& file) {
   try {
-    return YAML::Load(std::string(text));
+    std::string owned(text);
+    YAML::Node root = YAML::Load(owned);
+    // The document parsed: now its keys, every duplicate at once, each with both places.
+    std::istringstream in(std::move(owned));
+    YAML::Parser parser(in);
+    Diagnostics d;
+    DuplicateKeys keys(file, d);
+    parser.HandleNextDocument(keys);
+    if (d.has_errors()) throw ConfigError(std::move(d));
+    return root;
   } catch (const YAML::Exception& e) {
     throw ConfigError(SourceLocation{file, e.mark.line + 1, e.mark.column + 1}, "YAML syntax error: " + e.msg);
   }
@@ -113,6 +178,13 @@ std::optional<double> Reader::positive(const YAML::Node& node, std::string_view 
   const auto v = finite(node);
   if (v && *v > 0.0) return v;
   error(node, fmt::format("{}: expected a number > 0, got {}", what, kind(node)));
+  return std::nullopt;
+}
+
+std::optional<double> Reader::seconds(const YAML::Node& node, std::string_view what, double min_s, double max_s) {
+  const auto v = finite(node);
+  if (v && *v >= min_s && *v <= max_s) return v;
+  error(node, fmt::format("{}: expected seconds from {:g} to {:g}, got {}", what, min_s, max_s, kind(node)));
   return std::nullopt;
 }
 

@@ -16,8 +16,12 @@
 #include <vector>
 
 #include "tripodal/core/diagnostic.hpp"
+#include "tripodal/core/time.hpp"
 
 namespace tripodal::yaml {
+
+/// The shortest period or timeout a configuration may give (s): 1 µs.
+inline constexpr double kMinPeriodSeconds = 1e-6;
 
 /// The keys a mapping may hold, in the order the error message lists them.
 using KeyList = std::initializer_list<std::string_view>;
@@ -81,6 +85,11 @@ class Reader {
   /// A number > 0 (strictly) or >= 0: "WHAT: expected a number > 0, got -1".
   std::optional<double> positive(const YAML::Node& node, std::string_view what);
   std::optional<double> non_negative(const YAML::Node& node, std::string_view what);
+  /// A duration in seconds within [min_s, max_s]: "WHAT: expected seconds from 1e-06 to 9e+09, got
+  /// 1e-12". A period shorter than a microsecond rounds to no time at all (nanosecond clock) and
+  /// one beyond kMaxSeconds would be capped: both are refused here, where the author wrote them.
+  std::optional<double> seconds(const YAML::Node& node, std::string_view what, double min_s = kMinPeriodSeconds,
+                                double max_s = kMaxSeconds);
   /// A whole number in [lo, hi]: "WHAT: expected a whole number from LO to HI, got 2.5".
   std::optional<std::int64_t> integer(const YAML::Node& node, std::string_view what, std::int64_t lo,
                                       std::int64_t hi);

@@ -1,9 +1,11 @@
 #include "tripodal/core/diagnostic.hpp"
 
+#include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <ostream>
 #include <sstream>
+#include <string>
 #include <unordered_set>
 #include <utility>
 
@@ -91,20 +93,43 @@ ConfigError::ConfigError(SourceLocation where, const std::string& message)
     : ConfigError(single(where, message)) {}
 
 std::string read_config_file(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw ConfigError(SourceLocation{file.string(), 0, 0}, "cannot read the file");
+  const SourceLocation where{file.string(), 0, 0};
+  // Only a regular file has a size to check before reading: a device (/dev/zero), a FIFO or a
+  // socket would be read until memory runs out, or block forever, and a directory has no text.
   std::error_code ec;
-  const std::uintmax_t size = std::filesystem::file_size(file, ec);
-  // A size that cannot be told (a pipe, /dev/stdin) is read as it comes.
-  if (!ec && size > kMaxConfigFileBytes) {
-    throw ConfigError(SourceLocation{file.string(), 0, 0},
-                      "the file has " + std::to_string(size) + " bytes, more than the " +
-                          std::to_string(kMaxConfigFileBytes) + " a configuration file may have");
+  const std::filesystem::file_status st = std::filesystem::status(file, ec);
+  if (ec || !std::filesystem::exists(st)) throw ConfigError(where, "cannot read the file");
+  if (!std::filesystem::is_regular_file(st)) {
+    const char* what = std::filesystem::is_directory(st)       ? "a directory"
+                       : std::filesystem::is_fifo(st)          ? "a FIFO"
+                       : std::filesystem::is_character_file(st) ? "a character device"
+                       : std::filesystem::is_block_file(st)     ? "a block device"
+                       : std::filesystem::is_socket(st)         ? "a socket"
+                                                                : "not a file";
+    throw ConfigError(where, std::string("cannot read ") + what + ": a configuration file must be a regular file");
   }
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw ConfigError(SourceLocation{file.string(), 0, 0}, "cannot read the file");
-  return text.str();
+  const auto too_big = [&](std::uintmax_t size) {
+    return ConfigError(where, "the file has " + std::to_string(size) + " bytes, more than the " +
+                                  std::to_string(kMaxConfigFileBytes) + " a configuration file may have");
+  };
+  const std::uintmax_t size = std::filesystem::file_size(file, ec);
+  if (!ec && size > kMaxConfigFileBytes) throw too_big(size);
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw ConfigError(where, "cannot read the file");
+  // Read no more than the limit even so: the file may grow (or be swapped) after the check.
+  std::string text;
+  text.resize(static_cast<std::size_t>(ec ? 0 : size));
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (in.bad()) throw ConfigError(where, "cannot read the file");
+  char chunk[65536];
+  while (in && !in.eof()) {
+    in.read(chunk, sizeof chunk);
+    text.append(chunk, static_cast<std::size_t>(in.gcount()));
+    if (text.size() > kMaxConfigFileBytes) throw too_big(text.size());
+  }
+  if (in.bad()) throw ConfigError(where, "cannot read the file");
+  return text;
 }
 
 }  // namespace tripodal

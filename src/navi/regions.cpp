@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include "../common/yaml_reader.hpp"
@@ -190,8 +191,37 @@ RegionMap load_regions(const std::filesystem::path& file) {
 
 std::vector<std::size_t> cells_in_region(const OccupancyGrid& grid, const Region& region) {
   std::vector<std::size_t> out;
-  for (std::size_t i = 0; i < grid.size(); ++i) {
-    if (region.contains(grid.cell_center(grid.cell(i)))) out.push_back(i);
+  if (region.polygon.empty() || grid.size() == 0) return out;
+  // Only the cells whose centres can be inside: those of the polygon's bounding box in the grid's
+  // frame (one cell of margin against rounding). A box the size of the region, not the whole map,
+  // keeps a world of 10^5 small obstacles linear in obstacles + map (the simulator's start-up).
+  double lo_x = std::numeric_limits<double>::infinity(), lo_y = lo_x, hi_x = -lo_x, hi_y = -lo_x;
+  for (const Point2D& p : region.polygon) {
+    const Point2D g = grid.to_grid_frame(p);
+    lo_x = std::min(lo_x, g.x_m);
+    lo_y = std::min(lo_y, g.y_m);
+    hi_x = std::max(hi_x, g.x_m);
+    hi_y = std::max(hi_y, g.y_m);
+  }
+  int x0 = 0, y0 = 0, x1 = grid.width() - 1, y1 = grid.height() - 1;
+  if (std::isfinite(lo_x) && std::isfinite(lo_y) && std::isfinite(hi_x) && std::isfinite(hi_y)) {
+    // cell x's centre is at (x + 0.5) * resolution; clamped before the integer conversion
+    const auto first = [&](double v, int n) {
+      return static_cast<int>(std::clamp(std::ceil(v / grid.resolution_m() - 0.5) - 1.0, 0.0, static_cast<double>(n)));
+    };
+    const auto last = [&](double v, int n) {
+      return static_cast<int>(std::clamp(std::floor(v / grid.resolution_m() - 0.5) + 1.0, -1.0, static_cast<double>(n - 1)));
+    };
+    x0 = first(lo_x, grid.width());
+    y0 = first(lo_y, grid.height());
+    x1 = last(hi_x, grid.width());
+    y1 = last(hi_y, grid.height());
+  }
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) {
+      const CellIndex c{x, y};
+      if (region.contains(grid.cell_center(c))) out.push_back(grid.index(c));
+    }
   }
   return out;
 }

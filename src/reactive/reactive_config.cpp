@@ -1,5 +1,6 @@
 #include "tripodal/reactive/reactive_config.hpp"
 
+#include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -280,7 +281,15 @@ LoopConfig read_loop(Reader& r, const YAML::Node& node, std::size_t index) {
     what = "loop '" + l.name + "'";
   }
   r.check_keys(node, {"name", "period_s", "controller", "realtime_priority", "cpu", "max_behaviors", "coordinator"}, what);
-  if (auto p = r.number(node, "period_s", true, Bound::positive, what)) l.period = from_seconds(*p);
+  if (auto p = r.number(node, "period_s", true, Bound::positive, what)) {
+    // Shorter than a microsecond rounds to no period at all; beyond kMaxSeconds it would be capped.
+    if (*p < yaml::kMinPeriodSeconds || *p > kMaxSeconds) {
+      r.error(node["period_s"], fmt::format("{}: 'period_s': expected seconds from {:g} to {:g}, got {}", what, yaml::kMinPeriodSeconds,
+                                            kMaxSeconds, node["period_s"].Scalar()));
+    } else {
+      l.period = from_seconds(*p);
+    }
+  }
   if (auto c = r.text(node, "controller", false, what)) l.controller = *c;
   if (auto p = r.integer(node, "realtime_priority", 0, 99, what)) l.timing.realtime_priority = *p;
   if (auto p = r.integer(node, "cpu", -1, 1023, what)) l.timing.cpu = *p;

@@ -52,7 +52,7 @@ struct Parser {
   std::optional<std::vector<std::string>> names(const YAML::Node& n, std::string_view what) { return r.names(n, what); }
 
   std::optional<double> positive_seconds(const YAML::Node& n, std::string_view what) {
-    return r.positive(n, std::string(what) + " (seconds)");
+    return r.seconds(n, what);
   }
 
   std::filesystem::path path_of(const YAML::Node& n, std::string_view what, SourceLocation& loc) {

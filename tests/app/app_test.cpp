@@ -222,3 +222,50 @@ TEST_CASE("run_task: the order of the processes follows the start (section D fir
   CHECK_THAT(a.processes[0], Catch::EndsWith("X0 PrAutoMove(goal=A.entry) succeeded"));
   CHECK_THAT(a.processes[1], Catch::Contains("X1 PrCleaning(section=A) failed: stopped"));
 }
+
+TEST_CASE("run_task: a run without a task writes a valid map and report, a signal stops a task in order", "[app][run][shutdown]") {
+  // Before, a run that never had a task drew the map from an empty vector of reachable cells
+  // (a segfault: exit 139 and no report), and a refused task wrote nothing at all.
+  const std::filesystem::path out = std::filesystem::temp_directory_path() / ("tripodal_app_empty_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(out);
+  RunOptions o;
+  o.robot = kSource / "configs/robots/psr2.yaml";
+  o.world = kSource / "configs/worlds/workspace.yaml";
+  o.seed = 2;
+  o.out = out / "refused";
+  o.task = "clean the kitchen now";
+  const RunResult refused = run_task(o);
+  CHECK(refused.state == "refused");
+  CHECK_THAT(refused.reason, Catch::Contains("not understood"));
+  CHECK(refused.reachable_cells == 0);
+  CHECK(refused.sections.empty());
+  CHECK(refused.base_at_rest);
+  for (const char* f : {"map.png", "trajectory.csv", "report.json", "lifecycle.txt"}) CHECK(std::filesystem::exists(o.out / f));
+  std::ifstream png(o.out / "map.png", std::ios::binary);
+  std::string signature(8, '\0');
+  png.read(signature.data(), 8);
+  CHECK(signature == "\x89PNG\r\n\x1a\n");
+  std::ifstream report_file(o.out / "report.json");
+  const nlohmann::json report = nlohmann::json::parse(report_file);
+  CHECK(report["state"] == "refused");
+  CHECK(report["stopped_by"] == "");
+
+  // A signal already received when the run starts its loop: the task is cancelled as interrupted,
+  // the base commanded zero, the report names the signal.
+  volatile std::sig_atomic_t stop = SIGTERM;
+  o.stop = &stop;
+  o.out = out / "interrupted";
+  o.task = "clean the room 2111";
+  const RunResult r = run_task(o);
+  CHECK(r.state == "interrupted");
+  CHECK(r.stopped_by == "interrupted by SIGTERM");
+  CHECK_THAT(r.reason, Catch::Contains("interrupted by SIGTERM"));
+  CHECK(r.base_at_rest);
+  REQUIRE(r.base_command_at_end_rad_s.size() == 3);  // the PSR-2's three omni wheels
+  for (const double w : r.base_command_at_end_rad_s) CHECK(w == 0.0);
+  std::ifstream interrupted_file(o.out / "report.json");
+  const nlohmann::json interrupted = nlohmann::json::parse(interrupted_file);
+  CHECK(interrupted["stopped_by"] == "interrupted by SIGTERM");
+  CHECK(interrupted["base_at_rest"] == true);
+  std::filesystem::remove_all(out);
+}

@@ -1,6 +1,9 @@
 // The YAML reading helper every loader uses: located errors, one wording for every loader.
 #include "common/yaml_reader.hpp"
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <catch2/catch.hpp>
 #include <filesystem>
 
@@ -118,4 +121,68 @@ TEST_CASE("yaml::Reader locates the empty document at 1:1") {
   yaml::Reader r("empty.yaml", d);
   const SourceLocation where = r.at(yaml::parse("", "empty.yaml"));
   CHECK(where.str() == "empty.yaml:1:1");
+}
+
+TEST_CASE("yaml::parse refuses a key given twice in a map, naming both places", "[yaml][errors]") {
+  // yaml-cpp keeps both pairs and map["k"] answers the first: the author's last word was ignored.
+  REQUIRE_THROWS_WITH(yaml::parse("period_s: 0.05\nname: x\nperiod_s: 0.01\n", "p.yaml"),
+                      Catch::Contains("p.yaml:3:1: error: duplicate key 'period_s' (first at p.yaml:1:1)"));
+  // Every duplicate at once, at any depth, in block and flow maps and inside lists.
+  try {
+    (void)yaml::parse("robot:\n  a: 1\n  b: 2\n  a: 3\nlist:\n  - {x: 1, x: 2}\n  - y: 1\n    y: 2\n", "d.yaml");
+    FAIL("no error");
+  } catch (const ConfigError& e) {
+    CHECK(e.diagnostics().error_count() == 3);
+    CHECK_THAT(std::string(e.what()), Catch::Contains("d.yaml:4:3: error: duplicate key 'a' (first at d.yaml:2:3)") &&
+                                          Catch::Contains("d.yaml:6:12: error: duplicate key 'x' (first at d.yaml:6:6)") &&
+                                          Catch::Contains("d.yaml:8:5: error: duplicate key 'y' (first at d.yaml:7:5)"));
+  }
+  // The same key in different maps, a value equal to a key, and a list of equal items are fine.
+  CHECK_NOTHROW(yaml::parse("a: {k: 1}\nb: {k: 1}\nc: [k, k]\nk: a\n", "ok.yaml"));
+  // Quoting does not make another key.
+  CHECK_THROWS_WITH(yaml::parse("'k': 1\nk: 2\n", "q.yaml"), Catch::Contains("q.yaml:2:1: error: duplicate key 'k'"));
+  // A key that is a map or a list is not compared (no loader takes one), and the nesting below it
+  // does not confuse the key/value order of the map around it.
+  CHECK_NOTHROW(yaml::parse("? [a]\n: 1\n? {b: 1}\n: 2\nc: 3\n", "c.yaml"));
+  CHECK_THROWS_WITH(yaml::parse("? [a]\n: {c: 1}\nc: 2\nc: 3\n", "c2.yaml"), Catch::Contains("c2.yaml:4:1: error: duplicate key 'c'"));
+}
+
+TEST_CASE("yaml::parse scans aliases as written, never expanded", "[yaml][limits]") {
+  // Nine levels of ten aliases each would be 10^9 nodes expanded; as written, a few hundred events.
+  std::string text = "a0: &a0 [x, x, x, x, x, x, x, x, x, x]\n";
+  for (int i = 1; i < 9; ++i) {
+    text += "a" + std::to_string(i) + ": &a" + std::to_string(i) + " [";
+    for (int k = 0; k < 10; ++k) text += (k ? ", *a" : "*a") + std::to_string(i - 1);
+    text += "]\n";
+  }
+  CHECK_NOTHROW(yaml::parse(text, "laughs.yaml"));
+  CHECK_THROWS_WITH(yaml::parse(text + "a3: 1\n", "laughs.yaml"), Catch::Contains("laughs.yaml:10:1: error: duplicate key 'a3' (first at laughs.yaml:4:1)"));
+}
+
+TEST_CASE("yaml::Reader::seconds refuses a period too short or too long, with the range", "[yaml][errors]") {
+  Fixture f("ok: 0.05\ntiny: 1e-12\nzero: 0\nhuge: 1e12\nword: soon\n");
+  CHECK(f.r.seconds(f.root["ok"], "period_s") == 0.05);
+  CHECK_FALSE(f.r.seconds(f.root["tiny"], "period_s"));
+  CHECK_FALSE(f.r.seconds(f.root["zero"], "period_s"));
+  CHECK_FALSE(f.r.seconds(f.root["huge"], "period_s"));
+  CHECK_FALSE(f.r.seconds(f.root["word"], "period_s"));
+  CHECK_THAT(f.errors(), Catch::Contains("t.yaml:2:7: error: period_s: expected seconds from 1e-06 to 9e+09, got '1e-12'") &&
+                             Catch::Contains("t.yaml:3:7: error: period_s: expected seconds from 1e-06 to 9e+09, got '0'") &&
+                             Catch::Contains("t.yaml:4:7: error: period_s: expected seconds from 1e-06 to 9e+09, got '1e12'") &&
+                             Catch::Contains("t.yaml:5:7: error: period_s: expected seconds from 1e-06 to 9e+09, got 'soon'"));
+}
+
+TEST_CASE("yaml::read_file reads regular files only, and no more than the limit", "[yaml][errors][limits]") {
+  // A device would be read until memory runs out (/dev/zero) or block for ever (a FIFO no one
+  // writes); a directory has no text.
+  CHECK_THROWS_WITH(yaml::read_file("/dev/zero"), Catch::Contains("/dev/zero: error: cannot read a character device: a configuration "
+                                                                  "file must be a regular file"));
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("tripodal_yaml_read_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  CHECK_THROWS_WITH(yaml::read_file(dir), Catch::Contains(dir.string() + ": error: cannot read a directory"));
+  const std::filesystem::path fifo = dir / "fifo";
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  CHECK_THROWS_WITH(yaml::read_file(fifo), Catch::Contains(fifo.string() + ": error: cannot read a FIFO"));
+  std::filesystem::remove_all(dir);
 }

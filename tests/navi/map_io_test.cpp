@@ -1,5 +1,7 @@
 #include "tripodal/navi/map_io.hpp"
 
+#include <sys/stat.h>
+
 #include <catch2/catch.hpp>
 
 #include <string>
@@ -237,4 +239,25 @@ TEST_CASE("map_io: a map file beyond the configuration file limit is refused unr
   CHECK_THROWS_WITH(load_map(dir / "m.yaml"),
                     Catch::Contains((dir / "m.pgm").string() + ": error: the file has 268435457 bytes, more than the "
                                     "268435456 a configuration file may have"));
+}
+
+TEST_CASE("map_io: only a regular file is read as a map image or description", "[navi][map][errors][limits]") {
+  // Before, /dev/zero was read until memory ran out and a FIFO blocked the load for ever.
+  TempDir dir("special");
+  const auto with_image = [&](const std::string& image) {
+    std::string y = kYaml;
+    y.replace(y.find("m.pgm"), 5, image);
+    write_file(dir / "m.yaml", y);
+  };
+  with_image("/dev/zero");
+  CHECK_THROWS_WITH(load_map(dir / "m.yaml"),
+                    Catch::Contains("/dev/zero: error: cannot read a character device: a configuration file must be a regular file"));
+  std::filesystem::create_directories(dir / "d.pgm");
+  with_image("d.pgm");
+  CHECK_THROWS_WITH(load_map(dir / "m.yaml"), Catch::Contains((dir / "d.pgm").string() + ": error: cannot read a directory"));
+  REQUIRE(::mkfifo((dir / "f.pgm").c_str(), 0600) == 0);
+  with_image("f.pgm");
+  CHECK_THROWS_WITH(load_map(dir / "m.yaml"), Catch::Contains((dir / "f.pgm").string() + ": error: cannot read a FIFO"));
+  // The description itself too.
+  CHECK_THROWS_WITH(load_map("/dev/zero"), Catch::Contains("/dev/zero: error: cannot read a character device"));
 }

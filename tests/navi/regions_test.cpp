@@ -2,6 +2,7 @@
 
 #include <catch2/catch.hpp>
 #include <filesystem>
+#include <random>
 
 #include "navi_test_util.hpp"
 #include "tripodal/navi/map_io.hpp"
@@ -119,4 +120,35 @@ TEST_CASE("the demo world: map, regions, splitter and planner agree", "[navi][re
     const PlannedPath p = planner.plan(Point2D{charger->pose.x_m, charger->pose.y_m}, Point2D{n.pose.x_m, n.pose.y_m});
     CHECK(p.ok());
   }
+}
+
+TEST_CASE("regions: cells_in_region looks at the region's bounding box, with the whole map's answer", "[navi][regions]") {
+  // The reference is the whole-map scan cells_in_region was: every cell's centre tested.
+  const auto whole_map = [](const OccupancyGrid& g, const Region& r) {
+    std::vector<std::size_t> out;
+    for (std::size_t i = 0; i < g.size(); ++i) {
+      if (r.contains(g.cell_center(g.cell(i)))) out.push_back(i);
+    }
+    return out;
+  };
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> coord(-3.0, 9.0), size(0.0, 2.5);
+  for (const Pose2D origin : {Pose2D{0.0, 0.0, 0.0}, Pose2D{-1.3, 0.7, 0.0}, Pose2D{0.4, -0.2, 0.6}, Pose2D{2.0, 1.0, -2.5}}) {
+    const OccupancyGrid g(61, 43, 0.1, origin, Occupancy::free);
+    for (int k = 0; k < 300; ++k) {
+      Region r{"r", {}, {}};
+      const double x = coord(rng), y = coord(rng);
+      const int corners = 3 + k % 5;
+      for (int c = 0; c < corners; ++c) r.polygon.push_back({x + size(rng), y + size(rng)});
+      CHECK(cells_in_region(g, r) == whole_map(g, r));
+    }
+    // On cell centres exactly, edges and corners of the map, a region larger than the map.
+    for (const Region& r : {Region{"centres", {{0.05, 0.05}, {1.05, 0.05}, {1.05, 1.05}, {0.05, 1.05}}, {}},
+                            Region{"all", {{-50, -50}, {50, -50}, {50, 50}, {-50, 50}}, {}},
+                            Region{"outside", {{100, 100}, {101, 100}, {101, 101}}, {}},
+                            Region{"far", {{-1e12, -1e12}, {1e12, -1e12}, {0, 1e12}}, {}}}) {
+      CHECK(cells_in_region(g, r) == whole_map(g, r));
+    }
+  }
+  CHECK(cells_in_region(OccupancyGrid(10, 10, 0.1), Region{"empty", {}, {}}).empty());
 }

@@ -281,3 +281,15 @@ loops:
   REQUIRE_THROWS_WITH(parse_reactive_config("controllers:\n  - {name: winch, type: gain}\n", "winch.yaml"),
                       Catch::Contains("unknown controller type 'gain'; known: differential, mecanum, omni"));
 }
+
+TEST_CASE("A loop period too short for the clock is refused at the file, with the range", "[errors]") {
+  // 1e-12 s rounds to 0 ns: the control loop refused it as it was built, unlocated.
+  REQUIRE_THROWS_WITH(parse_reactive_config(R"(loops:
+  - name: motion
+    period_s: 1e-12
+  - name: slow
+    period_s: 1e10
+)", "tiny.yaml"),
+                      Catch::Contains("tiny.yaml:3:15: error: loop 'motion': 'period_s': expected seconds from 1e-06 to 9e+09, got 1e-12") &&
+                          Catch::Contains("tiny.yaml:5:15: error: loop 'slow': 'period_s': expected seconds from 1e-06 to 9e+09, got 1e10"));
+}

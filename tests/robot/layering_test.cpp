@@ -160,7 +160,7 @@ TEST_CASE("Profile load errors are all reported, located", "[robot]") {
   } catch (const ConfigError& e) {
     const std::string m = e.what();
     CHECK_THAT(m, Catch::Contains("bad.yaml:2:1: error: unknown key 'colour' in the robot profile; expected one of: robot, hardware, controllers, loops"));
-    CHECK_THAT(m, Catch::Contains("bad.yaml:6:28: error: period_s (seconds): expected a number > 0, got '-1'"));
+    CHECK_THAT(m, Catch::Contains("bad.yaml:6:28: error: period_s: expected seconds from 1e-06 to 9e+09, got '-1'"));
     CHECK_THAT(m, Catch::Contains("bad.yaml:6:5: error: loop 'fast' drives controller 'wheels', which the profile does not list"));
     CHECK_THAT(m, Catch::Contains("bad.yaml:8:46: error: unknown layer 'upstairs'; expected one of: deliberate, sequencing, reactive"));
     CHECK_THAT(m, Catch::Contains("bad.yaml:8:56: error: unknown key 'wires' in a resource entry"));
@@ -169,6 +169,34 @@ TEST_CASE("Profile load errors are all reported, located", "[robot]") {
     CHECK_THAT(m, Catch::Contains("bad.yaml:13:5: error: process 'PrY' needs a net file (net: FILE)"));
     CHECK(e.diagnostics().error_count() == 8);
   }
+}
+
+TEST_CASE("Profile periods out of range are refused where written, with the range", "[robot][errors]") {
+  // 1e-12 s rounds to no time at all on the nanosecond clock: the control loop then refused its
+  // period while being built, and `tripodal run` reported that as a --monitor error.
+  const std::string bad =
+      "robot: {name: bad, sequencing_period_s: 1e-9}\n"
+      "controllers:\n  - {name: base, type: omni}\n"
+      "loops:\n  - {name: fast, period_s: 1e-12, controller: base}\n"
+      "dds: {period_s: 1e10}\n";
+  try {
+    (void)load_robot_profile_from_string(bad, "bad.yaml", kRobots);
+    FAIL("no error");
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    CHECK_THAT(m, Catch::Contains("bad.yaml:1:41: error: sequencing_period_s: expected seconds from 1e-06 to 9e+09, got '1e-9'"));
+    CHECK_THAT(m, Catch::Contains("bad.yaml:5:28: error: period_s: expected seconds from 1e-06 to 9e+09, got '1e-12'"));
+    CHECK_THAT(m, Catch::Contains("bad.yaml:6:17: error: dds period_s: expected seconds from 1e-06 to 9e+09, got '1e10'"));
+  }
+}
+
+TEST_CASE("Profile keys given twice are refused with both places", "[robot][errors]") {
+  const std::string bad =
+      "robot: {name: twice}\n"
+      "controllers:\n  - {name: base, type: omni}\n"
+      "loops:\n  - name: fast\n    period_s: 0.05\n    controller: base\n    period_s: 0.01\n";
+  CHECK_THROWS_WITH(load_robot_profile_from_string(bad, "twice.yaml", kRobots),
+                    Catch::Contains("twice.yaml:8:5: error: duplicate key 'period_s' (first at twice.yaml:6:5)"));
 }
 
 // A list or a map as a key (`? [a]: b`, `{a: 1}: b`) is valid YAML; it once escaped the loader as a

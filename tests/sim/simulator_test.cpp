@@ -2,6 +2,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
@@ -498,4 +499,61 @@ TEST_CASE("Simulator: the map's edge is a wall for the base and the bumpers", "[
   CHECK(sim.blocked());
   CHECK(sim.pose().y_m == Approx(2.0 - 0.25).margin(1e-4));
   CHECK(sim.bumpers().latest().pressed_mask == 0x1U);
+}
+
+TEST_CASE("Simulator: a world of 10^5 obstacles starts, laid as the whole-map method lays them", "[sim][faults][limits]") {
+  // Before, each obstacle was rasterised over the whole map and each appearance laid every present
+  // obstacle again: 10^4 obstacles took 30 s to start, 10^5 did not start in 120 s. Now an obstacle
+  // costs its bounding box and those appearing together are laid once (timings: bench/sim).
+  const auto boxes = [](World& world, int columns, int rows, double spacing_m, double x0_m, double y0_m) {
+    for (int r = 0; r < rows; ++r) {
+      for (int c = 0; c < columns; ++c) {
+        const double x = x0_m + c * spacing_m, y = y0_m + r * spacing_m;
+        // Every third box comes later, every fifth goes again: appearing and leaving in one step.
+        const Time appear = at((r * columns + c) % 3 == 0 ? 0.1 : 0.0);
+        const std::optional<Time> gone = (r * columns + c) % 5 == 0 ? std::optional<Time>(at(0.1)) : std::nullopt;
+        world.obstacles.push_back({"b" + std::to_string(r * columns + c), {{x, y}, {x + 0.08, y}, {x + 0.08, y + 0.08}, {x, y + 0.08}},
+                                   appear, gone, {}});
+      }
+    }
+  };
+  // The reference, the old method: every cell of the map tested against every present obstacle.
+  const auto expected_solid = [](const World& world, Time t, Pose2D robot) {
+    std::vector<std::uint8_t> solid = SolidMap(world.grid).cells();
+    const double keep_out = world.robot.radius_m + world.grid.resolution_m();
+    for (const DynamicObstacle& o : world.obstacles) {
+      if (!(t >= o.appear && (!o.disappear || t < *o.disappear))) continue;
+      const navi::Region region{o.name, o.polygon, o.where};
+      for (std::size_t i = 0; i < world.grid.size(); ++i) {
+        const navi::Point2D p = world.grid.cell_center(world.grid.cell(i));
+        if (region.contains(p) && std::hypot(p.x_m - robot.x_m, p.y_m - robot.y_m) >= keep_out) solid[i] = 1;
+      }
+    }
+    return solid;
+  };
+  SECTION("a small world, the same cells as the old method at each step") {
+    World world = room_world(121, 81, {0.6, 0.6, 0.0});  // 6 m x 4 m
+    boxes(world, 20, 12, 0.27, 0.5, 0.5);  // some boxes under the robot's keep-out disc
+    const World copy = world;
+    Simulator sim(std::move(world), omni3_base(), 1);
+    sim.step(10ms);
+    CHECK(sim.solid_map().cells() == expected_solid(copy, sim.now(), sim.pose()));
+    run(sim, 0.1);  // the late third appears, every fifth box goes
+    CHECK(sim.solid_map().cells() == expected_solid(copy, sim.now(), sim.pose()));
+  }
+  SECTION("10^5 obstacles on a 1000 x 1000 cell map") {
+    World world = room_world(1000, 1000, {0.5, 0.5, 0.0});  // 50 m x 50 m
+    boxes(world, 320, 313, 0.15, 1.5, 1.5);
+    REQUIRE(world.obstacles.size() >= 100000U);
+    Simulator sim(std::move(world), omni3_base(), 1);
+    sim.step(10ms);
+    // Each box covers 2 x 2 cells; at t = 0 the boxes not late and not gone... every fifth is
+    // gone only at 0.1 s, so present now: all but the late third.
+    std::size_t late = 0;
+    for (std::size_t k = 0; k < 320U * 313U; ++k) late += k % 3 == 0 ? 1 : 0;
+    const auto solid_cells = [&] { return static_cast<std::size_t>(std::count(sim.solid_map().cells().begin(), sim.solid_map().cells().end(), 1)); };
+    const std::size_t walls = 4U * 1000U - 4U;
+    CHECK(solid_cells() == walls + 4U * (320U * 313U - late));
+    CHECK(sim.events().size() == 320U * 313U - late);
+  }
 }

@@ -45,6 +45,18 @@ CLI::Validator positive_count() {
           "N>0"};
 }
 
+CLI::Validator whole_number(std::uint64_t max) {
+  return {[max](std::string& text) {
+            // CLI11 reads an unsigned option with strtoull, which takes "-1" as 2^64-1 and caps a
+            // number beyond 2^64-1 at it: both are refused here, before that conversion.
+            std::uint64_t v = 0;
+            const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+            if (ec == std::errc() && end == text.data() + text.size() && v <= max) return std::string();
+            return "expected a whole number from 0 to " + std::to_string(max) + ", got '" + text + "'";
+          },
+          "N"};
+}
+
 CLI::Validator positive_number() {
   return {[](std::string& text) {
             double v = 0.0;

@@ -5,7 +5,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstdint>
 #include <functional>
+#include <limits>
 #include <iosfwd>
 #include <string_view>
 #include <utility>
@@ -56,6 +58,10 @@ int run_tool(const Tool& tool, int argc, char** argv);
 /// Options that are a positive whole number (--max-states, --examples, ...): the error reads
 /// "--examples: expected a whole number > 0, got 'lots'".
 [[nodiscard]] CLI::Validator positive_count();
+/// Options that are a whole number from 0 to max (--seed): a sign, a fraction or a number beyond
+/// max is refused ("--seed: expected a whole number from 0 to 18446744073709551615, got '-1'"),
+/// not wrapped or capped.
+[[nodiscard]] CLI::Validator whole_number(std::uint64_t max = std::numeric_limits<std::uint64_t>::max());
 /// Options that are a positive number (--max-duration-s, --realtime SPEED).
 [[nodiscard]] CLI::Validator positive_number();
 

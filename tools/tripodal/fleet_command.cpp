@@ -450,7 +450,7 @@ cli::Action setup(CLI::App& cmd) {
       ->check(cli::positive_number())
       ->capture_default_str();
   cmd.add_option("--timeout-s", a->timeout_s, "S: wall time after which the fleet gives up")->check(cli::positive_number())->capture_default_str();
-  cmd.add_option("--seed", a->seed, "N: the simulators' seed (default: the world's)");
+  cmd.add_option("--seed", a->seed, "N: the simulators' seed (default: the world's)")->check(cli::whole_number());
   cmd.add_option("--kill-robot", a->kill_robot, "K: kill robot K (1..N) with SIGKILL, with --kill-after-s");
   cmd.add_option("--kill-after-s", a->kill_after_s, "S: that many seconds after robot K was given its first unit")
       ->check(CLI::NonNegativeNumber);

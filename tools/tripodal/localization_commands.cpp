@@ -449,7 +449,7 @@ cli::Action setup_eval(CLI::App& cmd) {
   cmd.add_option("--odom-noise", a->odom_noise, "SIGMA: relative noise added to the odometry's increments")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
-  cmd.add_option("--seed", a->seed, "N: seed of the odometry noise")->capture_default_str();
+  cmd.add_option("--seed", a->seed, "N: seed of the odometry noise")->check(cli::whole_number())->capture_default_str();
   cmd.add_option("--global-trials", a->global_trials, "N: unknown starts spread over the log")->capture_default_str()->check(positive_count());
   cmd.add_option("--global-max-scans", a->global_max_scans, "N: scans a start may take to converge")
       ->capture_default_str()

@@ -38,9 +38,9 @@ RgbImage draw_map(const Navigation& nav, const navi::CleanedCells& cleaned, cons
       case navi::Occupancy::unknown: fill_cell(c, {170, 170, 170}, 1.0); continue;
       case navi::Occupancy::free: break;
     }
-    if (label[i] >= 0) fill_cell(c, kSectionColours[static_cast<std::size_t>(label[i]) % kSectionColours.size()], 1.0);
+    if (i < label.size() && label[i] >= 0) fill_cell(c, kSectionColours[static_cast<std::size_t>(label[i]) % kSectionColours.size()], 1.0);
     if (cleaned.cleaned(i)) fill_cell(c, {60, 170, 60}, 0.45);
-    else if (reachable[i] != 0) fill_cell(c, {230, 40, 40}, 0.6);
+    else if (i < reachable.size() && reachable[i] != 0) fill_cell(c, {230, 40, 40}, 0.6);
   }
   for (const int row : nav.splitter->sections().virtual_wall_rows) {
     const int y = (g.height() - 1 - row) * kScale;  // the edge between rows row and row + 1

@@ -39,6 +39,7 @@ std::string RunResult::json() const {
                        {"state", state},
                        {"succeeded", succeeded},
                        {"reason", reason},
+                       {"stopped_by", stopped_by},
                        {"duration_s", rounded(duration_s, 2)},
                        {"coverage", rounded(coverage, 4)},
                        {"reachable_cells", reachable_cells},
@@ -51,7 +52,9 @@ std::string RunResult::json() const {
                        {"recoveries", recoveries},
                        {"faults", faults},
                        {"collisions", collisions},
-                       {"robot_steps", robot_steps}};
+                       {"robot_steps", robot_steps},
+                       {"base_at_rest", base_at_rest},
+                       {"base_command_at_end_rad_s", base_command_at_end_rad_s}};
   if (disinfection) {
     const DisinfectionFigures& d = *disinfection;
     const auto ms = [&](Duration t) { return rounded(to_seconds(t) * 1000.0, 3); };

@@ -17,6 +17,7 @@
 #include "run_task.hpp"
 #include "visit.hpp"
 #include "tripodal/core/diagnostic.hpp"
+#include "tripodal/monitor/monitor_server.hpp"
 #include "tripodal/robot/robot_profile.hpp"
 
 #include <spdlog/spdlog.h>
@@ -60,7 +61,9 @@ constexpr std::string_view kExitCodes =
     "exit codes: 0 task succeeded, 1 bad profile/world/faults, 2 bad command line, 3 I/O error,\n"
     "            4 the task failed, was refused or timed out (with --monitor or dds: and no task given at all,\n"
     "            the run ends with 0 when stopped); with --visit: a collision, an outcome not as\n"
-    "            expected, or the visit not completed.";
+    "            expected, or the visit not completed;\n"
+    "            130 (SIGINT, Ctrl-C) or 143 (SIGTERM): a task or visit was still running when the signal\n"
+    "            stopped the run (it is cancelled, the base brought to rest, the outputs written).";
 
 struct Args {
   app::RunOptions options;
@@ -73,8 +76,39 @@ struct Args {
   double realtime_speed = 0.0;      // 0: --realtime without SPEED
 };
 
+// The signal that asked the run to stop (0: none). The first SIGINT or SIGTERM stops the run in
+// order (the task cancelled, the base at rest, the report written); the handler then gives the
+// signal back its default, so a second Ctrl-C ends a run that does not stop.
 volatile std::sig_atomic_t g_stop = 0;
-extern "C" void on_stop_signal(int) { g_stop = 1; }
+extern "C" void on_stop_signal(int sig) {
+  g_stop = sig;
+  std::signal(sig, SIG_DFL);
+}
+
+void stop_on_signals() {
+  std::signal(SIGINT, on_stop_signal);
+  std::signal(SIGTERM, on_stop_signal);
+}
+
+// A run a signal cut short (a task or visit not finished) exits as a shell reports the signal:
+// 128 + N (130 for SIGINT, 143 for SIGTERM).
+constexpr int interrupted_exit(int sig) { return 128 + sig; }
+
+// A bad --monitor address or token file, refused as a command-line error before anything is
+// built (the monitor's own std::invalid_argument; later ones are the robot's, not --monitor's).
+std::optional<int> check_monitor(const app::RunOptions& o, std::ostream& err) {
+  if (!o.monitor) return std::nullopt;
+  try {
+    (void)monitor::server_options(*o.monitor, o.monitor_token_file);
+  } catch (const std::invalid_argument& e) {
+    err << "tripodal run: --monitor: " << e.what() << '\n';
+    return kUsage;
+  } catch (const std::runtime_error& e) {
+    err << "tripodal run: " << e.what() << '\n';
+    return kIoError;
+  }
+  return std::nullopt;
+}
 
 // The guide robot's runs (docs/guide.md): `--visit FILE`, the scripted visit, and `--monitor` on a
 // robot whose HRI is the guide's (type Hri), its RKMS and touch page served with or without a visit.
@@ -103,10 +137,8 @@ int run_guide(const Args& args, std::ostream& out, std::ostream& err) {
       return kIoError;
     }
   }
-  if (o.monitor) {
-    std::signal(SIGINT, on_stop_signal);
-    std::signal(SIGTERM, on_stop_signal);
-  }
+  if (const auto rc = check_monitor(o, err)) return *rc;
+  stop_on_signals();
   try {
     spdlog::set_level(spdlog::level::warn);
     app::VisitOptions vo;
@@ -126,7 +158,7 @@ int run_guide(const Args& args, std::ostream& out, std::ostream& err) {
     vo.start_paused = o.start_paused;
     vo.realtime_speed = o.realtime && args.realtime_speed > 0.0 ? args.realtime_speed : 1.0;
     vo.max_duration_s = o.max_duration_s;
-    vo.stop = o.monitor ? &g_stop : nullptr;
+    vo.stop = &g_stop;
     out << "tripodal run: robot " << o.robot.string() << ", world " << o.world.string()
         << (args.visit.empty() ? std::string(", no visit file: the monitor's visitors") : ", visit " + args.visit.string()) << "\n";
     out.flush();
@@ -137,15 +169,18 @@ int run_guide(const Args& args, std::ostream& out, std::ostream& err) {
         << r.min_visitor_clearance_m << " m; visitors stopped " << r.visitor_waits << " times to let the robot pass, the robot waited "
         << r.robot_waited_s << " s for visitors\n";
     if (!o.out.empty()) out << "wrote " << (o.out / "dialogue.txt").string() << ", report.json" << (r.voice ? ", audio/*.wav" : "") << "\n";
-    // A monitored run stopped by the operator after (or without) its visit: nothing failed.
+    if (!r.stopped_by.empty()) out << "run " << r.stopped_by << "\n";
+    // A visit cut short by a signal: 128 + N. A monitored run stopped by the operator after (or
+    // without) its visit: nothing failed.
+    if (g_stop != 0 && !args.visit.empty() && !r.completed) return interrupted_exit(g_stop);
     const bool visit_ok = args.visit.empty() || (r.completed && r.mismatches == 0);
     return visit_ok && r.collisions == 0 ? kOk : kTaskFailed;
   } catch (const ConfigError& e) {
     err << e.what() << '\n';
     return kBadInput;
-  } catch (const std::invalid_argument& e) {  // --monitor's address or token file
-    err << "tripodal run: --monitor: " << e.what() << '\n';
-    return kUsage;
+  } catch (const std::invalid_argument& e) {  // a value the robot's parts refused as they were built
+    err << "tripodal run: " << e.what() << '\n';
+    return kBadInput;
   } catch (const std::runtime_error& e) {
     err << "tripodal run: " << e.what() << '\n';
     return kIoError;
@@ -203,12 +238,10 @@ int run(Args& args, std::ostream& out, std::ostream& err) {
            "--monitor-allow-origin need --monitor [ADDR:]PORT\n";
     return kUsage;
   }
-  if (o.monitor) {
-    // The run serves until stopped; the report is still written when it is.
-    std::signal(SIGINT, on_stop_signal);
-    std::signal(SIGTERM, on_stop_signal);
-    o.stop = &g_stop;
-  }
+  if (const auto rc = check_monitor(o, err)) return *rc;
+  // Every run stops in order on a signal; one that serves (--monitor, dds: tasks) runs until one.
+  stop_on_signals();
+  o.stop = &g_stop;
   for (const auto& f : {o.robot, o.world}) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(f, ec)) {
@@ -249,16 +282,18 @@ int run(Args& args, std::ostream& out, std::ostream& err) {
           << d->disinfectant_used_l << " l; link over " << d->line << ": " << d->link.requests << " requests, "
           << d->link.missed << " missed, " << d->decoder_errors << " decoder errors, " << d->link.link_losses << " link losses\n";
     }
+    if (!r.stopped_by.empty()) out << "run " << r.stopped_by << (r.base_at_rest ? ", the base at rest" : ", the base NOT at rest") << "\n";
     if (!o.out.empty()) out << "wrote " << (o.out / "map.png").string() << ", trajectory.csv, report.json, lifecycle.txt\n";
+    if (r.state == "interrupted") return interrupted_exit(g_stop);
     // A monitored robot the operator never gave a task: nothing failed.
     const bool idle_monitor = (o.monitor.has_value() || o.task.empty()) && r.state == "idle";
     return r.succeeded || idle_monitor ? kOk : kTaskFailed;
   } catch (const ConfigError& e) {
     err << e.what() << '\n';
     return kBadInput;
-  } catch (const std::invalid_argument& e) {  // --monitor's address or token file
-    err << "tripodal run: --monitor: " << e.what() << '\n';
-    return kUsage;
+  } catch (const std::invalid_argument& e) {  // a value the robot's parts refused as they were built
+    err << "tripodal run: " << e.what() << '\n';
+    return kBadInput;
   } catch (const std::runtime_error& e) {
     err << "tripodal run: " << e.what() << '\n';
     return kIoError;
@@ -278,7 +313,7 @@ cli::Action setup(CLI::App& cmd) {
                  "M: the guide robot's runs: every visitor keeps M from the robot (the world's give_way_m); 0: walkers that do "
                  "not yield")
       ->check(CLI::NonNegativeNumber);
-  cmd.add_option("--seed", o.seed, "N: the simulator's seed (default: the world's)");
+  cmd.add_option("--seed", o.seed, "N: the simulator's seed (default: the world's)")->check(cli::whole_number());
   cmd.add_option("--hardware", o.hardware,
                  "TYPE: instead of the profile's hardware: dds, the simulator in another process (tripodal sim-server; "
                  "docs/distribution.md), the world still giving the map and regions");

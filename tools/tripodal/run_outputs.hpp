@@ -48,7 +48,8 @@ void write_text(const std::filesystem::path& file, const std::string& text);
 
 // The map (2 pixels per cell): walls black, unknown grey, sections tinted, cleaned cells green,
 // cells the footprint could reach but did not clean red, virtual walls dashed red, the true path
-// dark blue, start and end markers.
+// dark blue, start and end markers. A run without a task has no reachable cells and no path:
+// `reachable` may be empty (or shorter than the grid), `traj` too; the map is drawn all the same.
 RgbImage draw_map(const Navigation& nav, const navi::CleanedCells& cleaned, const std::vector<char>& reachable,
                   const std::vector<TrajectorySample>& traj);
 

@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "run_outputs.hpp"
+#include "shutdown.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/monitor/robot_monitor.hpp"
 #include "tripodal/navi/grid_maps.hpp"
@@ -434,7 +435,7 @@ RunResult run_task(const RunOptions& o) {
       res.state = "refused";
       res.reason = answer.text;
       if (o.log != nullptr) *o.log << answer.text << '\n';
-      if (!serve) return res;
+      // Not served, the run ends here, but it still writes its (empty) map and report below.
     }
   }
   flush_log();
@@ -442,7 +443,7 @@ RunResult run_task(const RunOptions& o) {
   // The room's sections and the reachable area, for the measures: of the task running (a task
   // submitted on the monitor's console is measured from when it starts).
   std::vector<std::string> room_sections;
-  std::vector<char> reachable;
+  std::vector<char> reachable(nav.maps->grid().size(), 0);  // none until a task names its room
   navi::PathPlanner reach_planner(nav.maps->grid(), navi::PathPlannerOptions{.robot_radius_m = nav.maps->robot_radius_m()});
   auto measure_room = [&] {
     room_sections.clear();
@@ -544,11 +545,28 @@ RunResult run_task(const RunOptions& o) {
     if (pacer) pacer->pace(now);
   }
   monitor_update();
+  const int sig = stop_signal(o.stop);
+  res.stopped_by = stop_reason(sig);
   if (robot->planner().busy()) {
-    robot->planner().cancel(stopped() ? "the run was stopped" : "no end within " + fixed(o.max_duration_s, 0) + " s of simulated time");
+    robot->planner().cancel(sig != 0 ? res.stopped_by : "no end within " + fixed(o.max_duration_s, 0) + " s of simulated time");
     robot->step_sequencing();
-    res.state = stopped() ? "stopped" : "timed out";
+    res.state = sig != 0 ? "interrupted" : "timed out";
   }
+  // Whatever ended the run, the base is left at rest before the devices close.
+  WheelCommands commanded;
+  if (board_hw != nullptr) {
+    // The board's firmware holds the speeds the host asked (m/s); its motors then spin down with
+    // their own inertia, which the simulator's wheels follow.
+    const board::BoardFirmware& fw = board_hw->embedded().firmware();
+    std::array<double, 2> per_m_s{};
+    board_hw->simulator().inverse_kinematics({1.0, 0.0, 0.0}, per_m_s);  // rad/s of each wheel at 1 m/s
+    commanded = [&fw, per_m_s] { return std::vector<double>{fw.required_m_s(0) * per_m_s[0], fw.required_m_s(1) * per_m_s[1]}; };
+  } else if (const sim::Simulator* s = truth.local()) {
+    commanded = [s] { return std::vector<double>(s->wheel_commands().begin(), s->wheel_commands().end()); };
+  }
+  const BaseStop rest = stop_base(*robot, commanded, tick_period);
+  res.base_command_at_end_rad_s = rest.command_rad_s;
+  res.base_at_rest = rest.at_rest;
   flush_log();
   draw_progress(true);
 
@@ -556,7 +574,9 @@ RunResult run_task(const RunOptions& o) {
   res.succeeded = tr.state == TaskState::succeeded;
   // With the monitor a task from the console may follow a refused --task: the last task counts.
   if (res.state.empty() || (serve && res.state == "refused" && tr.state != TaskState::idle)) res.state = std::string(to_string(tr.state));
-  if (!serve || tr.state != TaskState::idle) res.reason = tr.reason;
+  // A refused task leaves the planner idle: the refusal's words stay the reason.
+  const bool only_refused = res.state == "refused" && tr.state == TaskState::idle;
+  if (!only_refused && (!serve || tr.state != TaskState::idle)) res.reason = tr.reason;
   res.duration_s = to_seconds(clock.now());
   res.cleaned_cells = covered();
   res.coverage = res.reachable_cells == 0 ? 0.0 : static_cast<double>(res.cleaned_cells) / static_cast<double>(res.reachable_cells);

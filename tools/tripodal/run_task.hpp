@@ -68,6 +68,8 @@ struct RunOptions {
   std::vector<std::string> monitor_allowed_hosts;    ///< Host names served besides loopback and addresses
   std::vector<std::string> monitor_allowed_origins;  ///< Origins served besides the page's own
   bool start_paused = false;         ///< hold the run until the operator resumes it
+  /// Set (by a signal handler) to the signal's number to stop the run: the task is cancelled, the
+  /// base brought to rest and the outputs written, naming it ("interrupted by SIGTERM").
   const volatile std::sig_atomic_t* stop = nullptr;
   std::ostream* log = nullptr;       ///< task and process life cycle, as it happens
   std::ostream* progress = nullptr;  ///< progress bar
@@ -113,7 +115,13 @@ struct DisinfectionFigures {
 
 struct RunResult {
   bool succeeded = false;
-  std::string state;            ///< "succeeded", "failed", "timed out", "refused"
+  std::string state;            ///< "succeeded", "failed", "timed out", "refused", "interrupted"
+  /// "interrupted by SIGTERM" when a signal ended the run (the task, if one was running, is then
+  /// "interrupted"); "" when it ended by itself.
+  std::string stopped_by;
+  /// The wheel velocities the base was commanded last (rad/s), after the run brought it to rest.
+  std::vector<double> base_command_at_end_rad_s;
+  bool base_at_rest = false;
   std::string reason;
   std::string robot, task;
   std::string coverage_pattern;  ///< "hybrid", "balloon" or "boustrophedon"

@@ -302,7 +302,7 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_option("--domain", a->domain, "ID: the DDS domain (ROS_DOMAIN_ID)")
       ->check(CLI::Range(0, 232))
       ->capture_default_str();
-  cmd.add_option("--seed", a->seed, "N: the simulator's seed (default: the world's)");
+  cmd.add_option("--seed", a->seed, "N: the simulator's seed (default: the world's)")->check(cli::whole_number());
   cmd.add_option("--lease-s", a->lease_s, "S: the participant lease: a killed server is seen silent after S")
       ->check(cli::positive_number())
       ->capture_default_str();

@@ -15,6 +15,7 @@
 #include "guide_hri.hpp"
 #include "run_outputs.hpp"
 #include "run_task.hpp"
+#include "shutdown.hpp"
 #include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/hri/hri_module.hpp"
@@ -368,6 +369,16 @@ VisitResult run_visit(const VisitOptions& o) {
     if (pacer) pacer->pace(clock.now());
   }
   monitor_update();
+  res.stopped_by = stop_reason(stop_signal(o.stop));
+  if (robot->planner().busy()) {
+    robot->planner().cancel(!res.stopped_by.empty() ? res.stopped_by : "the visit did not end within " + fixed(visit.max_duration_s, 0) + " s");
+    robot->step_sequencing();
+  }
+  // Whatever ended the run, the base is left at rest before the devices close.
+  const BaseStop rest =
+      stop_base(*robot, [&sim] { return std::vector<double>(sim.wheel_commands().begin(), sim.wheel_commands().end()); }, period);
+  res.base_command_at_end_rad_s = rest.command_rad_s;
+  res.base_at_rest = rest.at_rest;
   flush_life();
   for (const sim::SimEvent& e : sim.events()) {
     if (e.kind == sim::SimEvent::Kind::collision) say("simulator: collision " + e.detail + " at " + fixed(to_seconds(e.stamp), 1) + " s");
@@ -379,7 +390,7 @@ VisitResult run_visit(const VisitOptions& o) {
   res.min_visitor_clearance_m = sim.min_visitor_clearance_m();
   res.processes = guide.processes();
   for (const VisitExchange& x : res.exchanges) res.mismatches += x.as_expected ? 0 : 1;
-  if (!res.completed) say(stopped() ? std::string("the run was stopped") : "the visit did not end within " + fixed(visit.max_duration_s, 0) + " s");
+  if (!res.completed) say(stopped() ? "the run was " + res.stopped_by : "the visit did not end within " + fixed(visit.max_duration_s, 0) + " s");
   if (!o.out.empty()) {
     write_text(o.out / "dialogue.txt", dialogue.str());
     write_text(o.out / "report.json", res.json());
@@ -394,6 +405,7 @@ std::string VisitResult::json() const {
   j["seed"] = seed;
   j["voice"] = voice;
   j["completed"] = completed;
+  j["stopped_by"] = stopped_by;
   j["duration_s"] = std::round(duration_s * 10.0) / 10.0;
   j["distance_m"] = std::round(distance_m * 100.0) / 100.0;
   j["collisions"] = collisions;
@@ -411,6 +423,8 @@ std::string VisitResult::json() const {
   }
   j["dialogue"] = xs;
   j["processes"] = processes;
+  j["base_at_rest"] = base_at_rest;
+  j["base_command_at_end_rad_s"] = base_command_at_end_rad_s;
   return j.dump(2) + "\n";
 }
 

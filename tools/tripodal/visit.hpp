@@ -96,6 +96,9 @@ struct VisitResult {
   std::uint64_t seed = 0;
   bool voice = false;
   bool completed = false;        ///< every step ran within max_duration_s
+  std::string stopped_by;        ///< "interrupted by SIGTERM" when a signal ended the run, else ""
+  std::vector<double> base_command_at_end_rad_s;  ///< the wheels' last command, the base brought to rest
+  bool base_at_rest = false;
   double duration_s = 0.0;       ///< simulated
   double distance_m = 0.0;       ///< ground truth
   std::uint64_t collisions = 0;  ///< of the robot's footprint (walls, exhibits, visitors)

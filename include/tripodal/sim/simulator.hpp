@@ -82,6 +82,9 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   /// Stores the commanded wheel velocities; applied from now until the next write. Refused
   /// (false) for a wrong count or non-finite values.
   bool write_wheel_velocities(std::span<const double> wheel_rad_s) noexcept override;
+  /// The wheel velocities last commanded (rad/s, configuration order): what the base is told to
+  /// do now, e.g. to check that a run stopping left its motors at zero.
+  [[nodiscard]] std::span<const double> wheel_commands() const noexcept { return wheel_cmd_; }
   /// The wheels' actual velocities (zero while blocked) and encoder positions (with the
   /// odometry noise). False for wrong sizes or while the odometry sensor is dead.
   bool read_wheel_states(std::span<double> velocity_rad_s, std::span<double> position_rad) noexcept override;
@@ -181,7 +184,8 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   void update_faults() noexcept;
   void sample_sensors() noexcept;
   void update_bumpers() noexcept;
-  void set_obstacle(std::size_t index, bool present) noexcept;
+  void set_obstacle(std::size_t index, bool present) noexcept;  // marks it, restores its cells
+  void lay_obstacles() noexcept;  // every present obstacle on the solid map, the ray jumps refreshed
   void move_visitors(double h) noexcept;
   void move_joints(double h) noexcept;
   void add_visitors_to_scan(LaserScan& scan) const noexcept;
