@@ -85,6 +85,17 @@ namespace {
 
 std::string who(const std::string& author) { return author.empty() ? std::string("operator") : author; }
 
+KnowledgeEntry knowledge_entry(const EntryFields& f) {
+  KnowledgeEntry e;
+  e.id = f.id;
+  e.topic = f.topic;
+  e.keywords = f.keywords;
+  e.questions = f.questions;
+  e.answer = f.answer;
+  e.action = f.action;
+  return e;
+}
+
 struct HriOps {
   HriService& hri;
   KnowledgeStore& store;
@@ -119,9 +130,9 @@ struct HriOps {
     for (auto it = newest.rbegin(); it != newest.rend(); ++it) changes.push_back(std::move(*it));
     return {200, json{{"version", store.version()}, {"changes", std::move(changes)}, {"omitted", omitted}}};
   }
-  HriOpResult operator()(const RkmsAddRequest& r) const { return changed(store.add(r.entry, r.author), r.author); }
+  HriOpResult operator()(const RkmsAddRequest& r) const { return changed(store.add(knowledge_entry(r.entry), r.author), r.author); }
   HriOpResult operator()(const RkmsEditRequest& r) const {
-    KnowledgeEntry entry = r.entry;
+    KnowledgeEntry entry = knowledge_entry(r.entry);
     if (entry.id.empty()) entry.id = r.id;  // the entry of the id the request names
     return changed(store.edit(r.id, std::move(entry), r.version, r.author), r.author);
   }

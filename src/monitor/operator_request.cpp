@@ -154,7 +154,9 @@ class Checker {
   explicit Checker(std::string_view op) : op_(op) {}
 
   void object(const json& body, std::span<const FieldSpec> fields, const std::string& prefix) {
-    for (const auto& [key, value] : body.items()) {
+    for (const auto& item : body.items()) {
+      const std::string& key = item.key();  // (not a structured binding: a lambda below names it)
+      const json& value = item.value();
       const auto spec = std::find_if(fields.begin(), fields.end(), [&](const FieldSpec& f) { return f.name == key; });
       if (spec == fields.end()) {
         if (prefix.empty() && key == "op") continue;
@@ -272,8 +274,8 @@ std::vector<std::string> texts_of(const json& j, const char* key) {
   for (const json& v : *it) out.push_back(v.get<std::string>());
   return out;
 }
-KnowledgeEntry entry_of(const json& j) {
-  KnowledgeEntry e;
+EntryFields entry_of(const json& j) {
+  EntryFields e;
   e.id = text_or(j, "id");
   e.topic = text_or(j, "topic");
   e.keywords = texts_of(j, "keywords");

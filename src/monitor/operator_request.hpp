@@ -17,8 +17,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "tripodal/hri/knowledge_base.hpp"
-
 namespace tripodal::monitor {
 
 /// What an operator can make the robot keep or build, bounded (docs/monitor.md, "Budgets").
@@ -109,16 +107,23 @@ struct BreakpointRequest {
   std::string place;
   bool on = true;
 };
+/// An RKMS entry as a request gives it (the hri area's KnowledgeEntry without its location); kept
+/// apart so this layer depends on no area but core (its fuzz target builds alone).
+struct EntryFields {
+  std::string id, topic;
+  std::vector<std::string> keywords, questions;
+  std::string answer, action;
+};
 struct RkmsListRequest { std::string query; };
 struct RkmsGetRequest { std::string id; };
 struct RkmsAddRequest {
-  KnowledgeEntry entry;
+  EntryFields entry;
   std::string author;
 };
 struct RkmsEditRequest {
   std::string id;  ///< the entry's id when the request names none
   std::uint64_t version = 0;
-  KnowledgeEntry entry;
+  EntryFields entry;
   std::string author;
 };
 struct RkmsDeleteRequest {
