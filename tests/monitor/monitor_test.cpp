@@ -1327,3 +1327,36 @@ TEST_CASE("An RKMS entry with U+FFFE is refused at its character; later saves su
   CHECK(reloaded.entries().size() == 26);
   server.stop();
 }
+
+namespace {
+
+// An HRI that fails inside an op: what the last-resort catch of RobotMonitor::update() is for.
+class FailingHri final : public HriService {
+ public:
+  explicit FailingHri(const std::filesystem::path& knowledge) : store_(knowledge) {}
+  KnowledgeStore& knowledge_store() override { return store_; }
+  HriReply ask(std::string_view) override { throw std::runtime_error("the recognizer's index is gone"); }
+  SpeechSynthesizer* voice() noexcept override { return nullptr; }
+  HriDisplay display() override { return {}; }
+
+ private:
+  KnowledgeStore store_;
+};
+
+}  // namespace
+
+TEST_CASE("An exception inside an op is answered 500 and logged; the robot's thread goes on", "[monitor][robot][requests]") {
+  Psr2WithHri psr2;
+  FailingHri failing(psr2.file);
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
+  watch.set_hri(&failing);
+  server.start();
+  const JsonAnswer r = json_command(server, watch, {{"op", "ask"}, {"text", "hello"}});
+  CHECK(r.status == 500);
+  CHECK(r.body["error"] == "the request failed on the robot: the recognizer's index is gone");
+  CHECK(json_command(server, watch, {{"op", "pause"}}).status == 200);
+  CHECK(watch.paused());
+  watch.set_hri(nullptr);
+  server.stop();
+}
