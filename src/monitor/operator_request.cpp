@@ -143,6 +143,18 @@ std::string number_text(double v) {
   return json(v).dump();
 }
 
+// A name a client chose, fit to be quoted in an answer and a log: short, one line of text, no quote.
+bool plain_name(std::string_view s) noexcept {
+  return !s.empty() && s.size() <= 64 && !find_xml_text_fault(s, true) && s.find_first_of("\t\r\n'") == std::string_view::npos;
+}
+
+// An unknown field as the errors name it: as sent when plain, otherwise described (a key may be
+// empty or 60 KB of anything).
+std::string shown_name(const std::string& key) {
+  if (plain_name(key)) return key;
+  return key.empty() ? std::string("(empty name)") : "(a name of " + std::to_string(key.size()) + " bytes)";
+}
+
 bool file_name(std::string_view s) noexcept {
   return !s.empty() && s.front() != '.' && std::all_of(s.begin(), s.end(), [](char c) {
     return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-' || c == '.';
@@ -162,7 +174,7 @@ class Checker {
         if (prefix.empty() && key == "op") continue;
         std::string known;
         for (const FieldSpec& f : fields) known += (known.empty() ? "" : ", ") + std::string(f.name);
-        fail(prefix + key, known.empty() ? "unknown; op '" + std::string(op_) + "' takes no fields"
+        fail(prefix + shown_name(key), known.empty() ? "unknown; op '" + std::string(op_) + "' takes no fields"
                                          : "unknown; expected " + known);
         continue;
       }
@@ -353,8 +365,7 @@ ParsedRequest parse_operator_request(std::string_view body) {
   const OpSpec* spec = find_op(out.op);
   if (spec == nullptr) {
     // Named as sent when it is a short line of text; what a client sends may be anything.
-    const bool plain = out.op.size() <= 64 && !find_xml_text_fault(out.op, true) && out.op.find_first_of("\t\r\n") == std::string::npos;
-    out.errors.push_back({"op", "unknown op '" + (plain ? out.op : "(" + std::to_string(out.op.size()) + " bytes)") + "': expected " + op_names()});
+    out.errors.push_back({"op", "unknown op '" + shown_name(out.op) + "': expected " + op_names()});
     return out;
   }
   Checker checker(spec->op);

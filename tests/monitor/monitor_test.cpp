@@ -1143,6 +1143,14 @@ TEST_CASE("The request layer: every text field's length is refused one past its 
   CHECK(parse_operator_request(R"({"op":"rkms.history","limit":2.5})").errors.at(0).message ==
         "field 'limit' of op 'rkms.history': expected a whole number from 1 to 200, got 2.5");
   CHECK(parse_operator_request(R"({"op":"rkms.delete","id":"a","version":-1})").errors.at(0).field == "version");
+  // Unknown field names are quoted only when they are a short line of text (fuzz finding: an empty
+  // name was reported as the body's).
+  p = parse_operator_request(R"({"op":"task","text":"x","":1})");
+  CHECK(p.errors.at(0).field == "(empty name)");
+  CHECK(p.errors.at(0).message == "field '(empty name)' of op 'task': unknown; expected text");
+  p = parse_operator_request(nlohmann::json{{"op", "pause"}, {std::string(70, 'k'), 1}}.dump());
+  CHECK(p.errors.at(0).field == "(a name of 70 bytes)");
+  CHECK(parse_operator_request(R"({"op":"task\n"})").errors.at(0).message.starts_with("unknown op '(a name of 5 bytes)'"));
   // Every error of a request, in order.
   p = parse_operator_request(R"({"op":"drive","stop":1,"vx":"a"})");
   REQUIRE(p.errors.size() == 2);
