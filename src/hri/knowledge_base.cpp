@@ -12,6 +12,7 @@
 
 #include "../core/xml_document.hpp"
 #include "../core/xml_locator.hpp"
+#include "tripodal/core/xml_text.hpp"
 
 namespace tripodal {
 
@@ -424,9 +425,30 @@ std::uint64_t version_on_disk(const std::filesystem::path& file) {
   return *parsed;
 }
 
+// The file is XML: a text XML cannot hold (U+FFFE, a control character, bytes that are not UTF-8)
+// would be written and then refused by every reader, so it is refused before anything is written.
+void check_saveable(const std::string& robot, const std::vector<KnowledgeEntry>& entries) {
+  const auto check = [](const std::string& where, std::string_view text) {
+    if (const auto fault = find_xml_text_fault(text)) {
+      throw std::invalid_argument("knowledge base: " + where + ": " + describe(*fault) + "; nothing was saved");
+    }
+  };
+  check("the robot's name", robot);
+  for (const KnowledgeEntry& e : entries) {
+    const std::string entry = "entry '" + e.id + "'";
+    check(entry + " id", e.id);
+    check(entry + " topic", e.topic);
+    for (std::size_t i = 0; i < e.keywords.size(); ++i) check(entry + " keywords[" + std::to_string(i) + "]", e.keywords[i]);
+    for (std::size_t i = 0; i < e.questions.size(); ++i) check(entry + " questions[" + std::to_string(i) + "]", e.questions[i]);
+    check(entry + " answer", e.answer);
+    check(entry + " action", e.action);
+  }
+}
+
 }  // namespace
 
 void KnowledgeBase::save(const std::filesystem::path& file) {
+  check_saveable(robot_, entries_);
   const std::string lock_path = file.string() + ".lock";
   const Fd lock(::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644));
   if (lock.get() < 0) throw_errno("cannot open the lock file " + lock_path);

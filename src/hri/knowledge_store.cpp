@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "text.hpp"
+#include "tripodal/core/xml_text.hpp"
 
 namespace tripodal {
 
@@ -65,15 +66,37 @@ json entry_json(const KnowledgeEntry& e) {
   return json{{"id", e.id}, {"topic", e.topic}, {"keywords", e.keywords}, {"questions", e.questions}, {"answer", e.answer}, {"action", e.action}};
 }
 
+// The history file is read back field by field with the types checked (json::value() throws on a
+// field of another type): a line someone edited by hand is skipped, it cannot stop the store.
+std::optional<std::string> text_of(const json& j, const char* key) {
+  const auto it = j.find(key);
+  if (it == j.end() || it->is_null()) return std::string();
+  if (!it->is_string()) return std::nullopt;
+  return it->get<std::string>();
+}
+
+bool texts_of(const json& j, const char* key, std::vector<std::string>& out) {
+  const auto it = j.find(key);
+  if (it == j.end() || it->is_null()) return true;
+  if (!it->is_array()) return false;
+  for (const json& v : *it) {
+    if (!v.is_string()) return false;
+    out.push_back(v.get<std::string>());
+  }
+  return true;
+}
+
 std::optional<KnowledgeEntry> entry_from_json(const json& j) {
   if (!j.is_object()) return std::nullopt;
   KnowledgeEntry e;
-  e.id = j.value("id", "");
-  e.topic = j.value("topic", "");
-  e.keywords = j.value("keywords", std::vector<std::string>{});
-  e.questions = j.value("questions", std::vector<std::string>{});
-  e.answer = j.value("answer", "");
-  e.action = j.value("action", "");
+  const auto id = text_of(j, "id"), topic = text_of(j, "topic"), answer = text_of(j, "answer"), action = text_of(j, "action");
+  if (!id || !topic || !answer || !action || !texts_of(j, "keywords", e.keywords) || !texts_of(j, "questions", e.questions)) {
+    return std::nullopt;
+  }
+  e.id = *id;
+  e.topic = *topic;
+  e.answer = *answer;
+  e.action = *action;
   return e;
 }
 
@@ -120,8 +143,9 @@ void check_text(std::vector<KnowledgeFieldError>& out, const std::string& field,
     out.push_back({field, field + " is " + std::to_string(text.size()) + " bytes long; expected at most " + std::to_string(max_bytes)});
     return;
   }
-  if (!hri::is_text(text)) {
-    out.push_back({field, field + " is not text: expected UTF-8 without control characters"});
+  // XML's characters, so nothing the store accepts can fail to save or to load again.
+  if (const auto fault = find_xml_text_fault(text, true)) {
+    out.push_back({field, field + " is not text: " + describe(*fault) + "; expected UTF-8 without control characters"});
     return;
   }
   if (!lines_allowed && text.find_first_of("\t\r\n") != std::string_view::npos) {
@@ -193,16 +217,24 @@ void KnowledgeStore::load_locked() {
     while (std::getline(in, line)) {
       const json j = json::parse(line, nullptr, false);
       if (j.is_discarded() || !j.is_object() || !j.contains("version") || !j["version"].is_number_unsigned()) continue;
-      const auto kind = kind_of(j.value("op", ""));
+      const auto op = text_of(j, "op"), time = text_of(j, "time"), author = text_of(j, "author"), id = text_of(j, "id");
+      if (!op || !time || !author || !id) continue;
+      const auto kind = kind_of(*op);
       if (!kind) continue;
       KnowledgeChange c;
       c.version = j["version"].get<std::uint64_t>();
-      c.time_utc = j.value("time", "");
-      c.author = j.value("author", "");
+      c.time_utc = *time;
+      c.author = *author;
       c.kind = *kind;
-      c.id = j.value("id", "");
-      if (j.contains("before") && !j["before"].is_null()) c.before = entry_from_json(j["before"]);
-      if (j.contains("after") && !j["after"].is_null()) c.after = entry_from_json(j["after"]);
+      c.id = *id;
+      bool readable = true;
+      for (const auto& [key, slot] : {std::pair{"before", &c.before}, std::pair{"after", &c.after}}) {
+        const auto it = j.find(key);
+        if (it == j.end() || it->is_null()) continue;
+        *slot = entry_from_json(*it);
+        readable = readable && slot->has_value();
+      }
+      if (!readable) continue;
       history.push_back(std::move(c));
     }
   }

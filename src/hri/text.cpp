@@ -4,6 +4,8 @@
 #include <array>
 #include <cstdint>
 
+#include "tripodal/core/xml_text.hpp"
+
 namespace tripodal::hri {
 
 std::vector<std::string> words(std::string_view text) {
@@ -65,41 +67,9 @@ std::size_t edit_distance(std::string_view a, std::string_view b, std::size_t li
 }
 
 bool is_text(std::string_view bytes) noexcept {
-  std::size_t i = 0;
-  while (i < bytes.size()) {
-    const auto c = static_cast<unsigned char>(bytes[i]);
-    if (c < 0x80) {
-      if ((c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7F) return false;
-      ++i;
-      continue;
-    }
-    std::size_t len = 0;
-    std::uint32_t cp = 0;
-    if ((c & 0xE0) == 0xC0) {
-      len = 2;
-      cp = c & 0x1FU;
-    } else if ((c & 0xF0) == 0xE0) {
-      len = 3;
-      cp = c & 0x0FU;
-    } else if ((c & 0xF8) == 0xF0) {
-      len = 4;
-      cp = c & 0x07U;
-    } else {
-      return false;
-    }
-    if (i + len > bytes.size()) return false;
-    for (std::size_t k = 1; k < len; ++k) {
-      const auto cc = static_cast<unsigned char>(bytes[i + k]);
-      if ((cc & 0xC0) != 0x80) return false;
-      cp = (cp << 6U) | (cc & 0x3FU);
-    }
-    // Overlong forms, surrogates and code points beyond Unicode are not text; neither are the C1
-    // controls.
-    static constexpr std::array<std::uint32_t, 5> kMin = {0, 0, 0x80, 0x800, 0x10000};
-    if (cp < kMin[len] || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF) || (cp >= 0x80 && cp < 0xA0)) return false;
-    i += len;
-  }
-  return true;
+  // What XML 1.0 allows (every text of the HRI may end up in the knowledge file), without the C1
+  // controls it only discourages.
+  return !find_xml_text_fault(bytes, true).has_value();
 }
 
 bool has_digit(std::string_view word) noexcept {

@@ -21,7 +21,8 @@ namespace tripodal::hri {
 /// neighbours), or `limit` + 1 as soon as it must exceed `limit`.
 [[nodiscard]] std::size_t edit_distance(std::string_view a, std::string_view b, std::size_t limit);
 
-/// Valid UTF-8 without control characters other than tab, line feed and carriage return.
+/// Valid UTF-8 without control characters other than tab, line feed and carriage return, and
+/// without U+FFFE and U+FFFF: text XML 1.0 can hold (find_xml_text_fault says where it is not).
 [[nodiscard]] bool is_text(std::string_view bytes) noexcept;
 
 [[nodiscard]] bool has_digit(std::string_view word) noexcept;

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <optional>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "tripodal/monitor/wire.hpp"
@@ -24,47 +25,6 @@ json versioned_json(const VersionedEntry& v) {
   json j = entry_json(v.entry);
   j["version"] = v.version;
   return j;
-}
-
-// The entry of a request, each field checked for its JSON type; a wrong type is named like the
-// store names its fields, so the page puts it at the same place.
-std::optional<KnowledgeEntry> entry_from(const json& j, std::vector<KnowledgeFieldError>& errors) {
-  if (!j.is_object()) {
-    errors.push_back({"entry", "expected \"entry\": an object with id, topic, keywords, questions, answer, action"});
-    return std::nullopt;
-  }
-  KnowledgeEntry e;
-  const auto text = [&](const char* field, std::string& out) {
-    if (!j.contains(field) || j[field].is_null()) return;
-    if (!j[field].is_string()) {
-      errors.push_back({field, std::string(field) + ": expected a string"});
-      return;
-    }
-    out = j[field].get<std::string>();
-  };
-  const auto list = [&](const char* field, std::vector<std::string>& out) {
-    if (!j.contains(field) || j[field].is_null()) return;
-    if (!j[field].is_array()) {
-      errors.push_back({field, std::string(field) + ": expected an array of strings"});
-      return;
-    }
-    for (std::size_t i = 0; i < j[field].size(); ++i) {
-      const json& v = j[field][i];
-      if (!v.is_string()) {
-        errors.push_back({std::string(field) + "[" + std::to_string(i) + "]", std::string(field) + "[" + std::to_string(i) + "]: expected a string"});
-        continue;
-      }
-      out.push_back(v.get<std::string>());
-    }
-  };
-  text("id", e.id);
-  text("topic", e.topic);
-  list("keywords", e.keywords);
-  list("questions", e.questions);
-  text("answer", e.answer);
-  text("action", e.action);
-  if (!errors.empty()) return std::nullopt;
-  return e;
 }
 
 json errors_json(const std::vector<KnowledgeFieldError>& errors) {
@@ -101,17 +61,6 @@ HriOpResult edit_result(const KnowledgeEdit& r) {
   return {http_status(r.status), std::move(j)};
 }
 
-HriOpResult bad(std::string message) { return {400, json{{"error", std::move(message)}}}; }
-
-std::optional<std::uint64_t> version_of(const json& body) {
-  if (!body.contains("version") || !body["version"].is_number_unsigned()) return std::nullopt;
-  return body["version"].get<std::uint64_t>();
-}
-
-std::string author_of(const json& body) {
-  return body.contains("author") && body["author"].is_string() ? body["author"].get<std::string>() : std::string();
-}
-
 json change_json(const KnowledgeChange& c) {
   return json{{"version", c.version},
               {"time", c.time_utc},
@@ -125,105 +74,120 @@ json change_json(const KnowledgeChange& c) {
 }  // namespace
 
 
-bool is_hri_op(std::string_view op) noexcept {
-  return op == "rkms.list" || op == "rkms.get" || op == "rkms.add" || op == "rkms.edit" || op == "rkms.delete" ||
-         op == "rkms.history" || op == "touch" || op == "ask";
+bool is_hri_op(const OperatorCommand& command) noexcept {
+  return std::holds_alternative<RkmsListRequest>(command) || std::holds_alternative<RkmsGetRequest>(command) ||
+         std::holds_alternative<RkmsAddRequest>(command) || std::holds_alternative<RkmsEditRequest>(command) ||
+         std::holds_alternative<RkmsDeleteRequest>(command) || std::holds_alternative<RkmsHistoryRequest>(command) ||
+         std::holds_alternative<TouchRequest>(command) || std::holds_alternative<AskRequest>(command);
 }
 
-HriOpResult handle_hri_op(HriService* hri, std::string_view op, const json& body, const std::function<void(std::string)>& note) {
-  if (hri == nullptr) {
-    return {404, json{{"error", std::string(op) + ": this robot has no HRI knowledge store (a module of the robot implementing "
-                                                  "tripodal::HriService, docs/hri.md)"}}};
-  }
-  KnowledgeStore& store = hri->knowledge_store();
-  if (op == "rkms.list") {
-    std::string query;
-    if (body.contains("query")) {
-      if (!body["query"].is_string()) return bad("rkms.list: \"query\" must be a string");
-      query = body["query"].get<std::string>();
-      if (query.size() > 200) return bad("rkms.list: \"query\" is " + std::to_string(query.size()) + " bytes; expected at most 200");
-    }
+namespace {
+
+std::string who(const std::string& author) { return author.empty() ? std::string("operator") : author; }
+
+KnowledgeEntry knowledge_entry(const EntryFields& f) {
+  KnowledgeEntry e;
+  e.id = f.id;
+  e.topic = f.topic;
+  e.keywords = f.keywords;
+  e.questions = f.questions;
+  e.answer = f.answer;
+  e.action = f.action;
+  return e;
+}
+
+struct HriOps {
+  HriService& hri;
+  KnowledgeStore& store;
+  const std::function<void(std::string)>& note;
+
+  HriOpResult operator()(const RkmsListRequest& r) const {
     json entries = json::array();
-    for (const VersionedEntry& v : store.search(query)) entries.push_back(versioned_json(v));
+    for (const VersionedEntry& v : store.search(r.query)) entries.push_back(versioned_json(v));
     return {200, json{{"version", store.version()}, {"file", store.file().filename().string()}, {"entries", std::move(entries)}}};
   }
-  if (op == "rkms.get") {
-    if (!body.contains("id") || !body["id"].is_string()) return bad("rkms.get: expected \"id\": an entry id");
-    const auto v = store.get(body["id"].get<std::string>());
-    if (!v) return {404, json{{"error", "rkms.get: there is no entry '" + body["id"].get<std::string>() + "'"}}};
+  HriOpResult operator()(const RkmsGetRequest& r) const {
+    const auto v = store.get(r.id);
+    if (!v) return {404, json{{"error", "rkms.get: there is no entry '" + r.id + "'"}}};
     return {200, json{{"version", store.version()}, {"entry", versioned_json(*v)}}};
   }
-  if (op == "rkms.history") {
-    std::size_t limit = 0;
-    if (body.contains("limit")) {
-      if (!body["limit"].is_number_unsigned()) return bad("rkms.history: \"limit\" must be a whole number");
-      limit = body["limit"].get<std::size_t>();
+  HriOpResult operator()(const RkmsHistoryRequest& r) const {
+    // The newest changes first, as many as the limit and the answer's byte budget allow (a change
+    // holds two entries of up to ~45 KB each): a long history never makes an answer the server
+    // cannot send.
+    const std::vector<KnowledgeChange> all = store.history(r.limit);
+    std::vector<json> newest;
+    std::size_t bytes = 0;
+    for (auto it = all.rbegin(); it != all.rend(); ++it) {
+      json c = change_json(*it);
+      const std::size_t size = c.dump().size() + 1;
+      if (bytes + size > OperatorBudgets::kMaxHistoryAnswerBytes) break;
+      bytes += size;
+      newest.push_back(std::move(c));
     }
+    const std::size_t omitted = all.size() - newest.size();
     json changes = json::array();
-    for (const KnowledgeChange& c : store.history(limit)) changes.push_back(change_json(c));
-    return {200, json{{"version", store.version()}, {"changes", std::move(changes)}}};
+    for (auto it = newest.rbegin(); it != newest.rend(); ++it) changes.push_back(std::move(*it));
+    return {200, json{{"version", store.version()}, {"changes", std::move(changes)}, {"omitted", omitted}}};
   }
-  if (op == "rkms.add" || op == "rkms.edit") {
-    std::vector<KnowledgeFieldError> errors;
-    auto entry = entry_from(body.contains("entry") ? body["entry"] : json(nullptr), errors);
-    if (!entry) {
-      HriOpResult r = bad(std::string(op) + ": the entry is not valid; nothing was saved");
-      r.body["status"] = "invalid";
-      r.body["errors"] = errors_json(errors);
-      return r;
-    }
-    KnowledgeEdit r;
-    if (op == "rkms.add") {
-      r = store.add(*entry, author_of(body));
-    } else {
-      const auto version = version_of(body);
-      if (!version) return bad("rkms.edit: expected \"version\": the entry's version you edited (from rkms.list)");
-      const std::string id = body.contains("id") && body["id"].is_string() ? body["id"].get<std::string>() : entry->id;
-      if (entry->id.empty()) entry->id = id;  // the entry of the id the request names
-      r = store.edit(id, *entry, *version, author_of(body));
-    }
-    const bool changed = r.ok() && r.message.find("unchanged") == std::string::npos;
-    if (changed) note("rkms: " + r.message + " by " + (author_of(body).empty() ? std::string("operator") : author_of(body)));
-    return edit_result(r);
+  HriOpResult operator()(const RkmsAddRequest& r) const { return changed(store.add(knowledge_entry(r.entry), r.author), r.author); }
+  HriOpResult operator()(const RkmsEditRequest& r) const {
+    KnowledgeEntry entry = knowledge_entry(r.entry);
+    if (entry.id.empty()) entry.id = r.id;  // the entry of the id the request names
+    return changed(store.edit(r.id, std::move(entry), r.version, r.author), r.author);
   }
-  if (op == "rkms.delete") {
-    if (!body.contains("id") || !body["id"].is_string()) return bad("rkms.delete: expected \"id\": an entry id");
-    const auto version = version_of(body);
-    if (!version) return bad("rkms.delete: expected \"version\": the entry's version you read (from rkms.list)");
-    const KnowledgeEdit r = store.remove(body["id"].get<std::string>(), *version, author_of(body));
-    if (r.ok()) note("rkms: " + r.message + " by " + (author_of(body).empty() ? std::string("operator") : author_of(body)));
-    return edit_result(r);
-  }
-  if (op == "touch") {
+  HriOpResult operator()(const RkmsDeleteRequest& r) const { return changed(store.remove(r.id, r.version, r.author), r.author); }
+  HriOpResult operator()(const TouchRequest&) const {
     // The big buttons: the first question form of the first entries that have one.
     json questions = json::array();
     for (const VersionedEntry& v : store.entries()) {
       if (questions.size() >= kTouchQuestions) break;
       if (!v.entry.questions.empty()) questions.push_back(v.entry.questions.front());
     }
-    return {200, json{{"robot", store.base().robot()}, {"voice", hri->voice() != nullptr}, {"questions", std::move(questions)}}};
+    return {200, json{{"robot", store.base().robot()}, {"voice", hri.voice() != nullptr}, {"questions", std::move(questions)}}};
   }
-  // ask
-  if (!body.contains("text") || !body["text"].is_string()) return bad("ask: expected \"text\": what the visitor typed");
-  const HriReply reply = hri->ask(body["text"].get<std::string>());
-  json j{{"kind", std::string(to_string(reply.kind))},
-         {"text", reply.text},
-         {"entry", reply.entry_id},
-         {"task", reply.task},
-         {"confidence", reply.confidence},
-         {"topics", reply.closest_topics},
-         {"voice", hri->voice() != nullptr}};
-  if (reply.kind == HriReply::Kind::task_started || (reply.kind == HriReply::Kind::answered && !reply.task.empty())) note("hri: touch screen: task " + reply.task + " started");
-  if (body.contains("speak") && body["speak"].is_boolean() && body["speak"].get<bool>()) {
-    if (SpeechSynthesizer* voice = hri->voice()) {
-      try {
-        j["audio"] = base64(wav_bytes(voice->synthesize(reply.text)));
-      } catch (const std::exception& e) {
-        j["voice_error"] = std::string("the voice failed: ") + e.what();
+  HriOpResult operator()(const AskRequest& r) const {
+    const HriReply reply = hri.ask(r.text);
+    json j{{"kind", std::string(to_string(reply.kind))},
+           {"text", reply.text},
+           {"entry", reply.entry_id},
+           {"task", reply.task},
+           {"confidence", reply.confidence},
+           {"topics", reply.closest_topics},
+           {"voice", hri.voice() != nullptr}};
+    if (reply.kind == HriReply::Kind::task_started || (reply.kind == HriReply::Kind::answered && !reply.task.empty())) {
+      note("hri: touch screen: task " + reply.task + " started");
+    }
+    if (r.speak) {
+      if (SpeechSynthesizer* voice = hri.voice()) {
+        try {
+          j["audio"] = base64(wav_bytes(voice->synthesize(reply.text)));
+        } catch (const std::exception& e) {
+          j["voice_error"] = std::string("the voice failed: ") + e.what();
+        }
       }
     }
+    return {200, std::move(j)};
   }
-  return {200, std::move(j)};
+  template <class Other>
+  HriOpResult operator()(const Other&) const {
+    return {500, json{{"error", "not an HRI op"}}};
+  }
+
+  HriOpResult changed(const KnowledgeEdit& r, const std::string& author) const {
+    if (r.ok() && r.message.find("unchanged") == std::string::npos) note("rkms: " + r.message + " by " + who(author));
+    return edit_result(r);
+  }
+};
+
+}  // namespace
+
+HriOpResult handle_hri_op(HriService* hri, std::string_view op, const OperatorCommand& command, const std::function<void(std::string)>& note) {
+  if (hri == nullptr) {
+    return {404, json{{"error", std::string(op) + ": this robot has no HRI knowledge store (a module of the robot implementing "
+                                                  "tripodal::HriService, docs/hri.md)"}}};
+  }
+  return std::visit(HriOps{*hri, hri->knowledge_store(), note}, command);
 }
 
 }  // namespace tripodal::monitor

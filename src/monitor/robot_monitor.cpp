@@ -2,16 +2,18 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <map>
 #include <mutex>
 #include <set>
+#include <stdexcept>
 #include <utility>
+#include <variant>
 
 #include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
 
 #include "tripodal/behaviors/behavior_registry.hpp"
 #include "tripodal/board/board_hardware.hpp"
@@ -22,6 +24,7 @@
 #include "tripodal/planner/lifecycle_recorder.hpp"
 #include "hri_ops.hpp"
 #include "net_drawing.hpp"
+#include "operator_request.hpp"
 
 namespace tripodal::monitor {
 namespace {
@@ -160,7 +163,8 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
 
   bool paused = false;
   std::string pause_reason;
-  std::set<std::string, std::less<>> breakpoints;
+  std::set<std::string, std::less<>> breakpoints;  // at most OperatorBudgets::kMaxBreakpoints
+  std::size_t ack_notes = 0;  // ack notes with a text kept in the life cycle
   std::map<std::string, std::string, std::less<>> last_firing;  // run -> transition id
   std::map<std::string, std::string, std::less<>> behavior_params;  // behavior -> "a=1, b=2"
   bool nets_changed = true;
@@ -336,144 +340,130 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
   }
 
   // Live mapping (navi::CMappingModule): begin, end, status, save NAME into options.map_dir.
-  void map_request(const OperatorRequest& r, const json& body) {
-    auto reply = [&](int status, const json& j) { server.answer(r.id, status, j.dump()); };
+  void map_request(std::uint64_t id, const MapRequest& m) {
     auto* mapper = robot.module<navi::CMappingModule>();
-    if (mapper == nullptr) return reply(404, {{"error", "map: the robot has no MapBuilder module (add one to its profile's navigation)"}});
-    const std::string action = body.value("action", "");
+    if (mapper == nullptr) return reply(id, 404, {{"error", "map: the robot has no MapBuilder module (add one to its profile's navigation)"}});
     const auto status = [&] {
       return json{{"mapping", mapper->mapping()}, {"scans", mapper->scans()}, {"quality", mapper->last_quality()}};
     };
-    if (action == "begin") {
-      // in the frame of the robot's current estimate, so a new map overlays the one it runs on
-      mapper->begin(robot.navigation().map_from_base);
-      note("operator: mapping begun");
-      return reply(200, status());
+    switch (m.action) {
+      case MapRequest::Action::begin:
+        // in the frame of the robot's current estimate, so a new map overlays the one it runs on
+        mapper->begin(robot.navigation().map_from_base);
+        note("operator: mapping begun");
+        return reply(id, 200, status());
+      case MapRequest::Action::end:
+        mapper->end();
+        note("operator: mapping ended after " + std::to_string(mapper->scans()) + " scans");
+        return reply(id, 200, status());
+      case MapRequest::Action::status: return reply(id, 200, status());
+      case MapRequest::Action::save: break;
     }
-    if (action == "end") {
-      mapper->end();
-      note("operator: mapping ended after " + std::to_string(mapper->scans()) + " scans");
-      return reply(200, status());
+    if (options.map_dir.empty()) return reply(id, 403, {{"error", "map: saving is off (the application sets the monitor's map folder)"}});
+    // a bare file name (checked by the request layer): the operator chooses the name, never the folder
+    const std::filesystem::path file = options.map_dir / (m.name + ".yaml");
+    try {
+      std::filesystem::create_directories(options.map_dir);
+      mapper->save(file);
+    } catch (const std::exception& e) {
+      return reply(id, 409, {{"error", std::string("map: ") + e.what()}});
     }
-    if (action == "status") return reply(200, status());
-    if (action == "save") {
-      if (options.map_dir.empty()) return reply(403, {{"error", "map: saving is off (the application sets the monitor's map folder)"}});
-      const std::string name = body.contains("name") && body["name"].is_string() ? body["name"].get<std::string>() : "";
-      // a bare file name: the operator chooses the name, never the folder
-      const bool plain = !name.empty() && name.size() <= 64 && name.front() != '.' &&
-                         std::all_of(name.begin(), name.end(), [](char c) {
-                           return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-' || c == '.';
-                         });
-      if (!plain) return reply(400, {{"error", "map: expected \"name\": letters, digits, '_', '-' or '.', at most 64, not starting with '.'"}});
-      const std::filesystem::path file = options.map_dir / (name + ".yaml");
-      try {
-        std::filesystem::create_directories(options.map_dir);
-        mapper->save(file);
-      } catch (const std::exception& e) {
-        return reply(409, {{"error", std::string("map: ") + e.what()}});
-      }
-      note("operator: map saved to " + file.string());
-      json j = status();
-      j["saved"] = file.string();
-      return reply(200, j);
-    }
-    reply(400, {{"error", "map: expected \"action\": begin, end, status or save"}});
+    note("operator: map saved to " + file.string());
+    json j = status();
+    j["saved"] = file.string();
+    reply(id, 200, j);
   }
 
-  void reload(const OperatorRequest& r, const json& body) {
-    auto reply = [&](int status, const json& j) { server.answer(r.id, status, j.dump()); };
-    if (!body.contains("run") || !body["run"].is_string() || !body.contains("xml") || !body["xml"].is_string()) {
-      return reply(400, {{"error", "reload: expected \"run\": a running process's run id and \"xml\": its edited net"}});
-    }
-    const std::string run = body["run"];
-    if (run == "task") {
-      return reply(409, {{"error", "reload: the task's net is composed by the planner from the process modules; reload a process net"}});
+  void reload(std::uint64_t id, const ReloadRequest& r) {
+    if (r.run == "task") {
+      return reply(id, 409, {{"error", "reload: the task's net is composed by the planner from the process modules; reload a process net"}});
     }
     if (pending_reload) {
-      return reply(409, {{"error", "reload: the reload of " + pending_reload->run + " is waiting for a quiet marking"}});
+      return reply(id, 409, {{"error", "reload: the reload of " + pending_reload->run + " is waiting for a quiet marking"}});
     }
-    const CProcess* process = robot.supervisor().process(run);
+    const CProcess* process = robot.supervisor().process(r.run);
     // The name diagnostics give the edited text: the process's own file name, marked as edited.
-    const std::string source = (process != nullptr ? process->name() : run) + ".edited.xml";
-    const std::string text = body["xml"];
+    const std::string source = (process != nullptr ? process->name() : r.run) + ".edited.xml";
     // Paused, nothing steps: a run that is not quiet now will not become quiet, so no waiting.
-    if (try_reload(r.id, run, text, source, paused)) return;
-    pending_reload = PendingReload{r.id, run, text, source,
+    if (try_reload(id, r.run, r.xml, source, paused)) return;
+    pending_reload = PendingReload{id, r.run, r.xml, source,
                                    std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                                                           std::chrono::duration<double>(options.reload_wait_s))};
   }
 
   // --- operator requests --------------------------------------------------------------------------
+  // Read and checked by one layer (operator_request.hpp): what reaches the ops below has the right
+  // types, ranges and lengths; a request that does not is answered 400 naming the field.
   void handle(const OperatorRequest& r) {
-    const json body = json::parse(r.body, nullptr, false);
-    const std::string op = body.value("op", "");
-    auto reply = [&](int status, const json& j) { server.answer(r.id, status, j.dump()); };
-    if (op == "task") {
-      if (!body.contains("text") || !body["text"].is_string()) return reply(400, {{"error", "task: expected \"text\": the task in plain words"}});
-      const std::string text = body["text"];
-      const CommandAnswer a = robot.command(text);
-      note(std::string("operator: \"") + text + "\": " + (a.accepted ? "accepted" : "refused") + ": " + a.text);
-      return reply(200, {{"accepted", a.accepted}, {"text", a.text}});
+    const ParsedRequest parsed = parse_operator_request(r.body);
+    if (!parsed.command) return server.answer(r.id, 400, refusal_json(parsed).dump());
+    const OperatorCommand& command = *parsed.command;
+    if (is_hri_op(command)) {
+      const HriOpResult result = handle_hri_op(hri, parsed.op, command, [this](std::string text) { note(std::move(text)); });
+      return server.answer(r.id, result.status, result.body.dump());
     }
-    if (op == "pause") {
-      pause_now("by the operator");
-      return reply(200, {{"paused", true}});
+    std::visit([&](const auto& request) { op(r.id, request); }, command);
+  }
+
+  void reply(std::uint64_t id, int status, const json& j) { server.answer(id, status, j.dump()); }
+
+  void op(std::uint64_t id, const TaskRequest& t) {
+    const CommandAnswer a = robot.command(t.text);
+    note(std::string("operator: \"") + t.text + "\": " + (a.accepted ? "accepted" : "refused") + ": " + a.text);
+    reply(id, 200, {{"accepted", a.accepted}, {"text", a.text}});
+  }
+  void op(std::uint64_t id, const PauseRequest&) {
+    pause_now("by the operator");
+    reply(id, 200, {{"paused", true}});
+  }
+  void op(std::uint64_t id, const ResumeRequest&) {
+    paused = false;
+    note("monitor: resumed by the operator");
+    reply(id, 200, {{"paused", false}});
+  }
+  void op(std::uint64_t id, const CancelRequest&) {
+    if (!robot.planner().busy()) return reply(id, 409, {{"error", "no task is running"}});
+    robot.planner().cancel("cancelled by the operator");
+    reply(id, 200, {{"cancelled", true}});
+  }
+  void op(std::uint64_t id, const DriveRequest& d) {
+    if (d.stop) {
+      stop_driving("stopped by the operator");
+      return reply(id, 200, {{"driving", false}});
     }
-    if (op == "resume") {
-      paused = false;
-      note("monitor: resumed by the operator");
-      return reply(200, {{"paused", false}});
+    drive_with(d.vx_m_s, d.vy_m_s, d.wz_rad_s);
+    reply(id, 200, {{"driving", true}, {"deadman_s", options.drive_deadman_s}});
+  }
+  void op(std::uint64_t id, const AckRequest& a) {
+    // An acknowledgement is never refused; its note is kept while the run's budget of notes lasts.
+    const bool keep = !a.text.empty() && ack_notes < OperatorBudgets::kMaxAckNotesKept;
+    if (keep) ++ack_notes;
+    note("operator: fault acknowledged" + (keep ? ": " + a.text : a.text.empty() ? std::string() : std::string(" (its note is not kept: ") +
+                                                                                       std::to_string(OperatorBudgets::kMaxAckNotesKept) +
+                                                                                       " notes were kept already)"));
+    reply(id, 200, {{"acknowledged", true}, {"note_kept", keep}});
+  }
+  void op(std::uint64_t id, const NetRequest& n) {
+    if (n.run == "task") return reply(id, 409, {{"error", "net: the task's net is composed by the planner; only process nets are edited"}});
+    const CProcess* process = robot.supervisor().process(n.run);
+    if (process == nullptr) return reply(id, 404, {{"error", "net: no process is running as '" + n.run + "'"}});
+    reply(id, 200, {{"run", n.run}, {"process", process->name()}, {"xml", net_to_string(process->net(), NetFormat::native_xml)}});
+  }
+  void op(std::uint64_t id, const ReloadRequest& r) { reload(id, r); }
+  void op(std::uint64_t id, const MapRequest& m) { map_request(id, m); }
+  void op(std::uint64_t id, const BreakpointRequest& b) {
+    if (b.on && !breakpoints.contains(b.place) && breakpoints.size() >= OperatorBudgets::kMaxBreakpoints) {
+      return reply(id, 409, {{"error", "breakpoint: " + std::to_string(breakpoints.size()) + " breakpoints are set, the most the monitor keeps; clear one first"},
+                             {"field", "place"}});
     }
-    if (op == "cancel") {
-      if (!robot.planner().busy()) return reply(409, {{"error", "no task is running"}});
-      robot.planner().cancel("cancelled by the operator");
-      return reply(200, {{"cancelled", true}});
-    }
-    if (op == "drive") {
-      if (body.value("stop", false)) {
-        stop_driving("stopped by the operator");
-        return reply(200, {{"driving", false}});
-      }
-      for (const char* k : {"vx", "vy", "wz"}) {
-        if (body.contains(k) && !body[k].is_number()) return reply(400, {{"error", std::string("drive: \"") + k + "\" must be a number"}});
-      }
-      // Bounds of a hand on a joystick; the controller's limits apply after the coordinator.
-      const double vx = std::clamp(body.value("vx", 0.0), -1.0, 1.0);
-      const double vy = std::clamp(body.value("vy", 0.0), -1.0, 1.0);
-      const double wz = std::clamp(body.value("wz", 0.0), -2.0, 2.0);
-      drive_with(vx, vy, wz);
-      return reply(200, {{"driving", true}, {"deadman_s", options.drive_deadman_s}});
-    }
-    if (op == "ack") {
-      note("operator: fault acknowledged" + (body.contains("text") && body["text"].is_string() ? ": " + body["text"].get<std::string>() : ""));
-      return reply(200, {{"acknowledged", true}});
-    }
-    if (op == "net") {
-      const std::string run = body.value("run", "");
-      if (run == "task") return reply(409, {{"error", "net: the task's net is composed by the planner; only process nets are edited"}});
-      const CProcess* process = robot.supervisor().process(run);
-      if (process == nullptr) return reply(404, {{"error", "net: no process is running as '" + run + "'"}});
-      return reply(200, {{"run", run}, {"process", process->name()}, {"xml", net_to_string(process->net(), NetFormat::native_xml)}});
-    }
-    if (op == "reload") return reload(r, body);
-    if (is_hri_op(op)) {
-      const HriOpResult result = handle_hri_op(hri, op, body, [this](std::string text) { note(std::move(text)); });
-      return reply(result.status, result.body);
-    }
-    if (op == "map") return map_request(r, body);
-    if (op == "breakpoint") {
-      if (!body.contains("place") || !body["place"].is_string() || body["place"].get<std::string>().empty()) {
-        return reply(400, {{"error", "breakpoint: expected \"place\": a place id or name"}});
-      }
-      const bool on = body.value("on", true);
-      const std::string place = body["place"];
-      if (on) breakpoints.insert(place);
-      else breakpoints.erase(place);
-      note("monitor: breakpoint " + std::string(on ? "set" : "cleared") + " on place " + place);
-      return reply(200, {{"breakpoints", std::vector<std::string>(breakpoints.begin(), breakpoints.end())}});
-    }
-    reply(400, {{"error", "unknown op '" + op + "': expected task, pause, resume, cancel, ack, breakpoint, drive, net, reload, map, "
-                                          "rkms.list, rkms.get, rkms.add, rkms.edit, rkms.delete, rkms.history, touch or ask"}});
+    if (b.on) breakpoints.insert(b.place);
+    else breakpoints.erase(b.place);
+    note("monitor: breakpoint " + std::string(b.on ? "set" : "cleared") + " on place " + b.place);
+    reply(id, 200, {{"breakpoints", std::vector<std::string>(breakpoints.begin(), breakpoints.end())}});
+  }
+  template <class HriRequest>
+  void op(std::uint64_t id, const HriRequest&) {
+    reply(id, 500, {{"error", "not a console op"}});  // the HRI's, handled above
   }
 
   // --- topics -------------------------------------------------------------------------------------
@@ -607,7 +597,17 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
 
   void update(const MonitorExtras& extras) {
     retry_pending_reload();
-    for (const OperatorRequest& r : server.take_requests()) handle(r);
+    for (const OperatorRequest& r : server.take_requests()) {
+      // The last resort: whatever a request sets off, the robot's thread goes on (the layer in
+      // operator_request.hpp means nothing should get here).
+      try {
+        handle(r);
+      } catch (const std::exception& e) {
+        spdlog::error("monitor: request {} failed: {}", r.id, e.what());
+        note(std::string("monitor: an operator request failed: ") + e.what());
+        server.answer(r.id, 500, json{{"error", std::string("the request failed on the robot: ") + e.what()}}.dump(-1, ' ', false, json::error_handler_t::replace));
+      }
+    }
     // The dead-man switch: the console repeats the command while a key is held.
     if (driving && std::chrono::steady_clock::now() - last_drive > std::chrono::duration<double>(options.drive_deadman_s)) {
       stop_driving("no command for " + std::to_string(static_cast<int>(options.drive_deadman_s * 1000)) + " ms");
@@ -659,8 +659,18 @@ void RobotMonitor::resume() {
   impl_->note("monitor: resumed");
 }
 void RobotMonitor::set_breakpoint(std::string place, bool on) {
-  if (on) impl_->breakpoints.insert(std::move(place));
-  else impl_->breakpoints.erase(place);
+  if (!on) {
+    impl_->breakpoints.erase(place);
+    return;
+  }
+  if (place.empty() || place.size() > OperatorBudgets::kMaxBreakpointBytes) {
+    throw std::invalid_argument("breakpoint: a place of " + std::to_string(place.size()) + " bytes; expected 1 to " +
+                                std::to_string(OperatorBudgets::kMaxBreakpointBytes));
+  }
+  if (!impl_->breakpoints.contains(place) && impl_->breakpoints.size() >= OperatorBudgets::kMaxBreakpoints) {
+    throw std::invalid_argument("breakpoint: " + std::to_string(OperatorBudgets::kMaxBreakpoints) + " breakpoints are set, the most the monitor keeps");
+  }
+  impl_->breakpoints.insert(std::move(place));
 }
 void RobotMonitor::set_hri(HriService* hri) noexcept { impl_->hri = hri; }
 std::vector<std::string> RobotMonitor::breakpoints() const {

@@ -210,7 +210,7 @@ TEST_CASE("store: invalid entries are refused naming the field, and nothing is s
   refused_at(e, "answer", "answer is 1048576 bytes long; expected at most 4000");
   e = parking();
   e.questions = {std::string("Where\0is it?", 12)};
-  refused_at(e, "questions[0]", "not text: expected UTF-8 without control characters");
+  refused_at(e, "questions[0]", "not text: U+0000 at character 5 (byte 5)");
   e = parking();
   e.topic = "\xff\xfe parking";
   refused_at(e, "topic", "not text");
@@ -436,4 +436,71 @@ TEST_CASE("store: changes from two threads are all saved, each under a version o
   CHECK(store.version() == 21);
   CHECK(store.entries().size() == 45);
   require_disk_equals_store(store);
+}
+
+TEST_CASE("store: a text XML cannot hold (U+FFFE, U+FFFF, controls, bad UTF-8) is refused at its place; later saves and the file still load",
+          "[hri][store][xml]") {
+  Folder f;
+  KnowledgeStore store(f.file);
+  const std::string before = slurp(f.file);
+  const auto refused = [&](KnowledgeEntry e, const std::string& field, const std::string& where) {
+    const KnowledgeEdit r = store.add(std::move(e), "x");
+    REQUIRE(r.status == KnowledgeEdit::Status::invalid);
+    REQUIRE_FALSE(r.errors.empty());
+    CHECK(r.errors.front().field == field);
+    CHECK_THAT(r.errors.front().message, Catch::Contains("is not text") && Catch::Contains(where));
+  };
+  KnowledgeEntry e = parking();
+  e.answer = "Behind the hall \xEF\xBF\xBE entrance B.";  // U+FFFE at character 16
+  refused(e, "answer", "U+FFFE at character 16 (byte 16)");
+  e = parking();
+  e.questions = {"Where \xC3\xA9 \xEF\xBF\xBF?"};  // U+FFFF after "é": character 8, byte 9
+  refused(e, "questions[0]", "U+FFFF at character 8 (byte 9)");
+  e = parking();
+  e.topic = "the \xED\xA0\x80 parking";  // an encoded lone surrogate
+  refused(e, "topic", "byte 0xED at character 4 (byte 4) is not UTF-8");
+  e = parking();
+  e.keywords = {"car", std::string("pa\x01rk")};
+  refused(e, "keywords[1]", "U+0001 at character 2 (byte 2)");
+  CHECK(slurp(f.file) == before);
+  CHECK(store.version() == 1);
+
+  // Nothing refused was kept: the next change saves, and the file loads again (Jinny would start).
+  REQUIRE(store.add(parking(), "x").ok());
+  CHECK(store.version() == 2);
+  require_disk_equals_store(store);
+  CHECK(KnowledgeBase::load(f.file).find("parking") != nullptr);
+}
+
+TEST_CASE("KnowledgeBase::save refuses a text XML cannot hold, naming entry, field and place, and writes nothing", "[hri][store][xml]") {
+  Folder f;
+  KnowledgeBase base = KnowledgeBase::load(f.file);
+  const std::string before = slurp(f.file);
+  KnowledgeEntry e = parking();
+  e.answer = "ok \xEF\xBF\xBF";
+  base.put(e);
+  CHECK_THROWS_WITH(base.save(f.file), Catch::Contains("entry 'parking' answer: U+FFFF at character 3 (byte 3)") &&
+                                           Catch::Contains("nothing was saved"));
+  CHECK(slurp(f.file) == before);
+  CHECK(base.version() == 1);
+}
+
+TEST_CASE("store: history lines whose fields have the wrong JSON type are skipped, the store still loads", "[hri][store]") {
+  Folder f;
+  {
+    KnowledgeStore store(f.file, fixed_time());
+    REQUIRE(store.add(parking(), "alice").ok());
+  }
+  // Edited by hand: each line a field of another type than the store writes.
+  std::ofstream(f.dir / "jinny.xml.history", std::ios::app)
+      << R"({"version":3,"op":5,"id":"x"})" << "\n"
+      << R"({"version":3,"op":"edit","id":["x"]})" << "\n"
+      << R"({"version":3,"op":"edit","id":"parking","time":7})" << "\n"
+      << R"({"version":3,"op":"edit","id":"parking","after":{"keywords":"car"}})" << "\n"
+      << R"({"version":3,"op":"edit","id":"parking","after":{"keywords":[1,2]}})" << "\n"
+      << R"({"version":3,"op":"edit","id":"parking","before":{"answer":false}})" << "\n";
+  const KnowledgeStore again(f.file);
+  REQUIRE(again.history().size() == 1);
+  CHECK(again.history().front().author == "alice");
+  CHECK(again.get("parking")->version == 2);
 }

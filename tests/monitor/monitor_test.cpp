@@ -33,6 +33,7 @@
 #include "tripodal/sim/sim_hardware.hpp"
 #include "loopback_client.hpp"
 #include "test_hri_module.hpp"
+#include "../../src/monitor/operator_request.hpp"
 
 using namespace tripodal;
 using namespace tripodal::monitor;
@@ -348,7 +349,7 @@ TEST_CASE("Manual drive goes through the coordinator, masks the task's motion an
   robot->run_for(std::chrono::seconds(5));
   CHECK(robot->behavior_active("BhCleaning"));
 
-  CHECK_THAT(post(R"({"op":"drive","vx":"fast"})"), Catch::Contains(R"(drive: \"vx\" must be a number)"));
+  CHECK_THAT(post(R"({"op":"drive","vx":"fast"})"), Catch::Contains(R"(field 'vx' of op 'drive': expected a number, got a string)"));
   CHECK_THAT(post(R"({"op":"drive","vx":0.0,"wz":1.0})"), Catch::Contains(R"("driving":true)"));
   const Pose2D before = robot->navigation().map_from_base;
   robot->run_for(std::chrono::seconds(1));
@@ -610,13 +611,15 @@ struct Psr2WithHri {
   RobotPlugins plugins = RobotPlugins::with_builtins();
   SimClock clock;
   std::unique_ptr<Robot> robot;
-  Psr2WithHri() {
+  // `prepare` may write files beside the knowledge (its history) before the robot loads it.
+  explicit Psr2WithHri(const std::function<void(const std::filesystem::path& knowledge)>& prepare = {}) {
     const std::filesystem::path source = TRIPODAL_SOURCE_DIR;
     dir = std::filesystem::temp_directory_path() / ("tripodal_rkms_monitor_" + std::to_string(::getpid()));
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     file = dir / "jinny.xml";
     std::filesystem::copy_file(source / "configs/hri/jinny.xml", file);
+    if (prepare) prepare(file);
     plugins.modules.add<testing_hri::TestHri>();
     sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(source / "configs/worlds/workspace.yaml")));
     RobotProfile profile = load_robot_profile(source / "configs/robots/psr2.yaml");
@@ -728,7 +731,8 @@ TEST_CASE("RKMS administration: list, add, edit, delete and history through the 
   bad["answer"] = std::string("bell\x07", 5);
   r = json_command(server, watch, {{"op", "rkms.add"}, {"entry", bad}});
   CHECK(r.status == 400);
-  CHECK(r.body["errors"][0]["message"] == "answer is not text: expected UTF-8 without control characters");
+  CHECK(r.body["errors"][0]["field"] == "answer");
+  CHECK_THAT(r.body["errors"][0]["message"].get<std::string>(), Catch::Contains("not text: U+0007 at character 4 (byte 4)"));
   CHECK(file_text(psr2.file) == before);
 
   r = json_command(server, watch, {{"op", "rkms.delete"}, {"id", "parking"}, {"version", 3}, {"author", "dave"}});
@@ -880,6 +884,410 @@ TEST_CASE("An HRI built by the application outside the robot's modules is given 
   CHECK(r.status == 200);
   CHECK(r.body["entry"] == "weather");
   CHECK(r.body["text"] == "The weather today: rain.");
+  watch.set_hri(nullptr);
+  server.stop();
+}
+
+// --- the operator request layer (src/monitor/operator_request.hpp) --------------------------------
+
+namespace {
+
+// A value of the field's own type that the schema accepts.
+nlohmann::json valid_value(const FieldSpec& f) {
+  switch (f.type) {
+    case FieldType::boolean: return true;
+    case FieldType::number: return std::clamp(0.0, f.min, f.max);
+    case FieldType::count: return static_cast<std::uint64_t>(std::max(f.min, 1.0));
+    case FieldType::text: return f.choices.empty() ? std::string("x") : std::string(f.choices.front());
+    case FieldType::text_list: return nlohmann::json::array({"x"});
+    case FieldType::object: {
+      nlohmann::json o = nlohmann::json::object();
+      for (const FieldSpec& m : f.members) o[std::string(m.name)] = valid_value(m);
+      return o;
+    }
+  }
+  return nullptr;
+}
+
+// The op's required fields, each valid.
+nlohmann::json valid_body(const OpSpec& op) {
+  nlohmann::json body{{"op", op.op}};
+  for (const FieldSpec& f : op.fields) {
+    if (f.required) body[std::string(f.name)] = valid_value(f);
+  }
+  return body;
+}
+
+// One value of each JSON type.
+const std::vector<std::pair<std::string, nlohmann::json>>& json_kinds() {
+  static const std::vector<std::pair<std::string, nlohmann::json>> kinds = {
+      {"null", nullptr}, {"boolean", true}, {"number", 7}, {"string", "seven"}, {"array", nlohmann::json::array({1})}, {"object", {{"a", 1}}}};
+  return kinds;
+}
+
+bool right_kind(FieldType type, const std::string& kind) {
+  switch (type) {
+    case FieldType::boolean: return kind == "boolean";
+    case FieldType::number:
+    case FieldType::count: return kind == "number";
+    case FieldType::text: return kind == "string";
+    case FieldType::text_list: return kind == "array";
+    case FieldType::object: return kind == "object";
+  }
+  return false;
+}
+
+// Every (body, field path) of the schema with one field of a wrong JSON type; fields of an object
+// field (an RKMS entry) and the items of a list field included.
+std::vector<std::pair<nlohmann::json, std::string>> wrong_type_requests() {
+  std::vector<std::pair<nlohmann::json, std::string>> out;
+  for (const OpSpec& op : request_schema()) {
+    const nlohmann::json base = valid_body(op);
+    for (const FieldSpec& f : op.fields) {
+      const std::string name(f.name);
+      for (const auto& [kind, value] : json_kinds()) {
+        if (right_kind(f.type, kind)) continue;
+        nlohmann::json body = base;
+        body[name] = value;
+        out.emplace_back(body, name);
+      }
+      if (f.type == FieldType::text_list) {
+        for (const auto& [kind, value] : json_kinds()) {
+          if (kind == "string") continue;
+          nlohmann::json body = base;
+          body[name] = nlohmann::json::array({"x", value});
+          out.emplace_back(body, name + "[1]");
+        }
+      }
+      for (const FieldSpec& m : f.members) {
+        const std::string member(m.name);
+        for (const auto& [kind, value] : json_kinds()) {
+          nlohmann::json body = base;
+          body[name] = valid_value(f);
+          if (!right_kind(m.type, kind)) {
+            body[name][member] = value;
+            out.emplace_back(body, name + "." + member);
+          }
+          if (m.type == FieldType::text_list && kind != "string") {
+            body[name][member] = nlohmann::json::array({"x", value});
+            out.emplace_back(body, name + "." + member + "[1]");
+          }
+        }
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("Every field of every op sent with every wrong JSON type is refused with 400 naming it, and the robot goes on",
+          "[monitor][robot][requests]") {
+  Psr2WithHri psr2;
+  const std::filesystem::path maps = psr2.dir / "maps";
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0, .map_dir = maps});
+  server.start();
+  REQUIRE(psr2.robot->command("clean the room 3211").accepted);
+  const auto requests = wrong_type_requests();
+  REQUIRE(requests.size() > 150);  // 18 ops; a schema that lost its fields would pass vacuously
+  std::size_t sent = 0;
+  for (const auto& [body, field] : requests) {
+    INFO(body.dump());
+    const JsonAnswer r = json_command(server, watch, body);
+    CHECK(r.status == 400);
+    CHECK(r.body["field"] == field);
+    CHECK_THAT(r.body["error"].get<std::string>(),
+               Catch::StartsWith("field '" + field + "' of op '" + body["op"].get<std::string>() + "': expected "));
+    // The robot keeps running between requests.
+    if (++sent % 25 == 0) psr2.robot->run_for(std::chrono::milliseconds(200));
+  }
+  // The issue's examples, by name.
+  JsonAnswer r = json_command(server, watch, {{"op", "drive"}, {"stop", "yes"}});
+  CHECK(r.status == 400);
+  CHECK(r.body["error"] == "field 'stop' of op 'drive': expected a boolean, got a string");
+  CHECK(json_command(server, watch, {{"op", "net"}, {"run", 5}}).body["error"] == "field 'run' of op 'net': expected a string, got a number");
+  CHECK(json_command(server, watch, {{"op", "breakpoint"}, {"place", "P1"}, {"on", "no"}}).body["field"] == "on");
+  CHECK(json_command(server, watch, {{"op", "map"}, {"action", 1}}).body["field"] == "action");
+  // Unknown fields are refused with their name; nothing happened.
+  r = json_command(server, watch, {{"op", "pause"}, {"now", true}});
+  CHECK(r.status == 400);
+  CHECK(r.body["error"] == "field 'now' of op 'pause': unknown; op 'pause' takes no fields");
+  r = json_command(server, watch, {{"op", "drive"}, {"vx", 0.1}, {"vz", 0.1}});
+  CHECK(r.body["error"] == "field 'vz' of op 'drive': unknown; expected stop, vx, vy, wz");
+  CHECK_FALSE(watch.paused());
+  // Ranges: a joystick's bounds, not clamped silently.
+  r = json_command(server, watch, {{"op", "drive"}, {"vx", 5.0}});
+  CHECK(r.body["error"] == "field 'vx' of op 'drive': expected a number from -1 to 1, got 5.0");
+  // The robot kept running and answers: a later valid request is served.
+  psr2.robot->run_for(std::chrono::seconds(1));
+  CHECK(psr2.robot->planner().busy());
+  r = json_command(server, watch, {{"op", "pause"}});
+  CHECK(r.status == 200);
+  CHECK(watch.paused());
+  CHECK(json_command(server, watch, {{"op", "rkms.list"}}).body["entries"].size() == 25);
+  server.stop();
+}
+
+TEST_CASE("The request layer: every text field's length is refused one past its limit, not at it, and texts must be XML's",
+          "[monitor][requests]") {
+  std::size_t checked = 0;
+  for (const OpSpec& op : request_schema()) {
+    for (const FieldSpec& f : op.fields) {
+      if (f.type != FieldType::text || f.max_bytes == 0 || !f.choices.empty()) continue;
+      nlohmann::json body = valid_body(op);
+      body[std::string(f.name)] = std::string(f.max_bytes, 'a');
+      if (op.op == "map") body["action"] = "save";
+      INFO(body.dump().substr(0, 200));
+      const ParsedRequest at = parse_operator_request(body.dump());
+      CHECK(at.command.has_value());
+      body[std::string(f.name)] = std::string(f.max_bytes + 1, 'a');
+      const ParsedRequest past = parse_operator_request(body.dump());
+      REQUIRE_FALSE(past.command.has_value());
+      CHECK(past.errors.front().field == f.name);
+      CHECK_THAT(past.errors.front().message, Catch::Contains(std::to_string(f.max_bytes + 1) + " bytes; expected at most " + std::to_string(f.max_bytes)));
+      ++checked;
+    }
+  }
+  CHECK(checked >= 14);
+  // Text XML cannot hold, in any string: refused at its character.
+  ParsedRequest p = parse_operator_request(R"({"op":"task","text":"clean \uFFFE room"})");
+  REQUIRE(p.errors.size() == 1);
+  CHECK(p.errors[0].message == "field 'text' of op 'task': not text: U+FFFE at character 6 (byte 6) is not a character XML allows");
+  p = parse_operator_request(R"({"op":"ack","text":"done\u0000"})");
+  CHECK(p.errors.at(0).message == "field 'text' of op 'ack': not text: U+0000 at character 4 (byte 4) is not a character XML allows");
+  // Log lines stay lines.
+  p = parse_operator_request(R"({"op":"ack","text":"ok\nmonitor: resumed"})");
+  CHECK(p.errors.at(0).message == "field 'text' of op 'ack': holds a line break or a tab at byte 2; expected one line");
+  // Not an object, no op, an unknown op, counts that are not whole.
+  CHECK(parse_operator_request("[1]").errors.at(0).message == "body: expected a JSON object with a string \"op\"");
+  CHECK(parse_operator_request(R"({"op":7})").errors.at(0).field == "op");
+  CHECK_THAT(parse_operator_request(R"({"op":"warp"})").errors.at(0).message, Catch::StartsWith("unknown op 'warp': expected task, pause,"));
+  CHECK(parse_operator_request(R"({"op":"rkms.history","limit":2.5})").errors.at(0).message ==
+        "field 'limit' of op 'rkms.history': expected a whole number from 1 to 200, got 2.5");
+  CHECK(parse_operator_request(R"({"op":"rkms.delete","id":"a","version":-1})").errors.at(0).field == "version");
+  // Unknown field names are quoted only when they are a short line of text (fuzz finding: an empty
+  // name was reported as the body's).
+  p = parse_operator_request(R"({"op":"task","text":"x","":1})");
+  CHECK(p.errors.at(0).field == "(empty name)");
+  CHECK(p.errors.at(0).message == "field '(empty name)' of op 'task': unknown; expected text");
+  p = parse_operator_request(nlohmann::json{{"op", "pause"}, {std::string(70, 'k'), 1}}.dump());
+  CHECK(p.errors.at(0).field == "(a name of 70 bytes)");
+  CHECK(parse_operator_request(R"({"op":"task\n"})").errors.at(0).message.starts_with("unknown op '(a name of 5 bytes)'"));
+  // Every error of a request, in order.
+  p = parse_operator_request(R"({"op":"drive","stop":1,"vx":"a"})");
+  REQUIRE(p.errors.size() == 2);
+  CHECK(p.errors[1].field == "vx");
+}
+
+TEST_CASE("Budgets: breakpoints, ack notes and task text at their limit and one past it", "[monitor][robot][requests][budgets]") {
+  Psr2 psr2;
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
+  server.start();
+  using B = OperatorBudgets;
+  // Breakpoints: names of at most 256 bytes, at most 64 of them.
+  JsonAnswer r = json_command(server, watch, {{"op", "breakpoint"}, {"place", std::string(B::kMaxBreakpointBytes, 'p')}});
+  CHECK(r.status == 200);
+  r = json_command(server, watch, {{"op", "breakpoint"}, {"place", std::string(B::kMaxBreakpointBytes + 1, 'p')}});
+  CHECK(r.status == 400);
+  CHECK(r.body["error"] == "field 'place' of op 'breakpoint': 257 bytes; expected at most 256");
+  for (std::size_t i = 1; i < B::kMaxBreakpoints; ++i) watch.set_breakpoint("P" + std::to_string(i), true);
+  REQUIRE(watch.breakpoints().size() == B::kMaxBreakpoints);
+  r = json_command(server, watch, {{"op", "breakpoint"}, {"place", "one-too-many"}});
+  CHECK(r.status == 409);
+  CHECK(r.body["error"] == "breakpoint: 64 breakpoints are set, the most the monitor keeps; clear one first");
+  CHECK_THROWS_WITH(watch.set_breakpoint("one-too-many", true), Catch::Contains("64 breakpoints are set"));
+  CHECK(json_command(server, watch, {{"op", "breakpoint"}, {"place", "P1"}, {"on", true}}).status == 200);  // set already: no new one
+  CHECK(json_command(server, watch, {{"op", "breakpoint"}, {"place", "P1"}, {"on", false}}).status == 200);
+  CHECK(json_command(server, watch, {{"op", "breakpoint"}, {"place", "one-too-many"}}).status == 200);
+  CHECK(watch.breakpoints().size() == B::kMaxBreakpoints);
+
+  // Task text: 500 bytes reach the planner (which refuses nonsense), 501 do not.
+  r = json_command(server, watch, {{"op", "task"}, {"text", std::string(B::kMaxTaskTextBytes, 'a')}});
+  CHECK(r.status == 200);
+  CHECK(r.body["accepted"] == false);
+  r = json_command(server, watch, {{"op", "task"}, {"text", std::string(B::kMaxTaskTextBytes + 1, 'a')}});
+  CHECK(r.status == 400);
+  CHECK(r.body["field"] == "text");
+
+  // Ack notes: 500 bytes each; the first 100 kept; an acknowledgement itself is never refused.
+  CHECK(json_command(server, watch, {{"op", "ack"}, {"text", std::string(B::kMaxAckTextBytes + 1, 'n')}}).status == 400);
+  for (std::size_t i = 0; i < B::kMaxAckNotesKept; ++i) {
+    r = json_command(server, watch, {{"op", "ack"}, {"text", std::string(B::kMaxAckTextBytes, 'n')}});
+    REQUIRE(r.status == 200);
+    REQUIRE(r.body["note_kept"] == true);
+  }
+  r = json_command(server, watch, {{"op", "ack"}, {"text", std::string(B::kMaxAckTextBytes, 'n')}});
+  CHECK(r.status == 200);
+  CHECK(r.body["acknowledged"] == true);
+  CHECK(r.body["note_kept"] == false);
+  CHECK(json_command(server, watch, {{"op", "ack"}}).body["acknowledged"] == true);
+  server.stop();
+}
+
+namespace {
+
+// A history line of the knowledge store, as it appends them.
+std::string history_line(std::uint64_t version, const nlohmann::json& entry) {
+  return nlohmann::json{{"version", version}, {"time", "2026-11-27T12:00:00Z"}, {"author", "h"}, {"op", "edit"}, {"id", "weather"},
+                        {"before", entry}, {"after", entry}}
+             .dump() +
+         "\n";
+}
+
+}  // namespace
+
+TEST_CASE("Budgets: rkms.history sends 50 changes by default, at most 200, and never more than its byte budget", "[monitor][robot][rkms][budgets]") {
+  using B = OperatorBudgets;
+  {
+    Psr2WithHri psr2([](const std::filesystem::path& knowledge) {
+      std::ofstream out(knowledge.string() + ".history");
+      for (std::uint64_t v = 2; v <= 251; ++v) out << history_line(v, {{"id", "weather"}, {"topic", "t"}, {"answer", "a"}});
+    });
+    MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+    RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
+    server.start();
+    JsonAnswer r = json_command(server, watch, {{"op", "rkms.history"}});
+    REQUIRE(r.status == 200);
+    REQUIRE(r.body["changes"].size() == B::kDefaultHistoryLimit);
+    CHECK(r.body["changes"].back()["version"] == 251);  // the newest
+    CHECK(r.body["omitted"] == 0);
+    CHECK(json_command(server, watch, {{"op", "rkms.history"}, {"limit", B::kMaxHistoryLimit}}).body["changes"].size() == B::kMaxHistoryLimit);
+    r = json_command(server, watch, {{"op", "rkms.history"}, {"limit", B::kMaxHistoryLimit + 1}});
+    CHECK(r.status == 400);
+    CHECK(r.body["error"] == "field 'limit' of op 'rkms.history': expected a whole number from 1 to 200, got 201");
+    CHECK(json_command(server, watch, {{"op", "rkms.history"}, {"limit", 0}}).status == 400);
+    server.stop();
+  }
+  // Changes as large as the store allows (two entries of ~40 KB each): the newest that fit in the
+  // byte budget are sent, the answer says how many were left out, and the answer arrives.
+  Psr2WithHri psr2([](const std::filesystem::path& knowledge) {
+    const nlohmann::json big{{"id", "weather"}, {"topic", "t"}, {"answer", std::string(4000, 'a')},
+                             {"questions", std::vector<std::string>(64, std::string(500, 'q'))}};
+    std::ofstream out(knowledge.string() + ".history");
+    for (std::uint64_t v = 2; v <= 81; ++v) out << history_line(v, big);
+  });
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
+  server.start();
+  const std::string http = post_command(server, watch, R"({"op":"rkms.history","limit":200})");
+  CHECK(http.size() < B::kMaxHistoryAnswerBytes + 4096);
+  const nlohmann::json j = answer_json(http);
+  const std::size_t sent = j["changes"].size();
+  CHECK(sent > 10);
+  CHECK(sent < 80);
+  CHECK(j["omitted"] == 80 - sent);
+  CHECK(j["changes"].back()["version"] == 81);
+  server.stop();
+}
+
+TEST_CASE("Budgets: knowledge entry fields at the store's limits are saved, one past them refused naming the field", "[monitor][robot][rkms][budgets]") {
+  Psr2WithHri psr2;
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
+  server.start();
+  const KnowledgeLimits limits;
+  int n = 0;
+  const auto entry = [&] {
+    return nlohmann::json{{"id", "e" + std::to_string(++n)}, {"topic", "t"}, {"keywords", {"k"}}, {"questions", {"Q?"}}, {"answer", "A."}};
+  };
+  const auto numbered = [](const std::string& stem, std::size_t count) {
+    std::vector<std::string> out;
+    for (std::size_t i = 0; i < count; ++i) out.push_back(stem + std::to_string(i));
+    return out;
+  };
+  struct Case {
+    std::string field;
+    nlohmann::json at, past;
+  };
+  const std::vector<Case> cases = {
+      {"id", std::string(limits.max_id_bytes, 'i'), std::string(limits.max_id_bytes + 1, 'i')},
+      {"topic", std::string(limits.max_topic_bytes, 't'), std::string(limits.max_topic_bytes + 1, 't')},
+      {"answer", std::string(limits.max_answer_bytes, 'a'), std::string(limits.max_answer_bytes + 1, 'a')},
+      {"keywords", numbered("k", limits.max_keywords), numbered("k", limits.max_keywords + 1)},
+      {"keywords", std::vector<std::string>{std::string(limits.max_keyword_bytes, 'k')},
+       std::vector<std::string>{std::string(limits.max_keyword_bytes + 1, 'k')}},
+      {"questions", numbered("Q", limits.max_questions), numbered("Q", limits.max_questions + 1)},
+      {"questions", std::vector<std::string>{std::string(limits.max_question_bytes, 'q')},
+       std::vector<std::string>{std::string(limits.max_question_bytes + 1, 'q')}},
+  };
+  for (const Case& c : cases) {
+    INFO(c.field);
+    nlohmann::json e = entry();
+    e[c.field] = c.at;
+    JsonAnswer r = json_command(server, watch, {{"op", "rkms.add"}, {"entry", e}});
+    CHECK(r.status == 200);
+    e = entry();
+    e[c.field] = c.past;
+    r = json_command(server, watch, {{"op", "rkms.add"}, {"entry", e}});
+    CHECK(r.status == 400);
+    CHECK_THAT(r.body["errors"][0]["field"].get<std::string>(), Catch::StartsWith(c.field));
+  }
+  // The action's limit (what an action says is the planner's to judge).
+  nlohmann::json e = entry();
+  e["action"] = std::string(limits.max_action_bytes + 1, 'a');
+  JsonAnswer r = json_command(server, watch, {{"op", "rkms.add"}, {"entry", e}});
+  CHECK(r.status == 400);
+  CHECK(r.body["errors"][0]["message"] == "action is 501 bytes long; expected at most 500");
+  server.stop();
+}
+
+TEST_CASE("An RKMS entry with U+FFFE is refused at its character; later saves succeed and Jinny's knowledge still loads",
+          "[monitor][robot][rkms][xml]") {
+  Psr2WithHri psr2;
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
+  server.start();
+  const std::string before = file_text(psr2.file);
+  nlohmann::json entry{{"id", "parking"}, {"topic", "the parking"}, {"keywords", {"parking"}}, {"answer", "Behind the hall \xEF\xBF\xBE B."}};
+  JsonAnswer r = json_command(server, watch, {{"op", "rkms.add"}, {"entry", entry}});
+  CHECK(r.status == 400);
+  CHECK(r.body["field"] == "entry.answer");
+  CHECK(r.body["error"] == "field 'entry.answer' of op 'rkms.add': not text: U+FFFE at character 16 (byte 16) is not a character XML allows");
+  CHECK(r.body["errors"][0]["field"] == "answer");
+  entry["answer"] = "Behind the hall \xEF\xBF\xBF B.";
+  CHECK(json_command(server, watch, {{"op", "rkms.add"}, {"entry", entry}}).status == 400);
+  CHECK(file_text(psr2.file) == before);
+  entry["answer"] = "Behind the hall, entrance B.";
+  r = json_command(server, watch, {{"op", "rkms.add"}, {"entry", entry}});
+  CHECK(r.status == 200);
+  const KnowledgeBase reloaded = KnowledgeBase::load(psr2.file);
+  CHECK(reloaded.version() == 2);
+  CHECK(reloaded.find("parking") != nullptr);
+  CHECK(reloaded.entries().size() == 26);
+  server.stop();
+}
+
+namespace {
+
+// An HRI that fails inside an op: what the last-resort catch of RobotMonitor::update() is for.
+class FailingHri final : public HriService {
+ public:
+  explicit FailingHri(const std::filesystem::path& knowledge) : store_(knowledge) {}
+  KnowledgeStore& knowledge_store() override { return store_; }
+  HriReply ask(std::string_view) override { throw std::runtime_error("the recognizer's index is gone"); }
+  SpeechSynthesizer* voice() noexcept override { return nullptr; }
+  HriDisplay display() override { return {}; }
+
+ private:
+  KnowledgeStore store_;
+};
+
+}  // namespace
+
+TEST_CASE("An exception inside an op is answered 500 and logged; the robot's thread goes on", "[monitor][robot][requests]") {
+  Psr2WithHri psr2;
+  FailingHri failing(psr2.file);
+  MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+  RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
+  watch.set_hri(&failing);
+  server.start();
+  const JsonAnswer r = json_command(server, watch, {{"op", "ask"}, {"text", "hello"}});
+  CHECK(r.status == 500);
+  CHECK(r.body["error"] == "the request failed on the robot: the recognizer's index is gone");
+  CHECK(json_command(server, watch, {{"op", "pause"}}).status == 200);
+  CHECK(watch.paused());
   watch.set_hri(nullptr);
   server.stop();
 }

@@ -105,7 +105,9 @@ class KnowledgeBase {
   /// (`file`.lock). Refuses with StaleVersionError, writing nothing, when `file` exists with a
   /// version other than version() (someone saved since this copy was read); a missing file is
   /// version 0. Throws ConfigError when the file on disk cannot be read, std::system_error when
-  /// it cannot be written. On success version() is the new version.
+  /// it cannot be written, std::invalid_argument (naming the entry, the field and the character's
+  /// place, writing nothing) when a text is not one XML can hold (find_xml_text_fault). On success
+  /// version() is the new version.
   void save(const std::filesystem::path& file);
 
  private:

@@ -68,7 +68,9 @@ class RobotMonitor final {
   [[nodiscard]] bool paused() const noexcept;
   void pause(const std::string& reason);
   void resume();
-  /// Places ("P1" or a place's name in any net, "PrCleaning.P1" in one net) where the run pauses when they become marked.
+  /// Places ("P1" or a place's name in any net, "PrCleaning.P1" in one net) where the run pauses
+  /// when they become marked. Throws std::invalid_argument for a place of 0 or more than 256 bytes
+  /// or a 65th breakpoint (the operator's budget, docs/monitor.md "Budgets").
   void set_breakpoint(std::string place, bool on);
   [[nodiscard]] std::vector<std::string> breakpoints() const;
   /// The HRI the RKMS and touch ops reach, when the application builds it after the monitor
