@@ -149,9 +149,9 @@ void Reader::fail(std::uint64_t offset, const std::string& what) const { throw T
 
 void Reader::truncated(std::uint64_t record_offset, const std::string& what) {
   state_ = State::kTruncated;
-  warning_ = name_ + ": truncated at byte " + std::to_string(record_offset) + " (" + what +
-             "): no Footer, so the summary (statistics, chunk and attachment indexes) is lost; every whole "
-             "record before that byte was read";
+  warning_ = name_ + ": truncated at byte " + std::to_string(record_offset) + " (" + what + "): the " +
+             std::to_string(size_ - record_offset) + " bytes from there on are lost, and with no Footer the "
+             "summary (statistics, chunk and attachment indexes); every whole record before that byte was read";
 }
 
 bool Reader::read_exact(std::uint8_t* dst, std::size_t n) {
@@ -164,6 +164,10 @@ bool Reader::next(Record& record) {
   if (in_chunk_) {
     if (next_in_chunk(record)) return true;
     in_chunk_ = false;
+    if (partial_chunk_) {
+      state_ = State::kTruncated;
+      return false;
+    }
   }
   if (pos_ == 0) {
     std::array<std::uint8_t, 8> magic{};
@@ -196,8 +200,25 @@ bool Reader::next(Record& record) {
                  std::to_string(options_.max_record_bytes) + " a record may have (corrupt length?)");
   }
   if (length > size_ - pos_ - kRecordHeaderBytes) {
-    truncated(at, std::string("the ") + op_name + " record there declares " + std::to_string(length) + " bytes, only " +
-                      std::to_string(size_ - pos_ - kRecordHeaderBytes) + " follow");
+    const std::string what = std::string("the ") + op_name + " record there declares " + std::to_string(length) +
+                             " bytes, only " + std::to_string(size_ - pos_ - kRecordHeaderBytes) + " follow";
+    truncated(at, what);
+    if (op == static_cast<std::uint8_t>(Opcode::kChunk)) {
+      // A recorder killed while writing a chunk: the whole records at its start are still there.
+      const std::uint64_t recovered = recover_chunk(at);
+      if (recovered > 0) {
+        warning_ += "; " + std::to_string(recovered) + " whole records were recovered from the start of that Chunk";
+        partial_chunk_ = true;
+        record.opcode = Opcode::kChunk;
+        record.offset = at;
+        record.chunk_offset = 0;
+        record.in_chunk = false;
+        record.body = partial_;
+        ++counts_[Opcode::kChunk];
+        state_ = State::kReading;  // until the recovered records are read
+        return true;
+      }
+    }
     return false;
   }
   body_.resize(static_cast<std::size_t>(length));
@@ -355,6 +376,69 @@ void Reader::load_chunk(const Bytes& body, std::uint64_t offset, Chunk& chunk) {
   chunk_pos_ = 0;
   chunk_file_offset_ = offset;
   in_chunk_ = true;
+}
+
+std::uint64_t Reader::recover_chunk(std::uint64_t offset) {
+  Bytes rest(static_cast<std::size_t>(size_ - pos_ - kRecordHeaderBytes));
+  in_->seekg(static_cast<std::streamoff>(pos_ + kRecordHeaderBytes));
+  if (!read_exact(rest.data(), rest.size())) return 0;
+  Chunk& chunk = partial_;
+  const std::uint8_t* packed = nullptr;
+  std::size_t packed_size = 0;
+  try {
+    Fields f(rest.data(), rest.size(), "Chunk");
+    chunk.message_start_time = f.u64();
+    chunk.message_end_time = f.u64();
+    chunk.uncompressed_size = f.u64();
+    chunk.uncompressed_crc = f.u32();
+    chunk.compression = f.str();
+    chunk.compressed_size = f.u64();
+    packed_size = static_cast<std::size_t>(std::min<std::uint64_t>(chunk.compressed_size, rest.size() - f.pos()));
+    packed = f.need(packed_size, "records");
+  } catch (const std::out_of_range&) {
+    return 0;
+  }
+  if (chunk.uncompressed_size > options_.max_record_bytes) return 0;
+  chunk_.clear();
+  if (chunk.compression.empty()) {
+    chunk_.assign(packed, packed + packed_size);
+  } else if (chunk.compression == "zstd") {
+    // Streamed, so that the cut-off frame gives what it holds.
+    ZSTD_DStream* z = ZSTD_createDStream();
+    chunk_.resize(static_cast<std::size_t>(chunk.uncompressed_size));
+    ZSTD_inBuffer in{packed, packed_size, 0};
+    ZSTD_outBuffer out{chunk_.data(), chunk_.size(), 0};
+    while (in.pos < in.size && out.pos < out.size) {
+      const std::size_t rc = ZSTD_decompressStream(z, &out, &in);
+      if (ZSTD_isError(rc) != 0u) break;
+    }
+    ZSTD_freeDStream(z);
+    chunk_.resize(out.pos);
+  } else if (chunk.compression == "lz4") {
+    LZ4F_dctx* ctx = nullptr;
+    if (LZ4F_isError(LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION)) != 0u) return 0;
+    chunk_.resize(static_cast<std::size_t>(chunk.uncompressed_size));
+    std::size_t dst = chunk_.size();
+    std::size_t src = packed_size;
+    if (LZ4F_isError(LZ4F_decompress(ctx, chunk_.data(), &dst, packed, &src, nullptr)) != 0u) dst = 0;
+    LZ4F_freeDecompressionContext(ctx);
+    chunk_.resize(dst);
+  }
+  // Keep the whole records only.
+  std::size_t end = 0;
+  std::uint64_t whole = 0;
+  while (chunk_.size() - end >= kRecordHeaderBytes) {
+    const std::uint64_t length = le64(chunk_.data() + end + 1);
+    if (length > chunk_.size() - end - kRecordHeaderBytes) break;
+    end += kRecordHeaderBytes + static_cast<std::size_t>(length);
+    ++whole;
+  }
+  chunk_.resize(end);
+  pos_ = size_;
+  chunk_pos_ = 0;
+  chunk_file_offset_ = offset;
+  in_chunk_ = whole > 0;
+  return whole;
 }
 
 bool Reader::next_in_chunk(Record& record) {

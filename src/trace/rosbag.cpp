@@ -49,8 +49,10 @@ std::optional<Storage> storage_of_file(const fs::path& file) {
   return std::nullopt;
 }
 
-BagFiles locate(const fs::path& path) {
-  if (!fs::exists(path)) throw TraceIoError(path.string() + ": no such file or folder");
+BagFiles locate(const fs::path& given) {
+  if (!fs::exists(given)) throw TraceIoError(given.string() + ": no such file or folder");
+  // The bag's metadata.yaml names its folder.
+  const fs::path path = given.filename() == "metadata.yaml" ? given.parent_path() : given;
   BagFiles bag;
   if (!fs::is_directory(path)) {
     const auto storage = storage_of_file(path);
@@ -349,6 +351,7 @@ class Converter {
 
 bool is_rosbag(const fs::path& path) {
   std::error_code ec;
+  if (path.filename() == "metadata.yaml") return fs::is_regular_file(path, ec);
   if (fs::is_directory(path, ec)) {
     if (fs::exists(path / "metadata.yaml", ec)) return true;
     for (const auto& e : fs::directory_iterator(path, ec)) {

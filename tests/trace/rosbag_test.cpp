@@ -561,16 +561,28 @@ TEST_CASE("rosbag: a truncated MCAP (no footer) gives the whole chunks before th
   CHECK(report.messages == 20);  // the talker's only chunk came through
   REQUIRE(report.warnings.size() == 1);
   CHECK_THAT(report.warnings[0], Contains("truncated.mcap: truncated at byte " + std::to_string(second_record)));
-  CHECK_THAT(report.warnings[0], Contains("no Footer, so the summary"));
+  CHECK_THAT(report.warnings[0], Contains("with no Footer the summary"));
 
-  // Cut inside the chunk: nothing is recovered, and the warning says so.
-  bytes.resize(300);
+  // Cut inside the zstd chunk: its one zstd block decodes only whole, so nothing is recovered.
+  bytes.resize(600);
   write_file(cut, bytes);
-  BagImportReport none;
-  (void)read_bag(cut, {}, &none);
-  CHECK(none.messages == 0);
-  REQUIRE(none.warnings.size() == 1);
-  CHECK_THAT(none.warnings[0], Contains("the Chunk record there declares"));
+  BagImportReport part;
+  auto partial = read_bag(cut, {}, &part);
+  CHECK(part.messages == 0);
+  REQUIRE(part.warnings.size() == 1);
+  CHECK_THAT(part.warnings[0], Contains("truncated at byte 45 (the Chunk record there declares 2956 bytes, only 546 "
+                                        "follow): the 555 bytes from there on are lost"));
+
+  // Cut inside an uncompressed chunk: the same, without a decompressor.
+  auto plain = read_file(kBags / "rosbag2-cdr_test-mcap" / "cdr_test_0.mcap");
+  plain.resize(plain.size() / 3);
+  write_file(cut, plain);
+  BagImportReport cdr;
+  (void)read_bag(cut, {}, &cdr);
+  CHECK(cdr.messages > 0);
+  CHECK(cdr.messages < 7);
+  REQUIRE(cdr.warnings.size() == 1);
+  CHECK_THAT(cdr.warnings[0], Contains("whole records were recovered from the start of that Chunk"));
 }
 
 TEST_CASE("rosbag: bad MCAP input is refused with the file and the record offset", "[trace][rosbag]") {

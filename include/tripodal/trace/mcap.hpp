@@ -117,8 +117,9 @@ enum class State { kReading, kEnd, kTruncated };
 /// Reads an MCAP file record by record, expanding chunks (the Chunk record comes first, then its
 /// records with in_chunk set). Checks the magic at both ends, the chunk, data-section, summary and
 /// attachment CRCs (where not 0), every length against the bytes left. A file cut short (a
-/// recorder killed: no footer) ends with state() kTruncated after the last whole record, and
-/// warning() says what is lost. Every refusal throws TraceFormatError naming the file and the
+/// recorder killed: no footer) ends with state() kTruncated after the last whole record — for a
+/// chunk cut short, after the whole records its first bytes decompress to — and warning() says
+/// what is lost. Every refusal throws TraceFormatError naming the file and the
 /// byte offset of the record.
 class Reader final {
  public:
@@ -142,6 +143,7 @@ class Reader final {
   bool read_exact(std::uint8_t* dst, std::size_t n);
   void parse(Opcode op, const Bytes& body, std::uint64_t offset, RecordBody& out) const;
   void load_chunk(const Bytes& body, std::uint64_t offset, Chunk& chunk);
+  std::uint64_t recover_chunk(std::uint64_t offset);  // whole records at the start of a cut chunk
   void check_summary_crc(const Footer& footer, std::uint64_t footer_offset);
   void truncated(std::uint64_t record_offset, const std::string& what);
   [[noreturn]] void fail(std::uint64_t offset, const std::string& what) const;
@@ -159,6 +161,8 @@ class Reader final {
   std::uint64_t chunk_file_offset_ = 0;
   bool in_chunk_ = false;
   bool footer_seen_ = false;
+  bool partial_chunk_ = false;  // the chunk being read was cut short: the file ends after it
+  Chunk partial_;
   State state_ = State::kReading;
   std::string warning_;
   std::map<Opcode, std::uint64_t> counts_;
