@@ -26,6 +26,12 @@ struct Topic {
   std::string name, type, encoding;
 };
 
+std::string fs_absolute(const std::filesystem::path& file) {
+  std::error_code ec;
+  const auto abs = std::filesystem::absolute(file, ec);
+  return ec ? file.string() : abs.string();
+}
+
 std::string text(sqlite3_stmt* s, int col) {
   const auto* p = sqlite3_column_text(s, col);
   return p == nullptr ? std::string() : std::string(reinterpret_cast<const char*>(p),
@@ -38,8 +44,22 @@ void for_each_db3_message(const std::filesystem::path& file, const std::function
                           BagImportReport& report) {
   const std::string name = file.string();
   if (!std::filesystem::is_regular_file(file)) throw TraceIoError(name + ": no such file");
+  // immutable=1: a closed bag is only read, so SQLite takes no locks and writes no -shm/-wal files
+  // beside it (a WAL-mode bag in a read-only folder, or in the source tree, stays untouched).
+  std::string uri = "file:";
+  for (const char c : fs_absolute(file)) {
+    if (c == '%' || c == '?' || c == '#') {
+      static constexpr char kHex[] = "0123456789ABCDEF";
+      uri += '%';
+      uri += kHex[static_cast<unsigned char>(c) >> 4];
+      uri += kHex[static_cast<unsigned char>(c) & 15];
+    } else {
+      uri += c;
+    }
+  }
+  uri += "?immutable=1";
   sqlite3* raw = nullptr;
-  const int rc = sqlite3_open_v2(name.c_str(), &raw, SQLITE_OPEN_READONLY, nullptr);
+  const int rc = sqlite3_open_v2(uri.c_str(), &raw, SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, nullptr);
   Db db(raw);
   if (rc != SQLITE_OK) throw TraceIoError(name + ": cannot open as SQLite3: " + sqlite3_errstr(rc));
   const auto prepare = [&](const char* sql, const std::string& what) {
