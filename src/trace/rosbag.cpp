@@ -5,8 +5,11 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <fstream>
 #include <optional>
@@ -394,6 +397,29 @@ std::unique_ptr<TraceReader> read_bag(const fs::path& path, const BagImportOptio
   }
   if (report != nullptr) *report = std::move(r);
   return std::make_unique<TraceReader>(std::make_unique<std::istringstream>(text->str()), path.string());
+}
+
+TraceSource::TraceSource(const fs::path& path, const BagImportOptions& options) : trace_(path) {
+  if (!is_rosbag(path)) return;
+  static std::atomic<unsigned> counter{0};
+  trace_ = fs::temp_directory_path() /
+           ("tripodal_bag_" + std::to_string(::getpid()) + "_" + std::to_string(counter++) + ".trp");
+  temporary_ = true;
+  try {
+    TraceWriter writer(trace_);
+    report_ = import_rosbag(path, writer, options);
+    writer.close();
+  } catch (...) {
+    std::error_code ec;
+    fs::remove(trace_, ec);
+    throw;
+  }
+}
+
+TraceSource::~TraceSource() {
+  if (!temporary_) return;
+  std::error_code ec;
+  fs::remove(trace_, ec);
 }
 
 // --- Export -------------------------------------------------------------------------------------

@@ -9,6 +9,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -100,6 +101,27 @@ BagImportReport import_rosbag(const std::filesystem::path& path, TraceWriter& ou
 [[nodiscard]] std::unique_ptr<TraceReader> read_bag(const std::filesystem::path& path,
                                                     const BagImportOptions& options = {},
                                                     BagImportReport* report = nullptr);
+
+/// The trace file to open for `path`: `path` itself when it is not a rosbag2 bag; a bag is
+/// converted (with `options`) into a temporary trace file, removed with this object. Lets what
+/// opens a trace by path (BehaviorHarness::load_trace, TraceHardware and so RobotHarness) take a bag.
+class TraceSource final {
+ public:
+  /// Throws as import_rosbag for a bag; nothing for a trace path (opening it reports errors).
+  explicit TraceSource(const std::filesystem::path& path, const BagImportOptions& options = {});
+  ~TraceSource();
+  TraceSource(const TraceSource&) = delete;
+  TraceSource& operator=(const TraceSource&) = delete;
+
+  [[nodiscard]] const std::filesystem::path& trace() const noexcept { return trace_; }
+  /// The conversion report when `path` was a bag.
+  [[nodiscard]] const std::optional<BagImportReport>& bag_report() const noexcept { return report_; }
+
+ private:
+  std::filesystem::path trace_;
+  bool temporary_ = false;
+  std::optional<BagImportReport> report_;
+};
 
 struct McapExportReport {
   std::uint64_t records = 0;   ///< trace records read
