@@ -100,3 +100,4 @@ BENCHMARK(BM_BagToTrace)->Arg(static_cast<int>(mcap::Compression::kNone))->Arg(s
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace
+BENCHMARK_MAIN();
