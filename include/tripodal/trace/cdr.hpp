@@ -10,6 +10,8 @@
 #include <string_view>
 #include <vector>
 
+#include "tripodal/trace/trace_record.hpp"  // TraceFormatError
+
 namespace tripodal::trace {
 
 /// Reads one CDR-encoded message: the 4-byte encapsulation header (CDR_BE 00 00 or CDR_LE 00 01),
