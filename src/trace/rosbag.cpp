@@ -138,6 +138,8 @@ void for_each_mcap_message(const fs::path& file, const std::function<void(const 
       }
       report.topic_types[c->topic] = type;
       channels[c->id] = Topic{c->topic, type, c->message_encoding};
+    } else if (const auto* md = std::get_if<mcap::Metadata>(&record.body)) {
+      for (const auto& [k, v] : md->metadata) report.storage_metadata[md->name + "." + k] = v;
     } else if (auto* m = std::get_if<mcap::Message>(&record.body)) {
       const auto it = channels.find(m->channel_id);
       if (it == channels.end()) {

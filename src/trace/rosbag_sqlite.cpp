@@ -85,6 +85,15 @@ void for_each_db3_message(const std::filesystem::path& file, const std::function
     }
   }
 
+  // Newer bags (rosbag2 schema 3 and later) say which ROS release wrote them.
+  if (tables.count("schema") != 0) {
+    Stmt s = prepare("SELECT schema_version, ros_distro FROM schema", "table schema");
+    if (sqlite3_step(s.get()) == SQLITE_ROW) {
+      report.storage_metadata["schema_version"] = text(s.get(), 0);
+      report.storage_metadata["ros_distro"] = text(s.get(), 1);
+    }
+  }
+
   std::map<std::int64_t, Topic> topics;
   {
     Stmt s = prepare("SELECT id, name, type, serialization_format FROM topics", "table topics");

@@ -221,6 +221,14 @@ TEST_CASE("rosbag: the talker MCAP bag (zstd chunks, Go writer): every message c
   CHECK(report.skipped_unsupported.at("rcl_interfaces/msg/Log") == 10);
   CHECK(report.records_written == 10);
   CHECK(report.mcap_records.at(mcap::Opcode::kChunk) >= 1);
+  // Header, a zstd chunk (3 schemas, 3 channels, 20 messages), 2 message indexes, DataEnd, and the
+  // summary: 3 schemas, 3 channels, statistics, a chunk index, 4 summary offsets; then the footer.
+  CHECK(report.mcap_records.at(mcap::Opcode::kChunk) == 1);
+  CHECK(report.mcap_records.at(mcap::Opcode::kMessage) == 20);
+  CHECK(report.mcap_records.at(mcap::Opcode::kMessageIndex) == 2);
+  CHECK(report.mcap_records.at(mcap::Opcode::kSchema) == 6);
+  CHECK(report.mcap_records.at(mcap::Opcode::kSummaryOffset) == 4);
+  CHECK(report.mcap_records.at(mcap::Opcode::kFooter) == 1);
   CHECK(report.warnings.empty());
   const auto records = all_records(*reader);
   REQUIRE(records.size() == 10);
@@ -401,6 +409,7 @@ fs::path sensor_bag() {
   grid.data = {0, 100, -1, 0, 50, 0};
   w.write(add("/map", "nav_msgs/msg/OccupancyGrid"), 17'000'000'000, 0, ros::encode_cdr(grid));
   w.write(add("/note", "std_msgs/msg/String"), 18'000'000'000, 0, encode_cdr_string("docked"));
+  w.write_metadata("rosbag2", {{"ros_distro", "jazzy"}});
   w.close();
   return path;
 }
@@ -410,6 +419,7 @@ TEST_CASE("rosbag: a synthetic sensor bag converts each supported type field by 
   BagImportReport report;
   auto reader = read_bag(sensor_bag(), {}, &report);
   CHECK(report.messages == 9);
+  CHECK(report.storage_metadata.at("rosbag2.ros_distro") == "jazzy");
   CHECK(report.skipped_no_channel_kind.at("sensor_msgs/msg/JointState") == 1);
   CHECK(report.skipped_no_channel_kind.at("rosgraph_msgs/msg/Clock") == 1);
   CHECK(report.skipped_no_channel_kind.at("nav_msgs/msg/OccupancyGrid") == 1);
@@ -697,4 +707,10 @@ TEST_CASE("rosbag: a db3 without table messages is refused naming the file and t
   const fs::path junk = scratch("junk.db3");
   write_file(junk, std::vector<std::uint8_t>(100, 'x'));
   CHECK_THROWS_AS(read_bag(junk), BagFormatError);
+
+  // The talker's table schema says which ROS release wrote it (schema 4, rolling).
+  BagImportReport report;
+  (void)read_bag(kBags / "rosbag2-talker-db3", {}, &report);
+  CHECK(report.storage_metadata.at("ros_distro") == "rolling");
+  CHECK(report.storage_metadata.at("schema_version") == "4");
 }

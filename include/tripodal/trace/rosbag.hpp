@@ -62,6 +62,9 @@ struct BagImportReport {
   std::map<std::string, std::uint64_t> skipped_unmapped;  ///< topic -> messages (only_mapped)
   std::uint64_t tf_transforms_skipped = 0;  ///< /tf transforms other than parent -> child
   std::map<mcap::Opcode, std::uint64_t> mcap_records;  ///< MCAP records read, by opcode
+  /// What the storage says of itself: MCAP Metadata records as "NAME.KEY" (rosbag2 writes one
+  /// named "rosbag2"), the db3 table schema (where present) as "schema_version" and "ros_distro".
+  std::map<std::string, std::string> storage_metadata;
   /// Files cut short (no MCAP footer): what was recovered and what is lost.
   std::vector<std::string> warnings;
 };
