@@ -282,7 +282,7 @@ void Reader::check_summary_crc(const Footer& footer, std::uint64_t footer_offset
   std::uint32_t crc = 0;
   in_->clear();
   in_->seekg(static_cast<std::streamoff>(start));
-  std::vector<std::uint8_t> block(64 * 1024);
+  std::vector<std::uint8_t> block(std::size_t{64} * 1024);
   for (std::uint64_t left = end - start; left > 0;) {
     const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(left, block.size()));
     if (!read_exact(block.data(), n)) throw TraceIoError(name_ + ": read error in the summary");

@@ -79,6 +79,7 @@ int trace_import(const ImportArgs& args, std::ostream& out, std::ostream& err) {
 // ---------------------------------------------------------------------------------------------
 constexpr std::string_view kInfoDescription =
     "Prints the format version, duration, channels and the number of records of each kind.\n"
+    "FILE may be a rosbag2 bag: it is read as the trace it converts to (docs/rosbag.md).\n"
     "A trace cut inside a record (recorder killed) is summarised up to its last whole record\n"
     "with a warning (exit 0); a corrupt trace is an error naming the byte offset (exit 1).";
 
@@ -97,12 +98,19 @@ constexpr std::string_view kind_label(ChannelKind kind) {
   return "unknown";
 }
 
+// A rosbag2 bag is read as the trace it converts to (default topic mapping, docs/rosbag.md).
 int with_reader(const std::string& path, std::ostream& err, const std::function<int(TraceReader&)>& body) {
   try {
-    TraceReader reader(path);
-    const int rc = body(reader);
-    if (reader.state() == ReadState::kTruncated) err << "warning: " << reader.warning() << '\n';
+    BagImportReport bag;
+    const bool is_bag = is_rosbag(path);
+    const auto reader = is_bag ? read_bag(path, {}, &bag) : std::make_unique<TraceReader>(path);
+    const int rc = body(*reader);
+    if (reader->state() == ReadState::kTruncated) err << "warning: " << reader->warning() << '\n';
+    for (const auto& w : bag.warnings) err << "warning: " << w << '\n';
     return rc;
+  } catch (const BagFormatError& e) {
+    err << "error: " << e.what() << '\n';
+    return kBadInput;
   } catch (const TraceFormatError& e) {
     err << "error: " << e.what() << '\n';
     return kBadInput;
@@ -288,7 +296,8 @@ int trace_convert(const ConvertArgs& args, std::ostream& out, std::ostream& err)
     err << "tripodal trace convert: " << args.in.string() << ": no such file or folder\n";
     return kIoError;
   }
-  if (args.out.extension() == ".mcap" && !is_rosbag(args.in)) return convert_trace_to_mcap(args, out, err);
+  // To MCAP: a trace, or a bag read as the trace it converts to (its supported topics re-encoded).
+  if (args.out.extension() == ".mcap") return convert_trace_to_mcap(args, out, err);
   BagImportOptions options;
   options.only_mapped = args.only_mapped;
   options.use_header_stamp = args.header_stamps;
@@ -360,13 +369,13 @@ cli::Action setup_import(CLI::App& cmd) {
 
 cli::Action setup_info(CLI::App& cmd) {
   auto file = std::make_shared<std::string>();
-  cmd.add_option("FILE", *file, "the trace")->required();
+  cmd.add_option("FILE", *file, "the trace (or a rosbag2 bag)")->required();
   return [file](std::ostream& out, std::ostream& err) { return trace_info(*file, out, err); };
 }
 
 cli::Action setup_dump(CLI::App& cmd) {
   auto a = std::make_shared<DumpArgs>();
-  cmd.add_option("FILE", a->file, "the trace")->required();
+  cmd.add_option("FILE", a->file, "the trace (or a rosbag2 bag)")->required();
   cmd.add_option("--limit", a->limit, "N: stop after N records (0: all)")->capture_default_str();
   cmd.add_option("--beams", a->beams, "K: the first K ranges of each scan (0: all)")->capture_default_str();
   return [a](std::ostream& out, std::ostream& err) { return trace_dump(*a, out, err); };
