@@ -177,15 +177,15 @@ std::string canonical_type(const std::string& type) {
 enum class Handler { kLaser, kOdometry, kImu, kTwist, kTwistStamped, kString, kTf, kJointState, kClock, kOccupancyGrid };
 
 std::optional<Handler> handler_of(const std::string& type) {
-  static const std::map<std::string, Handler> kTypes = {
+  static const std::map<std::string, Handler> types = {
       {"sensor_msgs/msg/LaserScan", Handler::kLaser},        {"nav_msgs/msg/Odometry", Handler::kOdometry},
       {"sensor_msgs/msg/Imu", Handler::kImu},                {"geometry_msgs/msg/Twist", Handler::kTwist},
       {"geometry_msgs/msg/TwistStamped", Handler::kTwistStamped}, {"std_msgs/msg/String", Handler::kString},
       {"tf2_msgs/msg/TFMessage", Handler::kTf},              {"sensor_msgs/msg/JointState", Handler::kJointState},
       {"rosgraph_msgs/msg/Clock", Handler::kClock},          {"nav_msgs/msg/OccupancyGrid", Handler::kOccupancyGrid},
   };
-  const auto it = kTypes.find(canonical_type(type));
-  if (it == kTypes.end()) return std::nullopt;
+  const auto it = types.find(canonical_type(type));
+  if (it == types.end()) return std::nullopt;
   return it->second;
 }
 
@@ -427,33 +427,33 @@ TraceSource::~TraceSource() {
 // --- Export -------------------------------------------------------------------------------------
 
 std::string ros2msg_definition(const std::string& type) {
-  static const std::string kSep = "\n================================================================================\n";
-  static const std::string kHeader = "MSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id";
-  static const std::string kTime = "MSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec";
-  static const std::string kVector3 = "MSG: geometry_msgs/Vector3\nfloat64 x\nfloat64 y\nfloat64 z";
-  static const std::string kQuaternion =
+  static const std::string sep = "\n================================================================================\n";
+  static const std::string header_def = "MSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id";
+  static const std::string time_def = "MSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec";
+  static const std::string vector3_def = "MSG: geometry_msgs/Vector3\nfloat64 x\nfloat64 y\nfloat64 z";
+  static const std::string quaternion_def =
       "MSG: geometry_msgs/Quaternion\nfloat64 x 0\nfloat64 y 0\nfloat64 z 0\nfloat64 w 1";
-  static const std::string kTwist = "MSG: geometry_msgs/Twist\nVector3 linear\nVector3 angular";
+  static const std::string twist_def = "MSG: geometry_msgs/Twist\nVector3 linear\nVector3 angular";
   if (type == "sensor_msgs/msg/LaserScan") {
     return "std_msgs/Header header\nfloat32 angle_min\nfloat32 angle_max\nfloat32 angle_increment\n"
            "float32 time_increment\nfloat32 scan_time\nfloat32 range_min\nfloat32 range_max\nfloat32[] ranges\n"
-           "float32[] intensities" + kSep + kHeader + kSep + kTime;
+           "float32[] intensities" + sep + header_def + sep + time_def;
   }
   if (type == "nav_msgs/msg/Odometry") {
     return "std_msgs/Header header\nstring child_frame_id\ngeometry_msgs/PoseWithCovariance pose\n"
-           "geometry_msgs/TwistWithCovariance twist" + kSep + kHeader + kSep + kTime + kSep +
-           "MSG: geometry_msgs/PoseWithCovariance\nPose pose\nfloat64[36] covariance" + kSep +
-           "MSG: geometry_msgs/Pose\nPoint position\nQuaternion orientation" + kSep +
-           "MSG: geometry_msgs/Point\nfloat64 x\nfloat64 y\nfloat64 z" + kSep + kQuaternion + kSep +
-           "MSG: geometry_msgs/TwistWithCovariance\nTwist twist\nfloat64[36] covariance" + kSep + kTwist + kSep + kVector3;
+           "geometry_msgs/TwistWithCovariance twist" + sep + header_def + sep + time_def + sep +
+           "MSG: geometry_msgs/PoseWithCovariance\nPose pose\nfloat64[36] covariance" + sep +
+           "MSG: geometry_msgs/Pose\nPoint position\nQuaternion orientation" + sep +
+           "MSG: geometry_msgs/Point\nfloat64 x\nfloat64 y\nfloat64 z" + sep + quaternion_def + sep +
+           "MSG: geometry_msgs/TwistWithCovariance\nTwist twist\nfloat64[36] covariance" + sep + twist_def + sep + vector3_def;
   }
   if (type == "sensor_msgs/msg/Imu") {
     return "std_msgs/Header header\ngeometry_msgs/Quaternion orientation\nfloat64[9] orientation_covariance\n"
            "geometry_msgs/Vector3 angular_velocity\nfloat64[9] angular_velocity_covariance\n"
-           "geometry_msgs/Vector3 linear_acceleration\nfloat64[9] linear_acceleration_covariance" + kSep + kHeader +
-           kSep + kTime + kSep + kQuaternion + kSep + kVector3;
+           "geometry_msgs/Vector3 linear_acceleration\nfloat64[9] linear_acceleration_covariance" + sep + header_def +
+           sep + time_def + sep + quaternion_def + sep + vector3_def;
   }
-  if (type == "geometry_msgs/msg/Twist") return "Vector3 linear\nVector3 angular" + kSep + kVector3;
+  if (type == "geometry_msgs/msg/Twist") return "Vector3 linear\nVector3 angular" + sep + vector3_def;
   if (type == "std_msgs/msg/String") return "string data";
   throw std::invalid_argument("ros2msg_definition: no definition for '" + type + "'");
 }
