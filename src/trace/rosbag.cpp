@@ -472,7 +472,7 @@ McapExportReport export_trace_to_mcap(TraceReader& in, mcap::Writer& out) {
   };
   const auto header = [](Time t, const std::string& frame) {
     ros::Header h;
-    const std::int64_t ns = to_ns(t);
+    const std::int64_t ns = std::max<std::int64_t>(0, to_ns(t));  // a ROS stamp is not before 1970
     h.stamp.sec = static_cast<std::int32_t>(ns / 1'000'000'000);
     h.stamp.nanosec = static_cast<std::uint32_t>(ns % 1'000'000'000);
     h.frame_id = frame;
