@@ -21,6 +21,7 @@ packages=(
   catch2 libbenchmark-dev
   graphviz libxml2-utils
   zlib1g-dev
+  libzstd-dev liblz4-dev libsqlite3-dev  # rosbag2 bags: MCAP chunks and .db3 storage (docs/rosbag.md)
   libpng-dev  # tripodal-coverage-eval reads the ipa floor plans (docs/coverage.md)
 )
 # The monitor: Graphviz's library lays out the nets it draws (src/monitor/net_drawing.cpp); its

@@ -233,7 +233,8 @@ void BehaviorHarness::load_trace(const std::filesystem::path& trace_path) {
   if (replay_) throw std::logic_error("BehaviorHarness: a trace is already loaded");
   // First pass: the channel declarations (resources must exist before behaviors activate) and the
   // last stamp (where the run ends). Streams: nothing is kept but the channels.
-  trace::TraceSummary summary = trace::summarize_trace(trace_path);
+  auto source = std::make_unique<trace::TraceSource>(trace_path);
+  trace::TraceSummary summary = trace::summarize_trace(source->trace());
   warning_ = summary.warning;
   const auto& channels = summary.channels;
   // Checked before any resource exists, so a failed load leaves the harness as it was.
@@ -250,7 +251,8 @@ void BehaviorHarness::load_trace(const std::filesystem::path& trace_path) {
   sink_->add_to(table_);
   laser_ = options_.laser.empty() ? table_.first<LaserScan>() : table_.find<LaserScan>(options_.laser);
   if (!options_.localization_channel.empty()) localization_ = table_.find<OdometryReading>(options_.localization_channel);
-  replay_ = std::make_unique<trace::TraceReplay>(std::make_unique<trace::TraceReader>(trace_path));
+  replay_ = std::make_unique<trace::TraceReplay>(std::make_unique<trace::TraceReader>(source->trace()));
+  source_ = std::move(source);
   start_ = replay_->start_time();
   now_ = start_;
   last_record_ = summary.empty ? start_ : summary.last;

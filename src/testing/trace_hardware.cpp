@@ -19,7 +19,8 @@ std::size_t wheel_count_of(const ControllerConfig& base) noexcept {
 TraceHardware::TraceHardware(TraceHardwareOptions options, const ControllerConfig& base, ModuleManifest manifest)
     : options_(std::move(options)),
       manifest_(std::move(manifest)),
-      summary_(trace::summarize_trace(options_.trace)),
+      source_(options_.trace),
+      summary_(trace::summarize_trace(source_.trace())),
       resources_(summary_.channels, options_.resource_max_age, options_.skip),
       wheels_(wheel_count_of(base), base.period) {
   if (!options_.localization_channel.empty() &&
@@ -27,7 +28,7 @@ TraceHardware::TraceHardware(TraceHardwareOptions options, const ControllerConfi
     throw std::invalid_argument("hardware 'trace': " + options_.trace.string() + " has no odometry channel '" +
                                 options_.localization_channel + "' for the localization");
   }
-  replay_ = std::make_unique<trace::TraceReplay>(std::make_unique<trace::TraceReader>(options_.trace));
+  replay_ = std::make_unique<trace::TraceReplay>(std::make_unique<trace::TraceReader>(source_.trace()));
 }
 
 std::optional<Pose2D> TraceHardware::recorded_pose(Time t) const {

@@ -11,6 +11,8 @@
 #include "tripodal/behaviors/builtin_behaviors.hpp"
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/trace/carmen_import.hpp"
+#include "tripodal/trace/cdr.hpp"
+#include "tripodal/trace/mcap.hpp"
 #include "tripodal/trace/trace_reader.hpp"
 #include "tripodal/trace/trace_writer.hpp"
 
@@ -313,4 +315,40 @@ TEST_CASE("harness: resource_max_age makes sparse scans go stale, and BhAvoidObs
   CHECK(moving > 0);
   CHECK(moving <= 30u * 11u);
   CHECK(run.never_drives_toward_obstacle_closer_than(0.7));
+}
+
+TEST_CASE("harness: a rosbag2 bag loads where a trace does (converted with the default topic mapping)",
+          "[testing][harness][rosbag]") {
+  TempFile bag{"harness_bag"};  // no extension: the MCAP magic tells
+  {
+    trace::mcap::Writer w(bag.path());
+    const auto scan_ch = w.add_channel("/scan", "cdr", w.add_schema("sensor_msgs/msg/LaserScan", "ros2msg", ""));
+    const auto odom_ch = w.add_channel("/odom", "cdr", w.add_schema("nav_msgs/msg/Odometry", "ros2msg", ""));
+    trace::ros::LaserScan scan;
+    scan.angle_min = -1.5f;
+    scan.angle_max = 1.5f;
+    scan.angle_increment = 0.1f;
+    scan.range_max = 10.0f;
+    scan.ranges.assign(31, 0.6f);  // a wall 0.6 m away all round
+    trace::ros::Odometry odom;
+    for (int i = 0; i <= 10; ++i) {
+      const std::int64_t ns = 1'000'000'000 + i * 100'000'000LL;
+      scan.header.stamp = {static_cast<std::int32_t>(ns / 1'000'000'000), static_cast<std::uint32_t>(ns % 1'000'000'000)};
+      odom.header.stamp = scan.header.stamp;
+      w.write(scan_ch, static_cast<std::uint64_t>(ns), 0, trace::ros::encode_cdr(scan));
+      w.write(odom_ch, static_cast<std::uint64_t>(ns), 0, trace::ros::encode_cdr(odom));
+    }
+    w.close();
+  }
+  BehaviorHarness h;
+  h.load_trace(bag.path());
+  REQUIRE(h.resources().find<LaserScan>("laser") != nullptr);
+  REQUIRE(h.resources().find<OdometryReading>("odometry") != nullptr);
+  h.attach(std::make_unique<test::BhBlindCruise>(), {{"speed_m_s", Value{0.6}}}, normal(1));
+  h.attach(std::make_unique<BhAvoidObstacle>(), avoid_params(), safety());
+  const RunLog& run = h.run();
+  CHECK(to_seconds(h.start_time()) == Approx(1.0));
+  CHECK(run.steps().size() == 22);  // 1.0 s to 2.0 s at 20 Hz, plus one period
+  // The wall is inside the stop distance: the safety behavior holds the robot still throughout.
+  for (const auto& step : run.steps()) CHECK(step.command.vx_m_s <= 0.0);
 }

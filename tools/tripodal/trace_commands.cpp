@@ -1,4 +1,5 @@
-// `tripodal trace import|info|dump`: convert CARMEN logs to tripodal traces and inspect traces.
+// `tripodal trace import|convert|info|dump`: convert CARMEN logs and rosbag2 bags to tripodal traces
+// (and traces to MCAP bags), inspect traces.
 #include <algorithm>
 #include <filesystem>
 #include <functional>
@@ -9,6 +10,7 @@
 #include "cli_tool.hpp"
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/trace/carmen_import.hpp"
+#include "tripodal/trace/rosbag.hpp"
 #include "tripodal/trace/trace_reader.hpp"
 
 namespace tripodal::tool {
@@ -77,6 +79,7 @@ int trace_import(const ImportArgs& args, std::ostream& out, std::ostream& err) {
 // ---------------------------------------------------------------------------------------------
 constexpr std::string_view kInfoDescription =
     "Prints the format version, duration, channels and the number of records of each kind.\n"
+    "FILE may be a rosbag2 bag: it is read as the trace it converts to (docs/rosbag.md).\n"
     "A trace cut inside a record (recorder killed) is summarised up to its last whole record\n"
     "with a warning (exit 0); a corrupt trace is an error naming the byte offset (exit 1).";
 
@@ -95,12 +98,19 @@ constexpr std::string_view kind_label(ChannelKind kind) {
   return "unknown";
 }
 
+// A rosbag2 bag is read as the trace it converts to (default topic mapping, docs/rosbag.md).
 int with_reader(const std::string& path, std::ostream& err, const std::function<int(TraceReader&)>& body) {
   try {
-    TraceReader reader(path);
-    const int rc = body(reader);
-    if (reader.state() == ReadState::kTruncated) err << "warning: " << reader.warning() << '\n';
+    BagImportReport bag;
+    const bool is_bag = is_rosbag(path);
+    const auto reader = is_bag ? read_bag(path, {}, &bag) : std::make_unique<TraceReader>(path);
+    const int rc = body(*reader);
+    if (reader->state() == ReadState::kTruncated) err << "warning: " << reader->warning() << '\n';
+    for (const auto& w : bag.warnings) err << "warning: " << w << '\n';
     return rc;
+  } catch (const BagFormatError& e) {
+    err << "error: " << e.what() << '\n';
+    return kBadInput;
   } catch (const TraceFormatError& e) {
     err << "error: " << e.what() << '\n';
     return kBadInput;
@@ -242,6 +252,109 @@ int trace_dump(const DumpArgs& args, std::ostream& out, std::ostream& err) {
   });
 }
 
+// ---------------------------------------------------------------------------------------------
+constexpr std::string_view kConvertDescription =
+    "Converts a rosbag2 bag (a folder with metadata.yaml, or an .mcap or .db3 file) to a tripodal\n"
+    "trace, or a trace to an MCAP bag file when OUT ends in .mcap (docs/rosbag.md).\n"
+    "Topics become channels: /scan -> laser, /odom -> odometry, /imu -> imu, /cmd_vel -> cmd_vel,\n"
+    "/tf -> tf (the odom -> base_link transform); --topic /my_scan=front_laser adds or overrides one;\n"
+    "other supported topics are named after the topic unless --only-mapped. Messages of types not\n"
+    "decoded are skipped and counted per type. A bad bag is an error naming the file and the\n"
+    "record's byte offset (or db3 row) and OUT is removed (exit 1).";
+
+struct ConvertArgs {
+  std::filesystem::path in, out;
+  std::vector<std::string> topics;
+  bool only_mapped = false;
+  bool header_stamps = true;
+  std::string compression = "zstd";
+};
+
+int convert_trace_to_mcap(const ConvertArgs& args, std::ostream& out, std::ostream& err) {
+  mcap::WriterOptions options;
+  options.compression = args.compression == "none" ? mcap::Compression::kNone : mcap::Compression::kZstd;
+  McapExportReport report;
+  const int rc = with_reader(args.in.string(), err, [&](TraceReader& r) {
+    mcap::Writer writer(args.out, options);
+    report = export_trace_to_mcap(r, writer);
+    return static_cast<int>(kOk);
+  });
+  if (rc != kOk) {
+    std::error_code ec;
+    std::filesystem::remove(args.out, ec);
+    return rc;
+  }
+  out << "converted " << args.in.string() << " -> " << args.out.string() << '\n'
+      << "records: " << report.records << '\n'
+      << "messages: " << report.messages << '\n';
+  for (const auto& [kind, n] : report.skipped) out << "skipped " << kind << " (no ROS message here): " << n << '\n';
+  return kOk;
+}
+
+int trace_convert(const ConvertArgs& args, std::ostream& out, std::ostream& err) {
+  if (!std::filesystem::exists(args.in)) {
+    err << "tripodal trace convert: " << args.in.string() << ": no such file or folder\n";
+    return kIoError;
+  }
+  // To MCAP: a trace, or a bag read as the trace it converts to (its supported topics re-encoded).
+  if (args.out.extension() == ".mcap") return convert_trace_to_mcap(args, out, err);
+  BagImportOptions options;
+  options.only_mapped = args.only_mapped;
+  options.use_header_stamp = args.header_stamps;
+  for (const auto& t : args.topics) {
+    const auto eq = t.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == t.size()) {
+      err << "tripodal trace convert: --topic " << t << ": expected TOPIC=CHANNEL, e.g. /my_scan=laser\n";
+      return kUsage;
+    }
+    options.topic_channels[t.substr(0, eq)] = t.substr(eq + 1);
+  }
+  BagImportReport report;
+  const auto failed = [&](const std::string& what, int rc) {
+    err << "error: " << what << '\n';
+    std::error_code ec;
+    std::filesystem::remove(args.out, ec);
+    return rc;
+  };
+  try {
+    TraceWriter writer(args.out);
+    report = import_rosbag(args.in, writer, options);
+    writer.close();
+  } catch (const TraceFormatError& e) {
+    return failed(e.what(), kBadInput);
+  } catch (const BagFormatError& e) {
+    return failed(e.what(), kBadInput);
+  } catch (const TraceIoError& e) {
+    return failed(e.what(), kIoError);
+  }
+  out << "converted " << args.in.string() << " (" << report.storage << ") -> " << args.out.string() << '\n'
+      << "messages: " << report.messages << '\n';
+  for (const auto& [topic, n] : report.topic_messages) {
+    out << "  " << topic << " (" << report.topic_types[topic] << "): " << n << '\n';
+  }
+  out << "records: " << report.records_written << '\n';
+  for (const auto& [type, n] : report.converted) out << "converted " << type << ": " << n << '\n';
+  for (const auto& [type, n] : report.skipped_unsupported) out << "skipped unsupported " << type << ": " << n << '\n';
+  for (const auto& [type, n] : report.skipped_no_channel_kind) out << "skipped, no channel kind " << type << ": " << n << '\n';
+  for (const auto& [topic, n] : report.skipped_unmapped) out << "skipped unmapped " << topic << ": " << n << '\n';
+  if (report.tf_transforms_skipped > 0) out << "tf transforms skipped: " << report.tf_transforms_skipped << '\n';
+  for (const auto& w : report.warnings) err << "warning: " << w << '\n';
+  return kOk;
+}
+
+cli::Action setup_convert(CLI::App& cmd) {
+  auto a = std::make_shared<ConvertArgs>();
+  cmd.add_option("IN", a->in, "the bag (folder, .mcap or .db3), or a trace to write as MCAP")->required();
+  cmd.add_option("--out", a->out, "OUT: the trace to write (or an .mcap file)")->required();
+  cmd.add_option("--topic", a->topics, "TOPIC=CHANNEL: the trace channel of a topic (repeatable)");
+  cmd.add_flag("--only-mapped", a->only_mapped, "convert only the topics --topic and the defaults name");
+  cmd.add_flag("!--receive-stamps", a->header_stamps, "stamp records with the bag's receive time, not the header's");
+  cmd.add_option("--compression", a->compression, "zstd|none: MCAP chunks, when writing .mcap")
+      ->check(CLI::IsMember({"zstd", "none"}))
+      ->capture_default_str();
+  return [a](std::ostream& out, std::ostream& err) { return trace_convert(*a, out, err); };
+}
+
 cli::Action setup_import(CLI::App& cmd) {
   auto a = std::make_shared<ImportArgs>();
   cmd.add_option("LOG", a->log, "the CARMEN log (.log or .log.gz)")->required();
@@ -256,13 +369,13 @@ cli::Action setup_import(CLI::App& cmd) {
 
 cli::Action setup_info(CLI::App& cmd) {
   auto file = std::make_shared<std::string>();
-  cmd.add_option("FILE", *file, "the trace")->required();
+  cmd.add_option("FILE", *file, "the trace (or a rosbag2 bag)")->required();
   return [file](std::ostream& out, std::ostream& err) { return trace_info(*file, out, err); };
 }
 
 cli::Action setup_dump(CLI::App& cmd) {
   auto a = std::make_shared<DumpArgs>();
-  cmd.add_option("FILE", a->file, "the trace")->required();
+  cmd.add_option("FILE", a->file, "the trace (or a rosbag2 bag)")->required();
   cmd.add_option("--limit", a->limit, "N: stop after N records (0: all)")->capture_default_str();
   cmd.add_option("--beams", a->beams, "K: the first K ranges of each scan (0: all)")->capture_default_str();
   return [a](std::ostream& out, std::ostream& err) { return trace_dump(*a, out, err); };
@@ -272,6 +385,8 @@ cli::Action setup_dump(CLI::App& cmd) {
 
 TRIPODAL_CLI_COMMAND("trace", "import", "convert a CARMEN log (.log or .log.gz) to a tripodal trace", kImportDescription,
                      kExitCodes, &setup_import);
+TRIPODAL_CLI_COMMAND("trace", "convert", "convert a rosbag2 bag (MCAP or db3) to a trace, or a trace to MCAP",
+                     kConvertDescription, kExitCodes, &setup_convert);
 TRIPODAL_CLI_COMMAND("trace", "info", "duration, channels and record counts of a trace", kInfoDescription, kExitCodes,
                      &setup_info);
 TRIPODAL_CLI_COMMAND("trace", "dump", "print a trace's records, one per line", kDumpDescription, kExitCodes, &setup_dump);

@@ -18,6 +18,7 @@
 #include "tripodal/core/manifest.hpp"
 #include "tripodal/core/time.hpp"
 #include "tripodal/resources/resource.hpp"
+#include "tripodal/trace/rosbag.hpp"
 #include "tripodal/trace/trace_replay.hpp"
 
 namespace tripodal::testing {
@@ -146,8 +147,9 @@ class BehaviorHarness final {
   BehaviorHarness& operator=(const BehaviorHarness&) = delete;
 
   /// Opens `trace` and creates one resource per sensor channel (a first pass over the file reads
-  /// the channel declarations). Throws trace::TraceIoError / trace::TraceFormatError (with the
-  /// byte offset). Must precede attach().
+  /// the channel declarations). A rosbag2 bag (folder, .mcap or .db3) is converted first with the
+  /// default topic mapping (docs/rosbag.md). Throws trace::TraceIoError / trace::TraceFormatError
+  /// (with the byte offset), trace::BagFormatError. Must precede attach().
   void load_trace(const std::filesystem::path& trace);
 
   /// Attaches a behavior, activated with `params` at the first step (ConfigError then names
@@ -182,6 +184,7 @@ class BehaviorHarness final {
   HarnessOptions options_;
   ResourceTable table_;
   NavigationData navi_;
+  std::unique_ptr<trace::TraceSource> source_;  // before replay_: the replay reads its file
   std::unique_ptr<trace::TraceReplay> replay_;
   std::unique_ptr<Sink> sink_;
   std::unique_ptr<CBehaviorCoordinator> coordinator_;

@@ -15,13 +15,14 @@
 #include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/navi/localizer.hpp"
 #include "tripodal/sim/world.hpp"
+#include "tripodal/trace/rosbag.hpp"
 #include "tripodal/trace/trace_replay.hpp"
 #include "tripodal/trace/trace_resources.hpp"
 
 namespace tripodal::testing {
 
 struct TraceHardwareOptions {
-  std::filesystem::path trace;
+  std::filesystem::path trace;  ///< a trace, or a rosbag2 bag (converted with the default topic mapping)
   /// An odometry channel of map_from_base poses (the recorded robot's true or corrected pose) the
   /// localizer reads as ground truth; empty: none (a robot with a Localizer then stays lost).
   std::string localization_channel;
@@ -62,6 +63,7 @@ class TraceHardware final : public CHardware, public navi::GroundTruthSource, pu
  private:
   TraceHardwareOptions options_;
   ModuleManifest manifest_;
+  trace::TraceSource source_;  // the trace file (a bag converted): before summary_, which reads it
   trace::TraceSummary summary_;
   trace::TraceResources resources_;
   std::unique_ptr<trace::TraceReplay> replay_;
