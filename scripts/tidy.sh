@@ -6,8 +6,9 @@
 #   scripts/tidy.sh                 every translation unit (about 150; 30-60 min of CPU: clang-tidy
 #                                   walks the whole AST of each, the standard library's included)
 #   scripts/tidy.sh --since REV     only those that differ from REV: a changed source, or one that
-#                                   includes (directly or not) a changed header; every unit when
-#                                   .clang-tidy, a CMakeLists.txt or cmake/ changed, or REV is not an
+#                                   includes (directly or not) a changed header, or one whose
+#                                   compile command differs from REV's (.ci/tidy-flags.json); every
+#                                   unit when .clang-tidy or cmake/ changed, or REV is not an
 #                                   ancestor of HEAD. CI passes the commit of .ci/tidy-clean, the
 #                                   last one whose whole tree was clean (see that file).
 set -euo pipefail
