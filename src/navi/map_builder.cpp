@@ -107,13 +107,29 @@ Pose2D MapBuilder::add(const LaserScan& scan, const Pose2D& odom_from_base, cons
     }
   }
   bool matched = false;
+  ++health_.scans;
   if (matcher_) {
     ++since_refresh_;
     matcher_->set_scan(scan, base_from_laser);
-    const ScanMatch m = matcher_->track(pose_, motion, options_.window);
+    ScanMatch m = matcher_->track(pose_, motion, options_.window);
+    const double typical = qualities_.typical();
+    const double margin = options_.recovery_margin;
+    if (margin > 0.0 && typical > 0.0 && m.quality < typical - margin) {
+      // Far weaker than usual: the odometry may have jumped beyond the window. Mapping on would
+      // lay the rest of the map at the wrong angle, so search the map around the robot globally.
+      ++health_.weak;
+      const ScanMatch g = rematch_globally(scan, base_from_laser);
+      if (g.quality >= typical - margin && g.quality >= m.quality + options_.recovery_gain) {
+        m = g;
+        ++health_.recovered;
+      } else {
+        ++health_.unreliable;
+      }
+    }
     last_quality_ = m.quality;
     matched = m.quality >= options_.min_quality;
     if (matched) pose_ = m.pose;
+    if (typical <= 0.0 || m.quality >= typical - margin) qualities_.add(m.quality);
   }
   travel_m_ += std::hypot(motion.x_m, motion.y_m);
   insert(scan, pose_, base_from_laser);
@@ -198,6 +214,14 @@ void MapBuilder::try_closure() {
   redraw();
   pose_ = graph_.pose(c);
   matcher_.reset();  // the tracker's window is refreshed from the redrawn map at the next scan
+}
+
+ScanMatch MapBuilder::rematch_globally(const LaserScan& scan, const Pose2D& base_from_laser) const {
+  const OccupancyGrid g = grid_around({pose_.x_m, pose_.y_m});
+  if (g.count(Occupancy::occupied) == 0) return {};
+  ScanMatcher global(g, closure_matcher_);
+  if (global.set_scan(scan, base_from_laser) == 0) return {};
+  return global.match_global();
 }
 
 void MapBuilder::redraw() {

@@ -1,5 +1,6 @@
 #include "tripodal/navi/scan_matching_localizer.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -92,6 +93,9 @@ void CScanMatchingLocalizer::on_configure(const ParameterSet& params) {
   last_odom_.reset();
   state_ = State::unknown;
   low_scans_ = 0;
+  qualities_.clear();
+  unreliable_ = 0;
+  verdict_ = ScanVerdict::kNone;
   matcher_.reset();
 }
 
@@ -151,15 +155,33 @@ void CScanMatchingLocalizer::step(const LaserScan& scan, const Pose2D& odom_from
   // nowhere).
   m.quality = matcher_->explained_quality(m.pose);
   last_ = m;
-  if (m.quality >= options_.lost_quality) {
+  verdict_ = judge(m, motion);
+  if (verdict_ == ScanVerdict::kConsistent) {
     pose_ = m.pose;
     low_scans_ = 0;
+    qualities_.add(m.quality);
     post(State::ok, now, out);
     return;
   }
-  // No evidence: keep dead reckoning, and after enough scans in a row say so.
+  // No evidence, or evidence at odds with the odometry: keep dead reckoning, and after enough
+  // scans in a row say so.
+  ++unreliable_;
   if (++low_scans_ >= options_.lost_after_scans) post(State::lost, now, out);
 }
+
+ScanVerdict CScanMatchingLocalizer::judge(const ScanMatch& m, const Pose2D& motion) const noexcept {
+  if (m.quality < options_.lost_quality) return ScanVerdict::kNoEvidence;
+  const double typical = typical_quality();
+  if (typical <= 0.0 || m.quality >= typical - options_.consistency_margin) return ScanVerdict::kConsistent;
+  // weaker than usual: taken only where the odometry put the robot
+  const Pose2D correction = compose(inverse(pose_), m.pose);
+  const double moved_m = std::hypot(motion.x_m, motion.y_m), turned = std::abs(motion.theta_rad);
+  const double k = options_.tolerance_per_motion;
+  const bool agrees = std::hypot(correction.x_m, correction.y_m) <= options_.odometry_tolerance_m + k * moved_m &&
+                      std::abs(correction.theta_rad) <= options_.odometry_tolerance_rad + k * turned;
+  return agrees ? ScanVerdict::kConsistent : ScanVerdict::kInconsistent;
+}
+
 
 bool CScanMatchingLocalizer::plausible(const Pose2D& motion) const noexcept {
   // Translation only: a base turns fast between scans, while a reset moves the origin by metres.
@@ -174,6 +196,7 @@ bool CScanMatchingLocalizer::relocalize() {
   pose_ = m.pose;
   last_ = m;
   low_scans_ = 0;
+  verdict_ = ScanVerdict::kConsistent;
   return true;
 }
 

@@ -281,8 +281,14 @@ int eval_one(const EvalArgs& a, const std::filesystem::path& file, std::ostream&
     int lost = 0;
     for (const ModuleEvent& ev : events) lost += ev.name == "localizer.lost" ? 1 : 0;
     out << e.format("scans");
-    out << "; localizer.lost " << lost << " times; " << std::setprecision(2) << ms / static_cast<double>(log.scans.size())
-        << " ms per scan\n";
+    const std::uint64_t unreliable = loc.unreliable_scans();
+    out << "; localizer.lost " << lost << " times; " << unreliable << " scans unreliable; " << std::setprecision(2)
+        << ms / static_cast<double>(log.scans.size()) << " ms per scan\n";
+    // the localizer's own word on its estimate, printed where a reader looks for the figures
+    if (lost > 0 || 20 * unreliable > log.scans.size()) {
+      out << "  WARNING: the localizer judged " << unreliable << " of " << log.scans.size()
+          << " scans unreliable and was lost " << lost << " times: its estimate there is not to be trusted\n";
+    }
   };
   out << "  tracking:      ";
   track(false, csv.is_open() ? &csv : nullptr);
@@ -419,6 +425,13 @@ int map_build(const BuildArgs& a, std::ostream& out, std::ostream& err) {
     out << "  loop closure: " << (o.loop.enabled ? "" : "off; ") << loop.keyframes << " key scans, " << loop.attempts
         << " local matches tried, " << loop.closures << " closures kept, " << loop.rejected << " rejected, " << loop.solves
         << " graph solves\n";
+    const navi::MappingHealth& health = b.health();
+    out << "  self-check: " << health.weak << " scans matched far below the recent median, " << health.recovered
+        << " of them re-matched globally (an odometry jump), " << health.unreliable << " left unreliable\n";
+    if (20 * health.unreliable > health.scans) {
+      out << "  WARNING: " << health.unreliable << " of " << health.scans
+          << " scans were mapped on matches the builder does not trust: the map may be wrong there\n";
+    }
     out << "  odometry: " << log.odometry_note << "\n";
     if (!log.odometry_usable) {
       out << "  WARNING: no odometry in this log: every scan is predicted where the previous one was, and the map\n"

@@ -64,7 +64,22 @@ struct MapBuilderOptions {
   /// A match below this quality (new ground, clutter) is no better than the odometry: the scan
   /// is inserted at the predicted pose.
   double min_quality = 0.2;
+  /// Recovery from an odometry jump (seattle's odometry turns 80 degrees between two scans, beyond
+  /// any tracking window): a match more than recovery_margin below the median of the recent
+  /// matches is searched again globally over the matcher's window of the map, and the global
+  /// match is taken when it is a usual one (within recovery_margin of that median) and better
+  /// than the tracked one by recovery_gain. 0 margin: off.
+  double recovery_margin = 0.15;
+  double recovery_gain = 0.05;
   LoopClosureOptions loop;
+};
+
+/// What the builder thought of its own matches.
+struct MappingHealth {
+  std::size_t scans = 0;
+  std::size_t weak = 0;          ///< matches far below the recent median (a global search followed)
+  std::size_t recovered = 0;     ///< of those, replaced by a global match
+  std::size_t unreliable = 0;    ///< of those, left as they were: the scan may be mapped wrong
 };
 
 /// What the loop closure did so far.
@@ -96,6 +111,7 @@ class MapBuilder {
   /// add() returned the estimate at the time).
   [[nodiscard]] std::vector<Pose2D> trajectory() const;
   [[nodiscard]] const LoopClosureStats& loop_stats() const noexcept { return stats_; }
+  [[nodiscard]] const MappingHealth& health() const noexcept { return health_; }
   /// The quality of the last match (0 before the matcher has a map).
   [[nodiscard]] double last_quality() const noexcept { return last_quality_; }
 
@@ -111,6 +127,7 @@ class MapBuilder {
   void add_keyframe(const LaserScan& scan, const Pose2D& base_from_laser, bool matched);
   void try_closure();
   void redraw();
+  [[nodiscard]] ScanMatch rematch_globally(const LaserScan& scan, const Pose2D& base_from_laser) const;
   struct Keyframe {
     LaserScan scan;
     Pose2D base_from_laser;
@@ -135,6 +152,8 @@ class MapBuilder {
   std::vector<ScanRef> scans_;
   double travel_m_ = 0.0;
   LoopClosureStats stats_;
+  RecentQualities qualities_;
+  MappingHealth health_;
 };
 
 }  // namespace tripodal::navi
