@@ -59,6 +59,15 @@ const ModuleManifest& CScanMatchingLocalizer::static_manifest() {
                      "scans in a row below lost_quality that make the robot lost", 1.0, 100000.0},
        ParameterSpec{"relocalize_quality", ValueType::number, Value{d.relocalize_quality}, "",
                      "quality a global search must reach to be accepted", 0.0, 1.0},
+       ParameterSpec{"consistency_margin", ValueType::number, Value{d.consistency_margin}, "",
+                     "a match this far below the median of the recent ones, and far from the odometry's prediction, "
+                     "is not taken (unreliable)", 0.0, 1.0},
+       ParameterSpec{"odometry_tolerance_m", ValueType::number, Value{d.odometry_tolerance_m}, "m",
+                     "a correction of the odometry within this (plus 0.3 m per metre moved) agrees with it", 0.0,
+                     100.0},
+       ParameterSpec{"odometry_tolerance_rad", ValueType::number, Value{d.odometry_tolerance_rad}, "rad",
+                     "a heading correction within this (plus 0.3 rad per radian turned) agrees with the odometry",
+                     0.0, 3.15},
        ParameterSpec{"retry_quality", ValueType::number, Value{d.window.retry_quality}, "",
                      "below this quality a scan is searched again in the widest window", 0.0, 1.0},
        ParameterSpec{"serves", ValueType::string, Value{std::string("BhGlobalLocalization")}, "",
@@ -82,6 +91,9 @@ void CScanMatchingLocalizer::on_configure(const ParameterSet& params) {
   o.lost_quality = params.number("lost_quality");
   o.lost_after_scans = static_cast<int>(params.number("lost_after_scans"));
   o.relocalize_quality = params.number("relocalize_quality");
+  o.consistency_margin = params.number("consistency_margin");
+  o.odometry_tolerance_m = params.number("odometry_tolerance_m");
+  o.odometry_tolerance_rad = params.number("odometry_tolerance_rad");
   o.window.retry_quality = params.number("retry_quality");
   validate(o.matcher, where());
   laser_name_ = params.string("laser");

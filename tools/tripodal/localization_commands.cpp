@@ -382,6 +382,8 @@ struct BuildArgs {
   double gap_m = 5.0;
   bool loop_closure = false;
   double closure_quality = navi::LoopClosureOptions{}.min_quality;
+  double recovery_margin = navi::MapBuilderOptions{}.recovery_margin;
+  std::filesystem::path trajectory;  // CSV: scan by scan, the match as made (before any closure)
   std::string laser_channel = "front_laser", odom_channel = "odom", pose_channel = "laser_pose";
 };
 
@@ -408,11 +410,27 @@ int map_build(const BuildArgs& a, std::ostream& out, std::ostream& err) {
     o.matcher.max_range_m = a.max_range_m;
     o.loop.enabled = a.loop_closure;
     o.loop.min_quality = a.closure_quality;
+    o.recovery_margin = a.recovery_margin;
     navi::MapBuilder b(lo, hi, o);
+    std::ofstream csv;
+    if (!a.trajectory.empty()) {
+      csv.open(a.trajectory);
+      if (!csv) throw std::runtime_error(a.trajectory.string() + ": cannot be written");
+      csv << "scan,x_m,y_m,theta_rad,quality,weak,recovered,unreliable\n";
+    }
     std::vector<Pose2D> est;
     est.reserve(log.scans.size());
     const auto t0 = Clock::now();
-    for (const LoggedScan& s : log.scans) b.add(s.scan, s.odom);
+    for (const LoggedScan& s : log.scans) {
+      const navi::MappingHealth before = b.health();
+      const Pose2D p = b.add(s.scan, s.odom);
+      if (csv.is_open()) {
+        const navi::MappingHealth& h = b.health();
+        csv << (h.scans - 1) << ',' << p.x_m << ',' << p.y_m << ',' << p.theta_rad << ',' << b.last_quality() << ','
+            << (h.weak - before.weak) << ',' << (h.recovered - before.recovered) << ','
+            << (h.unreliable - before.unreliable) << '\n';
+      }
+    }
     const double ms = ms_since(t0);
     // scored on the poses as the graph places them at the end (a closure moves past poses too)
     est = b.trajectory();
@@ -501,6 +519,10 @@ cli::Action setup_build(CLI::App& cmd) {
   cmd.add_option("--gap", a->gap_s, "S: time between the far pairs of the relative errors")->capture_default_str()->check(positive_number());
   cmd.add_option("--gap-m", a->gap_m, "M: reference travel between the pairs counted by distance (needs no time stamps)")
       ->capture_default_str()->check(positive_number());
+  cmd.add_option("--recovery-margin", a->recovery_margin,
+                 "Q: a match this far below the recent median is re-matched globally (0: never)")
+      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+  cmd.add_option("--trajectory", a->trajectory, "FILE: CSV of the matches, scan by scan, as made (before closures)");
   cmd.add_flag("--loop-closure", a->loop_closure, "keep a pose graph of key scans and close loops (docs/localization.md)");
   cmd.add_option("--closure-quality", a->closure_quality, "Q: with --loop-closure, the match quality a closure needs, in (0, 1]")
       ->capture_default_str()->check(CLI::Range(0.01, 1.0));

@@ -64,22 +64,26 @@ struct MapBuilderOptions {
   /// A match below this quality (new ground, clutter) is no better than the odometry: the scan
   /// is inserted at the predicted pose.
   double min_quality = 0.2;
-  /// Recovery from an odometry jump (seattle's odometry turns 80 degrees between two scans, beyond
-  /// any tracking window): a match more than recovery_margin below the median of the recent
-  /// matches is searched again globally over the matcher's window of the map, and the global
-  /// match is taken when it is a usual one (within recovery_margin of that median) and better
-  /// than the tracked one by recovery_gain. 0 margin: off.
+  /// Recovery from an odometry jump (seattle's odometry misses an 80 degree turn between two
+  /// scans, beyond any tracking window): a match more than recovery_margin below the median of
+  /// the recent matches is searched again over every heading within the widest window around the
+  /// odometry's position, and that match is taken when it is a usual one (within recovery_margin
+  /// of the median) and better than the tracked one by recovery_gain. Otherwise the weak match is
+  /// taken only if it stays within recovery_tolerance (+ 0.3 per metre / radian moved) of the
+  /// odometry's prediction. 0 margin: off.
   double recovery_margin = 0.15;
   double recovery_gain = 0.05;
+  double recovery_tolerance_m = 0.3;
+  double recovery_tolerance_rad = 0.25;
   LoopClosureOptions loop;
 };
 
 /// What the builder thought of its own matches.
 struct MappingHealth {
   std::size_t scans = 0;
-  std::size_t weak = 0;          ///< matches far below the recent median (a global search followed)
-  std::size_t recovered = 0;     ///< of those, replaced by a global match
-  std::size_t unreliable = 0;    ///< of those, left as they were: the scan may be mapped wrong
+  std::size_t weak = 0;          ///< matches far below the recent median (a search of all headings followed)
+  std::size_t recovered = 0;     ///< of those, replaced by a match at another heading
+  std::size_t unreliable = 0;    ///< the others: the weak match, or the odometry where they disagree
 };
 
 /// What the loop closure did so far.
@@ -127,7 +131,7 @@ class MapBuilder {
   void add_keyframe(const LaserScan& scan, const Pose2D& base_from_laser, bool matched);
   void try_closure();
   void redraw();
-  [[nodiscard]] ScanMatch rematch_globally(const LaserScan& scan, const Pose2D& base_from_laser) const;
+  [[nodiscard]] ScanMatch rematch_all_headings() noexcept;
   struct Keyframe {
     LaserScan scan;
     Pose2D base_from_laser;
