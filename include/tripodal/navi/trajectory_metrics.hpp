@@ -35,7 +35,8 @@ class PoseErrors {
 
 /// Whether a log's scan stamps can measure time between scans. Unusable: fewer than two scans,
 /// all equal, more than 5 % of the steps not advancing (repeated values, or steps backwards that
-/// an importer clamped), or a jump of over 100 times the median step and over 60 s (a wrap).
+/// an importer clamped), or a jump of over 100 times the median step and over a day (a wrap). A
+/// shorter hole leaves them usable (pairs_by_time refuses the pairs across it).
 struct StampCheck {
   bool usable = false;
   std::string why;  ///< empty when usable
