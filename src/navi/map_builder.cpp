@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <numbers>
 #include <string>
 
 #include "tripodal/navi/map_io.hpp"
@@ -229,7 +228,9 @@ void MapBuilder::try_closure() {
 ScanMatch MapBuilder::rematch_all_headings() noexcept {
   const ScanMatcherOptions& mo = options_.matcher;
   const double half = mo.max_search_theta_rad;
-  const int turns = static_cast<int>(std::ceil(std::numbers::pi / (2.0 * half)));
+  // windows centred 2 x half apart, out to recovery_max_turn_rad (not the half turn: a corridor
+  // matches itself backwards, and CSAIL's map flipped there)
+  const int turns = std::max(1, static_cast<int>(std::floor((options_.recovery_max_turn_rad - half) / (2.0 * half) + 1e-9)));
   ScanMatch best;
   for (int k = -turns; k <= turns; ++k) {
     if (k == 0) continue;  // the tracker searched there

@@ -73,6 +73,9 @@ struct MapBuilderOptions {
   /// odometry's prediction. 0 margin: off.
   double recovery_margin = 0.15;
   double recovery_gain = 0.05;
+  /// The recovery searches headings up to this far from the odometry's: a missed turn (seattle's
+  /// 1.41 rad), not the half turn a symmetric corridor matches at.
+  double recovery_max_turn_rad = 2.4;
   double recovery_tolerance_m = 0.3;
   double recovery_tolerance_rad = 0.25;
   LoopClosureOptions loop;
