@@ -107,13 +107,38 @@ Pose2D MapBuilder::add(const LaserScan& scan, const Pose2D& odom_from_base, cons
     }
   }
   bool matched = false;
+  ++health_.scans;
   if (matcher_) {
     ++since_refresh_;
     matcher_->set_scan(scan, base_from_laser);
-    const ScanMatch m = matcher_->track(pose_, motion, options_.window);
+    ScanMatch m = matcher_->track(pose_, motion, options_.window);
+    const double typical = qualities_.typical();
+    const double margin = options_.recovery_margin;
+    if (margin > 0.0 && typical > 0.0 && m.quality < typical - margin) {
+      // Far weaker than usual: the odometry may have turned (or not) beyond the window. Mapping
+      // on would lay the rest of the map at the wrong angle, so search every heading around the
+      // odometry's position. Not the whole map: a corridor elsewhere often looks as good.
+      ++health_.weak;
+      const ScanMatch g = rematch_all_headings();
+      if (g.quality >= typical - margin && g.quality >= m.quality + options_.recovery_gain) {
+        m = g;
+        ++health_.recovered;
+      } else {
+        ++health_.unreliable;
+        // a weak match that moves the pose far from the odometry is not taken (a corridor's
+        // match slides along it): the odometry's word is kept
+        const Pose2D c = compose(inverse(pose_), m.pose);
+        const double moved = std::hypot(motion.x_m, motion.y_m);
+        if (std::hypot(c.x_m, c.y_m) > options_.recovery_tolerance_m + 0.3 * moved ||
+            std::abs(c.theta_rad) > options_.recovery_tolerance_rad + 0.3 * std::abs(motion.theta_rad)) {
+          m.quality = 0.0;
+        }
+      }
+    }
     last_quality_ = m.quality;
     matched = m.quality >= options_.min_quality;
     if (matched) pose_ = m.pose;
+    if (typical <= 0.0 || m.quality >= typical - margin) qualities_.add(m.quality);
   }
   travel_m_ += std::hypot(motion.x_m, motion.y_m);
   insert(scan, pose_, base_from_laser);
@@ -198,6 +223,22 @@ void MapBuilder::try_closure() {
   redraw();
   pose_ = graph_.pose(c);
   matcher_.reset();  // the tracker's window is refreshed from the redrawn map at the next scan
+}
+
+ScanMatch MapBuilder::rematch_all_headings() noexcept {
+  const ScanMatcherOptions& mo = options_.matcher;
+  const double half = mo.max_search_theta_rad;
+  // windows centred 2 x half apart, out to recovery_max_turn_rad (not the half turn: a corridor
+  // matches itself backwards, and CSAIL's map flipped there)
+  const int turns = std::max(1, static_cast<int>(std::floor((options_.recovery_max_turn_rad - half) / (2.0 * half) + 1e-9)));
+  ScanMatch best;
+  for (int k = -turns; k <= turns; ++k) {
+    if (k == 0) continue;  // the tracker searched there
+    const Pose2D around{pose_.x_m, pose_.y_m, wrap_angle(pose_.theta_rad + 2.0 * half * k)};
+    const ScanMatch m = matcher_->match(around, mo.max_search_xy_m, half);
+    if (m.quality > best.quality) best = m;
+  }
+  return best;
 }
 
 void MapBuilder::redraw() {

@@ -502,4 +502,18 @@ ScanMatch ScanMatcher::match_global() {
   return match(from_grid(g));
 }
 
+void RecentQualities::add(double quality) noexcept {
+  q_[count_ % kSize] = static_cast<float>(quality);
+  ++count_;
+}
+
+double RecentQualities::typical() const noexcept {
+  const std::size_t n = std::min(count_, kSize);
+  if (n < kMin) return 0.0;
+  std::array<float, kSize> sorted = q_;
+  const auto mid = sorted.begin() + static_cast<std::ptrdiff_t>(n / 2);
+  std::nth_element(sorted.begin(), mid, sorted.begin() + static_cast<std::ptrdiff_t>(n));
+  return *mid;
+}
+
 }  // namespace tripodal::navi

@@ -1,5 +1,6 @@
 #include "tripodal/navi/scan_matching_localizer.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -58,6 +59,15 @@ const ModuleManifest& CScanMatchingLocalizer::static_manifest() {
                      "scans in a row below lost_quality that make the robot lost", 1.0, 100000.0},
        ParameterSpec{"relocalize_quality", ValueType::number, Value{d.relocalize_quality}, "",
                      "quality a global search must reach to be accepted", 0.0, 1.0},
+       ParameterSpec{"consistency_margin", ValueType::number, Value{d.consistency_margin}, "",
+                     "a match this far below the median of the recent ones, and far from the odometry's prediction, "
+                     "is not taken (unreliable)", 0.0, 1.0},
+       ParameterSpec{"odometry_tolerance_m", ValueType::number, Value{d.odometry_tolerance_m}, "m",
+                     "a correction of the odometry within this (plus 0.3 m per metre moved) agrees with it", 0.0,
+                     100.0},
+       ParameterSpec{"odometry_tolerance_rad", ValueType::number, Value{d.odometry_tolerance_rad}, "rad",
+                     "a heading correction within this (plus 0.3 rad per radian turned) agrees with the odometry",
+                     0.0, 3.15},
        ParameterSpec{"retry_quality", ValueType::number, Value{d.window.retry_quality}, "",
                      "below this quality a scan is searched again in the widest window", 0.0, 1.0},
        ParameterSpec{"serves", ValueType::string, Value{std::string("BhGlobalLocalization")}, "",
@@ -81,6 +91,9 @@ void CScanMatchingLocalizer::on_configure(const ParameterSet& params) {
   o.lost_quality = params.number("lost_quality");
   o.lost_after_scans = static_cast<int>(params.number("lost_after_scans"));
   o.relocalize_quality = params.number("relocalize_quality");
+  o.consistency_margin = params.number("consistency_margin");
+  o.odometry_tolerance_m = params.number("odometry_tolerance_m");
+  o.odometry_tolerance_rad = params.number("odometry_tolerance_rad");
   o.window.retry_quality = params.number("retry_quality");
   validate(o.matcher, where());
   laser_name_ = params.string("laser");
@@ -92,6 +105,9 @@ void CScanMatchingLocalizer::on_configure(const ParameterSet& params) {
   last_odom_.reset();
   state_ = State::unknown;
   low_scans_ = 0;
+  qualities_.clear();
+  unreliable_ = 0;
+  verdict_ = ScanVerdict::kNone;
   matcher_.reset();
 }
 
@@ -151,15 +167,33 @@ void CScanMatchingLocalizer::step(const LaserScan& scan, const Pose2D& odom_from
   // nowhere).
   m.quality = matcher_->explained_quality(m.pose);
   last_ = m;
-  if (m.quality >= options_.lost_quality) {
+  verdict_ = judge(m, motion);
+  if (verdict_ == ScanVerdict::kConsistent) {
     pose_ = m.pose;
     low_scans_ = 0;
+    qualities_.add(m.quality);
     post(State::ok, now, out);
     return;
   }
-  // No evidence: keep dead reckoning, and after enough scans in a row say so.
+  // No evidence, or evidence at odds with the odometry: keep dead reckoning, and after enough
+  // scans in a row say so.
+  ++unreliable_;
   if (++low_scans_ >= options_.lost_after_scans) post(State::lost, now, out);
 }
+
+ScanVerdict CScanMatchingLocalizer::judge(const ScanMatch& m, const Pose2D& motion) const noexcept {
+  if (m.quality < options_.lost_quality) return ScanVerdict::kNoEvidence;
+  const double typical = typical_quality();
+  if (typical <= 0.0 || m.quality >= typical - options_.consistency_margin) return ScanVerdict::kConsistent;
+  // weaker than usual: taken only where the odometry put the robot
+  const Pose2D correction = compose(inverse(pose_), m.pose);
+  const double moved_m = std::hypot(motion.x_m, motion.y_m), turned = std::abs(motion.theta_rad);
+  const double k = options_.tolerance_per_motion;
+  const bool agrees = std::hypot(correction.x_m, correction.y_m) <= options_.odometry_tolerance_m + k * moved_m &&
+                      std::abs(correction.theta_rad) <= options_.odometry_tolerance_rad + k * turned;
+  return agrees ? ScanVerdict::kConsistent : ScanVerdict::kInconsistent;
+}
+
 
 bool CScanMatchingLocalizer::plausible(const Pose2D& motion) const noexcept {
   // Translation only: a base turns fast between scans, while a reset moves the origin by metres.
@@ -174,6 +208,7 @@ bool CScanMatchingLocalizer::relocalize() {
   pose_ = m.pose;
   last_ = m;
   low_scans_ = 0;
+  verdict_ = ScanVerdict::kConsistent;
   return true;
 }
 

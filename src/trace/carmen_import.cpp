@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "tripodal/core/diagnostic.hpp"
+#include "tripodal/core/geometry.hpp"
 
 namespace tripodal::trace {
 
@@ -200,6 +201,7 @@ class Importer {
       }
     }
     if (diagnostics_.has_errors()) throw ConfigError(diagnostics_);
+    classify_odometry();
     return report_;
   }
 
@@ -244,7 +246,7 @@ class Importer {
     scan.scan_time_s = 0.0;
     scan.range_min_m = 0.0;
     scan.range_max_m = kCarmenFlaserMaxRangeM;
-    emit_scan(channel, laser_pose);
+    emit_scan(channel, laser_pose, laser_pose);
   }
 
   // ROBOTLASER1 laser_type start_angle field_of_view angular_resolution maximum_range accuracy
@@ -276,15 +278,18 @@ class Importer {
     laser_pose.x_m = f.number("laser_pose_x");
     laser_pose.y_m = f.number("laser_pose_y");
     laser_pose.theta_rad = f.number("laser_pose_theta");
-    for (const char* field : {"robot_pose_x", "robot_pose_y", "robot_pose_theta", "laser_tv", "laser_rv",
-                              "forward_safety_dist", "side_safety_dist", "turn_axis"}) {
+    Pose2D robot_pose;
+    robot_pose.x_m = f.number("robot_pose_x");
+    robot_pose.y_m = f.number("robot_pose_y");
+    robot_pose.theta_rad = f.number("robot_pose_theta");
+    for (const char* field : {"laser_tv", "laser_rv", "forward_safety_dist", "side_safety_dist", "turn_axis"}) {
       f.number(field);
     }
     scan.stamp = clamp(f.stamp());
     scan.angle_max_rad = scan.angle_min_rad + scan.angle_increment_rad * static_cast<double>(n > 0 ? n - 1 : 0);
     scan.time_increment_s = 0.0;
     scan.scan_time_s = 0.0;
-    emit_scan(channel, laser_pose);
+    emit_scan(channel, laser_pose, robot_pose);
   }
 
   // ODOM x y theta tv rv accel timestamp hostname logger_timestamp
@@ -297,13 +302,71 @@ class Importer {
     r.twist.vx_m_s = f.number("tv");
     r.twist.wz_rad_s = f.number("rv");
     f.number("accel");
-    r.stamp = clamp(f.stamp());
+    const Time stamp = f.stamp();
+    // The first ODOM after a scan that repeats the scan's pose is the log's re-anchoring, not a
+    // reading (its stamp is 0 in the corrected logs): dropped, and the increments that follow
+    // are chained onto the odometry the robot had at the scan.
+    const std::optional<Pose2D> echoed = echo_of_;
+    echo_of_.reset();
+    if (echoed && (same_pose(r.pose, *echoed) || same_pose(r.pose, echo_of_robot_))) {
+      ++report_.odometry_echoes;
+      if (options_.recover_anchored_odometry) {
+        anchor_log_ = r.pose;
+        anchor_odom_ = written_odom_.value_or(r.pose);
+        return;
+      }
+    }
+    if (anchor_log_) r.pose = compose(anchor_odom_, compose(inverse(*anchor_log_), r.pose));
+    r.stamp = clamp(stamp);
+    written_odom_ = r.pose;
     out_.write(channel(options_.odometry_channel, ChannelKind::kOdometry, odom_id_), r);
     ++report_.odometry_readings;
   }
 
-  void emit_scan(const std::string& name, const Pose2D& laser_pose) {
-    auto& id = name == options_.laser_channel ? front_id_ : rear_id_;
+  // Digits as printed: an echo repeats the scan's pose to the last digit.
+  static bool same_pose(const Pose2D& a, const Pose2D& b) noexcept {
+    constexpr double kTol = 1e-6;
+    return std::abs(a.x_m - b.x_m) <= kTol && std::abs(a.y_m - b.y_m) <= kTol &&
+           std::abs(a.theta_rad - b.theta_rad) <= kTol;
+  }
+
+  // Odometry that stays exactly still while the laser poses move is no odometry (orebro's ODOMs
+  // repeat the previous scan's pose).
+  void watch_odometry(const Pose2D& laser_pose) {
+    if (last_scan_pose_) {
+      const Pose2D moved = compose(inverse(*last_scan_pose_), laser_pose);
+      if (std::hypot(moved.x_m, moved.y_m) >= 0.05 || std::abs(wrap_angle(moved.theta_rad)) >= 0.05) {
+        ++report_.moving_scans;
+        const bool still = !written_odom_ || (odom_at_last_scan_ && same_pose(*written_odom_, *odom_at_last_scan_));
+        if (still) ++report_.still_odometry_scans;
+      }
+    }
+    last_scan_pose_ = laser_pose;
+    odom_at_last_scan_ = written_odom_;
+  }
+
+  void classify_odometry() {
+    CarmenImportReport& r = report_;
+    const std::uint64_t front = front_scans_;
+    if (r.odometry_readings == 0 || (r.moving_scans >= 3 && 2 * r.still_odometry_scans > r.moving_scans)) {
+      r.odometry = CarmenOdometry::kNone;
+    } else if (r.odometry_echoes > 0 && 2 * r.odometry_echoes >= front) {
+      r.odometry = options_.recover_anchored_odometry ? CarmenOdometry::kRecovered : CarmenOdometry::kAnchored;
+    } else {
+      r.odometry = CarmenOdometry::kRaw;
+    }
+  }
+
+  void emit_scan(const std::string& name, const Pose2D& laser_pose, const Pose2D& robot_pose) {
+    const bool front = name == options_.laser_channel;
+    if (front) {
+      ++front_scans_;
+      watch_odometry(laser_pose);
+      // FLASER's echo is its laser pose; a ROBOTLASER1 log may echo the robot's pose instead
+      echo_of_ = laser_pose;
+      echo_of_robot_ = robot_pose;
+    }
+    auto& id = front ? front_id_ : rear_id_;
     out_.write(channel(name, ChannelKind::kLaser, id), scan_);
     ++report_.laser_scans;
     if (!options_.laser_pose_channel.empty()) {
@@ -343,6 +406,14 @@ class Importer {
   Diagnostics diagnostics_;
   LaserScan scan_;  // reused: no allocation per scan once the largest scan was seen
   std::optional<ChannelId> front_id_, rear_id_, odom_id_, pose_id_;
+  // re-anchored odometry: the pose the next ODOM may echo, the last echo and the odometry then
+  std::optional<Pose2D> echo_of_;
+  Pose2D echo_of_robot_;
+  std::optional<Pose2D> anchor_log_;
+  Pose2D anchor_odom_;
+  std::optional<Pose2D> written_odom_;
+  std::optional<Pose2D> last_scan_pose_, odom_at_last_scan_;
+  std::uint64_t front_scans_ = 0;
   bool started_ = false;
   Time last_{};
 };
@@ -368,6 +439,24 @@ class StreamLines {
 };
 
 }  // namespace
+
+std::string CarmenImportReport::odometry_note() const {
+  const std::string echoes = std::to_string(odometry_echoes);
+  switch (odometry) {
+    case CarmenOdometry::kNone:
+      if (odometry_readings == 0) return "no odometry in this log (no ODOM message)";
+      return "no odometry in this log: its ODOMs repeat the previous pose (" + std::to_string(still_odometry_scans) +
+             " of " + std::to_string(moving_scans) + " moving scans without odometry motion)";
+    case CarmenOdometry::kRaw: return "odometry as logged (no re-anchoring found)";
+    case CarmenOdometry::kRecovered:
+      return "re-anchored odometry recovered: " + echoes +
+             " ODOMs echoing the corrected scan pose dropped, the wheel increments chained again";
+    case CarmenOdometry::kAnchored:
+      return "odometry re-anchored to the corrected pose at every scan (" + echoes +
+             " echoes): it cannot drift, it is not raw odometry";
+  }
+  return {};
+}
 
 double carmen_flaser_angle_increment(std::size_t beams) noexcept {
   constexpr double kPi = std::numbers::pi;

@@ -217,7 +217,7 @@ TEST_CASE("harness: damaged traces are refused at load with the byte offset, a c
     trace::TraceRecord rec;
     while (r.next(rec)) offsets.push_back(rec.offset);
   }
-  REQUIRE(offsets.size() > 700);
+  REQUIRE(offsets.size() > 650);  // 690 records: the 29 odometry echoes are dropped on import
   TempFile bad("harness_bad");
 
   SECTION("wrong version") {

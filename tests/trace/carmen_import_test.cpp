@@ -24,12 +24,12 @@ struct Imported {
   std::vector<OdometryReading> laser_poses;
 };
 
-Imported import_and_read(const std::filesystem::path& log) {
+Imported import_and_read(const std::filesystem::path& log, const CarmenImportOptions& options = {}) {
   TempFile out("carmen");
   Imported result;
   {
     TraceWriter w(out.path());
-    result.report = import_carmen_log(log, w);
+    result.report = import_carmen_log(log, w, options);
   }
   TraceReader r(out.path());
   TraceRecord rec;
@@ -44,20 +44,51 @@ Imported import_and_read(const std::filesystem::path& log) {
   return result;
 }
 
-Imported import_text(const std::string& text, const std::string& name = "mem.log") {
+Imported import_text(const std::string& text, const CarmenImportOptions& options = {}) {
   TempFile log("carmen_text");
   {
     std::ofstream f(log.path());
     f << text;
   }
-  (void)name;
-  return import_and_read(log.path());
+  return import_and_read(log.path(), options);
+}
+
+CarmenImportOptions as_logged() {
+  CarmenImportOptions o;
+  o.recover_anchored_odometry = false;
+  return o;
+}
+
+// A FLASER line of 4 beams at 2 m with the given laser pose and stamp (odom fields = the pose, as
+// in the corrected logs).
+std::string flaser(const Pose2D& p, double stamp) {
+  std::ostringstream s;
+  s.precision(9);
+  s << "FLASER 4 2 2 2 2 " << p.x_m << ' ' << p.y_m << ' ' << p.theta_rad << ' ' << p.x_m << ' ' << p.y_m << ' '
+    << p.theta_rad << ' ' << stamp << " host " << stamp << "\n";
+  return s.str();
+}
+
+std::string odom(const Pose2D& p, double stamp) {
+  std::ostringstream s;
+  s.precision(9);
+  s << "ODOM " << p.x_m << ' ' << p.y_m << ' ' << p.theta_rad << " 0 0 0 " << stamp << " host " << stamp << "\n";
+  return s.str();
+}
+
+Pose2D lerp(const Pose2D& a, const Pose2D& b, double f) {
+  return {a.x_m + f * (b.x_m - a.x_m), a.y_m + f * (b.y_m - a.y_m), a.theta_rad + f * (b.theta_rad - a.theta_rad)};
+}
+
+bool near(const Pose2D& a, const Pose2D& b, double tol = 1e-6) {
+  return std::abs(a.x_m - b.x_m) < tol && std::abs(a.y_m - b.y_m) < tol &&
+         std::abs(wrap_angle(a.theta_rad - b.theta_rad)) < tol;
 }
 
 }  // namespace
 
 TEST_CASE("the Intel excerpt imports with the counts of its lines") {
-  const Imported im = import_and_read(kExcerpt);
+  const Imported im = import_and_read(kExcerpt, as_logged());
   // grep -c '^FLASER' / '^ODOM' on the excerpt: 30 and 659.
   CHECK(im.report.laser_scans == 30);
   CHECK(im.report.odometry_readings == 659);
@@ -71,6 +102,8 @@ TEST_CASE("the Intel excerpt imports with the counts of its lines") {
   CHECK(im.report.skipped.at("NEFF") == 29);
   // Each FLASER is followed by an ODOM stamped 0 (the corrected pose): those step backwards.
   CHECK(im.report.backwards_steps == 117);
+  CHECK(im.report.odometry_echoes == 29);
+  CHECK(im.report.odometry == CarmenOdometry::kAnchored);
   CHECK(im.report.first_stamp == time_from_seconds(0.000246));
 }
 
@@ -99,7 +132,7 @@ TEST_CASE("FLASER beams follow CARMEN's angle convention and keep their ranges")
 }
 
 TEST_CASE("ODOM lines become odometry readings with twist, backwards stamps are clamped") {
-  const Imported im = import_and_read(kExcerpt);
+  const Imported im = import_and_read(kExcerpt, as_logged());
   // Line 173: ODOM ... 33.1085; line 174: ODOM 0.698035 -0.0132843 -0.460915 0 0 0 32.9068 (backwards);
   // line 175: FLASER at 32.9068; line 176: ODOM 0.600266 -0.0320327 -0.354665 0 0 0 0 (backwards).
   // All three are clamped to 33.1085, the latest stamp seen before them.
@@ -117,6 +150,78 @@ TEST_CASE("ODOM lines become odometry readings with twist, backwards stamps are 
   CHECK(t.odometry[0].pose == Pose2D{1, 2, 0.5});
   CHECK(t.odometry[0].twist == Twist2D{0.3, 0.0, -0.1});
   CHECK(t.odometry[0].stamp == time_from_seconds(10.5));
+}
+
+TEST_CASE("re-anchored odometry: the echoes are dropped and the wheel odometry is chained again") {
+  // The wheel odometry the robot had, and the corrected poses of its scans (off by a growing drift).
+  const std::vector<Pose2D> wheel{{0, 0, 0}, {0.5, 0, 0.1}, {1.0, 0.1, 0.3}, {1.4, 0.3, 0.7}, {1.6, 0.7, 1.2}};
+  const std::vector<Pose2D> ref{{0.1, 0, 0}, {0.58, 0.05, 0.12}, {1.05, 0.2, 0.36}, {1.4, 0.45, 0.8}, {1.55, 0.9, 1.35}};
+  // As the corrected logs write it: after each scan an ODOM equal to its corrected pose (stamp 0),
+  // then the wheel motion since, added onto that pose; two readings between scans.
+  std::string log;
+  Pose2D anchor_log, anchor_wheel;
+  bool anchored = false;
+  double t = 1.0;
+  for (std::size_t k = 0; k < wheel.size(); ++k) {
+    for (int h = 1; h <= 2; ++h) {
+      // the wheel pose half-way and at the scan, as the log would show it
+      const Pose2D w = k == 0 ? wheel[0] : lerp(wheel[k - 1], wheel[k], 0.5 * h);
+      log += odom(anchored ? compose(anchor_log, compose(inverse(anchor_wheel), w)) : w, t += 0.1);
+    }
+    log += flaser(ref[k], t);
+    log += odom(ref[k], 0.0);  // the echo
+    log += "NEFF 15\n";
+    anchor_log = ref[k];
+    anchor_wheel = wheel[k];
+    anchored = true;
+  }
+  const Imported im = import_text(log);
+  CHECK(im.report.odometry == CarmenOdometry::kRecovered);
+  CHECK(im.report.odometry_echoes == wheel.size());
+  CHECK_THAT(im.report.odometry_note(), Catch::Contains("re-anchored odometry recovered"));
+  REQUIRE(im.odometry.size() == 2 * wheel.size());
+  // The odometry at each scan (the reading before it) is the wheel odometry, drift and all.
+  for (std::size_t k = 0; k < wheel.size(); ++k) CHECK(near(im.odometry[2 * k + 1].pose, wheel[k]));
+  // No echo stamped 0 is left to step backwards.
+  CHECK(im.report.backwards_steps == 0);
+
+  // Read as logged (the old reading), the odometry at each scan is one scan's motion off the reference.
+  const Imported raw = import_text(log, as_logged());
+  CHECK(raw.report.odometry == CarmenOdometry::kAnchored);
+  REQUIRE(raw.odometry.size() == 3 * wheel.size());
+  CHECK_FALSE(near(raw.odometry[3 * 4 + 1].pose, wheel[4], 0.05));
+}
+
+TEST_CASE("odometry that repeats the previous scan's pose is no odometry") {
+  // orebro: after each scan its echo, and nothing until the next scan.
+  std::string log = odom({0, 0, 0}, 0.0);
+  for (int k = 0; k < 6; ++k) {
+    const Pose2D p{0.5 * k, 0.1 * k, 0.2 * k};
+    log += flaser(p, 0.0);
+    log += odom(p, 0.0);
+  }
+  const Imported im = import_text(log);
+  CHECK(im.report.odometry == CarmenOdometry::kNone);
+  CHECK(im.report.moving_scans == 5);
+  CHECK(im.report.still_odometry_scans == 5);
+  CHECK_THAT(im.report.odometry_note(), Catch::Contains("no odometry in this log"));
+
+  const Imported none = import_text(flaser({0, 0, 0}, 1.0) + flaser({1, 0, 0}, 2.0));
+  CHECK(none.report.odometry == CarmenOdometry::kNone);
+  CHECK_THAT(none.report.odometry_note(), Catch::Contains("no ODOM message"));
+}
+
+TEST_CASE("a raw log with an ODOM after each scan that moved on is left as logged") {
+  std::string log;
+  for (int k = 0; k < 5; ++k) {
+    log += flaser({0.3 * k, 0, 0}, k + 0.0);
+    log += odom({0.3 * k + 0.01, 0, 0}, k + 0.5);
+  }
+  const Imported im = import_text(log);
+  CHECK(im.report.odometry == CarmenOdometry::kRaw);
+  CHECK(im.report.odometry_echoes == 0);
+  REQUIRE(im.odometry.size() == 5);
+  CHECK(im.odometry[4].pose == Pose2D{1.21, 0, 0});
 }
 
 TEST_CASE("the gzip-compressed excerpt imports like the plain one") {

@@ -8,7 +8,9 @@
 #include <fstream>
 #include <iomanip>
 #include <memory>
+#include <optional>
 #include <ostream>
+#include <sstream>
 #include <random>
 #include <string>
 #include <unistd.h>
@@ -19,6 +21,7 @@
 #include "tripodal/navi/map_builder.hpp"
 #include "tripodal/navi/map_io.hpp"
 #include "tripodal/navi/scan_matching_localizer.hpp"
+#include "tripodal/navi/trajectory_metrics.hpp"
 #include "tripodal/trace/carmen_import.hpp"
 #include "tripodal/trace/trace_reader.hpp"
 
@@ -42,7 +45,28 @@ struct Log {
   std::string name;
   std::vector<LoggedScan> scans;
   bool has_odometry = false;
+  /// False when the log holds no odometry worth the name (none, or odometry that repeats the
+  /// previous pose): the tools then warn, and figures "on odometry" are not given.
+  bool odometry_usable = true;
+  std::string odometry_note;  ///< what the odometry is (the importer's word for a CARMEN log)
+
+  [[nodiscard]] std::vector<Pose2D> references() const {
+    std::vector<Pose2D> r;
+    r.reserve(scans.size());
+    for (const LoggedScan& s : scans) r.push_back(s.reference);
+    return r;
+  }
+  [[nodiscard]] std::vector<Time> stamps() const {
+    std::vector<Time> t;
+    t.reserve(scans.size());
+    for (const LoggedScan& s : scans) t.push_back(s.scan.stamp);
+    return t;
+  }
 };
+
+// Where every figure's reference comes from: named in the tools' output beside the figures.
+constexpr std::string_view kReferenceNote =
+    "the log's corrected laser poses (a SLAM result, not ground truth)";
 
 bool is_carmen(const std::filesystem::path& p) {
   const std::string s = p.filename().string();
@@ -58,6 +82,7 @@ Log read_log(const std::filesystem::path& file, const std::string& laser_channel
   log.name = file.filename().string();
   std::filesystem::path trace_path = file;
   std::filesystem::path temp;
+  std::optional<trace::CarmenImportReport> imported;
   if (is_carmen(file)) {
     temp = std::filesystem::temp_directory_path() /
            ("tripodal_localization_" + std::to_string(::getpid()) + "_" + file.filename().string() + ".trp");
@@ -66,7 +91,7 @@ Log read_log(const std::filesystem::path& file, const std::string& laser_channel
     o.laser_channel = laser_channel;
     o.odometry_channel = odom_channel;
     o.laser_pose_channel = pose_channel;
-    trace::import_carmen_log(file, w, o);
+    imported = trace::import_carmen_log(file, w, o);
     w.close();
     trace_path = temp;
   }
@@ -100,8 +125,29 @@ Log read_log(const std::filesystem::path& file, const std::string& laser_channel
   if (log.scans.empty()) {
     throw ConfigError(SourceLocation{file.string(), 0, 0}, "no scans on the laser channel '" + laser_channel + "'");
   }
-  if (!log.has_odometry) {
+  if (!log.has_odometry && !imported) {
     throw ConfigError(SourceLocation{file.string(), 0, 0}, "no odometry on the channel '" + odom_channel + "'");
+  }
+  if (imported) {
+    log.odometry_note = imported->odometry_note();
+    log.odometry_usable = imported->odometry != trace::CarmenOdometry::kNone;
+  } else {
+    // A trace: the same test as the importer's, odometry that stays still while the reference moves
+    std::size_t moving = 0, still = 0;
+    for (std::size_t i = 1; i < log.scans.size(); ++i) {
+      const LoggedScan &a = log.scans[i - 1], &b = log.scans[i];
+      if (!a.has_reference || !b.has_reference) continue;
+      const Pose2D moved = compose(inverse(a.reference), b.reference);
+      if (std::hypot(moved.x_m, moved.y_m) < 0.05 && std::abs(wrap_angle(moved.theta_rad)) < 0.05) continue;
+      ++moving;
+      const Pose2D odo = compose(inverse(a.odom), b.odom);
+      if (odo.x_m == 0.0 && odo.y_m == 0.0 && odo.theta_rad == 0.0) ++still;
+    }
+    log.odometry_usable = !(moving >= 3 && 2 * still > moving);
+    log.odometry_note = log.odometry_usable ? "odometry as recorded in the trace"
+                                            : "no odometry in this trace: it repeats the previous pose (" +
+                                                  std::to_string(still) + " of " + std::to_string(moving) +
+                                                  " moving scans without odometry motion)";
   }
   return log;
 }
@@ -145,61 +191,13 @@ void extent(const std::vector<Pose2D>& poses, double margin_m, Point2D& lower, P
   upper = {std::ceil(upper.x_m + margin_m), std::ceil(upper.y_m + margin_m)};
 }
 
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const auto k = static_cast<std::size_t>(std::ceil(p * static_cast<double>(v.size()))) - 1;
-  return v[std::min(k, v.size() - 1)];
-}
-
 double mean(const std::vector<double>& v) {
-  double s = 0.0;
-  for (double x : v) s += x;
-  return v.empty() ? 0.0 : s / static_cast<double>(v.size());
+  double sum = 0.0;
+  for (double x : v) sum += x;
+  return v.empty() ? 0.0 : sum / static_cast<double>(v.size());
 }
 
-constexpr double kDeg = 180.0 / 3.14159265358979323846;
-
-struct Errors {
-  std::vector<double> m, rad;
-  void add(const Pose2D& est, const Pose2D& ref) {
-    m.push_back(std::hypot(est.x_m - ref.x_m, est.y_m - ref.y_m));
-    rad.push_back(std::abs(wrap_angle(est.theta_rad - ref.theta_rad)));
-  }
-  void print(std::ostream& out) const {
-    out << std::fixed << std::setprecision(3) << mean(m) << " m (p95 " << percentile(m, 0.95) << "), "
-        << std::setprecision(2) << mean(rad) * kDeg << " deg (p95 " << percentile(rad, 0.95) * kDeg << ")";
-  }
-};
-
-// Kuemmerle et al. 2009: errors of the relative motions between pairs of poses, compared with the
-// reference's; pairs of consecutive scans, and pairs `gap_s` apart.
-Errors relative_errors(const Log& log, const std::vector<Pose2D>& est, double gap_s) {
-  Errors e;
-  const std::size_t n = est.size();
-  for (std::size_t i = 0; i + 1 < n; ++i) {
-    std::size_t j = i + 1;
-    if (gap_s > 0.0) {
-      const Time target = log.scans[i].scan.stamp + from_seconds(gap_s);
-      while (j < n && log.scans[j].scan.stamp < target) ++j;
-      if (j >= n) break;
-    }
-    const Pose2D d_est = compose(inverse(est[i]), est[j]);
-    const Pose2D d_ref = compose(inverse(log.scans[i].reference), log.scans[j].reference);
-    e.add(d_est, d_ref);
-  }
-  return e;
-}
-
-// The whole path's consistency, which relative errors over short pairs cannot show: each pose
-// against the reference, the two frames joined at the first scan (both start there).
-Errors absolute_errors(const Log& log, const std::vector<Pose2D>& est) {
-  Errors e;
-  if (est.empty()) return e;
-  const Pose2D first_ref = inverse(log.scans[0].reference);
-  for (std::size_t i = 0; i < est.size(); ++i) e.add(compose(inverse(est[0]), est[i]), compose(first_ref, log.scans[i].reference));
-  return e;
-}
+using navi::PoseErrors;
 
 OccupancyGrid reference_map(const Log& log, double resolution_m, double max_range_m) {
   std::vector<Pose2D> ref;
@@ -241,6 +239,12 @@ int eval_one(const EvalArgs& a, const std::filesystem::path& file, std::ostream&
   out.unsetf(std::ios::floatfield);
   out << std::setprecision(6) << log.name << ": " << log.scans.size() << " scans, map " << map.width() << " x " << map.height() << " cells of "
       << map.resolution_m() << " m, odometry noise " << a.odom_noise << "\n";
+  out << "  odometry:      " << log.odometry_note << "\n";
+  out << "  reference:     " << kReferenceNote << "; errors per scan, mean (p95)\n";
+  if (!log.odometry_usable) {
+    out << "  WARNING: no odometry in this log: tracking predicts no motion between scans, and a scan that moved\n"
+           "  farther than the search window is matched wherever it fits best\n";
+  }
 
   // Tracking from the first reference pose, on the odometry.
   navi::ScanMatchingLocalizerOptions lo;
@@ -259,7 +263,7 @@ int eval_one(const EvalArgs& a, const std::filesystem::path& file, std::ostream&
     navi::CScanMatchingLocalizer loc(lo);
     loc.set_map(map);
     std::vector<ModuleEvent> events;
-    Errors e;
+    PoseErrors e;
     double ms = 0.0;
     for (std::size_t i = 0; i < log.scans.size(); ++i) {
       const auto t0 = Clock::now();
@@ -276,23 +280,28 @@ int eval_one(const EvalArgs& a, const std::filesystem::path& file, std::ostream&
     }
     int lost = 0;
     for (const ModuleEvent& ev : events) lost += ev.name == "localizer.lost" ? 1 : 0;
-    e.print(out);
-    out << "; localizer.lost " << lost << " times; " << std::setprecision(2) << ms / static_cast<double>(log.scans.size())
-        << " ms per scan\n";
+    out << e.format("scans");
+    const std::uint64_t unreliable = loc.unreliable_scans();
+    out << "; localizer.lost " << lost << " times; " << unreliable << " scans unreliable; " << std::setprecision(2)
+        << ms / static_cast<double>(log.scans.size()) << " ms per scan\n";
+    // the localizer's own word on its estimate, printed where a reader looks for the figures
+    if (lost > 0 || 20 * unreliable > log.scans.size()) {
+      out << "  WARNING: the localizer judged " << unreliable << " of " << log.scans.size()
+          << " scans unreliable and was lost " << lost << " times: its estimate there is not to be trusted\n";
+    }
   };
   out << "  tracking:      ";
   track(false, csv.is_open() ? &csv : nullptr);
   out << "  + recovery:    ";
   track(true, nullptr);
-  Errors dead;
+  PoseErrors dead;
   Pose2D dead_pose = log.scans[0].reference;
   for (std::size_t i = 0; i < log.scans.size(); ++i) {
     if (i > 0) dead_pose = compose(dead_pose, compose(inverse(odom[i - 1]), odom[i]));
     dead.add(dead_pose, log.scans[i].reference);
   }
-  out << "  odometry only: ";
-  dead.print(out);
-  out << "\n";
+  out << "  odometry only: " << (log.odometry_usable ? dead.format("scans") : std::string("none (no odometry)"))
+      << " (dead reckoning from the first reference pose)\n";
 
   // Global localization from unknown starts spread over the log.
   int converged = 0, wrong = 0;
@@ -370,8 +379,11 @@ struct BuildArgs {
   double resolution_m = 0.05;
   double max_range_m = 30.0;
   double gap_s = 10.0;
+  double gap_m = 5.0;
   bool loop_closure = false;
   double closure_quality = navi::LoopClosureOptions{}.min_quality;
+  double recovery_margin = navi::MapBuilderOptions{}.recovery_margin;
+  std::filesystem::path trajectory;  // CSV: scan by scan, the match as made (before any closure)
   std::string laser_channel = "front_laser", odom_channel = "odom", pose_channel = "laser_pose";
 };
 
@@ -398,11 +410,27 @@ int map_build(const BuildArgs& a, std::ostream& out, std::ostream& err) {
     o.matcher.max_range_m = a.max_range_m;
     o.loop.enabled = a.loop_closure;
     o.loop.min_quality = a.closure_quality;
+    o.recovery_margin = a.recovery_margin;
     navi::MapBuilder b(lo, hi, o);
+    std::ofstream csv;
+    if (!a.trajectory.empty()) {
+      csv.open(a.trajectory);
+      if (!csv) throw std::runtime_error(a.trajectory.string() + ": cannot be written");
+      csv << "scan,x_m,y_m,theta_rad,quality,weak,recovered,unreliable\n";
+    }
     std::vector<Pose2D> est;
     est.reserve(log.scans.size());
     const auto t0 = Clock::now();
-    for (const LoggedScan& s : log.scans) b.add(s.scan, s.odom);
+    for (const LoggedScan& s : log.scans) {
+      const navi::MappingHealth before = b.health();
+      const Pose2D p = b.add(s.scan, s.odom);
+      if (csv.is_open()) {
+        const navi::MappingHealth& h = b.health();
+        csv << (h.scans - 1) << ',' << p.x_m << ',' << p.y_m << ',' << p.theta_rad << ',' << b.last_quality() << ','
+            << (h.weak - before.weak) << ',' << (h.recovered - before.recovered) << ','
+            << (h.unreliable - before.unreliable) << '\n';
+      }
+    }
     const double ms = ms_since(t0);
     // scored on the poses as the graph places them at the end (a closure moves past poses too)
     est = b.trajectory();
@@ -415,22 +443,45 @@ int map_build(const BuildArgs& a, std::ostream& out, std::ostream& err) {
     out << "  loop closure: " << (o.loop.enabled ? "" : "off; ") << loop.keyframes << " key scans, " << loop.attempts
         << " local matches tried, " << loop.closures << " closures kept, " << loop.rejected << " rejected, " << loop.solves
         << " graph solves\n";
+    const navi::MappingHealth& health = b.health();
+    out << "  self-check: " << health.weak << " scans matched far below the recent median, " << health.recovered
+        << " of them re-matched globally (an odometry jump), " << health.unreliable << " left unreliable\n";
+    if (20 * health.unreliable > health.scans) {
+      out << "  WARNING: " << health.unreliable << " of " << health.scans
+          << " scans were mapped on matches the builder does not trust: the map may be wrong there\n";
+    }
+    out << "  odometry: " << log.odometry_note << "\n";
+    if (!log.odometry_usable) {
+      out << "  WARNING: no odometry in this log: every scan is predicted where the previous one was, and the map\n"
+             "  is scan matching alone; no figure below is \"on odometry\"\n";
+    }
     if (all_referenced(log)) {
-      const std::vector<Pose2D>& odo_rel = odom;
-      out << "  relative errors vs the corrected poses (Kuemmerle et al. 2009):\n";
-      for (const double gap : {0.0, a.gap_s}) {
-        out << "    " << (gap == 0.0 ? std::string("consecutive scans") : "scans " + std::to_string(static_cast<int>(gap)) + " s apart")
-            << ": mapping ";
-        relative_errors(log, est, gap).print(out);
-        out << "; odometry ";
-        relative_errors(log, odo_rel, gap).print(out);
+      const std::vector<Pose2D> ref = log.references();
+      const navi::StampCheck stamps = navi::check_stamps(log.stamps());
+      auto line = [&](const std::string& what, const navi::PoseErrors& mapping, const navi::PoseErrors& odometry,
+                      const char* unit = "pairs") {
+        out << "    " << what << ": mapping " << mapping.format(unit);
+        if (log.odometry_usable) out << "; odometry " << odometry.format(unit);
         out << "\n";
+      };
+      out << "  errors vs " << kReferenceNote << ", mean (p95):\n";
+      out << "  relative (Kuemmerle et al. 2009):\n";
+      const navi::PosePairs consecutive = navi::consecutive_pairs(ref.size());
+      line("consecutive scans", navi::relative_errors(est, ref, consecutive), navi::relative_errors(odom, ref, consecutive));
+      std::ostringstream gap_s, gap_m;
+      gap_s << "scans " << a.gap_s << " s apart";
+      gap_m << "scans " << a.gap_m << " m of travel apart";
+      if (stamps.usable) {
+        const navi::PosePairs by_time = navi::pairs_by_time(log.stamps(), a.gap_s);
+        line(gap_s.str(), navi::relative_errors(est, ref, by_time), navi::relative_errors(odom, ref, by_time));
+      } else {
+        out << "    " << gap_s.str() << ": no pairs (time stamps unusable: " << stamps.why << ")\n";
       }
-      out << "    whole path, frames joined at the first scan: mapping ";
-      absolute_errors(log, est).print(out);
-      out << "; odometry ";
-      absolute_errors(log, odo_rel).print(out);
-      out << "\n";
+      const navi::PosePairs by_travel = navi::pairs_by_travel(ref, a.gap_m);
+      line(gap_m.str(), navi::relative_errors(est, ref, by_travel), navi::relative_errors(odom, ref, by_travel));
+      out << "  whole path (global consistency):\n";
+      line("frames joined at the first scan", navi::errors_from_start(est, ref), navi::errors_from_start(odom, ref), "scans");
+      line("after the best rigid alignment", navi::errors_aligned(est, ref), navi::errors_aligned(odom, ref), "scans");
     }
   });
 }
@@ -466,6 +517,12 @@ cli::Action setup_build(CLI::App& cmd) {
   cmd.add_option("--resolution", a->resolution_m, "M: cell side")->capture_default_str()->check(positive_number());
   cmd.add_option("--max-range", a->max_range_m, "M: returns beyond are not mapped")->capture_default_str()->check(positive_number());
   cmd.add_option("--gap", a->gap_s, "S: time between the far pairs of the relative errors")->capture_default_str()->check(positive_number());
+  cmd.add_option("--gap-m", a->gap_m, "M: reference travel between the pairs counted by distance (needs no time stamps)")
+      ->capture_default_str()->check(positive_number());
+  cmd.add_option("--recovery-margin", a->recovery_margin,
+                 "Q: a match this far below the recent median is re-matched globally (0: never)")
+      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+  cmd.add_option("--trajectory", a->trajectory, "FILE: CSV of the matches, scan by scan, as made (before closures)");
   cmd.add_flag("--loop-closure", a->loop_closure, "keep a pose graph of key scans and close loops (docs/localization.md)");
   cmd.add_option("--closure-quality", a->closure_quality, "Q: with --loop-closure, the match quality a closure needs, in (0, 1]")
       ->capture_default_str()->check(CLI::Range(0.01, 1.0));

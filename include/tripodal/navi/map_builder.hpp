@@ -64,7 +64,29 @@ struct MapBuilderOptions {
   /// A match below this quality (new ground, clutter) is no better than the odometry: the scan
   /// is inserted at the predicted pose.
   double min_quality = 0.2;
+  /// Recovery from an odometry jump (seattle's odometry misses an 80 degree turn between two
+  /// scans, beyond any tracking window): a match more than recovery_margin below the median of
+  /// the recent matches is searched again over every heading within the widest window around the
+  /// odometry's position, and that match is taken when it is a usual one (within recovery_margin
+  /// of the median) and better than the tracked one by recovery_gain. Otherwise the weak match is
+  /// taken only if it stays within recovery_tolerance (+ 0.3 per metre / radian moved) of the
+  /// odometry's prediction. 0 margin: off.
+  double recovery_margin = 0.15;
+  double recovery_gain = 0.05;
+  /// The recovery searches headings up to this far from the odometry's: a missed turn (seattle's
+  /// 1.41 rad), not the half turn a symmetric corridor matches at.
+  double recovery_max_turn_rad = 2.4;
+  double recovery_tolerance_m = 0.3;
+  double recovery_tolerance_rad = 0.25;
   LoopClosureOptions loop;
+};
+
+/// What the builder thought of its own matches.
+struct MappingHealth {
+  std::size_t scans = 0;
+  std::size_t weak = 0;          ///< matches far below the recent median (a search of all headings followed)
+  std::size_t recovered = 0;     ///< of those, replaced by a match at another heading
+  std::size_t unreliable = 0;    ///< the others: the weak match, or the odometry where they disagree
 };
 
 /// What the loop closure did so far.
@@ -96,6 +118,7 @@ class MapBuilder {
   /// add() returned the estimate at the time).
   [[nodiscard]] std::vector<Pose2D> trajectory() const;
   [[nodiscard]] const LoopClosureStats& loop_stats() const noexcept { return stats_; }
+  [[nodiscard]] const MappingHealth& health() const noexcept { return health_; }
   /// The quality of the last match (0 before the matcher has a map).
   [[nodiscard]] double last_quality() const noexcept { return last_quality_; }
 
@@ -111,6 +134,7 @@ class MapBuilder {
   void add_keyframe(const LaserScan& scan, const Pose2D& base_from_laser, bool matched);
   void try_closure();
   void redraw();
+  [[nodiscard]] ScanMatch rematch_all_headings() noexcept;
   struct Keyframe {
     LaserScan scan;
     Pose2D base_from_laser;
@@ -135,6 +159,8 @@ class MapBuilder {
   std::vector<ScanRef> scans_;
   double travel_m_ = 0.0;
   LoopClosureStats stats_;
+  RecentQualities qualities_;
+  MappingHealth health_;
 };
 
 }  // namespace tripodal::navi

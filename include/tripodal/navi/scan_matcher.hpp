@@ -48,6 +48,22 @@ struct TrackingWindow {
   double retry_quality = 0.8;
 };
 
+/// The median quality of a tracker's recent good matches: what "a usual match" scores on this map
+/// with this scanner. Absolute thresholds do not transfer between logs (right matches score 0.35
+/// on one, wrong ones 0.95 on another); a drop from the recent median does. No allocation.
+class RecentQualities {
+ public:
+  static constexpr std::size_t kSize = 64;
+  static constexpr std::size_t kMin = 5;  ///< fewer samples: no judgement (typical() is 0)
+  void add(double quality) noexcept;
+  [[nodiscard]] double typical() const noexcept;
+  void clear() noexcept { count_ = 0; }
+
+ private:
+  std::array<float, kSize> q_{};
+  std::size_t count_ = 0;
+};
+
 /// Throws ConfigError located at where naming every option out of its range.
 void validate(const ScanMatcherOptions& options, const SourceLocation& where = {});
 

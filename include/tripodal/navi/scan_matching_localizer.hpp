@@ -5,6 +5,7 @@
 // localizer.ok when it recovers. relocalize() is the global search of PrGlobalLocalization.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -33,6 +34,25 @@ struct ScanMatchingLocalizerOptions {
   /// origin (the simulator's, when `tripodal run` puts the robot on its start pose), not motion;
   /// 0: every increment is motion (logs whose scans are far apart, `localization eval`).
   double odometry_reset_m = 1.0;
+  /// Self-judgement (docs/localization.md, "No silent failure"). A match that moves the pose away
+  /// from the odometry's prediction by more than odometry_tolerance (plus a share of the motion)
+  /// is taken only when its quality is typical of this robot's recent matches: at most
+  /// consistency_margin below their median. Otherwise it is "unreliable": the pose follows the
+  /// odometry, and lost_after_scans such scans in a row make the robot lost. Absolute quality
+  /// thresholds do not transfer between logs (right matches score 0.35 on one, wrong ones 0.95 on
+  /// another); the disagreement with the odometry and the drop from the recent median do.
+  double odometry_tolerance_m = 0.3;
+  double odometry_tolerance_rad = 0.25;
+  double tolerance_per_motion = 0.3;   ///< added tolerance, per metre (m) and per radian (rad) moved
+  double consistency_margin = 0.1;
+};
+
+/// How the last scan was judged.
+enum class ScanVerdict {
+  kNone,          ///< no scan yet, or no map
+  kConsistent,    ///< matched, and taken
+  kNoEvidence,    ///< quality below lost_quality: the pose follows the odometry
+  kInconsistent,  ///< a match far from the odometry's prediction and weaker than usual: not taken
 };
 
 /// Type "ScanMatchingLocalizer". As a module of the robot it takes the map of the GridMaps module
@@ -60,6 +80,11 @@ class CScanMatchingLocalizer final : public CNaviModules {
   [[nodiscard]] const Pose2D& estimate() const noexcept { return pose_; }
   [[nodiscard]] const ScanMatch& last_match() const noexcept { return last_; }
   [[nodiscard]] bool localized() const noexcept { return state_ == State::ok; }
+  [[nodiscard]] ScanVerdict last_verdict() const noexcept { return verdict_; }
+  /// Scans judged unreliable so far (no evidence or inconsistent): the pose then is the odometry's.
+  [[nodiscard]] std::uint64_t unreliable_scans() const noexcept { return unreliable_; }
+  /// The median quality of the recent consistent matches (0 before there are enough).
+  [[nodiscard]] double typical_quality() const noexcept { return qualities_.typical(); }
   void publish(NavigationData& data) const noexcept;
   [[nodiscard]] const ScanMatchingLocalizerOptions& options() const noexcept { return options_; }
 
@@ -76,6 +101,7 @@ class CScanMatchingLocalizer final : public CNaviModules {
   void post(State next, Time now, std::vector<ModuleEvent>& out);
   // Whether an odometry increment between two scans is motion the tracker can follow (not a reset).
   [[nodiscard]] bool plausible(const Pose2D& motion) const noexcept;
+  [[nodiscard]] ScanVerdict judge(const ScanMatch& m, const Pose2D& motion) const noexcept;
 
   ScanMatchingLocalizerOptions options_;
   std::unique_ptr<ScanMatcher> matcher_;
@@ -92,6 +118,10 @@ class CScanMatchingLocalizer final : public CNaviModules {
   int low_scans_ = 0;
   bool need_global_ = false;  // start_global before the first scan
   State state_ = State::unknown;
+
+  RecentQualities qualities_;  // of the consistent matches
+  ScanVerdict verdict_ = ScanVerdict::kNone;
+  std::uint64_t unreliable_ = 0;
 
   GlobalFixAttempts fix_attempts_;  // global localization while BhGlobalLocalization is active
   std::uint32_t fixes_ = 0;

@@ -22,6 +22,20 @@ struct CarmenImportOptions {
   /// The laser pose of each FLASER/ROBOTLASER (in the corrected logs: the SLAM-corrected pose) as an
   /// OdometryReading with zero twist; empty: not written.
   std::string laser_pose_channel = "laser_pose";
+  /// The corrected logs re-anchor their odometry: after every scan comes an ODOM equal to that
+  /// scan's corrected pose, and the following ODOMs add the wheel odometry travelled since. Read
+  /// as it stands, that odometry never drifts (it is the reference, plus one scan's motion). With
+  /// this on, such an echo is dropped and the odometry is chained again from the increments since
+  /// each echo: the wheel odometry the robot had (docs/localization.md, "Honest inputs").
+  bool recover_anchored_odometry = true;
+};
+
+/// What a log's odometry channel holds after the import.
+enum class CarmenOdometry {
+  kNone,       ///< no ODOM at all, or odometry that stays still while the laser poses move
+  kRaw,        ///< the log's ODOMs as they are (no re-anchoring found)
+  kRecovered,  ///< re-anchored in the log; the wheel odometry was chained again from its increments
+  kAnchored,   ///< re-anchored in the log, and left so (recover_anchored_odometry off)
 };
 
 struct CarmenImportReport {
@@ -41,6 +55,17 @@ struct CarmenImportReport {
   Duration largest_backwards_step{0};
   Time first_stamp{};
   Time last_stamp{};
+  /// ODOMs that echo the scan before them (equal to its laser pose: the re-anchoring); dropped
+  /// from the trace when recover_anchored_odometry is on.
+  std::uint64_t odometry_echoes = 0;
+  /// Front scans whose laser pose moved (5 cm or 0.05 rad) since the previous scan, and those of
+  /// them whose odometry (as written) did not move at all: odometry that repeats the previous pose.
+  std::uint64_t moving_scans = 0;
+  std::uint64_t still_odometry_scans = 0;
+  CarmenOdometry odometry = CarmenOdometry::kNone;
+
+  /// One line on the odometry, for the tools: what it is and whether it can be used.
+  [[nodiscard]] std::string odometry_note() const;
 };
 
 /// The longest line the importer reads: a 1081-beam ROBOTLASER1 line with remissions is about
