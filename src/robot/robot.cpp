@@ -56,15 +56,16 @@ ParameterValues parameters_of(const ModuleEntry& e, const std::vector<ParameterO
 }
 
 // A controller's full configuration (limits, wheel geometry): the reactive configuration file its
-// profile entry names in the parameter `config`.
-ControllerConfig controller_config(const RobotProfile& p, const ModuleEntry& e) {
+// profile entry names in the parameter `config`, its types checked against `registry` (the
+// application's, so that its own controller types are known).
+ControllerConfig controller_config(const RobotProfile& p, const ModuleEntry& e, const ControllerRegistry& registry) {
   const auto it = e.parameters.find("config");
   if (it == e.parameters.end()) {
     throw ConfigError(e.where, "controller '" + e.name +
                                    "' needs parameters: {config: FILE}, the reactive configuration with its limits and wheels");
   }
   const std::filesystem::path file = p.dir / it->second;
-  const ReactiveConfig rc = load_reactive_config(file.string());
+  const ReactiveConfig rc = load_reactive_config(file.string(), registry);
   const ControllerConfig* c = rc.find_controller(e.name);
   if (c == nullptr) throw ConfigError(e.where, file.string() + " configures no controller named '" + e.name + "'");
   if (c->type != e.type) {
@@ -73,16 +74,156 @@ ControllerConfig controller_config(const RobotProfile& p, const ModuleEntry& e) 
   return *c;
 }
 
-}  // namespace
+// Whether the type of entry `e` of `profile` is registered in its family's registry.
+bool registered(const RobotProfile& profile, const RobotPlugins& plugins, const ModuleEntry& e) {
+  if (profile.hardware && &e == &*profile.hardware) return plugins.hardware.contains(e.type);
+  switch (e.kind) {
+    case ModuleKind::behavior: return plugins.behaviors.contains(e.type);
+    case ModuleKind::controller: return plugins.controllers.contains(e.type);
+    case ModuleKind::resource: return plugins.resources.contains(e.type);
+    default: return plugins.modules.contains(e.type);
+  }
+}
 
-std::optional<ControllerConfig> base_controller_config(const RobotProfile& profile) {
+// What the checks of a profile load on the way, for Robot::assemble to keep.
+struct CheckedProfile {
+  RobotDescription description;
+  TaskLibrary tasks;
+  RecoveryPolicy recovery;
+  std::vector<ProcessDefinition> processes;
+  std::vector<ControllerConfig> controllers;  // of the loops that drive one, in loop order
+  std::map<std::string, std::string, std::less<>> behavior_types;  // profile name -> type; not the safety ones
+};
+
+// Whether a type declared in the profile but not registered refuses the robot (assembly) or is
+// noted (the diagram of a design, whose modules may not be implemented yet).
+enum class DeclaredTypes { must_be_registered, may_be_designs };
+
+// Every check of a profile that builds no instance — the tasks and recovery rules, the diagram's
+// providers and layering, every type registered, the process nets against the behaviors the profile
+// lists, the controllers' reactive configurations — so that `tripodal describe` (check_robot) says
+// what Robot::assemble would refuse. Problems go to `d`, located.
+CheckedProfile check_profile(const RobotProfile& profile, const RobotPlugins& plugins,
+                             std::function<PetriNet(const std::filesystem::path&)> load, DeclaredTypes declared, Diagnostics& d) {
+  CheckedProfile out;
+  auto collect = [&](const auto& fn) {
+    try {
+      fn();
+    } catch (const ConfigError& e) {
+      d.append(e.diagnostics());
+    }
+  };
+  std::vector<std::string> process_names;
+  for (const ProcessEntry& p : profile.processes) process_names.push_back(p.name);
+  auto is_process = [&](std::string_view n) { return std::find(process_names.begin(), process_names.end(), n) != process_names.end(); };
+  // Safety behaviors are the loop's own, active from the start: the nets do not activate them.
+  for (const ModuleEntry& b : profile.behaviors) {
+    if (!b.safety) out.behavior_types.emplace(b.name, b.type);
+  }
+  auto is_safety = [&](std::string_view n) {
+    return std::any_of(profile.behaviors.begin(), profile.behaviors.end(), [&](const ModuleEntry& b) { return b.safety && b.name == n; });
+  };
+  auto is_behavior = [&](std::string_view n) { return out.behavior_types.count(n) != 0; };
+
+  if (!profile.tasks.empty()) {
+    collect([&] { out.tasks = TaskLibrary::load(profile.tasks, TaskLoadOptions{is_process}); });
+  }
+  if (!profile.recovery.empty()) collect([&] { out.recovery = RecoveryPolicy::load(profile.recovery, is_process); });
+
+  out.description = describe_robot(profile, plugins, knowledge_inputs(out.tasks), d);
+
+  // A type declared in the profile (layer, inputs, outputs) draws the diagram of a module designed
+  // before it is implemented; running needs the type itself. (describe_robot reported the
+  // undeclared unknown ones.)
+  std::vector<const ModuleEntry*> entries;
+  if (profile.hardware) entries.push_back(&*profile.hardware);
+  for (const ModuleEntry* e : profile.all_modules()) entries.push_back(e);
+  for (const ModuleEntry* e : entries) {
+    if (!(e->layer || e->inputs || e->outputs) || registered(profile, plugins, *e)) continue;
+    const bool is_hardware = profile.hardware && e == &*profile.hardware;
+    const std::string kind = is_hardware ? "hardware" : std::string(to_string(e->kind));
+    const bool own_family = is_hardware || e->kind == ModuleKind::behavior || e->kind == ModuleKind::controller ||
+                            e->kind == ModuleKind::resource;
+    std::string why = kind + " '" + e->name + "' cannot be started: its type '" + e->type +
+                      "' is declared here (layer, inputs, outputs), which draws the diagram, but no " +
+                      (own_family ? kind : std::string("module")) + " type of that name is registered";
+    if (declared == DeclaredTypes::must_be_registered) {
+      d.error(e->where, std::move(why));
+    } else {
+      d.warning(e->where, std::move(why) + " (a design: `tripodal run` refuses it)");
+    }
+  }
+
+  // Processes: nets, parameters and their own recovery rules.
+  if (!load) {
+    load = [&](const std::filesystem::path& f) {
+      LoadOptions lo;
+      // A safety behavior is known, so that a net binding it is refused below with the reason.
+      lo.is_known_behavior = [&](std::string_view n) { return is_behavior(n) || is_safety(n); };
+      lo.structural_warnings = false;
+      return load_net_or_throw(f, lo);
+    };
+  }
+  for (const ProcessEntry& p : profile.processes) {
+    collect([&] {
+      ProcessDefinition def;
+      def.name = p.name;
+      def.type = p.type;
+      def.parameters = p.parameters;
+      def.where = p.where;
+      def.net = load(p.net);
+      if (!p.module.empty()) {
+        def.module = load(p.module);
+        check_module_net(*def.module, p.name, d);
+      }
+      if (!p.recovery.empty()) def.recovery = RecoveryPolicy::load(p.recovery, is_process).rules();
+      for (const Place& place : def.net.places()) {
+        if (place.behavior && is_safety(place.behavior->behavior)) {
+          d.error(p.net_where.line > 0 ? p.net_where : p.where,
+                  "process '" + p.name + "': place '" + place.id + "' of " + p.net.filename().string() + " binds behavior '" +
+                      place.behavior->behavior + "', which the robot runs as a safety behavior (safety: true: always active, never a net's)");
+        } else if (place.behavior && !is_behavior(place.behavior->behavior)) {
+          d.error(p.net_where.line > 0 ? p.net_where : p.where,
+                  "process '" + p.name + "': place '" + place.id + "' of " + p.net.filename().string() + " binds behavior '" +
+                      place.behavior->behavior + "', which the robot does not list under behaviors");
+        }
+      }
+      out.processes.push_back(std::move(def));
+    });
+  }
+
+  // Behaviors are created anew at each activation; here their types are checked.
+  for (const ModuleEntry& b : profile.behaviors) {
+    if (!plugins.behaviors.contains(b.type)) continue;  // reported above
+    if (b.name != b.type) {
+      d.error(b.where, "behavior '" + b.name + "' is of type '" + b.type + "'; behaviors are known to the nets by their type name");
+    }
+  }
+
+  // The base controllers' configurations, read through the application's controller types.
   for (const LoopEntry& l : profile.loops) {
     if (l.controller.empty()) continue;
     for (const ModuleEntry& c : profile.controllers) {
-      if (c.name == l.controller) return controller_config(profile, c);
+      if (c.name == l.controller) collect([&] { out.controllers.push_back(controller_config(profile, c, plugins.controllers)); });
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::optional<ControllerConfig> base_controller_config(const RobotProfile& profile, const ControllerRegistry& controllers) {
+  for (const LoopEntry& l : profile.loops) {
+    if (l.controller.empty()) continue;
+    for (const ModuleEntry& c : profile.controllers) {
+      if (c.name == l.controller) return controller_config(profile, c, controllers);
     }
   }
   return std::nullopt;
+}
+
+RobotDescription check_robot(const RobotProfile& profile, const RobotPlugins& plugins, Diagnostics& d) {
+  return check_profile(profile, plugins, nullptr, DeclaredTypes::may_be_designs, d).description;
 }
 
 struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
@@ -277,80 +418,16 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
     }
   };
 
-  std::vector<std::string> process_names;
-  for (const ProcessEntry& p : profile.processes) process_names.push_back(p.name);
-  auto is_process = [&](std::string_view n) { return std::find(process_names.begin(), process_names.end(), n) != process_names.end(); };
-  // Safety behaviors are the loop's own, active from the start: the nets do not activate them.
-  for (const ModuleEntry& b : profile.behaviors) {
-    if (!b.safety) m->behavior_types.emplace(b.name, b.type);
-  }
-  auto is_safety = [&](std::string_view n) {
-    return std::any_of(profile.behaviors.begin(), profile.behaviors.end(), [&](const ModuleEntry& b) { return b.safety && b.name == n; });
-  };
-  auto is_behavior = [&](std::string_view n) { return m->behavior_types.count(n) != 0; };
-
-  if (!profile.tasks.empty()) {
-    collect([&] { m->tasks = TaskLibrary::load(profile.tasks, TaskLoadOptions{is_process}); });
-  }
-  if (!profile.recovery.empty()) collect([&] { m->recovery = RecoveryPolicy::load(profile.recovery, is_process); });
-
-  m->description = describe_robot(profile, plugins, knowledge_inputs(m->tasks), d);
-
-  // Processes: nets, parameters and their own recovery rules.
+  CheckedProfile checked = check_profile(profile, plugins, m->options.load_net, DeclaredTypes::must_be_registered, d);
+  m->description = std::move(checked.description);
+  m->tasks = std::move(checked.tasks);
+  m->recovery = std::move(checked.recovery);
+  m->behavior_types = std::move(checked.behavior_types);
+  m->controller_configs = std::move(checked.controllers);
   m->processes = ProcessRegistry(plugins.processes);
-  auto load = m->options.load_net;
-  if (!load) {
-    load = [&](const std::filesystem::path& f) {
-      LoadOptions lo;
-      // A safety behavior is known, so that a net binding it is refused below with the reason.
-      lo.is_known_behavior = [&](std::string_view n) { return is_behavior(n) || is_safety(n); };
-      lo.structural_warnings = false;
-      return load_net_or_throw(f, lo);
-    };
-  }
-  for (const ProcessEntry& p : profile.processes) {
-    collect([&] {
-      ProcessDefinition def;
-      def.name = p.name;
-      def.type = p.type;
-      def.parameters = p.parameters;
-      def.where = p.where;
-      def.net = load(p.net);
-      if (!p.module.empty()) {
-        def.module = load(p.module);
-        check_module_net(*def.module, p.name, d);
-      }
-      if (!p.recovery.empty()) def.recovery = RecoveryPolicy::load(p.recovery, is_process).rules();
-      for (const Place& place : def.net.places()) {
-        if (place.behavior && is_safety(place.behavior->behavior)) {
-          d.error(p.net_where.line > 0 ? p.net_where : p.where,
-                  "process '" + p.name + "': place '" + place.id + "' of " + p.net.filename().string() + " binds behavior '" +
-                      place.behavior->behavior + "', which the robot runs as a safety behavior (safety: true: always active, never a net's)");
-        } else if (place.behavior && !is_behavior(place.behavior->behavior)) {
-          d.error(p.net_where.line > 0 ? p.net_where : p.where,
-                  "process '" + p.name + "': place '" + place.id + "' of " + p.net.filename().string() + " binds behavior '" +
-                      place.behavior->behavior + "', which the robot does not list under behaviors");
-        }
-      }
-      m->processes.add(std::move(def));
-    });
-  }
+  for (ProcessDefinition& def : checked.processes) collect([&] { m->processes.add(std::move(def)); });
 
-  // Behaviors are created anew at each activation; here their types are checked.
-  for (const ModuleEntry& b : profile.behaviors) {
-    if (!plugins.behaviors.contains(b.type)) continue;  // describe_robot reported it
-    if (b.name != b.type) {
-      d.error(b.where, "behavior '" + b.name + "' is of type '" + b.type + "'; behaviors are known to the nets by their type name");
-    }
-  }
-
-  // The hardware and the base controllers on it.
-  for (const LoopEntry& l : profile.loops) {
-    if (l.controller.empty()) continue;
-    for (const ModuleEntry& c : profile.controllers) {
-      if (c.name == l.controller) collect([&] { m->controller_configs.push_back(controller_config(profile, c)); });
-    }
-  }
+  // The hardware.
   if (profile.hardware && plugins.hardware.contains(profile.hardware->type)) {
     const ModuleEntry& h = *profile.hardware;
     collect([&] {
@@ -368,10 +445,7 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
     });
   }
   for (const ModuleEntry& e : profile.resources) {
-    if (!plugins.resources.contains(e.type)) {
-      if (e.layer || e.inputs || e.outputs) d.error(e.where, "resource '" + e.name + "' cannot be started: no resource type '" + e.type + "' is registered");
-      continue;
-    }
+    if (!plugins.resources.contains(e.type)) continue;  // check_profile reported it
     collect([&] {
       ResourceConfig rc{e.name, ParameterSet::resolve(plugins.resources.manifest(e.type), parameters_of(e, m->options.parameters), e.where),
                         e.where, m->hardware.get()};
@@ -432,10 +506,7 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
   // The modules of the sequencing loop.
   for (const auto* list : {&profile.navigation, &profile.hri, &profile.modules}) {
     for (const ModuleEntry& e : *list) {
-      if (!plugins.modules.contains(e.type)) {
-        if (e.layer) d.error(e.where, "module '" + e.name + "' cannot be started: no module type '" + e.type + "' is registered");
-        continue;  // an unknown undeclared type: describe_robot reported it
-      }
+      if (!plugins.modules.contains(e.type)) continue;  // check_profile reported it
       collect([&] {
         auto mod = plugins.modules.create_at(e.where, e.type);
         mod->configure(parameters_of(e, m->options.parameters), e.where);

@@ -1,20 +1,17 @@
 // `tripodal describe ROBOT.yaml [--dot]`: the layered functionality diagram of a robot profile —
 // modules by layer with their inputs and outputs, or a Graphviz drawing of it (paper, Figs. 4, 6,
-// 7) — after the start-up checks (one provider per input, layering rules).
+// 7) — after the start-up checks `tripodal run` makes before it builds the robot (check_robot).
 #include <algorithm>
 #include <memory>
 #include <ostream>
 
 #include "cli_tool.hpp"
-#include "guide_hri.hpp"
 #include "run_task.hpp"
-#include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/behaviors/behavior_registry.hpp"
 #include "tripodal/controllers/controller_config.hpp"
 #include "tripodal/planner/task_library.hpp"
 #include "tripodal/robot/layering.hpp"
 #include "tripodal/robot/robot.hpp"
-#include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/robot/robot_profile.hpp"
 
 namespace tripodal::tool {
@@ -26,9 +23,10 @@ constexpr std::string_view kDescription =
     "Prints the modules of a robot profile by layer (deliberate, sequencing, reactive) with their\n"
     "inputs and outputs, including the core components (planner, process supervisor,\n"
     "configurations, behavior coordinator). --dot prints the layered functionality diagram in\n"
-    "Graphviz DOT instead (render with: dot -Tsvg). The profile is checked first: every input\n"
-    "needs exactly one provider and the layering rules must hold (docs/processes.md); errors are\n"
-    "printed as FILE:LINE:COL and the exit code is 1.";
+    "Graphviz DOT instead (render with: dot -Tsvg). The profile is checked first, as `tripodal run`\n"
+    "checks it before it builds the robot: every input needs exactly one provider, the layering\n"
+    "rules must hold (docs/processes.md), every type must be registered, the process nets may bind\n"
+    "only the profile's behaviors; errors are printed as FILE:LINE:COL and the exit code is 1.";
 
 constexpr std::string_view kExitCodes =
     "exit codes: 0 ok, 1 the profile has errors, 2 bad command line, 3 the profile cannot be read";
@@ -48,31 +46,17 @@ int describe(const Args& args, std::ostream& out, std::ostream& err) {
   }
   try {
     const RobotProfile profile = load_robot_profile(file);
-    Diagnostics d;
-    std::vector<std::string> processes;
-    for (const auto& p : profile.processes) processes.push_back(p.name);
-    TaskLibrary tasks;
-    if (!profile.tasks.empty()) {
-      try {
-        tasks = TaskLibrary::load(profile.tasks, TaskLoadOptions{[&](std::string_view n) {
-                                    return std::find(processes.begin(), processes.end(), n) != processes.end();
-                                  }});
-      } catch (const ConfigError& e) {
-        d.append(e.diagnostics());
-      }
-    }
-    // The types this program knows: the framework's own, the simulator's hardware, and the guide
-    // robot's gestures and HRI (the types `tripodal run` registers).
+    // The types `tripodal run` knows, registered by the same function: no world, as no robot is built.
     RobotPlugins plugins = RobotPlugins::with_builtins();
-    sim::register_sim_hardware(plugins.hardware);
-    app::register_dds_robot_modules(plugins);
-    register_gesture_behaviors(plugins.behaviors);
-    app::register_guide_modules(plugins.modules);
-    const RobotDescription r = describe_robot(profile, plugins, knowledge_inputs(tasks), d);
+    app::register_tool_plugins(plugins, nullptr);
+    // The checks `tripodal run` makes before it builds anything (Robot::assemble runs the same).
+    Diagnostics d;
+    const RobotDescription r = check_robot(profile, plugins, d);
     if (d.has_errors()) {
       err << d.str() << '\n' << "robot '" << profile.name << "' would refuse to start: " << d.error_count() << " error(s)\n";
       return kBadInput;
     }
+    if (!d.empty()) err << d.str() << '\n';  // warnings: types designed here, not yet registered
     out << (dot ? describe_dot(r) : describe_text(r));
     return kOk;
   } catch (const ConfigError& e) {

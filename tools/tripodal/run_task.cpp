@@ -12,7 +12,9 @@
 #include <stdexcept>
 
 #include "run_outputs.hpp"
+#include "guide_hri.hpp"
 #include "shutdown.hpp"
+#include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/monitor/robot_monitor.hpp"
 #include "tripodal/navi/grid_maps.hpp"
@@ -192,11 +194,13 @@ std::vector<ParameterOverride> simulation_overrides(const RobotProfile& profile,
   return out;
 }
 
+namespace {
 #ifdef TRIPODAL_HAVE_DDS
 void register_dds_robot_modules(RobotPlugins& plugins) { dds::register_dds_modules(plugins.resources, plugins.controllers); }
 #else
 void register_dds_robot_modules(RobotPlugins&) {}
 #endif
+}  // namespace
 
 // The robot on DDS when its profile has a `dds:` section (docs/distribution.md); a tool built
 // without the dds area refuses such a profile rather than run a robot its peers cannot see.
@@ -241,6 +245,17 @@ void register_remote_hardware(HardwareRegistry& registry, const std::shared_ptr<
 #else
 void register_remote_hardware(HardwareRegistry&, const std::shared_ptr<const sim::World>&) {}
 #endif
+
+void register_tool_plugins(RobotPlugins& plugins, const std::shared_ptr<const sim::World>& world) {
+  sim::register_sim_hardware(plugins.hardware, world);
+  sim::register_sim_board_hardware(plugins.hardware, world);
+  register_remote_hardware(plugins.hardware, world);
+  register_dds_robot_modules(plugins);
+  board::register_board_modules(plugins.modules);
+  board::register_board_behaviors(plugins.behaviors);
+  register_gesture_behaviors(plugins.behaviors);
+  register_guide_modules(plugins.modules);
+}
 
 // What a run measures itself by: the simulator's ground truth, in this process, or in the
 // sim-server's, as its lock-step answers carry it (before the first: the world's start).
@@ -342,12 +357,7 @@ RunResult run_task(const RunOptions& o) {
   // The robot, on simulated hardware in this world, with this run's seed and coverage pattern;
   // the board's modules and actuator behaviors for a robot on the control board.
   RobotPlugins plugins = RobotPlugins::with_builtins();
-  sim::register_sim_hardware(plugins.hardware, world);
-  sim::register_sim_board_hardware(plugins.hardware, world);
-  register_remote_hardware(plugins.hardware, world);
-  register_dds_robot_modules(plugins);
-  board::register_board_modules(plugins.modules);
-  board::register_board_behaviors(plugins.behaviors);
+  register_tool_plugins(plugins, world);
   RobotOptions ro;
   ro.parameters = simulation_overrides(profile, *world, res.seed);
   if (!o.board_line.empty()) ro.parameters.push_back({profile.hardware->name, "line", o.board_line});

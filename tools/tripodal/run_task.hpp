@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <iosfwd>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -24,13 +25,22 @@
 namespace tripodal {
 struct RobotPlugins;
 }
+namespace tripodal::sim {
+struct World;
+}
 
 namespace tripodal::app {
 
-/// With the dds area: its resource and controller types (DdsLaser, DdsOdometry, DdsImu, DdsPose,
-/// dds_cmd_vel), so that any robot profile can name them; without it, nothing (such a profile is
-/// then refused as naming an unknown type).
-void register_dds_robot_modules(RobotPlugins& plugins);
+/// Adds the types every command of the `tripodal` tool knows to `plugins` (which holds the
+/// built-ins): `run`, `run --visit` and `describe` call this one function, so that a profile
+/// `describe` accepts is one `run` can assemble. The simulator's hardware "sim" and "board" (the
+/// control board simulated in `world`), and "dds" (the simulator in another process); the board's
+/// modules (BoardMonitor) and actuator behaviors (BhUvLamp, BhAtomize, BhVoicePrompt); the guide
+/// robot's gestures (BhNeckGesture, ...) and HRI module (Hri); with the dds area, its resource and
+/// controller types (DdsLaser, DdsOdometry, DdsImu, DdsPose, dds_cmd_vel) — without it a profile
+/// naming them is refused as naming an unknown type. `world` may be null where no robot is built
+/// (describe reads the types' manifests only); hardware created from it then refuses to start.
+void register_tool_plugins(RobotPlugins& plugins, const std::shared_ptr<const sim::World>& world);
 
 struct RunOptions {
   std::filesystem::path robot;  ///< robot profile (YAML)

@@ -16,6 +16,7 @@
 
 #include "cli_tool.hpp"
 #include "run_outputs.hpp"
+#include "run_task.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/dds/dds_hardware.hpp"
@@ -102,7 +103,11 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
   }
   try {
     const RobotProfile profile = load_robot_profile(a.robot);
-    const std::optional<ControllerConfig> base = base_controller_config(profile);
+    // The controller types `tripodal run` knows (the same registration), so that the base of any
+    // profile `run` takes is simulated here.
+    RobotPlugins plugins = RobotPlugins::with_builtins();
+    app::register_tool_plugins(plugins, nullptr);
+    const std::optional<ControllerConfig> base = base_controller_config(profile, plugins.controllers);
     if (!base)
       throw ConfigError(
           profile.where,

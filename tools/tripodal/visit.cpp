@@ -16,7 +16,6 @@
 #include "run_outputs.hpp"
 #include "run_task.hpp"
 #include "shutdown.hpp"
-#include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/hri/hri_module.hpp"
 #include "tripodal/monitor/robot_monitor.hpp"
@@ -110,10 +109,7 @@ VisitResult run_visit(const VisitOptions& o) {
   res.seed = o.seed.value_or(world->seed);
 
   RobotPlugins plugins = RobotPlugins::with_builtins();
-  sim::register_sim_hardware(plugins.hardware, world);
-  register_dds_robot_modules(plugins);
-  register_gesture_behaviors(plugins.behaviors);
-  register_guide_modules(plugins.modules);
+  register_tool_plugins(plugins, world);
   RobotOptions ro;
   ro.parameters = simulation_overrides(profile, *world, res.seed);
   SimClock clock;

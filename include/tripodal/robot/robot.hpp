@@ -50,14 +50,28 @@ struct RobotOptions {
 /// first loop that has one, read from the reactive configuration its entry names), as the robot
 /// gives it to its hardware (HardwareConfig::base): what a simulator of the base in another process
 /// needs. nullopt when no loop drives a controller; throws ConfigError (located) for a bad entry.
-[[nodiscard]] std::optional<ControllerConfig> base_controller_config(const RobotProfile& profile);
+/// Controller types are checked against `controllers`: the application's registry when it has
+/// types of its own (RobotPlugins::controllers), the built-in ones by default.
+[[nodiscard]] std::optional<ControllerConfig> base_controller_config(
+    const RobotProfile& profile, const ControllerRegistry& controllers = default_controller_registry());
+
+/// Every start-up check of Robot::assemble that builds no instance, as `tripodal describe` runs
+/// them: the tasks and recovery rules, one provider per input and the layering rules
+/// (describe_robot), every type registered — a type only declared in the profile (layer, inputs,
+/// outputs) draws the diagram of a design: a warning here, an error at assembly —, the process
+/// nets loaded and each behavior
+/// they bind listed under the profile's behaviors (and not a safety one), behaviors named by their
+/// type, the controllers' reactive configurations read through `plugins.controllers`. Problems go
+/// to `d`, located in the profile or the file they are in; returns the diagram.
+[[nodiscard]] RobotDescription check_robot(const RobotProfile& profile, const RobotPlugins& plugins, Diagnostics& d);
 
 class Robot final {
  public:
-  /// Builds the robot. Throws ConfigError listing every problem, located: unknown types (the
-  /// closest registered name suggested), missing or duplicate providers, layering violations,
-  /// nets that do not load, processes binding behaviors the robot lacks, task templates or
-  /// recovery rules naming unknown processes, modules that do not configure or start.
+  /// Builds the robot. Throws ConfigError listing every problem, located: those of check_robot()
+  /// (unknown types, the closest registered name suggested; types declared in the profile but not
+  /// registered; missing or duplicate providers, layering violations, nets that do not load,
+  /// processes binding behaviors the robot lacks, task templates or recovery rules naming unknown
+  /// processes), then hardware, resources and modules that do not configure or start.
   static std::unique_ptr<Robot> assemble(const RobotProfile& profile, const RobotPlugins& plugins, Clock& clock,
                                          RobotOptions options = {});
   ~Robot();
