@@ -1,6 +1,7 @@
 #include "tripodal/hri/hri_module.hpp"
 
 #include <algorithm>
+#include <array>
 
 #include "text.hpp"
 
@@ -72,6 +73,49 @@ std::string plain_refusal(std::string_view explanation) {
     }
   }
   return detail.empty() ? "Sorry, I did not understand that command." : "Sorry, I did not understand that command: " + detail + ".";
+}
+
+namespace {
+
+// "0, 1 or 2".
+std::string spoken_list(const std::vector<std::string>& items) {
+  std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i) out += (i == 0 ? "" : i + 1 == items.size() ? " or " : ", ") + items[i];
+  return out;
+}
+
+// The "(known: 0, 1, 2)" a TaskKnowledge's refusal ends with (task_library.hpp's convention).
+std::vector<std::string> known_in(std::string_view explanation) {
+  std::vector<std::string> out;
+  const auto at = explanation.rfind("(known: ");
+  if (at == std::string_view::npos) return out;
+  const auto end = explanation.find(')', at);
+  if (end == std::string_view::npos) return out;
+  std::string_view rest = explanation.substr(at + 8, end - at - 8);
+  while (!rest.empty()) {
+    const auto comma = rest.find(", ");
+    out.emplace_back(rest.substr(0, comma));
+    if (comma == std::string_view::npos) break;
+    rest.remove_prefix(comma + 2);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string HriModule::refusal(const Understanding& u) const {
+  std::vector<std::string> places = knowledge_.known(options_.places_list);
+  if (places.empty()) places = known_in(u.explanation);
+  const std::string offer = places.empty() ? std::string() : " I can " + options_.places_offer + " " + spoken_list(places) + ".";
+  if (!u.task.empty()) {
+    // Understood, not plannable: a place that does not exist, or the planner's own reason.
+    if (const auto slot = u.slots.find(options_.places_list); slot != u.slots.end() && !places.empty() &&
+                                                              std::find(places.begin(), places.end(), slot->second) == places.end()) {
+      return "Sorry, there is no " + options_.places_list + " " + slot->second + " here." + offer;
+    }
+    return plain_refusal(u.explanation);
+  }
+  return "Sorry, I did not understand that request." + offer;
 }
 
 std::string display_text(const InternalState& state) {
@@ -204,7 +248,10 @@ HriReply HriModule::handle_heard(const SpeechRecognizer::Result& heard) {
   bool from_alternative = false;
   // Only a command is taken from the alternatives: the task grammar is strict, so a sentence
   // misheard into a full command is rare, while retrieval finds some entry in almost anything.
-  if (!chosen.understood()) {
+  // Never for a command heard whole that names what does not exist: "node seven" must not become
+  // the guide to node one an alternative heard.
+  const bool names_unknown = chosen.what == Decision::What::refuse_command && !chosen.understanding.task.empty();
+  if (!chosen.understood() && !names_unknown) {
     for (const auto& alt : heard.alternatives) {
       if (alt.log_score < -options_.max_alternative_log_gap) continue;
       if (Decision d = decide(typed_form(alt.words)); d.what == Decision::What::command) {
@@ -218,22 +265,34 @@ HriReply HriModule::handle_heard(const SpeechRecognizer::Result& heard) {
   // A task heard unsurely (a command, or an answer whose entry starts one) waits for a yes.
   const bool starts_task = chosen.what == Decision::What::command ||
                            (chosen.what == Decision::What::answer && !entries_[chosen.retrieval.hits.front().entry].action.empty());
-  if (starts_task && (from_alternative || heard.confidence < options_.confirm_heard_tasks_below)) {
-    HriReply reply;
-    reply.kind = HriReply::Kind::confirm_task;
-    if (chosen.what == Decision::What::command) {
-      reply.task = chosen.understanding.task;
-    } else {
-      const KnowledgeEntry& e = entries_[chosen.retrieval.hits.front().entry];
-      reply.entry_id = e.id;
-      reply.task = tasks_.understand(e.action, knowledge_).task;
-    }
-    reply.confidence = heard.confidence;
-    reply.text = "Did you say \"" + typed_form(words) + "\"? Please say yes or no.";
-    asked_ = std::move(chosen);
-    return remember("heard", words, std::move(reply));
+  const bool consented = chosen.what == Decision::What::command && chosen.whole && !from_alternative &&
+                         heard.confidence >= options_.confirm_heard_tasks_below;
+  if (starts_task && options_.confirm_heard_tasks_below > 0.0 && !consented) {
+    return remember("heard", words, ask_about(std::move(chosen), typed_form(words), heard.confidence));
   }
   return remember("heard", words, carry_out(chosen));
+}
+
+HriReply HriModule::ask_about(Decision chosen, std::string_view words, double confidence) {
+  HriReply reply;
+  reply.kind = HriReply::Kind::confirm_task;
+  if (chosen.what == Decision::What::command) {
+    reply.task = chosen.understanding.task;
+  } else {
+    const KnowledgeEntry& e = entries_[chosen.retrieval.hits.front().entry];
+    reply.entry_id = e.id;
+    reply.task = tasks_.understand(e.action, knowledge_).task;
+  }
+  reply.confidence = confidence;
+  reply.text = "Did you say \"" + std::string(words) + "\"? Please say yes or no.";
+  asked_ = std::move(chosen);
+  return reply;
+}
+
+bool HriModule::is_question(std::string_view utterance) {
+  const auto ws = hri::words(utterance);
+  static constexpr std::array<std::string_view, 9> kAsking = {"what", "where", "who", "whom", "which", "why", "when", "how", "whats"};
+  return !ws.empty() && std::find(kAsking.begin(), kAsking.end(), ws.front()) != kAsking.end();
 }
 
 std::optional<HriReply> HriModule::answer_to_question(std::string_view input) {
@@ -260,7 +319,17 @@ HriReply HriModule::handle(std::string_view utterance) {
   const bool readable = utterance.size() <= options_.max_utterance_bytes && hri::is_text(utterance);
   if (!readable) asked_.reset();  // refused unread: not an answer, and the question is dropped
   std::optional<HriReply> answered = readable ? answer_to_question(utterance) : std::nullopt;
-  HriReply reply = answered ? std::move(*answered) : classify(utterance);
+  HriReply reply;
+  if (answered) {
+    reply = std::move(*answered);
+  } else if (Decision d = decide(utterance); d.what == Decision::What::answer && is_question(utterance) &&
+                                             !entries_[d.retrieval.hits.front().entry].action.empty()) {
+    // A question is not a request: an entry that would start a task ("what will you show me" ->
+    // the visit to PSR-1) asks first, even typed.
+    reply = ask_about(std::move(d), utterance, 1.0);
+  } else {
+    reply = carry_out(d);
+  }
   // What the display may show of the input: the text itself, unless it was refused unread.
   std::string shown = utterance.size() > options_.max_utterance_bytes ? "(" + std::to_string(utterance.size()) + " bytes: too long)"
                       : !hri::is_text(utterance)                       ? "(" + std::to_string(utterance.size()) + " bytes: not text)"
@@ -295,10 +364,17 @@ HriModule::Decision HriModule::decide(std::string_view utterance) const {
   // The words as typed first: typo correction knows only the base's and the commands' words, and
   // could bend a slot's value ("carry the kettle ...") towards one of them.
   d.what = Decision::What::command;
-  const std::vector<std::string> typed_words = hri::without_politeness(hri::words(utterance));
+  const std::vector<std::string> typed_words = hri::command_phrasing(hri::words(utterance));
   d.understanding = tasks_.understand(joined(typed_words), knowledge_);
+  d.whole = d.understanding.understood;
   if (d.understanding.understood) return d;
-  d.understanding = tasks_.understand(joined(hri::without_politeness(hri::words(corrected))), knowledge_);
+  // A request naming a place that does not exist is refused, never bent towards a known one.
+  if (!d.understanding.task.empty()) {
+    d.what = Decision::What::refuse_command;
+    d.text = refusal(d.understanding);
+    return d;
+  }
+  d.understanding = tasks_.understand(joined(hri::command_phrasing(hri::words(corrected))), knowledge_);
   if (d.understanding.understood) return d;
 
   d.retrieval = index_.search(utterance);
@@ -311,7 +387,7 @@ HriModule::Decision HriModule::decide(std::string_view utterance) const {
                              !entries_[r.hits.front().entry].action.empty();
   if (!d.understanding.task.empty() || (starts_like_command && !action_covers)) {
     d.what = Decision::What::refuse_command;
-    d.text = plain_refusal(d.understanding.explanation);
+    d.text = refusal(d.understanding);
     return d;
   }
   // A reaction input: answered from the RKMS.

@@ -46,3 +46,19 @@ enum class Answer { yes, no, neither };
 [[nodiscard]] std::vector<std::string> without_politeness(std::vector<std::string> ws);
 
 }  // namespace tripodal::hri
+
+namespace tripodal::hri {
+
+/// The words of a request as the task grammar is written ("guide me to node 1"): without fillers
+/// ("um", "well", "okay", "hey", the robot's name "jinny" first or last), polite openings ("could
+/// you", "i'd like you to") and tails ("for me", "please", "now", "if you can"); "i want to go to"
+/// as "go to", "show us node" and "i would like to see node" as "take me to node", "us" after a
+/// guiding verb as "me", and the number after "node" ("node number one", "node twelve") as digits
+/// (zero to twenty). Every rule is grammar: a word it does not know is left for the planner to
+/// refuse, so a command parsed from the result accounts for every word of the request.
+[[nodiscard]] std::vector<std::string> command_phrasing(std::vector<std::string> ws);
+
+/// "zero".."twenty" as "0".."20"; other words unchanged.
+[[nodiscard]] std::string number_word_as_digits(const std::string& word);
+
+}  // namespace tripodal::hri

@@ -105,10 +105,10 @@ TEST_CASE("GuideHri: reaction inputs from the robot's RKMS, an edit answered at 
   CHECK(r.entry_id == "souvenirs");
   CHECK(KnowledgeBase::load(g.dir / "jinny.xml").version() == 2);
 
-  // A command with a node the hall lacks: the planner's reason, in plain words; nothing starts.
+  // A command with a node the hall lacks: refused with the nodes there are (from the planner's reason); nothing starts.
   r = service.ask("guide me to node 7");
   CHECK(r.kind == HriReply::Kind::task_refused);
-  CHECK_THAT(r.text, Contains("unknown node '7' (known: 0, 1, 2)"));
+  CHECK(r.text == "Sorry, there is no node 7 here. I can guide you to node 0, 1 or 2.");
   CHECK_FALSE(g.robot->planner().busy());
   CHECK(guide.take_started_task().empty());
 

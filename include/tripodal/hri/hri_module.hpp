@@ -40,12 +40,19 @@ struct HriOptions {
   /// less likely (natural log of the path score ratio) are tried in order, and the first one
   /// understood is acted on. 0 turns the n-best list off.
   double max_alternative_log_gap = 1.0;
-  /// A command heard less surely than this (SpeechRecognizer::Result::confidence), or taken from
-  /// the recognizer's alternatives, and an answer whose entry starts a task heard less surely, are
-  /// not carried out at once: the HRI asks 'Did you say "..."? Please say yes or no.' and carries
-  /// it out on a yes (confirm_task, then task_started or answered; task_cancelled on a no); any
-  /// other input drops the question. A robot must not drive off on a misheard thanks. 0 never asks.
-  double confirm_heard_tasks_below = 0.05;
+  /// No task without consent: a task from speech starts at once only when the command was parsed
+  /// whole (every word of what was heard accounted for by the command grammar: no typo correction,
+  /// not from the recognizer's alternatives, not an RKMS entry's action) and heard at least this
+  /// surely (SpeechRecognizer::Result::confidence). Any other task from speech is asked about
+  /// first: 'Did you say "..."? Please say yes or no.', carried out on a yes (confirm_task, then
+  /// task_started or answered; task_cancelled on a no); any other input drops the question. A robot
+  /// must not drive off on a misheard question. 0 never asks.
+  double confirm_heard_tasks_below = 0.5;
+  /// The planner's list of the places a visitor can be guided to ("node": TaskKnowledge::known, or
+  /// the "(known: ...)" of the planner's refusal), and how a refusal offers them: "I can guide you
+  /// to node 0, 1 or 2."
+  std::string places_list = "node";
+  std::string places_offer = "guide you to node";
   /// LED buttons (Table 3): each button's name and the request a press stands for ("hello" ->
   /// "Introduce yourself."). A press is handled as that input was typed.
   std::map<std::string, std::string, std::less<>> buttons;
@@ -160,11 +167,16 @@ class HriModule {
     std::string text;             // refuse_input, refuse_command: what to say
     Understanding understanding;  // command, refuse_command
     Retrieval retrieval;          // answer, not_understood
+    bool whole = false;           // command: parsed from the words as given, every one accounted for
     [[nodiscard]] bool understood() const noexcept { return what == What::command || what == What::answer; }
   };
   [[nodiscard]] Decision decide(std::string_view utterance) const;
   HriReply carry_out(const Decision& decision);
   HriReply classify(std::string_view utterance) { return carry_out(decide(utterance)); }
+  // confirm_task: 'Did you say "words"? Please say yes or no.', remembering what was asked about.
+  HriReply ask_about(Decision chosen, std::string_view words, double confidence);
+  // Starts with a question word ("what", "where", "how", ...): a question, not a request.
+  [[nodiscard]] static bool is_question(std::string_view utterance);
   // The visitor's answer to a confirm_task question: a reply when `words` say yes or no; nullopt
   // (and the question dropped) otherwise.
   std::optional<HriReply> answer_to_question(std::string_view words);
@@ -172,6 +184,8 @@ class HriModule {
   HriReply answer(const KnowledgeEntry& entry, double confidence);
   HriReply command(const Understanding& understanding);
   [[nodiscard]] std::string fill(std::string_view answer) const;
+  // What a refused command is told: what does not exist, and what the robot can do instead.
+  [[nodiscard]] std::string refusal(const Understanding& understanding) const;
 
   std::vector<KnowledgeEntry> entries_;
   const TaskLibrary& tasks_;

@@ -29,6 +29,9 @@ class TaskKnowledge {
   };
   virtual ~TaskKnowledge() = default;
   [[nodiscard]] virtual ListResult list(std::string_view function, std::string_view argument) const = 0;
+  /// Every argument `function` knows ("node" -> 0, 1, 2), for telling a user what is possible
+  /// (the HRI's refusals); empty when the knowledge cannot enumerate them.
+  [[nodiscard]] virtual std::vector<std::string> known(std::string_view /*function*/) const { return {}; }
 };
 
 /// One word of a command pattern: a literal ("clean"), an optional literal ("[the]"), a slot
