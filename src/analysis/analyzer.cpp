@@ -101,8 +101,12 @@ std::vector<std::uint8_t> can_reach_outcome(const StateSpace& space) {
 }
 
 // The first state, in BFS order (so with a shortest path), where place p holds at least `k`.
-std::optional<StateId> first_state_with(const StateSpace& space, PlaceIndex p, Tokens k) {
-  for (StateId s = 0; s < space.states(); ++s) {
+// Each marking costs O(places) to unpack: the scan stops after a budget of place reads, so a
+// huge net with such a place is still reported, with its largest-count state instead.
+std::optional<StateId> first_state_with(const StateSpace& space, PlaceIndex p, Tokens k, std::size_t places) {
+  constexpr std::size_t kBudget = 400'000'000;
+  const std::size_t states = std::min<std::size_t>(space.states(), kBudget / std::max<std::size_t>(places, 1));
+  for (StateId s = 0; s < states; ++s) {
     if (space.marking(s)[p] >= k) return s;
   }
   return std::nullopt;
@@ -281,7 +285,8 @@ AnalysisReport analyze(const PetriNet& net, const AnalysisOptions& options) {
   for (PlaceIndex p = 0; p < r.places; ++p) {
     const Place& place = net.place(p);
     if ((!place.behavior && !place.process) || r.bounds[p].max_seen < 2) continue;
-    if (const auto s = first_state_with(space, p, 2)) r.double_started.push_back({p, witness_of(space, *s)});
+    const auto s = first_state_with(space, p, 2, r.places);
+    r.double_started.push_back({p, s ? witness_of(space, *s) : Witness{}});
   }
   // A search cut short on a net that may be unbounded: look for the cycle that fills it.
   const bool may_grow =
@@ -294,6 +299,7 @@ AnalysisReport analyze(const PetriNet& net, const AnalysisOptions& options) {
     if (r.growth && r.growth->confirmed()) {
       r.bounded = Verdict::fail;
       r.safe = Verdict::fail;
+      r.bounds[r.growth->place].kind = BoundKind::unbounded;
     }
   }
   {
@@ -449,9 +455,12 @@ OnceResult check_once(const PetriNet& net, Diagnostics& diagnostics, const Behav
   // Found in the explored part: errors even when the exploration stopped short.
   for (const DoubleStart& d : r.double_started) {
     const Place& place = net.place(d.place);
-    diagnostics.error(place.where, prefix + binding_of(place) + " is started twice: place '" + place.id + "' holds " +
-                                       std::to_string(d.witness.marking[d.place]) + " tokens in marking " +
-                                       marking_ids(net, d.witness.marking) + ", reached by " + path_ids(net, d.witness.path));
+    const std::string where =
+        d.witness.marking.empty()
+            ? "up to " + std::to_string(r.bounds[d.place].max_seen) + " tokens (the net is too large to search for the path)"
+            : std::to_string(d.witness.marking[d.place]) + " tokens in marking " + marking_ids(net, d.witness.marking) +
+                  ", reached by " + path_ids(net, d.witness.path);
+    diagnostics.error(place.where, prefix + binding_of(place) + " is started twice: place '" + place.id + "' holds " + where);
     failed = true;
   }
   if (r.growth && r.growth->confirmed()) {

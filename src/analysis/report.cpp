@@ -235,7 +235,7 @@ std::string format_text(const AnalysisReport& r, const PetriNet& net) {
     for (const DoubleStart& d : r.double_started) {
       const Place& p = net.place(d.place);
       out << "  " << p.id << " (" << (p.behavior ? p.behavior->behavior : p.process ? p.process->process : std::string()) << ")\n";
-      witness_text(out, net, d.witness);
+      if (!d.witness.marking.empty()) witness_text(out, net, d.witness);
     }
   }
 
@@ -328,7 +328,8 @@ std::string format_json(const AnalysisReport& r, const PetriNet& net) {
   for (const Witness& w : r.stuck) stuck.push_back(witness_json(net, w));
   Json doubles = Json::array();
   for (const DoubleStart& d : r.double_started) {
-    doubles.push_back({{"place", net.place(d.place).id}, {"witness", witness_json(net, d.witness)}});
+    doubles.push_back({{"place", net.place(d.place).id},
+                       {"witness", d.witness.marking.empty() ? Json(nullptr) : witness_json(net, d.witness)}});
   }
   Json growth = nullptr;
   if (r.growth) {

@@ -103,7 +103,8 @@ TEST_CASE("a place that grows without end is an error with the cycle that fills 
   REQUIRE(r.growth->pump.size() == 1);
   CHECK(net.transition(r.growth->pump[0]).id == "tick");
   CHECK(r.bounded == Verdict::fail);
-  CHECK_THAT(format_text(r, net), Contains("UNBOUNDED"));
+  CHECK(r.bounds[r.growth->place].kind == BoundKind::unbounded);
+  CHECK_THAT(format_text(r, net), Contains("UNBOUNDED (pumping cycle)") && Contains("  log: unbounded"));
   BehaviourCheckOptions o;
   o.max_states = 2'000;
   BehaviourCheckResult result;
