@@ -101,8 +101,8 @@ std::vector<std::uint8_t> can_reach_outcome(const StateSpace& space) {
 }
 
 // The first state, in BFS order (so with a shortest path), where place p holds at least `k`.
-// Each marking costs O(places) to unpack: the scan stops after a budget of place reads, so a
-// huge net with such a place is still reported, with its largest-count state instead.
+// Each marking costs O(places) to unpack: the scan stops after a budget of place reads (a huge
+// net with such a place is still reported, without the path).
 std::optional<StateId> first_state_with(const StateSpace& space, PlaceIndex p, Tokens k, std::size_t places) {
   constexpr std::size_t kBudget = 400'000'000;
   const std::size_t states = std::min<std::size_t>(space.states(), kBudget / std::max<std::size_t>(places, 1));
@@ -117,6 +117,14 @@ void apply(const detail::CompiledNet& c, TransitionIndex t, Marking& m) {
     const detail::Change& d = c.changes[i];
     m[d.place] = m[d.place] - d.consumed + d.produced;
   }
+}
+
+// The supervisor ends a net at an outcome: nothing fires after it.
+bool marks_outcome(const detail::CompiledNet& c, const Marking& m) {
+  for (PlaceIndex p = 0; p < m.size(); ++p) {
+    if (m[p] != 0 && c.is_outcome[p] != 0) return true;
+  }
+  return false;
 }
 
 bool may_fire(const detail::CompiledNet& c, const Marking& m, TransitionIndex t) {
@@ -163,7 +171,7 @@ std::optional<GrowthWitness> find_growth(const PetriNet& net, const StateSpace& 
         const Tokens start = cur[*grown];
         bool fired = true;
         for (const TransitionIndex t : g.pump) {
-          if (!may_fire(c, cur, t)) {
+          if (!may_fire(c, cur, t) || (options.stop_at_outcome && marks_outcome(c, cur))) {
             fired = false;
             break;
           }
