@@ -44,9 +44,9 @@ ParameterValues parse_parameter_assignments(const PetriNet& net, const std::vect
       std::vector<std::string> names;
       for (const auto& d : net.parameters) names.push_back(d.name);
       const auto close = closest_name(name, names);
-      problems.error(net.where, "--param '" + item + "': unknown parameter '" + name + "' (declared: " +
-                                    (declared.empty() ? std::string("none") : declared) + ")" +
-                                    (close ? "; did you mean '" + *close + "'?" : std::string()));
+      problems.error(net.where, "--param '" + item + "': unknown parameter '" + name +
+                                    "' (declared: " + (declared.empty() ? std::string("none") : declared) +
+                                    ")" + (close ? "; did you mean '" + *close + "'?" : std::string()));
       continue;
     }
     auto value = parse_value(decl->type, text);
@@ -105,7 +105,8 @@ std::vector<std::uint8_t> can_reach_outcome(const StateSpace& space) {
 // net with such a place is still reported, without the path).
 std::optional<StateId> first_state_with(const StateSpace& space, PlaceIndex p, Tokens k, std::size_t places) {
   constexpr std::size_t kBudget = 400'000'000;
-  const std::size_t states = std::min<std::size_t>(space.states(), kBudget / std::max<std::size_t>(places, 1));
+  const std::size_t states =
+      std::min<std::size_t>(space.states(), kBudget / std::max<std::size_t>(places, 1));
   for (StateId s = 0; s < states; ++s) {
     if (space.marking(s)[p] >= k) return s;
   }
@@ -138,7 +139,8 @@ bool may_fire(const detail::CompiledNet& c, const Marking& m, TransitionIndex t)
 // The cycle is then replayed from m_j under the analysis semantics: it confirms the growth when
 // it can fire again and again, each round growing the place (priorities and inhibitor arcs can
 // stop a cycle that a marking with more tokens would otherwise repeat).
-std::optional<GrowthWitness> find_growth(const PetriNet& net, const StateSpace& space, const AnalysisOptions& options) {
+std::optional<GrowthWitness> find_growth(const PetriNet& net, const StateSpace& space,
+                                         const AnalysisOptions& options) {
   if (space.states() == 0) return std::nullopt;
   constexpr std::size_t kMaxPath = 4096;  // ancestors compared: the search stays linear in the path
   constexpr std::size_t kWindow = 256;
@@ -163,7 +165,8 @@ std::optional<GrowthWitness> find_growth(const PetriNet& net, const StateSpace& 
       GrowthWitness g;
       g.place = *grown;
       g.prefix.assign(path.begin(), path.begin() + static_cast<std::ptrdiff_t>(i));
-      g.pump.assign(path.begin() + static_cast<std::ptrdiff_t>(i), path.begin() + static_cast<std::ptrdiff_t>(j));
+      g.pump.assign(path.begin() + static_cast<std::ptrdiff_t>(i),
+                    path.begin() + static_cast<std::ptrdiff_t>(j));
       g.before = m[i][*grown];
       Marking cur = m[j];
       g.after = cur[*grown];
@@ -300,8 +303,8 @@ AnalysisReport analyze(const PetriNet& net, const AnalysisOptions& options) {
   const bool may_grow =
       r.stop == StopReason::token_overflow ||
       (!complete && r.coverability_ran &&
-       (!r.coverability.complete ||
-        std::any_of(r.bounds.begin(), r.bounds.end(), [](const PlaceBound& b) { return b.may_be_unbounded; })));
+       (!r.coverability.complete || std::any_of(r.bounds.begin(), r.bounds.end(),
+                                                [](const PlaceBound& b) { return b.may_be_unbounded; })));
   if (may_grow) {
     r.growth = find_growth(net, space, options);
     if (r.growth && r.growth->confirmed()) {
@@ -433,9 +436,10 @@ std::string binding_of(const Place& p) {
 
 std::string growth_text(const PetriNet& net, const GrowthWitness& g) {
   return "place '" + net.place(g.place).id + "' grows without end: " +
-         (g.prefix.empty() ? std::string("from the initial marking") : "after " + path_ids(net, g.prefix)) + ", the cycle " +
-         path_ids(net, g.pump) + " can fire again and again, adding tokens each time (" + std::to_string(g.before) +
-         " -> " + std::to_string(g.after) + " after " + std::to_string(g.rounds + 1) + " rounds)";
+         (g.prefix.empty() ? std::string("from the initial marking") : "after " + path_ids(net, g.prefix)) +
+         ", the cycle " + path_ids(net, g.pump) + " can fire again and again, adding tokens each time (" +
+         std::to_string(g.before) + " -> " + std::to_string(g.after) + " after " +
+         std::to_string(g.rounds + 1) + " rounds)";
 }
 
 struct OnceResult {
@@ -463,12 +467,14 @@ OnceResult check_once(const PetriNet& net, Diagnostics& diagnostics, const Behav
   // Found in the explored part: errors even when the exploration stopped short.
   for (const DoubleStart& d : r.double_started) {
     const Place& place = net.place(d.place);
-    const std::string where =
-        d.witness.marking.empty()
-            ? "up to " + std::to_string(r.bounds[d.place].max_seen) + " tokens (the net is too large to search for the path)"
-            : std::to_string(d.witness.marking[d.place]) + " tokens in marking " + marking_ids(net, d.witness.marking) +
-                  ", reached by " + path_ids(net, d.witness.path);
-    diagnostics.error(place.where, prefix + binding_of(place) + " is started twice: place '" + place.id + "' holds " + where);
+    const std::string where = d.witness.marking.empty()
+                                  ? "up to " + std::to_string(r.bounds[d.place].max_seen) +
+                                        " tokens (the net is too large to search for the path)"
+                                  : std::to_string(d.witness.marking[d.place]) + " tokens in marking " +
+                                        marking_ids(net, d.witness.marking) + ", reached by " +
+                                        path_ids(net, d.witness.path);
+    diagnostics.error(place.where, prefix + binding_of(place) + " is started twice: place '" + place.id +
+                                       "' holds " + where);
     failed = true;
   }
   if (r.growth && r.growth->confirmed()) {
@@ -479,7 +485,8 @@ OnceResult check_once(const PetriNet& net, Diagnostics& diagnostics, const Behav
     if (r.growth && !r.growth->confirmed()) {
       diagnostics.note(net.place(r.growth->place).where,
                        prefix + "place '" + net.place(r.growth->place).id + "' may grow without end: " +
-                           (r.growth->prefix.empty() ? std::string("from the initial marking") : "after " + path_ids(net, r.growth->prefix)) +
+                           (r.growth->prefix.empty() ? std::string("from the initial marking")
+                                                     : "after " + path_ids(net, r.growth->prefix)) +
                            ", the cycle " + path_ids(net, r.growth->pump) + " adds tokens to it");
     }
     if (!failed) {
@@ -531,14 +538,18 @@ BehaviourCheckResult check_behaviour_detailed(const PetriNet& net, Diagnostics& 
   bool has_outcome = false;
   for (const Place& p : net.places()) has_outcome = has_outcome || p.outcome != Outcome::none;
   bool passed = true;
-  if (options.process_net && options.semantics == Semantics::engine && net.level == NetLevel::low && !has_outcome) {
-    diagnostics.error(net.where, "net '" + net.id + "' has no outcome place: the process supervisor ends a process "
-                                 "when a place with outcome=\"success\" or outcome=\"fault\" is marked, so this one "
-                                 "could never finish (mark its end places with an outcome)");
+  if (options.process_net && options.semantics == Semantics::engine && net.level == NetLevel::low &&
+      !has_outcome) {
+    diagnostics.error(net.where,
+                      "net '" + net.id +
+                          "' has no outcome place: the process supervisor ends a process "
+                          "when a place with outcome=\"success\" or outcome=\"fault\" is marked, so this one "
+                          "could never finish (mark its end places with an outcome)");
     passed = false;
   }
-  const std::vector<ParameterValues> sets =
-      options.parameter_sets.empty() ? std::vector<ParameterValues>{ParameterValues{}} : options.parameter_sets;
+  const std::vector<ParameterValues> sets = options.parameter_sets.empty()
+                                                ? std::vector<ParameterValues>{ParameterValues{}}
+                                                : options.parameter_sets;
   std::set<std::string> facts;
   std::vector<std::uint8_t> fired_somewhere(net.transitions().size(), 0);
   bool all_decided = true;
@@ -555,9 +566,10 @@ BehaviourCheckResult check_behaviour_detailed(const PetriNet& net, Diagnostics& 
       values.push_back(candidate_values(net, p));
       combinations *= values.back().size();
       if (combinations > kCheckParameterCombinations) {
-        diagnostics.note(net.where, "behaviour not checked: more than " + std::to_string(kCheckParameterCombinations) +
-                                        " combinations of the values the guards give parameters without defaults "
-                                        "(run tripodal-net analyze with --param NAME=VALUE)");
+        diagnostics.note(net.where,
+                         "behaviour not checked: more than " + std::to_string(kCheckParameterCombinations) +
+                             " combinations of the values the guards give parameters without defaults "
+                             "(run tripodal-net analyze with --param NAME=VALUE)");
         too_many = true;
         break;
       }
@@ -568,7 +580,8 @@ BehaviourCheckResult check_behaviour_detailed(const PetriNet& net, Diagnostics& 
     }
     std::string given_prefix;
     if (!options.parameter_sets.empty()) {
-      for (const auto& [k, v] : given) given_prefix += (given_prefix.empty() ? "with " : ", ") + k + "=" + tripodal::to_string(v);
+      for (const auto& [k, v] : given)
+        given_prefix += (given_prefix.empty() ? "with " : ", ") + k + "=" + tripodal::to_string(v);
     }
     std::vector<std::size_t> pick(open.size(), 0);
     for (std::size_t c = 0; c < combinations; ++c) {
@@ -576,7 +589,8 @@ BehaviourCheckResult check_behaviour_detailed(const PetriNet& net, Diagnostics& 
       std::string prefix = given_prefix;
       for (std::size_t i = 0; i < open.size(); ++i) {
         parameters[open[i]->name] = values[i][pick[i]];
-        prefix += (prefix.empty() ? "with " : ", ") + open[i]->name + "=" + tripodal::to_string(values[i][pick[i]]);
+        prefix +=
+            (prefix.empty() ? "with " : ", ") + open[i]->name + "=" + tripodal::to_string(values[i][pick[i]]);
       }
       if (!prefix.empty()) prefix += ": ";
       const OnceResult once = check_once(net, diagnostics, options, parameters, prefix);

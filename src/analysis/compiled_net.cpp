@@ -37,9 +37,9 @@ std::vector<Value> bind_parameters(const PetriNet& net, const ParameterValues& g
       std::vector<std::string> names;
       for (const auto& d : net.parameters) names.push_back(d.name);
       const auto close = closest_name(name, names);
-      problems.error(net.where, "unknown parameter '" + name + "' for " + net_name + " (declared: " +
-                                    (declared.empty() ? std::string("none") : declared) + ")" +
-                                    (close ? "; did you mean '" + *close + "'?" : std::string()));
+      problems.error(net.where, "unknown parameter '" + name + "' for " + net_name +
+                                    " (declared: " + (declared.empty() ? std::string("none") : declared) +
+                                    ")" + (close ? "; did you mean '" + *close + "'?" : std::string()));
     }
   }
   for (const Transition& tr : net.transitions()) {
@@ -69,9 +69,15 @@ std::vector<GuardState> classify_guards(const PetriNet& net, const std::vector<V
       }
     }
     switch (tr.guard->partial_evaluate(slots)) {
-      case Guard::Truth::no: out[t] = GuardState::never; break;
-      case Guard::Truth::yes: out[t] = GuardState::always; break;
-      case Guard::Truth::unknown: out[t] = GuardState::maybe; break;
+      case Guard::Truth::no:
+        out[t] = GuardState::never;
+        break;
+      case Guard::Truth::yes:
+        out[t] = GuardState::always;
+        break;
+      case Guard::Truth::unknown:
+        out[t] = GuardState::maybe;
+        break;
     }
   }
   return out;

@@ -193,7 +193,9 @@ std::string format_text(const AnalysisReport& r, const PetriNet& net) {
   out << "\nbounds: ";
   switch (r.bounded) {
     case Verdict::pass: out << "bounded"; break;
-    case Verdict::fail: out << (r.growth && r.growth->confirmed() ? "UNBOUNDED (pumping cycle)" : "UNBOUNDED (Karp-Miller)"); break;
+    case Verdict::fail:
+      out << (r.growth && r.growth->confirmed() ? "UNBOUNDED (pumping cycle)" : "UNBOUNDED (Karp-Miller)");
+      break;
     default: out << "unknown"; break;
   }
   out << "; 1-safe: " << (r.safe == Verdict::pass ? "yes" : r.safe == Verdict::fail ? "NO" : "unknown") << '\n';
@@ -225,16 +227,20 @@ std::string format_text(const AnalysisReport& r, const PetriNet& net) {
   if (r.growth) {
     const GrowthWitness& g = *r.growth;
     out << "  " << (g.confirmed() ? "grows without end: " : "may grow without end: ") << net.place(g.place).id
-        << ": after " << path_text(net, g.prefix) << ", repeating " << path_text(net, g.pump) << " adds tokens ("
-        << g.before << " -> " << g.after << (g.confirmed() ? ", replayed " + std::to_string(g.rounds) + " more times" : "")
-        << ")\n";
+        << ": after " << path_text(net, g.prefix) << ", repeating " << path_text(net, g.pump)
+        << " adds tokens (" << g.before << " -> " << g.after
+        << (g.confirmed() ? ", replayed " + std::to_string(g.rounds) + " more times" : "") << ")\n";
   }
   if (!r.double_started.empty()) {
     out << "\nbehaviors started twice: " << r.double_started.size()
         << " (a place binding a behavior or process holds 2 tokens)\n";
     for (const DoubleStart& d : r.double_started) {
       const Place& p = net.place(d.place);
-      out << "  " << p.id << " (" << (p.behavior ? p.behavior->behavior : p.process ? p.process->process : std::string()) << ")\n";
+      out << "  " << p.id << " ("
+          << (p.behavior  ? p.behavior->behavior
+              : p.process ? p.process->process
+                          : std::string())
+          << ")\n";
       if (!d.witness.marking.empty()) witness_text(out, net, d.witness);
     }
   }
@@ -247,7 +253,8 @@ std::string format_text(const AnalysisReport& r, const PetriNet& net) {
   };
   const char* so_far = r.complete() ? "" : " (so far)";
   out << "\ndead transitions" << so_far << ": " << list(r.dead_transitions, false) << '\n';
-  if (!r.guard_false.empty()) out << "  guards false for these parameters: " << list(r.guard_false, false) << '\n';
+  if (!r.guard_false.empty())
+    out << "  guards false for these parameters: " << list(r.guard_false, false) << '\n';
   out << "never-marked places" << so_far << ": " << list(r.never_marked, true) << '\n';
 
   out << "\noutcome check: ";
@@ -328,8 +335,9 @@ std::string format_json(const AnalysisReport& r, const PetriNet& net) {
   for (const Witness& w : r.stuck) stuck.push_back(witness_json(net, w));
   Json doubles = Json::array();
   for (const DoubleStart& d : r.double_started) {
-    doubles.push_back({{"place", net.place(d.place).id},
-                       {"witness", d.witness.marking.empty() ? Json(nullptr) : witness_json(net, d.witness)}});
+    doubles.push_back(
+        {{"place", net.place(d.place).id},
+         {"witness", d.witness.marking.empty() ? Json(nullptr) : witness_json(net, d.witness)}});
   }
   Json growth = nullptr;
   if (r.growth) {
@@ -364,7 +372,8 @@ std::string format_json(const AnalysisReport& r, const PetriNet& net) {
         {"bytes_per_state", r.bytes_per_state},
         {"bytes_per_marking", r.bytes_per_marking}}},
       {"deadlocks", {{"count", r.deadlock_count}, {"examples", std::move(deadlocks)}}},
-      {"bounds", {{"bounded", to_string(r.bounded)}, {"safe", to_string(r.safe)}, {"places", std::move(places)}}},
+      {"bounds",
+       {{"bounded", to_string(r.bounded)}, {"safe", to_string(r.safe)}, {"places", std::move(places)}}},
       {"coverability", std::move(coverability)},
       {"structure", {{"max_size", r.max_structural_size}, {"skipped", r.structure_skipped}}},
       {"double_started", std::move(doubles)},

@@ -297,10 +297,14 @@ Operand Guard::Impl::eval(std::uint32_t n, std::span<const Value* const> slots) 
 bool Guard::Impl::reads_unknown(std::uint32_t n, std::span<const Value* const> slots) const noexcept {
   const Node& node = nodes[n];
   switch (node.op) {
-    case Op::literal: return false;
-    case Op::ident: return node.a >= slots.size() || slots[node.a] == nullptr;
-    case Op::logical_not: return reads_unknown(node.a, slots);
-    default: return reads_unknown(node.a, slots) || reads_unknown(node.b, slots);
+    case Op::literal:
+      return false;
+    case Op::ident:
+      return node.a >= slots.size() || slots[node.a] == nullptr;
+    case Op::logical_not:
+      return reads_unknown(node.a, slots);
+    default:
+      return reads_unknown(node.a, slots) || reads_unknown(node.b, slots);
   }
 }
 
@@ -326,7 +330,8 @@ Guard::Truth Guard::Impl::partial(std::uint32_t n, std::span<const Value* const>
       if (a == Truth::yes || b == Truth::yes) return Truth::yes;
       return a == Truth::no && b == Truth::no ? Truth::no : Truth::unknown;
     }
-    default: return Truth::unknown;  // an unknown identifier, or a comparison reading one
+    default:
+      return Truth::unknown;  // an unknown identifier, or a comparison reading one
   }
 }
 

@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <array>
-#include <span>
 #include <charconv>
 #include <cmath>
 #include <limits>
 #include <set>
+#include <span>
 #include <stdexcept>
 
 #include "tripodal/core/registry.hpp"
@@ -80,8 +80,9 @@ void read_guard(const ReadContext& ctx, const XmlElement* e, Transition& t, cons
       if (decl == nullptr) {
         std::vector<std::string> names = names_of(net.parameters);
         for (auto& f : names_of(net.facts)) names.push_back(std::move(f));
-        ctx.error_at_value(e, "guard", "unknown parameter '" + ids[i] + "' in guard of transition '" + t.id + "' (" +
-                                           declared_list(net) + ")" + did_you_mean(ids[i], names),
+        ctx.error_at_value(e, "guard",
+                           "unknown parameter '" + ids[i] + "' in guard of transition '" + t.id + "' (" +
+                               declared_list(net) + ")" + did_you_mean(ids[i], names),
                            find_identifier(text, ids[i]));
         ok = false;
         continue;
@@ -125,9 +126,10 @@ void read_binding_params(const ReadContext& ctx, const XmlElement* e, std::vecto
       const std::string ref(value->substr(1));
       if (net.find_parameter(ref) == nullptr) {
         const auto close = closest_name(ref, names_of(net.parameters));
-        ctx.error_at_value(c, "value", "unknown parameter '$" + ref + "' passed to " + std::string(owner) +
-                                           " (declared parameters: " + join_names(net.parameters) + ")" +
-                                           (close ? "; did you mean '$" + *close + "'?" : std::string()));
+        ctx.error_at_value(c, "value",
+                           "unknown parameter '$" + ref + "' passed to " + std::string(owner) +
+                               " (declared parameters: " + join_names(net.parameters) + ")" +
+                               (close ? "; did you mean '$" + *close + "'?" : std::string()));
         continue;
       }
     }
@@ -373,8 +375,9 @@ void read_place_details(const ReadContext& ctx, const XmlElement* e, Place& plac
     const auto& known = behavior ? ctx.options.is_known_behavior : ctx.options.is_known_process;
     if (known && !known(*name)) {
       const auto& names = behavior ? ctx.options.behavior_names : ctx.options.process_names;
-      ctx.error_at_value(c, "name", "unknown " + std::string(kind) + " '" + std::string(*name) + "'" +
-                                        did_you_mean(*name, names));
+      ctx.error_at_value(
+          c, "name",
+          "unknown " + std::string(kind) + " '" + std::string(*name) + "'" + did_you_mean(*name, names));
     }
     std::vector<BindingParam> params;
     read_binding_params(ctx, c, params, net, std::string(kind) + " " + std::string(*name));
@@ -390,7 +393,8 @@ namespace {
 // process); a source that is not bound here but is close to one that is, and is written like one
 // (Bh.../Pr..., or an event .success/.fault), is a typo. Module events (localizer.lost,
 // board.battery_low) are left alone: the net cannot know them.
-void check_event_source(const ReadContext& ctx, const XmlElement* e, const std::string& event, const PetriNet& net) {
+void check_event_source(const ReadContext& ctx, const XmlElement* e, const std::string& event,
+                        const PetriNet& net) {
   const auto dot = event.rfind('.');
   if (dot == std::string::npos || dot == 0) return;
   const std::string source = event.substr(0, dot);
@@ -412,21 +416,24 @@ void check_event_source(const ReadContext& ctx, const XmlElement* e, const std::
     if (std::find(kinds_of_source->begin(), kinds_of_source->end(), kind) != kinds_of_source->end()) return;
     std::vector<std::string> own;
     for (const auto& k : *kinds_of_source) own.push_back(source + "." + k);
-    ctx.error_at_value(e, "event", "unknown event '" + event + "': '" + source + "' posts " + own[0] + " and " + own[1] +
-                                       did_you_mean(event, own));
+    ctx.error_at_value(e, "event",
+                       "unknown event '" + event + "': '" + source + "' posts " + own[0] + " and " + own[1] +
+                           did_you_mean(event, own));
     return;
   }
   // Behaviors and processes are named Bh... and Pr...; a process's events are its place's
   // (P1.success). Other sources are modules.
   const auto prefixed = [&](char a, char b) {
-    return source.size() > 2 && (source[0] == a || source[0] == a - 'a' + 'A') && (source[1] == b || source[1] == b - 'a' + 'A');
+    return source.size() > 2 && (source[0] == a || source[0] == a - 'a' + 'A') &&
+           (source[1] == b || source[1] == b - 'a' + 'A');
   };
   const bool looks_bound = prefixed('b', 'h') || prefixed('p', 'r') || kind == "success" || kind == "fault";
   if (!looks_bound) return;
   if (const auto close = closest_name(source, sources)) {
     const auto event_close = closest_name(*close + "." + kind, known_events);
-    ctx.error_at_value(e, "event", "unknown event '" + event + "': no place of net '" + net.id + "' binds '" + source +
-                                       "'; did you mean '" + (event_close ? *event_close : *close + "." + kind) + "'?");
+    ctx.error_at_value(e, "event",
+                       "unknown event '" + event + "': no place of net '" + net.id + "' binds '" + source +
+                           "'; did you mean '" + (event_close ? *event_close : *close + "." + kind) + "'?");
   }
 }
 
@@ -508,11 +515,13 @@ bool add_checked_arc(const ReadContext& ctx, const XmlElement* e, PetriNet& net,
     for (const Transition& t : net.transitions()) nodes.push_back(t.id);
   }
   if (!fp && !ft) {
-    ctx.error_at_value(e, "source", "arc from unknown node '" + std::string(from) + "'" + did_you_mean(from, nodes));
+    ctx.error_at_value(e, "source",
+                       "arc from unknown node '" + std::string(from) + "'" + did_you_mean(from, nodes));
     ok = false;
   }
   if (!tp && !tt) {
-    ctx.error_at_value(e, "target", "arc to unknown node '" + std::string(to) + "'" + did_you_mean(to, nodes));
+    ctx.error_at_value(e, "target",
+                       "arc to unknown node '" + std::string(to) + "'" + did_you_mean(to, nodes));
     ok = false;
   }
   if (!ok) return false;

@@ -1,7 +1,8 @@
 # Runs `tripodal-net check` on one net of the corpus of wrong nets (tests/data/nets/wrong/) and
 # compares with what the file's header comment expects:
 #   expect-exit: N        the exit status
-#   expect-args: A;B      extra arguments for check (optional)
+#   expect-args: A B      extra arguments for check, separated by spaces (optional); @DIR@ is
+#                         the net's directory
 #   expect: REGEX         the output (stdout and stderr) must match, one line per key part of the
 #                         message; no ';' (CMake would split the line): write '.' for it
 # Usage: cmake -DTOOL=tripodal-net -DNET=file.xml -P wrong_net.cmake
@@ -26,6 +27,9 @@ endforeach()
 if(exit_expected STREQUAL "" OR NOT patterns)
   message(FATAL_ERROR "${NET}: the header needs 'expect-exit: N' and at least one 'expect: REGEX' line")
 endif()
+get_filename_component(dir "${NET}" DIRECTORY)
+string(REPLACE "@DIR@" "${dir}" args "${args}")
+separate_arguments(args UNIX_COMMAND "${args}")
 execute_process(COMMAND "${TOOL}" check "${NET}" ${args} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 set(all "${out}${err}")
 message("${all}")

@@ -69,8 +69,8 @@ std::string file_head(const std::filesystem::path& file) {
 
 // The parameter sets of one file: those of the profiles that run it, and those of the command line.
 struct FileSets {
-  std::vector<ParameterSetText> sets;   // from --param / --params: every declared name must exist
-  std::vector<ProfileNet> profile;      // from --profile
+  std::vector<ParameterSetText> sets;  // from --param / --params: every declared name must exist
+  std::vector<ProfileNet> profile;     // from --profile
 };
 
 std::string key_of(const std::filesystem::path& p) {
@@ -81,7 +81,8 @@ std::string key_of(const std::filesystem::path& p) {
 
 // Checks one net file: the loader's diagnostics, then the behavioural checks on a net that loaded.
 FileStatus check_file(const std::filesystem::path& file, const LoadOptions& options, const Args& args,
-                      const FileSets& given, std::vector<PetriNet>& loaded, std::ostream& out, std::ostream& err) {
+                      const FileSets& given, std::vector<PetriNet>& loaded, std::ostream& out,
+                      std::ostream& err) {
   const bool behaviour = !args.no_behaviour;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec)) {
@@ -105,8 +106,10 @@ FileStatus check_file(const std::filesystem::path& file, const LoadOptions& opti
     check.process_net = check.semantics == analysis::Semantics::engine && net->level == NetLevel::low;
     check.max_states = args.max_states;
     check.max_memory_bytes = args.max_memory_mb << 20;
-    for (const ParameterSetText& s : given.sets) check.parameter_sets.push_back(typed_set(*net, s, false, diagnostics));
-    for (const ProfileNet& p : given.profile) check.parameter_sets.push_back(typed_set(*net, p.set, p.module, diagnostics));
+    for (const ParameterSetText& s : given.sets)
+      check.parameter_sets.push_back(typed_set(*net, s, false, diagnostics));
+    for (const ProfileNet& p : given.profile)
+      check.parameter_sets.push_back(typed_set(*net, p.set, p.module, diagnostics));
     if (!diagnostics.has_errors()) {
       try {
         result = analysis::check_behaviour_detailed(*net, diagnostics, check);
@@ -179,7 +182,7 @@ int run_check(const Args& args, std::ostream& out, std::ostream& err) {
       for (auto& s : load_parameter_sets(f)) sets.push_back(std::move(s));
     }
     for (const auto& profile : args.profiles) {
-      for (ProfileNet& n : profile_nets(profile)) {
+      for (ProfileNet& n : profile_nets(profile, &options.behavior_names)) {
         const std::string key = key_of(n.file);
         if (!by_file.count(key) && args.inputs.empty()) files.push_back(n.file);
         by_file[key].push_back(std::move(n));
@@ -188,6 +191,12 @@ int run_check(const Args& args, std::ostream& out, std::ostream& err) {
   } catch (const ConfigError& e) {
     err << e.diagnostics().str();
     return kBadInput;
+  }
+  // With profiles, the behaviors a net may bind are theirs: an unknown one gets a suggestion.
+  if (!args.profiles.empty()) {
+    options.is_known_behavior = [&options](std::string_view n) {
+      return std::find(options.behavior_names.begin(), options.behavior_names.end(), n) != options.behavior_names.end();
+    };
   }
   for (const auto& a : args.inputs) {
     if (std::filesystem::is_directory(a)) {
@@ -208,7 +217,8 @@ int run_check(const Args& args, std::ostream& out, std::ostream& err) {
     }
   }
   if (files.empty() && !unreadable) {
-    err << "tripodal-net check: no net files in " << (args.inputs.empty() ? std::string("the profiles") : args.inputs.front()) << '\n';
+    err << "tripodal-net check: no net files in "
+        << (args.inputs.empty() ? std::string("the profiles") : args.inputs.front()) << '\n';
     return kUsage;
   }
   bool invalid = false;
@@ -231,8 +241,9 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_option("FILE|DIR", a->inputs, "nets, or directories of *.xml and *.pnml nets");
   cmd.add_option("--param", a->params, "NAME=VALUE: check with this parameter value (repeatable: one set)")
       ->allow_extra_args(false);
-  cmd.add_option("--params", a->params_files,
-                 "FILE: YAML parameter sets to check with, a map NAME: VALUE or a list of such maps (repeatable)")
+  cmd.add_option(
+         "--params", a->params_files,
+         "FILE: YAML parameter sets to check with, a map NAME: VALUE or a list of such maps (repeatable)")
       ->allow_extra_args(false);
   cmd.add_option("--profile", a->profiles,
                  "ROBOT.yaml: check the profile's process nets with the parameters its process entries give "

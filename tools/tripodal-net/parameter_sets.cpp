@@ -27,7 +27,8 @@ std::vector<ParameterSetText> load_parameter_sets(const std::filesystem::path& f
       sets.push_back(std::move(set));
     };
     if (root.IsSequence()) {
-      for (std::size_t i = 0; i < root.size(); ++i) read_set(root[i], "parameter set " + std::to_string(i + 1));
+      for (std::size_t i = 0; i < root.size(); ++i)
+        read_set(root[i], "parameter set " + std::to_string(i + 1));
     } else {
       read_set(root, "parameter set");
     }
@@ -36,8 +37,11 @@ std::vector<ParameterSetText> load_parameter_sets(const std::filesystem::path& f
   });
 }
 
-std::vector<ProfileNet> profile_nets(const std::filesystem::path& profile) {
+std::vector<ProfileNet> profile_nets(const std::filesystem::path& profile, std::vector<std::string>* behaviors) {
   const RobotProfile p = load_robot_profile(profile);
+  if (behaviors != nullptr) {
+    for (const ModuleEntry& b : p.behaviors) behaviors->push_back(b.name);
+  }
   std::vector<ProfileNet> out;
   for (const ProcessEntry& e : p.processes) {
     ParameterSetText set;
@@ -50,7 +54,8 @@ std::vector<ProfileNet> profile_nets(const std::filesystem::path& profile) {
   return out;
 }
 
-ParameterValues typed_set(const PetriNet& net, const ParameterSetText& set, bool only_declared, Diagnostics& diagnostics) {
+ParameterValues typed_set(const PetriNet& net, const ParameterSetText& set, bool only_declared,
+                          Diagnostics& diagnostics) {
   ParameterValues out;
   std::vector<std::string> declared;
   for (const auto& d : net.parameters) declared.push_back(d.name);
@@ -59,8 +64,8 @@ ParameterValues typed_set(const PetriNet& net, const ParameterSetText& set, bool
     if (decl == nullptr) {
       if (only_declared) continue;
       const auto close = closest_name(name, declared);
-      diagnostics.error(set.where, set.origin + ": net '" + net.id + "' declares no parameter '" + name + "'" +
-                                       (close ? "; did you mean '" + *close + "'?" : std::string()));
+      diagnostics.error(set.where, set.origin + ": net '" + net.id + "' declares no parameter '" + name +
+                                       "'" + (close ? "; did you mean '" + *close + "'?" : std::string()));
       continue;
     }
     auto value = parse_value(decl->type, text);

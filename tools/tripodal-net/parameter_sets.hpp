@@ -28,13 +28,15 @@ struct ParameterSetText {
 [[nodiscard]] std::vector<ParameterSetText> load_parameter_sets(const std::filesystem::path& file);
 
 /// A profile's nets with the parameter sets it binds them with: for each process entry, its net
-/// and its module net (if any), each with the entry's parameters. Throws ConfigError.
+/// and its module net (if any), each with the entry's parameters; `behaviors` (if given) gets
+/// the names of the profile's behaviors, the ones its nets may bind. Throws ConfigError.
 struct ProfileNet {
   std::filesystem::path file;
   ParameterSetText set;
   bool module = false;  ///< the process's module net (high-level): it takes the parameters it declares
 };
-[[nodiscard]] std::vector<ProfileNet> profile_nets(const std::filesystem::path& profile);
+[[nodiscard]] std::vector<ProfileNet> profile_nets(const std::filesystem::path& profile,
+                                                 std::vector<std::string>* behaviors = nullptr);
 
 /// Types a set by the net's declarations. `only_declared`: names the net does not declare are
 /// skipped (a module net declares few of its process's parameters); else they are errors, with

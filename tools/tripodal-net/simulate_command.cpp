@@ -69,9 +69,9 @@ int run_simulate(const Args& args, std::ostream& out, std::ostream& err) {
       std::vector<std::string> names;
       for (const auto& d : net->parameters) names.push_back(d.name);
       const auto close = closest_name(name, names);
-      err << "tripodal-net simulate: the net declares no parameter '" << name << "' (declared: "
-          << (declared.empty() ? "none" : declared) << ")" << (close ? "; did you mean '" + *close + "'?" : std::string())
-          << "\n";
+      err << "tripodal-net simulate: the net declares no parameter '" << name
+          << "' (declared: " << (declared.empty() ? "none" : declared) << ")"
+          << (close ? "; did you mean '" + *close + "'?" : std::string()) << "\n";
       return kBadInput;
     }
     auto value = parse_value(decl->type, text);
@@ -109,7 +109,8 @@ int run_simulate(const Args& args, std::ostream& out, std::ostream& err) {
   const bool success = result.outcome == Outcome::success;
   if (!args.expect.empty() && (args.expect == "success") != success) {
     err << "tripodal-net simulate: expected " << args.expect << ", the run ended in "
-        << (success ? "success at " + result.outcome_place : "failure at " + result.outcome_place + ": " + result.fault_message)
+        << (success ? "success at " + result.outcome_place
+                    : "failure at " + result.outcome_place + ": " + result.fault_message)
         << "\n";
     return kBadInput;
   }
@@ -128,7 +129,8 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_flag("--no-stop", a->no_stop, "keep running after an outcome place is marked");
   cmd.add_flag("--allow-unknown-events", a->allow_unknown_events,
                "accept script events no transition waits for (they are dropped)");
-  cmd.add_option("--expect", a->expect, "success|failure: fail (exit 1) when the run ends in the other outcome")
+  cmd.add_option("--expect", a->expect,
+                 "success|failure: fail (exit 1) when the run ends in the other outcome")
       ->check(CLI::IsMember({"success", "failure"}));
   return [a](std::ostream& out, std::ostream& err) { return run_simulate(*a, out, err); };
 }
