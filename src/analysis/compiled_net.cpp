@@ -5,6 +5,7 @@
 #include <unordered_map>
 
 #include "tripodal/core/diagnostic.hpp"
+#include "tripodal/core/registry.hpp"
 
 namespace tripodal::analysis::detail {
 
@@ -33,8 +34,12 @@ std::vector<Value> bind_parameters(const PetriNet& net, const ParameterValues& g
     if (net.find_parameter(name) == nullptr) {
       std::string declared;
       for (const auto& d : net.parameters) declared += (declared.empty() ? "" : ", ") + d.name;
-      problems.error(net.where, "unknown parameter '" + name + "' for " + net_name + " (declared: " +
-                                    (declared.empty() ? std::string("none") : declared) + ")");
+      std::vector<std::string> names;
+      for (const auto& d : net.parameters) names.push_back(d.name);
+      const auto close = closest_name(name, names);
+      problems.error(net.where, "unknown parameter '" + name + "' for " + net_name +
+                                    " (declared: " + (declared.empty() ? std::string("none") : declared) +
+                                    ")" + (close ? "; did you mean '" + *close + "'?" : std::string()));
     }
   }
   for (const Transition& tr : net.transitions()) {
@@ -50,6 +55,34 @@ std::vector<Value> bind_parameters(const PetriNet& net, const ParameterValues& g
   return values;
 }
 
+std::vector<GuardState> classify_guards(const PetriNet& net, const std::vector<Value>& parameter_values) {
+  std::vector<GuardState> out(net.transitions().size(), GuardState::always);
+  std::vector<const Value*> slots;
+  for (TransitionIndex t = 0; t < out.size(); ++t) {
+    const Transition& tr = net.transition(t);
+    if (!tr.guard) continue;
+    const auto& ids = tr.guard->identifiers();
+    slots.assign(ids.size(), nullptr);
+    for (std::size_t s = 0; s < ids.size(); ++s) {
+      for (std::size_t i = 0; i < net.parameters.size() && i < parameter_values.size(); ++i) {
+        if (net.parameters[i].name == ids[s]) slots[s] = &parameter_values[i];
+      }
+    }
+    switch (tr.guard->partial_evaluate(slots)) {
+      case Guard::Truth::no:
+        out[t] = GuardState::never;
+        break;
+      case Guard::Truth::yes:
+        out[t] = GuardState::always;
+        break;
+      case Guard::Truth::unknown:
+        out[t] = GuardState::maybe;
+        break;
+    }
+  }
+  return out;
+}
+
 CompiledNet::CompiledNet(const PetriNet& net, const ParameterValues& parameters, CompileOptions options)
     : places(net.places().size()), transitions(net.transitions().size()), semantics(options.semantics) {
   const std::vector<Value> values = bind_parameters(net, parameters);
@@ -62,28 +95,11 @@ CompiledNet::CompiledNet(const PetriNet& net, const ParameterValues& parameters,
   is_outcome.assign(places, 0);
   for (PlaceIndex p = 0; p < places; ++p) is_outcome[p] = pl[p].outcome != Outcome::none ? 1 : 0;
   std::vector<Change> scratch;
+  guard = classify_guards(net, values);
 
   for (TransitionIndex t = 0; t < transitions; ++t) {
     const Transition& tr = net.transition(t);
     kind[t] = !tr.event.empty() ? Kind::event : (tr.delay.count() > 0 ? Kind::delayed : Kind::immediate);
-    guard[t] = GuardState::always;
-    if (tr.guard) {
-      const auto& ids = tr.guard->identifiers();
-      std::vector<const Value*> slots(ids.size(), nullptr);
-      bool reads_fact = false;
-      for (std::size_t s = 0; s < ids.size(); ++s) {
-        for (std::size_t i = 0; i < net.parameters.size(); ++i) {
-          if (net.parameters[i].name == ids[s]) slots[s] = &values[i];
-        }
-        if (slots[s] == nullptr) reads_fact = true;
-      }
-      if (reads_fact) {
-        guard[t] = GuardState::maybe;
-      } else {
-        guard[t] = tr.guard->evaluate(slots) ? GuardState::always : GuardState::never;
-      }
-    }
-
     // Only the places whose count a firing changes matter to the search.
     scratch.clear();
     tripodal::detail::fold_transition(net, tr, {.capacities_and_inhibitors = !options.monotone}, checks, scratch);

@@ -121,6 +121,10 @@ class CompiledNet {
   }
 };
 
+/// Each transition's guard with the parameters bound and the facts unknown (three-valued: a
+/// conjunct false by the parameters alone makes the guard never true, whatever the facts).
+std::vector<GuardState> classify_guards(const PetriNet& net, const std::vector<Value>& parameter_values);
+
 /// Checks parameter values against the declarations (defaults applied, types, unknown names)
 /// and that guards read only declared names; throws ConfigError listing every problem.
 std::vector<Value> bind_parameters(const PetriNet& net, const ParameterValues& given);

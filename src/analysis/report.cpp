@@ -193,7 +193,9 @@ std::string format_text(const AnalysisReport& r, const PetriNet& net) {
   out << "\nbounds: ";
   switch (r.bounded) {
     case Verdict::pass: out << "bounded"; break;
-    case Verdict::fail: out << "UNBOUNDED (Karp-Miller)"; break;
+    case Verdict::fail:
+      out << (r.growth && r.growth->confirmed() ? "UNBOUNDED (pumping cycle)" : "UNBOUNDED (Karp-Miller)");
+      break;
     default: out << "unknown"; break;
   }
   out << "; 1-safe: " << (r.safe == Verdict::pass ? "yes" : r.safe == Verdict::fail ? "NO" : "unknown") << '\n';
@@ -222,6 +224,27 @@ std::string format_text(const AnalysisReport& r, const PetriNet& net) {
     out << '\n';
   }
 
+  if (r.growth) {
+    const GrowthWitness& g = *r.growth;
+    out << "  " << (g.confirmed() ? "grows without end: " : "may grow without end: ") << net.place(g.place).id
+        << ": after " << path_text(net, g.prefix) << ", repeating " << path_text(net, g.pump)
+        << " adds tokens (" << g.before << " -> " << g.after
+        << (g.confirmed() ? ", replayed " + std::to_string(g.rounds) + " more times" : "") << ")\n";
+  }
+  if (!r.double_started.empty()) {
+    out << "\nbehaviors started twice: " << r.double_started.size()
+        << " (a place binding a behavior or process holds 2 tokens)\n";
+    for (const DoubleStart& d : r.double_started) {
+      const Place& p = net.place(d.place);
+      out << "  " << p.id << " ("
+          << (p.behavior  ? p.behavior->behavior
+              : p.process ? p.process->process
+                          : std::string())
+          << ")\n";
+      if (!d.witness.marking.empty()) witness_text(out, net, d.witness);
+    }
+  }
+
   auto list = [&](const std::vector<std::uint32_t>& items, bool places) {
     std::vector<std::string> names;
     names.reserve(items.size());
@@ -230,6 +253,8 @@ std::string format_text(const AnalysisReport& r, const PetriNet& net) {
   };
   const char* so_far = r.complete() ? "" : " (so far)";
   out << "\ndead transitions" << so_far << ": " << list(r.dead_transitions, false) << '\n';
+  if (!r.guard_false.empty())
+    out << "  guards false for these parameters: " << list(r.guard_false, false) << '\n';
   out << "never-marked places" << so_far << ": " << list(r.never_marked, true) << '\n';
 
   out << "\noutcome check: ";
@@ -265,9 +290,10 @@ std::string format_text(const AnalysisReport& r, const PetriNet& net) {
   // A cut search never says OK: it says what was found so far and that the rest is unknown.
   out << "\nverdict: ";
   if (r.ok()) {
-    out << "OK\n";
+    // Facts are free in the analysis: an OK that depends on them says so.
+    out << "OK" << (r.assumed_facts.empty() ? "" : " under " + assumption_text(r.assumed_facts)) << '\n';
   } else if (!r.complete()) {
-    const bool found = r.deadlock_count > 0 || r.bounded == Verdict::fail;
+    const bool found = r.deadlock_count > 0 || r.bounded == Verdict::fail || !r.double_started.empty();
     out << (found ? "PROBLEMS FOUND; " : "") << "INCOMPLETE: not every reachable marking was explored ("
         << incomplete_reason(r) << ")\n";
   } else {
@@ -307,6 +333,22 @@ std::string format_json(const AnalysisReport& r, const PetriNet& net) {
   }
   Json stuck = Json::array();
   for (const Witness& w : r.stuck) stuck.push_back(witness_json(net, w));
+  Json doubles = Json::array();
+  for (const DoubleStart& d : r.double_started) {
+    doubles.push_back(
+        {{"place", net.place(d.place).id},
+         {"witness", d.witness.marking.empty() ? Json(nullptr) : witness_json(net, d.witness)}});
+  }
+  Json growth = nullptr;
+  if (r.growth) {
+    growth = {{"place", net.place(r.growth->place).id},
+              {"prefix", ids_json(net, r.growth->prefix, false)},
+              {"pump", ids_json(net, r.growth->pump, false)},
+              {"before", r.growth->before},
+              {"after", r.growth->after},
+              {"rounds", r.growth->rounds},
+              {"confirmed", r.growth->confirmed()}};
+  }
   Json invariants = nullptr;
   if (r.invariants_computed) {
     invariants = {{"place", invariants_json(net, r.p_invariants, true)},
@@ -330,10 +372,14 @@ std::string format_json(const AnalysisReport& r, const PetriNet& net) {
         {"bytes_per_state", r.bytes_per_state},
         {"bytes_per_marking", r.bytes_per_marking}}},
       {"deadlocks", {{"count", r.deadlock_count}, {"examples", std::move(deadlocks)}}},
-      {"bounds", {{"bounded", to_string(r.bounded)}, {"safe", to_string(r.safe)}, {"places", std::move(places)}}},
+      {"bounds",
+       {{"bounded", to_string(r.bounded)}, {"safe", to_string(r.safe)}, {"places", std::move(places)}}},
       {"coverability", std::move(coverability)},
       {"structure", {{"max_size", r.max_structural_size}, {"skipped", r.structure_skipped}}},
+      {"double_started", std::move(doubles)},
+      {"growth", std::move(growth)},
       {"dead_transitions", ids_json(net, r.dead_transitions, false)},
+      {"guard_false", ids_json(net, r.guard_false, false)},
       {"never_marked_places", ids_json(net, r.never_marked, true)},
       {"outcome",
        {{"verdict", to_string(r.outcome)},
@@ -341,6 +387,7 @@ std::string format_json(const AnalysisReport& r, const PetriNet& net) {
         {"stuck_count", r.stuck_count},
         {"stuck", std::move(stuck)}}},
       {"invariants", std::move(invariants)},
+      {"assumed_facts", r.assumed_facts},
       {"ok", r.ok()}};
   // Names come from net files: a byte sequence that is not UTF-8 is replaced, not thrown on.
   return out.dump(-1, ' ', false, Json::error_handler_t::replace) + '\n';

@@ -49,6 +49,8 @@ struct Guard::Impl {
   std::uint32_t root = 0;
 
   Operand eval(std::uint32_t n, std::span<const Value* const> slots) const noexcept;
+  Guard::Truth partial(std::uint32_t n, std::span<const Value* const> slots) const noexcept;
+  bool reads_unknown(std::uint32_t n, std::span<const Value* const> slots) const noexcept;
   bool truth(std::uint32_t n, std::span<const Value* const> slots) const noexcept {
     const Operand o = eval(n, slots);
     return o.valid && o.type == ValueType::boolean && o.boolean;
@@ -292,6 +294,47 @@ Operand Guard::Impl::eval(std::uint32_t n, std::span<const Value* const> slots) 
   return boolean(false);
 }
 
+bool Guard::Impl::reads_unknown(std::uint32_t n, std::span<const Value* const> slots) const noexcept {
+  const Node& node = nodes[n];
+  switch (node.op) {
+    case Op::literal:
+      return false;
+    case Op::ident:
+      return node.a >= slots.size() || slots[node.a] == nullptr;
+    case Op::logical_not:
+      return reads_unknown(node.a, slots);
+    default:
+      return reads_unknown(node.a, slots) || reads_unknown(node.b, slots);
+  }
+}
+
+// Kleene's logic over the same rules as truth(): a node that reads no unknown value is decided
+// by eval(); otherwise the connectives decide what they can without it.
+Guard::Truth Guard::Impl::partial(std::uint32_t n, std::span<const Value* const> slots) const noexcept {
+  const Node& node = nodes[n];
+  if (!reads_unknown(n, slots)) return truth(n, slots) ? Truth::yes : Truth::no;
+  switch (node.op) {
+    case Op::logical_not: {
+      const Truth a = partial(node.a, slots);
+      return a == Truth::unknown ? a : (a == Truth::yes ? Truth::no : Truth::yes);
+    }
+    case Op::logical_and: {
+      const Truth a = partial(node.a, slots);
+      const Truth b = partial(node.b, slots);
+      if (a == Truth::no || b == Truth::no) return Truth::no;
+      return a == Truth::yes && b == Truth::yes ? Truth::yes : Truth::unknown;
+    }
+    case Op::logical_or: {
+      const Truth a = partial(node.a, slots);
+      const Truth b = partial(node.b, slots);
+      if (a == Truth::yes || b == Truth::yes) return Truth::yes;
+      return a == Truth::no && b == Truth::no ? Truth::no : Truth::unknown;
+    }
+    default:
+      return Truth::unknown;  // an unknown identifier, or a comparison reading one
+  }
+}
+
 Guard Guard::parse(std::string_view text) {
   auto impl = std::make_unique<Impl>();
   impl->text = std::string(text);
@@ -338,5 +381,9 @@ std::vector<Value> Guard::compared_literals(std::size_t slot) const {
 }
 
 bool Guard::evaluate(std::span<const Value* const> slots) const noexcept { return impl_->truth(impl_->root, slots); }
+
+Guard::Truth Guard::partial_evaluate(std::span<const Value* const> slots) const noexcept {
+  return impl_->partial(impl_->root, slots);
+}
 
 }  // namespace tripodal

@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <array>
-#include <span>
 #include <charconv>
 #include <cmath>
 #include <limits>
 #include <set>
+#include <span>
 #include <stdexcept>
+
+#include "tripodal/core/registry.hpp"
 
 namespace tripodal::detail {
 
@@ -20,6 +22,19 @@ std::string join_names(const std::vector<VariableDecl>& decls) {
     out += d.name;
   }
   return out.empty() ? std::string("none") : out;
+}
+
+// "; did you mean 'x'?" when one of `known` is close to `name` (registry.hpp's closest_name, the
+// helper the profile errors use), else nothing.
+std::string did_you_mean(std::string_view name, const std::vector<std::string>& known) {
+  const auto close = closest_name(name, known);
+  return close ? "; did you mean '" + *close + "'?" : std::string();
+}
+
+std::vector<std::string> names_of(const std::vector<VariableDecl>& decls) {
+  std::vector<std::string> out;
+  for (const auto& d : decls) out.push_back(d.name);
+  return out;
 }
 
 std::string declared_list(const PetriNet& net) {
@@ -63,8 +78,11 @@ void read_guard(const ReadContext& ctx, const XmlElement* e, Transition& t, cons
       const VariableDecl* decl = net.find_parameter(ids[i]);
       if (decl == nullptr) decl = net.find_fact(ids[i]);
       if (decl == nullptr) {
-        ctx.error_at_value(e, "guard", "unknown parameter '" + ids[i] + "' in guard of transition '" + t.id + "' (" +
-                                           declared_list(net) + ")",
+        std::vector<std::string> names = names_of(net.parameters);
+        for (auto& f : names_of(net.facts)) names.push_back(std::move(f));
+        ctx.error_at_value(e, "guard",
+                           "unknown parameter '" + ids[i] + "' in guard of transition '" + t.id + "' (" +
+                               declared_list(net) + ")" + did_you_mean(ids[i], names),
                            find_identifier(text, ids[i]));
         ok = false;
         continue;
@@ -107,8 +125,11 @@ void read_binding_params(const ReadContext& ctx, const XmlElement* e, std::vecto
     if (!value->empty() && (*value)[0] == '$') {
       const std::string ref(value->substr(1));
       if (net.find_parameter(ref) == nullptr) {
-        ctx.error_at_value(c, "value", "unknown parameter '$" + ref + "' passed to " + std::string(owner) +
-                                           " (declared parameters: " + join_names(net.parameters) + ")");
+        const auto close = closest_name(ref, names_of(net.parameters));
+        ctx.error_at_value(c, "value",
+                           "unknown parameter '$" + ref + "' passed to " + std::string(owner) +
+                               " (declared parameters: " + join_names(net.parameters) + ")" +
+                               (close ? "; did you mean '$" + *close + "'?" : std::string()));
         continue;
       }
     }
@@ -353,7 +374,10 @@ void read_place_details(const ReadContext& ctx, const XmlElement* e, Place& plac
     const bool behavior = kind == "behavior";
     const auto& known = behavior ? ctx.options.is_known_behavior : ctx.options.is_known_process;
     if (known && !known(*name)) {
-      ctx.error_at_value(c, "name", "unknown " + std::string(kind) + " '" + std::string(*name) + "'");
+      const auto& names = behavior ? ctx.options.behavior_names : ctx.options.process_names;
+      ctx.error_at_value(
+          c, "name",
+          "unknown " + std::string(kind) + " '" + std::string(*name) + "'" + did_you_mean(*name, names));
     }
     std::vector<BindingParam> params;
     read_binding_params(ctx, c, params, net, std::string(kind) + " " + std::string(*name));
@@ -361,6 +385,59 @@ void read_place_details(const ReadContext& ctx, const XmlElement* e, Place& plac
     else place.process = ProcessRef{std::string(*name), std::move(params)};
   }
 }
+
+namespace {
+
+// An event "SOURCE.KIND" whose source is a behavior or a process bound in this net must be one
+// that source posts (BhX.done / BhX.failed; PLACE.success / PLACE.fault for a place running a
+// process); a source that is not bound here but is close to one that is, and is written like one
+// (Bh.../Pr..., or an event .success/.fault), is a typo. Module events (localizer.lost,
+// board.battery_low) are left alone: the net cannot know them.
+void check_event_source(const ReadContext& ctx, const XmlElement* e, const std::string& event,
+                        const PetriNet& net) {
+  const auto dot = event.rfind('.');
+  if (dot == std::string::npos || dot == 0) return;
+  const std::string source = event.substr(0, dot);
+  const std::string kind = event.substr(dot + 1);
+  std::vector<std::string> sources;
+  std::vector<std::string> known_events;
+  const std::vector<std::string>* kinds_of_source = nullptr;
+  static const std::vector<std::string> kBehaviorKinds{"done", "failed"};
+  static const std::vector<std::string> kProcessKinds{"success", "fault"};
+  for (const Place& p : net.places()) {
+    const std::string* name = p.behavior ? &p.behavior->behavior : (p.process ? &p.id : nullptr);
+    if (name == nullptr) continue;
+    const auto& kinds = p.behavior ? kBehaviorKinds : kProcessKinds;
+    if (*name == source) kinds_of_source = &kinds;
+    sources.push_back(*name);
+    for (const auto& k : kinds) known_events.push_back(*name + "." + k);
+  }
+  if (kinds_of_source != nullptr) {
+    if (std::find(kinds_of_source->begin(), kinds_of_source->end(), kind) != kinds_of_source->end()) return;
+    std::vector<std::string> own;
+    for (const auto& k : *kinds_of_source) own.push_back(source + "." + k);
+    ctx.error_at_value(e, "event",
+                       "unknown event '" + event + "': '" + source + "' posts " + own[0] + " and " + own[1] +
+                           did_you_mean(event, own));
+    return;
+  }
+  // Behaviors and processes are named Bh... and Pr...; a process's events are its place's
+  // (P1.success). Other sources are modules.
+  const auto prefixed = [&](char a, char b) {
+    return source.size() > 2 && (source[0] == a || source[0] == a - 'a' + 'A') &&
+           (source[1] == b || source[1] == b - 'a' + 'A');
+  };
+  const bool looks_bound = prefixed('b', 'h') || prefixed('p', 'r') || kind == "success" || kind == "fault";
+  if (!looks_bound) return;
+  if (const auto close = closest_name(source, sources)) {
+    const auto event_close = closest_name(*close + "." + kind, known_events);
+    ctx.error_at_value(e, "event",
+                       "unknown event '" + event + "': no place of net '" + net.id + "' binds '" + source +
+                           "'; did you mean '" + (event_close ? *event_close : *close + "." + kind) + "'?");
+  }
+}
+
+}  // namespace
 
 void read_transition_details(const ReadContext& ctx, const XmlElement* e, Transition& t, const PetriNet& net,
                              bool allow_name) {
@@ -383,6 +460,7 @@ void read_transition_details(const ReadContext& ctx, const XmlElement* e, Transi
                                          "': expected a letter or '_' then letters, digits, '_', '.', '-', '/'");
     } else {
       t.event = *ev;
+      check_event_source(ctx, e, t.event, net);
     }
   }
   if (const auto& g = attr[kGuard]) read_guard(ctx, e, t, net, std::string(*g));
@@ -431,12 +509,19 @@ bool add_checked_arc(const ReadContext& ctx, const XmlElement* e, PetriNet& net,
   const auto tp = net.find_place(to);
   const auto tt = net.find_transition(to);
   bool ok = true;
+  std::vector<std::string> nodes;
+  if ((!fp && !ft) || (!tp && !tt)) {
+    for (const Place& p : net.places()) nodes.push_back(p.id);
+    for (const Transition& t : net.transitions()) nodes.push_back(t.id);
+  }
   if (!fp && !ft) {
-    ctx.error_at_value(e, "source", "arc from unknown node '" + std::string(from) + "'");
+    ctx.error_at_value(e, "source",
+                       "arc from unknown node '" + std::string(from) + "'" + did_you_mean(from, nodes));
     ok = false;
   }
   if (!tp && !tt) {
-    ctx.error_at_value(e, "target", "arc to unknown node '" + std::string(to) + "'");
+    ctx.error_at_value(e, "target",
+                       "arc to unknown node '" + std::string(to) + "'" + did_you_mean(to, nodes));
     ok = false;
   }
   if (!ok) return false;

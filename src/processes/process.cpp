@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <set>
 
+#include "tripodal/core/registry.hpp"
+
 namespace tripodal {
 
 namespace {
@@ -32,8 +34,12 @@ CProcess::CProcess(ProcessDefinition definition) : definition_(std::move(definit
     if (decl == nullptr) {
       std::string known;
       for (const auto& v : net.parameters) known += (known.empty() ? "" : ", ") + v.name;
+      std::vector<std::string> names;
+      for (const auto& v : net.parameters) names.push_back(v.name);
+      const auto close = closest_name(p.name, names);
       d.error(loc, "process '" + definition_.name + "': parameter '" + p.name + "' is not declared by net '" + net.id +
-                       "' (declared: " + (known.empty() ? "none" : known) + ")");
+                       "' (declared: " + (known.empty() ? "none" : known) + ")" +
+                       (close ? "; did you mean '" + *close + "'?" : std::string()));
     } else if (!parse_value(decl->type, p.value)) {
       d.error(loc, "process '" + definition_.name + "': parameter '" + p.name + "' expects a " +
                        std::string(to_string(decl->type)) + ", got '" + p.value + "'");

@@ -160,6 +160,7 @@ CheckedProfile check_profile(const RobotProfile& profile, const RobotPlugins& pl
       LoadOptions lo;
       // A safety behavior is known, so that a net binding it is refused below with the reason.
       lo.is_known_behavior = [&](std::string_view n) { return is_behavior(n) || is_safety(n); };
+      for (const ModuleEntry& b : profile.behaviors) lo.behavior_names.push_back(b.name);
       lo.structural_warnings = false;
       return load_net_or_throw(f, lo);
     };

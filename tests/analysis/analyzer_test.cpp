@@ -240,10 +240,23 @@ TEST_CASE("An unbounded net: Karp-Miller proves it, the exploration stops at the
   CHECK_THAT(text, Catch::Contains("UNBOUNDED"));
   CHECK_THAT(text, Catch::Contains("requests: unbounded"));
   CHECK_THAT(text, Catch::Contains("repeating request after (initial marking) grows requests"));
-  // Under engine semantics the same request is urgent and the analysis only suspects it.
+  // Under engine semantics Karp-Miller only suspects it (it runs on the interleaving
+  // over-approximation); the pumping cycle found on the explored path, replayed under the engine's
+  // rules (request is urgent and fires again and again), confirms it.
   const AnalysisReport e = analyze(net, {.max_states = 1'000});
-  CHECK(e.bounded == Verdict::unknown);
   CHECK(e.bounds[1].may_be_unbounded);
+  REQUIRE(e.growth.has_value());
+  CHECK(e.growth->confirmed());
+  CHECK(e.growth->place == 1);
+  CHECK(e.bounded == Verdict::fail);
+  CHECK_THAT(format_text(e, net), Catch::Contains("grows without end: requests: after (initial marking), repeating request"));
+  // Capped by an inhibitor arc (request only while fewer than 3 requests), the place is bounded:
+  // the exploration completes and no growth is reported.
+  net.add_arc("requests", "request", 3, ArcKind::inhibitor);
+  const AnalysisReport capped = analyze(net, {.max_states = 1'000});
+  CHECK(capped.complete());
+  CHECK_FALSE(capped.growth.has_value());
+  CHECK(capped.bounded == Verdict::pass);
 }
 
 TEST_CASE("Parameters: typed from the declarations, bad ones reported together", "[analysis][report]") {

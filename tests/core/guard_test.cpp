@@ -87,3 +87,39 @@ TEST_CASE("compared_literals lists the literals compared with one identifier", "
   CHECK(g.compared_literals(1) == std::vector<Value>{Value{std::string("fast")}, Value{std::string("slow")}});
   CHECK(g.compared_literals(2).empty());
 }
+
+TEST_CASE("three-valued evaluation: parameters known, facts unknown", "[guard]") {
+  using T = Guard::Truth;
+  auto partial = [](const Guard& g, std::initializer_list<const Value*> slots) {
+    const std::vector<const Value*> v(slots);
+    return g.partial_evaluate(v);
+  };
+  const Value no{false};
+  const Value yes{true};
+  const Value full{95.0};
+  // The hang of issue 40: a false parameter in a conjunction decides it whatever the fact says.
+  const Guard charge = Guard::parse("auto_charge && battery_percent >= full_percent");
+  REQUIRE(charge.identifiers() == std::vector<std::string>{"auto_charge", "battery_percent", "full_percent"});
+  CHECK(partial(charge, {&no, nullptr, &full}) == T::no);
+  CHECK(partial(charge, {&yes, nullptr, &full}) == T::unknown);
+  CHECK(partial(Guard::parse("!auto_charge || battery_low"), {&no, nullptr}) == T::yes);
+  CHECK(partial(Guard::parse("!auto_charge || battery_low"), {&yes, nullptr}) == T::unknown);
+  CHECK(partial(Guard::parse("!(auto_charge && battery_low)"), {&no, nullptr}) == T::yes);
+  CHECK(partial(Guard::parse("!battery_low"), {nullptr}) == T::unknown);
+  // Comparisons reading an unknown value are unknown, also '!=' (evaluate() makes it false for a
+  // missing value, true for a different one).
+  CHECK(partial(Guard::parse("mode != 'x'"), {nullptr}) == T::unknown);
+  // Without unknowns it is evaluate().
+  const Value slow{std::string("slow")};
+  CHECK(partial(Guard::parse("mode == 'fast' || mode == 'slow'"), {&slow}) == T::yes);
+  CHECK(partial(Guard::parse("mode == 'fast'"), {&slow}) == T::no);
+  // A decided result holds for every value of the unknowns.
+  const Guard g = Guard::parse("(p || f) && !(q && f)");
+  for (const Value* p : {&no, &yes}) {
+    for (const Value* q : {&no, &yes}) {
+      const T t = partial(g, {p, nullptr, q});
+      if (t == T::unknown) continue;
+      for (const Value* f : {&no, &yes}) CHECK(eval(g, {p, f, q}) == (t == T::yes));
+    }
+  }
+}

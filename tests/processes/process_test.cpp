@@ -60,6 +60,14 @@ TEST_CASE("CProcess refuses a bad definition with every problem located", "[proc
     CHECK_THAT(m, Catch::Contains("cleaning.xml:7:3: error: process 'PrCleaning': place 'P1' passes $radius to BhCleaning, but the net declares no parameter 'radius'"));
     CHECK(e.diagnostics().error_count() == 3);
   }
+  // A typo of a declared name gets the suggestion (issue 40: every unknown name in a net).
+  try {
+    CProcess p(def("PrCleaning", pr_cleaning(), {BindingParam{"wheel_typ", "omni", {"robot.yaml", 16, 9}}}));
+    FAIL("no error");
+  } catch (const ConfigError& e) {
+    CHECK_THAT(std::string(e.what()), Catch::Contains("parameter 'wheel_typ' is not declared by net 'PrCleaning' "
+                                                      "(declared: section, wheel_type); did you mean 'wheel_type'?"));
+  }
 
   PetriNet no_outcome;
   no_outcome.id = "loop";

@@ -6,6 +6,7 @@
 #include "cli_tool.hpp"
 #include "net_tool_util.hpp"
 #include "tripodal/core/net_simulation.hpp"
+#include "tripodal/core/registry.hpp"
 
 namespace tripodal::net_tool {
 namespace {
@@ -15,10 +16,13 @@ using namespace cli;
 constexpr std::string_view kDescription =
     "Runs the net from its initial marking at time 0 against a script of timed events and fact\n"
     "changes (format in docs/engine.md, e.g. configs/petri/scenarios/*.events) and prints every\n"
-    "firing with its time, consumed event, description and the marking after it, then the outcome.";
+    "firing with its time, consumed event, description and the marking after it, then the outcome.\n"
+    "A run that ends without reaching an outcome place (the net waits for an event that never comes,\n"
+    "or hangs) fails; with --expect, so does a run whose outcome differs.";
 
 constexpr std::string_view kExitCodes =
-    "exit codes: 0 the simulation ran (whatever outcome it reached), 1 the net, the parameters or\n"
+    "exit codes: 0 the run reached an outcome (the one --expect names, if given), 1 the run ended\n"
+    "            without an outcome or with another one than expected, the net, the parameters or\n"
     "            the script have errors, or the net livelocked, 2 bad command line,\n"
     "            3 a file could not be read";
 
@@ -29,6 +33,7 @@ struct Args {
   double until_s = 3600.0;
   bool no_stop = false;
   bool allow_unknown_events = false;
+  std::string expect;  ///< "success", "failure" or empty
 };
 
 int run_simulate(const Args& args, std::ostream& out, std::ostream& err) {
@@ -61,8 +66,12 @@ int run_simulate(const Args& args, std::ostream& out, std::ostream& err) {
     if (decl == nullptr) {
       std::string declared;
       for (const auto& d : net->parameters) declared += (declared.empty() ? "" : ", ") + d.name;
-      err << "tripodal-net simulate: the net declares no parameter '" << name << "' (declared: "
-          << (declared.empty() ? "none" : declared) << ")\n";
+      std::vector<std::string> names;
+      for (const auto& d : net->parameters) names.push_back(d.name);
+      const auto close = closest_name(name, names);
+      err << "tripodal-net simulate: the net declares no parameter '" << name
+          << "' (declared: " << (declared.empty() ? "none" : declared) << ")"
+          << (close ? "; did you mean '" + *close + "'?" : std::string()) << "\n";
       return kBadInput;
     }
     auto value = parse_value(decl->type, text);
@@ -90,6 +99,21 @@ int run_simulate(const Args& args, std::ostream& out, std::ostream& err) {
         << "\n";
     return kBadInput;
   }
+  // A run that ends without an outcome is a process that never finishes: not a success.
+  if (result.outcome == Outcome::none) {
+    err << "tripodal-net simulate: the run ended at " << format_seconds(result.end_time)
+        << " s without reaching an outcome place (marking " << format_marking(*net, result.final_marking)
+        << "): the net waits for an event that did not come, or hangs\n";
+    return kBadInput;
+  }
+  const bool success = result.outcome == Outcome::success;
+  if (!args.expect.empty() && (args.expect == "success") != success) {
+    err << "tripodal-net simulate: expected " << args.expect << ", the run ended in "
+        << (success ? "success at " + result.outcome_place
+                    : "failure at " + result.outcome_place + ": " + result.fault_message)
+        << "\n";
+    return kBadInput;
+  }
   return kOk;
 }
 
@@ -105,6 +129,9 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_flag("--no-stop", a->no_stop, "keep running after an outcome place is marked");
   cmd.add_flag("--allow-unknown-events", a->allow_unknown_events,
                "accept script events no transition waits for (they are dropped)");
+  cmd.add_option("--expect", a->expect,
+                 "success|failure: fail (exit 1) when the run ends in the other outcome")
+      ->check(CLI::IsMember({"success", "failure"}));
   return [a](std::ostream& out, std::ostream& err) { return run_simulate(*a, out, err); };
 }
 

@@ -50,6 +50,27 @@ struct Witness {
   std::vector<TransitionIndex> path;
 };
 
+/// A place the net may fill without end: firing `prefix` from the initial marking, then `pump`,
+/// gives a marking that covers the one after `prefix` with more tokens in `place`. `rounds`
+/// further repetitions of `pump` were replayed under the analysis semantics, each growing the
+/// place again (0: the repetition could not be confirmed, the growth is only suspected).
+struct GrowthWitness {
+  PlaceIndex place = 0;
+  std::vector<TransitionIndex> prefix;
+  std::vector<TransitionIndex> pump;
+  Tokens before = 0;  ///< tokens in `place` after `prefix`
+  Tokens after = 0;   ///< ... after `prefix`, `pump` and the replayed rounds
+  std::size_t rounds = 0;
+  [[nodiscard]] bool confirmed() const noexcept { return rounds > 0; }
+};
+
+/// A place binding a behavior (or a process) that reaches two tokens: the behavior is started
+/// twice, which the supervisor cannot do. `witness` is the first such marking in BFS order.
+struct DoubleStart {
+  PlaceIndex place = 0;
+  Witness witness;
+};
+
 enum class BoundKind {
   exact,      ///< the largest count over the complete reachability graph
   unbounded,  ///< proved by Karp–Miller
@@ -93,6 +114,16 @@ struct AnalysisReport {
   bool coverability_ran = false;
   CoverabilityResult coverability;
 
+  /// Places binding a behavior or process seen with two tokens (an error: started twice).
+  std::vector<DoubleStart> double_started;
+  /// Set when the exploration was cut short and a pumping cycle was found on its deepest path.
+  std::optional<GrowthWitness> growth;
+  /// Facts read by guards the parameters leave undecided: every verdict holds under the
+  /// assumption that these facts can take any value at any time (sorted, each once).
+  std::vector<std::string> assumed_facts;
+  /// Per transition: its guard is false for these parameters whatever the facts.
+  std::vector<TransitionIndex> guard_false;
+
   std::vector<TransitionIndex> dead_transitions;  ///< never fired (seen so far if incomplete)
   std::vector<PlaceIndex> never_marked;
 
@@ -109,7 +140,8 @@ struct AnalysisReport {
   InvariantBasis p_invariants;
   InvariantBasis t_invariants;
 
-  /// Complete, no deadlock, bounded, and the outcome check passed or does not apply.
+  /// Complete, no deadlock, bounded, no behavior started twice, and the outcome check passed or
+  /// does not apply.
   [[nodiscard]] bool ok() const noexcept;
   [[nodiscard]] bool complete() const noexcept { return stop == StopReason::complete; }
 };
@@ -145,6 +177,14 @@ inline constexpr std::size_t kCheckParameterCombinations = 16;
 
 struct BehaviourCheckOptions {
   Semantics semantics = Semantics::engine;
+  /// The parameter sets the net is used with (`--param`, `--params FILE`, a robot profile's
+  /// process entries): each is checked; parameters a set leaves out take their defaults, or,
+  /// without one, every value their guards name. Empty: the defaults only.
+  std::vector<ParameterValues> parameter_sets;
+  /// Native low-level nets are process nets: the supervisor ends them at an outcome place, so a
+  /// net without one is an error. Applies to low-level nets under engine semantics; false for
+  /// nets written for other tools (PNML).
+  bool process_net = true;
   std::size_t max_states = kCheckStateLimit;            ///< `tripodal-net check --max-states`
   std::size_t max_memory_bytes = std::size_t{2} << 30;  ///< `tripodal-net check --max-memory-mb`
 };
@@ -156,6 +196,25 @@ struct BehaviourCheckOptions {
 /// literal); the diagnostics then start "with NAME=VALUE: ". Returns true when every check ran to
 /// completion and found nothing.
 bool check_behaviour(const PetriNet& net, Diagnostics& diagnostics, const BehaviourCheckOptions& options = {});
+
+struct BehaviourCheckResult {
+  bool checked = false;  ///< every check ran to completion and found nothing (what check_behaviour returns)
+  /// Facts the verdict treats as free (union over the parameter sets): "OK under the assumption
+  /// that facts X, Y can take any value".
+  std::vector<std::string> assumed_facts;
+  std::size_t parameter_sets = 0;  ///< parameter combinations checked
+};
+
+/// check_behaviour with what the verdict rests on. Besides the errors above: a place binding a
+/// behavior or process that can hold two tokens (started twice), a place that grows without end
+/// (a pumping cycle, confirmed by replaying it), and a process net without an outcome place are
+/// errors; a transition that fires for none of the default parameter sets (parameter_sets empty)
+/// is a warning.
+BehaviourCheckResult check_behaviour_detailed(const PetriNet& net, Diagnostics& diagnostics,
+                                              const BehaviourCheckOptions& options = {});
+
+/// "the assumption that facts battery_low, docked can take any value" (empty: nothing assumed).
+[[nodiscard]] std::string assumption_text(const std::vector<std::string>& facts);
 
 /// The default semantics for a file: interleaving for PNML (written for plain P/T tools), engine
 /// for tripodal's native XML. Decided by extension, then by a <pnml root element in `head`.

@@ -52,6 +52,13 @@ class Guard {
   /// different types is false, never an exception: a guard is a condition, not a program.
   [[nodiscard]] bool evaluate(std::span<const Value* const> slots) const noexcept;
 
+  /// Three-valued (Kleene) evaluation with some values unknown (slot nullptr): the verdict of a
+  /// check, where parameters are constants and facts may take any value. `false && x` is false
+  /// and `true || x` true whatever x; a comparison reading an unknown value is unknown. A result
+  /// other than unknown is what evaluate() gives for every value of the unknown slots.
+  enum class Truth : std::uint8_t { no, yes, unknown };
+  [[nodiscard]] Truth partial_evaluate(std::span<const Value* const> slots) const noexcept;
+
   struct Impl;
 
  private:

@@ -23,6 +23,9 @@ struct LoadOptions {
   /// rejects is an error: "unknown behavior 'BhClening'".
   std::function<bool(std::string_view)> is_known_behavior;
   std::function<bool(std::string_view)> is_known_process;
+  /// The names "did you mean" picks from when is_known_behavior / is_known_process rejects one.
+  std::vector<std::string> behavior_names;
+  std::vector<std::string> process_names;
   bool structural_warnings = true;  ///< places no transition can mark, transitions never enabled
 };
 
