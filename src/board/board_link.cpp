@@ -79,7 +79,7 @@ void BoardLink::check_port(Time now) noexcept {
   const std::string_view fault = stream_.check();
   if (fault.empty()) return;
   last_port_fault_ = fault;
-  if (fault == kDeviceGone) {
+  if (fault == kDeviceGone || fault == kConnectionGone) {
     ++stats_.port_failures;
   } else {
     ++stats_.settings_changed;

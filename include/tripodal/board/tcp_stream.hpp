@@ -14,9 +14,6 @@
 
 namespace tripodal::board {
 
-/// What check() says of a connection the peer closed or reset.
-inline constexpr std::string_view kConnectionGone = "the TCP connection is closed";
-
 /// Whether a port spec names the TCP transport ("tcp://HOST:PORT").
 [[nodiscard]] bool is_tcp_port(std::string_view spec) noexcept;
 
