@@ -123,9 +123,9 @@ class Loader {
     p.source = r_.file();
     if (!r_.expect_map(root, "protocol profile")) return p;
     r_.expect_keys(root, {"name", "description", "frame", "sync_echo", "errors", "commands"}, "protocol profile");
-    if (auto n = r_.text(r_.require(root, "name", "protocol profile", "its name, e.g. thesis"), "name", true)) p.name = *n;
+    if (auto n = text(r_.require(root, "name", "protocol profile", "its name, e.g. thesis"), "name", true)) p.name = *n;
     if (root["description"]) {
-      if (auto t = r_.text(root["description"], "description")) p.description = *t;
+      if (auto t = text(root["description"], "description")) p.description = *t;
     }
     frame(r_.require(root, "frame", "protocol profile", "the framing: flags, type, length_rule, checksum, ..."), p.frame);
     if (root["sync_echo"]) {
@@ -137,8 +137,20 @@ class Loader {
   }
 
  private:
+  // The reader's typed reads, after a missing key (already reported by require): nothing.
+  std::optional<std::string> text(const YAML::Node& n, std::string_view what, bool non_empty = false) {
+    return n ? r_.text(n, what, non_empty) : std::nullopt;
+  }
+  std::optional<std::string> choice(const YAML::Node& n, std::string_view what, yaml::KeyList choices) {
+    return n ? r_.choice(n, what, choices) : std::nullopt;
+  }
+  std::optional<std::int64_t> integer(const YAML::Node& n, std::string_view what, std::int64_t lo, std::int64_t hi) {
+    return n ? r_.integer(n, what, lo, hi) : std::nullopt;
+  }
+
   std::optional<std::uint8_t> byte(const YAML::Node& node, std::string_view what) {
-    const std::optional<std::string> t = r_.text(node, what, true);
+    if (!node) return std::nullopt;
+    const std::optional<std::string> t = text(node, what, true);
     if (!t) return std::nullopt;
     std::size_t used = 0;
     unsigned long v = 0;
@@ -162,17 +174,17 @@ class Loader {
     if (auto b = byte(r_.require(n, "flag_short", "frame", "0x10 in the thesis"), "frame.flag_short")) out.flag_short = *b;
     if (auto b = byte(r_.require(n, "flag_long", "frame", "0x50 in the thesis"), "frame.flag_long")) out.flag_long = *b;
     if (auto b = byte(r_.require(n, "type", "frame", "0xA8 in the thesis"), "frame.type")) out.type_byte = *b;
-    if (auto c = r_.choice(r_.require(n, "length_rule", "frame", "cmd_payload or type_cmd_payload"), "frame.length_rule",
+    if (auto c = choice(r_.require(n, "length_rule", "frame", "cmd_payload or type_cmd_payload"), "frame.length_rule",
                            {"cmd_payload", "type_cmd_payload"})) {
       out.length_rule = *c == "cmd_payload" ? LengthRule::cmd_payload : LengthRule::type_cmd_payload;
     }
     if (n["max_length"]) {
-      if (auto v = r_.integer(n["max_length"], "frame.max_length", 2, static_cast<std::int64_t>(kMaxLength))) out.max_length = static_cast<std::uint16_t>(*v);
+      if (auto v = integer(n["max_length"], "frame.max_length", 2, static_cast<std::int64_t>(kMaxLength))) out.max_length = static_cast<std::uint16_t>(*v);
     }
     if (n["max_short_length"]) {
-      if (auto v = r_.integer(n["max_short_length"], "frame.max_short_length", 1, 255)) out.max_short_length = static_cast<std::uint16_t>(*v);
+      if (auto v = integer(n["max_short_length"], "frame.max_short_length", 1, 255)) out.max_short_length = static_cast<std::uint16_t>(*v);
     }
-    if (auto c = r_.choice(r_.require(n, "checksum", "frame", "crc8_smbus, sum8, xor8 or none"), "frame.checksum",
+    if (auto c = choice(r_.require(n, "checksum", "frame", "crc8_smbus, sum8, xor8 or none"), "frame.checksum",
                            {"crc8_smbus", "sum8", "xor8", "none"})) {
       out.checksum = *c == "crc8_smbus" ? ChecksumKind::crc8_smbus
                      : *c == "sum8"     ? ChecksumKind::sum8
@@ -180,7 +192,7 @@ class Loader {
                                         : ChecksumKind::none;
     }
     if (n["checksum_enable"]) {
-      if (auto c = r_.choice(n["checksum_enable"], "frame.checksum_enable", {"always", "optional"})) out.checksum_optional = *c == "optional";
+      if (auto c = choice(n["checksum_enable"], "frame.checksum_enable", {"always", "optional"})) out.checksum_optional = *c == "optional";
     }
     // Table 3-2: bit 6 LongFrame, bit 4 CheckSumEn, the low four bits zero.
     const std::uint8_t chk = out.checksum == ChecksumKind::none ? 0 : kFlagChecksumEn;
@@ -230,22 +242,22 @@ class Loader {
       r_.expect_keys(e, {"name", "type", "unit", "scale", "repeat", "max"}, fw);
       FieldSpec s;
       s.where = r_.at(e);
-      if (auto t = r_.text(r_.require(e, "name", fw, "the field's name"), fw + " name", true)) s.name = *t;
+      if (auto t = text(r_.require(e, "name", fw, "the field's name"), fw + " name", true)) s.name = *t;
       const YAML::Node type = r_.require(e, "type", fw, "u8, i8, u16, i16, u32, i32, f32, bitmap8, bitmap16, bitmap32 or bytes");
       if (type) {
-        if (auto t = r_.choice(type, fw + " type", {"u8", "i8", "u16", "i16", "u32", "i32", "f32", "bitmap8", "bitmap16", "bitmap32", "bytes"})) {
+        if (auto t = choice(type, fw + " type", {"u8", "i8", "u16", "i16", "u32", "i32", "f32", "bitmap8", "bitmap16", "bitmap32", "bytes"})) {
           s.type = static_cast<FieldType>(std::find(kFieldTypeNames.begin(), kFieldTypeNames.end(), *t) - kFieldTypeNames.begin());
         }
       }
       if (e["unit"]) {
-        if (auto t = r_.text(e["unit"], fw + " unit")) s.unit = *t;
+        if (auto t = text(e["unit"], fw + " unit")) s.unit = *t;
       }
       if (e["scale"]) {
         if (auto v = r_.positive(e["scale"], fw + " scale")) s.scale = *v;
       }
       if (e["repeat"]) {
-        if (auto t = r_.text(e["repeat"], fw + " repeat", true)) s.repeat = *t;
-        if (auto v = r_.integer(r_.require(e, "max", fw, "the most repetitions"), fw + " max", 1, 65535)) s.max_count = static_cast<std::size_t>(*v);
+        if (auto t = text(e["repeat"], fw + " repeat", true)) s.repeat = *t;
+        if (auto v = integer(r_.require(e, "max", fw, "the most repetitions"), fw + " max", 1, 65535)) s.max_count = static_cast<std::size_t>(*v);
         // Each name of a count must be an earlier, fixed field.
         if (s.repeat != "*") {
           std::size_t start = 0;
@@ -279,7 +291,7 @@ class Loader {
       c.where = r_.at(e);
       const YAML::Node name = r_.require(e, "name", what, "SYNC, STATUS, DRIVE, ...");
       std::optional<std::string> nm;
-      if (name) nm = r_.text(name, what + " name", true);
+      if (name) nm = text(name, what + " name", true);
       std::optional<Command> command;
       if (nm) {
         for (Command k : kCommands) {
@@ -313,9 +325,9 @@ class Loader {
       if (!command || !idv) continue;
       c.command = *command;
       c.id = *idv;
-      check_size(c.request, e["request"], label + " request", 1 + (p.frame.length_rule == LengthRule::type_cmd_payload ? 1 : 0),
+      check_size(c.request, e["request"] ? e["request"] : e, label + " request", 1 + (p.frame.length_rule == LengthRule::type_cmd_payload ? 1 : 0),
                  p.frame.max_length);
-      check_size(c.response, e["response"], label + " response", 1, p.frame.max_length);
+      check_size(c.response, e["response"] ? e["response"] : e, label + " response", 1, p.frame.max_length);
       check_builtin(c, e);
       p.commands.push_back(std::move(c));
     }
@@ -341,7 +353,7 @@ class Loader {
       const std::string what = fmt::format("{} {}", to_string(c.command), which);
       for (std::size_t i = 0; i < std::max(got.size(), want.size()); ++i) {
         if (i < got.size() && i < want.size() && same_field(got[i], want[i])) continue;
-        const YAML::Node at = i < got.size() ? e[which][i] : e[which];
+        const YAML::Node at = i < got.size() ? e[which][i] : (e[which] ? e[which] : e);
         r_.error(at, fmt::format("{} field {}: expected {} (what this host and the firmware model implement), got {}", what, i + 1,
                                  i < want.size() ? describe_field(want[i]) : "no more fields",
                                  i < got.size() ? describe_field(got[i]) : "no more fields"));

@@ -353,6 +353,18 @@ TEST_CASE("a profile's errors are located and all reported", "[board][protocol][
     REQUIRE_THROWS_WITH(parse_protocol_profile(text, "flag.yaml"),
                         Catch::Contains("frame.flag_long: 0x51 does not fit Table 3-2 with checksum CRC-8/SMBUS; expected 0x50"));
   }
+  SECTION("a missing key is located, not a YAML exception (found by fuzzing)") {
+    const std::string text = thesis_text_with("  resp: 0xEE\n", "");
+    try {
+      (void)parse_protocol_profile(text, "missing.yaml");
+      FAIL("no error");
+    } catch (const ConfigError& e) {
+      const std::string what = e.what();
+      CHECK_THAT(what, Catch::Contains("errors: missing 'resp'"));
+      CHECK_THAT(what, Catch::Matches("(.|\\n)*missing\\.yaml:\\d+:\\d+: error: errors: missing 'resp'(.|\\n)*"));
+      CHECK_THAT(what, !Catch::Contains("invalid node"));
+    }
+  }
   SECTION("a missing file") {
     REQUIRE_THROWS_WITH(load_protocol_profile("/nonexistent/board.yaml"), Catch::Contains("/nonexistent/board.yaml"));
   }

@@ -79,7 +79,8 @@ struct ActuatorCommand {
 
 class BoardLink {
  public:
-  BoardLink(ByteStream& stream, LinkConfig config = {}) noexcept;
+  /// Builds its messages and takes the profile (the thesis's when none): may allocate, once.
+  BoardLink(ByteStream& stream, LinkConfig config = {});
 
   /// One control cycle at `now`: takes the responses that arrived, times out the overdue ones,
   /// then sends SYNC (link not synchronised) or DRIVE with `speeds` and at most one other request.
