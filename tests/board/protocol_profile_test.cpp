@@ -189,6 +189,13 @@ TEST_CASE("golden frames of the thesis profile: requests count CMD + payload, wr
   CHECK(found == thesis_requests().size());
   CHECK(split.stats().errors() == 0);
 
+  // A long request (Table 3-3: Flag 0x50, Len [7:0], LenH [15:8]) may carry a small Length:
+  // SYNC, Len 0x01 LenH 0x00 (1 = CMD), CRC-8 over 50 01 00 A8 00 = 0x5C.
+  FrameDecoder long_frame(p.frame, FrameSide::requests);
+  REQUIRE(decode_all(long_frame, Bytes{0x50, 0x01, 0x00, 0xA8, 0x00, 0x5C}).size() == 1);
+  CHECK(long_frame.frame().long_frame);
+  CHECK(long_frame.frame().body.size() == 2);
+
   // Responses (Table 3-6): Length = Resp + payload, as in tripodal-v1.
   // DRIVE response: Resp 0x12, then 5000 and 5200 pulses (i32: 88 13 00 00, 50 14 00 00), 198 and
   // 251 mm/s (i16: C6 00, FB 00), bitmap 0x00000102 (bump 1, cliff 0), buttons 0x01, status 0x01;
@@ -303,6 +310,16 @@ TEST_CASE("every command round-trips with the firmware model in the thesis profi
   CHECK(pair.board.uv_lamp());
   CHECK(pair.board.wheel_speed_m_s(0) == Approx(0.2).margin(0.01));
   CHECK(pair.link.dialect_mismatch().empty());
+}
+
+TEST_CASE("a profile without the SYNC echo: the board answers SYNC with its Resp", "[board][protocol]") {
+  const auto no_echo = shared(parse_protocol_profile(thesis_text_with("sync_echo: true", "sync_echo: false"), "no_echo.yaml"));
+  Pair pair(no_echo, no_echo);
+  pair.run_for(1s);
+  CHECK(pair.link.synchronised());
+  CHECK(pair.link.stats().resyncs == 1);
+  CHECK(pair.link.stats().error_responses == 0);
+  CHECK(pair.board.counters().resyncs == 1);
 }
 
 TEST_CASE("a profile's errors are located and all reported", "[board][protocol][config]") {
