@@ -217,7 +217,15 @@ class Loader {
   void errors(const YAML::Node& n, ProtocolProfile& p) {
     if (!n || !r_.expect_map(n, "errors")) return;
     r_.expect_keys(n, {"resp", "checksum", "not_synchronised", "wrong_type", "unknown_command", "overflow", "bad_payload"}, "errors");
-    if (auto b = byte(r_.require(n, "resp", "errors", "the Resp byte of an error response"), "errors.resp")) p.error_resp = *b;
+    const YAML::Node resp = r_.require(n, "resp", "errors", "the Resp byte of an error response");
+    if (auto b = byte(resp, "errors.resp")) {
+      p.error_resp = *b;
+      if (p.frame.length_rule == LengthRule::cmd_payload && *b == p.frame.type_byte) {
+        r_.error(resp, fmt::format("errors.resp: 0x{:02X} is the TYPE byte, which marks a SYNC echo among responses under "
+                                   "length_rule cmd_payload",
+                                   *b));
+      }
+    }
     std::map<std::uint8_t, std::string> seen;
     for (std::size_t i = 0; i < kErrorCodeCount; ++i) {
       const std::string key(kErrorKeys[i]);

@@ -365,6 +365,10 @@ TEST_CASE("a profile's errors are located and all reported", "[board][protocol][
                                        "model implement), got {name: track, type: u16}"));
     }
   }
+  SECTION("an error Resp equal to TYPE, which would read as a SYNC echo") {
+    const std::string text = thesis_text_with("  resp: 0xEE", "  resp: 0xA8");
+    REQUIRE_THROWS_WITH(parse_protocol_profile(text, "resp.yaml"), Catch::Contains("errors.resp: 0xA8 is the TYPE byte"));
+  }
   SECTION("a Flag that does not fit Table 3-2") {
     const std::string text = thesis_text_with("flag_long: 0x50", "flag_long: 0x51");
     REQUIRE_THROWS_WITH(parse_protocol_profile(text, "flag.yaml"),
