@@ -149,6 +149,14 @@ void BoardFirmware::answer_error(ErrorCode code, std::uint8_t cmd) noexcept {
 void BoardFirmware::serve(Command cmd, std::uint8_t c, std::span<const std::uint8_t> payload) noexcept {
   std::array<std::uint8_t, 64> out{};
   ByteWriter w(out);
+  // A profile whose layouts differ from the model's (order, types, scales): payloads transcoded.
+  const CommandSpec* spec = profile_.spec(cmd);
+  std::array<std::uint8_t, kMaxLength> staged{};
+  if (spec != nullptr && spec->request_transcoded) {
+    const std::ptrdiff_t n = transcode(spec->request, builtin_command(cmd).request, payload, staged);
+    if (n < 0) return answer_error(ErrorCode::bad_payload, c);
+    payload = std::span<const std::uint8_t>(staged.data(), static_cast<std::size_t>(n));
+  }
   const auto expect = [&](std::size_t size) {
     if (payload.size() == size) return true;
     answer_error(ErrorCode::bad_payload, c);
@@ -238,6 +246,11 @@ void BoardFirmware::serve(Command cmd, std::uint8_t c, std::span<const std::uint
       std::memcpy(line.data(), payload.data() + 1, payload.size() - 1);
       break;
     }
+  }
+  if (spec != nullptr && spec->response_transcoded) {
+    const std::ptrdiff_t n = transcode(builtin_command(cmd).response, spec->response, w.written(), staged);
+    if (n >= 0) answer(c, std::span<const std::uint8_t>(staged.data(), static_cast<std::size_t>(n)));
+    return;
   }
   answer(c, w.written());
 }

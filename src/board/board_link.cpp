@@ -133,6 +133,13 @@ bool BoardLink::send(Command cmd, std::span<const std::uint8_t> payload, Time no
   if (outstanding_size_ == outstanding_.size()) return false;
   const std::optional<std::uint8_t> id = profile_.id(cmd);
   if (!id) return false;  // the board's dialect has no such command: the poll is skipped
+  // A board whose layouts differ from the host's: the payload in the board's layout.
+  std::array<std::uint8_t, kMaxLength> staged{};
+  if (const CommandSpec* spec = profile_.spec(cmd); spec != nullptr && spec->request_transcoded) {
+    const std::ptrdiff_t t = transcode(builtin_command(cmd).request, spec->request, payload, staged);
+    if (t < 0) return false;
+    payload = std::span<const std::uint8_t>(staged.data(), static_cast<std::size_t>(t));
+  }
   const std::size_t n = encode_request(*id, payload, tx_, profile_.frame);
   if (n == 0) return false;
   if (cmd == Command::sync && n <= sync_frame_.size()) {
@@ -201,6 +208,13 @@ void BoardLink::on_frame(const FrameView& frame, Time now) noexcept {
     return;
   }
   refused_checksums_ = 0;
+  // A board whose layouts differ from the host's (order, types, scales): into the host's layout.
+  std::span<const std::uint8_t> payload = r->payload;
+  const CommandSpec* spec = profile_.spec(front.cmd);
+  if (spec != nullptr && spec->response_transcoded && !echo) {
+    const std::ptrdiff_t n = transcode(spec->response, builtin_command(front.cmd).response, payload, transcoded_);
+    payload = n < 0 ? std::span<const std::uint8_t>{} : std::span<const std::uint8_t>(transcoded_.data(), static_cast<std::size_t>(n));
+  }
   ++stats_.responses;
   consecutive_missed_ = 0;
   if (front.actuator && queue_size_ > 0) {
@@ -213,34 +227,34 @@ void BoardLink::on_frame(const FrameView& frame, Time now) noexcept {
       synchronised_ = true;
       break;
     case Command::drive:
-      if (const auto d = unpack_drive(r->payload)) {
+      if (const auto d = unpack_drive(payload)) {
         drive_ = *d;
         drive_stamp_ = now;
         has_drive_ = true;
       }
       break;
     case Command::battery:
-      if (const auto b = unpack_battery(r->payload)) {
+      if (const auto b = unpack_battery(payload)) {
         battery_ = *b;
         has_battery_ = true;
       }
       break;
     case Command::liquid_level:
-      if (r->payload.size() == 2) {
-        tank_percent_ = r->payload[0];
-        tank_empty_ = r->payload[1] != 0;
+      if (payload.size() == 2) {
+        tank_percent_ = payload[0];
+        tank_empty_ = payload[1] != 0;
         has_tank_ = true;
       }
       break;
     case Command::ultrasonic: {
-      ByteReader rd(r->payload);
+      ByteReader rd(payload);
       ultrasonic_count_ = std::min<std::size_t>(rd.u8(), kMaxUltrasonic);
       for (std::size_t i = 0; i < ultrasonic_count_; ++i) ultrasonic_[i] = rd.u16();
       if (rd.failed()) ultrasonic_count_ = 0;
       break;
     }
     case Command::infrared: {
-      ByteReader rd(r->payload);
+      ByteReader rd(payload);
       cliff_count_ = std::min<std::size_t>(rd.u8(), kMaxInfrared);
       infrared_count_ = cliff_count_ + std::min<std::size_t>(rd.u8(), kMaxInfrared);
       for (std::size_t i = 0; i < infrared_count_; ++i) infrared_[i] = rd.u16();

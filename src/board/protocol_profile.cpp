@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <set>
 
@@ -107,6 +108,14 @@ std::string describe_field(const FieldSpec& s) {
 bool same_field(const FieldSpec& a, const FieldSpec& b) noexcept {
   return a.name == b.name && a.type == b.type && a.unit == b.unit && std::abs(a.scale - b.scale) <= 1e-12 * std::abs(b.scale) &&
          a.repeat == b.repeat && (a.repeat.empty() || a.max_count == b.max_count);
+}
+
+bool same_layout(const std::vector<FieldSpec>& a, const std::vector<FieldSpec>& b) noexcept {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (!same_field(a[i], b[i])) return false;
+  }
+  return true;
 }
 
 constexpr std::array<std::string_view, 11> kFieldTypeNames{"u8",      "i8",       "u16",      "i16",     "u32",  "i32",
@@ -336,7 +345,7 @@ class Loader {
       check_size(c.request, e["request"] ? e["request"] : e, label + " request", 1 + (p.frame.length_rule == LengthRule::type_cmd_payload ? 1 : 0),
                  p.frame.max_length);
       check_size(c.response, e["response"] ? e["response"] : e, label + " response", 1, p.frame.max_length);
-      check_builtin(c, e);
+      check_builtin(c, e);  // may mark the layouts as transcoded
       p.commands.push_back(std::move(c));
     }
     for (Command required : {Command::sync, Command::drive}) {
@@ -355,21 +364,60 @@ class Loader {
     }
   }
 
-  void check_builtin(const CommandSpec& c, const YAML::Node& e) {
+  // A layout may differ from the one the host implements in its fields' order, types, scales and
+  // repetition limits (the payload is transcoded, transcode()), not in what the fields are: the
+  // same names, the same units, integers for integers, bitmaps for bitmaps, bytes for bytes, the
+  // same counts, and no more repetitions than the host's arrays hold.
+  void check_builtin(CommandSpec& c, const YAML::Node& e) {
     const CommandSpec& b = builtin_command(c.command);
+    const auto kind = [](FieldType t) {
+      return t == FieldType::bytes ? 2 : (t == FieldType::bitmap8 || t == FieldType::bitmap16 || t == FieldType::bitmap32) ? 1 : 0;
+    };
     const auto compare = [&](const std::vector<FieldSpec>& got, const std::vector<FieldSpec>& want, const char* which) {
       const std::string what = fmt::format("{} {}", to_string(c.command), which);
-      for (std::size_t i = 0; i < std::max(got.size(), want.size()); ++i) {
-        if (i < got.size() && i < want.size() && same_field(got[i], want[i])) continue;
-        const YAML::Node at = i < got.size() ? e[which][i] : (e[which] ? e[which] : e);
-        r_.error(at, fmt::format("{} field {}: expected {} (what this host and the firmware model implement), got {}", what, i + 1,
-                                 i < want.size() ? describe_field(want[i]) : "no more fields",
-                                 i < got.size() ? describe_field(got[i]) : "no more fields"));
-        return;
+      const YAML::Node list = e[which] ? e[which] : e;
+      bool same = got.size() == want.size();
+      for (std::size_t i = 0; same && i < got.size(); ++i) same = same_field(got[i], want[i]);
+      if (same) return true;
+      bool ok = true;
+      for (std::size_t i = 0; i < got.size(); ++i) {
+        const FieldSpec& g = got[i];
+        const auto w = std::find_if(want.begin(), want.end(), [&](const FieldSpec& x) { return x.name == g.name; });
+        const YAML::Node at = list.IsSequence() && i < list.size() ? list[i] : list;
+        if (w == want.end()) {
+          std::string names;
+          for (const FieldSpec& x : want) names += (names.empty() ? "" : ", ") + x.name;
+          r_.error(at, fmt::format("{} field {} '{}': not a field of {} (this host and the firmware model know: {})", what, i + 1, g.name,
+                                   what, names.empty() ? "none" : names));
+          ok = false;
+          continue;
+        }
+        std::string problem;
+        if (kind(g.type) != kind(w->type)) {
+          problem = fmt::format("type {} cannot carry {}", to_string(g.type), to_string(w->type));
+        } else if (g.unit != w->unit) {
+          problem = fmt::format("unit '{}', expected '{}'", g.unit, w->unit);
+        } else if (g.repeat != w->repeat) {
+          problem = fmt::format("repeat '{}', expected '{}'", g.repeat, w->repeat);
+        } else if (!g.repeat.empty() && g.max_count > w->max_count) {
+          problem = fmt::format("max {}, more than the {} this host holds", g.max_count, w->max_count);
+        }
+        if (!problem.empty()) {
+          r_.error(at, fmt::format("{} field {} '{}': {} (this host and the firmware model implement {})", what, i + 1, g.name, problem,
+                                   describe_field(*w)));
+          ok = false;
+        }
       }
+      for (const FieldSpec& w : want) {
+        if (std::none_of(got.begin(), got.end(), [&](const FieldSpec& x) { return x.name == w.name; })) {
+          r_.error(list, fmt::format("{}: no field '{}' (this host and the firmware model implement {})", what, w.name, describe_field(w)));
+          ok = false;
+        }
+      }
+      return !ok;  // an error already reported; otherwise a layout to transcode
     };
-    compare(c.request, b.request, "request");
-    compare(c.response, b.response, "response");
+    c.request_transcoded = !compare(c.request, b.request, "request") && !same_layout(c.request, b.request);
+    c.response_transcoded = !compare(c.response, b.response, "response") && !same_layout(c.response, b.response);
   }
 
   yaml::Reader r_;
@@ -426,6 +474,106 @@ std::size_t max_payload_bytes(const std::vector<FieldSpec>& layout) noexcept {
 }
 
 const CommandSpec& builtin_command(Command command) noexcept { return builtins()[index_of(command)]; }
+
+namespace {
+
+struct Parsed {
+  static constexpr std::size_t kMaxFields = 16;
+  static constexpr std::size_t kMaxValues = 96;
+  std::array<std::size_t, kMaxFields> first{};
+  std::array<std::size_t, kMaxFields> count{};
+  std::array<double, kMaxValues> value{};    // physical (wire * scale)
+  std::array<bool, kMaxValues> saturated{};  // the wire value was its type's largest (a "no echo")
+};
+
+std::uint64_t read_le(const std::uint8_t* p, std::size_t n) noexcept {
+  std::uint64_t v = 0;
+  for (std::size_t i = n; i-- > 0;) v = (v << 8) | p[i];
+  return v;
+}
+
+bool is_signed(FieldType t) noexcept { return t == FieldType::i8 || t == FieldType::i16 || t == FieldType::i32; }
+
+std::size_t count_of(const std::vector<FieldSpec>& layout, const Parsed& parsed, const FieldSpec& f, std::size_t remaining) noexcept {
+  if (f.repeat.empty()) return 1;
+  if (f.repeat == "*") return remaining / field_size(f.type);
+  std::size_t total = 0;
+  std::size_t start = 0;
+  while (start <= f.repeat.size()) {
+    const std::size_t plus = std::min(f.repeat.find('+', start), f.repeat.size());
+    const std::string_view ref = std::string_view(f.repeat).substr(start, plus - start);
+    for (std::size_t i = 0; i < layout.size() && i < Parsed::kMaxFields; ++i) {
+      if (layout[i].name == ref && parsed.count[i] == 1) total += static_cast<std::size_t>(std::llround(parsed.value[parsed.first[i]]));
+    }
+    start = plus + 1;
+  }
+  return total;
+}
+
+}  // namespace
+
+std::ptrdiff_t transcode(const std::vector<FieldSpec>& from, const std::vector<FieldSpec>& to, std::span<const std::uint8_t> in,
+                         std::span<std::uint8_t> out) noexcept {
+  if (from.size() > Parsed::kMaxFields || to.size() > Parsed::kMaxFields) return -1;
+  Parsed parsed;
+  std::size_t pos = 0;
+  std::size_t next = 0;
+  for (std::size_t i = 0; i < from.size(); ++i) {
+    const FieldSpec& f = from[i];
+    const std::size_t size = field_size(f.type);
+    const std::size_t n = count_of(from, parsed, f, in.size() - pos);
+    if ((!f.repeat.empty() && n > f.max_count) || n * size > in.size() - pos || next + n > Parsed::kMaxValues) return -1;
+    parsed.first[i] = next;
+    parsed.count[i] = n;
+    for (std::size_t k = 0; k < n; ++k, pos += size) {
+      const std::uint64_t raw = read_le(in.data() + pos, size);
+      double v = 0.0;
+      if (f.type == FieldType::f32) {
+        float x = 0.0F;
+        const auto bits = static_cast<std::uint32_t>(raw);
+        std::memcpy(&x, &bits, sizeof x);
+        v = static_cast<double>(x);
+      } else if (is_signed(f.type)) {
+        const unsigned shift = static_cast<unsigned>(64 - 8 * size);
+        v = static_cast<double>(static_cast<std::int64_t>(raw << shift) >> shift);
+      } else {
+        v = static_cast<double>(raw);
+        parsed.saturated[next] = f.type != FieldType::bytes && raw == (std::uint64_t{1} << (8 * size)) - 1 && size > 1;
+      }
+      parsed.value[next++] = v * f.scale;
+    }
+  }
+  if (pos != in.size()) return -1;
+  std::size_t written = 0;
+  for (const FieldSpec& t : to) {
+    std::size_t src = Parsed::kMaxFields;
+    for (std::size_t i = 0; i < from.size(); ++i) {
+      if (from[i].name == t.name) src = i;
+    }
+    if (src == Parsed::kMaxFields) return -1;
+    const std::size_t size = field_size(t.type);
+    if (parsed.count[src] * size > out.size() - written) return -1;
+    for (std::size_t k = 0; k < parsed.count[src]; ++k, written += size) {
+      const std::size_t at = parsed.first[src] + k;
+      std::uint64_t raw = 0;
+      if (t.type == FieldType::f32) {
+        const auto x = static_cast<float>(parsed.value[at] / t.scale);
+        std::uint32_t bits = 0;
+        std::memcpy(&bits, &x, sizeof bits);
+        raw = bits;
+      } else {
+        const double bits = 8.0 * static_cast<double>(size);
+        const double hi = is_signed(t.type) ? std::exp2(bits - 1) - 1 : std::exp2(bits) - 1;
+        const double lo = is_signed(t.type) ? -std::exp2(bits - 1) : 0.0;
+        // Rounded and saturated; a saturated value (no echo) stays saturated whatever the width.
+        const double v = parsed.saturated[at] ? hi : std::clamp(std::round(parsed.value[at] / t.scale), lo, hi);
+        raw = static_cast<std::uint64_t>(static_cast<std::int64_t>(v));
+      }
+      for (std::size_t b = 0; b < size; ++b) out[written + b] = static_cast<std::uint8_t>((raw >> (8 * b)) & 0xFFU);
+    }
+  }
+  return static_cast<std::ptrdiff_t>(written);
+}
 std::span<const Command> all_commands() noexcept { return kCommands; }
 
 void ProtocolProfile::index() {

@@ -312,6 +312,65 @@ TEST_CASE("every command round-trips with the firmware model in the thesis profi
   CHECK(pair.link.dialect_mismatch().empty());
 }
 
+namespace {
+// A board whose layouts are not the host's: DRIVE's speeds swapped and in i32 of 0.1 mm/s, the
+// battery's voltage in u8 of 0.1 V, the ultrasonic ranges in u8 of 1 cm.
+std::string other_layouts() {
+  std::string text = thesis_text_with("    id: 0x12\n    request:\n      - {name: left, type: i16, unit: m/s, scale: 0.001}\n"
+                                      "      - {name: right, type: i16, unit: m/s, scale: 0.001}\n",
+                                      "    id: 0x12\n    request:\n      - {name: right, type: i32, unit: m/s, scale: 0.0001}\n"
+                                      "      - {name: left, type: i32, unit: m/s, scale: 0.0001}\n");
+  text.replace(text.find("{name: voltage, type: u16, unit: V, scale: 0.001}"), 49, "{name: voltage, type: u8, unit: V, scale: 0.1}");
+  text.replace(text.find("{name: range, type: u16, unit: m, scale: 0.001, repeat: count, max: 8}"), 70,
+               "{name: range, type: u8, unit: m, scale: 0.01, repeat: count, max: 8}");
+  return text;
+}
+}  // namespace
+
+TEST_CASE("a board whose layouts differ in order, type and scale: payloads transcoded both ways", "[board][protocol][golden]") {
+  const auto other = shared(parse_protocol_profile(other_layouts(), "other.yaml"));
+  REQUIRE(other->spec(Command::drive)->request_transcoded);
+  CHECK_FALSE(other->spec(Command::drive)->response_transcoded);
+  CHECK(other->spec(Command::battery)->response_transcoded);
+  // DRIVE left 200 mm/s, right 250 mm/s (the host's C8 00 FA 00): right first, 0.25 m/s / 0.0001
+  // = 2500 = 0x000009C4, then left 2000 = 0x000007D0; Length 1 + 8 = 9; CRC-8 0x7C.
+  std::array<std::uint8_t, 16> staged{};
+  const Bytes host_payload{0xC8, 0x00, 0xFA, 0x00};
+  const std::ptrdiff_t n = transcode(builtin_command(Command::drive).request, other->spec(Command::drive)->request, host_payload, staged);
+  REQUIRE(n == 8);
+  const Bytes wire(staged.begin(), staged.begin() + n);
+  CHECK(encode(other->frame, Command::drive, 0x12, wire) == Bytes{0x10, 0x09, 0xA8, 0x12, 0xC4, 0x09, 0x00, 0x00, 0xD0, 0x07, 0x00, 0x00, 0x7C});
+  // BATTERY 87 %, not charging, 15.800 V: voltage 158 (0x9E) of 0.1 V; Length 1 + 3 = 4; CRC 0x3E.
+  const Bytes battery{0x57, 0x00, 0xB8, 0x3D};
+  const std::ptrdiff_t m = transcode(builtin_command(Command::battery).response, other->spec(Command::battery)->response, battery, staged);
+  REQUIRE(m == 3);
+  std::array<std::uint8_t, 16> out{};
+  const std::size_t k = encode_response(0x20, std::span<const std::uint8_t>(staged.data(), 3), out, other->frame);
+  CHECK(Bytes(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(k)) == Bytes{0x10, 0x04, 0x20, 0x57, 0x00, 0x9E, 0x3E});
+  // No echo (FFFF) stays no echo (FF) in a narrower type; a payload that does not fit is refused.
+  const Bytes ranges{0x02, 0xB0, 0x04, 0xFF, 0xFF};
+  REQUIRE(transcode(builtin_command(Command::ultrasonic).response, other->spec(Command::ultrasonic)->response, ranges, staged) == 3);
+  CHECK(Bytes(staged.begin(), staged.begin() + 3) == Bytes{0x02, 0x78, 0xFF});  // 1.200 m = 120 cm
+  CHECK(transcode(builtin_command(Command::ultrasonic).response, other->spec(Command::ultrasonic)->response, Bytes{0x02, 0xB0}, staged) == -1);
+
+  // Host and board both in it: driving, polling and the sensors as in the host's own layout.
+  Pair pair(other, other);
+  pair.run_for(3s);
+  CHECK(pair.link.synchronised());
+  CHECK(pair.link.stats().error_responses == 0);
+  CHECK(pair.board.required_m_s(0) == Approx(0.2));
+  CHECK(pair.board.required_m_s(1) == Approx(0.2));
+  CHECK(pair.link.drive().encoders.left_mm_s == Approx(200).margin(10));
+  REQUIRE(pair.link.has_battery());
+  CHECK(pair.link.battery().voltage_mv == 16800);
+  REQUIRE(pair.link.ultrasonic_mm().size() == 3);
+  CHECK(pair.link.ultrasonic_mm()[2] == 1200);
+  // A host in the thesis's own layouts against this board: DRIVE refused (8 bytes expected).
+  Pair mixed(resolve_protocol_profile("thesis", {}), other);
+  mixed.run_for(1s);
+  CHECK(mixed.link.stats().error_responses > 0);
+}
+
 TEST_CASE("a profile without the SYNC echo: the board answers SYNC with its Resp", "[board][protocol]") {
   const auto no_echo = shared(parse_protocol_profile(thesis_text_with("sync_echo: true", "sync_echo: false"), "no_echo.yaml"));
   Pair pair(no_echo, no_echo);
@@ -352,7 +411,7 @@ TEST_CASE("a profile's errors are located and all reported", "[board][protocol][
   SECTION("several errors at once, and a layout this host does not implement") {
     std::string text = thesis_text_with("    id: 0x01\n", "    id: 0xEE\n");  // the error Resp
     text.replace(text.find("length_rule: cmd_payload"), 24, "length_rule: sideways");
-    text.replace(text.find("{name: track, type: u8}"), 23, "{name: track, type: u16}");
+    text.replace(text.find("{name: track, type: u8}"), 23, "{name: track, type: u8, unit: m}");
     try {
       (void)parse_protocol_profile(text, "many.yaml");
       FAIL("no error");
@@ -361,13 +420,25 @@ TEST_CASE("a profile's errors are located and all reported", "[board][protocol][
       const std::string what = e.what();
       CHECK_THAT(what, Catch::Contains("frame.length_rule: expected one of cmd_payload, type_cmd_payload; got 'sideways'"));
       CHECK_THAT(what, Catch::Contains("STATUS: id 0xEE is the error Resp (errors.resp)"));
-      CHECK_THAT(what, Catch::Contains("VOICE request field 1: expected {name: track, type: u8} (what this host and the firmware "
-                                       "model implement), got {name: track, type: u16}"));
+      CHECK_THAT(what, Catch::Contains("VOICE request field 1 'track': unit 'm', expected '' (this host and the firmware model "
+                                       "implement {name: track, type: u8})"));
     }
   }
   SECTION("an error Resp equal to TYPE, which would read as a SYNC echo") {
     const std::string text = thesis_text_with("  resp: 0xEE", "  resp: 0xA8");
     REQUIRE_THROWS_WITH(parse_protocol_profile(text, "resp.yaml"), Catch::Contains("errors.resp: 0xA8 is the TYPE byte"));
+  }
+  SECTION("a field the host does not know, and one it misses") {
+    const std::string text = thesis_text_with("{name: on, type: u8}", "{name: lamp, type: u8}");
+    try {
+      (void)parse_protocol_profile(text, "field.yaml");
+      FAIL("no error");
+    } catch (const ConfigError& e) {
+      const std::string what = e.what();
+      CHECK_THAT(what, Catch::Contains("UV_LAMP request field 1 'lamp': not a field of UV_LAMP request (this host and the firmware "
+                                       "model know: on)"));
+      CHECK_THAT(what, Catch::Contains("UV_LAMP request: no field 'on'"));
+    }
   }
   SECTION("a Flag that does not fit Table 3-2") {
     const std::string text = thesis_text_with("flag_long: 0x50", "flag_long: 0x51");

@@ -145,6 +145,7 @@ class BoardLink {
   std::uint32_t refused_checksums_ = 0;  // consecutive checksum errors reported by the board
   std::array<std::uint8_t, 256> rx_{};
   std::array<std::uint8_t, kMaxFrameBytes> tx_{};
+  std::array<std::uint8_t, kMaxLength> transcoded_{};  // a response's payload in the host's layout
   std::array<std::uint8_t, 16> sync_frame_{};
   std::size_t sync_size_ = 0;
   std::array<Outstanding, 4> outstanding_{};

@@ -87,12 +87,22 @@ struct CommandSpec {
   std::uint8_t id = 0;
   std::vector<FieldSpec> request;
   std::vector<FieldSpec> response;
+  /// The layout differs from the host's (order, types, scales): payloads are transcoded.
+  bool request_transcoded = false;
+  bool response_transcoded = false;
   SourceLocation where;
 };
 /// The most bytes a layout takes.
 [[nodiscard]] std::size_t max_payload_bytes(const std::vector<FieldSpec>& layout) noexcept;
-/// The layouts this host and the firmware model implement for `command` (what a profile's must
-/// match, field for field).
+/// Rewrites a payload laid out as `from` into the layout `to` (the same fields by name, in any
+/// order, type and scale): each value read as physical (wire x scale), written rounded and
+/// saturated in the other's type and scale; a value at its unsigned type's largest (0xFFFF: no
+/// echo) stays the largest. Returns the bytes written, or -1 when `in` does not fit `from` or
+/// `out` is too small. No allocation.
+[[nodiscard]] std::ptrdiff_t transcode(const std::vector<FieldSpec>& from, const std::vector<FieldSpec>& to,
+                                       std::span<const std::uint8_t> in, std::span<std::uint8_t> out) noexcept;
+/// The layouts this host and the firmware model implement for `command` (what a profile's are
+/// transcoded to and from: the same fields, units and counts; order, types and scales may differ).
 [[nodiscard]] const CommandSpec& builtin_command(Command command) noexcept;
 /// Every command of the table, in the order of the Command enum.
 [[nodiscard]] std::span<const Command> all_commands() noexcept;
