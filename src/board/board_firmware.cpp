@@ -38,7 +38,13 @@ void SpeedPid::reset() noexcept {
 }
 
 BoardFirmware::BoardFirmware(const FirmwareConfig& config, ByteStream& link, BoardPlant& plant, Time start)
-    : config_(config), link_(link), plant_(plant), now_(start), last_request_(start), next_motor_(start),
+    : config_(config),
+      protocol_(config.protocol ? config.protocol : resolve_protocol_profile("", {})),
+      profile_(*protocol_),
+      link_(link),
+      plant_(plant),
+      decoder_(profile_.frame, FrameSide::requests),
+      now_(start), last_request_(start), next_motor_(start),
       next_battery_(start), soc_(config.battery_initial), tank_l_(config.tank_initial_l) {
   config_.ultrasonic_count = std::min(config_.ultrasonic_count, kMaxUltrasonic);
   config_.cliff_count = std::min(config_.cliff_count, kMaxInfrared);
@@ -102,8 +108,15 @@ void BoardFirmware::handle(const FrameView& frame) noexcept {
   last_request_ = now_;  // the link watchdog's "last decoded packet"
   const std::span<const std::uint8_t> body = frame.body;
   // Figure 3-5: SYNC echoed unchanged, then synchronisation, TYPE, the command table.
-  if (body.size() >= 2 && body[1] == static_cast<std::uint8_t>(Command::sync)) {
-    if (!link_.write(frame.bytes)) return;
+  const std::optional<std::uint8_t> sync_id = profile_.id(Command::sync);
+  if (body.size() >= 2 && sync_id && body[1] == *sync_id) {
+    // Section 3.3.3: the unchanged packet back (a profile without the echo answers with Resp).
+    if (profile_.sync_echo) {
+      if (!link_.write(frame.bytes)) return;
+    } else {
+      const std::size_t n = encode_response(*sync_id, {}, tx_, profile_.frame);
+      if (n == 0 || !link_.write(std::span<const std::uint8_t>(tx_.data(), n))) return;
+    }
     // A SYNC (re)starts the session: a master that synchronises again has lost track of the
     // board, so the wheels stop until it drives them again.
     stop_motors();
@@ -115,28 +128,35 @@ void BoardFirmware::handle(const FrameView& frame) noexcept {
   }
   const std::uint8_t cmd = body.size() >= 2 ? body[1] : 0;
   if (!synchronised_) return answer_error(ErrorCode::not_synchronised, cmd);
-  if (body[0] != kRequestType) return answer_error(ErrorCode::wrong_type, cmd);
+  if (body[0] != profile_.frame.type_byte) return answer_error(ErrorCode::wrong_type, cmd);
   if (body.size() < 2) return answer_error(ErrorCode::bad_payload, 0);  // TYPE without CMD
-  const std::optional<Command> command = command_of(cmd);
+  const std::optional<Command> command = profile_.command_of(cmd);
   if (!command) return answer_error(ErrorCode::unknown_command, cmd);
-  serve(*command, body.subspan(2));
+  serve(*command, cmd, body.subspan(2));
 }
 
 void BoardFirmware::answer(std::uint8_t resp, std::span<const std::uint8_t> payload) noexcept {
-  const std::size_t n = encode_response(resp, payload, tx_);
-  if (n > 0 && link_.write(std::span<const std::uint8_t>(tx_.data(), n)) && resp != kErrorResp) ++counters_.requests;
+  const std::size_t n = encode_response(resp, payload, tx_, profile_.frame);
+  if (n > 0 && link_.write(std::span<const std::uint8_t>(tx_.data(), n)) && resp != profile_.error_resp) ++counters_.requests;
 }
 
 void BoardFirmware::answer_error(ErrorCode code, std::uint8_t cmd) noexcept {
-  const std::array<std::uint8_t, 2> payload{static_cast<std::uint8_t>(code), cmd};
+  const std::array<std::uint8_t, 2> payload{profile_.code(code), cmd};
   ++counters_.error_responses;
-  answer(kErrorResp, payload);
+  answer(profile_.error_resp, payload);
 }
 
-void BoardFirmware::serve(Command cmd, std::span<const std::uint8_t> payload) noexcept {
+void BoardFirmware::serve(Command cmd, std::uint8_t c, std::span<const std::uint8_t> payload) noexcept {
   std::array<std::uint8_t, 64> out{};
   ByteWriter w(out);
-  const auto c = static_cast<std::uint8_t>(cmd);
+  // A profile whose layouts differ from the model's (order, types, scales): payloads transcoded.
+  const CommandSpec* spec = profile_.spec(cmd);
+  std::array<std::uint8_t, kMaxLength> staged{};
+  if (spec != nullptr && spec->request_transcoded) {
+    const std::ptrdiff_t n = transcode(spec->request, builtin_command(cmd).request, payload, staged);
+    if (n < 0) return answer_error(ErrorCode::bad_payload, c);
+    payload = std::span<const std::uint8_t>(staged.data(), static_cast<std::size_t>(n));
+  }
   const auto expect = [&](std::size_t size) {
     if (payload.size() == size) return true;
     answer_error(ErrorCode::bad_payload, c);
@@ -226,6 +246,11 @@ void BoardFirmware::serve(Command cmd, std::span<const std::uint8_t> payload) no
       std::memcpy(line.data(), payload.data() + 1, payload.size() - 1);
       break;
     }
+  }
+  if (spec != nullptr && spec->response_transcoded) {
+    const std::ptrdiff_t n = transcode(builtin_command(cmd).response, spec->response, w.written(), staged);
+    if (n >= 0) answer(c, std::span<const std::uint8_t>(staged.data(), static_cast<std::size_t>(n)));
+    return;
   }
   answer(c, w.written());
 }

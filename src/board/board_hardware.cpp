@@ -1,5 +1,7 @@
 #include "tripodal/board/board_hardware.hpp"
 
+#include "tripodal/board/tcp_stream.hpp"
+
 #include <cmath>
 #include <limits>
 #include <typeinfo>
@@ -31,9 +33,12 @@ class BoardHardware::LinkResource final : public CResource {
 
 const ModuleManifest& BoardHardware::static_manifest() {
   static const ModuleManifest m = hardware_manifest(
-      "board", "a differential base behind the disinfection robot's control board (UART, docs/board-protocol.md)",
+      "board", "a differential base behind the disinfection robot's control board (UART or TCP, docs/board-protocol.md)",
       {"odometry", "battery", "sonar", "cliff", "bumpers", "board_link"},
-      {ParameterSpec{"port", ValueType::string, Value{std::string()}, "", "the board's tty (e.g. /dev/ttyUSB0)", {}, {}},
+      {ParameterSpec{"port", ValueType::string, Value{std::string()}, "",
+                     "the board's tty (e.g. /dev/ttyUSB0), or tcp://HOST:PORT for its ESP8266 Wi-Fi link", {}, {}},
+       ParameterSpec{"protocol", ValueType::string, Value{std::string("thesis")}, "",
+                     "the board's protocol profile: thesis, tripodal-v1 or a YAML file (configs/board/)", {}, {}},
        ParameterSpec{"baud", ValueType::number, Value{115200.0}, "bit/s", "line rate", 9600.0, 921600.0},
        ParameterSpec{"pulses_per_m", ValueType::number, Value{5000.0}, "1/m", "encoder pulses per metre of wheel travel", 1.0, 1e6},
        ParameterSpec{"response_timeout_s", ValueType::number, Value{0.01}, "s", "a response later than this is missed", 0.001, 1.0},
@@ -133,6 +138,15 @@ BoardHardwareConfig board_hardware_config(const HardwareConfig& c) {
   config.pulses_per_m = c.parameters.number("pulses_per_m");
   config.link.response_timeout = from_seconds(c.parameters.number("response_timeout_s"));
   config.link.max_missed = static_cast<std::uint32_t>(c.parameters.number("max_missed"));
+  const std::string& protocol = c.parameters.string("protocol");
+  try {
+    config.link.protocol = resolve_protocol_profile(protocol, c.profile_dir);
+  } catch (const ConfigError& e) {
+    // The profile's own errors are located in its file; say which robot entry named it.
+    Diagnostics d = e.diagnostics();
+    d.note(c.where, "protocol profile '" + protocol + "' named by hardware 'board' here");
+    throw ConfigError(std::move(d));
+  }
   return config;
 }
 
@@ -143,8 +157,14 @@ void register_board_hardware(HardwareRegistry& registry) {
     if (port.empty()) throw ConfigError(c.where, "hardware 'board' needs its port: parameters: {port: /dev/ttyUSB0}");
     // The port's reads are bounded by its own steady clock; the link never waits on them.
     static const SteadyClock port_clock;
-    auto stream = std::make_unique<SerialPort>(port, port_clock,
-                                               SerialSettings{static_cast<std::uint32_t>(c.parameters.number("baud"))});
+    std::unique_ptr<ByteStream> stream;
+    if (is_tcp_port(port)) {
+      // The backup channel (seed 001 section 2.x: the ESP8266 on the control board): the same
+      // frames over a TCP byte stream; reconnected like a reopened tty.
+      stream = std::make_unique<TcpStream>(port, port_clock);
+    } else {
+      stream = std::make_unique<SerialPort>(port, port_clock, SerialSettings{static_cast<std::uint32_t>(c.parameters.number("baud"))});
+    }
     ByteStream& s = *stream;
     return std::make_unique<BoardHardware>(s, config, std::move(stream));
   });

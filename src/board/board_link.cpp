@@ -3,12 +3,53 @@
 #include <algorithm>
 #include <cstring>
 
+#include <fmt/format.h>
+
 namespace tripodal::board {
 
-BoardLink::BoardLink(ByteStream& stream, LinkConfig config) noexcept : stream_(stream), config_(config) {}
+BoardLink::BoardLink(ByteStream& stream, LinkConfig config)
+    : stream_(stream),
+      config_(config),
+      protocol_(config.protocol ? config.protocol : resolve_protocol_profile("", {})),
+      profile_(*protocol_),
+      decoder_(profile_.frame, FrameSide::responses) {
+  const std::string expected(to_string(profile_.frame.checksum));
+  for (std::size_t k = 0; k < kChecksumKindCount; ++k) {
+    const auto kind = static_cast<ChecksumKind>(k);
+    mismatch_text_[k] = fmt::format("protocol profile {} expects {}, the board's frames fit {}{}", profile_.name, expected,
+                                    kind == ChecksumKind::sum8 ? "an " : "", to_string(kind));
+  }
+  const LengthRule other = profile_.frame.length_rule == LengthRule::cmd_payload ? LengthRule::type_cmd_payload : LengthRule::cmd_payload;
+  mismatch_text_[kChecksumKindCount] =
+      fmt::format("protocol profile {} reads a request's Length as {}, the board's frames fit Length = {}", profile_.name,
+                  to_string(profile_.frame.length_rule), to_string(other));
+  mismatch_text_[kChecksumKindCount + 1] =
+      fmt::format("the board refuses the checksum of requests framed by protocol profile {} (Length = {}), while its own frames "
+                  "pass {}: it reads Length as {}, or computes another checksum",
+                  profile_.name, to_string(profile_.frame.length_rule), expected, to_string(other));
+}
+
+// Two pieces of the same evidence name the mismatch: one could be line noise.
+void BoardLink::check_dialect() noexcept {
+  const DecoderStats& s = decoder_.stats();
+  for (std::size_t k = 0; k < kChecksumKindCount; ++k) {
+    if (s.fits[k] >= 2 && dialect_mismatch_.empty()) {
+      dialect_mismatch_ = mismatch_text_[k];
+      ++stats_.dialect_mismatches;
+    }
+  }
+  if (s.fits_other_length_rule >= 2 && dialect_mismatch_.empty()) {
+    dialect_mismatch_ = mismatch_text_[kChecksumKindCount];
+    ++stats_.dialect_mismatches;
+  }
+  if (refused_checksums_ >= 2 && dialect_mismatch_.empty()) {
+    dialect_mismatch_ = mismatch_text_[kChecksumKindCount + 1];
+    ++stats_.dialect_mismatches;
+  }
+}
 
 bool BoardLink::queue(Command cmd, std::span<const std::uint8_t> payload) noexcept {
-  if (queue_size_ == queue_.size() || payload.size() > queue_[0].payload.size()) return false;
+  if (queue_size_ == queue_.size() || payload.size() > queue_[0].payload.size() || !profile_.has(cmd)) return false;
   ActuatorCommand& c = queue_[(queue_head_ + queue_size_) % queue_.size()];
   c.cmd = cmd;
   c.size = static_cast<std::uint8_t>(payload.size());
@@ -38,7 +79,7 @@ void BoardLink::check_port(Time now) noexcept {
   const std::string_view fault = stream_.check();
   if (fault.empty()) return;
   last_port_fault_ = fault;
-  if (fault == kDeviceGone) {
+  if (fault == kDeviceGone || fault == kConnectionGone) {
     ++stats_.port_failures;
   } else {
     ++stats_.settings_changed;
@@ -90,9 +131,18 @@ void BoardLink::cycle(Time now, WheelSpeeds speeds) noexcept {
 
 bool BoardLink::send(Command cmd, std::span<const std::uint8_t> payload, Time now, bool actuator) noexcept {
   if (outstanding_size_ == outstanding_.size()) return false;
-  const std::size_t n = encode_request(static_cast<std::uint8_t>(cmd), payload, tx_);
+  const std::optional<std::uint8_t> id = profile_.id(cmd);
+  if (!id) return false;  // the board's dialect has no such command: the poll is skipped
+  // A board whose layouts differ from the host's: the payload in the board's layout.
+  std::array<std::uint8_t, kMaxLength> staged{};
+  if (const CommandSpec* spec = profile_.spec(cmd); spec != nullptr && spec->request_transcoded) {
+    const std::ptrdiff_t t = transcode(builtin_command(cmd).request, spec->request, payload, staged);
+    if (t < 0) return false;
+    payload = std::span<const std::uint8_t>(staged.data(), static_cast<std::size_t>(t));
+  }
+  const std::size_t n = encode_request(*id, payload, tx_, profile_.frame);
   if (n == 0) return false;
-  if (cmd == Command::sync) {
+  if (cmd == Command::sync && n <= sync_frame_.size()) {
     std::memcpy(sync_frame_.data(), tx_.data(), n);
     sync_size_ = n;
   }
@@ -119,6 +169,7 @@ void BoardLink::receive(Time now) noexcept {
     stats_.bytes_received += static_cast<std::uint64_t>(n);
     decoder_.feed(std::span<const std::uint8_t>(rx_.data(), static_cast<std::size_t>(n)),
                   [&](const FrameView& f) { on_frame(f, now); });
+    check_dialect();
   }
 }
 
@@ -126,9 +177,10 @@ void BoardLink::on_frame(const FrameView& frame, Time now) noexcept {
   const std::optional<Response> r = parse_response(frame.body);
   if (!r || outstanding_size_ == 0) return;  // nothing asked: stray bytes
   const Outstanding front = outstanding_[0];
-  const bool echo = front.cmd == Command::sync && frame.bytes.size() == sync_size_ &&
+  const bool echo = front.cmd == Command::sync && profile_.sync_echo && frame.bytes.size() == sync_size_ &&
                     std::equal(frame.bytes.begin(), frame.bytes.end(), sync_frame_.begin());
-  const bool matches = echo || r->resp == static_cast<std::uint8_t>(front.cmd) || r->is_error();
+  const bool is_error = r->resp == profile_.error_resp;
+  const bool matches = echo || r->resp == profile_.id(front.cmd) || is_error;
   if (!matches) {
     // The front's response never came (this one answers a later request). No re-scan: the
     // decoder is mid-feed.
@@ -142,14 +194,26 @@ void BoardLink::on_frame(const FrameView& frame, Time now) noexcept {
   stats_.last_round_trip = rtt;
   stats_.max_round_trip = std::max(stats_.max_round_trip, rtt);
   stats_.total_round_trip += rtt;
-  if (r->is_error()) {
+  if (is_error) {
     ++stats_.error_responses;
     check_port_now_ = true;
     if (front.actuator) ++stats_.retries;  // stays queued: sent again next period
+    const std::optional<ErrorCode> code = r->payload.empty() ? std::nullopt : profile_.error_of(r->payload[0]);
+    // A checksum error on a request we framed: noise, or a board of another dialect.
+    refused_checksums_ = code == ErrorCode::checksum ? refused_checksums_ + 1 : 0;
+    check_dialect();
     // The board's watchdog tripped (it stopped the motors and wants SYNC), or too many errors.
-    if (r->error() == ErrorCode::not_synchronised && synchronised_) ++stats_.watchdog_trips;
-    if (r->error() == ErrorCode::not_synchronised || ++consecutive_missed_ >= config_.max_missed) lose(now);
+    if (code == ErrorCode::not_synchronised && synchronised_) ++stats_.watchdog_trips;
+    if (code == ErrorCode::not_synchronised || ++consecutive_missed_ >= config_.max_missed) lose(now);
     return;
+  }
+  refused_checksums_ = 0;
+  // A board whose layouts differ from the host's (order, types, scales): into the host's layout.
+  std::span<const std::uint8_t> payload = r->payload;
+  const CommandSpec* spec = profile_.spec(front.cmd);
+  if (spec != nullptr && spec->response_transcoded && !echo) {
+    const std::ptrdiff_t n = transcode(spec->response, builtin_command(front.cmd).response, payload, transcoded_);
+    payload = n < 0 ? std::span<const std::uint8_t>{} : std::span<const std::uint8_t>(transcoded_.data(), static_cast<std::size_t>(n));
   }
   ++stats_.responses;
   consecutive_missed_ = 0;
@@ -163,34 +227,34 @@ void BoardLink::on_frame(const FrameView& frame, Time now) noexcept {
       synchronised_ = true;
       break;
     case Command::drive:
-      if (const auto d = unpack_drive(r->payload)) {
+      if (const auto d = unpack_drive(payload)) {
         drive_ = *d;
         drive_stamp_ = now;
         has_drive_ = true;
       }
       break;
     case Command::battery:
-      if (const auto b = unpack_battery(r->payload)) {
+      if (const auto b = unpack_battery(payload)) {
         battery_ = *b;
         has_battery_ = true;
       }
       break;
     case Command::liquid_level:
-      if (r->payload.size() == 2) {
-        tank_percent_ = r->payload[0];
-        tank_empty_ = r->payload[1] != 0;
+      if (payload.size() == 2) {
+        tank_percent_ = payload[0];
+        tank_empty_ = payload[1] != 0;
         has_tank_ = true;
       }
       break;
     case Command::ultrasonic: {
-      ByteReader rd(r->payload);
+      ByteReader rd(payload);
       ultrasonic_count_ = std::min<std::size_t>(rd.u8(), kMaxUltrasonic);
       for (std::size_t i = 0; i < ultrasonic_count_; ++i) ultrasonic_[i] = rd.u16();
       if (rd.failed()) ultrasonic_count_ = 0;
       break;
     }
     case Command::infrared: {
-      ByteReader rd(r->payload);
+      ByteReader rd(payload);
       cliff_count_ = std::min<std::size_t>(rd.u8(), kMaxInfrared);
       infrared_count_ = cliff_count_ + std::min<std::size_t>(rd.u8(), kMaxInfrared);
       for (std::size_t i = 0; i < infrared_count_; ++i) infrared_[i] = rd.u16();

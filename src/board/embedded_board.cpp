@@ -5,6 +5,12 @@
 namespace tripodal::board {
 
 namespace {
+// Both ends speak the robot's profile: the firmware takes the host's unless given its own.
+FirmwareConfig with_protocol(FirmwareConfig firmware, const BoardHardwareConfig& host) {
+  if (!firmware.protocol) firmware.protocol = host.link.protocol;
+  return firmware;
+}
+
 std::unique_ptr<PseudoTerminal> open_carrier(BoardLine carrier, const Clock& clock, std::uint32_t baud) {
   if (carrier == BoardLine::in_process) return nullptr;
   return std::make_unique<PseudoTerminal>(clock, SerialSettings{baud});
@@ -17,7 +23,7 @@ EmbeddedBoard::EmbeddedBoard(const FirmwareConfig& firmware, BoardPlant& plant, 
       pty_(open_carrier(carrier, real_clock_, baud)),
       port_(pty_ ? std::make_unique<SerialPort>(pty_->slave_path(), real_clock_, SerialSettings{baud}) : nullptr),
       line_(clock_, baud),
-      firmware_(firmware, line_.board(), plant),
+      firmware_(with_protocol(firmware, host), line_.board(), plant),
       host_(line_.host(), host) {
   if (pty_) line_.carry_over(*port_, *pty_, real_clock_);
 }

@@ -45,7 +45,12 @@ struct Bench {
     c.link_timeout = 1h;
     return c;
   }
-  explicit Bench(FirmwareConfig c = patient()) : config(c) { board = std::make_unique<BoardFirmware>(config, line.board(), plant); }
+  // The frames below are tripodal-v1's (docs/board-protocol.md's golden table before profiles):
+  // the board speaks that dialect here; the thesis's is tested in protocol_profile_test.cpp.
+  explicit Bench(FirmwareConfig c = patient()) : config(c) {
+    if (!config.protocol) config.protocol = resolve_protocol_profile("tripodal-v1", {});
+    board = std::make_unique<BoardFirmware>(config, line.board(), plant);
+  }
 
   void run_for(Duration d) {
     clock.advance(d);

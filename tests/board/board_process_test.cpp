@@ -9,10 +9,13 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "tripodal/board/board_link.hpp"
+#include "tripodal/board/tcp_stream.hpp"
 #include "tripodal/board/serial_port.hpp"
 #include "tripodal/core/clock.hpp"
 
@@ -25,10 +28,16 @@ using namespace std::chrono_literals;
 namespace {
 
 // tripodal-board-sim on the workspace, its pseudo-terminal also reachable at `link`.
-pid_t start_board(const std::filesystem::path& link) {
+// With `tcp_port`, on TCP (the ESP8266 backup link) at 127.0.0.1:tcp_port instead.
+pid_t start_board(const std::filesystem::path& link, int tcp_port = -1) {
   const std::string exe = TRIPODAL_BOARD_SIM_EXE;
   const std::string world = (std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs" / "worlds" / "workspace.yaml").string();
-  std::vector<std::string> args{exe, "--world", world, "--link", link.string(), "--duration-s", "60", "--link-timeout-s", "2"};
+  std::vector<std::string> args{exe, "--world", world, "--duration-s", "60", "--link-timeout-s", "2"};
+  if (tcp_port >= 0) {
+    args.insert(args.end(), {"--tcp", std::to_string(tcp_port)});
+  } else {
+    args.insert(args.end(), {"--link", link.string()});
+  }
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -107,4 +116,45 @@ TEST_CASE("a board whose process is killed: link lost at once, restarted: the po
 
   stop_board(board);
   std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("the board's process on TCP (the ESP8266 link): connected, killed, restarted: reconnected and resynchronised",
+          "[board][process][tcp]") {
+  const SteadyClock clock;
+  // A free port: one the kernel gives a listener, released for the board's process to take.
+  std::uint16_t port = 0;
+  {
+    TcpServerStream probe(clock);
+    port = probe.port();
+  }
+  const std::string spec = "tcp://127.0.0.1:" + std::to_string(port);
+  const auto connect = [&] {
+    // The process listens once it has loaded its world: try for at most 10 s, in 10 ms steps.
+    for (int i = 0; i < 1000; ++i) {
+      try {
+        return std::make_unique<TcpStream>(spec, clock);
+      } catch (const std::runtime_error&) {
+        clock.sleep_until(clock.now() + 10ms);
+      }
+    }
+    FAIL("the board never listened on " << spec);
+    return std::unique_ptr<TcpStream>();
+  };
+  pid_t board = start_board({}, port);
+  const std::unique_ptr<TcpStream> stream = connect();
+  LinkConfig config;
+  config.response_timeout = 200ms;  // two processes on two loaded cores (see above)
+  BoardLink link(*stream, config);
+  REQUIRE(cycle_until(link, clock, 300, [&] { return link.synchronised() && link.has_drive(); }) <= 300);
+  (void)link.take_link_lost();
+
+  stop_board(board);
+  CHECK(cycle_until(link, clock, 100, [&] { return link.take_link_lost(); }) <= 2);
+  board = start_board({}, port);  // the module back, on the same port
+  const int to_sync = cycle_until(link, clock, 1000, [&] { return link.synchronised() && link.stats().reopens > 0; });
+  CHECK(to_sync <= 1000);
+  const std::uint64_t responses = link.stats().responses;
+  CHECK(cycle_until(link, clock, 500, [&] { return link.synchronised() && link.stats().responses >= responses + 20; }) <= 500);
+  CHECK(link.stats().port_failures >= 1);
+  stop_board(board);
 }

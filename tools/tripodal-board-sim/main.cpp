@@ -1,7 +1,9 @@
 // tripodal-board-sim: the disinfection robot's control board (seed 001, chapter 3) simulated
 // behind a pseudo-terminal. It prints the slave device; a host opens it as it would the real
 // board's UART (/dev/ttyUSB0) and speaks the protocol of docs/board-protocol.md byte for byte. The
-// board's wheels move the embedded simulator's robot in the given world in real time.
+// board's wheels move the embedded simulator's robot in the given world in real time. It speaks
+// the protocol profile given (--protocol; the thesis's by default), over the pseudo-terminal or,
+// with --tcp, over TCP on loopback as the board's ESP8266 backup link would.
 #include <CLI/CLI.hpp>
 
 #include <atomic>
@@ -9,8 +11,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 
 #include "tripodal/board/board_firmware.hpp"
+#include "tripodal/board/protocol_profile.hpp"
+#include "tripodal/board/tcp_stream.hpp"
 #include "tripodal/board/serial_port.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/core/diagnostic.hpp"
@@ -33,6 +38,8 @@ int run(int argc, char** argv) {
   double duration_s = 0.0;
   double link_timeout_s = 0.2;
   double tank_l = 1.5;
+  std::string protocol = "thesis";
+  int tcp_port = -1;
   app.add_option("--world", world_file, "world file (the simulator's map, start pose, sensors)")->check(CLI::ExistingFile);
   app.add_option("--link", link, "also make this path a symbolic link to the pseudo-terminal");
   app.add_option("--wheel-radius-m", wheel_radius_m, "wheel radius (m)")->check(CLI::PositiveNumber);
@@ -40,6 +47,9 @@ int run(int argc, char** argv) {
   app.add_option("--duration-s", duration_s, "stop after this many seconds (0: at SIGINT or SIGTERM)")->check(CLI::NonNegativeNumber);
   app.add_option("--link-timeout-s", link_timeout_s, "the board's link watchdog (s)")->check(CLI::PositiveNumber);
   app.add_option("--tank-l", tank_l, "disinfectant in the tank at power-on (l)")->check(CLI::NonNegativeNumber);
+  app.add_option("--protocol", protocol, "protocol profile: thesis, tripodal-v1 or a YAML file (configs/board/)");
+  app.add_option("--tcp", tcp_port, "serve the link over TCP on 127.0.0.1:PORT (0: any free port) instead of a pseudo-terminal")
+      ->check(CLI::Range(0, 65535));
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -50,18 +60,33 @@ int run(int argc, char** argv) {
     base.differential = {wheel_separation_m, wheel_radius_m};
     sim::Simulator simulator(std::move(world), base, 1, clock.now());
     sim::SimBoardPlant plant(simulator, wheel_radius_m);
-    board::PseudoTerminal pty(clock);
+    std::unique_ptr<board::PseudoTerminal> pty;
+    std::unique_ptr<board::TcpServerStream> tcp;
+    board::ByteStream* line = nullptr;
+    if (tcp_port >= 0) {
+      tcp = std::make_unique<board::TcpServerStream>(clock, static_cast<std::uint16_t>(tcp_port));
+      line = tcp.get();
+    } else {
+      pty = std::make_unique<board::PseudoTerminal>(clock);
+      line = pty.get();
+    }
     board::FirmwareConfig config;
     config.link_timeout = from_seconds(link_timeout_s);
     config.tank_initial_l = tank_l;
-    board::BoardFirmware firmware(config, pty, plant, clock.now());
-    if (!link.empty()) {
+    config.protocol = board::resolve_protocol_profile(protocol, std::filesystem::current_path());
+    board::BoardFirmware firmware(config, *line, plant, clock.now());
+    if (!link.empty() && pty) {
       std::filesystem::remove(link);
-      std::filesystem::create_symlink(pty.slave_path(), link);
+      std::filesystem::create_symlink(pty->slave_path(), link);
     }
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
-    std::cout << "tripodal-board-sim: board on " << pty.slave_path().string() << " (115200 8N1)" << std::endl;
+    if (tcp) {
+      std::cout << "tripodal-board-sim: board on " << tcp->spec() << " (protocol " << config.protocol->summary() << ")" << std::endl;
+    } else {
+      std::cout << "tripodal-board-sim: board on " << pty->slave_path().string() << " (115200 8N1, protocol "
+                << config.protocol->summary() << ")" << std::endl;
+    }
 
     const Time end = duration_s > 0.0 ? clock.now() + from_seconds(duration_s) : Time::max();
     Time next = clock.now();
@@ -75,7 +100,7 @@ int run(int argc, char** argv) {
     std::cout << "tripodal-board-sim: " << c.requests << " requests answered, " << c.error_responses << " error responses, "
               << d.errors() << " decoder errors, " << c.watchdog_trips << " watchdog trips, " << c.resyncs << " synchronisations"
               << std::endl;
-    if (!link.empty()) std::filesystem::remove(link);
+    if (!link.empty() && pty) std::filesystem::remove(link);
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "tripodal-board-sim: error: " << e.what() << '\n';

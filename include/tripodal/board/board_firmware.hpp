@@ -7,11 +7,13 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 
 #include "tripodal/board/commands.hpp"
 #include "tripodal/board/frame.hpp"
+#include "tripodal/board/protocol_profile.hpp"
 #include "tripodal/board/serial_port.hpp"
 #include "tripodal/core/time.hpp"
 
@@ -52,6 +54,8 @@ struct SpeedPid {
 };
 
 struct FirmwareConfig {
+  /// The dialect the board speaks (null: the thesis's, configs/board/thesis.yaml).
+  std::shared_ptr<const ProtocolProfile> protocol;
   Duration tick{std::chrono::milliseconds(1)};            ///< the timer interrupt
   Duration motor_period{std::chrono::milliseconds(10)};   ///< encoder speed and PID refresh
   Duration link_timeout{std::chrono::milliseconds(200)};  ///< no valid request this long: motors stop
@@ -131,6 +135,8 @@ class BoardFirmware {
   [[nodiscard]] double disinfectant_used_l() const noexcept { return used_l_; }
   [[nodiscard]] const FirmwareCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const DecoderStats& decoder_stats() const noexcept { return decoder_.stats(); }
+  [[nodiscard]] const DecodeError& last_decode_error() const noexcept { return decoder_.last_error(); }
+  [[nodiscard]] const ProtocolProfile& protocol() const noexcept { return profile_; }
   /// When the last valid request was decoded (what the watchdog measures from).
   [[nodiscard]] Time last_request_at() const noexcept { return last_request_; }
   /// When the watchdog last stopped the motors.
@@ -153,7 +159,7 @@ class BoardFirmware {
   void handle(const FrameView& frame) noexcept;
   void answer(std::uint8_t resp, std::span<const std::uint8_t> payload) noexcept;
   void answer_error(ErrorCode code, std::uint8_t cmd) noexcept;
-  void serve(Command cmd, std::span<const std::uint8_t> payload) noexcept;
+  void serve(Command cmd, std::uint8_t id, std::span<const std::uint8_t> payload) noexcept;
   void device_loop() noexcept;
   void update_motors() noexcept;
   void stop_motors() noexcept;
@@ -163,6 +169,8 @@ class BoardFirmware {
   [[nodiscard]] EncoderState encoders() const noexcept;
 
   FirmwareConfig config_;
+  std::shared_ptr<const ProtocolProfile> protocol_;
+  const ProtocolProfile& profile_;
   ByteStream& link_;
   BoardPlant& plant_;
   FrameDecoder decoder_;

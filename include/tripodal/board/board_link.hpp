@@ -8,17 +8,22 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
+#include <string>
 #include <string_view>
 
 #include "tripodal/board/commands.hpp"
 #include "tripodal/board/frame.hpp"
+#include "tripodal/board/protocol_profile.hpp"
 #include "tripodal/board/serial_port.hpp"
 #include "tripodal/core/time.hpp"
 
 namespace tripodal::board {
 
 struct LinkConfig {
+  /// The dialect the board speaks (null: the thesis's, configs/board/thesis.yaml).
+  std::shared_ptr<const ProtocolProfile> protocol;
   /// A response must be decoded within this of its request (the control period: the next cycle
   /// checks it).
   Duration response_timeout{std::chrono::milliseconds(10)};
@@ -57,6 +62,9 @@ struct LinkStats {
   std::uint64_t watchdog_trips = 0;
   std::uint64_t bytes_sent = 0;      ///< written to the line by the host
   std::uint64_t bytes_received = 0;  ///< read from the line by the host
+  /// Evidence that the board speaks another dialect: its frames failing our checksum but fitting
+  /// another, or checksum errors it reports on requests framed right by our profile.
+  std::uint64_t dialect_mismatches = 0;
   Duration max_round_trip{0};
   Duration last_round_trip{0};
   Duration total_round_trip{0};
@@ -71,13 +79,15 @@ struct ActuatorCommand {
 
 class BoardLink {
  public:
-  BoardLink(ByteStream& stream, LinkConfig config = {}) noexcept;
+  /// Builds its messages and takes the profile (the thesis's when none): may allocate, once.
+  BoardLink(ByteStream& stream, LinkConfig config = {});
 
   /// One control cycle at `now`: takes the responses that arrived, times out the overdue ones,
   /// then sends SYNC (link not synchronised) or DRIVE with `speeds` and at most one other request.
   void cycle(Time now, WheelSpeeds speeds) noexcept;
 
-  /// Queues an actuator command (UV lamp, atomizer, voice, LCD); false when the queue is full.
+  /// Queues an actuator command (UV lamp, atomizer, voice, LCD); false when the queue is full or
+  /// the profile has no such command.
   bool queue(Command cmd, std::span<const std::uint8_t> payload) noexcept;
 
   [[nodiscard]] bool synchronised() const noexcept { return synchronised_; }
@@ -100,6 +110,11 @@ class BoardLink {
   [[nodiscard]] std::size_t pending_actuator_commands() const noexcept { return queue_size_; }
   [[nodiscard]] const LinkStats& stats() const noexcept { return stats_; }
   [[nodiscard]] const DecoderStats& decoder_stats() const noexcept { return decoder_.stats(); }
+  /// The board seems to speak another dialect than the profile: what does not match, e.g.
+  /// "protocol profile thesis expects CRC-8/SMBUS, the board's frames fit an 8-bit sum". Empty
+  /// while nothing says so (two pieces of evidence are needed: one could be line noise).
+  [[nodiscard]] std::string_view dialect_mismatch() const noexcept { return dialect_mismatch_; }
+  [[nodiscard]] const ProtocolProfile& protocol() const noexcept { return profile_; }
   /// What the latest port check found wrong ("icanon on, expected off"); empty if none yet.
   [[nodiscard]] std::string_view last_port_fault() const noexcept { return last_port_fault_; }
 
@@ -116,13 +131,22 @@ class BoardLink {
   void fail_stream(Time now) noexcept;
   void check_port(Time now) noexcept;
   bool send(Command cmd, std::span<const std::uint8_t> payload, Time now, bool actuator) noexcept;
+  void check_dialect() noexcept;
 
   ByteStream& stream_;
   LinkConfig config_;
+  std::shared_ptr<const ProtocolProfile> protocol_;
+  const ProtocolProfile& profile_;
   FrameDecoder decoder_;
+  // The messages a mismatch may give, built once (no allocation in a cycle): one per checksum
+  // the board's frames may fit, then the Length rule, then "it refuses our checksums".
+  std::array<std::string, kChecksumKindCount + 2> mismatch_text_;
+  std::string_view dialect_mismatch_;
+  std::uint32_t refused_checksums_ = 0;  // consecutive checksum errors reported by the board
   std::array<std::uint8_t, 256> rx_{};
   std::array<std::uint8_t, kMaxFrameBytes> tx_{};
-  std::array<std::uint8_t, 8> sync_frame_{};
+  std::array<std::uint8_t, kMaxLength> transcoded_{};  // a response's payload in the host's layout
+  std::array<std::uint8_t, 16> sync_frame_{};
   std::size_t sync_size_ = 0;
   std::array<Outstanding, 4> outstanding_{};
   std::size_t outstanding_size_ = 0;

@@ -1,7 +1,10 @@
-// The command table of the control-board protocol (docs/board-protocol.md): the CMD bytes, the
-// error codes and each command's payload, packed little-endian in integer SI-derived units (mm,
-// mm/s, mV, encoder pulses). The board firmware (board_firmware.hpp) serves them; the host side
-// (board_link.hpp) sends them. Packing writes into caller storage and never allocates.
+// The command table of the control-board protocol (docs/board-protocol.md): the commands, the
+// error codes and each command's payload as this host and the firmware model implement it, packed
+// little-endian in integer SI-derived units (mm, mm/s, mV, encoder pulses). The bytes on the wire
+// (CMD ids, error codes and Resp, layouts) are the protocol profile's (protocol_profile.hpp); the
+// enum values below are the shipped profiles' ids. The board firmware (board_firmware.hpp) serves
+// them; the host side (board_link.hpp) sends them. Packing writes into caller storage and never
+// allocates.
 #pragma once
 
 #include <array>
@@ -35,7 +38,8 @@ enum class Command : std::uint8_t {
 /// The Command of a CMD byte; nullopt for a byte not in the table.
 [[nodiscard]] std::optional<Command> command_of(std::uint8_t cmd) noexcept;
 
-/// Resp of an error response; its payload is ErrorCode, then the offending CMD (0 if unknown).
+/// Resp of an error response in the shipped profiles (ProtocolProfile::error_resp is the
+/// dialect's); its payload is the error code, then the offending CMD (0 if unknown).
 inline constexpr std::uint8_t kErrorResp = 0xEE;
 enum class ErrorCode : std::uint8_t {
   checksum = 0x01,          ///< a frame whose CHKSUM did not match

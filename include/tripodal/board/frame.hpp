@@ -1,8 +1,10 @@
 // The control-board link's framing (seed 001, section 3.3, Tables 3-1 to 3-6), byte for byte: the
 // bottom of the board area, below the hardware type that drives a differential base through the
-// board. Encoding writes into caller storage; FrameDecoder finds frames in a byte stream across
-// partial reads and resynchronises by re-scanning, without allocating. docs/board-protocol.md is
-// the reference for every byte.
+// board. The dialect (Flags, Length rule, checksum) is a FrameFormat from a protocol profile
+// (protocol_profile.hpp); the functions without one speak tripodal-v1, the dialect of the golden
+// frames before profiles. Encoding writes into caller storage; FrameDecoder finds frames in a byte
+// stream across partial reads and resynchronises by re-scanning, without allocating.
+// docs/board-protocol.md is the reference for every byte.
 #pragma once
 
 #include <array>
@@ -11,6 +13,8 @@
 #include <span>
 #include <string>
 #include <string_view>
+
+#include "tripodal/board/protocol_profile.hpp"
 
 namespace tripodal::board {
 
@@ -23,39 +27,48 @@ inline constexpr std::uint8_t kFlagShort = kFlagChecksumEn;                  // 
 inline constexpr std::uint8_t kFlagLong = kFlagLongFrame | kFlagChecksumEn;  // 0x50
 /// The TYPE byte that opens the body of every request (Tables 3-3 and 3-4).
 inline constexpr std::uint8_t kRequestType = 0xA8;
-/// Largest Length field accepted: the thesis's 512-byte UART buffers. Length counts the body
-/// (TYPE of a request, CMD or Resp, payload), not Flag, Length or CHKSUM.
+/// Largest Length field accepted: the thesis's 512-byte UART buffers (a profile may set less).
+/// Length counts CMD or Resp and the payload, and a request's TYPE under tripodal-v1; never Flag,
+/// Length or CHKSUM.
 inline constexpr std::size_t kMaxLength = 512;
 /// Largest Length of a short frame (one Length byte); longer bodies go in a long frame.
 inline constexpr std::size_t kMaxShortLength = 255;
-/// Flag + Len + LenH + CHKSUM of a long frame: the most a frame adds to its body.
-inline constexpr std::size_t kMaxOverhead = 4;
+/// Flag + Len + LenH + an uncounted TYPE (the thesis's Length rule) + CHKSUM: the most a frame
+/// adds to its Length.
+inline constexpr std::size_t kMaxOverhead = 5;
 inline constexpr std::size_t kMaxFrameBytes = kMaxLength + kMaxOverhead;
 
 /// The checksum (CHKSUM): CRC-8 with polynomial x^8 + x^2 + x + 1 (0x07), initial value 0, no
 /// reflection, no final XOR (CRC-8/SMBUS; check value 0xF4 over "123456789"), over every byte of
 /// the frame before CHKSUM (Flag, Length bytes and body). Detects every error burst of up to 8
-/// bits and every odd number of flipped bits, which a byte sum does not.
+/// bits and every odd number of flipped bits, which a byte sum does not. Both shipped profiles'.
 [[nodiscard]] std::uint8_t crc8(std::span<const std::uint8_t> bytes, std::uint8_t crc = 0) noexcept;
 
-/// A decoded frame's body (TYPE, CMD or Resp, payload), viewing the decoder's storage: valid
-/// until the decoder is fed again.
+/// Which end's frames a decoder reads: under the thesis's Length rule a request carries a TYPE
+/// byte its Length does not count; among responses only a SYNC echo does (it starts with TYPE).
+enum class FrameSide : std::uint8_t { requests, responses };
+
+/// A decoded frame's body (TYPE, CMD or Resp, payload: every byte between Length and CHKSUM),
+/// viewing the decoder's storage: valid until the decoder is fed again.
 struct FrameView {
   bool long_frame = false;
-  std::span<const std::uint8_t> body;   ///< Length bytes
+  std::span<const std::uint8_t> body;   ///< Length bytes, and the uncounted TYPE if any
   std::span<const std::uint8_t> bytes;  ///< the whole frame, Flag to CHKSUM (a SYNC echo sends it back)
 };
 
-/// Writes a frame with body `body` into `out` (short when the body has at most 255 bytes, long
-/// otherwise) and returns its size; 0 when the body is empty or longer than kMaxLength or `out`
-/// is too small (nothing is written then).
-[[nodiscard]] std::size_t encode_frame(std::span<const std::uint8_t> body, std::span<std::uint8_t> out) noexcept;
-/// A request: body = TYPE (0xA8), CMD, payload. 0 on the same conditions as encode_frame.
-[[nodiscard]] std::size_t encode_request(std::uint8_t cmd, std::span<const std::uint8_t> payload,
-                                         std::span<std::uint8_t> out) noexcept;
-/// A response: body = Resp, payload.
-[[nodiscard]] std::size_t encode_response(std::uint8_t resp, std::span<const std::uint8_t> payload,
-                                          std::span<std::uint8_t> out) noexcept;
+/// Writes a frame with body `body` into `out` (short when its Length is at most the format's
+/// max_short_length, long otherwise) and returns its size. Length counts the body less its first
+/// `uncounted` bytes (1: a request's TYPE under the thesis's rule). 0 when Length would be 0 or
+/// above the format's max_length or `out` is too small (nothing is written then).
+[[nodiscard]] std::size_t encode_frame(std::span<const std::uint8_t> body, std::span<std::uint8_t> out,
+                                       const FrameFormat& format = kTripodalV1Format, std::size_t uncounted = 0) noexcept;
+/// A request: body = TYPE (0xA8), CMD, payload; Length by the format's rule. 0 on the same
+/// conditions as encode_frame.
+[[nodiscard]] std::size_t encode_request(std::uint8_t cmd, std::span<const std::uint8_t> payload, std::span<std::uint8_t> out,
+                                         const FrameFormat& format = kTripodalV1Format) noexcept;
+/// A response: body = Resp, payload; Length = Resp + payload.
+[[nodiscard]] std::size_t encode_response(std::uint8_t resp, std::span<const std::uint8_t> payload, std::span<std::uint8_t> out,
+                                          const FrameFormat& format = kTripodalV1Format) noexcept;
 
 /// What went wrong in the byte stream. Every kind is counted (DecoderStats).
 enum class DecodeErrorKind : std::uint8_t {
@@ -63,7 +76,7 @@ enum class DecodeErrorKind : std::uint8_t {
   garbage,    ///< bytes skipped while looking for a Flag (0x10 or 0x50)
   empty,      ///< Length 0: a frame has at least its CMD or Resp byte
   oversize,   ///< Length above 512
-  checksum,   ///< CHKSUM differs from the CRC-8 of the frame
+  checksum,   ///< CHKSUM differs from the profile's checksum of the frame
   truncated,  ///< a frame started but its remaining bytes never came (abandon_partial)
 };
 [[nodiscard]] std::string_view to_string(DecodeErrorKind kind) noexcept;
@@ -74,9 +87,18 @@ struct DecodeError {
   std::uint64_t offset = 0;    ///< stream offset of the Flag (or first garbage byte)
   std::uint32_t length = 0;    ///< Length field (empty, oversize, checksum, truncated) or bytes skipped (garbage)
   std::uint8_t carried = 0;    ///< checksum: the CHKSUM byte received
-  std::uint8_t computed = 0;   ///< checksum: the CRC-8 computed
+  std::uint8_t computed = 0;   ///< checksum: the profile's checksum computed
+  ChecksumKind expected = ChecksumKind::crc8_smbus;  ///< checksum: the profile's
+  /// checksum: another known checksum the frame fits (kChecksumKindCount: none fits), the hint
+  /// that the other end speaks another dialect.
+  std::uint8_t fits = kChecksumKindCount;
+  /// checksum: the frame fits its CHKSUM when Length is read by the other rule (TYPE counted or not).
+  bool fits_other_length_rule = false;
+  std::uint8_t flag_short = 0x10;  ///< garbage: the Flags that were looked for
+  std::uint8_t flag_long = 0x50;
 };
-/// One line: "stream offset 17: checksum mismatch: frame of Length 3 carries CHKSUM 0x12, expected 0xf4".
+/// One line: "stream offset 17: checksum mismatch: frame of Length 3 carries CHKSUM 0x12, expected
+/// 0xf4 (CRC-8/SMBUS); the frame fits an 8-bit sum".
 [[nodiscard]] std::string describe(const DecodeError& error);
 
 struct DecoderStats {
@@ -89,6 +111,10 @@ struct DecoderStats {
   std::uint64_t oversize = 0;
   std::uint64_t checksum = 0;
   std::uint64_t truncated = 0;
+  /// Checksum failures that another known checksum fits, per ChecksumKind, and those that fit
+  /// the other Length rule: evidence of a dialect mismatch rather than line noise.
+  std::array<std::uint64_t, kChecksumKindCount> fits{};
+  std::uint64_t fits_other_length_rule = 0;
   /// Every error event: garbage runs, empty, oversize, checksum and truncated candidates.
   [[nodiscard]] std::uint64_t errors() const noexcept { return garbage_runs + empty + oversize + checksum + truncated; }
 };
@@ -99,6 +125,10 @@ struct DecoderStats {
 /// one frame, no buffer dropped). No allocation, no exception; one thread.
 class FrameDecoder {
  public:
+  /// A decoder of `side`'s frames in `format`'s dialect (by default tripodal-v1's responses).
+  explicit FrameDecoder(const FrameFormat& format = kTripodalV1Format, FrameSide side = FrameSide::responses) noexcept
+      : format_(format), side_(side) {}
+
   struct Result {
     std::size_t consumed = 0;  ///< bytes of the input taken (the rest: feed them again)
     bool frame = false;        ///< frame() holds a new frame
@@ -141,12 +171,16 @@ class FrameDecoder {
  private:
   bool scan() noexcept;  // looks for a frame at the front; true when one is complete
   void fail(DecodeErrorKind kind, std::uint32_t length, std::uint8_t carried = 0, std::uint8_t computed = 0) noexcept;
+  [[nodiscard]] bool is_flag(std::uint8_t b) const noexcept;
+  void diagnose(const std::uint8_t* p, std::size_t header, std::size_t extra, std::size_t length, std::size_t avail) noexcept;
   void skip_garbage() noexcept;
   void compact() noexcept;
 
   // Twice a frame: a whole candidate plus what follows it always fits without moving bytes more
   // than once per frame.
   std::array<std::uint8_t, 2 * kMaxFrameBytes> buffer_{};
+  FrameFormat format_;
+  FrameSide side_;
   std::size_t begin_ = 0;  // first buffered byte not yet consumed
   std::size_t end_ = 0;    // one past the last buffered byte
   std::size_t drop_ = 0;   // bytes of the delivered frame to drop at the next call

@@ -19,6 +19,8 @@ namespace tripodal::board {
 /// What ByteStream::check says when the settings cannot be read at all: the device is gone, was
 /// closed under its owner, or is not a tty.
 inline constexpr std::string_view kDeviceGone = "tcgetattr failed: the device is gone or not a tty";
+/// What ByteStream::check says of a TCP connection (tcp_stream.hpp) the peer closed or reset.
+inline constexpr std::string_view kConnectionGone = "the TCP connection is closed";
 
 /// A byte pipe to the other end of the link: the serial port, or an in-memory line in simulation.
 /// One thread reads, one writes (may be the same).
