@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "instructions.hpp"
 #include "tripodal/board/commands.hpp"
 #include "tripodal/board/frame.hpp"
 
@@ -49,4 +50,9 @@ void BM_DecodeDriveResponsesWithGarbage(benchmark::State& state) { decode(state,
 
 BENCHMARK(BM_DecodeDriveResponses);
 BENCHMARK(BM_DecodeDriveResponsesWithGarbage);
+// The instruction-count guard's twins (bench/instructions.yaml).
+[[maybe_unused]] static const bool kDecodeTwins[] = {
+    tripodal::bench::register_instruction_twin("BM_DecodeDriveResponses", BM_DecodeDriveResponses),
+    tripodal::bench::register_instruction_twin("BM_DecodeDriveResponsesWithGarbage", BM_DecodeDriveResponsesWithGarbage),
+};
 BENCHMARK_MAIN();
