@@ -9,6 +9,7 @@
 #              (cmake -DTRIPODAL_BROWSER_TESTS=ON; ctest -L browser)
 #     ros2-peer  Fast DDS (ROS 2's default middleware), the independent peer of the ROS 2 graph
 #                tests (tests/dds/ros2_peer_test.cpp; without it they are not built)
+#     perf   valgrind (callgrind), for the instruction-count guard scripts/instructions.sh
 #   (ThreadSanitizer, scripts/tsan.sh, needs nothing more: libtsan2 comes with g++.)
 set -euo pipefail
 
@@ -44,7 +45,8 @@ for group in "$@"; do
     tidy) packages+=(clang-tidy) ;;
     browser) packages+=(chromium chromium-driver python3-selenium) ;;
     ros2-peer) packages+=(libfastrtps-dev libfastcdr-dev) ;;
-    *) echo "install-deps: unknown group '$group' (expected fuzz, tidy, browser or ros2-peer)" >&2; exit 2 ;;
+    perf) packages+=(valgrind) ;;
+    *) echo "install-deps: unknown group '$group' (expected fuzz, tidy, browser, ros2-peer or perf)" >&2; exit 2 ;;
   esac
 done
 

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "instructions.hpp"
 #include "tripodal/board/commands.hpp"
 #include "tripodal/board/frame.hpp"
 #include "tripodal/board/protocol_profile.hpp"
@@ -95,4 +96,9 @@ BENCHMARK(BM_Profile_Thesis_Responses);
 BENCHMARK(BM_Profile_Thesis_Requests);
 BENCHMARK(BM_Profile_ThesisSum8_Responses);
 BENCHMARK(BM_Profile_ThesisXor8_Responses);
+// The instruction-count guard's twins (bench/instructions.yaml).
+[[maybe_unused]] static const bool kDecodeTwins[] = {
+    tripodal::bench::register_instruction_twin("BM_DecodeDriveResponses", BM_DecodeDriveResponses),
+    tripodal::bench::register_instruction_twin("BM_DecodeDriveResponsesWithGarbage", BM_DecodeDriveResponsesWithGarbage),
+};
 BENCHMARK_MAIN();

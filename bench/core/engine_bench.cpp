@@ -3,6 +3,7 @@
 // second on a ring whose every transition waits for an event.
 #include <benchmark/benchmark.h>
 
+#include "instructions.hpp"
 #include "../../tests/core/engine_test_nets.hpp"
 #include "tripodal/core/engine.hpp"
 
@@ -27,6 +28,8 @@ void BM_RingFirings(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<std::int64_t>(firings));
 }
 BENCHMARK(BM_RingFirings)->Arg(10)->Arg(10'000);
+// The instruction-count guard's twins (bench/instructions.yaml).
+[[maybe_unused]] const bool kRingTwin = tripodal::bench::register_instruction_twin("BM_RingFirings/10", BM_RingFirings, {10});
 
 void BM_EventDispatch(benchmark::State& state) {
   const auto n = static_cast<std::size_t>(state.range(0));
@@ -45,6 +48,7 @@ void BM_EventDispatch(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()));
 }
 BENCHMARK(BM_EventDispatch)->Arg(10)->Arg(10'000);
+[[maybe_unused]] const bool kDispatchTwin = tripodal::bench::register_instruction_twin("BM_EventDispatch/10", BM_EventDispatch, {10});
 
 void BM_EventDispatchByName(benchmark::State& state) {
   PetriNet net = test::ring_net(10);
@@ -58,6 +62,7 @@ void BM_EventDispatchByName(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()));
 }
 BENCHMARK(BM_EventDispatchByName);
+[[maybe_unused]] const bool kByNameTwin = tripodal::bench::register_instruction_twin("BM_EventDispatchByName", BM_EventDispatchByName);
 
 }  // namespace
 

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "instructions.hpp"
 #include "tripodal/navi/map_builder.hpp"
 #include "tripodal/navi/map_io.hpp"
 #include "tripodal/navi/scan_matching_localizer.hpp"
@@ -59,6 +60,11 @@ void BM_ScanMatchTrack(benchmark::State& state) {
   state.counters["worst_error_m"] = worst_m;
 }
 BENCHMARK(BM_ScanMatchTrack)->Arg(181)->Arg(1450)->Unit(benchmark::kMillisecond);
+// The instruction-count guard's twins (bench/instructions.yaml): iterations a multiple of the 5 poses.
+[[maybe_unused]] const bool kTrackTwins[] = {
+    tripodal::bench::register_instruction_twin("BM_ScanMatchTrack/181", BM_ScanMatchTrack, {181}),
+    tripodal::bench::register_instruction_twin("BM_ScanMatchTrack/1450", BM_ScanMatchTrack, {1450}),
+};
 
 void BM_ScanMatchGlobal(benchmark::State& state) {
   const std::vector<LaserScan> scans = simulated_scans(1450);

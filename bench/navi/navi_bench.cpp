@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "instructions.hpp"
 #include "tripodal/navi/coverage.hpp"
 #include "tripodal/navi/distance_field.hpp"
 #include "tripodal/navi/map_io.hpp"
@@ -55,6 +56,8 @@ void BM_AStar(benchmark::State& state) {
   state.counters["waypoints"] = static_cast<double>(p.waypoints.size());
 }
 BENCHMARK(BM_AStar)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+// The instruction-count guard's twin (bench/instructions.yaml).
+[[maybe_unused]] const bool kAStarTwin = tripodal::bench::register_instruction_twin("BM_AStar/short", BM_AStar, {1});
 
 // A replan around what a laser saw: the long plan with a 1 m wall of 21 returns across its first
 // leg (BhAutoMove / the cleaning detour call plan_around with the returns of one scan).

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <new>
 
+#include "instructions.hpp"
 #include "reactive_rig.hpp"
 
 namespace {
@@ -38,6 +39,13 @@ static void BM_ReactiveCycle(benchmark::State& state) {
       static_cast<double>(g_allocations.load() - before) / static_cast<double>(state.iterations());
 }
 BENCHMARK(BM_ReactiveCycle)->ArgNames({"weighted", "omni"})->Args({0, 0})->Args({1, 0})->Args({0, 1})->Args({1, 1});
+// The instruction-count guard's twins (bench/instructions.yaml).
+[[maybe_unused]] static const bool kTwins[] = {
+    tripodal::bench::register_instruction_twin("BM_ReactiveCycle/priority/differential", BM_ReactiveCycle, {0, 0}),
+    tripodal::bench::register_instruction_twin("BM_ReactiveCycle/weighted/differential", BM_ReactiveCycle, {1, 0}),
+    tripodal::bench::register_instruction_twin("BM_ReactiveCycle/priority/omni", BM_ReactiveCycle, {0, 1}),
+    tripodal::bench::register_instruction_twin("BM_ReactiveCycle/weighted/omni", BM_ReactiveCycle, {1, 1}),
+};
 
 static void BM_CoordinatorFuse(benchmark::State& state) {
   const auto mode = state.range(0) != 0 ? CoordinationMode::weighted_sum : CoordinationMode::priority;
@@ -55,6 +63,8 @@ static void BM_CoordinatorFuse(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_CoordinatorFuse)->ArgName("weighted")->Arg(0)->Arg(1);
+[[maybe_unused]] static const bool kFuseTwin =
+    tripodal::bench::register_instruction_twin("BM_CoordinatorFuse/weighted", BM_CoordinatorFuse, {1});
 
 static void BM_ControllerUpdate(benchmark::State& state) {
   const ControllerConfig config = state.range(0) != 0 ? test::omni_base_psr() : test::differential_base();
@@ -68,5 +78,7 @@ static void BM_ControllerUpdate(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_ControllerUpdate)->ArgName("omni")->Arg(0)->Arg(1);
+[[maybe_unused]] static const bool kControllerTwin =
+    tripodal::bench::register_instruction_twin("BM_ControllerUpdate/omni", BM_ControllerUpdate, {1});
 
 BENCHMARK_MAIN();

@@ -13,6 +13,7 @@
 #include <memory>
 #include <sstream>
 
+#include "instructions.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
 
@@ -117,6 +118,13 @@ void BM_Psr2SequencingPeriod(benchmark::State& state) {
 }
 BENCHMARK(BM_Psr2SequencingPeriod)->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(4000)->Repetitions(5)
     ->ReportAggregatesOnly(true);
+
+// The instruction-count guard's twins (bench/instructions.yaml): callgrind counts inside
+// ControlLoop::step and Robot::step_sequencing alone, as the manual timing does.
+[[maybe_unused]] const bool kPeriodTwins[] = {
+    tripodal::bench::register_instruction_twin("BM_Psr2ReactivePeriod", BM_Psr2ReactivePeriod),
+    tripodal::bench::register_instruction_twin("BM_Psr2SequencingPeriod", BM_Psr2SequencingPeriod),
+};
 
 }  // namespace
 
