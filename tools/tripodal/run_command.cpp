@@ -122,6 +122,10 @@ int run_guide(const Args& args, std::ostream& out, std::ostream& err) {
     err << "tripodal run: --visit runs as fast as it can; --realtime goes with --monitor\n";
     return kUsage;
   }
+  if (!o.record.empty()) {
+    err << "tripodal run: --record records a task's run (--task or the monitor's console), not the guide robot's visit\n";
+    return kUsage;
+  }
   if (!o.monitor && (o.start_paused || o.monitor_read_open || !o.monitor_token_file.empty() || !o.monitor_allowed_hosts.empty() ||
                      !o.monitor_allowed_origins.empty())) {
     err << "tripodal run: --start-paused, --monitor-read-open, --monitor-token-file, --monitor-allow-host and "
@@ -320,6 +324,9 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_option("--hardware-param", a->hardware_params,
                  "KEY=VALUE: a parameter of the hardware slot (repeatable): namespace=NS, domain_id=N, step_timeout_s=S");
   cmd.add_option("--out", o.out, "DIR: where map.png, trajectory.csv, report.json and lifecycle.txt go");
+  cmd.add_option("--record", o.record,
+                 "FILE.mcap: record the run (sensor readings, commands, the life cycle with every firing) as MCAP "
+                 "(docs/rosbag.md); `tripodal trace convert` turns it into a trace");
   // Without SPEED CLI11 hands the option an empty value, which leaves realtime_speed at 0.
   a->realtime = cmd.add_option("--realtime", a->realtime_speed, "[SPEED]: SPEED times real time (default 1)")
                     ->expected(0, 1)

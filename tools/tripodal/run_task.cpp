@@ -31,6 +31,11 @@
 #include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/sim/simulator.hpp"
 #include "tripodal/sim/world.hpp"
+#include "tripodal/trace/mcap.hpp"
+#include "tripodal/trace/rosbag.hpp"
+#include "tripodal/trace/trace_reader.hpp"
+#include "tripodal/trace/trace_recorder.hpp"
+#include "tripodal/trace/trace_writer.hpp"
 #ifdef TRIPODAL_HAVE_DDS
 #include "tripodal/dds/dds_hardware.hpp"
 #include "tripodal/dds/robot_bridge.hpp"
@@ -307,6 +312,69 @@ class GroundTruth {
 #endif
 };
 
+/// `tripodal run --record FILE.mcap`: the run is recorded into a trace beside FILE (the recorder
+/// writes as the run goes, so a long run holds no readings in memory), which becomes MCAP at the
+/// end through the trace kit's exporter, so that the file replays as a trace and opens in any MCAP
+/// tool. The life cycle (task, processes, every firing) goes to the "events" channel.
+class RunRecording {
+ public:
+  RunRecording(const std::filesystem::path& mcap, const Robot& robot)
+      : mcap_(mcap), trace_path_(with_parent_folder(mcap.string() + ".trace.partial")), writer_(trace_path_), recorder_(writer_) {
+    const ResourceTable& table = robot.resources();
+    for (std::size_t i = 0; i < table.size(); ++i) {
+      try {
+        recorder_.watch(table.at(i));
+      } catch (const std::invalid_argument&) {
+        ++unrecorded_;  // a reading the trace format does not carry (joints, buttons ...)
+      }
+    }
+    recorder_.record_commands("cmd");
+    recorder_.record_events("events");
+  }
+  RunRecording(const RunRecording&) = delete;
+  RunRecording& operator=(const RunRecording&) = delete;
+  ~RunRecording() {
+    std::error_code ignored;
+    std::filesystem::remove(trace_path_, ignored);
+  }
+
+  void record(Time now, Robot& robot, const LifecycleRecorder& life) {
+    recorder_.record(now);
+    const CoordinatorOutput& fused = robot.behavior_loop().coordinator().output();
+    recorder_.record_command(fused.stamp, fused.command, fused.winner);
+    for (; noted_ < life.entries().size(); ++noted_) {
+      const LifecycleEntry& e = life.entries()[noted_];
+      recorder_.record_event(e.time, e.text);
+    }
+  }
+
+  /// Writes the MCAP file; returns how many messages it holds.
+  std::uint64_t finish() {
+    writer_.close();
+    trace::TraceReader reader(trace_path_);
+    trace::mcap::Writer out(mcap_);
+    trace::export_trace_to_mcap(reader, out);
+    return out.messages_written();
+  }
+
+  [[nodiscard]] std::size_t unrecorded_resources() const noexcept { return unrecorded_; }
+
+ private:
+  // As --out does, the file's folder is made when missing (its failure is the writer's to report).
+  static std::filesystem::path with_parent_folder(std::filesystem::path file) {
+    std::error_code ignored;
+    if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path(), ignored);
+    return file;
+  }
+
+  std::filesystem::path mcap_;
+  std::filesystem::path trace_path_;
+  trace::TraceWriter writer_;
+  trace::TraceRecorder recorder_;
+  std::size_t noted_ = 0;
+  std::size_t unrecorded_ = 0;
+};
+
 RunResult run_task(const RunOptions& o) {
   RobotProfile profile = load_robot_profile(o.robot);
   if (!o.hardware.empty()) {
@@ -385,6 +453,8 @@ RunResult run_task(const RunOptions& o) {
   robot->planner().add_observer(life);
   robot->supervisor().add_observer(life);
   robot->planner().add_observer(report);
+  std::unique_ptr<RunRecording> recording;
+  if (!o.record.empty()) recording = std::make_unique<RunRecording>(o.record, *robot);
 
   // On DDS without a task given here, the run waits for one from a peer: paced like the monitor's.
   const std::unique_ptr<DdsBridge> bridge = make_dds_bridge(*robot, clock, profile);
@@ -540,6 +610,7 @@ RunResult run_task(const RunOptions& o) {
     }
     was_cleaning = cleaning;
     last_truth = true_pose;
+    if (recording) recording->record(now, *robot, life);
     flush_log();
     if (now >= next_sample) {  // 10 Hz trajectory
       next_sample += std::chrono::milliseconds(100);
@@ -577,6 +648,17 @@ RunResult run_task(const RunOptions& o) {
   const BaseStop rest = stop_base(*robot, commanded, tick_period);
   res.base_command_at_end_rad_s = rest.command_rad_s;
   res.base_at_rest = rest.at_rest;
+  if (recording) {
+    recording->record(clock.now(), *robot, life);
+    const std::uint64_t messages = recording->finish();
+    if (o.log != nullptr) {
+      *o.log << "recorded " << messages << " messages into " << o.record.string()
+             << (recording->unrecorded_resources() > 0
+                     ? " (" + std::to_string(recording->unrecorded_resources()) + " resources carry readings MCAP export does not)"
+                     : std::string())
+             << '\n';
+    }
+  }
   flush_log();
   draw_progress(true);
 

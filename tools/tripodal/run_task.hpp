@@ -56,6 +56,10 @@ struct RunOptions {
   bool realtime = false;        ///< pace the simulation to wall time
   double realtime_speed = 1.0;
   std::filesystem::path out;    ///< folder for map.png, trajectory.csv, report.json (empty: none)
+  /// An MCAP file (docs/rosbag.md) the run records into: every resource's readings the trace format
+  /// carries (laser, odometry, gyro ...), the base's commands, and the task and process life cycle
+  /// (with every firing of the nets) as events. Empty: none.
+  std::filesystem::path record;
   /// Extra localization losses ("10-20; 35-40", seconds), added to the world's fault schedule.
   std::vector<navi::LocalizationFault> faults;
   /// The CoveragePlanner's pattern (hybrid, balloon, boustrophedon); empty: the profile's.
