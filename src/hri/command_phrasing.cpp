@@ -38,7 +38,7 @@ const std::vector<Phrase>& tails() {
   static const std::vector<Phrase> list = {
       {"for", "me"},  {"for", "us"},  {"if", "you", "can"},  {"if", "you", "could"},  {"if", "you", "would"},
       {"if", "possible"},  {"if", "you", "please"},  {"right", "now"},  {"now"},  {"please"},  {"jinny"},
-      {"thanks"},  {"thank", "you"},  {"robot"},  {"ok"},  {"okay"},
+      {"thanks"},  {"thank", "you"},  {"ok"},  {"okay"},  // not "robot": "explain this robot"
   };
   return list;
 }

@@ -364,8 +364,15 @@ HriModule::Decision HriModule::decide(std::string_view utterance) const {
   // The words as typed first: typo correction knows only the base's and the commands' words, and
   // could bend a slot's value ("carry the kettle ...") towards one of them.
   d.what = Decision::What::command;
-  const std::vector<std::string> typed_words = hri::command_phrasing(hri::words(utterance));
-  d.understanding = tasks_.understand(joined(typed_words), knowledge_);
+  // The grammar's own wording first ("explain this robot"), then the visitor's rephrased
+  // (fillers, politeness and tails stripped: "um jinny could you take us to node one please").
+  const std::vector<std::string> literal_words = hri::words(utterance);
+  std::vector<std::string> typed_words = literal_words;
+  d.understanding = tasks_.understand(joined(literal_words), knowledge_);
+  if (!d.understanding.understood) {
+    typed_words = hri::command_phrasing(literal_words);
+    d.understanding = tasks_.understand(joined(typed_words), knowledge_);
+  }
   d.whole = d.understanding.understood;
   if (d.understanding.understood) return d;
   // A request naming a place that does not exist is refused, never bent towards a known one.

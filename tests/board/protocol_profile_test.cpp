@@ -505,7 +505,7 @@ TEST_CASE("a board of another dialect is named: the checksum it fits, or the Len
   }
 }
 
-TEST_CASE("a robot names its board's protocol profile; errors say where", "[board][protocol][config]") {
+TEST_CASE("a robot names its board's protocol profile, and errors say where", "[board][protocol][config]") {
   HardwareRegistry registry("hardware type");
   register_board_hardware(registry);
   HardwareConfig c;

@@ -327,14 +327,14 @@ TEST_CASE("dds: a malformed dds: section is refused, located", "[dds]") {
              Catch::Contains("bot.yaml:2:28: error: dds publish lists 'odom' twice (first at bot.yaml:2:17)"));
   CHECK_THAT(errors_of("{domain: 3}"), Catch::Contains("bot.yaml:2:7: error: unknown key 'domain' in dds; expected one of: domain_id"));
   CHECK_THAT(errors_of("[odom]"), Catch::Contains("bot.yaml:2:6: error: dds: expected a map, got a list"));
-  CHECK_THAT(errors_of("{period_s: 0}"), Catch::Contains("dds period_s (seconds): expected a number > 0, got '0'"));
+  CHECK_THAT(errors_of("{period_s: 0}"), Catch::Contains("bot.yaml:2:17: error: dds period_s: expected seconds from 1e-06 to 9e+09, got '0'"));
   CHECK_THAT(errors_of("{loopback: maybe}"), Catch::Contains("dds loopback: expected true or false, got 'maybe'"));
   CHECK_THAT(errors_of("{tasks: 3}"), Catch::Contains("dds tasks: expected true or false"));
   // Every error of one section at once.
   const std::string all = errors_of("{domain_id: -1, publish: [odom, odom], participant_lease_s: fast}");
   CHECK_THAT(all, Catch::Contains("dds domain_id"));
   CHECK_THAT(all, Catch::Contains("twice"));
-  CHECK_THAT(all, Catch::Contains("dds participant_lease_s (seconds): expected a number"));
+  CHECK_THAT(all, Catch::Contains("dds participant_lease_s: expected seconds from 1e-06 to"));
   // The default namespace is the robot's name, which must then be one.
   try {
     (void)load_robot_profile_from_string("robot: {name: PSR-2}\ndds: {domain_id: 3}\n", "psr.yaml", kConfigs / "robots");

@@ -438,7 +438,7 @@ TEST_CASE("store: changes from two threads are all saved, each under a version o
   require_disk_equals_store(store);
 }
 
-TEST_CASE("store: a text XML cannot hold (U+FFFE, U+FFFF, controls, bad UTF-8) is refused at its place; later saves and the file still load",
+TEST_CASE("store: a text XML cannot hold (U+FFFE, U+FFFF, controls, bad UTF-8) is refused at its place, and later saves and the file still load",
           "[hri][store][xml]") {
   Folder f;
   KnowledgeStore store(f.file);

@@ -224,7 +224,7 @@ TEST_CASE("The history is held at its byte and count budgets, and one past eithe
   }
 }
 
-TEST_CASE("Host names the server: loopback, IP literals and allowed names; Origin must be the page's own", "[monitor][wire]") {
+TEST_CASE("Host names the server: loopback, IP literals and allowed names, and Origin must be the page's own", "[monitor][wire]") {
   const std::vector<std::string> none;
   CHECK(host_allowed("127.0.0.1:8765", none));
   CHECK(host_allowed("127.0.0.1", none));

@@ -1233,7 +1233,7 @@ TEST_CASE("Budgets: knowledge entry fields at the store's limits are saved, one 
   server.stop();
 }
 
-TEST_CASE("An RKMS entry with U+FFFE is refused at its character; later saves succeed and Jinny's knowledge still loads",
+TEST_CASE("An RKMS entry with U+FFFE is refused at its character, and later saves succeed and Jinny's knowledge still loads",
           "[monitor][robot][rkms][xml]") {
   Psr2WithHri psr2;
   MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
@@ -1276,7 +1276,7 @@ class FailingHri final : public HriService {
 
 }  // namespace
 
-TEST_CASE("An exception inside an op is answered 500 and logged; the robot's thread goes on", "[monitor][robot][requests]") {
+TEST_CASE("An exception inside an op is answered 500 and logged, and the robot's thread goes on", "[monitor][robot][requests]") {
   Psr2WithHri psr2;
   FailingHri failing(psr2.file);
   MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});

@@ -121,7 +121,7 @@ TEST_CASE("A controller type the application did not register is refused at the 
                           Catch::Contains("reactive.yaml:3:11: error: controller 'base': unknown controller type 'winch'"));
 }
 
-TEST_CASE("A type declared in the profile but not registered is refused at assembly, at its entry; check_robot only warns",
+TEST_CASE("A type declared in the profile but not registered is refused at assembly, at its entry, and check_robot only warns",
           "[robot][plugins][errors]") {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("tripodal_declared_types_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);

@@ -23,6 +23,7 @@
 #include "tripodal/navi/scan_matching_localizer.hpp"
 #include "tripodal/navi/trajectory_metrics.hpp"
 #include "tripodal/trace/carmen_import.hpp"
+#include "tripodal/trace/rosbag.hpp"
 #include "tripodal/trace/trace_reader.hpp"
 
 namespace tripodal::tool {
@@ -75,7 +76,10 @@ bool is_carmen(const std::filesystem::path& p) {
 }
 
 // Reads the laser channel, the odometry channel and the laser poses of a trace; a CARMEN log is
-// imported to a temporary trace first (the importer's located errors pass through).
+// imported to a temporary trace first (the importer's located errors pass through), and so is a
+// rosbag2 bag (docs/rosbag.md: /scan and /odom, or /tf's odom -> base_link, become the laser and
+// odometry channels named here; other topics keep their names, so --laser-channel front_laser
+// reads /front_laser).
 Log read_log(const std::filesystem::path& file, const std::string& laser_channel, const std::string& odom_channel,
              const std::string& pose_channel) {
   Log log;
@@ -102,6 +106,15 @@ Log read_log(const std::filesystem::path& file, const std::string& laser_channel
       if (!p.empty()) std::filesystem::remove(p, ec);
     }
   } cleanup{temp};
+  std::optional<trace::TraceSource> bag;
+  if (!imported && trace::is_rosbag(file)) {
+    trace::BagImportOptions bo;
+    bo.topic_channels["/scan"] = laser_channel;
+    bo.topic_channels["/odom"] = odom_channel;
+    bo.topic_channels["/tf"] = odom_channel;
+    bag.emplace(file, bo);
+    trace_path = bag->trace();
+  }
   trace::TraceReader reader(trace_path);
   trace::TraceRecord rec;
   Pose2D odom;
@@ -512,7 +525,8 @@ cli::Action setup_eval(CLI::App& cmd) {
 
 cli::Action setup_build(CLI::App& cmd) {
   auto a = std::make_shared<BuildArgs>();
-  cmd.add_option("TRACE", a->trace, "a trace or a CARMEN log (.log, .log.gz) with laser and odometry")->required();
+  cmd.add_option("TRACE", a->trace, "a trace, a CARMEN log (.log, .log.gz) or a rosbag2 bag (MCAP, db3) with laser and odometry")
+      ->required();
   cmd.add_option("--out", a->out, "MAP.yaml: the map_server map to write (and MAP.pgm beside it)")->required();
   cmd.add_option("--resolution", a->resolution_m, "M: cell side")->capture_default_str()->check(positive_number());
   cmd.add_option("--max-range", a->max_range_m, "M: returns beyond are not mapped")->capture_default_str()->check(positive_number());

@@ -633,6 +633,9 @@ RunResult run_task(const RunOptions& o) {
     robot->step_sequencing();
     res.state = sig != 0 ? "interrupted" : "timed out";
   }
+  // The run's time is the task's: braking to rest below is not part of it (on a remote base,
+  // which cannot be read back, it takes the whole braking allowance).
+  const Time ended = clock.now();
   // Whatever ended the run, the base is left at rest before the devices close.
   WheelCommands commanded;
   if (board_hw != nullptr) {
@@ -669,7 +672,7 @@ RunResult run_task(const RunOptions& o) {
   // A refused task leaves the planner idle: the refusal's words stay the reason.
   const bool only_refused = res.state == "refused" && tr.state == TaskState::idle;
   if (!only_refused && (!serve || tr.state != TaskState::idle)) res.reason = tr.reason;
-  res.duration_s = to_seconds(clock.now());
+  res.duration_s = to_seconds(ended);
   res.cleaned_cells = covered();
   res.coverage = res.reachable_cells == 0 ? 0.0 : static_cast<double>(res.cleaned_cells) / static_cast<double>(res.reachable_cells);
   const double res_m = nav.maps->grid().resolution_m();
