@@ -154,11 +154,11 @@ struct ReadingTraits;
 
 template <>
 struct ReadingTraits<OdometryReading, msg::Odometry> {
-  static constexpr std::string_view type = "DdsOdometry";
-  static constexpr std::string_view topic = "odom";
-  static constexpr std::string_view output = "odometry";
-  static constexpr std::string_view description = "the latest nav_msgs/Odometry of a DDS topic (a ROS 2 base driver's odom)";
-  static constexpr TopicKind kind = TopicKind::state;
+  static constexpr std::string_view kType = "DdsOdometry";
+  static constexpr std::string_view kTopic = "odom";
+  static constexpr std::string_view kOutput = "odometry";
+  static constexpr std::string_view kDescription = "the latest nav_msgs/Odometry of a DDS topic (a ROS 2 base driver's odom)";
+  static constexpr TopicKind kKind = TopicKind::state;
   static void convert(const msg::Odometry& m, OdometryReading& r) {
     r.pose = pose2d_of(m.pose.pose);
     r.twist = {m.twist.twist.linear.x, m.twist.twist.linear.y, m.twist.twist.angular.z};
@@ -167,11 +167,11 @@ struct ReadingTraits<OdometryReading, msg::Odometry> {
 
 template <>
 struct ReadingTraits<GyroReading, msg::Imu> {
-  static constexpr std::string_view type = "DdsImu";
-  static constexpr std::string_view topic = "imu";
-  static constexpr std::string_view output = "gyro";
-  static constexpr std::string_view description = "the yaw rate and yaw of the latest sensor_msgs/Imu of a DDS topic";
-  static constexpr TopicKind kind = TopicKind::scan;  // sensor data: best effort
+  static constexpr std::string_view kType = "DdsImu";
+  static constexpr std::string_view kTopic = "imu";
+  static constexpr std::string_view kOutput = "gyro";
+  static constexpr std::string_view kDescription = "the yaw rate and yaw of the latest sensor_msgs/Imu of a DDS topic";
+  static constexpr TopicKind kKind = TopicKind::scan;  // sensor data: best effort
   static void convert(const msg::Imu& m, GyroReading& r) {
     r.yaw_rate_rad_s = m.angular_velocity.z;
     // orientation_covariance[0] = -1: the IMU gives no orientation (ROS's convention)
@@ -181,13 +181,13 @@ struct ReadingTraits<GyroReading, msg::Imu> {
 
 template <>
 struct ReadingTraits<PoseEstimate, msg::PoseWithCovarianceStamped> {
-  static constexpr std::string_view type = "DdsPose";
-  static constexpr std::string_view topic = "amcl_pose";
-  static constexpr std::string_view output = "pose_estimate";
-  static constexpr std::string_view description =
+  static constexpr std::string_view kType = "DdsPose";
+  static constexpr std::string_view kTopic = "amcl_pose";
+  static constexpr std::string_view kOutput = "pose_estimate";
+  static constexpr std::string_view kDescription =
       "the latest geometry_msgs/PoseWithCovarianceStamped of a DDS topic (a ROS 2 localizer's amcl_pose)";
   // Reliable, volatile: matches AMCL's transient local writer too, and gets its last pose at once.
-  static constexpr TopicKind kind = TopicKind::state;
+  static constexpr TopicKind kKind = TopicKind::state;
   static void convert(const msg::PoseWithCovarianceStamped& m, PoseEstimate& r) {
     r.map_from_base = pose2d_of(m.pose.pose);
     constexpr std::array<std::size_t, 3> kRosIndex{0, 1, 5};  // x, y, yaw of ROS's 6 x 6
@@ -202,12 +202,12 @@ struct ReadingTraits<PoseEstimate, msg::PoseWithCovarianceStamped> {
 template <class Reading, class Msg>
 const ModuleManifest& DdsReadingResource<Reading, Msg>::static_manifest() {
   using Traits = ReadingTraits<Reading, Msg>;
-  static const ModuleManifest m = ManifestBuilder(std::string(Traits::type), ModuleKind::resource)
-                                      .description(std::string(Traits::description))
-                                      .output(std::string(Traits::output))
-                                      .parameters(topic_parameters(std::string(Traits::topic)))
+  static const ModuleManifest m = ManifestBuilder(std::string(Traits::kType), ModuleKind::resource)
+                                      .description(std::string(Traits::kDescription))
+                                      .output(std::string(Traits::kOutput))
+                                      .parameters(topic_parameters(std::string(Traits::kTopic)))
                                       .number("max_age_s", 0.5, "s", "older than this the reading is stale; 0: never", 0.0)
-                                      .flag("reliable", Traits::kind != TopicKind::scan,
+                                      .flag("reliable", Traits::kKind != TopicKind::scan,
                                             "a reliable reader (only reliable publishers match); false: best effort, any "
                                             "publisher, a sample lost is not repaired")
                                       .build();
@@ -219,16 +219,16 @@ DdsReadingResource<Reading, Msg>::DdsReadingResource(std::string name, const Par
     : TypedResource<Reading>(std::move(name), from_seconds(p.contains("max_age_s") ? p.number("max_age_s") : 0.5),
                              static_manifest()) {
   using Traits = ReadingTraits<Reading, Msg>;
-  const TopicBinding b = topic_binding(p, Traits::topic);
+  const TopicBinding b = topic_binding(p, Traits::kTopic);
   participant_ = std::make_unique<Participant>(b.participant);
   declare_module_node(*participant_, this->name(), p);
-  EndpointOptions options{.kind = Traits::kind, .on_status = [this](const StatusEvent& e) {
+  EndpointOptions options{.kind = Traits::kKind, .on_status = [this](const StatusEvent& e) {
                             if (e.kind == StatusKind::liveliness_lost && e.current_count == 0) {
                               faults_.report("the publisher of " + e.topic + " went silent (DDS liveliness lost)");
                             }
                           }};
-  Qos q = qos_for(Traits::kind, Role::subscriber);
-  q.reliability = (p.contains("reliable") ? p.boolean("reliable") : Traits::kind != TopicKind::scan) ? Reliability::reliable
+  Qos q = qos_for(Traits::kKind, Role::subscriber);
+  q.reliability = (p.contains("reliable") ? p.boolean("reliable") : Traits::kKind != TopicKind::scan) ? Reliability::reliable
                                                                                                     : Reliability::best_effort;
   options.qos = q;
   subscriber_ = std::make_unique<Subscriber<Msg>>(*participant_, b.topic, options, [this](const Msg& m) {
