@@ -46,7 +46,7 @@ const ModuleManifest& BoardHardware::static_manifest() {
   return m;
 }
 
-BoardHardware::BoardHardware(ByteStream& stream, BoardHardwareConfig config, std::unique_ptr<ByteStream> owned)
+BoardHardware::BoardHardware(ByteStream& stream, const BoardHardwareConfig& config, std::unique_ptr<ByteStream> owned)
     : owned_(std::move(owned)), config_(config), link_(stream, config.link), link_resource_(std::make_unique<LinkResource>(*this)) {}
 
 BoardHardware::~BoardHardware() = default;

@@ -7,7 +7,7 @@
 
 namespace tripodal::board {
 
-BoardLink::BoardLink(ByteStream& stream, LinkConfig config)
+BoardLink::BoardLink(ByteStream& stream, const LinkConfig& config)
     : stream_(stream),
       config_(config),
       protocol_(config.protocol ? config.protocol : resolve_protocol_profile("", {})),

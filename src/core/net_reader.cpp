@@ -33,6 +33,7 @@ std::string did_you_mean(std::string_view name, const std::vector<std::string>& 
 
 std::vector<std::string> names_of(const std::vector<VariableDecl>& decls) {
   std::vector<std::string> out;
+  out.reserve(decls.size());
   for (const auto& d : decls) out.push_back(d.name);
   return out;
 }
@@ -402,12 +403,12 @@ void check_event_source(const ReadContext& ctx, const XmlElement* e, const std::
   std::vector<std::string> sources;
   std::vector<std::string> known_events;
   const std::vector<std::string>* kinds_of_source = nullptr;
-  static const std::vector<std::string> kBehaviorKinds{"done", "failed"};
-  static const std::vector<std::string> kProcessKinds{"success", "fault"};
+  static const std::vector<std::string> behavior_kinds{"done", "failed"};
+  static const std::vector<std::string> process_kinds{"success", "fault"};
   for (const Place& p : net.places()) {
     const std::string* name = p.behavior ? &p.behavior->behavior : (p.process ? &p.id : nullptr);
     if (name == nullptr) continue;
-    const auto& kinds = p.behavior ? kBehaviorKinds : kProcessKinds;
+    const auto& kinds = p.behavior ? behavior_kinds : process_kinds;
     if (*name == source) kinds_of_source = &kinds;
     sources.push_back(*name);
     for (const auto& k : kinds) known_events.push_back(*name + "." + k);

@@ -35,7 +35,7 @@ class BoardHardware final : public CHardware, public HardwareInterface, public B
   /// Parameters of type "board": port (the tty), baud, pulses_per_m, response_timeout_s, max_missed.
   static const ModuleManifest& static_manifest();
   /// Talks over `stream` (not owned; `owned` may hold it).
-  BoardHardware(ByteStream& stream, BoardHardwareConfig config, std::unique_ptr<ByteStream> owned = nullptr);
+  BoardHardware(ByteStream& stream, const BoardHardwareConfig& config, std::unique_ptr<ByteStream> owned = nullptr);
   ~BoardHardware() override;
 
   // HardwareInterface: wheels [left, right].

@@ -80,7 +80,7 @@ struct ActuatorCommand {
 class BoardLink {
  public:
   /// Builds its messages and takes the profile (the thesis's when none): may allocate, once.
-  BoardLink(ByteStream& stream, LinkConfig config = {});
+  BoardLink(ByteStream& stream, const LinkConfig& config = {});
 
   /// One control cycle at `now`: takes the responses that arrived, times out the overdue ones,
   /// then sends SYNC (link not synchronised) or DRIVE with `speeds` and at most one other request.
