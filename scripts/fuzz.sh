@@ -35,7 +35,7 @@ cmake --build "$build" -j "$jobs" --target fuzz_all
 
 targets=("$@")
 if [[ ${#targets[@]} -eq 0 ]]; then
-  mapfile -t targets < <(sed -n 's/^\([a-z_]*\):.*/\1/p' fuzz/seeds.txt)
+  mapfile -t targets < <(sed -n 's/^\([a-z0-9_]*\):.*/\1/p' fuzz/seeds.txt)
 fi
 
 summary=()
