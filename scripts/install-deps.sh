@@ -34,6 +34,9 @@ packages+=(libgraphviz-dev python3 python3-websockets)
 packages+=(cyclonedds-dev cyclonedds-tools)
 # The HRI (tripodal::hri, docs/hri.md): Xapian ranks the knowledge base (BM25, English stemming).
 packages+=(libxapian-dev)
+# Its lexicon (src/hri/lexicon.cpp): WordNet's synonyms and base forms, and an English word list so
+# typo correction leaves English words alone. Without them the HRI matches words as the base has them.
+packages+=(wordnet-base wamerican)
 # Its voice (optional, TRIPODAL_VOICE): espeak-ng synthesises, pocketsphinx recognises with the
 # US English acoustic model.
 packages+=(libespeak-ng-dev libpocketsphinx-dev pocketsphinx-en-us)

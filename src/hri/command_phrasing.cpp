@@ -27,7 +27,7 @@ const std::vector<Phrase>& openings() {
       {"i", "would", "like", "you", "to"}, {"i", "d", "like", "you", "to"}, {"i", "want", "you", "to"},
       {"we", "would", "like", "you", "to"}, {"we", "want", "you", "to"},  {"could", "you"},
       {"would", "you"},  {"can", "you"},  {"will", "you"},  {"would", "you", "mind"},
-      {"let", "s"},  {"um"},  {"uh"},  {"er"},  {"erm"},  {"hmm"},  {"well"},  {"so"},  {"okay"},  {"ok"},
+      {"let", "s"},  {"lets"},  {"um"},  {"uh"},  {"er"},  {"erm"},  {"hmm"},  {"well"},  {"so"},  {"okay"},  {"ok"},
       {"please"},  {"kindly"},  {"jinny"},  {"hey"},  {"hi"},  {"hello"},  {"oh"},  {"and"},  {"robot"},
   };
   return list;
@@ -62,6 +62,8 @@ const std::vector<Rewrite>& rewrites() {
       {{"we", "would", "like", "to", "see"}, {"take", "me", "to"}},
       {{"i", "d", "like", "to", "see"}, {"take", "me", "to"}},
       {{"let", "us", "go", "to"}, {"go", "to"}},
+      {{"lead", "the", "way", "to"}, {"guide", "me", "to"}},
+      {{"show", "the", "way", "to"}, {"guide", "me", "to"}},
       {{"walk", "me", "to"}, {"guide", "me", "to"}},
       {{"walk", "us", "to"}, {"guide", "me", "to"}},
       {{"escort", "me", "to"}, {"guide", "me", "to"}},

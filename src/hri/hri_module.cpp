@@ -32,8 +32,17 @@ std::vector<std::string> command_vocabulary(const TaskLibrary& tasks) {
   return out;
 }
 
-RetrievalOptions retrieval_options(const TaskLibrary& tasks) {
+// A yes-or-no question: it opens with an auxiliary ("are you ...", "is there ..."). "can you",
+// "could you", "would you" and "will you" are the polite form of a request and do not count; a
+// question word ("what will you show me") is HriModule::is_question's, asked about first.
+bool asks_rather_than_requests(const std::vector<std::string>& ws) {
+  static constexpr std::array<std::string_view, 8> kOpenings = {"are", "is", "am", "was", "were", "does", "did", "have"};
+  return !ws.empty() && std::find(kOpenings.begin(), kOpenings.end(), ws.front()) != kOpenings.end();
+}
+
+RetrievalOptions retrieval_options(const TaskLibrary& tasks, std::shared_ptr<const Lexicon> lexicon) {
   RetrievalOptions o;
+  o.lexicon = std::move(lexicon);
   o.extra_vocabulary = command_vocabulary(tasks);
   // Politeness the command path strips must survive the typo correction.
   for (const auto& opening : hri::polite_openings()) o.extra_vocabulary.insert(o.extra_vocabulary.end(), opening.begin(), opening.end());
@@ -151,7 +160,7 @@ HriModule::HriModule(const KnowledgeBase& base, const TaskLibrary& tasks, const 
       providers_(providers),
       start_task_(std::move(start_task)),
       options_(std::move(options)),
-      index_(base, retrieval_options(tasks)) {
+      index_(base, retrieval_options(tasks, options_.lexicon)) {
   Diagnostics d;
   std::string available;
   for (const auto& n : providers_.names()) available += (available.empty() ? "" : ", ") + n;
@@ -375,8 +384,17 @@ HriModule::Decision HriModule::decide(std::string_view utterance) const {
   }
   d.whole = d.understanding.understood;
   if (d.understanding.understood) return d;
-  // A request naming a place that does not exist is refused, never bent towards a known one.
+  // A request naming a place that does not exist is refused, never bent towards a known one,
+  // unless an entry that starts a task is about it by name ("i would like to see the cleaning
+  // robot": the visit to PSR-2).
   if (!d.understanding.task.empty()) {
+    Retrieval r = index_.search(utterance);
+    if (!r.hits.empty() && r.hits.front().confidence >= options_.command_confidence_threshold &&
+        !entries_[r.hits.front().entry].action.empty()) {
+      d.what = Decision::What::answer;
+      d.retrieval = std::move(r);
+      return d;
+    }
     d.what = Decision::What::refuse_command;
     d.text = refusal(d.understanding);
     return d;
@@ -385,6 +403,14 @@ HriModule::Decision HriModule::decide(std::string_view utterance) const {
   if (d.understanding.understood) return d;
 
   d.retrieval = index_.search(utterance);
+  // A question is no request: "are you a robot?" may rank a visit's entry first ("I will take you
+  // to the cleaning robot"), and answering it would start the visit. A question is answered from
+  // the entries that start nothing.
+  if (asks_rather_than_requests(literal_words) && !d.retrieval.hits.empty() && !entries_[d.retrieval.hits.front().entry].action.empty()) {
+    auto& hits = d.retrieval.hits;
+    hits.erase(std::remove_if(hits.begin(), hits.end(), [&](const RetrievalHit& h) { return !entries_[h.entry].action.empty(); }),
+               hits.end());
+  }
   const Retrieval& r = d.retrieval;
   const bool confident = !r.hits.empty() && r.hits.front().confidence >= options_.confidence_threshold;
   // The verb as typed: a correction that made one ("cook pasta" -> "look") is no command.

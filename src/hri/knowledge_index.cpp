@@ -22,6 +22,21 @@ constexpr Xapian::termcount kQuestionWdf = 1;
 // How much a stop word of the utterance counts in the ranking, relative to a content word.
 constexpr double kStopWordScale = 0.2;
 
+// True when one word is the other with one letter doubled ("helo", "hello").
+bool differs_by_doubling(std::string_view a, std::string_view b) {
+  if (a.size() > b.size()) std::swap(a, b);
+  if (b.size() != a.size() + 1) return false;
+  for (std::size_t i = 1; i < b.size(); ++i) {
+    if (b[i] == b[i - 1] && a.substr(0, i) == b.substr(0, i) && a.substr(i) == b.substr(i + 1)) return true;
+  }
+  return false;
+}
+
+// The terms one word of an utterance may match, each with how close it is to the word.
+struct WordTerms {
+  std::vector<std::pair<std::string, double>> terms;
+};
+
 }  // namespace
 
 struct KnowledgeIndex::Impl {
@@ -42,11 +57,43 @@ struct KnowledgeIndex::Impl {
       // Stop words are indexed too: the query weighs them little, but they tell apart entries
       // whose telling words are the same ("what can you do" vs "how are you").
       doc.add_term(term(w), wdf);
+      // Its base forms too ("made" -> "make"): a visitor's "produced" relates to "make", which
+      // the English stemmer does not derive from "made".
+      if (options.lexicon && !hri::is_stop_word(w)) {
+        for (const auto& f : options.lexicon->base_forms(w)) doc.add_term(term(f), wdf);
+      }
     }
   }
 
-  [[nodiscard]] std::string corrected_word(const std::string& w) const {
+  // Each word's own term, and when no entry has it, the terms of the words the lexicon relates to
+  // it that some entry has (only those: the others could not match).
+  [[nodiscard]] std::vector<WordTerms> word_terms(const std::vector<std::string>& ws) const {
+    std::vector<WordTerms> out;
+    out.reserve(ws.size());
+    for (const auto& w : ws) {
+      WordTerms g;
+      g.terms.emplace_back(term(w), 1.0);
+      // Words of one or two letters are abbreviations more often than words ("no" is WordNet's
+      // "number"): they are matched as they are.
+      if (options.lexicon && w.size() >= 3 && !db.term_exists(term(w)) && !hri::has_digit(w)) {
+        for (const auto& f : options.lexicon->base_forms(w)) {
+          if (db.term_exists(term(f))) g.terms.emplace_back(term(f), 1.0);
+        }
+        for (const auto& rel : options.lexicon->related(w)) {
+          if (db.term_exists(term(rel.word))) g.terms.emplace_back(term(rel.word), rel.closeness);
+        }
+      }
+      out.push_back(std::move(g));
+    }
+    return out;
+  }
+
+  [[nodiscard]] std::string corrected_word(const std::string& typed) const {
+    const std::string w(hri::expand_chat_word(typed));
     if (known.count(w) != 0 || hri::is_stop_word(w) || hri::has_digit(w) || db.term_exists(term(w))) return w;
+    // An English word is what the visitor meant, even when the base does not have it: "kind" is
+    // no typo of "find".
+    if (options.lexicon && options.lexicon->is_english(w)) return w;
     const std::size_t limit = w.size() >= 7 ? 2 : (w.size() >= 4 ? 1 : 0);
     if (limit == 0) return w;
     std::string best;
@@ -57,7 +104,13 @@ struct KnowledgeIndex::Impl {
       if (it == by_length.end()) continue;
       for (const auto& [candidate, freq] : it->second) {
         const std::size_t d = hri::edit_distance(w, candidate, std::min(limit, best_d));
-        if (d < best_d || (d == best_d && d <= limit && freq > best_freq)) {
+        // Ties go to a doubled or undoubled letter, the commonest slip ("helo" is "hello", not
+        // "help"), then to the more common word.
+        const bool better_tie = d == best_d && d <= limit &&
+                                (differs_by_doubling(w, candidate) != differs_by_doubling(w, best)
+                                     ? differs_by_doubling(w, candidate)
+                                     : freq > best_freq);
+        if (d < best_d || better_tie) {
           best = candidate;
           best_d = d;
           best_freq = freq;
@@ -123,32 +176,51 @@ Retrieval KnowledgeIndex::search_unguarded(std::string_view utterance) const {
 
   // Content words decide the confidence; stop words only break ties between entries (weighed
   // kStopWordScale), unless the utterance has nothing else ("who are you" without "who"...).
-  std::set<std::string> terms;
+  std::vector<std::string> content;
+  std::vector<std::string> stop;
+  std::set<std::string> seen;  // a word said twice counts once
+  for (const auto& w : ws) {
+    if (seen.insert(w).second) (hri::is_stop_word(w) ? stop : content).push_back(w);
+  }
   std::set<std::string> stop_terms;
-  for (const auto& w : ws) {
-    if (!hri::is_stop_word(w)) terms.insert(x.term(w));
+  if (content.empty()) {
+    content.swap(stop);
+  } else {
+    std::set<std::string> content_terms;
+    for (const auto& w : content) content_terms.insert(x.term(w));
+    for (const auto& w : stop) {
+      if (content_terms.count(x.term(w)) == 0) stop_terms.insert(x.term(w));
+    }
   }
-  for (const auto& w : ws) {
-    if (hri::is_stop_word(w) && terms.count(x.term(w)) == 0) stop_terms.insert(x.term(w));
-  }
-  if (terms.empty()) terms.swap(stop_terms);
-  if (terms.empty() || x.db.get_doccount() == 0) return r;
+  if (content.empty() || x.db.get_doccount() == 0) return r;
 
-  // The confidence weighs each term by its inverse document frequency, so a match on a rare,
+  // The confidence weighs each word by its inverse document frequency, so a match on a rare,
   // telling word counts more than one on a word many entries share; a word no entry has gets
-  // the largest weight (the utterance is about something the base does not know).
+  // the largest weight (the utterance is about something the base does not know); an entry with a
+  // word the lexicon relates to it covers part of that weight.
   const double n = static_cast<double>(x.db.get_doccount());
-  std::map<std::string, double> idf;
+  auto idf_of = [&](const std::string& t) {
+    return std::log((n + 1.0) / (static_cast<double>(x.db.get_termfreq(t)) + 0.5));
+  };
+  const std::vector<WordTerms> groups = x.word_terms(content);
+  std::map<std::string, double> query_terms;  // term -> its best closeness over the words
+  std::vector<double> weight(groups.size());
   double total = 0.0;
-  for (const auto& t : terms) {
-    const double df = static_cast<double>(x.db.get_termfreq(t));
-    const double w = std::log((n + 1.0) / (df + 0.5));
-    idf[t] = w;
-    total += w;
+  for (std::size_t i = 0; i < groups.size(); ++i) {
+    for (const auto& [t, closeness] : groups[i].terms) {
+      double& q = query_terms[t];
+      q = std::max(q, closeness);
+    }
+    weight[i] = idf_of(groups[i].terms.front().first);
+    total += weight[i];
   }
 
   Xapian::Enquire enquire(x.db);
-  Xapian::Query query(Xapian::Query::OP_OR, terms.begin(), terms.end());
+  std::vector<Xapian::Query> subqueries;
+  for (const auto& [t, closeness] : query_terms) {
+    subqueries.push_back(closeness >= 1.0 ? Xapian::Query(t) : Xapian::Query(Xapian::Query::OP_SCALE_WEIGHT, Xapian::Query(t), closeness));
+  }
+  Xapian::Query query(Xapian::Query::OP_OR, subqueries.begin(), subqueries.end());
   if (!stop_terms.empty()) {
     query = Xapian::Query(Xapian::Query::OP_OR, query,
                           Xapian::Query(Xapian::Query::OP_SCALE_WEIGHT,
@@ -161,14 +233,25 @@ Retrieval KnowledgeIndex::search_unguarded(std::string_view utterance) const {
     RetrievalHit hit;
     hit.entry = static_cast<std::size_t>(*it - 1);
     hit.weight = it.get_weight();
+    std::set<std::string> matching(enquire.get_matching_terms_begin(it), enquire.get_matching_terms_end(it));
     double matched = 0.0;
-    for (auto t = enquire.get_matching_terms_begin(it); t != enquire.get_matching_terms_end(it); ++t) {
-      const auto found = idf.find(*t);
-      if (found != idf.end()) matched += found->second;
+    for (std::size_t i = 0; i < groups.size(); ++i) {
+      // The word's own term counts whole; a related one as much as it tells (its own rarity) and
+      // as close as the relation is, so a match through the lexicon never outweighs an exact one.
+      double best = 0.0;
+      for (const auto& [t, closeness] : groups[i].terms) {
+        if (matching.count(t) == 0) continue;
+        best = std::max(best, t == groups[i].terms.front().first ? weight[i] : std::min(weight[i], idf_of(t)) * closeness);
+      }
+      matched += best;
     }
     hit.confidence = total > 0.0 ? matched / total : 0.0;
     r.hits.push_back(hit);
   }
+  // The entry that covers most of the utterance first: BM25 alone would put an entry matched
+  // through several loosely related words ahead of one with the utterance's own telling word.
+  std::stable_sort(r.hits.begin(), r.hits.end(),
+                   [](const RetrievalHit& a, const RetrievalHit& b) { return a.confidence > b.confidence; });
   return r;
 }
 

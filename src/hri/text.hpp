@@ -27,6 +27,10 @@ namespace tripodal::hri {
 
 [[nodiscard]] bool has_digit(std::string_view word) noexcept;
 
+/// The word a chat abbreviation stands for ("u" -> "you", "thx" -> "thanks"), or `word` itself.
+/// Typed visitors write them; neither the base nor a dictionary has them.
+[[nodiscard]] std::string_view expand_chat_word(std::string_view word) noexcept;
+
 /// Polite openings a visitor puts before a command ("could you", "please", "jinny") and closings
 /// after it ("please"): the task templates are written without them, so the HRI strips them
 /// before asking the planner (and typo correction must keep them).

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -56,6 +57,9 @@ struct HriOptions {
   /// LED buttons (Table 3): each button's name and the request a press stands for ("hello" ->
   /// "Introduce yourself."). A press is handled as that input was typed.
   std::map<std::string, std::string, std::less<>> buttons;
+  /// English lexical knowledge for the matcher (KnowledgeIndex): the system's WordNet and word
+  /// list by default; null matches words only as the base has them.
+  std::shared_ptr<const Lexicon> lexicon = Lexicon::system();
 };
 
 /// The robot's internal state as the HRI displays it to the visitor and the operator (paper,

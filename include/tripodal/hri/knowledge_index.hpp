@@ -1,7 +1,9 @@
 // Retrieval over the RKMS knowledge base (paper, section 4): the HRI module of the deliberate
 // layer asks it which entry an utterance is about. Entries are ranked by BM25 over English stems
 // (Xapian, in memory); a word the base does not know is first corrected to the nearest one it does
-// (typed input has typos), and a confidence says how much of the utterance the best entry covers.
+// (typed input has typos) unless it is English, an English word the base does not know is matched
+// through the words a lexicon relates to it, and a confidence says how much of the utterance the
+// best entry covers.
 #pragma once
 
 #include <memory>
@@ -10,6 +12,7 @@
 #include <vector>
 
 #include "tripodal/hri/knowledge_base.hpp"
+#include "tripodal/hri/lexicon.hpp"
 
 namespace tripodal {
 
@@ -18,6 +21,10 @@ struct RetrievalOptions {
   /// Extra words the typo correction may correct to (the planner's command words), besides the
   /// base's own.
   std::vector<std::string> extra_vocabulary;
+  /// English lexical knowledge (none: words are matched as they are, and every word the base does
+  /// not know is a typo candidate). With one, typo correction leaves English words alone, and a
+  /// word the base does not know matches the entries of the words WordNet relates to it.
+  std::shared_ptr<const Lexicon> lexicon;
 };
 
 /// One ranked entry.
