@@ -40,6 +40,8 @@ packages+=(wordnet-base wamerican)
 # Its voice (optional, TRIPODAL_VOICE): espeak-ng synthesises, pocketsphinx recognises with the
 # US English acoustic model.
 packages+=(libespeak-ng-dev libpocketsphinx-dev pocketsphinx-en-us)
+# Its live audio (optional, TRIPODAL_ALSA): microphone and speaker through ALSA.
+packages+=(libasound2-dev)
 
 for group in "$@"; do
   case $group in

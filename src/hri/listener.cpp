@@ -16,15 +16,15 @@ std::size_t frames_of(double seconds, double frame_s) {
   return std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(seconds / frame_s - 1e-9)));
 }
 
-// Mean power of a frame, dB relative to a full-scale square wave.
-double level_dbfs(const std::vector<std::int16_t>& frame) {
+}  // namespace
+
+double level_dbfs(std::span<const std::int16_t> samples) noexcept {
+  if (samples.empty()) return -120.0;
   double sum = 0.0;
-  for (const std::int16_t s : frame) sum += static_cast<double>(s) * static_cast<double>(s);
-  const double mean = sum / static_cast<double>(frame.size()) / (32768.0 * 32768.0);
+  for (const std::int16_t s : samples) sum += static_cast<double>(s) * static_cast<double>(s);
+  const double mean = sum / static_cast<double>(samples.size()) / (32768.0 * 32768.0);
   return 10.0 * std::log10(mean + 1e-12);
 }
-
-}  // namespace
 
 UtteranceSegmenter::UtteranceSegmenter(int sample_rate_hz, VadOptions options)
     : rate_hz_(sample_rate_hz), options_(options) {

@@ -38,6 +38,9 @@ struct VadOptions {
   double floor_rise = 0.02;
 };
 
+/// The mean power of `samples` in dB relative to a full-scale square wave (-120 for none).
+[[nodiscard]] double level_dbfs(std::span<const std::int16_t> samples) noexcept;
+
 /// One utterance found in the stream: its audio (with the pre- and post-roll) and where it lies
 /// in the stream, in seconds from the first sample fed.
 struct SegmentedUtterance {
