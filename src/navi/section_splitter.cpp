@@ -179,6 +179,42 @@ void CSectionSplitter::on_configure(const ParameterSet& params) {
   options_.min_section_area_m2 = params.number("min_section_area_m2");
 }
 
+SectionSet sections_of_labels(const OccupancyGrid& grid, const std::vector<int>& label) {
+  SectionSet out;
+  const std::size_t n = grid.size();
+  out.label.assign(n, -1);
+  std::map<int, int> id_of;  // label -> section id, in the order of each label's first cell
+  for (std::size_t i = 0; i < n && i < label.size(); ++i) {
+    if (label[i] < 0) continue;
+    const auto [it, added] = id_of.try_emplace(label[i], static_cast<int>(out.sections.size()));
+    if (added) {
+      Section s;
+      s.id = it->second;
+      s.name = section_name(it->second);
+      out.sections.push_back(std::move(s));
+    }
+    out.label[i] = it->second;
+    out.sections[static_cast<std::size_t>(it->second)].cells.push_back(i);
+  }
+  const double cell_area = grid.resolution_m() * grid.resolution_m();
+  for (Section& s : out.sections) {
+    s.min = {grid.width(), grid.height()};
+    s.max = {-1, -1};
+    double sx = 0.0, sy = 0.0;
+    for (const std::size_t i : s.cells) {
+      const CellIndex c = grid.cell(i);
+      s.min = {std::min(s.min.x, c.x), std::min(s.min.y, c.y)};
+      s.max = {std::max(s.max.x, c.x), std::max(s.max.y, c.y)};
+      const Point2D p = grid.cell_center(c);
+      sx += p.x_m;
+      sy += p.y_m;
+    }
+    s.area_m2 = static_cast<double>(s.cells.size()) * cell_area;
+    if (!s.cells.empty()) s.centroid = {sx / static_cast<double>(s.cells.size()), sy / static_cast<double>(s.cells.size())};
+  }
+  return out;
+}
+
 SectionSet CSectionSplitter::split(const OccupancyGrid& grid) const {
   SectionSet out;
   const int w = grid.width(), h = grid.height();
@@ -339,48 +375,16 @@ SectionSet CSectionSplitter::split(const OccupancyGrid& grid) const {
     parent[static_cast<std::size_t>(rk)] = best->first;
     size[static_cast<std::size_t>(best->first)] += size[static_cast<std::size_t>(rk)];
   }
-  // sections in scan order: by their lowest cell index (row first)
-  std::map<int, int> section_of_root;
-  std::vector<std::pair<std::size_t, int>> firsts;  // (first cell, root)
-  for (std::size_t k = 0; k < comps.size(); ++k) {
-    const int r = root(static_cast<int>(k));
-    if (dropped[static_cast<std::size_t>(r)] != 0) continue;
-    firsts.emplace_back(comps[k].front(), r);
-  }
-  std::sort(firsts.begin(), firsts.end());
-  for (const auto& [first, r] : firsts) {
-    if (section_of_root.count(r) == 0) {
-      const int id = static_cast<int>(out.sections.size());
-      section_of_root[r] = id;
-      Section s;
-      s.id = id;
-      s.name = section_name(id);
-      out.sections.push_back(std::move(s));
-    }
-  }
+  // one label per kept root; sections_of_labels numbers them in scan order
+  std::vector<int> root_label(n, -1);
   for (std::size_t i = 0; i < n; ++i) {
     if (comp_of[i] < 0) continue;
     const int r = root(comp_of[i]);
-    const auto it = section_of_root.find(r);
-    if (it == section_of_root.end()) continue;
-    out.label[i] = it->second;
-    out.sections[static_cast<std::size_t>(it->second)].cells.push_back(i);
+    if (dropped[static_cast<std::size_t>(r)] == 0) root_label[i] = r;
   }
-  for (Section& s : out.sections) {
-    s.min = {w, h};
-    s.max = {-1, -1};
-    double sx = 0.0, sy = 0.0;
-    for (const std::size_t i : s.cells) {
-      const CellIndex c = grid.cell(i);
-      s.min = {std::min(s.min.x, c.x), std::min(s.min.y, c.y)};
-      s.max = {std::max(s.max.x, c.x), std::max(s.max.y, c.y)};
-      const Point2D p = grid.cell_center(c);
-      sx += p.x_m;
-      sy += p.y_m;
-    }
-    s.area_m2 = static_cast<double>(s.cells.size()) * cell_area;
-    if (!s.cells.empty()) s.centroid = {sx / static_cast<double>(s.cells.size()), sy / static_cast<double>(s.cells.size())};
-  }
+  SectionSet labelled = sections_of_labels(grid, root_label);
+  out.sections = std::move(labelled.sections);
+  out.label = std::move(labelled.label);
   return out;
 }
 

@@ -52,6 +52,11 @@ struct SectionSet {
   std::size_t isolated_obstacles = 0;
 };
 
+/// Sections from a label per grid cell (-1: none; any other value names a section): ids and names
+/// in scan order (the section whose first cell comes first is "A"), cells ascending, extent, area
+/// and centroid filled. The section splitter and the room segmentation both end here.
+[[nodiscard]] SectionSet sections_of_labels(const OccupancyGrid& grid, const std::vector<int>& label);
+
 /// The section splitter. The rule, on the paper's criterion (isolated obstacles):
 ///  1. The outer wall is every occupied or unknown cell 8-connected to the border of the grid
 ///     through occupied/unknown cells; the other occupied components, at least
