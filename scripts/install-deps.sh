@@ -4,7 +4,8 @@
 #
 #   scripts/install-deps.sh [GROUP...]   also the packages of the hardening scripts that need them:
 #     fuzz   clang and its runtime (libFuzzer, ASan, UBSan), for scripts/fuzz.sh
-#     tidy   clang-tidy, for scripts/tidy.sh
+#     tidy   clang-tidy and clang-format (with clang-format-diff), for scripts/tidy.sh and
+#            scripts/format.sh
 #     browser  headless Chromium and Selenium, for the monitor's browser tests
 #              (cmake -DTRIPODAL_BROWSER_TESTS=ON; ctest -L browser)
 #     ros2-peer  Fast DDS (ROS 2's default middleware), the independent peer of the ROS 2 graph
@@ -42,7 +43,7 @@ for group in "$@"; do
   case $group in
     # libclang-rt-14-dev holds libFuzzer itself (libclang_rt.fuzzer), which -fsanitize=fuzzer links.
     fuzz) packages+=(clang libclang-rt-14-dev) ;;
-    tidy) packages+=(clang-tidy) ;;
+    tidy) packages+=(clang-tidy clang-format) ;;
     browser) packages+=(chromium chromium-driver python3-selenium) ;;
     ros2-peer) packages+=(libfastrtps-dev libfastcdr-dev) ;;
     perf) packages+=(valgrind) ;;
