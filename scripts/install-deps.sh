@@ -29,6 +29,8 @@ packages=(
 # The monitor: Graphviz's library lays out the nets it draws (src/monitor/net_drawing.cpp); its
 # protocol test (tests/monitor/protocol_test.py) is a WebSocket client in Python.
 packages+=(libgraphviz-dev python3 python3-websockets)
+# The docs' checks (scripts/doc_blocks.py parses the YAML blocks).
+packages+=(python3-yaml)
 # Distribution over DDS (tripodal::dds, docs/distribution.md): Eclipse Cyclone DDS and its IDL
 # compiler idlc, which generates the message types at build time. Without them the build leaves
 # the dds area out (TRIPODAL_DDS=OFF).
