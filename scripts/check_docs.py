@@ -28,7 +28,7 @@ import re
 import sys
 
 CODE_DIRS = ["include", "src", "tools", "tests", "examples", "bench", "fuzz"]
-COMMENT_DIRS = CODE_DIRS + ["scripts", "cmake", ".ci"]
+COMMENT_DIRS = CODE_DIRS + ["scripts", "cmake", ".ci", "configs"]
 TOP_DIRS = ["src", "include", "tests", "tools", "configs", "docs", "examples", "scripts", "bench", "fuzz",
             "cmake", "schema", ".ci"]
 
@@ -244,8 +244,13 @@ COMMENT_LINE_RE = re.compile(r"^\s*(?://|#|\*|/\*)(.*)$")
 
 
 def check_comments(tree: Tree, report: Report, path: str) -> None:
+    # The configurations: comments and values alike name files (bench/ and tests/ YAML name build outputs).
+    whole = os.path.relpath(path, tree.root).startswith("configs" + os.sep)
     for lineno, line in enumerate(read(path).splitlines(), 1):
         if "check-docs: ignore" in line:
+            continue
+        if whole:
+            check_paths(tree, report, path, lineno, line, in_doc=False)
             continue
         m = COMMENT_LINE_RE.match(line)
         if m is None:
@@ -271,7 +276,7 @@ def main() -> int:
         check_vocabulary(root, report, doc)
     for example in files_under(root, ["examples"], (".cpp", ".hpp")):
         check_vocabulary(root, report, example)
-    for src in files_under(root, COMMENT_DIRS, (".hpp", ".cpp", ".h", ".sh", ".py", ".cmake", ".txt", ".in", ".yaml")):
+    for src in files_under(root, COMMENT_DIRS, (".hpp", ".cpp", ".h", ".sh", ".py", ".cmake", ".txt", ".in", ".yaml", ".xml")):
         # tests/data/ holds fixtures: trees of their own (tests/data/layers/) and wrong files on purpose.
         if not os.path.relpath(src, root).startswith(os.path.join("tests", "data") + os.sep):
             check_comments(tree, report, src)
