@@ -23,7 +23,7 @@ on the line right before its fence, that says how it is checked:
 
 A block of a checked language without a marker is an error. Subcommands:
 
-  doc_blocks.py check [--net-tool PATH]   the excerpts, nets and yaml; fails naming FILE:LINE
+  doc_blocks.py [--root DIR] check [--net-tool PATH]   the excerpts, nets and yaml; fails naming FILE:LINE
   doc_blocks.py extract --out DIR         writes each program/main/compile block as DIR/<doc>_<line>.cpp
                                           and DIR/blocks.cmake (the kinds), for tests/docs/CMakeLists.txt
 """
@@ -240,13 +240,16 @@ def cmd_extract(args) -> int:
 
 
 def main() -> int:
+    global ROOT
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--root", default=ROOT, help="the tree whose docs are checked (default: this script's)")
     sub = p.add_subparsers(dest="cmd", required=True)
     c = sub.add_parser("check")
     c.add_argument("--net-tool")
     e = sub.add_parser("extract")
     e.add_argument("--out", required=True)
     args = p.parse_args()
+    ROOT = os.path.abspath(args.root)
     return cmd_check(args) if args.cmd == "check" else cmd_extract(args)
 
 
