@@ -20,6 +20,15 @@ on the line right before its fence, that says how it is checked:
   <!-- doc-block: xml -->              xml: well-formed (a part of a file, another program's file)
   <!-- doc-block: fragment REASON -->  not checked, for the REASON given (pseudo-code, a synopsis);
                                        listed in the summary, so that none goes unnoticed
+  <!-- doc-block: shell -->            a shell block (sh or a plain fence): run with bash -eu in a
+                                       scratch folder that links the tree's top folders (configs/,
+                                       tests/, ...), the project's tools first on PATH; must exit 0
+  <!-- doc-block: transcript -->       a shell session: each `$ command` line is run as above, and
+                                       the lines shown after it must appear in what it prints, in
+                                       order (a line `...` stands for lines left out); its exit
+                                       status is not checked (transcripts show errors too)
+
+Shell blocks without a marker are not run (many need a robot, a network, minutes of time).
 
 A block of a checked language without a marker is an error. Subcommands:
 
@@ -33,6 +42,7 @@ import argparse
 import glob
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -41,7 +51,8 @@ ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), 
 CHECKED = {"cpp", "yaml", "xml", "cmake"}
 FENCE_RE = re.compile(r"^(\s*)```(\w*)\s*$")
 MARKER_RE = re.compile(r"^\s*<!--\s*doc-block:\s*(\w[\w-]*)\s*(.*?)\s*-->\s*$")
-KINDS = {"program", "main", "compile", "excerpt", "net", "yaml", "xml", "fragment"}
+KINDS = {"program", "main", "compile", "excerpt", "net", "yaml", "xml", "fragment", "shell", "transcript"}
+SHELL_LANGS = {"", "sh", "bash", "shell", "console"}
 CPP_KINDS = {"program", "main", "compile"}
 
 
@@ -147,17 +158,75 @@ def check_net(b: Block, tool: str | None) -> str | None:
     return None
 
 
+def scratch_folder() -> str:
+    """A folder to run shell blocks in: the tree's top folders linked, so that relative paths of
+    the docs (configs/..., tests/data/...) resolve and what the commands write stays out of the tree."""
+    d = tempfile.mkdtemp(prefix="doc_blocks_")
+    for name in os.listdir(ROOT):
+        if not name.startswith(".") and name != "build" and os.path.isdir(os.path.join(ROOT, name)):
+            os.symlink(os.path.join(ROOT, name), os.path.join(d, name))
+    return d
+
+
+def run_shell(command: str, bin_dirs: list[str], cwd: str) -> subprocess.CompletedProcess:
+    env = dict(os.environ)
+    env["PATH"] = os.pathsep.join([os.path.abspath(b) for b in bin_dirs] + [env.get("PATH", "")])
+    return subprocess.run(["bash", "-euc", command], cwd=cwd, env=env, capture_output=True, text=True, timeout=300)
+
+
+def check_shell(b: Block, bin_dirs: list[str]) -> str | None:
+    cwd = scratch_folder()
+    r = run_shell("\n".join(b.text), bin_dirs, cwd)
+    shutil.rmtree(cwd, ignore_errors=True)
+    if r.returncode != 0:
+        return f"the commands exit {r.returncode}:\n{r.stdout}{r.stderr}"
+    return None
+
+
+def check_transcript(b: Block, bin_dirs: list[str]) -> str | None:
+    cwd = scratch_folder()
+    steps: list[tuple[int, str, list[str]]] = []
+    for n, line in enumerate(b.text):
+        if line.startswith("$ "):
+            steps.append((n, line[2:], []))
+        elif steps and steps[-1][1].endswith("\\") and not steps[-1][2]:
+            steps[-1] = (steps[-1][0], steps[-1][1] + "\n" + line, [])
+        elif steps:
+            steps[-1][2].append(line)
+    if not steps:
+        return "a transcript without a `$ command` line"
+    for n, command, shown in steps:
+        r = run_shell(command, bin_dirs, cwd)
+        shutil.rmtree(cwd, ignore_errors=True) if n == steps[-1][0] else None
+        printed = [re.sub(r"\s+", " ", l).strip() for l in (r.stdout + r.stderr).split("\n")]
+        at = 0
+        for want in shown:
+            w = re.sub(r"\s+", " ", want).strip()
+            if not w or w == "...":
+                continue
+            # A shown line may be cut short: it matches a printed line it begins.
+            found = next((i for i in range(at, len(printed)) if printed[i].startswith(w)), None)
+            if found is not None:
+                at = found + 1
+            else:
+                return (f"'{want.strip()}' (the output shown after the command of line {b.line + 1 + n}) is not in what it prints "
+                        f"(exit {r.returncode}):\n{r.stdout}{r.stderr}")
+    return None
+
+
 def all_blocks() -> tuple[list[Block], list[str]]:
     blocks, errors = [], []
     for doc in docs():
         for b in blocks_of(doc):
-            if b.lang not in CHECKED:
+            if b.lang not in CHECKED and not (b.lang in SHELL_LANGS and b.kind is not None):
                 continue
             if b.kind is None:
                 errors.append(f"{b.where}: a {b.lang} block without a marker; put <!-- doc-block: KIND ... --> on the "
                               f"line before its fence (docs/CONTRIBUTING.md)")
             elif b.kind not in KINDS:
                 errors.append(f"{b.where}: unknown doc-block kind '{b.kind}'; expected one of {', '.join(sorted(KINDS))}")
+            elif b.kind in ("shell", "transcript") and b.lang not in SHELL_LANGS:
+                errors.append(f"{b.where}: doc-block '{b.kind}' is for shell blocks, this one is {b.lang}")
             elif b.kind in CPP_KINDS and b.lang != "cpp":
                 errors.append(f"{b.where}: doc-block '{b.kind}' is for cpp blocks, this one is {b.lang}")
             elif b.kind == "fragment" and not b.arg:
@@ -182,6 +251,10 @@ def cmd_check(args) -> int:
             problem = check_xml(b)
         elif b.kind == "net":
             problem = check_net(b, args.net_tool)
+        elif b.kind == "shell":
+            problem = check_shell(b, args.bin_dir)
+        elif b.kind == "transcript":
+            problem = check_transcript(b, args.bin_dir)
         elif b.kind == "fragment":
             fragments.append(f"  {b.where}: {b.arg}")
         if problem:
@@ -246,6 +319,7 @@ def main() -> int:
     sub = p.add_subparsers(dest="cmd", required=True)
     c = sub.add_parser("check")
     c.add_argument("--net-tool")
+    c.add_argument("--bin-dir", action="append", default=[], help="put first on PATH for shell blocks (repeatable)")
     e = sub.add_parser("extract")
     e.add_argument("--out", required=True)
     args = p.parse_args()

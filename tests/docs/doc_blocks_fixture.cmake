@@ -11,7 +11,9 @@ foreach(expected
     "docs/blocks.md:23: a fragment says why it is not checked"
     "docs/blocks.md:28: unknown doc-block kind 'guess'"
     "docs/blocks.md:33: not YAML"
-    "docs/blocks.md:38: doc-block 'main' is for cpp blocks, this one is yaml")
+    "docs/blocks.md:38: doc-block 'main' is for cpp blocks, this one is yaml"
+    "docs/blocks.md:43: 'bye' (the output shown after the command of line 44) is not in what it prints (exit 0)"
+    "docs/blocks.md:49: the commands exit 1")
   string(FIND "${out}" "${expected}" at)
   if(at EQUAL -1)
     message(FATAL_ERROR "doc_blocks.py did not report: ${expected}\nit reported:\n${out}")
@@ -21,6 +23,6 @@ string(FIND "${out}" "docs/blocks.md:13:" at)
 if(NOT at EQUAL -1)
   message(FATAL_ERROR "doc_blocks.py refused the excerpt with `...` (docs/blocks.md:13):\n${out}")
 endif()
-if(NOT err MATCHES "3 marked blocks \\(2 excerpt, 1 yaml\\); 6 problems")
+if(NOT err MATCHES "5 marked blocks \\(2 excerpt, 1 shell, 1 transcript, 1 yaml\\); 8 problems")
   message(FATAL_ERROR "unexpected summary:\n${err}")
 endif()
