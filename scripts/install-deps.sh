@@ -4,7 +4,8 @@
 #
 #   scripts/install-deps.sh [GROUP...]   also the packages of the hardening scripts that need them:
 #     fuzz   clang and its runtime (libFuzzer, ASan, UBSan), for scripts/fuzz.sh
-#     tidy   clang-tidy, for scripts/tidy.sh
+#     tidy   clang-tidy and clang-format (with clang-format-diff), for scripts/tidy.sh and
+#            scripts/format.sh
 #     browser  headless Chromium and Selenium, for the monitor's browser tests
 #              (cmake -DTRIPODAL_BROWSER_TESTS=ON; ctest -L browser)
 #     ros2-peer  Fast DDS (ROS 2's default middleware), the independent peer of the ROS 2 graph
@@ -28,6 +29,8 @@ packages=(
 # The monitor: Graphviz's library lays out the nets it draws (src/monitor/net_drawing.cpp); its
 # protocol test (tests/monitor/protocol_test.py) is a WebSocket client in Python.
 packages+=(libgraphviz-dev python3 python3-websockets)
+# The docs' checks (scripts/doc_blocks.py parses the YAML blocks).
+packages+=(python3-yaml)
 # Distribution over DDS (tripodal::dds, docs/distribution.md): Eclipse Cyclone DDS and its IDL
 # compiler idlc, which generates the message types at build time. Without them the build leaves
 # the dds area out (TRIPODAL_DDS=OFF).
@@ -47,7 +50,7 @@ for group in "$@"; do
   case $group in
     # libclang-rt-14-dev holds libFuzzer itself (libclang_rt.fuzzer), which -fsanitize=fuzzer links.
     fuzz) packages+=(clang libclang-rt-14-dev) ;;
-    tidy) packages+=(clang-tidy) ;;
+    tidy) packages+=(clang-tidy clang-format) ;;
     browser) packages+=(chromium chromium-driver python3-selenium) ;;
     ros2-peer) packages+=(libfastrtps-dev libfastcdr-dev) ;;
     perf) packages+=(valgrind) ;;

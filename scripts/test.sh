@@ -2,7 +2,7 @@
 # The README's test command, the quick path a newcomer runs: installs dependencies, then
 #   1. a Release build with -Werror and the whole test suite (ctest; the tests' own sources at -O1,
 #      36 % less compile time than -O3 for no run time: the library keeps -O3),
-#   2. the example consumer, the behavior tutorial's test (examples/behavior_test) and the
+#   2. the example consumer, the behavior tutorial's tests (examples/behavior_test) and the
 #      application robot (examples/custom_robot) built against the *installed* package
 #      (find_package(tripodal)), and the DDS consumer (examples/dds_consumer) when the package has dds.
 # The slower passes are their own scripts, which .ci/run runs after this one: scripts/sanitize.sh
@@ -38,11 +38,12 @@ cmake -S examples/consumer -B "$build_root/consumer" "${generator[@]}" \
   -DCMAKE_PREFIX_PATH="$build_root/install" -DCMAKE_COMPILE_WARNING_AS_ERROR=ON
 cmake --build "$build_root/consumer" -j "$jobs"
 "$build_root/consumer/tripodal_consumer"
-stage "Build and run the behavior tutorial's trace test against the installed package"
+stage "Build and run the behavior tutorial's tests (trace replay, closed loop) against the installed package"
 cmake -S examples/behavior_test -B "$build_root/behavior_test" "${generator[@]}" \
   -DCMAKE_PREFIX_PATH="$build_root/install" -DCMAKE_COMPILE_WARNING_AS_ERROR=ON
 cmake --build "$build_root/behavior_test" -j "$jobs"
 "$build_root/behavior_test/bh_approach_test"
+"$build_root/behavior_test/bh_approach_robot_test"
 stage "Build and run the application robot (examples/custom_robot) against the installed package"
 cmake -S examples/custom_robot -B "$build_root/custom_robot" "${generator[@]}" \
   -DCMAKE_PREFIX_PATH="$build_root/install" -DCMAKE_COMPILE_WARNING_AS_ERROR=ON

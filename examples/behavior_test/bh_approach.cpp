@@ -12,7 +12,7 @@ const ModuleManifest& BhApproach::static_manifest() {
   static const ModuleManifest m = ManifestBuilder("BhApproach", ModuleKind::behavior, Layer::reactive)
                                       .description("approaches the obstacle ahead and stops short of it")
                                       .input("laser_scan")
-                                      .output("cmd_vel")
+                                      .output("behavior_command")
                                       .number("speed_m_s", 0.4, "m/s", "cruise speed", 0.0)
                                       .number("slow_distance_m", 1.5, "m", "slow down below this clearance", 0.0)
                                       .number("stop_distance_m", 0.8, "m", "succeed at this clearance", 0.0)

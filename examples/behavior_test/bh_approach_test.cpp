@@ -1,9 +1,11 @@
 // The trace test of BhApproach (docs/behavior-tutorial.md): a real laser log, the behavior stepped
 // on the simulated clock, assertions on its commands and outcome over time.
 #define CATCH_CONFIG_MAIN
+#include "bh_approach.hpp"
+
 #include <catch2/catch.hpp>
 
-#include "bh_approach.hpp"
+#include "tripodal/behaviors/builtin_behaviors.hpp"
 #include "tripodal/testing/behavior_harness.hpp"
 #include "tripodal/trace/carmen_import.hpp"
 #include "tripodal/trace/trace_writer.hpp"
@@ -47,4 +49,15 @@ TEST_CASE("BhApproach slows down before it stops") {
   CHECK(slowed);
   // The helpers fail when the behavior breaks a promise: here a speed limit below its cruise speed.
   CHECK_FALSE(run.command_never_exceeds({.max_vx_m_s = 0.3}));
+}
+
+TEST_CASE("BhApproach under the safety behavior BhAvoidObstacle, as the reactive layer runs them") {
+  testing::BehaviorHarness harness;
+  harness.load_trace(excerpt_trace());
+  harness.attach(std::make_unique<example::BhApproach>(), {}, {.priority = 1});
+  harness.attach(std::make_unique<BhAvoidObstacle>(), {{"stop_distance_m", Value{0.7}}, {"slow_distance_m", Value{1.5}}},
+                 {.priority = 100, .role = InputRole::safety});
+  const testing::RunLog& run = harness.run(std::nullopt, true);
+  CHECK(run.succeeds_before("BhApproach", Time{40s}));
+  CHECK(run.never_drives_toward_obstacle_closer_than(0.7));
 }

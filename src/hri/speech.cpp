@@ -412,7 +412,7 @@ std::vector<std::string> pocketsphinx_dictionary_words(const std::filesystem::pa
 }
 
 std::optional<std::string> arpabet_from_espeak(std::string_view mnemonics) {
-  // espeak-ng's English mnemonics (docs/phonemes of espeak-ng, US variant), longest first where
+  // espeak-ng's English mnemonics (its own phoneme documentation, US variant), longest first where
   // one is the start of another ("aI@" before "aI", "tS" before "t").
   struct Phone {
     std::string_view espeak;

@@ -163,8 +163,9 @@ class DdsCmdVelController final : public CController {
 };
 
 // Adds "DdsLaser", "DdsOdometry", "DdsImu" and "DdsPose" to a robot's resource registry
-// (RobotPlugins::resources) and "dds_cmd_vel" to its controller registry. A template over the resource registry so that this area needs not link the
-// robot's, whose ResourceConfig is read for its name and parameters only.
+// (RobotPlugins::resources) and "dds_cmd_vel" to its controller registry. A template over the
+// resource registry: any registry whose factories take a config with a name and parameters will do
+// (the area links robot publicly all the same, for RobotBridge: src/dds/CMakeLists.txt).
 template <class ResourceRegistry>
 void register_dds_modules(ResourceRegistry& resources, ControllerRegistry& controllers) {
   resources.add(DdsLaserResource::static_manifest(), [](const auto& config) -> std::unique_ptr<CResource> {

@@ -1,0 +1,4 @@
+int twice(int x) {
+  const int y = 2 * x;
+  return y;
+}
