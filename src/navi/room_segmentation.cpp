@@ -96,24 +96,47 @@ std::vector<int> components(const FreeSpace& f, In in, std::vector<std::size_t>&
 // Morphological: erode step by step; a part that comes loose within the area limits is a core.
 std::vector<int> morphological_cores(const FreeSpace& f, double cell_m2, const RoomSegmentationOptions& o) {
   const std::vector<int> d = chessboard_distance(f);
-  const int deepest = d.empty() ? 0 : *std::max_element(d.begin(), d.end());
   std::vector<int> core(f.size(), -1);
   int rooms = 0;
-  std::vector<std::size_t> sizes;
-  for (int k = 1; k <= deepest; ++k) {
-    const auto in = [&](std::size_t i) { return d[i] >= k && core[i] < 0; };
-    const std::vector<int> part = components(f, in, sizes);
-    std::vector<int> room_of(sizes.size(), -1);
-    bool any_left = false;
-    for (std::size_t c = 0; c < sizes.size(); ++c) {
-      const double area = static_cast<double>(sizes[c]) * cell_m2;
-      if (area >= o.room_min_area_m2 && area <= o.room_max_area_m2) room_of[c] = rooms++;
-      else if (area > o.room_max_area_m2) any_left = true;
+  // Only the cells of parts still too large are eroded further: each step visits those alone,
+  // not the whole plan (a floor's rooms come loose early, its halls take many steps).
+  std::vector<std::size_t> active;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    if (d[i] >= 1) active.push_back(i);
+  }
+  std::vector<int> part(f.size(), -1);
+  std::vector<std::size_t> stack, members, next;
+  std::array<std::size_t, 4> nb{};
+  for (int k = 1; !active.empty(); ++k) {
+    next.clear();
+    for (const std::size_t s : active) {
+      if (d[s] < k || part[s] >= 0) continue;
+      // One part of the map eroded k - 1 times, among the active cells.
+      members.clear();
+      part[s] = k;
+      stack.push_back(s);
+      while (!stack.empty()) {
+        const std::size_t i = stack.back();
+        stack.pop_back();
+        members.push_back(i);
+        const std::size_t m = f.neighbours(i, nb);
+        for (std::size_t q = 0; q < m; ++q) {
+          if (part[nb[q]] < 0 && d[nb[q]] >= k && core[nb[q]] < 0) {
+            part[nb[q]] = k;
+            stack.push_back(nb[q]);
+          }
+        }
+      }
+      const double area = static_cast<double>(members.size()) * cell_m2;
+      if (area >= o.room_min_area_m2 && area <= o.room_max_area_m2) {
+        for (const std::size_t i : members) core[i] = rooms;
+        ++rooms;
+      } else if (area > o.room_max_area_m2) {
+        next.insert(next.end(), members.begin(), members.end());
+      }
     }
-    for (std::size_t i = 0; i < f.size(); ++i) {
-      if (part[i] >= 0 && room_of[static_cast<std::size_t>(part[i])] >= 0) core[i] = room_of[static_cast<std::size_t>(part[i])];
-    }
-    if (!any_left) break;  // what is left is too small to ever count
+    for (const std::size_t i : active) part[i] = -1;
+    active.swap(next);
   }
   return core;
 }
@@ -198,10 +221,11 @@ std::vector<int> voronoi_cores(const FreeSpace& f, const DistanceField& field, d
       }
     }
   }
-  // Critical points: axis cells with clearance under half a door whose distance is the smallest
-  // of the axis within a door's width around them (a passage's narrowest point).
+  // Critical points: axis cells with clearance under half a door where the passage is narrowest
+  // along its own direction and opens up on both sides within reach (a door between two wider
+  // spaces; not a corridor of even width, not a branch of the axis running into a corner).
   const double half_door = o.door_max_width_m / 2.0;
-  const int radius = std::max(1, static_cast<int>(std::lround(half_door / resolution_m)));
+  const int reach = std::max(2, static_cast<int>(std::lround(1.0 / resolution_m)));
   std::vector<std::uint8_t> cut(f.size(), 0);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
@@ -209,22 +233,7 @@ std::vector<int> voronoi_cores(const FreeSpace& f, const DistanceField& field, d
       if (axis[i] == 0) continue;
       const double c = dist(x, y);
       if (c > half_door || c < 1.5 * resolution_m) continue;
-      bool minimum = true;
-      for (int dy = -radius; dy <= radius && minimum; ++dy) {
-        for (int dx = -radius; dx <= radius; ++dx) {
-          const int nx = x + dx, ny = y + dy;
-          if (nx < 0 || ny < 0 || nx >= w || ny >= h || (dx == 0 && dy == 0) || axis[idx(nx, ny)] == 0) continue;
-          const double n = dist(nx, ny);
-          // Ties broken by position, so a passage of even width gets one cut, not a band.
-          if (n < c || (n == c && idx(nx, ny) < i)) {
-            minimum = false;
-            break;
-          }
-        }
-      }
-      if (!minimum) continue;
-      // The cut: the line through the point across the passage, in the direction along which the
-      // distance falls fastest (towards the two walls), out to the walls on both sides.
+      // Across the passage: the direction along which the distance falls fastest (to the walls).
       double best_rise = -1.0;
       std::array<int, 2> across{1, 0};
       for (const auto& dir : kDirs) {
@@ -234,6 +243,27 @@ std::vector<int> voronoi_cores(const FreeSpace& f, const DistanceField& field, d
           across = dir;
         }
       }
+      const std::array<int, 2> along{-across[1], across[0]};
+      bool narrowest = true;
+      std::array<bool, 2> opens{false, false};
+      for (std::size_t side = 0; side < 2 && narrowest; ++side) {
+        const int sign = side == 0 ? -1 : 1;
+        for (int s = 1; s <= reach; ++s) {
+          const int nx = x + sign * s * along[0], ny = y + sign * s * along[1];
+          if (nx < 0 || ny < 0 || nx >= w || ny >= h || f.free[idx(nx, ny)] == 0) break;
+          const double n = dist(nx, ny);
+          if (n < c - 1e-6) {
+            narrowest = false;
+            break;
+          }
+          if (n >= 1.3 * c + resolution_m) {
+            opens[side] = true;
+            break;
+          }
+        }
+      }
+      if (!narrowest || !opens[0] || !opens[1]) continue;
+      // The cut: the line through the point across the passage, out to the walls on both sides.
       cut[i] = 1;
       for (const int sign : {-1, 1}) {
         for (int s = 1;; ++s) {
@@ -274,42 +304,39 @@ void grow(const FreeSpace& f, std::vector<int>& label) {
 // Rooms under the minimum area join the neighbour they share the longest border with, smallest
 // first, until none is left; one that touches no other is dropped.
 void merge_small(const FreeSpace& f, std::vector<int>& label, double cell_m2, double min_area_m2) {
+  int count = 0;
+  for (const int l : label) count = std::max(count, l + 1);
+  std::vector<std::vector<std::size_t>> cells(static_cast<std::size_t>(count));
+  for (std::size_t i = 0; i < label.size(); ++i) {
+    if (label[i] >= 0) cells[static_cast<std::size_t>(label[i])].push_back(i);
+  }
+  const auto small = [&](std::size_t l) {
+    return !cells[l].empty() && static_cast<double>(cells[l].size()) * cell_m2 < min_area_m2;
+  };
+  std::array<std::size_t, 4> nb{};
   for (;;) {
-    std::map<int, std::size_t> size;
-    for (const int l : label) {
-      if (l >= 0) ++size[l];
+    std::size_t smallest = cells.size();
+    for (std::size_t l = 0; l < cells.size(); ++l) {
+      if (small(l) && (smallest == cells.size() || cells[l].size() < cells[smallest].size())) smallest = l;
     }
-    int smallest = -1;
-    std::size_t smallest_size = 0;
-    std::map<int, std::map<int, std::size_t>> border;
-    std::array<std::size_t, 4> nb{};
-    for (std::size_t i = 0; i < f.size(); ++i) {
-      if (label[i] < 0) continue;
+    if (smallest == cells.size()) return;
+    std::map<int, std::size_t> border;  // neighbour -> shared edges
+    for (const std::size_t i : cells[smallest]) {
       const std::size_t k = f.neighbours(i, nb);
       for (std::size_t q = 0; q < k; ++q) {
-        if (label[nb[q]] >= 0 && label[nb[q]] != label[i]) ++border[label[i]][label[nb[q]]];
+        if (label[nb[q]] >= 0 && label[nb[q]] != static_cast<int>(smallest)) ++border[label[nb[q]]];
       }
     }
-    for (const auto& [l, n] : size) {
-      if (static_cast<double>(n) * cell_m2 >= min_area_m2) continue;
-      if (border[l].empty()) {
-        // Alone and too small to be a room (a closet behind a wall, a speck): no room at all.
-        for (int& x : label) {
-          if (x == l) x = -1;
-        }
-        continue;
-      }
-      if (smallest < 0 || n < smallest_size) {
-        smallest = l;
-        smallest_size = n;
-      }
+    const int into = border.empty() ? -1
+                                    : std::max_element(border.begin(), border.end(),
+                                                       [](const auto& x, const auto& y) { return x.second < y.second; })->first;
+    // Alone and too small to be a room (a closet behind a wall, a speck): no room at all.
+    for (const std::size_t i : cells[smallest]) label[i] = into;
+    if (into >= 0) {
+      auto& target = cells[static_cast<std::size_t>(into)];
+      target.insert(target.end(), cells[smallest].begin(), cells[smallest].end());
     }
-    if (smallest < 0) break;
-    const auto& b = border[smallest];
-    const int into = std::max_element(b.begin(), b.end(), [](const auto& x, const auto& y) { return x.second < y.second; })->first;
-    for (int& l : label) {
-      if (l == smallest) l = into;
-    }
+    cells[smallest].clear();
   }
 }
 

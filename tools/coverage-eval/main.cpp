@@ -23,6 +23,7 @@
 
 #include "tripodal/navi/coverage.hpp"
 #include "tripodal/navi/map_io.hpp"
+#include "tripodal/navi/room_segmentation.hpp"
 #include "tripodal/navi/section_splitter.hpp"
 
 using namespace tripodal::navi;
@@ -150,8 +151,27 @@ void print_row(const std::string& map, Pattern p, const Figures& f, double width
 
 void header(bool segmentation) {
   std::printf("| map | pattern | reachable m2 | coverage | length m | length / bound | turns | rotation deg | plan ms | worst section ms |%s\n",
-              segmentation ? " sections | rooms | precision | recall |" : "");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|%s\n", segmentation ? "---|---|---|---|" : "");
+              segmentation ? " sections | rooms | precision | recall | segmentation ms |" : "");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|%s\n", segmentation ? "---|---|---|---|---|" : "");
+}
+
+// The sections to cover: the section splitter's, or the rooms of a room segmentation method.
+struct Split {
+  SectionSet sections;
+  double ms = 0.0;
+};
+Split split(const OccupancyGrid& grid, const std::string& rooms) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Split s;
+  if (rooms.empty()) {
+    s.sections = CSectionSplitter().split(grid);
+  } else {
+    RoomSegmentationOptions ro;
+    ro.method = room_segmentation_method(rooms);
+    s.sections = segment_rooms(grid, ro).rooms;
+  }
+  s.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return s;
 }
 
 // Sums over maps per pattern, printed last.
@@ -188,7 +208,7 @@ std::string segmentation(const SectionSet& sections, const std::vector<int>& gt,
   std::size_t ps = 0, pn = 0, rs = 0, rn = 0;
   for (std::size_t k = 0; k < sec_size.size(); ++k) ps += best_sec[k], pn += sec_size[k];
   for (std::size_t k = 0; k < room_size.size(); ++k) rs += best_room[k], rn += room_size[k];
-  char buf[128];
+  char buf[160];
   std::snprintf(buf, sizeof buf, " %zu | %d | %.2f | %.2f |", sections.sections.size(), rooms,
                 pn > 0 ? static_cast<double>(ps) / static_cast<double>(pn) : 0.0,
                 rn > 0 ? static_cast<double>(rs) / static_cast<double>(rn) : 0.0);
@@ -267,14 +287,17 @@ int usage() {
                "  --pictures DIR   the workspace's paths per pattern as PNG pictures; --verbose 1: per section figures\n"
                "  --width M        cleaning width (default 0.64, PSR-2's); --radius M robot radius (default 0.3)\n"
                "  --lane-overlap M, --lane-inset M, --turn-cost M   the hybrid's CoverageOptions of the same names\n"
-               "  --link-margin M   CoverageOptions::link_margin_m (the clearance links keep beyond the robot radius)\n";
+               "  --link-margin M   CoverageOptions::link_margin_m (the clearance links keep beyond the robot radius)\n"
+               "  --rooms METHOD   cover the rooms of a room segmentation (morphological, distance_transform, voronoi)\n"
+               "                   instead of the section splitter's sections; --segment-only 1: no coverage, P/R only\n";
   return 2;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string ipa, workspace, pictures;
+  std::string ipa, workspace, pictures, rooms;
+  bool segment_only = false;
   bool verbose = false;
   int random_rooms = 0;
   CoverageOptions o;
@@ -295,13 +318,15 @@ int main(int argc, char** argv) {
     else if (a == "--link-margin") o.link_margin_m = std::atof(v.c_str());
     else if (a == "--pictures") pictures = v;
     else if (a == "--verbose") verbose = v == "1";
+    else if (a == "--rooms") rooms = v;
+    else if (a == "--segment-only") segment_only = v == "1";
     else return usage();
   }
   if (ipa.empty() && workspace.empty() && random_rooms <= 0) return usage();
   try {
     if (!workspace.empty()) {
       const MapFile m = load_map(workspace);
-      const SectionSet sections = CSectionSplitter().split(m.grid);
+      const SectionSet sections = split(m.grid, rooms).sections;
       header(false);
       for (const Pattern p : kPatterns) {
         std::vector<CoverageResult> results;
@@ -331,17 +356,26 @@ int main(int argc, char** argv) {
         const Gray plan = read_png(fs::path(ipa) / (name + ".png"));
         const Gray truth = read_png(fs::path(ipa) / (name + "_gt_segmentation.png"));
         const OccupancyGrid grid = grid_of(plan, 0.05);
-        const SectionSet sections = CSectionSplitter().split(grid);
-        int rooms = 0;
-        const std::vector<int> gt = rooms_of(truth, 400, rooms);  // rooms of at least 1 m2
-        const std::string seg = truth.width == plan.width && truth.height == plan.height ? segmentation(sections, gt, rooms) : " - | - | - | - |";
+        const Split cut = split(grid, rooms);
+        const SectionSet& sections = cut.sections;
+        int truth_rooms = 0;
+        const std::vector<int> gt = rooms_of(truth, 400, truth_rooms);  // rooms of at least 1 m2
+        char ms[32];
+        std::snprintf(ms, sizeof ms, " %.1f |", cut.ms);
+        const std::string seg = (truth.width == plan.width && truth.height == plan.height ? segmentation(sections, gt, truth_rooms) : " - | - | - | - |") + ms;
+        if (segment_only) {
+          std::printf("| %s | %s |%s\n", name.c_str(), rooms.empty() ? "splitter" : rooms.c_str(), seg.c_str());
+          continue;
+        }
         for (const Pattern p : kPatterns) {
           const Figures f = cover(grid, sections, p, o);
           add(p, f);
           print_row(name, p, f, o.cleaning_width_m, seg);
         }
       }
-      for (const Pattern p : kPatterns) print_row("all ipa maps", p, totals[p], o.cleaning_width_m);
+      if (!segment_only) {
+        for (const Pattern p : kPatterns) print_row("all ipa maps", p, totals[p], o.cleaning_width_m);
+      }
       totals.clear();
       std::printf("\n");
     }
