@@ -1,6 +1,7 @@
 #include "tripodal/navi/section_splitter.hpp"
 
 #include "tripodal/navi/grid_maps.hpp"
+#include "tripodal/navi/room_segmentation.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -168,7 +169,17 @@ const ModuleManifest& CSectionSplitter::static_manifest() {
        ParameterSpec{"min_section_height_m", ValueType::number, Value{3.0}, "m",
                      "a wall is kept only if the strips on both sides are at least this tall", 0.0, std::nullopt},
        ParameterSpec{"min_section_area_m2", ValueType::number, Value{2.0}, "m^2",
-                     "smaller free components merge into a neighbour across a virtual wall", 0.0, std::nullopt}});
+                     "smaller free components merge into a neighbour across a virtual wall", 0.0, std::nullopt},
+       ParameterSpec{"method", ValueType::string, Value{std::string("splitter")}, "",
+                     "splitter (the paper's virtual walls between obstacle bands) or a room segmentation: "
+                     "morphological, distance_transform, voronoi (include/tripodal/navi/room_segmentation.hpp)",
+                     std::nullopt, std::nullopt},
+       ParameterSpec{"room_min_area_m2", ValueType::number, Value{1.0}, "m^2",
+                     "room segmentation: smaller rooms merge into their neighbour", 0.0, std::nullopt},
+       ParameterSpec{"room_max_area_m2", ValueType::number, Value{50.0}, "m^2",
+                     "room segmentation: a larger part is not one room (morphological, distance_transform)", 0.0, std::nullopt},
+       ParameterSpec{"door_max_width_m", ValueType::number, Value{1.6}, "m",
+                     "room segmentation (voronoi): a narrower passage may be a door", 0.0, std::nullopt}});
   return m;
 }
 
@@ -177,6 +188,17 @@ void CSectionSplitter::on_configure(const ParameterSet& params) {
   options_.min_gap_m = params.number("min_gap_m");
   options_.min_section_height_m = params.number("min_section_height_m");
   options_.min_section_area_m2 = params.number("min_section_area_m2");
+  const std::string method = params.string("method");
+  if (method == "splitter") {
+    rooms_.reset();
+  } else {
+    RoomSegmentationOptions rooms;
+    rooms.method = room_segmentation_method(method);  // throws naming the known methods
+    rooms.room_min_area_m2 = params.number("room_min_area_m2");
+    rooms.room_max_area_m2 = params.number("room_max_area_m2");
+    rooms.door_max_width_m = params.number("door_max_width_m");
+    rooms_ = std::make_shared<const RoomSegmentationOptions>(rooms);
+  }
 }
 
 SectionSet sections_of_labels(const OccupancyGrid& grid, const std::vector<int>& label) {
@@ -216,6 +238,7 @@ SectionSet sections_of_labels(const OccupancyGrid& grid, const std::vector<int>&
 }
 
 SectionSet CSectionSplitter::split(const OccupancyGrid& grid) const {
+  if (rooms_) return segment_rooms(grid, *rooms_).rooms;
   SectionSet out;
   const int w = grid.width(), h = grid.height();
   const std::size_t n = grid.size();

@@ -127,3 +127,15 @@ TEST_CASE("plans with no room in them give no rooms, never a hang") {
   CHECK_THROWS_WITH(room_segmentation_method("watershed"), Catch::Contains("known: morphological, distance_transform, voronoi"));
   CHECK(room_segmentation_method("distance") == RoomSegmentationMethod::distance_transform);
 }
+
+TEST_CASE("the section splitter module takes a room segmentation method from its parameters") {
+  const OccupancyGrid g = three_rooms();
+  CSectionSplitter splitter;
+  splitter.configure({{"method", tripodal::Value{std::string("morphological")}}});
+  CHECK(splitter.split(g).sections.size() == 3);
+  CHECK_THROWS_WITH(splitter.configure({{"method", tripodal::Value{std::string("watershed")}}}),
+                    Catch::Contains("known: morphological, distance_transform, voronoi"));
+  splitter.configure({{"method", tripodal::Value{std::string("splitter")}}});
+  // The paper's splitter: no isolated obstacle, no virtual wall, one component.
+  CHECK(splitter.split(g).sections.size() == 1);
+}

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -13,6 +14,8 @@
 #include "tripodal/navi/occupancy_grid.hpp"
 
 namespace tripodal::navi {
+
+struct RoomSegmentationOptions;  // room_segmentation.hpp
 
 struct SectionSplitterOptions {
   /// Occupied components smaller than this are noise, not isolated obstacles.
@@ -72,7 +75,9 @@ struct SectionSet {
 /// Every free cell ends up in exactly one section (unless dropped in 4).
 ///
 /// As a navigation module (type "SectionSplitter") its parameters are the option fields (same
-/// names); it splits the map of the robot's GridMaps at start and answers the planner's question
+/// names) and `method`: "splitter" (the rule above, the default) or a room segmentation
+/// (segment_rooms: "morphological", "distance_transform", "voronoi", with room_min_area_m2,
+/// room_max_area_m2 and door_max_width_m), whose rooms are then the sections; it splits the map of the robot's GridMaps at start and answers the planner's question
 /// sections(room): the room's sections nearest first from the robot's pose when the localizer
 /// trusts it (order_nearest_first; paper, section 5.1: the order of the processes follows the
 /// initial position), else in scan order. split() may be called without configure() with the
@@ -104,6 +109,8 @@ class CSectionSplitter final : public CNaviModules {
 
  private:
   SectionSplitterOptions options_;
+  // The profile's `method` when it is a room segmentation (null: the paper's splitter).
+  std::shared_ptr<const RoomSegmentationOptions> rooms_;
   SectionSet sections_;
   const OccupancyGrid* grid_ = nullptr;
   const RegionMap* regions_ = nullptr;
