@@ -124,6 +124,7 @@ std::unique_ptr<RplidarA1> RplidarA1::open(std::string name, const std::filesyst
     const std::string why = lidar->last_error().empty() ? fmt::format("not scanning after {:.2f} s", to_seconds(budget)) : lidar->last_error();
     throw std::runtime_error(fmt::format("RPLIDAR on {}: {}", port.string(), why));
   }
+  lidar->rebase_ = true;  // the loop's clock may not be `clock`: its first poll re-anchors the times
   return lidar;
 }
 
@@ -257,6 +258,11 @@ bool RplidarA1::take_descriptor(const rplidar::Descriptor& expected, std::string
 void RplidarA1::on_poll(Time now) noexcept { step(now); }
 
 void RplidarA1::step(Time now) noexcept {
+  if (rebase_) {
+    rebase_ = false;
+    entered_ = last_start_ = now;
+    assembler_.restart();
+  }
   if (!started_) {
     started_ = true;
     if (motor_ != nullptr && !motor_->set_motor(true)) motor_switchable_ = false;
@@ -278,8 +284,9 @@ void RplidarA1::step(Time now) noexcept {
         return;
       }
       port_lost_ = false;
-      if (motor_ != nullptr && !motor_->set_motor(true)) motor_switchable_ = false;
     }
+    // Motor on again (whoever stopped it), the lidar out of any session, then the handshake.
+    if (motor_ != nullptr && !motor_->set_motor(true)) motor_switchable_ = false;
     ++stats_.restarts;
     send(rplidar::Command::stop);
     rx_size_ = 0;

@@ -7,13 +7,16 @@
 #include <poll.h>
 
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <thread>
 #include <vector>
 
+#include "tripodal/board/board_hardware.hpp"
 #include "tripodal/board/rplidar_a1.hpp"
 #include "tripodal/board/rplidar_protocol.hpp"
 #include "tripodal/board/serial_port.hpp"
@@ -93,9 +96,10 @@ struct LidarRig {
   struct Motor final : MotorSwitch {
     LidarRig* rig = nullptr;
     std::uint32_t switched = 0;
+    bool stuck = false;  // a rotor that does not turn, whatever DTR says
     bool set_motor(bool on) noexcept override {
       ++switched;
-      rig->emulator->set_motor(on, rig->clock.now());
+      if (!stuck) rig->emulator->set_motor(on, rig->clock.now());
       return true;
     }
   } motor;
@@ -315,8 +319,10 @@ TEST_CASE("RPLIDAR A1 over a pty: a motor stopped by DTR is a fault within the t
   rig.run_for(500ms);
   REQUIRE(rig.lidar->stats().scans >= 1);
   CHECK(rig.lidar->take_faults().empty());
+  const std::uint64_t scans_before_stop = rig.lidar->stats().scans;
 
-  rig.emulator->set_motor(false, rig.clock.now());  // the motor stops (a stuck rotor, DTR held)
+  rig.emulator->set_motor(false, rig.clock.now());  // the motor stops (a stuck rotor)
+  rig.motor.stuck = true;                            // and stays stopped whatever DTR says
   const Time stopped = rig.clock.now();
   Time faulted{};
   std::vector<std::string> faults;
@@ -334,10 +340,13 @@ TEST_CASE("RPLIDAR A1 over a pty: a motor stopped by DTR is a fault within the t
   rig.run_for(1s);
   CHECK(rig.lidar->take_faults().empty());
   CHECK(rig.lidar->stats().restarts >= 1);
-  // The driver's restart switches the motor on again: scans resume.
+  CHECK(rig.lidar->stats().scans == scans_before_stop);
+  rig.motor.stuck = false;  // freed: the next restart's DTR spins it
+  // The driver's restarts switch the motor on again (DTR released): scans resume.
   const std::uint64_t scans = rig.lidar->stats().scans;
-  rig.emulator->set_motor(true, rig.clock.now());
+  const std::uint32_t switched = rig.motor.switched;
   rig.run_for(1500ms);
+  CHECK(rig.motor.switched > switched);
   CHECK(rig.lidar->stats().scans > scans);
   CHECK(rig.lidar->state() == RplidarA1::State::scanning);
 }
@@ -392,4 +401,53 @@ TEST_CASE("RPLIDAR A1 open: a path that does not exist, a regular file, a silent
   PseudoTerminal pty{clock};
   REQUIRE_THROWS_WITH(RplidarA1::open("laser", pty.slave_path(), config, clock),
                       Catch::Contains("no answer to GET_INFO within 0.05 s") && Catch::Contains(pty.slave_path().string()));
+}
+
+TEST_CASE("hardware 'board' with lidar_port: the A1 opened beside the board as the resource 'laser'", "[board][rplidar][threads]") {
+  HardwareRegistry registry("hardware type");
+  register_board_hardware(registry);
+  SteadyClock real;
+  PseudoTerminal board_pty{real};  // the board's port: opened, never spoken to in this test
+  PseudoTerminal lidar_pty{real};
+  HardwareConfig c;
+  c.type = "board";
+  c.where = SourceLocation{SourceFile(std::string_view("robot.yaml")), 12, 3};
+  ControllerConfig base;
+  base.type = "differential";
+  base.differential = {0.42, 0.09};
+  c.base = &base;
+  const auto params = [&](const std::string& lidar_port) {
+    return ParameterSet::resolve(registry.manifest("board"),
+                                 {{"port", Value{board_pty.slave_path().string()}}, {"lidar_port", Value{lidar_port}}}, c.where);
+  };
+  c.parameters = params("/nonexistent/ttyLIDAR");
+  REQUIRE_THROWS_WITH(registry.create("board", c),
+                      Catch::Contains("robot.yaml:12:3: error: hardware 'board', lidar_port: RPLIDAR port /nonexistent/ttyLIDAR does not exist"));
+
+  // The emulator on its own thread and clock, as in another process.
+  RingScene scene;
+  sim::RplidarEmulator emulator(lidar_pty, scene, {}, real.now());
+  std::atomic<bool> stop{false};
+  std::thread device([&] {
+    Time next = real.now();
+    while (!stop.load()) {
+      next += 1ms;
+      real.sleep_until(next);
+      emulator.run_until(real.now());
+    }
+  });
+  c.parameters = params(lidar_pty.slave_path().string());
+  std::unique_ptr<CHardware> hw;
+  CHECK_NOTHROW(hw = registry.create("board", c));
+  stop.store(true);
+  device.join();
+  REQUIRE(hw);
+  auto& board = dynamic_cast<BoardHardware&>(*hw);
+  REQUIRE(board.lidar() != nullptr);
+  CHECK(board.lidar()->state() == RplidarA1::State::scanning);
+  CHECK(board.lidar()->device_info().model == 0x18);
+  CHECK_FALSE(board.lidar()->motor_switchable());  // a pseudo-terminal has no DTR
+  ResourceTable table;
+  hw->add_resources(table);
+  CHECK(table.find<LaserScan>("laser") == board.lidar());
 }

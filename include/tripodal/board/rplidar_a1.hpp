@@ -116,6 +116,7 @@ class RplidarA1 final : public LaserResource, public ResourceFaultSource {
   bool started_ = false;  // a first poll happened
   bool reported_ = false;  // the current failure's fault was raised (until the next scan)
   bool port_lost_ = false;
+  bool rebase_ = false;  // opened on another clock than the loop's
   bool have_descriptor_ = false;  // the awaited answer's descriptor was read, its data not yet
   std::string garbage_head_;      // the first garbage bytes, in hex, for the error
   std::array<std::uint8_t, 512> rx_{};
