@@ -108,7 +108,7 @@ TEST_CASE("from: binds an input several modules provide to the one named", "[rob
   CHECK_THAT(diag, Catch::Contains("testbot.yaml:9:5: error: from: sequencing navigation 'localizer' takes 'laser_scan' from 'maps', "
                                    "which does not provide it; its providers: front_laser, rear_laser"));
   CHECK_THAT(diag, Catch::Contains("testbot.yaml:9:5: error: from: sequencing navigation 'localizer' has no input 'sonar' to bind to "
-                                   "'front_laser'; its inputs: grid_map, laser_scan, odometry"));
+                                   "'front_laser'; its inputs: laser_scan, odometry, grid_map"));
 }
 
 TEST_CASE("The disinfection robot on its lidar binds the localizer's odometry and passes the checks", "[robot]") {
