@@ -80,6 +80,15 @@ RplidarConfig rplidar_config(const ParameterSet& p) {
   return c;
 }
 
+std::unique_ptr<RplidarA1> open_rplidar_resource(const std::string& name, const ParameterSet& p, const SourceLocation& where) {
+  static const SteadyClock port_clock;  // the port's reads and the open's waits; polls bring the loop's time
+  try {
+    return RplidarA1::open(name, p.string("port"), rplidar_config(p), port_clock);
+  } catch (const std::runtime_error& e) {
+    throw ConfigError(where, "resource '" + name + "' (RplidarA1): " + e.what());
+  }
+}
+
 RplidarA1::RplidarA1(std::string name, ByteStream& stream, const RplidarConfig& config, MotorSwitch* motor,
                      std::unique_ptr<ByteStream> owned)
     : LaserResource(std::move(name), config.timeout, static_manifest()),

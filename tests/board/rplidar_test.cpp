@@ -20,6 +20,7 @@
 #include "tripodal/board/rplidar_a1.hpp"
 #include "tripodal/board/rplidar_protocol.hpp"
 #include "tripodal/board/serial_port.hpp"
+#include "tripodal/robot/plugins.hpp"
 #include "tripodal/sim/rplidar_emulator.hpp"
 #include "tripodal/sim/simulator.hpp"
 #include "tripodal/sim/world.hpp"
@@ -450,4 +451,67 @@ TEST_CASE("hardware 'board' with lidar_port: the A1 opened beside the board as t
   ResourceTable table;
   hw->add_resources(table);
   CHECK(table.find<LaserScan>("laser") == board.lidar());
+}
+
+TEST_CASE("resource type RplidarA1: registered with its manifest, a port that cannot be opened is a located error", "[board][rplidar]") {
+  ResourceRegistry resources{"resource type"};
+  register_rplidar_resource(resources);
+  REQUIRE(resources.contains("RplidarA1"));
+  CHECK(resources.manifest("RplidarA1").outputs == std::vector<std::string>{"laser_scan"});
+  const SourceLocation where{SourceFile(std::string_view("robot.yaml")), 7, 5};
+  REQUIRE_THROWS_WITH(ParameterSet::resolve(resources.manifest("RplidarA1"), {}, where), Catch::Contains("port"));
+  const ResourceConfig c{"laser", ParameterSet::resolve(resources.manifest("RplidarA1"), {{"port", Value{std::string("/nonexistent/ttyUSB7")}}}, where),
+                         where, nullptr};
+  REQUIRE_THROWS_WITH(resources.create("RplidarA1", c),
+                      Catch::Contains("robot.yaml:7:5: error: resource 'laser' (RplidarA1): RPLIDAR port /nonexistent/ttyUSB7 does not exist"));
+}
+
+TEST_CASE("A1 emulator: STOP ends the node stream, RESET answers with its banner, a bad checksum is refused", "[board][rplidar]") {
+  RingScene scene;
+  SimClock clock{Time{1s}};
+  SteadyClock real;
+  PseudoTerminal pty{real};
+  SerialPort host{pty.slave_path(), real};
+  sim::RplidarEmulator emulator(pty, scene, {}, clock.now());
+  std::array<std::uint8_t, 4096> in{};
+  const auto request = [&](std::initializer_list<std::uint8_t> bytes) {
+    const Bytes b(bytes);
+    REQUIRE(host.write(b));
+    await_readable(pty.master_fd());
+  };
+  // Everything the emulator sends in `d`, read as the host would.
+  const auto run_for = [&](Duration d) {
+    Bytes got;
+    const Time end = clock.now() + d;
+    while (clock.now() < end) {
+      clock.advance(1ms);
+      emulator.run_until(clock.now());
+      for (std::ptrdiff_t n = host.read(in, Time{}); n > 0; n = host.read(in, Time{})) got.insert(got.end(), in.begin(), in.begin() + n);
+    }
+    for (int i = 0; i < 20; ++i) {  // what the kernel still holds
+      await_readable(host.fd());
+      const std::ptrdiff_t n = host.read(in, Time{});
+      if (n <= 0) break;
+      got.insert(got.end(), in.begin(), in.begin() + n);
+    }
+    return got;
+  };
+  request({0xA5, 0x20});
+  const Bytes scan = run_for(100ms);
+  REQUIRE(scan.size() >= 7);
+  CHECK(Bytes(scan.begin(), scan.begin() + 7) == Bytes{0xA5, 0x5A, 0x05, 0x00, 0x00, 0x40, 0x81});
+  CHECK((scan.size() - 7) / 5 == Approx(200).margin(2));  // 2000 samples/s for 100 ms
+  CHECK(emulator.scanning());
+  request({0xA5, 0x25});
+  (void)run_for(10ms);
+  CHECK_FALSE(emulator.scanning());
+  CHECK(run_for(100ms).empty());
+  request({0xA5, 0x40});
+  const Bytes banner = run_for(20ms);
+  CHECK_THAT(std::string(banner.begin(), banner.end()), Catch::Contains("RPLIDAR A1"));
+  const std::uint64_t requests = emulator.counters().requests;
+  request({0xA5, 0x84, 0x01, 0x00, 0x00});  // a payload command whose checksum is wrong
+  (void)run_for(10ms);
+  CHECK(emulator.counters().requests == requests);
+  CHECK(emulator.counters().bad_requests >= 1);
 }

@@ -17,6 +17,7 @@
 #include "tripodal/board/rplidar_protocol.hpp"
 #include "tripodal/board/serial_port.hpp"
 #include "tripodal/core/clock.hpp"
+#include "tripodal/core/diagnostic.hpp"
 #include "tripodal/resources/resource.hpp"
 #include "tripodal/resources/resource_faults.hpp"
 
@@ -137,5 +138,19 @@ class RplidarA1 final : public LaserResource, public ResourceFaultSource {
 
 /// The driver's configuration from the resolved parameters of static_manifest().
 [[nodiscard]] RplidarConfig rplidar_config(const ParameterSet& p);
+
+/// A profile's resource of type "RplidarA1": opened on its `port` (RplidarA1::open, the port's own
+/// steady clock). Throws ConfigError at `where` with the open's reason.
+[[nodiscard]] std::unique_ptr<RplidarA1> open_rplidar_resource(const std::string& name, const ParameterSet& p, const SourceLocation& where);
+
+/// Adds the resource type "RplidarA1" to a robot's resource registry (RobotPlugins::resources): the
+/// lidar as a profile's `resources:` entry, beside any hardware. A template over the registry, as
+/// dds::register_dds_modules, so that this area needs not link the robot's.
+template <class ResourceRegistry>
+void register_rplidar_resource(ResourceRegistry& resources) {
+  resources.add(RplidarA1::static_manifest(), [](const auto& config) -> std::unique_ptr<CResource> {
+    return open_rplidar_resource(config.name, config.parameters, config.where);
+  });
+}
 
 }  // namespace tripodal::board
