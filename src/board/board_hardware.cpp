@@ -34,7 +34,7 @@ class BoardHardware::LinkResource final : public CResource {
 const ModuleManifest& BoardHardware::static_manifest() {
   static const ModuleManifest m = hardware_manifest(
       "board", "a differential base behind the disinfection robot's control board (UART or TCP, docs/board-protocol.md)",
-      {"odometry", "battery", "sonar", "cliff", "bumpers", "board_link"},
+      {"odometry", "battery", "sonar", "cliff", "bumpers", "board_link", "laser_scan"},
       {ParameterSpec{"port", ValueType::string, Value{std::string()}, "",
                      "the board's tty (e.g. /dev/ttyUSB0), or tcp://HOST:PORT for its ESP8266 Wi-Fi link", {}, {}},
        ParameterSpec{"protocol", ValueType::string, Value{std::string("thesis")}, "",
@@ -42,7 +42,13 @@ const ModuleManifest& BoardHardware::static_manifest() {
        ParameterSpec{"baud", ValueType::number, Value{115200.0}, "bit/s", "line rate", 9600.0, 921600.0},
        ParameterSpec{"pulses_per_m", ValueType::number, Value{5000.0}, "1/m", "encoder pulses per metre of wheel travel", 1.0, 1e6},
        ParameterSpec{"response_timeout_s", ValueType::number, Value{0.01}, "s", "a response later than this is missed", 0.001, 1.0},
-       ParameterSpec{"max_missed", ValueType::number, Value{1.0}, "", "consecutive missed responses that lose the link", 1.0, 100.0}});
+       ParameterSpec{"max_missed", ValueType::number, Value{1.0}, "", "consecutive missed responses that lose the link", 1.0, 100.0},
+       ParameterSpec{"lidar_port", ValueType::string, Value{std::string()}, "",
+                     "the RPLIDAR A1's tty (e.g. /dev/ttyUSB1, or the path tripodal-board-sim --lidar made): the laser "
+                     "resource 'laser' (docs/lidar.md); empty: no lidar", {}, {}},
+       ParameterSpec{"lidar_timeout_s", ValueType::number, Value{1.0}, "s", "no lidar revolution for this long is the laser's fault",
+                     0.05, 60.0},
+       ParameterSpec{"lidar_beams", ValueType::number, Value{360.0}, "", "bins of the laser scan over a full turn", 8.0, 8192.0}});
   return m;
 }
 
@@ -127,6 +133,7 @@ void BoardHardware::on_add_resources(ResourceTable& table) {
   table.add(ultrasonic_);
   table.add(cliff_);
   table.add(bumpers_);
+  if (lidar_) table.add(*lidar_);
 }
 
 BoardHardwareConfig board_hardware_config(const HardwareConfig& c) {
@@ -166,7 +173,18 @@ void register_board_hardware(HardwareRegistry& registry) {
       stream = std::make_unique<SerialPort>(port, port_clock, SerialSettings{static_cast<std::uint32_t>(c.parameters.number("baud"))});
     }
     ByteStream& s = *stream;
-    return std::make_unique<BoardHardware>(s, config, std::move(stream));
+    auto hw = std::make_unique<BoardHardware>(s, config, std::move(stream));
+    if (const std::string& lidar_port = c.parameters.string("lidar_port"); !lidar_port.empty()) {
+      RplidarConfig lidar;
+      lidar.timeout = from_seconds(c.parameters.number("lidar_timeout_s"));
+      lidar.scan.beams = static_cast<std::uint32_t>(std::lround(c.parameters.number("lidar_beams")));
+      try {
+        hw->attach_lidar(RplidarA1::open("laser", lidar_port, lidar, port_clock));
+      } catch (const std::runtime_error& e) {
+        throw ConfigError(c.where, std::string("hardware 'board', lidar_port: ") + e.what());
+      }
+    }
+    return hw;
   });
 }
 

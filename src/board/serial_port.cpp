@@ -222,6 +222,12 @@ std::string_view SerialPort::check() noexcept {
 
 SerialPort::~SerialPort() { close_port(fd_); }
 
+bool SerialPort::set_dtr(bool asserted) noexcept {
+  if (fd_ < 0) return false;
+  const int bits = TIOCM_DTR;
+  return ::ioctl(fd_, asserted ? TIOCMBIS : TIOCMBIC, &bits) == 0;
+}
+
 bool SerialPort::write(std::span<const std::uint8_t> bytes) noexcept {
   const bool ok = write_fd(fd_, bytes);
   if (ok) written_ += bytes.size();

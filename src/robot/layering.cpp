@@ -59,13 +59,35 @@ void check_layering(const std::vector<DescribedModule>& modules, Diagnostics& d)
                            " modules belong to the " + std::string(to_string(*expected)) + " layer (rule R1)");
     }
   }
-  // R0: every input has exactly one provider (or any number, for a fused input "name*").
+  // R0: every input has exactly one provider (or any number, for a fused input "name*"); where
+  // several provide it, the module's `from:` names the one it takes the input from.
   for (const DescribedModule& m : modules) {
+    for (const auto& [info, provider] : m.from) {
+      const bool is_input = std::any_of(m.inputs.begin(), m.inputs.end(), [&](const std::string& in) { return base_name(in) == info; });
+      if (!is_input) {
+        std::string list;
+        for (const std::string& in : m.inputs) list += (list.empty() ? "" : ", ") + base_name(in);
+        d.error(m.where, "from: " + module_phrase(m) + " has no input '" + info + "' to bind to '" + provider +
+                             "'; its inputs: " + (list.empty() ? std::string("none") : list));
+      }
+    }
     for (const std::string& in : m.inputs) {
       const std::string info = base_name(in);
       std::vector<const DescribedModule*> providers;
       for (const DescribedModule& p : modules) {
         if (&p != &m && std::find(p.outputs.begin(), p.outputs.end(), info) != p.outputs.end()) providers.push_back(&p);
+      }
+      if (const auto bound = m.from.find(info); bound != m.from.end()) {
+        const auto named = std::find_if(providers.begin(), providers.end(), [&](const DescribedModule* p) { return p->name == bound->second; });
+        if (named == providers.end()) {
+          std::string list;
+          for (const auto* p : providers) list += (list.empty() ? "" : ", ") + p->name;
+          d.error(m.where, "from: " + module_phrase(m) + " takes '" + info + "' from '" + bound->second + "', which does not provide it; " +
+                               (list.empty() ? std::string("no module provides it") : "its providers: " + list));
+          continue;
+        }
+        const DescribedModule* chosen = *named;
+        providers.assign(1, chosen);
       }
       if (!many(in)) {
         if (providers.empty()) {
@@ -153,6 +175,7 @@ RobotDescription describe_robot(const RobotProfile& profile, const RobotPlugins&
     dm.kind = e->kind;
     dm.where = e->where;
     dm.description = e->description;
+    dm.from = e->from;
     if (m != nullptr) {
       dm.layer = m->layer;
       if (e->layer || e->inputs || e->outputs) {
@@ -254,7 +277,9 @@ std::string describe_dot(const RobotDescription& r) {
   for (const DescribedModule& c : r.modules) {
     for (const std::string& in : c.inputs) {
       const std::string info = base_name(in);
+      const auto bound = c.from.find(info);  // only the provider `from:` names, where it names one
       for (const DescribedModule& p : r.modules) {
+        if (bound != c.from.end() && p.name != bound->second) continue;
         if (&p != &c && std::find(p.outputs.begin(), p.outputs.end(), info) != p.outputs.end()) edges[{p.name, c.name}].push_back(info);
       }
     }

@@ -443,6 +443,10 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
       m->hardware->add_resources(m->resources);
       // Hardware whose link detects faults of its own (a base on DDS) reports them like a resource.
       if (auto* faults = dynamic_cast<ResourceFaultSource*>(m->hardware.get())) m->fault_sources.emplace_back(h.name, faults);
+      // So do the hardware's own resources that detect faults (the board's lidar): "<resource>.fault".
+      for (std::size_t i = 0; i < m->resources.size(); ++i) {
+        if (auto* faults = dynamic_cast<ResourceFaultSource*>(&m->resources.at(i))) m->fault_sources.emplace_back(m->resources.at(i).name(), faults);
+      }
     });
   }
   for (const ModuleEntry& e : profile.resources) {

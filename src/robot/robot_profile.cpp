@@ -78,8 +78,8 @@ struct Parser {
     }
     const std::string entry = "a " + std::string(to_string(kind)) + " entry";
     const bool known = kind == ModuleKind::behavior
-                           ? r.expect_keys(n, {"name", "type", "description", "layer", "inputs", "outputs", "parameters", "watchdog", "safety"}, entry)
-                           : r.expect_keys(n, {"name", "type", "description", "layer", "inputs", "outputs", "parameters", "watchdog"}, entry);
+                           ? r.expect_keys(n, {"name", "type", "description", "layer", "inputs", "outputs", "from", "parameters", "watchdog", "safety"}, entry)
+                           : r.expect_keys(n, {"name", "type", "description", "layer", "inputs", "outputs", "from", "parameters", "watchdog"}, entry);
     if (!known) return;
     for (const auto& kv : n) {
       const std::string key = yaml::Reader::checked_key(kv.first);
@@ -100,6 +100,13 @@ struct Parser {
         e.inputs = names(v, "inputs");
       } else if (key == "outputs") {
         e.outputs = names(v, "outputs");
+      } else if (key == "from") {
+        if (!r.expect_map(v, "from")) continue;
+        for (const auto& p : v) {
+          const auto info = r.key(p.first, "from");
+          std::string provider;
+          if (info && scalar(p.second, provider, "from '" + *info + "'")) e.from[*info] = provider;
+        }
       } else if (key == "parameters") {
         if (!r.expect_map(v, "parameters")) continue;
         for (const auto& p : v) {

@@ -61,7 +61,7 @@ const ModuleManifest& SimBoardHardware::static_manifest() {
   static const ModuleManifest m = [] {
     const ModuleManifest& real = board::BoardHardware::static_manifest();
     std::vector<std::string> outputs = real.outputs;
-    outputs.insert(outputs.end(), {"laser_scan", "yaw_rate", "ground_truth_pose"});
+    outputs.insert(outputs.end(), {"yaw_rate", "ground_truth_pose"});  // laser_scan: the world's laser stands in for the lidar
     std::vector<ParameterSpec> parameters = real.parameters;
     const UvLamp lamp;
     parameters.insert(parameters.end(), {

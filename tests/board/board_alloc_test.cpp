@@ -7,6 +7,9 @@
 #include "../support/counting_new.hpp"
 #include "tripodal/board/commands.hpp"
 #include "tripodal/board/frame.hpp"
+#include "tripodal/board/rplidar_a1.hpp"
+#include "tripodal/board/serial_line.hpp"
+#include "tripodal/sim/rplidar_emulator.hpp"
 
 using namespace tripodal::board;
 
@@ -31,5 +34,34 @@ TEST_CASE("decoding and encoding frames allocates nothing", "[board][alloc]") {
   CHECK(n == 9);
   CHECK(frames == 1000);
   CHECK(decoder.stats().garbage_runs == 100);
+  CHECK(after == before);
+}
+
+TEST_CASE("the RPLIDAR driver's scanning cycle allocates nothing, garbage included", "[board][alloc][rplidar]") {
+  // The A1 emulator on the in-process line's far end, the driver on the near one, one clock.
+  struct Flat final : tripodal::sim::LidarScene {
+    double range_m(double, tripodal::Time) const noexcept override { return 3.0; }
+  } scene;
+  tripodal::SimClock clock{tripodal::Time{std::chrono::seconds(1)}};
+  SerialLine line(clock);
+  tripodal::sim::RplidarEmulator emulator(line.board(), scene, {}, clock.now());
+  RplidarA1 lidar("laser", line.host(), RplidarConfig{});
+  const auto run_for = [&](std::chrono::milliseconds d) {
+    for (std::chrono::milliseconds t{0}; t < d; ++t) {
+      clock.advance(std::chrono::milliseconds(1));
+      emulator.run_until(clock.now());
+      lidar.poll(clock.now());
+    }
+  };
+  run_for(std::chrono::milliseconds(1000));
+  REQUIRE(lidar.state() == RplidarA1::State::scanning);
+  REQUIRE(lidar.stats().scans >= 2);  // the scan's storage exists
+  const std::size_t before = tripodal::test::allocations();
+  const std::array<std::uint8_t, 7> garbage{0xFF, 0x00, 0xFF, 0xFC, 0xFF, 0x13, 0x00};
+  emulator.inject(garbage);
+  run_for(std::chrono::milliseconds(2000));
+  const std::size_t after = tripodal::test::allocations();
+  CHECK(lidar.stats().scans >= 12);
+  CHECK(lidar.stats().decoder_errors >= 1);
   CHECK(after == before);
 }

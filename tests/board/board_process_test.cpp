@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "tripodal/board/board_link.hpp"
+#include "tripodal/board/rplidar_a1.hpp"
 #include "tripodal/board/tcp_stream.hpp"
 #include "tripodal/board/serial_port.hpp"
 #include "tripodal/core/clock.hpp"
@@ -29,7 +31,7 @@ namespace {
 
 // tripodal-board-sim on the workspace, its pseudo-terminal also reachable at `link`.
 // With `tcp_port`, on TCP (the ESP8266 backup link) at 127.0.0.1:tcp_port instead.
-pid_t start_board(const std::filesystem::path& link, int tcp_port = -1) {
+pid_t start_board(const std::filesystem::path& link, int tcp_port = -1, const std::filesystem::path& lidar = {}) {
   const std::string exe = TRIPODAL_BOARD_SIM_EXE;
   const std::string world = (std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs" / "worlds" / "workspace.yaml").string();
   std::vector<std::string> args{exe, "--world", world, "--duration-s", "60", "--link-timeout-s", "2"};
@@ -38,6 +40,7 @@ pid_t start_board(const std::filesystem::path& link, int tcp_port = -1) {
   } else {
     args.insert(args.end(), {"--link", link.string()});
   }
+  if (!lidar.empty()) args.insert(args.end(), {"--lidar", lidar.string()});
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -157,4 +160,59 @@ TEST_CASE("the board's process on TCP (the ESP8266 link): connected, killed, res
   CHECK(cycle_until(link, clock, 500, [&] { return link.synchronised() && link.stats().responses >= responses + 20; }) <= 500);
   CHECK(link.stats().port_failures >= 1);
   stop_board(board);
+}
+
+TEST_CASE("the lidar beside the board in tripodal-board-sim: scans of the world, its process killed: a fault, restarted: scans again",
+          "[board][process][rplidar]") {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("tripodal-lidar-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path board_link = dir / "board";
+  const std::filesystem::path lidar_link = dir / "lidar";
+  const SteadyClock clock;
+  const auto wait_for_link = [&] {
+    for (int i = 0; i < 1000 && !std::filesystem::exists(lidar_link); ++i) clock.sleep_until(clock.now() + 10ms);
+    REQUIRE(std::filesystem::exists(lidar_link));
+  };
+  // The control loop: the lidar polled at 100 Hz until `done` (at most `max_cycles`).
+  const auto poll_until = [&](RplidarA1& lidar, int max_cycles, const auto& done) {
+    Time next = clock.now();
+    for (int i = 0; i < max_cycles && !done(); ++i) {
+      next += 10ms;
+      clock.sleep_until(next);
+      lidar.poll(clock.now());
+    }
+  };
+
+  pid_t sim = start_board(board_link, -1, lidar_link);
+  wait_for_link();
+  RplidarConfig config;
+  config.timeout = 500ms;
+  std::unique_ptr<RplidarA1> lidar;
+  REQUIRE_NOTHROW(lidar = RplidarA1::open("laser", lidar_link, config, clock));
+  CHECK(lidar->device_info().model == 0x18);
+  poll_until(*lidar, 300, [&] { return lidar->stats().scans >= 5; });
+  CHECK(lidar->stats().scans >= 5);
+  CHECK(lidar->stats().decoder_errors == 0);
+  std::size_t returns = 0;
+  for (const float r : lidar->latest().ranges_m) returns += std::isfinite(r) ? 1 : 0;
+  CHECK(returns > 300);  // the workspace's walls all round the start pose
+  CHECK(lidar->take_faults().empty());
+
+  // Unplugged: the emulator's process dies, the port hangs up.
+  stop_board(sim);
+  poll_until(*lidar, 200, [&] { return lidar->state() == RplidarA1::State::failed || lidar->state() == RplidarA1::State::stalled; });
+  const std::vector<std::string> faults = lidar->take_faults();
+  REQUIRE(faults.size() == 1);
+  CHECK_THAT(faults[0], Catch::Contains("serial port is gone") || Catch::Contains("no revolution"));
+
+  // Replugged: the device simulator starts again behind the same path; the driver reopens it.
+  sim = start_board(board_link, -1, lidar_link);
+  wait_for_link();
+  const std::uint64_t scans = lidar->stats().scans;
+  poll_until(*lidar, 500, [&] { return lidar->stats().scans >= scans + 3; });
+  CHECK(lidar->stats().scans >= scans + 3);
+  CHECK(lidar->stats().restarts >= 1);
+  lidar.reset();
+  stop_board(sim);
+  std::filesystem::remove_all(dir);
 }

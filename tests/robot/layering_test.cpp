@@ -89,6 +89,36 @@ TEST_CASE("Duplicate providers are refused with every provider located", "[robot
             .empty());
 }
 
+TEST_CASE("from: binds an input several modules provide to the one named", "[robot]") {
+  Catalog c;
+  const std::string two_lasers = kResources + "  - {name: rear_laser, type: LaserScanner}\n";
+  const auto navigation = [](const std::string& from) {
+    return "  - {name: maps, type: GridMaps}\n"
+           "  - {name: localizer, type: ScanMatchingLocalizer, from: " + from + "}\n"
+           "  - {name: section_splitter, type: SectionSplitter}\n";
+  };
+  // Bound: the two providers are no longer ambiguous, and the diagram's edge comes from the one.
+  RobotDescription r;
+  CHECK(c.check(profile(two_lasers, navigation("{laser_scan: rear_laser}"), kBehaviors), &r).empty());
+  const std::string dot = describe_dot(r);
+  CHECK_THAT(dot, Catch::Contains("\"rear_laser\" -> \"localizer\""));
+  CHECK_THAT(dot, !Catch::Contains("\"front_laser\" -> \"localizer\""));
+  // A provider that does not provide it, and an input the module does not have: both located.
+  const std::string diag = c.check(profile(two_lasers, navigation("{laser_scan: maps, sonar: front_laser}"), kBehaviors));
+  CHECK_THAT(diag, Catch::Contains("testbot.yaml:9:5: error: from: sequencing navigation 'localizer' takes 'laser_scan' from 'maps', "
+                                   "which does not provide it; its providers: front_laser, rear_laser"));
+  CHECK_THAT(diag, Catch::Contains("testbot.yaml:9:5: error: from: sequencing navigation 'localizer' has no input 'sonar' to bind to "
+                                   "'front_laser'; its inputs: laser_scan, odometry, grid_map"));
+}
+
+TEST_CASE("The disinfection robot on its lidar binds the localizer's odometry and passes the checks", "[robot]") {
+  Catalog c;
+  RobotProfile p = load_robot_profile(kRobots / "disinfection_lidar.yaml");
+  REQUIRE(p.navigation.size() >= 2);
+  CHECK(p.navigation[1].type == "ScanMatchingLocalizer");
+  CHECK(p.navigation[1].from.at("odometry") == "base");
+}
+
 TEST_CASE("Layering rules R1-R5 are enforced with the rule named", "[robot]") {
   Catalog c;
   SECTION("R1: a navigation module in the reactive layer") {

@@ -19,6 +19,7 @@
 #include "tripodal/board/serial_port.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/core/diagnostic.hpp"
+#include "tripodal/sim/rplidar_emulator.hpp"
 #include "tripodal/sim/sim_board.hpp"
 #include "tripodal/sim/simulator.hpp"
 #include "tripodal/sim/world.hpp"
@@ -40,6 +41,7 @@ int run(int argc, char** argv) {
   double tank_l = 1.5;
   std::string protocol = "thesis";
   int tcp_port = -1;
+  std::string lidar_link;
   app.add_option("--world", world_file, "world file (the simulator's map, start pose, sensors)")->check(CLI::ExistingFile);
   app.add_option("--link", link, "also make this path a symbolic link to the pseudo-terminal");
   app.add_option("--wheel-radius-m", wheel_radius_m, "wheel radius (m)")->check(CLI::PositiveNumber);
@@ -50,6 +52,9 @@ int run(int argc, char** argv) {
   app.add_option("--protocol", protocol, "protocol profile: thesis, tripodal-v1 or a YAML file (configs/board/)");
   app.add_option("--tcp", tcp_port, "serve the link over TCP on 127.0.0.1:PORT (0: any free port) instead of a pseudo-terminal")
       ->check(CLI::Range(0, 65535));
+  app.add_option("--lidar", lidar_link,
+                 "also serve an RPLIDAR A1 (docs/lidar.md) on a second pseudo-terminal, this path a symbolic link to it; "
+                 "it scans the same world");
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -79,6 +84,20 @@ int run(int argc, char** argv) {
       std::filesystem::remove(link);
       std::filesystem::create_symlink(pty->slave_path(), link);
     }
+    // The lidar: the A1 emulated on its own pseudo-terminal, its ranges cast in the world the
+    // board's wheels move the robot in, on the same clock.
+    std::unique_ptr<board::PseudoTerminal> lidar_pty;
+    std::unique_ptr<sim::SimLidarScene> lidar_scene;
+    std::unique_ptr<sim::RplidarEmulator> lidar;
+    if (!lidar_link.empty()) {
+      lidar_pty = std::make_unique<board::PseudoTerminal>(clock);
+      lidar_scene = std::make_unique<sim::SimLidarScene>(simulator);
+      lidar = std::make_unique<sim::RplidarEmulator>(*lidar_pty, *lidar_scene, sim::RplidarEmulatorConfig{}, clock.now());
+      std::filesystem::remove(lidar_link);
+      std::filesystem::create_symlink(lidar_pty->slave_path(), lidar_link);
+      std::cout << "tripodal-board-sim: RPLIDAR A1 on " << lidar_pty->slave_path().string() << " (" << lidar_link
+                << ", 115200 8N1)" << std::endl;
+    }
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
     if (tcp) {
@@ -94,6 +113,7 @@ int run(int argc, char** argv) {
       next += std::chrono::milliseconds(1);
       clock.sleep_until(next);
       firmware.run_until(clock.now());
+      if (lidar) lidar->run_until(clock.now());
     }
     const auto& c = firmware.counters();
     const auto& d = firmware.decoder_stats();
@@ -101,6 +121,12 @@ int run(int argc, char** argv) {
               << d.errors() << " decoder errors, " << c.watchdog_trips << " watchdog trips, " << c.resyncs << " synchronisations"
               << std::endl;
     if (!link.empty() && pty) std::filesystem::remove(link);
+    if (lidar) {
+      const auto& l = lidar->counters();
+      std::cout << "tripodal-board-sim: lidar " << l.requests << " requests, " << l.revolutions << " revolutions, " << l.nodes
+                << " nodes sent, " << l.bytes_lost << " bytes lost" << std::endl;
+      std::filesystem::remove(lidar_link);
+    }
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "tripodal-board-sim: error: " << e.what() << '\n';

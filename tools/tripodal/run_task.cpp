@@ -27,6 +27,7 @@
 #include "tripodal/robot/robot_profile.hpp"
 #include "tripodal/board/actuator_behaviors.hpp"
 #include "tripodal/board/board_monitor.hpp"
+#include "tripodal/board/rplidar_a1.hpp"
 #include "tripodal/sim/sim_board.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/sim/simulator.hpp"
@@ -258,6 +259,7 @@ void register_tool_plugins(RobotPlugins& plugins, const std::shared_ptr<const si
   register_dds_robot_modules(plugins);
   board::register_board_modules(plugins.modules);
   board::register_board_behaviors(plugins.behaviors);
+  board::register_rplidar_resource(plugins.resources);
   register_gesture_behaviors(plugins.behaviors);
   register_guide_modules(plugins.modules);
 }

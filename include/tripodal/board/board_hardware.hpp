@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "tripodal/board/board_link.hpp"
+#include "tripodal/board/rplidar_a1.hpp"
 #include "tripodal/board/serial_port.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/hardware/hardware.hpp"
@@ -32,7 +33,9 @@ struct BoardHardwareConfig {
 
 class BoardHardware final : public CHardware, public HardwareInterface, public BoardHost {
  public:
-  /// Parameters of type "board": port (the tty), baud, pulses_per_m, response_timeout_s, max_missed.
+  /// Parameters of type "board": port (the tty), baud, pulses_per_m, response_timeout_s, max_missed,
+  /// and the RPLIDAR A1 beside the board: lidar_port (its tty; empty: none), lidar_timeout_s,
+  /// lidar_beams.
   static const ModuleManifest& static_manifest();
   /// Talks over `stream` (not owned; `owned` may hold it).
   BoardHardware(ByteStream& stream, const BoardHardwareConfig& config, std::unique_ptr<ByteStream> owned = nullptr);
@@ -53,6 +56,9 @@ class BoardHardware final : public CHardware, public HardwareInterface, public B
   [[nodiscard]] BoardHardware& board() noexcept override { return *this; }
   /// Queues an actuator command (UV lamp, atomizer, voice, LCD): sent until acknowledged.
   bool command(Command cmd, std::span<const std::uint8_t> payload) noexcept { return link_.queue(cmd, payload); }
+  /// The robot's laser, the resource "laser" (before add_resources; the hardware owns it).
+  void attach_lidar(std::unique_ptr<RplidarA1> lidar) noexcept { lidar_ = std::move(lidar); }
+  [[nodiscard]] RplidarA1* lidar() noexcept { return lidar_.get(); }
 
  protected:
   [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
@@ -72,6 +78,7 @@ class BoardHardware final : public CHardware, public HardwareInterface, public B
   SonarResource ultrasonic_{"ultrasonic"};
   InfraredResource cliff_{"cliff"};
   BumperResource bumpers_{"bumpers"};
+  std::unique_ptr<RplidarA1> lidar_;
 };
 
 /// The host side's configuration from a profile's hardware entry of type "board" (ConfigError

@@ -78,6 +78,10 @@ class SerialPort final : public ByteStream {
   /// Why the latest reopen failed (empty after a success).
   [[nodiscard]] const std::string& last_reopen_error() const noexcept { return reopen_error_; }
 
+  /// Asserts or releases the DTR modem line (TIOCMBIS / TIOCMBIC): what switches the RPLIDAR A1's
+  /// motor on its USB adapter. False when the device has no modem lines (a pseudo-terminal).
+  bool set_dtr(bool asserted) noexcept;
+
   [[nodiscard]] const std::filesystem::path& path() const noexcept { return path_; }
   [[nodiscard]] int fd() const noexcept { return fd_; }
   /// Bytes written and read so far.

@@ -5,6 +5,7 @@
 // and its text and Graphviz renderings (`tripodal describe`).
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,8 @@ struct DescribedModule {
   std::vector<std::string> inputs;
   std::vector<std::string> outputs;
   SourceLocation where;
+  /// Inputs bound to one provider by name (the profile entry's `from:`), where several provide it.
+  std::map<std::string, std::string, std::less<>> from;
 };
 
 struct RobotDescription {

@@ -31,6 +31,9 @@ struct ModuleEntry {
   std::optional<Layer> layer;           ///< declared layer (must agree with a registered manifest)
   std::optional<std::vector<std::string>> inputs;   ///< replace the manifest's inputs
   std::optional<std::vector<std::string>> outputs;  ///< replace the manifest's outputs
+  /// `from: {odometry: base}`: which module provides an input that several provide (the control
+  /// board's and the base controller's odometry); input information name -> provider's name.
+  std::map<std::string, std::string, std::less<>> from;
   std::string description;
   std::map<std::string, std::string, std::less<>> parameters;
   std::optional<Duration> watchdog_timeout;  ///< supervisor watchdog on the module's heartbeat
