@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "tripodal/navi/coverage.hpp"
+#include "tripodal/navi/distance_transform_coverage.hpp"
 #include "tripodal/navi/map_io.hpp"
 #include "tripodal/navi/room_segmentation.hpp"
 #include "tripodal/navi/section_splitter.hpp"
@@ -112,9 +113,9 @@ struct Figures {
   std::size_t turns = 0;
 };
 
-enum class Pattern { balloon, boustrophedon, hybrid };
+enum class Pattern { balloon, boustrophedon, hybrid, distance_transform };
 const char* name_of(Pattern p) {
-  return p == Pattern::balloon ? "balloon" : p == Pattern::boustrophedon ? "boustrophedon" : "hybrid";
+  return p == Pattern::balloon ? "balloon" : p == Pattern::boustrophedon ? "boustrophedon" : p == Pattern::hybrid ? "hybrid" : "distance_transform";
 }
 
 // Every section of the grid covered by one pattern, one after the other from the previous end.
@@ -125,9 +126,10 @@ Figures cover(const OccupancyGrid& grid, const SectionSet& sections, Pattern pat
   CoveragePlanner cp(grid, o);
   for (const Section& s : sections.sections) {
     const auto ts = std::chrono::steady_clock::now();
-    const CoverageResult r = pattern == Pattern::balloon ? cp.balloon(s)
+    const CoverageResult r = pattern == Pattern::balloon         ? cp.balloon(s)
                              : pattern == Pattern::boustrophedon ? cp.boustrophedon(s)
-                                                                 : cp.hybrid(s);
+                             : pattern == Pattern::hybrid        ? cp.hybrid(s)
+                                                                 : distance_transform_coverage(grid, s, o);
     f.worst_ms = std::max(f.worst_ms, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - ts).count());
     const double cell_m2 = grid.resolution_m() * grid.resolution_m();
     f.reachable_m2 += static_cast<double>(r.reachable_cells) * cell_m2;
@@ -187,7 +189,7 @@ void add(Pattern p, const Figures& f) {
   t.worst_ms = std::max(t.worst_ms, f.worst_ms);
 }
 
-const Pattern kPatterns[] = {Pattern::balloon, Pattern::boustrophedon, Pattern::hybrid};
+const Pattern kPatterns[] = {Pattern::balloon, Pattern::boustrophedon, Pattern::hybrid, Pattern::distance_transform};
 
 // Area-weighted precision (each section's best-matching room over the section) and recall (each
 // room's best-matching section over the room), with the counts.
