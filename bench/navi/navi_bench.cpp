@@ -13,6 +13,7 @@
 #include "tripodal/navi/distance_field.hpp"
 #include "tripodal/navi/map_io.hpp"
 #include "tripodal/navi/path_planner.hpp"
+#include "tripodal/navi/room_segmentation.hpp"
 #include "tripodal/navi/section_splitter.hpp"
 
 using namespace tripodal::navi;
@@ -168,6 +169,92 @@ void BM_CoverageWorkspace(benchmark::State& state) {
   state.counters["reachable_m2"] = reachable_m2;
 }
 BENCHMARK(BM_CoverageWorkspace)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+
+// A generated office floor of 2,800 m2 (70 x 40 m at 5 cm, 1,400 x 800 cells; issue 39's "whole
+// floor"): two 2 m corridors the length of the floor, rooms of 5 x 4 m on both sides of each and
+// between them, each with a 0.9 m door onto its corridor.
+const OccupancyGrid& office_floor() {
+  static const OccupancyGrid g = [] {
+    const int w = 1400, h = 800;
+    OccupancyGrid f(w, h, 0.05);
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) f.set_state({x, y}, x == 0 || y == 0 || x == w - 1 || y == h - 1 ? Occupancy::occupied : Occupancy::free);
+    }
+    const auto wall_x = [&](int x, int y0, int y1) {
+      for (int y = y0; y <= y1; ++y) f.set_state({x, y}, Occupancy::occupied);
+    };
+    const auto wall_y = [&](int y, int x0, int x1) {
+      for (int x = x0; x <= x1; ++x) f.set_state({x, y}, Occupancy::occupied);
+    };
+    // Bands from the bottom: rooms 0-80, corridor 80-120, rooms 120-200 | 200-280, corridor
+    // 280-320 ... : rows of rooms 4 m deep (80 cells) around 2 m corridors (40 cells).
+    const std::vector<std::pair<int, int>> corridors = {{160, 200}, {600, 640}};
+    for (const auto& [c0, c1] : corridors) {
+      for (const int wall : {c0, c1}) {
+        wall_y(wall, 1, w - 2);
+        for (int x = 50; x < w - 50; x += 100) {  // a door per 5 m room, 0.9 m wide
+          for (int d = 0; d < 18; ++d) f.set_state({x + d, wall}, Occupancy::free);
+        }
+      }
+    }
+    for (const int y : {80, 280, 400, 520, 720}) wall_y(y, 1, w - 2);  // rooms 4 m deep
+    for (int x = 100; x < w - 1; x += 100) {                          // 5 m wide, between the corridors' walls
+      wall_x(x, 1, 159);
+      wall_x(x, 201, 599);
+      wall_x(x, 641, h - 2);
+    }
+    // Doors between the stacked rooms and the rooms on the corridors (else they are closed cells).
+    for (int x = 30; x < w - 50; x += 100) {
+      for (const int y : {80, 280, 520, 720}) {
+        for (int d = 0; d < 18; ++d) f.set_state({x + d, y}, Occupancy::free);
+      }
+      for (int d = 0; d < 18; ++d) f.set_state({x + d, 400}, Occupancy::free);
+    }
+    return f;
+  }();
+  return g;
+}
+
+// Rooms of the office floor. arg: RoomSegmentationMethod.
+void BM_RoomSegmentation(benchmark::State& state) {
+  RoomSegmentationOptions o;
+  o.method = static_cast<RoomSegmentationMethod>(state.range(0));
+  std::size_t rooms = 0, doors = 0;
+  for (auto _ : state) {
+    const RoomSegmentation r = segment_rooms(office_floor(), o);
+    rooms = r.rooms.sections.size();
+    doors = r.doors.size();
+    benchmark::DoNotOptimize(r.rooms.label.data());
+  }
+  state.SetLabel(std::string(to_string(o.method)));
+  state.counters["rooms"] = static_cast<double>(rooms);
+  state.counters["doors"] = static_cast<double>(doors);
+}
+BENCHMARK(BM_RoomSegmentation)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+
+// The whole floor planned: rooms (morphological) and the hybrid's path in every room, the
+// planner built on the floor. Issue 39's budget: 1 s.
+void BM_WholeFloorPlan(benchmark::State& state) {
+  double length_m = 0.0, reachable_m2 = 0.0;
+  std::size_t rooms = 0;
+  for (auto _ : state) {
+    const RoomSegmentation r = segment_rooms(office_floor());
+    CoveragePlanner cp(office_floor(), psr2_options());
+    length_m = 0.0;
+    reachable_m2 = 0.0;
+    for (const Section& s : r.rooms.sections) {
+      const CoverageResult c = cp.hybrid(s);
+      length_m += c.stats.length_m;
+      reachable_m2 += static_cast<double>(c.reachable_cells) * 0.05 * 0.05;
+    }
+    rooms = r.rooms.sections.size();
+  }
+  state.counters["rooms"] = static_cast<double>(rooms);
+  state.counters["length_m"] = length_m;
+  state.counters["reachable_m2"] = reachable_m2;
+  state.counters["length_per_bound"] = reachable_m2 > 0 ? length_m / (reachable_m2 / 0.64) : 0.0;
+}
+BENCHMARK(BM_WholeFloorPlan)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 }  // namespace
 
