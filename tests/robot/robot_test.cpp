@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "robot_doubles.hpp"
+#include "tripodal/behaviors/teleop.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
 #include "tripodal/robot/robot.hpp"
 
@@ -65,7 +66,7 @@ TEST_CASE("PSR-2 assembles from its profile with the paper's nets", "[robot]") {
   CHECK(p.robot->hardware() != nullptr);
   REQUIRE(p.robot->loop("motion") != nullptr);
   CHECK(&p.robot->behavior_loop() == p.robot->loop("motion"));
-  CHECK(p.robot->behavior_loop().coordinator().input_count() == 4);
+  CHECK(p.robot->behavior_loop().coordinator().input_count() == 5);  // the profile's 4 behaviors and "operator" (driving by hand)
   CHECK(p.robot->behavior_loop().controller() != nullptr);
   CHECK(p.robot->behavior_loop().period() == std::chrono::milliseconds(10));
   const auto& mods = p.robot->description().modules;
@@ -273,4 +274,34 @@ TEST_CASE("PSR-2 on its threads takes a command from another thread and stops cl
   CHECK_FALSE(robot->started());
   CHECK(accepted);
   CHECK(robot->planner().busy());
+}
+
+TEST_CASE("Driving by hand is an ordinary coordinator input: BhTeleop runs from the start on 'operator', its resource set from outside", "[robot][teleop]") {
+  Psr2 p;
+  ControlLoop& loop = p.robot->behavior_loop();
+  const CBehaviorCoordinator& co = loop.coordinator();
+  // Configured at assembly, above every normal input; nothing is added later.
+  const std::optional<InputId> op = co.find_input(kTeleopInput);
+  REQUIRE(op.has_value());
+  const std::size_t inputs = co.input_count();
+  auto* teleop = dynamic_cast<TeleopResource*>(loop.resources().find(kTeleopResource));
+  REQUIRE(teleop != nullptr);
+  REQUIRE(p.robot->command("clean the room 3211").accepted);
+  p.robot->run_for(std::chrono::seconds(2));
+  CHECK(loop.last_cycle().coordinator.winner != kTeleopInput);  // not engaged: gives nothing
+
+  teleop->set(true, Twist2D{0.0, 0.0, 0.4}, p.clock.now());
+  loop.set_lock(kTeleopInput, true, p.clock.now());
+  p.robot->run_for(std::chrono::milliseconds(100));
+  const CoordinatorOutput& out = loop.last_cycle().coordinator;
+  CHECK(out.winner == kTeleopInput);
+  CHECK(out.command == Twist2D{0.0, 0.0, 0.4});
+  CHECK(out.lock == kTeleopInput);
+  CHECK(co.input_count() == inputs);
+
+  teleop->set(false, Twist2D{}, p.clock.now());
+  loop.set_lock(kTeleopInput, false, p.clock.now());
+  p.robot->run_for(std::chrono::milliseconds(100));
+  CHECK(loop.last_cycle().coordinator.winner != kTeleopInput);
+  CHECK(p.robot->planner().busy());
 }
