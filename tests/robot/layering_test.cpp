@@ -4,10 +4,10 @@
 
 #include "robot_doubles.hpp"
 #include "tripodal/board/actuator_behaviors.hpp"
-#include "tripodal/board/board_hardware.hpp"
 #include "tripodal/board/board_monitor.hpp"
 #include "tripodal/robot/layering.hpp"
 #include "tripodal/robot/robot.hpp"
+#include "tripodal/sim/sim_board.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
 
 using namespace tripodal;
@@ -290,7 +290,7 @@ TEST_CASE("describe_text lists modules by layer, describe_dot draws clusters and
 
 TEST_CASE("describe shows command channels, who writes and who exports them; R6 refuses a channel the hardware lacks", "[robot][channels]") {
   RobotPlugins plugins = RobotPlugins::with_builtins();
-  board::register_board_hardware(plugins.hardware);
+  sim::register_sim_board_hardware(plugins.hardware, nullptr);  // the real board's channels, the world's laser
   board::register_board_modules(plugins.modules);
   board::register_board_behaviors(plugins.behaviors);
   RobotProfile p = load_robot_profile(std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/disinfection.yaml");

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "sim_test_util.hpp"
+#include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/sim/simulator.hpp"
@@ -249,8 +250,13 @@ TEST_CASE("Jinny's neck is driven through its command channel by the behavior lo
   SimClock clock;
   RobotPlugins plugins = RobotPlugins::with_builtins();
   register_sim_hardware(plugins.hardware, world);
+  register_gesture_behaviors(plugins.behaviors);
   RobotProfile profile = load_robot_profile(std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/jinny.yaml");
-  profile.hri.clear();  // the HRI module type belongs to the guide application
+  // Its hardware, base and behaviors; not the guide application's HRI, nor the tasks that ask it.
+  profile.hri.clear();
+  profile.tasks.clear();
+  profile.processes.clear();
+  profile.recovery.clear();
   std::unique_ptr<Robot> robot = Robot::assemble(profile, plugins, clock);
   auto& hw = dynamic_cast<SimHardware&>(*robot->hardware());
   REQUIRE(hw.command_channels().find("neck").has_value());
