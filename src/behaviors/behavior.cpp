@@ -26,8 +26,6 @@ void CBehavior::activate(const ParameterValues& params, const BehaviorContext& c
 }
 
 void CBehavior::activate(const ParameterSet& params, const BehaviorContext& context) {
-  // Running before on_activate() so that a hook reporting an immediate outcome (goal already
-  // reached, resource missing) is not overwritten.
   const std::vector<ChannelWrite>& writes = manifest().writes;
   if (writes.size() > kMaxBehaviorChannels) {
     throw ConfigError(SourceLocation{}, "behavior '" + std::string(name()) + "' declares " + std::to_string(writes.size()) +
@@ -38,6 +36,8 @@ void CBehavior::activate(const ParameterSet& params, const BehaviorContext& cont
                         : writes[i].parameter.empty()     ? writes[i].name
                                                           : params.string(writes[i].parameter);
   }
+  // Running before on_activate() so that a hook reporting an immediate outcome (goal already
+  // reached, resource missing) is not overwritten.
   status_ = BehaviorStatus::running;
   failure_reason_ = {};
   envelope_.reset();
