@@ -268,6 +268,19 @@ TEST_CASE("PSR-2 on its threads takes a command from another thread and stops cl
   bool accepted = false;
   std::thread operator_thread([&] { accepted = robot->command("clean the room 3211").accepted; });
   operator_thread.join();
+  // Driving by hand from another thread, as the monitor does: BhTeleop's input and the lock.
+  auto* teleop = dynamic_cast<TeleopResource*>(robot->behavior_loop().resources().find(kTeleopResource));
+  REQUIRE(teleop != nullptr);
+  std::thread console([&] {
+    robot->behavior_loop().set_lock(kTeleopInput, true, clock.now());
+    for (int i = 0; i < 20; ++i) {
+      teleop->set(true, Twist2D{0.0, 0.0, 0.2}, clock.now());
+      clock.sleep_until(clock.now() + std::chrono::milliseconds(5));
+    }
+    teleop->set(false, Twist2D{}, clock.now());
+    robot->behavior_loop().set_lock(kTeleopInput, false, clock.now());
+  });
+  console.join();
   clock.sleep_until(clock.now() + std::chrono::milliseconds(200));
   robot->stop();
   robot->stop();  // idempotent
