@@ -26,11 +26,22 @@ void CBehavior::activate(const ParameterValues& params, const BehaviorContext& c
 }
 
 void CBehavior::activate(const ParameterSet& params, const BehaviorContext& context) {
+  const std::vector<ChannelWrite>& writes = manifest().writes;
+  if (writes.size() > kMaxBehaviorChannels) {
+    throw ConfigError(SourceLocation{}, "behavior '" + std::string(name()) + "' declares " + std::to_string(writes.size()) +
+                                            " channel writes, at most " + std::to_string(kMaxBehaviorChannels));
+  }
+  for (std::size_t i = 0; i < kMaxBehaviorChannels; ++i) {
+    channel_names_[i] = i >= writes.size()                ? std::string()
+                        : writes[i].parameter.empty()     ? writes[i].name
+                                                          : params.string(writes[i].parameter);
+  }
   // Running before on_activate() so that a hook reporting an immediate outcome (goal already
   // reached, resource missing) is not overwritten.
   status_ = BehaviorStatus::running;
   failure_reason_ = {};
   envelope_.reset();
+  clear_writes();
   steps_ = 0;
   try {
     on_activate(params, context);
@@ -45,16 +56,19 @@ void CBehavior::deactivate() noexcept {
   status_ = BehaviorStatus::idle;
   failure_reason_ = {};
   envelope_.reset();
+  clear_writes();
 }
 
 std::optional<Twist2D> CBehavior::step(const BehaviorContext& context) noexcept {
   envelope_.reset();
+  clear_writes();
   if (status_ != BehaviorStatus::running) return std::nullopt;
   ++steps_;
   std::optional<Twist2D> command = on_step(context);
   // A behavior that finished in this step has nothing more to command.
   if (status_ != BehaviorStatus::running) {
     envelope_.reset();
+    clear_writes();
     return std::nullopt;
   }
   return command;

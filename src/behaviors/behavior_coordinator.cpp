@@ -14,6 +14,7 @@ std::string_view to_string(CoordinationMode mode) noexcept {
 }
 
 CBehaviorCoordinator::CBehaviorCoordinator(CoordinatorConfig config) : mode_(config.mode) {
+  for (auto& ch : config.channels) add_channel(std::move(ch));
   for (auto& in : config.inputs) add_input(std::move(in));
   for (auto& lock : config.locks) add_lock(std::move(lock));
 }
@@ -24,6 +25,7 @@ InputId CBehaviorCoordinator::add_input(CoordinatorInputConfig input) {
   if (input.timeout.count() < 0) throw std::invalid_argument("coordinator input '" + input.name + "': timeout must be >= 0");
   InputState s;
   s.config = std::move(input);
+  s.channels.resize(channels_.size());
   inputs_.push_back(std::move(s));
   return static_cast<InputId>(inputs_.size() - 1);
 }
@@ -35,6 +37,42 @@ LockId CBehaviorCoordinator::add_lock(CoordinatorLockConfig lock) {
   s.config = std::move(lock);
   locks_.push_back(std::move(s));
   return static_cast<LockId>(locks_.size() - 1);
+}
+
+ChannelId CBehaviorCoordinator::add_channel(ChannelSpec spec) {
+  if (spec.name.empty()) throw std::invalid_argument("a coordinator channel needs a name");
+  if (find_channel(spec.name)) throw std::invalid_argument("coordinator channel '" + spec.name + "' already exists");
+  ChannelState c;
+  c.output.value = spec.safe;
+  c.spec = std::move(spec);
+  channels_.push_back(std::move(c));
+  for (InputState& in : inputs_) in.channels.resize(channels_.size());
+  return static_cast<ChannelId>(channels_.size() - 1);
+}
+
+std::optional<ChannelId> CBehaviorCoordinator::find_channel(std::string_view name) const noexcept {
+  for (std::size_t i = 0; i < channels_.size(); ++i) {
+    if (channels_[i].spec.name == name) return static_cast<ChannelId>(i);
+  }
+  return std::nullopt;
+}
+
+void CBehaviorCoordinator::submit_channel(InputId id, ChannelId channel, const ChannelValue& value, Time stamp) noexcept {
+  if (id >= inputs_.size() || channel >= channels_.size()) return;
+  ChannelWriteState& w = inputs_[id].channels[channel];
+  w.has = true;
+  w.value = value;
+  w.stamp = stamp;
+}
+
+void CBehaviorCoordinator::withdraw_channel(InputId id, ChannelId channel) noexcept {
+  if (id >= inputs_.size() || channel >= channels_.size()) return;
+  inputs_[id].channels[channel].has = false;
+}
+
+void CBehaviorCoordinator::withdraw_channels(InputId id) noexcept {
+  if (id >= inputs_.size()) return;
+  for (ChannelWriteState& w : inputs_[id].channels) w.has = false;
 }
 
 std::optional<InputId> CBehaviorCoordinator::find_input(std::string_view name) const noexcept {
@@ -91,7 +129,9 @@ void CBehaviorCoordinator::reset() noexcept {
   for (auto& s : inputs_) {
     s.has_command = false;
     s.has_envelope = false;
+    for (ChannelWriteState& w : s.channels) w.has = false;
   }
+  for (ChannelState& c : channels_) c.output = ChannelOutput{c.spec.safe, {}, false, false};
   for (auto& s : locks_) {
     s.has_message = false;
     s.engaged = false;
@@ -221,7 +261,52 @@ const CoordinatorOutput& CBehaviorCoordinator::update(Time now) noexcept {
   }
   out.command = fused;
   output_ = out;
+  for (std::size_t c = 0; c < channels_.size(); ++c) fuse_channel(static_cast<ChannelId>(c), now, masking, mask_priority);
   return output_;
+}
+
+void CBehaviorCoordinator::fuse_channel(ChannelId id, Time now, bool masking, int mask_priority) noexcept {
+  ChannelState& ch = channels_[id];
+  const ChannelSpec& spec = ch.spec;
+  auto usable = [&](const InputState& s) noexcept {
+    const ChannelWriteState& w = s.channels[id];
+    if (!w.has || expired(now, w.stamp, s.config.timeout) || expired(now, w.stamp, spec.timeout)) return false;
+    return !(masking && s.config.priority <= mask_priority);
+  };
+  ChannelOutput out;
+  const bool weighted = mode_ == CoordinationMode::weighted_sum && is_numeric(spec.type);
+  const InputState* best = nullptr;
+  double total = 0.0, sum = 0.0;
+  for (const InputState& s : inputs_) {
+    if (s.config.role != InputRole::normal || !usable(s)) continue;
+    if (weighted) {
+      if (s.config.weight <= 0.0) continue;
+      total += s.config.weight;
+      sum += s.config.weight * s.channels[id].value.number;
+    } else if (best == nullptr || s.config.priority > best->config.priority) {
+      best = &s;  // strictly greater: ties go to the earlier input, as for motion
+    }
+  }
+  if (weighted && total > 0.0) {
+    out.value = ChannelValue::of(sum / total);
+    out.writer = "weighted_sum";
+    out.live = true;
+  } else if (!weighted && best != nullptr) {
+    out.value = best->channels[id].value;
+    out.writer = best->config.name;
+    out.live = true;
+  }
+  for (const InputState& s : inputs_) {
+    if (s.config.role != InputRole::safety || !usable(s)) continue;
+    out.safety_override = !out.live || !(out.value == s.channels[id].value);
+    out.value = s.channels[id].value;
+    out.writer = s.config.name;
+    out.live = true;
+    break;
+  }
+  if (!out.live) out.value = spec.hold ? ch.output.value : spec.safe;
+  if (is_numeric(spec.type) && spec.min < spec.max) out.value.number = std::clamp(out.value.number, spec.min, spec.max);
+  ch.output = out;
 }
 
 }  // namespace tripodal

@@ -23,7 +23,7 @@ const ModuleManifest& JointResource::static_manifest() {
     mm.name = "JointResource";
     mm.layer = Layer::reactive;
     mm.kind = ModuleKind::resource;
-    mm.description = "a neck or arm joint: position, speed, command and limits; takes a position command";
+    mm.description = "a neck or arm joint's state: position, speed, the command it follows, limits";
     mm.outputs = {"joint_state"};
     return mm;
   }();
@@ -121,12 +121,16 @@ std::optional<Twist2D> BhFaceVisitor::on_step(const BehaviorContext& context) no
 // --- BhNeckGesture ----------------------------------------------------------------------------
 
 const ModuleManifest& BhNeckGesture::static_manifest() {
-  static const ModuleManifest m = behavior_manifest(
-      "BhNeckGesture", "moves a neck or arm joint to a position (a gesture: look at the visitor, at an exhibit)", {"joint_state"},
-      {parameter::number("angle_deg", 0.0, "deg", "the joint's target position", -360.0, 360.0),
-       parameter::number("tolerance_deg", 1.0, "deg", "success within this of the target, the joint stopped", 1e-3, 45.0),
-       parameter::number("timeout_s", 10.0, "s", "fail when the joint has not arrived by then", 0.1),
-       parameter::text("joint", "neck", "the joint's resource name")});
+  static const ModuleManifest m = [] {
+    ModuleManifest r = behavior_manifest(
+        "BhNeckGesture", "moves a neck or arm joint to a position (a gesture: look at the visitor, at an exhibit)", {"joint_state"},
+        {parameter::number("angle_deg", 0.0, "deg", "the joint's target position", -360.0, 360.0),
+         parameter::number("tolerance_deg", 1.0, "deg", "success within this of the target, the joint stopped", 1e-3, 45.0),
+         parameter::number("timeout_s", 10.0, "s", "fail when the joint has not arrived by then", 0.1),
+         parameter::text("joint", "neck", "the joint: its state resource and its position channel")});
+    r.writes.push_back(ChannelWrite{{}, "joint", ChannelType::joint_position, "the target position while active"});
+    return r;
+  }();
   return m;
 }
 
@@ -136,15 +140,14 @@ void BhNeckGesture::on_activate(const ParameterSet& params, const BehaviorContex
   timeout_ = from_seconds(params.number("timeout_s"));
   started_ = context.now;
   commanded_ = false;
-  joint_ = context.resources != nullptr ? dynamic_cast<JointResource*>(context.resources->find(params.string("joint"))) : nullptr;
+  joint_ = context.resources != nullptr ? context.resources->find<JointReading>(params.string("joint")) : nullptr;
   if (joint_ == nullptr) fail("no joint");
 }
 
 std::optional<Twist2D> BhNeckGesture::on_step(const BehaviorContext& context) noexcept {
+  write_channel(0, ChannelValue::of(target_rad_));  // the joint's channel holds it after the gesture
   if (!commanded_) {
-    // Commanded from the loop's thread, where the joint's driver takes it.
-    joint_->command(target_rad_);
-    commanded_ = true;
+    commanded_ = true;  // the state tells of the command from the next period on
     return std::nullopt;
   }
   const JointReading& j = joint_->latest();

@@ -2,6 +2,8 @@
 
 #include "tripodal/board/tcp_stream.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <typeinfo>
@@ -49,11 +51,32 @@ const ModuleManifest& BoardHardware::static_manifest() {
        ParameterSpec{"lidar_timeout_s", ValueType::number, Value{1.0}, "s", "no lidar revolution for this long is the laser's fault",
                      0.05, 60.0},
        ParameterSpec{"lidar_beams", ValueType::number, Value{360.0}, "", "bins of the laser scan over a full turn", 8.0, 8192.0}});
-  return m;
+  static const ModuleManifest with_channels = [] {
+    ModuleManifest r = m;
+    // In this order: BoardHardware::apply_channels() goes by index (kUvLamp ...).
+    r.command_channels = {
+        ChannelSpec{"uv_lamp", ChannelType::digital, ChannelValue::of(false), false, Duration{0}, 0.0, 0.0, "", "the UV lamp (command 0x31)"},
+        ChannelSpec{"atomizer", ChannelType::analog, ChannelValue::of(0.0), false, Duration{0}, 0.0, 1.0, "",
+                    "the atomizer's dry fog, on above 0 (command 0x30)"},
+        ChannelSpec{"atomizer_fan", ChannelType::digital, ChannelValue::of(false), false, Duration{0}, 0.0, 0.0, "",
+                    "the fan that carries the fog, with the atomizer only (command 0x30)"},
+        ChannelSpec{"voice", ChannelType::track, ChannelValue::of(0.0), false, Duration{0}, 0.0, 255.0, "",
+                    "the WT2003S track to play, played when it changes to a track > 0 (command 0x32)"},
+        ChannelSpec{"lcd", ChannelType::text, ChannelValue::of_text(""), false, Duration{0}, 0.0, 0.0, "",
+                    "the LCD's first line, sent when it changes (command 0x33)"}};
+    return r;
+  }();
+  return with_channels;
 }
 
+namespace {
+enum ChannelIndex : std::size_t { kUvLamp, kAtomizer, kAtomizerFan, kVoice, kLcd };
+}  // namespace
+
 BoardHardware::BoardHardware(ByteStream& stream, const BoardHardwareConfig& config, std::unique_ptr<ByteStream> owned)
-    : owned_(std::move(owned)), config_(config), link_(stream, config.link), link_resource_(std::make_unique<LinkResource>(*this)) {}
+    : owned_(std::move(owned)), config_(config), link_(stream, config.link), link_resource_(std::make_unique<LinkResource>(*this)) {
+  for (const ChannelSpec& c : static_manifest().command_channels) applied_.at(export_channel(c)) = c.safe;
+}
 
 BoardHardware::~BoardHardware() = default;
 
@@ -77,7 +100,38 @@ bool BoardHardware::read_wheel_states(std::span<double> velocity_rad_s, std::spa
   return true;
 }
 
+void BoardHardware::apply_channels() noexcept {
+  const CommandChannels& ch = command_channels();
+  auto changed = [&](std::size_t i) noexcept { return !(ch.value(i) == applied_[i]); };
+  if (changed(kUvLamp)) {
+    const bool on = ch.value(kUvLamp).on();
+    if (link_.queue(Command::uv_lamp, std::array<std::uint8_t, 1>{static_cast<std::uint8_t>(on ? 1 : 0)})) applied_[kUvLamp] = ch.value(kUvLamp);
+  }
+  if (changed(kAtomizer) || changed(kAtomizerFan)) {
+    const bool fog = ch.value(kAtomizer).number > 0.0;
+    const bool fan = fog && ch.value(kAtomizerFan).on();
+    if (link_.queue(Command::atomizer, std::array<std::uint8_t, 2>{static_cast<std::uint8_t>(fog ? 1 : 0), static_cast<std::uint8_t>(fan ? 1 : 0)})) {
+      applied_[kAtomizer] = ch.value(kAtomizer);
+      applied_[kAtomizerFan] = ch.value(kAtomizerFan);
+    }
+  }
+  if (changed(kVoice)) {
+    const double track = ch.value(kVoice).number;
+    // A track plays once, when the channel changes to it; back to 0 plays nothing.
+    if (track < 1.0 || link_.queue(Command::voice, std::array<std::uint8_t, 1>{static_cast<std::uint8_t>(track)})) {
+      applied_[kVoice] = ch.value(kVoice);
+    }
+  }
+  if (changed(kLcd)) {
+    const std::string_view text = ch.value(kLcd).text();
+    std::array<std::uint8_t, 1 + kChannelTextCapacity> payload{};  // line 0, then the text
+    std::copy(text.begin(), text.end(), payload.begin() + 1);
+    if (link_.queue(Command::lcd_text, std::span<const std::uint8_t>(payload.data(), 1 + text.size()))) applied_[kLcd] = ch.value(kLcd);
+  }
+}
+
 void BoardHardware::cycle(Time now) noexcept {
+  apply_channels();
   link_.cycle(now, speeds_);
   publish(now);
 }

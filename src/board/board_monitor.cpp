@@ -1,10 +1,6 @@
 #include "tripodal/board/board_monitor.hpp"
 
-#include "tripodal/board/actuator_behaviors.hpp"
-
 #include <fmt/format.h>
-
-#include <array>
 
 #include <stdexcept>
 #include <string>
@@ -34,27 +30,6 @@ void BoardMonitor::on_start(ModuleContext& context) {
 }
 
 void BoardMonitor::on_configure(const ParameterSet& params) { battery_low_percent_ = params.number("battery_low_percent"); }
-
-void BoardMonitor::on_behavior_activated(const BehaviorActivation& activation, ModuleContext& /*context*/) {
-  if (host_ == nullptr) return;
-  BoardHardware& board = host_->board();
-  if (activation.behavior == BhUvLamp::static_manifest().name) {
-    board.command(Command::uv_lamp, std::array<std::uint8_t, 1>{1});
-  } else if (activation.behavior == BhAtomize::static_manifest().name) {
-    const bool fan = activation.resolved().boolean("fan");
-    board.command(Command::atomizer, std::array<std::uint8_t, 2>{1, static_cast<std::uint8_t>(fan ? 1 : 0)});
-  } else if (activation.behavior == BhVoicePrompt::static_manifest().name) {
-    const auto track = static_cast<std::uint8_t>(activation.resolved().number("track"));
-    board.command(Command::voice, std::array<std::uint8_t, 1>{track});
-  }
-}
-
-void BoardMonitor::on_behavior_deactivated(std::string_view behavior, ModuleContext& /*context*/) {
-  if (host_ == nullptr) return;
-  BoardHardware& board = host_->board();
-  if (behavior == BhUvLamp::static_manifest().name) board.command(Command::uv_lamp, std::array<std::uint8_t, 1>{0});
-  if (behavior == BhAtomize::static_manifest().name) board.command(Command::atomizer, std::array<std::uint8_t, 2>{0, 0});
-}
 
 void BoardMonitor::on_update(ModuleContext& context) {
   if (host_ == nullptr) return;

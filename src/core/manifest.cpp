@@ -137,6 +137,18 @@ ManifestBuilder& ManifestBuilder::outputs(std::vector<std::string> information) 
   for (auto& o : information) manifest_.outputs.push_back(std::move(o));
   return *this;
 }
+ManifestBuilder& ManifestBuilder::writes(std::string channel, ChannelType type, std::string description) {
+  manifest_.writes.push_back(ChannelWrite{std::move(channel), {}, type, std::move(description)});
+  return *this;
+}
+ManifestBuilder& ManifestBuilder::writes_named_by(std::string parameter, ChannelType type, std::string description) {
+  manifest_.writes.push_back(ChannelWrite{{}, std::move(parameter), type, std::move(description)});
+  return *this;
+}
+ManifestBuilder& ManifestBuilder::command_channel(ChannelSpec spec) {
+  manifest_.command_channels.push_back(std::move(spec));
+  return *this;
+}
 ManifestBuilder& ManifestBuilder::parameter(ParameterSpec spec) {
   manifest_.parameters.push_back(std::move(spec));
   return *this;

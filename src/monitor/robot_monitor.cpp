@@ -16,6 +16,7 @@
 #include <spdlog/spdlog.h>
 
 #include "tripodal/behaviors/behavior_registry.hpp"
+#include "tripodal/behaviors/teleop.hpp"
 #include "tripodal/board/board_hardware.hpp"
 #include "tripodal/core/net_loader.hpp"
 #include "tripodal/navi/grid_maps.hpp"
@@ -54,35 +55,7 @@ std::string base64_bytes(const std::vector<std::uint8_t>& v) {
   return base64(std::string_view(reinterpret_cast<const char*>(v.data()), v.size()));
 }
 
-// The operator's hand on the robot: the velocity the console sends, submitted through the behavior
-// loop's coordinator on an input of its own ("operator") while a lock of the same name masks the
-// task's behaviors (never the safety inputs above them). Written by the monitor, read by the loop
-// (which may run on its own thread), hence atomics.
-struct DriveCommand {
-  std::atomic<double> vx_m_s{0.0}, vy_m_s{0.0}, wz_rad_s{0.0};
-};
 
-class BhOperatorDrive final : public CBehavior {
- public:
-  explicit BhOperatorDrive(std::shared_ptr<const DriveCommand> command) : command_(std::move(command)) {}
-  static const ModuleManifest& static_manifest() {
-    static const ModuleManifest m =
-        behavior_manifest("BhOperatorDrive", "the velocity the operator gives on the monitor's console (body frame)", {}, {});
-    return m;
-  }
-
- protected:
-  const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
-  void on_activate(const ParameterSet&, const BehaviorContext&) override {}
-  std::optional<Twist2D> on_step(const BehaviorContext&) noexcept override {
-    return Twist2D{command_->vx_m_s.load(), command_->vy_m_s.load(), command_->wz_rad_s.load()};
-  }
-
- private:
-  std::shared_ptr<const DriveCommand> command_;
-};
-
-constexpr std::string_view kOperator = "operator";
 
 // The control board's link as the host sees it (hardware type "board", real or simulated): the
 // panel of the page. Everything here is what the board reported over the line or the host counted.
@@ -180,7 +153,9 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
     std::chrono::steady_clock::time_point deadline{};
   };
   std::optional<PendingReload> pending_reload;
-  std::shared_ptr<DriveCommand> drive = std::make_shared<DriveCommand>();
+  // The operator's hand on the robot: the input of the behavior BhTeleop the robot runs on the
+  // coordinator input "operator" (behaviors/teleop.hpp); nullptr for a robot without a loop.
+  TeleopResource* teleop = nullptr;
   bool driving = false;
   std::chrono::steady_clock::time_point last_drive{};
   // The robot's HRI, found once: the modules do not change after assembly.
@@ -212,7 +187,7 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
     ch_status = server.advertise("/status", "tripodal.Status",
                                  R"({"type":"object","properties":{"time_s":{"type":"number"},"paused":{"type":"boolean"},"task_state":{"type":"string"},"velocity":{"type":"object"},"battery":{"type":["number","null"]},"coverage":{"type":["number","null"]},"behaviors":{"type":"array"},"winner":{"type":"string"},"board":{"type":"object","description":"the control board's link as the host sees it; only on hardware board"},"hri":{"type":["object","null"],"description":"what the robot's HRI displays: task, task_state, process, fault, status, and the last input with its answer (last); null without an HRI"}}})",
                                  Delivery::bulk);
-    add_operator_input();
+    teleop = dynamic_cast<TeleopResource*>(robot.behavior_loop().resources().find(kTeleopResource));
     paused = options.start_paused;
     if (paused) pause_reason = "started paused";
     robot.planner().add_observer(*this);
@@ -233,38 +208,20 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
 
   double now_s() const { return to_seconds(clock.now()); }
 
-  // The operator's input ranks just above every normal input of the behavior loop, and its lock
-  // masks exactly those: the task's behaviors stop while the operator drives, safety stays.
-  void add_operator_input() {
-    CBehaviorCoordinator& c = robot.behavior_loop().coordinator();
-    if (c.find_input(kOperator)) return;
-    int top = 0;
-    for (std::size_t i = 0; i < c.input_count(); ++i) {
-      const CoordinatorInputConfig& in = c.input_config(static_cast<InputId>(i));
-      if (in.role == InputRole::normal) top = std::max(top, in.priority);
-    }
-    c.add_input(CoordinatorInputConfig{.name = std::string(kOperator), .priority = top + 1, .timeout = std::chrono::milliseconds(200), .weight = 1.0});
-    c.add_lock(CoordinatorLockConfig{.name = std::string(kOperator), .priority = top});
-  }
-
   void stop_driving(std::string_view why) {
     if (!driving) return;
     driving = false;
-    ControlLoop& loop = robot.behavior_loop();
-    loop.deactivate(kOperator);
-    loop.set_lock(kOperator, false, clock.now());
+    teleop->set(false, Twist2D{}, clock.now());
+    robot.behavior_loop().set_lock(kTeleopInput, false, clock.now());
     note("operator: manual drive ended (" + std::string(why) + ")");
   }
 
   void drive_with(double vx, double vy, double wz) {
-    drive->vx_m_s = vx;
-    drive->vy_m_s = vy;
-    drive->wz_rad_s = wz;
+    if (teleop == nullptr) throw std::runtime_error("this robot has no behavior loop to drive by hand");
+    teleop->set(true, Twist2D{vx, vy, wz}, clock.now());
     last_drive = std::chrono::steady_clock::now();
     if (driving) return;
-    ControlLoop& loop = robot.behavior_loop();
-    loop.activate(std::make_unique<BhOperatorDrive>(drive), {}, kOperator);
-    loop.set_lock(kOperator, true, clock.now());
+    robot.behavior_loop().set_lock(kTeleopInput, true, clock.now());
     driving = true;
     note("operator: manual drive (the task's motion masked)");
   }

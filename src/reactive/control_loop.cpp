@@ -62,6 +62,7 @@ BehaviorHandle ControlLoop::activate(std::unique_ptr<CBehavior> behavior, const 
   context.navi = &navi_shared_;
   context.base = base_;
   behavior->activate(params, context, where);
+  const ChannelBinding channels = bind_channels(*behavior, where);
 
   // One behavior per input: the previous one on this input leaves in the same batch.
   for (std::uint32_t s = 0; s < slot_used_.size(); ++s) {
@@ -77,8 +78,50 @@ BehaviorHandle ControlLoop::activate(std::unique_ptr<CBehavior> behavior, const 
   slot_used_[slot] = 1;
   slot_input_[slot] = *id;
   slot_status_[slot] = behavior->status();
-  pending_activations_.push_back({std::move(behavior), *id, slot, generation});
+  pending_activations_.push_back({std::move(behavior), *id, slot, generation, channels});
   return {slot, generation};
+}
+
+ControlLoop::ChannelBinding ControlLoop::bind_channels(const CBehavior& behavior, const SourceLocation& where) const {
+  ChannelBinding b;
+  const std::vector<ChannelWrite>& writes = behavior.manifest().writes;
+  for (std::size_t i = 0; i < writes.size() && i < kMaxBehaviorChannels; ++i) {
+    const std::string_view name = behavior.channel_name(i);
+    const std::optional<ChannelId> id = coordinator_.find_channel(name);
+    if (!id) {
+      throw ConfigError(where, "behavior " + std::string(behavior.name()) + " writes the command channel '" + std::string(name) +
+                                   "', which the hardware does not export (" + exported_channels() + ")");
+    }
+    if (coordinator_.channel_spec(*id).type != writes[i].type) {
+      throw ConfigError(where, "behavior " + std::string(behavior.name()) + " writes the command channel '" + std::string(name) +
+                                   "' as " + std::string(to_string(writes[i].type)) + ", and the hardware exports it as " +
+                                   std::string(to_string(coordinator_.channel_spec(*id).type)));
+    }
+    b.ids[i] = *id;
+    ++b.count;
+  }
+  return b;
+}
+
+std::string ControlLoop::exported_channels() const {
+  if (coordinator_.channel_count() == 0) return "it exports none";
+  std::string out = "it exports";
+  for (ChannelId c = 0; c < coordinator_.channel_count(); ++c) {
+    out += (c == 0 ? " " : ", ") + coordinator_.channel_spec(c).name + " (" + std::string(to_string(coordinator_.channel_spec(c).type)) + ")";
+  }
+  return out;
+}
+
+void ControlLoop::set_command_output(CommandChannels* channels) {
+  if (channels != nullptr) {
+    bool same = channels->size() == coordinator_.channel_count();
+    for (ChannelId c = 0; same && c < coordinator_.channel_count(); ++c) same = channels->spec(c).name == coordinator_.channel_spec(c).name;
+    if (!same) {
+      throw std::invalid_argument("control loop '" + options_.name +
+                                  "': the command output's channels are not the coordinator's, in its order");
+    }
+  }
+  channels_out_ = channels;
 }
 
 bool ControlLoop::deactivate(BehaviorHandle handle) {
@@ -167,6 +210,7 @@ std::optional<BehaviorStatus> ControlLoop::status(BehaviorHandle handle) const {
 
 void ControlLoop::retire(Slot& slot) noexcept {
   coordinator_.withdraw(slot.input);
+  coordinator_.withdraw_channels(slot.input);
   if (slot.behavior) {
     slot.behavior->deactivate();
     // Handed to the supervisor's side for destruction; if that buffer is full (the supervisor
@@ -207,6 +251,7 @@ void ControlLoop::apply_pending() noexcept {
     if (slot.active) retire(slot);
     slot.behavior = std::move(a.behavior);
     slot.input = a.input;
+    slot.channels = a.channels;
     slot.generation = a.generation;
     slot.active = true;
     slot.last_status = BehaviorStatus::running;
@@ -272,6 +317,13 @@ const CycleReport& ControlLoop::step(Time now) noexcept {
     } else {
       coordinator_.withdraw(slot.input);
     }
+    for (std::uint8_t i = 0; i < slot.channels.count; ++i) {
+      if (const std::optional<ChannelValue>& w = b.channel_write(i)) {
+        coordinator_.submit_channel(slot.input, slot.channels.ids[i], *w, now);
+      } else {
+        coordinator_.withdraw_channel(slot.input, slot.channels.ids[i]);
+      }
+    }
     const BehaviorStatus status = b.status();
     if (status != slot.last_status) {
       if (status == BehaviorStatus::succeeded || status == BehaviorStatus::failed) {
@@ -293,6 +345,9 @@ const CycleReport& ControlLoop::step(Time now) noexcept {
   report_.now = now;
   report_.active_behaviors = active;
   report_.coordinator = coordinator_.update(now);
+  if (channels_out_ != nullptr) {
+    for (ChannelId c = 0; c < coordinator_.channel_count(); ++c) channels_out_->set(c, coordinator_.channel_output(c).value);
+  }
   if (controller_) {
     controller_->set_command(report_.coordinator.command, now);
     report_.controller_status = controller_->update(now);

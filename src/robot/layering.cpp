@@ -127,6 +127,44 @@ void check_layering(const std::vector<DescribedModule>& modules, Diagnostics& d)
   }
 }
 
+namespace {
+
+// R6: the channels behaviors write by name against those the hardware's type exports. A hardware
+// that exports channels of its world too (the simulator's joints) is checked at assembly.
+void check_channels(const std::vector<DescribedModule>& modules, Diagnostics& d) {
+  const auto hw = std::find_if(modules.begin(), modules.end(), [](const DescribedModule& m) { return m.hardware; });
+  if (hw == modules.end()) return;
+  std::string exported;
+  for (const ChannelSpec& c : hw->channels) exported += (exported.empty() ? "" : ", ") + c.name + " (" + std::string(to_string(c.type)) + ")";
+  for (const DescribedModule& m : modules) {
+    for (const ChannelWrite& w : m.writes) {
+      if (w.name.empty()) continue;
+      const auto c = std::find_if(hw->channels.begin(), hw->channels.end(), [&](const ChannelSpec& s) { return s.name == w.name; });
+      if (c == hw->channels.end()) {
+        d.error(m.where, "behavior '" + m.name + "' writes the command channel '" + w.name + "' (" + std::string(to_string(w.type)) +
+                             "), which hardware '" + hw->type + "' does not export; it exports " +
+                             (exported.empty() ? std::string("none") : exported) + " (rule R6)");
+      } else if (c->type != w.type) {
+        d.error(m.where, "behavior '" + m.name + "' writes the command channel '" + w.name + "' as " + std::string(to_string(w.type)) +
+                             ", and hardware '" + hw->type + "' exports it as " + std::string(to_string(c->type)) + " (rule R6)");
+      }
+    }
+  }
+}
+
+// "uv_lamp (digital) <- BhUvLamp": a channel with the behaviors that write it.
+std::string channel_phrase(const ChannelSpec& c, const std::vector<DescribedModule>& modules) {
+  std::vector<std::string> writers;
+  for (const DescribedModule& m : modules) {
+    for (const ChannelWrite& w : m.writes) {
+      if (w.name == c.name || (w.name.empty() && w.type == c.type)) writers.push_back(m.name);
+    }
+  }
+  return c.name + " (" + std::string(to_string(c.type)) + ")" + (writers.empty() ? std::string() : " <- " + join(writers));
+}
+
+}  // namespace
+
 std::vector<std::string> knowledge_inputs(const TaskLibrary& tasks) {
   std::set<std::string> out;
   std::function<void(const std::vector<TemplateNode>&)> walk = [&](const std::vector<TemplateNode>& nodes) {
@@ -151,13 +189,13 @@ RobotDescription describe_robot(const RobotProfile& profile, const RobotPlugins&
   pin.push_back("process_result");
   out.modules.push_back(DescribedModule{CoreNames::kPlanner, "CPlanner", ModuleKind::planner, Layer::deliberate, true,
                                         "turns task commands into plans of process modules; recovers from faults",
-                                        pin, {"process_plan"}, profile.where});
+                                        pin, {"process_plan"}, profile.where, {}, {}, false});
   out.modules.push_back(DescribedModule{CoreNames::kSupervisor, "CProcessSupervisor", ModuleKind::other, Layer::sequencing, true,
                                         "runs the processes' nets, activates behaviors, posts faults",
-                                        {"process_plan"}, {"process_result"}, profile.where});
+                                        {"process_plan"}, {"process_result"}, profile.where, {}, {}, false});
   out.modules.push_back(DescribedModule{CoreNames::kCoordinator, "CBehaviorCoordinator", ModuleKind::other, Layer::reactive,
-                                        true, "fuses the commands of the active behaviors", {"behavior_command*"},
-                                        {"cmd_vel"}, profile.where});
+                                        true, "fuses the commands and the command channels of the active behaviors", {"behavior_command*"},
+                                        {"cmd_vel"}, profile.where, {}, {}, false});
   std::vector<const ModuleEntry*> entries;
   if (profile.hardware) entries.push_back(&*profile.hardware);
   for (const ModuleEntry* e : profile.all_modules()) entries.push_back(e);
@@ -176,6 +214,7 @@ RobotDescription describe_robot(const RobotProfile& profile, const RobotPlugins&
     dm.where = e->where;
     dm.description = e->description;
     dm.from = e->from;
+    dm.hardware = is_hardware;
     if (m != nullptr) {
       dm.layer = m->layer;
       if (e->layer || e->inputs || e->outputs) {
@@ -191,6 +230,8 @@ RobotDescription describe_robot(const RobotProfile& profile, const RobotPlugins&
       }
       dm.inputs = m->inputs;
       dm.outputs = m->outputs;
+      dm.writes = m->writes;
+      dm.channels = m->command_channels;
       if (dm.description.empty()) dm.description = m->description;
     } else if (e->layer) {
       dm.layer = *e->layer;  // declared in the profile: a module designed before it is implemented
@@ -219,6 +260,7 @@ RobotDescription describe_robot(const RobotProfile& profile, const RobotPlugins&
   }
   for (const ProcessEntry& p : profile.processes) out.processes.push_back(p.name);
   check_layering(out.modules, d);
+  check_channels(out.modules, d);
   return out;
 }
 
@@ -238,6 +280,12 @@ std::string describe_text(const RobotDescription& r) {
       }
       o << "      in:  " << (m.inputs.empty() ? "-" : join(m.inputs)) << '\n';
       o << "      out: " << (m.outputs.empty() ? "-" : join(m.outputs)) << '\n';
+      if (!m.writes.empty()) {
+        std::vector<std::string> w;
+        for (const ChannelWrite& c : m.writes) w.push_back(c.label() + " (" + std::string(to_string(c.type)) + ")");
+        o << "      writes: " << join(w) << '\n';
+      }
+      for (const ChannelSpec& c : m.channels) o << "      channel: " << channel_phrase(c, r.modules) << '\n';
     }
     if (layer == Layer::sequencing) {
       o << "  configurations (core): " << (r.processes.empty() ? "-" : join(r.processes)) << '\n';
@@ -300,6 +348,23 @@ std::string describe_dot(const RobotDescription& r) {
   for (const auto& [pc, infos] : edges) {
     o << "  " << dot_id(pc.first) << " -> " << dot_id(pc.second) << " [label=" << dot_id(join(infos, ", "))
       << (rank[pc.first] > rank[pc.second] ? ", constraint=false" : "") << "];\n";
+  }
+  // Command channels: behavior -> coordinator -> hardware, bold.
+  std::vector<std::string> fused;
+  for (const DescribedModule& m : r.modules) {
+    if (m.writes.empty()) continue;
+    std::vector<std::string> labels;
+    for (const ChannelWrite& w : m.writes) labels.push_back(w.label());
+    fused.insert(fused.end(), labels.begin(), labels.end());
+    o << "  " << dot_id(m.name) << " -> " << dot_id(CoreNames::kCoordinator) << " [label=" << dot_id(join(labels))
+      << ", style=bold, color=\"#8a4b08\", constraint=false];\n";
+  }
+  for (const DescribedModule& m : r.modules) {
+    if (!m.hardware || m.channels.empty() || fused.empty()) continue;
+    std::vector<std::string> names;
+    for (const ChannelSpec& c : m.channels) names.push_back(c.name);
+    o << "  " << dot_id(CoreNames::kCoordinator) << " -> " << dot_id(m.name) << " [label=" << dot_id(join(names))
+      << ", style=bold, color=\"#8a4b08\"];\n";
   }
   o << "  " << dot_id(CoreNames::kSupervisor) << " -> \"configurations\" [style=dashed, arrowhead=none, label=\"runs\"];\n";
   for (const DescribedModule& m : r.modules) {

@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "tripodal/behaviors/navigation_behaviors.hpp"
+#include "tripodal/behaviors/teleop.hpp"
 #include "tripodal/core/net_loader.hpp"
 #include "tripodal/navi/navi_modules.hpp"
 #include "tripodal/reactive/reactive_config.hpp"
@@ -227,6 +228,31 @@ RobotDescription check_robot(const RobotProfile& profile, const RobotPlugins& pl
   return check_profile(profile, plugins, nullptr, DeclaredTypes::may_be_designs, d).description;
 }
 
+namespace {
+
+// What the layering check (rule R6) cannot see from the hardware type's manifest: a channel named by
+// a behavior's parameter needs the hardware instance to export channels of its type (the
+// simulator's joints come from its world). Named channels R6 has checked.
+void check_channel_writes(const RobotProfile& profile, const RobotPlugins& plugins, CHardware* hardware, Diagnostics& d) {
+  const CommandChannels* exported = hardware != nullptr ? &hardware->command_channels() : nullptr;
+  for (const ModuleEntry& b : profile.behaviors) {
+    if (!plugins.behaviors.contains(b.type)) continue;
+    for (const ChannelWrite& w : plugins.behaviors.manifest(b.type).writes) {
+      if (!w.name.empty()) continue;
+      bool any = false;
+      for (std::size_t i = 0; exported != nullptr && i < exported->size(); ++i) any = any || exported->spec(i).type == w.type;
+      if (!any) {
+        d.error(b.where, "behavior '" + b.name + "' writes " + std::string(to_string(w.type)) + " channels (the one its parameter '" +
+                             w.parameter + "' names), and " +
+                             (hardware != nullptr ? "hardware '" + std::string(hardware->manifest().name) + "'" : std::string("the robot (no hardware)")) +
+                             " exports none of that type");
+      }
+    }
+  }
+}
+
+}  // namespace
+
 struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
   Clock& clock;
   const RobotPlugins& plugins;
@@ -245,6 +271,7 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
   // The resources that detect faults of their own (ResourceFaultSource), by instance name.
   std::vector<std::pair<std::string, ResourceFaultSource*>> fault_sources;
   OdometryResource odometry{"odometry"};
+  TeleopResource teleop;  // what an operator console drives by hand
   ResourceTable resources;
   std::vector<std::unique_ptr<ControlLoop>> loops;
   std::map<std::string, std::string, std::less<>> behavior_types;  // profile name -> type
@@ -466,6 +493,7 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
   // The reactive loops. The first runs the behaviors; its coordinator's inputs are the profile's
   // behaviors in order (earlier ones win ties by priority).
   m->resources.add(m->odometry);
+  m->resources.add(m->teleop);
   bool first = true;
   std::size_t controller_index = 0;
   for (const LoopEntry& l : profile.loops) {
@@ -476,11 +504,21 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
         controller = plugins.controllers.create(m->controller_configs.at(controller_index++), m->hardware->wheels());
       }
       CoordinatorConfig cc;
+      if (first && m->hardware) {
+        // The hardware's command channels, fused by this coordinator and written back each cycle.
+        const auto specs = m->hardware->command_channels().specs();
+        cc.channels.assign(specs.begin(), specs.end());
+      }
       if (first) {
         int priority = static_cast<int>(profile.behaviors.size());
         // Safety inputs rank above every other input (the monitor's operator too), so no lock
         // below the emergency stop masks them.
         const int safety_priority = priority + 1000;
+        // Driving by hand (BhTeleop, set by an operator console) ranks just above every other
+        // normal input, and its lock masks exactly those: the task stops, safety stays.
+        const int top = priority;
+        cc.inputs.push_back(CoordinatorInputConfig{.name = std::string(kTeleopInput), .priority = top + 1, .timeout = std::chrono::milliseconds(200)});
+        cc.locks.push_back(CoordinatorLockConfig{.name = std::string(kTeleopInput), .priority = top});
         for (const ModuleEntry& b : profile.behaviors) {
           if (b.safety) {
             cc.inputs.push_back(CoordinatorInputConfig{.name = b.name, .priority = safety_priority, .role = InputRole::safety});
@@ -495,6 +533,7 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
       lo.max_path_points = CPathFollowingBehavior::kMaxPathPoints;
       auto loop = std::make_unique<ControlLoop>(lo, m->resources, CBehaviorCoordinator(cc), std::move(controller));
       if (first && loop->controller() != nullptr) loop->set_odometry_output(&m->odometry);
+      if (first && m->hardware) loop->set_command_output(&m->hardware->command_channels());
       m->loops.push_back(std::move(loop));
       first = false;
     });
@@ -502,6 +541,8 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
   if (m->loops.empty() && !profile.behaviors.empty()) {
     d.error(profile.where, "the robot lists behaviors but no loop to run them: add loops: [{name, period_s, controller}]");
   }
+  check_channel_writes(profile, plugins, m->hardware.get(), d);
+  if (!m->loops.empty()) collect([&] { m->loops.front()->activate(std::make_unique<BhTeleop>(), {}, kTeleopInput); });
   // The safety behaviors run from the start, with the parameters the profile gives them.
   for (const ModuleEntry& b : profile.behaviors) {
     if (!b.safety || m->loops.empty() || !plugins.behaviors.contains(b.type)) continue;

@@ -73,9 +73,11 @@ const ModuleManifest& SimBoardHardware::static_manifest() {
         ParameterSpec{"uv_power_w", ValueType::number, Value{lamp.uvc_power_w}, "W", "the lamp's UVC output", 0.0, 1000.0, true},
         ParameterSpec{"uv_height_m", ValueType::number, Value{lamp.height_m}, "m", "the lamp above the floor", 0.0, 1.0, true},
         ParameterSpec{"uv_radius_m", ValueType::number, Value{lamp.radius_m}, "m", "the lit disc's radius on the floor", 0.0, 5.0, true}});
-    return hardware_manifest("board", "the control board simulated in process in the embedded simulator's world, "
-                                      "every exchange over the line byte for byte (docs/board-protocol.md)",
-                             std::move(outputs), std::move(parameters));
+    ModuleManifest r = hardware_manifest("board", "the control board simulated in process in the embedded simulator's world, "
+                                                  "every exchange over the line byte for byte (docs/board-protocol.md)",
+                                         std::move(outputs), std::move(parameters));
+    r.command_channels = real.command_channels;  // the embedded host side's
+    return r;
   }();
   return m;
 }

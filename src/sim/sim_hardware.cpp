@@ -52,8 +52,14 @@ SimHardware::SimHardware(World world, const HardwareConfig& config)
 }
 
 void SimHardware::make_joints() {
-  for (const JointConfig& j : sim_.world().robot.joints) {
+  for (std::size_t i = 0; i < sim_.world().robot.joints.size(); ++i) {
+    const JointConfig& j = sim_.world().robot.joints[i];
     joints_.push_back(std::make_unique<JointResource>(j.name, 3 * from_seconds(1.0 / j.rate_hz)));
+    // Its position command: held where it was last sent (a servo stays), from where it starts.
+    const ChannelValue start = ChannelValue::of(sim_.joints()[i].target_rad);
+    export_channel(ChannelSpec{j.name, ChannelType::joint_position, start, true, Duration{0}, j.min_rad, j.max_rad, "rad",
+                               "the position joint " + j.name + " goes to"});
+    joint_applied_.push_back(start);
   }
   on_advance_to(sim_.now());  // a first state at the start
 }
@@ -64,8 +70,12 @@ void SimHardware::on_add_resources(ResourceTable& table) {
 }
 
 void SimHardware::on_advance_to(Time now) noexcept {
+  // The joints' command channels (exported first, in joint order) as the behavior loop fused them.
+  const CommandChannels& commands = command_channels();
   for (std::size_t i = 0; i < joints_.size(); ++i) {
-    if (const auto c = joints_[i]->take_command()) sim_.command_joint(i, *c);
+    if (commands.value(i) == joint_applied_[i]) continue;
+    joint_applied_[i] = commands.value(i);
+    sim_.command_joint(i, commands.value(i).number);
   }
   sim_.step_until(now);
   for (std::size_t i = 0; i < joints_.size(); ++i) {

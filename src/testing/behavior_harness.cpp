@@ -224,7 +224,7 @@ class BehaviorHarness::Sink final : public trace::TraceResources {
 BehaviorHarness::BehaviorHarness(HarnessOptions options)
     : options_(std::move(options)) {
   if (options_.period <= Duration{0}) throw std::invalid_argument("BehaviorHarness: period must be positive");
-  coordinator_ = std::make_unique<CBehaviorCoordinator>(CoordinatorConfig{options_.mode, {}, {}});
+  coordinator_ = std::make_unique<CBehaviorCoordinator>(CoordinatorConfig{options_.mode, {}, {}, {}});
 }
 
 BehaviorHarness::~BehaviorHarness() = default;

@@ -231,3 +231,108 @@ TEST_CASE("Coordinator configuration errors") {
   co.reset();
   CHECK(co.update(Time{0ms}).all_expired);
 }
+
+// --- command channels -----------------------------------------------------------------------------
+
+namespace {
+CoordinatorConfig with_channels(CoordinationMode mode = CoordinationMode::priority) {
+  CoordinatorConfig c = three_inputs(mode);
+  c.channels = {ChannelSpec{"uv_lamp", ChannelType::digital, ChannelValue::of(false), false, 0ms, 0.0, 0.0, "", ""},
+                ChannelSpec{"neck", ChannelType::joint_position, ChannelValue::of(0.25), true, 0ms, -1.0, 1.0, "rad", ""},
+                ChannelSpec{"fog", ChannelType::analog, ChannelValue::of(0.0), false, 300ms, 0.0, 1.0, "", ""},
+                ChannelSpec{"lcd", ChannelType::text, ChannelValue::of_text("idle"), false, 0ms, 0.0, 0.0, "", ""}};
+  c.inputs.push_back({"interlock", 0, 0ms, 1.0, InputRole::safety});
+  return c;
+}
+}  // namespace
+
+TEST_CASE("Channels: the live writer of highest priority wins each channel on its own, the others keep theirs", "[channels]") {
+  CBehaviorCoordinator co(with_channels());
+  const ChannelId lamp = *co.find_channel("uv_lamp");
+  const ChannelId lcd = *co.find_channel("lcd");
+  const InputId joy = *co.find_input("joystick");
+  const InputId go = *co.find_input("BhGoToPose");
+  co.update(Time{0ms});
+  CHECK_FALSE(co.channel_output(lamp).live);
+  CHECK(co.channel_output(lcd).value.text() == "idle");  // the safe value before any write
+  co.submit_channel(go, lamp, ChannelValue::of(true), Time{0ms});
+  co.submit_channel(go, lcd, ChannelValue::of_text("covering"), Time{0ms});
+  co.submit_channel(joy, lcd, ChannelValue::of_text("driven by hand, a text longer than the LCD"), Time{0ms});
+  co.update(Time{10ms});
+  CHECK(co.channel_output(lamp).value.on());
+  CHECK(co.channel_output(lamp).writer == "BhGoToPose");
+  CHECK(co.channel_output(lcd).writer == "joystick");
+  CHECK(co.channel_output(lcd).value.text() == "driven by hand, a text longer th");  // cut at 32
+  // Motion is not touched by channel writes.
+  CHECK(co.output().all_expired);
+  co.withdraw_channels(joy);
+  co.update(Time{20ms});
+  CHECK(co.channel_output(lcd).value.text() == "covering");
+}
+
+TEST_CASE("Channels: a write past its input's or the channel's timeout falls to the safe value; a holding channel keeps its last", "[channels]") {
+  CBehaviorCoordinator co(with_channels());
+  const ChannelId lamp = *co.find_channel("uv_lamp");
+  const ChannelId neck = *co.find_channel("neck");
+  const ChannelId fog = *co.find_channel("fog");
+  const InputId go = *co.find_input("BhGoToPose");  // timeout 200 ms
+  const InputId stop = *co.find_input("BhStop");    // no timeout
+  co.submit_channel(go, lamp, ChannelValue::of(true), Time{0ms});
+  co.submit_channel(go, neck, ChannelValue::of(0.5), Time{0ms});
+  co.submit_channel(stop, fog, ChannelValue::of(0.7), Time{0ms});
+  co.update(Time{200ms});
+  CHECK(co.channel_output(lamp).value.on());
+  CHECK(co.channel_output(neck).value.number == 0.5);
+  CHECK(co.channel_output(fog).value.number == 0.7);
+  co.update(Time{250ms});  // the input's 200 ms passed
+  CHECK_FALSE(co.channel_output(lamp).value.on());
+  CHECK_FALSE(co.channel_output(lamp).live);
+  CHECK(co.channel_output(neck).value.number == 0.5);  // holds
+  CHECK(co.channel_output(fog).value.number == 0.7);   // its input never expires, the channel's 300 ms not yet
+  co.update(Time{301ms});
+  CHECK(co.channel_output(fog).value.number == 0.0);  // the channel's own timeout
+  co.reset();
+  CHECK(co.channel_output(neck).value.number == 0.25);
+}
+
+TEST_CASE("Channels: weighted mean for numeric channels only, clamped; locks mask; a safety write replaces the result", "[channels]") {
+  CBehaviorCoordinator co(with_channels(CoordinationMode::weighted_sum));
+  const ChannelId lamp = *co.find_channel("uv_lamp");
+  const ChannelId neck = *co.find_channel("neck");
+  const InputId joy = *co.find_input("joystick");   // weight 1, priority 100
+  const InputId go = *co.find_input("BhGoToPose");  // weight 3, priority 10
+  const InputId interlock = *co.find_input("interlock");
+  co.submit_channel(joy, neck, ChannelValue::of(1.0), Time{0ms});
+  co.submit_channel(go, neck, ChannelValue::of(0.2), Time{0ms});
+  co.submit_channel(joy, lamp, ChannelValue::of(false), Time{0ms});
+  co.submit_channel(go, lamp, ChannelValue::of(true), Time{0ms});
+  co.update(Time{10ms});
+  CHECK(co.channel_output(neck).value.number == Approx((1.0 + 3 * 0.2) / 4));
+  CHECK(co.channel_output(neck).writer == "weighted_sum");
+  CHECK_FALSE(co.channel_output(lamp).value.on());  // digital: priority, the joystick's
+  co.submit_channel(joy, neck, ChannelValue::of(9.0), Time{10ms});
+  co.withdraw_channel(go, neck);
+  co.update(Time{20ms});
+  CHECK(co.channel_output(neck).value.number == 1.0);  // clamped into [-1, 1]
+  // A lock of priority 100 masks both writers: the lamp falls to off, the neck holds.
+  const LockId lock = co.add_lock({"pause", 100, 0ms});
+  co.set_lock(lock, true, Time{20ms});
+  co.submit_channel(go, lamp, ChannelValue::of(true), Time{20ms});
+  co.update(Time{30ms});
+  CHECK_FALSE(co.channel_output(lamp).live);
+  co.set_lock(lock, false, Time{30ms});
+  co.withdraw_channels(joy);
+  co.update(Time{40ms});
+  CHECK(co.channel_output(lamp).value.on());
+  co.submit_channel(interlock, lamp, ChannelValue::of(false), Time{40ms});
+  co.update(Time{50ms});
+  CHECK_FALSE(co.channel_output(lamp).value.on());
+  CHECK(co.channel_output(lamp).safety_override);
+  CHECK(co.channel_output(lamp).writer == "interlock");
+}
+
+TEST_CASE("Channels: a duplicate or unnamed channel is refused") {
+  CBehaviorCoordinator co(with_channels());
+  CHECK_THROWS_WITH(co.add_channel(ChannelSpec{"uv_lamp", ChannelType::digital, {}, false, 0ms, 0.0, 0.0, "", ""}), Catch::Contains("'uv_lamp' already exists"));
+  CHECK_THROWS_WITH(co.add_channel(ChannelSpec{"", ChannelType::digital, {}, false, 0ms, 0.0, 0.0, "", ""}), Catch::Contains("needs a name"));
+}

@@ -290,3 +290,53 @@ TEST_CASE("BhAvoidObstacle handles odd beam counts, NaN and out-of-range returns
   CHECK(std::isinf(e.vx_hi_m_s));
   CHECK(std::isinf(e.vx_lo_m_s));
 }
+
+namespace {
+
+// Writes its channels while running; succeeds at step `finish_at` (writing in that step too).
+class BhChannelWriter final : public CBehavior {
+ public:
+  explicit BhChannelWriter(std::size_t channels, std::uint64_t finish_at = 0) : finish_at_(finish_at) {
+    ManifestBuilder b("BhChannelWriter", ModuleKind::behavior);
+    for (std::size_t i = 0; i < channels; ++i) b.writes("out" + std::to_string(i), ChannelType::analog, "");
+    b.writes_named_by("target", ChannelType::joint_position, "");
+    b.text("target", "neck", "");
+    manifest_ = std::move(b).build();
+  }
+
+ protected:
+  const ModuleManifest& do_manifest() const noexcept override { return manifest_; }
+  void on_activate(const ParameterSet&, const BehaviorContext&) override {}
+  std::optional<Twist2D> on_step(const BehaviorContext&) noexcept override {
+    write_channel(0, ChannelValue::of(0.5));
+    if (steps() == finish_at_) succeed();
+    return std::nullopt;
+  }
+
+ private:
+  ModuleManifest manifest_;
+  std::uint64_t finish_at_;
+};
+
+}  // namespace
+
+TEST_CASE("Channel writes: names resolved at activation (a parameter names one), kept for one step, none from a finishing step",
+          "[channels]") {
+  BehaviorContext ctx;
+  BhChannelWriter b(1, 3);
+  b.activate(ParameterValues{{"target", Value{std::string("arm")}}}, ctx);
+  CHECK(b.channel_name(0) == "out0");
+  CHECK(b.channel_name(1) == "arm");
+  (void)b.step(ctx);
+  REQUIRE(b.channel_write(0).has_value());
+  CHECK(b.channel_write(0)->number == 0.5);
+  CHECK_FALSE(b.channel_write(1).has_value());  // not written this step
+  (void)b.step(ctx);
+  (void)b.step(ctx);  // succeeds: like its motion command, its writes of this step do not count
+  CHECK(b.status() == BehaviorStatus::succeeded);
+  CHECK_FALSE(b.channel_write(0).has_value());
+
+  BhChannelWriter greedy(kMaxBehaviorChannels);  // one more with the named one
+  CHECK_THROWS_WITH(greedy.activate(ParameterValues{}, ctx),
+                    Catch::Contains("behavior 'BhChannelWriter' declares 5 channel writes, at most 4"));
+}

@@ -1,5 +1,6 @@
 // The gesture behaviors: BhFaceVisitor turns the base to the person the laser sees (not to the
-// walls the map holds), BhNeckGesture drives a joint through its JointResource.
+// walls the map holds), BhNeckGesture drives a joint through its position channel (it reads the
+// joint's state from its JointResource).
 #include "tripodal/behaviors/gesture_behaviors.hpp"
 
 #include <catch2/catch.hpp>
@@ -147,7 +148,8 @@ struct JointModel {
       const auto cmd = b.step(ctx);
       CHECK_FALSE(cmd.has_value());  // a gesture of the head never drives the base
       ctx.now += ctx.period;
-      if (const auto c = joint.take_command()) target = std::clamp(*c, -0.5, 0.8);
+      // The joint's driver takes what the behavior wrote to its channel (the behavior's only one).
+      if (const auto& c = b.channel_write(0)) target = std::clamp(c->number, -0.5, 0.8);
       const double step = std::clamp(target - position, -0.01, 0.01);
       position = std::abs(target - position) <= 0.01 ? target : position + step;
       publish(step / 0.01);
@@ -162,6 +164,7 @@ TEST_CASE("BhNeckGesture moves the joint to its angle and succeeds when it has s
   JointModel m;
   BhNeckGesture nod;
   nod.activate(ParameterValues{{"angle_deg", Value{30.0}}}, m.ctx);
+  CHECK(nod.channel_name(0) == "neck");  // the channel its parameter joint names
   const int steps = m.run(nod, 1000);
   CHECK(nod.status() == BehaviorStatus::succeeded);
   CHECK(m.position == Approx(30.0 * std::numbers::pi / 180.0));

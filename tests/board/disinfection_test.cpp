@@ -11,6 +11,7 @@
 #include "tripodal/board/board_monitor.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_board.hpp"
+#include "tripodal/sim/sim_hardware.hpp"
 
 using namespace tripodal;
 using namespace std::chrono_literals;
@@ -162,4 +163,90 @@ TEST_CASE("the disinfection task faults within two periods of a dead board link,
   CHECK(fw.link_lost());
   CHECK(fw.required_m_s(0) == 0.0);
   CHECK(fw.required_m_s(1) == 0.0);
+}
+
+// --- the board's actuators as command channels -------------------------------------------------------
+
+namespace {
+
+// The disinfection profile without its nets' driver and BoardMonitor (nothing else could switch an
+// actuator), plus BhLcdText, so that the behaviors alone drive the board through their channels.
+struct ChannelRobot {
+  std::shared_ptr<const sim::World> world = std::make_shared<const sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml"));
+  SimClock clock;
+  RobotPlugins plugins = RobotPlugins::with_builtins();
+  std::unique_ptr<Robot> robot;
+  sim::SimBoardHardware* hw = nullptr;
+
+  ChannelRobot() {
+    sim::register_sim_board_hardware(plugins.hardware, world);
+    board::register_board_behaviors(plugins.behaviors);
+    RobotProfile profile = load_robot_profile(kConfigs / "robots/disinfection.yaml");
+    profile.modules.clear();
+    ModuleEntry lcd;
+    lcd.kind = ModuleKind::behavior;
+    lcd.name = lcd.type = "BhLcdText";
+    profile.behaviors.push_back(lcd);
+    robot = Robot::assemble(profile, plugins, clock);
+    hw = &dynamic_cast<sim::SimBoardHardware&>(*robot->hardware());
+    robot->run_for(100ms);  // SYNC
+  }
+  void activate(const std::string& type, ParameterValues params = {}) {
+    robot->behavior_loop().activate(plugins.behaviors.create(type), params, type);
+  }
+};
+
+}  // namespace
+
+TEST_CASE("The board's lamp, atomizer, voice and LCD are command channels the behaviors write and the board applies", "[board][channels]") {
+  ChannelRobot r;
+  const board::BoardFirmware& fw = r.hw->embedded().firmware();
+  CommandChannels& channels = r.hw->command_channels();
+  for (const char* name : {"uv_lamp", "atomizer", "atomizer_fan", "voice", "lcd"}) CHECK(channels.find(name).has_value());
+  REQUIRE_FALSE(fw.uv_lamp());
+
+  r.activate("BhUvLamp");
+  r.activate("BhAtomize", {{"fan", Value{false}}});
+  r.activate("BhVoicePrompt", {{"track", Value{5.0}}});
+  r.activate("BhLcdText", {{"text", Value{std::string("UV ON - KEEP OUT")}}});
+  r.robot->run_for(100ms);
+  CHECK(fw.uv_lamp());
+  CHECK(fw.atomizer());
+  CHECK_FALSE(fw.fan());
+  CHECK(fw.last_voice_track() == 5);
+  CHECK(fw.lcd_line(0) == "UV ON - KEEP OUT");
+  const CBehaviorCoordinator& co = r.robot->behavior_loop().coordinator();
+  CHECK(co.channel_output(*co.find_channel("uv_lamp")).writer == "BhUvLamp");
+  CHECK(co.channel_output(*co.find_channel("voice")).value.number == 0.0);  // played once: back to its safe value
+
+  // Withdrawn: every channel falls to its safe value and the board switches off.
+  for (const char* b : {"BhUvLamp", "BhAtomize", "BhLcdText"}) r.robot->behavior_loop().deactivate(std::string_view(b));
+  r.robot->run_for(100ms);
+  CHECK_FALSE(fw.uv_lamp());
+  CHECK_FALSE(fw.atomizer());
+  CHECK(fw.lcd_line(0).empty());
+}
+
+TEST_CASE("A behavior writing a channel the hardware does not export is refused at assembly, located", "[board][channels]") {
+  const auto world = std::make_shared<const sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml"));
+  SimClock clock;
+  RobotPlugins plugins = RobotPlugins::with_builtins();
+  sim::register_sim_hardware(plugins.hardware, world);  // "sim": joints only, no lamp
+  board::register_board_behaviors(plugins.behaviors);
+  RobotProfile profile = load_robot_profile(kConfigs / "robots/disinfection.yaml");
+  profile.modules.clear();
+  profile.hardware->type = "sim";
+  profile.hardware->parameters.clear();
+  try {
+    (void)Robot::assemble(profile, plugins, clock);
+    FAIL("assembled");
+  } catch (const ConfigError& e) {
+    const std::string what = e.what();
+    CHECK_THAT(what, Catch::Contains("disinfection.yaml:"));
+    CHECK_THAT(what, Catch::Contains("disinfection.yaml:57:"));
+    CHECK_THAT(what, Catch::Contains("behavior 'BhUvLamp' writes the command channel 'uv_lamp' (digital), which hardware 'sim' does "
+                                     "not export; it exports none (rule R6)"));
+    CHECK_THAT(what, Catch::Contains("behavior 'BhAtomize' writes the command channel 'atomizer' (analog)"));
+    CHECK_THAT(what, Catch::Contains("behavior 'BhVoicePrompt' writes the command channel 'voice' (track)"));
+  }
 }

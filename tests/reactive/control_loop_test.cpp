@@ -9,6 +9,7 @@
 
 #include "reactive_rig.hpp"
 #include "tripodal/behaviors/builtin_behaviors.hpp"
+#include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/controllers/kinematics.hpp"
 
 using namespace tripodal;
@@ -400,4 +401,37 @@ TEST_CASE("The loop tells the behavior that won the last fusion what the safety 
   REQUIRE(drive.told);
   CHECK_FALSE(drive.seen.limited);
   CHECK(loop.last_cycle().coordinator.requested == loop.last_cycle().coordinator.command);
+}
+
+TEST_CASE("Command channels: a behavior's writes reach the loop's command output; an unknown channel is refused at activation, located",
+          "[reactive][channels]") {
+  JointResource neck("neck");
+  neck.publish(JointReading{Time{0ms}, 0.0, 0.0, 0.0, -1.0, 1.0});
+  ResourceTable resources;
+  resources.add(neck);
+  const ChannelSpec spec{"neck", ChannelType::joint_position, ChannelValue::of(0.0), true, 0ms, -1.0, 1.0, "rad", ""};
+  CoordinatorConfig cc;
+  cc.inputs = {{"BhNeckGesture", 10, 0ms}};
+  cc.channels = {spec};
+  ControlLoop loop(ControlLoopOptions{}, resources, CBehaviorCoordinator(cc), nullptr);
+  CommandChannels hardware;  // what a hardware exports
+  CommandChannels other;
+  other.add(ChannelSpec{"arm", ChannelType::joint_position, {}, true, 0ms, 0.0, 0.0, "", ""});
+  CHECK_THROWS_WITH(loop.set_command_output(&other), Catch::Contains("not the coordinator's"));
+  hardware.add(spec);
+  loop.set_command_output(&hardware);
+
+  loop.activate(std::make_unique<BhNeckGesture>(), {{"angle_deg", Value{20.0}}});
+  loop.step(Time{10ms});
+  CHECK(hardware.value(0).number == Approx(20.0 * kPi / 180.0));
+  CHECK(loop.coordinator().channel_output(0).writer == "BhNeckGesture");
+
+  CHECK_THROWS_WITH(loop.activate(std::make_unique<BhNeckGesture>(), {{"joint", Value{std::string("arm")}}}, {},
+                                  SourceLocation{"PrGuide.xml", 14, 5}),
+                    Catch::Contains("PrGuide.xml:14:5") &&
+                        Catch::Contains("behavior BhNeckGesture writes the command channel 'arm', which the hardware does not "
+                                        "export (it exports neck (joint_position))"));
+  // The refused activation changed nothing: the first gesture still holds the channel.
+  loop.step(Time{20ms});
+  CHECK(loop.coordinator().channel_output(0).writer == "BhNeckGesture");
 }

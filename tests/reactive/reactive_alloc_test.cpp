@@ -4,6 +4,8 @@
 #include <catch2/catch.hpp>
 
 #include "reactive_rig.hpp"
+#include "tripodal/behaviors/gesture_behaviors.hpp"
+#include "tripodal/board/actuator_behaviors.hpp"
 #include "../support/counting_new.hpp"
 
 using namespace tripodal;
@@ -49,4 +51,42 @@ TEST_CASE("Supervisor-side changes applied by the loop allocate nothing on the l
   const CycleReport& r = rig.cycle();  // applies the path copy and the lock
   CHECK(test::allocations() == before);
   CHECK(r.coordinator.locked);
+}
+
+TEST_CASE("Fusing and writing command channels allocates nothing (joint, lamp, fog, LCD text; both modes)") {
+  for (const CoordinationMode mode : {CoordinationMode::priority, CoordinationMode::weighted_sum}) {
+    INFO(to_string(mode));
+    JointResource neck("neck");
+    neck.publish(JointReading{Time{}, 0.0, 0.0, 0.0, -1.0, 1.0});
+    ResourceTable resources;
+    resources.add(neck);
+    CoordinatorConfig cc;
+    cc.mode = mode;
+    cc.inputs = {{"BhNeckGesture", 4, Duration{0}}, {"BhUvLamp", 3, Duration{0}}, {"BhAtomize", 2, Duration{0}}, {"BhLcdText", 1, Duration{0}}};
+    const Duration none{0};
+    cc.channels = {ChannelSpec{"neck", ChannelType::joint_position, ChannelValue::of(0.0), true, none, -1.0, 1.0, "rad", ""},
+                   ChannelSpec{"uv_lamp", ChannelType::digital, ChannelValue::of(false), false, none, 0.0, 0.0, "", ""},
+                   ChannelSpec{"atomizer", ChannelType::analog, ChannelValue::of(0.0), false, none, 0.0, 1.0, "", ""},
+                   ChannelSpec{"atomizer_fan", ChannelType::digital, ChannelValue::of(false), false, none, 0.0, 0.0, "", ""},
+                   ChannelSpec{"lcd", ChannelType::text, ChannelValue::of_text(""), false, none, 0.0, 0.0, "", ""}};
+    CommandChannels hardware;
+    for (const ChannelSpec& c : cc.channels) hardware.add(c);
+    ControlLoop loop(ControlLoopOptions{}, resources, CBehaviorCoordinator(cc), nullptr);
+    loop.set_command_output(&hardware);
+    loop.activate(std::make_unique<BhNeckGesture>(), {{"angle_deg", Value{20.0}}, {"timeout_s", Value{1000.0}}});
+    loop.activate(std::make_unique<board::BhUvLamp>(), {});
+    loop.activate(std::make_unique<board::BhAtomize>(), {});
+    loop.activate(std::make_unique<board::BhLcdText>(), {{"text", Value{std::string("UV ON - KEEP OUT")}}});
+    Time now{};
+    for (int i = 0; i < 10; ++i) loop.step(now += std::chrono::milliseconds(10));
+    const std::size_t before = test::allocations();
+    for (int i = 0; i < 10'000; ++i) loop.step(now += std::chrono::milliseconds(10));
+    CHECK(test::allocations() - before == 0);
+    CHECK(loop.last_cycle().active_behaviors == 4);
+    CHECK(hardware.value(0).number > 0.3);
+    CHECK(hardware.value(1).on());
+    CHECK(hardware.value(2).number == 1.0);
+    CHECK(hardware.value(4).text() == "UV ON - KEEP OUT");
+    CHECK(hardware.writes(4) == 10'010);
+  }
 }

@@ -3,8 +3,12 @@
 #include <catch2/catch.hpp>
 
 #include "robot_doubles.hpp"
+#include "tripodal/board/actuator_behaviors.hpp"
+#include "tripodal/board/board_monitor.hpp"
 #include "tripodal/robot/layering.hpp"
 #include "tripodal/robot/robot.hpp"
+#include "tripodal/sim/sim_board.hpp"
+#include "tripodal/sim/sim_hardware.hpp"
 
 using namespace tripodal;
 using namespace tripodal::test;
@@ -312,4 +316,33 @@ TEST_CASE("describe_text lists modules by layer, describe_dot draws clusters and
   CHECK_THAT(dot, Catch::Contains("\"front_laser\" -> \"localizer\" [label=\"laser_scan\", constraint=false];"));
   CHECK_THAT(dot, Catch::Contains("\"behavior_coordinator\" -> \"base\" [label=\"cmd_vel\"];"));
   CHECK_THAT(dot, Catch::Contains("\"process_supervisor\" -> \"BhCleaning\" [style=dashed"));
+}
+
+TEST_CASE("describe shows command channels, who writes and who exports them; R6 refuses a channel the hardware lacks", "[robot][channels]") {
+  RobotPlugins plugins = RobotPlugins::with_builtins();
+  sim::register_sim_board_hardware(plugins.hardware, nullptr);  // the real board's channels, the world's laser
+  board::register_board_modules(plugins.modules);
+  board::register_board_behaviors(plugins.behaviors);
+  RobotProfile p = load_robot_profile(std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/disinfection.yaml");
+  Diagnostics d;
+  const RobotDescription r = describe_robot(p, plugins, knowledge_inputs(TaskLibrary::load(p.tasks)), d);
+  INFO(d.str());
+  REQUIRE_FALSE(d.has_errors());
+  const std::string text = describe_text(r);
+  CHECK_THAT(text, Catch::Contains("  BhAtomize (behavior)\n      in:  -\n      out: -\n      writes: atomizer (analog), atomizer_fan (digital)\n"));
+  CHECK_THAT(text, Catch::Contains("      channel: uv_lamp (digital) <- BhUvLamp\n"));
+  CHECK_THAT(text, Catch::Contains("      channel: voice (track) <- BhVoicePrompt\n      channel: lcd (text)\n"));
+  const std::string dot = describe_dot(r);
+  CHECK_THAT(dot, Catch::Contains("\"BhUvLamp\" -> \"behavior_coordinator\" [label=\"uv_lamp\", style=bold"));
+  CHECK_THAT(dot, Catch::Contains("\"behavior_coordinator\" -> \"hardware\" [label=\"uv_lamp, atomizer, atomizer_fan, voice, lcd\", style=bold"));
+
+  // The same behaviors on hardware that exports no lamp: refused at the behaviors' entry.
+  p.hardware->type = "sim";
+  p.hardware->parameters.clear();
+  sim::register_sim_hardware(plugins.hardware);
+  Diagnostics bad;
+  (void)describe_robot(p, plugins, knowledge_inputs(TaskLibrary::load(p.tasks)), bad);
+  CHECK_THAT(bad.str(), Catch::Contains("disinfection.yaml:57:") &&
+                            Catch::Contains("behavior 'BhUvLamp' writes the command channel 'uv_lamp' (digital), which hardware 'sim' does "
+                                            "not export; it exports none (rule R6)"));
 }

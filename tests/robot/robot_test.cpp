@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "robot_doubles.hpp"
+#include "tripodal/behaviors/teleop.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
 #include "tripodal/robot/robot.hpp"
 
@@ -65,7 +66,7 @@ TEST_CASE("PSR-2 assembles from its profile with the paper's nets", "[robot]") {
   CHECK(p.robot->hardware() != nullptr);
   REQUIRE(p.robot->loop("motion") != nullptr);
   CHECK(&p.robot->behavior_loop() == p.robot->loop("motion"));
-  CHECK(p.robot->behavior_loop().coordinator().input_count() == 4);
+  CHECK(p.robot->behavior_loop().coordinator().input_count() == 5);  // the profile's 4 behaviors and "operator" (driving by hand)
   CHECK(p.robot->behavior_loop().controller() != nullptr);
   CHECK(p.robot->behavior_loop().period() == std::chrono::milliseconds(10));
   const auto& mods = p.robot->description().modules;
@@ -267,10 +268,53 @@ TEST_CASE("PSR-2 on its threads takes a command from another thread and stops cl
   bool accepted = false;
   std::thread operator_thread([&] { accepted = robot->command("clean the room 3211").accepted; });
   operator_thread.join();
+  // Driving by hand from another thread, as the monitor does: BhTeleop's input and the lock.
+  auto* teleop = dynamic_cast<TeleopResource*>(robot->behavior_loop().resources().find(kTeleopResource));
+  REQUIRE(teleop != nullptr);
+  std::thread console([&] {
+    robot->behavior_loop().set_lock(kTeleopInput, true, clock.now());
+    for (int i = 0; i < 20; ++i) {
+      teleop->set(true, Twist2D{0.0, 0.0, 0.2}, clock.now());
+      clock.sleep_until(clock.now() + std::chrono::milliseconds(5));
+    }
+    teleop->set(false, Twist2D{}, clock.now());
+    robot->behavior_loop().set_lock(kTeleopInput, false, clock.now());
+  });
+  console.join();
   clock.sleep_until(clock.now() + std::chrono::milliseconds(200));
   robot->stop();
   robot->stop();  // idempotent
   CHECK_FALSE(robot->started());
   CHECK(accepted);
   CHECK(robot->planner().busy());
+}
+
+TEST_CASE("Driving by hand is an ordinary coordinator input: BhTeleop runs from the start on 'operator', its resource set from outside", "[robot][teleop]") {
+  Psr2 p;
+  ControlLoop& loop = p.robot->behavior_loop();
+  const CBehaviorCoordinator& co = loop.coordinator();
+  // Configured at assembly, above every normal input; nothing is added later.
+  const std::optional<InputId> op = co.find_input(kTeleopInput);
+  REQUIRE(op.has_value());
+  const std::size_t inputs = co.input_count();
+  auto* teleop = dynamic_cast<TeleopResource*>(loop.resources().find(kTeleopResource));
+  REQUIRE(teleop != nullptr);
+  REQUIRE(p.robot->command("clean the room 3211").accepted);
+  p.robot->run_for(std::chrono::seconds(2));
+  CHECK(loop.last_cycle().coordinator.winner != kTeleopInput);  // not engaged: gives nothing
+
+  teleop->set(true, Twist2D{0.0, 0.0, 0.4}, p.clock.now());
+  loop.set_lock(kTeleopInput, true, p.clock.now());
+  p.robot->run_for(std::chrono::milliseconds(100));
+  const CoordinatorOutput& out = loop.last_cycle().coordinator;
+  CHECK(out.winner == kTeleopInput);
+  CHECK(out.command == Twist2D{0.0, 0.0, 0.4});
+  CHECK(out.lock == kTeleopInput);
+  CHECK(co.input_count() == inputs);
+
+  teleop->set(false, Twist2D{}, p.clock.now());
+  loop.set_lock(kTeleopInput, false, p.clock.now());
+  p.robot->run_for(std::chrono::milliseconds(100));
+  CHECK(loop.last_cycle().coordinator.winner != kTeleopInput);
+  CHECK(p.robot->planner().busy());
 }

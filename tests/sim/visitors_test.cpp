@@ -9,6 +9,8 @@
 #include <string>
 
 #include "sim_test_util.hpp"
+#include "tripodal/behaviors/gesture_behaviors.hpp"
+#include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/sim/simulator.hpp"
 #include "tripodal/sim/world.hpp"
@@ -170,7 +172,7 @@ TEST_CASE("visitors: a walker gives way to the robot standing on its path", "[si
   CHECK(sim.min_visitor_clearance_m() >= v.give_way_m - 0.02);
 }
 
-TEST_CASE("joints: limits, speed, and the state a JointResource shows", "[sim][joints]") {
+TEST_CASE("joints: limits, speed, the state a JointResource shows, the position channel the hardware exports", "[sim][joints]") {
   World w = room_world(60, 60, {1.5, 1.5, 0.0});
   w.robot.joints.push_back({"neck", -0.5, 0.8, 1.0, 0.0, 50.0, {}});
   w.robot.buttons.push_back({"hello", {}});
@@ -181,7 +183,11 @@ TEST_CASE("joints: limits, speed, and the state a JointResource shows", "[sim][j
   REQUIRE(joint != nullptr);
   CHECK(joint->latest().max_rad == 0.8);
 
-  joint->command(0.6);
+  CommandChannels& channels = hw.command_channels();
+  REQUIRE(channels.find("neck") == std::size_t{0});
+  CHECK(channels.spec(0).type == ChannelType::joint_position);
+  CHECK(channels.spec(0).hold);
+  channels.set(0, ChannelValue::of(0.6));  // as the behavior loop writes it
   hw.advance_to(time_from_seconds(0.3));  // 1 rad/s: 0.3 rad in 0.3 s
   CHECK(joint->latest().position_rad == Approx(0.3).margin(1e-6));
   CHECK(joint->latest().velocity_rad_s == Approx(1.0));
@@ -235,4 +241,36 @@ TEST_CASE("visitors: a guided visitor follows the robot along its trail and keep
   CHECK(p.x_m < 4.05);
   CHECK(p.y_m < sim.pose().y_m - 0.6);
   CHECK(sim.collisions() == 0);
+}
+
+// Jinny's neck through the robot: BhNeckGesture writes the joint's position channel, the behavior
+// loop fuses it, the simulated hardware applies it; after the gesture the channel holds.
+TEST_CASE("Jinny's neck is driven through its command channel by the behavior loop", "[sim][joints][channels]") {
+  const auto world = std::make_shared<const World>(load_world(kWorlds + "exhibit_hall.yaml"));
+  SimClock clock;
+  RobotPlugins plugins = RobotPlugins::with_builtins();
+  register_sim_hardware(plugins.hardware, world);
+  register_gesture_behaviors(plugins.behaviors);
+  RobotProfile profile = load_robot_profile(std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/jinny.yaml");
+  // Its hardware, base and behaviors; not the guide application's HRI, nor the tasks that ask it.
+  profile.hri.clear();
+  profile.tasks.clear();
+  profile.processes.clear();
+  profile.recovery.clear();
+  std::unique_ptr<Robot> robot = Robot::assemble(profile, plugins, clock);
+  auto& hw = dynamic_cast<SimHardware&>(*robot->hardware());
+  REQUIRE(hw.command_channels().find("neck").has_value());
+  ControlLoop& loop = robot->behavior_loop();
+  const ChannelId neck = *loop.coordinator().find_channel("neck");
+
+  loop.activate(plugins.behaviors.create("BhNeckGesture"), {{"angle_deg", Value{30.0}}}, "BhNeckGesture");
+  robot->run_for(std::chrono::milliseconds(100));
+  CHECK(loop.coordinator().channel_output(neck).writer == "BhNeckGesture");
+  robot->run_for(std::chrono::seconds(1));  // 60 deg/s: there in 0.5 s
+  CHECK(hw.simulator().joints()[0].position_rad == Approx(30.0 * std::numbers::pi / 180.0));
+  CHECK_FALSE(robot->behavior_active("BhNeckGesture"));  // not through the supervisor
+  loop.deactivate(std::string_view("BhNeckGesture"));
+  robot->run_for(std::chrono::seconds(1));
+  CHECK_FALSE(loop.coordinator().channel_output(neck).live);
+  CHECK(hw.simulator().joints()[0].position_rad == Approx(30.0 * std::numbers::pi / 180.0));  // held
 }

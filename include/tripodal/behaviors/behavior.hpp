@@ -141,7 +141,8 @@ class CBehavior {
   [[nodiscard]] std::string_view name() const noexcept { return manifest().name; }
 
   /// Resolves `params` against the manifest (ConfigError listing every problem, located at
-  /// `where`), then calls on_activate(). Status becomes running unless on_activate() already
+  /// `where`; also when the manifest declares more than kMaxBehaviorChannels writes), resolves
+  /// the names of the channels it writes, then calls on_activate(). Status becomes running unless on_activate() already
   /// reported an outcome. May be called again to re-activate with new parameters.
   void activate(const ParameterValues& params, const BehaviorContext& context,
                 const SourceLocation& where = {});
@@ -160,6 +161,12 @@ class CBehavior {
   [[nodiscard]] std::string_view failure_reason() const noexcept { return failure_reason_; }
   /// The envelope a safety behavior imposes this period, if any (set during step()).
   [[nodiscard]] const std::optional<VelocityEnvelope>& envelope() const noexcept { return envelope_; }
+  /// This period's write to the behavior's i-th declared channel (manifest().writes), if any.
+  /// Cleared before every step, and after a step in which the behavior finished.
+  [[nodiscard]] const std::optional<ChannelValue>& channel_write(std::size_t i) const noexcept { return writes_[i]; }
+  /// The channel the i-th declared write goes to, resolved at activation (a parameter-named
+  /// write takes the parameter's value); "" before.
+  [[nodiscard]] std::string_view channel_name(std::size_t i) const noexcept { return channel_names_[i]; }
   /// Number of step() calls since the last activation.
   [[nodiscard]] std::uint64_t steps() const noexcept { return steps_; }
 
@@ -181,11 +188,21 @@ class CBehavior {
   }
   /// Sets (or clears with nullopt) this period's safety envelope; cleared before every step.
   void set_envelope(const std::optional<VelocityEnvelope>& envelope) noexcept { envelope_ = envelope; }
+  /// Writes `value` to the i-th channel the manifest declares (i < manifest().writes.size()).
+  void write_channel(std::size_t i, const ChannelValue& value) noexcept {
+    if (i < writes_.size()) writes_[i] = value;
+  }
 
  private:
+  void clear_writes() noexcept {
+    for (auto& w : writes_) w.reset();
+  }
+
   BehaviorStatus status_ = BehaviorStatus::idle;
   std::string_view failure_reason_;
   std::optional<VelocityEnvelope> envelope_;
+  std::array<std::optional<ChannelValue>, kMaxBehaviorChannels> writes_{};
+  std::array<std::string, kMaxBehaviorChannels> channel_names_;
   std::uint64_t steps_ = 0;
 };
 

@@ -1,7 +1,8 @@
 // CBehaviorCoordinator: a core component of the reactive layer. Every sampling period it fuses the
 // commands of the active behaviors into the one command the controller executes: priority
 // arbitration (as ROS twist_mux, with locks as dead-man switches) or weighted-sum fusion (motor
-// schemas), both under a safety override taking the most restrictive command.
+// schemas), both under a safety override taking the most restrictive command. The same rules fuse
+// each command channel the hardware exports (core/command_channel.hpp): the lamp, a joint, the LCD.
 #pragma once
 
 #include <cstddef>
@@ -49,10 +50,20 @@ struct CoordinatorConfig {
   CoordinationMode mode = CoordinationMode::priority;
   std::vector<CoordinatorInputConfig> inputs;
   std::vector<CoordinatorLockConfig> locks;
+  std::vector<ChannelSpec> channels;  ///< the command channels the hardware exports
 };
 
 using InputId = std::uint32_t;
 using LockId = std::uint32_t;
+using ChannelId = std::uint32_t;
+
+/// A command channel after update().
+struct ChannelOutput {
+  ChannelValue value;        ///< what the hardware is to apply
+  std::string_view writer;   ///< the winning input; "weighted_sum"; "" when no live input wrote it
+  bool live = false;         ///< a live, unmasked input wrote it (else: the safe or held value)
+  bool safety_override = false;  ///< a safety input's write replaced the winner's
+};
 
 /// What update() produced.
 struct CoordinatorOutput {
@@ -86,6 +97,12 @@ struct CoordinatorOutput {
 ///   [min(0,c), max(0,c)] per axis). The envelopes are intersected (most restrictive) and the
 ///   fused command is clamped into the intersection per axis; an empty intersection on an axis
 ///   gives 0 on that axis.
+/// - Command channels, each on its own: a write is live when its input's timeout and the channel's
+///   timeout both allow it; locks mask as above. Priority decides, or in weighted_sum mode the
+///   weighted mean for numeric channels (is_numeric). A live safety input's write replaces the
+///   result (an interlock: the lamp off while someone is near), the first in configuration order.
+///   No live write: the channel's safe value, or its last value for a channel that holds.
+///   Numeric results are clamped into the channel's [min, max].
 class CBehaviorCoordinator final {
  public:
   explicit CBehaviorCoordinator(CoordinatorConfig config = {});
@@ -101,25 +118,45 @@ class CBehaviorCoordinator final {
   [[nodiscard]] CoordinationMode mode() const noexcept { return mode_; }
   void set_mode(CoordinationMode mode) noexcept { mode_ = mode; }
 
+  /// Adds a command channel; throws std::invalid_argument for a duplicate or empty name.
+  ChannelId add_channel(ChannelSpec spec);
+  [[nodiscard]] std::optional<ChannelId> find_channel(std::string_view name) const noexcept;
+  [[nodiscard]] const ChannelSpec& channel_spec(ChannelId id) const noexcept { return channels_[id].spec; }
+  [[nodiscard]] std::size_t channel_count() const noexcept { return channels_.size(); }
+
   /// A new command from input `id`, stamped `stamp`.
   void submit(InputId id, const Twist2D& command, Time stamp) noexcept;
   /// A new envelope from safety input `id` (replaces a plain command for this input).
   void submit_envelope(InputId id, const VelocityEnvelope& envelope, Time stamp) noexcept;
   /// Input `id` has nothing to say any more (its behavior returned nothing or stopped).
   void withdraw(InputId id) noexcept;
+  /// Input `id` writes `value` to channel `channel`, stamped `stamp`.
+  void submit_channel(InputId id, ChannelId channel, const ChannelValue& value, Time stamp) noexcept;
+  /// Input `id` no longer writes `channel` ...
+  void withdraw_channel(InputId id, ChannelId channel) noexcept;
+  /// ... or any channel.
+  void withdraw_channels(InputId id) noexcept;
   /// A lock message: engaged or released, stamped `stamp` (refreshes the dead-man timer).
   void set_lock(LockId id, bool engaged, Time stamp) noexcept;
 
   /// Fuses at `now`; called once per sampling period (fixed rate) by the control loop.
   const CoordinatorOutput& update(Time now) noexcept;
   [[nodiscard]] const CoordinatorOutput& output() const noexcept { return output_; }
+  /// Channel `id` as the last update() fused it (its safe value before the first).
+  [[nodiscard]] const ChannelOutput& channel_output(ChannelId id) const noexcept { return channels_[id].output; }
 
   /// Forgets every submitted command and lock message (e.g. on loop restart).
   void reset() noexcept;
 
  private:
+  struct ChannelWriteState {
+    bool has = false;
+    ChannelValue value;
+    Time stamp{};
+  };
   struct InputState {
     CoordinatorInputConfig config;
+    std::vector<ChannelWriteState> channels;  // one per channel, by ChannelId
     bool has_command = false;
     bool has_envelope = false;
     Twist2D command;
@@ -133,7 +170,15 @@ class CBehaviorCoordinator final {
     Time stamp{};
   };
 
+  struct ChannelState {
+    ChannelSpec spec;
+    ChannelOutput output;
+  };
+
+  void fuse_channel(ChannelId id, Time now, bool masking, int mask_priority) noexcept;
+
   CoordinationMode mode_;
+  std::vector<ChannelState> channels_;
   std::vector<InputState> inputs_;
   std::vector<LockState> locks_;
   CoordinatorOutput output_;

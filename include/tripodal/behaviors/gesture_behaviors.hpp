@@ -1,8 +1,8 @@
 // Gestures as behaviors (paper, section 4, Table 3: Jinny's interaction elements): BhFaceVisitor
 // turns the base to face the visitor the laser sees, BhNeckGesture moves a neck or arm joint to a
-// position. The joint is a resource of its own (JointResource): its driver (the simulator's joint,
-// sim/sim_hardware.hpp, or a servo board) publishes the state and takes the command a behavior
-// gives, both on the control loop's thread.
+// position. A joint's state is a resource (JointResource) its driver (the simulator's joint,
+// sim/sim_hardware.hpp, or a servo board) publishes; its position is a command channel the
+// hardware exports under the joint's name (core/command_channel.hpp), written by the behavior.
 #pragma once
 
 #include <optional>
@@ -24,24 +24,13 @@ struct JointReading {
   friend bool operator==(const JointReading&, const JointReading&) = default;
 };
 
-/// A joint as a resource: the latest state (read like any sensor) plus a command slot a behavior
-/// writes and the driver takes. Output information "joint_state".
+/// A joint's state as a resource (output information "joint_state"). It is read only: the joint
+/// is moved through its command channel.
 class JointResource final : public TypedResource<JointReading> {
  public:
   static const ModuleManifest& static_manifest();
   explicit JointResource(std::string name, Duration max_age = Duration{0})
       : TypedResource<JointReading>(std::move(name), max_age, static_manifest()) {}
-  /// Asks the joint to go to `target_rad` (the driver clamps it to the limits).
-  void command(double target_rad) noexcept { command_ = target_rad; }
-  /// The command given since the last call, for the driver.
-  [[nodiscard]] std::optional<double> take_command() noexcept {
-    const std::optional<double> c = command_;
-    command_.reset();
-    return c;
-  }
-
- private:
-  std::optional<double> command_;
 };
 
 /// Turns the base on the spot to face the visitor: the nearest laser return within max_range_m
@@ -84,7 +73,7 @@ class BhNeckGesture final : public CBehavior {
   std::optional<Twist2D> on_step(const BehaviorContext& context) noexcept override;
 
  private:
-  JointResource* joint_ = nullptr;
+  const TypedResource<JointReading>* joint_ = nullptr;
   double target_rad_ = 0.0, tolerance_rad_ = 0.0;
   Duration timeout_{0};
   Time started_{};

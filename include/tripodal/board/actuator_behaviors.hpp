@@ -1,8 +1,8 @@
 // The disinfection robot's actuators as behaviors a process net marks (seed 001, sections 2.5 and
-// 3.4): the UV lamp, the atomizer (dry fog) and the voice prompt. They do not drive the base (a
-// step gives no command); BoardMonitor (board_monitor.hpp), which sees the supervisor's
-// activations in the sequencing loop, sends their board commands: on at activation, off at
-// deactivation, so a process that ends or faults always switches them off.
+// 3.4): the UV lamp, the atomizer (dry fog), the voice prompt and the LCD. They do not drive the
+// base (a step gives no command); each writes the board's command channels (board_hardware.hpp)
+// while active, and the behavior coordinator fuses them like any command. When a process ends or
+// faults its behaviors are withdrawn and the channels fall to their safe values: lamp and fog off.
 #pragma once
 
 #include "tripodal/behaviors/behavior.hpp"
@@ -10,49 +10,66 @@
 
 namespace tripodal::board {
 
-/// What the actuator behaviors share: no command for the base; BoardMonitor acts on activation.
-class CActuatorBehavior : public CBehavior {
+/// The UV lamp on (channel uv_lamp) while active; never finishes.
+class BhUvLamp final : public CBehavior {
+ public:
+  static const ModuleManifest& static_manifest();
+
  protected:
+  const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
   void on_activate(const ParameterSet& /*params*/, const BehaviorContext& /*context*/) override {}
-  std::optional<Twist2D> on_step(const BehaviorContext& /*context*/) noexcept override { return std::nullopt; }
+  std::optional<Twist2D> on_step(const BehaviorContext& context) noexcept override;
 };
 
-/// The UV lamp on while active; never finishes.
-class BhUvLamp final : public CActuatorBehavior {
+/// The atomizer on (channel atomizer at 1) and its fan (channel atomizer_fan: parameter fan)
+/// while active; never finishes. The board stops the fog when the tank runs dry (BoardMonitor
+/// posts board.tank_empty).
+class BhAtomize final : public CBehavior {
  public:
   static const ModuleManifest& static_manifest();
 
  protected:
   const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  void on_activate(const ParameterSet& params, const BehaviorContext& context) override;
+  std::optional<Twist2D> on_step(const BehaviorContext& context) noexcept override;
+
+ private:
+  bool fan_ = true;
 };
 
-/// The atomizer (and its fan: parameter fan) on while active; never finishes. The board stops it
-/// when the tank runs dry (BoardMonitor posts board.tank_empty).
-class BhAtomize final : public CActuatorBehavior {
+/// Plays the WT2003S track `track` once (channel voice): writes it at its first step, succeeds at
+/// the next, when the board has been given it.
+class BhVoicePrompt final : public CBehavior {
  public:
   static const ModuleManifest& static_manifest();
 
  protected:
   const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  void on_activate(const ParameterSet& params, const BehaviorContext& context) override;
+  std::optional<Twist2D> on_step(const BehaviorContext& context) noexcept override;
+
+ private:
+  double track_ = 0.0;
 };
 
-/// Plays the WT2003S track `track` once; succeeds at its first step.
-class BhVoicePrompt final : public CActuatorBehavior {
+/// Shows `text` on the LCD's first line (channel lcd) while active; never finishes.
+class BhLcdText final : public CBehavior {
  public:
   static const ModuleManifest& static_manifest();
 
  protected:
   const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
-  std::optional<Twist2D> on_step(const BehaviorContext& /*context*/) noexcept override {
-    succeed();
-    return std::nullopt;
-  }
+  void on_activate(const ParameterSet& params, const BehaviorContext& context) override;
+  std::optional<Twist2D> on_step(const BehaviorContext& context) noexcept override;
+
+ private:
+  ChannelValue text_;
 };
 
 /// The voice chip's tracks the disinfection task plays.
 inline constexpr double kTrackAddDisinfectant = 3;
 
-/// Registers BhUvLamp, BhAtomize and BhVoicePrompt.
+/// Registers BhUvLamp, BhAtomize, BhVoicePrompt and BhLcdText.
 void register_board_behaviors(BehaviorRegistry& registry);
 
 }  // namespace tripodal::board

@@ -2,9 +2,12 @@
 // base behind the control board's UART (seed 001). The wheels are the board's motors (speeds out
 // in DRIVE, odometry from its encoders), its sensors are the robot's resources (battery,
 // ultrasonic, cliff infrared, bumpers), and a missing, late or corrupt response makes the wheels
-// refuse writes (the base controller reports a hardware fault) within two control periods.
+// refuse writes (the base controller reports a hardware fault) within two control periods. Its
+// actuators are command channels (uv_lamp, atomizer, atomizer_fan, voice, lcd): each cycle the
+// values the behavior loop fused become board commands where they changed.
 #pragma once
 
+#include <array>
 #include <memory>
 
 #include "tripodal/board/board_link.hpp"
@@ -48,7 +51,8 @@ class BoardHardware final : public CHardware, public HardwareInterface, public B
   /// From the latest DRIVE response; false before one or while the link is lost.
   bool read_wheel_states(std::span<double> velocity_rad_s, std::span<double> position_rad) noexcept override;
 
-  /// One link cycle (the "board_link" resource's poll calls it every control period).
+  /// One link cycle (the "board_link" resource's poll calls it every control period): first the
+  /// board commands of the command channels that changed since the last cycle.
   void cycle(Time now) noexcept;
   /// True once per link loss: what a module posts as `board.link_lost`.
   [[nodiscard]] bool take_link_lost() noexcept { return link_.take_link_lost(); }
@@ -68,6 +72,7 @@ class BoardHardware final : public CHardware, public HardwareInterface, public B
  private:
   class LinkResource;
   void publish(Time now) noexcept;
+  void apply_channels() noexcept;
 
   std::unique_ptr<ByteStream> owned_;
   BoardHardwareConfig config_;
@@ -79,6 +84,7 @@ class BoardHardware final : public CHardware, public HardwareInterface, public B
   InfraredResource cliff_{"cliff"};
   BumperResource bumpers_{"bumpers"};
   std::unique_ptr<RplidarA1> lidar_;
+  std::array<ChannelValue, 5> applied_{};  // the channels' values last sent, by channel index
 };
 
 /// The host side's configuration from a profile's hardware entry of type "board" (ConfigError

@@ -7,8 +7,7 @@
 //   board.emergency_stop  the e-stop pressed: the board has already braked; a fault
 //   board.tank_empty / board.tank_refilled   the liquid level module's empty flag changed
 //   board.battery_low     the battery at or below battery_low_percent (and not charging)
-// and serves the actuator behaviors (actuator_behaviors.hpp): their board commands at activation
-// and deactivation.
+// It only reads: the actuators are command channels the behaviors write (actuator_behaviors.hpp).
 // A fault is also reported as the module's failure ("<module>.fault"), so every running process
 // fails unless its net takes the event, and the planner's recovery rules decide.
 #pragma once
@@ -31,8 +30,6 @@ class BoardMonitor final : public CModule {
   /// Throws std::runtime_error (the module's fault) on a link loss or an emergency stop.
   void on_update(ModuleContext& context) override;
   void on_configure(const ParameterSet& params) override;
-  void on_behavior_activated(const BehaviorActivation& activation, ModuleContext& context) override;
-  void on_behavior_deactivated(std::string_view behavior, ModuleContext& context) override;
 
  private:
   BoardHost* host_ = nullptr;

@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "tripodal/core/command_channel.hpp"
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/core/value.hpp"
 
@@ -72,6 +73,11 @@ struct ModuleManifest {
   std::vector<std::string> inputs;
   std::vector<std::string> outputs;
   std::vector<ParameterSpec> parameters;
+  /// Behaviors: the command channels the behavior writes (at most kMaxBehaviorChannels; its
+  /// writes are indexed in this order). Hardware: the channels every instance of the type
+  /// exports (an instance may export more, e.g. the joints of its world).
+  std::vector<ChannelWrite> writes;
+  std::vector<ChannelSpec> command_channels;
 
   [[nodiscard]] const ParameterSpec* find_parameter(std::string_view parameter) const noexcept;
 };
@@ -97,6 +103,12 @@ class ManifestBuilder {
                           std::optional<double> max = std::nullopt);
   ManifestBuilder& text(std::string name, std::optional<std::string> default_value, std::string description);
   ManifestBuilder& flag(std::string name, std::optional<bool> default_value, std::string description);
+  /// A command channel the behavior writes, by name ...
+  ManifestBuilder& writes(std::string channel, ChannelType type, std::string description);
+  /// ... or named by the value of its string parameter `parameter`.
+  ManifestBuilder& writes_named_by(std::string parameter, ChannelType type, std::string description);
+  /// A command channel the hardware type exports.
+  ManifestBuilder& command_channel(ChannelSpec spec);
   [[nodiscard]] ModuleManifest build() const& { return manifest_; }
   [[nodiscard]] ModuleManifest build() && { return std::move(manifest_); }
 

@@ -1,6 +1,7 @@
 // CHardware: the robot's hardware as its runtime owns it, below the reactive layer — the wheels the
-// base controller drives (HardwareInterface) and the sensors that publish into the reactive loop's
-// resources. The robot profile's `hardware:` slot names its type: "sim" (the embedded simulator,
+// base controller drives (HardwareInterface), the command channels it exports for everything else
+// it drives (joints, lamp, atomizer, voice, LCD; core/command_channel.hpp) and the sensors that
+// publish into the reactive loop's resources. The robot profile's `hardware:` slot names its type: "sim" (the embedded simulator,
 // sim/sim_hardware.hpp) or one an application registers (e.g. a serial control board).
 #pragma once
 
@@ -40,6 +41,9 @@ class CHardware {
   [[nodiscard]] const ModuleManifest& manifest() const noexcept { return do_manifest(); }
   /// The wheels of the base controller. Called from the reactive loop's thread.
   [[nodiscard]] HardwareInterface& wheels() noexcept { return do_wheels(); }
+  /// The command channels it exports: the behavior loop writes their fused values every cycle
+  /// (its thread), the hardware applies them in its own cycle. Fixed after construction.
+  [[nodiscard]] CommandChannels& command_channels() noexcept { return do_command_channels(); }
   /// Adds the sensors' resources to the reactive loop's table (once, at assembly).
   void add_resources(ResourceTable& table) { on_add_resources(table); }
   /// Simulated hardware moves with simulated time: the robot's simulation driver calls this before
@@ -53,10 +57,17 @@ class CHardware {
   CHardware() = default;
   [[nodiscard]] virtual const ModuleManifest& do_manifest() const noexcept = 0;
   [[nodiscard]] virtual HardwareInterface& do_wheels() noexcept = 0;
+  /// A hardware that embeds another (the simulated board) hands out the embedded one's channels.
+  [[nodiscard]] virtual CommandChannels& do_command_channels() noexcept { return channels_; }
+  /// Exports a channel (from the constructor); returns its index.
+  std::size_t export_channel(ChannelSpec spec) { return channels_.add(std::move(spec)); }
   virtual void on_add_resources(ResourceTable& /*table*/) {}
   virtual void on_advance_to(Time /*now*/) noexcept {}
   virtual void on_start() {}
   virtual void on_stop() noexcept {}
+
+ private:
+  CommandChannels channels_;
 };
 
 /// A manifest for a hardware type: layer reactive, kind other (below the reactive layer's

@@ -91,7 +91,8 @@ class ControlLoop final {
   /// behavior's name). Parameters are resolved and on_activate() runs on the caller's thread;
   /// the behavior joins the loop at its next cycle. A behavior already bound to that input is
   /// replaced. Throws ConfigError for bad parameters (located at `where`), std::invalid_argument
-  /// for an input the coordinator does not have or when every slot is taken.
+  /// for an input the coordinator does not have or when every slot is taken; ConfigError when the
+  /// behavior writes a command channel the coordinator does not have (or of another type).
   BehaviorHandle activate(std::unique_ptr<CBehavior> behavior, const ParameterValues& params,
                           std::string_view input = {}, const SourceLocation& where = {});
   /// Removes the behavior at its next cycle; false for an unknown or stale handle.
@@ -137,6 +138,10 @@ class ControlLoop final {
   /// The odometry resource the loop publishes the controller's odometry to after each cycle
   /// (nullptr: none). Set before the loop runs.
   void set_odometry_output(OdometryResource* odometry) noexcept { odometry_out_ = odometry; }
+  /// The channels (the hardware's) the loop writes the coordinator's fused channels into after
+  /// each cycle, for the hardware to apply (nullptr: none). They must be the coordinator's
+  /// channels in its order (std::invalid_argument otherwise). Set before the loop runs.
+  void set_command_output(CommandChannels* channels);
 
   [[nodiscard]] const ControlLoopOptions& options() const noexcept { return options_; }
   [[nodiscard]] const std::string& name() const noexcept { return options_.name; }
@@ -150,9 +155,15 @@ class ControlLoop final {
   [[nodiscard]] std::uint64_t deferred_applies() const noexcept { return deferred_.load(std::memory_order_relaxed); }
 
  private:
+  // The coordinator's channels a behavior's declared writes go to, by declaration index.
+  struct ChannelBinding {
+    std::array<ChannelId, kMaxBehaviorChannels> ids{};
+    std::uint8_t count = 0;
+  };
   struct Slot {
     std::unique_ptr<CBehavior> behavior;
     InputId input = 0;
+    ChannelBinding channels;
     std::uint32_t generation = 0;
     BehaviorStatus last_status = BehaviorStatus::idle;
     bool active = false;
@@ -162,6 +173,7 @@ class ControlLoop final {
     InputId input = 0;
     std::uint32_t slot = 0;
     std::uint32_t generation = 0;
+    ChannelBinding channels;
   };
   struct PendingLock {
     LockId lock = 0;
@@ -170,6 +182,8 @@ class ControlLoop final {
   };
 
   void apply_pending() noexcept;
+  [[nodiscard]] ChannelBinding bind_channels(const CBehavior& behavior, const SourceLocation& where) const;
+  [[nodiscard]] std::string exported_channels() const;
   bool deactivate_locked(BehaviorHandle handle);
   void push_event(const LoopEvent& event) noexcept;
   void retire(Slot& slot) noexcept;
@@ -179,6 +193,7 @@ class ControlLoop final {
   CBehaviorCoordinator coordinator_;
   std::unique_ptr<CController> controller_;
   OdometryResource* odometry_out_ = nullptr;
+  CommandChannels* channels_out_ = nullptr;
   BaseCapabilities base_;
 
   // Loop-thread state.

@@ -33,6 +33,11 @@ struct DescribedModule {
   SourceLocation where;
   /// Inputs bound to one provider by name (the profile entry's `from:`), where several provide it.
   std::map<std::string, std::string, std::less<>> from;
+  /// Behaviors: the command channels they write ("uv_lamp", "<joint>" for one their parameter
+  /// names). Hardware: the command channels its type exports.
+  std::vector<ChannelWrite> writes;
+  std::vector<ChannelSpec> channels;
+  bool hardware = false;  ///< the profile's hardware entry
 };
 
 struct RobotDescription {
@@ -58,7 +63,8 @@ struct CoreNames {
                                               const std::vector<std::string>& planner_inputs, Diagnostics& diagnostics);
 
 /// Only the checks, over an already resolved list of modules: exactly one provider per input
-/// (R0) and the layering rules R1-R5 (docs/processes.md).
+/// (R0), the layering rules R1-R5 (docs/processes.md) and R6: a command channel a behavior
+/// writes by name is one the hardware exports, of the same type (when the hardware is described).
 void check_layering(const std::vector<DescribedModule>& modules, Diagnostics& diagnostics);
 
 /// The knowledge functions task templates ask for in their foreach lists ("sections"), sorted.

@@ -67,6 +67,7 @@ class SimBoardHardware final : public CHardware, public board::BoardHost, public
   [[nodiscard]] const Simulator& world_sim() const noexcept override { return sim_; }
   [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
   [[nodiscard]] HardwareInterface& do_wheels() noexcept override { return board_.host().wheels(); }
+  [[nodiscard]] CommandChannels& do_command_channels() noexcept override { return board_.host().command_channels(); }
   void on_add_resources(ResourceTable& table) override;
   void on_advance_to(Time now) noexcept override;
 

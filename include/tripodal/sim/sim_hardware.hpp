@@ -56,7 +56,7 @@ class SimHardware : public CHardware, public SimulatorSources {
   [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
   [[nodiscard]] HardwareInterface& do_wheels() noexcept override { return sim_; }
   void on_add_resources(ResourceTable& table) override;
-  /// Takes the joints' commands, steps the simulator, publishes the joints' states.
+  /// Applies the joints' command channels, steps the simulator, publishes the joints' states.
   void on_advance_to(Time now) noexcept override;
 
  private:
@@ -65,6 +65,7 @@ class SimHardware : public CHardware, public SimulatorSources {
   std::uint64_t seed_;
   Simulator sim_;
   std::vector<std::unique_ptr<JointResource>> joints_;  // World robot.joints, same order
+  std::vector<ChannelValue> joint_applied_;             // the joints' channels as last applied
 };
 
 /// The parameter "seed" of the simulated hardware types, and the seed it gives in world `w`
