@@ -83,15 +83,27 @@ CoverageResult distance_transform_coverage(const OccupancyGrid& grid, const Sect
 
   // Where the robot may stand: inside the section, half the tool from its boundary and the body's
   // radius from anything physical (as CoveragePlanner has it).
-  std::vector<bool> outside(grid.size(), true);
-  for (const std::size_t i : section.cells) outside[i] = false;
-  std::vector<bool> physical(grid.size(), false);
-  for (std::size_t i = 0; i < grid.size(); ++i) physical[i] = grid.state(i) != Occupancy::free;
-  const DistanceField to_boundary(grid.width(), grid.height(), res, outside);
-  const DistanceField to_obstacle(grid.width(), grid.height(), res, physical);
+  // Computed in a window around the section (its extent and a margin beyond the body and the
+  // tool): a floor's rooms each cost their own size, not the floor's.
+  const int margin = static_cast<int>(std::ceil(std::max(body, half) / res)) + 2;
+  const int wx0 = std::max(0, section.min.x - margin), wy0 = std::max(0, section.min.y - margin);
+  const int wx1 = std::min(grid.width() - 1, section.max.x + margin), wy1 = std::min(grid.height() - 1, section.max.y + margin);
+  const int ww = wx1 - wx0 + 1, wh = wy1 - wy0 + 1;
+  const auto local = [&](std::size_t i) {
+    const CellIndex c = grid.cell(i);
+    return static_cast<std::size_t>(c.y - wy0) * static_cast<std::size_t>(ww) + static_cast<std::size_t>(c.x - wx0);
+  };
+  std::vector<bool> outside(static_cast<std::size_t>(ww) * static_cast<std::size_t>(wh), true);
+  for (const std::size_t i : section.cells) outside[local(i)] = false;
+  std::vector<bool> physical(outside.size(), false);
+  for (int y = wy0; y <= wy1; ++y) {
+    for (int x = wx0; x <= wx1; ++x) physical[static_cast<std::size_t>(y - wy0) * static_cast<std::size_t>(ww) + static_cast<std::size_t>(x - wx0)] = !grid.is_free({x, y});
+  }
+  const DistanceField to_boundary(ww, wh, res, outside);
+  const DistanceField to_obstacle(ww, wh, res, physical);
   std::vector<bool> standable(grid.size(), false);
   for (const std::size_t i : section.cells) {
-    standable[i] = to_boundary.clearance_m(i) >= half - 1e-9 && to_obstacle.clearance_m(i) >= body - 1e-9;
+    standable[i] = to_boundary.clearance_m(local(i)) >= half - 1e-9 && to_obstacle.clearance_m(local(i)) >= body - 1e-9;
   }
 
   // The tool-sized cells over the section's extent.
@@ -192,13 +204,13 @@ CoverageResult distance_transform_coverage(const OccupancyGrid& grid, const Sect
 
   // Reachable: section cells within half the tool of a standable cell; covered: of those, the
   // ones the footprint sweeps along the path.
-  std::vector<bool> stand(grid.size(), false);
-  for (const std::size_t i : section.cells) stand[i] = standable[i];
-  const DistanceField to_stand(grid.width(), grid.height(), res, stand, false);
+  std::vector<bool> stand(outside.size(), false);
+  for (const std::size_t i : section.cells) stand[local(i)] = standable[i];
+  const DistanceField to_stand(ww, wh, res, stand, false);
   CleanedCells cleaned(grid);
   cleaned.mark_path(r.path, half);
   for (const std::size_t i : section.cells) {
-    if (to_stand.distance_m(i) > half + 1e-9) continue;
+    if (to_stand.distance_m(local(i)) > half + 1e-9) continue;
     ++r.reachable_cells;
     if (cleaned.cleaned(i)) ++r.covered_cells;
   }

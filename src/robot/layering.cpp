@@ -189,13 +189,13 @@ RobotDescription describe_robot(const RobotProfile& profile, const RobotPlugins&
   pin.push_back("process_result");
   out.modules.push_back(DescribedModule{CoreNames::kPlanner, "CPlanner", ModuleKind::planner, Layer::deliberate, true,
                                         "turns task commands into plans of process modules; recovers from faults",
-                                        pin, {"process_plan"}, profile.where, {}, {}, false});
+                                        pin, {"process_plan"}, profile.where, {}, {}, {}, false});
   out.modules.push_back(DescribedModule{CoreNames::kSupervisor, "CProcessSupervisor", ModuleKind::other, Layer::sequencing, true,
                                         "runs the processes' nets, activates behaviors, posts faults",
-                                        {"process_plan"}, {"process_result"}, profile.where, {}, {}, false});
+                                        {"process_plan"}, {"process_result"}, profile.where, {}, {}, {}, false});
   out.modules.push_back(DescribedModule{CoreNames::kCoordinator, "CBehaviorCoordinator", ModuleKind::other, Layer::reactive,
                                         true, "fuses the commands and the command channels of the active behaviors", {"behavior_command*"},
-                                        {"cmd_vel"}, profile.where, {}, {}, false});
+                                        {"cmd_vel"}, profile.where, {}, {}, {}, false});
   std::vector<const ModuleEntry*> entries;
   if (profile.hardware) entries.push_back(&*profile.hardware);
   for (const ModuleEntry* e : profile.all_modules()) entries.push_back(e);
