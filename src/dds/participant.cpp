@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <map>
 #include <stdexcept>
+#include <filesystem>
 #include <mutex>
 #include <string>
 
@@ -47,6 +48,35 @@ struct detail::Domain {
 };
 
 namespace {
+// The OMG DDS Security plugins and the identity's files, as participant QoS properties (Cyclone
+// DDS reads "dds.sec.*"); the files are checked first so a missing one is named, not Cyclone's
+// "Error".
+void apply_security(dds_qos_t* qos, const SecurityFiles& f, const std::string& where) {
+  for (const auto& p : {f.identity_ca, f.identity_certificate, f.private_key, f.permissions_ca, f.governance, f.permissions}) {
+    if (!std::filesystem::is_regular_file(p)) throw DdsError(where + ": security file " + p.string() + " does not exist");
+  }
+  const std::filesystem::path lib = security_plugin_dir();
+  const auto file = [](const std::filesystem::path& p) { return "file:" + std::filesystem::absolute(p).string(); };
+  const std::pair<const char*, std::string> props[] = {
+      {"dds.sec.auth.library.path", (lib / "libdds_security_auth.so").string()},
+      {"dds.sec.auth.library.init", "init_authentication"},
+      {"dds.sec.auth.library.finalize", "finalize_authentication"},
+      {"dds.sec.crypto.library.path", (lib / "libdds_security_crypto.so").string()},
+      {"dds.sec.crypto.library.init", "init_crypto"},
+      {"dds.sec.crypto.library.finalize", "finalize_crypto"},
+      {"dds.sec.access.library.path", (lib / "libdds_security_ac.so").string()},
+      {"dds.sec.access.library.init", "init_access_control"},
+      {"dds.sec.access.library.finalize", "finalize_access_control"},
+      {"dds.sec.auth.identity_ca", file(f.identity_ca)},
+      {"dds.sec.auth.identity_certificate", file(f.identity_certificate)},
+      {"dds.sec.auth.private_key", file(f.private_key)},
+      {"dds.sec.access.permissions_ca", file(f.permissions_ca)},
+      {"dds.sec.access.governance", file(f.governance)},
+      {"dds.sec.access.permissions", file(f.permissions)},
+  };
+  for (const auto& [name, value] : props) dds_qset_prop(qos, name, value.c_str());
+}
+
 std::mutex domains_mutex;
 std::map<std::uint32_t, std::weak_ptr<detail::Domain>>& domains() {
   static std::map<std::uint32_t, std::weak_ptr<detail::Domain>> registry;
@@ -90,6 +120,7 @@ Participant::Participant(const ParticipantOptions& options) : options_(options) 
   const detail::QosPtr qos(dds_create_qos());
   static constexpr std::string_view kEnclave = "enclave=/;";
   dds_qset_userdata(qos.get(), kEnclave.data(), kEnclave.size());
+  if (options.security) apply_security(qos.get(), *options.security, where);
   handle_ = dds_create_participant(options.domain_id, qos.get(), nullptr);
   detail::check(handle_, where + ": dds_create_participant");
   graph_ = std::make_shared<detail::NodeGraph>(handle_);

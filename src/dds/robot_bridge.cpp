@@ -85,6 +85,7 @@ struct RobotBridge::Impl final : TaskObserver, SupervisorObserver {
     po.domain_id = s.domain_id;
     po.network = s.loopback ? Network::loopback : Network::system;
     if (s.participant_lease) po.participant_lease = std::chrono::duration_cast<std::chrono::milliseconds>(*s.participant_lease);
+    if (!s.security_identity.empty()) po.security = fleet_identity(s.security_keys, s.security_identity);
     participant = std::make_unique<Participant>(po);
     participant->declare_node("tripodal", s.ros_namespace);
     if (s.publishes("odom")) odom.emplace(*participant, name("odom"), EndpointOptions{.kind = TopicKind::state});

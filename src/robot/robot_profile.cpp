@@ -180,8 +180,21 @@ struct Parser {
   void dds_section(const YAML::Node& n, RobotProfile& prof) {
     DdsSection s;
     s.where = at(n);
-    if (!r.expect_keys(n, {"domain_id", "namespace", "loopback", "participant_lease_s", "period_s", "publish", "tasks", "frames"}, "dds")) {
+    if (!r.expect_keys(n, {"domain_id", "namespace", "loopback", "participant_lease_s", "period_s", "publish", "tasks", "frames", "security"},
+                       "dds")) {
       return;
+    }
+    if (const YAML::Node v = n["security"]) {
+      if (r.expect_keys(v, {"keys", "identity"}, "dds security")) {
+        const auto keys = v["keys"] ? r.text(v["keys"], "dds security keys") : std::nullopt;
+        const auto identity = v["identity"] ? r.text(v["identity"], "dds security identity") : std::nullopt;
+        if (!keys || !identity) {
+          d.error(at(v), "dds security needs keys (the folder `tripodal fleet-keys` made) and identity (this robot's name in it)");
+        } else {
+          s.security_keys = std::filesystem::path(*keys).is_absolute() ? std::filesystem::path(*keys) : prof.dir / *keys;
+          s.security_identity = *identity;
+        }
+      }
     }
     if (const YAML::Node v = n["domain_id"]) {
       if (auto id = r.integer(v, "dds domain_id", 0, 232)) s.domain_id = static_cast<std::uint32_t>(*id);

@@ -5,11 +5,13 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 
 #include "tripodal/dds/messages.hpp"
+#include "tripodal/dds/security.hpp"
 
 namespace tripodal::dds {
 
@@ -33,6 +35,9 @@ struct ParticipantOptions {
   std::chrono::milliseconds participant_lease{std::chrono::seconds(10)};
   // Participants discovered per host on loopback (Discovery/MaxAutoParticipantIndex).
   std::uint32_t max_participants = 32;
+  // DDS Security (security.hpp): the identity's files; unset, the participant is not secured
+  // (and a secured fleet will not talk to it).
+  std::optional<SecurityFiles> security;
 };
 
 namespace detail {

@@ -94,6 +94,10 @@ struct DdsSection {
   /// `frames: {laser: [x_m, y_m, theta_rad]}`: the sensors' mounts on tf_static (laser resources
   /// not listed go there at the base's origin).
   std::vector<DdsFrame> frames;
+  /// `security: {keys: DIR, identity: NAME}`: DDS Security with the identity NAME of the fleet's
+  /// keys in DIR (made by `tripodal fleet-keys`; relative to the profile). Empty: not secured.
+  std::filesystem::path security_keys;
+  std::string security_identity;
   SourceLocation where;
   [[nodiscard]] bool publishes(std::string_view topic) const noexcept {
     for (const std::string& t : publish) {
