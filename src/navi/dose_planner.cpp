@@ -141,7 +141,8 @@ DosePlan plan_dose(const UvLamp& lamp, double target_j_m2, const DoseLimits& lim
         "passes at the minimum speed {} m/s give at most {:.3g} J/m^2",
         target_j_m2, lamp.uvc_power_w, lamp.height_m, s, limits.max_passes, limits.min_speed_m_s, most));
   }
-  best.reach_m = lateral_reach_m(lamp, target_j_m2, limits.min_speed_m_s, best.passes);
+  // The wall round may run the tracking error farther out than planned, as the lanes may.
+  best.reach_m = std::max(0.0, lateral_reach_m(lamp, target_j_m2, limits.min_speed_m_s, best.passes) - limits.tracking_error_m);
   return best;
 }
 
@@ -158,7 +159,9 @@ double lane_speed_m_s(const UvLamp& lamp, const DosePlan& plan, const DoseLimits
 
 std::vector<double> lane_speeds(const std::vector<Point2D>& path, const UvLamp& lamp, const DosePlan& plan,
                                 const DoseLimits& limits, double min_lane_m) {
-  std::vector<double> speeds(path.size(), plan.speed_m_s);
+  // Legs that are not lanes (the wall round's cell chains, short links, touch-ups) have floor on
+  // their outer side that no lane doses: the minimum speed, which gives the target out to reach_m.
+  std::vector<double> speeds(path.size(), limits.min_speed_m_s);
   struct Lane {
     std::size_t leg;
     Point2D a;
@@ -187,6 +190,30 @@ std::vector<double> lane_speeds(const std::vector<Point2D>& path, const UvLamp& 
   }
   if (speeds.size() >= 2) speeds.back() = speeds[speeds.size() - 2];
   return speeds;
+}
+
+DosePath dose_path(const std::vector<Point2D>& path, const UvLamp& lamp, const DosePlan& plan, const DoseLimits& limits,
+                   double min_lane_m) {
+  const std::vector<double> speeds = lane_speeds(path, lamp, plan, limits, min_lane_m);
+  DosePath out;
+  out.path.reserve(path.size());
+  out.speed_m_s.reserve(path.size());
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    out.path.push_back(path[i]);
+    out.speed_m_s.push_back(speeds[i]);
+    if (i + 1 == path.size()) break;
+    const double dx = path[i + 1].x_m - path[i].x_m, dy = path[i + 1].y_m - path[i].y_m;
+    const double len = std::hypot(dx, dy);
+    if (len < min_lane_m) continue;
+    const double end = std::min(lamp.radius_m, len / 2.0);
+    const double slow = std::max(limits.min_speed_m_s, speeds[i] / 2.0);
+    out.speed_m_s.back() = slow;
+    out.path.push_back({path[i].x_m + dx * end / len, path[i].y_m + dy * end / len});
+    out.speed_m_s.push_back(speeds[i]);
+    out.path.push_back({path[i + 1].x_m - dx * end / len, path[i + 1].y_m - dy * end / len});
+    out.speed_m_s.push_back(slow);
+  }
+  return out;
 }
 
 double path_time_s(const std::vector<Point2D>& path, const std::vector<double>& speeds) noexcept {

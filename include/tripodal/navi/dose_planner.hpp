@@ -65,7 +65,8 @@ struct DosePlan {
   double min_dose_j_m2 = 0.0;   ///< the least dose between lanes at spacing + tracking error
   double area_rate_m2_s = 0.0;  ///< floor dosed per second of lane travel: spacing * speed / passes
   /// Beside the outermost lane (the wall round), the floor within this lateral distance gets the
-  /// target in `passes` passes at the minimum speed: the floor the lamp can dose at all.
+  /// target in `passes` passes at the minimum speed even with the round the tracking error off its
+  /// line: the floor the lamp can dose at all.
   double reach_m = 0.0;
 };
 
@@ -86,10 +87,24 @@ struct DosePlan {
 
 /// The speed limit of each leg of a coverage path (speeds[i]: the leg from path[i] to path[i+1];
 /// the last entry repeats): a straight leg at least `min_lane_m` long is a lane, sped up per
-/// lane_speed_m_s() from its nearest parallel neighbours that overlap it; every other leg (wall
-/// round, links, touch-ups) keeps the plan's speed.
+/// lane_speed_m_s() from its nearest parallel neighbours that overlap it; every shorter leg (the
+/// wall round's cell chains, short links, touch-ups) goes at the minimum speed, which doses the
+/// floor beside it out to the plan's reach_m where no lane does.
 [[nodiscard]] std::vector<double> lane_speeds(const std::vector<Point2D>& path, const UvLamp& lamp, const DosePlan& plan,
                                               const DoseLimits& limits, double min_lane_m = 0.5);
+
+/// A coverage path with its speed limits (DosePath::speed_m_s[i]: the leg from path[i] on).
+struct DosePath {
+  std::vector<Point2D> path;
+  std::vector<double> speed_m_s;
+};
+
+/// The coverage path as driven for the dose: lane_speeds(), and each lane's last lit radius at
+/// each end split off at half its speed (not below the minimum): a lane end gets light from one
+/// side of the lamp only, so half the dose of the lane's middle at the same speed; at half speed
+/// its end point gets the middle's dose.
+[[nodiscard]] DosePath dose_path(const std::vector<Point2D>& path, const UvLamp& lamp, const DosePlan& plan,
+                                 const DoseLimits& limits, double min_lane_m = 0.5);
 
 /// Time (s) to drive `path` at these per-leg speeds (turns not counted; +inf for a leg of speed 0).
 [[nodiscard]] double path_time_s(const std::vector<Point2D>& path, const std::vector<double>& speeds) noexcept;
