@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace tripodal::navi {
 
@@ -64,9 +65,11 @@ bool ObstacleReplanner::observe(const CGridMaps& maps, const ModuleContext& cont
   return seen_.size() != before;
 }
 
-void PublishedPath::publish(const std::vector<Point2D>& points, double start_m, bool final, ModuleContext& context) {
+void PublishedPath::publish(const std::vector<Point2D>& points, double start_m, bool final, ModuleContext& context,
+                            const std::vector<double>& speeds_m_s) {
   points_.clear();
   s_.clear();
+  speeds_ = speeds_m_s;
   for (const Point2D& p : points) {
     s_.push_back(points_.empty() ? 0.0 : s_.back() + std::hypot(p.x_m - points_.back().x_m, p.y_m - points_.back().y_m));
     points_.push_back({p.x_m, p.y_m, 0.0});
@@ -74,6 +77,7 @@ void PublishedPath::publish(const std::vector<Point2D>& points, double start_m, 
   id_ = context.new_path_id();
   NavigationData& n = *context.navigation;
   n.path = points_;
+  n.path_speed_m_s = speeds_;
   n.path_id = id_;
   n.path_start_m = start_m;
   n.path_final = final;
@@ -88,6 +92,7 @@ void PublishedPath::fail(std::string_view reason, ModuleContext& context) {
   id_ = context.new_path_id();
   NavigationData& n = *context.navigation;
   n.path = {};
+  n.path_speed_m_s = {};
   n.path_id = id_;
   n.path_failure = reason;
   n.has_goal = false;
@@ -97,6 +102,7 @@ void PublishedPath::withdraw(ModuleContext& context) {
   NavigationData& n = *context.navigation;
   if (n.path_id != id_ || id_ == 0) return;  // another module's path is being followed now
   n.path = {};
+  n.path_speed_m_s = {};
   n.path_id = 0;
   n.path_failure = {};
   n.has_goal = false;
@@ -221,7 +227,21 @@ const ModuleManifest& CCoverageModule::static_manifest() {
                      "hybrid (a wall-following round, then lanes), balloon (the paper's wall-following rounds) or "
                      "boustrophedon (plough lanes)", {}, {}},
        ParameterSpec{"serves", ValueType::string, Value{std::string("BhCleaning, BhCleaningTwoWheel")}, "",
-                     "the behaviors it gives coverage paths to, comma separated (their parameter `section`)", {}, {}}});
+                     "the behaviors it gives coverage paths to, comma separated (their parameter `section`)", {}, {}},
+       ParameterSpec{"dose_target_j_m2", ValueType::number, Value{0.0}, "J/m^2",
+                     "UV disinfection: the dose every point between the lanes must get; lanes spaced and speeds "
+                     "limited for it from the lamp (docs/coverage.md, \"A dose that is reached\"). 0: off", 0.0, 1e6},
+       ParameterSpec{"uv_power_w", ValueType::number, Value{UvLamp{}.uvc_power_w}, "W", "the UV lamp's UVC output", 0.0, 1000.0, true},
+       ParameterSpec{"uv_height_m", ValueType::number, Value{UvLamp{}.height_m}, "m", "the UV lamp above the floor", 0.0, 1.0, true},
+       ParameterSpec{"uv_radius_m", ValueType::number, Value{UvLamp{}.radius_m}, "m", "the UV lamp's lit disc on the floor", 0.0, 5.0, true},
+       ParameterSpec{"dose_min_speed_m_s", ValueType::number, Value{DoseLimits{}.min_speed_m_s}, "m/s",
+                     "the slowest lane speed the plan may ask for", 0.0, 5.0, true},
+       ParameterSpec{"dose_max_speed_m_s", ValueType::number, Value{DoseLimits{}.max_speed_m_s}, "m/s",
+                     "the fastest lane speed (the cleaning behavior's cruise speed)", 0.0, 5.0, true},
+       ParameterSpec{"dose_max_passes", ValueType::number, Value{static_cast<double>(DoseLimits{}.max_passes)}, "",
+                     "passes over the same lanes the plan may ask for", 1.0, 10.0},
+       ParameterSpec{"dose_tracking_error_m", ValueType::number, Value{DoseLimits{}.tracking_error_m}, "m",
+                     "lanes may lie this much farther apart than planned (tracking error, cells)", 0.0, 0.5}});
   return m;
 }
 
@@ -238,6 +258,25 @@ void CCoverageModule::on_configure(const ParameterSet& params) {
   }
   pattern_ = pattern;
   serves_ = split_names(params.string("serves"));
+  footprint_width_m_ = options_.cleaning_width_m;
+  lamp_ = UvLamp{params.number("uv_power_w"), params.number("uv_height_m"), params.number("uv_radius_m")};
+  dose_limits_.min_speed_m_s = params.number("dose_min_speed_m_s");
+  dose_limits_.max_speed_m_s = params.number("dose_max_speed_m_s");
+  dose_limits_.max_passes = static_cast<int>(params.number("dose_max_passes"));
+  dose_limits_.tracking_error_m = params.number("dose_tracking_error_m");
+  dose_plan_.reset();
+  if (const double target = params.number("dose_target_j_m2"); target > 0.0) {
+    if (pattern_ != "hybrid") throw ConfigError(where(), "CoveragePlanner: dose_target_j_m2 plans lanes: it needs pattern hybrid");
+    // Lanes on grid rows, at most the lit disc's diameter apart.
+    dose_limits_.max_spacing_m = std::max(dose_limits_.min_spacing_m, 2.0 * lamp_.radius_m);
+    try {
+      dose_plan_ = plan_dose(lamp_, target, dose_limits_);
+    } catch (const std::invalid_argument& e) {
+      throw ConfigError(where(), std::string("CoveragePlanner: ") + e.what());
+    }
+    // The hybrid planner spaces lanes cleaning_width - lane_overlap apart.
+    options_.cleaning_width_m = dose_plan_->spacing_m + options_.lane_overlap_m;
+  }
   planner_.reset();
 }
 
@@ -262,7 +301,28 @@ CoveragePlanner& CCoverageModule::planner() {
 CoverageResult CCoverageModule::plan(const Section& section, Point2D from) {
   if (pattern_ == "boustrophedon") return planner().boustrophedon(section, from);
   if (pattern_ == "balloon") return planner().balloon(section, from);
-  return planner().hybrid(section, from, next_section_centroid(section));
+  CoverageResult r = planner().hybrid(section, from, next_section_centroid(section));
+  if (dose_plan_) {
+    // The grid quantises lanes to cells: the planner's real spacing is one cell finer than the
+    // plan's at most, never wider (hybrid spreads lanes at most one spacing apart).
+    DosePath driven = dose_path(r.path, lamp_, *dose_plan_, dose_limits_, 2.0 * dose_plan_->spacing_m);
+    r.path = std::move(driven.path);
+    r.speed_m_s = std::move(driven.speed_m_s);
+    // Further passes go back over the same path, reversed (no walk back to the start).
+    const std::vector<Point2D> one = r.path;
+    const std::vector<double> speeds = r.speed_m_s;
+    for (int k = 1; k < dose_plan_->passes; ++k) {
+      const bool back = k % 2 == 1;
+      for (std::size_t i = 1; i < one.size(); ++i) {
+        const std::size_t j = back ? one.size() - 1 - i : i;
+        r.path.push_back(one[j]);
+        // The leg arriving at one[j] backwards is the leg leaving it forwards (j to j + 1).
+        r.speed_m_s.back() = back ? speeds[j] : speeds[j - 1];
+        r.speed_m_s.push_back(speeds[j]);
+      }
+    }
+  }
+  return r;
 }
 
 std::optional<Point2D> CCoverageModule::next_section_centroid(const Section& section) const {
@@ -327,7 +387,7 @@ void CCoverageModule::on_behavior_activated(const BehaviorActivation& activation
     it = progress_.insert_or_assign(section->name, std::move(p)).first;
   }
   active_ = &it->second;
-  coverage_path_.publish(active_->plan.path, active_->done_m, true, context);
+  coverage_path_.publish(active_->plan.path, active_->done_m, true, context, active_->plan.speed_m_s);
   rejoin(from, context);
 }
 
@@ -373,7 +433,7 @@ void CCoverageModule::on_update(ModuleContext& context) {
   } else if (detouring_ && fb.path_id == detour_.id() && fb.reached_end) {
     detouring_ = false;  // back on the coverage path, beyond the obstacle
     active_->done_m = std::max(active_->done_m, resume_m_);
-    coverage_path_.publish(active_->plan.path, active_->done_m, true, context);
+    coverage_path_.publish(active_->plan.path, active_->done_m, true, context, active_->plan.speed_m_s);
     return;
   }
   const bool following = fb.path_id != 0 && (fb.path_id == coverage_path_.id() || fb.path_id == detour_.id());

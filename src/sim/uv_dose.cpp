@@ -8,23 +8,6 @@
 
 namespace tripodal::sim {
 
-void validate(const UvLamp& lamp) {
-  const auto check = [](double v, const char* name) {
-    if (!std::isfinite(v) || v <= 0.0) {
-      throw std::invalid_argument(std::string("UV lamp: ") + name + " must be finite and > 0, got " + std::to_string(v));
-    }
-  };
-  check(lamp.uvc_power_w, "uvc_power_w");
-  check(lamp.height_m, "height_m");
-  check(lamp.radius_m, "radius_m");
-}
-
-double uv_irradiance_w_m2(const UvLamp& lamp, double r_m) noexcept {
-  if (!(r_m <= lamp.radius_m)) return 0.0;
-  const double d2 = r_m * r_m + lamp.height_m * lamp.height_m;
-  return lamp.uvc_power_w * lamp.height_m / (4.0 * std::numbers::pi * d2 * std::sqrt(d2));
-}
-
 UvDoseMap::UvDoseMap(const navi::OccupancyGrid& grid, UvLamp lamp) : grid_(grid), lamp_(lamp), dose_(grid.size(), 0.0) {
   validate(lamp_);
 }

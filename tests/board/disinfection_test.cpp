@@ -32,7 +32,11 @@ struct DisinfectionRobot {
     sim::register_sim_board_hardware(plugins.hardware, world);
     board::register_board_modules(plugins.modules);
     board::register_board_behaviors(plugins.behaviors);
-    robot = Robot::assemble(load_robot_profile(kConfigs / "robots/disinfection.yaml"), plugins, clock);
+    // These tests are about the board's protocol and the net: the lanes as without a dose target
+    // (the dose-planned run of a room is tests/app, tripodal_run_cli:disinfection_reaches_dose_2111).
+    RobotOptions ro;
+    ro.parameters.push_back({"coverage", "dose_target_j_m2", "0"});
+    robot = Robot::assemble(load_robot_profile(kConfigs / "robots/disinfection.yaml"), plugins, clock, ro);
     hw = &dynamic_cast<sim::SimBoardHardware&>(*robot->hardware());
     if (CController* c = robot->behavior_loop().controller()) c->reset_odometry(world->start_pose);
     robot->run_for(100ms);  // SYNC, the localizer's first estimate

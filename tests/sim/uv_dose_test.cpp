@@ -44,6 +44,9 @@ TEST_CASE("a straight pass doses the floor under its centre line as the line int
   const double y = 0.1, c = std::sqrt(R * R - y * y);
   const double aside = lamp.uvc_power_w * h * c / (2.0 * std::numbers::pi * v * (y * y + h * h) * std::sqrt(c * c + y * y + h * h));
   CHECK(dose.dose_at_j_m2({0.0, 0.105}) == Approx(aside).epsilon(0.01));
+  // The dose planner's closed form (navi/dose_planner.hpp) is what the simulator counts.
+  CHECK(dose.dose_at_j_m2({0.0, 0.105}) == Approx(navi::lane_dose_j_m2(lamp, y, v)).epsilon(0.01));
+  CHECK(dose.dose_at_j_m2({0.0, 0.005}) == Approx(navi::lane_dose_j_m2(lamp, 0.0, v)).epsilon(0.01));
   // Outside the lit band and outside the grid: nothing.
   CHECK(dose.dose_at_j_m2({0.0, -0.4}) == 0.0);
   CHECK(dose.dose_at_j_m2({5.0, 0.0}) == 0.0);

@@ -67,12 +67,27 @@ std::string RunResult::json() const {
         {"lamp_on_s", rounded(d.lamp_on_s, 2)},
         {"disinfectant_used_l", rounded(d.disinfectant_used_l, 4)},
         {"disinfectant_left_l", rounded(d.disinfectant_left_l, 4)},
+        {"battery_used_ah", rounded(d.battery_used_ah, 4)},
+        {"lamp_energy_wh", rounded(d.lamp_energy_wh, 3)},
+        {"uvc_energy_j", rounded(d.uvc_energy_j, 1)},
         {"link", {{"requests", d.link.requests}, {"responses", d.link.responses}, {"missed", d.link.missed},
                   {"error_responses", d.link.error_responses}, {"retries", d.link.retries}, {"link_losses", d.link.link_losses},
                   {"mean_round_trip_ms", rounded(mean_rtt_ms, 3)}, {"max_round_trip_ms", ms(d.link.max_round_trip)},
                   {"decoder_errors", d.decoder_errors}, {"board_requests", d.board_requests},
                   {"watchdog_trips", d.watchdog_trips}, {"bytes_to_board", d.bytes_to_board},
                   {"bytes_to_host", d.bytes_to_host}, {"bytes_lost", d.bytes_lost}}}};
+    if (d.plan) {
+      report["disinfection"]["dose_plan"] = {
+          {"target_j_m2", d.plan->target_j_m2},
+          {"spacing_m", rounded(d.plan->spacing_m, 3)},
+          {"speed_m_s", rounded(d.plan->speed_m_s, 4)},
+          {"passes", d.plan->passes},
+          {"reach_m", rounded(d.plan->reach_m, 4)},
+          {"estimate_s", rounded(d.estimate_s, 1)},
+          {"estimate_ah", rounded(d.estimate_ah, 3)},
+          {"lamp_floor_m2", rounded(d.lamp_floor_m2, 2)},
+          {"lamp_floor_dose_coverage", rounded(d.lamp_floor_dose_coverage, 4)}};
+    }
   }
   // Task text and names come from the user: bytes that are not UTF-8 are replaced, not thrown on.
   return report.dump(2, ' ', false, Json::error_handler_t::replace) + '\n';

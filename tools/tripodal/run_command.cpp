@@ -285,9 +285,19 @@ int run(Args& args, std::ostream& out, std::ostream& err) {
           << " J/m2 (median " << d->median_dose_j_m2 << " J/m2, lamp on " << d->lamp_on_s << " s); disinfectant used "
           << d->disinfectant_used_l << " l; link over " << d->line << ": " << d->link.requests << " requests, "
           << d->link.missed << " missed, " << d->decoder_errors << " decoder errors, " << d->link.link_losses << " link losses\n";
+      if (d->plan) {
+        out << "dose reached: " << d->lamp_floor_dose_coverage * 100.0 << " % of the " << d->lamp_floor_m2
+            << " m2 the lamp can dose (within " << d->plan->reach_m << " m of where the robot stands) >= " << d->uv_target_dose_j_m2
+            << " J/m2, planned lanes " << d->plan->spacing_m << " m apart at up to " << d->plan->speed_m_s << " m/s, "
+            << d->plan->passes << " pass" << (d->plan->passes > 1 ? "es" : "") << " (estimated " << d->estimate_s << " s, "
+            << d->estimate_ah << " Ah); battery used " << d->battery_used_ah << " Ah, lamp " << d->lamp_energy_wh << " Wh ("
+            << d->uvc_energy_j << " J of UVC)\n";
+      }
     }
     if (!r.stopped_by.empty()) out << "run " << r.stopped_by << (r.base_at_rest ? ", the base at rest" : ", the base NOT at rest") << "\n";
-    if (!o.out.empty()) out << "wrote " << (o.out / "map.png").string() << ", trajectory.csv, report.json, lifecycle.txt\n";
+    if (!o.out.empty()) {
+      out << "wrote " << (o.out / "map.png").string() << (r.disinfection ? ", dose.png" : "") << ", trajectory.csv, report.json, lifecycle.txt\n";
+    }
     if (r.state == "interrupted") return interrupted_exit(g_stop);
     // A monitored robot the operator never gave a task: nothing failed.
     const bool idle_monitor = (o.monitor.has_value() || o.task.empty()) && r.state == "idle";
@@ -342,7 +352,14 @@ cli::Action setup(CLI::App& cmd) {
                  "kernel pseudo-terminal, the host opening its slave device as it would the board's UART")
       ->check(CLI::IsMember({"in_process", "pty"}));
   cmd.add_option("--uv-target-dose", o.uv_target_dose_j_m2,
-                 "J/m2: on the control board, the dose a cell must receive to count as disinfected (default 10)")
+                 "J/m2: on the control board, the dose a cell must receive to count as disinfected, and the dose the lanes "
+                 "are planned for (default: the CoveragePlanner's dose_target_j_m2, else 10)")
+      ->check(cli::positive_number());
+  cmd.add_flag("--no-dose-plan", [&o](std::int64_t) { o.dose_plan = false; },
+               "lanes as without a dose target (the CoveragePlanner's dose_target_j_m2 off); the dose is still measured");
+  cmd.add_option("--time-limit", o.time_limit_s,
+                 "S: a disinfection planned for a dose (the CoveragePlanner's dose_target_j_m2) that needs longer is "
+                 "refused before it starts")
       ->check(cli::positive_number());
   cmd.add_option("--monitor", o.monitor, "[ADDR:]PORT: serve the live monitor and console (docs/monitor.md); 0: a free port");
   cmd.add_option("--monitor-token-file", o.monitor_token_file, "FILE: the console's token (first line; default: generated)");

@@ -3,6 +3,9 @@
 // tool (tools/tripodal), between run_task.cpp and the writers, one file each.
 #pragma once
 
+#include <algorithm>
+#include <array>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -53,7 +56,38 @@ void write_text(const std::filesystem::path& file, const std::string& text);
 RgbImage draw_map(const Navigation& nav, const navi::CleanedCells& cleaned, const std::vector<char>& reachable,
                   const std::vector<TrajectorySample>& traj);
 
+/// dose.png: each floor cell's UV dose against the target (dose(i), J/m^2): walls black, cells
+/// outside the measured floor grey; on it, red (no dose) through yellow (half) to green (the
+/// target reached), and a darker green from twice the target.
+template <typename DoseAt>
+RgbImage draw_dose_map(const navi::OccupancyGrid& g, const std::vector<char>& floor, double target_j_m2, DoseAt dose);
+
 /// trajectory.csv: one line per sample, SI units, header line first.
 std::string trajectory_csv(const std::vector<TrajectorySample>& traj);
+
+template <typename DoseAt>
+RgbImage draw_dose_map(const navi::OccupancyGrid& g, const std::vector<char>& floor, double target_j_m2, DoseAt dose) {
+  constexpr int kScale = 2;
+  RgbImage img(g.width() * kScale, g.height() * kScale);
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const navi::CellIndex c = g.cell(i);
+    std::array<std::uint8_t, 3> rgb{225, 225, 225};
+    if (g.state(i) == navi::Occupancy::occupied) {
+      rgb = {0, 0, 0};
+    } else if (i < floor.size() && floor[i] != 0) {
+      const double f = target_j_m2 > 0.0 ? dose(i) / target_j_m2 : 0.0;
+      if (f >= 2.0) rgb = {20, 120, 40};
+      else if (f >= 1.0) rgb = {60, 190, 70};
+      else {
+        const double t = std::clamp(f, 0.0, 1.0);  // red -> yellow
+        rgb = {230, static_cast<std::uint8_t>(40 + 190 * t), 40};
+      }
+    }
+    for (int dy = 0; dy < kScale; ++dy) {
+      for (int dx = 0; dx < kScale; ++dx) img.set(c.x * kScale + dx, (g.height() - 1 - c.y) * kScale + dy, rgb[0], rgb[1], rgb[2]);
+    }
+  }
+  return img;
+}
 
 }  // namespace tripodal::app

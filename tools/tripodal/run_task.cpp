@@ -11,12 +11,16 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 #include "run_outputs.hpp"
 #include "guide_hri.hpp"
 #include "shutdown.hpp"
 #include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/monitor/robot_monitor.hpp"
+#include "tripodal/behaviors/navigation_behaviors.hpp"
+#include "tripodal/board/board_firmware.hpp"
 #include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/navi/localizer.hpp"
 #include "tripodal/navi/planning_modules.hpp"
@@ -66,10 +70,11 @@ PathFigures path_figures(const std::vector<Point2D>& path, double tolerance_m) {
 
 namespace {
 
-// The cells of the room a cleaning footprint can reach at all: within half the cleaning width of
-// a cell where the robot can stand (clearance >= its radius) connected to its start.
+// The cells of the room a cleaning footprint can reach at all: within `reach_m` (half the cleaning
+// width; for the UV dose, the lamp's reach) of a cell where the robot can stand (clearance >= its
+// radius) connected to its start.
 std::vector<char> reachable_area(const Navigation& nav, navi::PathPlanner& planner, const std::vector<std::string>& sections,
-                                 Pose2D start) {
+                                 Pose2D start, double reach_m) {
   const navi::OccupancyGrid& g = nav.maps->grid();
   std::vector<char> in_room(g.size(), 0);
   for (const std::string& name : sections) {
@@ -94,7 +99,7 @@ std::vector<char> reachable_area(const Navigation& nav, navi::PathPlanner& plann
       queue.push_back(n);
     }
   }
-  const double r_cells = nav.coverage->cleaning_width_m() / 2.0 / g.resolution_m();
+  const double r_cells = reach_m / g.resolution_m();
   const int r = static_cast<int>(std::floor(r_cells));
   std::vector<navi::CellIndex> disc;
   for (int dy = -r; dy <= r; ++dy) {
@@ -112,6 +117,52 @@ std::vector<char> reachable_area(const Navigation& nav, navi::PathPlanner& plann
     }
   }
   return reach;
+}
+
+// What a dose-planned disinfection of these sections will take, for the up-front check: each
+// section's coverage path as it will be planned, at its lane speeds, its turns at the cleaning
+// behavior's yaw rate, the way between sections at the lane speed; the charge from the board's
+// currents (the lamp and the boards all along, the atomizer while the tank lasts, the motors at
+// the duty of the speed).
+struct DoseEstimate {
+  double time_s = 0.0;
+  double charge_ah = 0.0;
+  double path_m = 0.0;
+};
+
+DoseEstimate estimate_dose(navi::CCoverageModule& cov, const navi::CSectionSplitter& splitter,
+                           const std::vector<std::string>& sections, Point2D from, const board::FirmwareConfig& fw) {
+  double yaw_rate = 1.0;
+  for (const ParameterSpec& p : BhCleaningTwoWheel::static_manifest().parameters) {
+    if (p.name == "max_yaw_rate_rad_s" && p.default_value) yaw_rate = std::get<double>(*p.default_value);
+  }
+  const double plan_speed = cov.dose_plan() ? cov.dose_plan()->speed_m_s : cov.dose_limits().max_speed_m_s;
+  DoseEstimate e;
+  double motor_as = 0.0;  // motor duty x seconds, both motors
+  for (const std::string& name : sections) {
+    const navi::Section* sec = splitter.section(name);
+    if (sec == nullptr) continue;
+    const navi::CoverageResult r = cov.plan(*sec, from);
+    if (r.path.empty()) continue;
+    const double transit = std::hypot(r.path.front().x_m - from.x_m, r.path.front().y_m - from.y_m);
+    e.time_s += transit / plan_speed;
+    motor_as += 2.0 * plan_speed / fw.max_wheel_speed_m_s * transit / plan_speed;
+    for (std::size_t i = 0; i + 1 < r.path.size(); ++i) {
+      const double v = i < r.speed_m_s.size() ? r.speed_m_s[i] : plan_speed;
+      const double len = std::hypot(r.path[i + 1].x_m - r.path[i].x_m, r.path[i + 1].y_m - r.path[i].y_m);
+      e.time_s += len / v;
+      e.path_m += len;
+      motor_as += 2.0 * v / fw.max_wheel_speed_m_s * len / v;
+    }
+    // turning in place: one motor forward, one back, at the yaw rate's wheel speed
+    const int passes = cov.dose_plan() ? cov.dose_plan()->passes : 1;
+    e.time_s += passes * r.stats.total_turn_rad / yaw_rate;
+    from = r.path.back();
+  }
+  const double atomizer_s = std::min(e.time_s, fw.tank_initial_l / fw.atomizer_l_per_h * 3600.0);
+  e.charge_ah = ((fw.idle_current_a + fw.uv_lamp_current_a) * e.time_s + fw.atomizer_current_a * atomizer_s +
+                 fw.motor_current_a * motor_as) / 3600.0;
+  return e;
 }
 
 std::string step_text(const ProcessStep& s) {
@@ -142,8 +193,9 @@ class ReportObserver final : public TaskObserver {
 
 // The dose of each reachable cell (the dose map is on the world's grid, the reachable cells on the
 // robot's map: matched by the cell centre), the tank, and both sides of the link.
-DisinfectionFigures disinfection_figures(sim::SimBoardHardware& hw, const std::vector<char>& reachable, const navi::OccupancyGrid& grid,
-                                         double target_j_m2) {
+DisinfectionFigures disinfection_figures(sim::SimBoardHardware& hw, const std::vector<char>& reachable,
+                                         const std::vector<char>& lamp_floor, const navi::OccupancyGrid& grid, double target_j_m2,
+                                         double soc_at_start) {
   DisinfectionFigures f;
   board::EmbeddedBoard& b = hw.embedded();
   const std::filesystem::path device = b.device();
@@ -160,7 +212,20 @@ DisinfectionFigures disinfection_figures(sim::SimBoardHardware& hw, const std::v
     std::nth_element(doses.begin(), mid, doses.end());
     f.median_dose_j_m2 = *mid;
   }
+  std::size_t floor_cells = 0, floor_dosed = 0;
+  for (std::size_t i = 0; i < lamp_floor.size(); ++i) {
+    if (lamp_floor[i] == 0) continue;
+    ++floor_cells;
+    floor_dosed += hw.uv_dose().dose_at_j_m2(grid.cell_center(grid.cell(i))) >= target_j_m2 ? 1 : 0;
+  }
+  f.lamp_floor_m2 = static_cast<double>(floor_cells) * grid.resolution_m() * grid.resolution_m();
+  f.lamp_floor_dose_coverage = floor_cells == 0 ? 0.0 : static_cast<double>(floor_dosed) / static_cast<double>(floor_cells);
   f.lamp_on_s = to_seconds(hw.uv_dose().lamp_on());
+  const board::FirmwareConfig& fc = b.firmware().config();
+  f.battery_used_ah = (soc_at_start - b.firmware().state_of_charge()) * fc.battery_capacity_ah;
+  const double volts = b.firmware().battery().voltage_mv > 0 ? b.firmware().battery().voltage_mv / 1000.0 : board::kBatteryFullV;
+  f.lamp_energy_wh = fc.uv_lamp_current_a * 0.5 * (board::kBatteryFullV + volts) * f.lamp_on_s / 3600.0;
+  f.uvc_energy_j = hw.uv_dose().lamp().uvc_power_w * f.lamp_on_s;
   f.disinfectant_left_l = b.firmware().tank_l();
   f.disinfectant_used_l = b.firmware().disinfectant_used_l();
   f.link = b.host().link().stats();
@@ -432,7 +497,11 @@ RunResult run_task(const RunOptions& o) {
   ro.parameters = simulation_overrides(profile, *world, res.seed);
   if (!o.board_line.empty()) ro.parameters.push_back({profile.hardware->name, "line", o.board_line});
   for (const ModuleEntry& e : profile.navigation) {
-    if (e.type == navi::CCoverageModule::static_manifest().name && !o.pattern.empty()) ro.parameters.push_back({e.name, "pattern", o.pattern});
+    if (e.type != navi::CCoverageModule::static_manifest().name) continue;
+    if (!o.pattern.empty()) ro.parameters.push_back({e.name, "pattern", o.pattern});
+    // The dose the lanes are planned for (the profile's dose_target_j_m2 otherwise).
+    if (!o.dose_plan) ro.parameters.push_back({e.name, "dose_target_j_m2", "0"});
+    else if (o.uv_target_dose_j_m2) ro.parameters.push_back({e.name, "dose_target_j_m2", fmt::format("{}", *o.uv_target_dose_j_m2)});
   }
   SimClock clock;
   const auto robot = Robot::assemble(profile, plugins, clock, ro);
@@ -449,6 +518,19 @@ RunResult run_task(const RunOptions& o) {
                                              " m): planned paths would collide");
   }
   const Pose2D start = world->start_pose;
+  // The planner's lamp must be the one the simulated board lights (one lamp, two consumers).
+  const std::optional<navi::DosePlan>& dose_plan = nav.coverage->dose_plan();
+  if (board_hw != nullptr && dose_plan) {
+    const navi::UvLamp& a = nav.coverage->uv_lamp();
+    const navi::UvLamp& b = board_hw->uv_dose().lamp();
+    if (a.uvc_power_w != b.uvc_power_w || a.height_m != b.height_m || a.radius_m != b.radius_m) {
+      throw ConfigError(nav.coverage->where(), fmt::format("the coverage planner plans the dose for a lamp of {} W, {} m high, {} m lit "
+                                                           "radius, the board's lamp is {} W, {} m, {} m: give both the same uv_ parameters",
+                                                           a.uvc_power_w, a.height_m, a.radius_m, b.uvc_power_w, b.height_m, b.radius_m));
+    }
+  }
+  const double target_dose_j_m2 = o.uv_target_dose_j_m2.value_or(dose_plan ? dose_plan->target_j_m2 : kDefaultUvTargetDose);
+  const double soc_at_start = board_hw != nullptr ? board_hw->embedded().firmware().state_of_charge() : 0.0;
   if (CController* c = robot->behavior_loop().controller()) c->reset_odometry(start);
   LifecycleRecorder life(true);
   ReportObserver report;
@@ -526,6 +608,7 @@ RunResult run_task(const RunOptions& o) {
   // submitted on the monitor's console is measured from when it starts).
   std::vector<std::string> room_sections;
   std::vector<char> reachable(nav.maps->grid().size(), 0);  // none until a task names its room
+  std::vector<char> lamp_floor;  // with a dose plan: the floor the lamp can dose at all
   navi::PathPlanner reach_planner(nav.maps->grid(), navi::PathPlannerOptions{.robot_radius_m = nav.maps->robot_radius_m()});
   auto measure_room = [&] {
     room_sections.clear();
@@ -538,17 +621,57 @@ RunResult run_task(const RunOptions& o) {
         }
       }
     }
-    reachable = reachable_area(nav, reach_planner, room_sections, start);
+    reachable = reachable_area(nav, reach_planner, room_sections, start, nav.coverage->footprint_width_m() / 2.0);
+    if (dose_plan) lamp_floor = reachable_area(nav, reach_planner, room_sections, start, dose_plan->reach_m);
     res.reachable_cells = 0;
     for (const char c : reachable) res.reachable_cells += c != 0 ? 1 : 0;
   };
   bool measured_busy = robot->planner().busy();
   if (measured_busy) measure_room();
+  // A dose-planned disinfection is checked up front: refused when the battery (down to the board
+  // monitor's low threshold) or the time limit cannot carry it.
+  if (measured_busy && dose_plan && board_hw != nullptr) {
+    const board::BoardFirmware& fw = board_hw->embedded().firmware();
+    double low_percent = 15.0;
+    for (const ModuleEntry& e : profile.modules) {
+      if (e.type != "BoardMonitor") continue;
+      if (const auto it = e.parameters.find("battery_low_percent"); it != e.parameters.end()) low_percent = std::stod(it->second);
+    }
+    const double available_ah = std::max(0.0, fw.state_of_charge() - low_percent / 100.0) * fw.config().battery_capacity_ah;
+    const DoseEstimate est = estimate_dose(*nav.coverage, *nav.splitter, room_sections, {start.x_m, start.y_m}, fw.config());
+    res.dose_estimate_s = est.time_s;
+    res.dose_estimate_ah = est.charge_ah;
+    if (o.log != nullptr) {
+      *o.log << fmt::format("dose plan: {} J/m2: lanes {:.2f} m apart at {:.3f} m/s (faster between closer lanes), {} pass{}; "
+                            "estimated {:.0f} s, {:.2f} Ah of the {:.2f} Ah above the {}% low-battery mark\n",
+                            dose_plan->target_j_m2, dose_plan->spacing_m, dose_plan->speed_m_s, dose_plan->passes,
+                            dose_plan->passes > 1 ? "es" : "", est.time_s, est.charge_ah, available_ah, low_percent);
+    }
+    std::string why;
+    if (est.charge_ah > available_ah) {
+      why = fmt::format("target dose {} J/m2 cannot be reached within the battery: the plan (lanes {:.2f} m apart at {:.3f} m/s, "
+                        "{} pass{}) needs about {:.2f} Ah ({:.0f} s), the battery holds {:.2f} Ah above the {}% low mark",
+                        dose_plan->target_j_m2, dose_plan->spacing_m, dose_plan->speed_m_s, dose_plan->passes,
+                        dose_plan->passes > 1 ? "es" : "", est.charge_ah, est.time_s, available_ah, low_percent);
+    } else if (o.time_limit_s && est.time_s > *o.time_limit_s) {
+      why = fmt::format("target dose {} J/m2 cannot be reached within the time limit of {:.0f} s: the plan (lanes {:.2f} m apart "
+                        "at {:.3f} m/s, {} pass{}) needs about {:.0f} s",
+                        dose_plan->target_j_m2, *o.time_limit_s, dose_plan->spacing_m, dose_plan->speed_m_s, dose_plan->passes,
+                        dose_plan->passes > 1 ? "es" : "", est.time_s);
+    }
+    if (!why.empty()) {
+      robot->planner().cancel(why);
+      robot->step_sequencing();
+      res.state = "refused";
+      res.reason = why;
+      if (o.log != nullptr) *o.log << why << '\n';
+    }
+  }
 
   navi::CleanedCells cleaned(nav.maps->grid());  // from the true pose, while a cleaning behavior runs
   std::vector<TrajectorySample> traj;
   std::vector<Point2D> path_all, path_cleaning;
-  const double half_width = nav.coverage->cleaning_width_m() / 2.0;
+  const double half_width = nav.coverage->footprint_width_m() / 2.0;  // the fog's, whatever the lanes' spacing
   const Duration tick_period = robot->behavior_loop().period();
   const Time deadline = time_from_seconds(o.max_duration_s);
   bool was_cleaning = false;
@@ -713,12 +836,25 @@ RunResult run_task(const RunOptions& o) {
     res.sections.push_back(f);
   }
 
-  if (board_hw != nullptr) res.disinfection = disinfection_figures(*board_hw, reachable, nav.maps->grid(),
-                                                                    o.uv_target_dose_j_m2.value_or(kDefaultUvTargetDose));
+  if (board_hw != nullptr) {
+    res.disinfection = disinfection_figures(*board_hw, reachable, lamp_floor, nav.maps->grid(), target_dose_j_m2, soc_at_start);
+    if (dose_plan) {
+      res.disinfection->plan = *dose_plan;
+      res.disinfection->estimate_s = res.dose_estimate_s;
+      res.disinfection->estimate_ah = res.dose_estimate_ah;
+    }
+  }
 
   if (!o.out.empty()) {
     std::filesystem::create_directories(o.out);
     write_png(o.out / "map.png", draw_map(nav, cleaned, reachable, traj));
+    if (board_hw != nullptr) {
+      const std::vector<char>& floor = lamp_floor.empty() ? reachable : lamp_floor;
+      const navi::OccupancyGrid& g = nav.maps->grid();
+      write_png(o.out / "dose.png", draw_dose_map(g, floor, target_dose_j_m2, [&](std::size_t i) {
+                  return board_hw->uv_dose().dose_at_j_m2(g.cell_center(g.cell(i)));
+                }));
+    }
     write_text(o.out / "trajectory.csv", trajectory_csv(traj));
     write_text(o.out / "report.json", res.json());
     write_text(o.out / "lifecycle.txt", life.str());

@@ -20,6 +20,7 @@
 #include "tripodal/board/board_link.hpp"
 #include "tripodal/core/time.hpp"
 #include "tripodal/navi/coverage.hpp"
+#include "tripodal/navi/dose_planner.hpp"
 #include "tripodal/navi/localizer.hpp"
 
 namespace tripodal {
@@ -71,6 +72,12 @@ struct RunOptions {
   /// The UV dose a cell of the floor must receive to count as disinfected (J/m^2; 10 = 1 mJ/cm^2);
   /// only for a robot on the control board. Default kDefaultUvTargetDose.
   std::optional<double> uv_target_dose_j_m2;
+  /// A dose-planned disinfection (the CoveragePlanner's dose_target_j_m2) whose plan needs longer
+  /// than this (s) is refused before it starts. nullopt: the battery alone bounds it.
+  std::optional<double> time_limit_s;
+  /// false: the CoveragePlanner's lanes as without a dose target (dose_target_j_m2 0), the dose
+  /// still measured: the behaviour before dose planning, kept measurable.
+  bool dose_plan = true;
   /// The monitor (docs/monitor.md): serve the page, the topics and the operator console on
   /// ADDRESS:PORT while the run goes on. With a monitor the run is paced to real time (default
   /// speed 1), the task may come from the console instead of `task`, and the run goes on after
@@ -120,6 +127,17 @@ struct DisinfectionFigures {
   double lamp_on_s = 0.0;
   double disinfectant_used_l = 0.0;
   double disinfectant_left_l = 0.0;
+  /// With a dose plan: the floor the lamp can dose at all (within the plan's reach_m of where the
+  /// robot can stand) and the share of it at the target; dose_coverage stays the share of the
+  /// cleaning footprint's reachable floor.
+  std::optional<navi::DosePlan> plan;
+  double lamp_floor_m2 = 0.0;
+  double lamp_floor_dose_coverage = 0.0;
+  double estimate_s = 0.0;     ///< the up-front estimate of the run's time
+  double estimate_ah = 0.0;    ///< and of its charge
+  double battery_used_ah = 0.0;  ///< the board's state of charge, start to end, x capacity
+  double lamp_energy_wh = 0.0;   ///< electrical: the lamp's current at the battery's voltage, while on
+  double uvc_energy_j = 0.0;     ///< radiant UVC emitted: the lamp's UVC power x time on
   board::LinkStats link;        ///< the host's side
   std::uint64_t decoder_errors = 0;  ///< host and board decoders together
   std::uint64_t board_requests = 0;  ///< answered by the firmware
@@ -153,6 +171,8 @@ struct RunResult {
   std::size_t collisions = 0;
   std::size_t robot_steps = 0;
   std::optional<DisinfectionFigures> disinfection;  ///< on hardware "board" only
+  double dose_estimate_s = 0.0;   ///< a dose-planned disinfection's up-front time estimate
+  double dose_estimate_ah = 0.0;  ///< and its charge
   [[nodiscard]] std::string json() const;
 };
 

@@ -49,6 +49,9 @@ struct NavigationData {
   std::span<const Pose2D> path;
   std::uint32_t path_id = 0;
   double path_start_m = 0.0;
+  /// Speed limits (m/s) along the path: entry i bounds the leg from path[i] to path[i + 1] (a
+  /// disinfection's lanes, navi/dose_planner.hpp). Empty: the behavior's own speed only.
+  std::span<const double> path_speed_m_s;
   /// True when the end of the path is the behavior's goal (it succeeds there); false for a
   /// detour, after which the sequencing layer publishes the way on.
   bool path_final = true;

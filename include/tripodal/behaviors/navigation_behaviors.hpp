@@ -41,6 +41,8 @@ class PathTracker {
   /// progress and the inputs).
   Target update(const Pose2D& position, double lookahead_m, double search_m) noexcept;
   [[nodiscard]] double progress_m() const noexcept { return s_now_; }
+  /// The leg the progress is on: from points()[segment()] to the next point.
+  [[nodiscard]] std::size_t segment() const noexcept { return seg_; }
   [[nodiscard]] double length_m() const noexcept { return s_.empty() ? 0.0 : s_.back(); }
   [[nodiscard]] bool empty() const noexcept { return pts_.empty(); }
   [[nodiscard]] std::size_t capacity() const noexcept { return pts_.capacity(); }

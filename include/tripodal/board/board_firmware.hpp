@@ -120,6 +120,7 @@ class BoardFirmware {
   [[nodiscard]] bool link_lost() const noexcept { return link_lost_; }
   [[nodiscard]] bool emergency_stop() const noexcept { return (buttons_ & kButtonEmergencyStop) != 0; }
   [[nodiscard]] bool uv_lamp() const noexcept { return uv_lamp_; }
+  [[nodiscard]] const FirmwareConfig& config() const noexcept { return config_; }
   [[nodiscard]] bool atomizer() const noexcept { return atomizer_; }
   [[nodiscard]] bool fan() const noexcept { return fan_; }
   [[nodiscard]] std::uint8_t last_voice_track() const noexcept { return voice_track_; }

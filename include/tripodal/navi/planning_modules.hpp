@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "tripodal/navi/coverage.hpp"
+#include "tripodal/navi/dose_planner.hpp"
 #include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/navi/navi_modules.hpp"
 #include "tripodal/navi/section_splitter.hpp"
@@ -50,7 +51,9 @@ class ObstacleReplanner {
 class PublishedPath {
  public:
   /// Publishes `points` under a new id, taken up at start_m; `final`: its end is the goal.
-  void publish(const std::vector<Point2D>& points, double start_m, bool final, ModuleContext& context);
+  /// `speeds_m_s`: per-leg speed limits (NavigationData::path_speed_m_s), empty for none.
+  void publish(const std::vector<Point2D>& points, double start_m, bool final, ModuleContext& context,
+               const std::vector<double>& speeds_m_s = {});
   /// Publishes a failure reason (static storage) for the active behavior.
   void fail(std::string_view reason, ModuleContext& context);
   /// Withdraws what this module published (if it is still what the loop is given).
@@ -64,6 +67,7 @@ class PublishedPath {
  private:
   std::vector<Pose2D> points_;
   std::vector<double> s_;
+  std::vector<double> speeds_;
   std::uint32_t id_ = 0;
 };
 
@@ -121,7 +125,18 @@ class CCoverageModule final : public CNaviModules {
   [[nodiscard]] const std::map<std::string, SectionProgress, std::less<>>& progress() const noexcept { return progress_; }
   [[nodiscard]] const CleanedCells& cleaned() const noexcept { return cleaned_; }
   [[nodiscard]] CoveragePlanner& planner();
+  /// The lane width the paths are planned with (a dose plan's spacing + lane overlap when
+  /// dose_target_j_m2 is set).
   [[nodiscard]] double cleaning_width_m() const noexcept { return options_.cleaning_width_m; }
+  /// The coverage path of `section` from `from` as an activation would plan it (not kept): the
+  /// dose plan's lane speeds and passes included.
+  [[nodiscard]] CoverageResult plan(const Section& section, Point2D from);
+  /// The profile's cleaning footprint (parameter cleaning_width_m), whatever the dose plan spaces.
+  [[nodiscard]] double footprint_width_m() const noexcept { return footprint_width_m_; }
+  /// The dose plan (parameter dose_target_j_m2 > 0), from the lamp and the speed limits.
+  [[nodiscard]] const std::optional<DosePlan>& dose_plan() const noexcept { return dose_plan_; }
+  [[nodiscard]] const UvLamp& uv_lamp() const noexcept { return lamp_; }
+  [[nodiscard]] const DoseLimits& dose_limits() const noexcept { return dose_limits_; }
   /// "hybrid", "balloon" or "boustrophedon"
   [[nodiscard]] const std::string& pattern() const noexcept { return pattern_; }
   /// Fraction of the cells its plan can reach in `section` cleaned so far.
@@ -136,7 +151,7 @@ class CCoverageModule final : public CNaviModules {
   void on_behavior_deactivated(std::string_view behavior, ModuleContext& context) override;
 
  private:
-  [[nodiscard]] CoverageResult plan(const Section& section, Point2D from);
+
   /// The centroid of the nearest section not cleaned yet (where the hybrid path should end).
   [[nodiscard]] std::optional<Point2D> next_section_centroid(const Section& section) const;
   void plan_detour(const Pose2D& pose, ModuleContext& context);
@@ -145,6 +160,10 @@ class CCoverageModule final : public CNaviModules {
 
   std::vector<std::string> serves_;
   CoverageOptions options_;
+  double footprint_width_m_ = 0.0;
+  UvLamp lamp_;
+  DoseLimits dose_limits_;
+  std::optional<DosePlan> dose_plan_;
   std::string pattern_ = "hybrid";
   CGridMaps* maps_ = nullptr;
   const CSectionSplitter* splitter_ = nullptr;

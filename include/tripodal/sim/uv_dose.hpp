@@ -9,26 +9,16 @@
 
 #include "tripodal/core/geometry.hpp"
 #include "tripodal/core/time.hpp"
+#include "tripodal/navi/dose_planner.hpp"
 #include "tripodal/navi/occupancy_grid.hpp"
 
 namespace tripodal::sim {
 
-/// The lamp as a point source under the chassis centre. The thesis gives no optical figures: the
-/// defaults are a small low-pressure tube (about 1 W of UVC) a few centimetres above the floor,
-/// lighting the disc its reflector and skirt leave open.
-struct UvLamp {
-  double uvc_power_w = 1.0;  ///< radiant UVC output (not the electrical power)
-  double height_m = 0.05;    ///< above the floor
-  double radius_m = 0.3;     ///< lit disc on the floor, centred under the lamp (the shield's edge)
-};
-
-/// Throws std::invalid_argument naming the field when a value is not finite and > 0.
-void validate(const UvLamp& lamp);
-
-/// Irradiance (W/m^2) on the floor at horizontal distance `r_m` from the point under the lamp: an
-/// isotropic source, inverse square with the cosine of incidence, E = P h / (4 pi d^3) with
-/// d^2 = r^2 + h^2; zero beyond the lit disc.
-[[nodiscard]] double uv_irradiance_w_m2(const UvLamp& lamp, double r_m) noexcept;
+/// The lamp model is navigation's (navi/dose_planner.hpp), so the dose a plan promises and the
+/// dose the simulator counts come from one formula.
+using navi::UvLamp;
+using navi::uv_irradiance_w_m2;
+using navi::validate;
 
 /// Dose (J/m^2) received by each cell of a grid: irradiance at the cell's centre integrated over
 /// the time the lamp is on. Allocates once, at construction.
