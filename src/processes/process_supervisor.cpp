@@ -67,6 +67,9 @@ struct CProcessSupervisor::Inbox {
   std::vector<std::string> events;
   std::vector<std::pair<std::string, Value>> facts;
   std::vector<std::pair<std::string, std::string>> faults;  // module, reason
+  // The latest value of every fact set (supervisor thread only): a process started after a fact
+  // was set reads it, not its net's default (the robot docked before PrDockCharge started).
+  std::map<std::string, Value, std::less<>> latest_facts;
   std::map<std::string, Watch, std::less<>> watches;
 };
 
@@ -106,6 +109,13 @@ bool CProcessSupervisor::start(std::string run, const CProcess& process, Paramet
   } catch (const std::exception& e) {
     if (error) *error = process.name() + ": " + e.what();
     return false;
+  }
+  for (const auto& [name, value] : inbox_->latest_facts) {
+    if (!r->engine->fact_id(name)) continue;
+    try {
+      r->engine->set_fact(name, value);
+    } catch (const std::exception&) {  // NOLINT(bugprone-empty-catch): reported when it was set
+    }
   }
   r->forwarder.run = r.get();
   r->forwarder.observers = &observers_;
@@ -278,6 +288,7 @@ void CProcessSupervisor::step() {
     module_events.push_back(event);
   }
   for (auto& [name, value] : facts) {
+    inbox_->latest_facts.insert_or_assign(name, value);
     for (auto& r : runs_) {
       if (r->engine->fact_id(name)) {
         try {

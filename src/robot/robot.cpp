@@ -5,6 +5,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <thread>
 
@@ -14,6 +15,7 @@
 #include "tripodal/navi/navi_modules.hpp"
 #include "tripodal/reactive/reactive_config.hpp"
 #include "tripodal/resources/resource_faults.hpp"
+#include "tripodal/robot/battery_monitor.hpp"
 
 namespace tripodal {
 
@@ -23,6 +25,7 @@ RobotPlugins RobotPlugins::with_builtins() {
   register_navigation_behaviors(p.behaviors);
   register_builtin_controllers(p.controllers);
   navi::register_navigation_modules(p.modules);
+  p.modules.add<BatteryMonitor>();
   return p;
 }
 
@@ -95,6 +98,53 @@ struct CheckedProfile {
   std::vector<ControllerConfig> controllers;  // of the loops that drive one, in loop order
   std::map<std::string, std::string, std::less<>> behavior_types;  // profile name -> type; not the safety ones
 };
+
+// Facts: a guard reading a fact no module sets waits on the net's default for ever (the robot
+// docks, the net waits for `charging`). Every fact the nets read must be among the outputs of a
+// module of the profile (a type that calls ModuleContext::set_fact lists its facts there); one the
+// profile lists under external_facts comes from the application, and is only noted. Reported at
+// the first guard of each net that reads it, with the process entry of the profile.
+void check_facts(const RobotProfile& profile, const CheckedProfile& checked, Diagnostics& d) {
+  std::set<std::string, std::less<>> provided;
+  for (const DescribedModule& m : checked.description.modules)
+    provided.insert(m.outputs.begin(), m.outputs.end());
+  const std::vector<std::string> provided_names(provided.begin(), provided.end());
+  auto is_external = [&](std::string_view f) {
+    return std::find(profile.external_facts.begin(), profile.external_facts.end(), f) !=
+           profile.external_facts.end();
+  };
+  for (const ProcessDefinition& def : checked.processes) {
+    const auto entry = std::find_if(profile.processes.begin(), profile.processes.end(),
+                                    [&](const ProcessEntry& p) { return p.name == def.name; });
+    for (const PetriNet* net : {&def.net, def.module ? &*def.module : nullptr}) {
+      if (net == nullptr) continue;
+      std::set<std::string, std::less<>> reported;
+      for (const Transition& t : net->transitions()) {
+        if (!t.guard) continue;
+        for (const std::string& name : t.guard->identifiers()) {
+          if (net->find_fact(name) == nullptr || provided.count(name) != 0 || !reported.insert(name).second)
+            continue;
+          const std::string what = "process '" + def.name + "': the guard of transition '" + t.id +
+                                   "' reads fact '" + name + "', which no module of robot '" + profile.name +
+                                   "' provides (lists among its outputs)";
+          if (is_external(name)) {
+            d.warning(t.where, what + "; the profile lists it under external_facts (" +
+                                   profile.external_facts_where.str() +
+                                   "), so the application must set it (CProcessSupervisor::set_fact)");
+            continue;
+          }
+          const auto close = closest_name(name, provided_names);
+          d.error(t.where,
+                  what + (close ? "; did you mean '" + *close + "'?" : std::string()) +
+                      "; add a module that sets it (BatteryMonitor sets charging and "
+                      "battery_percent), or list it under external_facts: when the application sets it");
+          if (entry != profile.processes.end())
+            d.note(entry->where, "process '" + def.name + "' is listed here");
+        }
+      }
+    }
+  }
+}
 
 // Whether a type declared in the profile but not registered refuses the robot (assembly) or is
 // noted (the diagram of a design, whose modules may not be implemented yet).
@@ -193,6 +243,8 @@ CheckedProfile check_profile(const RobotProfile& profile, const RobotPlugins& pl
       out.processes.push_back(std::move(def));
     });
   }
+
+  check_facts(profile, out, d);
 
   // Behaviors are created anew at each activation; here their types are checked.
   for (const ModuleEntry& b : profile.behaviors) {
@@ -332,6 +384,8 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
   void deliver(std::string_view module, ModuleContext& ctx) {
     for (ModuleEvent& e : ctx.events) supervisor->post_event(std::move(e.name));
     ctx.events.clear();
+    for (auto& [fact, value] : ctx.facts) supervisor->set_fact(std::move(fact), std::move(value));
+    ctx.facts.clear();
     if (ctx.heartbeat) supervisor->heartbeat(module);
     ctx.heartbeat = false;
   }

@@ -261,8 +261,9 @@ struct Parser {
     prof.dir = base;
     const YAML::Node root = yaml::parse(text, file);
     prof.where = SourceLocation{file, 1, 1};
-    if (!r.expect_keys(root, {"robot", "hardware", "controllers", "loops", "resources", "navigation", "hri", "modules", "behaviors",
-                              "processes", "tasks", "recovery", "dds"},
+    if (!r.expect_keys(root,
+                       {"robot", "hardware", "controllers", "loops", "resources", "navigation", "hri",
+                        "modules", "behaviors", "processes", "tasks", "recovery", "dds", "external_facts"},
                        "the robot profile")) {
       throw ConfigError(d);
     }
@@ -315,6 +316,9 @@ struct Parser {
         prof.recovery = path_of(v, "recovery file", prof.recovery_where);
       } else if (key == "dds") {
         dds_section(v, prof);
+      } else if (key == "external_facts") {
+        prof.external_facts_where = at(v);
+        if (auto n = names(v, "external_facts")) prof.external_facts = std::move(*n);
       }
     }
     if (prof.name.empty()) d.error(prof.where, "the profile needs robot: {name: ...}");

@@ -65,6 +65,10 @@ std::string_view to_string(SimEvent::Kind kind) noexcept {
     case SimEvent::Kind::fell: return "fell";
     case SimEvent::Kind::battery_empty: return "battery_empty";
     case SimEvent::Kind::button_pressed: return "button_pressed";
+    case SimEvent::Kind::docked:
+      return "docked";
+    case SimEvent::Kind::undocked:
+      return "undocked";
   }
   return "?";
 }
@@ -446,11 +450,27 @@ void Simulator::substep(Duration dt) noexcept {
                                            odom_twist_.wz_rad_s * h);
   gyro_yaw_ = wrap_angle(gyro_yaw_ + (actual.wz_rad_s + rc.gyro.bias_rad_s) * h);
 
-  // Battery.
+  // Docks: the contacts touch within the dock's radius and heading tolerance.
+  int dock = -1;
+  for (std::size_t i = 0; i < world_.docks.size() && dock < 0; ++i) {
+    const Dock& k = world_.docks[i];
+    const bool near = std::hypot(pose_.x_m - k.pose.x_m, pose_.y_m - k.pose.y_m) <= k.contact_radius_m;
+    const bool aligned = k.heading_tolerance_rad >= std::numbers::pi ||
+                         std::abs(wrap_angle(pose_.theta_rad - k.pose.theta_rad)) <= k.heading_tolerance_rad;
+    if (near && aligned) dock = static_cast<int>(i);
+  }
+  if (dock != dock_) {
+    if (dock_ >= 0) log(SimEvent::Kind::undocked, world_.docks[static_cast<std::size_t>(dock_)].name);
+    if (dock >= 0) log(SimEvent::Kind::docked, world_.docks[static_cast<std::size_t>(dock)].name);
+    dock_ = dock;
+  }
+
+  // Battery: the electronics and any extra load drain it with time, the wheels with distance.
   const BatteryConfig& bc = rc.battery;
   if (bc.enabled) {
-    double d = -bc.drain_per_s * h - bc.drain_per_m * std::hypot(actual.vx_m_s, actual.vy_m_s) * h;
-    if (charging_) d += bc.charge_per_s * h;
+    double d = -(bc.drain_per_s + extra_drain_per_s_) * h -
+               bc.drain_per_m * std::hypot(actual.vx_m_s, actual.vy_m_s) * h;
+    if (charging()) d += bc.charge_per_s * h;
     const double before = soc_;
     soc_ = std::clamp(soc_ + d, 0.0, 1.0);
     soc_rate_ = h > 0.0 ? (soc_ - before) / h : 0.0;
@@ -671,7 +691,7 @@ void Simulator::sample_sensors() noexcept {
     br.percentage = soc_;
     br.voltage_v = bc.voltage_empty_v + soc_ * (bc.voltage_full_v - bc.voltage_empty_v);
     br.current_a = soc_rate_ * bc.capacity_ah * 3600.0;
-    br.charging = charging_;
+    br.charging = charging();
     battery_.commit();
   }
 }

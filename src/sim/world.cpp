@@ -134,6 +134,56 @@ class Reader {
   yaml::Reader r_;
 };
 
+// `docks: [{name, pose: [x, y, theta] | node: NAME, contact_radius_m, heading_tolerance_deg}]`.
+void read_docks(Reader& r, const YAML::Node& list, World& w) {
+  if (!list.IsSequence()) {
+    r.error(list,
+            "docks must be a list of {name, pose | node, contact_radius_m, heading_tolerance_deg}, got " +
+                Reader::kind(list));
+    return;
+  }
+  std::set<std::string> names;
+  for (const auto& item : list) {
+    if (!r.check_map(item, "a docks entry",
+                     {"name", "pose", "node", "contact_radius_m", "heading_tolerance_deg"}))
+      continue;
+    Dock k;
+    k.where = r.at(item);
+    r.text(item, "name", k.name, "docks entry");
+    const YAML::Node pose = item["pose"];
+    const YAML::Node node = item["node"];
+    if ((pose ? 1 : 0) + (node ? 1 : 0) != 1) {
+      r.error(item,
+              "a docks entry needs exactly one of pose: [x, y, theta] (the robot docked, map frame) or node: "
+              "NAME (a node of "
+              "the regions file)");
+      continue;
+    }
+    if (pose) {
+      auto p = r.pose(pose, "dock pose");
+      if (!p) continue;
+      k.pose = *p;
+    } else {
+      const navi::MapNode* n = node.IsScalar() ? w.regions.node(node.Scalar()) : nullptr;
+      if (n == nullptr) {
+        r.error(node, "unknown node " + Reader::kind(node) +
+                          (w.regions_file.empty() ? " (the world names no regions file)" : ""));
+        continue;
+      }
+      k.pose = n->pose;
+      if (k.name.empty()) k.name = n->name;
+    }
+    if (k.name.empty()) k.name = "dock " + std::to_string(w.docks.size() + 1);
+    if (!names.insert(k.name).second)
+      r.error(item["name"] ? item["name"] : item, "duplicate dock name '" + k.name + "'");
+    r.number_at_least(item, "contact_radius_m", k.contact_radius_m, 0.0, true, "dock '" + k.name + "'");
+    double tolerance_deg = k.heading_tolerance_rad / kDegToRad;
+    r.number_at_least(item, "heading_tolerance_deg", tolerance_deg, 0.0, false, "dock '" + k.name + "'");
+    k.heading_tolerance_rad = tolerance_deg * kDegToRad;
+    w.docks.push_back(std::move(k));
+  }
+}
+
 void read_laser(Reader& r, const YAML::Node& n, LaserConfig& c) {
   const std::string w = "robot.laser";
   if (!r.check_map(n, w, {"preset", "enabled", "name", "angle_min_deg", "angle_max_deg", "beams", "range_min_m",
@@ -497,8 +547,9 @@ World walk_world(std::string_view text, const std::filesystem::path& file) {
   Reader r(fname);
   World w;
   w.file = file;
-  if (!r.check_map(root, "the world file", {"map", "regions", "start_pose", "seed", "robot", "drops", "obstacles", "visitors",
-                                              "faults"})) {
+  if (!r.check_map(root, "the world file",
+                   {"map", "regions", "start_pose", "seed", "robot", "drops", "obstacles", "visitors",
+                    "docks", "faults"})) {
     throw ConfigError(std::move(r.diagnostics()));
   }
   const std::filesystem::path dir = file.parent_path();
@@ -629,6 +680,7 @@ World walk_world(std::string_view text, const std::filesystem::path& file) {
     }
   }
 
+  if (const YAML::Node docks = root["docks"]) read_docks(r, docks, w);
   if (const YAML::Node f = root["faults"]) read_faults(r, f, w.faults);
   if (const YAML::Node v = root["visitors"]) read_visitors(r, v, w.visitors);
 
@@ -668,6 +720,13 @@ World walk_world(std::string_view text, const std::filesystem::path& file) {
     for (const Kidnapping& k : w.faults.kidnappings) {
       if (solid.disc_overlaps({k.to.x_m, k.to.y_m}, w.robot.radius_m)) {
         r.diagnostics().error(k.where, "kidnap.to: there the robot's footprint (radius " + std::to_string(w.robot.radius_m) +
+                                           " m) overlaps an occupied cell or leaves the map");
+      }
+    }
+    for (const Dock& k : w.docks) {
+      if (solid.disc_overlaps({k.pose.x_m, k.pose.y_m}, w.robot.radius_m)) {
+        r.diagnostics().error(k.where, "dock '" + k.name + "': docked there, the robot's footprint (radius " +
+                                           std::to_string(w.robot.radius_m) +
                                            " m) overlaps an occupied cell or leaves the map");
       }
     }

@@ -323,6 +323,30 @@ TEST_CASE("Facts reach the running nets that declare them", "[processes]") {
   CHECK(to_seconds(rig.results[0].finished) == Approx(0.5));
 }
 
+TEST_CASE("A process started after a fact was set begins with the fact's latest value, not its net's default",
+          "[processes][facts]") {
+  // The robot docked (charging) before the dock-and-charge process started: a module sets a fact
+  // when it changes, so the net must not wait for a change that already happened.
+  Rig rig;
+  PetriNet net = pr_auto_move();
+  net.facts.push_back(decl("battery_low", ValueType::boolean, Value{false}));
+  Transition t = transition("t9");
+  t.guard = Guard::parse("battery_low == true");
+  net.add_transition(std::move(t));
+  net.add_arc("P1", "t9");
+  net.add_arc("t9", "P7");
+  rig.processes.add(def("PrWatched", net));
+  rig.supervisor.set_fact("battery_low", Value{false});
+  rig.supervisor.set_fact("battery_low", Value{true});  // the latest counts
+  rig.supervisor.set_fact("unrelated", Value{1.0});     // declared by no net: kept, harmless
+  rig.supervisor.step();                                // no process runs yet
+  rig.start("X0", "PrWatched", {{"goal", "dock", {}}});
+  rig.run(0.2);
+  REQUIRE(rig.results.size() == 1);
+  CHECK(rig.results[0].place == "P7");
+  CHECK(to_seconds(rig.results[0].finished) == Approx(0.0));
+}
+
 TEST_CASE("Modules post events, facts, heartbeats and faults from their own threads while the supervisor steps",
           "[processes][threads]") {
   // The supervisor's inbox is the one part of it other threads touch (scripts/tsan.sh runs this

@@ -1,17 +1,17 @@
 // What an application registers reaches the robot: its own controller type, named in the reactive
 // configuration a profile's controller entry points to, is checked and built through the
 // application's registry (RobotPlugins::controllers), not the process-wide built-in one.
-#include <catch2/catch.hpp>
-
 #include <unistd.h>
 
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
 
 #include "tripodal/controllers/ideal_hardware.hpp"
 #include "tripodal/core/manifest.hpp"
 #include "tripodal/robot/robot.hpp"
+#include "tripodal/sim/sim_hardware.hpp"
 
 using namespace tripodal;
 
@@ -170,4 +170,102 @@ TEST_CASE("check_robot refuses a net binding a behavior the profile does not lis
   CHECK_THAT(d.str(), Catch::Contains("PrAutoMove.xml:17:") && Catch::Contains("error: unknown behavior 'BhAutoMove'"));
   SimClock clock;
   REQUIRE_THROWS_WITH(Robot::assemble(profile, plugins, clock), Catch::Contains("error: unknown behavior 'BhAutoMove'"));
+}
+
+namespace {
+
+// The robot of tests/data/robot/dock_charge.yaml, which runs the dock-and-charge net
+// (configs/petri/PrDockCharge.xml), without its BatteryMonitor and with `extra` appended: the
+// modules that provide the net's facts, or an external_facts list.
+RobotProfile dock_profile(const std::string& extra) {
+  const std::filesystem::path dir = std::filesystem::path(TRIPODAL_SOURCE_DIR) / "tests/data/robot";
+  std::ifstream in(dir / "dock_charge.yaml");
+  std::string text, line;
+  bool skipping = false;
+  while (std::getline(in, line)) {
+    if (line == "modules:")
+      skipping = true;
+    else if (!line.empty() && line[0] != ' ')
+      skipping = false;
+    if (!skipping) text += line + "\n";
+  }
+  return load_robot_profile_from_string(text + extra, "robot.yaml", dir);
+}
+
+// The built-in types and the simulator's hardware "sim" (no world: none is built here).
+RobotPlugins dock_plugins() {
+  RobotPlugins p = RobotPlugins::with_builtins();
+  sim::register_sim_hardware(p.hardware);
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "A fact a net reads that no module provides is refused by check_robot and assembly, at the guard and the "
+    "profile",
+    "[robot][plugins][errors][facts]") {
+  const RobotPlugins plugins = dock_plugins();
+  const RobotProfile profile = dock_profile("");
+  Diagnostics d;
+  (void)check_robot(profile, plugins, d);
+  INFO(d.str());
+  CHECK(d.error_count() == 2);
+  CHECK_THAT(
+      d.str(),
+      Catch::Contains("PrDockCharge.xml:34:") &&
+          Catch::Contains(
+              "error: process 'PrDockCharge': the guard of transition 't3' reads fact 'charging', which no "
+              "module of robot 'psr2_dock' provides (lists among its outputs)") &&
+          Catch::Contains("or list it under external_facts: when the application sets it"));
+  CHECK_THAT(d.str(), Catch::Contains("PrDockCharge.xml:36:") &&
+                          Catch::Contains("transition 't5' reads fact 'battery_percent'"));
+  CHECK_THAT(d.str(), Catch::Contains("robot.yaml:35:5: note: process 'PrDockCharge' is listed here"));
+  SimClock clock;
+  REQUIRE_THROWS_WITH(Robot::assemble(profile, plugins, clock),
+                      Catch::Contains("reads fact 'charging', which no module"));
+}
+
+TEST_CASE(
+    "A fact the profile lists under external_facts is a warning; BatteryMonitor provides charging and "
+    "battery_percent",
+    "[robot][plugins][facts]") {
+  const RobotPlugins plugins = dock_plugins();
+  SECTION("external") {
+    Diagnostics d;
+    (void)check_robot(dock_profile("external_facts: [charging, battery_percent]\n"), plugins, d);
+    INFO(d.str());
+    CHECK_FALSE(d.has_errors());
+    CHECK_THAT(d.str(), Catch::Contains("PrDockCharge.xml:34:") &&
+                            Catch::Contains("warning: process 'PrDockCharge'") &&
+                            Catch::Contains("the profile lists it under external_facts (robot.yaml:38:17), "
+                                            "so the application must set it"));
+  }
+  SECTION("one external, one missing") {
+    Diagnostics d;
+    (void)check_robot(dock_profile("external_facts: [charging]\n"), plugins, d);
+    CHECK(d.error_count() == 1);
+    CHECK_THAT(d.str(), Catch::Contains("reads fact 'battery_percent'"));
+  }
+  SECTION("a module whose type lists them among its outputs") {
+    Diagnostics d;
+    (void)check_robot(dock_profile("modules:\n  - {name: battery_monitor, type: BatteryMonitor}\n"), plugins,
+                      d);
+    INFO(d.str());
+    CHECK(d.empty());
+  }
+  SECTION("a near miss: did you mean") {
+    Diagnostics d;
+    (void)check_robot(
+        dock_profile(
+            "modules:\n  - {name: power, type: PowerBoard, layer: sequencing, inputs: [battery], outputs: "
+            "[chargin, battery_percent]}\n"),
+        plugins, d);
+    CHECK(d.error_count() == 1);
+    CHECK_THAT(
+        d.str(),
+        Catch::Contains(
+            "reads fact 'charging', which no module of robot 'psr2_dock' provides (lists among its outputs); "
+            "did you mean 'chargin'?"));
+  }
 }

@@ -4,11 +4,12 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
-
 #include <cstdint>
 #include <functional>
-#include <limits>
 #include <iosfwd>
+#include <limits>
+#include <optional>
+#include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
@@ -55,6 +56,14 @@ struct Tool {
 /// --version, kUsage (message naming the option, on stderr) for a bad command line.
 int run_tool(const Tool& tool, int argc, char** argv);
 
+/// For a program without sub-commands (tripodal-board-sim): gives `app` the tools' help layout,
+/// --version and `exit_codes` as the last lines of its help, then parses argv as run_tool does.
+/// Returns the exit code when the program should stop here: kOk after --help or --version,
+/// kUsage for a bad command line (the message, a "did you mean" and where to find the usage on
+/// stderr, prefixed with `name`); nullopt when the command line parsed.
+[[nodiscard]] std::optional<int> parse_command_line(CLI::App& app, std::string_view name,
+                                                    std::string_view exit_codes, int argc, char** argv);
+
 /// Options that are a positive whole number (--max-states, --examples, ...): the error reads
 /// "--examples: expected a whole number > 0, got 'lots'".
 [[nodiscard]] CLI::Validator positive_count();
@@ -64,6 +73,20 @@ int run_tool(const Tool& tool, int argc, char** argv);
 [[nodiscard]] CLI::Validator whole_number(std::uint64_t max = std::numeric_limits<std::uint64_t>::max());
 /// Options that are a positive number (--max-duration-s, --realtime SPEED).
 [[nodiscard]] CLI::Validator positive_number();
+/// Options that are a number >= 0 (--duration-s, --tank-l): "expected a number >= 0, got '-1'".
+[[nodiscard]] CLI::Validator non_negative_number();
+/// Options naming a folder the command writes into (--out DIR): checked before the command runs,
+/// so that an unwritable place is refused at once, not after a whole simulation. The folder may
+/// not exist yet; then the nearest existing folder above it must be writable.
+[[nodiscard]] CLI::Validator writable_folder();
+/// Options naming a file the command writes (--record FILE, -o OUT): not a folder, and its folder
+/// writable (or creatable, as for writable_folder).
+[[nodiscard]] CLI::Validator writable_file();
+
+/// What a mistyped command line probably meant, walking argv down `app`'s sub-commands: "unknown
+/// command 'rnu'; did you mean 'run'?" or "unknown option '--sed'; did you mean '--seed'?"; empty
+/// when every command and option is known. For any CLI11 program (tools/*), on a ParseError.
+[[nodiscard]] std::string did_you_mean(const CLI::App& app, int argc, const char* const* argv);
 
 }  // namespace tripodal::cli
 

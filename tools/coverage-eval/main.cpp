@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_tool.hpp"
 #include "tripodal/navi/coverage.hpp"
 #include "tripodal/navi/distance_transform_coverage.hpp"
 #include "tripodal/navi/map_io.hpp"
@@ -29,6 +30,7 @@
 
 using namespace tripodal::navi;
 namespace fs = std::filesystem;
+namespace cli = tripodal::cli;
 
 namespace {
 
@@ -281,20 +283,6 @@ void write_picture(const fs::path& file, const OccupancyGrid& grid, const Sectio
   }
 }
 
-int usage() {
-  std::cerr << "usage: tripodal-coverage-eval [--ipa DIR] [--workspace MAP.yaml] [--random N] [--width M] [--radius M]\n"
-               "  --ipa DIR        the ipa floor plans (NAME.png + NAME_gt_segmentation.png), e.g. ../shared/data/ipa-maps\n"
-               "  --workspace MAP  a map_server map (e.g. configs/worlds/workspace_map.yaml)\n"
-               "  --random N       N seeded random rooms (seeds 1..N)\n"
-               "  --pictures DIR   the workspace's paths per pattern as PNG pictures; --verbose 1: per section figures\n"
-               "  --width M        cleaning width (default 0.64, PSR-2's); --radius M robot radius (default 0.3)\n"
-               "  --lane-overlap M, --lane-inset M, --turn-cost M   the hybrid's CoverageOptions of the same names\n"
-               "  --link-margin M   CoverageOptions::link_margin_m (the clearance links keep beyond the robot radius)\n"
-               "  --rooms METHOD   cover the rooms of a room segmentation (morphological, distance_transform, voronoi)\n"
-               "                   instead of the section splitter's sections; --segment-only 1: no coverage, P/R only\n";
-  return 2;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -305,26 +293,51 @@ int main(int argc, char** argv) {
   CoverageOptions o;
   o.cleaning_width_m = 0.64;
   o.robot_radius_m = 0.3;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (i + 1 >= argc) return usage();
-    const std::string v = argv[++i];
-    if (a == "--ipa") ipa = v;
-    else if (a == "--workspace") workspace = v;
-    else if (a == "--random") random_rooms = std::atoi(v.c_str());
-    else if (a == "--width") o.cleaning_width_m = std::atof(v.c_str());
-    else if (a == "--radius") o.robot_radius_m = std::atof(v.c_str());
-    else if (a == "--lane-overlap") o.lane_overlap_m = std::atof(v.c_str());
-    else if (a == "--lane-inset") o.lane_inset_m = std::atof(v.c_str());
-    else if (a == "--turn-cost") o.turn_cost_m = std::atof(v.c_str());
-    else if (a == "--link-margin") o.link_margin_m = std::atof(v.c_str());
-    else if (a == "--pictures") pictures = v;
-    else if (a == "--verbose") verbose = v == "1";
-    else if (a == "--rooms") rooms = v;
-    else if (a == "--segment-only") segment_only = v == "1";
-    else return usage();
+  CLI::App app{
+      "Evaluates the coverage patterns (hybrid, balloon, boustrophedon, distance_transform) on floor plans: the ipa maps,\n"
+      "a map_server map, or seeded random rooms (docs/coverage.md).\n"};
+  app.add_option(
+         "--ipa", ipa,
+         "DIR: the ipa floor plans (NAME.png + NAME_gt_segmentation.png), e.g. ../shared/data/ipa-maps")
+      ->check(CLI::ExistingDirectory);
+  app.add_option("--workspace", workspace,
+                 "MAP.yaml: a map_server map (e.g. configs/worlds/workspace_map.yaml)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--random", random_rooms, "N: N seeded random rooms (seeds 1..N)")
+      ->check(cli::positive_count());
+  app.add_option("--pictures", pictures, "DIR: the workspace's paths per pattern as PNG pictures")
+      ->check(cli::writable_folder());
+  app.add_flag("--verbose", verbose, "per-section figures of the workspace");
+  app.add_option("--width", o.cleaning_width_m, "M: cleaning width (PSR-2's)")
+      ->check(cli::positive_number())
+      ->capture_default_str();
+  app.add_option("--radius", o.robot_radius_m, "M: robot radius")
+      ->check(cli::positive_number())
+      ->capture_default_str();
+  app.add_option("--lane-overlap", o.lane_overlap_m, "M: CoverageOptions::lane_overlap_m")
+      ->check(cli::non_negative_number());
+  app.add_option("--lane-inset", o.lane_inset_m, "M: CoverageOptions::lane_inset_m")
+      ->check(cli::non_negative_number());
+  app.add_option("--turn-cost", o.turn_cost_m, "M: CoverageOptions::turn_cost_m")
+      ->check(cli::non_negative_number());
+  app.add_option("--link-margin", o.link_margin_m,
+                 "M: CoverageOptions::link_margin_m (the clearance links keep beyond the robot radius)")
+      ->check(cli::non_negative_number());
+  app.add_option("--rooms", rooms,
+                 "METHOD: cover the rooms of a room segmentation (morphological, distance_transform, voronoi) instead of the "
+                 "section splitter's sections")
+      ->check(CLI::IsMember({"morphological", "distance_transform", "voronoi"}));
+  app.add_flag("--segment-only", segment_only, "with --ipa: only the room segmentation's precision and recall, no coverage");
+  if (auto code = cli::parse_command_line(
+          app, "tripodal-coverage-eval",
+          "exit codes: 0 ok, 1 a map could not be read or covered, 2 bad command line", argc, argv)) {
+    return *code;
   }
-  if (ipa.empty() && workspace.empty() && random_rooms <= 0) return usage();
+  if (ipa.empty() && workspace.empty() && random_rooms <= 0) {
+    std::cerr << "tripodal-coverage-eval: give --ipa DIR, --workspace MAP.yaml or --random N\nrun "
+                 "'tripodal-coverage-eval --help' for the usage\n";
+    return cli::kUsage;
+  }
   try {
     if (!workspace.empty()) {
       const MapFile m = load_map(workspace);

@@ -4,19 +4,20 @@
 // board's wheels move the embedded simulator's robot in the given world in real time. It speaks
 // the protocol profile given (--protocol; the thesis's by default), over the pseudo-terminal or,
 // with --tcp, over TCP on loopback as the board's ESP8266 backup link would.
-#include <CLI/CLI.hpp>
-
 #include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <string_view>
+#include <vector>
 
+#include "cli_tool.hpp"
 #include "tripodal/board/board_firmware.hpp"
 #include "tripodal/board/protocol_profile.hpp"
-#include "tripodal/board/tcp_stream.hpp"
 #include "tripodal/board/serial_port.hpp"
+#include "tripodal/board/tcp_stream.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/sim/rplidar_emulator.hpp"
@@ -28,11 +29,37 @@ namespace {
 std::atomic<bool> g_stop{false};
 void on_signal(int /*sig*/) { g_stop.store(true); }
 
-// The tool; main() only keeps what escapes it (CLI11's own errors are answered inside).
+// The default world: the installed one (PREFIX/share/tripodal/configs, beside PREFIX/bin where
+// this program is), else the source tree's (a build tree's program), else ./configs.
+std::filesystem::path default_world() {
+  const std::filesystem::path rel = std::filesystem::path("worlds") / "workspace.yaml";
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  std::vector<std::filesystem::path> candidates;
+  if (!ec) candidates.push_back(exe.parent_path().parent_path() / TRIPODAL_CONFIGS_INSTALL_DIR / rel);
+  candidates.push_back(std::filesystem::path(TRIPODAL_SOURCE_CONFIGS_DIR) / rel);
+  candidates.push_back(std::filesystem::path("configs") / rel);
+  for (const auto& c : candidates) {
+    if (std::filesystem::is_regular_file(c, ec)) return c;
+  }
+  return {};
+}
+
+constexpr std::string_view kExitCodes =
+    "exit codes: 0 ok, 1 the board could not start (bad world or protocol profile), 2 bad command line, 3 "
+    "the world file cannot "
+    "be read";
+
+// The tool; main() only keeps what escapes it.
 int run(int argc, char** argv) {
   using namespace tripodal;
-  CLI::App app{"tripodal-board-sim: the disinfection robot's control board, simulated behind a pseudo-terminal"};
-  std::string world_file = "configs/worlds/workspace.yaml";
+  CLI::App app{
+      "The disinfection robot's control board, simulated behind a pseudo-terminal (or, with --tcp, on a "
+      "loopback\n"
+      "TCP port): it prints the device a host opens as it would the board's UART. The board's wheels move "
+      "the\n"
+      "embedded simulator's robot in the world, in real time (docs/board-protocol.md).\n"};
+  std::string world_file;
   std::string link;
   double wheel_radius_m = 0.09;
   double wheel_separation_m = 0.42;
@@ -42,20 +69,47 @@ int run(int argc, char** argv) {
   std::string protocol = "thesis";
   int tcp_port = -1;
   std::string lidar_link;
-  app.add_option("--world", world_file, "world file (the simulator's map, start pose, sensors)")->check(CLI::ExistingFile);
-  app.add_option("--link", link, "also make this path a symbolic link to the pseudo-terminal");
-  app.add_option("--wheel-radius-m", wheel_radius_m, "wheel radius (m)")->check(CLI::PositiveNumber);
-  app.add_option("--wheel-separation-m", wheel_separation_m, "wheel separation (m)")->check(CLI::PositiveNumber);
-  app.add_option("--duration-s", duration_s, "stop after this many seconds (0: at SIGINT or SIGTERM)")->check(CLI::NonNegativeNumber);
-  app.add_option("--link-timeout-s", link_timeout_s, "the board's link watchdog (s)")->check(CLI::PositiveNumber);
-  app.add_option("--tank-l", tank_l, "disinfectant in the tank at power-on (l)")->check(CLI::NonNegativeNumber);
-  app.add_option("--protocol", protocol, "protocol profile: thesis, tripodal-v1 or a YAML file (configs/board/)");
-  app.add_option("--tcp", tcp_port, "serve the link over TCP on 127.0.0.1:PORT (0: any free port) instead of a pseudo-terminal")
+  app.add_option("--world", world_file,
+                 "WORLD.yaml: the simulator's map, start pose and sensors (default: the installed "
+                 "configs/worlds/workspace.yaml)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--link", link, "PATH: also make this path a symbolic link to the pseudo-terminal");
+  app.add_option("--wheel-radius-m", wheel_radius_m, "M: wheel radius")
+      ->check(tripodal::cli::positive_number())
+      ->capture_default_str();
+  app.add_option("--wheel-separation-m", wheel_separation_m, "M: wheel separation")
+      ->check(tripodal::cli::positive_number())
+      ->capture_default_str();
+  app.add_option("--duration-s", duration_s, "S: stop after this many seconds (0: at SIGINT or SIGTERM)")
+      ->check(tripodal::cli::non_negative_number())
+      ->capture_default_str();
+  app.add_option("--link-timeout-s", link_timeout_s, "S: the board's link watchdog")
+      ->check(tripodal::cli::positive_number())
+      ->capture_default_str();
+  app.add_option("--tank-l", tank_l, "L: disinfectant in the tank at power-on")
+      ->check(tripodal::cli::non_negative_number())
+      ->capture_default_str();
+  app.add_option("--protocol", protocol,
+                 "NAME|FILE: protocol profile: thesis, tripodal-v1 or a YAML file (configs/board/)")
+      ->capture_default_str();
+  app.add_option(
+         "--tcp", tcp_port,
+         "PORT: serve the link over TCP on 127.0.0.1:PORT (0: any free port) instead of a pseudo-terminal")
       ->check(CLI::Range(0, 65535));
   app.add_option("--lidar", lidar_link,
-                 "also serve an RPLIDAR A1 (docs/lidar.md) on a second pseudo-terminal, this path a symbolic link to it; "
+                 "PATH: also serve an RPLIDAR A1 (docs/lidar.md) on a second pseudo-terminal, this path a symbolic link to it; "
                  "it scans the same world");
-  CLI11_PARSE(app, argc, argv);
+  if (auto code = tripodal::cli::parse_command_line(app, "tripodal-board-sim", kExitCodes, argc, argv))
+    return *code;
+  if (world_file.empty()) {
+    world_file = default_world().string();
+    if (world_file.empty()) {
+      std::cerr << "tripodal-board-sim: no world given and none installed "
+                   "(share/tripodal/configs/worlds/workspace.yaml); "
+                   "give --world FILE\n";
+      return tripodal::cli::kIoError;
+    }
+  }
 
   try {
     SteadyClock clock;

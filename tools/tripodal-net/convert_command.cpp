@@ -57,7 +57,9 @@ int run_convert(const Args& args, std::ostream& out, std::ostream& err) {
 cli::Action setup(CLI::App& cmd) {
   auto a = std::make_shared<Args>();
   cmd.add_option("IN", a->in, "the net to read (.xml or .pnml)")->required();
-  cmd.add_option("OUT", a->target, "the file to write: PNML when it ends in .pnml, else native XML")->required();
+  cmd.add_option("OUT", a->target, "the file to write: PNML when it ends in .pnml, else native XML")
+      ->required()
+      ->check(cli::writable_file());
   return [a](std::ostream& out, std::ostream& err) { return run_convert(*a, out, err); };
 }
 

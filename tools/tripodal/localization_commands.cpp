@@ -518,7 +518,8 @@ cli::Action setup_eval(CLI::App& cmd) {
   cmd.add_option("--global-max-scans", a->global_max_scans, "N: scans a start may take to converge")
       ->capture_default_str()
       ->check(positive_count());
-  cmd.add_option("--trajectory", a->trajectory, "FILE: CSV of the tracking run, scan by scan (last log)");
+  cmd.add_option("--trajectory", a->trajectory, "FILE: CSV of the tracking run, scan by scan (last log)")
+      ->check(cli::writable_file());
   channel_options(cmd, a->laser_channel, a->odom_channel, a->pose_channel);
   return [a](std::ostream& out, std::ostream& err) { return localization_eval(*a, out, err); };
 }
@@ -527,7 +528,9 @@ cli::Action setup_build(CLI::App& cmd) {
   auto a = std::make_shared<BuildArgs>();
   cmd.add_option("TRACE", a->trace, "a trace, a CARMEN log (.log, .log.gz) or a rosbag2 bag (MCAP, db3) with laser and odometry")
       ->required();
-  cmd.add_option("--out", a->out, "MAP.yaml: the map_server map to write (and MAP.pgm beside it)")->required();
+  cmd.add_option("--out", a->out, "MAP.yaml: the map_server map to write (and MAP.pgm beside it)")
+      ->required()
+      ->check(cli::writable_file());
   cmd.add_option("--resolution", a->resolution_m, "M: cell side")->capture_default_str()->check(positive_number());
   cmd.add_option("--max-range", a->max_range_m, "M: returns beyond are not mapped")->capture_default_str()->check(positive_number());
   cmd.add_option("--gap", a->gap_s, "S: time between the far pairs of the relative errors")->capture_default_str()->check(positive_number());
@@ -536,7 +539,9 @@ cli::Action setup_build(CLI::App& cmd) {
   cmd.add_option("--recovery-margin", a->recovery_margin,
                  "Q: a match this far below the recent median is re-matched globally (0: never)")
       ->capture_default_str()->check(CLI::Range(0.0, 1.0));
-  cmd.add_option("--trajectory", a->trajectory, "FILE: CSV of the matches, scan by scan, as made (before closures)");
+  cmd.add_option("--trajectory", a->trajectory,
+                 "FILE: CSV of the matches, scan by scan, as made (before closures)")
+      ->check(cli::writable_file());
   cmd.add_flag("--loop-closure", a->loop_closure, "keep a pose graph of key scans and close loops (docs/localization.md)");
   cmd.add_option("--closure-quality", a->closure_quality, "Q: with --loop-closure, the match quality a closure needs, in (0, 1]")
       ->capture_default_str()->check(CLI::Range(0.01, 1.0));

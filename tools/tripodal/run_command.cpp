@@ -333,10 +333,13 @@ cli::Action setup(CLI::App& cmd) {
                  "docs/distribution.md), the world still giving the map and regions");
   cmd.add_option("--hardware-param", a->hardware_params,
                  "KEY=VALUE: a parameter of the hardware slot (repeatable): namespace=NS, domain_id=N, step_timeout_s=S");
-  cmd.add_option("--out", o.out, "DIR: where map.png, trajectory.csv, report.json and lifecycle.txt go");
-  cmd.add_option("--record", o.record,
-                 "FILE.mcap: record the run (sensor readings, commands, the life cycle with every firing) as MCAP "
-                 "(docs/rosbag.md); `tripodal trace convert` turns it into a trace");
+  cmd.add_option("--out", o.out, "DIR: where map.png, trajectory.csv, report.json and lifecycle.txt go")
+      ->check(cli::writable_folder());
+  cmd.add_option(
+         "--record", o.record,
+         "FILE.mcap: record the run (sensor readings, commands, the life cycle with every firing) as MCAP "
+         "(docs/rosbag.md); `tripodal trace convert` turns it into a trace")
+      ->check(cli::writable_file());
   // Without SPEED CLI11 hands the option an empty value, which leaves realtime_speed at 0.
   a->realtime = cmd.add_option("--realtime", a->realtime_speed, "[SPEED]: SPEED times real time (default 1)")
                     ->expected(0, 1)

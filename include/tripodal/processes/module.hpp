@@ -13,6 +13,7 @@
 #include <string>
 #include <string_view>
 #include <typeinfo>
+#include <utility>
 #include <vector>
 
 #include "tripodal/behaviors/behavior.hpp"
@@ -85,9 +86,15 @@ struct ModuleContext {
   std::filesystem::path profile_dir;             ///< relative file parameters are relative to it
 
   std::vector<ModuleEvent> events;               ///< posted to the running processes' nets
+  /// Fact changes for the nets' guards (`charging`, `battery_percent`), in order; the supervisor
+  /// keeps the latest value of each, so a process started later reads it too.
+  std::vector<std::pair<std::string, Value>> facts;
   bool heartbeat = false;                        ///< the module is alive (supervisor watchdog)
 
   void post(std::string event, std::string message = {}) { events.push_back({now, std::move(event), std::move(message)}); }
+  /// Sets a fact the running processes' nets declare. A type that sets facts lists them among its
+  /// manifest's outputs: the profile check (check_robot) finds there who provides a fact a net reads.
+  void set_fact(std::string name, Value value) { facts.emplace_back(std::move(name), std::move(value)); }
   /// A fresh id for a path published in navigation->path_id.
   [[nodiscard]] std::uint32_t new_path_id() noexcept { return path_ids != nullptr ? ++*path_ids : 1; }
 };

@@ -132,6 +132,11 @@ struct RobotProfile {
   SourceLocation recovery_where;
   /// The robot on DDS; none: the robot speaks no DDS.
   std::optional<DdsSection> dds;
+  /// `external_facts: [door_open, ...]`: facts the nets read that come from outside the robot's
+  /// modules (set through the supervisor by the application); the check warns instead of refusing
+  /// when no module lists one among its outputs.
+  std::vector<std::string> external_facts;
+  SourceLocation external_facts_where;
 
   /// Every module entry, in profile order: controllers, resources, navigation, hri, modules, behaviors.
   [[nodiscard]] std::vector<const ModuleEntry*> all_modules() const;

@@ -42,6 +42,8 @@ struct SimEvent {
     fell,                     ///< the robot's centre entered a drop area
     battery_empty,
     button_pressed,           ///< an LED button was pressed (detail: its name)
+    docked,                   ///< the robot's contacts touch a dock's (detail: its name): charging
+    undocked,                 ///< they no longer touch (detail: the dock's name)
   };
   Kind kind = Kind::collision;
   Time stamp{};
@@ -126,8 +128,17 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   [[nodiscard]] double distance_m() const noexcept { return distance_m_; }
   [[nodiscard]] double rotation_rad() const noexcept { return rotation_rad_; }
   [[nodiscard]] double battery_charge() const noexcept { return soc_; }
+  /// A charger plugged in by hand (a test, a tool): charges wherever the robot is.
   void set_charging(bool charging) noexcept { charging_ = charging; }
-  [[nodiscard]] bool charging() const noexcept { return charging_; }
+  /// Charging: plugged in by hand, or on a dock's contacts (World::docks).
+  [[nodiscard]] bool charging() const noexcept { return charging_ || dock_ >= 0; }
+  /// The dock whose contacts the robot touches (index into World::docks), -1 for none.
+  [[nodiscard]] int dock() const noexcept { return dock_; }
+  /// An extra load on the battery (a UV lamp, a pump), as a fraction of the capacity per second,
+  /// until changed; a device of the hardware sets it while it runs.
+  void set_extra_drain_per_s(double fraction_per_s) noexcept {
+    extra_drain_per_s_ = fraction_per_s > 0.0 ? fraction_per_s : 0.0;
+  }
   /// Whether `sensor` is silenced by the fault schedule at time t.
   [[nodiscard]] bool sensor_dead(SensorKind sensor, Time t) const noexcept;
   /// Whether a localization loss window covers t (the laser returns nothing then).
@@ -223,6 +234,8 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   bool blocked_ = false;
   bool fallen_ = false;
   bool charging_ = false;
+  int dock_ = -1;
+  double extra_drain_per_s_ = 0.0;
   bool battery_empty_ = false;
   std::uint64_t collisions_ = 0;
   double distance_m_ = 0.0;

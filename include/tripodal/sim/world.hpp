@@ -95,7 +95,7 @@ struct BatteryConfig {
   double voltage_full_v = 25.2;
   double drain_per_s = 2.0e-5;      ///< fraction of the capacity per second (electronics)
   double drain_per_m = 2.0e-4;      ///< fraction of the capacity per metre driven
-  double charge_per_s = 5.0e-4;     ///< fraction of the capacity per second while charging
+  double charge_per_s = 5.0e-4;     ///< fraction of the capacity per second while charging (on a dock)
   double rate_hz = 1.0;
 };
 
@@ -178,6 +178,18 @@ struct DropArea {
   SourceLocation where;
 };
 
+/// A charging dock: its contacts touch the robot's while the robot's centre is within
+/// contact_radius_m of `pose` and its heading within heading_tolerance_rad of pose.theta (a
+/// tolerance of pi or more: a charging pad, any heading). While they touch the battery charges
+/// at robot.battery.charge_per_s (BatteryReading::charging is true).
+struct Dock {
+  std::string name;
+  Pose2D pose;  ///< map_from_base of the robot docked
+  double contact_radius_m = 0.1;
+  double heading_tolerance_rad = 0.35;
+  SourceLocation where;
+};
+
 /// Which simulated sensor a dead-sensor fault silences.
 enum class SensorKind : std::uint8_t { laser, odometry, gyro, bumpers, cliff, battery };
 [[nodiscard]] std::string_view to_string(SensorKind kind) noexcept;
@@ -223,6 +235,7 @@ struct World {
   std::vector<DropArea> drops;
   std::vector<DynamicObstacle> obstacles;
   std::vector<Visitor> visitors;
+  std::vector<Dock> docks;
   FaultSchedule faults;
 };
 
