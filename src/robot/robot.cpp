@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "tripodal/behaviors/navigation_behaviors.hpp"
+#include "tripodal/behaviors/safety_behaviors.hpp"
 #include "tripodal/core/net_loader.hpp"
 #include "tripodal/navi/navi_modules.hpp"
 #include "tripodal/reactive/reactive_config.hpp"
@@ -20,6 +21,7 @@ RobotPlugins RobotPlugins::with_builtins() {
   RobotPlugins p;
   register_builtin_behaviors(p.behaviors);
   register_navigation_behaviors(p.behaviors);
+  register_safety_behaviors(p.behaviors);
   register_builtin_controllers(p.controllers);
   navi::register_navigation_modules(p.modules);
   return p;
@@ -374,7 +376,8 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
           break;
         }
         case LoopEvent::Kind::controller_fault:
-        case LoopEvent::Kind::controller_recovered: supervisor->post_event(e.event_name()); break;
+        case LoopEvent::Kind::controller_recovered:
+        case LoopEvent::Kind::behavior_signal: supervisor->post_event(e.event_name()); break;
       }
     }
   }
