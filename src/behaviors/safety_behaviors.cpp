@@ -17,6 +17,8 @@ namespace {
 using parameter::number;
 using parameter::text;
 
+constexpr std::array<double, 3> kBeyond_m{0.0, 0.35, 0.7};  // hazard points ahead of a cliff sensor
+
 // "a, b, c" or "x,y; x,y": numbers in groups of `per` (1 or 2); ConfigError naming the parameter.
 std::vector<double> parse_numbers(const std::string& value, std::size_t per, std::size_t max_groups, std::string_view behavior,
                                   std::string_view parameter) {
@@ -165,9 +167,16 @@ std::optional<Twist2D> BhCliffGuard::on_step(const BehaviorContext& context) noe
     if (any && context.navi != nullptr) {
       // Where the drop is: under each sensor that sees it (kept for the whole reflex, so the
       // sequencing layer still has it when the path follower reports itself blocked).
+      // A ledge does not end at the edge: the floor is gone beyond it too, so the points go on
+      // ahead of each sensor (kBeyond), and a detour keeps off the drop, not only off its edge.
       hazard_count_ = 0;
-      for (std::size_t i = 0; i < bits.size() && i < sensor_count_ && hazard_count_ < hazards_.size(); ++i) {
-        if (bits[i] != 0) hazards_[hazard_count_++] = to_map(context.navi->map_from_base, sensors_[i].x_m, sensors_[i].y_m);
+      for (std::size_t i = 0; i < bits.size() && i < sensor_count_; ++i) {
+        if (bits[i] == 0) continue;
+        for (const double ahead : kBeyond_m) {
+          if (hazard_count_ < hazards_.size()) {
+            hazards_[hazard_count_++] = to_map(context.navi->map_from_base, sensors_[i].x_m + ahead, sensors_[i].y_m);
+          }
+        }
       }
     }
   }

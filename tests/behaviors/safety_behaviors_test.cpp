@@ -84,9 +84,11 @@ TEST_CASE("BhCliffGuard: a cliff bit stops the robot, backs it straight off, hol
   CHECK(e->wz_lo_rad_s == 0.0);
   CHECK(e->wz_hi_rad_s == 0.0);
   CHECK(guard.take_signal() == "cliff");
-  REQUIRE(w.feedback.hazard_count == 1);
+  REQUIRE(w.feedback.hazard_count == 3);  // under the sensor, and beyond the edge
   CHECK(w.feedback.hazards[0].x_m == Approx(1.1));
   CHECK(w.feedback.hazards[0].y_m == Approx(2.17));
+  CHECK(w.feedback.hazards[2].x_m == Approx(1.8));
+  CHECK(w.feedback.hazards[2].y_m == Approx(2.17));
   // Still over the drop: it keeps backing, without a second event.
   (void)w.step(guard);
   CHECK(guard.take_signal().empty());
@@ -100,7 +102,7 @@ TEST_CASE("BhCliffGuard: a cliff bit stops the robot, backs it straight off, hol
   CHECK(e->vx_hi_m_s == 0.0);
   CHECK(e->vx_lo_m_s == -kInf);
   CHECK(e->wz_lo_rad_s == -kInf);  // turning in place is free while holding
-  CHECK(w.feedback.hazard_count == 1);  // the place is reported while it holds
+  CHECK(w.feedback.hazard_count == 3);  // the place is reported while it holds
   for (int k = 0; k < 200; ++k) (void)w.step(guard);
   CHECK_FALSE(w.step(guard).has_value());
   CHECK(w.feedback.hazard_count == 0);

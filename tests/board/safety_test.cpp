@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <random>
 #include <string>
 
 #include "tripodal/board/actuator_behaviors.hpp"
@@ -49,6 +50,12 @@ struct WardRun {
 WardRun run_ward(std::uint64_t seed, double max_s, const std::function<void(sim::World&)>& edit = {}) {
   sim::World w = sim::load_world(kConfigs / "worlds/safety_ward.yaml");
   w.seed = seed;
+  // The simulated board's sensors are exact and the localizer is the ground truth, so the seed
+  // alone would change little: it also places the robot, within 0.3 m and 0.5 rad of the world's
+  // start pose, so every seed drives its own coverage.
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> offset(-0.3, 0.3), turn(-0.5, 0.5);
+  w.start_pose = {w.start_pose.x_m + offset(rng), w.start_pose.y_m + offset(rng), w.start_pose.theta_rad + turn(rng)};
   if (edit) edit(w);
   const auto world = std::make_shared<const sim::World>(std::move(w));
   SimClock clock;
@@ -82,6 +89,11 @@ WardRun run_ward(std::uint64_t seed, double max_s, const std::function<void(sim:
     const std::uint32_t bits = hw.board().link().has_drive() ? (hw.board().link().drive().sensors >> board::kCliffShift) & 0xFFU : 0U;
     if (bits != 0 && last_bits == 0) ++out.cliff_detections;
     last_bits = bits;
+    if (std::getenv("SAFETY_DEBUG") != nullptr && std::lround(to_seconds(clock.now() - start) * 100) % 50 == 0) {
+      std::fprintf(stderr, "t=%.2f x=%.3f y=%.3f th=%.2f bits=%x cmd=%.3f limited=%d\n", to_seconds(clock.now() - start), p.x_m, p.y_m,
+                   p.theta_rad, bits, robot->behavior_loop().last_cycle().coordinator.command.vx_m_s,
+                   robot->behavior_loop().last_cycle().coordinator.safety_limited ? 1 : 0);
+    }
   }
   out.fell = sim.fallen();
   out.contacts = sim.collisions();

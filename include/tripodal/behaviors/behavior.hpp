@@ -73,7 +73,7 @@ struct NavigationFeedback {
   /// unused): where a cliff sensor saw a drop, where an ultrasonic echo or a bumper met glass or a
   /// low table. The sequencing layer plans detours around them as around the laser's unmapped
   /// returns. Written every period while they hold the robot back.
-  static constexpr std::size_t kMaxHazards = 8;
+  static constexpr std::size_t kMaxHazards = 16;
   std::array<Pose2D, kMaxHazards> hazards{};
   std::uint8_t hazard_count = 0;
   /// Adds a hazard point (ignored when full).

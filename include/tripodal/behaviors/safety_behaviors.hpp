@@ -49,7 +49,8 @@ class BackOffReflex {
 /// Cliff: when a cliff bit is set (the board's judgment, InfraredReading::cliff) the robot stops,
 /// backs straight off back_off_m, then may not drive forward for hold_s, and the net event `event`
 /// ("cliff") is raised once per detection. The sensors' places on the chassis (parameter
-/// `sensors`) give the hazard points. Fails at activation without a cliff resource.
+/// `sensors`) give the hazard points: under each firing sensor and 0.35 and 0.7 m ahead of it
+/// (the floor is gone beyond the edge too). Fails at activation without a cliff resource.
 class BhCliffGuard final : public CBehavior {
  public:
   static const ModuleManifest& static_manifest();
