@@ -55,6 +55,7 @@ BackOffReflex::Options reflex_options(const ParameterSet& params) {
   o.back_off_m = params.number("back_off_m");
   o.back_speed_m_s = params.number("back_speed_m_s");
   o.hold_s = params.number("hold_s");
+  o.release_turn_rad = params.number("release_turn_rad");
   o.max_back_off_m = params.number("max_back_off_m");
   if (o.max_back_off_m < o.back_off_m) {
     throw ConfigError(SourceLocation{}, "max_back_off_m (" + std::to_string(o.max_back_off_m) + ") must be at least back_off_m (" +
@@ -67,10 +68,13 @@ std::vector<ParameterSpec> reflex_parameters(double back_off_m) {
   return {number("back_off_m", back_off_m, "m", "how far to back straight away once triggered", 0.0, 1.0),
           parameter::positive("back_speed_m_s", 0.1, "m/s", "backing speed"),
           number("max_back_off_m", 0.4, "m", "backing while the sensor still fires stops here (a sensor stuck)", 0.0, 2.0),
-          number("hold_s", 5.0, "s",
+          number("hold_s", 12.0, "s",
                  "after backing, no forward translation this long (rotation free): the path follower counts itself "
-                 "blocked and the sequencing layer plans around the hazard",
-                 0.0, 600.0)};
+                 "blocked and the sequencing layer plans around the hazard; longer than its blocked timeout, so "
+                 "with no way around it gives up",
+                 0.0, 600.0),
+          number("release_turn_rad", 1.0, "rad", "the hold ends once the robot has turned this far away (toward a detour)",
+                 0.0, 3.2)};
 }
 
 Pose2D to_map(const Pose2D& map_from_base, double bx, double by) noexcept {
@@ -88,11 +92,12 @@ void report_hazards(const BehaviorContext& context, const std::array<Pose2D, N>&
 
 // --- BackOffReflex ----------------------------------------------------------------------------
 
-bool BackOffReflex::update(bool triggered, Time now) noexcept {
+bool BackOffReflex::update(bool triggered, Time now, double heading_rad) noexcept {
   bool fresh = false;
   if (triggered && phase_ != Phase::backing) {
     phase_ = Phase::backing;
     started_ = now;
+    heading0_rad_ = heading_rad;
     fresh = true;
   }
   if (triggered) back_until_ = now + from_seconds(options_.back_off_m / options_.back_speed_m_s);
@@ -100,7 +105,10 @@ bool BackOffReflex::update(bool triggered, Time now) noexcept {
     phase_ = Phase::holding;
     hold_until_ = now + from_seconds(options_.hold_s);
   }
-  if (phase_ == Phase::holding && now >= hold_until_) phase_ = Phase::idle;
+  if (phase_ == Phase::holding &&
+      (now >= hold_until_ || std::abs(std::remainder(heading_rad - heading0_rad_, 2.0 * std::numbers::pi)) > options_.release_turn_rad)) {
+    phase_ = Phase::idle;
+  }
   return fresh;
 }
 
@@ -180,7 +188,8 @@ std::optional<Twist2D> BhCliffGuard::on_step(const BehaviorContext& context) noe
       }
     }
   }
-  if (reflex_.update(any, context.now) && !event_.empty()) signal(event_);
+  const double heading = context.navi != nullptr ? context.navi->map_from_base.theta_rad : 0.0;
+  if (reflex_.update(any, context.now, heading) && !event_.empty()) signal(event_);
   const std::optional<VelocityEnvelope> e = reflex_.envelope(context.now);
   if (!e) hazard_count_ = 0;
   report_hazards(context, hazards_, hazard_count_);
@@ -231,7 +240,7 @@ std::optional<Twist2D> BhBumperGuard::on_step(const BehaviorContext& context) no
       hazards_[hazard_count_++] = to_map(context.navi->map_from_base, r * std::cos(a), r * std::sin(a));
     }
   }
-  (void)reflex_.update(front != 0, context.now);
+  (void)reflex_.update(front != 0, context.now, context.navi != nullptr ? context.navi->map_from_base.theta_rad : 0.0);
   std::optional<VelocityEnvelope> e = reflex_.envelope(context.now);
   if (!e) hazard_count_ = 0;
   if ((pressed & back_mask_) != 0) {

@@ -224,3 +224,18 @@ TEST_CASE("register_safety_behaviors registers the three reflexes", "[behaviors]
     CHECK(reg.create(name) != nullptr);
   }
 }
+
+TEST_CASE("BhCliffGuard: the hold ends early once the robot has turned away (toward a detour)", "[behaviors][safety]") {
+  Readings w;
+  BhCliffGuard guard;
+  guard.activate(ParameterValues{{"back_off_m", Value{0.1}}, {"hold_s", Value{12.0}}, {"release_turn_rad", Value{1.0}}}, w.ctx);
+  w.set_cliff({1, 0, 0});
+  (void)w.step(guard);
+  w.set_cliff({0, 0, 0});
+  for (int k = 0; k < 150; ++k) (void)w.step(guard);  // backed off: holding
+  REQUIRE(w.step(guard).has_value());
+  w.navi.map_from_base.theta_rad = 0.8;  // turning in place: still facing the drop
+  REQUIRE(w.step(guard).has_value());
+  w.navi.map_from_base.theta_rad = -1.1;  // turned away
+  CHECK_FALSE(w.step(guard).has_value());
+}

@@ -24,7 +24,8 @@ class BackOffReflex {
   struct Options {
     double back_off_m = 0.12;       ///< how far to back away
     double back_speed_m_s = 0.1;    ///< at this speed, straight (no rotation)
-    double hold_s = 5.0;            ///< then no forward translation this long (rotation free)
+    double hold_s = 12.0;           ///< then no forward translation this long (rotation free)...
+    double release_turn_rad = 1.0;  ///< ...unless the robot turned this far from its heading at the trigger
     double max_back_off_m = 0.4;    ///< backing while the trigger stays on stops here (a stuck sensor)
   };
   enum class Phase : std::uint8_t { idle, backing, holding };
@@ -35,7 +36,12 @@ class BackOffReflex {
   /// holding). The robot backs while the trigger is on and back_off_m beyond (it may have stopped
   /// with its sensors past the edge), at most max_back_off_m in all: a trigger still on then (a
   /// sensor stuck at a drop) leaves it standing until it goes off.
-  bool update(bool triggered, Time now) noexcept;
+  /// `heading_rad`: the robot's heading now (map frame). The hold ends early once the robot has
+  /// turned release_turn_rad away from where it was heading when triggered (toward the detour the
+  /// sequencing layer planned); a hold that lasts (no way around) outlasts the path follower's
+  /// blocked timeout, which ends its activity with "path blocked" rather than driving at the
+  /// hazard again and again.
+  bool update(bool triggered, Time now, double heading_rad = 0.0) noexcept;
   /// The envelope of the phase (nullopt when idle).
   [[nodiscard]] std::optional<VelocityEnvelope> envelope(Time now) const noexcept;
   [[nodiscard]] Phase phase() const noexcept { return phase_; }
@@ -44,10 +50,12 @@ class BackOffReflex {
   Options options_;
   Phase phase_ = Phase::idle;
   Time started_{}, back_until_{}, hold_until_{};
+  double heading0_rad_ = 0.0;
 };
 
 /// Cliff: when a cliff bit is set (the board's judgment, InfraredReading::cliff) the robot stops,
-/// backs straight off back_off_m, then may not drive forward for hold_s, and the net event `event`
+/// backs straight off back_off_m, then may not drive forward for hold_s (or until it has turned
+/// away: BackOffReflex), and the net event `event`
 /// ("cliff") is raised once per detection. The sensors' places on the chassis (parameter
 /// `sensors`) give the hazard points: under each firing sensor and 0.35 and 0.7 m ahead of it
 /// (the floor is gone beyond the edge too). Fails at activation without a cliff resource.
