@@ -3,7 +3,6 @@
 #include "tripodal/behaviors/safety_behaviors.hpp"
 
 #include <catch2/catch.hpp>
-
 #include <limits>
 
 #include "tripodal/behaviors/behavior_coordinator.hpp"
@@ -33,7 +32,8 @@ struct Readings {
     navi.map_from_base = {1.0, 2.0, 0.0};
     set_cliff({0, 0, 0});
     set_bumps(0);
-    set_sonar({std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity()});
+    set_sonar({std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity(),
+               std::numeric_limits<float>::infinity()});
   }
   void set_cliff(std::vector<std::uint8_t> bits) {
     InfraredReading r;
@@ -67,11 +67,14 @@ constexpr double kInf = VelocityEnvelope::kInf;
 
 }  // namespace
 
-TEST_CASE("BhCliffGuard: a cliff bit stops the robot, backs it straight off, holds it and raises `cliff` once",
-          "[behaviors][safety]") {
+TEST_CASE(
+    "BhCliffGuard: a cliff bit stops the robot, backs it straight off, holds it and raises `cliff` once",
+    "[behaviors][safety]") {
   Readings w;
   BhCliffGuard guard;
-  guard.activate(ParameterValues{{"back_off_m", Value{0.1}}, {"back_speed_m_s", Value{0.1}}, {"hold_s", Value{2.0}}}, w.ctx);
+  guard.activate(
+      ParameterValues{{"back_off_m", Value{0.1}}, {"back_speed_m_s", Value{0.1}}, {"hold_s", Value{2.0}}},
+      w.ctx);
   REQUIRE(guard.running());
   CHECK_FALSE(w.step(guard).has_value());  // floor everywhere: nothing imposed
   CHECK(guard.take_signal().empty());
@@ -101,27 +104,29 @@ TEST_CASE("BhCliffGuard: a cliff bit stops the robot, backs it straight off, hol
   REQUIRE(e.has_value());
   CHECK(e->vx_hi_m_s == 0.0);
   CHECK(e->vx_lo_m_s == -kInf);
-  CHECK(e->wz_lo_rad_s == -kInf);  // turning in place is free while holding
+  CHECK(e->wz_lo_rad_s == -kInf);       // turning in place is free while holding
   CHECK(w.feedback.hazard_count == 3);  // the place is reported while it holds
   for (int k = 0; k < 200; ++k) (void)w.step(guard);
   CHECK_FALSE(w.step(guard).has_value());
   CHECK(w.feedback.hazard_count == 0);
 }
 
-TEST_CASE("BhCliffGuard: a sensor stuck over a drop backs the robot at most max_back_off_m, then it stands", "[behaviors][safety]") {
+TEST_CASE("BhCliffGuard: a sensor stuck over a drop backs the robot at most max_back_off_m, then it stands",
+          "[behaviors][safety]") {
   Readings w;
   BhCliffGuard guard;
   guard.activate(ParameterValues{}, w.ctx);
   w.set_cliff({1, 0, 0});
   for (int k = 0; k < 390; ++k) CHECK(w.step(guard)->vx_lo_m_s == -0.1);  // 3.9 s at 0.1 m/s: 0.39 m
-  for (int k = 0; k < 20; ++k) (void)w.step(guard);  // past the 0.4 m cap
+  for (int k = 0; k < 20; ++k) (void)w.step(guard);                       // past the 0.4 m cap
   const auto e = w.step(guard);
   REQUIRE(e.has_value());
   CHECK(e->vx_lo_m_s == 0.0);
   CHECK(e->vx_hi_m_s == 0.0);
 }
 
-TEST_CASE("BhCliffGuard: bad sensor places are refused with the parameter named; no resource fails", "[behaviors][safety][errors]") {
+TEST_CASE("BhCliffGuard: bad sensor places are refused with the parameter named; no resource fails",
+          "[behaviors][safety][errors]") {
   Readings w;
   BhCliffGuard guard;
   CHECK_THROWS_WITH(guard.activate(ParameterValues{{"sensors", Value{std::string("0.2,0; 0.1")}}}, w.ctx),
@@ -148,18 +153,21 @@ TEST_CASE("BhBumperGuard: a front bump backs off; a back bump alone forbids back
   CHECK(e->vx_hi_m_s == -0.1);
   REQUIRE(w.feedback.hazard_count == 1);
   CHECK(w.feedback.hazards[0].x_m == Approx(1.3));  // radius 0.25 + 0.05 ahead
-  w.set_bumps(0x4);  // the back one only (front released): no backing into it
+  w.set_bumps(0x4);                                 // the back one only (front released): no backing into it
   e = w.step(guard);
   REQUIRE(e.has_value());
   CHECK(e->vx_lo_m_s == 0.0);
   CHECK(e->vx_hi_m_s == 0.0);
 }
 
-TEST_CASE("BhSonarGuard: slows down and stops before an echo ahead, not for one beside the corridor", "[behaviors][safety]") {
+TEST_CASE("BhSonarGuard: slows down and stops before an echo ahead, not for one beside the corridor",
+          "[behaviors][safety]") {
   Readings w;
   BhSonarGuard guard;
-  guard.activate(ParameterValues{{"stop_distance_m", Value{0.1}}, {"slow_distance_m", Value{0.6}}, {"max_speed_m_s", Value{0.5}}},
-                 w.ctx);
+  guard.activate(
+      ParameterValues{
+          {"stop_distance_m", Value{0.1}}, {"slow_distance_m", Value{0.6}}, {"max_speed_m_s", Value{0.5}}},
+      w.ctx);
   constexpr float kNone = std::numeric_limits<float>::infinity();
   auto e = w.step(guard);
   REQUIRE(e.has_value());
@@ -188,8 +196,9 @@ TEST_CASE("BhSonarGuard: slows down and stops before an echo ahead, not for one 
   CHECK(blind.step(g2)->vx_hi_m_s == 0.0);
 }
 
-TEST_CASE("safety reflexes through the coordinator: the back-off wins over the task's command, the hold stops it",
-          "[behaviors][safety]") {
+TEST_CASE(
+    "safety reflexes through the coordinator: the back-off wins over the task's command, the hold stops it",
+    "[behaviors][safety]") {
   CBehaviorCoordinator c;
   const InputId cover = c.add_input({.name = "BhCleaningTwoWheel", .priority = 5});
   const InputId cliff = c.add_input({.name = "BhCliffGuard", .priority = 1000, .role = InputRole::safety});
@@ -225,10 +234,13 @@ TEST_CASE("register_safety_behaviors registers the three reflexes", "[behaviors]
   }
 }
 
-TEST_CASE("BhCliffGuard: the hold ends early once the robot has turned away (toward a detour)", "[behaviors][safety]") {
+TEST_CASE("BhCliffGuard: the hold ends early once the robot has turned away (toward a detour)",
+          "[behaviors][safety]") {
   Readings w;
   BhCliffGuard guard;
-  guard.activate(ParameterValues{{"back_off_m", Value{0.1}}, {"hold_s", Value{12.0}}, {"release_turn_rad", Value{1.0}}}, w.ctx);
+  guard.activate(
+      ParameterValues{{"back_off_m", Value{0.1}}, {"hold_s", Value{12.0}}, {"release_turn_rad", Value{1.0}}},
+      w.ctx);
   w.set_cliff({1, 0, 0});
   (void)w.step(guard);
   w.set_cliff({0, 0, 0});
