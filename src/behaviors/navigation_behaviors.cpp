@@ -409,11 +409,17 @@ Twist2D CPathFollowingBehavior::command_toward(const Pose2D& pose, const PathTra
 }
 
 bool CPathFollowingBehavior::held_by_safety(const BehaviorContext& context) noexcept {
-  // Held: the last command asked to move and the safety override let it crawl at most. Turning is
+  // Held: the last command asked to move and the safety override let it crawl at most the way it
+  // asked (a reflex backing the robot off a drop holds it too: it makes no progress). Turning is
   // never held (a safety input leaves rotation free), so a turn in place toward a new path is not.
   const SafetyFeedback* safety = context.safety;
-  const bool holding = safety != nullptr && safety->limited && safety->requested_speed_m_s() >= kCrawl_m_s &&
-                       safety->allowed_speed_m_s() < kCrawl_m_s;
+  bool holding = false;
+  if (safety != nullptr && safety->limited && safety->requested_speed_m_s() >= kCrawl_m_s) {
+    const Twist2D& req = safety->requested;
+    const Twist2D& allowed = safety->allowed;
+    const double progress_m_s = (req.vx_m_s * allowed.vx_m_s + req.vy_m_s * allowed.vy_m_s) / safety->requested_speed_m_s();
+    holding = progress_m_s < kCrawl_m_s;
+  }
   if (!holding) {
     held_ = false;
     return false;

@@ -50,6 +50,10 @@ BoardFirmware::BoardFirmware(const FirmwareConfig& config, ByteStream& link, Boa
   config_.cliff_count = std::min(config_.cliff_count, kMaxInfrared);
   config_.wall_count = std::min(config_.wall_count, kMaxInfrared - config_.cliff_count);
   for (Motor& m : motors_) m.pid = config_.pid;
+  // The reading "before the first" is the flat floor the data section assumes: a robot switched on
+  // over a drop sees it at the first measurement.
+  cliff_threshold_adc_ = cliff_adc_threshold(config_);
+  cliff_adc_.fill(cliff_sensor_adc(config_.cliff_floor_m));
   sample_battery();
 }
 
@@ -302,6 +306,7 @@ void BoardFirmware::device_loop() noexcept {
     next_motor_ += config_.motor_period;
     update_motors();
     plant_.sense(now_, sensors_);
+    judge_cliffs();
   }
 
   current_a_ = config_.idle_current_a + motor_load * config_.motor_current_a + (uv_lamp_ ? config_.uv_lamp_current_a : 0.0) +
@@ -350,13 +355,31 @@ void BoardFirmware::sample_battery() noexcept {
   battery_.voltage_mv = static_cast<std::uint16_t>(std::lround((kBatteryEmptyV + (kBatteryFullV - kBatteryEmptyV) * soc_) * 1000.0));
 }
 
-std::uint32_t BoardFirmware::sensor_bitmap() const noexcept {
-  std::uint32_t bits = static_cast<std::uint32_t>(sensors_.bumps) << kBumpShift;
+std::uint16_t cliff_sensor_adc(double distance_m) noexcept {
+  // V = a / (d + b) through (2 cm, 2.0 V) and (15 cm, 0.4 V); beyond 15 cm the reading stays at
+  // its far end, as there is nothing nearer to see.
+  constexpr double kA = 0.065, kB = 0.0125, kMin = 0.02, kMax = 0.15, kVref = 3.3;
+  const double d = std::isnan(distance_m) ? kMax : std::clamp(distance_m, kMin, kMax);
+  return static_cast<std::uint16_t>(std::lround(kA / (d + kB) / kVref * 4095.0));
+}
+
+int cliff_adc_threshold(const FirmwareConfig& config) noexcept {
+  return static_cast<int>(cliff_sensor_adc(config.cliff_floor_m)) - static_cast<int>(cliff_sensor_adc(config.cliff_threshold_m));
+}
+
+void BoardFirmware::judge_cliffs() noexcept {
   for (std::size_t i = 0; i < config_.cliff_count; ++i) {
-    const float floor = sensors_.cliff_floor_m[i];
-    if (!std::isfinite(floor) || floor > config_.cliff_threshold_m) bits |= 1U << (kCliffShift + i);
+    const std::uint16_t now = cliff_sensor_adc(sensors_.cliff_floor_m[i]);
+    const int difference = static_cast<int>(cliff_adc_[i]) - static_cast<int>(now);  // > 0: the floor went farther
+    const std::uint32_t bit = 1U << (kCliffShift + i);
+    if (difference > cliff_threshold_adc_) cliff_bits_ |= bit;
+    if (-difference > cliff_threshold_adc_) cliff_bits_ &= ~bit;
+    cliff_adc_[i] = now;
   }
-  return bits;
+}
+
+std::uint32_t BoardFirmware::sensor_bitmap() const noexcept {
+  return (static_cast<std::uint32_t>(sensors_.bumps) << kBumpShift) | cliff_bits_;
 }
 
 std::uint8_t BoardFirmware::status_flags() const noexcept {

@@ -12,6 +12,7 @@ namespace {
 // the detour keeps this much more than the robot radius from them, and a cleaning detour takes
 // the coverage path up again this far beyond them (the laser sees only the near face of a box).
 constexpr double kObstacleRange_m = 3.0;
+constexpr double kHazardSame_m = 0.02;  // hazard points closer than this to a known one add nothing
 constexpr double kDetourMargin_m = 0.1;
 constexpr double kResumeClearance_m = 0.3;
 
@@ -61,6 +62,16 @@ bool ObstacleReplanner::observe(const CGridMaps& maps, const ModuleContext& cont
   const LaserResource* laser = context.resources != nullptr ? context.resources->first<LaserScan>() : nullptr;
   if (laser != nullptr && laser->is_fresh(context.now)) {
     maps.unmapped_returns(laser->latest(), context.navigation->map_from_base, kObstacleRange_m, seen_);
+  }
+  // What the safety behaviors found (a drop, glass): obstacles the laser cannot see. A point
+  // already known is not news.
+  const NavigationFeedback& fb = context.feedback;
+  for (std::size_t i = 0; i < fb.hazard_count; ++i) {
+    const Point2D h{fb.hazards[i].x_m, fb.hazards[i].y_m};
+    const bool known = std::any_of(seen_.begin(), seen_.end(), [&](const Point2D& o) {
+      return (o.x_m - h.x_m) * (o.x_m - h.x_m) + (o.y_m - h.y_m) * (o.y_m - h.y_m) < kHazardSame_m * kHazardSame_m;
+    });
+    if (!known) seen_.push_back(h);
   }
   return seen_.size() != before;
 }

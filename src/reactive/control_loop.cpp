@@ -11,6 +11,7 @@ std::string LoopEvent::event_name() const {
     case Kind::behavior_failed: return failed_event_name(behavior);
     case Kind::controller_fault: return std::string(loop) + ".controller_fault";
     case Kind::controller_recovered: return std::string(loop) + ".controller_recovered";
+    case Kind::behavior_signal: return std::string(reason);
   }
   return {};
 }
@@ -310,6 +311,17 @@ const CycleReport& ControlLoop::step(Time now) noexcept {
     CBehavior& b = *slot.behavior;
     context.safety = last.winner_id && *last.winner_id == slot.input ? &safety_ : nullptr;
     const std::optional<Twist2D> command = b.step(context);
+    if (const std::string_view signal = b.take_signal(); !signal.empty()) {
+      LoopEvent e;
+      e.kind = LoopEvent::Kind::behavior_signal;
+      e.stamp = now;
+      e.handle = {static_cast<std::uint32_t>(&slot - slots_.data()), slot.generation};
+      e.behavior = b.name();
+      e.input = coordinator_.input_config(slot.input).name;
+      e.reason = signal;
+      e.loop = options_.name;
+      push_event(e);
+    }
     if (b.envelope()) {
       coordinator_.submit_envelope(slot.input, *b.envelope(), now);
     } else if (command) {

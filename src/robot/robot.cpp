@@ -11,6 +11,7 @@
 
 #include "tripodal/behaviors/navigation_behaviors.hpp"
 #include "tripodal/behaviors/teleop.hpp"
+#include "tripodal/behaviors/safety_behaviors.hpp"
 #include "tripodal/core/net_loader.hpp"
 #include "tripodal/navi/navi_modules.hpp"
 #include "tripodal/reactive/reactive_config.hpp"
@@ -23,6 +24,7 @@ RobotPlugins RobotPlugins::with_builtins() {
   RobotPlugins p;
   register_builtin_behaviors(p.behaviors);
   register_navigation_behaviors(p.behaviors);
+  register_safety_behaviors(p.behaviors);
   register_builtin_controllers(p.controllers);
   navi::register_navigation_modules(p.modules);
   p.modules.add<BatteryMonitor>();
@@ -327,6 +329,9 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
   ResourceTable resources;
   std::vector<std::unique_ptr<ControlLoop>> loops;
   std::map<std::string, std::string, std::less<>> behavior_types;  // profile name -> type
+  // A net-bound behavior's parameters in the profile: defaults under the net's (e.g. the cleaning
+  // behavior's max_replans on a robot whose safety reflexes make it plan many detours).
+  std::map<std::string, ParameterValues, std::less<>> behavior_defaults;
 
   // The sequencing layer.
   std::vector<std::pair<std::string, std::unique_ptr<CModule>>> modules;
@@ -417,10 +422,13 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
   void activate(std::string_view behavior, const ParameterValues& params, Time now) override {
     const auto type = behavior_types.find(behavior);
     if (type == behavior_types.end()) throw std::out_of_range("no behavior '" + std::string(behavior) + "'");
+    ParameterValues merged;
+    if (const auto d = behavior_defaults.find(behavior); d != behavior_defaults.end()) merged = d->second;
+    for (const auto& [key, value] : params) merged.insert_or_assign(key, value);
     // Throws ConfigError for bad parameters: the supervisor makes it the behavior's failure.
-    const BehaviorHandle h = behavior_loop().activate(plugins.behaviors.create(type->second), params, behavior);
+    const BehaviorHandle h = behavior_loop().activate(plugins.behaviors.create(type->second), merged, behavior);
     active.insert_or_assign(std::string(behavior), ActiveBehavior{h, BehaviorStatus::running, {}});
-    const BehaviorActivation a{behavior, params, now, plugins.behaviors.find(type->second)};
+    const BehaviorActivation a{behavior, merged, now, plugins.behaviors.find(type->second)};
     ModuleContext ctx = context(now);
     for_each_module(ctx, [&](CModule& m) { m.behavior_activated(a, ctx); });
   }
@@ -455,7 +463,8 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
           break;
         }
         case LoopEvent::Kind::controller_fault:
-        case LoopEvent::Kind::controller_recovered: supervisor->post_event(e.event_name()); break;
+        case LoopEvent::Kind::controller_recovered:
+        case LoopEvent::Kind::behavior_signal: supervisor->post_event(e.event_name()); break;
       }
     }
   }
@@ -505,6 +514,9 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
   m->tasks = std::move(checked.tasks);
   m->recovery = std::move(checked.recovery);
   m->behavior_types = std::move(checked.behavior_types);
+  for (const ModuleEntry& b : profile.behaviors) {
+    if (!b.safety) m->behavior_defaults.emplace(b.name, parameters_of(b, m->options.parameters));
+  }
   m->controller_configs = std::move(checked.controllers);
   m->processes = ProcessRegistry(plugins.processes);
   for (ProcessDefinition& def : checked.processes) collect([&] { m->processes.add(std::move(def)); });

@@ -1,5 +1,6 @@
 #include "tripodal/sim/sim_board.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -24,12 +25,26 @@ void SimBoardPlant::sense(Time /*now*/, board::PlantSensors& out) noexcept {
     const double d = sim_.solid_map().cast(from, heading, range_m);
     return std::isfinite(d) && d <= range_m ? static_cast<float>(d) : std::numeric_limits<float>::infinity();
   };
-  for (std::size_t i = 0; i < mounts_.ultrasonic_rad.size(); ++i) out.ultrasonic_m[i] = cast(mounts_.ultrasonic_rad[i], mounts_.ultrasonic_range_m);
+  // The ultrasonic echo: the nearest solid thing in the cone (glass and low tables included: the
+  // solid map holds them, the laser's does not), measured from the sensor on the rim.
+  const int rays = std::max(1, mounts_.ultrasonic_rays);
+  for (std::size_t i = 0; i < mounts_.ultrasonic_rad.size(); ++i) {
+    float nearest = std::numeric_limits<float>::infinity();
+    for (int k = 0; k < rays; ++k) {
+      const double off = rays == 1 ? 0.0 : mounts_.ultrasonic_cone_rad * (static_cast<double>(k) / (rays - 1) - 0.5);
+      const double mount = mounts_.ultrasonic_rad[i];
+      const navi::Point2D from{pose.x_m + radius * std::cos(pose.theta_rad + mount), pose.y_m + radius * std::sin(pose.theta_rad + mount)};
+      const double d = sim_.solid_map().cast(from, pose.theta_rad + mount + off, mounts_.ultrasonic_range_m);
+      if (std::isfinite(d) && d <= mounts_.ultrasonic_range_m) nearest = std::min(nearest, static_cast<float>(d));
+    }
+    out.ultrasonic_m[i] = nearest;
+  }
   for (std::size_t i = 0; i < mounts_.wall_rad.size(); ++i) out.wall_m[i] = cast(mounts_.wall_rad[i], mounts_.wall_range_m);
-  const auto& cliff = sim_.cliff().latest().cliff;
+  // Each cliff sensor looks down at its place on the chassis: the floor at floor_m, a drop
+  // depth_m farther, no return beyond the sensor's range (and a stuck sensor as the fault says).
   for (std::size_t i = 0; i < out.cliff_floor_m.size(); ++i) {
-    const bool drop = i < cliff.size() && cliff[i] != 0;
-    out.cliff_floor_m[i] = drop ? std::numeric_limits<float>::infinity() : static_cast<float>(mounts_.floor_m);
+    const double d = mounts_.floor_m + sim_.cliff_depth_m(i);
+    out.cliff_floor_m[i] = d > mounts_.cliff_range_m ? std::numeric_limits<float>::infinity() : static_cast<float>(d);
   }
   out.bumps = static_cast<std::uint8_t>(sim_.bumpers().latest().pressed_mask & 0xFFU);
 }
@@ -96,6 +111,8 @@ void register_sim_board_hardware(HardwareRegistry& registry, const std::shared_p
     board::FirmwareConfig firmware;
     firmware.pulses_per_m = host.pulses_per_m;
     firmware.tank_initial_l = c.parameters.number("tank_l");
+    // The board has as many cliff sensors as the world's robot (at most 8: the bitmap's segment).
+    firmware.cliff_count = std::min(world->robot.cliff.positions.size(), std::size_t{8});
     const std::string& line = c.parameters.string("line");
     if (line != "in_process" && line != "pty") {
       throw ConfigError(c.where, "parameter 'line' is '" + line + "'; expected in_process or pty");

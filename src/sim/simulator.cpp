@@ -99,11 +99,34 @@ Simulator::Simulator(World world, const ControllerConfig& base, std::uint64_t se
   }
 
   solid_ = SolidMap(world_.grid);
+  if (!world_.sonar_only.empty()) {
+    // The sonar-only obstacles are part of the static solid map (the body, the bumpers and the
+    // ultrasonic cones meet them); the laser casts on a copy without them.
+    sonar_only_.assign(world_.grid.size(), 0);
+    for (const SonarOnlyObstacle& o : world_.sonar_only) {
+      navi::Region r{o.name, o.polygon, o.where};
+      for (std::size_t i : navi::cells_in_region(world_.grid, r)) {
+        sonar_only_[i] = 1;
+        const navi::CellIndex c = world_.grid.cell(i);
+        solid_.set_solid(c.x, c.y, true);
+      }
+    }
+    solid_.refresh();
+    laser_solid_ = SolidMap(world_.grid);
+    copy_laser_map();
+  }
   static_solid_ = solid_.cells();
-  drop_.assign(world_.grid.size(), 0);
+  drop_depth_.assign(world_.grid.size(), 0.0F);
   for (const DropArea& a : world_.drops) {
     navi::Region r{a.name, a.polygon, a.where};
-    for (std::size_t i : navi::cells_in_region(world_.grid, r)) drop_[i] = 1;
+    for (std::size_t i : navi::cells_in_region(world_.grid, r)) drop_depth_[i] = static_cast<float>(a.depth_m);
+  }
+  // The wheels touch the floor at these points: one over a drop and the robot falls.
+  if (base.type == "differential") {
+    const double half = base.differential.wheel_separation_m / 2.0;
+    wheel_points_ = {{0.0, half}, {0.0, -half}};
+  } else {
+    for (const OmniWheelConfig& wc : base.holonomic.wheels) wheel_points_.push_back({wc.x_m, wc.y_m});
   }
   for (const DynamicObstacle& o : world_.obstacles) {
     navi::Region r{o.name, o.polygon, o.where};
@@ -418,6 +441,9 @@ void Simulator::substep(Duration dt) noexcept {
         if (const auto v = visitor_hit(touching); v && !solid_.disc_overlaps({touching.x_m, touching.y_m}, rc.radius_m)) {
           ++visitor_collisions_;
           std::snprintf(where, sizeof where, "with %s at (%.2f, %.2f)", world_.visitors[*v].name.c_str(), pose_.x_m, pose_.y_m);
+        } else if (touches_sonar_only(touching)) {
+          ++sonar_only_collisions_;
+          std::snprintf(where, sizeof where, "with a sonar-only obstacle at (%.2f, %.2f)", pose_.x_m, pose_.y_m);
         } else {
           std::snprintf(where, sizeof where, "at (%.2f, %.2f)", pose_.x_m, pose_.y_m);
         }
@@ -482,14 +508,67 @@ void Simulator::substep(Duration dt) noexcept {
     }
   }
 
-  // A centre over a drop cell: the robot has fallen.
-  if (!fallen_) {
-    const navi::CellIndex c = world_.grid.cell_at({pose_.x_m, pose_.y_m});
-    if (world_.grid.contains(c) && drop_[world_.grid.index(c)] != 0) {
+  // The centre or a wheel's contact point over a drop cell: the robot has fallen.
+  if (!fallen_ && !world_.drops.empty()) {
+    const char* what = drop_depth_at(pose_.x_m, pose_.y_m) > 0.0 ? "centre" : nullptr;
+    const double c = std::cos(pose_.theta_rad), s = std::sin(pose_.theta_rad);
+    for (std::size_t i = 0; what == nullptr && i < wheel_points_.size(); ++i) {
+      const navi::Point2D& w = wheel_points_[i];
+      if (drop_depth_at(pose_.x_m + c * w.x_m - s * w.y_m, pose_.y_m + s * w.x_m + c * w.y_m) > 0.0) what = "wheel";
+    }
+    if (what != nullptr) {
       fallen_ = true;
       velocity_ = {};
-      log(SimEvent::Kind::fell, {});
+      char detail[64];
+      std::snprintf(detail, sizeof detail, "%s over the edge at (%.2f, %.2f)", what, pose_.x_m, pose_.y_m);
+      log(SimEvent::Kind::fell, detail);
     }
+  }
+}
+
+double Simulator::drop_depth_at(double x_m, double y_m) const noexcept {
+  const navi::CellIndex c = world_.grid.cell_at({x_m, y_m});
+  return world_.grid.contains(c) ? drop_depth_[world_.grid.index(c)] : 0.0;
+}
+
+double Simulator::cliff_depth_m(std::size_t index) const noexcept {
+  const std::vector<navi::Point2D>& positions = world_.robot.cliff.positions;
+  if (index >= positions.size()) return 0.0;
+  for (const StuckCliffSensor& st : world_.faults.stuck_cliff) {
+    if (st.index == index) return st.reads_drop ? std::numeric_limits<double>::infinity() : 0.0;
+  }
+  const navi::Point2D& b = positions[index];
+  const double c = std::cos(pose_.theta_rad), s = std::sin(pose_.theta_rad);
+  return drop_depth_at(pose_.x_m + c * b.x_m - s * b.y_m, pose_.y_m + s * b.x_m + c * b.y_m);
+}
+
+bool Simulator::touches_sonar_only(const Pose2D& p) const noexcept {
+  if (sonar_only_.empty()) return false;
+  const navi::OccupancyGrid& g = world_.grid;
+  const double r = world_.robot.radius_m + g.resolution_m();
+  // The cells around the footprint, one cell wider (the contact is at the next substep's pose).
+  const navi::CellIndex lo = g.cell_at({p.x_m - r, p.y_m - r}), hi = g.cell_at({p.x_m + r, p.y_m + r});
+  for (int y = std::min(lo.y, hi.y); y <= std::max(lo.y, hi.y); ++y) {
+    for (int x = std::min(lo.x, hi.x); x <= std::max(lo.x, hi.x); ++x) {
+      const navi::CellIndex c{x, y};
+      if (!g.contains(c) || sonar_only_[g.index(c)] == 0) continue;
+      const navi::Point2D q = g.cell_center(c);
+      if (std::hypot(q.x_m - p.x_m, q.y_m - p.y_m) <= r) return true;
+    }
+  }
+  return false;
+}
+
+void Simulator::copy_laser_map() noexcept {
+  const std::vector<std::uint8_t>& cells = solid_.cells();
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    const navi::CellIndex c = world_.grid.cell(i);
+    laser_solid_.set_solid(c.x, c.y, cells[i] != 0 && sonar_only_[i] == 0);
+  }
+  try {
+    laser_solid_.refresh();
+  } catch (...) {
+    // Out of memory: the plain traversal stays exact, only slower.
   }
 }
 
@@ -575,6 +654,7 @@ void Simulator::lay_obstacles() noexcept {
   } catch (...) {
     // Out of memory: the plain traversal stays exact, only slower.
   }
+  if (!sonar_only_.empty()) copy_laser_map();
 }
 
 bool Simulator::due(Schedule& s) const noexcept {
@@ -646,7 +726,7 @@ void Simulator::sample_sensors() noexcept {
   const SimRobotConfig& rc = world_.robot;
   if (due(laser_due_) && !sensor_dead(SensorKind::laser, now_)) {
     LaserScan& scan = laser_.edit();
-    laser_model_.scan(solid_, pose_, now_, scan);
+    laser_model_.scan(laser_map(), pose_, now_, scan);
     add_visitors_to_scan(scan);
     // A localization loss is the scanner dazzled: it still publishes, without a return (after
     // drawing the beams' noise, so the noise stream is the same as without the fault).
@@ -675,13 +755,7 @@ void Simulator::sample_sensors() noexcept {
   if (due(cliff_due_) && !sensor_dead(SensorKind::cliff, now_)) {
     InfraredReading& ir = cliff_.edit();
     ir.stamp = now_;
-    const double c = std::cos(pose_.theta_rad), s = std::sin(pose_.theta_rad);
-    for (std::size_t i = 0; i < rc.cliff.positions.size() && i < ir.cliff.size(); ++i) {
-      const navi::Point2D& b = rc.cliff.positions[i];
-      const navi::CellIndex cell =
-          world_.grid.cell_at({pose_.x_m + c * b.x_m - s * b.y_m, pose_.y_m + s * b.x_m + c * b.y_m});
-      ir.cliff[i] = world_.grid.contains(cell) && drop_[world_.grid.index(cell)] != 0 ? 1 : 0;
-    }
+    for (std::size_t i = 0; i < rc.cliff.positions.size() && i < ir.cliff.size(); ++i) ir.cliff[i] = cliff_depth_m(i) > 0.0 ? 1 : 0;
     cliff_.commit();
   }
   if (due(battery_due_) && !sensor_dead(SensorKind::battery, now_)) {

@@ -469,8 +469,45 @@ std::optional<SensorKind> sensor_of(const std::string& s) {
   return std::nullopt;
 }
 
+void read_stuck_cliff(Reader& r, const YAML::Node& s, FaultSchedule& f) {
+  if (!s.IsSequence()) {
+    r.error(s, "faults.stuck_cliff must be a list of {index, reads: floor | drop}, got " + Reader::kind(s));
+    return;
+  }
+  for (const auto& item : s) {
+    if (!r.check_map(item, "a stuck_cliff entry", {"index", "reads"})) continue;
+    StuckCliffSensor st;
+    st.where = r.at(item);
+    const YAML::Node index = item["index"];
+    const YAML::Node reads = item["reads"];
+    bool ok = true;
+    if (!index) {
+      r.error(item, "a stuck_cliff entry needs index: the cliff sensor (0-based, robot.cliff.positions order)");
+      ok = false;
+    } else {
+      try {
+        st.index = index.as<std::size_t>();
+      } catch (const YAML::Exception&) {
+        r.error(index, "stuck_cliff.index must be a non-negative whole number, got " + Reader::kind(index));
+        ok = false;
+      }
+    }
+    const std::string what = reads && reads.IsScalar() ? reads.Scalar() : std::string();
+    if (!reads) {
+      r.error(item, "a stuck_cliff entry needs reads: floor or drop");
+      ok = false;
+    } else if (what != "floor" && what != "drop") {
+      r.error(reads, "stuck_cliff.reads must be floor or drop, got " + Reader::kind(reads));
+      ok = false;
+    }
+    st.reads_drop = what == "drop";
+    if (ok) f.stuck_cliff.push_back(st);
+  }
+}
+
 void read_faults(Reader& r, const YAML::Node& n, FaultSchedule& f) {
-  if (!r.check_map(n, "faults", {"localization_loss", "dead_sensors", "kidnap"})) return;
+  if (!r.check_map(n, "faults", {"localization_loss", "dead_sensors", "kidnap", "stuck_cliff"})) return;
+  if (const YAML::Node s = n["stuck_cliff"]) read_stuck_cliff(r, s, f);
   if (const YAML::Node k = n["kidnap"]) {
     if (!k.IsSequence()) {
       r.error(k, "faults.kidnap must be a list of {at_s: S, to: [x, y, theta]}, got " + Reader::kind(k));
@@ -549,7 +586,7 @@ World walk_world(std::string_view text, const std::filesystem::path& file) {
   w.file = file;
   if (!r.check_map(root, "the world file",
                    {"map", "regions", "start_pose", "seed", "robot", "drops", "obstacles", "visitors",
-                    "docks", "faults"})) {
+                    "docks", "faults", "sonar_only"})) {
     throw ConfigError(std::move(r.diagnostics()));
   }
   const std::filesystem::path dir = file.parent_path();
@@ -612,10 +649,16 @@ World walk_world(std::string_view text, const std::filesystem::path& file) {
       r.error(drops, "drops must be a list of {name, rectangle | polygon | region}, got " + Reader::kind(drops));
     } else {
       for (const auto& item : drops) {
-        if (!r.check_map(item, "a drops entry", {"name", "rectangle", "polygon", "region"})) continue;
+        if (!r.check_map(item, "a drops entry", {"name", "rectangle", "polygon", "region", "depth_m"})) continue;
         DropArea a;
         a.where = r.at(item);
         r.text(item, "name", a.name, "drops entry");
+        if (const YAML::Node depth = item["depth_m"]) {
+          if (auto v = r.number(depth, "drops entry depth_m")) {
+            if (!(*v > 0.0)) r.error(depth, "drops entry depth_m must be > 0 (how far the floor falls), got " + depth.Scalar());
+            a.depth_m = *v;
+          }
+        }
         const YAML::Node region = item["region"];
         const int given = (item["rectangle"] ? 1 : 0) + (item["polygon"] ? 1 : 0) + (region ? 1 : 0);
         if (given != 1) {
@@ -636,6 +679,30 @@ World walk_world(std::string_view text, const std::filesystem::path& file) {
           continue;
         }
         w.drops.push_back(std::move(a));
+      }
+    }
+  }
+
+  if (const YAML::Node glass = root["sonar_only"]) {
+    if (!glass.IsSequence()) {
+      r.error(glass, "sonar_only must be a list of {name, rectangle | polygon} (glass walls, low tables), got " + Reader::kind(glass));
+    } else {
+      std::set<std::string> names;
+      for (const auto& item : glass) {
+        if (!r.check_map(item, "a sonar_only entry", {"name", "rectangle", "polygon"})) continue;
+        SonarOnlyObstacle o;
+        o.where = r.at(item);
+        r.text(item, "name", o.name, "sonar_only entry");
+        if (o.name.empty()) o.name = "sonar_only " + std::to_string(w.sonar_only.size() + 1);
+        if (!names.insert(o.name).second) r.error(item["name"] ? item["name"] : item, "duplicate sonar_only name '" + o.name + "'");
+        if (!item["rectangle"] && !item["polygon"]) {
+          r.error(item, "sonar_only '" + o.name + "' needs rectangle: [x_min, y_min, x_max, y_max] or polygon: [[x, y], ...]");
+          continue;
+        }
+        if (auto s = r.shape(item, "sonar_only '" + o.name + "'")) {
+          o.polygon = std::move(*s);
+          w.sonar_only.push_back(std::move(o));
+        }
       }
     }
   }
@@ -715,6 +782,19 @@ World walk_world(std::string_view text, const std::filesystem::path& file) {
             i = legs;
           }
         }
+      }
+    }
+    for (const StuckCliffSensor& st : w.faults.stuck_cliff) {
+      if (st.index >= w.robot.cliff.positions.size()) {
+        r.diagnostics().error(st.where, fmt::format("stuck_cliff.index {} names no cliff sensor: the robot has {} (robot.cliff.positions)",
+                                                    st.index, w.robot.cliff.positions.size()));
+      }
+    }
+    // A glass pane over the start: the robot would start inside it.
+    const navi::Point2D start_point{w.start_pose.x_m, w.start_pose.y_m};
+    for (const SonarOnlyObstacle& o : w.sonar_only) {
+      if (navi::Region{o.name, o.polygon, o.where}.contains(start_point)) {
+        r.diagnostics().error(o.where, "sonar_only '" + o.name + "' covers start_pose: the robot would start inside it");
       }
     }
     for (const Kidnapping& k : w.faults.kidnappings) {

@@ -490,3 +490,30 @@ TEST_CASE(
   CHECK(b.failure_reason() == "path blocked");
   CHECK(to_seconds(bench.now - from) == Approx(4.1).margin(0.15));
 }
+
+// A safety reflex backing the robot off (a drop ahead: BhCliffGuard pins the translation at
+// -0.1 m/s) lets it make no progress along its path: held, as when stopped, so the sequencing
+// layer plans around the hazard instead of the behavior driving back at it once released.
+TEST_CASE("A path-following behavior backed off by a safety input counts as held", "[behaviors][navigation][safety]") {
+  Bench bench(false);
+  BhAutoMove b;
+  b.activate(params({{"goal", "door"}, {"safety_hold_s", "1"}, {"blocked_timeout_s", "30"}}), bench.ctx);
+  bench.publish({{0.6, 2.0, 0}, {5.4, 2.0, 0}}, 1);
+  SafetyFeedback safety;
+  bench.ctx.safety = &safety;
+  const Time from = bench.now;
+  std::optional<Time> blocked_at;
+  while (bench.now - from < 1500ms) {
+    bench.ctx.now = bench.now;
+    bench.feedback = NavigationFeedback{};
+    const Twist2D cmd = b.step(bench.ctx).value_or(Twist2D{});
+    safety.limited = true;
+    safety.requested = cmd;
+    safety.allowed = Twist2D{-0.1, 0.0, 0.0};
+    safety.limited_by = "BhCliffGuard";
+    if (bench.feedback.blocked && !blocked_at) blocked_at = bench.ctx.now;
+    bench.now += bench.ctx.period;
+  }
+  REQUIRE(blocked_at);
+  CHECK(to_seconds(*blocked_at - from) == Approx(1.0).margin(0.051));
+}

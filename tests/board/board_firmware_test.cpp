@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "tripodal/board/serial_line.hpp"
@@ -303,4 +304,57 @@ TEST_CASE("a frame whose bytes stop coming is given up on the idle line, so the 
   const Bytes sync{0x10, 0x02, 0xA8, 0x00, 0x01};
   CHECK(b.exchange_raw(sync) == sync);  // echoed: the board listened again
   CHECK(b.board->synchronised());
+}
+
+// Section 3.4.3: the cliff bit follows the difference of two successive ADC readings against the
+// threshold, not the distance itself: a step down sets it, a step up clears it, a floor that
+// drifts slowly farther (a ramp) does not, and a sensor stuck at the floor's reading never does.
+TEST_CASE("cliff judgment: ADC difference of two measurements against the pre-fixed threshold", "[board][firmware]") {
+  FirmwareConfig c = Bench::patient();
+  CHECK(cliff_sensor_adc(0.02) == 2482);  // 2.0 V of 3.3 V, 12 bits
+  CHECK(cliff_sensor_adc(0.15) == 496);
+  CHECK(cliff_sensor_adc(std::numeric_limits<double>::infinity()) == cliff_sensor_adc(0.15));  // no return: the far end
+  CHECK(cliff_adc_threshold(c) == cliff_sensor_adc(0.02) - cliff_sensor_adc(0.05));
+  Bench b(c);
+  const auto cliff_bits = [&] {
+    const Response r = b.response(Command::bump);
+    return static_cast<unsigned>(r.payload[1]);  // bits 8-15 of the bitmap: the cliff judgments
+  };
+  b.plant.view.cliff_floor_m = {0.02F, 0.02F, 0.02F};
+  b.sync();
+  b.run_for(30ms);
+  CHECK(cliff_bits() == 0U);
+  // Sensor 1 passes a ledge: one step to no return. The bit stays set while it sees no floor
+  // (the difference of two readings over the drop is zero), and clears on the step back.
+  b.plant.view.cliff_floor_m[1] = std::numeric_limits<float>::infinity();
+  b.run_for(30ms);
+  CHECK(cliff_bits() == 0x02U);
+  b.run_for(500ms);
+  CHECK(cliff_bits() == 0x02U);
+  b.plant.view.cliff_floor_m[1] = 0.02F;
+  b.run_for(30ms);
+  CHECK(cliff_bits() == 0U);
+  // A step smaller than the threshold (a 2 cm sill, floor at 4 cm) is floor.
+  b.plant.view.cliff_floor_m[2] = 0.04F;
+  b.run_for(30ms);
+  CHECK(cliff_bits() == 0U);
+  // A slope: the floor goes away a millimetre per measurement. Each difference stays under the
+  // threshold, so the thesis's rule does not see it (the reason the sensors look ahead of the
+  // wheels: a ledge is a step).
+  b.plant.view.cliff_floor_m[2] = 0.02F;
+  b.run_for(30ms);
+  for (int k = 0; k < 100; ++k) {
+    b.plant.view.cliff_floor_m[0] = 0.02F + 0.001F * static_cast<float>(k);
+    b.run_for(10ms);
+  }
+  CHECK(cliff_bits() == 0U);
+}
+
+TEST_CASE("cliff judgment: a robot switched on over a drop sees it at the first measurement", "[board][firmware]") {
+  Bench b;
+  b.plant.view.cliff_floor_m = {std::numeric_limits<float>::infinity(), 0.02F, 0.02F};
+  b.sync();
+  b.run_for(20ms);
+  const Response r = b.response(Command::bump);
+  CHECK(r.payload[1] == 0x01);
 }

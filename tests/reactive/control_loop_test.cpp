@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "reactive_rig.hpp"
+#include "tripodal/behaviors/behavior_registry.hpp"
 #include "tripodal/behaviors/builtin_behaviors.hpp"
 #include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/controllers/kinematics.hpp"
@@ -434,4 +435,37 @@ TEST_CASE("Command channels: a behavior's writes reach the loop's command output
   // The refused activation changed nothing: the first gesture still holds the channel.
   loop.step(Time{20ms});
   CHECK(loop.coordinator().channel_output(0).writer == "BhNeckGesture");
+}
+
+namespace {
+// Raises "cliff" on its second step and goes on running (a safety reflex's finding).
+class SignallingBehavior final : public CBehavior {
+ public:
+  static const ModuleManifest& static_manifest() {
+    static const ModuleManifest m = behavior_manifest("BhSignals", "test: raises an event while running", {}, {});
+    return m;
+  }
+
+ protected:
+  const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  void on_activate(const ParameterSet&, const BehaviorContext&) override {}
+  std::optional<Twist2D> on_step(const BehaviorContext&) noexcept override {
+    if (steps() == 2) signal("cliff");
+    return std::nullopt;
+  }
+};
+}  // namespace
+
+TEST_CASE("A behavior's signal is a loop event named after it, once, and the behavior keeps running") {
+  test::ReactiveRig rig(test::differential_base(), CoordinationMode::priority);
+  const BehaviorHandle h = rig.loop->activate(std::make_unique<SignallingBehavior>(), {}, "goto_a");
+  std::vector<LoopEvent> events;
+  for (int k = 0; k < 5; ++k) rig.cycle();
+  rig.loop->collect_events(events);
+  REQUIRE(events.size() == 1);
+  CHECK(events[0].kind == LoopEvent::Kind::behavior_signal);
+  CHECK(events[0].event_name() == "cliff");
+  CHECK(events[0].behavior == "BhSignals");
+  CHECK(events[0].input == "goto_a");
+  CHECK(events[0].handle == h);
 }

@@ -557,3 +557,53 @@ TEST_CASE("Simulator: a world of 10^5 obstacles starts, laid as the whole-map me
     CHECK(sim.events().size() == 320U * 313U - late);
   }
 }
+
+TEST_CASE("Simulator: a sonar-only obstacle (glass) is invisible to the laser, solid to the body and the bumpers",
+          "[sim][safety]") {
+  World world = room_world(81, 81, {1.0, 2.0, 0.0});
+  world.robot.laser.angle_min_rad = 0.0;  // one beam, straight ahead
+  world.robot.laser.angle_max_rad = 0.0;
+  world.robot.laser.beams = 1;
+  world.sonar_only.push_back({"glass", {{2.5, 1.0}, {2.6, 1.0}, {2.6, 3.0}, {2.5, 3.0}}, {}});
+  Simulator sim(std::move(world), differential_base(), 1);
+  // The laser sees the far wall (x = 4.0), the body's map holds the glass.
+  CHECK(sim.laser().latest().ranges_m[0] == Approx(2.95).margin(0.06));
+  CHECK(sim.solid_map().cast({1.0, 2.0}, 0.0, 5.0) == Approx(1.5).margin(0.06));
+  CHECK(sim.laser_map().cast({1.0, 2.0}, 0.0, 5.0) == Approx(2.95).margin(0.06));
+  sim.command_twist({0.5, 0.0, 0.0});
+  run(sim, 4.0);
+  CHECK(sim.pose().x_m == Approx(2.25).margin(0.06));  // stopped against the glass
+  CHECK(sim.collisions() == 1);
+  CHECK(sim.sonar_only_collisions() == 1);
+  CHECK((sim.bumpers().latest().pressed_mask & 1U) != 0);
+  REQUIRE_FALSE(sim.events().empty());
+  CHECK_THAT(sim.events().back().detail, Catch::Contains("sonar-only"));
+}
+
+TEST_CASE("Simulator: a wheel over a ledge is a fall, whatever the centre", "[sim][cliff][safety]") {
+  // Driving along the ledge 0.15 m beside it: the centre stays on the floor, the right wheel
+  // (0.21 m from it) goes over.
+  World world = room_world(81, 81, {1.0, 2.0, 0.0});
+  world.drops.push_back({"ledge", {{0.5, 0.5}, {3.5, 0.5}, {3.5, 1.85}, {0.5, 1.85}}, {}});
+  Simulator sim(std::move(world), differential_base(), 1);
+  run(sim, 0.1);
+  CHECK(sim.fallen());
+  REQUIRE_FALSE(sim.events().empty());
+  CHECK(sim.events().back().kind == SimEvent::Kind::fell);
+  CHECK_THAT(sim.events().back().detail, Catch::Contains("wheel over the edge"));
+}
+
+TEST_CASE("Simulator: a drop's depth under each cliff sensor; a stuck sensor reads its fault", "[sim][cliff][safety]") {
+  World world = room_world(81, 81, {2.0, 2.0, 0.0});
+  world.drops.push_back({"step", {{2.15, 1.0}, {3.5, 1.0}, {3.5, 3.0}, {2.15, 3.0}}, {}, 0.17});
+  world.faults.stuck_cliff.push_back({0, false, {}});
+  world.faults.stuck_cliff.push_back({2, true, {}});
+  Simulator sim(std::move(world), differential_base(), 1);
+  CHECK(sim.cliff_depth_m(0) == 0.0);  // over the step, stuck at the floor's reading
+  CHECK(sim.cliff_depth_m(1) == 0.0);  // at x = 2.1: floor
+  CHECK(std::isinf(sim.cliff_depth_m(2)));  // stuck at a drop's
+  CHECK(sim.cliff_depth_m(7) == 0.0);
+  CHECK(sim.cliff().latest().cliff == std::vector<std::uint8_t>{0, 0, 1});
+  sim.set_pose({2.1, 2.0, 0.0});
+  CHECK(sim.cliff_depth_m(1) == Approx(0.17));  // (0.1, 0.17) ahead: x = 2.2, over the step
+}

@@ -236,3 +236,57 @@ TEST_CASE("parse_world: kidnappings, in time order, refused with their location 
   CHECK_THAT(e, !Catch::Contains("world.yaml:6:"));
   CHECK_THAT(error_of(head() + "faults:\n  kidnap: {at_s: 1}\n"), Catch::Contains("faults.kidnap must be a list"));
 }
+
+TEST_CASE("load_world: the safety ward, its stairwell and glass partition", "[sim][world][safety]") {
+  const World w = load_world(kWorlds + "safety_ward.yaml");
+  REQUIRE(w.drops.size() == 1);
+  CHECK(w.drops[0].name == "stairwell");
+  CHECK(w.drops[0].depth_m == 0.17);
+  REQUIRE(w.sonar_only.size() == 1);
+  CHECK(w.sonar_only[0].name == "glass_partition");
+  CHECK(w.sonar_only[0].polygon.size() == 4);
+  CHECK(w.robot.cliff.positions.size() == 5);
+  // Neither is in the map the robot plans on: a lidar-built map shows free floor there.
+  CHECK(w.grid.is_free(w.grid.cell_at({4.2, 0.7})));
+  CHECK(w.grid.is_free(w.grid.cell_at({2.03, 3.0})));
+}
+
+TEST_CASE("parse_world: malformed drops, sonar_only and stuck_cliff entries give located errors", "[sim][world][errors][safety]") {
+  const std::string e = error_of(head() + R"(drops:
+  - {name: stairs, rectangle: [1, 1, 2, 2], depth_m: -0.2}
+  - {name: step, rectangle: [1, 1, 2, 2], depth_m: deep}
+  - {name: ramp, rectangle: [1, 1, 2, 2], slope: 3}
+sonar_only:
+  - {name: glass, rectangle: [2, 2, 1, 3]}
+  - {name: glass, rectangle: [3, 3, 4, 4]}
+  - {name: table}
+  - {name: pane, polygon: [[0, 0], [1, 0]]}
+  - {name: door, rectangle: [0.5, 0.5, 1.0, 1.0]}
+faults:
+  stuck_cliff:
+    - {index: 7, reads: floor}
+    - {index: -1, reads: floor}
+    - {index: 0, reads: sometimes}
+    - {reads: drop}
+)");
+  CHECK_THAT(e, Catch::Contains("world.yaml:5:") && Catch::Contains("depth_m must be > 0"));
+  CHECK_THAT(e, Catch::Contains("world.yaml:6:") && Catch::Contains("depth_m"));
+  CHECK_THAT(e, Catch::Contains("world.yaml:7:") && Catch::Contains("unknown key 'slope' in a drops entry"));
+  CHECK_THAT(e, Catch::Contains("world.yaml:9:") && Catch::Contains("rectangle is empty"));
+  CHECK_THAT(e, Catch::Contains("world.yaml:10:") && Catch::Contains("duplicate sonar_only name 'glass'"));
+  CHECK_THAT(e, Catch::Contains("world.yaml:11:") && Catch::Contains("sonar_only 'table' needs rectangle"));
+  CHECK_THAT(e, Catch::Contains("world.yaml:12:") && Catch::Contains("at least 3 [x, y] corners"));
+  CHECK_THAT(e, Catch::Contains("world.yaml:17:") && Catch::Contains("non-negative whole number"));
+  CHECK_THAT(e, Catch::Contains("world.yaml:18:") && Catch::Contains("stuck_cliff.reads must be floor or drop"));
+  CHECK_THAT(e, Catch::Contains("world.yaml:19:") && Catch::Contains("needs index"));
+  CHECK_THAT(error_of(head() + "sonar_only: {name: glass}\n"), Catch::Contains("world.yaml:4:13") && Catch::Contains("sonar_only must be a list"));
+  // Checked once the rest is valid: a sensor the robot does not have, a glass pane on the start.
+  const std::string late = error_of(head() + R"(sonar_only:
+  - {name: door, rectangle: [0.5, 0.5, 1.0, 1.0]}
+faults:
+  stuck_cliff:
+    - {index: 3, reads: floor}
+)");
+  CHECK_THAT(late, Catch::Contains("world.yaml:5:5") && Catch::Contains("sonar_only 'door' covers start_pose"));
+  CHECK_THAT(late, Catch::Contains("world.yaml:8:7") && Catch::Contains("stuck_cliff.index 3 names no cliff sensor: the robot has 3"));
+}

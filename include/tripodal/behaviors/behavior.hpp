@@ -72,6 +72,17 @@ struct NavigationFeedback {
   bool reached_end = false;   ///< at the end of the path
   bool blocked = false;       ///< stopped by an obstacle the map does not hold, or a bumper
   Time blocked_since{};
+  /// What the safety behaviors found that neither the map nor the laser holds (map frame, theta
+  /// unused): where a cliff sensor saw a drop, where an ultrasonic echo or a bumper met glass or a
+  /// low table. The sequencing layer plans detours around them as around the laser's unmapped
+  /// returns. Written every period while they hold the robot back.
+  static constexpr std::size_t kMaxHazards = 16;
+  std::array<Pose2D, kMaxHazards> hazards{};
+  std::uint8_t hazard_count = 0;
+  /// Adds a hazard point (ignored when full).
+  void add_hazard(double x_m, double y_m) noexcept {
+    if (hazard_count < kMaxHazards) hazards[hazard_count++] = Pose2D{x_m, y_m, 0.0};
+  }
   friend bool operator==(const NavigationFeedback&, const NavigationFeedback&) = default;
 };
 
@@ -172,6 +183,13 @@ class CBehavior {
   [[nodiscard]] std::string_view channel_name(std::size_t i) const noexcept { return channel_names_[i]; }
   /// Number of step() calls since the last activation.
   [[nodiscard]] std::uint64_t steps() const noexcept { return steps_; }
+  /// The event this behavior raised in its last step for the nets (e.g. "cliff"; static storage),
+  /// and forgets it; empty when none. The control loop posts it as a net event.
+  [[nodiscard]] std::string_view take_signal() noexcept {
+    const std::string_view s = signal_;
+    signal_ = {};
+    return s;
+  }
 
  protected:
   CBehavior() = default;
@@ -189,6 +207,9 @@ class CBehavior {
     status_ = BehaviorStatus::failed;
     failure_reason_ = static_reason;
   }
+  /// Raises net event `static_name` (a string literal) this period, without ending the behavior:
+  /// a safety behavior's finding the nets may react to ("cliff").
+  void signal(std::string_view static_name) noexcept { signal_ = static_name; }
   /// Sets (or clears with nullopt) this period's safety envelope; cleared before every step.
   void set_envelope(const std::optional<VelocityEnvelope>& envelope) noexcept { envelope_ = envelope; }
   /// Writes `value` to the i-th channel the manifest declares (i < manifest().writes.size()).
@@ -206,6 +227,7 @@ class CBehavior {
   std::optional<VelocityEnvelope> envelope_;
   std::array<std::optional<ChannelValue>, kMaxBehaviorChannels> writes_{};
   std::array<std::string, kMaxBehaviorChannels> channel_names_;
+  std::string_view signal_;
   std::uint64_t steps_ = 0;
 };
 

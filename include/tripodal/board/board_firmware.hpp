@@ -81,8 +81,22 @@ struct FirmwareConfig {
   std::size_t ultrasonic_count = 3;    ///< section 3.4.2: configurable
   std::size_t cliff_count = 3;
   std::size_t wall_count = 2;
-  double cliff_threshold_m = 0.05;     ///< floor farther than this under a cliff sensor: a cliff
+  /// Section 3.4.3: the cliff judgment compares the difference of two successive ADC readings of
+  /// a cliff sensor with a threshold pre-fixed in the data section. A fall of the reading by more
+  /// than the threshold (the floor went away) sets the sensor's cliff bit; a rise by more than it
+  /// (floor again) clears it. The threshold is what the reading falls from the floor the sensor
+  /// is mounted over (cliff_floor_m) to a floor cliff_threshold_m away.
+  double cliff_floor_m = 0.02;         ///< flat floor under a cliff sensor (its mount height)
+  double cliff_threshold_m = 0.05;     ///< a step down to a floor this far gives the threshold
 };
+
+/// The Sharp GP2Y0A51SK0F infrared sensor's output (section 2.4.2: 2-15 cm) as the STM32's 12-bit
+/// ADC reads it (3.3 V reference): the voltage falls as the inverse of the distance, about 2.0 V
+/// at 2 cm and 0.4 V at 15 cm, and stays at its 15 cm level beyond the range (no return: +inf).
+[[nodiscard]] std::uint16_t cliff_sensor_adc(double distance_m) noexcept;
+/// The cliff threshold (ADC counts) of a configuration: cliff_sensor_adc(cliff_floor_m) -
+/// cliff_sensor_adc(cliff_threshold_m).
+[[nodiscard]] int cliff_adc_threshold(const FirmwareConfig& config) noexcept;
 
 /// Battery: 16.8 V full, 12.0 V empty (must charge), linear in the state of charge.
 inline constexpr double kBatteryFullV = 16.8;
@@ -165,6 +179,7 @@ class BoardFirmware {
   void update_motors() noexcept;
   void stop_motors() noexcept;
   void sample_battery() noexcept;
+  void judge_cliffs() noexcept;
   [[nodiscard]] std::uint32_t sensor_bitmap() const noexcept;
   [[nodiscard]] std::uint8_t status_flags() const noexcept;
   [[nodiscard]] EncoderState encoders() const noexcept;
@@ -189,6 +204,9 @@ class BoardFirmware {
   bool link_lost_ = false;
   std::array<Motor, 2> motors_{};
   PlantSensors sensors_{};
+  int cliff_threshold_adc_ = 0;
+  std::array<std::uint16_t, kMaxInfrared> cliff_adc_{};  // reading t, against which t+1 is judged
+  std::uint32_t cliff_bits_ = 0;                          // latched judgments (kCliffShift + i)
   std::uint8_t buttons_ = 0;
   std::uint8_t pressed_ = 0;
   bool uv_lamp_ = false;

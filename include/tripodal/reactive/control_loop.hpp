@@ -42,6 +42,7 @@ struct LoopEvent {
     behavior_failed,     ///< post failed_event_name(behavior): "<BehaviorName>.failed", with reason
     controller_fault,      ///< the controller reported hardware_fault: "<loop>.controller_fault"
     controller_recovered,  ///< the next cycle without a fault: "<loop>.controller_recovered"
+    behavior_signal,       ///< a running behavior raised an event (CBehavior::signal): its name, in `reason`
   };
   Kind kind = Kind::behavior_succeeded;
   Time stamp{};
@@ -51,7 +52,7 @@ struct LoopEvent {
   std::string_view reason;    ///< failure reason
   std::string_view loop;      ///< the loop's name
   /// The net event name: "<behavior>.done", "<behavior>.failed", "<loop>.controller_fault",
-  /// "<loop>.controller_recovered".
+  /// "<loop>.controller_recovered", a signal's own name ("cliff").
   [[nodiscard]] std::string event_name() const;
 };
 

@@ -18,13 +18,19 @@
 
 namespace tripodal::sim {
 
-/// Where the board's range sensors sit on the round base (body frame, from the rim).
+/// Where the board's range sensors sit on the round base (body frame, from the rim). The cliff
+/// sensors sit where the world's robot.cliff.positions say, looking down from floor_m.
 struct BoardSensorMounts {
   std::array<double, 3> ultrasonic_rad{-0.5236, 0.0, 0.5236};  ///< front, +-30 deg (section 2.4.2)
   double ultrasonic_range_m = 4.5;                             ///< US-100
+  /// The US-100's beam: the echo comes from the nearest solid thing within this full cone angle
+  /// (about 15 degrees), traced with ultrasonic_rays rays across it.
+  double ultrasonic_cone_rad = 0.26;
+  int ultrasonic_rays = 7;
   std::array<double, 2> wall_rad{1.5708, -1.5708};             ///< left, right
   double wall_range_m = 0.15;                                  ///< GP2Y0A51SK0F: 2-15 cm
   double floor_m = 0.02;                                       ///< what a cliff sensor sees over floor
+  double cliff_range_m = 0.15;  ///< GP2Y0A51SK0F: farther floor (a drop) is no return
 };
 
 class SimBoardPlant final : public board::BoardPlant {

@@ -39,7 +39,7 @@ struct SimEvent {
     localization_loss_start,  ///< a localization loss window started: the laser is blinded
     localization_loss_end,
     kidnapped,                ///< the world moved the robot (detail: "to (x, y, theta)")
-    fell,                     ///< the robot's centre entered a drop area
+    fell,                     ///< the robot's centre or a wheel entered a drop area (detail: which)
     battery_empty,
     button_pressed,           ///< an LED button was pressed (detail: its name)
     docked,                   ///< the robot's contacts touch a dock's (detail: its name): charging
@@ -124,6 +124,12 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   [[nodiscard]] bool blocked() const noexcept { return blocked_; }
   [[nodiscard]] std::uint64_t collisions() const noexcept { return collisions_; }
   [[nodiscard]] bool fallen() const noexcept { return fallen_; }
+  /// Contacts (counted in collisions() too) whose footprint touched a sonar-only obstacle.
+  [[nodiscard]] std::uint64_t sonar_only_collisions() const noexcept { return sonar_only_collisions_; }
+  /// How far the floor under cliff sensor `index` (robot.cliff.positions) lies below the floor the
+  /// robot stands on: 0 over floor, the drop's depth_m over a drop; a stuck sensor (faults.
+  /// stuck_cliff) reads 0 or +infinity whatever is under it. 0 for an unknown index.
+  [[nodiscard]] double cliff_depth_m(std::size_t index) const noexcept;
   /// Ground-truth distance driven (m) and rotation (rad, absolute).
   [[nodiscard]] double distance_m() const noexcept { return distance_m_; }
   [[nodiscard]] double rotation_rad() const noexcept { return rotation_rad_; }
@@ -145,8 +151,11 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   [[nodiscard]] bool localization_lost(Time t) const noexcept override;
 
   [[nodiscard]] const World& world() const noexcept { return world_; }
-  /// The static map plus the boxes present now.
+  /// What stops the body, the bumpers and the ultrasonic cones: the static map, the sonar-only
+  /// obstacles and the boxes present now.
   [[nodiscard]] const SolidMap& solid_map() const noexcept { return solid_; }
+  /// What the laser sees: solid_map() without the sonar-only obstacles.
+  [[nodiscard]] const SolidMap& laser_map() const noexcept { return sonar_only_.empty() ? solid_ : laser_solid_; }
   /// The visitors now, in World::visitors order.
   [[nodiscard]] const std::vector<VisitorState>& visitors() const noexcept { return visitors_; }
   /// Contacts of the robot's footprint with a visitor (counted in collisions() too).
@@ -197,6 +206,9 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   void update_bumpers() noexcept;
   void set_obstacle(std::size_t index, bool present) noexcept;  // marks it, restores its cells
   void lay_obstacles() noexcept;  // every present obstacle on the solid map, the ray jumps refreshed
+  void copy_laser_map() noexcept;  // laser_solid_ = solid_ without the sonar-only cells
+  [[nodiscard]] bool touches_sonar_only(const Pose2D& p) const noexcept;
+  [[nodiscard]] double drop_depth_at(double x_m, double y_m) const noexcept;
   void move_visitors(double h) noexcept;
   void move_joints(double h) noexcept;
   void add_visitors_to_scan(LaserScan& scan) const noexcept;
@@ -217,7 +229,11 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   std::size_t wheels_ = 0;
   SolidMap solid_;
   std::vector<std::uint8_t> static_solid_;
-  std::vector<std::uint8_t> drop_;
+  std::vector<float> drop_depth_;            // per cell: 0 floor, > 0 a drop's depth_m
+  std::vector<std::uint8_t> sonar_only_;     // per cell: 1 inside a sonar-only obstacle; empty when none
+  SolidMap laser_solid_;                     // solid_ without the sonar-only cells (when there are some)
+  std::vector<navi::Point2D> wheel_points_;  // body frame: the wheels' contact points
+  std::uint64_t sonar_only_collisions_ = 0;
   std::vector<std::vector<std::size_t>> obstacle_cells_;
   std::vector<std::uint8_t> obstacle_present_;
   std::vector<std::uint8_t> outage_active_;

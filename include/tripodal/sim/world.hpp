@@ -171,10 +171,29 @@ struct Visitor {
 };
 
 /// Floor that drops away (stairs, a loading edge): the cliff sensors see it; a robot whose centre
-/// enters it falls and cannot move any more.
+/// or a wheel's contact point enters it falls and cannot move any more. The laser does not see it
+/// (it looks over it), so the map may show it as free floor.
 struct DropArea {
   std::string name;
   std::vector<navi::Point2D> polygon;  ///< map frame
+  SourceLocation where;
+  double depth_m = 1.0;  ///< how far the floor falls: a cliff sensor over it reads this much farther
+};
+
+/// An obstacle only the ultrasonic sensors see: a glass wall (the laser's light goes through), a
+/// low table (below the laser's plane). Invisible to the laser's ray casts, solid to the body, the
+/// bumpers and the ultrasonic cones.
+struct SonarOnlyObstacle {
+  std::string name;
+  std::vector<navi::Point2D> polygon;  ///< map frame
+  SourceLocation where;
+};
+
+/// A cliff sensor whose output is stuck for the whole run: at the floor's reading (it never sees a
+/// drop) or at a drop's (it always does). Index into robot.cliff.positions.
+struct StuckCliffSensor {
+  std::size_t index = 0;
+  bool reads_drop = false;
   SourceLocation where;
 };
 
@@ -220,6 +239,7 @@ struct FaultSchedule {
   std::vector<navi::LocalizationFault> localization_loss;
   std::vector<SensorOutage> dead_sensors;
   std::vector<Kidnapping> kidnappings;  ///< in time order
+  std::vector<StuckCliffSensor> stuck_cliff;
 };
 
 /// A world file, loaded: everything the simulator needs.
@@ -233,6 +253,7 @@ struct World {
   std::uint64_t seed = 1;              ///< default seed of a run (a command line may override)
   SimRobotConfig robot;
   std::vector<DropArea> drops;
+  std::vector<SonarOnlyObstacle> sonar_only;
   std::vector<DynamicObstacle> obstacles;
   std::vector<Visitor> visitors;
   std::vector<Dock> docks;
