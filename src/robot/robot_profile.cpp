@@ -242,7 +242,7 @@ struct Parser {
     const YAML::Node root = yaml::parse(text, file);
     prof.where = SourceLocation{file, 1, 1};
     if (!r.expect_keys(root, {"robot", "hardware", "controllers", "loops", "resources", "navigation", "hri", "modules", "behaviors",
-                              "processes", "tasks", "recovery", "dds"},
+                              "processes", "tasks", "recovery", "dds", "plugins"},
                        "the robot profile")) {
       throw ConfigError(d);
     }
@@ -295,6 +295,13 @@ struct Parser {
         prof.recovery = path_of(v, "recovery file", prof.recovery_where);
       } else if (key == "dds") {
         dds_section(v, prof);
+      } else if (key == "plugins") {
+        if (!r.expect_list(v, "plugins")) continue;
+        for (const auto& item : v) {
+          PluginEntry e;
+          e.path = path_of(item, "plugin library", e.where);
+          if (!e.path.empty()) prof.plugins.push_back(std::move(e));
+        }
       }
     }
     if (prof.name.empty()) d.error(prof.where, "the profile needs robot: {name: ...}");

@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/board/actuator_behaviors.hpp"
 #include "tripodal/board/board_monitor.hpp"
 #include "tripodal/robot/robot.hpp"
@@ -23,14 +24,12 @@ struct DisinfectionRobot {
   std::shared_ptr<const sim::World> world =
       std::make_shared<const sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml"));
   SimClock clock;
-  RobotPlugins plugins = RobotPlugins::with_builtins();  // the robot keeps using them
+  RobotPlugins plugins;  // the robot keeps using them
   std::unique_ptr<Robot> robot;
   sim::SimBoardHardware* hw = nullptr;
 
   DisinfectionRobot() {
-    sim::register_sim_board_hardware(plugins.hardware, world);
-    board::register_board_modules(plugins.modules);
-    board::register_board_behaviors(plugins.behaviors);
+    register_all(plugins, world);
     robot = Robot::assemble(load_robot_profile(kConfigs / "robots/disinfection.yaml"), plugins, clock);
     hw = &dynamic_cast<sim::SimBoardHardware&>(*robot->hardware());
     if (CController* c = robot->behavior_loop().controller()) c->reset_odometry(world->start_pose);

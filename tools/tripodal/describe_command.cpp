@@ -34,6 +34,7 @@ constexpr std::string_view kExitCodes =
 struct Args {
   std::string file;
   bool dot = false;
+  std::vector<std::filesystem::path> plugins;
 };
 
 int describe(const Args& args, std::ostream& out, std::ostream& err) {
@@ -47,8 +48,8 @@ int describe(const Args& args, std::ostream& out, std::ostream& err) {
   try {
     const RobotProfile profile = load_robot_profile(file);
     // The types `tripodal run` knows, registered by the same function: no world, as no robot is built.
-    RobotPlugins plugins = RobotPlugins::with_builtins();
-    app::register_tool_plugins(plugins, nullptr);
+    RobotPlugins plugins;
+    app::register_tool_plugins(plugins, nullptr, profile, args.plugins);
     // The checks `tripodal run` makes before it builds anything (Robot::assemble runs the same).
     Diagnostics d;
     const RobotDescription r = check_robot(profile, plugins, d);
@@ -69,6 +70,8 @@ cli::Action setup(CLI::App& cmd) {
   auto a = std::make_shared<Args>();
   cmd.add_option("ROBOT.yaml", a->file, "the robot profile")->required();
   cmd.add_flag("--dot", a->dot, "the layered functionality diagram in Graphviz DOT");
+  cmd.add_option("--plugin", a->plugins, "LIB.so: a shared-library plugin with the profile's own types (repeatable; docs/plugins.md)")
+      ->allow_extra_args(false);
   return [a](std::ostream& out, std::ostream& err) { return describe(*a, out, err); };
 }
 

@@ -100,6 +100,13 @@ struct DdsSection {
   }
 };
 
+/// One entry of a profile's `plugins:` list: the library's path (made absolute against the
+/// profile's folder) and where it was written.
+struct PluginEntry {
+  std::filesystem::path path;
+  SourceLocation where;
+};
+
 struct RobotProfile {
   std::string name;
   std::string description;
@@ -125,6 +132,10 @@ struct RobotProfile {
   SourceLocation recovery_where;
   /// The robot on DDS; none: the robot speaks no DDS.
   std::optional<DdsSection> dds;
+  /// Shared-library plugins the profile's types come from (`plugins: [lib/libpatrol.so]`, relative
+  /// to the profile): whoever builds the plugin set for this profile loads them first
+  /// (load_profile_plugins, robot/plugin_library.hpp), as `tripodal run` and `describe` do.
+  std::vector<PluginEntry> plugins;
 
   /// Every module entry, in profile order: controllers, resources, navigation, hri, modules, behaviors.
   [[nodiscard]] std::vector<const ModuleEntry*> all_modules() const;
