@@ -26,9 +26,9 @@
 /// for the reason when registration fails. Plain C layout, so that the entry point is C.
 extern "C" {
 struct tripodal_plugin_host {
-  std::uint32_t abi_version;         ///< the host's TRIPODAL_PLUGIN_ABI_VERSION
-  tripodal::RobotPlugins* plugins;   ///< an empty set, merged into the application's afterwards
-  char error[512];                   ///< filled by the plugin when it returns non-zero
+  std::uint32_t abi_version;        ///< the host's TRIPODAL_PLUGIN_ABI_VERSION
+  tripodal::RobotPlugins* plugins;  ///< an empty set, merged into the application's afterwards
+  char error[512];                  ///< filled by the plugin when it returns non-zero
 };
 }
 
@@ -42,7 +42,8 @@ inline constexpr const char* kPluginRegisterSymbol = "tripodal_plugin_register";
 namespace detail {
 /// Runs a plugin's registration function on host->plugins; an exception becomes return value 1
 /// and its message host->error, so that nothing is thrown across the C entry point.
-inline int run_plugin_registration(tripodal_plugin_host* host, void (*register_types)(RobotPlugins&)) noexcept {
+inline int run_plugin_registration(tripodal_plugin_host* host,
+                                   void (*register_types)(RobotPlugins&)) noexcept {
   const auto fail = [host](const char* what) {
     std::snprintf(host->error, sizeof host->error, "%s", what);
     return 1;
@@ -105,11 +106,11 @@ void merge_plugins(RobotPlugins& into, RobotPlugins&& from);
 /// `plugins` is a tripodal::RobotPlugins&. An exception from the body refuses the plugin with its
 /// message. Use once per library.
 #define TRIPODAL_REGISTER_PLUGINS(plugins)                                                                \
-  static void tripodal_plugin_register_types(::tripodal::RobotPlugins& plugins);                         \
-  extern "C" TRIPODAL_PLUGIN_EXPORT std::uint32_t tripodal_plugin_abi_version() noexcept {               \
-    return TRIPODAL_PLUGIN_ABI_VERSION;                                                                  \
-  }                                                                                                      \
+  static void tripodal_plugin_register_types(::tripodal::RobotPlugins& plugins);                          \
+  extern "C" TRIPODAL_PLUGIN_EXPORT std::uint32_t tripodal_plugin_abi_version() noexcept {                \
+    return TRIPODAL_PLUGIN_ABI_VERSION;                                                                   \
+  }                                                                                                       \
   extern "C" TRIPODAL_PLUGIN_EXPORT int tripodal_plugin_register(::tripodal_plugin_host* host) noexcept { \
-    return ::tripodal::detail::run_plugin_registration(host, &tripodal_plugin_register_types);           \
-  }                                                                                                      \
+    return ::tripodal::detail::run_plugin_registration(host, &tripodal_plugin_register_types);            \
+  }                                                                                                       \
   static void tripodal_plugin_register_types(::tripodal::RobotPlugins& plugins)

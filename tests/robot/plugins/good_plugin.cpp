@@ -17,7 +17,9 @@ class BhPluginWave final : public tripodal::CBehavior {
   }
 
  private:
-  [[nodiscard]] const tripodal::ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  [[nodiscard]] const tripodal::ModuleManifest& do_manifest() const noexcept override {
+    return static_manifest();
+  }
   void on_activate(const tripodal::ParameterSet& params, const tripodal::BehaviorContext&) override {
     yaw_rate_rad_s_ = params.number("yaw_rate_rad_s");
   }
@@ -34,9 +36,11 @@ TRIPODAL_REGISTER_PLUGINS(plugins) {
   // The built-in differential controller under another name: a controller type from a plugin.
   tripodal::ModuleManifest m = tripodal::DifferentialDriveController::static_manifest();
   m.name = "plugin_differential";
-  plugins.controllers.add(std::move(m), [](const tripodal::ControllerConfig& c, tripodal::HardwareInterface& h) {
-    tripodal::ControllerConfig differential = c;
-    differential.type = "differential";
-    return std::unique_ptr<tripodal::CController>(std::make_unique<tripodal::DifferentialDriveController>(differential, h));
-  });
+  plugins.controllers.add(std::move(m),
+                          [](const tripodal::ControllerConfig& c, tripodal::HardwareInterface& h) {
+                            tripodal::ControllerConfig differential = c;
+                            differential.type = "differential";
+                            return std::unique_ptr<tripodal::CController>(
+                                std::make_unique<tripodal::DifferentialDriveController>(differential, h));
+                          });
 }
