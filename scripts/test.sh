@@ -48,7 +48,8 @@ stage "Build and run the application robot (examples/custom_robot) against the i
 cmake -S examples/custom_robot -B "$build_root/custom_robot" "${generator[@]}" \
   -DCMAKE_PREFIX_PATH="$build_root/install" -DCMAKE_COMPILE_WARNING_AS_ERROR=ON
 cmake --build "$build_root/custom_robot" -j "$jobs"
-"$build_root/custom_robot/custom_robot"
+# The application's program, and its plugin through the installed `tripodal run` (report, map).
+ctest --test-dir "$build_root/custom_robot" --output-on-failure
 
 if [ -d "$build_root/install/include/tripodal/dds" ]; then
   stage "Build and run the DDS consumer (find_package(tripodal COMPONENTS dds)) against the installed package"

@@ -22,6 +22,7 @@
 #include <thread>
 #include <vector>
 
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/monitor/monitor_server.hpp"
 #include "tripodal/monitor/robot_monitor.hpp"
 #include "tripodal/robot/robot.hpp"
@@ -129,8 +130,8 @@ BENCHMARK(BM_Monitor10Clients20Hz)->Arg(10)->UseManualTime()->Iterations(1)->Rep
 
 void BM_RobotMonitorUpdate(benchmark::State& state) {
   const std::filesystem::path configs = std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs";
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(configs / "worlds/workspace.yaml")));
+  RobotPlugins plugins;
+  register_all(plugins, std::make_shared<sim::World>(sim::load_world(configs / "worlds/workspace.yaml")));
   SimClock clock;
   const auto robot = Robot::assemble(load_robot_profile(configs / "robots/psr2.yaml"), plugins, clock);
   MonitorServer server(MonitorServerOptions{.token = "bench-token-123"});

@@ -29,9 +29,13 @@ int main(int argc, char** argv) {
   ControlLoopOptions o;
   o.name = "jitter";
   o.period = base.period;
-  ControlLoop loop(o, resources, CBehaviorCoordinator(cc), default_controller_registry().create(base, hw));
+  ControllerRegistry controllers;
+  register_builtin_controllers(controllers);
+  BehaviorRegistry behaviors;
+  register_behaviors(behaviors);
+  ControlLoop loop(o, resources, CBehaviorCoordinator(cc), controllers.create(base, hw));
   loop.set_odometry_output(&odom);
-  loop.activate(default_behavior_registry().create("BhStop"), {});
+  loop.activate(behaviors.create("BhStop"), {});
 
   SteadyClock clock;
   LoopRunner runner(loop, clock, LoopTimingOptions{priority, cpu});

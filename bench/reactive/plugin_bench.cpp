@@ -26,15 +26,18 @@ std::string read_config(const char* name) {
 // Arg: 0 = jinny_differential.yaml, 1 = psr_omni.yaml.
 static void BM_ParseReactiveConfig(benchmark::State& state) {
   const std::string text = read_config(state.range(0) == 0 ? "jinny_differential.yaml" : "psr_omni.yaml");
+  ControllerRegistry controllers;
+  register_builtin_controllers(controllers);
   for (auto _ : state) {
-    ReactiveConfig c = parse_reactive_config(text, "reactive.yaml");
+    ReactiveConfig c = parse_reactive_config(text, "reactive.yaml", controllers);
     benchmark::DoNotOptimize(c);
   }
 }
 BENCHMARK(BM_ParseReactiveConfig)->ArgName("omni")->Arg(0)->Arg(1);
 
 static void BM_CreateBehaviorByName(benchmark::State& state) {
-  const BehaviorRegistry& reg = default_behavior_registry();
+  BehaviorRegistry reg;
+  register_behaviors(reg);
   for (auto _ : state) {
     auto b = reg.create("BhGoToPose");
     benchmark::DoNotOptimize(b);
@@ -43,7 +46,8 @@ static void BM_CreateBehaviorByName(benchmark::State& state) {
 BENCHMARK(BM_CreateBehaviorByName);
 
 static void BM_UnknownBehaviorName(benchmark::State& state) {
-  const BehaviorRegistry& reg = default_behavior_registry();
+  BehaviorRegistry reg;
+  register_behaviors(reg);
   for (auto _ : state) {
     try {
       auto b = reg.create("BhGoToPos");

@@ -69,7 +69,9 @@ BENCHMARK(BM_CoordinatorFuse)->ArgName("weighted")->Arg(0)->Arg(1);
 static void BM_ControllerUpdate(benchmark::State& state) {
   const ControllerConfig config = state.range(0) != 0 ? test::omni_base_psr() : test::differential_base();
   IdealWheelHardware hw(config.type == "differential" ? 2 : 3, config.period);
-  auto ctl = default_controller_registry().create(config, hw);
+  ControllerRegistry controllers;
+  register_builtin_controllers(controllers);
+  auto ctl = controllers.create(config, hw);
   Time now{};
   for (auto _ : state) {
     now += config.period;

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "instructions.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
 
@@ -25,12 +26,12 @@ using Clock = std::chrono::steady_clock;
 const std::filesystem::path kConfigs = std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs";
 
 struct MidCleaning {
-  RobotPlugins plugins = RobotPlugins::with_builtins();
+  RobotPlugins plugins;
   SimClock clock;
   std::unique_ptr<Robot> robot;
 
   MidCleaning() {
-    sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml")));
+    register_all(plugins, std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml")));
     std::ifstream in(kConfigs / "robots/psr2.yaml");
     std::stringstream text;
     text << in.rdbuf();

@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 
 #include "bh_approach.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/testing/robot_harness.hpp"
 #include "tripodal/trace/trace_writer.hpp"
@@ -27,7 +28,7 @@ std::filesystem::path start_at(const Pose2D& pose) {
 }  // namespace
 
 TEST_CASE("On the simulator, the tutorial's robot stops short of the wall ahead") {
-  RobotPlugins plugins = RobotPlugins::with_builtins();
+  RobotPlugins plugins = builtin_plugins();
   plugins.behaviors.add<example::BhApproach>();  // the application's behavior, next to the framework's
   testing::RobotHarnessOptions o;
   o.world = std::make_shared<const sim::World>(sim::load_world(TRIPODAL_CONFIGS "/worlds/workspace.yaml"));

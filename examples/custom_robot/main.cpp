@@ -1,150 +1,30 @@
-// A patrol robot on tripodal's runtime: its own hardware type, resource, behavior, navigation module and
-// process type; it patrols map nodes on simulated time. Usage: custom_robot [PROFILE [TASK]] (exit 1: the task failed).
-#include <cmath>
+// A patrol robot application: the framework's types and those of the plugin its profile names (patrol_plugin.cpp)
+// on simulated time; prints the life cycle. Usage: custom_robot [PROFILE [TASK]] (exit 1: the task failed).
 #include <iostream>
-#include <numbers>
-#include <string>
-
 #include <spdlog/spdlog.h>
 
-#include "tripodal/navi/grid_maps.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
+#include "tripodal/robot/plugin_library.hpp"
 #include "tripodal/robot/robot.hpp"
-#include "tripodal/sim/sim_hardware.hpp"
 
 using namespace tripodal;
-namespace {
-
-struct BeaconReading { Time stamp{}; bool on = false; };  // what the beacon's driver reads: flashing and beeping?
-
-/// Hardware "sim_with_beacon": the simulator (parameters as "sim") and the warning beacon (LED +
-/// buzzer) its base board sounds while the base turns in place, to warn the people around.
-class BeaconBase final : public sim::SimHardware {
- public:
-  static inline const ModuleManifest kManifest = [](ModuleManifest m) {
-    m.name = "sim_with_beacon";
-    m.outputs.push_back("beacon_state");
-    return m;
-  }(sim::SimHardware::static_manifest());
-  static const ModuleManifest& static_manifest() { return kManifest; }
-  using SimHardware::SimHardware;
-  [[nodiscard]] const BeaconReading& beacon() const noexcept { return beacon_; }
- private:
-  [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return kManifest; }
-  void on_advance_to(Time now) noexcept override {
-    SimHardware::on_advance_to(now);
-    const Twist2D& v = simulator().velocity();
-    beacon_ = {now, std::abs(v.wz_rad_s) > 0.3 && std::abs(v.vx_m_s) < 0.05};
-  }
-  BeaconReading beacon_;
-};
-
-/// Resource type "BeaconResource": the beacon's driver, which the reactive loop polls every cycle.
-class BeaconResource final : public TypedResource<BeaconReading> {
- public:
-  static inline const ModuleManifest kManifest =
-      ManifestBuilder("BeaconResource", ModuleKind::resource).description("the beacon").input("beacon_state").output("beacon").build();
-  static const ModuleManifest& static_manifest() { return kManifest; }
-  explicit BeaconResource(const ResourceConfig& c)
-      : TypedResource(c.name, Duration{0}, kManifest), board_(dynamic_cast<const BeaconBase*>(c.hardware)) {
-    if (board_ == nullptr) throw ConfigError(c.where, "resource '" + c.name + "' reads the beacon of hardware 'sim_with_beacon'");
-  }
- private:
-  void on_poll(Time /*now*/) noexcept override { publish(board_->beacon()); }
-  const BeaconBase* board_;
-};
-
-/// BhAnnounce: announces an arrival by turning in place until the beacon has sounded for beacon_s.
-class BhAnnounce final : public CBehavior {
- public:
-  static inline const ModuleManifest kManifest = behavior_manifest(
-      "BhAnnounce", "turns in place until the beacon has sounded beacon_s", {"beacon"},
-      {parameter::number("yaw_rate_rad_s", 1.0, "rad/s", "turn rate", 0.5),
-       parameter::number("beacon_s", 3.0, "s", "beacon time")});
-  static const ModuleManifest& static_manifest() { return kManifest; }
- private:
-  [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return kManifest; }
-  void on_activate(const ParameterSet& params, const BehaviorContext& context) override {
-    yaw_rate_rad_s_ = params.number("yaw_rate_rad_s");
-    left_s_ = params.number("beacon_s");
-    if ((beacon_ = context.resources->first<BeaconReading>()) == nullptr) fail("no beacon resource");
-  }
-  std::optional<Twist2D> on_step(const BehaviorContext& context) noexcept override {
-    if (beacon_->is_fresh(context.now) && beacon_->latest().on) left_s_ -= to_seconds(context.period);
-    if (left_s_ <= 0.0) succeed();
-    return Twist2D{.wz_rad_s = running() ? yaw_rate_rad_s_ : 0.0};
-  }
-  const TypedResource<BeaconReading>* beacon_ = nullptr;
-  double yaw_rate_rad_s_ = 0.0, left_s_ = 0.0;
-};
-
-/// Navigation module "RoomWatcher": posts room.entered when the pose estimate enters another room.
-class RoomWatcher final : public navi::CNaviModules {
- public:
-  static inline const ModuleManifest kManifest = navi::navi_manifest(
-      "RoomWatcher", "posts room.entered on entering another room", {"map_from_base", "grid_map"}, {"room.entered"}, {});
-  static const ModuleManifest& static_manifest() { return kManifest; }
-  [[nodiscard]] const std::string& room() const noexcept { return room_; }
- private:
-  [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return kManifest; }
-  void on_start(ModuleContext& context) override {
-    if ((maps_ = context.modules->find<navi::CGridMaps>()) == nullptr) throw ConfigError(where(), "RoomWatcher needs GridMaps");
-  }
-  void on_update(ModuleContext& context) override {
-    const Pose2D& p = context.navigation->map_from_base;
-    const navi::Region* in = nullptr;  // rooms may nest (a hall holds its rooms): the smallest counts
-    for (const navi::Region& r : maps_->regions().rooms)
-      if (r.contains({p.x_m, p.y_m}) && (in == nullptr || r.area_m2() < in->area_m2())) in = &r;
-    if (context.navigation->localized && in != nullptr && in->name != room_) context.post("room.entered", room_ = in->name);
-  }
-  const navi::CGridMaps* maps_ = nullptr;
-  std::string room_;
-};
-
-/// Process type "announce": the profile counts an announcement in turns, the behavior in seconds.
-class PrAnnounce final : public CProcess {
- public:
-  static ModuleManifest static_manifest() { return ManifestBuilder("announce", ModuleKind::process, Layer::sequencing).build(); }
-  using CProcess::CProcess;
- private:
-  std::string on_bind(ParameterValues& values) const override {
-    const double turns = std::get<double>(values.at("turns")), rate_rad_s = std::get<double>(values.at("yaw_rate_rad_s"));
-    if (turns <= 0.0) return name() + ": turns must be positive, got " + std::to_string(turns);
-    values["beacon_s"] = Value{turns * 2.0 * std::numbers::pi / rate_rad_s};
-    return {};
-  }
-};
-
-}  // namespace
 
 int main(int argc, char** argv) try {
   spdlog::set_level(spdlog::level::warn);  // the life cycle is printed at the end, on simulated time
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  plugins.hardware.add<BeaconBase>();
-  plugins.resources.add<BeaconResource>();
-  plugins.behaviors.add<BhAnnounce>();
-  plugins.modules.add<RoomWatcher>();
-  plugins.processes.add<PrAnnounce>();
+  const RobotProfile profile = load_robot_profile(argc > 1 ? argv[1] : PATROL_PROFILE);
+  RobotPlugins plugins = builtin_plugins();        // the framework's types,
+  (void)load_profile_plugins(profile, plugins);    // then those of the profile's plugins: [patrol_plugin.so]
   SimClock clock;
-  const auto robot = Robot::assemble(load_robot_profile(argc > 1 ? argv[1] : PATROL_PROFILE), plugins, clock);
+  const auto robot = Robot::assemble(profile, plugins, clock);
   LifecycleRecorder life;
   robot->planner().add_observer(life);
   std::cout << robot->command(argc > 2 ? argv[2] : "patrol door_2111 and door_2133").text << '\n';
-  // Simulated time until the task ends; the rooms entered and the beacon join the life cycle.
-  const auto* watcher = robot->module<RoomWatcher>();
-  const auto* beacon = robot->resources().find<BeaconReading>("beacon");
-  if (watcher == nullptr || beacon == nullptr) throw ConfigError({}, "the robot needs a RoomWatcher and a resource 'beacon'");
-  std::string room;
-  bool beacon_on = false;
-  while (robot->planner().busy() && clock.now() < time_from_seconds(600.0)) {
-    robot->run_for(robot->behavior_loop().period());
-    if (watcher->room() != room) life.note(clock.now(), "entered room " + (room = watcher->room()));
-    if (beacon->latest().on != beacon_on) life.note(clock.now(), (beacon_on = beacon->latest().on) ? "beacon on" : "beacon off");
-  }
+  while (robot->planner().busy() && clock.now() < time_from_seconds(600.0)) robot->run_for(robot->behavior_loop().period());
   const TaskReport report = robot->planner().report();
   std::cout << life.str() << "task " << to_string(report.state) << (report.reason.empty() ? "" : ": " + report.reason) << '\n';
   return report.state == TaskState::succeeded ? 0 : 1;
-} catch (const std::exception& e) {  // a profile, net or task file that does not load: its errors, located
+} catch (const std::exception& e) {  // a profile, net or task file that does not load, a plugin refused: located
   std::cerr << e.what() << '\n';
   return 2;
 }

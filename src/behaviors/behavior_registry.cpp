@@ -1,5 +1,10 @@
 #include "tripodal/behaviors/behavior_registry.hpp"
 
+#include "tripodal/behaviors/safety_behaviors.hpp"
+
+#include "tripodal/behaviors/gesture_behaviors.hpp"
+#include "tripodal/behaviors/navigation_behaviors.hpp"
+
 namespace tripodal {
 
 ModuleManifest behavior_manifest(std::string name, std::string description, std::vector<std::string> inputs,
@@ -12,13 +17,11 @@ ModuleManifest behavior_manifest(std::string name, std::string description, std:
       .build();
 }
 
-BehaviorRegistry& default_behavior_registry() {
-  static BehaviorRegistry registry = [] {
-    BehaviorRegistry r;
-    register_builtin_behaviors(r);
-    return r;
-  }();
-  return registry;
+void register_behaviors(BehaviorRegistry& registry) {
+  register_builtin_behaviors(registry);
+  register_navigation_behaviors(registry);
+  register_gesture_behaviors(registry);
+  register_safety_behaviors(registry);
 }
 
 }  // namespace tripodal

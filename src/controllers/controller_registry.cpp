@@ -144,13 +144,4 @@ void register_builtin_controllers(ControllerRegistry& registry) {
   registry.add(HolonomicController::mecanum_manifest(), holonomic);
 }
 
-ControllerRegistry& default_controller_registry() {
-  static ControllerRegistry registry = [] {
-    ControllerRegistry r;
-    register_builtin_controllers(r);
-    return r;
-  }();
-  return registry;
-}
-
 }  // namespace tripodal

@@ -20,17 +20,6 @@
 
 namespace tripodal {
 
-RobotPlugins RobotPlugins::with_builtins() {
-  RobotPlugins p;
-  register_builtin_behaviors(p.behaviors);
-  register_navigation_behaviors(p.behaviors);
-  register_safety_behaviors(p.behaviors);
-  register_builtin_controllers(p.controllers);
-  navi::register_navigation_modules(p.modules);
-  p.modules.add<BatteryMonitor>();
-  return p;
-}
-
 namespace {
 
 // The planner's questions go to the module that lists the question among its outputs.

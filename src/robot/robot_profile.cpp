@@ -263,7 +263,7 @@ struct Parser {
     prof.where = SourceLocation{file, 1, 1};
     if (!r.expect_keys(root,
                        {"robot", "hardware", "controllers", "loops", "resources", "navigation", "hri",
-                        "modules", "behaviors", "processes", "tasks", "recovery", "dds", "external_facts"},
+                        "modules", "behaviors", "processes", "tasks", "recovery", "dds", "external_facts", "plugins"},
                        "the robot profile")) {
       throw ConfigError(d);
     }
@@ -319,6 +319,13 @@ struct Parser {
       } else if (key == "external_facts") {
         prof.external_facts_where = at(v);
         if (auto n = names(v, "external_facts")) prof.external_facts = std::move(*n);
+      } else if (key == "plugins") {
+        if (!r.expect_list(v, "plugins")) continue;
+        for (const auto& item : v) {
+          PluginEntry e;
+          e.path = path_of(item, "plugin library", e.where);
+          if (!e.path.empty()) prof.plugins.push_back(std::move(e));
+        }
       }
     }
     if (prof.name.empty()) d.error(prof.where, "the profile needs robot: {name: ...}");

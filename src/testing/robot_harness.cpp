@@ -3,6 +3,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "tripodal/robot/plugin_library.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/trace/trace_reader.hpp"
 
@@ -121,6 +122,7 @@ RobotHarness::RobotHarness(Mode mode, const RobotProfile& profile, RobotPlugins 
                                 (options_.localization_channel.empty() ? "" : " on '" + options_.localization_channel + "'") + ")");
   }
   start_pose_ = *start;
+  (void)load_profile_plugins(profile, plugins_, options_.plugins);
 
   // The recorded robot's hardware is replaced; the rest of its profile is kept as written.
   RobotProfile p = profile;

@@ -18,6 +18,7 @@
 
 #include "guide_hri.hpp"
 #include "run_outputs.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/behaviors/behavior_coordinator.hpp"
 #include "tripodal/behaviors/behavior_registry.hpp"
 #include "tripodal/behaviors/gesture_behaviors.hpp"
@@ -42,7 +43,7 @@ struct GuideRobot {
   std::filesystem::path dir = std::filesystem::temp_directory_path() / ("tripodal_guide_hri_" + std::to_string(::getpid()));
   std::shared_ptr<sim::World> world = std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/exhibit_hall.yaml"));
   RobotProfile profile = load_robot_profile(kConfigs / "robots/jinny.yaml");
-  RobotPlugins plugins = RobotPlugins::with_builtins();
+  RobotPlugins plugins;
   SimClock clock;
   std::unique_ptr<Robot> robot;
   CHri* hri = nullptr;
@@ -52,9 +53,7 @@ struct GuideRobot {
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     std::filesystem::copy_file(kConfigs / "hri/jinny.xml", dir / "jinny.xml");
-    sim::register_sim_hardware(plugins.hardware, world);
-    register_gesture_behaviors(plugins.behaviors);
-    register_guide_modules(plugins.modules);
+    register_all(plugins, world);
     RobotOptions ro;
     ro.parameters = simulation_overrides(profile, *world, 1);
     ro.parameters.push_back({"hri", "knowledge", (dir / "jinny.xml").string()});
@@ -193,10 +192,8 @@ PushResult push_towards_visitor(bool with_safety) {
   standing.radius_m = 0.25;
   world->visitors = {standing};
   RobotProfile profile = jinny_profile(with_safety);
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  sim::register_sim_hardware(plugins.hardware, world);
-  register_gesture_behaviors(plugins.behaviors);
-  register_guide_modules(plugins.modules);
+  RobotPlugins plugins;
+  register_all(plugins, world);
   SimClock clock;
   RobotOptions ro;
   ro.parameters = simulation_overrides(profile, *world, 1);
@@ -220,10 +217,8 @@ TEST_CASE("BhAvoidObstacle as Jinny's safety behavior (safety: true) stops a beh
     REQUIRE(std::count_if(profile.behaviors.begin(), profile.behaviors.end(), [](const ModuleEntry& e) { return e.safety; }) == 1);
     SimClock clock;
     auto world = std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/exhibit_hall.yaml"));
-    RobotPlugins plugins = RobotPlugins::with_builtins();
-    sim::register_sim_hardware(plugins.hardware, world);
-    register_gesture_behaviors(plugins.behaviors);
-    register_guide_modules(plugins.modules);
+    RobotPlugins plugins;
+    register_all(plugins, world);
     const auto robot = Robot::assemble(profile, plugins, clock);
     const CBehaviorCoordinator& c = robot->behavior_loop().coordinator();
     const auto id = c.find_input("BhAvoidObstacle");
@@ -264,10 +259,8 @@ TEST_CASE("A safety behavior: safety takes true or false, behaviors only, and no
   RobotProfile profile = load_robot_profile(kConfigs / "robots/jinny.yaml");
   for (ModuleEntry& b : profile.behaviors) b.safety = b.name == "BhAutoMove";
   auto world = std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/exhibit_hall.yaml"));
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  sim::register_sim_hardware(plugins.hardware, world);
-  register_gesture_behaviors(plugins.behaviors);
-  register_guide_modules(plugins.modules);
+  RobotPlugins plugins;
+  register_all(plugins, world);
   SimClock clock;
   try {
     (void)Robot::assemble(profile, plugins, clock);

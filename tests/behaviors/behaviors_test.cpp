@@ -59,7 +59,8 @@ struct KinematicWorld {
 }  // namespace
 
 TEST_CASE("Every registered behavior can be created by name and describes itself") {
-  const BehaviorRegistry& reg = default_behavior_registry();
+  BehaviorRegistry reg;
+  register_builtin_behaviors(reg);
   const auto names = reg.names();
   CHECK(names == std::vector<std::string>{"BhAvoidObstacle", "BhBackOff", "BhGoToPose", "BhRotateInPlace", "BhStop"});
   KinematicWorld w;

@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/board/actuator_behaviors.hpp"
 #include "tripodal/board/board_monitor.hpp"
 #include "tripodal/robot/robot.hpp"
@@ -24,14 +25,12 @@ struct DisinfectionRobot {
   std::shared_ptr<const sim::World> world =
       std::make_shared<const sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml"));
   SimClock clock;
-  RobotPlugins plugins = RobotPlugins::with_builtins();  // the robot keeps using them
+  RobotPlugins plugins;  // the robot keeps using them
   std::unique_ptr<Robot> robot;
   sim::SimBoardHardware* hw = nullptr;
 
   DisinfectionRobot() {
-    sim::register_sim_board_hardware(plugins.hardware, world);
-    board::register_board_modules(plugins.modules);
-    board::register_board_behaviors(plugins.behaviors);
+    register_all(plugins, world);
     // These tests are about the board's protocol and the net: the lanes as without a dose target
     // (the dose-planned run of a room is tests/app, tripodal_run_cli:disinfection_reaches_dose_2111).
     RobotOptions ro;
@@ -178,13 +177,11 @@ namespace {
 struct ChannelRobot {
   std::shared_ptr<const sim::World> world = std::make_shared<const sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml"));
   SimClock clock;
-  RobotPlugins plugins = RobotPlugins::with_builtins();
+  RobotPlugins plugins = builtin_plugins(world);
   std::unique_ptr<Robot> robot;
   sim::SimBoardHardware* hw = nullptr;
 
   ChannelRobot() {
-    sim::register_sim_board_hardware(plugins.hardware, world);
-    board::register_board_behaviors(plugins.behaviors);
     RobotProfile profile = load_robot_profile(kConfigs / "robots/disinfection.yaml");
     profile.modules.clear();
     ModuleEntry lcd;
@@ -234,9 +231,7 @@ TEST_CASE("The board's lamp, atomizer, voice and LCD are command channels the be
 TEST_CASE("A behavior writing a channel the hardware does not export is refused at assembly, located", "[board][channels]") {
   const auto world = std::make_shared<const sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml"));
   SimClock clock;
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  sim::register_sim_hardware(plugins.hardware, world);  // "sim": joints only, no lamp
-  board::register_board_behaviors(plugins.behaviors);
+  RobotPlugins plugins = builtin_plugins(world);
   RobotProfile profile = load_robot_profile(kConfigs / "robots/disinfection.yaml");
   profile.modules.clear();
   profile.hardware->type = "sim";

@@ -11,6 +11,7 @@
 #include <random>
 #include <string>
 
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/board/actuator_behaviors.hpp"
 #include "tripodal/board/board_monitor.hpp"
 #include "tripodal/robot/robot.hpp"
@@ -57,10 +58,7 @@ WardRun run_ward(std::uint64_t seed, double max_s, const std::function<void(sim:
   if (edit) edit(w);
   const auto world = std::make_shared<const sim::World>(std::move(w));
   SimClock clock;
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  sim::register_sim_board_hardware(plugins.hardware, world);
-  board::register_board_modules(plugins.modules);
-  board::register_board_behaviors(plugins.behaviors);
+  RobotPlugins plugins = builtin_plugins(world);
   auto robot = Robot::assemble(load_robot_profile(kConfigs / "robots/disinfection.yaml"), plugins, clock);
   auto& hw = dynamic_cast<sim::SimBoardHardware&>(*robot->hardware());
   if (CController* c = robot->behavior_loop().controller()) c->reset_odometry(world->start_pose);
@@ -127,10 +125,7 @@ Approach drive_at(Pose2D start, Pose2D goal, const std::function<void(sim::World
   if (edit) edit(w);
   const auto world = std::make_shared<const sim::World>(std::move(w));
   SimClock clock;
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  sim::register_sim_board_hardware(plugins.hardware, world);
-  board::register_board_modules(plugins.modules);
-  board::register_board_behaviors(plugins.behaviors);
+  RobotPlugins plugins = builtin_plugins(world);
   auto robot = Robot::assemble(load_robot_profile(kConfigs / "robots/disinfection.yaml"), plugins, clock);
   auto& hw = dynamic_cast<sim::SimBoardHardware&>(*robot->hardware());
   if (CController* c = robot->behavior_loop().controller()) c->reset_odometry(world->start_pose);

@@ -10,6 +10,7 @@
 #include "tripodal/controllers/differential_drive_controller.hpp"
 #include "tripodal/controllers/holonomic_controller.hpp"
 #include "tripodal/controllers/ideal_hardware.hpp"
+#include "../support/builtin_registries.hpp"
 
 using namespace tripodal;
 using namespace std::chrono_literals;
@@ -231,7 +232,7 @@ TEST_CASE("Hardware faults are reported, not thrown") {
 }
 
 TEST_CASE("Controllers are created by name from configuration") {
-  const ControllerRegistry& reg = default_controller_registry();
+  const ControllerRegistry& reg = test::builtin_controllers();
   CHECK(reg.names() == std::vector<std::string>{"differential", "mecanum", "omni"});
   IdealWheelHardware two(2, 10ms), three(3, 10ms), four(4, 10ms);
   auto d = reg.create(diff_config(), two);

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "dds_test_support.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/dds/endpoint.hpp"
 #include "tripodal/dds/robot_bridge.hpp"
 #include "tripodal/dds/robot_modules.hpp"
@@ -81,8 +82,8 @@ TEST_CASE("dds: a robot with a dds: section publishes its state and takes a task
   REQUIRE(profile.dds);
   CHECK(profile.dds->publish == std::vector<std::string>{"odom", "pose", "map", "events", "markings", "tf", "clock"});
 
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml")));
+  RobotPlugins plugins;
+  register_all(plugins, std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml")));
   SimClock clock;
   const auto robot = Robot::assemble(profile, plugins, clock);
 
@@ -192,8 +193,8 @@ TEST_CASE("dds: the robot's frames on /tf and /tf_static, its time on /clock, am
                            "\n  namespace: " + ns + "\n  participant_lease_s: 1\n  period_s: 0.1\n  tasks: false\n" +
                            "  frames: {front_laser: [0.2, 0.0, 0.0]}\n";
   const RobotProfile profile = load_robot_profile_from_string(yaml, "psr2-dds.yaml", kConfigs / "robots");
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml")));
+  RobotPlugins plugins;
+  register_all(plugins, std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml")));
   SimClock clock;
   const auto robot = Robot::assemble(profile, plugins, clock);
 
@@ -272,7 +273,7 @@ TEST_CASE("dds: a pause command holds the run until resume", "[dds]") {
       "robot: {name: idle}\ndds: {domain_id: " + std::to_string(domain) + ", namespace: " + ns +
           ", participant_lease_s: 1, publish: [events]}\n",
       "idle.yaml", kConfigs / "robots");
-  RobotPlugins plugins = RobotPlugins::with_builtins();
+  RobotPlugins plugins = builtin_plugins();
   SimClock clock;
   const auto robot = Robot::assemble(profile, plugins, clock);
   Participant peer(test_options(31));
@@ -369,7 +370,7 @@ TEST_CASE("dds: a DdsLaser whose publisher leaves is the resource's fault, a fau
       "resources:\n  - {name: laser, type: DdsLaser, parameters: {namespace: " + ns + ", domain_id: " + std::to_string(domain) + "}}\n"
       "dds: {domain_id: " + std::to_string(domain) + ", namespace: " + ns + ", publish: [events], tasks: false}\n",
       "lidar.yaml", kConfigs / "robots");
-  RobotPlugins plugins = RobotPlugins::with_builtins();
+  RobotPlugins plugins = builtin_plugins();
   register_dds_modules(plugins.resources, plugins.controllers);
   SimClock clock;
   const auto robot = Robot::assemble(profile, plugins, clock);
@@ -445,8 +446,8 @@ TEST_CASE("dds: a resource's fault during a task fails its process and the plann
           ", participant_lease_s: 1, publish: [events]}\n";
   const RobotProfile profile = load_robot_profile_from_string(yaml, "psr2-remote.yaml", kConfigs / "robots");
 
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml")));
+  RobotPlugins plugins;
+  register_all(plugins, std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml")));
   plugins.resources.add(RemoteDevice::static_manifest(),
                         [](const ResourceConfig& c) -> std::unique_ptr<CResource> { return std::make_unique<RemoteDevice>(c.name); });
   SimClock clock;

@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "dds_test_support.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/controllers/ideal_hardware.hpp"
 #include "tripodal/dds/robot_modules.hpp"
 #include "tripodal/robot/plugins.hpp"
@@ -29,7 +30,7 @@ ParameterValues binding(std::uint32_t domain) {
 }  // namespace
 
 TEST_CASE("dds: the DdsLaser resource holds the scans of its topic", "[dds]") {
-  RobotPlugins plugins = RobotPlugins::with_builtins();
+  RobotPlugins plugins = builtin_plugins();
   register_dds_modules(plugins.resources, plugins.controllers);
   REQUIRE(plugins.resources.contains("DdsLaser"));
   const ModuleManifest& manifest = plugins.resources.manifest("DdsLaser");
@@ -69,7 +70,7 @@ TEST_CASE("dds: the DdsLaser resource holds the scans of its topic", "[dds]") {
 }
 
 TEST_CASE("dds: the dds_cmd_vel controller publishes its limited command", "[dds]") {
-  RobotPlugins plugins = RobotPlugins::with_builtins();
+  RobotPlugins plugins = builtin_plugins();
   register_dds_modules(plugins.resources, plugins.controllers);
   REQUIRE(plugins.controllers.contains("dds_cmd_vel"));
 
@@ -106,7 +107,7 @@ TEST_CASE("dds: the dds_cmd_vel controller publishes its limited command", "[dds
 }
 
 TEST_CASE("dds: DdsPose, DdsImu and DdsOdometry hold a ROS 2 node's pose, IMU and odometry", "[dds]") {
-  RobotPlugins plugins = RobotPlugins::with_builtins();
+  RobotPlugins plugins = builtin_plugins();
   register_dds_modules(plugins.resources, plugins.controllers);
   const std::uint32_t domain = test_domain(22);
   auto create = [&](const std::string& type, const std::string& name) {

@@ -16,6 +16,7 @@
 
 #include "child_process.hpp"
 #include "dds_test_support.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/dds/endpoint.hpp"
 #include "tripodal/dds/robot_bridge.hpp"
 #include "tripodal/dds/robot_modules.hpp"
@@ -56,8 +57,8 @@ TEST_CASE("dds: a ROS 2 peer on Fast DDS sees the robot's tf, tf_static, clock, 
   const std::string yaml = read_text(kConfigs / "robots/psr2.yaml") + "\ndds:\n  domain_id: " + std::to_string(domain) +
                            "\n  namespace: " + ns + "\n  participant_lease_s: 1\n  period_s: 0.1\n";
   const RobotProfile profile = load_robot_profile_from_string(yaml, "psr2-dds.yaml", kConfigs / "robots");
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml")));
+  RobotPlugins plugins;
+  register_all(plugins, std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml")));
   SimClock clock;
   const auto robot = Robot::assemble(profile, plugins, clock);
   RobotBridge bridge(*robot, clock, *profile.dds, RobotBridgeOptions{.simulated_time = true});
@@ -127,7 +128,7 @@ TEST_CASE("dds: a ROS 2 laser driver on Fast DDS feeds a robot whose profile nam
   RobotProfile profile = load_robot_profile(kData / "ros2_lidar_robot.yaml");
   REQUIRE(profile.dds);
   profile.dds->domain_id = domain;
-  RobotPlugins plugins = RobotPlugins::with_builtins();
+  RobotPlugins plugins = builtin_plugins();
   register_dds_modules(plugins.resources, plugins.controllers);
   SimClock clock;
   RobotOptions ro;

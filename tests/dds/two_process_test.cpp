@@ -7,6 +7,7 @@
 
 #include "child_process.hpp"
 #include "dds_test_support.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/dds/endpoint.hpp"
 #include "tripodal/dds/robot_modules.hpp"
 #include "tripodal/robot/robot.hpp"
@@ -115,7 +116,7 @@ TEST_CASE("dds: a robot's DdsLaser whose process is killed is a fault within the
       "robot: {name: lidar}\nresources:\n  - {name: laser, type: DdsLaser, parameters: {namespace: " + test_namespace() +
           ", domain_id: " + std::to_string(domain) + "}}\n",
       "lidar.yaml", ".");
-  RobotPlugins plugins = RobotPlugins::with_builtins();
+  RobotPlugins plugins = builtin_plugins();
   register_dds_modules(plugins.resources, plugins.controllers);
   SimClock clock;
   const auto robot = Robot::assemble(profile, plugins, clock);

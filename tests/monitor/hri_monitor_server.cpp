@@ -11,6 +11,7 @@
 #include <memory>
 #include <thread>
 
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/monitor/robot_monitor.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
@@ -31,9 +32,9 @@ int main(int argc, char** argv) {
   }
   try {
     const std::filesystem::path source = argv[1];
-    RobotPlugins plugins = RobotPlugins::with_builtins();
+    RobotPlugins plugins;
     plugins.modules.add<testing_hri::TestHri>();
-    sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(source / "configs/worlds/workspace.yaml")));
+    register_all(plugins, std::make_shared<sim::World>(sim::load_world(source / "configs/worlds/workspace.yaml")));
     RobotProfile profile = load_robot_profile(source / "configs/robots/psr2.yaml");
     testing_hri::add_test_hri(profile, argv[2], source);
     SimClock clock;

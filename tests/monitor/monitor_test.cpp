@@ -21,6 +21,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/board/actuator_behaviors.hpp"
 #include "tripodal/board/board_monitor.hpp"
 #include "tripodal/monitor/monitor_server.hpp"
@@ -58,12 +59,12 @@ std::string hex(const std::array<std::uint8_t, 20>& d) {
 
 // The PSR-2 demo robot on the simulator, in the workspace world.
 struct Psr2 {
-  RobotPlugins plugins = RobotPlugins::with_builtins();  // the robot keeps using them
+  RobotPlugins plugins;  // the robot keeps using them
   SimClock clock;
   std::unique_ptr<Robot> robot;
   Psr2() {
     const std::filesystem::path configs = std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs";
-    sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(configs / "worlds/workspace.yaml")));
+    register_all(plugins, std::make_shared<sim::World>(sim::load_world(configs / "worlds/workspace.yaml")));
     robot = Robot::assemble(load_robot_profile(configs / "robots/psr2.yaml"), plugins, clock);
   }
 };
@@ -522,11 +523,9 @@ TEST_CASE("The status carries the control board's link for a board robot and not
   }
   SECTION("the disinfection robot on the simulated board: the link as the host sees it") {
     const std::filesystem::path configs = std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs";
-    RobotPlugins plugins = RobotPlugins::with_builtins();
+    RobotPlugins plugins;
     SimClock clock;
-    sim::register_sim_board_hardware(plugins.hardware, std::make_shared<const sim::World>(sim::load_world(configs / "worlds/workspace.yaml")));
-    board::register_board_modules(plugins.modules);
-    board::register_board_behaviors(plugins.behaviors);
+    register_all(plugins, std::make_shared<const sim::World>(sim::load_world(configs / "worlds/workspace.yaml")));
     const auto robot = Robot::assemble(load_robot_profile(configs / "robots/disinfection.yaml"), plugins, clock);
     MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
     RobotMonitor watch(*robot, clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
@@ -608,7 +607,7 @@ namespace {
 struct Psr2WithHri {
   std::filesystem::path dir;
   std::filesystem::path file;
-  RobotPlugins plugins = RobotPlugins::with_builtins();
+  RobotPlugins plugins;
   SimClock clock;
   std::unique_ptr<Robot> robot;
   // `prepare` may write files beside the knowledge (its history) before the robot loads it.
@@ -621,7 +620,7 @@ struct Psr2WithHri {
     std::filesystem::copy_file(source / "configs/hri/jinny.xml", file);
     if (prepare) prepare(file);
     plugins.modules.add<testing_hri::TestHri>();
-    sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(source / "configs/worlds/workspace.yaml")));
+    register_all(plugins, std::make_shared<sim::World>(sim::load_world(source / "configs/worlds/workspace.yaml")));
     RobotProfile profile = load_robot_profile(source / "configs/robots/psr2.yaml");
     testing_hri::add_test_hri(profile, file, source);
     robot = Robot::assemble(profile, plugins, clock);

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "navi_test_util.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/behaviors/navigation_behaviors.hpp"
 #include "tripodal/navi/localizer.hpp"
 #include "tripodal/navi/planning_modules.hpp"
@@ -210,7 +211,7 @@ class NavRobot {
  public:
   NavRobot(bool omni, const sim::World& w, std::vector<Task> tasks, const std::string& localizer = {})
       : tasks_(std::move(tasks)), box_cells_(box_cells(w)) {
-    sim::register_sim_hardware(plugins_.hardware, std::make_shared<const sim::World>(w));
+    register_all(plugins_, std::make_shared<const sim::World>(w));
     for (std::size_t i = 0; i < tasks_.size(); ++i) {
       const std::string id = "task" + std::to_string(i);
       navi::test::write_file(nets_ / (id + ".xml"), task_net(id, tasks_[i]));
@@ -311,7 +312,7 @@ class NavRobot {
 
   std::vector<Task> tasks_;
   navi::test::TempDir nets_{"navigation_modules"};
-  RobotPlugins plugins_ = RobotPlugins::with_builtins();
+  RobotPlugins plugins_;  // register_all in the constructor, with the world
   SimClock clock_;
   std::unique_ptr<Robot> robot_;
   std::string last_run_;

@@ -6,6 +6,7 @@
 #include "tripodal/behaviors/builtin_behaviors.hpp"
 #include "tripodal/processes/behavior_set.hpp"
 #include "tripodal/processes/process_supervisor.hpp"
+#include "../support/builtin_registries.hpp"
 
 using namespace tripodal;
 using namespace tripodal::test;
@@ -37,8 +38,8 @@ struct Rig {
   BehaviorSet set{clock};
   CProcessSupervisor supervisor;
   explicit Rig(SupervisorOptions o = {}) : supervisor(set, clock, o) {
-    set.add(default_behavior_registry(), "BhRotateInPlace");
-    set.add(default_behavior_registry(), "BhStop");
+    set.add(test::builtin_behaviors(), "BhRotateInPlace");
+    set.add(test::builtin_behaviors(), "BhStop");
   }
 };
 
@@ -49,9 +50,9 @@ TEST_CASE("BehaviorSet holds registry behaviors by name", "[processes]") {
   CHECK(rig.set.names() == std::vector<std::string>{"BhRotateInPlace", "BhStop"});
   CHECK(rig.set.has("BhStop"));
   CHECK_FALSE(rig.set.has("BhFly"));
-  REQUIRE_THROWS_AS(rig.set.add(default_behavior_registry(), "BhStop"), std::invalid_argument);
-  REQUIRE_THROWS_AS(rig.set.add(default_behavior_registry(), "BhFly"), ConfigError);
-  REQUIRE_THROWS_WITH(rig.set.add(default_behavior_registry(), "BhStpo"),
+  REQUIRE_THROWS_AS(rig.set.add(test::builtin_behaviors(), "BhStop"), std::invalid_argument);
+  REQUIRE_THROWS_AS(rig.set.add(test::builtin_behaviors(), "BhFly"), ConfigError);
+  REQUIRE_THROWS_WITH(rig.set.add(test::builtin_behaviors(), "BhStpo"),
                       Catch::Contains("unknown behavior type 'BhStpo'; known: ") && Catch::Contains("did you mean 'BhStop'?"));
 }
 

@@ -12,6 +12,7 @@
 #include "tripodal/behaviors/builtin_behaviors.hpp"
 #include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/controllers/kinematics.hpp"
+#include "../support/builtin_registries.hpp"
 
 using namespace tripodal;
 using namespace std::chrono_literals;
@@ -40,12 +41,12 @@ GoalRun drive_to(const ControllerConfig& base, Pose2D goal) {
   ControlLoopOptions o;
   o.name = "motion";
   o.period = base.period;
-  ControlLoop loop(o, resources, CBehaviorCoordinator(cc), default_controller_registry().create(base, hw));
+  ControlLoop loop(o, resources, CBehaviorCoordinator(cc), test::builtin_controllers().create(base, hw));
   loop.set_odometry_output(&odom);
   SimLoopDriver driver(clock);
   driver.add(loop);
-  loop.activate(default_behavior_registry().create("BhStop"), {});
-  loop.activate(default_behavior_registry().create("BhGoToPose"),
+  loop.activate(test::builtin_behaviors().create("BhStop"), {});
+  loop.activate(test::builtin_behaviors().create("BhGoToPose"),
                 {{"goal_x_m", Value{goal.x_m}}, {"goal_y_m", Value{goal.y_m}}, {"goal_theta_rad", Value{goal.theta_rad}},
                  {"position_tolerance_m", Value{0.02}}, {"heading_tolerance_rad", Value{0.02}}});
   GoalRun run;
@@ -83,7 +84,7 @@ TEST_CASE("The same behavior drives an omni and a differential base to a goal po
 TEST_CASE("Activation, replacement, deactivation and status through the loop") {
   test::ReactiveRig rig(test::differential_base(), CoordinationMode::priority);
   ControlLoop& loop = *rig.loop;
-  const BehaviorRegistry& reg = default_behavior_registry();
+  const BehaviorRegistry& reg = test::builtin_behaviors();
   const BehaviorHandle stop = loop.activate(reg.create("BhStop"), {}, "stop");
   CHECK(loop.status(stop) == BehaviorStatus::running);
   rig.cycle();
@@ -124,7 +125,7 @@ TEST_CASE("Activation, replacement, deactivation and status through the loop") {
 TEST_CASE("Behavior outcomes become supervisor events, a failure carries its reason") {
   test::ReactiveRig rig(test::omni_base_psr(), CoordinationMode::priority);
   ControlLoop& loop = *rig.loop;
-  const BehaviorRegistry& reg = default_behavior_registry();
+  const BehaviorRegistry& reg = test::builtin_behaviors();
   loop.activate(reg.create("BhRotateInPlace"), {{"angle_rad", Value{0.5}}}, "rotate_a");
   loop.activate(reg.create("BhGoToPose"), {{"frame", Value{std::string("map")}}, {"stale_timeout_s", Value{0.05}}}, "goto_a");
   std::vector<LoopEvent> events;
@@ -161,7 +162,7 @@ TEST_CASE("Controller faults are reported as loop events") {
 TEST_CASE("Navigation data and locks reach the behaviors and the coordinator") {
   test::ReactiveRig rig(test::omni_base_psr(), CoordinationMode::priority);
   ControlLoop& loop = *rig.loop;
-  loop.activate(default_behavior_registry().create("BhGoToPose"), {{"use_navigation_goal", Value{true}}}, "goto_a");
+  loop.activate(test::builtin_behaviors().create("BhGoToPose"), {{"use_navigation_goal", Value{true}}}, "goto_a");
   NavigationData navi;
   navi.localized = true;
   navi.map_from_base = {0, 0, 0};
@@ -302,7 +303,7 @@ TEST_CASE("A runner on the steady clock runs, and asks for real-time priority wi
   CoordinatorConfig cc;
   cc.inputs = {{"BhStop", 0, 0ms}};
   ControlLoop loop(o, resources, CBehaviorCoordinator(cc), nullptr);
-  loop.activate(default_behavior_registry().create("BhStop"), {});
+  loop.activate(test::builtin_behaviors().create("BhStop"), {});
   LoopRunner runner(loop, clock, LoopTimingOptions{10, -1});
   runner.start();
   while (loop.cycles() < 20) std::this_thread::sleep_for(1ms);
@@ -384,7 +385,7 @@ TEST_CASE("The loop tells the behavior that won the last fusion what the safety 
   CHECK_FALSE(other.told);  // it lost: the command restricted was not its own
 
   // A safety input commanding a stop (envelope [0, 0] on every axis) holds the winner still.
-  const BehaviorHandle guard = loop.activate(default_behavior_registry().create("BhStop"), {}, "guard");
+  const BehaviorHandle guard = loop.activate(test::builtin_behaviors().create("BhStop"), {}, "guard");
   cycle();  // the guard joins and clamps this fusion
   cycle();  // the winner hears of it
   REQUIRE(drive.told);

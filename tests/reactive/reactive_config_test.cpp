@@ -10,8 +10,20 @@
 using namespace tripodal;
 using namespace std::chrono_literals;
 
+namespace {
+// The built-in controller types, as an application's plugin set has them.
+const ControllerRegistry& builtins() {
+  static const ControllerRegistry registry = [] {
+    ControllerRegistry r;
+    register_builtin_controllers(r);
+    return r;
+  }();
+  return registry;
+}
+}  // namespace
+
 TEST_CASE("The shipped configurations load into typed structs") {
-  const ReactiveConfig jinny = load_reactive_config(std::string(TRIPODAL_SOURCE_DIR) + "/configs/reactive/jinny_differential.yaml");
+  const ReactiveConfig jinny = load_reactive_config(std::string(TRIPODAL_SOURCE_DIR) + "/configs/reactive/jinny_differential.yaml", builtins());
   REQUIRE(jinny.controllers.size() == 1);
   const ControllerConfig& base = jinny.controllers[0];
   CHECK(base.type == "differential");
@@ -37,12 +49,12 @@ TEST_CASE("The shipped configurations load into typed structs") {
 
   IdealWheelHardware hw(2, 10ms);
   ResourceTable resources;
-  auto built = make_control_loop(jinny, loop, resources, &hw);
+  auto built = make_control_loop(jinny, loop, resources, &hw, builtins());
   CHECK(built->controller()->type_name() == "differential");
   CHECK(built->coordinator().input_count() == 5);
   CHECK(built->period() == 10ms);
 
-  const ReactiveConfig psr = load_reactive_config(std::string(TRIPODAL_SOURCE_DIR) + "/configs/reactive/psr_omni.yaml");
+  const ReactiveConfig psr = load_reactive_config(std::string(TRIPODAL_SOURCE_DIR) + "/configs/reactive/psr_omni.yaml", builtins());
   REQUIRE(psr.controllers[0].holonomic.wheels.size() == 3);
   CHECK(psr.controllers[0].holonomic.wheels[1].x_m == Approx(-0.22));
   CHECK(psr.loops.size() == 2);
@@ -50,8 +62,8 @@ TEST_CASE("The shipped configurations load into typed structs") {
   CHECK(psr.loops[1].controller.empty());
   CHECK(psr.loops[1].period == 50ms);
   IdealWheelHardware hw3(3, 10ms);
-  CHECK(make_control_loop(psr, psr.loops[0], resources, &hw3)->controller()->type_name() == "omni");
-  CHECK(make_control_loop(psr, psr.loops[1], resources, nullptr)->controller() == nullptr);
+  CHECK(make_control_loop(psr, psr.loops[0], resources, &hw3, builtins())->controller()->type_name() == "omni");
+  CHECK(make_control_loop(psr, psr.loops[1], resources, nullptr, builtins())->controller() == nullptr);
 }
 
 TEST_CASE("Omni wheels given one by one, and mecanum bases") {
@@ -70,7 +82,7 @@ controllers:
     wheel_radius_m: 0.05
     half_length_m: 0.2
     half_width_m: 0.15
-)", "inline.yaml");
+)", "inline.yaml", builtins());
   REQUIRE(c.controllers.size() == 2);
   CHECK(c.controllers[0].holonomic.wheels.size() == 4);
   CHECK(c.controllers[0].holonomic.wheels[1].drive_angle_rad == Approx(210 * std::numbers::pi / 180));
@@ -84,7 +96,7 @@ TEST_CASE("A negative radius is reported at its value") {
     type: differential
     wheel_separation_m: 0.4
     wheel_radius_m: -0.05
-)", "robot.yaml"),
+)", "robot.yaml", builtins()),
                       Catch::Contains("robot.yaml:5:21: error: controller 'base': parameter 'wheel_radius_m' = -0.05 m is outside (0, inf]"));
 }
 
@@ -95,13 +107,13 @@ TEST_CASE("A missing wheel is reported") {
     wheel_radius_m: 0.05
     base_radius_m: 0.2
     wheel_angles_deg: [90, 210]
-)", "psr.yaml"),
+)", "psr.yaml", builtins()),
                       Catch::Contains("psr.yaml:6:23: error: controller 'psr': an omni base needs 3 to 8 wheels, got 2"));
   REQUIRE_THROWS_WITH(parse_reactive_config(R"(controllers:
   - name: psr
     type: omni
     wheel_radius_m: 0.05
-)", "psr.yaml"),
+)", "psr.yaml", builtins()),
                       Catch::Contains("psr.yaml:2:5: error: controller 'psr': missing wheel geometry"));
   REQUIRE_THROWS_WITH(parse_reactive_config(R"(controllers:
   - name: psr
@@ -109,14 +121,14 @@ TEST_CASE("A missing wheel is reported") {
     wheel_radius_m: 0.05
     wheels:
       - {x_m: 0.2, drive_angle_deg: 90}
-)", "psr.yaml"),
+)", "psr.yaml", builtins()),
                       Catch::Contains("psr.yaml:6:9: error: controller 'psr' wheel #1: missing 'y_m' (a number)") &&
                           Catch::Contains("psr.yaml:6:7: error: controller 'psr': an omni base needs 3 to 8 wheels, got 1"));
   REQUIRE_THROWS_WITH(parse_reactive_config(R"(controllers:
   - name: jinny
     type: differential
     wheel_radius_m: 0.05
-)", "jinny.yaml"),
+)", "jinny.yaml", builtins()),
                       Catch::Contains("jinny.yaml:2:5: error: controller 'jinny': missing 'wheel_separation_m' (a number)"));
 }
 
@@ -128,7 +140,7 @@ loops:
   - name: motion
     period_s: 0.01
     controller: basis
-)", "robot.yaml"),
+)", "robot.yaml", builtins()),
                       Catch::Contains("robot.yaml:3:11: error: controller 'base': unknown controller type 'tracked'; known: differential, mecanum, omni") &&
                           Catch::Contains("robot.yaml:7:17: error: loop 'motion': unknown controller 'basis'"));
 }
@@ -154,7 +166,7 @@ loops:
       inputs:
         - {name: a, role: boss}
         - {name: a, priority: 1.5}
-)", "many.yaml");
+)", "many.yaml", builtins());
     FAIL("expected a ConfigError");
   } catch (const ConfigError& e) {
     const std::string what = e.what();
@@ -177,11 +189,11 @@ loops:
 }
 
 TEST_CASE("Syntax errors and unreadable files are located too") {
-  REQUIRE_THROWS_WITH(parse_reactive_config("controllers: [\n  {name: a\n", "broken.yaml"),
+  REQUIRE_THROWS_WITH(parse_reactive_config("controllers: [\n  {name: a\n", "broken.yaml", builtins()),
                       Catch::Contains("broken.yaml:") && Catch::Contains("YAML syntax error"));
-  REQUIRE_THROWS_WITH(parse_reactive_config("- 1\n- 2\n", "list.yaml"),
+  REQUIRE_THROWS_WITH(parse_reactive_config("- 1\n- 2\n", "list.yaml", builtins()),
                       Catch::Contains("list.yaml:1:1: error: expected a map with 'controllers' and 'loops'"));
-  REQUIRE_THROWS_WITH(load_reactive_config("/nonexistent/reactive.yaml"),
+  REQUIRE_THROWS_WITH(load_reactive_config("/nonexistent/reactive.yaml", builtins()),
                       Catch::Contains("/nonexistent/reactive.yaml: error: cannot read the file"));
 }
 
@@ -277,8 +289,8 @@ loops:
                                             "winch.yaml", registry),
                       Catch::Contains("winch.yaml:2:44: error: controller 'winch' limits.vx: expected a map, got '5'") &&
                           Catch::Contains("unknown key 'yaw' in controller 'winch' limits; expected one of: vx, vy, wz"));
-  // The default registry does not know it.
-  REQUIRE_THROWS_WITH(parse_reactive_config("controllers:\n  - {name: winch, type: gain}\n", "winch.yaml"),
+  // A plugin set without it does not know it.
+  REQUIRE_THROWS_WITH(parse_reactive_config("controllers:\n  - {name: winch, type: gain}\n", "winch.yaml", builtins()),
                       Catch::Contains("unknown controller type 'gain'; known: differential, mecanum, omni"));
 }
 
@@ -289,7 +301,7 @@ TEST_CASE("A loop period too short for the clock is refused at the file, with th
     period_s: 1e-12
   - name: slow
     period_s: 1e10
-)", "tiny.yaml"),
+)", "tiny.yaml", builtins()),
                       Catch::Contains("tiny.yaml:3:15: error: loop 'motion': 'period_s': expected seconds from 1e-06 to 9e+09, got 1e-12") &&
                           Catch::Contains("tiny.yaml:5:15: error: loop 'slow': 'period_s': expected seconds from 1e-06 to 9e+09, got 1e10"));
 }

@@ -11,6 +11,7 @@
 #include "tripodal/controllers/controller_config.hpp"
 #include "tripodal/controllers/ideal_hardware.hpp"
 #include "tripodal/reactive/control_loop.hpp"
+#include "../support/builtin_registries.hpp"
 
 namespace tripodal::test {
 
@@ -77,7 +78,7 @@ struct ReactiveRig {
     o.name = "motion";
     o.period = base.period;
     loop = std::make_unique<ControlLoop>(o, resources, CBehaviorCoordinator(eight_inputs(mode)),
-                                         default_controller_registry().create(base, *hardware));
+                                         test::builtin_controllers().create(base, *hardware));
     loop->set_odometry_output(&odom);
     constexpr double kPi = std::numbers::pi;
     scan.angle_min_rad = -kPi;
@@ -96,7 +97,7 @@ struct ReactiveRig {
 
   /// Activates the eight behaviors (2 go-to-pose, 2 rotate, back-off, stop, 2 obstacle guards).
   void activate_eight() {
-    const BehaviorRegistry& reg = default_behavior_registry();
+    const BehaviorRegistry& reg = test::builtin_behaviors();
     auto act = [&](const char* type, const char* input, ParameterValues params) {
       loop->activate(reg.create(type), params, input);
     };

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include "robot_doubles.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/board/actuator_behaviors.hpp"
 #include "tripodal/board/board_monitor.hpp"
 #include "tripodal/robot/layering.hpp"
@@ -319,10 +320,7 @@ TEST_CASE("describe_text lists modules by layer, describe_dot draws clusters and
 }
 
 TEST_CASE("describe shows command channels, who writes and who exports them; R6 refuses a channel the hardware lacks", "[robot][channels]") {
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  sim::register_sim_board_hardware(plugins.hardware, nullptr);  // the real board's channels, the world's laser
-  board::register_board_modules(plugins.modules);
-  board::register_board_behaviors(plugins.behaviors);
+  RobotPlugins plugins = builtin_plugins(nullptr);
   RobotProfile p = load_robot_profile(std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/disinfection.yaml");
   Diagnostics d;
   const RobotDescription r = describe_robot(p, plugins, knowledge_inputs(TaskLibrary::load(p.tasks)), d);

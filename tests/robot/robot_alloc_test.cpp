@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "../support/counting_new.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/navi/planning_modules.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
@@ -17,8 +18,8 @@ using namespace tripodal;
 
 TEST_CASE("The PSR-2 robot's reactive loop allocates nothing over 10,000 periods mid-cleaning", "[robot][alloc]") {
   const std::filesystem::path configs = std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs";
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(configs / "worlds/workspace.yaml")));
+  RobotPlugins plugins;
+  register_all(plugins, std::make_shared<sim::World>(sim::load_world(configs / "worlds/workspace.yaml")));
   SimClock clock;
   const auto robot = Robot::assemble(load_robot_profile(configs / "robots/psr2.yaml"), plugins, clock);
   REQUIRE(robot->command("clean the room 3211").accepted);

@@ -1,6 +1,8 @@
 // What an application registers reaches the robot: its own controller type, named in the reactive
 // configuration a profile's controller entry points to, is checked and built through the
-// application's registry (RobotPlugins::controllers), not the process-wide built-in one.
+// application's plugin set (RobotPlugins::controllers); the built-in areas do not know it.
+#include <catch2/catch.hpp>
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -8,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/controllers/ideal_hardware.hpp"
 #include "tripodal/core/manifest.hpp"
 #include "tripodal/robot/robot.hpp"
@@ -89,11 +92,11 @@ struct WinchProfile {
 
 TEST_CASE("An application's own controller type, registered in its plugins, drives the robot's loop", "[robot][plugins]") {
   const WinchProfile files;
-  RobotPlugins plugins = RobotPlugins::with_builtins();
+  RobotPlugins plugins = builtin_plugins();
   plugins.controllers.add<WinchController>();
   plugins.hardware.add(WinchHardware::static_manifest(), [](const HardwareConfig& c) { return std::make_unique<WinchHardware>(c); });
-  // Only the application's registry knows the type: the process-wide one must not decide.
-  REQUIRE_FALSE(default_controller_registry().contains("winch"));
+  // Only the application's plugin set knows the type: the built-in areas do not.
+  REQUIRE_FALSE(builtin_plugins().controllers.contains("winch"));
 
   SimClock clock;
   const RobotProfile profile = load_robot_profile(files.dir / "robot.yaml");
@@ -112,7 +115,7 @@ TEST_CASE("An application's own controller type, registered in its plugins, driv
 
 TEST_CASE("A controller type the application did not register is refused at the reactive file, with the known ones", "[robot][plugins][errors]") {
   const WinchProfile files;
-  RobotPlugins plugins = RobotPlugins::with_builtins();
+  RobotPlugins plugins = builtin_plugins();
   plugins.hardware.add(WinchHardware::static_manifest(), [](const HardwareConfig& c) { return std::make_unique<WinchHardware>(c); });
   SimClock clock;
   const RobotProfile profile = load_robot_profile(files.dir / "robot.yaml");
@@ -132,7 +135,7 @@ TEST_CASE("A type declared in the profile but not registered is refused at assem
                                        "behaviors:\n"
                                        "  - {name: BhDance, type: BhDance, layer: reactive, inputs: [laser_scan], outputs: [behavior_command]}\n";
   const RobotProfile profile = load_robot_profile(dir / "robot.yaml");
-  const RobotPlugins plugins = RobotPlugins::with_builtins();
+  const RobotPlugins plugins = builtin_plugins();
 
   // The diagram of a design: both drawn, both noted.
   Diagnostics d;
@@ -163,7 +166,7 @@ TEST_CASE("A type declared in the profile but not registered is refused at assem
 TEST_CASE("check_robot refuses a net binding a behavior the profile does not list, as assembly does", "[robot][plugins][errors]") {
   const RobotProfile profile =
       load_robot_profile(std::filesystem::path(TRIPODAL_SOURCE_DIR) / "tests/data/robot/net-binds-unlisted-behavior.yaml");
-  const RobotPlugins plugins = RobotPlugins::with_builtins();
+  const RobotPlugins plugins = builtin_plugins();
   Diagnostics d;
   (void)check_robot(profile, plugins, d);
   CHECK(d.error_count() == 1);
@@ -194,8 +197,7 @@ RobotProfile dock_profile(const std::string& extra) {
 
 // The built-in types and the simulator's hardware "sim" (no world: none is built here).
 RobotPlugins dock_plugins() {
-  RobotPlugins p = RobotPlugins::with_builtins();
-  sim::register_sim_hardware(p.hardware);
+  RobotPlugins p = builtin_plugins();
   return p;
 }
 

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "sim_test_util.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
@@ -130,8 +131,7 @@ TEST_CASE("Simulator: a dock's contacts need the heading within its tolerance", 
 TEST_CASE("A robot drives to its dock and charges: PrDockCharge on the simulator with BatteryMonitor's facts",
           "[sim][dock][robot]") {
   auto world = std::make_shared<const World>(load_world(kWorlds + "workspace_dock.yaml"));
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  register_sim_hardware(plugins.hardware, world);
+  RobotPlugins plugins = builtin_plugins(world);
   SimClock clock;
   const RobotProfile profile =
       load_robot_profile(std::string(TRIPODAL_TEST_DATA_DIR) + "/robot/dock_charge.yaml");

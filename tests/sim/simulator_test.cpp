@@ -15,6 +15,7 @@
 #include "tripodal/controllers/kinematics.hpp"
 #include "tripodal/navi/localizer.hpp"
 #include "tripodal/reactive/reactive_config.hpp"
+#include "../support/builtin_registries.hpp"
 
 using namespace tripodal;
 using namespace tripodal::sim;
@@ -409,7 +410,7 @@ TEST_CASE("Simulator: a controller drives the simulated base through the Hardwar
   for (const ControllerConfig& base : {differential_base(), omni3_base()}) {
     INFO(base.type);
     Simulator sim(room_world(81, 81, {1.0, 1.0, 0.0}), base, 1);
-    std::unique_ptr<CController> ctrl = default_controller_registry().create(base, sim);
+    std::unique_ptr<CController> ctrl = tripodal::test::builtin_controllers().create(base, sim);
     ctrl->reset_odometry(sim.world().start_pose);
     const Twist2D cmd{0.3, 0.0, 0.2};
     for (int k = 0; k < 500; ++k) {
@@ -427,7 +428,7 @@ TEST_CASE("Simulator: a controller drives the simulated base through the Hardwar
 }
 
 TEST_CASE("SimRunner: control loops and the simulator step together, BhGoToPose reaches a goal", "[sim][runner]") {
-  const ReactiveConfig rc = load_reactive_config(std::string(TRIPODAL_SOURCE_DIR) + "/configs/reactive/psr_omni.yaml");
+  const ReactiveConfig rc = load_reactive_config(std::string(TRIPODAL_SOURCE_DIR) + "/configs/reactive/psr_omni.yaml", tripodal::test::builtin_controllers());
   const ControllerConfig& base = *rc.find_controller("base");
   Simulator sim(room_world(81, 81, {1.0, 1.0, 0.0}), base, 5);
   SimClock clock;
@@ -436,10 +437,10 @@ TEST_CASE("SimRunner: control loops and the simulator step together, BhGoToPose 
   table.add(odom);
   sim.add_resources(table);
   CHECK(table.size() == 6);
-  std::unique_ptr<ControlLoop> loop = make_control_loop(rc, *rc.find_loop("motion"), table, &sim);
+  std::unique_ptr<ControlLoop> loop = make_control_loop(rc, *rc.find_loop("motion"), table, &sim, tripodal::test::builtin_controllers());
   loop->set_odometry_output(&odom);
   loop->controller()->reset_odometry(sim.world().start_pose);
-  const BehaviorRegistry& reg = default_behavior_registry();
+  const BehaviorRegistry& reg = tripodal::test::builtin_behaviors();
   const BehaviorHandle go = loop->activate(reg.create("BhGoToPose"), {{"goal_x_m", Value{3.0}}, {"goal_y_m", Value{2.5}}}, "BhGoToPose");
   loop->activate(reg.create("BhAvoidObstacle"), {}, "BhAvoidObstacle");
   SimRunner runner(sim, clock);

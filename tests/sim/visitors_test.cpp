@@ -9,6 +9,7 @@
 #include <string>
 
 #include "sim_test_util.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
@@ -248,9 +249,7 @@ TEST_CASE("visitors: a guided visitor follows the robot along its trail and keep
 TEST_CASE("Jinny's neck is driven through its command channel by the behavior loop", "[sim][joints][channels]") {
   const auto world = std::make_shared<const World>(load_world(kWorlds + "exhibit_hall.yaml"));
   SimClock clock;
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  register_sim_hardware(plugins.hardware, world);
-  register_gesture_behaviors(plugins.behaviors);
+  RobotPlugins plugins = builtin_plugins(world);
   RobotProfile profile = load_robot_profile(std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/jinny.yaml");
   // Its hardware, base and behaviors; not the guide application's HRI, nor the tasks that ask it.
   profile.hri.clear();

@@ -11,6 +11,7 @@
 #include <map>
 
 #include "../trace/trace_test_util.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/testing/robot_harness.hpp"
@@ -55,8 +56,8 @@ RobotProfile psr2() {
 // The live run: the simulated PSR-2 patrols to door_2111; every behavior-loop period the recorder
 // writes its sensors, the true pose (channel "truth") and the fused command.
 Recording record_patrol(const std::filesystem::path& out) {
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  sim::register_sim_hardware(plugins.hardware, workspace());
+  RobotPlugins plugins;
+  register_all(plugins, workspace());
   SimClock clock;
   auto robot = Robot::assemble(psr2(), plugins, clock);
   auto& sim = dynamic_cast<sim::SimHardware&>(*robot->hardware()).simulator();
@@ -122,7 +123,7 @@ TEST_CASE("robot harness, replay: the recorded patrol succeeds again on the reco
   REQUIRE(rec.succeeded);
   REQUIRE(distance(rec.start, rec.end) > 6.0);
 
-  testing::RobotHarness h(testing::RobotHarness::Mode::replay, psr2(), RobotPlugins::with_builtins(), *trace, options());
+  testing::RobotHarness h(testing::RobotHarness::Mode::replay, psr2(), builtin_plugins(), *trace, options());
   CHECK(h.robot().hardware()->manifest().name == "trace");
   CHECK(distance(h.start_pose(), rec.start) < 1e-9);
   REQUIRE(h.command(kTask).accepted);
@@ -166,7 +167,7 @@ TEST_CASE("robot harness, replay: a trace cut before the goal does not let the t
     }
     writer.close();
   }
-  testing::RobotHarness h(testing::RobotHarness::Mode::replay, psr2(), RobotPlugins::with_builtins(), cut.path(), options());
+  testing::RobotHarness h(testing::RobotHarness::Mode::replay, psr2(), builtin_plugins(), cut.path(), options());
   REQUIRE(h.command(kTask).accepted);
   const testing::RunLog& log = h.run(time_from_seconds(60.0));
   // The replay ends with the trace, the robot still on its way.
@@ -186,7 +187,7 @@ TEST_CASE("robot harness, closed loop: the robot starts at the recorded pose and
   moved.start_pose = Pose2D{3.0, 3.0, 1.0};
   testing::RobotHarnessOptions o = options();
   o.world = std::make_shared<const sim::World>(moved);
-  testing::RobotHarness h(testing::RobotHarness::Mode::closed_loop, psr2(), RobotPlugins::with_builtins(), *trace, o);
+  testing::RobotHarness h(testing::RobotHarness::Mode::closed_loop, psr2(), builtin_plugins(), *trace, o);
   auto& sim = dynamic_cast<sim::SimHardware&>(*h.robot().hardware()).simulator();
   CHECK(distance(sim.pose(), rec.start) < 1e-9);
   CHECK(h.now() == h.start_time());
@@ -206,23 +207,29 @@ TEST_CASE("robot harness: bad traces and options are refused, naming what is wro
   (void)recorded(trace);
   testing::RobotHarnessOptions o = options();
   o.localization_channel = "amcl_pose";
-  REQUIRE_THROWS_WITH(testing::RobotHarness(testing::RobotHarness::Mode::replay, psr2(), RobotPlugins::with_builtins(), *trace, o),
+  REQUIRE_THROWS_WITH(testing::RobotHarness(testing::RobotHarness::Mode::replay, psr2(), builtin_plugins(), *trace, o),
                       Contains("has no odometry channel 'amcl_pose'"));
   o = options();
   o.world = nullptr;
-  REQUIRE_THROWS_WITH(testing::RobotHarness(testing::RobotHarness::Mode::closed_loop, psr2(), RobotPlugins::with_builtins(), *trace, o),
+  REQUIRE_THROWS_WITH(testing::RobotHarness(testing::RobotHarness::Mode::closed_loop, psr2(), builtin_plugins(), *trace, o),
                       Contains("needs a simulated world"));
+  // A shared-library plugin the harness is told to load, refused as `tripodal run --plugin` refuses it.
+  o = options();
+  o.plugins = {TRIPODAL_TEST_PLUGIN_THROWING};
+  REQUIRE_THROWS_WITH(testing::RobotHarness(testing::RobotHarness::Mode::replay, psr2(), builtin_plugins(), *trace, o),
+                      Contains("--plugin: error: plugin '" TRIPODAL_TEST_PLUGIN_THROWING
+                               "' failed to register its types: the licence file /etc/waver.lic is missing"));
 
   trace::test::TempFile empty("robot_harness_empty");
   {
     trace::TraceWriter writer(empty.path());
     writer.close();
   }
-  REQUIRE_THROWS_WITH(testing::RobotHarness(testing::RobotHarness::Mode::replay, psr2(), RobotPlugins::with_builtins(), empty.path(), options()),
+  REQUIRE_THROWS_WITH(testing::RobotHarness(testing::RobotHarness::Mode::replay, psr2(), builtin_plugins(), empty.path(), options()),
                       Contains("has no records"));
 
   trace::test::TempFile missing("robot_harness_missing");
-  REQUIRE_THROWS_WITH(testing::RobotHarness(testing::RobotHarness::Mode::replay, psr2(), RobotPlugins::with_builtins(), missing.path(), options()),
+  REQUIRE_THROWS_WITH(testing::RobotHarness(testing::RobotHarness::Mode::replay, psr2(), builtin_plugins(), missing.path(), options()),
                       Contains(missing.str()));
 
   // Corrupt in the middle: the replay stops there and says where.
@@ -234,6 +241,6 @@ TEST_CASE("robot harness: bad traces and options are refused, naming what is wro
     std::ofstream f(corrupt.path(), std::ios::binary);
     f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   }
-  REQUIRE_THROWS_WITH(testing::RobotHarness(testing::RobotHarness::Mode::replay, psr2(), RobotPlugins::with_builtins(), corrupt.path(), options()),
+  REQUIRE_THROWS_WITH(testing::RobotHarness(testing::RobotHarness::Mode::replay, psr2(), builtin_plugins(), corrupt.path(), options()),
                       Contains("byte"));
 }

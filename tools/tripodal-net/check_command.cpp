@@ -13,7 +13,10 @@
 #include "net_tool_util.hpp"
 #include "parameter_sets.hpp"
 #include "tripodal/analysis/analyzer.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/planner/recovery.hpp"
+#include "tripodal/robot/plugin_library.hpp"
+#include "tripodal/robot/robot_profile.hpp"
 
 namespace tripodal::net_tool {
 namespace {
@@ -50,6 +53,7 @@ struct Args {
   std::vector<std::string> params;
   std::vector<std::filesystem::path> params_files;
   std::vector<std::filesystem::path> profiles;
+  std::vector<std::filesystem::path> plugins;
   std::vector<std::filesystem::path> recovery_files;
   bool no_warnings = false;
   bool no_behaviour = false;
@@ -181,7 +185,12 @@ int run_check(const Args& args, std::ostream& out, std::ostream& err) {
     for (const auto& f : args.params_files) {
       for (auto& s : load_parameter_sets(f)) sets.push_back(std::move(s));
     }
+    // The plugin set the profiles' types come from, as `tripodal run` builds it: a plugin refused
+    // here would refuse the robot too.
+    RobotPlugins plugins = builtin_plugins();
+    for (const auto& l : args.plugins) (void)load_plugin_library(l, plugins, SourceLocation{"--plugin", 0, 0});
     for (const auto& profile : args.profiles) {
+      (void)load_profile_plugins(load_robot_profile(profile), plugins);
       for (ProfileNet& n : profile_nets(profile, &options.behavior_names)) {
         const std::string key = key_of(n.file);
         if (!by_file.count(key) && args.inputs.empty()) files.push_back(n.file);
@@ -248,6 +257,9 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_option("--profile", a->profiles,
                  "ROBOT.yaml: check the profile's process nets with the parameters its process entries give "
                  "(without FILE: all of its nets; repeatable)")
+      ->allow_extra_args(false);
+  cmd.add_option("--plugin", a->plugins,
+                 "LIB.so: a shared-library plugin the profiles' types come from (repeatable; docs/plugins.md)")
       ->allow_extra_args(false);
   cmd.add_flag("--no-warnings", a->no_warnings,
                "leave out the structural warnings (places never marked, transitions never enabled)");

@@ -40,6 +40,7 @@ struct Args {
   std::string file;
   bool dot = false;
   std::string type;
+  std::vector<std::filesystem::path> plugins;
 };
 
 // "[0.01, 2]", "> 0", ">= 0", "" for a parameter's bounds.
@@ -87,9 +88,10 @@ std::string manifest_text(const ModuleManifest& m, std::string_view family) {
 }
 
 // `describe --type NAME`: the type in whichever family registers it (a name in several: each).
-int describe_type(const std::string& type, std::ostream& out, std::ostream& err) {
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  app::register_tool_plugins(plugins, nullptr);
+int describe_type(const std::string& type, const std::vector<std::filesystem::path>& libraries, std::ostream& out,
+                  std::ostream& err) {
+  RobotPlugins plugins;
+  app::register_tool_plugins(plugins, nullptr, RobotProfile{}, libraries);
   std::vector<std::string> known;
   bool found = false;
   auto look = [&](const auto& registry, std::string_view family) {
@@ -113,7 +115,7 @@ int describe_type(const std::string& type, std::ostream& out, std::ostream& err)
 }
 
 int describe(const Args& args, std::ostream& out, std::ostream& err) {
-  if (!args.type.empty()) return describe_type(args.type, out, err);
+  if (!args.type.empty()) return describe_type(args.type, args.plugins, out, err);
   if (args.file.empty()) {
     err << "tripodal describe: give a robot profile (ROBOT.yaml) or --type NAME\nrun 'tripodal describe "
            "--help' for the usage\n";
@@ -129,8 +131,8 @@ int describe(const Args& args, std::ostream& out, std::ostream& err) {
   try {
     const RobotProfile profile = load_robot_profile(file);
     // The types `tripodal run` knows, registered by the same function: no world, as no robot is built.
-    RobotPlugins plugins = RobotPlugins::with_builtins();
-    app::register_tool_plugins(plugins, nullptr);
+    RobotPlugins plugins;
+    app::register_tool_plugins(plugins, nullptr, profile, args.plugins);
     // The checks `tripodal run` makes before it builds anything (Robot::assemble runs the same).
     Diagnostics d;
     const RobotDescription r = check_robot(profile, plugins, d);
@@ -154,6 +156,8 @@ cli::Action setup(CLI::App& cmd) {
       cmd.add_option("--type", a->type, "NAME: print the manifest of a registered type instead");
   cmd.add_flag("--dot", a->dot, "the layered functionality diagram in Graphviz DOT")->excludes(type);
   file->excludes(type);
+  cmd.add_option("--plugin", a->plugins, "LIB.so: a shared-library plugin with the profile's own types (repeatable; docs/plugins.md)")
+      ->allow_extra_args(false);
   return [a](std::ostream& out, std::ostream& err) { return describe(*a, out, err); };
 }
 

@@ -1,9 +1,6 @@
-// The HRI as a module of the guide robot (profile section `hri:`, type "Hri"; docs/guide.md): it
-// holds the robot's RKMS knowledge store and the LED buttons' requests, answers the planner's
-// questions about the exhibit hall (node(1) -> node1, exhibit_here() -> the node the robot stands
-// at) and turns the simulated buttons' presses into events for the nets ("button.hello"). GuideHri
-// is the HRI the robot program runs on it, the same for the scripted visit and the monitor's touch
-// and RKMS pages. Application layer, not installed.
+// GuideHri, the HRI the guide robot's program runs on its Hri module (hri/hri_robot_module.hpp,
+// docs/guide.md), the same for the scripted visit and the monitor's touch and RKMS pages.
+// Application layer, not installed.
 #pragma once
 
 #include <map>
@@ -19,63 +16,18 @@
 
 #include "tripodal/core/clock.hpp"
 #include "tripodal/hri/answer_providers.hpp"
+#include "tripodal/hri/hri_robot_module.hpp"
 #include "tripodal/hri/hri_service.hpp"
 #include "tripodal/hri/knowledge_store.hpp"
 #include "tripodal/planner/planner.hpp"
 #include "tripodal/planner/task_library.hpp"
 #include "tripodal/processes/module.hpp"
 
-namespace tripodal::sim {
-class Simulator;
-}
-namespace tripodal::navi {
-class CGridMaps;
-}
 namespace tripodal {
 class Robot;
 }
 
 namespace tripodal::app {
-
-/// Type "Hri". Parameters: knowledge (an RKMS XML file, relative to the profile), buttons
-/// ("hello=Introduce yourself.; help=What can you do?"), exhibit_radius_m (how near a node the
-/// robot must stand for exhibit_here). Outputs the planner's functions node and exhibit_here.
-class CHri final : public CModule {
- public:
-  static const ModuleManifest& static_manifest();
-
-  /// The RKMS knowledge file, administered while the robot runs (the monitor's /rkms page edits
-  /// it; every change saved atomically). Loaded at start.
-  [[nodiscard]] KnowledgeStore& knowledge_store() const;
-  /// Each button's request (HriOptions::buttons).
-  [[nodiscard]] const std::map<std::string, std::string, std::less<>>& buttons() const noexcept { return buttons_; }
-  /// The LED buttons pressed since the last call, in order.
-  [[nodiscard]] std::vector<std::string> take_presses();
-  /// The simulator the buttons are on (nullptr on other hardware).
-  [[nodiscard]] sim::Simulator* simulator() const noexcept { return sim_; }
-
- protected:
-  [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
-  void on_configure(const ParameterSet& params) override;
-  void on_start(ModuleContext& context) override;
-  void on_update(ModuleContext& context) override;
-  [[nodiscard]] std::optional<KnowledgeAnswer> on_answer(std::string_view function, std::string_view argument,
-                                                         const NavigationData& navigation) const override;
-
- private:
-  std::string knowledge_file_;
-  double exhibit_radius_m_ = 1.0;
-  std::unique_ptr<KnowledgeStore> store_;
-  std::map<std::string, std::string, std::less<>> buttons_;
-  std::vector<std::string> presses_;
-  const navi::CGridMaps* maps_ = nullptr;
-  sim::Simulator* sim_ = nullptr;
-};
-
-/// "hello=Introduce yourself.; help=What can you do?" as a map; ConfigError at `where` for an
-/// entry without '=' or with an empty name or request, or a name given twice.
-[[nodiscard]] std::map<std::string, std::string, std::less<>> parse_button_bindings(std::string_view text,
-                                                                                    const SourceLocation& where);
 
 /// The words of the task's first command form with the slots the HRI understood: what the robot's
 /// planner is told ("guide me to node 1").
@@ -145,8 +97,5 @@ class GuideHri final : private TaskObserver {
   std::vector<std::string> processes_;
   std::string last_task_end_;
 };
-
-/// Registers the module type "Hri".
-void register_guide_modules(ModuleRegistry& registry);
 
 }  // namespace tripodal::app

@@ -30,7 +30,9 @@ RgbImage draw_map(const Navigation& nav, const navi::CleanedCells& cleaned, cons
       }
     }
   };
-  const auto& label = nav.splitter->sections().label;
+  // The sections and virtual walls of a robot that cleans (one without a SectionSplitter has none).
+  static const std::vector<int> kNoLabels, kNoWalls;
+  const auto& label = nav.splitter != nullptr ? nav.splitter->sections().label : kNoLabels;
   for (std::size_t i = 0; i < g.size(); ++i) {
     const navi::CellIndex c = g.cell(i);
     switch (g.state(i)) {
@@ -42,7 +44,7 @@ RgbImage draw_map(const Navigation& nav, const navi::CleanedCells& cleaned, cons
     if (cleaned.cleaned(i)) fill_cell(c, {60, 170, 60}, 0.45);
     else if (i < reachable.size() && reachable[i] != 0) fill_cell(c, {230, 40, 40}, 0.6);
   }
-  for (const int row : nav.splitter->sections().virtual_wall_rows) {
+  for (const int row : nav.splitter != nullptr ? nav.splitter->sections().virtual_wall_rows : kNoWalls) {
     const int y = (g.height() - 1 - row) * kScale;  // the edge between rows row and row + 1
     for (int x = 0; x < img.width; ++x) {
       if ((x / 6) % 2 == 0) img.set(x, y, 220, 0, 0);

@@ -148,6 +148,7 @@ int run_guide(const Args& args, std::ostream& out, std::ostream& err) {
     app::VisitOptions vo;
     vo.robot = o.robot;
     vo.world = o.world;
+    vo.plugins = o.plugins;
     vo.visit = args.visit;
     vo.seed = o.seed;
     vo.out = o.out;
@@ -319,6 +320,8 @@ cli::Action setup(CLI::App& cmd) {
   app::RunOptions& o = a->options;
   cmd.add_option("--robot", o.robot, "ROBOT.yaml: the robot profile")->required();
   cmd.add_option("--world", o.world, "WORLD.yaml: map, regions, start pose and faults")->required();
+  cmd.add_option("--plugin", o.plugins, "LIB.so: a shared-library plugin with the profile's own types (repeatable; docs/plugins.md)")
+      ->allow_extra_args(false);
   cmd.add_option("--task", o.task, "\"COMMAND\": the task in plain words (optional with --monitor)");
   cmd.add_option("--visit", a->visit,
                  "VISIT.yaml: the guide robot's scripted visit (typed and spoken requests, buttons; docs/guide.md) instead of a task");

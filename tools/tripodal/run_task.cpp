@@ -16,7 +16,7 @@
 #include "run_outputs.hpp"
 #include "guide_hri.hpp"
 #include "shutdown.hpp"
-#include "tripodal/behaviors/gesture_behaviors.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/monitor/robot_monitor.hpp"
 #include "tripodal/behaviors/navigation_behaviors.hpp"
@@ -27,6 +27,7 @@
 #include "tripodal/navi/scan_matching_localizer.hpp"
 #include "tripodal/navi/section_splitter.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
+#include "tripodal/robot/plugin_library.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/robot/robot_profile.hpp"
 #include "tripodal/board/actuator_behaviors.hpp"
@@ -76,6 +77,7 @@ namespace {
 std::vector<char> reachable_area(const Navigation& nav, navi::PathPlanner& planner, const std::vector<std::string>& sections,
                                  Pose2D start, double reach_m) {
   const navi::OccupancyGrid& g = nav.maps->grid();
+  if (nav.splitter == nullptr || nav.coverage == nullptr) return std::vector<char>(g.size(), 0);  // a robot that does not clean
   std::vector<char> in_room(g.size(), 0);
   for (const std::string& name : sections) {
     if (const navi::Section* s = nav.splitter->section(name)) {
@@ -318,15 +320,15 @@ void register_remote_hardware(HardwareRegistry&, const std::shared_ptr<const sim
 #endif
 
 void register_tool_plugins(RobotPlugins& plugins, const std::shared_ptr<const sim::World>& world) {
-  sim::register_sim_hardware(plugins.hardware, world);
-  sim::register_sim_board_hardware(plugins.hardware, world);
+  register_all(plugins, world);
   register_remote_hardware(plugins.hardware, world);
   register_dds_robot_modules(plugins);
-  board::register_board_modules(plugins.modules);
-  board::register_board_behaviors(plugins.behaviors);
-  board::register_rplidar_resource(plugins.resources);
-  register_gesture_behaviors(plugins.behaviors);
-  register_guide_modules(plugins.modules);
+}
+
+void register_tool_plugins(RobotPlugins& plugins, const std::shared_ptr<const sim::World>& world, const RobotProfile& profile,
+                           const std::vector<std::filesystem::path>& libraries) {
+  register_tool_plugins(plugins, world);
+  (void)load_profile_plugins(profile, plugins, libraries);
 }
 
 // What a run measures itself by: the simulator's ground truth, in this process, or in the
@@ -465,12 +467,11 @@ RunResult run_task(const RunOptions& o) {
   res.coverage_pattern = o.pattern;
   std::vector<navi::LocalizationFault>& faults = world->faults.localization_loss;
   faults.insert(faults.end(), o.faults.begin(), o.faults.end());
-  if (!profile.hardware ||
-      (profile.hardware->type != "sim" && profile.hardware->type != "board" && profile.hardware->type != "dds")) {
-    throw ConfigError(profile.hardware ? profile.hardware->where : profile.where,
+  if (!profile.hardware) {
+    throw ConfigError(profile.where,
                       "`tripodal run` runs the robot on the simulator: its profile needs hardware: {type: sim} "
-                      "(or {type: board}, the control board simulated in the same world, or {type: dds}, the simulator "
-                      "in another process: tripodal sim-server)");
+                      "(or {type: board}, the control board simulated in the same world, {type: dds}, the simulator "
+                      "in another process: tripodal sim-server, or a plugin's type derived from sim::SimHardware)");
   }
   const bool remote = profile.hardware->type == "dds";
 #ifndef TRIPODAL_HAVE_DDS
@@ -491,8 +492,8 @@ RunResult run_task(const RunOptions& o) {
 
   // The robot, on simulated hardware in this world, with this run's seed and coverage pattern;
   // the board's modules and actuator behaviors for a robot on the control board.
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  register_tool_plugins(plugins, world);
+  RobotPlugins plugins;
+  register_tool_plugins(plugins, world, profile, o.plugins);
   RobotOptions ro;
   ro.parameters = simulation_overrides(profile, *world, res.seed);
   if (!o.board_line.empty()) ro.parameters.push_back({profile.hardware->name, "line", o.board_line});
@@ -506,12 +507,17 @@ RunResult run_task(const RunOptions& o) {
   SimClock clock;
   const auto robot = Robot::assemble(profile, plugins, clock, ro);
   GroundTruth truth(robot->hardware(), world->start_pose);
+  // A plugin's hardware type runs here when it simulates (derives from sim::SimHardware).
+  if (!remote && truth.local() == nullptr) {
+    throw ConfigError(profile.hardware->where, "hardware type '" + profile.hardware->type +
+                                                   "' does not run on the simulator: `tripodal run` needs hardware: {type: sim}, "
+                                                   "{type: board}, {type: dds} or a type derived from sim::SimHardware");
+  }
   sim::SimBoardHardware* const board_hw = dynamic_cast<sim::SimBoardHardware*>(robot->hardware());
   Navigation nav{robot->module<navi::CGridMaps>(), robot->module<navi::CSectionSplitter>(), robot->module<navi::CCoverageModule>()};
   if (nav.coverage != nullptr) res.coverage_pattern = nav.coverage->pattern();
-  if (nav.maps == nullptr || nav.splitter == nullptr || nav.coverage == nullptr) {
-    throw ConfigError(profile.where, "`tripodal run` measures cleaning: the robot needs GridMaps, SectionSplitter and CoveragePlanner modules");
-  }
+  // Cleaning is measured when the robot has SectionSplitter and CoveragePlanner; the map always.
+  if (nav.maps == nullptr) throw ConfigError(profile.where, "`tripodal run` measures the run on the map: the robot needs a GridMaps module");
   if (nav.maps->robot_radius_m() < world->robot.radius_m) {
     throw ConfigError(nav.maps->where(), "robot_radius_m " + fixed(nav.maps->robot_radius_m(), 3) +
                                              " m is smaller than the simulated body (" + fixed(world->robot.radius_m, 3) +
@@ -671,7 +677,7 @@ RunResult run_task(const RunOptions& o) {
   navi::CleanedCells cleaned(nav.maps->grid());  // from the true pose, while a cleaning behavior runs
   std::vector<TrajectorySample> traj;
   std::vector<Point2D> path_all, path_cleaning;
-  const double half_width = nav.coverage->footprint_width_m() / 2.0;  // the fog's, whatever the lanes' spacing
+  const double half_width = nav.coverage != nullptr ? nav.coverage->footprint_width_m() / 2.0 : 0.0;  // the fog's, whatever the lanes' spacing
   const Duration tick_period = robot->behavior_loop().period();
   const Time deadline = time_from_seconds(o.max_duration_s);
   bool was_cleaning = false;
@@ -819,7 +825,7 @@ RunResult run_task(const RunOptions& o) {
 
   // The planned paths of the three patterns over the same sections (same grid and width).
   for (const std::string& name : room_sections) {
-    const navi::Section* s = nav.splitter->section(name);
+    const navi::Section* s = nav.splitter != nullptr && nav.coverage != nullptr ? nav.splitter->section(name) : nullptr;
     if (s == nullptr) continue;
     SectionFigures f;
     f.name = name;

@@ -25,6 +25,7 @@
 
 namespace tripodal {
 struct RobotPlugins;
+struct RobotProfile;
 }
 namespace tripodal::sim {
 struct World;
@@ -32,20 +33,27 @@ struct World;
 
 namespace tripodal::app {
 
-/// Adds the types every command of the `tripodal` tool knows to `plugins` (which holds the
-/// built-ins): `run`, `run --visit` and `describe` call this one function, so that a profile
-/// `describe` accepts is one `run` can assemble. The simulator's hardware "sim" and "board" (the
-/// control board simulated in `world`), and "dds" (the simulator in another process); the board's
-/// modules (BoardMonitor) and actuator behaviors (BhUvLamp, BhAtomize, BhVoicePrompt); the guide
-/// robot's gestures (BhNeckGesture, ...) and HRI module (Hri); with the dds area, its resource and
-/// controller types (DdsLaser, DdsOdometry, DdsImu, DdsPose, dds_cmd_vel) — without it a profile
-/// naming them is refused as naming an unknown type. `world` may be null where no robot is built
-/// (describe reads the types' manifests only); hardware created from it then refuses to start.
+/// Fills `plugins` (empty) with the types every command of the `tripodal` tool knows: `run`,
+/// `run --visit`, `describe` and `sim-server` call this one function, so that a profile `describe`
+/// accepts is one `run` can assemble. The built-in areas' types (register_all: the simulator's
+/// hardware "sim" and "board" in `world`, the board's modules and actuator behaviors, gestures,
+/// navigation, the HRI module Hri); "dds" (the simulator in another process); with
+/// the dds area, its resource and controller types (DdsLaser, DdsOdometry, DdsImu, DdsPose,
+/// dds_cmd_vel) — without it a profile naming them is refused as naming an unknown type. `world`
+/// may be null where no robot is built (describe reads the types' manifests only); hardware
+/// created from it then refuses to start.
 void register_tool_plugins(RobotPlugins& plugins, const std::shared_ptr<const sim::World>& world);
+/// register_tool_plugins, then the shared-library plugins `libraries` (the command line's) and
+/// the profile's `plugins:`: the one plugin set a command builds for `profile`. Throws ConfigError
+/// for a library refused (robot/plugin_library.hpp).
+void register_tool_plugins(RobotPlugins& plugins, const std::shared_ptr<const sim::World>& world, const RobotProfile& profile,
+                           const std::vector<std::filesystem::path>& libraries);
 
 struct RunOptions {
   std::filesystem::path robot;  ///< robot profile (YAML)
   std::filesystem::path world;  ///< world file (sim::load_world)
+  /// Shared-library plugins (`--plugin`, docs/plugins.md), loaded before the profile's `plugins:`.
+  std::vector<std::filesystem::path> plugins;
   std::string task;             ///< the command in plain words
   /// Overrides the type of the profile's hardware slot (its parameters then start empty): "dds",
   /// the simulator in another process (`tripodal sim-server`, docs/distribution.md). Empty: the

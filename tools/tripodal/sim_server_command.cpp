@@ -105,8 +105,8 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
     const RobotProfile profile = load_robot_profile(a.robot);
     // The controller types `tripodal run` knows (the same registration), so that the base of any
     // profile `run` takes is simulated here.
-    RobotPlugins plugins = RobotPlugins::with_builtins();
-    app::register_tool_plugins(plugins, nullptr);
+    RobotPlugins plugins;
+    app::register_tool_plugins(plugins, nullptr, profile, {});
     const std::optional<ControllerConfig> base = base_controller_config(profile, plugins.controllers);
     if (!base)
       throw ConfigError(

@@ -108,8 +108,8 @@ VisitResult run_visit(const VisitOptions& o) {
   res.visit = visit.name.empty() ? o.visit.filename().string() : visit.name;
   res.seed = o.seed.value_or(world->seed);
 
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  register_tool_plugins(plugins, world);
+  RobotPlugins plugins;
+  register_tool_plugins(plugins, world, profile, o.plugins);
   RobotOptions ro;
   ro.parameters = simulation_overrides(profile, *world, res.seed);
   SimClock clock;
@@ -309,7 +309,7 @@ VisitResult run_visit(const VisitOptions& o) {
         (void)guide.take_started_task();
         guide.clear_task_end();
         if (s.kind == VisitStep::Kind::button) {
-          if (hri_module->simulator() != nullptr && hri_module->simulator()->press_button(s.text)) {
+          if (hw.simulator().press_button(s.text)) {
             ++pending_button;
           } else {
             say("visitor presses " + in_quotes(s.text) + ": the robot has no such button");

@@ -51,6 +51,7 @@ struct Visit {
 
 struct VisitOptions {
   std::filesystem::path robot, world;
+  std::vector<std::filesystem::path> plugins;  ///< shared-library plugins (`--plugin`)
   std::filesystem::path visit;        ///< the visit file; empty: none (the monitor's visitors only)
   std::optional<std::uint64_t> seed;  ///< default: the world's
   std::filesystem::path out;          ///< dialogue.txt, report.json, answers' WAV files (empty: none)

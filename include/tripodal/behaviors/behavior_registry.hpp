@@ -28,7 +28,9 @@ class BehaviorRegistry : public Registry<CBehavior> {
 /// BhAvoidObstacle) to `registry`.
 void register_builtin_behaviors(BehaviorRegistry& registry);
 
-/// A process-wide registry holding the built-in behaviors, created on first use.
-[[nodiscard]] BehaviorRegistry& default_behavior_registry();
+/// The behaviors area's types: register_builtin_behaviors, register_navigation_behaviors
+/// (navigation_behaviors.hpp) and register_gesture_behaviors (gesture_behaviors.hpp). An
+/// application's plugin set gets them from register_all (builtin/register_all.hpp).
+void register_behaviors(BehaviorRegistry& registry);
 
 }  // namespace tripodal

@@ -83,7 +83,7 @@ struct ControllerConfig {
 void apply_parameters(ControllerConfig& config);
 
 /// Controller types by name; each is created from its configuration on a hardware interface
-/// (which must outlive it). The built-in types are registered by default_controller_registry().
+/// (which must outlive it). register_builtin_controllers() adds the built-in types.
 class ControllerRegistry : public Registry<CController, const ControllerConfig&, HardwareInterface&> {
  public:
   ControllerRegistry() : Registry("controller type") {}
@@ -96,9 +96,8 @@ class ControllerRegistry : public Registry<CController, const ControllerConfig&,
   }
 };
 
-/// Adds "differential", "omni" and "mecanum" to `registry`.
+/// The controllers area's types: adds "differential", "omni" and "mecanum" to `registry`. An
+/// application's plugin set gets them from register_all (builtin/register_all.hpp).
 void register_builtin_controllers(ControllerRegistry& registry);
-/// A process-wide registry holding the built-in controllers, created on first use.
-[[nodiscard]] ControllerRegistry& default_controller_registry();
 
 }  // namespace tripodal

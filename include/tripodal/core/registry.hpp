@@ -89,6 +89,35 @@ class Registry {
     return made;
   }
 
+  /// Removes type `name`; false when it is not registered.
+  bool erase(std::string_view name) noexcept {
+    const auto it = entries_.find(name);
+    if (it == entries_.end()) return false;
+    entries_.erase(it);
+    return true;
+  }
+
+  /// The names registered both here and in `other`, in alphabetical order.
+  [[nodiscard]] std::vector<std::string> common_names(const Registry& other) const {
+    std::vector<std::string> out;
+    for (const auto& [name, e] : other.entries_) {
+      if (contains(name)) out.push_back(name);
+    }
+    return out;
+  }
+
+  /// Moves every type of `other` into this registry (a set registered apart, as a shared-library
+  /// plugin's is). Throws std::invalid_argument naming the names both have, and then moves none.
+  void merge(Registry&& other) {
+    const std::vector<std::string> both = common_names(other);
+    if (!both.empty()) {
+      std::string list;
+      for (const std::string& n : both) list += (list.empty() ? "'" : ", '") + n + "'";
+      throw std::invalid_argument(kind_ + (both.size() == 1 ? " " : "s ") + list + " already registered");
+    }
+    entries_.merge(other.entries_);
+  }
+
   /// Registered names in alphabetical order.
   [[nodiscard]] std::vector<std::string> names() const {
     std::vector<std::string> out;

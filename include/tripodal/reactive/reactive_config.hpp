@@ -36,17 +36,17 @@ struct ReactiveConfig {
 /// every problem: unknown keys, values of the wrong type, a negative or zero radius, a missing
 /// wheel geometry, an unknown controller type, a loop naming an unknown controller, duplicate
 /// names. Controller types are checked against `registry`.
-[[nodiscard]] ReactiveConfig parse_reactive_config(std::string_view text, const std::string& file = "<input>",
-                                                   const ControllerRegistry& registry = default_controller_registry());
+[[nodiscard]] ReactiveConfig parse_reactive_config(std::string_view text, const std::string& file,
+                                                   const ControllerRegistry& registry);
 /// Reads and parses the file at `path`; ConfigError also when it cannot be read.
 [[nodiscard]] ReactiveConfig load_reactive_config(const std::string& path,
-                                                  const ControllerRegistry& registry = default_controller_registry());
+                                                  const ControllerRegistry& registry);
 
 /// Builds the loop `config` describes: its coordinator, and its controller (created through
 /// `registry` on `hardware`, which must outlive the loop; may be null when the loop has no
 /// controller). Throws ConfigError for an unknown controller name.
 [[nodiscard]] std::unique_ptr<ControlLoop> make_control_loop(const ReactiveConfig& reactive, const LoopConfig& config,
                                                              ResourceTable& resources, HardwareInterface* hardware,
-                                                             const ControllerRegistry& registry = default_controller_registry());
+                                                             const ControllerRegistry& registry);
 
 }  // namespace tripodal

@@ -1,7 +1,9 @@
-// The robot's plugin registries: one Registry (core/registry.hpp) per family — behaviors,
-// controllers, modules (CModule: navigation, HRI, application modules), hardware — in which the
-// types a robot profile names are found. An application adds its own types next to the built-in
-// ones before it assembles a robot.
+// The plugin set an application owns: one Registry (core/registry.hpp) per family — behaviors,
+// controllers, modules (CModule: navigation, HRI, application modules), resources, hardware,
+// process types — in which the types a robot profile names are found. The application builds it
+// (register_all for the built-in areas, builtin/register_all.hpp; its own types; shared-library
+// plugins, robot/plugin_library.hpp) and passes it to the robot and to every tool; there is no
+// process-wide registry.
 #pragma once
 
 #include "tripodal/behaviors/behavior_registry.hpp"
@@ -25,6 +27,7 @@ struct ResourceConfig {
 /// reactive loops' resource table; the loop polls it every cycle (CResource::on_poll).
 using ResourceRegistry = Registry<CResource, const ResourceConfig&>;
 
+/// The application's plugin set. Movable, not copyable (a factory may own state).
 struct RobotPlugins {
   BehaviorRegistry behaviors;
   ControllerRegistry controllers;
@@ -33,12 +36,6 @@ struct RobotPlugins {
   HardwareRegistry hardware{"hardware type"};
   /// Process types: "net" (a plain CProcess) and the application's CProcess subclasses.
   ProcessTypeRegistry processes;
-
-  /// The framework's own types: the built-in and navigation behaviors, the differential, omni and
-  /// mecanum controllers, and the navigation modules (GridMaps, SectionSplitter, Localizer,
-  /// PathPlanner, CoveragePlanner). Hardware types live below the robot: the simulator's is added
-  /// with sim::register_sim_hardware().
-  [[nodiscard]] static RobotPlugins with_builtins();
 };
 
 }  // namespace tripodal

@@ -51,9 +51,9 @@ struct RobotOptions {
 /// gives it to its hardware (HardwareConfig::base): what a simulator of the base in another process
 /// needs. nullopt when no loop drives a controller; throws ConfigError (located) for a bad entry.
 /// Controller types are checked against `controllers`: the application's registry when it has
-/// types of its own (RobotPlugins::controllers), the built-in ones by default.
+/// types of its own (RobotPlugins::controllers).
 [[nodiscard]] std::optional<ControllerConfig> base_controller_config(
-    const RobotProfile& profile, const ControllerRegistry& controllers = default_controller_registry());
+    const RobotProfile& profile, const ControllerRegistry& controllers);
 
 /// Every start-up check of Robot::assemble that builds no instance, as `tripodal describe` runs
 /// them: the tasks and recovery rules, one provider per input and the layering rules

@@ -107,6 +107,13 @@ struct DdsSection {
   }
 };
 
+/// One entry of a profile's `plugins:` list: the library's path (made absolute against the
+/// profile's folder) and where it was written.
+struct PluginEntry {
+  std::filesystem::path path;
+  SourceLocation where;
+};
+
 struct RobotProfile {
   std::string name;
   std::string description;
@@ -137,6 +144,10 @@ struct RobotProfile {
   /// when no module lists one among its outputs.
   std::vector<std::string> external_facts;
   SourceLocation external_facts_where;
+  /// Shared-library plugins the profile's types come from (`plugins: [lib/libpatrol.so]`, relative
+  /// to the profile): whoever builds the plugin set for this profile loads them first
+  /// (load_profile_plugins, robot/plugin_library.hpp), as `tripodal run` and `describe` do.
+  std::vector<PluginEntry> plugins;
 
   /// Every module entry, in profile order: controllers, resources, navigation, hri, modules, behaviors.
   [[nodiscard]] std::vector<const ModuleEntry*> all_modules() const;

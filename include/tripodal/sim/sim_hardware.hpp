@@ -7,9 +7,11 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "tripodal/behaviors/gesture_behaviors.hpp"
+#include "tripodal/hardware/buttons.hpp"
 #include "tripodal/hardware/hardware.hpp"
 #include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/navi/localizer.hpp"
@@ -36,7 +38,7 @@ class SimulatorSources : public navi::GroundTruthSource, public navi::MapSource 
 
 /// Not final: an application's hardware that adds devices to the simulated base derives from it
 /// (constructed from its HardwareConfig, with the parameters of "sim" in its own manifest).
-class SimHardware : public CHardware, public SimulatorSources {
+class SimHardware : public CHardware, public SimulatorSources, public ButtonPanel {
  public:
   /// Parameters of type "sim": world (a world file, relative to the profile) and seed (negative:
   /// the world's own).
@@ -50,6 +52,8 @@ class SimHardware : public CHardware, public SimulatorSources {
   [[nodiscard]] Simulator& simulator() noexcept { return sim_; }
   [[nodiscard]] const Simulator& simulator() const noexcept { return sim_; }
   [[nodiscard]] std::uint64_t seed() const noexcept { return seed_; }
+  /// The world's LED buttons pressed since the last call (Simulator::take_button_presses).
+  [[nodiscard]] std::vector<std::string> take_button_presses() override;
 
  protected:
   [[nodiscard]] const Simulator& world_sim() const noexcept override { return sim_; }

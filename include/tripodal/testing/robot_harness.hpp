@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "tripodal/core/clock.hpp"
 #include "tripodal/robot/robot.hpp"
@@ -30,6 +31,9 @@ struct RobotHarnessOptions {
   /// The footprint and laser mount of RunLog::never_drives_toward_obstacle_closer_than.
   double robot_radius_m = 0.25;
   Pose2D laser_in_body;
+  /// Shared-library plugins added to the plugin set before the profile's own `plugins:` list
+  /// (docs/plugins.md); the harness loads both, as `tripodal run --plugin` does.
+  std::vector<std::filesystem::path> plugins;
 };
 
 class RobotHarness final {
@@ -38,8 +42,10 @@ class RobotHarness final {
 
   /// Assembles the robot of `profile` (its hardware slot replaced: by the trace for a replay, by
   /// the simulator in options.world for a closed loop) with `plugins` and the trace's recorded
-  /// start. Throws what Robot::assemble throws, trace::TraceIoError / TraceFormatError, and
-  /// std::invalid_argument (a missing world or channel, a trace without a pose to start from).
+  /// start. Loads options.plugins and the profile's `plugins:` into `plugins` first. Throws what
+  /// Robot::assemble throws, ConfigError for a refused plugin, trace::TraceIoError /
+  /// TraceFormatError, and std::invalid_argument (a missing world or channel, a trace without a
+  /// pose to start from).
   RobotHarness(Mode mode, const RobotProfile& profile, RobotPlugins plugins, const std::filesystem::path& trace,
                RobotHarnessOptions options = {});
   ~RobotHarness();
