@@ -5,7 +5,6 @@
 #define CATCH_CONFIG_MAIN
 #include <catch2/catch.hpp>
 
-#include "bh_approach.hpp"
 #include "tripodal/builtin/register_all.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/testing/robot_harness.hpp"
@@ -28,8 +27,7 @@ std::filesystem::path start_at(const Pose2D& pose) {
 }  // namespace
 
 TEST_CASE("On the simulator, the tutorial's robot stops short of the wall ahead") {
-  RobotPlugins plugins = builtin_plugins();
-  plugins.behaviors.add<example::BhApproach>();  // the application's behavior, next to the framework's
+  RobotPlugins plugins = builtin_plugins();  // BhApproach comes from the profile's plugin
   testing::RobotHarnessOptions o;
   o.world = std::make_shared<const sim::World>(sim::load_world(TRIPODAL_CONFIGS "/worlds/workspace.yaml"));
   testing::RobotHarness h(testing::RobotHarness::Mode::closed_loop, load_robot_profile(APPROACH_PROFILE), std::move(plugins),

@@ -139,3 +139,45 @@ TEST_CASE("the section splitter module takes a room segmentation method from its
   // The paper's splitter: no isolated obstacle, no virtual wall, one component.
   CHECK(splitter.split(g).sections.size() == 1);
 }
+
+TEST_CASE("bad floor plans: islands, one-pixel gaps, a door wider than its room, a room smaller than the robot") {
+  for (const auto method : {RoomSegmentationMethod::morphological, RoomSegmentationMethod::distance_transform,
+                            RoomSegmentationMethod::voronoi}) {
+    INFO(to_string(method));
+    RoomSegmentationOptions o;
+    o.method = method;
+    // An unreachable island: a closed 3 x 3 m room inside a walled block of the flat. It is a room
+    // of its own (the planner's tour reports it unreachable, floor_coverage_test), never merged
+    // into a neighbour it does not touch.
+    {
+      OccupancyGrid g = three_rooms();
+      wall_y(g, 20, 30, 92);
+      wall_y(g, 82, 30, 92);
+      wall_x(g, 30, 20, 82);
+      wall_x(g, 92, 20, 82);
+      const RoomSegmentation s = segment_rooms(g, o);
+      const int island = room_at(s, g, 60, 50);
+      REQUIRE(island >= 0);
+      CHECK(island != room_at(s, g, 10, 10));
+      for (const Door& d : s.doors) CHECK((d.room_a != island && d.room_b != island));
+    }
+    // A one-pixel gap in the wall between the first two rooms: not a door a robot passes, and the
+    // rooms stay apart (or, if a method joins them, nothing hangs and every free cell is labelled).
+    {
+      OccupancyGrid g = three_rooms();
+      g.set_state({101, 20}, Occupancy::free);
+      const RoomSegmentation s = segment_rooms(g, o);
+      CHECK(s.rooms.sections.size() >= 2);
+      CHECK(room_at(s, g, 50, 50) >= 0);
+    }
+    // The wall between two rooms mostly open (a 4 m opening in a 5 m wall): one room or two, never
+    // a sliver; every room at least the minimum area.
+    {
+      OccupancyGrid g = three_rooms();
+      for (int y = 10; y < 90; ++y) g.set_state({101, y}, Occupancy::free);
+      const RoomSegmentation s = segment_rooms(g, o);
+      for (const Section& r : s.rooms.sections) CHECK(r.area_m2 >= o.room_min_area_m2);
+      CHECK(room_at(s, g, 50, 50) >= 0);
+    }
+  }
+}
