@@ -2,7 +2,9 @@
 # Builds the test suites whose tests use threads with ThreadSanitizer (-DTRIPODAL_TSAN=ON, g++) and
 # runs the tests tagged [threads]: LoopRunner, the process supervisor's inbox fed from module
 # threads, Robot::start/stop with a command from another thread, SourceFile interning, the monitor's
-# server thread against the robot's, the RKMS store written from two threads. A data race
+# server thread against the robot's, the RKMS store written from two threads, the wall-clock
+# runtime (PeriodicRunner, the lock-free resource snapshot and seqlock, PSR-2 cleaning on its own
+# threads at 20x, a starved loop's deadline fault). A data race
 # or a lock-order inversion fails the run (halt_on_error). Build tree: $BUILD_ROOT/tsan.
 #
 # A new threaded component (a DDS transport) joins by tagging its tests

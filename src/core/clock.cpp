@@ -32,6 +32,16 @@ void SteadyClock::sleep_until(Time deadline) const noexcept {
 #endif
 }
 
+Time ScaledClock::now() const noexcept {
+  return Time{Duration{static_cast<Duration::rep>(static_cast<double>(to_ns(wall_.now())) * speed_)}};
+}
+
+void ScaledClock::sleep_until(Time deadline) const noexcept {
+  // The wall instant at which now() reaches the deadline (rounded up, so that now() >= deadline).
+  const double wall_ns = static_cast<double>(to_ns(deadline)) / speed_;
+  wall_.sleep_until(Time{Duration{static_cast<Duration::rep>(wall_ns) + 1}});
+}
+
 void SimClock::advance(Duration d) noexcept {
   if (d.count() > 0) now_.fetch_add(d.count(), std::memory_order_acq_rel);
 }

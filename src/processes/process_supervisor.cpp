@@ -66,7 +66,12 @@ struct CProcessSupervisor::Inbox {
   std::mutex mutex;
   std::vector<std::string> events;
   std::vector<std::pair<std::string, Value>> facts;
-  std::vector<std::pair<std::string, std::string>> faults;  // module, reason
+  struct Fault {
+    std::string source;
+    std::string reason;
+    std::string event;  // "<source>.fault" unless the reporter named another
+  };
+  std::vector<Fault> faults;
   // The latest value of every fact set (supervisor thread only): a process started after a fact
   // was set reads it, not its net's default (the robot docked before PrDockCharge started).
   std::map<std::string, Value, std::less<>> latest_facts;
@@ -261,7 +266,7 @@ void CProcessSupervisor::step() {
   const Time now = clock_.now();
   std::vector<std::string> module_events;
   std::vector<std::pair<std::string, Value>> facts;
-  std::vector<std::pair<std::string, std::string>> faults;
+  std::vector<Inbox::Fault> faults;
   {
     std::lock_guard lock(inbox_->mutex);
     module_events.swap(inbox_->events);
@@ -272,7 +277,7 @@ void CProcessSupervisor::step() {
       w.fired = true;
       const std::string why = "stopped answering (no heartbeat for " + format_seconds(now - w.last) + " s)";
       if (w.event.empty()) {
-        faults.emplace_back(module, why);
+        faults.push_back({module, why, module + ".fault"});
       } else {
         for (SupervisorObserver* o : observers_) o->on_fault(module, why, now);
         module_events.push_back(w.event);
@@ -281,11 +286,10 @@ void CProcessSupervisor::step() {
   }
   // Module faults: an event each; remembered so that an unhandled one fails the processes.
   std::map<std::string, std::string, std::less<>> fault_messages;
-  for (auto& [module, reason] : faults) {
-    for (SupervisorObserver* o : observers_) o->on_fault(module, reason, now);
-    const std::string event = module + ".fault";
-    fault_messages.emplace(event, "module " + module + " failed: " + reason);
-    module_events.push_back(event);
+  for (Inbox::Fault& f : faults) {
+    for (SupervisorObserver* o : observers_) o->on_fault(f.source, f.reason, now);
+    fault_messages.emplace(f.event, "module " + f.source + " failed: " + f.reason);
+    module_events.push_back(std::move(f.event));
   }
   for (auto& [name, value] : facts) {
     inbox_->latest_facts.insert_or_assign(name, value);
@@ -402,7 +406,13 @@ void CProcessSupervisor::heartbeat(std::string_view module) {
 
 void CProcessSupervisor::report_module_fault(std::string module, std::string reason) {
   std::lock_guard lock(inbox_->mutex);
-  inbox_->faults.emplace_back(std::move(module), std::move(reason));
+  std::string event = module + ".fault";
+  inbox_->faults.push_back({std::move(module), std::move(reason), std::move(event)});
+}
+
+void CProcessSupervisor::report_fault(std::string source, std::string event, std::string reason) {
+  std::lock_guard lock(inbox_->mutex);
+  inbox_->faults.push_back({std::move(source), std::move(reason), std::move(event)});
 }
 
 bool CProcessSupervisor::running(std::string_view run) const noexcept {

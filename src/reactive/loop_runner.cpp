@@ -1,11 +1,15 @@
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <stdexcept>
+#include <string>
 
 #include "tripodal/reactive/control_loop.hpp"
 
 #if defined(__linux__)
 #include <pthread.h>
 #include <sched.h>
+#include <sys/mman.h>
 #endif
 
 namespace tripodal {
@@ -48,78 +52,145 @@ Duration LoopStatistics::quantile(const std::array<std::uint32_t, kBins>& h, dou
   return std::chrono::microseconds(static_cast<std::int64_t>(kBins));
 }
 
-LoopRunner::LoopRunner(ControlLoop& loop, const Clock& clock, LoopTimingOptions options)
-    : loop_(loop), clock_(clock), options_(options), owned_stats_(std::make_unique<LoopStatistics>()), stats_(*owned_stats_) {}
-
-LoopRunner::~LoopRunner() { stop(); }
-
-void LoopRunner::start() {
-  if (running_.load(std::memory_order_acquire) || thread_.joinable()) {
-    throw std::logic_error("LoopRunner for '" + loop_.name() + "' is already running");
+ThreadSetup apply_thread_options(const LoopTimingOptions& options, std::string_view who) {
+  ThreadSetup out;
+  std::string refused;
+  auto refuse = [&](const std::string& what, int err) {
+    refused += (refused.empty() ? "" : ", ") + what + " (" + std::strerror(err) + ")";
+  };
+#if defined(__linux__)
+  if (options.lock_memory) {
+    // Process-wide: the first thread that asks locks what is mapped now and what is mapped later.
+    static std::atomic<int> locked{-1};  // -1: not tried; else the errno of the one attempt (0: locked)
+    int expected = -1;
+    if (locked.load(std::memory_order_acquire) == -1) {
+      const int err = mlockall(MCL_CURRENT | MCL_FUTURE) == 0 ? 0 : errno;
+      locked.compare_exchange_strong(expected, err, std::memory_order_acq_rel);
+    }
+    const int err = locked.load(std::memory_order_acquire);
+    out.memory_locked = err == 0;
+    if (err != 0) refuse("mlockall", err);
   }
-  stop_.store(false, std::memory_order_release);
-  stats_.reset();
-  running_.store(true, std::memory_order_release);
-  thread_ = std::thread([this] { run(); });
+  if (options.cpu >= 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(options.cpu, &set);
+    const int err = pthread_setaffinity_np(pthread_self(), sizeof set, &set);
+    out.pinned = err == 0;
+    if (err != 0) refuse("CPU " + std::to_string(options.cpu), err);
+  }
+  if (options.realtime_priority > 0) {
+    sched_param param{};
+    param.sched_priority = std::clamp(options.realtime_priority, sched_get_priority_min(SCHED_FIFO),
+                                      sched_get_priority_max(SCHED_FIFO));
+    // Refused without CAP_SYS_NICE or an rtprio limit: the loop then keeps normal scheduling.
+    const int err = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
+    out.realtime = err == 0;
+    if (err != 0) refuse("SCHED_FIFO " + std::to_string(param.sched_priority), err);
+  }
+#else
+  if (options.lock_memory) refused += "mlockall (not on this system)";
+  if (options.cpu >= 0) refused += std::string(refused.empty() ? "" : ", ") + "CPU pinning (not on this system)";
+  if (options.realtime_priority > 0) refused += std::string(refused.empty() ? "" : ", ") + "SCHED_FIFO (not on this system)";
+#endif
+  if (!refused.empty()) out.warning = "warning: " + std::string(who) + ": not permitted: " + refused + "; running with normal scheduling";
+  return out;
 }
 
-void LoopRunner::stop() noexcept {
+PeriodicRunner::PeriodicRunner(std::string name, Duration period, const Clock& clock, Cycle cycle, LoopTimingOptions options)
+    : name_(std::move(name)),
+      period_(period),
+      budget_(options.budget > Duration{0} ? options.budget : period),
+      clock_(clock),
+      cycle_(std::move(cycle)),
+      options_(options),
+      stats_(std::make_unique<LoopStatistics>()) {
+  if (period_ <= Duration{0}) throw std::invalid_argument("periodic thread '" + name_ + "': the period must be > 0");
+  if (!cycle_) throw std::invalid_argument("periodic thread '" + name_ + "': no cycle to run");
+}
+
+PeriodicRunner::~PeriodicRunner() { stop(); }
+
+void PeriodicRunner::start() {
+  if (running_.load(std::memory_order_acquire) || thread_.joinable()) {
+    throw std::logic_error("periodic thread '" + name_ + "' is already running");
+  }
+  stop_.store(false, std::memory_order_release);
+  started_.store(false, std::memory_order_release);
+  stats_->reset();
+  running_.store(true, std::memory_order_release);
+  thread_ = std::thread([this] { run(); });
+  // setup() is the thread's until it says it has applied its options.
+  while (!started_.load(std::memory_order_acquire)) std::this_thread::yield();
+}
+
+void PeriodicRunner::stop() noexcept {
   stop_.store(true, std::memory_order_release);
   if (thread_.joinable()) thread_.join();
   running_.store(false, std::memory_order_release);
 }
 
-void LoopRunner::run() noexcept {
-#if defined(__linux__)
-  if (options_.cpu >= 0) {
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    CPU_SET(options_.cpu, &set);
-    pthread_setaffinity_np(pthread_self(), sizeof set, &set);  // best effort
-  }
-  if (options_.realtime_priority > 0) {
-    sched_param param{};
-    param.sched_priority = std::clamp(options_.realtime_priority, sched_get_priority_min(SCHED_FIFO),
-                                      sched_get_priority_max(SCHED_FIFO));
-    // Refused without CAP_SYS_NICE or an rtprio limit: the loop then keeps normal scheduling.
-    realtime_granted_.store(pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0, std::memory_order_release);
-  }
-#endif
-  const Duration period = loop_.period();
-  Time deadline = clock_.now() + period;
+void PeriodicRunner::run() noexcept {
+  setup_ = apply_thread_options(options_, "loop '" + name_ + "'");
+  started_.store(true, std::memory_order_release);
+  Time deadline = clock_.now() + period_;
+  std::uint32_t in_a_row = 0;
   while (!stop_.load(std::memory_order_acquire)) {
     clock_.sleep_until(deadline);
     const Time wake = clock_.now();
-    loop_.step(wake);
+    cycle_(wake);
     const Time end = clock_.now();
-    stats_.record(wake - deadline, end - wake);
-    deadline += period;
+    stats_->record(wake - deadline, end - wake);
+    if (end - deadline > budget_) {
+      stats_->record_overrun();
+      overruns_.fetch_add(1, std::memory_order_acq_rel);
+      // One fault per run of N: a loop that stays late does not flood the supervisor.
+      if (++in_a_row == options_.deadline_overruns) deadline_faults_.fetch_add(1, std::memory_order_acq_rel);
+    } else {
+      in_a_row = 0;
+    }
+    deadline += period_;
     if (end >= deadline) {
-      // Overrun: skip the ticks already missed, keep the phase of the original grid.
-      const auto missed = static_cast<std::uint64_t>((end - deadline) / period) + 1;
-      deadline += static_cast<std::int64_t>(missed) * period;
-      stats_.record_overrun(missed);
+      // Skip the ticks already missed, keep the phase of the original grid.
+      const auto missed = static_cast<std::uint64_t>((end - deadline) / period_) + 1;
+      deadline += static_cast<std::int64_t>(missed) * period_;
+      stats_->record_skipped(missed);
     }
   }
 }
 
-void SimLoopDriver::add(ControlLoop& loop) { loops_.push_back({&loop, clock_.now()}); }
+LoopRunner::LoopRunner(ControlLoop& loop, const Clock& clock, LoopTimingOptions options)
+    : runner_(loop.name(), loop.period(), clock, [&loop](Time now) { (void)loop.step(now); }, options) {}
 
-std::size_t SimLoopDriver::run_until(Time until) noexcept {
-  std::size_t cycles = 0;
+void SimLoopDriver::add(ControlLoop& loop) {
+  entries_.push_back({[&loop](Time now) { (void)loop.step(now); }, loop.period(), clock_.now()});
+}
+
+void SimLoopDriver::add(Duration period, Step step) {
+  if (period <= Duration{0}) throw std::invalid_argument("SimLoopDriver: a period must be > 0");
+  entries_.push_back({std::move(step), period, clock_.now()});
+}
+
+std::size_t SimLoopDriver::run_until(Time until) {
+  std::size_t steps = 0;
   for (;;) {
     Entry* next = nullptr;
-    for (Entry& e : loops_) {
+    for (Entry& e : entries_) {
       if (e.next <= until && (next == nullptr || e.next < next->next)) next = &e;
     }
     if (next == nullptr) break;
-    clock_.set(next->next);
-    next->loop->step(next->next);
-    next->next += next->loop->period();
-    ++cycles;
+    const Time t = next->next;
+    clock_.set(t);
+    if (before_instant_ && (!instant_ || *instant_ < t)) {
+      before_instant_(t);
+      instant_ = t;
+    }
+    next->step(t);
+    next->next += next->period;
+    ++steps;
   }
   clock_.set(until);
-  return cycles;
+  return steps;
 }
 
 }  // namespace tripodal

@@ -73,3 +73,34 @@ CResource* ResourceTable::find(std::string_view name) const noexcept {
 }
 
 }  // namespace tripodal
+
+namespace tripodal {
+
+void ResourceMirror::set_published(CResource& copy, Time stamp, bool has_reading, std::size_t sequence) noexcept {
+  copy.stamp_ = stamp;
+  copy.has_reading_ = has_reading;
+  copy.sequence_ = sequence;
+}
+
+ResourceSnapshot::ResourceSnapshot(const ResourceTable& source) : table_(std::make_unique<ResourceTable>()) {
+  for (std::size_t i = 0; i < source.size(); ++i) {
+    std::unique_ptr<ResourceMirror> m = source.at(i).make_mirror();
+    if (!m) continue;
+    table_->add(m->mirror());
+    mirrors_.push_back(std::move(m));
+  }
+}
+
+ResourceSnapshot::~ResourceSnapshot() = default;
+
+void ResourceSnapshot::publish() noexcept {
+  for (auto& m : mirrors_) m->publish();
+}
+
+std::size_t ResourceSnapshot::refresh() {
+  std::size_t changed = 0;
+  for (auto& m : mirrors_) changed += m->refresh() ? 1 : 0;
+  return changed;
+}
+
+}  // namespace tripodal

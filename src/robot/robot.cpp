@@ -316,7 +316,11 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
   OdometryResource odometry{"odometry"};
   TeleopResource teleop;  // what an operator console drives by hand
   ResourceTable resources;
+  // What the modules read: the resources as the behavior loop last handed them over.
+  std::unique_ptr<ResourceSnapshot> snapshot;
   std::vector<std::unique_ptr<ControlLoop>> loops;
+  std::vector<LoopTimingOptions> loop_timing;  // per loop, from the profile
+  LoopTimingOptions sequencing_timing;
   std::map<std::string, std::string, std::less<>> behavior_types;  // profile name -> type
   // A net-bound behavior's parameters in the profile: defaults under the net's (e.g. the cleaning
   // behavior's max_replans on a robot whose safety reflexes make it plan many detours).
@@ -341,12 +345,11 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
 
   // Drivers.
   std::recursive_mutex sequencing_mutex;  // the sequencing loop vs. command() from another thread
-  std::vector<Time> next_reactive;
-  Time next_sequencing{};
-  bool schedule_started = false;
-  std::vector<std::unique_ptr<LoopRunner>> runners;
-  std::thread sequencing_thread;
-  std::atomic<bool> stop_requested{false};
+  std::unique_ptr<SimLoopDriver> schedule;  // simulated time: made at the first run_until
+  // The wall-clock runtime: one periodic thread per reactive loop, then the sequencing one.
+  std::vector<std::unique_ptr<PeriodicRunner>> runners;
+  std::vector<std::uint64_t> deadline_faults_seen;  // per runner, as reported to the supervisor
+  RealtimeOptions realtime;
   bool started = false;
 
   Impl(Clock& c, const RobotPlugins& p, RobotOptions o) : clock(c), plugins(p), options(std::move(o)) {}
@@ -364,7 +367,7 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
   ModuleContext context(Time now) {
     ModuleContext ctx;
     ctx.now = now;
-    ctx.resources = &resources;
+    ctx.resources = snapshot ? &snapshot->table() : &resources;
     ctx.navigation = &navigation;
     ctx.hardware = hardware.get();
     ctx.modules = this;
@@ -458,9 +461,27 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
     }
   }
 
+  // A run of overruns of a periodic thread is that loop's fault, once per run.
+  void report_deadline_faults() {
+    for (std::size_t i = 0; i < runners.size(); ++i) {
+      const std::uint64_t faults = runners[i]->deadline_faults();
+      if (faults == deadline_faults_seen[i]) continue;
+      deadline_faults_seen[i] = faults;
+      const PeriodicRunner& r = *runners[i];
+      supervisor->report_fault(r.name(), r.name() + ".deadline",
+                               "missed its deadline " + std::to_string(r.options().deadline_overruns) +
+                                   " times in a row (period " + format_seconds(r.period()) + " s, budget " +
+                                   format_seconds(r.budget()) + " s)");
+    }
+  }
+
   void step_sequencing() {
     std::lock_guard lock(sequencing_mutex);
     const Time now = clock.now();
+    // On simulated time this thread is also the loops': it hands the resources over itself.
+    if (!started) snapshot->publish();
+    snapshot->refresh();
+    report_deadline_faults();
     // The changes of this period (activations, the paths planned for them) reach the loops together.
     std::vector<std::unique_ptr<ControlLoop::ChangeBatch>> batches;
     for (auto& loop : loops) batches.push_back(std::make_unique<ControlLoop::ChangeBatch>(*loop));
@@ -488,6 +509,7 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
                                        RobotOptions options) {
   auto m = std::make_unique<Impl>(clock, plugins, std::move(options));
   m->sequencing_period = profile.sequencing_period;
+  m->sequencing_timing = profile.sequencing_timing;
   m->profile_dir = profile.dir;
   Diagnostics d;
   auto collect = [&](const auto& fn) {
@@ -590,6 +612,7 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
       if (first && loop->controller() != nullptr) loop->set_odometry_output(&m->odometry);
       if (first && m->hardware) loop->set_command_output(&m->hardware->command_channels());
       m->loops.push_back(std::move(loop));
+      m->loop_timing.push_back(l.timing);
       first = false;
     });
   }
@@ -616,6 +639,10 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
     }
   }
   if (d.has_errors()) throw ConfigError(d);
+  // Every resource is in the table now (the hardware's, the profile's, the odometry).
+  m->snapshot = std::make_unique<ResourceSnapshot>(m->resources);
+  m->snapshot->publish();
+  m->snapshot->refresh();
   {
     ModuleContext ctx = m->context(clock.now());
     // Not a structured binding: clang 14 (the fuzzing compiler) cannot capture one in a lambda.
@@ -654,62 +681,96 @@ void Robot::run_until(Time until) {
   auto* clock = dynamic_cast<SimClock*>(&m.clock);
   if (clock == nullptr) throw std::logic_error("Robot::run_until needs a SimClock; on real time use start()");
   if (m.started) throw std::logic_error("Robot::run_until: the robot's threads are running");
-  SimClock& sim_clock = *clock;
-  if (!m.schedule_started) {
-    m.next_sequencing = sim_clock.now();
-    m.next_reactive.assign(m.loops.size(), sim_clock.now());
-    m.schedule_started = true;
+  if (!m.schedule) {
+    // The simulated-time scheduler: at each instant the hardware first, then the sequencing loop
+    // when due, then each reactive loop when due (ties in the order added).
+    m.schedule = std::make_unique<SimLoopDriver>(*clock);
+    if (m.hardware) m.schedule->set_before_instant([&m](Time t) { m.hardware->advance_to(t); });
+    m.schedule->add(m.sequencing_period, [&m](Time) { m.step_sequencing(); });
+    for (auto& loop : m.loops) m.schedule->add(*loop);
   }
-  while (true) {
-    Time t = m.next_sequencing;
-    for (const Time r : m.next_reactive) t = std::min(t, r);
-    if (t > until) break;
-    sim_clock.set(t);
-    if (m.hardware) m.hardware->advance_to(t);
-    if (m.next_sequencing == t) {
-      m.step_sequencing();
-      m.next_sequencing += m.sequencing_period;
-    }
-    for (std::size_t i = 0; i < m.loops.size(); ++i) {
-      if (m.next_reactive[i] != t) continue;
-      m.loops[i]->step(t);
-      m.next_reactive[i] += m.loops[i]->period();
-    }
-  }
-  if (sim_clock.now() < until) sim_clock.set(until);
+  m.schedule->run_until(until);
 }
 
 void Robot::run_for(Duration d) { run_until(impl_->clock.now() + d); }
 
-void Robot::start() {
+void Robot::start(RealtimeOptions options) {
   Impl& m = *impl_;
   if (m.started) throw std::logic_error("Robot::start: already started");
   if (m.hardware) m.hardware->start();
-  m.stop_requested = false;
-  for (auto& loop : m.loops) {
-    m.runners.push_back(std::make_unique<LoopRunner>(*loop, m.clock));
-    m.runners.back()->start();
-  }
-  m.sequencing_thread = std::thread([&m] {
-    Time deadline = m.clock.now();
-    while (!m.stop_requested.load(std::memory_order_acquire)) {
-      m.step_sequencing();
-      deadline += m.sequencing_period;
-      m.clock.sleep_until(deadline);
+  m.realtime = std::move(options);
+  m.runners.clear();
+  // The behavior loop's thread owns the hardware's motion and the resources: it advances the
+  // hardware to the cycle's time, runs the cycle, and hands the resources to the sequencing layer.
+  for (std::size_t i = 0; i < m.loops.size(); ++i) {
+    ControlLoop& loop = *m.loops[i];
+    PeriodicRunner::Cycle cycle;
+    if (i == 0) {
+      cycle = [&m, &loop](Time now) {
+        if (m.hardware) m.hardware->advance_to(now);
+        (void)loop.step(now);
+        m.snapshot->publish();
+      };
+    } else {
+      cycle = [&loop](Time now) { (void)loop.step(now); };
     }
-  });
+    m.runners.push_back(std::make_unique<PeriodicRunner>(loop.name(), loop.period(), m.clock, std::move(cycle), m.loop_timing[i]));
+  }
+  m.runners.push_back(std::make_unique<PeriodicRunner>(
+      "sequencing", m.sequencing_period, m.clock,
+      [&m](Time now) {
+        m.step_sequencing();
+        if (m.realtime.after_sequencing) {
+          std::lock_guard lock(m.sequencing_mutex);
+          m.realtime.after_sequencing(now);
+        }
+      },
+      m.sequencing_timing));
+  m.deadline_faults_seen.assign(m.runners.size(), 0);
   m.started = true;
+  // The loops first: the sequencing layer's first period sees their first hand-over.
+  for (auto& r : m.runners) r->start();
 }
 
 void Robot::stop() noexcept {
   Impl& m = *impl_;
   if (!m.started) return;
-  m.stop_requested = true;
-  if (m.sequencing_thread.joinable()) m.sequencing_thread.join();
-  for (auto& r : m.runners) r->stop();
-  m.runners.clear();
+  // The sequencing thread first: it activates behaviors in the loops still running.
+  for (auto it = m.runners.rbegin(); it != m.runners.rend(); ++it) (*it)->stop();
   if (m.hardware) m.hardware->stop();
   m.started = false;
+}
+
+std::vector<std::string> Robot::realtime_warnings() const {
+  std::vector<std::string> out;
+  for (const auto& r : impl_->runners) {
+    if (!r->setup().warning.empty()) out.push_back(r->setup().warning);
+  }
+  return out;
+}
+
+std::vector<LoopTimingReport> Robot::timing() const {
+  std::vector<LoopTimingReport> out;
+  for (const auto& r : impl_->runners) {
+    const LoopStatistics& s = r->statistics();
+    LoopTimingReport t;
+    t.name = r->name();
+    t.period = r->period();
+    t.budget = r->budget();
+    t.cycles = s.cycles();
+    t.overruns = r->overruns();
+    t.skipped_ticks = s.skipped_ticks();
+    t.deadline_faults = r->deadline_faults();
+    t.period_error_p50 = s.jitter_quantile(0.5);
+    t.period_error_p99 = s.jitter_quantile(0.99);
+    t.period_error_max = s.max_jitter();
+    t.execution_p99 = s.execution_quantile(0.99);
+    t.execution_max = s.max_execution();
+    t.realtime = r->setup().realtime;
+    t.warning = r->setup().warning;
+    out.push_back(std::move(t));
+  }
+  return out;
 }
 
 bool Robot::started() const noexcept { return impl_->started; }
@@ -720,6 +781,7 @@ const ProcessRegistry& Robot::processes() const noexcept { return impl_->process
 ControlLoop& Robot::behavior_loop() noexcept { return impl_->behavior_loop(); }
 CHardware* Robot::hardware() noexcept { return impl_->hardware.get(); }
 const ResourceTable& Robot::resources() const noexcept { return impl_->resources; }
+const ResourceTable& Robot::sequencing_resources() const noexcept { return impl_->snapshot->table(); }
 const NavigationData& Robot::navigation() const noexcept { return impl_->navigation; }
 
 bool Robot::behavior_active(std::string_view name) const noexcept {

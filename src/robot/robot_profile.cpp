@@ -55,6 +55,25 @@ struct Parser {
     return r.seconds(n, what);
   }
 
+  // The thread keys of a loop (or of the sequencing loop), those present in `n`.
+  void timing(const YAML::Node& n, LoopTimingOptions& t, const std::string& what) {
+    if (const YAML::Node v = n["realtime_priority"]) {
+      if (auto p = r.integer(v, what + " realtime_priority", 0, 99)) t.realtime_priority = static_cast<int>(*p);
+    }
+    if (const YAML::Node v = n["cpu"]) {
+      if (auto c = r.integer(v, what + " cpu", -1, 1023)) t.cpu = static_cast<int>(*c);
+    }
+    if (const YAML::Node v = n["lock_memory"]) {
+      if (auto b = r.boolean(v, what + " lock_memory")) t.lock_memory = *b;
+    }
+    if (const YAML::Node v = n["budget_s"]) {
+      if (auto s = positive_seconds(v, what + " budget_s")) t.budget = from_seconds(*s);
+    }
+    if (const YAML::Node v = n["deadline_overruns"]) {
+      if (auto k = r.integer(v, what + " deadline_overruns", 0, 1000000)) t.deadline_overruns = static_cast<std::uint32_t>(*k);
+    }
+  }
+
   std::filesystem::path path_of(const YAML::Node& n, std::string_view what, SourceLocation& loc) {
     std::string s;
     loc = at(n);
@@ -271,12 +290,17 @@ struct Parser {
       const std::string key = yaml::Reader::checked_key(kv.first);
       const YAML::Node v = kv.second;
       if (key == "robot") {
-        if (!r.expect_keys(v, {"name", "description", "sequencing_period_s"}, "robot")) continue;
+        if (!r.expect_keys(v, {"name", "description", "sequencing_period_s", "sequencing_loop"}, "robot")) continue;
         prof.where = at(v);
         if (const YAML::Node name = v["name"]) scalar(name, prof.name, "robot name");
         if (const YAML::Node description = v["description"]) scalar(description, prof.description, "description");
         if (const YAML::Node period = v["sequencing_period_s"]) {
           if (auto s = positive_seconds(period, "sequencing_period_s")) prof.sequencing_period = from_seconds(*s);
+        }
+        if (const YAML::Node sl = v["sequencing_loop"]) {
+          if (r.expect_keys(sl, {"realtime_priority", "cpu", "lock_memory", "budget_s", "deadline_overruns"}, "robot sequencing_loop")) {
+            timing(sl, prof.sequencing_timing, "sequencing_loop");
+          }
         }
       } else if (key == "hardware") {
         std::vector<ModuleEntry> hw;
@@ -299,12 +323,17 @@ struct Parser {
         for (const auto& l : v) {
           LoopEntry loop;
           loop.where = at(l);
-          if (!r.expect_keys(l, {"name", "period_s", "controller"}, "a loop")) continue;
+          if (!r.expect_keys(l, {"name", "period_s", "controller", "realtime_priority", "cpu", "lock_memory", "budget_s",
+                                 "deadline_overruns"},
+                             "a loop")) {
+            continue;
+          }
           if (const YAML::Node name = r.require(l, "name", "a loop", "the loop's name")) scalar(name, loop.name, "name");
           if (const YAML::Node c = l["controller"]) scalar(c, loop.controller, "controller");
           if (const YAML::Node p = r.require(l, "period_s", "a loop", "seconds")) {
             if (auto s = positive_seconds(p, "period_s")) loop.period = from_seconds(*s);
           }
+          timing(l, loop.timing, "loop '" + loop.name + "'");
           prof.loops.push_back(std::move(loop));
         }
       } else if (key == "processes") {

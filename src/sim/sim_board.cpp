@@ -59,7 +59,9 @@ SimBoardHardware::SimBoardHardware(World world, const ControllerConfig& base, st
     : sim_(std::move(world), base, seed),
       plant_(sim_, base.differential.wheel_radius_m),
       board_(firmware, plant_, host, 115200, line),
-      dose_(sim_.world().grid, lamp) {}
+      dose_(sim_.world().grid, lamp) {
+  publish_truth();
+}
 
 // The lamp's state is the firmware's (what the board switched, whatever the host believes); the
 // dose is counted per robot instant, at the pose reached, as the lamp moves a few millimetres
@@ -68,6 +70,7 @@ void SimBoardHardware::on_advance_to(Time now) noexcept {
   const Time before = sim_.now();
   board_.advance_to(now);
   if (board_.firmware().uv_lamp()) dose_.expose({sim_.pose().x_m, sim_.pose().y_m}, sim_.now() - before);
+  publish_truth();
 }
 
 // The real board's type, its parameters, plus what the simulated world adds (the laser, the gyro,

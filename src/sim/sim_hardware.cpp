@@ -87,6 +87,7 @@ void SimHardware::on_advance_to(Time now) noexcept {
     r = {sim_.now(), s.position_rad, s.velocity_rad_s, s.target_rad, c.min_rad, c.max_rad};
     joints_[i]->commit();
   }
+  publish_truth();
 }
 
 void register_sim_hardware(HardwareRegistry& registry, std::shared_ptr<const World> world) {

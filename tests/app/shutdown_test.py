@@ -5,8 +5,9 @@ was idle), report.json valid JSON naming the stop ("interrupted by SIGTERM"), th
 zero at the end, and map.png a PNG (also when the run had no task: no cells, no path, no sections).
 
 usage: shutdown_test.py TRIPODAL SOURCE_DIR MODE SIGNAL
-MODE: task, monitor_idle, monitor_task, board_pty, dds_profile, hardware_dds (the simulator in a
-`tripodal sim-server` of its own), visit. Exit 77: skipped (a build without DDS for the DDS modes)."""
+MODE: task, realtime_task (the robot on its own threads, `--realtime 4`: the report also gives each
+loop's period error and overruns), monitor_idle, monitor_task, board_pty, dds_profile, hardware_dds
+(the simulator in a `tripodal sim-server` of its own), visit. Exit 77: skipped (a build without DDS for the DDS modes)."""
 import json
 import os
 import re
@@ -51,6 +52,9 @@ def run(exe, source, mode, sig, sig_name, work):
     if mode == "task":
         cmd = ["run", "--robot", psr2, "--world", workspace, "--task", "clean the room 3211", "--seed", "1"]
         ready, cut = running_task, True
+    elif mode == "realtime_task":
+        cmd = ["run", "--robot", psr2, "--world", workspace, "--task", "clean the room 3211", "--seed", "1", "--realtime", "4"]
+        ready, cut = running_task, True
     elif mode == "monitor_idle":  # the "task from the console" flow, no task ever given
         cmd = ["run", "--robot", psr2, "--world", workspace, "--monitor", "0"]
         ready, cut = r"monitor: http://", False
@@ -86,7 +90,7 @@ def run(exe, source, mode, sig, sig_name, work):
         cmd = ["run", "--robot", os.path.join(robots, "jinny.yaml"), "--world", os.path.join(worlds, "exhibit_hall.yaml"), "--visit",
                os.path.join(configs, "visits", "exhibit_hall.yaml"), "--no-voice", "--monitor", "0", "--realtime", "2"]
         ready, cut = r"PrAutoMove\(goal=node1\) started", True
-    elif mode not in ("task", "monitor_idle", "monitor_task", "board_pty", "hardware_dds"):
+    elif mode not in ("task", "realtime_task", "monitor_idle", "monitor_task", "board_pty", "hardware_dds"):
         fail("unknown mode " + mode)
     cmd = [exe] + cmd + ["--out", out]
 
@@ -162,6 +166,17 @@ def run(exe, source, mode, sig, sig_name, work):
                 fail("map.png is not a PNG", output())
         if mode == "board_pty" and not report.get("disinfection", {}).get("line", "").startswith("pty "):
             fail("the board's line is not a pty: %r" % report.get("disinfection"), output())
+    if mode == "realtime_task":
+        realtime = report.get("realtime") or {}
+        loops = {l.get("name"): l for l in realtime.get("loops", [])}
+        if realtime.get("speed") != 4 or set(loops) != {"motion", "sequencing"}:
+            fail("report.json realtime: %r, expected speed 4 and the loops motion and sequencing" % realtime, output())
+        for name, l in loops.items():
+            error = l.get("period_error_us", {})
+            if not l.get("cycles", 0) > 0 or not (0 <= error.get("p50", -1) <= error.get("p99", -1) <= error.get("max", -1)):
+                fail("report.json realtime loop %s: %r" % (name, l), output())
+            if not isinstance(l.get("overruns"), int) or not isinstance(l.get("deadline_faults"), int):
+                fail("report.json realtime loop %s has no overrun counts: %r" % (name, l), output())
     print("%s: %s -> exit %d, %s, path %s m, base at rest %s" % (mode, sig_name, rc, report.get("stopped_by"), moved, command))
     print("".join(lines[-5:]))
 

@@ -344,3 +344,46 @@ TEST_CASE("describe shows command channels, who writes and who exports them; R6 
                             Catch::Contains("behavior 'BhUvLamp' writes the command channel 'uv_lamp' (digital), which hardware 'sim' does "
                                             "not export; it exports none (rule R6)"));
 }
+
+TEST_CASE("A loop's thread settings are read from the profile, every bad one located", "[robot][errors]") {
+  const RobotProfile p = load_robot_profile_from_string(
+      "robot: {name: rt, sequencing_loop: {budget_s: 0.08, deadline_overruns: 20, realtime_priority: 70}}\n"
+      "loops:\n"
+      "  - {name: motion, period_s: 0.01, realtime_priority: 80, cpu: 1, lock_memory: true, budget_s: 0.004, deadline_overruns: 5}\n"
+      "  - {name: arm, period_s: 0.002}\n",
+      "rt.yaml", kRobots);
+  REQUIRE(p.loops.size() == 2);
+  const LoopTimingOptions& t = p.loops[0].timing;
+  CHECK(t.realtime_priority == 80);
+  CHECK(t.cpu == 1);
+  CHECK(t.lock_memory);
+  CHECK(t.budget == std::chrono::milliseconds(4));
+  CHECK(t.deadline_overruns == 5);
+  // Unset: normal scheduling, no pinning, the period as the budget, overruns counted only.
+  CHECK(p.loops[1].timing.realtime_priority == 0);
+  CHECK(p.loops[1].timing.cpu == -1);
+  CHECK_FALSE(p.loops[1].timing.lock_memory);
+  CHECK(p.loops[1].timing.budget == Duration{0});
+  CHECK(p.loops[1].timing.deadline_overruns == 0);
+  CHECK(p.sequencing_timing.budget == std::chrono::milliseconds(80));
+  CHECK(p.sequencing_timing.deadline_overruns == 20);
+  CHECK(p.sequencing_timing.realtime_priority == 70);
+
+  const std::string bad =
+      "robot: {name: rt, sequencing_loop: {priority: 3}}\n"
+      "loops:\n"
+      "  - {name: motion, period_s: 0.01, realtime_priority: 100, cpu: -2, lock_memory: maybe, budget_s: 0, deadline_overruns: -1}\n";
+  try {
+    (void)load_robot_profile_from_string(bad, "bad.yaml", kRobots);
+    FAIL("no error");
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    CHECK_THAT(m, Catch::Contains("bad.yaml:1:37: error: unknown key 'priority' in robot sequencing_loop"));
+    CHECK_THAT(m, Catch::Contains("loop 'motion' realtime_priority: expected a whole number from 0 to 99, got '100'"));
+    CHECK_THAT(m, Catch::Contains("loop 'motion' cpu: expected a whole number from -1 to 1023, got '-2'"));
+    CHECK_THAT(m, Catch::Contains("loop 'motion' lock_memory: expected true or false, got 'maybe'"));
+    CHECK_THAT(m, Catch::Contains("loop 'motion' budget_s: expected seconds from 1e-06 to 9e+09, got '0'"));
+    CHECK_THAT(m, Catch::Contains("loop 'motion' deadline_overruns: expected a whole number from 0 to 1000000, got '-1'"));
+    CHECK(e.diagnostics().error_count() == 6);
+  }
+}

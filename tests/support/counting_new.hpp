@@ -14,13 +14,17 @@
 
 namespace tripodal::test {
 inline std::atomic<std::size_t> g_allocations{0};
+inline thread_local std::size_t t_allocations = 0;
 /// Heap allocations made through operator new since the program started.
 inline std::size_t allocations() noexcept { return g_allocations.load(std::memory_order_relaxed); }
+/// Those made by the calling thread (a loop's own thread, counted while others allocate freely).
+inline std::size_t thread_allocations() noexcept { return t_allocations; }
 }  // namespace tripodal::test
 
 namespace tripodal::test::detail {
 inline void* counted_malloc(std::size_t size) noexcept {
   g_allocations.fetch_add(1, std::memory_order_relaxed);
+  ++t_allocations;
   return std::malloc(size == 0 ? 1 : size);
 }
 }  // namespace tripodal::test::detail

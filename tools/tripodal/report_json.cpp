@@ -55,6 +55,24 @@ std::string RunResult::json() const {
                        {"robot_steps", robot_steps},
                        {"base_at_rest", base_at_rest},
                        {"base_command_at_end_rad_s", base_command_at_end_rad_s}};
+  if (!loops.empty()) {
+    const auto us = [&](Duration d) { return rounded(static_cast<double>(d.count()) / 1000.0, 1); };
+    Json list = Json::array();
+    for (const LoopTimingReport& l : loops) {
+      list.push_back({{"name", l.name},
+                      {"period_s", to_seconds(l.period)},
+                      {"budget_s", to_seconds(l.budget)},
+                      {"cycles", l.cycles},
+                      {"period_error_us", {{"p50", us(l.period_error_p50)}, {"p99", us(l.period_error_p99)}, {"max", us(l.period_error_max)}}},
+                      {"execution_us", {{"p99", us(l.execution_p99)}, {"max", us(l.execution_max)}}},
+                      {"overruns", l.overruns},
+                      {"skipped_ticks", l.skipped_ticks},
+                      {"deadline_faults", l.deadline_faults},
+                      {"sched_fifo", l.realtime},
+                      {"warning", l.warning}});
+    }
+    report["realtime"] = {{"speed", realtime_speed}, {"loops", std::move(list)}};
+  }
   if (disinfection) {
     const DisinfectionFigures& d = *disinfection;
     const auto ms = [&](Duration t) { return rounded(to_seconds(t) * 1000.0, 3); };

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <deque>
 #include <fstream>
@@ -336,14 +337,18 @@ void register_tool_plugins(RobotPlugins& plugins, const std::shared_ptr<const si
 class GroundTruth {
  public:
   GroundTruth(CHardware* hw, Pose2D start) : start_(start) {
-    if (auto* s = dynamic_cast<sim::SimulatorSources*>(hw)) local_ = &s->simulation();
+    if (auto* s = dynamic_cast<sim::SimulatorSources*>(hw)) {
+      sources_ = s;
+      local_ = &s->simulation();
+    }
 #ifdef TRIPODAL_HAVE_DDS
     remote_ = dynamic_cast<const dds::DdsHardware*>(hw);
 #endif
   }
   [[nodiscard]] const sim::Simulator* local() const noexcept { return local_; }
+  /// Any thread: the pose the hardware published after its last advance.
   [[nodiscard]] Pose2D pose() const {
-    if (local_ != nullptr) return local_->pose();
+    if (sources_ != nullptr) return sources_->true_pose(Time{}).value_or(start_);
 #ifdef TRIPODAL_HAVE_DDS
     if (remote_ != nullptr && remote_->truth()) return remote_->truth()->map_from_base;
 #endif
@@ -376,6 +381,7 @@ class GroundTruth {
   Pose2D last_ = start_;
   double sampled_rotation_rad_ = 0.0;
   const sim::Simulator* local_ = nullptr;
+  const sim::SimulatorSources* sources_ = nullptr;
 #ifdef TRIPODAL_HAVE_DDS
   const dds::DdsHardware* remote_ = nullptr;
 #endif
@@ -504,7 +510,16 @@ RunResult run_task(const RunOptions& o) {
     if (!o.dose_plan) ro.parameters.push_back({e.name, "dose_target_j_m2", "0"});
     else if (o.uv_target_dose_j_m2) ro.parameters.push_back({e.name, "dose_target_j_m2", fmt::format("{}", *o.uv_target_dose_j_m2)});
   }
-  SimClock clock;
+  // --realtime (without a monitor or DDS, which pace one thread): the robot on its own threads, on
+  // the wall clock sped up SPEED times; otherwise the caller's thread steps it on simulated time.
+  const bool threaded = o.realtime && !o.monitor && !profile.dds;
+  if (threaded && !o.record.empty()) {
+    throw ConfigError(SourceLocation{"--record", 1, 1}, "--record goes with a run on simulated time (without --realtime): its recorder "
+                                                        "reads the loop between cycles, which the robot's own threads do not leave");
+  }
+  SimClock sim_clock;
+  ScaledClock wall_clock(o.realtime_speed);
+  Clock& clock = threaded ? static_cast<Clock&>(wall_clock) : static_cast<Clock&>(sim_clock);
   const auto robot = Robot::assemble(profile, plugins, clock, ro);
   GroundTruth truth(robot->hardware(), world->start_pose);
   // A plugin's hardware type runs here when it simulates (derives from sim::SimHardware).
@@ -557,7 +572,7 @@ RunResult run_task(const RunOptions& o) {
 
   SteadyClock wall;
   std::optional<sim::RealtimePacer> pacer;
-  if (o.realtime || o.monitor || serve_dds) pacer.emplace(wall, o.realtime ? o.realtime_speed : 1.0);
+  if (!threaded && (o.realtime || o.monitor || serve_dds)) pacer.emplace(wall, o.realtime ? o.realtime_speed : 1.0);
 
   // The monitor: its own thread serves the clients; this loop hands it the robot's state and takes
   // the operator's requests between periods.
@@ -582,7 +597,7 @@ RunResult run_task(const RunOptions& o) {
   const bool serve = watch != nullptr || serve_dds;
   auto stopped = [&] { return o.stop != nullptr && *o.stop != 0; };
 
-  robot->run_until(clock.now());  // the localizer's first estimate, before the planner asks where to start
+  if (!threaded) robot->run_until(sim_clock.now());  // the localizer's first estimate, before the planner asks where to start
   std::size_t printed = 0;
   bool bar_shown = false;  // a bar drawn in place on the terminal, to be wiped before a log line
   auto flush_log = [&] {
@@ -717,17 +732,15 @@ RunResult run_task(const RunOptions& o) {
     extras.cleaned_mask = &cleaned.mask();
     watch->update(extras);
   };
-  while (clock.now() < deadline && !stopped() && (serve || robot->planner().busy())) {
-    monitor_update();
-    if ((watch && watch->paused()) || (bridge && bridge->paused())) {
-      wall.sleep_until(wall.now() + std::chrono::milliseconds(20));
-      if (pacer) pacer.emplace(wall, o.realtime ? o.realtime_speed : 1.0);  // no catching up after a pause
-      continue;
-    }
+  // What the run measures after each step of the robot: on simulated time after each tick, on the
+  // robot's own threads after each sequencing period, on the sequencing thread.
+  auto measure_when_busy = [&] {
     if (robot->planner().busy() && !measured_busy) measure_room();
     measured_busy = robot->planner().busy();
-    robot->run_for(tick_period);
-    for (; truth.local() != nullptr && sim_events_noted < truth.local()->events().size(); ++sim_events_noted) {
+  };
+  auto observe = [&] {
+    // (the simulator's events, written by the loop's thread on --realtime, are noted at the end)
+    for (; !threaded && truth.local() != nullptr && sim_events_noted < truth.local()->events().size(); ++sim_events_noted) {
       const sim::SimEvent& e = truth.local()->events()[sim_events_noted];
       life.note(e.stamp, "simulator: " + std::string(sim::to_string(e.kind)) + (e.detail.empty() ? "" : " " + e.detail));
     }
@@ -754,7 +767,42 @@ RunResult run_task(const RunOptions& o) {
       draw_progress(false);
       next_progress_s += o.progress_is_terminal ? (o.realtime || serve ? 1.0 : 10.0) : 60.0;
     }
-    if (pacer) pacer->pace(now);
+  };
+  if (threaded) {
+    // The main thread only waits (and takes the signal); the robot's threads run the task.
+    std::atomic<bool> busy{robot->planner().busy()};
+    bool warned = false;
+    RealtimeOptions rto;
+    rto.after_sequencing = [&](Time) {
+      if (!warned && o.log != nullptr) {  // what the threads asked of the system and were refused, once
+        for (const std::string& w : robot->realtime_warnings()) *o.log << w << '\n';
+        warned = true;
+      }
+      measure_when_busy();
+      observe();
+      busy.store(robot->planner().busy(), std::memory_order_release);
+    };
+    robot->start(std::move(rto));
+    while (clock.now() < deadline && !stopped() && busy.load(std::memory_order_acquire)) {
+      wall.sleep_until(wall.now() + std::chrono::milliseconds(10));
+    }
+    robot->stop();
+    for (; truth.local() != nullptr && sim_events_noted < truth.local()->events().size(); ++sim_events_noted) {
+      const sim::SimEvent& e = truth.local()->events()[sim_events_noted];
+      life.note(e.stamp, "simulator: " + std::string(sim::to_string(e.kind)) + (e.detail.empty() ? "" : " " + e.detail));
+    }
+  }
+  while (!threaded && clock.now() < deadline && !stopped() && (serve || robot->planner().busy())) {
+    monitor_update();
+    if ((watch && watch->paused()) || (bridge && bridge->paused())) {
+      wall.sleep_until(wall.now() + std::chrono::milliseconds(20));
+      if (pacer) pacer.emplace(wall, o.realtime ? o.realtime_speed : 1.0);  // no catching up after a pause
+      continue;
+    }
+    measure_when_busy();
+    robot->run_for(tick_period);
+    observe();
+    if (pacer) pacer->pace(clock.now());
   }
   monitor_update();
   const int sig = stop_signal(o.stop);
@@ -779,7 +827,8 @@ RunResult run_task(const RunOptions& o) {
   } else if (const sim::Simulator* s = truth.local()) {
     commanded = [s] { return std::vector<double>(s->wheel_commands().begin(), s->wheel_commands().end()); };
   }
-  const BaseStop rest = stop_base(*robot, commanded, tick_period);
+  // On the robot's own threads (stopped by now) the wheels are commanded zero at once.
+  const BaseStop rest = stop_base(*robot, commanded, threaded ? Duration{0} : tick_period);
   res.base_command_at_end_rad_s = rest.command_rad_s;
   res.base_at_rest = rest.at_rest;
   if (recording) {
@@ -816,6 +865,10 @@ RunResult run_task(const RunOptions& o) {
   res.recoveries = report.recoveries;
   res.collisions = truth.collisions();
   res.robot_steps = robot->behavior_loop().cycles();
+  if (threaded) {
+    res.realtime_speed = o.realtime_speed;
+    res.loops = robot->timing();
+  }
   for (const navi::LocalizationFault& f : faults) {
     res.faults.push_back("localization loss " + fixed(to_seconds(f.start), 1) + "-" + fixed(to_seconds(f.end), 1) + " s");
   }

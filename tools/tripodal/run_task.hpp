@@ -22,6 +22,7 @@
 #include "tripodal/navi/coverage.hpp"
 #include "tripodal/navi/dose_planner.hpp"
 #include "tripodal/navi/localizer.hpp"
+#include "tripodal/robot/robot.hpp"
 
 namespace tripodal {
 struct RobotPlugins;
@@ -62,7 +63,10 @@ struct RunOptions {
   /// Parameters of the hardware slot (KEY, VALUE), over the profile's: "namespace", "psr2".
   std::vector<std::pair<std::string, std::string>> hardware_parameters;
   std::optional<std::uint64_t> seed;  ///< default: the world's seed
-  bool realtime = false;        ///< pace the simulation to wall time
+  /// Run on wall-clock time, SPEED times real time: the robot on its own threads (Robot::start: a
+  /// thread per loop, deadlines watched, report.json "realtime"); with a monitor or DDS the
+  /// simulation is stepped on one thread paced to wall time instead.
+  bool realtime = false;
   double realtime_speed = 1.0;
   std::filesystem::path out;    ///< folder for map.png, trajectory.csv, report.json (empty: none)
   /// An MCAP file (docs/rosbag.md) the run records into: every resource's readings the trace format
@@ -178,6 +182,10 @@ struct RunResult {
   std::vector<std::string> faults;     ///< injected faults and what happened (simulator events)
   std::size_t collisions = 0;
   std::size_t robot_steps = 0;
+  /// --realtime SPEED on the robot's own threads: the speed, and each thread's deadline record
+  /// (report.json "loops": period error p50/p99/max, overruns, deadline faults).
+  double realtime_speed = 0.0;
+  std::vector<LoopTimingReport> loops;
   std::optional<DisinfectionFigures> disinfection;  ///< on hardware "board" only
   double dose_estimate_s = 0.0;   ///< a dose-planned disinfection's up-front time estimate
   double dose_estimate_ah = 0.0;  ///< and its charge

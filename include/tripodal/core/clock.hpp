@@ -32,6 +32,23 @@ class SteadyClock final : public Clock {
   std::chrono::steady_clock::time_point start_;
 };
 
+/// The steady clock sped up `speed` times: the clock of a simulated robot on the wall-clock runtime
+/// (`tripodal run --realtime SPEED`). now() is `speed` times the steady time since construction;
+/// sleep_until() sleeps on the steady clock's absolute timer until the matching wall instant, so a
+/// loop at a period P of this clock wakes every P / speed of wall time without drift.
+class ScaledClock final : public Clock {
+ public:
+  /// `speed` > 0 (anything else counts as 1).
+  explicit ScaledClock(double speed = 1.0) noexcept : speed_(speed > 0.0 ? speed : 1.0) {}
+  [[nodiscard]] Time now() const noexcept override;
+  void sleep_until(Time deadline) const noexcept override;
+  [[nodiscard]] double speed() const noexcept { return speed_; }
+
+ private:
+  SteadyClock wall_;
+  double speed_;
+};
+
 /// Simulated time that only moves when told to; starts at `start` (default 0).
 class SimClock final : public Clock {
  public:

@@ -132,6 +132,11 @@ class CProcessSupervisor final {
   /// A module failed at run time (threw, returned a failure): posts "<module>.fault". When no
   /// running process consumes it, every running process fails with "module <m> failed: <reason>".
   void report_module_fault(std::string module, std::string reason);
+  /// A fault of `source` posted as `event` rather than "<source>.fault" — a loop's missed deadlines
+  /// ("motion.deadline"): observers see it as a fault, and when no running process consumes the
+  /// event every running process fails with "module <source> failed: <reason>" (the planner's
+  /// recovery rules match that message).
+  void report_fault(std::string source, std::string event, std::string reason);
 
   // --- inspection ------------------------------------------------------------------------------
   [[nodiscard]] bool running(std::string_view run) const noexcept;

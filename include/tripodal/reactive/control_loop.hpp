@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -23,6 +24,7 @@
 #include "tripodal/core/clock.hpp"
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/core/time.hpp"
+#include "tripodal/reactive/periodic_runner.hpp"
 #include "tripodal/resources/resource.hpp"
 
 namespace tripodal {
@@ -235,98 +237,62 @@ class ControlLoop final {
   std::vector<BehaviorStatus> slot_status_;  // as last reported by the loop, for slot_generation_
 };
 
-/// How a LoopRunner treats a missed deadline (a cycle that ends after the next deadline):
-/// the missed ticks are skipped, not caught up. The next deadline is the first one of the
-/// original grid (start + k * period) later than the moment the late cycle ended, so the phase is
-/// kept, no burst of back-to-back cycles follows an overrun, and every tick is either run or
-/// counted as skipped.
-struct LoopTimingOptions {
-  int realtime_priority = 0;  ///< SCHED_FIFO priority 1..99; 0 = normal scheduling
-  int cpu = -1;               ///< pin to this CPU; -1 = no pinning
-};
-
-/// Period jitter and execution time statistics, in 1 microsecond histogram bins (quantiles are
-/// bin upper edges); no allocation while recording.
-class LoopStatistics {
- public:
-  static constexpr std::size_t kBins = 20000;  ///< 0..20 ms; later values land in the last bin
-  void record(Duration jitter, Duration execution) noexcept;
-  void record_overrun(std::uint64_t skipped_ticks) noexcept {
-    ++overruns_;
-    skipped_ += skipped_ticks;
-  }
-  void reset() noexcept;
-  [[nodiscard]] std::uint64_t cycles() const noexcept { return cycles_; }
-  [[nodiscard]] std::uint64_t overruns() const noexcept { return overruns_; }
-  [[nodiscard]] std::uint64_t skipped_ticks() const noexcept { return skipped_; }
-  /// Quantile q in [0, 1] of the wake-up jitter (wake time - deadline) and execution time.
-  [[nodiscard]] Duration jitter_quantile(double q) const noexcept { return quantile(jitter_, q); }
-  [[nodiscard]] Duration execution_quantile(double q) const noexcept { return quantile(exec_, q); }
-  [[nodiscard]] Duration max_jitter() const noexcept { return max_jitter_; }
-  [[nodiscard]] Duration max_execution() const noexcept { return max_exec_; }
-  [[nodiscard]] double mean_jitter_us() const noexcept;
-
- private:
-  Duration quantile(const std::array<std::uint32_t, kBins>& h, double q) const noexcept;
-  std::array<std::uint32_t, kBins> jitter_{};
-  std::array<std::uint32_t, kBins> exec_{};
-  std::uint64_t cycles_ = 0, overruns_ = 0, skipped_ = 0;
-  Duration max_jitter_{0}, max_exec_{0};
-  double jitter_sum_us_ = 0.0;
-};
-
-/// Runs a ControlLoop on its own thread at absolute deadlines of `clock`.
+/// Runs a ControlLoop on its own thread at absolute deadlines of `clock` (a PeriodicRunner whose
+/// cycle is the loop's step), with its period error, overruns and deadline faults.
 class LoopRunner final {
  public:
   LoopRunner(ControlLoop& loop, const Clock& clock, LoopTimingOptions options = {});
-  ~LoopRunner();  ///< stops the thread
+  ~LoopRunner() = default;  ///< stops the thread (the runner's destructor)
   LoopRunner(const LoopRunner&) = delete;
   LoopRunner& operator=(const LoopRunner&) = delete;
 
   /// Starts the thread; the first deadline is one period after now. Throws std::logic_error when
   /// already running.
-  void start();
+  void start() { runner_.start(); }
   /// Stops after the current cycle and joins.
-  void stop() noexcept;
-  [[nodiscard]] bool running() const noexcept { return running_.load(std::memory_order_acquire); }
-  /// Whether SCHED_FIFO was granted (false when not asked or not permitted; the loop then runs
-  /// with normal scheduling). Valid once the thread has started its first cycle.
-  [[nodiscard]] bool realtime_granted() const noexcept { return realtime_granted_.load(std::memory_order_acquire); }
+  void stop() noexcept { runner_.stop(); }
+  [[nodiscard]] bool running() const noexcept { return runner_.running(); }
+  /// Whether SCHED_FIFO was granted (false when not asked or not permitted).
+  [[nodiscard]] bool realtime_granted() const noexcept { return runner_.realtime_granted(); }
   /// Statistics; read them after stop() (the loop thread writes them while running).
-  [[nodiscard]] const LoopStatistics& statistics() const noexcept { return stats_; }
+  [[nodiscard]] const LoopStatistics& statistics() const noexcept { return runner_.statistics(); }
+  [[nodiscard]] PeriodicRunner& runner() noexcept { return runner_; }
 
  private:
-  void run() noexcept;
-  ControlLoop& loop_;
-  const Clock& clock_;
-  LoopTimingOptions options_;
-  std::thread thread_;
-  std::atomic<bool> running_{false};
-  std::atomic<bool> stop_{false};
-  std::atomic<bool> realtime_granted_{false};
-  std::unique_ptr<LoopStatistics> owned_stats_;
-  LoopStatistics& stats_;
+  PeriodicRunner runner_;
 };
 
-/// Steps loops by simulated time on the caller's thread: each loop at its own deadlines
-/// (start + k * period), in time order, ties in the order the loops were added.
+/// The simulated-time scheduler, the one every simulated run uses (Robot::run_until, SimRunner,
+/// replay): steps periodic work on the caller's thread, each entry at its own deadlines
+/// (first + k * period), in time order, ties in the order the entries were added. At each instant
+/// where something is due, the before-instant hook runs first (a simulator advanced to it).
 class SimLoopDriver final {
  public:
+  using Step = std::function<void(Time now)>;
   explicit SimLoopDriver(SimClock& clock) noexcept : clock_(clock) {}
   /// Adds `loop` (not owned); its first cycle is at the clock's current time.
   void add(ControlLoop& loop);
-  /// Advances the clock to `until`, running every cycle that falls due on the way; the clock ends
-  /// at `until`. Returns the number of cycles run.
-  std::size_t run_until(Time until) noexcept;
-  std::size_t run_for(Duration d) noexcept { return run_until(clock_.now() + d); }
+  /// Adds periodic work (a sequencing loop): `step` at the clock's current time, then every
+  /// `period` (> 0; std::invalid_argument otherwise).
+  void add(Duration period, Step step);
+  /// Runs before the entries due at each instant (nullptr: none).
+  void set_before_instant(Step hook) { before_instant_ = std::move(hook); }
+  /// Advances the clock to `until`, running every step that falls due on the way; the clock ends
+  /// at `until`. Returns the number of steps run. What a step throws propagates (the loops' own
+  /// steps never throw).
+  std::size_t run_until(Time until);
+  std::size_t run_for(Duration d) { return run_until(clock_.now() + d); }
 
  private:
   struct Entry {
-    ControlLoop* loop;
+    Step step;
+    Duration period;
     Time next;
   };
   SimClock& clock_;
-  std::vector<Entry> loops_;
+  std::vector<Entry> entries_;
+  Step before_instant_;
+  std::optional<Time> instant_;  // the last instant the hook ran at
 };
 
 }  // namespace tripodal

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <typeinfo>
@@ -11,10 +12,36 @@
 #include <vector>
 
 #include "tripodal/core/manifest.hpp"
+#include "tripodal/core/snapshot.hpp"
 #include "tripodal/core/time.hpp"
 #include "tripodal/resources/readings.hpp"
 
 namespace tripodal {
+
+class CResource;
+
+/// A copy of a resource for another thread: the sequencing layer's view of what the reactive loop
+/// reads (Robot::start). The loop's thread publish()es the resource's latest reading into a
+/// lock-free triple buffer (no lock; no allocation once the buffers have the reading's steady
+/// size); the reader's thread refresh()es mirror() from the newest complete copy.
+class ResourceMirror {
+ public:
+  virtual ~ResourceMirror() = default;
+  ResourceMirror(const ResourceMirror&) = delete;
+  ResourceMirror& operator=(const ResourceMirror&) = delete;
+  /// The source's thread: hands over its latest reading when it changed since the last call.
+  virtual void publish() noexcept = 0;
+  /// The reader's thread: mirror() takes the newest handed-over reading; whether it changed.
+  virtual bool refresh() = 0;
+  /// The copy: same name, type, manifest, stamp and sequence as the source at its last hand-over.
+  [[nodiscard]] virtual const CResource& mirror() const noexcept = 0;
+  [[nodiscard]] virtual CResource& mirror() noexcept = 0;
+
+ protected:
+  ResourceMirror() = default;
+  /// Gives `copy` the source's publication state (stamp, whether a reading exists, its sequence).
+  static void set_published(CResource& copy, Time stamp, bool has_reading, std::size_t sequence) noexcept;
+};
 
 /// Base of every resource. Public non-virtual methods; drivers implement the protected hooks.
 /// Threading: a resource is read and written on its control loop's thread. A driver that
@@ -53,7 +80,13 @@ class CResource {
   /// The type of the reading this resource holds (for typed lookups).
   [[nodiscard]] const std::type_info& reading_type() const noexcept { return do_reading_type(); }
 
+  /// A mirror of this resource for another thread (ResourceMirror); nullptr when its reading is
+  /// not a copyable value (a link's own state). Every TypedResource has one.
+  [[nodiscard]] std::unique_ptr<ResourceMirror> make_mirror() const { return do_make_mirror(); }
+
  protected:
+  friend class ResourceMirror;
+  virtual std::unique_ptr<ResourceMirror> do_make_mirror() const { return nullptr; }
   CResource(std::string name, Duration max_age) : name_(std::move(name)), max_age_(max_age) {}
   virtual const ModuleManifest& do_manifest() const noexcept = 0;
   virtual const std::type_info& do_reading_type() const noexcept = 0;
@@ -107,11 +140,56 @@ class TypedResource : public CResource {
  protected:
   const std::type_info& do_reading_type() const noexcept final { return typeid(Reading); }
   const ModuleManifest& do_manifest() const noexcept override { return *manifest_; }
+  std::unique_ptr<ResourceMirror> do_make_mirror() const override;
 
  private:
   const ModuleManifest* manifest_;
   Reading latest_{};
 };
+
+/// The mirror of a TypedResource<Reading>: a plain TypedResource of the same name and manifest.
+template <class Reading>
+class TypedResourceMirror final : public ResourceMirror {
+ public:
+  explicit TypedResourceMirror(const TypedResource<Reading>& source)
+      : source_(source), copy_(source.name(), source.max_age(), source.manifest()) {}
+  void publish() noexcept override {
+    if (source_.sequence() == handed_) return;
+    handed_ = source_.sequence();
+    Entry& e = buffer_.back();
+    e.reading = source_.latest();  // copy-assignment: the buffer's capacity is reused
+    e.stamp = source_.stamp();
+    e.has_reading = source_.has_reading();
+    e.sequence = handed_;
+    buffer_.publish();
+  }
+  bool refresh() override {
+    if (!buffer_.fetch()) return false;
+    const Entry& e = buffer_.front();
+    copy_.edit() = e.reading;
+    set_published(copy_, e.stamp, e.has_reading, e.sequence);
+    return true;
+  }
+  [[nodiscard]] const CResource& mirror() const noexcept override { return copy_; }
+  [[nodiscard]] CResource& mirror() noexcept override { return copy_; }
+
+ private:
+  struct Entry {
+    Reading reading{};
+    Time stamp{};
+    bool has_reading = false;
+    std::size_t sequence = 0;
+  };
+  const TypedResource<Reading>& source_;
+  std::size_t handed_ = 0;  // the source's sequence last handed over (the writer's)
+  TripleBuffer<Entry> buffer_;
+  TypedResource<Reading> copy_;  // the reader's
+};
+
+template <class Reading>
+std::unique_ptr<ResourceMirror> TypedResource<Reading>::do_make_mirror() const {
+  return std::make_unique<TypedResourceMirror<Reading>>(*this);
+}
 
 using OdometryResource = TypedResource<OdometryReading>;
 using LaserResource = TypedResource<LaserScan>;
@@ -128,6 +206,30 @@ template <> const ModuleManifest& resource_manifest<InfraredReading>() noexcept;
 template <> const ModuleManifest& resource_manifest<BumperReading>() noexcept;
 template <> const ModuleManifest& resource_manifest<BatteryReading>() noexcept;
 template <> const ModuleManifest& resource_manifest<GyroReading>() noexcept;
+
+class ResourceTable;
+
+/// The sequencing layer's copy of a ResourceTable on the wall-clock runtime: a mirror of every
+/// resource that has one (ResourceMirror), in a table of its own. publish() on the thread that
+/// writes the source table (the reactive loop's), refresh() and table() on the reader's thread.
+class ResourceSnapshot {
+ public:
+  /// Mirrors the resources of `source` present now; `source` must outlive the snapshot.
+  explicit ResourceSnapshot(const ResourceTable& source);
+  ~ResourceSnapshot();
+  ResourceSnapshot(const ResourceSnapshot&) = delete;
+  ResourceSnapshot& operator=(const ResourceSnapshot&) = delete;
+  /// Writer: hands over every resource's reading that changed. Lock-free, allocation-free once warm.
+  void publish() noexcept;
+  /// Reader: every mirror takes the newest reading handed over. Returns how many changed.
+  std::size_t refresh();
+  /// The mirrors, by the sources' names (a resource without a mirror is absent).
+  [[nodiscard]] const ResourceTable& table() const noexcept { return *table_; }
+
+ private:
+  std::vector<std::unique_ptr<ResourceMirror>> mirrors_;
+  std::unique_ptr<ResourceTable> table_;
+};
 
 /// The resources a control loop owns or references, looked up by name and reading type.
 /// Lookups are for activation time (behaviors keep the pointer); the table does not own.

@@ -3,12 +3,14 @@
 // and the reactive control loops (ControlLoop: resources -> behaviors -> coordinator -> controller at
 // each loop's period), the modules of the sequencing loop (navigation, HRI, application modules),
 // the process supervisor and the planner — and drives them by its clock: on simulated time with
-// run_until() (the caller's thread), or in real time with start() (a LoopRunner thread per reactive
-// loop, one thread for the sequencing loop). The same code runs either way. It refuses to start when
+// run_until() (the caller's thread), or on wall-clock time with start() (a thread per reactive loop,
+// one for the sequencing loop, each watching its deadlines). The same code runs either way: the
+// modules read the resources through one snapshot in both. It refuses to start when
 // an input lacks exactly one provider or a layering rule is broken.
 #pragma once
 
 #include <filesystem>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -65,6 +67,29 @@ struct RobotOptions {
 /// to `d`, located in the profile or the file they are in; returns the diagram.
 [[nodiscard]] RobotDescription check_robot(const RobotProfile& profile, const RobotPlugins& plugins, Diagnostics& d);
 
+/// What the wall-clock runtime (Robot::start) is given besides the profile's loop settings.
+struct RealtimeOptions {
+  /// Called on the sequencing thread after each of its periods, under the sequencing lock: where a
+  /// program observes the sequencing layer's state (planner, active behaviors, navigation data)
+  /// without racing it. Must not call start() or stop().
+  std::function<void(Time now)> after_sequencing;
+};
+
+/// How one of the robot's periodic threads kept its deadlines (Robot::timing()).
+struct LoopTimingReport {
+  std::string name;             ///< a reactive loop's name, or "sequencing"
+  Duration period{0};
+  Duration budget{0};
+  std::uint64_t cycles = 0;
+  std::uint64_t overruns = 0;         ///< cycles ending later than deadline + budget
+  std::uint64_t skipped_ticks = 0;    ///< ticks of the grid missed after an overrun
+  std::uint64_t deadline_faults = 0;  ///< runs of deadline_overruns overruns: "<loop>.deadline" posted
+  Duration period_error_p50{0}, period_error_p99{0}, period_error_max{0};  ///< wake time - deadline
+  Duration execution_p99{0}, execution_max{0};
+  bool realtime = false;  ///< SCHED_FIFO granted
+  std::string warning;    ///< what the thread asked and was refused (empty: all granted)
+};
+
 class Robot final {
  public:
   /// Builds the robot. Throws ConfigError listing every problem, located: those of check_robot()
@@ -87,15 +112,29 @@ class Robot final {
   /// (std::logic_error otherwise) and the robot not started.
   void run_until(Time until);
   void run_for(Duration d);
-  /// Real time: starts the hardware, a LoopRunner per reactive loop and the sequencing thread.
-  void start();
-  /// Stops the threads and the hardware; idempotent.
+  /// Wall-clock time: starts the hardware and one thread per reactive loop and one for the
+  /// sequencing loop (its modules, the supervisor and the planner), each at absolute deadlines of
+  /// the robot's clock (a ScaledClock runs a simulated robot faster than real time) with the
+  /// profile's loop settings (SCHED_FIFO, CPU, mlockall where permitted; timing() names what was
+  /// refused). The behavior loop's thread also advances the hardware (a simulator's physics)
+  /// before each cycle and hands its resources to the sequencing layer through a lock-free
+  /// snapshot after it. A run of overruns posts "<loop>.deadline" (or "sequencing.deadline") as a
+  /// fault. Throws std::logic_error when already started.
+  void start(RealtimeOptions options = {});
+  /// Stops the threads (the sequencing thread first, then the loops) and the hardware; idempotent.
   void stop() noexcept;
+  /// Each periodic thread's deadline record of the last start(): the reactive loops in profile
+  /// order, then "sequencing". Complete after stop(); empty before the first start().
+  [[nodiscard]] std::vector<LoopTimingReport> timing() const;
+  /// What the threads asked of the system and were refused, one line each (SCHED_FIFO, CPU,
+  /// mlockall); any thread, once start() has returned (until the next start()).
+  [[nodiscard]] std::vector<std::string> realtime_warnings() const;
   [[nodiscard]] bool started() const noexcept;
 
   /// One period of the sequencing loop at the clock's time (what run_until() and the sequencing
-  /// thread call): the reactive loops' reports in, the modules' update, the planner or the
-  /// supervisor, the navigation data out. The loops' changes of one period apply together.
+  /// thread call): the reactive loops' reports and deadline faults in, the resource snapshot
+  /// refreshed, the modules' update, the planner or the supervisor, the navigation data out. The
+  /// loops' changes of one period apply together.
   void step_sequencing();
 
   [[nodiscard]] const RobotDescription& description() const noexcept;
@@ -107,7 +146,10 @@ class Robot final {
   /// The reactive loop `name`; nullptr when there is none.
   [[nodiscard]] ControlLoop* loop(std::string_view name) noexcept;
   [[nodiscard]] CHardware* hardware() noexcept;
+  /// The reactive loops' resources (written on the behavior loop's thread).
   [[nodiscard]] const ResourceTable& resources() const noexcept;
+  /// The sequencing layer's copy of them (what modules read): refreshed each sequencing period.
+  [[nodiscard]] const ResourceTable& sequencing_resources() const noexcept;
   /// The navigation data the sequencing loop publishes (as of its last period).
   [[nodiscard]] const NavigationData& navigation() const noexcept;
   /// Whether the behavior `name` is active (activated by the supervisor, not yet finished).

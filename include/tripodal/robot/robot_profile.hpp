@@ -17,6 +17,7 @@
 #include "tripodal/core/manifest.hpp"
 #include "tripodal/core/petri_net.hpp"
 #include "tripodal/core/time.hpp"
+#include "tripodal/reactive/periodic_runner.hpp"
 
 namespace tripodal {
 
@@ -45,11 +46,16 @@ struct ModuleEntry {
   SourceLocation where;
 };
 
-/// A control loop: a sampling period and the controller it drives.
+/// A control loop: a sampling period, the controller it drives, and how its thread runs on the
+/// wall-clock runtime (Robot::start): `realtime_priority` (SCHED_FIFO 1..99), `cpu` (pinning),
+/// `lock_memory` (mlockall), `budget_s` (a cycle ending later than its deadline + budget is an
+/// overrun; default the period) and `deadline_overruns` (that many overruns in a row post
+/// "<loop>.deadline" as a fault; default 0: counted only).
 struct LoopEntry {
   std::string name;
   Duration period{0};
   std::string controller;
+  LoopTimingOptions timing;
   SourceLocation where;
 };
 
@@ -122,6 +128,8 @@ struct RobotProfile {
   SourceLocation where;
   /// Period of the sequencing loop (navigation modules, process supervisor, planner).
   Duration sequencing_period{std::chrono::milliseconds(50)};
+  /// The sequencing loop's thread (`robot: {sequencing_loop: {...}}`, the keys of a loop's timing).
+  LoopTimingOptions sequencing_timing;
   /// The hardware slot: `hardware: {type: sim, parameters: {...}}`; none: the robot has no
   /// hardware (a description, or a test that drives the loops itself).
   std::optional<ModuleEntry> hardware;

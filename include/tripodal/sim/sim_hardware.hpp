@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "tripodal/behaviors/gesture_behaviors.hpp"
+#include "tripodal/core/snapshot.hpp"
 #include "tripodal/hardware/buttons.hpp"
 #include "tripodal/hardware/hardware.hpp"
 #include "tripodal/navi/grid_maps.hpp"
@@ -22,9 +23,15 @@ namespace tripodal::sim {
 
 /// The simulator as the localizer's ground truth and the maps module's map: what every hardware
 /// on the simulator gives (types "sim" and the simulated "board", sim_board.hpp).
+///
+/// Threading: the hardware moves on the thread that advances it (the reactive loop's on the
+/// wall-clock runtime) and publishes the true pose after each advance through a seqlock, so
+/// true_pose() may be asked from any thread (the localizer's sequencing thread, a tool measuring
+/// the run); the world's map, regions and fault windows never change.
 class SimulatorSources : public navi::GroundTruthSource, public navi::MapSource {
  public:
-  [[nodiscard]] std::optional<Pose2D> true_pose(Time now) const override { return world_sim().true_pose(now); }
+  /// The true pose as of the last advance (any thread).
+  [[nodiscard]] std::optional<Pose2D> true_pose(Time /*now*/) const override { return truth_.load(); }
   [[nodiscard]] bool localization_lost(Time now) const noexcept override { return world_sim().localization_lost(now); }
   [[nodiscard]] const navi::OccupancyGrid& world_map() const noexcept override { return world_sim().world().grid; }
   [[nodiscard]] const navi::RegionMap& world_regions() const noexcept override { return world_sim().world().regions; }
@@ -34,6 +41,11 @@ class SimulatorSources : public navi::GroundTruthSource, public navi::MapSource 
  protected:
   ~SimulatorSources() override = default;
   [[nodiscard]] virtual const Simulator& world_sim() const noexcept = 0;
+  /// The hardware's thread, after each advance (and once at construction).
+  void publish_truth() noexcept { truth_.store(world_sim().pose()); }
+
+ private:
+  SeqlockValue<Pose2D> truth_;
 };
 
 /// Not final: an application's hardware that adds devices to the simulated base derives from it
