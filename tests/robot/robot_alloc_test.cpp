@@ -112,8 +112,7 @@ TEST_CASE("The PSR-2 robot's reactive thread allocates nothing mid-cleaning on t
   // behavior loop's thread counted over 2,000 whole cycles, the simulator's physics and the
   // snapshot's hand-over included; the sequencing thread allocates as it likes meanwhile.
   const std::filesystem::path configs = std::filesystem::path(TRIPODAL_SOURCE_DIR) / "configs";
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(configs / "worlds/workspace.yaml")));
+  RobotPlugins plugins = builtin_plugins(std::make_shared<sim::World>(sim::load_world(configs / "worlds/workspace.yaml")));
   AllocationProbe* probe = nullptr;
   plugins.resources.add(AllocationProbe::manifest_of(), [&probe](const ResourceConfig& c) {
     auto p = std::make_unique<AllocationProbe>(c.name);

@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "robot_doubles.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/navi/planning_modules.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
 #include "tripodal/robot/robot.hpp"
@@ -53,8 +54,7 @@ class FaultLog final : public SupervisorObserver {
 }  // namespace
 
 TEST_CASE("PSR-2 cleans on its own threads at 20 times real time", "[robot][threads]") {
-  RobotPlugins plugins = RobotPlugins::with_builtins();
-  sim::register_sim_hardware(plugins.hardware, std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml")));
+  RobotPlugins plugins = builtin_plugins(std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml")));
   ScaledClock clock(20.0);
   const auto robot = Robot::assemble(load_robot_profile(kConfigs / "robots/psr2.yaml"), plugins, clock);
   REQUIRE(robot->command("clean the room 3211").accepted);

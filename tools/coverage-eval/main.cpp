@@ -16,6 +16,7 @@
 #include <iostream>
 #include <map>
 #include <numbers>
+#include <numeric>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -195,7 +196,11 @@ const Pattern kPatterns[] = {Pattern::balloon, Pattern::boustrophedon, Pattern::
 
 // Area-weighted precision (each section's best-matching room over the section) and recall (each
 // room's best-matching section over the room), with the counts.
-std::string segmentation(const SectionSet& sections, const std::vector<int>& gt, int rooms) {
+struct Score {
+  double precision = 0.0;
+  double recall = 0.0;
+};
+std::string segmentation(const SectionSet& sections, const std::vector<int>& gt, int rooms, Score* score = nullptr) {
   std::map<std::pair<int, int>, std::size_t> overlap;
   std::vector<std::size_t> sec_size(sections.sections.size(), 0), room_size(static_cast<std::size_t>(rooms), 0);
   for (std::size_t i = 0; i < gt.size(); ++i) {
@@ -212,6 +217,10 @@ std::string segmentation(const SectionSet& sections, const std::vector<int>& gt,
   std::size_t ps = 0, pn = 0, rs = 0, rn = 0;
   for (std::size_t k = 0; k < sec_size.size(); ++k) ps += best_sec[k], pn += sec_size[k];
   for (std::size_t k = 0; k < room_size.size(); ++k) rs += best_room[k], rn += room_size[k];
+  if (score != nullptr) {
+    score->precision = pn > 0 ? static_cast<double>(ps) / static_cast<double>(pn) : 0.0;
+    score->recall = rn > 0 ? static_cast<double>(rs) / static_cast<double>(rn) : 0.0;
+  }
   char buf[160];
   std::snprintf(buf, sizeof buf, " %zu | %d | %.2f | %.2f |", sections.sections.size(), rooms,
                 pn > 0 ? static_cast<double>(ps) / static_cast<double>(pn) : 0.0,
@@ -288,6 +297,8 @@ void write_picture(const fs::path& file, const OccupancyGrid& grid, const Sectio
 int main(int argc, char** argv) {
   std::string ipa, workspace, pictures, rooms;
   bool segment_only = false;
+  std::vector<std::string> pattern_names;
+  double expect_precision = -1.0, expect_recall = -1.0, expect_bound = -1.0, expect_worst_bound = -1.0;
   bool verbose = false;
   int random_rooms = 0;
   CoverageOptions o;
@@ -328,6 +339,15 @@ int main(int argc, char** argv) {
                  "section splitter's sections")
       ->check(CLI::IsMember({"morphological", "distance_transform", "voronoi"}));
   app.add_flag("--segment-only", segment_only, "with --ipa: only the room segmentation's precision and recall, no coverage");
+  app.add_option("--pattern", pattern_names, "NAME: only this pattern (repeatable): balloon, boustrophedon, hybrid, distance_transform")
+      ->check(CLI::IsMember({"balloon", "boustrophedon", "hybrid", "distance_transform"}));
+  app.add_option("--expect-precision", expect_precision, "P: with --ipa, exit 1 unless the mean room precision is at least P")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--expect-recall", expect_recall, "R: with --ipa, exit 1 unless the mean room recall is at least R")->check(CLI::Range(0.0, 1.0));
+  app.add_option("--expect-bound", expect_bound, "X: with --ipa, exit 1 unless the hybrid's mean length / bound over the maps is at most X")
+      ->check(cli::positive_number());
+  app.add_option("--expect-worst-bound", expect_worst_bound, "X: with --ipa, exit 1 unless the hybrid's length / bound is at most X on every map")
+      ->check(cli::positive_number());
   if (auto code = cli::parse_command_line(
           app, "tripodal-coverage-eval",
           "exit codes: 0 ok, 1 a map could not be read or covered, 2 bad command line", argc, argv)) {
@@ -338,12 +358,17 @@ int main(int argc, char** argv) {
                  "'tripodal-coverage-eval --help' for the usage\n";
     return cli::kUsage;
   }
+  const auto wanted = [&](Pattern p) {
+    return pattern_names.empty() || std::find(pattern_names.begin(), pattern_names.end(), name_of(p)) != pattern_names.end();
+  };
+  std::string failures;
   try {
     if (!workspace.empty()) {
       const MapFile m = load_map(workspace);
       const SectionSet sections = split(m.grid, rooms).sections;
       header(false);
       for (const Pattern p : kPatterns) {
+        if (!wanted(p)) continue;
         std::vector<CoverageResult> results;
         print_row(fs::path(workspace).stem().string(), p, cover(m.grid, sections, p, o, &results), o.cleaning_width_m);
         if (!pictures.empty()) {
@@ -367,6 +392,8 @@ int main(int argc, char** argv) {
       }
       std::sort(names.begin(), names.end());
       header(true);
+      std::vector<Score> scores;
+      std::vector<double> hybrid_ratio;
       for (const std::string& name : names) {
         const Gray plan = read_png(fs::path(ipa) / (name + ".png"));
         const Gray truth = read_png(fs::path(ipa) / (name + "_gt_segmentation.png"));
@@ -377,19 +404,44 @@ int main(int argc, char** argv) {
         const std::vector<int> gt = rooms_of(truth, 400, truth_rooms);  // rooms of at least 1 m2
         char ms[32];
         std::snprintf(ms, sizeof ms, " %.1f |", cut.ms);
-        const std::string seg = (truth.width == plan.width && truth.height == plan.height ? segmentation(sections, gt, truth_rooms) : " - | - | - | - |") + ms;
+        Score score;
+        const bool comparable = truth.width == plan.width && truth.height == plan.height;
+        const std::string seg = (comparable ? segmentation(sections, gt, truth_rooms, &score) : " - | - | - | - |") + ms;
+        if (comparable) scores.push_back(score);
         if (segment_only) {
           std::printf("| %s | %s |%s\n", name.c_str(), rooms.empty() ? "splitter" : rooms.c_str(), seg.c_str());
           continue;
         }
         for (const Pattern p : kPatterns) {
+          if (!wanted(p)) continue;
           const Figures f = cover(grid, sections, p, o);
           add(p, f);
           print_row(name, p, f, o.cleaning_width_m, seg);
+          if (p == Pattern::hybrid && f.reachable_m2 > 0) hybrid_ratio.push_back(f.length_m / (f.reachable_m2 / o.cleaning_width_m));
         }
       }
+      // The expectations (a test over the ipa set: tests/app, tripodal_coverage_eval_ipa:*).
+      auto mean = [](const std::vector<double>& v) { return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size()); };
+      std::vector<double> precision, recall;
+      for (const Score& sc : scores) precision.push_back(sc.precision), recall.push_back(sc.recall);
+      std::printf("\nmean over %zu maps: precision %.3f, recall %.3f", scores.size(), mean(precision), mean(recall));
+      if (!hybrid_ratio.empty()) {
+        std::printf(", hybrid length / bound %.3f (worst %.3f)", mean(hybrid_ratio), *std::max_element(hybrid_ratio.begin(), hybrid_ratio.end()));
+      }
+      std::printf("\n");
+      if (expect_precision >= 0 && mean(precision) < expect_precision) failures += "mean precision below the expected " + std::to_string(expect_precision) + "\n";
+      if (expect_recall >= 0 && mean(recall) < expect_recall) failures += "mean recall below the expected " + std::to_string(expect_recall) + "\n";
+      if ((expect_bound > 0 || expect_worst_bound > 0) && hybrid_ratio.empty()) failures += "no hybrid figures to check (--pattern hybrid)\n";
+      if (expect_bound > 0 && !hybrid_ratio.empty() && mean(hybrid_ratio) > expect_bound) {
+        failures += "mean hybrid length / bound above the expected " + std::to_string(expect_bound) + "\n";
+      }
+      if (expect_worst_bound > 0 && !hybrid_ratio.empty() && *std::max_element(hybrid_ratio.begin(), hybrid_ratio.end()) > expect_worst_bound) {
+        failures += "worst hybrid length / bound above the expected " + std::to_string(expect_worst_bound) + "\n";
+      }
       if (!segment_only) {
-        for (const Pattern p : kPatterns) print_row("all ipa maps", p, totals[p], o.cleaning_width_m);
+        for (const Pattern p : kPatterns) {
+          if (wanted(p)) print_row("all ipa maps", p, totals[p], o.cleaning_width_m);
+        }
       }
       totals.clear();
       std::printf("\n");
@@ -399,12 +451,20 @@ int main(int argc, char** argv) {
       for (int s = 1; s <= random_rooms; ++s) {
         const OccupancyGrid grid = random_room(static_cast<unsigned>(s), 0.05);
         const SectionSet sections = CSectionSplitter().split(grid);
-        for (const Pattern p : kPatterns) add(p, cover(grid, sections, p, o));
+        for (const Pattern p : kPatterns) {
+          if (wanted(p)) add(p, cover(grid, sections, p, o));
+        }
       }
-      for (const Pattern p : kPatterns) print_row(std::to_string(random_rooms) + " random rooms", p, totals[p], o.cleaning_width_m);
+      for (const Pattern p : kPatterns) {
+        if (wanted(p)) print_row(std::to_string(random_rooms) + " random rooms", p, totals[p], o.cleaning_width_m);
+      }
     }
   } catch (const std::exception& e) {
     std::cerr << "tripodal-coverage-eval: " << e.what() << "\n";
+    return 1;
+  }
+  if (!failures.empty()) {
+    std::cerr << "tripodal-coverage-eval: " << failures;
     return 1;
   }
   return 0;
