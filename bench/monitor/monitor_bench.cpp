@@ -6,6 +6,7 @@
 //  - BM_RobotMonitorUpdate: one RobotMonitor::update() on the PSR-2 demo robot mid-cleaning (the
 //    JSON of every topic built on the robot's thread); at 20 Hz it costs 20 times this per second.
 #include <arpa/inet.h>
+#include <benchmark/benchmark.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
@@ -13,8 +14,6 @@
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-#include <benchmark/benchmark.h>
 
 #include <chrono>
 #include <memory>

@@ -180,7 +180,8 @@ const OccupancyGrid& office_floor() {
     const int w = 1400, h = 800;
     OccupancyGrid f(w, h, 0.05);
     for (int y = 0; y < h; ++y) {
-      for (int x = 0; x < w; ++x) f.set_state({x, y}, x == 0 || y == 0 || x == w - 1 || y == h - 1 ? Occupancy::occupied : Occupancy::free);
+      for (int x = 0; x < w; ++x)
+        f.set_state({x, y}, x == 0 || y == 0 || x == w - 1 || y == h - 1 ? Occupancy::occupied : Occupancy::free);
     }
     const auto wall_x = [&](int x, int y0, int y1) {
       for (int y = y0; y <= y1; ++y) f.set_state({x, y}, Occupancy::occupied);
@@ -200,7 +201,7 @@ const OccupancyGrid& office_floor() {
       }
     }
     for (const int y : {80, 280, 400, 520, 720}) wall_y(y, 1, w - 2);  // rooms 4 m deep
-    for (int x = 100; x < w - 1; x += 100) {                          // 5 m wide, between the corridors' walls
+    for (int x = 100; x < w - 1; x += 100) {                           // 5 m wide, between the corridors' walls
       wall_x(x, 1, 159);
       wall_x(x, 201, 599);
       wall_x(x, 641, h - 2);

@@ -4,4 +4,6 @@
 #include "bh_approach.hpp"
 #include "tripodal/robot/plugin_library.hpp"
 
-TRIPODAL_REGISTER_PLUGINS(plugins) { plugins.behaviors.add<example::BhApproach>(); }
+TRIPODAL_REGISTER_PLUGINS(plugins) {
+  plugins.behaviors.add<example::BhApproach>();
+}

@@ -1,7 +1,8 @@
 // A patrol robot application: the framework's types and those of the plugin its profile names (patrol_plugin.cpp)
 // on simulated time; prints the life cycle. Usage: custom_robot [PROFILE [TASK]] (exit 1: the task failed).
-#include <iostream>
 #include <spdlog/spdlog.h>
+
+#include <iostream>
 
 #include "tripodal/builtin/register_all.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
@@ -13,8 +14,8 @@ using namespace tripodal;
 int main(int argc, char** argv) try {
   spdlog::set_level(spdlog::level::warn);  // the life cycle is printed at the end, on simulated time
   const RobotProfile profile = load_robot_profile(argc > 1 ? argv[1] : PATROL_PROFILE);
-  RobotPlugins plugins = builtin_plugins();        // the framework's types,
-  (void)load_profile_plugins(profile, plugins);    // then those of the profile's plugins: [patrol_plugin.so]
+  RobotPlugins plugins = builtin_plugins();      // the framework's types,
+  (void)load_profile_plugins(profile, plugins);  // then those of the profile's plugins: [patrol_plugin.so]
   SimClock clock;
   const auto robot = Robot::assemble(profile, plugins, clock);
   LifecycleRecorder life;

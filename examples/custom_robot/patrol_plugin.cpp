@@ -10,7 +10,10 @@
 
 using namespace tripodal;
 namespace {
-struct BeaconReading { Time stamp{}; bool on = false; };  // what the beacon's driver reads: flashing and beeping?
+struct BeaconReading {
+  Time stamp{};
+  bool on = false;
+};  // what the beacon's driver reads: flashing and beeping?
 
 /// Hardware "sim_with_beacon": the simulator (parameters as "sim") and the warning beacon (LED +
 /// buzzer) its base board sounds while the base turns in place, to warn the people around.
@@ -24,6 +27,7 @@ class BeaconBase final : public sim::SimHardware {
   static const ModuleManifest& static_manifest() { return kManifest; }
   using SimHardware::SimHardware;
   [[nodiscard]] const BeaconReading& beacon() const noexcept { return beacon_; }
+
  private:
   [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return kManifest; }
   void on_advance_to(Time now) noexcept override {
@@ -37,13 +41,17 @@ class BeaconBase final : public sim::SimHardware {
 /// Resource type "BeaconResource": the beacon's driver, which the reactive loop polls every cycle.
 class BeaconResource final : public TypedResource<BeaconReading> {
  public:
-  static inline const ModuleManifest kManifest =
-      ManifestBuilder("BeaconResource", ModuleKind::resource).description("the beacon").input("beacon_state").output("beacon").build();
+  static inline const ModuleManifest kManifest = ManifestBuilder("BeaconResource", ModuleKind::resource)
+                                                     .description("the beacon")
+                                                     .input("beacon_state")
+                                                     .output("beacon")
+                                                     .build();
   static const ModuleManifest& static_manifest() { return kManifest; }
   explicit BeaconResource(const ResourceConfig& c)
       : TypedResource(c.name, Duration{0}, kManifest), board_(dynamic_cast<const BeaconBase*>(c.hardware)) {
     if (board_ == nullptr) throw ConfigError(c.where, "resource '" + c.name + "' reads the beacon of hardware 'sim_with_beacon'");
   }
+
  private:
   void on_poll(Time /*now*/) noexcept override { publish(board_->beacon()); }
   const BeaconBase* board_;
@@ -52,11 +60,12 @@ class BeaconResource final : public TypedResource<BeaconReading> {
 /// BhAnnounce: announces an arrival by turning in place until the beacon has sounded for beacon_s.
 class BhAnnounce final : public CBehavior {
  public:
-  static inline const ModuleManifest kManifest = behavior_manifest(
-      "BhAnnounce", "turns in place until the beacon has sounded beacon_s", {"beacon"},
-      {parameter::number("yaw_rate_rad_s", 1.0, "rad/s", "turn rate", 0.5),
-       parameter::number("beacon_s", 3.0, "s", "beacon time")});
+  static inline const ModuleManifest kManifest =
+      behavior_manifest("BhAnnounce", "turns in place until the beacon has sounded beacon_s", {"beacon"},
+                        {parameter::number("yaw_rate_rad_s", 1.0, "rad/s", "turn rate", 0.5),
+                         parameter::number("beacon_s", 3.0, "s", "beacon time")});
   static const ModuleManifest& static_manifest() { return kManifest; }
+
  private:
   [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return kManifest; }
   void on_activate(const ParameterSet& params, const BehaviorContext& context) override {
@@ -76,10 +85,11 @@ class BhAnnounce final : public CBehavior {
 /// Navigation module "RoomWatcher": posts room.entered when the pose estimate enters another room.
 class RoomWatcher final : public navi::CNaviModules {
  public:
-  static inline const ModuleManifest kManifest = navi::navi_manifest(
-      "RoomWatcher", "posts room.entered on entering another room", {"map_from_base", "grid_map"}, {"room.entered"}, {});
+  static inline const ModuleManifest kManifest = navi::navi_manifest("RoomWatcher", "posts room.entered on entering another room",
+                                                                     {"map_from_base", "grid_map"}, {"room.entered"}, {});
   static const ModuleManifest& static_manifest() { return kManifest; }
   [[nodiscard]] const std::string& room() const noexcept { return room_; }
+
  private:
   [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return kManifest; }
   void on_start(ModuleContext& context) override {
@@ -101,6 +111,7 @@ class PrAnnounce final : public CProcess {
  public:
   static ModuleManifest static_manifest() { return ManifestBuilder("announce", ModuleKind::process, Layer::sequencing).build(); }
   using CProcess::CProcess;
+
  private:
   std::string on_bind(ParameterValues& values) const override {
     const double turns = std::get<double>(values.at("turns")), rate_rad_s = std::get<double>(values.at("yaw_rate_rad_s"));

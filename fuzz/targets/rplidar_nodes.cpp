@@ -54,7 +54,8 @@ TRIPODAL_FUZZ_TARGET(bytes) {
       const LaserScan& scan = assembler.scan();
       fuzz::require(scan.ranges_m.size() == config.beams, "a scan has its configured beams");
       for (const float r : scan.ranges_m) {
-        fuzz::require(std::isinf(r) || (r >= config.range_min_m - 1e-6 && r <= config.range_max_m + 1e-6), "a range is a return or none");
+        fuzz::require(std::isinf(r) || (r >= config.range_min_m - 1e-6 && r <= config.range_max_m + 1e-6),
+                      "a range is a return or none");
       }
     }
   }

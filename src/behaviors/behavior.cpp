@@ -32,9 +32,9 @@ void CBehavior::activate(const ParameterSet& params, const BehaviorContext& cont
                                             " channel writes, at most " + std::to_string(kMaxBehaviorChannels));
   }
   for (std::size_t i = 0; i < kMaxBehaviorChannels; ++i) {
-    channel_names_[i] = i >= writes.size()                ? std::string()
-                        : writes[i].parameter.empty()     ? writes[i].name
-                                                          : params.string(writes[i].parameter);
+    channel_names_[i] = i >= writes.size()            ? std::string()
+                        : writes[i].parameter.empty() ? writes[i].name
+                                                      : params.string(writes[i].parameter);
   }
   // Running before on_activate() so that a hook reporting an immediate outcome (goal already
   // reached, resource missing) is not overwritten.

@@ -1,9 +1,8 @@
 #include "tripodal/behaviors/behavior_registry.hpp"
 
-#include "tripodal/behaviors/safety_behaviors.hpp"
-
 #include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/behaviors/navigation_behaviors.hpp"
+#include "tripodal/behaviors/safety_behaviors.hpp"
 
 namespace tripodal {
 

@@ -123,7 +123,8 @@ std::optional<Twist2D> BhFaceVisitor::on_step(const BehaviorContext& context) no
 const ModuleManifest& BhNeckGesture::static_manifest() {
   static const ModuleManifest m = [] {
     ModuleManifest r = behavior_manifest(
-        "BhNeckGesture", "moves a neck or arm joint to a position (a gesture: look at the visitor, at an exhibit)", {"joint_state"},
+        "BhNeckGesture", "moves a neck or arm joint to a position (a gesture: look at the visitor, at an exhibit)",
+        {"joint_state"},
         {parameter::number("angle_deg", 0.0, "deg", "the joint's target position", -360.0, 360.0),
          parameter::number("tolerance_deg", 1.0, "deg", "success within this of the target, the joint stopped", 1e-3, 45.0),
          parameter::number("timeout_s", 10.0, "s", "fail when the joint has not arrived by then", 0.1),

@@ -370,7 +370,8 @@ Twist2D CPathFollowingBehavior::command_toward(const Pose2D& pose, const PathTra
   double speed = speed_ * std::clamp(std::cos(std::min(target.corner_rad, kPi / 2.0)), 0.35, 1.0);
   speed = std::min(speed, std::max(0.05, 1.5 * (target.remaining_m + dist)));
   // The path's own limit on this leg (a disinfection lane's speed for its dose).
-  if (const NavigationData* n = context.navi; n != nullptr && n->path_id == path_id_ && tracker_.segment() < n->path_speed_m_s.size()) {
+  if (const NavigationData* n = context.navi;
+      n != nullptr && n->path_id == path_id_ && tracker_.segment() < n->path_speed_m_s.size()) {
     speed = std::min(speed, n->path_speed_m_s[tracker_.segment()]);
   }
   if (dist < 1e-6) return cmd;

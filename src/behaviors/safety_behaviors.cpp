@@ -20,8 +20,8 @@ using parameter::text;
 constexpr std::array<double, 3> kBeyond_m{0.0, 0.35, 0.7};  // hazard points ahead of a cliff sensor
 
 // "a, b, c" or "x,y; x,y": numbers in groups of `per` (1 or 2); ConfigError naming the parameter.
-std::vector<double> parse_numbers(const std::string& value, std::size_t per, std::size_t max_groups,
-                                  std::string_view behavior, std::string_view parameter) {
+std::vector<double> parse_numbers(const std::string& value, std::size_t per, std::size_t max_groups, std::string_view behavior,
+                                  std::string_view parameter) {
   std::vector<double> out;
   std::string cleaned = value;
   std::replace(cleaned.begin(), cleaned.end(), ';', ' ');
@@ -37,17 +37,16 @@ std::vector<double> parse_numbers(const std::string& value, std::size_t per, std
       used = 0;
     }
     if (used != word.size() || !std::isfinite(v)) {
-      throw ConfigError(SourceLocation{}, std::string(behavior) + ": parameter '" + std::string(parameter) +
-                                              "': '" + word + "' is not a number (in '" + value + "')");
+      throw ConfigError(SourceLocation{}, std::string(behavior) + ": parameter '" + std::string(parameter) + "': '" + word +
+                                              "' is not a number (in '" + value + "')");
     }
     out.push_back(v);
   }
   if (out.empty() || out.size() % per != 0 || out.size() / per > max_groups) {
-    throw ConfigError(
-        SourceLocation{},
-        std::string(behavior) + ": parameter '" + std::string(parameter) + "' is '" + value +
-            "'; expected 1 to " + std::to_string(max_groups) +
-            (per == 2 ? " positions \"x,y; x,y; ...\" (body frame, m)" : " numbers \"a, b, ...\""));
+    throw ConfigError(SourceLocation{},
+                      std::string(behavior) + ": parameter '" + std::string(parameter) + "' is '" + value + "'; expected 1 to " +
+                          std::to_string(max_groups) +
+                          (per == 2 ? " positions \"x,y; x,y; ...\" (body frame, m)" : " numbers \"a, b, ...\""));
   }
   return out;
 }
@@ -61,26 +60,22 @@ BackOffReflex::Options reflex_options(const ParameterSet& params) {
   o.max_back_off_m = params.number("max_back_off_m");
   if (o.max_back_off_m < o.back_off_m) {
     throw ConfigError(SourceLocation{}, "max_back_off_m (" + std::to_string(o.max_back_off_m) +
-                                            ") must be at least back_off_m (" + std::to_string(o.back_off_m) +
-                                            ")");
+                                            ") must be at least back_off_m (" + std::to_string(o.back_off_m) + ")");
   }
   return o;
 }
 
 std::vector<ParameterSpec> reflex_parameters(double back_off_m) {
-  return {
-      number("back_off_m", back_off_m, "m", "how far to back straight away once triggered", 0.0, 1.0),
-      parameter::positive("back_speed_m_s", 0.1, "m/s", "backing speed"),
-      number("max_back_off_m", 0.4, "m", "backing while the sensor still fires stops here (a sensor stuck)",
-             0.0, 2.0),
-      number(
-          "hold_s", 12.0, "s",
-          "after backing, no forward translation this long (rotation free): the path follower counts itself "
-          "blocked and the sequencing layer plans around the hazard; longer than its blocked timeout, so "
-          "with no way around it gives up",
-          0.0, 600.0),
-      number("release_turn_rad", 1.0, "rad",
-             "the hold ends once the robot has turned this far away (toward a detour)", 0.0, 3.2)};
+  return {number("back_off_m", back_off_m, "m", "how far to back straight away once triggered", 0.0, 1.0),
+          parameter::positive("back_speed_m_s", 0.1, "m/s", "backing speed"),
+          number("max_back_off_m", 0.4, "m", "backing while the sensor still fires stops here (a sensor stuck)", 0.0, 2.0),
+          number("hold_s", 12.0, "s",
+                 "after backing, no forward translation this long (rotation free): the path follower counts itself "
+                 "blocked and the sequencing layer plans around the hazard; longer than its blocked timeout, so "
+                 "with no way around it gives up",
+                 0.0, 600.0),
+          number("release_turn_rad", 1.0, "rad", "the hold ends once the robot has turned this far away (toward a detour)", 0.0,
+                 3.2)};
 }
 
 Pose2D to_map(const Pose2D& map_from_base, double bx, double by) noexcept {
@@ -89,8 +84,7 @@ Pose2D to_map(const Pose2D& map_from_base, double bx, double by) noexcept {
 }
 
 template <std::size_t N>
-void report_hazards(const BehaviorContext& context, const std::array<Pose2D, N>& hazards,
-                    std::size_t count) noexcept {
+void report_hazards(const BehaviorContext& context, const std::array<Pose2D, N>& hazards, std::size_t count) noexcept {
   if (context.feedback == nullptr) return;
   for (std::size_t i = 0; i < count; ++i) context.feedback->add_hazard(hazards[i].x_m, hazards[i].y_m);
 }
@@ -113,8 +107,8 @@ bool BackOffReflex::update(bool triggered, Time now, double heading_rad) noexcep
     hold_until_ = now + from_seconds(options_.hold_s);
   }
   if (phase_ == Phase::holding &&
-      (now >= hold_until_ || std::abs(std::remainder(heading_rad - heading0_rad_, 2.0 * std::numbers::pi)) >
-                                 options_.release_turn_rad)) {
+      (now >= hold_until_ ||
+       std::abs(std::remainder(heading_rad - heading0_rad_, 2.0 * std::numbers::pi)) > options_.release_turn_rad)) {
     phase_ = Phase::idle;
   }
   return fresh;
@@ -146,19 +140,17 @@ std::optional<VelocityEnvelope> BackOffReflex::envelope(Time now) const noexcept
 
 const ModuleManifest& BhCliffGuard::static_manifest() {
   static const ModuleManifest m = [] {
-    std::vector<ParameterSpec> p{
-        text("cliff", "", "infrared resource whose cliff bits are watched (empty: the first one)"),
-        text("sensors", "0.2,0; 0.1,0.17; 0.1,-0.17",
-             "the cliff sensors' places on the chassis, \"x,y; ...\" (body frame, m), in the resource's "
-             "order: where a "
-             "drop was seen"),
-        text("event", "cliff", "the net event raised once per detection")};
+    std::vector<ParameterSpec> p{text("cliff", "", "infrared resource whose cliff bits are watched (empty: the first one)"),
+                                 text("sensors", "0.2,0; 0.1,0.17; 0.1,-0.17",
+                                      "the cliff sensors' places on the chassis, \"x,y; ...\" (body frame, m), in the resource's "
+                                      "order: where a "
+                                      "drop was seen"),
+                                 text("event", "cliff", "the net event raised once per detection")};
     for (ParameterSpec& s : reflex_parameters(0.12)) p.push_back(std::move(s));
-    return behavior_manifest(
-        "BhCliffGuard",
-        "cliff safety reflex: on a cliff bit stops, backs straight off, holds forward motion and "
-        "raises `cliff`",
-        {"cliff"}, std::move(p));
+    return behavior_manifest("BhCliffGuard",
+                             "cliff safety reflex: on a cliff bit stops, backs straight off, holds forward motion and "
+                             "raises `cliff`",
+                             {"cliff"}, std::move(p));
   }();
   return m;
 }
@@ -168,8 +160,7 @@ void BhCliffGuard::on_activate(const ParameterSet& params, const BehaviorContext
   cliff_ = context.resources == nullptr ? nullptr
            : name.empty()               ? context.resources->first<InfraredReading>()
                                         : context.resources->find<InfraredReading>(name);
-  const std::vector<double> xy =
-      parse_numbers(params.string("sensors"), 2, kMaxSensors, "BhCliffGuard", "sensors");
+  const std::vector<double> xy = parse_numbers(params.string("sensors"), 2, kMaxSensors, "BhCliffGuard", "sensors");
   sensor_count_ = xy.size() / 2;
   for (std::size_t i = 0; i < sensor_count_; ++i) sensors_[i] = {xy[2 * i], xy[2 * i + 1], 0.0};
   event_ = params.string("event");
@@ -194,8 +185,7 @@ std::optional<Twist2D> BhCliffGuard::on_step(const BehaviorContext& context) noe
         if (bits[i] == 0) continue;
         for (const double ahead : kBeyond_m) {
           if (hazard_count_ < hazards_.size()) {
-            hazards_[hazard_count_++] =
-                to_map(context.navi->map_from_base, sensors_[i].x_m + ahead, sensors_[i].y_m);
+            hazards_[hazard_count_++] = to_map(context.navi->map_from_base, sensors_[i].x_m + ahead, sensors_[i].y_m);
           }
         }
       }
@@ -216,15 +206,12 @@ const ModuleManifest& BhBumperGuard::static_manifest() {
   static const ModuleManifest m = [] {
     std::vector<ParameterSpec> p{
         text("bumpers", "", "bumper resource watched (empty: the first one)"),
-        number("back_mask", 4.0, "", "bits of the bump switches at the back (pressed alone: no backing)", 0.0,
-               255.0),
-        number("sectors", 4.0, "",
-               "the switches' equal sectors round the body, sector 0 ahead (for the contact's place)", 1.0,
+        number("back_mask", 4.0, "", "bits of the bump switches at the back (pressed alone: no backing)", 0.0, 255.0),
+        number("sectors", 4.0, "", "the switches' equal sectors round the body, sector 0 ahead (for the contact's place)", 1.0,
                32.0),
         number("robot_radius_m", 0.25, "m", "radius of the circular footprint", 0.0, 5.0)};
     for (ParameterSpec& s : reflex_parameters(0.1)) p.push_back(std::move(s));
-    return behavior_manifest("BhBumperGuard",
-                             "bump safety reflex: a front bump switch stops the robot and backs it off",
+    return behavior_manifest("BhBumperGuard", "bump safety reflex: a front bump switch stops the robot and backs it off",
                              {"bumpers"}, std::move(p));
   }();
   return m;
@@ -257,8 +244,7 @@ std::optional<Twist2D> BhBumperGuard::on_step(const BehaviorContext& context) no
       hazards_[hazard_count_++] = to_map(context.navi->map_from_base, r * std::cos(a), r * std::sin(a));
     }
   }
-  (void)reflex_.update(front != 0, context.now,
-                       context.navi != nullptr ? context.navi->map_from_base.theta_rad : 0.0);
+  (void)reflex_.update(front != 0, context.now, context.navi != nullptr ? context.navi->map_from_base.theta_rad : 0.0);
   std::optional<VelocityEnvelope> e = reflex_.envelope(context.now);
   if (!e) hazard_count_ = 0;
   if ((pressed & back_mask_) != 0) {
@@ -285,13 +271,11 @@ const ModuleManifest& BhSonarGuard::static_manifest() {
        text("angles_rad", "-0.5236, 0, 0.5236",
             "the transducers' directions on the rim (body frame, rad), in the resource's order"),
        number("cone_rad", 0.26, "rad", "full beam angle of a transducer", 0.0, 3.0),
-       number("robot_radius_m", 0.25, "m", "radius of the circular footprint (the transducers sit on it)",
-              0.0, 5.0),
+       number("robot_radius_m", 0.25, "m", "radius of the circular footprint (the transducers sit on it)", 0.0, 5.0),
        number("stop_distance_m", 0.1, "m", "no forward motion with this little clearance ahead", 0.0, 2.0),
        number("slow_distance_m", 0.6, "m", "full speed allowed beyond this clearance", 0.0, 5.0),
        number("max_speed_m_s", 0.5, "m/s", "speed allowed at slow_distance_m and beyond", 0.0, 5.0),
-       number("corridor_margin_m", 0.03, "m",
-              "the corridor ahead is the footprint's width plus this each side", 0.0, 1.0)});
+       number("corridor_margin_m", 0.03, "m", "the corridor ahead is the footprint's width plus this each side", 0.0, 1.0)});
   return m;
 }
 
@@ -300,8 +284,7 @@ void BhSonarGuard::on_activate(const ParameterSet& params, const BehaviorContext
   sonar_ = context.resources == nullptr ? nullptr
            : name.empty()               ? context.resources->first<SonarReading>()
                                         : context.resources->find<SonarReading>(name);
-  const std::vector<double> a =
-      parse_numbers(params.string("angles_rad"), 1, kMaxTransducers, "BhSonarGuard", "angles_rad");
+  const std::vector<double> a = parse_numbers(params.string("angles_rad"), 1, kMaxTransducers, "BhSonarGuard", "angles_rad");
   angle_count_ = a.size();
   std::copy(a.begin(), a.end(), angles_.begin());
   radius_m_ = params.number("robot_radius_m");
@@ -335,8 +318,7 @@ std::optional<Twist2D> BhSonarGuard::on_step(const BehaviorContext& context) noe
     if (x <= 0.0 || std::abs(y) > r + margin_m_) continue;  // beside the corridor the body sweeps
     const double m = r + d;
     if (context.navi != nullptr && context.navi->map != nullptr) {
-      const Pose2D on_axis =
-          to_map(context.navi->map_from_base, m * std::cos(angles_[i]), m * std::sin(angles_[i]));
+      const Pose2D on_axis = to_map(context.navi->map_from_base, m * std::cos(angles_[i]), m * std::sin(angles_[i]));
       const Pose2D nearest = to_map(context.navi->map_from_base, x, y);
       if (context.navi->map->near_obstacle(on_axis.x_m, on_axis.y_m) ||
           context.navi->map->near_obstacle(nearest.x_m, nearest.y_m))
@@ -345,8 +327,7 @@ std::optional<Twist2D> BhSonarGuard::on_step(const BehaviorContext& context) noe
     const double c = x - std::sqrt(std::max(0.0, r * r - std::min(r * r, y * y)));
     clearance = std::min(clearance, c);
     if (c <= stop_m_ + 0.05 && context.feedback != nullptr && context.navi != nullptr) {
-      const Pose2D p =
-          to_map(context.navi->map_from_base, m * std::cos(angles_[i]), m * std::sin(angles_[i]));
+      const Pose2D p = to_map(context.navi->map_from_base, m * std::cos(angles_[i]), m * std::sin(angles_[i]));
       context.feedback->add_hazard(p.x_m, p.y_m);
     }
   }

@@ -46,6 +46,8 @@ std::optional<Twist2D> BhTeleop::on_step(const BehaviorContext& /*context*/) noe
   return r.command;
 }
 
-void register_teleop_behavior(BehaviorRegistry& registry) { registry.add<BhTeleop>(); }
+void register_teleop_behavior(BehaviorRegistry& registry) {
+  registry.add<BhTeleop>();
+}
 
 }  // namespace tripodal

@@ -18,7 +18,8 @@ std::optional<Twist2D> BhUvLamp::on_step(const BehaviorContext& /*context*/) noe
 const ModuleManifest& BhAtomize::static_manifest() {
   static const ModuleManifest m =
       ManifestBuilder("BhAtomize", ModuleKind::behavior)
-          .description("dry fog while active: the atomizer and its fan (channels atomizer, atomizer_fan: the board's command 0x30)")
+          .description(
+              "dry fog while active: the atomizer and its fan (channels atomizer, atomizer_fan: the board's command 0x30)")
           .writes("atomizer", ChannelType::analog, "full fog while active")
           .writes("atomizer_fan", ChannelType::digital, "the fan, as parameter fan says")
           .flag("fan", true, "run the fan that carries the fog")
@@ -26,7 +27,9 @@ const ModuleManifest& BhAtomize::static_manifest() {
   return m;
 }
 
-void BhAtomize::on_activate(const ParameterSet& params, const BehaviorContext& /*context*/) { fan_ = params.boolean("fan"); }
+void BhAtomize::on_activate(const ParameterSet& params, const BehaviorContext& /*context*/) {
+  fan_ = params.boolean("fan");
+}
 
 std::optional<Twist2D> BhAtomize::on_step(const BehaviorContext& /*context*/) noexcept {
   write_channel(0, ChannelValue::of(1.0));
@@ -43,7 +46,9 @@ const ModuleManifest& BhVoicePrompt::static_manifest() {
   return m;
 }
 
-void BhVoicePrompt::on_activate(const ParameterSet& params, const BehaviorContext& /*context*/) { track_ = params.number("track"); }
+void BhVoicePrompt::on_activate(const ParameterSet& params, const BehaviorContext& /*context*/) {
+  track_ = params.number("track");
+}
 
 std::optional<Twist2D> BhVoicePrompt::on_step(const BehaviorContext& /*context*/) noexcept {
   if (steps() > 1) {
@@ -55,11 +60,12 @@ std::optional<Twist2D> BhVoicePrompt::on_step(const BehaviorContext& /*context*/
 }
 
 const ModuleManifest& BhLcdText::static_manifest() {
-  static const ModuleManifest m = ManifestBuilder("BhLcdText", ModuleKind::behavior)
-                                      .description("a text on the LCD's first line while active (channel lcd: the board's command 0x33)")
-                                      .writes("lcd", ChannelType::text, "the text")
-                                      .text("text", std::nullopt, "at most 32 characters (longer is cut)")
-                                      .build();
+  static const ModuleManifest m =
+      ManifestBuilder("BhLcdText", ModuleKind::behavior)
+          .description("a text on the LCD's first line while active (channel lcd: the board's command 0x33)")
+          .writes("lcd", ChannelType::text, "the text")
+          .text("text", std::nullopt, "at most 32 characters (longer is cut)")
+          .build();
   return m;
 }
 

@@ -1,12 +1,12 @@
 #include "tripodal/board/board_hardware.hpp"
 
-#include "tripodal/board/tcp_stream.hpp"
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <typeinfo>
+
+#include "tripodal/board/tcp_stream.hpp"
 
 namespace tripodal::board {
 
@@ -37,33 +37,52 @@ const ModuleManifest& BoardHardware::static_manifest() {
   static const ModuleManifest m = hardware_manifest(
       "board", "a differential base behind the disinfection robot's control board (UART or TCP, docs/board-protocol.md)",
       {"odometry", "battery", "sonar", "cliff", "bumpers", "board_link", "laser_scan"},
-      {ParameterSpec{"port", ValueType::string, Value{std::string()}, "",
-                     "the board's tty (e.g. /dev/ttyUSB0), or tcp://HOST:PORT for its ESP8266 Wi-Fi link", {}, {}},
-       ParameterSpec{"protocol", ValueType::string, Value{std::string("thesis")}, "",
-                     "the board's protocol profile: thesis, tripodal-v1 or a YAML file (configs/board/)", {}, {}},
+      {ParameterSpec{"port",
+                     ValueType::string,
+                     Value{std::string()},
+                     "",
+                     "the board's tty (e.g. /dev/ttyUSB0), or tcp://HOST:PORT for its ESP8266 Wi-Fi link",
+                     {},
+                     {}},
+       ParameterSpec{"protocol",
+                     ValueType::string,
+                     Value{std::string("thesis")},
+                     "",
+                     "the board's protocol profile: thesis, tripodal-v1 or a YAML file (configs/board/)",
+                     {},
+                     {}},
        ParameterSpec{"baud", ValueType::number, Value{115200.0}, "bit/s", "line rate", 9600.0, 921600.0},
-       ParameterSpec{"pulses_per_m", ValueType::number, Value{5000.0}, "1/m", "encoder pulses per metre of wheel travel", 1.0, 1e6},
-       ParameterSpec{"response_timeout_s", ValueType::number, Value{0.01}, "s", "a response later than this is missed", 0.001, 1.0},
-       ParameterSpec{"max_missed", ValueType::number, Value{1.0}, "", "consecutive missed responses that lose the link", 1.0, 100.0},
-       ParameterSpec{"lidar_port", ValueType::string, Value{std::string()}, "",
+       ParameterSpec{"pulses_per_m", ValueType::number, Value{5000.0}, "1/m", "encoder pulses per metre of wheel travel", 1.0,
+                     1e6},
+       ParameterSpec{"response_timeout_s", ValueType::number, Value{0.01}, "s", "a response later than this is missed", 0.001,
+                     1.0},
+       ParameterSpec{"max_missed", ValueType::number, Value{1.0}, "", "consecutive missed responses that lose the link", 1.0,
+                     100.0},
+       ParameterSpec{"lidar_port",
+                     ValueType::string,
+                     Value{std::string()},
+                     "",
                      "the RPLIDAR A1's tty (e.g. /dev/ttyUSB1, or the path tripodal-board-sim --lidar made): the laser "
-                     "resource 'laser' (docs/lidar.md); empty: no lidar", {}, {}},
-       ParameterSpec{"lidar_timeout_s", ValueType::number, Value{1.0}, "s", "no lidar revolution for this long is the laser's fault",
-                     0.05, 60.0},
-       ParameterSpec{"lidar_beams", ValueType::number, Value{360.0}, "", "bins of the laser scan over a full turn", 8.0, 8192.0}});
+                     "resource 'laser' (docs/lidar.md); empty: no lidar",
+                     {},
+                     {}},
+       ParameterSpec{"lidar_timeout_s", ValueType::number, Value{1.0}, "s",
+                     "no lidar revolution for this long is the laser's fault", 0.05, 60.0},
+       ParameterSpec{"lidar_beams", ValueType::number, Value{360.0}, "", "bins of the laser scan over a full turn", 8.0,
+                     8192.0}});
   static const ModuleManifest with_channels = [] {
     ModuleManifest r = m;
     // In this order: BoardHardware::apply_channels() goes by index (kUvLamp ...).
-    r.command_channels = {
-        ChannelSpec{"uv_lamp", ChannelType::digital, ChannelValue::of(false), false, Duration{0}, 0.0, 0.0, "", "the UV lamp (command 0x31)"},
-        ChannelSpec{"atomizer", ChannelType::analog, ChannelValue::of(0.0), false, Duration{0}, 0.0, 1.0, "",
-                    "the atomizer's dry fog, on above 0 (command 0x30)"},
-        ChannelSpec{"atomizer_fan", ChannelType::digital, ChannelValue::of(false), false, Duration{0}, 0.0, 0.0, "",
-                    "the fan that carries the fog, with the atomizer only (command 0x30)"},
-        ChannelSpec{"voice", ChannelType::track, ChannelValue::of(0.0), false, Duration{0}, 0.0, 255.0, "",
-                    "the WT2003S track to play, played when it changes to a track > 0 (command 0x32)"},
-        ChannelSpec{"lcd", ChannelType::text, ChannelValue::of_text(""), false, Duration{0}, 0.0, 0.0, "",
-                    "the LCD's first line, sent when it changes (command 0x33)"}};
+    r.command_channels = {ChannelSpec{"uv_lamp", ChannelType::digital, ChannelValue::of(false), false, Duration{0}, 0.0, 0.0, "",
+                                      "the UV lamp (command 0x31)"},
+                          ChannelSpec{"atomizer", ChannelType::analog, ChannelValue::of(0.0), false, Duration{0}, 0.0, 1.0, "",
+                                      "the atomizer's dry fog, on above 0 (command 0x30)"},
+                          ChannelSpec{"atomizer_fan", ChannelType::digital, ChannelValue::of(false), false, Duration{0}, 0.0, 0.0,
+                                      "", "the fan that carries the fog, with the atomizer only (command 0x30)"},
+                          ChannelSpec{"voice", ChannelType::track, ChannelValue::of(0.0), false, Duration{0}, 0.0, 255.0, "",
+                                      "the WT2003S track to play, played when it changes to a track > 0 (command 0x32)"},
+                          ChannelSpec{"lcd", ChannelType::text, ChannelValue::of_text(""), false, Duration{0}, 0.0, 0.0, "",
+                                      "the LCD's first line, sent when it changes (command 0x33)"}};
     return r;
   }();
   return with_channels;
@@ -74,7 +93,10 @@ enum ChannelIndex : std::size_t { kUvLamp, kAtomizer, kAtomizerFan, kVoice, kLcd
 }  // namespace
 
 BoardHardware::BoardHardware(ByteStream& stream, const BoardHardwareConfig& config, std::unique_ptr<ByteStream> owned)
-    : owned_(std::move(owned)), config_(config), link_(stream, config.link), link_resource_(std::make_unique<LinkResource>(*this)) {
+    : owned_(std::move(owned)),
+      config_(config),
+      link_(stream, config.link),
+      link_resource_(std::make_unique<LinkResource>(*this)) {
   for (const ChannelSpec& c : static_manifest().command_channels) applied_.at(export_channel(c)) = c.safe;
 }
 
@@ -105,12 +127,14 @@ void BoardHardware::apply_channels() noexcept {
   auto changed = [&](std::size_t i) noexcept { return !(ch.value(i) == applied_[i]); };
   if (changed(kUvLamp)) {
     const bool on = ch.value(kUvLamp).on();
-    if (link_.queue(Command::uv_lamp, std::array<std::uint8_t, 1>{static_cast<std::uint8_t>(on ? 1 : 0)})) applied_[kUvLamp] = ch.value(kUvLamp);
+    if (link_.queue(Command::uv_lamp, std::array<std::uint8_t, 1>{static_cast<std::uint8_t>(on ? 1 : 0)}))
+      applied_[kUvLamp] = ch.value(kUvLamp);
   }
   if (changed(kAtomizer) || changed(kAtomizerFan)) {
     const bool fog = ch.value(kAtomizer).number > 0.0;
     const bool fan = fog && ch.value(kAtomizerFan).on();
-    if (link_.queue(Command::atomizer, std::array<std::uint8_t, 2>{static_cast<std::uint8_t>(fog ? 1 : 0), static_cast<std::uint8_t>(fan ? 1 : 0)})) {
+    if (link_.queue(Command::atomizer, std::array<std::uint8_t, 2>{static_cast<std::uint8_t>(fog ? 1 : 0),
+                                                                   static_cast<std::uint8_t>(fan ? 1 : 0)})) {
       applied_[kAtomizer] = ch.value(kAtomizer);
       applied_[kAtomizerFan] = ch.value(kAtomizerFan);
     }
@@ -126,7 +150,8 @@ void BoardHardware::apply_channels() noexcept {
     const std::string_view text = ch.value(kLcd).text();
     std::array<std::uint8_t, 1 + kChannelTextCapacity> payload{};  // line 0, then the text
     std::copy(text.begin(), text.end(), payload.begin() + 1);
-    if (link_.queue(Command::lcd_text, std::span<const std::uint8_t>(payload.data(), 1 + text.size()))) applied_[kLcd] = ch.value(kLcd);
+    if (link_.queue(Command::lcd_text, std::span<const std::uint8_t>(payload.data(), 1 + text.size())))
+      applied_[kLcd] = ch.value(kLcd);
   }
 }
 

@@ -1,12 +1,12 @@
 #include "tripodal/board/rplidar_a1.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
 #include <system_error>
-
-#include <fmt/format.h>
 
 namespace tripodal::board {
 namespace {
@@ -31,7 +31,8 @@ class DtrMotor final : public MotorSwitch {
 
 std::string hex_prefix(std::span<const std::uint8_t> bytes) {
   std::string s;
-  for (std::size_t i = 0; i < std::min<std::size_t>(bytes.size(), 8); ++i) s += fmt::format("{}{:02X}", i == 0 ? "" : " ", bytes[i]);
+  for (std::size_t i = 0; i < std::min<std::size_t>(bytes.size(), 8); ++i)
+    s += fmt::format("{}{:02X}", i == 0 ? "" : " ", bytes[i]);
   if (bytes.size() > 8) s += " ...";
   return s;
 }
@@ -44,13 +45,20 @@ std::string describe(const rplidar::Descriptor& d) {
 
 std::string_view to_string(RplidarA1::State s) noexcept {
   switch (s) {
-    case RplidarA1::State::starting: return "starting";
-    case RplidarA1::State::awaiting_info: return "awaiting GET_INFO";
-    case RplidarA1::State::awaiting_health: return "awaiting GET_HEALTH";
-    case RplidarA1::State::awaiting_scan: return "awaiting SCAN";
-    case RplidarA1::State::scanning: return "scanning";
-    case RplidarA1::State::stalled: return "stalled";
-    case RplidarA1::State::failed: return "failed";
+    case RplidarA1::State::starting:
+      return "starting";
+    case RplidarA1::State::awaiting_info:
+      return "awaiting GET_INFO";
+    case RplidarA1::State::awaiting_health:
+      return "awaiting GET_HEALTH";
+    case RplidarA1::State::awaiting_scan:
+      return "awaiting SCAN";
+    case RplidarA1::State::scanning:
+      return "scanning";
+    case RplidarA1::State::stalled:
+      return "stalled";
+    case RplidarA1::State::failed:
+      return "failed";
   }
   return "?";
 }
@@ -58,7 +66,8 @@ std::string_view to_string(RplidarA1::State s) noexcept {
 const ModuleManifest& RplidarA1::static_manifest() {
   static const ModuleManifest m =
       ManifestBuilder("RplidarA1", ModuleKind::resource)
-          .description("SLAMTEC RPLIDAR A1 on a serial port (115200 8N1, motor by DTR): one laser_scan per revolution (docs/lidar.md)")
+          .description(
+              "SLAMTEC RPLIDAR A1 on a serial port (115200 8N1, motor by DTR): one laser_scan per revolution (docs/lidar.md)")
           .output("laser_scan")
           .text("port", std::nullopt, "the lidar's tty: /dev/ttyUSB0, or the pseudo-terminal tripodal-board-sim --lidar makes")
           .number("timeout_s", 1.0, "s", "no revolution for this long is the resource's fault", 0.05, 60.0)
@@ -105,20 +114,24 @@ RplidarA1::RplidarA1(std::string name, ByteStream& stream, const RplidarConfig& 
   }
 }
 
-RplidarA1::~RplidarA1() { shutdown(); }
+RplidarA1::~RplidarA1() {
+  shutdown();
+}
 
 std::unique_ptr<RplidarA1> RplidarA1::open(std::string name, const std::filesystem::path& port, const RplidarConfig& config,
                                            const Clock& clock) {
   std::error_code ec;
   const auto status = std::filesystem::status(port, ec);
   if (!std::filesystem::exists(status)) {
-    throw std::runtime_error(fmt::format("RPLIDAR port {} does not exist (is the lidar plugged in? a USB adapter shows as "
-                                         "/dev/ttyUSB0; the emulator's path is what tripodal-board-sim --lidar made)",
-                                         port.string()));
+    throw std::runtime_error(
+        fmt::format("RPLIDAR port {} does not exist (is the lidar plugged in? a USB adapter shows as "
+                    "/dev/ttyUSB0; the emulator's path is what tripodal-board-sim --lidar made)",
+                    port.string()));
   }
   if (!std::filesystem::is_character_file(status)) {
-    throw std::runtime_error(fmt::format("RPLIDAR port {} is not a tty (it is {}); expected a serial device such as /dev/ttyUSB0",
-                                         port.string(), std::filesystem::is_directory(status) ? "a directory" : "a regular file or other non-device"));
+    throw std::runtime_error(
+        fmt::format("RPLIDAR port {} is not a tty (it is {}); expected a serial device such as /dev/ttyUSB0", port.string(),
+                    std::filesystem::is_directory(status) ? "a directory" : "a regular file or other non-device"));
   }
   std::unique_ptr<SerialPort> serial;
   try {
@@ -130,7 +143,8 @@ std::unique_ptr<RplidarA1> RplidarA1::open(std::string name, const std::filesyst
   auto lidar = std::make_unique<RplidarA1>(std::move(name), s, config, nullptr, std::move(serial));
   const Duration budget = config.stop_settle + 3 * config.response_timeout;
   if (lidar->run_until_scanning(clock, clock.now() + budget) != State::scanning) {
-    const std::string why = lidar->last_error().empty() ? fmt::format("not scanning after {:.2f} s", to_seconds(budget)) : lidar->last_error();
+    const std::string why =
+        lidar->last_error().empty() ? fmt::format("not scanning after {:.2f} s", to_seconds(budget)) : lidar->last_error();
     throw std::runtime_error(fmt::format("RPLIDAR on {}: {}", port.string(), why));
   }
   lidar->rebase_ = true;  // the loop's clock may not be `clock`: its first poll re-anchors the times
@@ -228,8 +242,11 @@ bool RplidarA1::take_descriptor(const rplidar::Descriptor& expected, std::string
   }
   if (garbage_ > config_.max_garbage_bytes) {
     try {
-      fail(Fault::garbage, fmt::format("answered {} with {} bytes that hold no RPLIDAR response descriptor A5 5A (first: {}); "
-                                       "is this an RPLIDAR at 115200 baud?", request, garbage_, garbage_head_), now);
+      fail(Fault::garbage,
+           fmt::format("answered {} with {} bytes that hold no RPLIDAR response descriptor A5 5A (first: {}); "
+                       "is this an RPLIDAR at 115200 baud?",
+                       request, garbage_, garbage_head_),
+           now);
     } catch (...) {
       fail(Fault::garbage, kFaultText[3], now);
     }
@@ -239,10 +256,10 @@ bool RplidarA1::take_descriptor(const rplidar::Descriptor& expected, std::string
     if (now - entered_ > config_.response_timeout) {
       try {
         fail(garbage_ > 0 ? Fault::garbage : Fault::no_answer,
-             garbage_ > 0 ? fmt::format("answered {} with {} bytes of garbage (first: {}) and no response descriptor", request, garbage_,
-                                        garbage_head_)
-                          : fmt::format("no answer to {} within {:.2f} s: is the lidar connected, powered and at 115200 baud?", request,
-                                        to_seconds(config_.response_timeout)),
+             garbage_ > 0 ? fmt::format("answered {} with {} bytes of garbage (first: {}) and no response descriptor", request,
+                                        garbage_, garbage_head_)
+                          : fmt::format("no answer to {} within {:.2f} s: is the lidar connected, powered and at 115200 baud?",
+                                        request, to_seconds(config_.response_timeout)),
              now);
       } catch (...) {
         fail(Fault::no_answer, kFaultText[2], now);
@@ -250,11 +267,14 @@ bool RplidarA1::take_descriptor(const rplidar::Descriptor& expected, std::string
     }
     return false;
   }
-  const std::optional<rplidar::Descriptor> d = rplidar::decode_descriptor(std::span<const std::uint8_t, rplidar::kDescriptorBytes>(rx_.data(), rplidar::kDescriptorBytes));
+  const std::optional<rplidar::Descriptor> d =
+      rplidar::decode_descriptor(std::span<const std::uint8_t, rplidar::kDescriptorBytes>(rx_.data(), rplidar::kDescriptorBytes));
   if (!d || *d != expected) {
     try {
-      fail(Fault::garbage, fmt::format("answered {} with a response descriptor of {}, expected {}", request,
-                                       d ? describe(*d) : std::string("?"), describe(expected)), now);
+      fail(Fault::garbage,
+           fmt::format("answered {} with a response descriptor of {}, expected {}", request, d ? describe(*d) : std::string("?"),
+                       describe(expected)),
+           now);
     } catch (...) {
       fail(Fault::garbage, kFaultText[3], now);
     }
@@ -264,7 +284,9 @@ bool RplidarA1::take_descriptor(const rplidar::Descriptor& expected, std::string
   return true;
 }
 
-void RplidarA1::on_poll(Time now) noexcept { step(now); }
+void RplidarA1::on_poll(Time now) noexcept {
+  step(now);
+}
 
 void RplidarA1::step(Time now) noexcept {
   if (rebase_) {
@@ -328,8 +350,11 @@ void RplidarA1::step(Time now) noexcept {
       fail(Fault::port_lost, kFaultText[1], now);
     } else if (now - last_start_ >= config_.timeout) {
       try {
-        fail(Fault::stalled, fmt::format("no revolution (start flag) for {:.2f} s: the lidar stopped spinning (motor off, DTR) or "
-                                         "sending", to_seconds(now - last_start_)), now);
+        fail(Fault::stalled,
+             fmt::format("no revolution (start flag) for {:.2f} s: the lidar stopped spinning (motor off, DTR) or "
+                         "sending",
+                         to_seconds(now - last_start_)),
+             now);
       } catch (...) {
         fail(Fault::stalled, kFaultText[0], now);
       }
@@ -354,7 +379,8 @@ void RplidarA1::step(Time now) noexcept {
     case State::awaiting_info:
       if (!have_descriptor_ && !(have_descriptor_ = take_descriptor(rplidar::kInfoDescriptor, "GET_INFO", now))) break;
       if (rx_size_ < rplidar::kInfoBytes) {
-        if (now - entered_ > config_.response_timeout) fail(Fault::no_answer, "GET_INFO's answer stopped short of its 20 bytes", now);
+        if (now - entered_ > config_.response_timeout)
+          fail(Fault::no_answer, "GET_INFO's answer stopped short of its 20 bytes", now);
         break;
       }
       info_ = rplidar::decode_info(std::span<const std::uint8_t, rplidar::kInfoBytes>(rx_.data(), rplidar::kInfoBytes));
@@ -366,15 +392,19 @@ void RplidarA1::step(Time now) noexcept {
     case State::awaiting_health:
       if (!have_descriptor_ && !(have_descriptor_ = take_descriptor(rplidar::kHealthDescriptor, "GET_HEALTH", now))) break;
       if (rx_size_ < rplidar::kHealthBytes) {
-        if (now - entered_ > config_.response_timeout) fail(Fault::no_answer, "GET_HEALTH's answer stopped short of its 3 bytes", now);
+        if (now - entered_ > config_.response_timeout)
+          fail(Fault::no_answer, "GET_HEALTH's answer stopped short of its 3 bytes", now);
         break;
       }
       health_ = rplidar::decode_health(std::span<const std::uint8_t, rplidar::kHealthBytes>(rx_.data(), rplidar::kHealthBytes));
       consume(rplidar::kHealthBytes);
       if (health_.status == static_cast<std::uint8_t>(rplidar::HealthStatus::error)) {
         try {
-          fail(Fault::health_error, fmt::format("health status error (error code 0x{:04X}): the A1 is in its protection stop; "
-                                                "power-cycle it or send RESET", health_.error_code), now);
+          fail(Fault::health_error,
+               fmt::format("health status error (error code 0x{:04X}): the A1 is in its protection stop; "
+                           "power-cycle it or send RESET",
+                           health_.error_code),
+               now);
         } catch (...) {
           fail(Fault::health_error, kFaultText[4], now);
         }
@@ -382,7 +412,9 @@ void RplidarA1::step(Time now) noexcept {
       }
       if (health_.status > static_cast<std::uint8_t>(rplidar::HealthStatus::error)) {
         try {
-          fail(Fault::garbage, fmt::format("answered GET_HEALTH with status {}, expected 0 (good), 1 (warning) or 2 (error)", health_.status), now);
+          fail(Fault::garbage,
+               fmt::format("answered GET_HEALTH with status {}, expected 0 (good), 1 (warning) or 2 (error)", health_.status),
+               now);
         } catch (...) {
           fail(Fault::garbage, kFaultText[3], now);
         }

@@ -6,18 +6,23 @@ namespace tripodal {
 
 std::string_view to_string(ChannelType type) noexcept {
   switch (type) {
-    case ChannelType::joint_position: return "joint_position";
-    case ChannelType::digital: return "digital";
-    case ChannelType::analog: return "analog";
-    case ChannelType::track: return "track";
-    case ChannelType::text: return "text";
+    case ChannelType::joint_position:
+      return "joint_position";
+    case ChannelType::digital:
+      return "digital";
+    case ChannelType::analog:
+      return "analog";
+    case ChannelType::track:
+      return "track";
+    case ChannelType::text:
+      return "text";
   }
   return "?";
 }
 
 std::optional<ChannelType> parse_channel_type(std::string_view text) noexcept {
-  for (ChannelType t : {ChannelType::joint_position, ChannelType::digital, ChannelType::analog, ChannelType::track,
-                        ChannelType::text}) {
+  for (ChannelType t :
+       {ChannelType::joint_position, ChannelType::digital, ChannelType::analog, ChannelType::track, ChannelType::text}) {
     if (to_string(t) == text) return t;
   }
   return std::nullopt;

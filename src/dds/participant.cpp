@@ -4,10 +4,10 @@
 #include <dds/dds.h>
 
 #include <algorithm>
-#include <map>
-#include <stdexcept>
 #include <filesystem>
+#include <map>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 
 #include "node_graph.hpp"

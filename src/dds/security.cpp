@@ -70,7 +70,8 @@ std::string governance_xml(std::uint32_t domain) {
 <dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-SECURITY/20170901/omg_shared_ca_governance.xsd">
   <domain_access_rules>
     <domain_rule>
-      <domains><id>)" + d + R"(</id></domains>
+      <domains><id>)" +
+         d + R"(</id></domains>
       <allow_unauthenticated_participants>false</allow_unauthenticated_participants>
       <enable_join_access_control>true</enable_join_access_control>
       <discovery_protection_kind>ENCRYPT</discovery_protection_kind>
@@ -108,15 +109,21 @@ std::string permissions_xml(const std::string& subject, const std::string& name,
   std::strftime(until, sizeof until, "%Y-%m-%dT%H:%M:%S", &end_utc);
   const std::string publish = role == FleetRole::observer ? "" : "        <publish><topics><topic>*</topic></topics></publish>\n";
   return R"(<?xml version="1.0" encoding="UTF-8"?>
-<!-- Made by `tripodal fleet keys` for )" + name + R"(. -->
+<!-- Made by `tripodal fleet keys` for )" +
+         name + R"(. -->
 <dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-SECURITY/20170901/omg_shared_ca_permissions.xsd">
   <permissions>
-    <grant name=")" + name + R"(">
-      <subject_name>)" + subject + R"(</subject_name>
-      <validity><not_before>)" + std::to_string(year) + R"(-01-01T00:00:00</not_before><not_after>)" + until + R"(</not_after></validity>
+    <grant name=")" +
+         name + R"(">
+      <subject_name>)" +
+         subject + R"(</subject_name>
+      <validity><not_before>)" +
+         std::to_string(year) + R"(-01-01T00:00:00</not_before><not_after>)" + until + R"(</not_after></validity>
       <allow_rule>
-        <domains><id>)" + d + R"(</id></domains>
-)" + publish + R"(        <subscribe><topics><topic>*</topic></topics></subscribe>
+        <domains><id>)" +
+         d + R"(</id></domains>
+)" + publish +
+         R"(        <subscribe><topics><topic>*</topic></topics></subscribe>
       </allow_rule>
       <default>DENY</default>
     </grant>
@@ -129,8 +136,8 @@ std::string permissions_xml(const std::string& subject, const std::string& name,
 
 SecurityFiles fleet_identity(const fs::path& keys_dir, std::string_view identity) {
   const std::string name(identity);
-  SecurityFiles f{keys_dir / "ca.pem",        keys_dir / (name + ".pem"),    keys_dir / (name + "_key.pem"),
-                  keys_dir / "ca.pem",        keys_dir / "governance.p7s", keys_dir / (name + "_permissions.p7s")};
+  SecurityFiles f{keys_dir / "ca.pem", keys_dir / (name + ".pem"),  keys_dir / (name + "_key.pem"),
+                  keys_dir / "ca.pem", keys_dir / "governance.p7s", keys_dir / (name + "_permissions.p7s")};
   std::string missing;
   for (const fs::path& p : {f.identity_ca, f.identity_certificate, f.private_key, f.governance, f.permissions}) {
     if (!fs::is_regular_file(p)) missing += (missing.empty() ? "" : ", ") + p.string();
@@ -146,17 +153,20 @@ void make_fleet_keys(const FleetKeysOptions& o) {
   std::set<std::string> names;
   for (const auto& [name, role] : o.identities) {
     if (!is_ros_node_name(name)) {
-      throw std::invalid_argument("fleet keys: '" + name + "' is not an identity name (letters, digits and '_', not starting with a digit)");
+      throw std::invalid_argument("fleet keys: '" + name +
+                                  "' is not an identity name (letters, digits and '_', not starting with a digit)");
     }
     if (name == "ca" || name == "governance" || !names.insert(name).second) {
-      throw std::invalid_argument("fleet keys: the identity '" + name + "' is given twice or is a reserved name (ca, governance)");
+      throw std::invalid_argument("fleet keys: the identity '" + name +
+                                  "' is given twice or is a reserved name (ca, governance)");
     }
   }
   if (o.valid_days <= 0) throw std::invalid_argument("fleet keys: the validity must be at least one day");
   fs::create_directories(o.out);
   for (const auto& [name, role] : o.identities) {
     if (fs::exists(o.out / (name + ".pem"))) {
-      throw DdsError("fleet keys: " + (o.out / (name + ".pem")).string() + " exists: an identity is not made twice (remove it first)");
+      throw DdsError("fleet keys: " + (o.out / (name + ".pem")).string() +
+                     " exists: an identity is not made twice (remove it first)");
     }
   }
   const std::string days = std::to_string(o.valid_days);
@@ -167,19 +177,21 @@ void make_fleet_keys(const FleetKeysOptions& o) {
     fs::permissions(o.out / "ca_key.pem", fs::perms::owner_read | fs::perms::owner_write, fs::perm_options::replace);
   }
   write_file(o.out / "governance.xml", governance_xml(o.domain_id));
-  openssl(o.out, {"smime", "-sign", "-in", "governance.xml", "-text", "-out", "governance.p7s", "-signer", "ca.pem", "-inkey", "ca_key.pem"});
+  openssl(o.out, {"smime", "-sign", "-in", "governance.xml", "-text", "-out", "governance.p7s", "-signer", "ca.pem", "-inkey",
+                  "ca_key.pem"});
   for (const auto& [name, role] : o.identities) {
     openssl(o.out, {"ecparam", "-name", "prime256v1", "-genkey", "-noout", "-out", name + "_key.pem"});
     fs::permissions(o.out / (name + "_key.pem"), fs::perms::owner_read | fs::perms::owner_write, fs::perm_options::replace);
-    openssl(o.out, {"req", "-new", "-key", name + "_key.pem", "-out", name + ".csr", "-subj", "/CN=" + name + "/O=" + o.organisation});
+    openssl(o.out,
+            {"req", "-new", "-key", name + "_key.pem", "-out", name + ".csr", "-subj", "/CN=" + name + "/O=" + o.organisation});
     openssl(o.out, {"x509", "-req", "-in", name + ".csr", "-CA", "ca.pem", "-CAkey", "ca_key.pem", "-CAcreateserial", "-out",
                     name + ".pem", "-days", days, "-sha256"});
     fs::remove(o.out / (name + ".csr"));
     // The subject as access control compares it: the certificate's, in RFC 4514 order.
     write_file(o.out / (name + "_permissions.xml"),
                permissions_xml("CN=" + name + ",O=" + o.organisation, name, role, o.domain_id, o.valid_days));
-    openssl(o.out, {"smime", "-sign", "-in", name + "_permissions.xml", "-text", "-out", name + "_permissions.p7s", "-signer", "ca.pem",
-                    "-inkey", "ca_key.pem"});
+    openssl(o.out, {"smime", "-sign", "-in", name + "_permissions.xml", "-text", "-out", name + "_permissions.p7s", "-signer",
+                    "ca.pem", "-inkey", "ca_key.pem"});
   }
 }
 
@@ -188,12 +200,14 @@ fs::path security_plugin_dir() {
     if (fs::is_regular_file(fs::path(dir) / "libdds_security_auth.so")) return dir;
     throw DdsError(std::string("dds security: $TRIPODAL_DDS_SECURITY_DIR=") + dir + " has no libdds_security_auth.so");
   }
-  for (const char* dir : {"/usr/lib/x86_64-linux-gnu/libddsc0debian", "/usr/lib/aarch64-linux-gnu/libddsc0debian",
-                          "/usr/lib/arm-linux-gnueabihf/libddsc0debian", "/usr/lib/x86_64-linux-gnu", "/usr/lib", "/usr/local/lib"}) {
+  for (const char* dir :
+       {"/usr/lib/x86_64-linux-gnu/libddsc0debian", "/usr/lib/aarch64-linux-gnu/libddsc0debian",
+        "/usr/lib/arm-linux-gnueabihf/libddsc0debian", "/usr/lib/x86_64-linux-gnu", "/usr/lib", "/usr/local/lib"}) {
     if (fs::is_regular_file(fs::path(dir) / "libdds_security_auth.so")) return dir;
   }
-  throw DdsError("dds security: Cyclone DDS's security plugins (libdds_security_auth.so) are not installed "
-                 "(Debian's libddsc0debian has them; or set $TRIPODAL_DDS_SECURITY_DIR)");
+  throw DdsError(
+      "dds security: Cyclone DDS's security plugins (libdds_security_auth.so) are not installed "
+      "(Debian's libddsc0debian has them; or set $TRIPODAL_DDS_SECURITY_DIR)");
 }
 
 }  // namespace tripodal::dds

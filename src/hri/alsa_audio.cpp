@@ -13,8 +13,8 @@ namespace tripodal {
 namespace {
 
 [[noreturn]] void fail(const AlsaOptions& o, const std::string& what, int err) {
-  throw std::runtime_error("audio device '" + o.device + "'" + (o.config_file.empty() ? "" : " (" + o.config_file + ")") +
-                           ": " + what + ": " + snd_strerror(err));
+  throw std::runtime_error("audio device '" + o.device + "'" + (o.config_file.empty() ? "" : " (" + o.config_file + ")") + ": " +
+                           what + ": " + snd_strerror(err));
 }
 
 // The PCM, opened with the system's configuration or with it and `config_file`.
@@ -121,10 +121,16 @@ class AlsaOutput final : public AudioOutput {
 
 }  // namespace
 
-bool alsa_available() noexcept { return true; }
+bool alsa_available() noexcept {
+  return true;
+}
 
-std::unique_ptr<AudioInput> open_alsa_input(const AlsaOptions& options) { return std::make_unique<AlsaInput>(options); }
+std::unique_ptr<AudioInput> open_alsa_input(const AlsaOptions& options) {
+  return std::make_unique<AlsaInput>(options);
+}
 
-std::unique_ptr<AudioOutput> open_alsa_output(const AlsaOptions& options) { return std::make_unique<AlsaOutput>(options); }
+std::unique_ptr<AudioOutput> open_alsa_output(const AlsaOptions& options) {
+  return std::make_unique<AlsaOutput>(options);
+}
 
 }  // namespace tripodal

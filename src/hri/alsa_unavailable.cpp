@@ -5,7 +5,9 @@
 
 namespace tripodal {
 
-bool alsa_available() noexcept { return false; }
+bool alsa_available() noexcept {
+  return false;
+}
 
 std::unique_ptr<AudioInput> open_alsa_input(const AlsaOptions& options) {
   throw std::runtime_error("audio device '" + options.device + "': this build has no ALSA (install libasound2-dev and rebuild)");

@@ -406,7 +406,8 @@ HriModule::Decision HriModule::decide(std::string_view utterance) const {
   // A question is no request: "are you a robot?" may rank a visit's entry first ("I will take you
   // to the cleaning robot"), and answering it would start the visit. A question is answered from
   // the entries that start nothing.
-  if (asks_rather_than_requests(literal_words) && !d.retrieval.hits.empty() && !entries_[d.retrieval.hits.front().entry].action.empty()) {
+  if (asks_rather_than_requests(literal_words) && !d.retrieval.hits.empty() &&
+      !entries_[d.retrieval.hits.front().entry].action.empty()) {
     auto& hits = d.retrieval.hits;
     hits.erase(std::remove_if(hits.begin(), hits.end(), [&](const RetrievalHit& h) { return !entries_[h.entry].action.empty(); }),
                hits.end());

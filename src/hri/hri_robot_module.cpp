@@ -26,8 +26,7 @@ std::string trim(std::string_view s) {
 
 }  // namespace
 
-std::map<std::string, std::string, std::less<>> parse_button_bindings(std::string_view text,
-                                                                      const SourceLocation& where) {
+std::map<std::string, std::string, std::less<>> parse_button_bindings(std::string_view text, const SourceLocation& where) {
   std::map<std::string, std::string, std::less<>> out;
   Diagnostics d;
   std::size_t start = 0;
@@ -37,10 +36,8 @@ std::map<std::string, std::string, std::less<>> parse_button_bindings(std::strin
     start = end + 1;
     if (item.empty()) continue;
     const auto eq = item.find('=');
-    const std::string name =
-        eq == std::string::npos ? std::string() : trim(std::string_view(item).substr(0, eq));
-    const std::string request =
-        eq == std::string::npos ? std::string() : trim(std::string_view(item).substr(eq + 1));
+    const std::string name = eq == std::string::npos ? std::string() : trim(std::string_view(item).substr(0, eq));
+    const std::string request = eq == std::string::npos ? std::string() : trim(std::string_view(item).substr(eq + 1));
     if (name.empty() || request.empty()) {
       d.error(where, "buttons: '" + item + "' is not NAME=REQUEST (e.g. hello=Introduce yourself.)");
     } else if (!out.emplace(name, request).second) {
@@ -58,12 +55,9 @@ const ModuleManifest& CHri::static_manifest() {
               "the HRI of the guide robot: the RKMS knowledge, the LED buttons, the exhibit hall's nodes for "
               "the planner")
           .outputs({"node", "exhibit_here"})
-          .text("knowledge", std::string(),
-                "the RKMS knowledge file (XML, configs/hri/rkms.xsd), relative to the profile")
-          .text("buttons", std::string(),
-                "LED buttons and the requests they stand for: \"hello=Introduce yourself.; ...\"")
-          .number("exhibit_radius_m", 1.0, "m", "how near a node the robot must be for exhibit_here()", 0.1,
-                  10.0)
+          .text("knowledge", std::string(), "the RKMS knowledge file (XML, configs/hri/rkms.xsd), relative to the profile")
+          .text("buttons", std::string(), "LED buttons and the requests they stand for: \"hello=Introduce yourself.; ...\"")
+          .number("exhibit_radius_m", 1.0, "m", "how near a node the robot must be for exhibit_here()", 0.1, 10.0)
           .build();
   return m;
 }
@@ -81,8 +75,7 @@ void CHri::on_start(ModuleContext& context) {
   if (file.is_relative()) file = context.profile_dir / file;
   store_ = std::make_unique<KnowledgeStore>(file);
   maps_ = context.modules != nullptr ? context.modules->find<navi::CGridMaps>() : nullptr;
-  if (maps_ == nullptr)
-    throw ConfigError(where(), "module type 'Hri' needs a GridMaps module (the hall's nodes)");
+  if (maps_ == nullptr) throw ConfigError(where(), "module type 'Hri' needs a GridMaps module (the hall's nodes)");
   panel_ = dynamic_cast<ButtonPanel*>(context.hardware);
 }
 
@@ -109,14 +102,12 @@ std::optional<KnowledgeAnswer> CHri::on_answer(std::string_view function, std::s
   const navi::RegionMap& regions = maps_->regions();
   std::string known;
   for (const navi::MapNode& n : regions.nodes) {
-    if (n.name.starts_with(kNodePrefix))
-      known += (known.empty() ? "" : ", ") + n.name.substr(kNodePrefix.size());
+    if (n.name.starts_with(kNodePrefix)) known += (known.empty() ? "" : ", ") + n.name.substr(kNodePrefix.size());
   }
   KnowledgeAnswer a;
   if (function == "node") {
-    const std::string name = argument.starts_with(kNodePrefix)
-                                 ? std::string(argument)
-                                 : std::string(kNodePrefix) + std::string(argument);
+    const std::string name =
+        argument.starts_with(kNodePrefix) ? std::string(argument) : std::string(kNodePrefix) + std::string(argument);
     if (regions.node(name) == nullptr) {
       a.error = "unknown node '" + std::string(argument) + "' (known: " + known + ")";
       return a;
@@ -130,8 +121,7 @@ std::optional<KnowledgeAnswer> CHri::on_answer(std::string_view function, std::s
     double best = std::numeric_limits<double>::infinity();
     for (const navi::MapNode& n : regions.nodes) {
       if (!n.name.starts_with(kNodePrefix)) continue;
-      const double d =
-          std::hypot(n.pose.x_m - navigation.map_from_base.x_m, n.pose.y_m - navigation.map_from_base.y_m);
+      const double d = std::hypot(n.pose.x_m - navigation.map_from_base.x_m, n.pose.y_m - navigation.map_from_base.y_m);
       if (d < best) {
         best = d;
         nearest = &n;

@@ -106,10 +106,10 @@ struct KnowledgeIndex::Impl {
         const std::size_t d = hri::edit_distance(w, candidate, std::min(limit, best_d));
         // Ties go to a doubled or undoubled letter, the commonest slip ("helo" is "hello", not
         // "help"), then to the more common word.
-        const bool better_tie = d == best_d && d <= limit &&
-                                (differs_by_doubling(w, candidate) != differs_by_doubling(w, best)
-                                     ? differs_by_doubling(w, candidate)
-                                     : freq > best_freq);
+        const bool better_tie =
+            d == best_d && d <= limit &&
+            (differs_by_doubling(w, candidate) != differs_by_doubling(w, best) ? differs_by_doubling(w, candidate)
+                                                                               : freq > best_freq);
         if (d < best_d || better_tie) {
           best = candidate;
           best_d = d;
@@ -199,9 +199,7 @@ Retrieval KnowledgeIndex::search_unguarded(std::string_view utterance) const {
   // the largest weight (the utterance is about something the base does not know); an entry with a
   // word the lexicon relates to it covers part of that weight.
   const double n = static_cast<double>(x.db.get_doccount());
-  auto idf_of = [&](const std::string& t) {
-    return std::log((n + 1.0) / (static_cast<double>(x.db.get_termfreq(t)) + 0.5));
-  };
+  auto idf_of = [&](const std::string& t) { return std::log((n + 1.0) / (static_cast<double>(x.db.get_termfreq(t)) + 0.5)); };
   const std::vector<WordTerms> groups = x.word_terms(content);
   std::map<std::string, double> query_terms;  // term -> its best closeness over the words
   std::vector<double> weight(groups.size());
@@ -218,7 +216,8 @@ Retrieval KnowledgeIndex::search_unguarded(std::string_view utterance) const {
   Xapian::Enquire enquire(x.db);
   std::vector<Xapian::Query> subqueries;
   for (const auto& [t, closeness] : query_terms) {
-    subqueries.push_back(closeness >= 1.0 ? Xapian::Query(t) : Xapian::Query(Xapian::Query::OP_SCALE_WEIGHT, Xapian::Query(t), closeness));
+    subqueries.push_back(closeness >= 1.0 ? Xapian::Query(t)
+                                          : Xapian::Query(Xapian::Query::OP_SCALE_WEIGHT, Xapian::Query(t), closeness));
   }
   Xapian::Query query(Xapian::Query::OP_OR, subqueries.begin(), subqueries.end());
   if (!stop_terms.empty()) {

@@ -35,8 +35,8 @@ struct Detachment {
   std::string_view suffix;
   std::string_view ending;
 };
-constexpr std::array<Detachment, 8> kNounRules = {{{"s", ""}, {"ses", "s"}, {"xes", "x"}, {"zes", "z"},
-                                                   {"ches", "ch"}, {"shes", "sh"}, {"men", "man"}, {"ies", "y"}}};
+constexpr std::array<Detachment, 8> kNounRules = {
+    {{"s", ""}, {"ses", "s"}, {"xes", "x"}, {"zes", "z"}, {"ches", "ch"}, {"shes", "sh"}, {"men", "man"}, {"ies", "y"}}};
 constexpr std::array<Detachment, 8> kVerbRules = {
     {{"s", ""}, {"ies", "y"}, {"es", "e"}, {"es", ""}, {"ed", "e"}, {"ed", ""}, {"ing", "e"}, {"ing", ""}}};
 constexpr std::array<Detachment, 4> kAdjRules = {{{"er", ""}, {"est", ""}, {"er", "e"}, {"est", "e"}}};
@@ -189,7 +189,10 @@ struct Lexicon::Impl {
       unsigned long target = 0;
       std::string pos_letter;
       fields >> symbol >> target >> pos_letter >> skip;
-      const std::size_t target_pos = pos_letter == "n" ? 0 : pos_letter == "v" ? 1 : (pos_letter == "a" || pos_letter == "s") ? 2 : 3;
+      const std::size_t target_pos = pos_letter == "n"                          ? 0
+                                     : pos_letter == "v"                        ? 1
+                                     : (pos_letter == "a" || pos_letter == "s") ? 2
+                                                                                : 3;
       s.pointers.emplace_back(symbol, static_cast<std::uint32_t>(target), target_pos);
     }
     return s;
@@ -224,16 +227,19 @@ std::shared_ptr<const Lexicon> Lexicon::system() {
     try {
       return std::make_shared<const Lexicon>(paths);
     } catch (const std::exception& e) {
-      spdlog::warn("hri: no English lexicon ({}); install wordnet-base and wamerican for synonyms and typo "
-                   "correction that leaves English words alone",
-                   e.what());
+      spdlog::warn(
+          "hri: no English lexicon ({}); install wordnet-base and wamerican for synonyms and typo "
+          "correction that leaves English words alone",
+          e.what());
       return std::make_shared<const Lexicon>();
     }
   }();
   return lexicon;
 }
 
-bool Lexicon::empty() const noexcept { return !impl_ || impl_->word_list.empty(); }
+bool Lexicon::empty() const noexcept {
+  return !impl_ || impl_->word_list.empty();
+}
 
 bool Lexicon::is_english(std::string_view word) const {
   if (!impl_) return false;
@@ -278,10 +284,14 @@ std::vector<RelatedWord> Lexicon::related(std::string_view word) const {
       note(s.words, kSynonym);
       for (const auto& [symbol, target, target_pos] : s.pointers) {
         double closeness = 0.0;
-        if (symbol == "@" || symbol == "@i") closeness = kHypernym;
-        else if (symbol == "~" || symbol == "~i") closeness = kHyponym;
-        else if (symbol == "+") closeness = kDerivation;
-        else if (symbol == "&") closeness = kSimilar;
+        if (symbol == "@" || symbol == "@i")
+          closeness = kHypernym;
+        else if (symbol == "~" || symbol == "~i")
+          closeness = kHyponym;
+        else if (symbol == "+")
+          closeness = kDerivation;
+        else if (symbol == "&")
+          closeness = kSimilar;
         if (closeness == 0.0) continue;
         note(x.synset(target_pos, target).words, closeness);
       }

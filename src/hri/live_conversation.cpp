@@ -54,7 +54,8 @@ bool LiveConversation::step() {
     // The robot's own voice comes back at about played + coupling; a visitor speaking over it is
     // clearly louder than that, for a while (a cough is not a barge-in).
     const double mic = level_dbfs(heard);
-    const double needed = std::max(options_.barge_in_min_dbfs, played_dbfs + options_.echo_coupling_db + options_.barge_in_margin_db);
+    const double needed =
+        std::max(options_.barge_in_min_dbfs, played_dbfs + options_.echo_coupling_db + options_.barge_in_margin_db);
     loud_run_ = mic >= needed ? loud_run_ + 1 : 0;
     if (static_cast<double>(loud_run_) * options_.chunk_s >= options_.barge_in_s - 1e-9) {
       speaker_.drop();

@@ -34,11 +34,21 @@ std::vector<std::string> words(std::string_view text) {
 std::string_view expand_chat_word(std::string_view word) noexcept {
   // Sorted for binary search.
   static constexpr std::array<std::pair<std::string_view, std::string_view>, 12> kChat = {{
-      {"b4", "before"}, {"cu", "see"}, {"pls", "please"}, {"plz", "please"}, {"r", "are"}, {"thanx", "thanks"},
-      {"thnx", "thanks"}, {"thx", "thanks"}, {"u", "you"}, {"ur", "your"}, {"wat", "what"}, {"ya", "you"},
+      {"b4", "before"},
+      {"cu", "see"},
+      {"pls", "please"},
+      {"plz", "please"},
+      {"r", "are"},
+      {"thanx", "thanks"},
+      {"thnx", "thanks"},
+      {"thx", "thanks"},
+      {"u", "you"},
+      {"ur", "your"},
+      {"wat", "what"},
+      {"ya", "you"},
   }};
-  const auto it = std::lower_bound(kChat.begin(), kChat.end(), word,
-                                   [](const auto& entry, std::string_view w) { return entry.first < w; });
+  const auto it =
+      std::lower_bound(kChat.begin(), kChat.end(), word, [](const auto& entry, std::string_view w) { return entry.first < w; });
   return it != kChat.end() && it->first == word ? it->second : word;
 }
 

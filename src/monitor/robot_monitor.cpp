@@ -1,5 +1,7 @@
 #include "tripodal/monitor/robot_monitor.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -7,14 +9,15 @@
 #include <filesystem>
 #include <map>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <stdexcept>
 #include <utility>
 #include <variant>
 
-#include <nlohmann/json.hpp>
-#include <spdlog/spdlog.h>
-
+#include "hri_ops.hpp"
+#include "net_drawing.hpp"
+#include "operator_request.hpp"
 #include "tripodal/behaviors/behavior_registry.hpp"
 #include "tripodal/behaviors/teleop.hpp"
 #include "tripodal/board/board_hardware.hpp"
@@ -23,9 +26,6 @@
 #include "tripodal/navi/mapping_module.hpp"
 #include "tripodal/navi/section_splitter.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
-#include "hri_ops.hpp"
-#include "net_drawing.hpp"
-#include "operator_request.hpp"
 
 namespace tripodal::monitor {
 namespace {
@@ -54,8 +54,6 @@ json pose_json(const Pose2D& p) {
 std::string base64_bytes(const std::vector<std::uint8_t>& v) {
   return base64(std::string_view(reinterpret_cast<const char*>(v.data()), v.size()));
 }
-
-
 
 // The control board's link as the host sees it (hardware type "board", real or simulated): the
 // panel of the page. Everything here is what the board reported over the line or the host counted.

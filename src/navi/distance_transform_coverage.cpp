@@ -97,7 +97,9 @@ CoverageResult distance_transform_coverage(const OccupancyGrid& grid, const Sect
   for (const std::size_t i : section.cells) outside[local(i)] = false;
   std::vector<bool> physical(outside.size(), false);
   for (int y = wy0; y <= wy1; ++y) {
-    for (int x = wx0; x <= wx1; ++x) physical[static_cast<std::size_t>(y - wy0) * static_cast<std::size_t>(ww) + static_cast<std::size_t>(x - wx0)] = !grid.is_free({x, y});
+    for (int x = wx0; x <= wx1; ++x)
+      physical[static_cast<std::size_t>(y - wy0) * static_cast<std::size_t>(ww) + static_cast<std::size_t>(x - wx0)] =
+          !grid.is_free({x, y});
   }
   const DistanceField to_boundary(ww, wh, res, outside);
   const DistanceField to_obstacle(ww, wh, res, physical);

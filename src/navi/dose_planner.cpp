@@ -1,13 +1,13 @@
 #include "tripodal/navi/dose_planner.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <string>
-
-#include <fmt/format.h>
 
 namespace tripodal::navi {
 
@@ -93,7 +93,8 @@ void validate(const DoseLimits& l) {
   positive(l.max_spacing_m, "max_spacing_m");
   positive(l.spacing_step_m, "spacing_step_m");
   if (l.min_speed_m_s > l.max_speed_m_s) {
-    throw std::invalid_argument(fmt::format("dose limits: min_speed_m_s {} is above max_speed_m_s {}", l.min_speed_m_s, l.max_speed_m_s));
+    throw std::invalid_argument(
+        fmt::format("dose limits: min_speed_m_s {} is above max_speed_m_s {}", l.min_speed_m_s, l.max_speed_m_s));
   }
   if (l.min_spacing_m > l.max_spacing_m) {
     throw std::invalid_argument(
@@ -136,10 +137,10 @@ DosePlan plan_dose(const UvLamp& lamp, double target_j_m2, const DoseLimits& lim
   if (best.area_rate_m2_s <= 0.0) {
     const double s = std::max(limits.min_spacing_m, limits.spacing_step_m);
     const double most = lanes_min_dose_j_m2(lamp, s + limits.tracking_error_m, limits.min_speed_m_s, limits.max_passes);
-    throw std::invalid_argument(fmt::format(
-        "target dose {} J/m^2 cannot be reached by the lamp ({} W UVC, {} m above the floor): lanes {} m apart, {} "
-        "passes at the minimum speed {} m/s give at most {:.3g} J/m^2",
-        target_j_m2, lamp.uvc_power_w, lamp.height_m, s, limits.max_passes, limits.min_speed_m_s, most));
+    throw std::invalid_argument(
+        fmt::format("target dose {} J/m^2 cannot be reached by the lamp ({} W UVC, {} m above the floor): lanes {} m apart, {} "
+                    "passes at the minimum speed {} m/s give at most {:.3g} J/m^2",
+                    target_j_m2, lamp.uvc_power_w, lamp.height_m, s, limits.max_passes, limits.min_speed_m_s, most));
   }
   // The wall round may run the tracking error farther out than planned, as the lanes may.
   best.reach_m = std::max(0.0, lateral_reach_m(lamp, target_j_m2, limits.min_speed_m_s, best.passes) - limits.tracking_error_m);

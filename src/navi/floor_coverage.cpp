@@ -11,14 +11,17 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
 
 // Breadth-first search over free cells (4-connected) from `from` to the first cell of a section
 // not cleaned yet; the visited marks are a generation stamp, so each search costs only what it
 // explores.
 class NearestRoom {
  public:
-  NearestRoom(const OccupancyGrid& grid, const SectionSet& rooms) : grid_(grid), rooms_(rooms), stamp_(grid.size(), 0), dist_(grid.size(), 0) {}
+  NearestRoom(const OccupancyGrid& grid, const SectionSet& rooms)
+      : grid_(grid), rooms_(rooms), stamp_(grid.size(), 0), dist_(grid.size(), 0) {}
 
   struct Found {
     int room = -1;

@@ -221,7 +221,8 @@ const ModuleManifest& CCoverageModule::static_manifest() {
   static const ModuleManifest m = navi_manifest(
       "CoveragePlanner",
       "gives the cleaning behaviors their section's coverage path (hybrid: a balloon round along walls and "
-      "obstacles, lanes inside; or the paper's balloon, or the boustrophedon), resumes where a section stopped, plans detours, records the cleaned cells",
+      "obstacles, lanes inside; or the paper's balloon, or the boustrophedon), resumes where a section stopped, plans detours, "
+      "records the cleaned cells",
       {"grid_map", "sections", "map_from_base", "laser_scan"}, {"coverage_path", "cleaned_cells"},
       {ParameterSpec{"cleaning_width_m", ValueType::number, Value{0.4}, "m", "diameter of the cleaning footprint", 0.01, 5.0},
        ParameterSpec{"overlap_m", ValueType::number, Value{0.05}, "m", "overlap of neighbouring coverage rounds", 0.0, 1.0},
@@ -233,18 +234,33 @@ const ModuleManifest& CCoverageModule::static_manifest() {
                      "hybrid: the travel a turn weighs when the lane direction is chosen", 0.0, 100.0},
        ParameterSpec{"link_margin_m", ValueType::number, Value{CoverageOptions{}.link_margin_m}, "m",
                      "links between passes keep this much more than the robot radius from obstacles where the way "
-                     "allows (0: the robot radius)", 0.0, 1.0},
-       ParameterSpec{"pattern", ValueType::string, Value{std::string("hybrid")}, "",
+                     "allows (0: the robot radius)",
+                     0.0, 1.0},
+       ParameterSpec{"pattern",
+                     ValueType::string,
+                     Value{std::string("hybrid")},
+                     "",
                      "hybrid (a wall-following round, then lanes), balloon (the paper's wall-following rounds) or "
-                     "boustrophedon (plough lanes)", {}, {}},
-       ParameterSpec{"serves", ValueType::string, Value{std::string("BhCleaning, BhCleaningTwoWheel")}, "",
-                     "the behaviors it gives coverage paths to, comma separated (their parameter `section`)", {}, {}},
+                     "boustrophedon (plough lanes)",
+                     {},
+                     {}},
+       ParameterSpec{"serves",
+                     ValueType::string,
+                     Value{std::string("BhCleaning, BhCleaningTwoWheel")},
+                     "",
+                     "the behaviors it gives coverage paths to, comma separated (their parameter `section`)",
+                     {},
+                     {}},
        ParameterSpec{"dose_target_j_m2", ValueType::number, Value{0.0}, "J/m^2",
                      "UV disinfection: the dose every point between the lanes must get; lanes spaced and speeds "
-                     "limited for it from the lamp (docs/coverage.md, \"A dose that is reached\"). 0: off", 0.0, 1e6},
-       ParameterSpec{"uv_power_w", ValueType::number, Value{UvLamp{}.uvc_power_w}, "W", "the UV lamp's UVC output", 0.0, 1000.0, true},
-       ParameterSpec{"uv_height_m", ValueType::number, Value{UvLamp{}.height_m}, "m", "the UV lamp above the floor", 0.0, 1.0, true},
-       ParameterSpec{"uv_radius_m", ValueType::number, Value{UvLamp{}.radius_m}, "m", "the UV lamp's lit disc on the floor", 0.0, 5.0, true},
+                     "limited for it from the lamp (docs/coverage.md, \"A dose that is reached\"). 0: off",
+                     0.0, 1e6},
+       ParameterSpec{"uv_power_w", ValueType::number, Value{UvLamp{}.uvc_power_w}, "W", "the UV lamp's UVC output", 0.0, 1000.0,
+                     true},
+       ParameterSpec{"uv_height_m", ValueType::number, Value{UvLamp{}.height_m}, "m", "the UV lamp above the floor", 0.0, 1.0,
+                     true},
+       ParameterSpec{"uv_radius_m", ValueType::number, Value{UvLamp{}.radius_m}, "m", "the UV lamp's lit disc on the floor", 0.0,
+                     5.0, true},
        ParameterSpec{"dose_min_speed_m_s", ValueType::number, Value{DoseLimits{}.min_speed_m_s}, "m/s",
                      "the slowest lane speed the plan may ask for", 0.0, 5.0, true},
        ParameterSpec{"dose_max_speed_m_s", ValueType::number, Value{DoseLimits{}.max_speed_m_s}, "m/s",
@@ -277,7 +293,8 @@ void CCoverageModule::on_configure(const ParameterSet& params) {
   dose_limits_.tracking_error_m = params.number("dose_tracking_error_m");
   dose_plan_.reset();
   if (const double target = params.number("dose_target_j_m2"); target > 0.0) {
-    if (pattern_ != "hybrid") throw ConfigError(where(), "CoveragePlanner: dose_target_j_m2 plans lanes: it needs pattern hybrid");
+    if (pattern_ != "hybrid")
+      throw ConfigError(where(), "CoveragePlanner: dose_target_j_m2 plans lanes: it needs pattern hybrid");
     // Lanes on grid rows, at most the lit disc's diameter apart.
     dose_limits_.max_spacing_m = std::max(dose_limits_.min_spacing_m, 2.0 * lamp_.radius_m);
     try {

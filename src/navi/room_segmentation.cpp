@@ -144,7 +144,8 @@ std::vector<int> morphological_cores(const FreeSpace& f, double cell_m2, const R
 // Distance transform: the threshold on the distance to the walls that gives the most parts within
 // the limits. Cells are added in falling distance with a union-find, so every threshold is seen
 // in one pass; the cores are then the parts at the best one.
-std::vector<int> distance_cores(const FreeSpace& f, const DistanceField& field, double cell_m2, const RoomSegmentationOptions& o) {
+std::vector<int> distance_cores(const FreeSpace& f, const DistanceField& field, double cell_m2,
+                                const RoomSegmentationOptions& o) {
   std::vector<std::size_t> order;
   for (std::size_t i = 0; i < f.size(); ++i) {
     if (f.free[i] != 0) order.push_back(i);
@@ -190,7 +191,8 @@ std::vector<int> distance_cores(const FreeSpace& f, const DistanceField& field, 
     }
   }
   std::vector<std::size_t> sizes;
-  const std::vector<int> part = components(f, [&](std::size_t i) { return f.free[i] != 0 && field.distance_m(i) >= best_threshold; }, sizes);
+  const std::vector<int> part = components(
+      f, [&](std::size_t i) { return f.free[i] != 0 && field.distance_m(i) >= best_threshold; }, sizes);
   std::vector<int> core(f.size(), -1);
   for (std::size_t i = 0; i < f.size(); ++i) {
     if (part[i] >= 0 && counts(sizes[static_cast<std::size_t>(part[i])])) core[i] = part[i];
@@ -200,10 +202,15 @@ std::vector<int> distance_cores(const FreeSpace& f, const DistanceField& field, 
 
 // Voronoi: cut the free space across the medial axis where its clearance has a local minimum
 // narrower than a door; the parts are the cores (small ones merged later).
-std::vector<int> voronoi_cores(const FreeSpace& f, const DistanceField& field, double resolution_m, const RoomSegmentationOptions& o) {
+std::vector<int> voronoi_cores(const FreeSpace& f, const DistanceField& field, double resolution_m,
+                               const RoomSegmentationOptions& o) {
   const int w = f.w, h = f.h;
-  const auto idx = [&](int x, int y) { return static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x); };
-  const auto dist = [&](int x, int y) { return x < 0 || y < 0 || x >= w || y >= h ? 0.0 : static_cast<double>(field.distance_m(idx(x, y))); };
+  const auto idx = [&](int x, int y) {
+    return static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+  };
+  const auto dist = [&](int x, int y) {
+    return x < 0 || y < 0 || x >= w || y >= h ? 0.0 : static_cast<double>(field.distance_m(idx(x, y)));
+  };
   // The medial axis: free cells on a ridge of the distance (not lower than both neighbours along a
   // line through them, in one of four directions, and strictly higher than one of them).
   std::vector<std::uint8_t> axis(f.size(), 0);
@@ -277,7 +284,8 @@ std::vector<int> voronoi_cores(const FreeSpace& f, const DistanceField& field, d
     }
   }
   std::vector<std::size_t> sizes;
-  return components(f, [&](std::size_t i) { return f.free[i] != 0 && cut[i] == 0; }, sizes);
+  return components(
+      f, [&](std::size_t i) { return f.free[i] != 0 && cut[i] == 0; }, sizes);
 }
 
 // Every free cell reachable from a core joins the nearest core (a breadth-first wave from all
@@ -327,9 +335,9 @@ void merge_small(const FreeSpace& f, std::vector<int>& label, double cell_m2, do
         if (label[nb[q]] >= 0 && label[nb[q]] != static_cast<int>(smallest)) ++border[label[nb[q]]];
       }
     }
-    const int into = border.empty() ? -1
-                                    : std::max_element(border.begin(), border.end(),
-                                                       [](const auto& x, const auto& y) { return x.second < y.second; })->first;
+    const int into = border.empty() ? -1 : std::max_element(border.begin(), border.end(), [](const auto& x, const auto& y) {
+                                             return x.second < y.second;
+                                           })->first;
     // Alone and too small to be a room (a closet behind a wall, a speck): no room at all.
     for (const std::size_t i : cells[smallest]) label[i] = into;
     if (into >= 0) {

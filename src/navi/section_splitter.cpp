@@ -1,8 +1,5 @@
 #include "tripodal/navi/section_splitter.hpp"
 
-#include "tripodal/navi/grid_maps.hpp"
-#include "tripodal/navi/room_segmentation.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -12,6 +9,9 @@
 #include <map>
 #include <numbers>
 #include <queue>
+
+#include "tripodal/navi/grid_maps.hpp"
+#include "tripodal/navi/room_segmentation.hpp"
 
 namespace tripodal::navi {
 
@@ -159,7 +159,8 @@ std::vector<std::string> order_nearest_first(const OccupancyGrid& grid, const Se
 
 const ModuleManifest& CSectionSplitter::static_manifest() {
   static const ModuleManifest m = navi_manifest(
-      "SectionSplitter", "divides a large workspace into sections at virtual walls between bands of isolated obstacles; "
+      "SectionSplitter",
+      "divides a large workspace into sections at virtual walls between bands of isolated obstacles; "
       "answers sections(room)",
       {"grid_map"}, {"sections"},
       {ParameterSpec{"min_obstacle_area_m2", ValueType::number, Value{0.01}, "m^2",

@@ -11,7 +11,8 @@ std::string LoopEvent::event_name() const {
     case Kind::behavior_failed: return failed_event_name(behavior);
     case Kind::controller_fault: return std::string(loop) + ".controller_fault";
     case Kind::controller_recovered: return std::string(loop) + ".controller_recovered";
-    case Kind::behavior_signal: return std::string(reason);
+    case Kind::behavior_signal:
+      return std::string(reason);
   }
   return {};
 }
@@ -108,7 +109,8 @@ std::string ControlLoop::exported_channels() const {
   if (coordinator_.channel_count() == 0) return "it exports none";
   std::string out = "it exports";
   for (ChannelId c = 0; c < coordinator_.channel_count(); ++c) {
-    out += (c == 0 ? " " : ", ") + coordinator_.channel_spec(c).name + " (" + std::string(to_string(coordinator_.channel_spec(c).type)) + ")";
+    out += (c == 0 ? " " : ", ") + coordinator_.channel_spec(c).name + " (" +
+           std::string(to_string(coordinator_.channel_spec(c).type)) + ")";
   }
   return out;
 }
@@ -116,7 +118,8 @@ std::string ControlLoop::exported_channels() const {
 void ControlLoop::set_command_output(CommandChannels* channels) {
   if (channels != nullptr) {
     bool same = channels->size() == coordinator_.channel_count();
-    for (ChannelId c = 0; same && c < coordinator_.channel_count(); ++c) same = channels->spec(c).name == coordinator_.channel_spec(c).name;
+    for (ChannelId c = 0; same && c < coordinator_.channel_count(); ++c)
+      same = channels->spec(c).name == coordinator_.channel_spec(c).name;
     if (!same) {
       throw std::invalid_argument("control loop '" + options_.name +
                                   "': the command output's channels are not the coordinator's, in its order");

@@ -81,8 +81,8 @@ ThreadSetup apply_thread_options(const LoopTimingOptions& options, std::string_v
   }
   if (options.realtime_priority > 0) {
     sched_param param{};
-    param.sched_priority = std::clamp(options.realtime_priority, sched_get_priority_min(SCHED_FIFO),
-                                      sched_get_priority_max(SCHED_FIFO));
+    param.sched_priority =
+        std::clamp(options.realtime_priority, sched_get_priority_min(SCHED_FIFO), sched_get_priority_max(SCHED_FIFO));
     // Refused without CAP_SYS_NICE or an rtprio limit: the loop then keeps normal scheduling.
     const int err = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
     out.realtime = err == 0;
@@ -93,7 +93,8 @@ ThreadSetup apply_thread_options(const LoopTimingOptions& options, std::string_v
   if (options.cpu >= 0) refused += std::string(refused.empty() ? "" : ", ") + "CPU pinning (not on this system)";
   if (options.realtime_priority > 0) refused += std::string(refused.empty() ? "" : ", ") + "SCHED_FIFO (not on this system)";
 #endif
-  if (!refused.empty()) out.warning = "warning: " + std::string(who) + ": not permitted: " + refused + "; running with normal scheduling";
+  if (!refused.empty())
+    out.warning = "warning: " + std::string(who) + ": not permitted: " + refused + "; running with normal scheduling";
   return out;
 }
 
@@ -109,7 +110,9 @@ PeriodicRunner::PeriodicRunner(std::string name, Duration period, const Clock& c
   if (!cycle_) throw std::invalid_argument("periodic thread '" + name_ + "': no cycle to run");
 }
 
-PeriodicRunner::~PeriodicRunner() { stop(); }
+PeriodicRunner::~PeriodicRunner() {
+  stop();
+}
 
 void PeriodicRunner::start() {
   if (running_.load(std::memory_order_acquire) || thread_.joinable()) {
@@ -160,7 +163,8 @@ void PeriodicRunner::run() noexcept {
 }
 
 LoopRunner::LoopRunner(ControlLoop& loop, const Clock& clock, LoopTimingOptions options)
-    : runner_(loop.name(), loop.period(), clock, [&loop](Time now) { (void)loop.step(now); }, options) {}
+    : runner_(
+          loop.name(), loop.period(), clock, [&loop](Time now) { (void)loop.step(now); }, options) {}
 
 void SimLoopDriver::add(ControlLoop& loop) {
   entries_.push_back({[&loop](Time now) { (void)loop.step(now); }, loop.period(), clock_.now()});

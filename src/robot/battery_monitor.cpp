@@ -25,8 +25,7 @@ void BatteryMonitor::on_configure(const ParameterSet& params) {
 }
 
 void BatteryMonitor::on_update(ModuleContext& context) {
-  const auto* battery =
-      context.resources != nullptr ? context.resources->find<BatteryReading>(resource_) : nullptr;
+  const auto* battery = context.resources != nullptr ? context.resources->find<BatteryReading>(resource_) : nullptr;
   if (battery == nullptr) throw std::runtime_error("no battery resource named '" + resource_ + "'");
   if (!battery->has_reading()) return;
   const BatteryReading& r = battery->latest();

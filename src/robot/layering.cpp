@@ -63,7 +63,8 @@ void check_layering(const std::vector<DescribedModule>& modules, Diagnostics& d)
   // several provide it, the module's `from:` names the one it takes the input from.
   for (const DescribedModule& m : modules) {
     for (const auto& [info, provider] : m.from) {
-      const bool is_input = std::any_of(m.inputs.begin(), m.inputs.end(), [&](const std::string& in) { return base_name(in) == info; });
+      const bool is_input =
+          std::any_of(m.inputs.begin(), m.inputs.end(), [&](const std::string& in) { return base_name(in) == info; });
       if (!is_input) {
         std::string list;
         for (const std::string& in : m.inputs) list += (list.empty() ? "" : ", ") + base_name(in);
@@ -78,11 +79,13 @@ void check_layering(const std::vector<DescribedModule>& modules, Diagnostics& d)
         if (&p != &m && std::find(p.outputs.begin(), p.outputs.end(), info) != p.outputs.end()) providers.push_back(&p);
       }
       if (const auto bound = m.from.find(info); bound != m.from.end()) {
-        const auto named = std::find_if(providers.begin(), providers.end(), [&](const DescribedModule* p) { return p->name == bound->second; });
+        const auto named =
+            std::find_if(providers.begin(), providers.end(), [&](const DescribedModule* p) { return p->name == bound->second; });
         if (named == providers.end()) {
           std::string list;
           for (const auto* p : providers) list += (list.empty() ? "" : ", ") + p->name;
-          d.error(m.where, "from: " + module_phrase(m) + " takes '" + info + "' from '" + bound->second + "', which does not provide it; " +
+          d.error(m.where, "from: " + module_phrase(m) + " takes '" + info + "' from '" + bound->second +
+                               "', which does not provide it; " +
                                (list.empty() ? std::string("no module provides it") : "its providers: " + list));
           continue;
         }
@@ -135,18 +138,22 @@ void check_channels(const std::vector<DescribedModule>& modules, Diagnostics& d)
   const auto hw = std::find_if(modules.begin(), modules.end(), [](const DescribedModule& m) { return m.hardware; });
   if (hw == modules.end()) return;
   std::string exported;
-  for (const ChannelSpec& c : hw->channels) exported += (exported.empty() ? "" : ", ") + c.name + " (" + std::string(to_string(c.type)) + ")";
+  for (const ChannelSpec& c : hw->channels)
+    exported += (exported.empty() ? "" : ", ") + c.name + " (" + std::string(to_string(c.type)) + ")";
   for (const DescribedModule& m : modules) {
     for (const ChannelWrite& w : m.writes) {
       if (w.name.empty()) continue;
-      const auto c = std::find_if(hw->channels.begin(), hw->channels.end(), [&](const ChannelSpec& s) { return s.name == w.name; });
+      const auto c =
+          std::find_if(hw->channels.begin(), hw->channels.end(), [&](const ChannelSpec& s) { return s.name == w.name; });
       if (c == hw->channels.end()) {
-        d.error(m.where, "behavior '" + m.name + "' writes the command channel '" + w.name + "' (" + std::string(to_string(w.type)) +
-                             "), which hardware '" + hw->type + "' does not export; it exports " +
-                             (exported.empty() ? std::string("none") : exported) + " (rule R6)");
+        d.error(m.where, "behavior '" + m.name + "' writes the command channel '" + w.name + "' (" +
+                             std::string(to_string(w.type)) + "), which hardware '" + hw->type +
+                             "' does not export; it exports " + (exported.empty() ? std::string("none") : exported) +
+                             " (rule R6)");
       } else if (c->type != w.type) {
-        d.error(m.where, "behavior '" + m.name + "' writes the command channel '" + w.name + "' as " + std::string(to_string(w.type)) +
-                             ", and hardware '" + hw->type + "' exports it as " + std::string(to_string(c->type)) + " (rule R6)");
+        d.error(m.where, "behavior '" + m.name + "' writes the command channel '" + w.name + "' as " +
+                             std::string(to_string(w.type)) + ", and hardware '" + hw->type + "' exports it as " +
+                             std::string(to_string(c->type)) + " (rule R6)");
       }
     }
   }
@@ -187,15 +194,45 @@ RobotDescription describe_robot(const RobotProfile& profile, const RobotPlugins&
   out.description = profile.description;
   std::vector<std::string> pin = planner_inputs;
   pin.push_back("process_result");
-  out.modules.push_back(DescribedModule{CoreNames::kPlanner, "CPlanner", ModuleKind::planner, Layer::deliberate, true,
+  out.modules.push_back(DescribedModule{CoreNames::kPlanner,
+                                        "CPlanner",
+                                        ModuleKind::planner,
+                                        Layer::deliberate,
+                                        true,
                                         "turns task commands into plans of process modules; recovers from faults",
-                                        pin, {"process_plan"}, profile.where, {}, {}, {}, false});
-  out.modules.push_back(DescribedModule{CoreNames::kSupervisor, "CProcessSupervisor", ModuleKind::other, Layer::sequencing, true,
+                                        pin,
+                                        {"process_plan"},
+                                        profile.where,
+                                        {},
+                                        {},
+                                        {},
+                                        false});
+  out.modules.push_back(DescribedModule{CoreNames::kSupervisor,
+                                        "CProcessSupervisor",
+                                        ModuleKind::other,
+                                        Layer::sequencing,
+                                        true,
                                         "runs the processes' nets, activates behaviors, posts faults",
-                                        {"process_plan"}, {"process_result"}, profile.where, {}, {}, {}, false});
-  out.modules.push_back(DescribedModule{CoreNames::kCoordinator, "CBehaviorCoordinator", ModuleKind::other, Layer::reactive,
-                                        true, "fuses the commands and the command channels of the active behaviors", {"behavior_command*"},
-                                        {"cmd_vel"}, profile.where, {}, {}, {}, false});
+                                        {"process_plan"},
+                                        {"process_result"},
+                                        profile.where,
+                                        {},
+                                        {},
+                                        {},
+                                        false});
+  out.modules.push_back(DescribedModule{CoreNames::kCoordinator,
+                                        "CBehaviorCoordinator",
+                                        ModuleKind::other,
+                                        Layer::reactive,
+                                        true,
+                                        "fuses the commands and the command channels of the active behaviors",
+                                        {"behavior_command*"},
+                                        {"cmd_vel"},
+                                        profile.where,
+                                        {},
+                                        {},
+                                        {},
+                                        false});
   std::vector<const ModuleEntry*> entries;
   if (profile.hardware) entries.push_back(&*profile.hardware);
   for (const ModuleEntry* e : profile.all_modules()) entries.push_back(e);

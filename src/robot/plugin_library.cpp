@@ -58,8 +58,7 @@ void merge_plugins(RobotPlugins& into, RobotPlugins&& from) {
   into.processes.merge(std::move(from.processes));
 }
 
-PluginLibraryInfo load_plugin_library(const std::filesystem::path& path, RobotPlugins& plugins,
-                                      const SourceLocation& where) {
+PluginLibraryInfo load_plugin_library(const std::filesystem::path& path, RobotPlugins& plugins, const SourceLocation& where) {
   const std::string name = path.string();
   const SourceLocation at = where.file.empty() ? SourceLocation{name, 0, 0} : where;
   const auto refuse = [&](const std::string& why) { return ConfigError(at, "plugin '" + name + "' " + why); };
@@ -78,23 +77,20 @@ PluginLibraryInfo load_plugin_library(const std::filesystem::path& path, RobotPl
   const auto version = symbol<AbiVersionFn>(library, kPluginAbiSymbol);
   const auto register_fn = symbol<RegisterFn>(library, kPluginRegisterSymbol);
   if (version == nullptr || register_fn == nullptr) {
-    throw refuse(
-        std::string("is not a tripodal plugin: it exports no ") +
-        (version == nullptr ? kPluginAbiSymbol : kPluginRegisterSymbol) +
-        " (define its entry points with TRIPODAL_REGISTER_PLUGINS, tripodal/robot/plugin_library.hpp)");
+    throw refuse(std::string("is not a tripodal plugin: it exports no ") +
+                 (version == nullptr ? kPluginAbiSymbol : kPluginRegisterSymbol) +
+                 " (define its entry points with TRIPODAL_REGISTER_PLUGINS, tripodal/robot/plugin_library.hpp)");
   }
   const std::uint32_t theirs = version();
   if (theirs != kPluginAbiVersion) {
-    throw refuse("was built against tripodal plugin ABI version " + std::to_string(theirs) +
-                 ", this program has version " + std::to_string(kPluginAbiVersion) +
-                 ": rebuild the plugin against this tripodal");
+    throw refuse("was built against tripodal plugin ABI version " + std::to_string(theirs) + ", this program has version " +
+                 std::to_string(kPluginAbiVersion) + ": rebuild the plugin against this tripodal");
   }
   RobotPlugins registered;
   tripodal_plugin_host host{kPluginAbiVersion, &registered, {}};
   if (register_fn(&host) != 0) {
     host.error[sizeof host.error - 1] = '\0';
-    throw refuse("failed to register its types: " +
-                 std::string(host.error[0] != '\0' ? host.error : "no reason given"));
+    throw refuse("failed to register its types: " + std::string(host.error[0] != '\0' ? host.error : "no reason given"));
   }
   PluginLibraryInfo info{path, {}};
   add_names(info.types, registered.behaviors);
@@ -116,8 +112,7 @@ PluginLibraryInfo load_plugin_library(const std::filesystem::path& path, RobotPl
 std::vector<PluginLibraryInfo> load_profile_plugins(const RobotProfile& profile, RobotPlugins& plugins,
                                                     const std::vector<std::filesystem::path>& extra) {
   std::vector<PluginLibraryInfo> out;
-  for (const std::filesystem::path& p : extra)
-    out.push_back(load_plugin_library(p, plugins, SourceLocation{"--plugin", 0, 0}));
+  for (const std::filesystem::path& p : extra) out.push_back(load_plugin_library(p, plugins, SourceLocation{"--plugin", 0, 0}));
   for (const PluginEntry& e : profile.plugins) out.push_back(load_plugin_library(e.path, plugins, e.where));
   return out;
 }

@@ -10,8 +10,8 @@
 #include <thread>
 
 #include "tripodal/behaviors/navigation_behaviors.hpp"
-#include "tripodal/behaviors/teleop.hpp"
 #include "tripodal/behaviors/safety_behaviors.hpp"
+#include "tripodal/behaviors/teleop.hpp"
 #include "tripodal/core/net_loader.hpp"
 #include "tripodal/navi/navi_modules.hpp"
 #include "tripodal/reactive/reactive_config.hpp"
@@ -97,12 +97,10 @@ struct CheckedProfile {
 // the first guard of each net that reads it, with the process entry of the profile.
 void check_facts(const RobotProfile& profile, const CheckedProfile& checked, Diagnostics& d) {
   std::set<std::string, std::less<>> provided;
-  for (const DescribedModule& m : checked.description.modules)
-    provided.insert(m.outputs.begin(), m.outputs.end());
+  for (const DescribedModule& m : checked.description.modules) provided.insert(m.outputs.begin(), m.outputs.end());
   const std::vector<std::string> provided_names(provided.begin(), provided.end());
   auto is_external = [&](std::string_view f) {
-    return std::find(profile.external_facts.begin(), profile.external_facts.end(), f) !=
-           profile.external_facts.end();
+    return std::find(profile.external_facts.begin(), profile.external_facts.end(), f) != profile.external_facts.end();
   };
   for (const ProcessDefinition& def : checked.processes) {
     const auto entry = std::find_if(profile.processes.begin(), profile.processes.end(),
@@ -113,24 +111,19 @@ void check_facts(const RobotProfile& profile, const CheckedProfile& checked, Dia
       for (const Transition& t : net->transitions()) {
         if (!t.guard) continue;
         for (const std::string& name : t.guard->identifiers()) {
-          if (net->find_fact(name) == nullptr || provided.count(name) != 0 || !reported.insert(name).second)
-            continue;
-          const std::string what = "process '" + def.name + "': the guard of transition '" + t.id +
-                                   "' reads fact '" + name + "', which no module of robot '" + profile.name +
-                                   "' provides (lists among its outputs)";
+          if (net->find_fact(name) == nullptr || provided.count(name) != 0 || !reported.insert(name).second) continue;
+          const std::string what = "process '" + def.name + "': the guard of transition '" + t.id + "' reads fact '" + name +
+                                   "', which no module of robot '" + profile.name + "' provides (lists among its outputs)";
           if (is_external(name)) {
-            d.warning(t.where, what + "; the profile lists it under external_facts (" +
-                                   profile.external_facts_where.str() +
+            d.warning(t.where, what + "; the profile lists it under external_facts (" + profile.external_facts_where.str() +
                                    "), so the application must set it (CProcessSupervisor::set_fact)");
             continue;
           }
           const auto close = closest_name(name, provided_names);
-          d.error(t.where,
-                  what + (close ? "; did you mean '" + *close + "'?" : std::string()) +
-                      "; add a module that sets it (BatteryMonitor sets charging and "
-                      "battery_percent), or list it under external_facts: when the application sets it");
-          if (entry != profile.processes.end())
-            d.note(entry->where, "process '" + def.name + "' is listed here");
+          d.error(t.where, what + (close ? "; did you mean '" + *close + "'?" : std::string()) +
+                               "; add a module that sets it (BatteryMonitor sets charging and "
+                               "battery_percent), or list it under external_facts: when the application sets it");
+          if (entry != profile.processes.end()) d.note(entry->where, "process '" + def.name + "' is listed here");
         }
       }
     }
@@ -285,9 +278,10 @@ void check_channel_writes(const RobotProfile& profile, const RobotPlugins& plugi
       bool any = false;
       for (std::size_t i = 0; exported != nullptr && i < exported->size(); ++i) any = any || exported->spec(i).type == w.type;
       if (!any) {
-        d.error(b.where, "behavior '" + b.name + "' writes " + std::string(to_string(w.type)) + " channels (the one its parameter '" +
-                             w.parameter + "' names), and " +
-                             (hardware != nullptr ? "hardware '" + std::string(hardware->manifest().name) + "'" : std::string("the robot (no hardware)")) +
+        d.error(b.where, "behavior '" + b.name + "' writes " + std::string(to_string(w.type)) +
+                             " channels (the one its parameter '" + w.parameter + "' names), and " +
+                             (hardware != nullptr ? "hardware '" + std::string(hardware->manifest().name) + "'"
+                                                  : std::string("the robot (no hardware)")) +
                              " exports none of that type");
       }
     }
@@ -456,7 +450,9 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
         }
         case LoopEvent::Kind::controller_fault:
         case LoopEvent::Kind::controller_recovered:
-        case LoopEvent::Kind::behavior_signal: supervisor->post_event(e.event_name()); break;
+        case LoopEvent::Kind::behavior_signal:
+          supervisor->post_event(e.event_name());
+          break;
       }
     }
   }
@@ -549,7 +545,8 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
       if (auto* faults = dynamic_cast<ResourceFaultSource*>(m->hardware.get())) m->fault_sources.emplace_back(h.name, faults);
       // So do the hardware's own resources that detect faults (the board's lidar): "<resource>.fault".
       for (std::size_t i = 0; i < m->resources.size(); ++i) {
-        if (auto* faults = dynamic_cast<ResourceFaultSource*>(&m->resources.at(i))) m->fault_sources.emplace_back(m->resources.at(i).name(), faults);
+        if (auto* faults = dynamic_cast<ResourceFaultSource*>(&m->resources.at(i)))
+          m->fault_sources.emplace_back(m->resources.at(i).name(), faults);
       }
     });
   }
@@ -594,7 +591,8 @@ std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotP
         // Driving by hand (BhTeleop, set by an operator console) ranks just above every other
         // normal input, and its lock masks exactly those: the task stops, safety stays.
         const int top = priority;
-        cc.inputs.push_back(CoordinatorInputConfig{.name = std::string(kTeleopInput), .priority = top + 1, .timeout = std::chrono::milliseconds(200)});
+        cc.inputs.push_back(CoordinatorInputConfig{
+            .name = std::string(kTeleopInput), .priority = top + 1, .timeout = std::chrono::milliseconds(200)});
         cc.locks.push_back(CoordinatorLockConfig{.name = std::string(kTeleopInput), .priority = top});
         for (const ModuleEntry& b : profile.behaviors) {
           if (b.safety) {
@@ -714,7 +712,8 @@ void Robot::start(RealtimeOptions options) {
     } else {
       cycle = [&loop](Time now) { (void)loop.step(now); };
     }
-    m.runners.push_back(std::make_unique<PeriodicRunner>(loop.name(), loop.period(), m.clock, std::move(cycle), m.loop_timing[i]));
+    m.runners.push_back(
+        std::make_unique<PeriodicRunner>(loop.name(), loop.period(), m.clock, std::move(cycle), m.loop_timing[i]));
   }
   m.runners.push_back(std::make_unique<PeriodicRunner>(
       "sequencing", m.sequencing_period, m.clock,
@@ -781,7 +780,9 @@ const ProcessRegistry& Robot::processes() const noexcept { return impl_->process
 ControlLoop& Robot::behavior_loop() noexcept { return impl_->behavior_loop(); }
 CHardware* Robot::hardware() noexcept { return impl_->hardware.get(); }
 const ResourceTable& Robot::resources() const noexcept { return impl_->resources; }
-const ResourceTable& Robot::sequencing_resources() const noexcept { return impl_->snapshot->table(); }
+const ResourceTable& Robot::sequencing_resources() const noexcept {
+  return impl_->snapshot->table();
+}
 const NavigationData& Robot::navigation() const noexcept { return impl_->navigation; }
 
 bool Robot::behavior_active(std::string_view name) const noexcept {

@@ -96,9 +96,13 @@ struct Parser {
       return;
     }
     const std::string entry = "a " + std::string(to_string(kind)) + " entry";
-    const bool known = kind == ModuleKind::behavior
-                           ? r.expect_keys(n, {"name", "type", "description", "layer", "inputs", "outputs", "from", "parameters", "watchdog", "safety"}, entry)
-                           : r.expect_keys(n, {"name", "type", "description", "layer", "inputs", "outputs", "from", "parameters", "watchdog"}, entry);
+    const bool known =
+        kind == ModuleKind::behavior
+            ? r.expect_keys(
+                  n, {"name", "type", "description", "layer", "inputs", "outputs", "from", "parameters", "watchdog", "safety"},
+                  entry)
+            : r.expect_keys(n, {"name", "type", "description", "layer", "inputs", "outputs", "from", "parameters", "watchdog"},
+                            entry);
     if (!known) return;
     for (const auto& kv : n) {
       const std::string key = yaml::Reader::checked_key(kv.first);
@@ -199,8 +203,10 @@ struct Parser {
   void dds_section(const YAML::Node& n, RobotProfile& prof) {
     DdsSection s;
     s.where = at(n);
-    if (!r.expect_keys(n, {"domain_id", "namespace", "loopback", "participant_lease_s", "period_s", "publish", "tasks", "frames", "security"},
-                       "dds")) {
+    if (!r.expect_keys(
+            n,
+            {"domain_id", "namespace", "loopback", "participant_lease_s", "period_s", "publish", "tasks", "frames", "security"},
+            "dds")) {
       return;
     }
     if (const YAML::Node v = n["security"]) {
@@ -208,7 +214,8 @@ struct Parser {
         const auto keys = v["keys"] ? r.text(v["keys"], "dds security keys") : std::nullopt;
         const auto identity = v["identity"] ? r.text(v["identity"], "dds security identity") : std::nullopt;
         if (!keys || !identity) {
-          d.error(at(v), "dds security needs keys (the folder `tripodal fleet-keys` made) and identity (this robot's name in it)");
+          d.error(at(v),
+                  "dds security needs keys (the folder `tripodal fleet-keys` made) and identity (this robot's name in it)");
         } else {
           s.security_keys = std::filesystem::path(*keys).is_absolute() ? std::filesystem::path(*keys) : prof.dir / *keys;
           s.security_identity = *identity;
@@ -281,8 +288,8 @@ struct Parser {
     const YAML::Node root = yaml::parse(text, file);
     prof.where = SourceLocation{file, 1, 1};
     if (!r.expect_keys(root,
-                       {"robot", "hardware", "controllers", "loops", "resources", "navigation", "hri",
-                        "modules", "behaviors", "processes", "tasks", "recovery", "dds", "external_facts", "plugins"},
+                       {"robot", "hardware", "controllers", "loops", "resources", "navigation", "hri", "modules", "behaviors",
+                        "processes", "tasks", "recovery", "dds", "external_facts", "plugins"},
                        "the robot profile")) {
       throw ConfigError(d);
     }
@@ -298,7 +305,8 @@ struct Parser {
           if (auto s = positive_seconds(period, "sequencing_period_s")) prof.sequencing_period = from_seconds(*s);
         }
         if (const YAML::Node sl = v["sequencing_loop"]) {
-          if (r.expect_keys(sl, {"realtime_priority", "cpu", "lock_memory", "budget_s", "deadline_overruns"}, "robot sequencing_loop")) {
+          if (r.expect_keys(sl, {"realtime_priority", "cpu", "lock_memory", "budget_s", "deadline_overruns"},
+                            "robot sequencing_loop")) {
             timing(sl, prof.sequencing_timing, "sequencing_loop");
           }
         }
@@ -323,9 +331,10 @@ struct Parser {
         for (const auto& l : v) {
           LoopEntry loop;
           loop.where = at(l);
-          if (!r.expect_keys(l, {"name", "period_s", "controller", "realtime_priority", "cpu", "lock_memory", "budget_s",
-                                 "deadline_overruns"},
-                             "a loop")) {
+          if (!r.expect_keys(
+                  l,
+                  {"name", "period_s", "controller", "realtime_priority", "cpu", "lock_memory", "budget_s", "deadline_overruns"},
+                  "a loop")) {
             continue;
           }
           if (const YAML::Node name = r.require(l, "name", "a loop", "the loop's name")) scalar(name, loop.name, "name");

@@ -41,10 +41,13 @@ void RplidarEmulator::send(std::span<const std::uint8_t> bytes) noexcept {
   if (!line_.write(bytes)) counters_.bytes_lost += bytes.size();
 }
 
-void RplidarEmulator::inject(std::span<const std::uint8_t> bytes) noexcept { send(bytes); }
+void RplidarEmulator::inject(std::span<const std::uint8_t> bytes) noexcept {
+  send(bytes);
+}
 
 std::uint64_t RplidarEmulator::angle_q6_total(std::uint64_t k) const noexcept {
-  return static_cast<std::uint64_t>(std::llround(static_cast<double>(k) * static_cast<double>(kTurnQ6) * config_.rate_hz / config_.sample_rate_hz));
+  return static_cast<std::uint64_t>(
+      std::llround(static_cast<double>(k) * static_cast<double>(kTurnQ6) * config_.rate_hz / config_.sample_rate_hz));
 }
 
 void RplidarEmulator::run_until(Time now) noexcept {
@@ -108,7 +111,8 @@ void RplidarEmulator::handle(std::uint8_t cmd, Time now) noexcept {
       break;
     case rp::Command::get_health:
       rp::encode_descriptor(rp::kHealthDescriptor, descriptor);
-      rp::encode_health(config_.health, std::span<std::uint8_t, rp::kHealthBytes>(out.data() + rp::kDescriptorBytes, rp::kHealthBytes));
+      rp::encode_health(config_.health,
+                        std::span<std::uint8_t, rp::kHealthBytes>(out.data() + rp::kDescriptorBytes, rp::kHealthBytes));
       send(std::span<const std::uint8_t>(out.data(), rp::kDescriptorBytes + rp::kHealthBytes));
       break;
     case rp::Command::scan:

@@ -33,7 +33,8 @@ void SimBoardPlant::sense(Time /*now*/, board::PlantSensors& out) noexcept {
     for (int k = 0; k < rays; ++k) {
       const double off = rays == 1 ? 0.0 : mounts_.ultrasonic_cone_rad * (static_cast<double>(k) / (rays - 1) - 0.5);
       const double mount = mounts_.ultrasonic_rad[i];
-      const navi::Point2D from{pose.x_m + radius * std::cos(pose.theta_rad + mount), pose.y_m + radius * std::sin(pose.theta_rad + mount)};
+      const navi::Point2D from{pose.x_m + radius * std::cos(pose.theta_rad + mount),
+                               pose.y_m + radius * std::sin(pose.theta_rad + mount)};
       const double d = sim_.solid_map().cast(from, pose.theta_rad + mount + off, mounts_.ultrasonic_range_m);
       if (std::isfinite(d) && d <= mounts_.ultrasonic_range_m) nearest = std::min(nearest, static_cast<float>(d));
     }
@@ -91,8 +92,9 @@ const ModuleManifest& SimBoardHardware::static_manifest() {
         ParameterSpec{"uv_power_w", ValueType::number, Value{lamp.uvc_power_w}, "W", "the lamp's UVC output", 0.0, 1000.0, true},
         ParameterSpec{"uv_height_m", ValueType::number, Value{lamp.height_m}, "m", "the lamp above the floor", 0.0, 1.0, true},
         ParameterSpec{"uv_radius_m", ValueType::number, Value{lamp.radius_m}, "m", "the lit disc's radius on the floor", 0.0, 5.0, true}});
-    ModuleManifest r = hardware_manifest("board", "the control board simulated in process in the embedded simulator's world, "
-                                                  "every exchange over the line byte for byte (docs/board-protocol.md)",
+    ModuleManifest r = hardware_manifest("board",
+                                         "the control board simulated in process in the embedded simulator's world, "
+                                         "every exchange over the line byte for byte (docs/board-protocol.md)",
                                          std::move(outputs), std::move(parameters));
     r.command_channels = real.command_channels;  // the embedded host side's
     return r;

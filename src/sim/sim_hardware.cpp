@@ -64,7 +64,9 @@ void SimHardware::make_joints() {
   on_advance_to(sim_.now());  // a first state at the start
 }
 
-std::vector<std::string> SimHardware::take_button_presses() { return sim_.take_button_presses(); }
+std::vector<std::string> SimHardware::take_button_presses() {
+  return sim_.take_button_presses();
+}
 
 void SimHardware::on_add_resources(ResourceTable& table) {
   sim_.add_resources(table, false);

@@ -494,8 +494,7 @@ void Simulator::substep(Duration dt) noexcept {
   // Battery: the electronics and any extra load drain it with time, the wheels with distance.
   const BatteryConfig& bc = rc.battery;
   if (bc.enabled) {
-    double d = -(bc.drain_per_s + extra_drain_per_s_) * h -
-               bc.drain_per_m * std::hypot(actual.vx_m_s, actual.vy_m_s) * h;
+    double d = -(bc.drain_per_s + extra_drain_per_s_) * h - bc.drain_per_m * std::hypot(actual.vx_m_s, actual.vy_m_s) * h;
     if (charging()) d += bc.charge_per_s * h;
     const double before = soc_;
     soc_ = std::clamp(soc_ + d, 0.0, 1.0);
@@ -755,7 +754,8 @@ void Simulator::sample_sensors() noexcept {
   if (due(cliff_due_) && !sensor_dead(SensorKind::cliff, now_)) {
     InfraredReading& ir = cliff_.edit();
     ir.stamp = now_;
-    for (std::size_t i = 0; i < rc.cliff.positions.size() && i < ir.cliff.size(); ++i) ir.cliff[i] = cliff_depth_m(i) > 0.0 ? 1 : 0;
+    for (std::size_t i = 0; i < rc.cliff.positions.size() && i < ir.cliff.size(); ++i)
+      ir.cliff[i] = cliff_depth_m(i) > 0.0 ? 1 : 0;
     cliff_.commit();
   }
   if (due(battery_due_) && !sensor_dead(SensorKind::battery, now_)) {

@@ -138,15 +138,12 @@ class Reader {
 void read_docks(Reader& r, const YAML::Node& list, World& w) {
   if (!list.IsSequence()) {
     r.error(list,
-            "docks must be a list of {name, pose | node, contact_radius_m, heading_tolerance_deg}, got " +
-                Reader::kind(list));
+            "docks must be a list of {name, pose | node, contact_radius_m, heading_tolerance_deg}, got " + Reader::kind(list));
     return;
   }
   std::set<std::string> names;
   for (const auto& item : list) {
-    if (!r.check_map(item, "a docks entry",
-                     {"name", "pose", "node", "contact_radius_m", "heading_tolerance_deg"}))
-      continue;
+    if (!r.check_map(item, "a docks entry", {"name", "pose", "node", "contact_radius_m", "heading_tolerance_deg"})) continue;
     Dock k;
     k.where = r.at(item);
     r.text(item, "name", k.name, "docks entry");
@@ -166,16 +163,15 @@ void read_docks(Reader& r, const YAML::Node& list, World& w) {
     } else {
       const navi::MapNode* n = node.IsScalar() ? w.regions.node(node.Scalar()) : nullptr;
       if (n == nullptr) {
-        r.error(node, "unknown node " + Reader::kind(node) +
-                          (w.regions_file.empty() ? " (the world names no regions file)" : ""));
+        r.error(node,
+                "unknown node " + Reader::kind(node) + (w.regions_file.empty() ? " (the world names no regions file)" : ""));
         continue;
       }
       k.pose = n->pose;
       if (k.name.empty()) k.name = n->name;
     }
     if (k.name.empty()) k.name = "dock " + std::to_string(w.docks.size() + 1);
-    if (!names.insert(k.name).second)
-      r.error(item["name"] ? item["name"] : item, "duplicate dock name '" + k.name + "'");
+    if (!names.insert(k.name).second) r.error(item["name"] ? item["name"] : item, "duplicate dock name '" + k.name + "'");
     r.number_at_least(item, "contact_radius_m", k.contact_radius_m, 0.0, true, "dock '" + k.name + "'");
     double tolerance_deg = k.heading_tolerance_rad / kDegToRad;
     r.number_at_least(item, "heading_tolerance_deg", tolerance_deg, 0.0, false, "dock '" + k.name + "'");
@@ -584,9 +580,9 @@ World walk_world(std::string_view text, const std::filesystem::path& file) {
   Reader r(fname);
   World w;
   w.file = file;
-  if (!r.check_map(root, "the world file",
-                   {"map", "regions", "start_pose", "seed", "robot", "drops", "obstacles", "visitors",
-                    "docks", "faults", "sonar_only"})) {
+  if (!r.check_map(
+          root, "the world file",
+          {"map", "regions", "start_pose", "seed", "robot", "drops", "obstacles", "visitors", "docks", "faults", "sonar_only"})) {
     throw ConfigError(std::move(r.diagnostics()));
   }
   const std::filesystem::path dir = file.parent_path();
@@ -685,7 +681,8 @@ World walk_world(std::string_view text, const std::filesystem::path& file) {
 
   if (const YAML::Node glass = root["sonar_only"]) {
     if (!glass.IsSequence()) {
-      r.error(glass, "sonar_only must be a list of {name, rectangle | polygon} (glass walls, low tables), got " + Reader::kind(glass));
+      r.error(glass,
+              "sonar_only must be a list of {name, rectangle | polygon} (glass walls, low tables), got " + Reader::kind(glass));
     } else {
       std::set<std::string> names;
       for (const auto& item : glass) {
@@ -694,7 +691,8 @@ World walk_world(std::string_view text, const std::filesystem::path& file) {
         o.where = r.at(item);
         r.text(item, "name", o.name, "sonar_only entry");
         if (o.name.empty()) o.name = "sonar_only " + std::to_string(w.sonar_only.size() + 1);
-        if (!names.insert(o.name).second) r.error(item["name"] ? item["name"] : item, "duplicate sonar_only name '" + o.name + "'");
+        if (!names.insert(o.name).second)
+          r.error(item["name"] ? item["name"] : item, "duplicate sonar_only name '" + o.name + "'");
         if (!item["rectangle"] && !item["polygon"]) {
           r.error(item, "sonar_only '" + o.name + "' needs rectangle: [x_min, y_min, x_max, y_max] or polygon: [[x, y], ...]");
           continue;
@@ -786,8 +784,9 @@ World walk_world(std::string_view text, const std::filesystem::path& file) {
     }
     for (const StuckCliffSensor& st : w.faults.stuck_cliff) {
       if (st.index >= w.robot.cliff.positions.size()) {
-        r.diagnostics().error(st.where, fmt::format("stuck_cliff.index {} names no cliff sensor: the robot has {} (robot.cliff.positions)",
-                                                    st.index, w.robot.cliff.positions.size()));
+        r.diagnostics().error(st.where,
+                              fmt::format("stuck_cliff.index {} names no cliff sensor: the robot has {} (robot.cliff.positions)",
+                                          st.index, w.robot.cliff.positions.size()));
       }
     }
     // A glass pane over the start: the robot would start inside it.
@@ -806,8 +805,7 @@ World walk_world(std::string_view text, const std::filesystem::path& file) {
     for (const Dock& k : w.docks) {
       if (solid.disc_overlaps({k.pose.x_m, k.pose.y_m}, w.robot.radius_m)) {
         r.diagnostics().error(k.where, "dock '" + k.name + "': docked there, the robot's footprint (radius " +
-                                           std::to_string(w.robot.radius_m) +
-                                           " m) overlaps an occupied cell or leaves the map");
+                                           std::to_string(w.robot.radius_m) + " m) overlaps an occupied cell or leaves the map");
       }
     }
   }

@@ -3,25 +3,23 @@
 // answered from the RKMS of the profile's Hri module, an entry added to that store answered at once,
 // command inputs started on the robot's planner or refused in plain words, and the internal state
 // the HRI displays following the planner's life cycle.
-#include <catch2/catch.hpp>
+#include "guide_hri.hpp"
 
-#include <algorithm>
-
+#include <spdlog/spdlog.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 #include <string>
 
-#include <spdlog/spdlog.h>
-
-#include "guide_hri.hpp"
 #include "run_outputs.hpp"
-#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/behaviors/behavior_coordinator.hpp"
 #include "tripodal/behaviors/behavior_registry.hpp"
 #include "tripodal/behaviors/gesture_behaviors.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/reactive/control_loop.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/robot/robot_profile.hpp"

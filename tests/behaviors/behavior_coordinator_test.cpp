@@ -270,7 +270,8 @@ TEST_CASE("Channels: the live writer of highest priority wins each channel on it
   CHECK(co.channel_output(lcd).value.text() == "covering");
 }
 
-TEST_CASE("Channels: a write past its input's or the channel's timeout falls to the safe value; a holding channel keeps its last", "[channels]") {
+TEST_CASE("Channels: a write past its input's or the channel's timeout falls to the safe value; a holding channel keeps its last",
+          "[channels]") {
   CBehaviorCoordinator co(with_channels());
   const ChannelId lamp = *co.find_channel("uv_lamp");
   const ChannelId neck = *co.find_channel("neck");
@@ -295,7 +296,8 @@ TEST_CASE("Channels: a write past its input's or the channel's timeout falls to 
   CHECK(co.channel_output(neck).value.number == 0.25);
 }
 
-TEST_CASE("Channels: weighted mean for numeric channels only, clamped; locks mask; a safety write replaces the result", "[channels]") {
+TEST_CASE("Channels: weighted mean for numeric channels only, clamped; locks mask; a safety write replaces the result",
+          "[channels]") {
   CBehaviorCoordinator co(with_channels(CoordinationMode::weighted_sum));
   const ChannelId lamp = *co.find_channel("uv_lamp");
   const ChannelId neck = *co.find_channel("neck");
@@ -333,6 +335,8 @@ TEST_CASE("Channels: weighted mean for numeric channels only, clamped; locks mas
 
 TEST_CASE("Channels: a duplicate or unnamed channel is refused") {
   CBehaviorCoordinator co(with_channels());
-  CHECK_THROWS_WITH(co.add_channel(ChannelSpec{"uv_lamp", ChannelType::digital, {}, false, 0ms, 0.0, 0.0, "", ""}), Catch::Contains("'uv_lamp' already exists"));
-  CHECK_THROWS_WITH(co.add_channel(ChannelSpec{"", ChannelType::digital, {}, false, 0ms, 0.0, 0.0, "", ""}), Catch::Contains("needs a name"));
+  CHECK_THROWS_WITH(co.add_channel(ChannelSpec{"uv_lamp", ChannelType::digital, {}, false, 0ms, 0.0, 0.0, "", ""}),
+                    Catch::Contains("'uv_lamp' already exists"));
+  CHECK_THROWS_WITH(co.add_channel(ChannelSpec{"", ChannelType::digital, {}, false, 0ms, 0.0, 0.0, "", ""}),
+                    Catch::Contains("needs a name"));
 }

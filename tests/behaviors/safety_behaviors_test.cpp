@@ -32,8 +32,8 @@ struct Readings {
     navi.map_from_base = {1.0, 2.0, 0.0};
     set_cliff({0, 0, 0});
     set_bumps(0);
-    set_sonar({std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity(),
-               std::numeric_limits<float>::infinity()});
+    set_sonar(
+        {std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity()});
   }
   void set_cliff(std::vector<std::uint8_t> bits) {
     InfraredReading r;
@@ -67,14 +67,11 @@ constexpr double kInf = VelocityEnvelope::kInf;
 
 }  // namespace
 
-TEST_CASE(
-    "BhCliffGuard: a cliff bit stops the robot, backs it straight off, holds it and raises `cliff` once",
-    "[behaviors][safety]") {
+TEST_CASE("BhCliffGuard: a cliff bit stops the robot, backs it straight off, holds it and raises `cliff` once",
+          "[behaviors][safety]") {
   Readings w;
   BhCliffGuard guard;
-  guard.activate(
-      ParameterValues{{"back_off_m", Value{0.1}}, {"back_speed_m_s", Value{0.1}}, {"hold_s", Value{2.0}}},
-      w.ctx);
+  guard.activate(ParameterValues{{"back_off_m", Value{0.1}}, {"back_speed_m_s", Value{0.1}}, {"hold_s", Value{2.0}}}, w.ctx);
   REQUIRE(guard.running());
   CHECK_FALSE(w.step(guard).has_value());  // floor everywhere: nothing imposed
   CHECK(guard.take_signal().empty());
@@ -160,14 +157,11 @@ TEST_CASE("BhBumperGuard: a front bump backs off; a back bump alone forbids back
   CHECK(e->vx_hi_m_s == 0.0);
 }
 
-TEST_CASE("BhSonarGuard: slows down and stops before an echo ahead, not for one beside the corridor",
-          "[behaviors][safety]") {
+TEST_CASE("BhSonarGuard: slows down and stops before an echo ahead, not for one beside the corridor", "[behaviors][safety]") {
   Readings w;
   BhSonarGuard guard;
-  guard.activate(
-      ParameterValues{
-          {"stop_distance_m", Value{0.1}}, {"slow_distance_m", Value{0.6}}, {"max_speed_m_s", Value{0.5}}},
-      w.ctx);
+  guard.activate(ParameterValues{{"stop_distance_m", Value{0.1}}, {"slow_distance_m", Value{0.6}}, {"max_speed_m_s", Value{0.5}}},
+                 w.ctx);
   constexpr float kNone = std::numeric_limits<float>::infinity();
   auto e = w.step(guard);
   REQUIRE(e.has_value());
@@ -196,9 +190,8 @@ TEST_CASE("BhSonarGuard: slows down and stops before an echo ahead, not for one 
   CHECK(blind.step(g2)->vx_hi_m_s == 0.0);
 }
 
-TEST_CASE(
-    "safety reflexes through the coordinator: the back-off wins over the task's command, the hold stops it",
-    "[behaviors][safety]") {
+TEST_CASE("safety reflexes through the coordinator: the back-off wins over the task's command, the hold stops it",
+          "[behaviors][safety]") {
   CBehaviorCoordinator c;
   const InputId cover = c.add_input({.name = "BhCleaningTwoWheel", .priority = 5});
   const InputId cliff = c.add_input({.name = "BhCliffGuard", .priority = 1000, .role = InputRole::safety});
@@ -234,13 +227,10 @@ TEST_CASE("register_safety_behaviors registers the three reflexes", "[behaviors]
   }
 }
 
-TEST_CASE("BhCliffGuard: the hold ends early once the robot has turned away (toward a detour)",
-          "[behaviors][safety]") {
+TEST_CASE("BhCliffGuard: the hold ends early once the robot has turned away (toward a detour)", "[behaviors][safety]") {
   Readings w;
   BhCliffGuard guard;
-  guard.activate(
-      ParameterValues{{"back_off_m", Value{0.1}}, {"hold_s", Value{12.0}}, {"release_turn_rad", Value{1.0}}},
-      w.ctx);
+  guard.activate(ParameterValues{{"back_off_m", Value{0.1}}, {"hold_s", Value{12.0}}, {"release_turn_rad", Value{1.0}}}, w.ctx);
   w.set_cliff({1, 0, 0});
   (void)w.step(guard);
   w.set_cliff({0, 0, 0});

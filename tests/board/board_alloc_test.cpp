@@ -1,7 +1,6 @@
 // The decoder allocates nothing per frame (nor ever): counted with a replaced operator new.
-#include <catch2/catch.hpp>
-
 #include <array>
+#include <catch2/catch.hpp>
 #include <vector>
 
 #include "../support/counting_new.hpp"

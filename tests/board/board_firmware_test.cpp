@@ -1,7 +1,6 @@
 #include "tripodal/board/board_firmware.hpp"
 
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <limits>
 #include <vector>

@@ -1,13 +1,12 @@
 // A board that stops answering because its process was killed, and comes back (issue 17's fault
 // list): the real tripodal-board-sim behind a pseudo-terminal, the host's BoardLink on the
 // symbolic link the simulator keeps to it, in real time as on the robot. Bounded waits only.
-#include <catch2/catch.hpp>
-
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -17,8 +16,8 @@
 
 #include "tripodal/board/board_link.hpp"
 #include "tripodal/board/rplidar_a1.hpp"
-#include "tripodal/board/tcp_stream.hpp"
 #include "tripodal/board/serial_port.hpp"
+#include "tripodal/board/tcp_stream.hpp"
 #include "tripodal/core/clock.hpp"
 
 extern char** environ;
@@ -162,8 +161,9 @@ TEST_CASE("the board's process on TCP (the ESP8266 link): connected, killed, res
   stop_board(board);
 }
 
-TEST_CASE("the lidar beside the board in tripodal-board-sim: scans of the world, its process killed: a fault, restarted: scans again",
-          "[board][process][rplidar]") {
+TEST_CASE(
+    "the lidar beside the board in tripodal-board-sim: scans of the world, its process killed: a fault, restarted: scans again",
+    "[board][process][rplidar]") {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("tripodal-lidar-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const std::filesystem::path board_link = dir / "board";
@@ -200,7 +200,8 @@ TEST_CASE("the lidar beside the board in tripodal-board-sim: scans of the world,
 
   // Unplugged: the emulator's process dies, the port hangs up.
   stop_board(sim);
-  poll_until(*lidar, 200, [&] { return lidar->state() == RplidarA1::State::failed || lidar->state() == RplidarA1::State::stalled; });
+  poll_until(*lidar, 200,
+             [&] { return lidar->state() == RplidarA1::State::failed || lidar->state() == RplidarA1::State::stalled; });
   const std::vector<std::string> faults = lidar->take_faults();
   REQUIRE(faults.size() == 1);
   CHECK_THAT(faults[0], Catch::Contains("serial port is gone") || Catch::Contains("no revolution"));

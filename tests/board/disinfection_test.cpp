@@ -2,14 +2,13 @@
 // simulated board (hardware type "board", every exchange over the in-process line byte for byte),
 // the task "disinfect the room ..." through PrAutoMove and PrDisinfection.
 #include <catch2/catch.hpp>
-
 #include <filesystem>
 #include <memory>
 #include <string>
 
-#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/board/actuator_behaviors.hpp"
 #include "tripodal/board/board_monitor.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_board.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
@@ -175,7 +174,8 @@ namespace {
 // The disinfection profile without its nets' driver and BoardMonitor (nothing else could switch an
 // actuator), plus BhLcdText, so that the behaviors alone drive the board through their channels.
 struct ChannelRobot {
-  std::shared_ptr<const sim::World> world = std::make_shared<const sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml"));
+  std::shared_ptr<const sim::World> world =
+      std::make_shared<const sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml"));
   SimClock clock;
   RobotPlugins plugins = builtin_plugins(world);
   std::unique_ptr<Robot> robot;
@@ -199,7 +199,8 @@ struct ChannelRobot {
 
 }  // namespace
 
-TEST_CASE("The board's lamp, atomizer, voice and LCD are command channels the behaviors write and the board applies", "[board][channels]") {
+TEST_CASE("The board's lamp, atomizer, voice and LCD are command channels the behaviors write and the board applies",
+          "[board][channels]") {
   ChannelRobot r;
   const board::BoardFirmware& fw = r.hw->embedded().firmware();
   CommandChannels& channels = r.hw->command_channels();
@@ -243,8 +244,9 @@ TEST_CASE("A behavior writing a channel the hardware does not export is refused 
     const std::string what = e.what();
     CHECK_THAT(what, Catch::Contains("disinfection.yaml:"));
     CHECK_THAT(what, Catch::Contains("disinfection.yaml:57:"));
-    CHECK_THAT(what, Catch::Contains("behavior 'BhUvLamp' writes the command channel 'uv_lamp' (digital), which hardware 'sim' does "
-                                     "not export; it exports none (rule R6)"));
+    CHECK_THAT(what,
+               Catch::Contains("behavior 'BhUvLamp' writes the command channel 'uv_lamp' (digital), which hardware 'sim' does "
+                               "not export; it exports none (rule R6)"));
     CHECK_THAT(what, Catch::Contains("behavior 'BhAtomize' writes the command channel 'atomizer' (analog)"));
     CHECK_THAT(what, Catch::Contains("behavior 'BhVoicePrompt' writes the command channel 'voice' (track)"));
   }

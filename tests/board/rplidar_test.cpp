@@ -2,12 +2,11 @@
 // hand from Slamtec's protocol tables and against the A1 emulator (sim/rplidar_emulator.hpp)
 // through a kernel pseudo-terminal. Both ends run on one simulated clock in lock-step; the rig
 // only waits (bounded) for the kernel to hand over bytes one end wrote. No sleeps.
-#include <catch2/catch.hpp>
-
 #include <poll.h>
 
 #include <array>
 #include <atomic>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -42,7 +41,8 @@ std::span<const std::uint8_t, N> fixed(const Bytes& b, std::size_t at = 0) {
 std::vector<rp::Node> decode_all(rp::NodeDecoder& d, const Bytes& bytes, std::size_t chunk) {
   std::vector<rp::Node> nodes;
   for (std::size_t i = 0; i < bytes.size(); i += chunk) {
-    d.feed(std::span<const std::uint8_t>(bytes).subspan(i, std::min(chunk, bytes.size() - i)), [&](const rp::Node& n) { nodes.push_back(n); });
+    d.feed(std::span<const std::uint8_t>(bytes).subspan(i, std::min(chunk, bytes.size() - i)),
+           [&](const rp::Node& n) { nodes.push_back(n); });
   }
   return nodes;
 }
@@ -231,7 +231,9 @@ TEST_CASE("RPLIDAR scan assembler: a revolution per start flag, nearest return p
       // 90 deg clockwise (bin 90: -90 deg + 180) at 1 m, every other at 2 m; 10 deg nothing.
       const std::uint16_t q2 = i == 10 ? 0 : (i == 90 ? 4000 : 8000);
       completed += a.add(rp::Node{i == 0, static_cast<std::uint8_t>(q2 == 0 ? 0 : 10), static_cast<std::uint16_t>(i * 64), q2},
-                         t0 + std::chrono::milliseconds(rev * 180)) ? 1 : 0;
+                         t0 + std::chrono::milliseconds(rev * 180))
+                       ? 1
+                       : 0;
     }
   }
   CHECK(completed == 2);
@@ -323,7 +325,7 @@ TEST_CASE("RPLIDAR A1 over a pty: a motor stopped by DTR is a fault within the t
   const std::uint64_t scans_before_stop = rig.lidar->stats().scans;
 
   rig.emulator->set_motor(false, rig.clock.now());  // the motor stops (a stuck rotor)
-  rig.motor.stuck = true;                            // and stays stopped whatever DTR says
+  rig.motor.stuck = true;                           // and stays stopped whatever DTR says
   const Time stopped = rig.clock.now();
   Time faulted{};
   std::vector<std::string> faults;
@@ -404,7 +406,8 @@ TEST_CASE("RPLIDAR A1 open: a path that does not exist, a regular file, a silent
                       Catch::Contains("no answer to GET_INFO within 0.05 s") && Catch::Contains(pty.slave_path().string()));
 }
 
-TEST_CASE("hardware 'board' with lidar_port: the A1 opened beside the board as the resource 'laser'", "[board][rplidar][threads]") {
+TEST_CASE("hardware 'board' with lidar_port: the A1 opened beside the board as the resource 'laser'",
+          "[board][rplidar][threads]") {
   HardwareRegistry registry("hardware type");
   register_board_hardware(registry);
   SteadyClock real;
@@ -422,8 +425,9 @@ TEST_CASE("hardware 'board' with lidar_port: the A1 opened beside the board as t
                                  {{"port", Value{board_pty.slave_path().string()}}, {"lidar_port", Value{lidar_port}}}, c.where);
   };
   c.parameters = params("/nonexistent/ttyLIDAR");
-  REQUIRE_THROWS_WITH(registry.create("board", c),
-                      Catch::Contains("robot.yaml:12:3: error: hardware 'board', lidar_port: RPLIDAR port /nonexistent/ttyLIDAR does not exist"));
+  REQUIRE_THROWS_WITH(
+      registry.create("board", c),
+      Catch::Contains("robot.yaml:12:3: error: hardware 'board', lidar_port: RPLIDAR port /nonexistent/ttyLIDAR does not exist"));
 
   // The emulator on its own thread and clock, as in another process.
   RingScene scene;
@@ -453,20 +457,25 @@ TEST_CASE("hardware 'board' with lidar_port: the A1 opened beside the board as t
   CHECK(table.find<LaserScan>("laser") == board.lidar());
 }
 
-TEST_CASE("resource type RplidarA1: registered with its manifest, a port that cannot be opened is a located error", "[board][rplidar]") {
+TEST_CASE("resource type RplidarA1: registered with its manifest, a port that cannot be opened is a located error",
+          "[board][rplidar]") {
   ResourceRegistry resources{"resource type"};
   register_rplidar_resource(resources);
   REQUIRE(resources.contains("RplidarA1"));
   CHECK(resources.manifest("RplidarA1").outputs == std::vector<std::string>{"laser_scan"});
   const SourceLocation where{SourceFile(std::string_view("robot.yaml")), 7, 5};
   REQUIRE_THROWS_WITH(ParameterSet::resolve(resources.manifest("RplidarA1"), {}, where), Catch::Contains("port"));
-  const ResourceConfig c{"laser", ParameterSet::resolve(resources.manifest("RplidarA1"), {{"port", Value{std::string("/nonexistent/ttyUSB7")}}}, where),
-                         where, nullptr};
-  REQUIRE_THROWS_WITH(resources.create("RplidarA1", c),
-                      Catch::Contains("robot.yaml:7:5: error: resource 'laser' (RplidarA1): RPLIDAR port /nonexistent/ttyUSB7 does not exist"));
+  const ResourceConfig c{
+      "laser",
+      ParameterSet::resolve(resources.manifest("RplidarA1"), {{"port", Value{std::string("/nonexistent/ttyUSB7")}}}, where),
+      where, nullptr};
+  REQUIRE_THROWS_WITH(
+      resources.create("RplidarA1", c),
+      Catch::Contains("robot.yaml:7:5: error: resource 'laser' (RplidarA1): RPLIDAR port /nonexistent/ttyUSB7 does not exist"));
 }
 
-TEST_CASE("A1 emulator: STOP ends the node stream, RESET answers with its banner, a bad checksum is refused", "[board][rplidar]") {
+TEST_CASE("A1 emulator: STOP ends the node stream, RESET answers with its banner, a bad checksum is refused",
+          "[board][rplidar]") {
   RingScene scene;
   SimClock clock{Time{1s}};
   SteadyClock real;
@@ -486,7 +495,8 @@ TEST_CASE("A1 emulator: STOP ends the node stream, RESET answers with its banner
     while (clock.now() < end) {
       clock.advance(1ms);
       emulator.run_until(clock.now());
-      for (std::ptrdiff_t n = host.read(in, Time{}); n > 0; n = host.read(in, Time{})) got.insert(got.end(), in.begin(), in.begin() + n);
+      for (std::ptrdiff_t n = host.read(in, Time{}); n > 0; n = host.read(in, Time{}))
+        got.insert(got.end(), in.begin(), in.begin() + n);
     }
     for (int i = 0; i < 20; ++i) {  // what the kernel still holds
       await_readable(host.fd());

@@ -11,9 +11,9 @@
 #include <random>
 #include <string>
 
-#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/board/actuator_behaviors.hpp"
 #include "tripodal/board/board_monitor.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_board.hpp"
 
@@ -53,8 +53,7 @@ WardRun run_ward(std::uint64_t seed, double max_s, const std::function<void(sim:
   // start pose, so every seed drives its own coverage.
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> offset(-0.3, 0.3), turn(-0.5, 0.5);
-  w.start_pose = {w.start_pose.x_m + offset(rng), w.start_pose.y_m + offset(rng),
-                  w.start_pose.theta_rad + turn(rng)};
+  w.start_pose = {w.start_pose.x_m + offset(rng), w.start_pose.y_m + offset(rng), w.start_pose.theta_rad + turn(rng)};
   if (edit) edit(w);
   const auto world = std::make_shared<const sim::World>(std::move(w));
   SimClock clock;
@@ -77,15 +76,13 @@ WardRun run_ward(std::uint64_t seed, double max_s, const std::function<void(sim:
   while (robot->planner().busy() && clock.now() < end && !sim.fallen()) {
     robot->run_for(10ms);
     const Pose2D& p = sim.pose();
-    out.glass_clearance_m =
-        std::min(out.glass_clearance_m, to_rectangle(p.x_m, p.y_m, 2.0, 2.4, 2.06, 4.0) - 0.25);
+    out.glass_clearance_m = std::min(out.glass_clearance_m, to_rectangle(p.x_m, p.y_m, 2.0, 2.4, 2.06, 4.0) - 0.25);
     for (const double side : {half, -half}) {
       const double wx = p.x_m - std::sin(p.theta_rad) * side, wy = p.y_m + std::cos(p.theta_rad) * side;
       out.ledge_clearance_m = std::min(out.ledge_clearance_m, to_rectangle(wx, wy, 3.5, 0.0, 5.0, 1.4));
     }
-    const std::uint32_t bits = hw.board().link().has_drive()
-                                   ? (hw.board().link().drive().sensors >> board::kCliffShift) & 0xFFU
-                                   : 0U;
+    const std::uint32_t bits =
+        hw.board().link().has_drive() ? (hw.board().link().drive().sensors >> board::kCliffShift) & 0xFFU : 0U;
     if (bits != 0 && last_bits == 0) ++out.cliff_detections;
     last_bits = bits;
   }
@@ -99,10 +96,9 @@ WardRun run_ward(std::uint64_t seed, double max_s, const std::function<void(sim:
 }
 
 std::string describe(const WardRun& r) {
-  return "seed " + std::to_string(r.seed) + ": " + (r.fell ? "FELL" : "no fall") + ", " +
-         std::to_string(r.contacts) + " contacts (" + std::to_string(r.glass_contacts) + " glass), " +
-         std::to_string(r.cliff_detections) + " cliff detections, closest wheel to the ledge " +
-         std::to_string(r.ledge_clearance_m) + " m, footprint to the glass " +
+  return "seed " + std::to_string(r.seed) + ": " + (r.fell ? "FELL" : "no fall") + ", " + std::to_string(r.contacts) +
+         " contacts (" + std::to_string(r.glass_contacts) + " glass), " + std::to_string(r.cliff_detections) +
+         " cliff detections, closest wheel to the ledge " + std::to_string(r.ledge_clearance_m) + " m, footprint to the glass " +
          std::to_string(r.glass_clearance_m) + " m, task " + std::string(to_string(r.state)) +
          (r.reason.empty() ? "" : " (" + r.reason + ")") + " after " + std::to_string(r.duration_s) + " s";
 }
@@ -144,16 +140,14 @@ Approach drive_at(Pose2D start, Pose2D goal, const std::function<void(sim::World
     robot->run_for(10ms);
     const Pose2D& p = sim.pose();
     out.max_x_m = std::max(out.max_x_m, p.x_m);
-    out.glass_clearance_m =
-        std::min(out.glass_clearance_m, to_rectangle(p.x_m, p.y_m, 2.0, 2.4, 2.06, 4.0) - 0.25);
+    out.glass_clearance_m = std::min(out.glass_clearance_m, to_rectangle(p.x_m, p.y_m, 2.0, 2.4, 2.06, 4.0) - 0.25);
     for (const double side : {0.21, -0.21}) {
-      out.ledge_clearance_m = std::min(
-          out.ledge_clearance_m, to_rectangle(p.x_m - std::sin(p.theta_rad) * side,
-                                              p.y_m + std::cos(p.theta_rad) * side, 3.5, 0.0, 5.0, 1.4));
+      out.ledge_clearance_m =
+          std::min(out.ledge_clearance_m,
+                   to_rectangle(p.x_m - std::sin(p.theta_rad) * side, p.y_m + std::cos(p.theta_rad) * side, 3.5, 0.0, 5.0, 1.4));
     }
-    const std::uint32_t bits = hw.board().link().has_drive()
-                                   ? (hw.board().link().drive().sensors >> board::kCliffShift) & 0xFFU
-                                   : 0U;
+    const std::uint32_t bits =
+        hw.board().link().has_drive() ? (hw.board().link().drive().sensors >> board::kCliffShift) & 0xFFU : 0U;
     if (bits != 0 && last_bits == 0) ++out.cliff_detections;
     last_bits = bits;
   }
@@ -164,8 +158,7 @@ Approach drive_at(Pose2D start, Pose2D goal, const std::function<void(sim::World
 
 }  // namespace
 
-TEST_CASE("safety ward: driven straight at the glass, the ultrasonic stops the robot short of it",
-          "[board][safety]") {
+TEST_CASE("safety ward: driven straight at the glass, the ultrasonic stops the robot short of it", "[board][safety]") {
   const Approach a = drive_at({0.8, 3.2, 0.0}, {3.5, 3.2, 0.0});
   WARN("straight at the glass: closest " << a.glass_clearance_m << " m, " << a.contacts << " contacts");
   CHECK(a.contacts == 0);
@@ -173,18 +166,15 @@ TEST_CASE("safety ward: driven straight at the glass, the ultrasonic stops the r
   CHECK(a.glass_clearance_m < 0.3);  // it did drive up to it
 }
 
-TEST_CASE("safety ward: driven straight down the stairwell, the cliff sensors stop it every time",
-          "[board][safety]") {
+TEST_CASE("safety ward: driven straight down the stairwell, the cliff sensors stop it every time", "[board][safety]") {
   const Approach a = drive_at({2.3, 0.7, 0.0}, {4.5, 0.7, 0.0});
-  WARN("straight at the ledge: " << a.cliff_detections << " detections, closest wheel " << a.ledge_clearance_m
-                                 << " m");
+  WARN("straight at the ledge: " << a.cliff_detections << " detections, closest wheel " << a.ledge_clearance_m << " m");
   CHECK_FALSE(a.fell);
   CHECK(a.cliff_detections >= 2);  // stopped, backed off, held, tried again, stopped again
   CHECK(a.ledge_clearance_m > 0.0);
   // Obliquely (30 degrees off the edge's normal), the side sensors see it first.
   const Approach b = drive_at({2.3, 0.35, 0.5236}, {4.5, 1.6, 0.5236});
-  WARN("obliquely at the ledge: " << b.cliff_detections << " detections, closest wheel "
-                                  << b.ledge_clearance_m << " m");
+  WARN("obliquely at the ledge: " << b.cliff_detections << " detections, closest wheel " << b.ledge_clearance_m << " m");
   CHECK_FALSE(b.fell);
   CHECK(b.cliff_detections >= 1);
 }
@@ -195,8 +185,8 @@ TEST_CASE(
     "[board][safety][faults]") {
   const auto stuck = [](sim::World& w) { w.faults.stuck_cliff.push_back({0, false, {}}); };
   const Approach a = drive_at({2.3, 0.7, 0.0}, {4.5, 0.7, 0.0}, stuck);
-  WARN("front cliff sensor stuck at floor, straight at the ledge: "
-       << a.cliff_detections << " detections, closest wheel " << a.ledge_clearance_m << " m");
+  WARN("front cliff sensor stuck at floor, straight at the ledge: " << a.cliff_detections << " detections, closest wheel "
+                                                                    << a.ledge_clearance_m << " m");
   CHECK_FALSE(a.fell);
   CHECK(a.cliff_detections >= 1);
   CHECK(a.ledge_clearance_m > 0.0);
@@ -231,9 +221,7 @@ TEST_CASE(
 TEST_CASE("safety ward: with the front cliff sensor stuck at 'floor' the other sensors still stop it",
           "[board][safety][faults]") {
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-    const WardRun r = run_ward(seed, 900.0, [](sim::World& w) {
-      w.faults.stuck_cliff.push_back({0, false, {}});
-    });
+    const WardRun r = run_ward(seed, 900.0, [](sim::World& w) { w.faults.stuck_cliff.push_back({0, false, {}}); });
     WARN("front cliff sensor stuck at floor, " << describe(r));
     CHECK_FALSE(r.fell);
     CHECK(r.glass_contacts == 0);

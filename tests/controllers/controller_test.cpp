@@ -6,11 +6,11 @@
 #include <map>
 #include <numbers>
 
+#include "../support/builtin_registries.hpp"
 #include "tripodal/controllers/controller_config.hpp"
 #include "tripodal/controllers/differential_drive_controller.hpp"
 #include "tripodal/controllers/holonomic_controller.hpp"
 #include "tripodal/controllers/ideal_hardware.hpp"
-#include "../support/builtin_registries.hpp"
 
 using namespace tripodal;
 using namespace std::chrono_literals;

@@ -1,7 +1,6 @@
 // The hardware type "dds" through the library: created by name, its wheel commands out on cmd_vel by
 // the base's kinematics, no simulator a fault rather than a hang, its bad parameters located. The
 // lock-step with `tripodal sim-server` is tests/dds/sim_server_test.cpp (two processes).
-#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/dds/dds_hardware.hpp"
 
 #include <array>
@@ -9,6 +8,7 @@
 #include <chrono>
 
 #include "dds_test_support.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/controllers/base_kinematics.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/robot/robot_profile.hpp"
@@ -21,8 +21,8 @@ using namespace std::chrono_literals;
 namespace {
 
 ControllerConfig psr2_base() {
-  const auto base = base_controller_config(
-      load_robot_profile(std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/psr2.yaml"), builtin_plugins().controllers);
+  const auto base = base_controller_config(load_robot_profile(std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/psr2.yaml"),
+                                           builtin_plugins().controllers);
   REQUIRE(base.has_value());
   return *base;
 }

@@ -1,9 +1,10 @@
 // A robot on DDS, configured by its profile's dds: section: the PSR-2 on the built-in simulator
 // seen and commanded by a test participant on loopback; the section's errors; a DdsLaser whose
 // publisher leaves becoming the resource's fault and a fault event.
-#include <catch2/catch.hpp>
+#include "tripodal/dds/robot_bridge.hpp"
 
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <fstream>
 #include <optional>
@@ -13,7 +14,6 @@
 #include "dds_test_support.hpp"
 #include "tripodal/builtin/register_all.hpp"
 #include "tripodal/dds/endpoint.hpp"
-#include "tripodal/dds/robot_bridge.hpp"
 #include "tripodal/dds/robot_modules.hpp"
 #include "tripodal/resources/resource_faults.hpp"
 #include "tripodal/robot/robot.hpp"

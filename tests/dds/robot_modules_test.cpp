@@ -1,14 +1,14 @@
 // The robot modules on DDS, created by name from the robot's registries like any plugin: a laser
 // resource fed by a LaserScan topic, a controller publishing cmd_vel.
-#include <catch2/catch.hpp>
+#include "tripodal/dds/robot_modules.hpp"
 
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <thread>
 
 #include "dds_test_support.hpp"
 #include "tripodal/builtin/register_all.hpp"
 #include "tripodal/controllers/ideal_hardware.hpp"
-#include "tripodal/dds/robot_modules.hpp"
 #include "tripodal/robot/plugins.hpp"
 
 using namespace tripodal;

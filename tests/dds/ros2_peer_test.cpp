@@ -4,9 +4,8 @@
 // and its nodes in ros_discovery_info; its LaserScans on /scan must reach a robot whose profile
 // names a DdsLaser, the first one at once even when it is larger than a datagram.
 // Built only when Fast DDS is installed (tests/dds/CMakeLists.txt says so when it is not).
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cstdlib>
 #include <fstream>
 #include <mutex>

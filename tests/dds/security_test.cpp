@@ -2,14 +2,14 @@
 // Debian's openssl, participants secured with Cyclone DDS's OMG DDS Security plugins. A robot hears
 // an operator the fleet's CA vouches for; it does not hear a participant without security, nor one
 // whose certificate another CA signed; an observer may read but not write.
-#include <catch2/catch.hpp>
+#include "tripodal/dds/security.hpp"
 
+#include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
 
 #include "dds_test_support.hpp"
 #include "tripodal/dds/endpoint.hpp"
-#include "tripodal/dds/security.hpp"
 
 using namespace tripodal::dds;
 using namespace tripodal::dds::test;
@@ -56,7 +56,8 @@ msg::Twist forward(double v) {
 
 TEST_CASE("security: a fleet's keys are made by openssl, each identity with its files") {
   const fs::path fleet = keys() / "fleet";
-  for (const char* f : {"ca.pem", "governance.p7s", "robot1.pem", "robot1_key.pem", "robot1_permissions.p7s", "dashboard_permissions.p7s"}) {
+  for (const char* f :
+       {"ca.pem", "governance.p7s", "robot1.pem", "robot1_key.pem", "robot1_permissions.p7s", "dashboard_permissions.p7s"}) {
     INFO(f);
     CHECK(fs::is_regular_file(fleet / f));
   }

@@ -1,6 +1,5 @@
 // Two processes on loopback: this one and tests/dds/dds_peer.cpp, started with posix_spawn.
 #include <catch2/catch.hpp>
-
 #include <condition_variable>
 #include <mutex>
 #include <thread>

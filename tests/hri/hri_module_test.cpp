@@ -1,8 +1,8 @@
 #include "tripodal/hri/hri_module.hpp"
 
-#include <algorithm>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <iostream>
 #include <string>
@@ -423,8 +423,8 @@ TEST_CASE("the visitor held-out set (issue 37) is answered right typed") {
 
 TEST_CASE("no typed utterance of any set starts a task it did not ask for") {
   std::size_t inputs = 0;
-  for (const char* file : {"utterances.yaml", "utterances_dev.yaml", "utterances_heldout.yaml", "visitors_dev.yaml",
-                           "visitors_heldout.yaml"}) {
+  for (const char* file :
+       {"utterances.yaml", "utterances_dev.yaml", "utterances_heldout.yaml", "visitors_dev.yaml", "visitors_heldout.yaml"}) {
     for (const auto& e : utterance_set(file)) {
       Jinny jinny;  // fresh: no question left open by the previous input
       const HriReply r = jinny.hri.handle(e.say);

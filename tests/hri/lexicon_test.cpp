@@ -3,9 +3,8 @@
 // through the words WordNet relates to them.
 #include "tripodal/hri/lexicon.hpp"
 
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>

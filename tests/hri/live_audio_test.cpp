@@ -10,10 +10,9 @@
 #include <fstream>
 #include <numbers>
 
+#include "spoken_jinny.hpp"
 #include "tripodal/hri/audio_device.hpp"
 #include "tripodal/hri/live_conversation.hpp"
-
-#include "spoken_jinny.hpp"
 
 using namespace tripodal;
 
@@ -25,11 +24,14 @@ constexpr int kRate = 16000;
 void append_tone(std::vector<std::int16_t>& out, double freq_hz, double seconds, double amplitude = 8000.0) {
   const auto n = static_cast<std::size_t>(seconds * kRate);
   for (std::size_t i = 0; i < n; ++i) {
-    out.push_back(static_cast<std::int16_t>(amplitude * std::sin(2.0 * std::numbers::pi * freq_hz * static_cast<double>(i) / kRate)));
+    out.push_back(
+        static_cast<std::int16_t>(amplitude * std::sin(2.0 * std::numbers::pi * freq_hz * static_cast<double>(i) / kRate)));
   }
 }
 
-void append_silence(std::vector<std::int16_t>& out, double seconds) { out.resize(out.size() + static_cast<std::size_t>(seconds * kRate), 0); }
+void append_silence(std::vector<std::int16_t>& out, double seconds) {
+  out.resize(out.size() + static_cast<std::size_t>(seconds * kRate), 0);
+}
 
 // What the tone engines say and hear: each sentence is a tone of its own pitch.
 const std::vector<std::pair<double, std::string>>& tone_sentences() {
@@ -166,8 +168,8 @@ TEST_CASE("live: each thing a visitor says is heard once and answered aloud, and
   CHECK(events_of(live, LiveEvent::Kind::barge_in).empty());
   CHECK(jinny.started.empty());
   // Both answers were played whole.
-  const std::size_t answers = synthesizer.synthesize(heard[0]->reply.text).samples.size() +
-                              synthesizer.synthesize(heard[1]->reply.text).samples.size();
+  const std::size_t answers =
+      synthesizer.synthesize(heard[0]->reply.text).samples.size() + synthesizer.synthesize(heard[1]->reply.text).samples.size();
   CHECK(live.samples_spoken() == answers);
   CHECK(room.played.size() == answers);
 }
@@ -176,8 +178,8 @@ TEST_CASE("live: a visitor speaking over the robot stops its speech and is heard
   testing::SpokenJinny jinny;
   std::vector<std::int16_t> visitor;
   append_silence(visitor, 0.5);
-  append_tone(visitor, 500.0, 1.0);  // "introduce yourself": a long answer
-  append_silence(visitor, 1.5);      // the robot is speaking by now
+  append_tone(visitor, 500.0, 1.0);           // "introduce yourself": a long answer
+  append_silence(visitor, 1.5);               // the robot is speaking by now
   append_tone(visitor, 300.0, 1.0, 16000.0);  // "what time is it", over the robot's voice
   append_silence(visitor, 8.0);
   Room room(visitor, 0.3);

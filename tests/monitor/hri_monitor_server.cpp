@@ -4,18 +4,18 @@
 // touch page are tested against it (tests/monitor/rkms_browser_test.py, rkms_protocol_test.py).
 //
 // usage: tripodal_hri_monitor_server SOURCE_DIR KNOWLEDGE.xml
-#include <csignal>
 #include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <thread>
 
+#include "test_hri_module.hpp"
 #include "tripodal/builtin/register_all.hpp"
 #include "tripodal/monitor/robot_monitor.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
-#include "test_hri_module.hpp"
 
 namespace {
 

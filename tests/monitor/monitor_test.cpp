@@ -8,33 +8,31 @@
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
-
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iterator>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <regex>
 #include <string>
 #include <thread>
 
-#include <nlohmann/json.hpp>
-
-#include "tripodal/builtin/register_all.hpp"
+#include "../../src/monitor/operator_request.hpp"
+#include "../navi/navi_test_util.hpp"
+#include "loopback_client.hpp"
+#include "test_hri_module.hpp"
 #include "tripodal/board/actuator_behaviors.hpp"
 #include "tripodal/board/board_monitor.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/monitor/monitor_server.hpp"
 #include "tripodal/monitor/robot_monitor.hpp"
 #include "tripodal/monitor/wire.hpp"
-#include "../navi/navi_test_util.hpp"
 #include "tripodal/navi/map_io.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_board.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
-#include "loopback_client.hpp"
-#include "test_hri_module.hpp"
-#include "../../src/monitor/operator_request.hpp"
 
 using namespace tripodal;
 using namespace tripodal::monitor;

@@ -3,7 +3,6 @@
 #include "tripodal/navi/distance_transform_coverage.hpp"
 
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 using namespace tripodal::navi;
@@ -13,7 +12,8 @@ namespace {
 OccupancyGrid room(int w, int h) {
   OccupancyGrid g(w, h, 0.05);
   for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) g.set_state({x, y}, x == 0 || y == 0 || x == w - 1 || y == h - 1 ? Occupancy::occupied : Occupancy::free);
+    for (int x = 0; x < w; ++x)
+      g.set_state({x, y}, x == 0 || y == 0 || x == w - 1 || y == h - 1 ? Occupancy::occupied : Occupancy::free);
   }
   return g;
 }

@@ -4,7 +4,6 @@
 #include "tripodal/navi/dose_planner.hpp"
 
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <stdexcept>
 #include <vector>
@@ -39,8 +38,8 @@ TEST_CASE("the dose of a straight lane at speed v is the irradiance integrated a
   CHECK(lane_dose_j_m2(lamp, 0.0, 0.1) == Approx(under).epsilon(1e-9));
   CHECK(lane_dose_j_m2(lamp, 0.0, 0.1) == Approx(1.0 / (2.0 * 3.141592653589793 * 0.05 * 0.1)).epsilon(0.02));
   CHECK(lane_dose_j_m2(lamp, -0.1, 0.2) == lane_dose_j_m2(lamp, 0.1, 0.2));
-  CHECK(lane_dose_j_m2(lamp, 0.3, 0.1) == 0.0);   // the shield's edge
-  CHECK(lane_dose_j_m2(lamp, 0.1, 0.0) == 0.0);   // not moving: no lane dose
+  CHECK(lane_dose_j_m2(lamp, 0.3, 0.1) == 0.0);  // the shield's edge
+  CHECK(lane_dose_j_m2(lamp, 0.1, 0.0) == 0.0);  // not moving: no lane dose
   CHECK(lane_dose_j_m2(lamp, 0.1, 0.2) == Approx(lane_dose_j_m2(lamp, 0.1, 0.1) / 2.0));
 }
 
@@ -136,13 +135,13 @@ TEST_CASE("lane speeds of a path: lanes from their parallel neighbours, short le
   DosePlan p = plan_dose(lamp, 10.0, limits);
   // Four lanes along x, 0.05, 0.05 and the plan's spacing apart, joined by short links.
   const double s = p.spacing_m;
-  const std::vector<Point2D> path{{0.0, 0.0},  {2.0, 0.0},     {2.0, 0.05},    {0.0, 0.05},
-                                  {0.0, 0.1},  {2.0, 0.1},     {2.0, 0.1 + s}, {0.0, 0.1 + s}};
+  const std::vector<Point2D> path{{0.0, 0.0}, {2.0, 0.0}, {2.0, 0.05},    {0.0, 0.05},
+                                  {0.0, 0.1}, {2.0, 0.1}, {2.0, 0.1 + s}, {0.0, 0.1 + s}};
   const std::vector<double> v = lane_speeds(path, lamp, p, limits);
   REQUIRE(v.size() == path.size());
   const double inf = std::numeric_limits<double>::infinity();
-  CHECK(v[0] == p.speed_m_s);  // 0.05 one side, nothing the other: the wider gap rules
-  CHECK(v[1] == limits.min_speed_m_s);  // a short link: the floor beside it has no lane
+  CHECK(v[0] == p.speed_m_s);                                          // 0.05 one side, nothing the other: the wider gap rules
+  CHECK(v[1] == limits.min_speed_m_s);                                 // a short link: the floor beside it has no lane
   CHECK(v[2] == Approx(lane_speed_m_s(lamp, p, limits, 0.05, 0.05)));  // between two close lanes
   CHECK(v[2] > p.speed_m_s);
   CHECK(v[4] == p.speed_m_s);  // 0.05 one side, the spacing the other

@@ -2,9 +2,8 @@
 // through the doors, nearest first, its path begun where the robot came in, the links counted.
 #include "tripodal/navi/floor_coverage.hpp"
 
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 
 #include "tripodal/navi/room_segmentation.hpp"
@@ -18,7 +17,8 @@ OccupancyGrid flat() {
   const int w = 2 + 100 + 1 + 100 + 1 + 100 + 1 + 40, h = 102;
   OccupancyGrid g(w, h, 0.05);
   for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) g.set_state({x, y}, x == 0 || y == 0 || x == w - 1 || y == h - 1 ? Occupancy::occupied : Occupancy::free);
+    for (int x = 0; x < w; ++x)
+      g.set_state({x, y}, x == 0 || y == 0 || x == w - 1 || y == h - 1 ? Occupancy::occupied : Occupancy::free);
   }
   for (const int x : {101, 202, 303}) {
     for (int y = 0; y < h; ++y) g.set_state({x, y}, Occupancy::occupied);

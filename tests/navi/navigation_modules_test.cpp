@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "navi_test_util.hpp"
-#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/behaviors/navigation_behaviors.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/navi/localizer.hpp"
 #include "tripodal/navi/planning_modules.hpp"
 #include "tripodal/navi/section_splitter.hpp"

@@ -3,7 +3,6 @@
 #include "tripodal/navi/room_segmentation.hpp"
 
 #include <catch2/catch.hpp>
-
 #include <set>
 
 using namespace tripodal::navi;
@@ -16,7 +15,8 @@ constexpr double kRes = 0.05;
 OccupancyGrid box(int w, int h) {
   OccupancyGrid g(w, h, kRes);
   for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) g.set_state({x, y}, x == 0 || y == 0 || x == w - 1 || y == h - 1 ? Occupancy::occupied : Occupancy::free);
+    for (int x = 0; x < w; ++x)
+      g.set_state({x, y}, x == 0 || y == 0 || x == w - 1 || y == h - 1 ? Occupancy::occupied : Occupancy::free);
   }
   return g;
 }
@@ -41,14 +41,16 @@ OccupancyGrid three_rooms() {
   return g;
 }
 
-int room_at(const RoomSegmentation& s, const OccupancyGrid& g, int x, int y) { return s.rooms.label[g.index({x, y})]; }
+int room_at(const RoomSegmentation& s, const OccupancyGrid& g, int x, int y) {
+  return s.rooms.label[g.index({x, y})];
+}
 
 }  // namespace
 
 TEST_CASE("every method finds the three rooms of a flat and the two doors between them") {
   const OccupancyGrid g = three_rooms();
-  for (const auto method : {RoomSegmentationMethod::morphological, RoomSegmentationMethod::distance_transform,
-                            RoomSegmentationMethod::voronoi}) {
+  for (const auto method :
+       {RoomSegmentationMethod::morphological, RoomSegmentationMethod::distance_transform, RoomSegmentationMethod::voronoi}) {
     INFO(to_string(method));
     RoomSegmentationOptions o;
     o.method = method;
@@ -88,8 +90,8 @@ TEST_CASE("a hall larger than the room limit is cut at its narrowing, and small 
   wall_x(g, 120, 69, 121);
   wall_y(g, 110, 200, 241);  // the nook: 10 x 10 cells behind a stub, open at one side
   wall_x(g, 200, 100, 110);
-  for (const auto method : {RoomSegmentationMethod::morphological, RoomSegmentationMethod::distance_transform,
-                            RoomSegmentationMethod::voronoi}) {
+  for (const auto method :
+       {RoomSegmentationMethod::morphological, RoomSegmentationMethod::distance_transform, RoomSegmentationMethod::voronoi}) {
     INFO(to_string(method));
     RoomSegmentationOptions o;
     o.method = method;
@@ -102,8 +104,8 @@ TEST_CASE("a hall larger than the room limit is cut at its narrowing, and small 
 
 TEST_CASE("plans with no room in them give no rooms, never a hang") {
   RoomSegmentationOptions o;
-  for (const auto method : {RoomSegmentationMethod::morphological, RoomSegmentationMethod::distance_transform,
-                            RoomSegmentationMethod::voronoi}) {
+  for (const auto method :
+       {RoomSegmentationMethod::morphological, RoomSegmentationMethod::distance_transform, RoomSegmentationMethod::voronoi}) {
     INFO(to_string(method));
     o.method = method;
     CHECK(segment_rooms(OccupancyGrid(), o).rooms.sections.empty());
@@ -141,8 +143,8 @@ TEST_CASE("the section splitter module takes a room segmentation method from its
 }
 
 TEST_CASE("bad floor plans: islands, one-pixel gaps, a door wider than its room, a room smaller than the robot") {
-  for (const auto method : {RoomSegmentationMethod::morphological, RoomSegmentationMethod::distance_transform,
-                            RoomSegmentationMethod::voronoi}) {
+  for (const auto method :
+       {RoomSegmentationMethod::morphological, RoomSegmentationMethod::distance_transform, RoomSegmentationMethod::voronoi}) {
     INFO(to_string(method));
     RoomSegmentationOptions o;
     o.method = method;

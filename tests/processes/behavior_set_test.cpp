@@ -1,12 +1,13 @@
 // BehaviorSet: the supervisor driving real CBehavior instances (the built-in behaviors of the
 // reactive layer) — parameter conversion, failures at activation, stepping, the watchdog.
+#include "tripodal/processes/behavior_set.hpp"
+
 #include <catch2/catch.hpp>
 
+#include "../support/builtin_registries.hpp"
 #include "doubles.hpp"
 #include "tripodal/behaviors/builtin_behaviors.hpp"
-#include "tripodal/processes/behavior_set.hpp"
 #include "tripodal/processes/process_supervisor.hpp"
-#include "../support/builtin_registries.hpp"
 
 using namespace tripodal;
 using namespace tripodal::test;

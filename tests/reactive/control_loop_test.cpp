@@ -7,12 +7,12 @@
 #include <numbers>
 #include <thread>
 
+#include "../support/builtin_registries.hpp"
 #include "reactive_rig.hpp"
 #include "tripodal/behaviors/behavior_registry.hpp"
 #include "tripodal/behaviors/builtin_behaviors.hpp"
 #include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/controllers/kinematics.hpp"
-#include "../support/builtin_registries.hpp"
 
 using namespace tripodal;
 using namespace std::chrono_literals;
@@ -46,9 +46,11 @@ GoalRun drive_to(const ControllerConfig& base, Pose2D goal) {
   SimLoopDriver driver(clock);
   driver.add(loop);
   loop.activate(test::builtin_behaviors().create("BhStop"), {});
-  loop.activate(test::builtin_behaviors().create("BhGoToPose"),
-                {{"goal_x_m", Value{goal.x_m}}, {"goal_y_m", Value{goal.y_m}}, {"goal_theta_rad", Value{goal.theta_rad}},
-                 {"position_tolerance_m", Value{0.02}}, {"heading_tolerance_rad", Value{0.02}}});
+  loop.activate(test::builtin_behaviors().create("BhGoToPose"), {{"goal_x_m", Value{goal.x_m}},
+                                                                 {"goal_y_m", Value{goal.y_m}},
+                                                                 {"goal_theta_rad", Value{goal.theta_rad}},
+                                                                 {"position_tolerance_m", Value{0.02}},
+                                                                 {"heading_tolerance_rad", Value{0.02}}});
   GoalRun run;
   for (int k = 0; k < 6000 && run.events.empty(); ++k) {
     driver.run_for(base.period);
@@ -405,8 +407,9 @@ TEST_CASE("The loop tells the behavior that won the last fusion what the safety 
   CHECK(loop.last_cycle().coordinator.requested == loop.last_cycle().coordinator.command);
 }
 
-TEST_CASE("Command channels: a behavior's writes reach the loop's command output; an unknown channel is refused at activation, located",
-          "[reactive][channels]") {
+TEST_CASE(
+    "Command channels: a behavior's writes reach the loop's command output; an unknown channel is refused at activation, located",
+    "[reactive][channels]") {
   JointResource neck("neck");
   neck.publish(JointReading{Time{0ms}, 0.0, 0.0, 0.0, -1.0, 1.0});
   ResourceTable resources;

@@ -2,15 +2,15 @@
 // overrun budget, the run of overruns that raises a deadline fault, and the thread options asked of
 // an unprivileged process. The clocks are the test's own (JumpClock-like), so what is checked does
 // not depend on the machine's load.
-#include <catch2/catch.hpp>
+#include "tripodal/reactive/periodic_runner.hpp"
 
 #include <atomic>
+#include <catch2/catch.hpp>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "tripodal/reactive/control_loop.hpp"
-#include "tripodal/reactive/periodic_runner.hpp"
 
 using namespace tripodal;
 using namespace std::chrono_literals;
@@ -40,14 +40,15 @@ TEST_CASE("A periodic thread runs at absolute deadlines and counts overruns beyo
   LoopTimingOptions o;
   o.budget = 3ms;  // a cycle may end up to 3 ms after its deadline
   // Cycle 3 takes 2.5 ms (within budget), cycle 5 takes 4.5 ms (an overrun, ticks skipped).
-  PeriodicRunner runner("motion", 1ms, clock,
-                        [&](Time now) {
-                          woke.push_back(now);
-                          const int i = cycles.fetch_add(1);
-                          if (i == 3) clock.spend(2500us);
-                          if (i == 5) clock.spend(4500us);
-                        },
-                        o);
+  PeriodicRunner runner(
+      "motion", 1ms, clock,
+      [&](Time now) {
+        woke.push_back(now);
+        const int i = cycles.fetch_add(1);
+        if (i == 3) clock.spend(2500us);
+        if (i == 5) clock.spend(4500us);
+      },
+      o);
   CHECK(runner.budget() == 3ms);
   runner.start();
   while (cycles.load() < 12) std::this_thread::yield();
@@ -55,7 +56,7 @@ TEST_CASE("A periodic thread runs at absolute deadlines and counts overruns beyo
   REQUIRE(woke.size() >= 12);
   CHECK(woke[0] == Time{1ms});
   CHECK(woke[3] == Time{4ms});
-  CHECK(woke[4] == Time{7ms});   // 4 ms + 2.5 ms ended at 6.5 ms: tick 5 and 6 skipped
+  CHECK(woke[4] == Time{7ms});  // 4 ms + 2.5 ms ended at 6.5 ms: tick 5 and 6 skipped
   CHECK(woke[5] == Time{8ms});
   CHECK(woke[6] == Time{13ms});  // 8 + 4.5 = 12.5 ms
   const LoopStatistics& s = runner.statistics();
@@ -72,12 +73,13 @@ TEST_CASE("A starved periodic thread raises one deadline fault per run of overru
   std::atomic<int> cycles{0};
   LoopTimingOptions o;
   o.deadline_overruns = 4;
-  PeriodicRunner runner("motion", 1ms, clock,
-                        [&](Time) {
-                          const int i = cycles.fetch_add(1);
-                          if ((i >= 10 && i < 20) || (i >= 30 && i < 33)) clock.spend(2ms);
-                        },
-                        o);
+  PeriodicRunner runner(
+      "motion", 1ms, clock,
+      [&](Time) {
+        const int i = cycles.fetch_add(1);
+        if ((i >= 10 && i < 20) || (i >= 30 && i < 33)) clock.spend(2ms);
+      },
+      o);
   runner.start();
   while (cycles.load() < 40) std::this_thread::yield();
   runner.stop();
@@ -94,7 +96,8 @@ TEST_CASE("A periodic thread refuses a bad period and runs unprivileged with a o
   LoopTimingOptions o;
   o.realtime_priority = 80;
   o.cpu = 0;  // (not lock_memory: mlockall would lock this whole test process, sanitizer shadow included)
-  PeriodicRunner runner("motion", 1ms, clock, [&](Time) { cycles.fetch_add(1); }, o);
+  PeriodicRunner runner(
+      "motion", 1ms, clock, [&](Time) { cycles.fetch_add(1); }, o);
   runner.start();
   CHECK_THROWS_AS(runner.start(), std::logic_error);
   while (cycles.load() < 5) std::this_thread::yield();

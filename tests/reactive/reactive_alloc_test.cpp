@@ -3,10 +3,10 @@
 // cycles. Its own executable, so the replacement affects no other suite.
 #include <catch2/catch.hpp>
 
+#include "../support/counting_new.hpp"
 #include "reactive_rig.hpp"
 #include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/board/actuator_behaviors.hpp"
-#include "../support/counting_new.hpp"
 
 using namespace tripodal;
 
@@ -62,7 +62,10 @@ TEST_CASE("Fusing and writing command channels allocates nothing (joint, lamp, f
     resources.add(neck);
     CoordinatorConfig cc;
     cc.mode = mode;
-    cc.inputs = {{"BhNeckGesture", 4, Duration{0}}, {"BhUvLamp", 3, Duration{0}}, {"BhAtomize", 2, Duration{0}}, {"BhLcdText", 1, Duration{0}}};
+    cc.inputs = {{"BhNeckGesture", 4, Duration{0}},
+                 {"BhUvLamp", 3, Duration{0}},
+                 {"BhAtomize", 2, Duration{0}},
+                 {"BhLcdText", 1, Duration{0}}};
     const Duration none{0};
     cc.channels = {ChannelSpec{"neck", ChannelType::joint_position, ChannelValue::of(0.0), true, none, -1.0, 1.0, "rad", ""},
                    ChannelSpec{"uv_lamp", ChannelType::digital, ChannelValue::of(false), false, none, 0.0, 0.0, "", ""},

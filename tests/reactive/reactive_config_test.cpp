@@ -23,7 +23,8 @@ const ControllerRegistry& builtins() {
 }  // namespace
 
 TEST_CASE("The shipped configurations load into typed structs") {
-  const ReactiveConfig jinny = load_reactive_config(std::string(TRIPODAL_SOURCE_DIR) + "/configs/reactive/jinny_differential.yaml", builtins());
+  const ReactiveConfig jinny =
+      load_reactive_config(std::string(TRIPODAL_SOURCE_DIR) + "/configs/reactive/jinny_differential.yaml", builtins());
   REQUIRE(jinny.controllers.size() == 1);
   const ControllerConfig& base = jinny.controllers[0];
   CHECK(base.type == "differential");
@@ -54,7 +55,8 @@ TEST_CASE("The shipped configurations load into typed structs") {
   CHECK(built->coordinator().input_count() == 5);
   CHECK(built->period() == 10ms);
 
-  const ReactiveConfig psr = load_reactive_config(std::string(TRIPODAL_SOURCE_DIR) + "/configs/reactive/psr_omni.yaml", builtins());
+  const ReactiveConfig psr =
+      load_reactive_config(std::string(TRIPODAL_SOURCE_DIR) + "/configs/reactive/psr_omni.yaml", builtins());
   REQUIRE(psr.controllers[0].holonomic.wheels.size() == 3);
   CHECK(psr.controllers[0].holonomic.wheels[1].x_m == Approx(-0.22));
   CHECK(psr.loops.size() == 2);
@@ -82,7 +84,8 @@ controllers:
     wheel_radius_m: 0.05
     half_length_m: 0.2
     half_width_m: 0.15
-)", "inline.yaml", builtins());
+)",
+                                                 "inline.yaml", builtins());
   REQUIRE(c.controllers.size() == 2);
   CHECK(c.controllers[0].holonomic.wheels.size() == 4);
   CHECK(c.controllers[0].holonomic.wheels[1].drive_angle_rad == Approx(210 * std::numbers::pi / 180));
@@ -91,13 +94,15 @@ controllers:
 }
 
 TEST_CASE("A negative radius is reported at its value") {
-  REQUIRE_THROWS_WITH(parse_reactive_config(R"(controllers:
+  REQUIRE_THROWS_WITH(
+      parse_reactive_config(R"(controllers:
   - name: base
     type: differential
     wheel_separation_m: 0.4
     wheel_radius_m: -0.05
-)", "robot.yaml", builtins()),
-                      Catch::Contains("robot.yaml:5:21: error: controller 'base': parameter 'wheel_radius_m' = -0.05 m is outside (0, inf]"));
+)",
+                            "robot.yaml", builtins()),
+      Catch::Contains("robot.yaml:5:21: error: controller 'base': parameter 'wheel_radius_m' = -0.05 m is outside (0, inf]"));
 }
 
 TEST_CASE("A missing wheel is reported") {
@@ -107,13 +112,15 @@ TEST_CASE("A missing wheel is reported") {
     wheel_radius_m: 0.05
     base_radius_m: 0.2
     wheel_angles_deg: [90, 210]
-)", "psr.yaml", builtins()),
+)",
+                                            "psr.yaml", builtins()),
                       Catch::Contains("psr.yaml:6:23: error: controller 'psr': an omni base needs 3 to 8 wheels, got 2"));
   REQUIRE_THROWS_WITH(parse_reactive_config(R"(controllers:
   - name: psr
     type: omni
     wheel_radius_m: 0.05
-)", "psr.yaml", builtins()),
+)",
+                                            "psr.yaml", builtins()),
                       Catch::Contains("psr.yaml:2:5: error: controller 'psr': missing wheel geometry"));
   REQUIRE_THROWS_WITH(parse_reactive_config(R"(controllers:
   - name: psr
@@ -121,28 +128,33 @@ TEST_CASE("A missing wheel is reported") {
     wheel_radius_m: 0.05
     wheels:
       - {x_m: 0.2, drive_angle_deg: 90}
-)", "psr.yaml", builtins()),
+)",
+                                            "psr.yaml", builtins()),
                       Catch::Contains("psr.yaml:6:9: error: controller 'psr' wheel #1: missing 'y_m' (a number)") &&
                           Catch::Contains("psr.yaml:6:7: error: controller 'psr': an omni base needs 3 to 8 wheels, got 1"));
   REQUIRE_THROWS_WITH(parse_reactive_config(R"(controllers:
   - name: jinny
     type: differential
     wheel_radius_m: 0.05
-)", "jinny.yaml", builtins()),
+)",
+                                            "jinny.yaml", builtins()),
                       Catch::Contains("jinny.yaml:2:5: error: controller 'jinny': missing 'wheel_separation_m' (a number)"));
 }
 
 TEST_CASE("An unknown controller type is reported at the type, with the known ones") {
-  REQUIRE_THROWS_WITH(parse_reactive_config(R"(controllers:
+  REQUIRE_THROWS_WITH(
+      parse_reactive_config(R"(controllers:
   - name: base
     type: tracked
 loops:
   - name: motion
     period_s: 0.01
     controller: basis
-)", "robot.yaml", builtins()),
-                      Catch::Contains("robot.yaml:3:11: error: controller 'base': unknown controller type 'tracked'; known: differential, mecanum, omni") &&
-                          Catch::Contains("robot.yaml:7:17: error: loop 'motion': unknown controller 'basis'"));
+)",
+                            "robot.yaml", builtins()),
+      Catch::Contains(
+          "robot.yaml:3:11: error: controller 'base': unknown controller type 'tracked'; known: differential, mecanum, omni") &&
+          Catch::Contains("robot.yaml:7:17: error: loop 'motion': unknown controller 'basis'"));
 }
 
 TEST_CASE("Every problem of a file is reported in one pass") {
@@ -166,7 +178,8 @@ loops:
       inputs:
         - {name: a, role: boss}
         - {name: a, priority: 1.5}
-)", "many.yaml", builtins());
+)",
+                                "many.yaml", builtins());
     FAIL("expected a ConfigError");
   } catch (const ConfigError& e) {
     const std::string what = e.what();
@@ -296,12 +309,14 @@ loops:
 
 TEST_CASE("A loop period too short for the clock is refused at the file, with the range", "[errors]") {
   // 1e-12 s rounds to 0 ns: the control loop refused it as it was built, unlocated.
-  REQUIRE_THROWS_WITH(parse_reactive_config(R"(loops:
+  REQUIRE_THROWS_WITH(
+      parse_reactive_config(R"(loops:
   - name: motion
     period_s: 1e-12
   - name: slow
     period_s: 1e10
-)", "tiny.yaml", builtins()),
-                      Catch::Contains("tiny.yaml:3:15: error: loop 'motion': 'period_s': expected seconds from 1e-06 to 9e+09, got 1e-12") &&
-                          Catch::Contains("tiny.yaml:5:15: error: loop 'slow': 'period_s': expected seconds from 1e-06 to 9e+09, got 1e10"));
+)",
+                            "tiny.yaml", builtins()),
+      Catch::Contains("tiny.yaml:3:15: error: loop 'motion': 'period_s': expected seconds from 1e-06 to 9e+09, got 1e-12") &&
+          Catch::Contains("tiny.yaml:5:15: error: loop 'slow': 'period_s': expected seconds from 1e-06 to 9e+09, got 1e10"));
 }

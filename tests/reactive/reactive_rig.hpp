@@ -7,11 +7,11 @@
 #include <memory>
 #include <numbers>
 
+#include "../support/builtin_registries.hpp"
 #include "tripodal/behaviors/behavior_registry.hpp"
 #include "tripodal/controllers/controller_config.hpp"
 #include "tripodal/controllers/ideal_hardware.hpp"
 #include "tripodal/reactive/control_loop.hpp"
-#include "../support/builtin_registries.hpp"
 
 namespace tripodal::test {
 

@@ -1,12 +1,12 @@
 // The hand-over from the reactive loop to the sequencing layer on the wall-clock runtime: a writer
 // and a reader thread at full speed, the reader checking that every value it sees was written whole
 // (core/snapshot.hpp, ResourceSnapshot). scripts/tsan.sh runs the [threads] ones under TSan.
-#include <catch2/catch.hpp>
+#include "tripodal/core/snapshot.hpp"
 
 #include <atomic>
+#include <catch2/catch.hpp>
 #include <thread>
 
-#include "tripodal/core/snapshot.hpp"
 #include "tripodal/resources/resource.hpp"
 
 using namespace tripodal;
@@ -127,8 +127,7 @@ TEST_CASE("A resource snapshot mirrors name, reading, stamp and sequence, and sk
   CHECK(snapshot.refresh() == 0);
 }
 
-TEST_CASE("A resource snapshot read by the sequencing thread while the loop's thread publishes is consistent",
-          "[threads]") {
+TEST_CASE("A resource snapshot read by the sequencing thread while the loop's thread publishes is consistent", "[threads]") {
   // The writer stands for the behavior loop (publish after each cycle), the reader for the
   // sequencing loop (refresh, then read the mirror): every reading the reader sees is one the
   // writer published whole, its stamp and sequence with it, never going back.

@@ -1,12 +1,13 @@
 // Start-up checks of a robot profile: located load errors, exactly one provider per input, the
 // layering rules R1-R5 (docs/processes.md), refusals to assemble, and the describe renderings.
+#include "tripodal/robot/layering.hpp"
+
 #include <catch2/catch.hpp>
 
 #include "robot_doubles.hpp"
-#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/board/actuator_behaviors.hpp"
 #include "tripodal/board/board_monitor.hpp"
-#include "tripodal/robot/layering.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_board.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
@@ -99,7 +100,9 @@ TEST_CASE("from: binds an input several modules provide to the one named", "[rob
   const std::string two_lasers = kResources + "  - {name: rear_laser, type: LaserScanner}\n";
   const auto navigation = [](const std::string& from) {
     return "  - {name: maps, type: GridMaps}\n"
-           "  - {name: localizer, type: ScanMatchingLocalizer, from: " + from + "}\n"
+           "  - {name: localizer, type: ScanMatchingLocalizer, from: " +
+           from +
+           "}\n"
            "  - {name: section_splitter, type: SectionSplitter}\n";
   };
   // Bound: the two providers are no longer ambiguous, and the diagram's edge comes from the one.
@@ -110,10 +113,12 @@ TEST_CASE("from: binds an input several modules provide to the one named", "[rob
   CHECK_THAT(dot, !Catch::Contains("\"front_laser\" -> \"localizer\""));
   // A provider that does not provide it, and an input the module does not have: both located.
   const std::string diag = c.check(profile(two_lasers, navigation("{laser_scan: maps, sonar: front_laser}"), kBehaviors));
-  CHECK_THAT(diag, Catch::Contains("testbot.yaml:9:5: error: from: sequencing navigation 'localizer' takes 'laser_scan' from 'maps', "
-                                   "which does not provide it; its providers: front_laser, rear_laser"));
-  CHECK_THAT(diag, Catch::Contains("testbot.yaml:9:5: error: from: sequencing navigation 'localizer' has no input 'sonar' to bind to "
-                                   "'front_laser'; its inputs: laser_scan, odometry, grid_map"));
+  CHECK_THAT(diag,
+             Catch::Contains("testbot.yaml:9:5: error: from: sequencing navigation 'localizer' takes 'laser_scan' from 'maps', "
+                             "which does not provide it; its providers: front_laser, rear_laser"));
+  CHECK_THAT(diag,
+             Catch::Contains("testbot.yaml:9:5: error: from: sequencing navigation 'localizer' has no input 'sonar' to bind to "
+                             "'front_laser'; its inputs: laser_scan, odometry, grid_map"));
 }
 
 TEST_CASE("The disinfection robot on its lidar binds the localizer's odometry and passes the checks", "[robot]") {
@@ -319,7 +324,8 @@ TEST_CASE("describe_text lists modules by layer, describe_dot draws clusters and
   CHECK_THAT(dot, Catch::Contains("\"process_supervisor\" -> \"BhCleaning\" [style=dashed"));
 }
 
-TEST_CASE("describe shows command channels, who writes and who exports them; R6 refuses a channel the hardware lacks", "[robot][channels]") {
+TEST_CASE("describe shows command channels, who writes and who exports them; R6 refuses a channel the hardware lacks",
+          "[robot][channels]") {
   RobotPlugins plugins = builtin_plugins(nullptr);
   RobotProfile p = load_robot_profile(std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/disinfection.yaml");
   Diagnostics d;
@@ -327,12 +333,16 @@ TEST_CASE("describe shows command channels, who writes and who exports them; R6 
   INFO(d.str());
   REQUIRE_FALSE(d.has_errors());
   const std::string text = describe_text(r);
-  CHECK_THAT(text, Catch::Contains("  BhAtomize (behavior)\n      in:  -\n      out: -\n      writes: atomizer (analog), atomizer_fan (digital)\n"));
+  CHECK_THAT(
+      text, Catch::Contains(
+                "  BhAtomize (behavior)\n      in:  -\n      out: -\n      writes: atomizer (analog), atomizer_fan (digital)\n"));
   CHECK_THAT(text, Catch::Contains("      channel: uv_lamp (digital) <- BhUvLamp\n"));
   CHECK_THAT(text, Catch::Contains("      channel: voice (track) <- BhVoicePrompt\n      channel: lcd (text)\n"));
   const std::string dot = describe_dot(r);
   CHECK_THAT(dot, Catch::Contains("\"BhUvLamp\" -> \"behavior_coordinator\" [label=\"uv_lamp\", style=bold"));
-  CHECK_THAT(dot, Catch::Contains("\"behavior_coordinator\" -> \"hardware\" [label=\"uv_lamp, atomizer, atomizer_fan, voice, lcd\", style=bold"));
+  CHECK_THAT(dot,
+             Catch::Contains(
+                 "\"behavior_coordinator\" -> \"hardware\" [label=\"uv_lamp, atomizer, atomizer_fan, voice, lcd\", style=bold"));
 
   // The same behaviors on hardware that exports no lamp: refused at the behaviors' entry.
   p.hardware->type = "sim";
@@ -340,16 +350,18 @@ TEST_CASE("describe shows command channels, who writes and who exports them; R6 
   sim::register_sim_hardware(plugins.hardware);
   Diagnostics bad;
   (void)describe_robot(p, plugins, knowledge_inputs(TaskLibrary::load(p.tasks)), bad);
-  CHECK_THAT(bad.str(), Catch::Contains("disinfection.yaml:57:") &&
-                            Catch::Contains("behavior 'BhUvLamp' writes the command channel 'uv_lamp' (digital), which hardware 'sim' does "
-                                            "not export; it exports none (rule R6)"));
+  CHECK_THAT(bad.str(),
+             Catch::Contains("disinfection.yaml:57:") &&
+                 Catch::Contains("behavior 'BhUvLamp' writes the command channel 'uv_lamp' (digital), which hardware 'sim' does "
+                                 "not export; it exports none (rule R6)"));
 }
 
 TEST_CASE("A loop's thread settings are read from the profile, every bad one located", "[robot][errors]") {
   const RobotProfile p = load_robot_profile_from_string(
       "robot: {name: rt, sequencing_loop: {budget_s: 0.08, deadline_overruns: 20, realtime_priority: 70}}\n"
       "loops:\n"
-      "  - {name: motion, period_s: 0.01, realtime_priority: 80, cpu: 1, lock_memory: true, budget_s: 0.004, deadline_overruns: 5}\n"
+      "  - {name: motion, period_s: 0.01, realtime_priority: 80, cpu: 1, lock_memory: true, budget_s: 0.004, deadline_overruns: "
+      "5}\n"
       "  - {name: arm, period_s: 0.002}\n",
       "rt.yaml", kRobots);
   REQUIRE(p.loops.size() == 2);
@@ -372,7 +384,8 @@ TEST_CASE("A loop's thread settings are read from the profile, every bad one loc
   const std::string bad =
       "robot: {name: rt, sequencing_loop: {priority: 3}}\n"
       "loops:\n"
-      "  - {name: motion, period_s: 0.01, realtime_priority: 100, cpu: -2, lock_memory: maybe, budget_s: 0, deadline_overruns: -1}\n";
+      "  - {name: motion, period_s: 0.01, realtime_priority: 100, cpu: -2, lock_memory: maybe, budget_s: 0, deadline_overruns: "
+      "-1}\n";
   try {
     (void)load_robot_profile_from_string(bad, "bad.yaml", kRobots);
     FAIL("no error");

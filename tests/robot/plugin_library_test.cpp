@@ -23,8 +23,8 @@ namespace {
 // The names of every family, to show that a refused plugin changed nothing.
 std::vector<std::string> all_names(const RobotPlugins& p) {
   std::vector<std::string> out;
-  for (const auto& names : {p.behaviors.names(), p.controllers.names(), p.modules.names(),
-                            p.resources.names(), p.hardware.names(), p.processes.names()}) {
+  for (const auto& names : {p.behaviors.names(), p.controllers.names(), p.modules.names(), p.resources.names(),
+                            p.hardware.names(), p.processes.names()}) {
     out.insert(out.end(), names.begin(), names.end());
   }
   return out;
@@ -44,8 +44,7 @@ void require_refused(const std::string& library, const std::string& message) {
 TEST_CASE("A plugin's types join the application's plugin set and work there", "[robot][plugins]") {
   RobotPlugins plugins = builtin_plugins();
   const PluginLibraryInfo info = load_plugin_library(TRIPODAL_TEST_PLUGIN_GOOD, plugins);
-  CHECK(info.types ==
-        std::vector<std::string>{"behavior type 'BhPluginWave'", "controller type 'plugin_differential'"});
+  CHECK(info.types == std::vector<std::string>{"behavior type 'BhPluginWave'", "controller type 'plugin_differential'"});
   REQUIRE(plugins.behaviors.contains("BhPluginWave"));
   CHECK(plugins.behaviors.contains("BhStop"));  // the built-in ones stay
   const std::unique_ptr<CBehavior> b = plugins.behaviors.create("BhPluginWave");
@@ -61,8 +60,7 @@ TEST_CASE("A plugin's types join the application's plugin set and work there", "
         "differential");  // the plugin renamed the type, not the manifest it copied
 }
 
-TEST_CASE("A profile's plugins: list is loaded relative to the profile and reaches the robot",
-          "[robot][plugins]") {
+TEST_CASE("A profile's plugins: list is loaded relative to the profile and reaches the robot", "[robot][plugins]") {
   const RobotProfile profile = load_robot_profile(TRIPODAL_TEST_PLUGIN_PROFILE);
   REQUIRE(profile.plugins.size() == 1);
   CHECK(profile.plugins[0].path == std::filesystem::path(TRIPODAL_TEST_PLUGIN_GOOD));
@@ -79,35 +77,29 @@ TEST_CASE("A profile's plugins: list is loaded relative to the profile and reach
 }
 
 TEST_CASE("A profile naming a plugin that is not there is refused at the entry", "[robot][plugins][errors]") {
-  REQUIRE_THROWS_WITH(
-      load_robot_profile_from_string("robot: {name: r}\nplugins: [nowhere.so]\n", "r.yaml", "/tmp"),
-      Catch::Contains(
-          "r.yaml:2:11: error: plugin library 'nowhere.so' not found (looked for /tmp/nowhere.so)"));
+  REQUIRE_THROWS_WITH(load_robot_profile_from_string("robot: {name: r}\nplugins: [nowhere.so]\n", "r.yaml", "/tmp"),
+                      Catch::Contains("r.yaml:2:11: error: plugin library 'nowhere.so' not found (looked for /tmp/nowhere.so)"));
 }
 
-TEST_CASE("Plugins that must not load are refused, each with its reason, the set unchanged",
-          "[robot][plugins][errors]") {
+TEST_CASE("Plugins that must not load are refused, each with its reason, the set unchanged", "[robot][plugins][errors]") {
   SECTION("built against another plugin ABI version") {
-    require_refused(TRIPODAL_TEST_PLUGIN_ABI_MISMATCH,
-                    "was built against tripodal plugin ABI version 999, this program has version " +
-                        std::to_string(kPluginAbiVersion));
+    require_refused(
+        TRIPODAL_TEST_PLUGIN_ABI_MISMATCH,
+        "was built against tripodal plugin ABI version 999, this program has version " + std::to_string(kPluginAbiVersion));
   }
   SECTION("registers one name twice") {
     require_refused(TRIPODAL_TEST_PLUGIN_DUPLICATE,
                     "failed to register its types: behavior type 'BhTwice' is already registered");
   }
   SECTION("registers a built-in name: refused whole, its other type not kept") {
-    require_refused(
-        TRIPODAL_TEST_PLUGIN_BUILTIN_NAME,
-        "registers a name this program already has: behavior type 'BhStop' is already registered");
+    require_refused(TRIPODAL_TEST_PLUGIN_BUILTIN_NAME,
+                    "registers a name this program already has: behavior type 'BhStop' is already registered");
   }
   SECTION("throws from its registration") {
-    require_refused(TRIPODAL_TEST_PLUGIN_THROWING,
-                    "failed to register its types: the licence file /etc/waver.lic is missing");
+    require_refused(TRIPODAL_TEST_PLUGIN_THROWING, "failed to register its types: the licence file /etc/waver.lic is missing");
   }
   SECTION("a shared library without the entry points") {
-    require_refused(TRIPODAL_TEST_NOT_A_PLUGIN,
-                    "is not a tripodal plugin: it exports no tripodal_plugin_abi_version");
+    require_refused(TRIPODAL_TEST_NOT_A_PLUGIN, "is not a tripodal plugin: it exports no tripodal_plugin_abi_version");
   }
   SECTION("a file that is not a shared library") {
     const std::filesystem::path text =
@@ -124,10 +116,9 @@ TEST_CASE("Plugins that must not load are refused, each with its reason, the set
 TEST_CASE("The same plugin loaded twice is refused the second time", "[robot][plugins][errors]") {
   RobotPlugins plugins = builtin_plugins();
   (void)load_plugin_library(TRIPODAL_TEST_PLUGIN_GOOD, plugins);
-  REQUIRE_THROWS_WITH(
-      load_plugin_library(TRIPODAL_TEST_PLUGIN_GOOD, plugins),
-      Catch::Contains("registers a name this program already has: behavior type 'BhPluginWave', "
-                      "controller type 'plugin_differential' are already registered"));
+  REQUIRE_THROWS_WITH(load_plugin_library(TRIPODAL_TEST_PLUGIN_GOOD, plugins),
+                      Catch::Contains("registers a name this program already has: behavior type 'BhPluginWave', "
+                                      "controller type 'plugin_differential' are already registered"));
 }
 
 TEST_CASE("Registry::merge moves all or nothing", "[robot][plugins]") {

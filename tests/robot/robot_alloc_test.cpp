@@ -6,9 +6,8 @@
 // The same on the wall-clock runtime (Robot::start): the behavior loop's own thread, counted per
 // thread, whole cycles (the simulator's physics and the resource snapshot's hand-over included).
 // Its own executable, so the replacement affects no other suite.
-#include <catch2/catch.hpp>
-
 #include <atomic>
+#include <catch2/catch.hpp>
 #include <memory>
 #include <thread>
 
@@ -143,7 +142,8 @@ TEST_CASE("The PSR-2 robot's reactive thread allocates nothing mid-cleaning on t
   const Time counted_from = clock.now() + std::chrono::seconds(20);
   wait_until([&] { return clock.now() >= counted_from; }, std::chrono::seconds(60));
   probe->armed.store(true, std::memory_order_release);
-  const bool counted = wait_until([&] { return probe->cycles.load(std::memory_order_acquire) >= 2000; }, std::chrono::seconds(120));
+  const bool counted =
+      wait_until([&] { return probe->cycles.load(std::memory_order_acquire) >= 2000; }, std::chrono::seconds(120));
   probe->armed.store(false, std::memory_order_release);
   const bool still_cleaning = cleaning.load();
   robot->stop();

@@ -1,8 +1,6 @@
 // What an application registers reaches the robot: its own controller type, named in the reactive
 // configuration a profile's controller entry points to, is checked and built through the
 // application's plugin set (RobotPlugins::controllers); the built-in areas do not know it.
-#include <catch2/catch.hpp>
-
 #include <unistd.h>
 
 #include <algorithm>
@@ -213,19 +211,15 @@ TEST_CASE(
   (void)check_robot(profile, plugins, d);
   INFO(d.str());
   CHECK(d.error_count() == 2);
-  CHECK_THAT(
-      d.str(),
-      Catch::Contains("PrDockCharge.xml:34:") &&
-          Catch::Contains(
-              "error: process 'PrDockCharge': the guard of transition 't3' reads fact 'charging', which no "
-              "module of robot 'psr2_dock' provides (lists among its outputs)") &&
-          Catch::Contains("or list it under external_facts: when the application sets it"));
-  CHECK_THAT(d.str(), Catch::Contains("PrDockCharge.xml:36:") &&
-                          Catch::Contains("transition 't5' reads fact 'battery_percent'"));
+  CHECK_THAT(d.str(),
+             Catch::Contains("PrDockCharge.xml:34:") &&
+                 Catch::Contains("error: process 'PrDockCharge': the guard of transition 't3' reads fact 'charging', which no "
+                                 "module of robot 'psr2_dock' provides (lists among its outputs)") &&
+                 Catch::Contains("or list it under external_facts: when the application sets it"));
+  CHECK_THAT(d.str(), Catch::Contains("PrDockCharge.xml:36:") && Catch::Contains("transition 't5' reads fact 'battery_percent'"));
   CHECK_THAT(d.str(), Catch::Contains("robot.yaml:35:5: note: process 'PrDockCharge' is listed here"));
   SimClock clock;
-  REQUIRE_THROWS_WITH(Robot::assemble(profile, plugins, clock),
-                      Catch::Contains("reads fact 'charging', which no module"));
+  REQUIRE_THROWS_WITH(Robot::assemble(profile, plugins, clock), Catch::Contains("reads fact 'charging', which no module"));
 }
 
 TEST_CASE(
@@ -238,8 +232,7 @@ TEST_CASE(
     (void)check_robot(dock_profile("external_facts: [charging, battery_percent]\n"), plugins, d);
     INFO(d.str());
     CHECK_FALSE(d.has_errors());
-    CHECK_THAT(d.str(), Catch::Contains("PrDockCharge.xml:34:") &&
-                            Catch::Contains("warning: process 'PrDockCharge'") &&
+    CHECK_THAT(d.str(), Catch::Contains("PrDockCharge.xml:34:") && Catch::Contains("warning: process 'PrDockCharge'") &&
                             Catch::Contains("the profile lists it under external_facts (robot.yaml:38:17), "
                                             "so the application must set it"));
   }
@@ -251,23 +244,18 @@ TEST_CASE(
   }
   SECTION("a module whose type lists them among its outputs") {
     Diagnostics d;
-    (void)check_robot(dock_profile("modules:\n  - {name: battery_monitor, type: BatteryMonitor}\n"), plugins,
-                      d);
+    (void)check_robot(dock_profile("modules:\n  - {name: battery_monitor, type: BatteryMonitor}\n"), plugins, d);
     INFO(d.str());
     CHECK(d.empty());
   }
   SECTION("a near miss: did you mean") {
     Diagnostics d;
-    (void)check_robot(
-        dock_profile(
-            "modules:\n  - {name: power, type: PowerBoard, layer: sequencing, inputs: [battery], outputs: "
-            "[chargin, battery_percent]}\n"),
-        plugins, d);
+    (void)check_robot(dock_profile("modules:\n  - {name: power, type: PowerBoard, layer: sequencing, inputs: [battery], outputs: "
+                                   "[chargin, battery_percent]}\n"),
+                      plugins, d);
     CHECK(d.error_count() == 1);
-    CHECK_THAT(
-        d.str(),
-        Catch::Contains(
-            "reads fact 'charging', which no module of robot 'psr2_dock' provides (lists among its outputs); "
-            "did you mean 'chargin'?"));
+    CHECK_THAT(d.str(),
+               Catch::Contains("reads fact 'charging', which no module of robot 'psr2_dock' provides (lists among its outputs); "
+                               "did you mean 'chargin'?"));
   }
 }

@@ -3,9 +3,8 @@
 // race between the loops, the sequencing layer and the observer), and a starved behavior loop whose
 // run of overruns becomes the fault "motion.deadline" the supervisor and the task see. What is
 // checked does not depend on how fast the machine is: the wall time only bounds the run.
-#include <catch2/catch.hpp>
-
 #include <atomic>
+#include <catch2/catch.hpp>
 #include <mutex>
 #include <thread>
 
@@ -80,9 +79,10 @@ TEST_CASE("PSR-2 cleans on its own threads at 20 times real time", "[robot][thre
   const std::vector<LoopTimingReport> timing = robot->timing();
   REQUIRE(timing.size() == 2);
   INFO("finished " << finished << ", state " << to_string(robot->planner().state()) << " (" << robot->planner().report().reason
-                   << "), simulated " << to_seconds(clock.now()) << " s, distance " << sim.distance_m() << " m, section A " << progress_m
-                   << " m, " << sim.collisions() << " collisions; motion: " << timing[0].cycles << " cycles, " << timing[0].skipped_ticks << " skipped, period error p99 "
-                   << to_seconds(timing[0].period_error_p99) * 1e6 << " us");
+                   << "), simulated " << to_seconds(clock.now()) << " s, distance " << sim.distance_m() << " m, section A "
+                   << progress_m << " m, " << sim.collisions() << " collisions; motion: " << timing[0].cycles << " cycles, "
+                   << timing[0].skipped_ticks << " skipped, period error p99 " << to_seconds(timing[0].period_error_p99) * 1e6
+                   << " us");
   // Done, or under way: the base drove and the coverage of the first section advanced. (On a
   // machine too loaded for 0.5 ms wall periods the loop skips ticks, drives on stale commands and
   // may touch a wall or fail the task: a fact of starvation, which deadline_overruns would report;
@@ -133,7 +133,8 @@ class SlowResource final : public BumperResource {
 TEST_CASE("A starved behavior loop posts motion.deadline as a fault the supervisor and the task see", "[robot][threads]") {
   test::TestWorld world;
   RobotPlugins plugins = test::test_plugins(world);
-  plugins.resources.add(SlowResource::manifest_of(), [](const ResourceConfig& c) { return std::make_unique<SlowResource>(c.name); });
+  plugins.resources.add(SlowResource::manifest_of(),
+                        [](const ResourceConfig& c) { return std::make_unique<SlowResource>(c.name); });
   RobotProfile profile = load_robot_profile(kConfigs / "robots/psr2.yaml");
   ModuleEntry slow;
   slow.kind = ModuleKind::resource;

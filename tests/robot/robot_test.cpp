@@ -1,15 +1,15 @@
 // The PSR-2 robot assembled from configs/robots/psr2.yaml with test doubles registered under the
 // profile's type names, running the cleaning task end to end through the planner, the process
 // supervisor, the paper's nets (configs/petri) and CBehavior instances.
-#include <catch2/catch.hpp>
+#include "tripodal/robot/robot.hpp"
 
+#include <catch2/catch.hpp>
 #include <functional>
 #include <thread>
 
 #include "robot_doubles.hpp"
 #include "tripodal/behaviors/teleop.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
-#include "tripodal/robot/robot.hpp"
 
 using namespace tripodal;
 using namespace tripodal::test;
@@ -289,7 +289,9 @@ TEST_CASE("PSR-2 on its threads takes a command from another thread and stops cl
   CHECK(robot->planner().busy());
 }
 
-TEST_CASE("Driving by hand is an ordinary coordinator input: BhTeleop runs from the start on 'operator', its resource set from outside", "[robot][teleop]") {
+TEST_CASE(
+    "Driving by hand is an ordinary coordinator input: BhTeleop runs from the start on 'operator', its resource set from outside",
+    "[robot][teleop]") {
   Psr2 p;
   ControlLoop& loop = p.robot->behavior_loop();
   const CBehaviorCoordinator& co = loop.coordinator();

@@ -23,8 +23,8 @@ using namespace std::chrono_literals;
 namespace {
 
 const std::string kWorlds = std::string(TRIPODAL_SOURCE_DIR) + "/configs/worlds/";
-const std::string kHead = "map: " + kWorlds + "workspace_map.yaml\nregions: " + kWorlds +
-                          "workspace_regions.yaml\nstart_pose: [0.8, 0.8, 0.0]\n";
+const std::string kHead =
+    "map: " + kWorlds + "workspace_map.yaml\nregions: " + kWorlds + "workspace_regions.yaml\nstart_pose: [0.8, 0.8, 0.0]\n";
 
 void run(Simulator& sim, double seconds) {
   const auto steps = static_cast<int>(seconds / 0.01 + 0.5);
@@ -32,20 +32,18 @@ void run(Simulator& sim, double seconds) {
 }
 
 std::size_t count(const Simulator& sim, SimEvent::Kind kind) {
-  return static_cast<std::size_t>(std::count_if(sim.events().begin(), sim.events().end(),
-                                                [&](const SimEvent& e) { return e.kind == kind; }));
+  return static_cast<std::size_t>(
+      std::count_if(sim.events().begin(), sim.events().end(), [&](const SimEvent& e) { return e.kind == kind; }));
 }
 
 }  // namespace
 
-TEST_CASE("parse_world: docks by pose or by a node of the regions, with their contact",
-          "[sim][world][dock]") {
-  const World w = parse_world(
-      kHead +
-          "docks:\n"
-          "  - {name: pad, pose: [2.0, 3.0, 1.5708], contact_radius_m: 0.05, heading_tolerance_deg: 10}\n"
-          "  - {node: charger}\n",
-      "world.yaml");
+TEST_CASE("parse_world: docks by pose or by a node of the regions, with their contact", "[sim][world][dock]") {
+  const World w = parse_world(kHead +
+                                  "docks:\n"
+                                  "  - {name: pad, pose: [2.0, 3.0, 1.5708], contact_radius_m: 0.05, heading_tolerance_deg: 10}\n"
+                                  "  - {node: charger}\n",
+                              "world.yaml");
   REQUIRE(w.docks.size() == 2);
   CHECK(w.docks[0].name == "pad");
   CHECK(w.docks[0].pose.x_m == 2.0);
@@ -65,12 +63,10 @@ TEST_CASE("parse_world: a wrong dock is located", "[sim][world][dock][errors]") 
   CHECK_THAT(world_error_of(kHead + "docks:\n  - {node: chargr}\n"),
              Catch::Contains("world.yaml:5:12: error: unknown node 'chargr'"));
   CHECK_THAT(world_error_of(kHead + "docks:\n  - {pose: [1, 1], contact_radius_m: 0}\n"),
-             Catch::Contains(
-                 "world.yaml:5:38: error: dock 'dock 1'.contact_radius_m: expected a number > 0, got 0"));
+             Catch::Contains("world.yaml:5:38: error: dock 'dock 1'.contact_radius_m: expected a number > 0, got 0"));
   CHECK_THAT(world_error_of(kHead + "docks:\n  - {name: in_wall, pose: [0.0, 0.0]}\n"),
              Catch::Contains("world.yaml:5:5: error: dock 'in_wall': docked there, the robot's footprint"));
-  CHECK_THAT(world_error_of(kHead + "docks:\n  - {pose: [1, 1], voltage: 24}\n"),
-             Catch::Contains("unknown key 'voltage'"));
+  CHECK_THAT(world_error_of(kHead + "docks:\n  - {pose: [1, 1], voltage: 24}\n"), Catch::Contains("unknown key 'voltage'"));
 }
 
 TEST_CASE("Simulator: on a dock's contacts the battery charges, off them it drains", "[sim][battery][dock]") {
@@ -133,8 +129,7 @@ TEST_CASE("A robot drives to its dock and charges: PrDockCharge on the simulator
   auto world = std::make_shared<const World>(load_world(kWorlds + "workspace_dock.yaml"));
   RobotPlugins plugins = builtin_plugins(world);
   SimClock clock;
-  const RobotProfile profile =
-      load_robot_profile(std::string(TRIPODAL_TEST_DATA_DIR) + "/robot/dock_charge.yaml");
+  const RobotProfile profile = load_robot_profile(std::string(TRIPODAL_TEST_DATA_DIR) + "/robot/dock_charge.yaml");
   auto robot = Robot::assemble(profile, plugins, clock);
   LifecycleRecorder life(true);
   robot->planner().add_observer(life);

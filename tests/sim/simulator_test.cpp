@@ -1,21 +1,20 @@
 #include "tripodal/sim/simulator.hpp"
 
-#include <catch2/catch.hpp>
-
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <cstring>
 #include <numbers>
 #include <vector>
 
+#include "../support/builtin_registries.hpp"
 #include "sim_test_util.hpp"
 #include "tripodal/behaviors/behavior_registry.hpp"
 #include "tripodal/controllers/kinematics.hpp"
 #include "tripodal/navi/localizer.hpp"
 #include "tripodal/reactive/reactive_config.hpp"
-#include "../support/builtin_registries.hpp"
 
 using namespace tripodal;
 using namespace tripodal::sim;
@@ -428,7 +427,8 @@ TEST_CASE("Simulator: a controller drives the simulated base through the Hardwar
 }
 
 TEST_CASE("SimRunner: control loops and the simulator step together, BhGoToPose reaches a goal", "[sim][runner]") {
-  const ReactiveConfig rc = load_reactive_config(std::string(TRIPODAL_SOURCE_DIR) + "/configs/reactive/psr_omni.yaml", tripodal::test::builtin_controllers());
+  const ReactiveConfig rc = load_reactive_config(std::string(TRIPODAL_SOURCE_DIR) + "/configs/reactive/psr_omni.yaml",
+                                                 tripodal::test::builtin_controllers());
   const ControllerConfig& base = *rc.find_controller("base");
   Simulator sim(room_world(81, 81, {1.0, 1.0, 0.0}), base, 5);
   SimClock clock;
@@ -437,7 +437,8 @@ TEST_CASE("SimRunner: control loops and the simulator step together, BhGoToPose 
   table.add(odom);
   sim.add_resources(table);
   CHECK(table.size() == 6);
-  std::unique_ptr<ControlLoop> loop = make_control_loop(rc, *rc.find_loop("motion"), table, &sim, tripodal::test::builtin_controllers());
+  std::unique_ptr<ControlLoop> loop =
+      make_control_loop(rc, *rc.find_loop("motion"), table, &sim, tripodal::test::builtin_controllers());
   loop->set_odometry_output(&odom);
   loop->controller()->reset_odometry(sim.world().start_pose);
   const BehaviorRegistry& reg = tripodal::test::builtin_behaviors();
@@ -600,8 +601,8 @@ TEST_CASE("Simulator: a drop's depth under each cliff sensor; a stuck sensor rea
   world.faults.stuck_cliff.push_back({0, false, {}});
   world.faults.stuck_cliff.push_back({2, true, {}});
   Simulator sim(std::move(world), differential_base(), 1);
-  CHECK(sim.cliff_depth_m(0) == 0.0);  // over the step, stuck at the floor's reading
-  CHECK(sim.cliff_depth_m(1) == 0.0);  // at x = 2.1: floor
+  CHECK(sim.cliff_depth_m(0) == 0.0);       // over the step, stuck at the floor's reading
+  CHECK(sim.cliff_depth_m(1) == 0.0);       // at x = 2.1: floor
   CHECK(std::isinf(sim.cliff_depth_m(2)));  // stuck at a drop's
   CHECK(sim.cliff_depth_m(7) == 0.0);
   CHECK(sim.cliff().latest().cliff == std::vector<std::uint8_t>{0, 0, 1});

@@ -2,15 +2,14 @@
 // joints and LED buttons: the world syntax with located errors, determinism per seed, what the
 // laser and bumpers see, collisions with a visitor, giving way, joint limits and speed.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <string>
 
 #include "sim_test_util.hpp"
-#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/behaviors/gesture_behaviors.hpp"
+#include "tripodal/builtin/register_all.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/sim/simulator.hpp"

@@ -251,7 +251,8 @@ TEST_CASE("load_world: the safety ward, its stairwell and glass partition", "[si
   CHECK(w.grid.is_free(w.grid.cell_at({2.03, 3.0})));
 }
 
-TEST_CASE("parse_world: malformed drops, sonar_only and stuck_cliff entries give located errors", "[sim][world][errors][safety]") {
+TEST_CASE("parse_world: malformed drops, sonar_only and stuck_cliff entries give located errors",
+          "[sim][world][errors][safety]") {
   const std::string e = error_of(head() + R"(drops:
   - {name: stairs, rectangle: [1, 1, 2, 2], depth_m: -0.2}
   - {name: step, rectangle: [1, 1, 2, 2], depth_m: deep}
@@ -279,7 +280,8 @@ faults:
   CHECK_THAT(e, Catch::Contains("world.yaml:17:") && Catch::Contains("non-negative whole number"));
   CHECK_THAT(e, Catch::Contains("world.yaml:18:") && Catch::Contains("stuck_cliff.reads must be floor or drop"));
   CHECK_THAT(e, Catch::Contains("world.yaml:19:") && Catch::Contains("needs index"));
-  CHECK_THAT(error_of(head() + "sonar_only: {name: glass}\n"), Catch::Contains("world.yaml:4:13") && Catch::Contains("sonar_only must be a list"));
+  CHECK_THAT(error_of(head() + "sonar_only: {name: glass}\n"),
+             Catch::Contains("world.yaml:4:13") && Catch::Contains("sonar_only must be a list"));
   // Checked once the rest is valid: a sensor the robot does not have, a glass pane on the start.
   const std::string late = error_of(head() + R"(sonar_only:
   - {name: door, rectangle: [0.5, 0.5, 1.0, 1.0]}
@@ -288,5 +290,6 @@ faults:
     - {index: 3, reads: floor}
 )");
   CHECK_THAT(late, Catch::Contains("world.yaml:5:5") && Catch::Contains("sonar_only 'door' covers start_pose"));
-  CHECK_THAT(late, Catch::Contains("world.yaml:8:7") && Catch::Contains("stuck_cliff.index 3 names no cliff sensor: the robot has 3"));
+  CHECK_THAT(late,
+             Catch::Contains("world.yaml:8:7") && Catch::Contains("stuck_cliff.index 3 names no cliff sensor: the robot has 3"));
 }

@@ -18,7 +18,9 @@ inline thread_local std::size_t t_allocations = 0;
 /// Heap allocations made through operator new since the program started.
 inline std::size_t allocations() noexcept { return g_allocations.load(std::memory_order_relaxed); }
 /// Those made by the calling thread (a loop's own thread, counted while others allocate freely).
-inline std::size_t thread_allocations() noexcept { return t_allocations; }
+inline std::size_t thread_allocations() noexcept {
+  return t_allocations;
+}
 }  // namespace tripodal::test
 
 namespace tripodal::test::detail {

@@ -3,9 +3,10 @@
 // robot of the same profile (the same task must succeed on the recorded sensors alone, with the
 // recorded commands), cut short (the task must not succeed), and used as the start of a closed
 // loop on the simulator (the robot starts at the recorded pose, the world reacts).
-#include <catch2/catch.hpp>
+#include "tripodal/testing/robot_harness.hpp"
 
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -14,7 +15,6 @@
 #include "tripodal/builtin/register_all.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
-#include "tripodal/testing/robot_harness.hpp"
 #include "tripodal/trace/trace_reader.hpp"
 #include "tripodal/trace/trace_recorder.hpp"
 #include "tripodal/trace/trace_writer.hpp"
@@ -225,12 +225,14 @@ TEST_CASE("robot harness: bad traces and options are refused, naming what is wro
     trace::TraceWriter writer(empty.path());
     writer.close();
   }
-  REQUIRE_THROWS_WITH(testing::RobotHarness(testing::RobotHarness::Mode::replay, psr2(), builtin_plugins(), empty.path(), options()),
-                      Contains("has no records"));
+  REQUIRE_THROWS_WITH(
+      testing::RobotHarness(testing::RobotHarness::Mode::replay, psr2(), builtin_plugins(), empty.path(), options()),
+      Contains("has no records"));
 
   trace::test::TempFile missing("robot_harness_missing");
-  REQUIRE_THROWS_WITH(testing::RobotHarness(testing::RobotHarness::Mode::replay, psr2(), builtin_plugins(), missing.path(), options()),
-                      Contains(missing.str()));
+  REQUIRE_THROWS_WITH(
+      testing::RobotHarness(testing::RobotHarness::Mode::replay, psr2(), builtin_plugins(), missing.path(), options()),
+      Contains(missing.str()));
 
   // Corrupt in the middle: the replay stops there and says where.
   trace::test::TempFile corrupt("robot_harness_corrupt");
@@ -241,6 +243,7 @@ TEST_CASE("robot harness: bad traces and options are refused, naming what is wro
     std::ofstream f(corrupt.path(), std::ios::binary);
     f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   }
-  REQUIRE_THROWS_WITH(testing::RobotHarness(testing::RobotHarness::Mode::replay, psr2(), builtin_plugins(), corrupt.path(), options()),
-                      Contains("byte"));
+  REQUIRE_THROWS_WITH(
+      testing::RobotHarness(testing::RobotHarness::Mode::replay, psr2(), builtin_plugins(), corrupt.path(), options()),
+      Contains("byte"));
 }

@@ -77,8 +77,7 @@ CLI::Validator non_negative_number() {
   return {[](std::string& text) {
             double v = 0.0;
             const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-            if (ec == std::errc() && end == text.data() + text.size() && v >= 0.0 && v < 1e300)
-              return std::string();
+            if (ec == std::errc() && end == text.data() + text.size() && v >= 0.0 && v < 1e300) return std::string();
             return "expected a number >= 0, got '" + text + "'";
           },
           "X>=0"};
@@ -133,12 +132,11 @@ std::string did_you_mean(const CLI::App& app, int argc, const char* const* argv)
     const std::string arg = argv[i];
     if (arg == "--") break;
     // "-1" is a value (a refused --seed -1), not an option.
-    const bool negative_number = arg.size() > 1 && arg[0] == '-' &&
-                                 (std::isdigit(static_cast<unsigned char>(arg[1])) != 0 || arg[1] == '.');
+    const bool negative_number =
+        arg.size() > 1 && arg[0] == '-' && (std::isdigit(static_cast<unsigned char>(arg[1])) != 0 || arg[1] == '.');
     if (arg.size() > 1 && arg[0] == '-' && !negative_number) {
       const std::string name = arg.substr(0, arg.find('='));
-      if (at->get_option_no_throw(name) != nullptr || name == "--help" || name == "-h" || name == "--version")
-        continue;
+      if (at->get_option_no_throw(name) != nullptr || name == "--help" || name == "-h" || name == "--version") continue;
       std::vector<std::string> known;
       for (const CLI::Option* o : at->get_options()) {
         for (const std::string& l : o->get_lnames()) known.push_back("--" + l);
@@ -148,8 +146,7 @@ std::string did_you_mean(const CLI::App& app, int argc, const char* const* argv)
     }
     const std::vector<const CLI::App*> subs = at->get_subcommands([](const CLI::App*) { return true; });
     if (subs.empty()) continue;  // a positional argument or an option's value of a command
-    const auto next =
-        std::find_if(subs.begin(), subs.end(), [&](const CLI::App* s) { return s->check_name(arg); });
+    const auto next = std::find_if(subs.begin(), subs.end(), [&](const CLI::App* s) { return s->check_name(arg); });
     if (next != subs.end()) {
       at = *next;
       continue;
@@ -159,14 +156,12 @@ std::string did_you_mean(const CLI::App& app, int argc, const char* const* argv)
     const auto close = closest_name(arg, names);
     std::string known;
     for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
-    return "unknown command '" + arg + "'" +
-           (close ? "; did you mean '" + *close + "'?" : "; the commands: " + known);
+    return "unknown command '" + arg + "'" + (close ? "; did you mean '" + *close + "'?" : "; the commands: " + known);
   }
   return {};
 }
 
-std::optional<int> parse_command_line(CLI::App& app, std::string_view name, std::string_view exit_codes,
-                                      int argc, char** argv) {
+std::optional<int> parse_command_line(CLI::App& app, std::string_view name, std::string_view exit_codes, int argc, char** argv) {
   app.name(std::string(name));
   app.formatter(formatter());
   app.footer(std::string(exit_codes));
@@ -181,8 +176,7 @@ std::optional<int> parse_command_line(CLI::App& app, std::string_view name, std:
     return kOk;
   } catch (const CLI::ParseError& e) {
     std::cerr << name << ": " << e.what() << '\n';
-    if (const std::string hint = did_you_mean(app, argc, argv); !hint.empty())
-      std::cerr << name << ": " << hint << '\n';
+    if (const std::string hint = did_you_mean(app, argc, argv); !hint.empty()) std::cerr << name << ": " << hint << '\n';
     std::cerr << "run '" << name << " --help' for the usage\n";
     return kUsage;
   }

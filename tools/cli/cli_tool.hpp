@@ -61,8 +61,8 @@ int run_tool(const Tool& tool, int argc, char** argv);
 /// Returns the exit code when the program should stop here: kOk after --help or --version,
 /// kUsage for a bad command line (the message, a "did you mean" and where to find the usage on
 /// stderr, prefixed with `name`); nullopt when the command line parsed.
-[[nodiscard]] std::optional<int> parse_command_line(CLI::App& app, std::string_view name,
-                                                    std::string_view exit_codes, int argc, char** argv);
+[[nodiscard]] std::optional<int> parse_command_line(CLI::App& app, std::string_view name, std::string_view exit_codes, int argc,
+                                                    char** argv);
 
 /// Options that are a positive whole number (--max-states, --examples, ...): the error reads
 /// "--examples: expected a whole number > 0, got 'lots'".

@@ -118,7 +118,10 @@ struct Figures {
 
 enum class Pattern { balloon, boustrophedon, hybrid, distance_transform };
 const char* name_of(Pattern p) {
-  return p == Pattern::balloon ? "balloon" : p == Pattern::boustrophedon ? "boustrophedon" : p == Pattern::hybrid ? "hybrid" : "distance_transform";
+  return p == Pattern::balloon         ? "balloon"
+         : p == Pattern::boustrophedon ? "boustrophedon"
+         : p == Pattern::hybrid        ? "hybrid"
+                                       : "distance_transform";
 }
 
 // Every section of the grid covered by one pattern, one after the other from the previous end.
@@ -155,8 +158,10 @@ void print_row(const std::string& map, Pattern p, const Figures& f, double width
 }
 
 void header(bool segmentation) {
-  std::printf("| map | pattern | reachable m2 | coverage | length m | length / bound | turns | rotation deg | plan ms | worst section ms |%s\n",
-              segmentation ? " sections | rooms | precision | recall | segmentation ms |" : "");
+  std::printf(
+      "| map | pattern | reachable m2 | coverage | length m | length / bound | turns | rotation deg | plan ms | worst section ms "
+      "|%s\n",
+      segmentation ? " sections | rooms | precision | recall | segmentation ms |" : "");
   std::printf("|---|---|---|---|---|---|---|---|---|---|%s\n", segmentation ? "---|---|---|---|---|" : "");
 }
 
@@ -307,30 +312,20 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Evaluates the coverage patterns (hybrid, balloon, boustrophedon, distance_transform) on floor plans: the ipa maps,\n"
       "a map_server map, or seeded random rooms (docs/coverage.md).\n"};
-  app.add_option(
-         "--ipa", ipa,
-         "DIR: the ipa floor plans (NAME.png + NAME_gt_segmentation.png), e.g. ../shared/data/ipa-maps")
+  app.add_option("--ipa", ipa, "DIR: the ipa floor plans (NAME.png + NAME_gt_segmentation.png), e.g. ../shared/data/ipa-maps")
       ->check(CLI::ExistingDirectory);
-  app.add_option("--workspace", workspace,
-                 "MAP.yaml: a map_server map (e.g. configs/worlds/workspace_map.yaml)")
+  app.add_option("--workspace", workspace, "MAP.yaml: a map_server map (e.g. configs/worlds/workspace_map.yaml)")
       ->check(CLI::ExistingFile);
-  app.add_option("--random", random_rooms, "N: N seeded random rooms (seeds 1..N)")
-      ->check(cli::positive_count());
-  app.add_option("--pictures", pictures, "DIR: the workspace's paths per pattern as PNG pictures")
-      ->check(cli::writable_folder());
+  app.add_option("--random", random_rooms, "N: N seeded random rooms (seeds 1..N)")->check(cli::positive_count());
+  app.add_option("--pictures", pictures, "DIR: the workspace's paths per pattern as PNG pictures")->check(cli::writable_folder());
   app.add_flag("--verbose", verbose, "per-section figures of the workspace");
   app.add_option("--width", o.cleaning_width_m, "M: cleaning width (PSR-2's)")
       ->check(cli::positive_number())
       ->capture_default_str();
-  app.add_option("--radius", o.robot_radius_m, "M: robot radius")
-      ->check(cli::positive_number())
-      ->capture_default_str();
-  app.add_option("--lane-overlap", o.lane_overlap_m, "M: CoverageOptions::lane_overlap_m")
-      ->check(cli::non_negative_number());
-  app.add_option("--lane-inset", o.lane_inset_m, "M: CoverageOptions::lane_inset_m")
-      ->check(cli::non_negative_number());
-  app.add_option("--turn-cost", o.turn_cost_m, "M: CoverageOptions::turn_cost_m")
-      ->check(cli::non_negative_number());
+  app.add_option("--radius", o.robot_radius_m, "M: robot radius")->check(cli::positive_number())->capture_default_str();
+  app.add_option("--lane-overlap", o.lane_overlap_m, "M: CoverageOptions::lane_overlap_m")->check(cli::non_negative_number());
+  app.add_option("--lane-inset", o.lane_inset_m, "M: CoverageOptions::lane_inset_m")->check(cli::non_negative_number());
+  app.add_option("--turn-cost", o.turn_cost_m, "M: CoverageOptions::turn_cost_m")->check(cli::non_negative_number());
   app.add_option("--link-margin", o.link_margin_m,
                  "M: CoverageOptions::link_margin_m (the clearance links keep beyond the robot radius)")
       ->check(cli::non_negative_number());
@@ -339,18 +334,22 @@ int main(int argc, char** argv) {
                  "section splitter's sections")
       ->check(CLI::IsMember({"morphological", "distance_transform", "voronoi"}));
   app.add_flag("--segment-only", segment_only, "with --ipa: only the room segmentation's precision and recall, no coverage");
-  app.add_option("--pattern", pattern_names, "NAME: only this pattern (repeatable): balloon, boustrophedon, hybrid, distance_transform")
+  app.add_option("--pattern", pattern_names,
+                 "NAME: only this pattern (repeatable): balloon, boustrophedon, hybrid, distance_transform")
       ->check(CLI::IsMember({"balloon", "boustrophedon", "hybrid", "distance_transform"}));
   app.add_option("--expect-precision", expect_precision, "P: with --ipa, exit 1 unless the mean room precision is at least P")
       ->check(CLI::Range(0.0, 1.0));
-  app.add_option("--expect-recall", expect_recall, "R: with --ipa, exit 1 unless the mean room recall is at least R")->check(CLI::Range(0.0, 1.0));
-  app.add_option("--expect-bound", expect_bound, "X: with --ipa, exit 1 unless the hybrid's mean length / bound over the maps is at most X")
+  app.add_option("--expect-recall", expect_recall, "R: with --ipa, exit 1 unless the mean room recall is at least R")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--expect-bound", expect_bound,
+                 "X: with --ipa, exit 1 unless the hybrid's mean length / bound over the maps is at most X")
       ->check(cli::positive_number());
-  app.add_option("--expect-worst-bound", expect_worst_bound, "X: with --ipa, exit 1 unless the hybrid's length / bound is at most X on every map")
+  app.add_option("--expect-worst-bound", expect_worst_bound,
+                 "X: with --ipa, exit 1 unless the hybrid's length / bound is at most X on every map")
       ->check(cli::positive_number());
-  if (auto code = cli::parse_command_line(
-          app, "tripodal-coverage-eval",
-          "exit codes: 0 ok, 1 a map could not be read or covered, 2 bad command line", argc, argv)) {
+  if (auto code =
+          cli::parse_command_line(app, "tripodal-coverage-eval",
+                                  "exit codes: 0 ok, 1 a map could not be read or covered, 2 bad command line", argc, argv)) {
     return *code;
   }
   if (ipa.empty() && workspace.empty() && random_rooms <= 0) {
@@ -417,25 +416,33 @@ int main(int argc, char** argv) {
           const Figures f = cover(grid, sections, p, o);
           add(p, f);
           print_row(name, p, f, o.cleaning_width_m, seg);
-          if (p == Pattern::hybrid && f.reachable_m2 > 0) hybrid_ratio.push_back(f.length_m / (f.reachable_m2 / o.cleaning_width_m));
+          if (p == Pattern::hybrid && f.reachable_m2 > 0)
+            hybrid_ratio.push_back(f.length_m / (f.reachable_m2 / o.cleaning_width_m));
         }
       }
       // The expectations (a test over the ipa set: tests/app, tripodal_coverage_eval_ipa:*).
-      auto mean = [](const std::vector<double>& v) { return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size()); };
+      auto mean = [](const std::vector<double>& v) {
+        return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+      };
       std::vector<double> precision, recall;
       for (const Score& sc : scores) precision.push_back(sc.precision), recall.push_back(sc.recall);
       std::printf("\nmean over %zu maps: precision %.3f, recall %.3f", scores.size(), mean(precision), mean(recall));
       if (!hybrid_ratio.empty()) {
-        std::printf(", hybrid length / bound %.3f (worst %.3f)", mean(hybrid_ratio), *std::max_element(hybrid_ratio.begin(), hybrid_ratio.end()));
+        std::printf(", hybrid length / bound %.3f (worst %.3f)", mean(hybrid_ratio),
+                    *std::max_element(hybrid_ratio.begin(), hybrid_ratio.end()));
       }
       std::printf("\n");
-      if (expect_precision >= 0 && mean(precision) < expect_precision) failures += "mean precision below the expected " + std::to_string(expect_precision) + "\n";
-      if (expect_recall >= 0 && mean(recall) < expect_recall) failures += "mean recall below the expected " + std::to_string(expect_recall) + "\n";
-      if ((expect_bound > 0 || expect_worst_bound > 0) && hybrid_ratio.empty()) failures += "no hybrid figures to check (--pattern hybrid)\n";
+      if (expect_precision >= 0 && mean(precision) < expect_precision)
+        failures += "mean precision below the expected " + std::to_string(expect_precision) + "\n";
+      if (expect_recall >= 0 && mean(recall) < expect_recall)
+        failures += "mean recall below the expected " + std::to_string(expect_recall) + "\n";
+      if ((expect_bound > 0 || expect_worst_bound > 0) && hybrid_ratio.empty())
+        failures += "no hybrid figures to check (--pattern hybrid)\n";
       if (expect_bound > 0 && !hybrid_ratio.empty() && mean(hybrid_ratio) > expect_bound) {
         failures += "mean hybrid length / bound above the expected " + std::to_string(expect_bound) + "\n";
       }
-      if (expect_worst_bound > 0 && !hybrid_ratio.empty() && *std::max_element(hybrid_ratio.begin(), hybrid_ratio.end()) > expect_worst_bound) {
+      if (expect_worst_bound > 0 && !hybrid_ratio.empty() &&
+          *std::max_element(hybrid_ratio.begin(), hybrid_ratio.end()) > expect_worst_bound) {
         failures += "worst hybrid length / bound above the expected " + std::to_string(expect_worst_bound) + "\n";
       }
       if (!segment_only) {

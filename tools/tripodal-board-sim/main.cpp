@@ -89,18 +89,15 @@ int run(int argc, char** argv) {
   app.add_option("--tank-l", tank_l, "L: disinfectant in the tank at power-on")
       ->check(tripodal::cli::non_negative_number())
       ->capture_default_str();
-  app.add_option("--protocol", protocol,
-                 "NAME|FILE: protocol profile: thesis, tripodal-v1 or a YAML file (configs/board/)")
+  app.add_option("--protocol", protocol, "NAME|FILE: protocol profile: thesis, tripodal-v1 or a YAML file (configs/board/)")
       ->capture_default_str();
-  app.add_option(
-         "--tcp", tcp_port,
-         "PORT: serve the link over TCP on 127.0.0.1:PORT (0: any free port) instead of a pseudo-terminal")
+  app.add_option("--tcp", tcp_port,
+                 "PORT: serve the link over TCP on 127.0.0.1:PORT (0: any free port) instead of a pseudo-terminal")
       ->check(CLI::Range(0, 65535));
   app.add_option("--lidar", lidar_link,
                  "PATH: also serve an RPLIDAR A1 (docs/lidar.md) on a second pseudo-terminal, this path a symbolic link to it; "
                  "it scans the same world");
-  if (auto code = tripodal::cli::parse_command_line(app, "tripodal-board-sim", kExitCodes, argc, argv))
-    return *code;
+  if (auto code = tripodal::cli::parse_command_line(app, "tripodal-board-sim", kExitCodes, argc, argv)) return *code;
   if (world_file.empty()) {
     world_file = default_world().string();
     if (world_file.empty()) {

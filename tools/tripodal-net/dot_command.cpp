@@ -89,8 +89,7 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_option("FILE", a->file, "the net (native XML or PNML)")->required();
   cmd.add_option("--marking", a->marking_text, "P=N,...: draw this marking instead of the initial one (unlisted places: 0)");
   cmd.add_flag("--no-descriptions", a->no_descriptions, "ids and annotations only");
-  cmd.add_option("-o", a->output, "OUT: write to OUT instead of standard output")
-      ->check(cli::writable_file());
+  cmd.add_option("-o", a->output, "OUT: write to OUT instead of standard output")->check(cli::writable_file());
   return [a](std::ostream& out, std::ostream& err) { return run_dot(*a, out, err); };
 }
 

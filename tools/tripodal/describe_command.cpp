@@ -46,8 +46,7 @@ struct Args {
 // "[0.01, 2]", "> 0", ">= 0", "" for a parameter's bounds.
 std::string bounds_text(const ParameterSpec& p) {
   auto num = [](double v) { return to_string(Value{v}); };
-  if (p.min && p.max)
-    return std::string(p.min_exclusive ? "(" : "[") + num(*p.min) + ", " + num(*p.max) + "]";
+  if (p.min && p.max) return std::string(p.min_exclusive ? "(" : "[") + num(*p.min) + ", " + num(*p.max) + "]";
   if (p.min) return std::string(p.min_exclusive ? "> " : ">= ") + num(*p.min);
   if (p.max) return "<= " + num(*p.max);
   return {};
@@ -62,8 +61,7 @@ std::string list_text(const std::vector<std::string>& names) {
 
 // A registered type's manifest, as `describe --type` prints it.
 std::string manifest_text(const ModuleManifest& m, std::string_view family) {
-  std::string out =
-      m.name + " (" + std::string(family) + ", " + std::string(to_string(m.layer)) + " layer)\n";
+  std::string out = m.name + " (" + std::string(family) + ", " + std::string(to_string(m.layer)) + " layer)\n";
   if (!m.description.empty()) out += "  " + m.description + "\n";
   out += "  in:  " + list_text(m.inputs) + "\n";
   out += "  out: " + list_text(m.outputs) + "\n";
@@ -72,8 +70,7 @@ std::string manifest_text(const ModuleManifest& m, std::string_view family) {
   std::size_t width = 0;
   for (const ParameterSpec& p : m.parameters) width = std::max(width, p.name.size());
   for (const ParameterSpec& p : m.parameters) {
-    std::string line =
-        "    " + p.name + std::string(width - p.name.size() + 2, ' ') + std::string(to_string(p.type));
+    std::string line = "    " + p.name + std::string(width - p.name.size() + 2, ' ') + std::string(to_string(p.type));
     if (p.default_value) {
       line += " = " + to_string(*p.default_value);
     } else {
@@ -152,19 +149,18 @@ int describe(const Args& args, std::ostream& out, std::ostream& err) {
 cli::Action setup(CLI::App& cmd) {
   auto a = std::make_shared<Args>();
   CLI::Option* file = cmd.add_option("ROBOT.yaml", a->file, "the robot profile");
-  CLI::Option* type =
-      cmd.add_option("--type", a->type, "NAME: print the manifest of a registered type instead");
+  CLI::Option* type = cmd.add_option("--type", a->type, "NAME: print the manifest of a registered type instead");
   cmd.add_flag("--dot", a->dot, "the layered functionality diagram in Graphviz DOT")->excludes(type);
   file->excludes(type);
-  cmd.add_option("--plugin", a->plugins, "LIB.so: a shared-library plugin with the profile's own types (repeatable; docs/plugins.md)")
+  cmd.add_option("--plugin", a->plugins,
+                 "LIB.so: a shared-library plugin with the profile's own types (repeatable; docs/plugins.md)")
       ->allow_extra_args(false);
   return [a](std::ostream& out, std::ostream& err) { return describe(*a, out, err); };
 }
 
 }  // namespace
 
-TRIPODAL_CLI_COMMAND("", "describe",
-                     "layered functionality diagram of a robot profile (text or --dot), or a type's manifest",
+TRIPODAL_CLI_COMMAND("", "describe", "layered functionality diagram of a robot profile (text or --dot), or a type's manifest",
                      kDescription, kExitCodes, &setup);
 
 }  // namespace tripodal::tool

@@ -443,8 +443,7 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_option("--world", a->world, "WORLD.yaml: the world every robot runs in (its own copy)")->required();
   cmd.add_option("--task", a->task, "\"COMMAND\": \"clean the room 3211\" (by sections) or \"clean the rooms 2111 and 2133\"")->required();
   cmd.add_option("--robot", a->robot, "ROBOT.yaml: the robots' profile (default: robots/psr2.yaml beside the world's folder)");
-  cmd.add_option("--out", a->out, "DIR: fleet.json, fleet.txt, the robots' profiles and logs")
-      ->check(cli::writable_folder());
+  cmd.add_option("--out", a->out, "DIR: fleet.json, fleet.txt, the robots' profiles and logs")->check(cli::writable_folder());
   cmd.add_option("--speed", a->speed, "X: the robots run at X times real time")->check(cli::positive_number())->capture_default_str();
   cmd.add_option("--domain", a->domain, "ID: the DDS domain (ROS_DOMAIN_ID)")->check(CLI::Range(0, 232))->capture_default_str();
   cmd.add_option("--lease-s", a->lease_s, "S: the robots' participant lease: a dead robot is seen silent after S")

@@ -22,7 +22,8 @@ constexpr std::string_view kDescription =
     "(security: {keys: DIR, identity: NAME}). An identity that exists in DIR is refused, not\n"
     "overwritten. Keep ca_key.pem off the robots.";
 
-constexpr std::string_view kExitCodes = "exit codes: 0 ok, 1 a name is refused, 2 bad command line, 3 openssl failed or DIR is not writable";
+constexpr std::string_view kExitCodes =
+    "exit codes: 0 ok, 1 a name is refused, 2 bad command line, 3 openssl failed or DIR is not writable";
 
 struct Args {
   std::string out;
@@ -61,7 +62,9 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_option("--operator", a->operators, "NAME: an operator tool's identity: the monitor, the fleet tool (repeatable)");
   cmd.add_option("--observer", a->observers, "NAME: an identity that may only read (repeatable)");
   cmd.add_option("--domain", a->domain, "ID: the fleet's DDS domain")->check(CLI::Range(0, 232))->capture_default_str();
-  cmd.add_option("--days", a->days, "N: how long the certificates and permissions are valid")->check(CLI::Range(1, 36500))->capture_default_str();
+  cmd.add_option("--days", a->days, "N: how long the certificates and permissions are valid")
+      ->check(CLI::Range(1, 36500))
+      ->capture_default_str();
   return [a](std::ostream& out, std::ostream& err) {
     if (a->robots.empty() && a->operators.empty() && a->observers.empty()) {
       err << "tripodal fleet-keys: give at least one identity (--robot, --operator or --observer)\n";

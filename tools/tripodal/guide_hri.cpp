@@ -11,7 +11,6 @@
 
 namespace tripodal::app {
 
-
 std::string command_text(const TaskLibrary& tasks, const Understanding& u) {
   for (const TaskTemplate& t : tasks.templates()) {
     if (t.name != u.task || t.commands.empty()) continue;

@@ -3,16 +3,15 @@
 // Application layer, not installed.
 #pragma once
 
+#include <deque>
+#include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <deque>
-#include <filesystem>
-#include <functional>
 
 #include "tripodal/core/clock.hpp"
 #include "tripodal/hri/answer_providers.hpp"

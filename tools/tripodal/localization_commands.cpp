@@ -539,8 +539,7 @@ cli::Action setup_build(CLI::App& cmd) {
   cmd.add_option("--recovery-margin", a->recovery_margin,
                  "Q: a match this far below the recent median is re-matched globally (0: never)")
       ->capture_default_str()->check(CLI::Range(0.0, 1.0));
-  cmd.add_option("--trajectory", a->trajectory,
-                 "FILE: CSV of the matches, scan by scan, as made (before closures)")
+  cmd.add_option("--trajectory", a->trajectory, "FILE: CSV of the matches, scan by scan, as made (before closures)")
       ->check(cli::writable_file());
   cmd.add_flag("--loop-closure", a->loop_closure, "keep a pose graph of key scans and close loops (docs/localization.md)");
   cmd.add_option("--closure-quality", a->closure_quality, "Q: with --loop-closure, the match quality a closure needs, in (0, 1]")

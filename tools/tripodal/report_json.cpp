@@ -63,7 +63,8 @@ std::string RunResult::json() const {
                       {"period_s", to_seconds(l.period)},
                       {"budget_s", to_seconds(l.budget)},
                       {"cycles", l.cycles},
-                      {"period_error_us", {{"p50", us(l.period_error_p50)}, {"p99", us(l.period_error_p99)}, {"max", us(l.period_error_max)}}},
+                      {"period_error_us",
+                       {{"p50", us(l.period_error_p50)}, {"p99", us(l.period_error_p99)}, {"max", us(l.period_error_max)}}},
                       {"execution_us", {{"p99", us(l.execution_p99)}, {"max", us(l.execution_max)}}},
                       {"overruns", l.overruns},
                       {"skipped_ticks", l.skipped_ticks},
@@ -77,34 +78,41 @@ std::string RunResult::json() const {
     const DisinfectionFigures& d = *disinfection;
     const auto ms = [&](Duration t) { return rounded(to_seconds(t) * 1000.0, 3); };
     const double mean_rtt_ms = d.link.responses == 0 ? 0.0 : to_seconds(d.link.total_round_trip) * 1000.0 / static_cast<double>(d.link.responses);
-    report["disinfection"] = {
-        {"line", d.line},
-        {"uv_target_dose_j_m2", d.uv_target_dose_j_m2},
-        {"dose_coverage", rounded(d.dose_coverage, 4)},
-        {"median_dose_j_m2", rounded(d.median_dose_j_m2, 2)},
-        {"lamp_on_s", rounded(d.lamp_on_s, 2)},
-        {"disinfectant_used_l", rounded(d.disinfectant_used_l, 4)},
-        {"disinfectant_left_l", rounded(d.disinfectant_left_l, 4)},
-        {"battery_used_ah", rounded(d.battery_used_ah, 4)},
-        {"lamp_energy_wh", rounded(d.lamp_energy_wh, 3)},
-        {"uvc_energy_j", rounded(d.uvc_energy_j, 1)},
-        {"link", {{"requests", d.link.requests}, {"responses", d.link.responses}, {"missed", d.link.missed},
-                  {"error_responses", d.link.error_responses}, {"retries", d.link.retries}, {"link_losses", d.link.link_losses},
-                  {"mean_round_trip_ms", rounded(mean_rtt_ms, 3)}, {"max_round_trip_ms", ms(d.link.max_round_trip)},
-                  {"decoder_errors", d.decoder_errors}, {"board_requests", d.board_requests},
-                  {"watchdog_trips", d.watchdog_trips}, {"bytes_to_board", d.bytes_to_board},
-                  {"bytes_to_host", d.bytes_to_host}, {"bytes_lost", d.bytes_lost}}}};
+    report["disinfection"] = {{"line", d.line},
+                              {"uv_target_dose_j_m2", d.uv_target_dose_j_m2},
+                              {"dose_coverage", rounded(d.dose_coverage, 4)},
+                              {"median_dose_j_m2", rounded(d.median_dose_j_m2, 2)},
+                              {"lamp_on_s", rounded(d.lamp_on_s, 2)},
+                              {"disinfectant_used_l", rounded(d.disinfectant_used_l, 4)},
+                              {"disinfectant_left_l", rounded(d.disinfectant_left_l, 4)},
+                              {"battery_used_ah", rounded(d.battery_used_ah, 4)},
+                              {"lamp_energy_wh", rounded(d.lamp_energy_wh, 3)},
+                              {"uvc_energy_j", rounded(d.uvc_energy_j, 1)},
+                              {"link",
+                               {{"requests", d.link.requests},
+                                {"responses", d.link.responses},
+                                {"missed", d.link.missed},
+                                {"error_responses", d.link.error_responses},
+                                {"retries", d.link.retries},
+                                {"link_losses", d.link.link_losses},
+                                {"mean_round_trip_ms", rounded(mean_rtt_ms, 3)},
+                                {"max_round_trip_ms", ms(d.link.max_round_trip)},
+                                {"decoder_errors", d.decoder_errors},
+                                {"board_requests", d.board_requests},
+                                {"watchdog_trips", d.watchdog_trips},
+                                {"bytes_to_board", d.bytes_to_board},
+                                {"bytes_to_host", d.bytes_to_host},
+                                {"bytes_lost", d.bytes_lost}}}};
     if (d.plan) {
-      report["disinfection"]["dose_plan"] = {
-          {"target_j_m2", d.plan->target_j_m2},
-          {"spacing_m", rounded(d.plan->spacing_m, 3)},
-          {"speed_m_s", rounded(d.plan->speed_m_s, 4)},
-          {"passes", d.plan->passes},
-          {"reach_m", rounded(d.plan->reach_m, 4)},
-          {"estimate_s", rounded(d.estimate_s, 1)},
-          {"estimate_ah", rounded(d.estimate_ah, 3)},
-          {"lamp_floor_m2", rounded(d.lamp_floor_m2, 2)},
-          {"lamp_floor_dose_coverage", rounded(d.lamp_floor_dose_coverage, 4)}};
+      report["disinfection"]["dose_plan"] = {{"target_j_m2", d.plan->target_j_m2},
+                                             {"spacing_m", rounded(d.plan->spacing_m, 3)},
+                                             {"speed_m_s", rounded(d.plan->speed_m_s, 4)},
+                                             {"passes", d.plan->passes},
+                                             {"reach_m", rounded(d.plan->reach_m, 4)},
+                                             {"estimate_s", rounded(d.estimate_s, 1)},
+                                             {"estimate_ah", rounded(d.estimate_ah, 3)},
+                                             {"lamp_floor_m2", rounded(d.lamp_floor_m2, 2)},
+                                             {"lamp_floor_dose_coverage", rounded(d.lamp_floor_dose_coverage, 4)}};
     }
   }
   // Task text and names come from the user: bytes that are not UTF-8 are replaced, not thrown on.

@@ -291,16 +291,18 @@ int run(Args& args, std::ostream& out, std::ostream& err) {
           << d->link.missed << " missed, " << d->decoder_errors << " decoder errors, " << d->link.link_losses << " link losses\n";
       if (d->plan) {
         out << "dose reached: " << d->lamp_floor_dose_coverage * 100.0 << " % of the " << d->lamp_floor_m2
-            << " m2 the lamp can dose (within " << d->plan->reach_m << " m of where the robot stands) >= " << d->uv_target_dose_j_m2
-            << " J/m2, planned lanes " << d->plan->spacing_m << " m apart at up to " << d->plan->speed_m_s << " m/s, "
-            << d->plan->passes << " pass" << (d->plan->passes > 1 ? "es" : "") << " (estimated " << d->estimate_s << " s, "
-            << d->estimate_ah << " Ah); battery used " << d->battery_used_ah << " Ah, lamp " << d->lamp_energy_wh << " Wh ("
-            << d->uvc_energy_j << " J of UVC)\n";
+            << " m2 the lamp can dose (within " << d->plan->reach_m
+            << " m of where the robot stands) >= " << d->uv_target_dose_j_m2 << " J/m2, planned lanes " << d->plan->spacing_m
+            << " m apart at up to " << d->plan->speed_m_s << " m/s, " << d->plan->passes << " pass"
+            << (d->plan->passes > 1 ? "es" : "") << " (estimated " << d->estimate_s << " s, " << d->estimate_ah
+            << " Ah); battery used " << d->battery_used_ah << " Ah, lamp " << d->lamp_energy_wh << " Wh (" << d->uvc_energy_j
+            << " J of UVC)\n";
       }
     }
     if (!r.stopped_by.empty()) out << "run " << r.stopped_by << (r.base_at_rest ? ", the base at rest" : ", the base NOT at rest") << "\n";
     if (!o.out.empty()) {
-      out << "wrote " << (o.out / "map.png").string() << (r.disinfection ? ", dose.png" : "") << ", trajectory.csv, report.json, lifecycle.txt\n";
+      out << "wrote " << (o.out / "map.png").string() << (r.disinfection ? ", dose.png" : "")
+          << ", trajectory.csv, report.json, lifecycle.txt\n";
     }
     if (r.state == "interrupted") return interrupted_exit(g_stop);
     // A monitored robot the operator never gave a task: nothing failed.
@@ -323,7 +325,8 @@ cli::Action setup(CLI::App& cmd) {
   app::RunOptions& o = a->options;
   cmd.add_option("--robot", o.robot, "ROBOT.yaml: the robot profile")->required();
   cmd.add_option("--world", o.world, "WORLD.yaml: map, regions, start pose and faults")->required();
-  cmd.add_option("--plugin", o.plugins, "LIB.so: a shared-library plugin with the profile's own types (repeatable; docs/plugins.md)")
+  cmd.add_option("--plugin", o.plugins,
+                 "LIB.so: a shared-library plugin with the profile's own types (repeatable; docs/plugins.md)")
       ->allow_extra_args(false);
   cmd.add_option("--task", o.task, "\"COMMAND\": the task in plain words (optional with --monitor)");
   cmd.add_option("--visit", a->visit,
@@ -341,10 +344,9 @@ cli::Action setup(CLI::App& cmd) {
                  "KEY=VALUE: a parameter of the hardware slot (repeatable): namespace=NS, domain_id=N, step_timeout_s=S");
   cmd.add_option("--out", o.out, "DIR: where map.png, trajectory.csv, report.json and lifecycle.txt go")
       ->check(cli::writable_folder());
-  cmd.add_option(
-         "--record", o.record,
-         "FILE.mcap: record the run (sensor readings, commands, the life cycle with every firing) as MCAP "
-         "(docs/rosbag.md); `tripodal trace convert` turns it into a trace")
+  cmd.add_option("--record", o.record,
+                 "FILE.mcap: record the run (sensor readings, commands, the life cycle with every firing) as MCAP "
+                 "(docs/rosbag.md); `tripodal trace convert` turns it into a trace")
       ->check(cli::writable_file());
   // Without SPEED CLI11 hands the option an empty value, which leaves realtime_speed at 0.
   a->realtime = cmd.add_option("--realtime", a->realtime_speed, "[SPEED]: SPEED times real time (default 1)")
@@ -364,8 +366,9 @@ cli::Action setup(CLI::App& cmd) {
                  "J/m2: on the control board, the dose a cell must receive to count as disinfected, and the dose the lanes "
                  "are planned for (default: the CoveragePlanner's dose_target_j_m2, else 10)")
       ->check(cli::positive_number());
-  cmd.add_flag("--no-dose-plan", [&o](std::int64_t) { o.dose_plan = false; },
-               "lanes as without a dose target (the CoveragePlanner's dose_target_j_m2 off); the dose is still measured");
+  cmd.add_flag(
+      "--no-dose-plan", [&o](std::int64_t) { o.dose_plan = false; },
+      "lanes as without a dose target (the CoveragePlanner's dose_target_j_m2 off); the dose is still measured");
   cmd.add_option("--time-limit", o.time_limit_s,
                  "S: a disinfection planned for a dose (the CoveragePlanner's dose_target_j_m2) that needs longer is "
                  "refused before it starts")

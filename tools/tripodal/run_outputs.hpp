@@ -76,15 +76,18 @@ RgbImage draw_dose_map(const navi::OccupancyGrid& g, const std::vector<char>& fl
       rgb = {0, 0, 0};
     } else if (i < floor.size() && floor[i] != 0) {
       const double f = target_j_m2 > 0.0 ? dose(i) / target_j_m2 : 0.0;
-      if (f >= 2.0) rgb = {20, 120, 40};
-      else if (f >= 1.0) rgb = {60, 190, 70};
+      if (f >= 2.0)
+        rgb = {20, 120, 40};
+      else if (f >= 1.0)
+        rgb = {60, 190, 70};
       else {
         const double t = std::clamp(f, 0.0, 1.0);  // red -> yellow
         rgb = {230, static_cast<std::uint8_t>(40 + 190 * t), 40};
       }
     }
     for (int dy = 0; dy < kScale; ++dy) {
-      for (int dx = 0; dx < kScale; ++dx) img.set(c.x * kScale + dx, (g.height() - 1 - c.y) * kScale + dy, rgb[0], rgb[1], rgb[2]);
+      for (int dx = 0; dx < kScale; ++dx)
+        img.set(c.x * kScale + dx, (g.height() - 1 - c.y) * kScale + dy, rgb[0], rgb[1], rgb[2]);
     }
   }
   return img;

@@ -1,5 +1,7 @@
 #include "run_task.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -12,16 +14,17 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <fmt/format.h>
-
-#include "run_outputs.hpp"
 #include "guide_hri.hpp"
+#include "run_outputs.hpp"
 #include "shutdown.hpp"
+#include "tripodal/behaviors/navigation_behaviors.hpp"
+#include "tripodal/board/actuator_behaviors.hpp"
+#include "tripodal/board/board_firmware.hpp"
+#include "tripodal/board/board_monitor.hpp"
+#include "tripodal/board/rplidar_a1.hpp"
 #include "tripodal/builtin/register_all.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/monitor/robot_monitor.hpp"
-#include "tripodal/behaviors/navigation_behaviors.hpp"
-#include "tripodal/board/board_firmware.hpp"
 #include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/navi/localizer.hpp"
 #include "tripodal/navi/planning_modules.hpp"
@@ -31,9 +34,6 @@
 #include "tripodal/robot/plugin_library.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/robot/robot_profile.hpp"
-#include "tripodal/board/actuator_behaviors.hpp"
-#include "tripodal/board/board_monitor.hpp"
-#include "tripodal/board/rplidar_a1.hpp"
 #include "tripodal/sim/sim_board.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/sim/simulator.hpp"
@@ -164,7 +164,8 @@ DoseEstimate estimate_dose(navi::CCoverageModule& cov, const navi::CSectionSplit
   }
   const double atomizer_s = std::min(e.time_s, fw.tank_initial_l / fw.atomizer_l_per_h * 3600.0);
   e.charge_ah = ((fw.idle_current_a + fw.uv_lamp_current_a) * e.time_s + fw.atomizer_current_a * atomizer_s +
-                 fw.motor_current_a * motor_as) / 3600.0;
+                 fw.motor_current_a * motor_as) /
+                3600.0;
   return e;
 }
 
@@ -507,15 +508,18 @@ RunResult run_task(const RunOptions& o) {
     if (e.type != navi::CCoverageModule::static_manifest().name) continue;
     if (!o.pattern.empty()) ro.parameters.push_back({e.name, "pattern", o.pattern});
     // The dose the lanes are planned for (the profile's dose_target_j_m2 otherwise).
-    if (!o.dose_plan) ro.parameters.push_back({e.name, "dose_target_j_m2", "0"});
-    else if (o.uv_target_dose_j_m2) ro.parameters.push_back({e.name, "dose_target_j_m2", fmt::format("{}", *o.uv_target_dose_j_m2)});
+    if (!o.dose_plan)
+      ro.parameters.push_back({e.name, "dose_target_j_m2", "0"});
+    else if (o.uv_target_dose_j_m2)
+      ro.parameters.push_back({e.name, "dose_target_j_m2", fmt::format("{}", *o.uv_target_dose_j_m2)});
   }
   // --realtime (without a monitor or DDS, which pace one thread): the robot on its own threads, on
   // the wall clock sped up SPEED times; otherwise the caller's thread steps it on simulated time.
   const bool threaded = o.realtime && !o.monitor && !profile.dds;
   if (threaded && !o.record.empty()) {
-    throw ConfigError(SourceLocation{"--record", 1, 1}, "--record goes with a run on simulated time (without --realtime): its recorder "
-                                                        "reads the loop between cycles, which the robot's own threads do not leave");
+    throw ConfigError(SourceLocation{"--record", 1, 1},
+                      "--record goes with a run on simulated time (without --realtime): its recorder "
+                      "reads the loop between cycles, which the robot's own threads do not leave");
   }
   SimClock sim_clock;
   ScaledClock wall_clock(o.realtime_speed);
@@ -532,7 +536,8 @@ RunResult run_task(const RunOptions& o) {
   Navigation nav{robot->module<navi::CGridMaps>(), robot->module<navi::CSectionSplitter>(), robot->module<navi::CCoverageModule>()};
   if (nav.coverage != nullptr) res.coverage_pattern = nav.coverage->pattern();
   // Cleaning is measured when the robot has SectionSplitter and CoveragePlanner; the map always.
-  if (nav.maps == nullptr) throw ConfigError(profile.where, "`tripodal run` measures the run on the map: the robot needs a GridMaps module");
+  if (nav.maps == nullptr)
+    throw ConfigError(profile.where, "`tripodal run` measures the run on the map: the robot needs a GridMaps module");
   if (nav.maps->robot_radius_m() < world->robot.radius_m) {
     throw ConfigError(nav.maps->where(), "robot_radius_m " + fixed(nav.maps->robot_radius_m(), 3) +
                                              " m is smaller than the simulated body (" + fixed(world->robot.radius_m, 3) +
@@ -545,9 +550,10 @@ RunResult run_task(const RunOptions& o) {
     const navi::UvLamp& a = nav.coverage->uv_lamp();
     const navi::UvLamp& b = board_hw->uv_dose().lamp();
     if (a.uvc_power_w != b.uvc_power_w || a.height_m != b.height_m || a.radius_m != b.radius_m) {
-      throw ConfigError(nav.coverage->where(), fmt::format("the coverage planner plans the dose for a lamp of {} W, {} m high, {} m lit "
-                                                           "radius, the board's lamp is {} W, {} m, {} m: give both the same uv_ parameters",
-                                                           a.uvc_power_w, a.height_m, a.radius_m, b.uvc_power_w, b.height_m, b.radius_m));
+      throw ConfigError(nav.coverage->where(),
+                        fmt::format("the coverage planner plans the dose for a lamp of {} W, {} m high, {} m lit "
+                                    "radius, the board's lamp is {} W, {} m, {} m: give both the same uv_ parameters",
+                                    a.uvc_power_w, a.height_m, a.radius_m, b.uvc_power_w, b.height_m, b.radius_m));
     }
   }
   const double target_dose_j_m2 = o.uv_target_dose_j_m2.value_or(dose_plan ? dose_plan->target_j_m2 : kDefaultUvTargetDose);
@@ -629,7 +635,7 @@ RunResult run_task(const RunOptions& o) {
   // submitted on the monitor's console is measured from when it starts).
   std::vector<std::string> room_sections;
   std::vector<char> reachable(nav.maps->grid().size(), 0);  // none until a task names its room
-  std::vector<char> lamp_floor;  // with a dose plan: the floor the lamp can dose at all
+  std::vector<char> lamp_floor;                             // with a dose plan: the floor the lamp can dose at all
   navi::PathPlanner reach_planner(nav.maps->grid(), navi::PathPlannerOptions{.robot_radius_m = nav.maps->robot_radius_m()});
   auto measure_room = [&] {
     room_sections.clear();
@@ -663,22 +669,25 @@ RunResult run_task(const RunOptions& o) {
     res.dose_estimate_s = est.time_s;
     res.dose_estimate_ah = est.charge_ah;
     if (o.log != nullptr) {
-      *o.log << fmt::format("dose plan: {} J/m2: lanes {:.2f} m apart at {:.3f} m/s (faster between closer lanes), {} pass{}; "
-                            "estimated {:.0f} s, {:.2f} Ah of the {:.2f} Ah above the {}% low-battery mark\n",
-                            dose_plan->target_j_m2, dose_plan->spacing_m, dose_plan->speed_m_s, dose_plan->passes,
-                            dose_plan->passes > 1 ? "es" : "", est.time_s, est.charge_ah, available_ah, low_percent);
+      *o.log << fmt::format(
+          "dose plan: {} J/m2: lanes {:.2f} m apart at {:.3f} m/s (faster between closer lanes), {} pass{}; "
+          "estimated {:.0f} s, {:.2f} Ah of the {:.2f} Ah above the {}% low-battery mark\n",
+          dose_plan->target_j_m2, dose_plan->spacing_m, dose_plan->speed_m_s, dose_plan->passes,
+          dose_plan->passes > 1 ? "es" : "", est.time_s, est.charge_ah, available_ah, low_percent);
     }
     std::string why;
     if (est.charge_ah > available_ah) {
-      why = fmt::format("target dose {} J/m2 cannot be reached within the battery: the plan (lanes {:.2f} m apart at {:.3f} m/s, "
-                        "{} pass{}) needs about {:.2f} Ah ({:.0f} s), the battery holds {:.2f} Ah above the {}% low mark",
-                        dose_plan->target_j_m2, dose_plan->spacing_m, dose_plan->speed_m_s, dose_plan->passes,
-                        dose_plan->passes > 1 ? "es" : "", est.charge_ah, est.time_s, available_ah, low_percent);
+      why = fmt::format(
+          "target dose {} J/m2 cannot be reached within the battery: the plan (lanes {:.2f} m apart at {:.3f} m/s, "
+          "{} pass{}) needs about {:.2f} Ah ({:.0f} s), the battery holds {:.2f} Ah above the {}% low mark",
+          dose_plan->target_j_m2, dose_plan->spacing_m, dose_plan->speed_m_s, dose_plan->passes,
+          dose_plan->passes > 1 ? "es" : "", est.charge_ah, est.time_s, available_ah, low_percent);
     } else if (o.time_limit_s && est.time_s > *o.time_limit_s) {
-      why = fmt::format("target dose {} J/m2 cannot be reached within the time limit of {:.0f} s: the plan (lanes {:.2f} m apart "
-                        "at {:.3f} m/s, {} pass{}) needs about {:.0f} s",
-                        dose_plan->target_j_m2, *o.time_limit_s, dose_plan->spacing_m, dose_plan->speed_m_s, dose_plan->passes,
-                        dose_plan->passes > 1 ? "es" : "", est.time_s);
+      why = fmt::format(
+          "target dose {} J/m2 cannot be reached within the time limit of {:.0f} s: the plan (lanes {:.2f} m apart "
+          "at {:.3f} m/s, {} pass{}) needs about {:.0f} s",
+          dose_plan->target_j_m2, *o.time_limit_s, dose_plan->spacing_m, dose_plan->speed_m_s, dose_plan->passes,
+          dose_plan->passes > 1 ? "es" : "", est.time_s);
     }
     if (!why.empty()) {
       robot->planner().cancel(why);
@@ -692,7 +701,8 @@ RunResult run_task(const RunOptions& o) {
   navi::CleanedCells cleaned(nav.maps->grid());  // from the true pose, while a cleaning behavior runs
   std::vector<TrajectorySample> traj;
   std::vector<Point2D> path_all, path_cleaning;
-  const double half_width = nav.coverage != nullptr ? nav.coverage->footprint_width_m() / 2.0 : 0.0;  // the fog's, whatever the lanes' spacing
+  const double half_width =
+      nav.coverage != nullptr ? nav.coverage->footprint_width_m() / 2.0 : 0.0;  // the fog's, whatever the lanes' spacing
   const Duration tick_period = robot->behavior_loop().period();
   const Time deadline = time_from_seconds(o.max_duration_s);
   bool was_cleaning = false;
@@ -749,8 +759,10 @@ RunResult run_task(const RunOptions& o) {
     const Pose2D true_pose = truth.pose();
     const bool cleaning = is_cleaning();
     if (cleaning) {
-      if (was_cleaning) cleaned.mark_segment({last_truth.x_m, last_truth.y_m}, {true_pose.x_m, true_pose.y_m}, half_width);
-      else cleaned.mark_disc({true_pose.x_m, true_pose.y_m}, half_width);
+      if (was_cleaning)
+        cleaned.mark_segment({last_truth.x_m, last_truth.y_m}, {true_pose.x_m, true_pose.y_m}, half_width);
+      else
+        cleaned.mark_disc({true_pose.x_m, true_pose.y_m}, half_width);
     }
     was_cleaning = cleaning;
     last_truth = true_pose;

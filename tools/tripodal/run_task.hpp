@@ -145,8 +145,8 @@ struct DisinfectionFigures {
   std::optional<navi::DosePlan> plan;
   double lamp_floor_m2 = 0.0;
   double lamp_floor_dose_coverage = 0.0;
-  double estimate_s = 0.0;     ///< the up-front estimate of the run's time
-  double estimate_ah = 0.0;    ///< and of its charge
+  double estimate_s = 0.0;       ///< the up-front estimate of the run's time
+  double estimate_ah = 0.0;      ///< and of its charge
   double battery_used_ah = 0.0;  ///< the board's state of charge, start to end, x capacity
   double lamp_energy_wh = 0.0;   ///< electrical: the lamp's current at the battery's voltage, while on
   double uvc_energy_j = 0.0;     ///< radiant UVC emitted: the lamp's UVC power x time on
@@ -187,8 +187,8 @@ struct RunResult {
   double realtime_speed = 0.0;
   std::vector<LoopTimingReport> loops;
   std::optional<DisinfectionFigures> disinfection;  ///< on hardware "board" only
-  double dose_estimate_s = 0.0;   ///< a dose-planned disinfection's up-front time estimate
-  double dose_estimate_ah = 0.0;  ///< and its charge
+  double dose_estimate_s = 0.0;                     ///< a dose-planned disinfection's up-front time estimate
+  double dose_estimate_ah = 0.0;                    ///< and its charge
   [[nodiscard]] std::string json() const;
 };
 

@@ -59,9 +59,9 @@ using ChannelId = std::uint32_t;
 
 /// A command channel after update().
 struct ChannelOutput {
-  ChannelValue value;        ///< what the hardware is to apply
-  std::string_view writer;   ///< the winning input; "weighted_sum"; "" when no live input wrote it
-  bool live = false;         ///< a live, unmasked input wrote it (else: the safe or held value)
+  ChannelValue value;            ///< what the hardware is to apply
+  std::string_view writer;       ///< the winning input; "weighted_sum"; "" when no live input wrote it
+  bool live = false;             ///< a live, unmasked input wrote it (else: the safe or held value)
   bool safety_override = false;  ///< a safety input's write replaced the winner's
 };
 

@@ -121,8 +121,7 @@ class BhSonarGuard final : public CBehavior {
   const SonarResource* sonar_ = nullptr;
   std::array<double, kMaxTransducers> angles_{};
   std::size_t angle_count_ = 0;
-  double radius_m_ = 0.25, stop_m_ = 0.1, slow_m_ = 0.6, max_speed_ = 0.5, margin_m_ = 0.03,
-         cone_half_ = 0.13;
+  double radius_m_ = 0.25, stop_m_ = 0.1, slow_m_ = 0.6, max_speed_ = 0.5, margin_m_ = 0.03, cone_half_ = 0.13;
 };
 
 /// Registers BhCliffGuard, BhBumperGuard and BhSonarGuard.

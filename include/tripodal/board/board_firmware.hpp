@@ -86,8 +86,8 @@ struct FirmwareConfig {
   /// than the threshold (the floor went away) sets the sensor's cliff bit; a rise by more than it
   /// (floor again) clears it. The threshold is what the reading falls from the floor the sensor
   /// is mounted over (cliff_floor_m) to a floor cliff_threshold_m away.
-  double cliff_floor_m = 0.02;         ///< flat floor under a cliff sensor (its mount height)
-  double cliff_threshold_m = 0.05;     ///< a step down to a floor this far gives the threshold
+  double cliff_floor_m = 0.02;      ///< flat floor under a cliff sensor (its mount height)
+  double cliff_threshold_m = 0.05;  ///< a step down to a floor this far gives the threshold
 };
 
 /// The Sharp GP2Y0A51SK0F infrared sensor's output (section 2.4.2: 2-15 cm) as the STM32's 12-bit
@@ -206,7 +206,7 @@ class BoardFirmware {
   PlantSensors sensors_{};
   int cliff_threshold_adc_ = 0;
   std::array<std::uint16_t, kMaxInfrared> cliff_adc_{};  // reading t, against which t+1 is judged
-  std::uint32_t cliff_bits_ = 0;                          // latched judgments (kCliffShift + i)
+  std::uint32_t cliff_bits_ = 0;                         // latched judgments (kCliffShift + i)
   std::uint8_t buttons_ = 0;
   std::uint8_t pressed_ = 0;
   bool uv_lamp_ = false;

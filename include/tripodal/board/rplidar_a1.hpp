@@ -34,10 +34,10 @@ class MotorSwitch {
 
 struct RplidarConfig {
   rplidar::ScanAssemblerConfig scan;
-  Duration timeout = std::chrono::seconds(1);                   ///< no start flag for this long: fault
-  Duration response_timeout = std::chrono::milliseconds(500);   ///< for GET_INFO, GET_HEALTH, SCAN's descriptor
-  Duration stop_settle = std::chrono::milliseconds(20);         ///< after STOP, bytes still in flight are dropped
-  std::size_t max_garbage_bytes = 64;  ///< bytes without a descriptor before the answer counts as garbage
+  Duration timeout = std::chrono::seconds(1);                  ///< no start flag for this long: fault
+  Duration response_timeout = std::chrono::milliseconds(500);  ///< for GET_INFO, GET_HEALTH, SCAN's descriptor
+  Duration stop_settle = std::chrono::milliseconds(20);        ///< after STOP, bytes still in flight are dropped
+  std::size_t max_garbage_bytes = 64;                          ///< bytes without a descriptor before the answer counts as garbage
 };
 
 /// What the driver counted (read on the loop's thread, or after it stopped).
@@ -114,10 +114,10 @@ class RplidarA1 final : public LaserResource, public ResourceFaultSource {
   State state_ = State::starting;
   Time entered_{};
   Time last_start_{};
-  bool started_ = false;  // a first poll happened
+  bool started_ = false;   // a first poll happened
   bool reported_ = false;  // the current failure's fault was raised (until the next scan)
   bool port_lost_ = false;
-  bool rebase_ = false;  // opened on another clock than the loop's
+  bool rebase_ = false;           // opened on another clock than the loop's
   bool have_descriptor_ = false;  // the awaited answer's descriptor was read, its data not yet
   std::string garbage_head_;      // the first garbage bytes, in hex, for the error
   std::array<std::uint8_t, 512> rx_{};
@@ -141,7 +141,8 @@ class RplidarA1 final : public LaserResource, public ResourceFaultSource {
 
 /// A profile's resource of type "RplidarA1": opened on its `port` (RplidarA1::open, the port's own
 /// steady clock). Throws ConfigError at `where` with the open's reason.
-[[nodiscard]] std::unique_ptr<RplidarA1> open_rplidar_resource(const std::string& name, const ParameterSet& p, const SourceLocation& where);
+[[nodiscard]] std::unique_ptr<RplidarA1> open_rplidar_resource(const std::string& name, const ParameterSet& p,
+                                                               const SourceLocation& where);
 
 /// Adds the resource type "RplidarA1" to a robot's resource registry (RobotPlugins::resources): the
 /// lidar as a profile's `resources:` entry, beside any hardware. A template over the registry, as

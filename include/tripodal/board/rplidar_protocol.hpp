@@ -175,7 +175,7 @@ struct ScanAssemblerConfig {
   std::uint32_t beams = 360;
   double range_min_m = 0.15;  ///< the A1's
   double range_max_m = 12.0;
-  double rate_hz = 5.5;       ///< nominal revolutions per second (LaserScan::scan_time_s)
+  double rate_hz = 5.5;          ///< nominal revolutions per second (LaserScan::scan_time_s)
   std::uint32_t min_nodes = 50;  ///< a revolution with fewer nodes is dropped (a partial one)
 };
 

@@ -35,9 +35,7 @@ class CHri final : public CModule {
   /// it; every change saved atomically). Loaded at start; std::logic_error before.
   [[nodiscard]] KnowledgeStore& knowledge_store() const;
   /// Each button's request (the parameter buttons).
-  [[nodiscard]] const std::map<std::string, std::string, std::less<>>& buttons() const noexcept {
-    return buttons_;
-  }
+  [[nodiscard]] const std::map<std::string, std::string, std::less<>>& buttons() const noexcept { return buttons_; }
   /// The buttons pressed since the last call, in order.
   [[nodiscard]] std::vector<std::string> take_presses();
 
@@ -61,8 +59,8 @@ class CHri final : public CModule {
 
 /// "hello=Introduce yourself.; help=What can you do?" as a map; ConfigError at `where` for an
 /// entry without '=' or with an empty name or request, or a name given twice.
-[[nodiscard]] std::map<std::string, std::string, std::less<>> parse_button_bindings(
-    std::string_view text, const SourceLocation& where);
+[[nodiscard]] std::map<std::string, std::string, std::less<>> parse_button_bindings(std::string_view text,
+                                                                                    const SourceLocation& where);
 
 /// The hri area's module types: "Hri". An application's plugin set gets them from register_all
 /// (builtin/register_all.hpp).

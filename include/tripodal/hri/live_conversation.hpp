@@ -54,8 +54,8 @@ struct LiveEvent {
 class LiveConversation {
  public:
   /// Throws std::invalid_argument for a chunk that holds no sample or devices at different rates.
-  LiveConversation(AudioInput& microphone, AudioOutput& speaker, SpeechRecognizer& recognizer,
-                   SpeechSynthesizer& synthesizer, HriModule& hri, LiveOptions options = {});
+  LiveConversation(AudioInput& microphone, AudioOutput& speaker, SpeechRecognizer& recognizer, SpeechSynthesizer& synthesizer,
+                   HriModule& hri, LiveOptions options = {});
 
   /// One chunk: read from the microphone, play the next part of the speech, listen. False when
   /// the microphone stream has ended.
@@ -88,9 +88,9 @@ class LiveConversation {
   std::vector<std::int16_t> speech_;  // the reply being spoken, at the speaker's rate
   std::size_t speech_pos_ = 0;
   std::size_t spoken_ = 0;
-  std::size_t read_ = 0;              // samples read from the microphone
-  std::size_t gate_until_ = 0;        // the microphone is closed until this stream sample
-  std::size_t loud_run_ = 0;          // chunks in a row loud enough for a barge-in
+  std::size_t read_ = 0;        // samples read from the microphone
+  std::size_t gate_until_ = 0;  // the microphone is closed until this stream sample
+  std::size_t loud_run_ = 0;    // chunks in a row loud enough for a barge-in
   std::vector<LiveEvent> events_;
 };
 

@@ -15,17 +15,17 @@ namespace tripodal::navi {
 enum class FloorPattern { balloon, boustrophedon, hybrid };
 
 struct FloorCoverage {
-  std::vector<int> order;                   ///< section ids in the order cleaned
-  std::vector<CoverageResult> rooms;        ///< per entry of `order`, started where the robot came in
-  std::vector<double> link_m;               ///< per entry of `order`: the way there from the previous end
-  std::vector<int> unreachable;             ///< sections no way of free cells leads to (not cleaned)
-  double length_m = 0.0;                    ///< the rooms' paths and the links
+  std::vector<int> order;             ///< section ids in the order cleaned
+  std::vector<CoverageResult> rooms;  ///< per entry of `order`, started where the robot came in
+  std::vector<double> link_m;         ///< per entry of `order`: the way there from the previous end
+  std::vector<int> unreachable;       ///< sections no way of free cells leads to (not cleaned)
+  double length_m = 0.0;              ///< the rooms' paths and the links
   std::size_t turns = 0;
   double total_turn_rad = 0.0;
   std::size_t reachable_cells = 0;
   std::size_t covered_cells = 0;
-  double rooms_ms = 0.0;                    ///< planning the rooms' paths
-  double tour_ms = 0.0;                     ///< choosing the order and planning the links
+  double rooms_ms = 0.0;  ///< planning the rooms' paths
+  double tour_ms = 0.0;   ///< choosing the order and planning the links
   [[nodiscard]] double coverage() const noexcept {
     return reachable_cells == 0 ? 1.0 : static_cast<double>(covered_cells) / static_cast<double>(reachable_cells);
   }

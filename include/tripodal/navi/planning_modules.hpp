@@ -151,7 +151,6 @@ class CCoverageModule final : public CNaviModules {
   void on_behavior_deactivated(std::string_view behavior, ModuleContext& context) override;
 
  private:
-
   /// The centroid of the nearest section not cleaned yet (where the hybrid path should end).
   [[nodiscard]] std::optional<Point2D> next_section_centroid(const Section& section) const;
   void plan_detour(const Pose2D& pose, ModuleContext& context);

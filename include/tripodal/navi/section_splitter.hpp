@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "tripodal/navi/navi_modules.hpp"
-#include "tripodal/navi/regions.hpp"
 #include "tripodal/navi/occupancy_grid.hpp"
+#include "tripodal/navi/regions.hpp"
 
 namespace tripodal::navi {
 
@@ -77,8 +77,8 @@ struct SectionSet {
 /// As a navigation module (type "SectionSplitter") its parameters are the option fields (same
 /// names) and `method`: "splitter" (the rule above, the default) or a room segmentation
 /// (segment_rooms: "morphological", "distance_transform", "voronoi", with room_min_area_m2,
-/// room_max_area_m2 and door_max_width_m), whose rooms are then the sections; it splits the map of the robot's GridMaps at start and answers the planner's question
-/// sections(room): the room's sections nearest first from the robot's pose when the localizer
+/// room_max_area_m2 and door_max_width_m), whose rooms are then the sections; it splits the map of the robot's GridMaps at start
+/// and answers the planner's question sections(room): the room's sections nearest first from the robot's pose when the localizer
 /// trusts it (order_nearest_first; paper, section 5.1: the order of the processes follows the
 /// initial position), else in scan order. split() may be called without configure() with the
 /// options given to the constructor.

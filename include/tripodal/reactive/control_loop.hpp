@@ -40,8 +40,8 @@ struct BehaviorHandle {
 /// as the loop (the behavior's manifest, the coordinator's input names, string literals).
 struct LoopEvent {
   enum class Kind : std::uint8_t {
-    behavior_succeeded,  ///< post done_event_name(behavior): "<BehaviorName>.done"
-    behavior_failed,     ///< post failed_event_name(behavior): "<BehaviorName>.failed", with reason
+    behavior_succeeded,    ///< post done_event_name(behavior): "<BehaviorName>.done"
+    behavior_failed,       ///< post failed_event_name(behavior): "<BehaviorName>.failed", with reason
     controller_fault,      ///< the controller reported hardware_fault: "<loop>.controller_fault"
     controller_recovered,  ///< the next cycle without a fault: "<loop>.controller_recovered"
     behavior_signal,       ///< a running behavior raised an event (CBehavior::signal): its name, in `reason`

@@ -39,8 +39,7 @@ struct ReactiveConfig {
 [[nodiscard]] ReactiveConfig parse_reactive_config(std::string_view text, const std::string& file,
                                                    const ControllerRegistry& registry);
 /// Reads and parses the file at `path`; ConfigError also when it cannot be read.
-[[nodiscard]] ReactiveConfig load_reactive_config(const std::string& path,
-                                                  const ControllerRegistry& registry);
+[[nodiscard]] ReactiveConfig load_reactive_config(const std::string& path, const ControllerRegistry& registry);
 
 /// Builds the loop `config` describes: its coordinator, and its controller (created through
 /// `registry` on `hardware`, which must outlive the loop; may be null when the loop has no

@@ -42,8 +42,7 @@ inline constexpr const char* kPluginRegisterSymbol = "tripodal_plugin_register";
 namespace detail {
 /// Runs a plugin's registration function on host->plugins; an exception becomes return value 1
 /// and its message host->error, so that nothing is thrown across the C entry point.
-inline int run_plugin_registration(tripodal_plugin_host* host,
-                                   void (*register_types)(RobotPlugins&)) noexcept {
+inline int run_plugin_registration(tripodal_plugin_host* host, void (*register_types)(RobotPlugins&)) noexcept {
   const auto fail = [host](const char* what) {
     std::snprintf(host->error, sizeof host->error, "%s", what);
     return 1;
@@ -74,8 +73,7 @@ struct PluginLibraryInfo {
 /// tripodal_plugin_register, was built against another ABI version, throws from its registration
 /// (or registers a name twice), or registers a name `plugins` already has (a built-in one, or
 /// another plugin's). The library stays loaded until the process ends: the types' code is in it.
-PluginLibraryInfo load_plugin_library(const std::filesystem::path& path, RobotPlugins& plugins,
-                                      const SourceLocation& where = {});
+PluginLibraryInfo load_plugin_library(const std::filesystem::path& path, RobotPlugins& plugins, const SourceLocation& where = {});
 
 /// Loads the libraries of `extra` (the command line's `--plugin`, refused at "--plugin"), then
 /// those of `profile`'s `plugins:` list (each refused at its entry), into `plugins`. What the tools

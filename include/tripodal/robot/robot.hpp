@@ -9,8 +9,8 @@
 // an input lacks exactly one provider or a layering rule is broken.
 #pragma once
 
-#include <filesystem>
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -54,8 +54,8 @@ struct RobotOptions {
 /// needs. nullopt when no loop drives a controller; throws ConfigError (located) for a bad entry.
 /// Controller types are checked against `controllers`: the application's registry when it has
 /// types of its own (RobotPlugins::controllers).
-[[nodiscard]] std::optional<ControllerConfig> base_controller_config(
-    const RobotProfile& profile, const ControllerRegistry& controllers);
+[[nodiscard]] std::optional<ControllerConfig> base_controller_config(const RobotProfile& profile,
+                                                                     const ControllerRegistry& controllers);
 
 /// Every start-up check of Robot::assemble that builds no instance, as `tripodal describe` runs
 /// them: the tasks and recovery rules, one provider per input and the layering rules
@@ -77,7 +77,7 @@ struct RealtimeOptions {
 
 /// How one of the robot's periodic threads kept its deadlines (Robot::timing()).
 struct LoopTimingReport {
-  std::string name;             ///< a reactive loop's name, or "sequencing"
+  std::string name;  ///< a reactive loop's name, or "sequencing"
   Duration period{0};
   Duration budget{0};
   std::uint64_t cycles = 0;

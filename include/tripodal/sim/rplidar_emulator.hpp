@@ -38,23 +38,23 @@ class SimLidarScene final : public LidarScene {
 };
 
 struct RplidarEmulatorConfig {
-  double rate_hz = 5.5;             ///< revolutions per second (the A1's typical)
-  double sample_rate_hz = 2000.0;   ///< measurements per second in SCAN (the A1's standard mode)
+  double rate_hz = 5.5;            ///< revolutions per second (the A1's typical)
+  double sample_rate_hz = 2000.0;  ///< measurements per second in SCAN (the A1's standard mode)
   double range_min_m = 0.15;
   double range_max_m = 12.0;
-  std::uint8_t quality = 47;        ///< the quality of a return (0..63)
-  Duration spin_up = std::chrono::milliseconds(0);  ///< from motor on to the first node
-  Duration reset_time = std::chrono::milliseconds(5);  ///< from RESET to its start-up banner
+  std::uint8_t quality = 47;                            ///< the quality of a return (0..63)
+  Duration spin_up = std::chrono::milliseconds(0);      ///< from motor on to the first node
+  Duration reset_time = std::chrono::milliseconds(5);   ///< from RESET to its start-up banner
   board::rplidar::DeviceInfo info{0x18, 29, 1, 7, {}};  ///< model A1M8, firmware 1.29, hardware 7
   board::rplidar::Health health{};                      ///< good
 };
 
 struct RplidarEmulatorCounters {
-  std::uint64_t requests = 0;     ///< well-formed requests taken
-  std::uint64_t bad_requests = 0; ///< bytes that began no request, or a payload's checksum wrong
-  std::uint64_t nodes = 0;        ///< measurement nodes sent
-  std::uint64_t revolutions = 0;  ///< start flags sent
-  std::uint64_t bytes_lost = 0;   ///< bytes the stream would not take (no reader)
+  std::uint64_t requests = 0;      ///< well-formed requests taken
+  std::uint64_t bad_requests = 0;  ///< bytes that began no request, or a payload's checksum wrong
+  std::uint64_t nodes = 0;         ///< measurement nodes sent
+  std::uint64_t revolutions = 0;   ///< start flags sent
+  std::uint64_t bytes_lost = 0;    ///< bytes the stream would not take (no reader)
 };
 
 class RplidarEmulator {
@@ -90,7 +90,7 @@ class RplidarEmulator {
   bool motor_on_ = true;
   Time motor_since_{};
   bool scanning_ = false;
-  Time base_time_{};              // when sample base_sample_ is measured (samples follow at sample_rate_hz)
+  Time base_time_{};  // when sample base_sample_ is measured (samples follow at sample_rate_hz)
   std::uint64_t base_sample_ = 0;
   std::uint64_t sample_ = 0;      // next sample of the session
   std::uint64_t revolution_ = 0;  // of the last sample sent

@@ -30,7 +30,7 @@ struct BoardSensorMounts {
   std::array<double, 2> wall_rad{1.5708, -1.5708};             ///< left, right
   double wall_range_m = 0.15;                                  ///< GP2Y0A51SK0F: 2-15 cm
   double floor_m = 0.02;                                       ///< what a cliff sensor sees over floor
-  double cliff_range_m = 0.15;  ///< GP2Y0A51SK0F: farther floor (a drop) is no return
+  double cliff_range_m = 0.15;                                 ///< GP2Y0A51SK0F: farther floor (a drop) is no return
 };
 
 class SimBoardPlant final : public board::BoardPlant {

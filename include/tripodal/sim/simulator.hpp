@@ -31,19 +31,19 @@ namespace tripodal::sim {
 /// Something that happened to the simulated robot or world, for the run's report.
 struct SimEvent {
   enum class Kind : std::uint8_t {
-    collision,                ///< the footprint touched an occupied cell: the base stopped
-    obstacle_appeared,        ///< a DynamicObstacle appeared (blocked path)
+    collision,          ///< the footprint touched an occupied cell: the base stopped
+    obstacle_appeared,  ///< a DynamicObstacle appeared (blocked path)
     obstacle_removed,
-    sensor_dead,              ///< a SensorOutage started
+    sensor_dead,  ///< a SensorOutage started
     sensor_restored,
     localization_loss_start,  ///< a localization loss window started: the laser is blinded
     localization_loss_end,
-    kidnapped,                ///< the world moved the robot (detail: "to (x, y, theta)")
-    fell,                     ///< the robot's centre or a wheel entered a drop area (detail: which)
+    kidnapped,  ///< the world moved the robot (detail: "to (x, y, theta)")
+    fell,       ///< the robot's centre or a wheel entered a drop area (detail: which)
     battery_empty,
-    button_pressed,           ///< an LED button was pressed (detail: its name)
-    docked,                   ///< the robot's contacts touch a dock's (detail: its name): charging
-    undocked,                 ///< they no longer touch (detail: the dock's name)
+    button_pressed,  ///< an LED button was pressed (detail: its name)
+    docked,          ///< the robot's contacts touch a dock's (detail: its name): charging
+    undocked,        ///< they no longer touch (detail: the dock's name)
   };
   Kind kind = Kind::collision;
   Time stamp{};
@@ -142,9 +142,7 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   [[nodiscard]] int dock() const noexcept { return dock_; }
   /// An extra load on the battery (a UV lamp, a pump), as a fraction of the capacity per second,
   /// until changed; a device of the hardware sets it while it runs.
-  void set_extra_drain_per_s(double fraction_per_s) noexcept {
-    extra_drain_per_s_ = fraction_per_s > 0.0 ? fraction_per_s : 0.0;
-  }
+  void set_extra_drain_per_s(double fraction_per_s) noexcept { extra_drain_per_s_ = fraction_per_s > 0.0 ? fraction_per_s : 0.0; }
   /// Whether `sensor` is silenced by the fault schedule at time t.
   [[nodiscard]] bool sensor_dead(SensorKind sensor, Time t) const noexcept;
   /// Whether a localization loss window covers t (the laser returns nothing then).

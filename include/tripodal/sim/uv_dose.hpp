@@ -16,8 +16,8 @@ namespace tripodal::sim {
 
 /// The lamp model is navigation's (navi/dose_planner.hpp), so the dose a plan promises and the
 /// dose the simulator counts come from one formula.
-using navi::UvLamp;
 using navi::uv_irradiance_w_m2;
+using navi::UvLamp;
 using navi::validate;
 
 /// Dose (J/m^2) received by each cell of a grid: irradiance at the cell's centre integrated over

@@ -8,7 +8,6 @@ struct tripodal_plugin_host;
 extern "C" __attribute__((visibility("default"))) std::uint32_t tripodal_plugin_abi_version() noexcept {
   return 999;
 }
-extern "C" __attribute__((visibility("default"))) int tripodal_plugin_register(
-    tripodal_plugin_host*) noexcept {
+extern "C" __attribute__((visibility("default"))) int tripodal_plugin_register(tripodal_plugin_host*) noexcept {
   std::terminate();  // never called: a host that calls it with another layout would corrupt itself
 }

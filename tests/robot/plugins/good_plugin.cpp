@@ -10,16 +10,14 @@ namespace {
 class BhPluginWave final : public tripodal::CBehavior {
  public:
   static const tripodal::ModuleManifest& static_manifest() {
-    static const tripodal::ModuleManifest m = tripodal::behavior_manifest(
-        "BhPluginWave", "turns in place (a shared-library plugin's behavior)", {},
-        {tripodal::parameter::number("yaw_rate_rad_s", 0.5, "rad/s", "turn rate", 0.0, 2.0)});
+    static const tripodal::ModuleManifest m =
+        tripodal::behavior_manifest("BhPluginWave", "turns in place (a shared-library plugin's behavior)", {},
+                                    {tripodal::parameter::number("yaw_rate_rad_s", 0.5, "rad/s", "turn rate", 0.0, 2.0)});
     return m;
   }
 
  private:
-  [[nodiscard]] const tripodal::ModuleManifest& do_manifest() const noexcept override {
-    return static_manifest();
-  }
+  [[nodiscard]] const tripodal::ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
   void on_activate(const tripodal::ParameterSet& params, const tripodal::BehaviorContext&) override {
     yaw_rate_rad_s_ = params.number("yaw_rate_rad_s");
   }
@@ -36,11 +34,9 @@ TRIPODAL_REGISTER_PLUGINS(plugins) {
   // The built-in differential controller under another name: a controller type from a plugin.
   tripodal::ModuleManifest m = tripodal::DifferentialDriveController::static_manifest();
   m.name = "plugin_differential";
-  plugins.controllers.add(std::move(m),
-                          [](const tripodal::ControllerConfig& c, tripodal::HardwareInterface& h) {
-                            tripodal::ControllerConfig differential = c;
-                            differential.type = "differential";
-                            return std::unique_ptr<tripodal::CController>(
-                                std::make_unique<tripodal::DifferentialDriveController>(differential, h));
-                          });
+  plugins.controllers.add(std::move(m), [](const tripodal::ControllerConfig& c, tripodal::HardwareInterface& h) {
+    tripodal::ControllerConfig differential = c;
+    differential.type = "differential";
+    return std::unique_ptr<tripodal::CController>(std::make_unique<tripodal::DifferentialDriveController>(differential, h));
+  });
 }

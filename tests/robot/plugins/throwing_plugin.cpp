@@ -8,7 +8,6 @@
 TRIPODAL_REGISTER_PLUGINS(plugins) {
   tripodal::ModuleManifest m = tripodal::BhStop::static_manifest();
   m.name = "BhBeforeThrow";
-  plugins.behaviors.add(
-      m, [] { return std::unique_ptr<tripodal::CBehavior>(std::make_unique<tripodal::BhStop>()); });
+  plugins.behaviors.add(m, [] { return std::unique_ptr<tripodal::CBehavior>(std::make_unique<tripodal::BhStop>()); });
   throw std::runtime_error("the licence file /etc/waver.lic is missing");
 }
