@@ -220,7 +220,7 @@ OUTPUT_RE = re.compile(r'\.output\(\s*"(\w+\*?)"')
 def coordinator_vocabulary(root: str) -> tuple[str, str]:
     """What behaviors write and what the coordinator writes, as the layering check has them."""
     text = read(os.path.join(root, "src", "robot", "layering.cpp"))
-    m = re.search(r'"fuses the commands of the active behaviors",\s*\{"(\w+)\*"\},\s*\{"(\w+)"\}', text)
+    m = re.search(r'"fuses the commands[^"]*",\s*\{"(\w+)\*"\},\s*\{"(\w+)"\}', text)
     if m is None:
         raise SystemExit("check_docs: src/robot/layering.cpp no longer declares the coordinator's "
                          "inputs and outputs as this script reads them; update coordinator_vocabulary()")

@@ -760,11 +760,13 @@ std::vector<LoopTimingReport> Robot::timing() const {
     t.overruns = r->overruns();
     t.skipped_ticks = s.skipped_ticks();
     t.deadline_faults = r->deadline_faults();
-    t.period_error_p50 = s.jitter_quantile(0.5);
-    t.period_error_p99 = s.jitter_quantile(0.99);
     t.period_error_max = s.max_jitter();
-    t.execution_p99 = s.execution_quantile(0.99);
     t.execution_max = s.max_execution();
+    // The quantiles come from histogram buckets: one may read a bucket's edge above the largest
+    // sample; no quantile is above the maximum.
+    t.period_error_p50 = std::min(s.jitter_quantile(0.5), t.period_error_max);
+    t.period_error_p99 = std::min(s.jitter_quantile(0.99), t.period_error_max);
+    t.execution_p99 = std::min(s.execution_quantile(0.99), t.execution_max);
     t.realtime = r->setup().realtime;
     t.warning = r->setup().warning;
     out.push_back(std::move(t));

@@ -39,8 +39,17 @@ ChannelId TraceRecorder::watch(const CResource& resource) {
   return id;
 }
 
-void TraceRecorder::watch_all(const ResourceTable& table) {
-  for (std::size_t i = 0; i < table.size(); ++i) watch(table.at(i));
+std::size_t TraceRecorder::watch_all(const ResourceTable& table) {
+  std::size_t left_out = 0;
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    ChannelKind kind{};
+    if (!kind_of_type(table.at(i).reading_type(), kind)) {
+      ++left_out;
+      continue;
+    }
+    watch(table.at(i));
+  }
+  return left_out;
 }
 
 ChannelId TraceRecorder::record_commands(std::string_view channel) {

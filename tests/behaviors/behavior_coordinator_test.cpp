@@ -270,7 +270,7 @@ TEST_CASE("Channels: the live writer of highest priority wins each channel on it
   CHECK(co.channel_output(lcd).value.text() == "covering");
 }
 
-TEST_CASE("Channels: a write past its input's or the channel's timeout falls to the safe value; a holding channel keeps its last",
+TEST_CASE("Channels: a write past its input's or the channel's timeout falls to the safe value, a holding channel keeps its last",
           "[channels]") {
   CBehaviorCoordinator co(with_channels());
   const ChannelId lamp = *co.find_channel("uv_lamp");
@@ -296,7 +296,7 @@ TEST_CASE("Channels: a write past its input's or the channel's timeout falls to 
   CHECK(co.channel_output(neck).value.number == 0.25);
 }
 
-TEST_CASE("Channels: weighted mean for numeric channels only, clamped; locks mask; a safety write replaces the result",
+TEST_CASE("Channels: weighted mean for numeric channels only, clamped, locks mask, a safety write replaces the result",
           "[channels]") {
   CBehaviorCoordinator co(with_channels(CoordinationMode::weighted_sum));
   const ChannelId lamp = *co.find_channel("uv_lamp");

@@ -122,7 +122,7 @@ TEST_CASE("BhCliffGuard: a sensor stuck over a drop backs the robot at most max_
   CHECK(e->vx_hi_m_s == 0.0);
 }
 
-TEST_CASE("BhCliffGuard: bad sensor places are refused with the parameter named; no resource fails",
+TEST_CASE("BhCliffGuard: bad sensor places are refused with the parameter named, no resource fails",
           "[behaviors][safety][errors]") {
   Readings w;
   BhCliffGuard guard;
@@ -138,7 +138,7 @@ TEST_CASE("BhCliffGuard: bad sensor places are refused with the parameter named;
   CHECK(guard.failure_reason() == "no cliff resource");
 }
 
-TEST_CASE("BhBumperGuard: a front bump backs off; a back bump alone forbids backing", "[behaviors][safety]") {
+TEST_CASE("BhBumperGuard: a front bump backs off, a back bump alone forbids backing", "[behaviors][safety]") {
   Readings w;
   BhBumperGuard guard;
   guard.activate(ParameterValues{{"hold_s", Value{1.0}}}, w.ctx);

@@ -243,7 +243,7 @@ TEST_CASE("A behavior writing a channel the hardware does not export is refused 
   } catch (const ConfigError& e) {
     const std::string what = e.what();
     CHECK_THAT(what, Catch::Contains("disinfection.yaml:"));
-    CHECK_THAT(what, Catch::Contains("disinfection.yaml:57:"));
+    CHECK_THAT(what, Catch::Contains("disinfection.yaml:74:"));
     CHECK_THAT(what,
                Catch::Contains("behavior 'BhUvLamp' writes the command channel 'uv_lamp' (digital), which hardware 'sim' does "
                                "not export; it exports none (rule R6)"));

@@ -58,7 +58,11 @@ WardRun run_ward(std::uint64_t seed, double max_s, const std::function<void(sim:
   const auto world = std::make_shared<const sim::World>(std::move(w));
   SimClock clock;
   RobotPlugins plugins = builtin_plugins(world);
-  auto robot = Robot::assemble(load_robot_profile(kConfigs / "robots/disinfection.yaml"), plugins, clock);
+  // The reflexes, not the dose: the lanes as without a dose target (the dose plan's slow, close
+  // lanes are tests/app's tripodal_run_cli:disinfection_reaches_dose_2111).
+  RobotOptions ro;
+  ro.parameters.push_back({"coverage", "dose_target_j_m2", "0"});
+  auto robot = Robot::assemble(load_robot_profile(kConfigs / "robots/disinfection.yaml"), plugins, clock, ro);
   auto& hw = dynamic_cast<sim::SimBoardHardware&>(*robot->hardware());
   if (CController* c = robot->behavior_loop().controller()) c->reset_odometry(world->start_pose);
   robot->run_for(100ms);
@@ -122,7 +126,11 @@ Approach drive_at(Pose2D start, Pose2D goal, const std::function<void(sim::World
   const auto world = std::make_shared<const sim::World>(std::move(w));
   SimClock clock;
   RobotPlugins plugins = builtin_plugins(world);
-  auto robot = Robot::assemble(load_robot_profile(kConfigs / "robots/disinfection.yaml"), plugins, clock);
+  // The reflexes, not the dose: the lanes as without a dose target (the dose plan's slow, close
+  // lanes are tests/app's tripodal_run_cli:disinfection_reaches_dose_2111).
+  RobotOptions ro;
+  ro.parameters.push_back({"coverage", "dose_target_j_m2", "0"});
+  auto robot = Robot::assemble(load_robot_profile(kConfigs / "robots/disinfection.yaml"), plugins, clock, ro);
   auto& hw = dynamic_cast<sim::SimBoardHardware&>(*robot->hardware());
   if (CController* c = robot->behavior_loop().controller()) c->reset_odometry(world->start_pose);
   robot->run_for(300ms);  // SYNC, the first ultrasonic reading

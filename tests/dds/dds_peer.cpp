@@ -1,5 +1,6 @@
 // The other process of the dds two-process tests (tests/dds/two_process_test.cpp):
-//   tripodal_dds_peer cmd-vel <domain> <namespace> <count>  publishes <count> cmd_vel, linear.x = 0.1 * i
+//   tripodal_dds_peer cmd-vel <domain> <namespace> <count> [KEYS_DIR IDENTITY]  publishes <count> cmd_vel,
+//                                                        linear.x = 0.1 * i (secured with IDENTITY's files, security.hpp)
 //   tripodal_dds_peer echo <domain> <namespace>             returns every message type: <type>_ping -> <type>_pong
 //   tripodal_dds_peer alive <domain> <namespace> <lease_ms> a live event publisher, until killed
 //   tripodal_dds_peer scan <domain> <namespace> <lease_ms>  a laser: a LaserScan on scan at 10 Hz, until killed
@@ -44,8 +45,9 @@ int run(int argc, char** argv) {
   ParticipantOptions options;
   options.domain_id = static_cast<std::uint32_t>(std::stoul(argv[2]));
   const std::string ns = argv[3];
-  if (mode == "cmd-vel" && argc == 5) {
+  if (mode == "cmd-vel" && (argc == 5 || argc == 7)) {
     options.participant_lease = 1s;
+    if (argc == 7) options.security = fleet_identity(argv[5], argv[6]);
     Participant p(options);
     // The command QoS keeps only the latest sample, which a writer cannot resend once replaced;
     // the test checks that every one of its samples arrives, so it keeps them all.

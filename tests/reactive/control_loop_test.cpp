@@ -408,7 +408,7 @@ TEST_CASE("The loop tells the behavior that won the last fusion what the safety 
 }
 
 TEST_CASE(
-    "Command channels: a behavior's writes reach the loop's command output; an unknown channel is refused at activation, located",
+    "Command channels: a behavior's writes reach the loop's command output, an unknown channel is refused at activation, located",
     "[reactive][channels]") {
   JointResource neck("neck");
   neck.publish(JointReading{Time{0ms}, 0.0, 0.0, 0.0, -1.0, 1.0});

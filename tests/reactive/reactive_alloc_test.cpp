@@ -53,7 +53,7 @@ TEST_CASE("Supervisor-side changes applied by the loop allocate nothing on the l
   CHECK(r.coordinator.locked);
 }
 
-TEST_CASE("Fusing and writing command channels allocates nothing (joint, lamp, fog, LCD text; both modes)") {
+TEST_CASE("Fusing and writing command channels allocates nothing (joint, lamp, fog, LCD text, both modes)") {
   for (const CoordinationMode mode : {CoordinationMode::priority, CoordinationMode::weighted_sum}) {
     INFO(to_string(mode));
     JointResource neck("neck");

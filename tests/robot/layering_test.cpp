@@ -324,7 +324,7 @@ TEST_CASE("describe_text lists modules by layer, describe_dot draws clusters and
   CHECK_THAT(dot, Catch::Contains("\"process_supervisor\" -> \"BhCleaning\" [style=dashed"));
 }
 
-TEST_CASE("describe shows command channels, who writes and who exports them; R6 refuses a channel the hardware lacks",
+TEST_CASE("describe shows command channels, who writes and who exports them, R6 refuses a channel the hardware lacks",
           "[robot][channels]") {
   RobotPlugins plugins = builtin_plugins(nullptr);
   RobotProfile p = load_robot_profile(std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/disinfection.yaml");
@@ -347,11 +347,10 @@ TEST_CASE("describe shows command channels, who writes and who exports them; R6 
   // The same behaviors on hardware that exports no lamp: refused at the behaviors' entry.
   p.hardware->type = "sim";
   p.hardware->parameters.clear();
-  sim::register_sim_hardware(plugins.hardware);
   Diagnostics bad;
   (void)describe_robot(p, plugins, knowledge_inputs(TaskLibrary::load(p.tasks)), bad);
   CHECK_THAT(bad.str(),
-             Catch::Contains("disinfection.yaml:57:") &&
+             Catch::Contains("disinfection.yaml:74:") &&
                  Catch::Contains("behavior 'BhUvLamp' writes the command channel 'uv_lamp' (digital), which hardware 'sim' does "
                                  "not export; it exports none (rule R6)"));
 }

@@ -223,7 +223,7 @@ TEST_CASE(
 }
 
 TEST_CASE(
-    "A fact the profile lists under external_facts is a warning; BatteryMonitor provides charging and "
+    "A fact the profile lists under external_facts is a warning, BatteryMonitor provides charging and "
     "battery_percent",
     "[robot][plugins][facts]") {
   const RobotPlugins plugins = dock_plugins();

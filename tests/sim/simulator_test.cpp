@@ -595,7 +595,7 @@ TEST_CASE("Simulator: a wheel over a ledge is a fall, whatever the centre", "[si
   CHECK_THAT(sim.events().back().detail, Catch::Contains("wheel over the edge"));
 }
 
-TEST_CASE("Simulator: a drop's depth under each cliff sensor; a stuck sensor reads its fault", "[sim][cliff][safety]") {
+TEST_CASE("Simulator: a drop's depth under each cliff sensor, a stuck sensor reads its fault", "[sim][cliff][safety]") {
   World world = room_world(81, 81, {2.0, 2.0, 0.0});
   world.drops.push_back({"step", {{2.15, 1.0}, {3.5, 1.0}, {3.5, 3.0}, {2.15, 3.0}}, {}, 0.17});
   world.faults.stuck_cliff.push_back({0, false, {}});

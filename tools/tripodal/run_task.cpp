@@ -545,7 +545,8 @@ RunResult run_task(const RunOptions& o) {
   }
   const Pose2D start = world->start_pose;
   // The planner's lamp must be the one the simulated board lights (one lamp, two consumers).
-  const std::optional<navi::DosePlan>& dose_plan = nav.coverage->dose_plan();
+  static const std::optional<navi::DosePlan> kNoDosePlan;
+  const std::optional<navi::DosePlan>& dose_plan = nav.coverage != nullptr ? nav.coverage->dose_plan() : kNoDosePlan;
   if (board_hw != nullptr && dose_plan) {
     const navi::UvLamp& a = nav.coverage->uv_lamp();
     const navi::UvLamp& b = board_hw->uv_dose().lamp();
@@ -648,7 +649,8 @@ RunResult run_task(const RunOptions& o) {
         }
       }
     }
-    reachable = reachable_area(nav, reach_planner, room_sections, start, nav.coverage->footprint_width_m() / 2.0);
+    reachable = reachable_area(nav, reach_planner, room_sections, start,
+                               nav.coverage != nullptr ? nav.coverage->footprint_width_m() / 2.0 : 0.0);
     if (dose_plan) lamp_floor = reachable_area(nav, reach_planner, room_sections, start, dose_plan->reach_m);
     res.reachable_cells = 0;
     for (const char c : reachable) res.reachable_cells += c != 0 ? 1 : 0;
@@ -657,7 +659,7 @@ RunResult run_task(const RunOptions& o) {
   if (measured_busy) measure_room();
   // A dose-planned disinfection is checked up front: refused when the battery (down to the board
   // monitor's low threshold) or the time limit cannot carry it.
-  if (measured_busy && dose_plan && board_hw != nullptr) {
+  if (measured_busy && dose_plan && board_hw != nullptr && nav.splitter != nullptr) {
     const board::BoardFirmware& fw = board_hw->embedded().firmware();
     double low_percent = 15.0;
     for (const ModuleEntry& e : profile.modules) {

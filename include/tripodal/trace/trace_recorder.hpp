@@ -26,8 +26,9 @@ class TraceRecorder final {
   /// comes from the resource's reading type. Throws std::invalid_argument for a resource holding
   /// no reading kind a trace carries, or a name already declared in the writer.
   ChannelId watch(const CResource& resource);
-  /// Observes every resource of `table`, in order.
-  void watch_all(const ResourceTable& table);
+  /// Observes every resource of `table` whose reading a trace carries, in order; returns how many
+  /// it left out (the operator's teleop input, joints, buttons: inputs a replay does not feed).
+  std::size_t watch_all(const ResourceTable& table);
   /// Declares the channel record_command() writes to (default name "cmd").
   ChannelId record_commands(std::string_view channel = "cmd");
   /// Declares the channel record_event() writes to (default name "events").
