@@ -27,6 +27,7 @@ namespace {
 void openssl(const fs::path& dir, std::vector<std::string> args) {
   args.insert(args.begin(), "openssl");
   std::vector<char*> argv;
+  argv.reserve(args.size() + 1);
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   int err_pipe[2];

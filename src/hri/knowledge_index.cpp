@@ -90,12 +90,12 @@ struct KnowledgeIndex::Impl {
 
   [[nodiscard]] std::string corrected_word(const std::string& typed) const {
     const std::string w(hri::expand_chat_word(typed));
-    if (known.count(w) != 0 || hri::is_stop_word(w) || hri::has_digit(w) || db.term_exists(term(w))) return w;
+    if (known.count(w) != 0 || hri::is_stop_word(w) || hri::has_digit(w) || db.term_exists(term(w))) return std::string(w);
     // An English word is what the visitor meant, even when the base does not have it: "kind" is
     // no typo of "find".
-    if (options.lexicon && options.lexicon->is_english(w)) return w;
+    if (options.lexicon && options.lexicon->is_english(w)) return std::string(w);
     const std::size_t limit = w.size() >= 7 ? 2 : (w.size() >= 4 ? 1 : 0);
-    if (limit == 0) return w;
+    if (limit == 0) return std::string(w);
     std::string best;
     std::size_t best_d = limit + 1;
     Xapian::doccount best_freq = 0;
@@ -215,6 +215,7 @@ Retrieval KnowledgeIndex::search_unguarded(std::string_view utterance) const {
 
   Xapian::Enquire enquire(x.db);
   std::vector<Xapian::Query> subqueries;
+  subqueries.reserve(query_terms.size());
   for (const auto& [t, closeness] : query_terms) {
     subqueries.push_back(closeness >= 1.0 ? Xapian::Query(t)
                                           : Xapian::Query(Xapian::Query::OP_SCALE_WEIGHT, Xapian::Query(t), closeness));

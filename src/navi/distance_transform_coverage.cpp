@@ -20,11 +20,15 @@ struct Coarse {
   int w = 0;
   int h = 0;
   int k = 1;                          // fine cells per side
-  std::vector<std::size_t> waypoint;  // fine index, or npos where the robot cannot stand
-  [[nodiscard]] bool free(int x, int y) const noexcept {
-    return x >= 0 && y >= 0 && x < w && y < h && waypoint[static_cast<std::size_t>(y * w + x)] != npos;
+  std::vector<std::size_t> waypoint;  // fine index, or kNoWaypoint where the robot cannot stand
+  // The index of coarse cell (x, y) (both within the grid).
+  [[nodiscard]] std::size_t at(int x, int y) const noexcept {
+    return static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
   }
-  static constexpr std::size_t npos = std::numeric_limits<std::size_t>::max();
+  [[nodiscard]] bool free(int x, int y) const noexcept {
+    return x >= 0 && y >= 0 && x < w && y < h && waypoint[at(x, y)] != kNoWaypoint;
+  }
+  static constexpr std::size_t kNoWaypoint = std::numeric_limits<std::size_t>::max();
 };
 
 // Breadth-first distances (8-connected) over the free coarse cells from `from`.
@@ -37,8 +41,8 @@ std::vector<int> wave(const Coarse& c, int from) {
     q.pop_front();
     for (const auto& s : kSteps) {
       const int x = i % c.w + s[0], y = i / c.w + s[1];
-      if (!c.free(x, y) || d[static_cast<std::size_t>(y * c.w + x)] != kNone) continue;
-      d[static_cast<std::size_t>(y * c.w + x)] = d[static_cast<std::size_t>(i)] + 1;
+      if (!c.free(x, y) || d[c.at(x, y)] != kNone) continue;
+      d[c.at(x, y)] = d[static_cast<std::size_t>(i)] + 1;
       q.push_back(y * c.w + x);
     }
   }
@@ -62,8 +66,8 @@ std::vector<int> way_to_unvisited(const Coarse& c, int from, const std::vector<s
     }
     for (const auto& s : kSteps) {
       const int x = i % c.w + s[0], y = i / c.w + s[1];
-      if (!c.free(x, y) || parent[static_cast<std::size_t>(y * c.w + x)] != kNone - 1) continue;
-      parent[static_cast<std::size_t>(y * c.w + x)] = i;
+      if (!c.free(x, y) || parent[c.at(x, y)] != kNone - 1) continue;
+      parent[c.at(x, y)] = i;
       q.push_back(y * c.w + x);
     }
   }
@@ -114,7 +118,7 @@ CoverageResult distance_transform_coverage(const OccupancyGrid& grid, const Sect
   const int x0 = section.min.x, y0 = section.min.y;
   c.w = (section.max.x - x0) / c.k + 1;
   c.h = (section.max.y - y0) / c.k + 1;
-  c.waypoint.assign(static_cast<std::size_t>(c.w) * static_cast<std::size_t>(c.h), Coarse::npos);
+  c.waypoint.assign(static_cast<std::size_t>(c.w) * static_cast<std::size_t>(c.h), Coarse::kNoWaypoint);
   for (int cy = 0; cy < c.h; ++cy) {
     for (int cx = 0; cx < c.w; ++cx) {
       const double mx = x0 + cx * c.k + (c.k - 1) / 2.0, my = y0 + cy * c.k + (c.k - 1) / 2.0;
@@ -125,7 +129,7 @@ CoverageResult distance_transform_coverage(const OccupancyGrid& grid, const Sect
           const double d = std::hypot(x - mx, y - my);
           if (d < best) {
             best = d;
-            c.waypoint[static_cast<std::size_t>(cy * c.w + cx)] = grid.index({x, y});
+            c.waypoint[c.at(cx, cy)] = grid.index({x, y});
           }
         }
       }
@@ -137,7 +141,7 @@ CoverageResult distance_transform_coverage(const OccupancyGrid& grid, const Sect
     double best_d = std::numeric_limits<double>::infinity();
     for (int i = 0; i < c.w * c.h; ++i) {
       const std::size_t f = c.waypoint[static_cast<std::size_t>(i)];
-      if (f == Coarse::npos) continue;
+      if (f == Coarse::kNoWaypoint) continue;
       if (!p) return i;
       const Point2D q = grid.cell_center(grid.cell(f));
       const double d = std::hypot(q.x_m - p->x_m, q.y_m - p->y_m);
