@@ -222,7 +222,9 @@ double path_time_s(const std::vector<Point2D>& path, const std::vector<double>& 
   for (std::size_t i = 0; i + 1 < path.size(); ++i) {
     const double v = i < speeds.size() && speeds[i] > 0.0 ? speeds[i] : 0.0;
     const double len = std::hypot(path[i + 1].x_m - path[i].x_m, path[i + 1].y_m - path[i].y_m);
-    if (len > 0.0) t += v > 0.0 ? len / v : std::numeric_limits<double>::infinity();
+    if (len <= 0.0) continue;
+    if (v <= 0.0) return std::numeric_limits<double>::infinity();  // a leg it never covers
+    t += len / v;
   }
   return t;
 }

@@ -189,7 +189,7 @@ void CSectionSplitter::on_configure(const ParameterSet& params) {
   options_.min_gap_m = params.number("min_gap_m");
   options_.min_section_height_m = params.number("min_section_height_m");
   options_.min_section_area_m2 = params.number("min_section_area_m2");
-  const std::string method = params.string("method");
+  const std::string& method = params.string("method");
   if (method == "splitter") {
     rooms_.reset();
   } else {

@@ -62,7 +62,10 @@ void check_layering(const std::vector<DescribedModule>& modules, Diagnostics& d)
   // R0: every input has exactly one provider (or any number, for a fused input "name*"); where
   // several provide it, the module's `from:` names the one it takes the input from.
   for (const DescribedModule& m : modules) {
-    for (const auto& [info, provider] : m.from) {
+    for (const auto& binding : m.from) {
+      // Named, not a structured binding: the lambda below captures it (clang 14 cannot capture one).
+      const std::string& info = binding.first;
+      const std::string& provider = binding.second;
       const bool is_input =
           std::any_of(m.inputs.begin(), m.inputs.end(), [&](const std::string& in) { return base_name(in) == info; });
       if (!is_input) {

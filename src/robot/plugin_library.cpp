@@ -112,6 +112,7 @@ PluginLibraryInfo load_plugin_library(const std::filesystem::path& path, RobotPl
 std::vector<PluginLibraryInfo> load_profile_plugins(const RobotProfile& profile, RobotPlugins& plugins,
                                                     const std::vector<std::filesystem::path>& extra) {
   std::vector<PluginLibraryInfo> out;
+  out.reserve(extra.size() + profile.plugins.size());
   for (const std::filesystem::path& p : extra) out.push_back(load_plugin_library(p, plugins, SourceLocation{"--plugin", 0, 0}));
   for (const PluginEntry& e : profile.plugins) out.push_back(load_plugin_library(e.path, plugins, e.where));
   return out;

@@ -11,7 +11,7 @@ namespace tripodal::sim {
 namespace rp = board::rplidar;
 
 namespace {
-constexpr std::uint64_t kTurnQ6 = 360 * 64;
+constexpr std::uint64_t kTurnQ6 = std::uint64_t{360} * 64;
 // What the A1 prints after RESET before it takes requests (the host's decoder must skip it).
 constexpr std::string_view kBanner = "RPLIDAR A1 (tripodal emulator)\r\nFirmware 1.29, hardware 7\r\n";
 }  // namespace

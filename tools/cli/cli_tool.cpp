@@ -152,6 +152,7 @@ std::string did_you_mean(const CLI::App& app, int argc, const char* const* argv)
       continue;
     }
     std::vector<std::string> names;
+    names.reserve(subs.size());
     for (const CLI::App* s : subs) names.push_back(s->get_name());
     const auto close = closest_name(arg, names);
     std::string known;

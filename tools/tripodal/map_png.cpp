@@ -31,8 +31,8 @@ RgbImage draw_map(const Navigation& nav, const navi::CleanedCells& cleaned, cons
     }
   };
   // The sections and virtual walls of a robot that cleans (one without a SectionSplitter has none).
-  static const std::vector<int> kNoLabels, kNoWalls;
-  const auto& label = nav.splitter != nullptr ? nav.splitter->sections().label : kNoLabels;
+  static const std::vector<int> no_labels, no_walls;
+  const auto& label = nav.splitter != nullptr ? nav.splitter->sections().label : no_labels;
   for (std::size_t i = 0; i < g.size(); ++i) {
     const navi::CellIndex c = g.cell(i);
     switch (g.state(i)) {
@@ -44,7 +44,7 @@ RgbImage draw_map(const Navigation& nav, const navi::CleanedCells& cleaned, cons
     if (cleaned.cleaned(i)) fill_cell(c, {60, 170, 60}, 0.45);
     else if (i < reachable.size() && reachable[i] != 0) fill_cell(c, {230, 40, 40}, 0.6);
   }
-  for (const int row : nav.splitter != nullptr ? nav.splitter->sections().virtual_wall_rows : kNoWalls) {
+  for (const int row : nav.splitter != nullptr ? nav.splitter->sections().virtual_wall_rows : no_walls) {
     const int y = (g.height() - 1 - row) * kScale;  // the edge between rows row and row + 1
     for (int x = 0; x < img.width; ++x) {
       if ((x / 6) % 2 == 0) img.set(x, y, 220, 0, 0);

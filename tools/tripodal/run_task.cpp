@@ -545,8 +545,8 @@ RunResult run_task(const RunOptions& o) {
   }
   const Pose2D start = world->start_pose;
   // The planner's lamp must be the one the simulated board lights (one lamp, two consumers).
-  static const std::optional<navi::DosePlan> kNoDosePlan;
-  const std::optional<navi::DosePlan>& dose_plan = nav.coverage != nullptr ? nav.coverage->dose_plan() : kNoDosePlan;
+  static const std::optional<navi::DosePlan> no_dose_plan;
+  const std::optional<navi::DosePlan>& dose_plan = nav.coverage != nullptr ? nav.coverage->dose_plan() : no_dose_plan;
   if (board_hw != nullptr && dose_plan) {
     const navi::UvLamp& a = nav.coverage->uv_lamp();
     const navi::UvLamp& b = board_hw->uv_dose().lamp();
