@@ -128,7 +128,8 @@ TEST_CASE("security: an observer may not command a robot, and may read") {
   const std::string topic = ros_topic("cmd_vel", test_namespace() + "_observer");
   Participant dashboard(secured(fleet, "dashboard"));
   // Access control refuses the writer: its permissions grant no publication.
-  CHECK_THROWS_WITH(Publisher<msg::Twist>(dashboard, topic, {.kind = TopicKind::command}), Catch::Contains("Not Allowed By Security"));
+  CHECK_THROWS_WITH(Publisher<msg::Twist>(dashboard, topic, {.kind = TopicKind::command}),
+                    Catch::Contains("Not Allowed By Security"));
   Subscriber<msg::Twist> watch(dashboard, topic, {.kind = TopicKind::command});
   CHECK(watch.matched_publishers() == 0);
 }
