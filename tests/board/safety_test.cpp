@@ -31,6 +31,17 @@ double to_rectangle(double px, double py, double x0, double y0, double x1, doubl
   return std::hypot(dx, dy);
 }
 
+// The disinfection robot in a ward world, its odometry at the world's start. The reflexes are
+// under test, not the dose: the lanes as without a dose target (the dose plan's slow, close lanes
+// are tests/app's tripodal_run_cli:disinfection_reaches_dose_2111).
+std::unique_ptr<Robot> ward_robot(const sim::World& world, const RobotPlugins& plugins, SimClock& clock) {
+  RobotOptions ro;
+  ro.parameters.push_back({"coverage", "dose_target_j_m2", "0"});
+  auto robot = Robot::assemble(load_robot_profile(kConfigs / "robots/disinfection.yaml"), plugins, clock, ro);
+  if (CController* c = robot->behavior_loop().controller()) c->reset_odometry(world.start_pose);
+  return robot;
+}
+
 struct WardRun {
   std::uint64_t seed = 1;
   bool fell = false;
@@ -58,13 +69,8 @@ WardRun run_ward(std::uint64_t seed, double max_s, const std::function<void(sim:
   const auto world = std::make_shared<const sim::World>(std::move(w));
   SimClock clock;
   RobotPlugins plugins = builtin_plugins(world);
-  // The reflexes, not the dose: the lanes as without a dose target (the dose plan's slow, close
-  // lanes are tests/app's tripodal_run_cli:disinfection_reaches_dose_2111).
-  RobotOptions ro;
-  ro.parameters.push_back({"coverage", "dose_target_j_m2", "0"});
-  auto robot = Robot::assemble(load_robot_profile(kConfigs / "robots/disinfection.yaml"), plugins, clock, ro);
+  auto robot = ward_robot(*world, plugins, clock);
   auto& hw = dynamic_cast<sim::SimBoardHardware&>(*robot->hardware());
-  if (CController* c = robot->behavior_loop().controller()) c->reset_odometry(world->start_pose);
   robot->run_for(100ms);
   const CommandAnswer answer = robot->command("disinfect the room ward");
   INFO(answer.text);
@@ -126,13 +132,8 @@ Approach drive_at(Pose2D start, Pose2D goal, const std::function<void(sim::World
   const auto world = std::make_shared<const sim::World>(std::move(w));
   SimClock clock;
   RobotPlugins plugins = builtin_plugins(world);
-  // The reflexes, not the dose: the lanes as without a dose target (the dose plan's slow, close
-  // lanes are tests/app's tripodal_run_cli:disinfection_reaches_dose_2111).
-  RobotOptions ro;
-  ro.parameters.push_back({"coverage", "dose_target_j_m2", "0"});
-  auto robot = Robot::assemble(load_robot_profile(kConfigs / "robots/disinfection.yaml"), plugins, clock, ro);
+  auto robot = ward_robot(*world, plugins, clock);
   auto& hw = dynamic_cast<sim::SimBoardHardware&>(*robot->hardware());
-  if (CController* c = robot->behavior_loop().controller()) c->reset_odometry(world->start_pose);
   robot->run_for(300ms);  // SYNC, the first ultrasonic reading
   (void)robot->behavior_loop().activate(plugins.behaviors.create("BhGoToPose"),
                                         ParameterValues{{"goal_x_m", Value{goal.x_m}},
