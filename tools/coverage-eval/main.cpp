@@ -297,9 +297,7 @@ void write_picture(const fs::path& file, const OccupancyGrid& grid, const Sectio
   }
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   std::string ipa, workspace, pictures, rooms;
   bool segment_only = false;
   std::vector<std::string> pattern_names;
@@ -475,4 +473,18 @@ int main(int argc, char** argv) {
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // CLI11's own set-up and the printing can throw too (bad_alloc, stream errors): none may escape main.
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "tripodal-coverage-eval: error: " << e.what() << "\n";
+  } catch (...) {
+    std::cerr << "tripodal-coverage-eval: error: unexpected exception\n";
+  }
+  return 1;
 }
