@@ -18,6 +18,7 @@ int main(int argc, char** argv) try {
   (void)load_profile_plugins(profile, plugins);  // then those of the profile's plugins: [patrol_plugin.so]
   SimClock clock;
   const auto robot = Robot::assemble(profile, plugins, clock);
+  std::cout << "base controller: " << robot->behavior_loop().controller()->type_name() << '\n';  // the plugin's patrol_drive
   LifecycleRecorder life;
   robot->planner().add_observer(life);
   std::cout << robot->command(argc > 2 ? argv[2] : "patrol door_2111 and door_2133").text << '\n';

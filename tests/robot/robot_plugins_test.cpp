@@ -1,6 +1,8 @@
 // What an application registers reaches the robot: its own controller type, named in the reactive
 // configuration a profile's controller entry points to, is checked and built through the
-// application's plugin set (RobotPlugins::controllers); the built-in areas do not know it.
+// application's plugin set (RobotPlugins::controllers); the built-in areas do not know it. Its own
+// actuator, a command channel its hardware exports, is written by its own behavior and reaches
+// the hardware through the behavior coordinator like any built-in channel.
 #include <unistd.h>
 
 #include <algorithm>
@@ -49,14 +51,23 @@ class WinchController final : public CController {
   double wheel_ = 0.0;
 };
 
-// The application's hardware for it: one ideal wheel.
+// The application's hardware for it: one ideal wheel, and the winch's brake, an application's own
+// command channel (an analog level, released at 0 when nobody writes it).
 class WinchHardware final : public CHardware {
  public:
   static const ModuleManifest& static_manifest() {
-    static const ModuleManifest m = hardware_manifest("winch_board", "one ideal wheel", {}, {});
+    static const ModuleManifest m = [] {
+      ModuleManifest h = hardware_manifest("winch_board", "one ideal wheel and a brake", {}, {});
+      h.command_channels.push_back(ChannelSpec{"winch_brake", ChannelType::analog, ChannelValue::of(0.0), false, Duration{0}, 0.0,
+                                               1.0, "", "the brake's pressure, 0 released to 1 full"});
+      return h;
+    }();
     return m;
   }
-  explicit WinchHardware(const HardwareConfig& c) : wheel_(1, c.base != nullptr ? c.base->period : std::chrono::milliseconds(10)) {}
+  explicit WinchHardware(const HardwareConfig& c)
+      : wheel_(1, c.base != nullptr ? c.base->period : std::chrono::milliseconds(10)) {
+    export_channel(static_manifest().command_channels.front());
+  }
 
  protected:
   const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
@@ -66,9 +77,33 @@ class WinchHardware final : public CHardware {
   IdealWheelHardware wheel_;
 };
 
+// The application's behavior for it: holds the winch with the brake at `pressure` (beyond the
+// channel's range on purpose: the coordinator clamps it).
+class BhHoldWinch final : public CBehavior {
+ public:
+  static const ModuleManifest& static_manifest() {
+    static const ModuleManifest m = ManifestBuilder("BhHoldWinch", ModuleKind::behavior, Layer::reactive)
+                                        .description("holds the winch on its brake")
+                                        .output("behavior_command")
+                                        .writes("winch_brake", ChannelType::analog, "the brake's pressure")
+                                        .number("pressure", 0.8, "", "brake pressure")
+                                        .build();
+    return m;
+  }
+
+ private:
+  const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  void on_activate(const ParameterSet& params, const BehaviorContext&) override { pressure_ = params.number("pressure"); }
+  std::optional<Twist2D> on_step(const BehaviorContext&) noexcept override {
+    write_channel(0, ChannelValue::of(pressure_));
+    return Twist2D{};
+  }
+  double pressure_ = 0.0;
+};
+
 struct WinchProfile {
   std::filesystem::path dir = std::filesystem::temp_directory_path() / ("tripodal_robot_plugins_" + std::to_string(::getpid()));
-  WinchProfile() {
+  explicit WinchProfile(bool holds_winch = false) {
     std::filesystem::create_directories(dir);
     std::ofstream(dir / "reactive.yaml") << "controllers:\n  - name: base\n    type: winch\n    gain: 2.5\n    period_s: 0.02\n";
     std::ofstream(dir / "robot.yaml") << "robot: {name: winch}\n"
@@ -76,7 +111,8 @@ struct WinchProfile {
                                          "controllers:\n"
                                          "  - {name: base, type: winch, parameters: {config: reactive.yaml}}\n"
                                          "loops:\n"
-                                         "  - {name: motion, period_s: 0.02, controller: base}\n";
+                                         "  - {name: motion, period_s: 0.02, controller: base}\n"
+                                      << (holds_winch ? "behaviors: [BhHoldWinch]\n" : "");
   }
   ~WinchProfile() {
     std::error_code ec;
@@ -109,6 +145,40 @@ TEST_CASE("An application's own controller type, registered in its plugins, driv
   const std::optional<ControllerConfig> base = base_controller_config(profile, plugins.controllers);
   REQUIRE(base.has_value());
   CHECK(base->parameters.number("gain") == 2.5);
+}
+
+TEST_CASE("An application's own command channel, written by its behavior, reaches its hardware fused by the coordinator",
+          "[robot][plugins][channels]") {
+  const WinchProfile files(true);
+  RobotPlugins plugins = builtin_plugins();
+  plugins.controllers.add<WinchController>();
+  plugins.behaviors.add<BhHoldWinch>();
+  plugins.hardware.add(WinchHardware::static_manifest(),
+                       [](const HardwareConfig& c) { return std::make_unique<WinchHardware>(c); });
+  SimClock clock;
+  const auto robot = Robot::assemble(load_robot_profile(files.dir / "robot.yaml"), plugins, clock);
+  CommandChannels& channels = robot->hardware()->command_channels();
+  const std::optional<std::size_t> brake = channels.find("winch_brake");
+  REQUIRE(brake.has_value());
+  robot->run_for(std::chrono::milliseconds(100));
+  CHECK(channels.value(*brake).number == 0.0);  // nobody writes it: its safe value
+
+  ControlLoop& loop = robot->behavior_loop();
+  const BehaviorHandle held = loop.activate(plugins.behaviors.create("BhHoldWinch"), {{"pressure", Value{0.6}}});
+  robot->run_for(std::chrono::milliseconds(100));
+  CHECK(channels.value(*brake).number == Approx(0.6));
+  const std::uint64_t writes = channels.writes(*brake);
+  CHECK(writes > 0);
+
+  (void)loop.deactivate(held);
+  (void)loop.activate(plugins.behaviors.create("BhHoldWinch"), {{"pressure", Value{3.0}}});
+  robot->run_for(std::chrono::milliseconds(100));
+  CHECK(channels.value(*brake).number == 1.0);  // clamped into the channel's [0, 1]
+  CHECK(channels.writes(*brake) > writes);
+
+  (void)loop.deactivate("BhHoldWinch");
+  robot->run_for(std::chrono::milliseconds(100));
+  CHECK(channels.value(*brake).number == 0.0);  // released: back to the safe value
 }
 
 TEST_CASE("A controller type the application did not register is refused at the reactive file, with the known ones", "[robot][plugins][errors]") {
