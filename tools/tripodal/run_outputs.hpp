@@ -62,6 +62,11 @@ RgbImage draw_map(const Navigation& nav, const navi::CleanedCells& cleaned, cons
 template <typename DoseAt>
 RgbImage draw_dose_map(const navi::OccupancyGrid& g, const std::vector<char>& floor, double target_j_m2, DoseAt dose);
 
+/// The cells of the room's `sections` a footprint reaches: within `reach_m` of a cell where the
+/// robot can stand (clearance >= its radius) connected to `start` (run_task.cpp).
+std::vector<char> reachable_area(const Navigation& nav, navi::PathPlanner& planner, const std::vector<std::string>& sections,
+                                 Pose2D start, double reach_m);
+
 /// trajectory.csv: one line per sample, SI units, header line first.
 std::string trajectory_csv(const std::vector<TrajectorySample>& traj);
 

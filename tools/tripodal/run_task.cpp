@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "guide_hri.hpp"
+#include "run_devices.hpp"
 #include "run_outputs.hpp"
 #include "shutdown.hpp"
 #include "tripodal/behaviors/navigation_behaviors.hpp"
@@ -70,8 +71,6 @@ PathFigures path_figures(const std::vector<Point2D>& path, double tolerance_m) {
   return f;
 }
 
-namespace {
-
 // The cells of the room a cleaning footprint can reach at all: within `reach_m` (half the cleaning
 // width; for the UV dose, the lamp's reach) of a cell where the robot can stand (clearance >= its
 // radius) connected to its start.
@@ -121,6 +120,8 @@ std::vector<char> reachable_area(const Navigation& nav, navi::PathPlanner& plann
   }
   return reach;
 }
+
+namespace {
 
 // What a dose-planned disinfection of these sections will take, for the up-front check: each
 // section's coverage path as it will be planned, at its lane speeds, its turns at the cleaning
@@ -243,7 +244,6 @@ DisinfectionFigures disinfection_figures(sim::SimBoardHardware& hw, const std::v
 }
 
 }  // namespace
-
 
 std::vector<ParameterOverride> simulation_overrides(const RobotProfile& profile, const sim::World& world, std::uint64_t seed) {
   std::vector<ParameterOverride> out;
@@ -466,6 +466,8 @@ RunResult run_task(const RunOptions& o) {
     throw ConfigError(profile.where, "--hardware-param: the profile has no hardware slot (hardware: {type: ...}) and no --hardware is given");
   }
   for (const auto& [key, value] : o.hardware_parameters) profile.hardware->parameters.insert_or_assign(key, value);
+  // A port given (--hardware-param port=/dev/ttyUSB0): the devices are real, the run is run_devices.cpp's.
+  if (runs_on_devices(profile)) return run_on_devices(o, profile);
   auto world = std::make_shared<sim::World>(sim::load_world(o.world));
   RunResult res;
   res.robot = profile.name;
