@@ -4,7 +4,9 @@
 # threads, Robot::start/stop with a command from another thread, SourceFile interning, the monitor's
 # server thread against the robot's, the RKMS store written from two threads, the wall-clock
 # runtime (PeriodicRunner, the lock-free resource snapshot and seqlock, PSR-2 cleaning on its own
-# threads at 20x, a starved loop's deadline fault). A data race
+# threads at 20x, a starved loop's deadline fault), and the disinfection robot on its threads
+# against its board and lidar in a forked process over ptys, unplugged mid-run (BoardMonitor reading
+# the link through the snapshot). A data race
 # or a lock-order inversion fails the run (halt_on_error). Build tree: $BUILD_ROOT/tsan.
 #
 # A new threaded component (a DDS transport) joins by tagging its tests
@@ -14,7 +16,8 @@ cd "$(dirname "$0")/.."
 root=$(pwd)
 build="${BUILD_ROOT:-$root/build}/tsan"
 jobs=${JOBS:-$(nproc)}
-suites=(tripodal_core_tests tripodal_reactive_tests tripodal_processes_tests tripodal_robot_tests tripodal_monitor_tests tripodal_hri_tests)
+suites=(tripodal_core_tests tripodal_reactive_tests tripodal_processes_tests tripodal_robot_tests tripodal_monitor_tests tripodal_hri_tests
+        tripodal_board_devices_tests)
 
 scripts/install-deps.sh
 

@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 #include <typeinfo>
 
 #include "tripodal/board/tcp_stream.hpp"
@@ -11,22 +13,37 @@
 namespace tripodal::board {
 
 // Runs the link once per control cycle: the loop polls its resources at the start of each cycle.
-class BoardHardware::LinkResource final : public CResource {
+// Its reading is the link's state as a value (BoardLinkReading), mirrored to the sequencing layer.
+class BoardHardware::LinkResource final : public TypedResource<BoardLinkReading> {
  public:
-  explicit LinkResource(BoardHardware& hw) : CResource("board_link", Duration{0}), hw_(hw) {}
+  explicit LinkResource(BoardHardware& hw) : TypedResource<BoardLinkReading>("board_link", Duration{0}, manifest()), hw_(hw) {}
 
- protected:
-  const ModuleManifest& do_manifest() const noexcept override {
+  static const ModuleManifest& manifest() {
     static const ModuleManifest m = ManifestBuilder("BoardLink", ModuleKind::resource)
                                         .description("the control board's UART link: one exchange per control period")
                                         .output("board_link")
                                         .build();
     return m;
   }
-  const std::type_info& do_reading_type() const noexcept override { return typeid(LinkStats); }
+
+ protected:
   void on_poll(Time now) noexcept override {
     hw_.cycle(now);
-    mark_published(now);
+    const BoardLink& l = hw_.link_;
+    BoardLinkReading& r = edit();
+    r.stamp = now;
+    r.synchronised = l.synchronised();
+    r.has_drive = l.has_drive();
+    r.buttons = l.has_drive() ? l.drive().buttons : 0;
+    r.has_battery = l.has_battery();
+    r.battery = l.battery();
+    r.has_tank = l.has_tank();
+    r.tank_empty = l.tank_empty();
+    r.tank_percent = l.tank_percent();
+    r.lost_at = l.link_lost_at();
+    r.stats = l.stats();
+    r.decoder_errors = l.decoder_stats().errors();
+    commit();
   }
 
  private:
@@ -113,10 +130,29 @@ bool BoardHardware::write_wheel_velocities(std::span<const double> wheel_rad_s) 
 
 bool BoardHardware::read_wheel_states(std::span<double> velocity_rad_s, std::span<double> position_rad) noexcept {
   if (velocity_rad_s.size() != 2 || position_rad.size() != 2 || !link_.has_drive() || !link_.synchronised()) return false;
+  // Synchronised again after a loss: the board may have restarted (power cycle, its process
+  // replaced), its encoders counting from 0 again. The wheels' positions go on from where they
+  // were, from the first DRIVE answered after that SYNC, so that odometry does not jump. (The
+  // first synchronisation keeps the board's own counts.)
+  if (link_.stats().resyncs != resyncs_seen_) {
+    resyncs_seen_ = link_.stats().resyncs;
+    rebase_pending_ = positions_read_;
+  }
+  if (rebase_pending_ && link_.drive_stamp() <= link_.synchronised_at()) {
+    position_rad[0] = position_[0];
+    position_rad[1] = position_[1];
+    velocity_rad_s[0] = velocity_rad_s[1] = 0.0;
+    return true;
+  }
   const EncoderState& e = link_.drive().encoders;
   const double per_rad = config_.pulses_per_m * config_.wheel_radius_m;  // pulses per radian of wheel
-  position_rad[0] = e.left_pulses / per_rad;
-  position_rad[1] = e.right_pulses / per_rad;
+  const std::array<double, 2> raw{e.left_pulses / per_rad, e.right_pulses / per_rad};
+  if (rebase_pending_) {
+    rebase_pending_ = false;
+    for (std::size_t i = 0; i < 2; ++i) offset_[i] = position_[i] - raw[i];
+  }
+  for (std::size_t i = 0; i < 2; ++i) position_[i] = position_rad[i] = raw[i] + offset_[i];
+  positions_read_ = true;
   velocity_rad_s[0] = e.left_mm_s / 1000.0 / config_.wheel_radius_m;
   velocity_rad_s[1] = e.right_mm_s / 1000.0 / config_.wheel_radius_m;
   return true;
@@ -244,12 +280,18 @@ void register_board_hardware(HardwareRegistry& registry) {
     // The port's reads are bounded by its own steady clock; the link never waits on them.
     static const SteadyClock port_clock;
     std::unique_ptr<ByteStream> stream;
-    if (is_tcp_port(port)) {
-      // The backup channel (seed 001 section 2.x: the ESP8266 on the control board): the same
-      // frames over a TCP byte stream; reconnected like a reopened tty.
-      stream = std::make_unique<TcpStream>(port, port_clock);
-    } else {
-      stream = std::make_unique<SerialPort>(port, port_clock, SerialSettings{static_cast<std::uint32_t>(c.parameters.number("baud"))});
+    try {
+      if (is_tcp_port(port)) {
+        // The backup channel (seed 001 section 2.x: the ESP8266 on the control board): the same
+        // frames over a TCP byte stream; reconnected like a reopened tty.
+        stream = std::make_unique<TcpStream>(port, port_clock);
+      } else {
+        stream = std::make_unique<SerialPort>(port, port_clock,
+                                              SerialSettings{static_cast<std::uint32_t>(c.parameters.number("baud"))});
+      }
+    } catch (const std::runtime_error& e) {
+      // "serial port /dev/ttyUSB0: open: No such file or directory", located at the profile's entry.
+      throw ConfigError(c.where, std::string("hardware 'board', port: ") + e.what());
     }
     ByteStream& s = *stream;
     auto hw = std::make_unique<BoardHardware>(s, config, std::move(stream));

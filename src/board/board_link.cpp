@@ -223,7 +223,10 @@ void BoardLink::on_frame(const FrameView& frame, Time now) noexcept {
   }
   switch (front.cmd) {
     case Command::sync:
-      if (!synchronised_) ++stats_.resyncs;
+      if (!synchronised_) {
+        ++stats_.resyncs;
+        synced_at_ = now;
+      }
       synchronised_ = true;
       break;
     case Command::drive:

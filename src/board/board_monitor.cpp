@@ -12,7 +12,7 @@ const ModuleManifest& BoardMonitor::static_manifest() {
       ManifestBuilder("BoardMonitor", ModuleKind::other, Layer::sequencing)
           .description("the control board's link and panel as supervisor events (docs/board-protocol.md)")
           .input("board_link")
-          .outputs({"board.link_lost", "board.link_restored", "board.start", "board.pause", "board.home",
+          .outputs({"board_linked", "board.link_lost", "board.link_restored", "board.start", "board.pause", "board.home",
                     "board.emergency_stop", "board.tank_empty", "board.tank_refilled", "board.battery_low"})
           .number("battery_low_percent", 15.0, "%", "at or below this the task must end and the robot charge", 0.0, 100.0)
           .build();
@@ -20,33 +20,41 @@ const ModuleManifest& BoardMonitor::static_manifest() {
 }
 
 void BoardMonitor::on_start(ModuleContext& context) {
-  host_ = dynamic_cast<BoardHost*>(context.hardware);
-  if (host_ == nullptr) {
+  if (dynamic_cast<BoardHost*>(context.hardware) == nullptr) {
     const std::string type = context.hardware != nullptr ? std::string(context.hardware->manifest().name) : "none";
     throw ConfigError(where(), fmt::format("module BoardMonitor reads the control board; expected hardware of type "
                                            "'board' (hardware: {{type: board}}), this robot's is '{}'",
                                            type));
   }
+  started_ = true;
+  link_up_ = false;
+  losses_seen_ = 0;
 }
 
 void BoardMonitor::on_configure(const ParameterSet& params) { battery_low_percent_ = params.number("battery_low_percent"); }
 
 void BoardMonitor::on_update(ModuleContext& context) {
-  if (host_ == nullptr) return;
-  BoardLink& link = host_->board().link();
+  if (!started_ || context.resources == nullptr) return;
+  const TypedResource<BoardLinkReading>* resource = context.resources->find<BoardLinkReading>("board_link");
+  if (resource == nullptr || !resource->has_reading()) return;
+  const BoardLinkReading& link = resource->latest();
   std::string fault;
-  if (link.take_link_lost()) {
-    const LinkStats& s = link.stats();
-    fault = fmt::format("link lost at {:.3f} s: no valid response from the board ({} missed, {} error responses so far)",
-                        to_seconds(link.link_lost_at()), s.missed, s.error_responses);
-    context.post("board.link_lost", fault);
+  if (link.stats.link_losses > losses_seen_) {
+    // Counted, not taken: the snapshot may skip a period, never a loss.
+    losses_seen_ = link.stats.link_losses;
+    context.post("board.link_lost",
+                 fmt::format("link lost at {:.3f} s: no valid response from the board ({} missed, {} error responses so far)",
+                             to_seconds(link.lost_at), link.stats.missed, link.stats.error_responses));
+    context.set_fact("board_linked", Value{false});
+    fault = "link lost";
     link_up_ = false;
-  } else if (!link_up_ && link.synchronised()) {
-    if (link.stats().link_losses > 0) context.post("board.link_restored", "SYNC answered again");
+  } else if (!link_up_ && link.synchronised) {
+    if (link.stats.link_losses > 0) context.post("board.link_restored", "SYNC answered again");
+    context.set_fact("board_linked", Value{true});
     link_up_ = true;
   }
   // Buttons from the DRIVE response of every control period: a press is a held edge.
-  const std::uint8_t held = link.synchronised() && link.has_drive() ? link.drive().buttons : held_;
+  const std::uint8_t held = link.synchronised && link.has_drive ? link.buttons : held_;
   const auto pressed = static_cast<std::uint8_t>(held & ~held_);
   held_ = held;
   if ((pressed & kButtonStart) != 0) context.post("board.start", "start button");
@@ -56,13 +64,13 @@ void BoardMonitor::on_update(ModuleContext& context) {
     context.post("board.emergency_stop", "emergency stop pressed");
     if (fault.empty()) fault = "emergency stop pressed: the board braked the wheels";
   }
-  if (link.tank_empty() != tank_empty_) {
-    tank_empty_ = link.tank_empty();
+  if (link.tank_empty != tank_empty_) {
+    tank_empty_ = link.tank_empty;
     context.post(tank_empty_ ? "board.tank_empty" : "board.tank_refilled",
-                 fmt::format("disinfectant tank at {} %", link.tank_percent()));
+                 fmt::format("disinfectant tank at {} %", link.tank_percent));
   }
-  if (link.has_battery()) {
-    const BatteryState& b = link.battery();
+  if (link.has_battery) {
+    const BatteryState& b = link.battery;
     const bool low = !b.charging && b.percent <= battery_low_percent_;
     if (low && !battery_low_) context.post("board.battery_low", fmt::format("battery at {} % ({} mV)", b.percent, b.voltage_mv));
     battery_low_ = low;

@@ -1,12 +1,12 @@
 #include "tripodal/board/board_hardware.hpp"
 
-#include <catch2/catch.hpp>
-
 #include <array>
+#include <catch2/catch.hpp>
+#include <memory>
 
+#include "still_plant.hpp"
 #include "tripodal/board/board_firmware.hpp"
 #include "tripodal/board/serial_line.hpp"
-#include "still_plant.hpp"
 
 using namespace tripodal;
 using namespace tripodal::board;
@@ -69,6 +69,51 @@ TEST_CASE("hardware 'board': wheels through DRIVE, odometry from the encoders, s
   CHECK(hw.take_link_lost());
   CHECK_FALSE(hw.take_link_lost());
   CHECK_FALSE(hw.wheels().read_wheel_states(vel, pos));
+}
+
+// A board power-cycled (or its process replaced) under the host: its encoders count from 0 again.
+// The host's wheel positions go on from where they were (a jump back would be odometry's jump).
+TEST_CASE("hardware 'board': a board restarted under the host, the wheel positions go on without a jump", "[board][hardware]") {
+  SimClock clock;
+  SerialLine line(clock);
+  StillPlant plant;
+  auto board = std::make_unique<BoardFirmware>(FirmwareConfig{}, line.board(), plant);
+  BoardHardware hw(line.host(), BoardHardwareConfig{});
+  ResourceTable table;
+  hw.add_resources(table);
+  const std::array<double, 2> wheels{2.0, 2.0};
+  std::array<double, 2> vel{}, pos{};
+  const auto run_ms = [&](int ms_total, bool drive) {
+    for (int ms = 1; ms <= ms_total; ++ms) {
+      clock.advance(1ms);
+      board->run_until(clock.now());
+      if (ms % 10 == 0) {
+        table.poll_all(clock.now());
+        (void)hw.wheels().write_wheel_velocities(drive ? wheels : std::array<double, 2>{});
+        (void)hw.wheels().read_wheel_states(vel, pos);
+      }
+    }
+  };
+  run_ms(1000, true);
+  run_ms(1000, false);  // at rest
+  REQUIRE(hw.wheels().read_wheel_states(vel, pos));
+  const double before = pos[0];
+  REQUIRE(before > 1.0);  // about 0.15 m driven at r = 0.09 m
+
+  // Unplugged, a new board plugged in on the same line: its counts start at 0.
+  line.board().set_connected(false);
+  run_ms(100, false);
+  board = std::make_unique<BoardFirmware>(FirmwareConfig{}, line.board(), plant, clock.now());
+  line.board().set_connected(true);
+  run_ms(1000, false);
+  REQUIRE(hw.link().stats().link_losses == 1);
+  REQUIRE(hw.link().synchronised());
+  REQUIRE(board->pulses(0) == 0);
+  REQUIRE(hw.wheels().read_wheel_states(vel, pos));
+  CHECK(pos[0] == Approx(before).margin(1e-6));
+  run_ms(500, true);  // and the new counts add to them
+  REQUIRE(hw.wheels().read_wheel_states(vel, pos));
+  CHECK(pos[0] > before + 0.1);
 }
 
 TEST_CASE("hardware 'board' is registered with its parameters and refuses a wrong configuration", "[board][hardware]") {

@@ -8,8 +8,10 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string_view>
 #include <vector>
 
@@ -45,6 +47,25 @@ std::filesystem::path default_world() {
   return {};
 }
 
+// --pose-file: the robot's pose as "x_m y_m theta_rad", read at start when the file is there (the
+// board restarted under a robot that stays where it stood), written every 100 ms while it runs.
+std::optional<tripodal::Pose2D> read_pose(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  tripodal::Pose2D p;
+  if (in >> p.x_m >> p.y_m >> p.theta_rad) return p;
+  return std::nullopt;
+}
+void write_pose(const std::filesystem::path& file, const tripodal::Pose2D& p) {
+  const std::filesystem::path tmp = file.string() + ".tmp";
+  {
+    std::ofstream out(tmp);
+    out.precision(9);
+    out << p.x_m << ' ' << p.y_m << ' ' << p.theta_rad << '\n';
+  }
+  std::error_code ignored;
+  std::filesystem::rename(tmp, file, ignored);  // whole or not at all, for a reader after a kill
+}
+
 constexpr std::string_view kExitCodes =
     "exit codes: 0 ok, 1 the board could not start (bad world or protocol profile), 2 bad command line, 3 "
     "the world file cannot "
@@ -69,6 +90,7 @@ int run(int argc, char** argv) {
   std::string protocol = "thesis";
   int tcp_port = -1;
   std::string lidar_link;
+  std::string pose_file;
   app.add_option("--world", world_file,
                  "WORLD.yaml: the simulator's map, start pose and sensors (default: the installed "
                  "configs/worlds/workspace.yaml)")
@@ -97,6 +119,9 @@ int run(int argc, char** argv) {
   app.add_option("--lidar", lidar_link,
                  "PATH: also serve an RPLIDAR A1 (docs/lidar.md) on a second pseudo-terminal, this path a symbolic link to it; "
                  "it scans the same world");
+  app.add_option("--pose-file", pose_file,
+                 "FILE: start the robot at the pose in FILE (x_m y_m theta_rad) when it is there, and keep the robot's pose "
+                 "in it while running: a board restarted under a robot starts where the robot stands");
   if (auto code = tripodal::cli::parse_command_line(app, "tripodal-board-sim", kExitCodes, argc, argv)) return *code;
   if (world_file.empty()) {
     world_file = default_world().string();
@@ -111,6 +136,9 @@ int run(int argc, char** argv) {
   try {
     SteadyClock clock;
     sim::World world = sim::load_world(world_file);
+    if (!pose_file.empty()) {
+      if (const auto p = read_pose(pose_file)) world.start_pose = *p;
+    }
     ControllerConfig base;
     base.type = "differential";
     base.differential = {wheel_separation_m, wheel_radius_m};
@@ -160,11 +188,16 @@ int run(int argc, char** argv) {
 
     const Time end = duration_s > 0.0 ? clock.now() + from_seconds(duration_s) : Time::max();
     Time next = clock.now();
+    Time next_pose = next;
     while (!g_stop.load() && clock.now() < end) {
       next += std::chrono::milliseconds(1);
       clock.sleep_until(next);
       firmware.run_until(clock.now());
       if (lidar) lidar->run_until(clock.now());
+      if (!pose_file.empty() && clock.now() >= next_pose) {
+        next_pose += std::chrono::milliseconds(100);
+        write_pose(pose_file, simulator.pose());
+      }
     }
     const auto& c = firmware.counters();
     const auto& d = firmware.decoder_stats();

@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "guide_hri.hpp"
+#include "run_devices.hpp"
 #include "run_measures.hpp"
 #include "run_outputs.hpp"
 #include "run_recording.hpp"
@@ -154,6 +155,8 @@ RobotProfile run_profile(const RunOptions& o) {
     throw ConfigError(profile.where, "--hardware-param: the profile has no hardware slot (hardware: {type: ...}) and no --hardware is given");
   }
   for (const auto& [key, value] : o.hardware_parameters) profile.hardware->parameters.insert_or_assign(key, value);
+  // A port given (--hardware-param port=/dev/ttyUSB0): the devices are real, the run is run_devices.cpp's.
+  if (runs_on_devices(profile)) return run_on_devices(o, profile);
   return profile;
 }
 

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <memory>
 
 #include "tripodal/board/board_link.hpp"
@@ -15,8 +16,27 @@
 #include "tripodal/board/serial_port.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/hardware/hardware.hpp"
+#include "tripodal/resources/resource.hpp"
 
 namespace tripodal::board {
+
+/// The link's state as the resource "board_link" publishes it each control period: a plain value,
+/// so that the sequencing layer reads it through the robot's resource snapshot (Robot::start: the
+/// reactive loop's thread runs the link, the sequencing thread must not read BoardLink itself).
+struct BoardLinkReading {
+  Time stamp{};
+  bool synchronised = false;
+  bool has_drive = false;
+  std::uint8_t buttons = 0;  ///< held, from the latest DRIVE response
+  bool has_battery = false;
+  BatteryState battery{};
+  bool has_tank = false;
+  bool tank_empty = false;
+  std::uint8_t tank_percent = 0;
+  Time lost_at{};  ///< of the latest loss (stats.link_losses counts them)
+  LinkStats stats{};
+  std::uint64_t decoder_errors = 0;
+};
 
 /// What holds the robot's BoardHardware: the hardware itself, or a hardware that embeds one (the
 /// simulated board, embedded_board.hpp). The sequencing loop's BoardMonitor finds the link here.
@@ -54,8 +74,10 @@ class BoardHardware final : public CHardware, public HardwareInterface, public B
   /// One link cycle (the "board_link" resource's poll calls it every control period): first the
   /// board commands of the command channels that changed since the last cycle.
   void cycle(Time now) noexcept;
-  /// True once per link loss: what a module posts as `board.link_lost`.
+  /// True once per link loss (the control loop's thread; BoardMonitor counts stats.link_losses).
   [[nodiscard]] bool take_link_lost() noexcept { return link_.take_link_lost(); }
+  /// The link itself: for the thread that runs the control loop (or, between runs, the caller);
+  /// another thread reads the resource "board_link" (BoardLinkReading) through a snapshot.
   [[nodiscard]] BoardLink& link() noexcept { return link_; }
   [[nodiscard]] BoardHardware& board() noexcept override { return *this; }
   /// Queues an actuator command (UV lamp, atomizer, voice, LCD): sent until acknowledged.
@@ -85,6 +107,13 @@ class BoardHardware final : public CHardware, public HardwareInterface, public B
   BumperResource bumpers_{"bumpers"};
   std::unique_ptr<RplidarA1> lidar_;
   std::array<ChannelValue, 5> applied_{};  // the channels' values last sent, by channel index
+  // The wheels' positions as last read, and what the encoder counts add to them since the latest
+  // resynchronisation (read_wheel_states).
+  std::array<double, 2> position_{};
+  std::array<double, 2> offset_{};
+  std::uint64_t resyncs_seen_ = 0;
+  bool rebase_pending_ = false;
+  bool positions_read_ = false;
 };
 
 /// The host side's configuration from a profile's hardware entry of type "board" (ConfigError

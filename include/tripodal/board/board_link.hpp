@@ -94,6 +94,8 @@ class BoardLink {
   /// Lost since the last check: true once per loss (the event to post).
   [[nodiscard]] bool take_link_lost() noexcept;
   [[nodiscard]] Time link_lost_at() const noexcept { return lost_at_; }
+  /// When SYNC was last answered with the link not synchronised (stats().resyncs counts them).
+  [[nodiscard]] Time synchronised_at() const noexcept { return synced_at_; }
   /// The latest DRIVE response and when it was received; sensors polled less often.
   [[nodiscard]] const DriveState& drive() const noexcept { return drive_; }
   [[nodiscard]] Time drive_stamp() const noexcept { return drive_stamp_; }
@@ -162,6 +164,7 @@ class BoardLink {
   bool check_port_now_ = false;  // a response was missed: verify the port before going on
   std::string_view last_port_fault_;
   Time lost_at_{};
+  Time synced_at_{};
   Time next_battery_{}, next_tank_{}, next_ranges_{};
   bool ranges_toggle_ = false;
   DriveState drive_{};

@@ -1,13 +1,18 @@
 // BoardMonitor: the sequencing-loop module that turns what the control board's link and panel
 // report into process-supervisor events (seed 001, section 3.3: link monitoring; section 2.5: the
-// buttons). Each sequencing period it reads the robot's BoardHardware (through BoardHost) and posts
-//   board.link_lost       the host missed a response (missing, late or corrupt): a fault
+// buttons). Each sequencing period it reads the resource "board_link" (BoardLinkReading: on the
+// robot's own threads, the snapshot the reactive loop's thread hands over, never the link itself)
+// and posts
+//   board.link_lost       the host missed a response (missing, late or corrupt): a fault, whose
+//                         message is "link lost" (a recovery rule matches it: the details are the
+//                         event's message)
 //   board.link_restored   SYNC answered again after a loss
 //   board.start / board.pause / board.home   a panel button pressed (held edge)
 //   board.emergency_stop  the e-stop pressed: the board has already braked; a fault
 //   board.tank_empty / board.tank_refilled   the liquid level module's empty flag changed
 //   board.battery_low     the battery at or below battery_low_percent (and not charging)
-// It only reads: the actuators are command channels the behaviors write (actuator_behaviors.hpp).
+// and keeps the fact `board_linked` (the link synchronised) for the nets' guards (PrBoardReconnect
+// waits on it). It only reads: the actuators are command channels the behaviors write (actuator_behaviors.hpp).
 // A fault is also reported as the module's failure ("<module>.fault"), so every running process
 // fails unless its net takes the event, and the planner's recovery rules decide.
 #pragma once
@@ -32,8 +37,9 @@ class BoardMonitor final : public CModule {
   void on_configure(const ParameterSet& params) override;
 
  private:
-  BoardHost* host_ = nullptr;
+  bool started_ = false;
   bool link_up_ = false;
+  std::uint64_t losses_seen_ = 0;
   std::uint8_t held_ = 0;
   bool tank_empty_ = false;
   bool battery_low_ = false;

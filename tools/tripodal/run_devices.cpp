@@ -1,0 +1,355 @@
+#include "run_devices.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <iomanip>
+#include <ostream>
+#include <vector>
+
+#include "run_measures.hpp"
+#include "run_outputs.hpp"
+#include "shutdown.hpp"
+#include "tripodal/board/board_hardware.hpp"
+#include "tripodal/builtin/register_all.hpp"
+#include "tripodal/core/clock.hpp"
+#include "tripodal/navi/grid_maps.hpp"
+#include "tripodal/navi/path_planner.hpp"
+#include "tripodal/navi/planning_modules.hpp"
+#include "tripodal/navi/section_splitter.hpp"
+#include "tripodal/planner/lifecycle_recorder.hpp"
+#include "tripodal/robot/plugin_library.hpp"
+#include "tripodal/robot/robot.hpp"
+#include "tripodal/sim/world.hpp"
+
+namespace tripodal::app {
+
+namespace {
+
+constexpr Duration kSyncWait = std::chrono::seconds(5);  // a board that has not answered SYNC by then is not there
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + '"';
+}
+
+}  // namespace
+
+std::string DeviceFigures::json() const {
+  std::string outs = "[";
+  for (std::size_t i = 0; i < outages.size(); ++i) {
+    const Outage& o = outages[i];
+    outs += fmt::format("{}{{\"lost_s\": {:.3f}, \"restored_s\": {:.3f}, \"resumed_s\": {:.3f}}}", i == 0 ? "" : ", ", o.lost_s,
+                        o.restored_s, o.resumed_s);
+  }
+  outs += "]";
+  return fmt::format(
+      "{{\n  \"port\": {},\n  \"lidar_port\": {},\n  \"first_sync_s\": {:.3f},\n"
+      "  \"link\": {{\"requests\": {}, \"responses\": {}, \"missed\": {}, \"error_responses\": {}, \"retries\": {}, "
+      "\"link_losses\": {}, \"resyncs\": {}, \"reopens\": {}, \"port_failures\": {}, \"decoder_errors\": {}, "
+      "\"bytes_sent\": {}, \"bytes_received\": {}, \"max_round_trip_ms\": {:.3f}}},\n"
+      "  \"lidar\": {{\"scans\": {}, \"dropped\": {}, \"decoder_errors\": {}, \"restarts\": {}, \"faults\": {}}},\n"
+      "  \"outages\": {}\n}}\n",
+      json_string(port), json_string(lidar_port), first_sync_s, link.requests, link.responses, link.missed, link.error_responses,
+      link.retries, link.link_losses, link.resyncs, link.reopens, link.port_failures, decoder_errors, link.bytes_sent,
+      link.bytes_received, to_seconds(link.max_round_trip) * 1000.0, lidar_scans, lidar_dropped, lidar_decoder_errors,
+      lidar_restarts, lidar_faults, outs);
+}
+
+bool runs_on_devices(const RobotProfile& profile) {
+  if (!profile.hardware || profile.hardware->type != "board") return false;
+  const auto it = profile.hardware->parameters.find("port");
+  return it != profile.hardware->parameters.end() && !it->second.empty();
+}
+
+RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
+  const SourceLocation& where = profile.hardware->where;
+  const std::string port = profile.hardware->parameters.at("port");
+  const auto lidar_it = profile.hardware->parameters.find("lidar_port");
+  const std::string lidar_port = lidar_it != profile.hardware->parameters.end() ? lidar_it->second : std::string();
+  // What needs a simulator in this process, or a run on simulated time, does not go with devices.
+  const auto refuse = [&](const char* option, const std::string& why) {
+    throw ConfigError(SourceLocation{option, 1, 1}, std::string(option) + ": " + why + " (the board is on " + port + ")");
+  };
+  if (!o.realtime) refuse("--realtime", "a robot on its devices runs on wall-clock time: add --realtime");
+  if (o.realtime_speed != 1.0)
+    refuse("--realtime", fmt::format("devices on a tty run at 1x, not {}: give --realtime alone", o.realtime_speed));
+  if (!o.board_line.empty()) refuse("--board", "the simulated board's line; a port is given");
+  if (!o.faults.empty()) refuse("--faults", "injected into a simulated world; the world is the device's");
+  if (!o.record.empty()) refuse("--record", "records a run on simulated time");
+  if (o.monitor) refuse("--monitor", "the monitor paces a run on simulated time; not yet beside devices");
+  if (profile.dds) throw ConfigError(profile.dds->where, "dds: a robot on devices runs without DDS here");
+
+  // The world gives the map only: the robot's moves and sensors are the devices'.
+  const sim::World world = sim::load_world(o.world);
+  if (world.map_file.empty())
+    throw ConfigError(SourceLocation{o.world.string(), 1, 1},
+                      "a robot on devices loads the world's map: the world names no map file");
+  RobotPlugins plugins;
+  register_all(plugins);
+  plugins.hardware = HardwareRegistry{"hardware type"};  // the real board, not the simulated one
+  board::register_board_hardware(plugins.hardware);
+  (void)load_profile_plugins(profile, plugins, o.plugins);
+  RobotOptions ro;
+  for (const ModuleEntry& e : profile.navigation) {
+    if (e.type == navi::CGridMaps::static_manifest().name && e.parameters.count("map") == 0) {
+      ro.parameters.push_back({e.name, "map", std::filesystem::absolute(world.map_file).string()});
+      if (!world.regions_file.empty() && e.parameters.count("regions") == 0)
+        ro.parameters.push_back({e.name, "regions", std::filesystem::absolute(world.regions_file).string()});
+    }
+    if (e.type != navi::CCoverageModule::static_manifest().name) continue;
+    if (!o.pattern.empty()) ro.parameters.push_back({e.name, "pattern", o.pattern});
+    if (!o.dose_plan)
+      ro.parameters.push_back({e.name, "dose_target_j_m2", "0"});
+    else if (o.uv_target_dose_j_m2)
+      ro.parameters.push_back({e.name, "dose_target_j_m2", fmt::format("{}", *o.uv_target_dose_j_m2)});
+  }
+
+  RunResult res;
+  res.robot = profile.name;
+  res.task = o.task;
+  res.realtime_speed = 1.0;
+  ScaledClock clock(1.0);
+  const auto robot = Robot::assemble(profile, plugins, clock, ro);
+  auto* host = dynamic_cast<board::BoardHost*>(robot->hardware());
+  if (host == nullptr) throw ConfigError(where, "hardware 'board' with a port: expected the control board's hardware");
+  board::BoardHardware& hw = host->board();
+  Navigation nav{robot->module<navi::CGridMaps>(), robot->module<navi::CSectionSplitter>(),
+                 robot->module<navi::CCoverageModule>()};
+  if (nav.maps == nullptr)
+    throw ConfigError(profile.where, "`tripodal run` measures the run on the map: the robot needs a GridMaps module");
+  if (nav.coverage != nullptr) res.coverage_pattern = nav.coverage->pattern();
+  const Pose2D start = world.start_pose;  // where the device simulator (or the operator) puts the robot
+  if (CController* c = robot->behavior_loop().controller()) c->reset_odometry(start);
+
+  LifecycleRecorder life(true);
+  robot->planner().add_observer(life);
+  robot->supervisor().add_observer(life);
+  DeviceFigures dev;
+  dev.port = port;
+  dev.lidar_port = lidar_port;
+
+  // Measured on the sequencing thread, after each of its periods; read here once it has stopped.
+  std::vector<std::string> room_sections;
+  std::vector<char> reachable(nav.maps->grid().size(), 0);
+  navi::PathPlanner reach_planner(nav.maps->grid(), navi::PathPlannerOptions{.robot_radius_m = nav.maps->robot_radius_m()});
+  navi::CleanedCells cleaned(nav.maps->grid());  // from the localized pose: no ground truth here
+  std::vector<TrajectorySample> traj;
+  std::vector<navi::Point2D> path_all, path_cleaning;
+  const double half_width = nav.coverage != nullptr ? nav.coverage->footprint_width_m() / 2.0 : 0.0;
+  bool measured_busy = false, was_cleaning = false, link_up = false;
+  std::uint64_t losses_seen = 0;
+  Pose2D last = start;
+  Time next_sample{};
+  std::size_t printed = 0;
+  std::atomic<bool> synced{false}, busy{false};
+  const auto log = [&](Time t, const std::string& text) {
+    if (o.log == nullptr) return;
+    *o.log << std::setw(9) << fixed(to_seconds(t), 1) << " s  " << text << '\n';
+    o.log->flush();
+  };
+  const auto measure_room = [&] {
+    room_sections.clear();
+    for (const PlanStage& stage : robot->planner().current_plan().stages) {
+      for (const ProcessStep& step : stage.steps) {
+        for (const BindingParam& p : step.params) {
+          if (p.name == "section" && std::find(room_sections.begin(), room_sections.end(), p.value) == room_sections.end())
+            room_sections.push_back(p.value);
+        }
+      }
+    }
+    reachable = reachable_area(nav, reach_planner, room_sections, start, half_width);
+    res.reachable_cells = static_cast<std::size_t>(std::count(reachable.begin(), reachable.end(), char{1}));
+  };
+  const auto moving = [&] { return robot->behavior_active("BhAutoMove") || robot->behavior_active("BhCleaningTwoWheel"); };
+
+  RealtimeOptions rto;
+  rto.after_sequencing = [&](Time now) {
+    for (; printed < life.entries().size(); ++printed) {
+      const LifecycleEntry& e = life.entries()[printed];
+      if (e.text.find(" fire ") == std::string::npos) log(e.time, e.text);
+    }
+    // The board's link as the sequencing layer sees it (the snapshot of the resource board_link).
+    if (const auto* r = robot->sequencing_resources().find<board::BoardLinkReading>("board_link");
+        r != nullptr && r->has_reading()) {
+      const board::BoardLinkReading& l = r->latest();
+      if (l.stats.link_losses > losses_seen) {
+        losses_seen = l.stats.link_losses;
+        dev.outages.push_back({to_seconds(now), -1.0, -1.0});
+        log(now, fmt::format("board: link lost ({} missed, {} port failures so far): the motors stop", l.stats.missed,
+                             l.stats.port_failures));
+        link_up = false;
+      } else if (l.synchronised && !link_up) {
+        link_up = true;
+        if (!synced.load(std::memory_order_relaxed)) {
+          dev.first_sync_s = to_seconds(now);
+          log(now, "board: SYNC answered on " + port);
+        } else if (!dev.outages.empty()) {
+          dev.outages.back().restored_s = to_seconds(now);
+          log(now, fmt::format("board: link restored (SYNC answered again, {} reopens of the port)", l.stats.reopens));
+        }
+        synced.store(true, std::memory_order_release);
+      }
+    }
+    if (!dev.outages.empty() && dev.outages.back().restored_s >= 0.0 && dev.outages.back().resumed_s < 0.0 && moving()) {
+      dev.outages.back().resumed_s = to_seconds(now);
+      log(now, "board: the task moves again");
+    }
+    const bool is_busy = robot->planner().busy();
+    if (is_busy && !measured_busy) measure_room();
+    measured_busy = is_busy;
+    // The cleaned cells and the path from the localizer's estimate: the true pose is the device
+    // simulator's (or the world's), not this process's.
+    const NavigationData& navi = robot->navigation();
+    const Pose2D pose = navi.map_from_base;
+    const bool cleaning = robot->behavior_active("BhCleaningTwoWheel") || robot->behavior_active("BhCleaning");
+    if (cleaning && navi.localized) {
+      if (was_cleaning)
+        cleaned.mark_segment({last.x_m, last.y_m}, {pose.x_m, pose.y_m}, half_width);
+      else
+        cleaned.mark_disc({pose.x_m, pose.y_m}, half_width);
+    }
+    was_cleaning = cleaning && navi.localized;
+    last = pose;
+    if (now >= next_sample) {  // 10 Hz trajectory
+      next_sample = now + std::chrono::milliseconds(100);
+      traj.push_back({now, pose, pose, navi.localized, cleaning});
+      path_all.push_back({pose.x_m, pose.y_m});
+      if (cleaning) path_cleaning.push_back({pose.x_m, pose.y_m});
+    }
+    busy.store(is_busy, std::memory_order_release);
+  };
+  auto stopped = [&] { return o.stop != nullptr && *o.stop != 0; };
+  SteadyClock wall;
+  const auto wait = [&] { wall.sleep_until(wall.now() + std::chrono::milliseconds(10)); };
+
+  // The task is given before the threads start (the planner's observers then run on one thread):
+  // it waits, standing still, for the board's first SYNC.
+  if (!o.task.empty()) {
+    const CommandAnswer answer = robot->command(o.task);
+    if (!answer.accepted) {
+      res.state = "refused";
+      res.reason = answer.text;
+      if (o.log != nullptr) *o.log << answer.text << '\n';
+    }
+  }
+  busy.store(robot->planner().busy(), std::memory_order_release);
+  const Time task_start = clock.now();
+  robot->start(std::move(rto));
+  if (o.log != nullptr) {
+    for (const std::string& w : robot->realtime_warnings()) *o.log << w << '\n';
+  }
+  const Time sync_by = clock.now() + kSyncWait;
+  while (!synced.load(std::memory_order_acquire) && clock.now() < sync_by && !stopped()) wait();
+  if (!synced.load(std::memory_order_acquire) && !stopped()) {
+    robot->stop();
+    const board::LinkStats& s = hw.link().stats();
+    res.state = "failed";
+    res.reason = fmt::format(
+        "the board on {} did not answer SYNC within {:.0f} s ({} requests sent, {} bytes received, {} decoder errors)", port,
+        to_seconds(kSyncWait), s.requests, s.bytes_received, hw.link().decoder_stats().errors());
+  } else {
+    const Time deadline = task_start + from_seconds(o.max_duration_s);
+    while (clock.now() < deadline && !stopped() && (o.task.empty() || busy.load(std::memory_order_acquire))) wait();
+  }
+  robot->stop();
+  const Time ended = clock.now();
+  const int sig = stop_signal(o.stop);
+  res.stopped_by = stop_reason(sig);
+  if (robot->planner().busy()) {
+    robot->planner().cancel(sig != 0              ? res.stopped_by
+                            : !res.reason.empty() ? res.reason
+                                                  : "no end within " + fixed(o.max_duration_s, 0) + " s");
+    robot->step_sequencing();
+    if (res.state.empty() || sig != 0) res.state = sig != 0 ? "interrupted" : "timed out";
+  }
+  for (; printed < life.entries().size(); ++printed) {
+    const LifecycleEntry& e = life.entries()[printed];
+    if (e.text.find(" fire ") == std::string::npos) log(e.time, e.text);
+  }
+
+  // The robot's threads have stopped: this thread runs the link now. The wheels commanded zero,
+  // the lamp and the fog off, until the board has answered a DRIVE sent after that.
+  const std::array<double, 2> zeros{0.0, 0.0};
+  (void)hw.write_wheel_velocities(zeros);
+  (void)hw.command(board::Command::uv_lamp, std::array<std::uint8_t, 1>{0});
+  (void)hw.command(board::Command::atomizer, std::array<std::uint8_t, 2>{0, 0});
+  const Time zero_sent = clock.now();
+  bool zero_answered = false;
+  for (int i = 0; i < 50 && !zero_answered; ++i) {
+    hw.cycle(clock.now());
+    zero_answered = hw.link().synchronised() && hw.link().has_drive() &&
+                    hw.link().drive_stamp() > zero_sent + std::chrono::milliseconds(10) &&
+                    hw.link().pending_actuator_commands() == 0;
+    clock.sleep_until(clock.now() + std::chrono::milliseconds(10));
+  }
+  res.base_command_at_end_rad_s = {0.0, 0.0};
+  res.base_at_rest = zero_answered;
+  if (o.log != nullptr && !zero_answered)
+    *o.log << "board: no answer to the last DRIVE (speeds 0): its watchdog stops the motors\n";
+
+  const TaskReport tr = robot->planner().report();
+  res.succeeded = tr.state == TaskState::succeeded;
+  if (res.state.empty()) res.state = std::string(to_string(tr.state));
+  if (res.reason.empty()) res.reason = tr.reason;
+  res.duration_s = to_seconds(ended - task_start);
+  res.cleaned_cells = 0;
+  for (std::size_t i = 0; i < reachable.size(); ++i) res.cleaned_cells += (reachable[i] != 0 && cleaned.mask()[i] != 0) ? 1 : 0;
+  res.coverage =
+      res.reachable_cells == 0 ? 0.0 : static_cast<double>(res.cleaned_cells) / static_cast<double>(res.reachable_cells);
+  const double res_m = nav.maps->grid().resolution_m();
+  res.reachable_area_m2 = static_cast<double>(res.reachable_cells) * res_m * res_m;
+  res.total = path_figures(path_all);
+  res.cleaning = path_figures(path_cleaning);
+  for (const LifecycleEntry& e : life.entries()) {
+    const bool recovery = e.text.rfind("recovery: ", 0) == 0;
+    const bool finished = e.text.rfind("process ", 0) == 0 &&
+                          (e.text.find(" succeeded") != std::string::npos || e.text.find(" failed: ") != std::string::npos);
+    if (recovery) res.recoveries.push_back(fixed(to_seconds(e.time), 3) + " " + e.text.substr(10));
+    if (finished) res.processes.push_back(fixed(to_seconds(e.time), 3) + " " + e.text.substr(8));
+  }
+  res.robot_steps = robot->behavior_loop().cycles();
+  res.loops = robot->timing();
+
+  dev.link = hw.link().stats();
+  dev.decoder_errors = hw.link().decoder_stats().errors();
+  if (const board::RplidarA1* lidar = hw.lidar()) {
+    const board::RplidarStats& l = lidar->stats();
+    dev.lidar_scans = l.scans;
+    dev.lidar_dropped = l.dropped;
+    dev.lidar_decoder_errors = l.decoder_errors;
+    dev.lidar_restarts = l.restarts;
+    dev.lidar_faults = l.faults;
+  }
+  if (o.log != nullptr) {
+    *o.log << fmt::format(
+        "devices: board on {}: {} requests, {} responses, {} missed, {} decoder errors, {} link losses, {} reopens", port,
+        dev.link.requests, dev.link.responses, dev.link.missed, dev.decoder_errors, dev.link.link_losses, dev.link.reopens);
+    if (!lidar_port.empty())
+      *o.log << fmt::format("; lidar on {}: {} scans, {} dropped, {} decoder errors, {} restarts", lidar_port, dev.lidar_scans,
+                            dev.lidar_dropped, dev.lidar_decoder_errors, dev.lidar_restarts);
+    *o.log << '\n';
+    for (const DeviceFigures::Outage& u : dev.outages) {
+      *o.log << fmt::format("devices: link lost at {:.3f} s, restored at {:.3f} s, task moving again at {:.3f} s\n", u.lost_s,
+                            u.restored_s, u.resumed_s);
+    }
+    o.log->flush();
+  }
+  if (!o.out.empty()) {
+    std::filesystem::create_directories(o.out);
+    write_png(o.out / "map.png", draw_map(nav, cleaned, reachable, traj));
+    write_text(o.out / "trajectory.csv", trajectory_csv(traj));
+    write_text(o.out / "report.json", res.json());
+    write_text(o.out / "devices.json", dev.json());
+    write_text(o.out / "lifecycle.txt", life.str());
+  }
+  return res;
+}
+
+}  // namespace tripodal::app
