@@ -155,8 +155,6 @@ RobotProfile run_profile(const RunOptions& o) {
     throw ConfigError(profile.where, "--hardware-param: the profile has no hardware slot (hardware: {type: ...}) and no --hardware is given");
   }
   for (const auto& [key, value] : o.hardware_parameters) profile.hardware->parameters.insert_or_assign(key, value);
-  // A port given (--hardware-param port=/dev/ttyUSB0): the devices are real, the run is run_devices.cpp's.
-  if (runs_on_devices(profile)) return run_on_devices(o, profile);
   return profile;
 }
 
@@ -740,6 +738,8 @@ void TaskRun::write_outputs() const {
 
 RunResult run_task(const RunOptions& o) {
   const RobotProfile profile = run_profile(o);
+  // A port given (--hardware-param port=/dev/ttyUSB0): the devices are real, the run is run_devices.cpp's.
+  if (runs_on_devices(profile)) return run_on_devices(o, profile);
   auto world = std::make_shared<sim::World>(sim::load_world(o.world));
   RunResult res;
   res.robot = profile.name;
