@@ -50,6 +50,39 @@ void BM_EventDispatch(benchmark::State& state) {
 BENCHMARK(BM_EventDispatch)->Arg(10)->Arg(10'000);
 [[maybe_unused]] const bool kDispatchTwin = tripodal::bench::register_instruction_twin("BM_EventDispatch/10", BM_EventDispatch, {10});
 
+// One firing per call, a supervisor's shape (issue 42: PNP's fireAll takes 128 ns per call of this
+// shape; target <= 25 ns): a ring of 10 whose every transition waits 1 ns, stepped by 1 ns, so each
+// step pops one timer and fires one transition. The per-call fixed cost of step() is most of it.
+void BM_OneFiringStep(benchmark::State& state) {
+  PetriNet net = test::ring_net(10);
+  for (TransitionIndex t = 0; t < net.transitions().size(); ++t) net.transition(t).delay = Duration{1};
+  Engine engine(net);
+  Time now{};
+  std::size_t firings = 0;
+  for (auto _ : state) {
+    now += Duration{1};
+    const StepResult& r = engine.step(now);
+    firings += r.firings;
+    benchmark::DoNotOptimize(r.firings);
+  }
+  if (firings != static_cast<std::size_t>(state.iterations())) state.SkipWithError("not one firing per step");
+  state.SetItemsProcessed(static_cast<std::int64_t>(firings));
+}
+BENCHMARK(BM_OneFiringStep);
+[[maybe_unused]] const bool kOneFiringTwin = tripodal::bench::register_instruction_twin("BM_OneFiringStep", BM_OneFiringStep);
+
+// Nothing enabled to fire: a step that only advances the time (most periods of a supervisor).
+void BM_IdleStep(benchmark::State& state) {
+  Engine engine(test::ring_net(10, Duration{std::chrono::hours(1)}));
+  Time now{};
+  for (auto _ : state) {
+    now += Duration{1};
+    benchmark::DoNotOptimize(engine.step(now).firings);
+  }
+}
+BENCHMARK(BM_IdleStep);
+[[maybe_unused]] const bool kIdleTwin = tripodal::bench::register_instruction_twin("BM_IdleStep", BM_IdleStep);
+
 void BM_EventDispatchByName(benchmark::State& state) {
   PetriNet net = test::ring_net(10);
   for (TransitionIndex t = 0; t < net.transitions().size(); ++t) net.transition(t).event = "localizer.lost";

@@ -530,6 +530,10 @@ struct Engine::Impl {
     reporting = debug_log || !observers.empty();  // observers cannot change during a step
   }
   void finish_step() {
+    if (!touched_list.empty()) [[unlikely]]
+      report_bound_changes();  // most steps change no bound place
+  }
+  [[gnu::noinline]] void report_bound_changes() {
     for (const PlaceIndex p : touched_list) {
       place_flags[p] = PlaceFlags::bound;
       const std::uint8_t active = marking[p] > 0 ? 1 : 0;
@@ -538,17 +542,20 @@ struct Engine::Impl {
       (active != 0 ? result.activated : result.deactivated).push_back(p);
     }
     touched_list.clear();
-    std::sort(result.activated.begin(), result.activated.end());
-    std::sort(result.deactivated.begin(), result.deactivated.end());
+    if (result.activated.size() > 1) std::sort(result.activated.begin(), result.activated.end());
+    if (result.deactivated.size() > 1) std::sort(result.deactivated.begin(), result.deactivated.end());
   }
   bool start_step(Time to) {
     begin_step();
-    if (to < now) {
-      result.status = StepStatus::time_regressed;
-      result.error = "step to " + seconds_text(to) + " is earlier than the engine's time " + seconds_text(now);
+    if (to < now) [[unlikely]] {
+      report_time_regressed(to);
       return false;
     }
     return true;
+  }
+  [[gnu::noinline]] void report_time_regressed(Time to) {
+    result.status = StepStatus::time_regressed;
+    result.error = "step to " + seconds_text(to) + " is earlier than the engine's time " + seconds_text(now);
   }
 
   void reset(Time start);
@@ -839,7 +846,14 @@ Engine::~Engine() = default;
 Engine::Engine(Engine&&) noexcept = default;
 Engine& Engine::operator=(Engine&&) noexcept = default;
 
-const StepResult& Engine::step(Time now) { return step(now, std::span<const EventId>{}); }
+// The supervisor's common call, without the event loops.
+const StepResult& Engine::step(Time now) {
+  Impl& m = *impl_;
+  if (!m.start_step(now)) return m.result;
+  m.advance(now);
+  m.finish_step();
+  return m.result;
+}
 
 const StepResult& Engine::step(Time now, std::span<const EventId> events) {
   Impl& m = *impl_;

@@ -125,7 +125,7 @@ std::optional<PetriNet> load_net_from_string(std::string_view text, std::string_
     diagnostics.error(locator.offset(doc.error().offset), "malformed XML: " + doc.error().message);
     return std::nullopt;
   }
-  const detail::ReadContext ctx{locator, diagnostics, options};
+  const detail::ReadContext ctx{locator, diagnostics, options, {}};
   const detail::XmlElement* root = doc.root();
   NetFormat format = options.format;
   if (format == NetFormat::automatic) {

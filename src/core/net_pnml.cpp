@@ -4,6 +4,7 @@
 // P/T net cannot express is refused with a located error, never read as something else.
 #include <map>
 #include <set>
+#include <unordered_map>
 
 #include "net_formats.hpp"
 
@@ -344,7 +345,7 @@ class PnmlReader {
 
   const ReadContext& ctx_;
   PetriNet& net_;
-  std::map<std::string, SourceLocation, std::less<>> ids_;
+  std::unordered_map<std::string, SourceLocation> ids_;  // hashed: one look-up per element of a large net
   std::vector<RawArc> arcs_;
 };
 

@@ -398,27 +398,30 @@ void check_event_source(const ReadContext& ctx, const XmlElement* e, const std::
                         const PetriNet& net) {
   const auto dot = event.rfind('.');
   if (dot == std::string::npos || dot == 0) return;
-  const std::string source = event.substr(0, dot);
-  const std::string kind = event.substr(dot + 1);
-  std::vector<std::string> sources;
-  std::vector<std::string> known_events;
-  const std::vector<std::string>* kinds_of_source = nullptr;
+  const std::string_view source = std::string_view(event).substr(0, dot);
+  const std::string_view kind = std::string_view(event).substr(dot + 1);
   static const std::vector<std::string> behavior_kinds{"done", "failed"};
   static const std::vector<std::string> process_kinds{"success", "fault"};
-  for (const Place& p : net.places()) {
-    const std::string* name = p.behavior ? &p.behavior->behavior : (p.process ? &p.id : nullptr);
-    if (name == nullptr) continue;
-    const auto& kinds = p.behavior ? behavior_kinds : process_kinds;
-    if (*name == source) kinds_of_source = &kinds;
-    sources.push_back(*name);
-    for (const auto& k : kinds) known_events.push_back(*name + "." + k);
+  // The index holds every place read so far; the last place binding a name decides its kinds.
+  EventSourceIndex& index = ctx.event_sources;
+  const auto& places = net.places();
+  for (; index.places_indexed < places.size(); ++index.places_indexed) {
+    const Place& p = places[index.places_indexed];
+    if (p.behavior)
+      index.is_behavior.insert_or_assign(p.behavior->behavior, true);
+    else if (p.process)
+      index.is_behavior.insert_or_assign(p.id, false);
+  }
+  const std::vector<std::string>* kinds_of_source = nullptr;
+  if (const auto it = index.is_behavior.find(std::string(source)); it != index.is_behavior.end()) {
+    kinds_of_source = it->second ? &behavior_kinds : &process_kinds;
   }
   if (kinds_of_source != nullptr) {
     if (std::find(kinds_of_source->begin(), kinds_of_source->end(), kind) != kinds_of_source->end()) return;
     std::vector<std::string> own;
-    for (const auto& k : *kinds_of_source) own.push_back(source + "." + k);
+    for (const auto& k : *kinds_of_source) own.push_back(std::string(source) + "." + k);
     ctx.error_at_value(e, "event",
-                       "unknown event '" + event + "': '" + source + "' posts " + own[0] + " and " + own[1] +
+                       "unknown event '" + event + "': '" + std::string(source) + "' posts " + own[0] + " and " + own[1] +
                            did_you_mean(event, own));
     return;
   }
@@ -430,11 +433,20 @@ void check_event_source(const ReadContext& ctx, const XmlElement* e, const std::
   };
   const bool looks_bound = prefixed('b', 'h') || prefixed('p', 'r') || kind == "success" || kind == "fault";
   if (!looks_bound) return;
+  // The cold path (an error follows when a name is close): the names and events bound in the net.
+  std::vector<std::string> sources;
+  std::vector<std::string> known_events;
+  for (const Place& p : places) {
+    const std::string* name = p.behavior ? &p.behavior->behavior : (p.process ? &p.id : nullptr);
+    if (name == nullptr) continue;
+    sources.push_back(*name);
+    for (const auto& k : p.behavior ? behavior_kinds : process_kinds) known_events.push_back(*name + "." + k);
+  }
   if (const auto close = closest_name(source, sources)) {
-    const auto event_close = closest_name(*close + "." + kind, known_events);
+    const auto event_close = closest_name(*close + "." + std::string(kind), known_events);
     ctx.error_at_value(e, "event",
-                       "unknown event '" + event + "': no place of net '" + net.id + "' binds '" + source +
-                           "'; did you mean '" + (event_close ? *event_close : *close + "." + kind) + "'?");
+                       "unknown event '" + event + "': no place of net '" + net.id + "' binds '" + std::string(source) +
+                           "'; did you mean '" + (event_close ? *event_close : *close + "." + std::string(kind)) + "'?");
   }
 }
 

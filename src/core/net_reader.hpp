@@ -9,22 +9,33 @@
 #include <span>
 #include <string>
 #include <string_view>
-
-#include "xml_document.hpp"
+#include <unordered_map>
 
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/core/net_loader.hpp"
 #include "tripodal/core/petri_net.hpp"
+#include "xml_document.hpp"
 #include "xml_locator.hpp"
 
 namespace tripodal::detail {
 
 inline constexpr std::string_view kFormatVersion = "1";
 
+/// The names that post events (behaviors bound to places, and process places by id), for the
+/// event check of every transition: indexed once per load, extended by the places added since the
+/// last look-up, so a net's event checks cost O(places + transitions), not O(places x events).
+struct EventSourceIndex {
+  std::size_t places_indexed = 0;
+  /// Source name -> true when a behavior (posts done/failed), false when a process (success/fault).
+  std::unordered_map<std::string, bool> is_behavior;
+};
+
 struct ReadContext {
   const XmlLocator& loc;
   Diagnostics& diags;
   const LoadOptions& options;
+  /// A cache of the net being read, not a setting: mutable so the readers keep taking a const context.
+  mutable EventSourceIndex event_sources;
 
   void error(const XmlElement* e, const std::string& message) const;
   void error_at_attribute(const XmlElement* e, std::string_view attr, const std::string& message) const;
