@@ -231,6 +231,11 @@ void CoveragePlanner::finish(CoverageResult& r, Workspace& ws, CellIndex cur) {
       if (!ws.cleaned.cleaned(i)) todo.push_back(i);
     }
     const int reach = static_cast<int>(std::ceil(half / grid_.resolution_m()));
+    std::vector<std::uint8_t> left(ws.offset.size(), 0);  // reachable cells, window-local
+    for (const std::size_t i : ws.reachable) {
+      const CellIndex c = grid_.cell(i);
+      left[ws.local(c.x - ws.x0, c.y - ws.y0)] = 1;
+    }
     while (!todo.empty()) {
       // nearest uncleaned cell
       std::size_t best = 0;
@@ -244,10 +249,25 @@ void CoveragePlanner::finish(CoverageResult& r, Workspace& ws, CellIndex cur) {
         }
       }
       const CellIndex u = grid_.cell(todo[best]);
-      // a standing cell whose footprint covers u, the nearest to the robot
+      // A standing cell whose footprint covers u and the most cells still left around it (the
+      // nearest to the robot among equals): the cell nearest to the robot alone covered u at the
+      // footprint's edge and little else, so the wedges along a slanted wall took a visit each.
       std::optional<CellIndex> target;
       long long target_d = std::numeric_limits<long long>::max();
+      std::size_t target_gain = 0;
       const double r2 = (half / grid_.resolution_m()) * (half / grid_.resolution_m()) + 1e-9;
+      const auto gain = [&](CellIndex t) {
+        std::size_t g = 0;
+        for (int ey = -reach; ey <= reach; ++ey) {
+          for (int ex = -reach; ex <= reach; ++ex) {
+            if (ex * ex + ey * ey > r2) continue;
+            const int lx = t.x + ex - ws.x0, ly = t.y + ey - ws.y0;
+            if (!ws.inside(lx, ly) || left[ws.local(lx, ly)] == 0) continue;
+            g += ws.cleaned.cleaned(grid_.index({t.x + ex, t.y + ey})) ? 0 : 1;
+          }
+        }
+        return g;
+      };
       for (int dy = -reach; dy <= reach; ++dy) {
         for (int dx = -reach; dx <= reach; ++dx) {
           if (dx * dx + dy * dy > r2) continue;
@@ -255,7 +275,9 @@ void CoveragePlanner::finish(CoverageResult& r, Workspace& ws, CellIndex cur) {
           if (!ws.inside(lx, ly) || ws.stand[ws.local(lx, ly)] == 0) continue;
           const CellIndex t{u.x + dx, u.y + dy};
           const long long d = 1LL * (t.x - cur.x) * (t.x - cur.x) + 1LL * (t.y - cur.y) * (t.y - cur.y);
-          if (d < target_d) {
+          const std::size_t g = gain(t);
+          if (g > target_gain || (g == target_gain && d < target_d)) {
+            target_gain = g;
             target_d = d;
             target = t;
           }
@@ -263,14 +285,21 @@ void CoveragePlanner::finish(CoverageResult& r, Workspace& ws, CellIndex cur) {
       }
       const std::size_t before = r.path.size();
       if (target) {
-        if (r.path.empty()) r.path.push_back(grid_.cell_center(*target));
-        link(r.path, cur, *target);
-        cur = *target;
         ++r.touch_ups;
-        for (std::size_t k = before == 0 ? 0 : before - 1; k + 1 < r.path.size(); ++k) {
-          ws.cleaned.mark_segment(r.path[k], r.path[k + 1], half);
+        if (const auto inserted = insert_visit(r.path, *target)) {
+          for (std::size_t k = inserted->first == 0 ? 0 : inserted->first - 1; k < inserted->second && k + 1 < r.path.size();
+               ++k) {
+            ws.cleaned.mark_segment(r.path[k], r.path[k + 1], half);
+          }
+        } else {
+          if (r.path.empty()) r.path.push_back(grid_.cell_center(*target));
+          link(r.path, cur, *target);
+          cur = *target;
+          for (std::size_t k = before == 0 ? 0 : before - 1; k + 1 < r.path.size(); ++k) {
+            ws.cleaned.mark_segment(r.path[k], r.path[k + 1], half);
+          }
         }
-        ws.cleaned.mark_disc(grid_.cell_center(cur), half);
+        ws.cleaned.mark_disc(grid_.cell_center(*target), half);
       }
       ws.cleaned.mark_disc(grid_.cell_center(u), 0.0);  // never pick u again, even if unreachable
       const auto unclean = [&](std::size_t i) { return !ws.cleaned.cleaned(i); };
@@ -293,6 +322,44 @@ void CoveragePlanner::finish(CoverageResult& r, Workspace& ws, CellIndex cur) {
   r.reachable_cells = ws.reachable.size();
   r.covered_cells = 0;
   for (const std::size_t i : ws.reachable) r.covered_cells += ws.cleaned.cleaned(i) ? 1 : 0;
+}
+
+std::optional<std::pair<std::size_t, std::size_t>> CoveragePlanner::insert_visit(std::vector<Point2D>& path, CellIndex target) {
+  // The point S of a leg nearest to the target, from where it is in plain sight: the visit goes
+  // S -> target -> S there (2 |S t| + turn_cost_m), unless going on from the path's end (|end t|)
+  // is cheaper.
+  if (path.size() < 2) return std::nullopt;
+  const Point2D t = grid_.cell_center(target);
+  const auto d2 = [](Point2D p, Point2D q) { return (p.x_m - q.x_m) * (p.x_m - q.x_m) + (p.y_m - q.y_m) * (p.y_m - q.y_m); };
+  // a visit from a leg turns twice more than one from the end: weighed as turn_cost_m of travel
+  const double via_end_m = std::sqrt(d2(path.back(), t)) - options_.turn_cost_m;
+  if (via_end_m <= 0.0) return std::nullopt;
+  double best2 = via_end_m * via_end_m / 4.0;
+  std::size_t best_leg = path.size();
+  Point2D split{};
+  for (std::size_t k = 0; k + 1 < path.size(); ++k) {
+    const Point2D a = path[k], b = path[k + 1];
+    const double dx = b.x_m - a.x_m, dy = b.y_m - a.y_m, len2 = dx * dx + dy * dy;
+    const double u = len2 > 0.0 ? std::clamp(((t.x_m - a.x_m) * dx + (t.y_m - a.y_m) * dy) / len2, 0.0, 1.0) : 0.0;
+    const Point2D p{a.x_m + u * dx, a.y_m + u * dy};
+    if (d2(p, t) >= best2) continue;
+    const CellIndex sc = grid_.cell_at(p);
+    if (!grid_.contains(sc) || !planner_.traversable(sc)) continue;
+    const double keep = planner_.leg_clearance_m(sc, target);
+    if (!planner_.line_of_sight(sc, target, keep)) continue;
+    // the halves of the leg, cell to cell, in plain sight as every leg is
+    if (!planner_.line_of_sight(grid_.cell_at(a), sc) || !planner_.line_of_sight(sc, grid_.cell_at(b))) continue;
+    best2 = d2(p, t), best_leg = k, split = p;
+  }
+  if (best_leg == path.size()) return std::nullopt;
+  // S itself, not its cell's centre: the leg keeps its swath (the cells it cleaned stay cleaned)
+  std::vector<Point2D> detour{split, t, split};
+  const auto same = [](Point2D p, Point2D q) { return std::hypot(p.x_m - q.x_m, p.y_m - q.y_m) < 1e-9; };
+  if (same(detour.back(), path[best_leg + 1])) detour.pop_back();
+  if (same(detour.front(), path[best_leg])) detour.erase(detour.begin());
+  const std::size_t at = best_leg + 1;
+  path.insert(path.begin() + static_cast<std::ptrdiff_t>(at), detour.begin(), detour.end());
+  return std::pair{at, at + detour.size()};
 }
 
 std::optional<std::vector<CoveragePlanner::RoundPiece>> CoveragePlanner::round_pieces(
@@ -477,52 +544,71 @@ struct LaneRun {
 
 }  // namespace
 
-// The runs of `mask` along the given lanes (window rows when `rows`, else columns).
-static std::vector<LaneRun> lane_runs(const std::vector<std::uint8_t>& mask, int w, int h, int x0, int y0, bool rows,
-                                      const std::vector<int>& lanes) {
+// The cell of lane `lane` at `along` (window cells, rounded to the nearest cell centre).
+static CellIndex lane_cell(const CoveragePlanner::LaneFrame& f, int lane, int along) noexcept {
+  return {static_cast<int>(std::lround(lane * f.across_x + along * f.along_x)),
+          static_cast<int>(std::lround(lane * f.across_y + along * f.along_y))};
+}
+
+// The runs of `mask` along the given lanes of the frame (on the axes: window rows or columns).
+static std::vector<LaneRun> lane_runs(const std::vector<std::uint8_t>& mask, int w, int h, int x0, int y0,
+                                      const CoveragePlanner::LaneFrame& f, const std::vector<int>& lanes) {
   std::vector<LaneRun> runs;
-  const int along_extent = rows ? w : h;
+  // along positions that can fall in the window: the window's corners projected on the lanes
+  double amin = std::numeric_limits<double>::infinity(), amax = -amin;
+  for (const int cx : {0, w - 1}) {
+    for (const int cy : {0, h - 1}) {
+      const double a = cx * f.along_x + cy * f.along_y;
+      amin = std::min(amin, a);
+      amax = std::max(amax, a);
+    }
+  }
+  const int a0 = static_cast<int>(std::floor(amin - 1e-9)), a1 = static_cast<int>(std::ceil(amax + 1e-9));
   const auto at = [&](int lane, int a) {
-    return rows ? mask[static_cast<std::size_t>(lane) * static_cast<std::size_t>(w) + static_cast<std::size_t>(a)] != 0
-                : mask[static_cast<std::size_t>(a) * static_cast<std::size_t>(w) + static_cast<std::size_t>(lane)] != 0;
+    const CellIndex c = lane_cell(f, lane, a);
+    return c.x >= 0 && c.y >= 0 && c.x < w && c.y < h &&
+           mask[static_cast<std::size_t>(c.y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(c.x)] != 0;
   };
-  const auto cell = [&](int lane, int a) { return rows ? CellIndex{a + x0, lane + y0} : CellIndex{lane + x0, a + y0}; };
+  const auto cell = [&](int lane, int a) {
+    const CellIndex c = lane_cell(f, lane, a);
+    return CellIndex{c.x + x0, c.y + y0};
+  };
   for (std::size_t k = 0; k < lanes.size(); ++k) {
     const int l = lanes[k];
-    int a = 0;
-    while (a < along_extent) {
+    int a = a0;
+    while (a <= a1) {
       if (!at(l, a)) {
         ++a;
         continue;
       }
       const int s = a;
-      while (a < along_extent && at(l, a)) ++a;
+      while (a <= a1 && at(l, a)) ++a;
       runs.push_back({static_cast<int>(k), s, a - 1, cell(l, s), cell(l, a - 1), false});
     }
   }
   return runs;
 }
 
-// The first and last lane of `mask` (window rows or columns holding a marked cell); lo > hi if none.
-static std::pair<int, int> lane_extent(const std::vector<std::uint8_t>& mask, int w, int h, bool rows) {
-  const int lanes_extent = rows ? h : w;
-  int lo = lanes_extent, hi = -1;
+// The first and last lane of `mask` across the frame (lanes holding a marked cell); lo > hi if none.
+static std::pair<int, int> lane_extent(const std::vector<std::uint8_t>& mask, int w, int h, const CoveragePlanner::LaneFrame& f) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       if (mask[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] == 0) continue;
-      const int l = rows ? y : x;
+      const double l = x * f.across_x + y * f.across_y;
       lo = std::min(lo, l);
       hi = std::max(hi, l);
     }
   }
-  return {lo, hi};
+  if (lo > hi) return {1, 0};
+  return {static_cast<int>(std::lround(lo)), static_cast<int>(std::lround(hi))};
 }
 
 static long long dist2(CellIndex a, CellIndex b) noexcept {
   return 1LL * (a.x - b.x) * (a.x - b.x) + 1LL * (a.y - b.y) * (a.y - b.y);
 }
 
-void CoveragePlanner::plough(Workspace& ws, const std::vector<std::uint8_t>& mask, bool rows,
+void CoveragePlanner::plough(Workspace& ws, const std::vector<std::uint8_t>& mask, const LaneFrame& frame,
                              const std::vector<RoundPiece>& pieces, CellIndex& cur, CoverageResult& r,
                              std::optional<Point2D> start, std::optional<Point2D> finish_near) {
   // The lanes lie where the offset leaves a lane spacing to the wall round (the first lane's
@@ -532,7 +618,7 @@ void CoveragePlanner::plough(Workspace& ws, const std::vector<std::uint8_t>& mas
   for (std::size_t li = 0; li < mask.size(); ++li) {
     far[li] = mask[li] != 0 && ws.offset[li] >= static_cast<float>(lane_spacing) ? 1 : 0;
   }
-  const auto [lo, hi] = lane_extent(far, ws.w, ws.h, rows);
+  const auto [lo, hi] = lane_extent(far, ws.w, ws.h, frame);
   // Lanes spread evenly from the first to the last lane, at most one spacing apart: no thin
   // last lane that repeats its neighbour.
   const double step = lane_spacing / grid_.resolution_m();
@@ -543,13 +629,13 @@ void CoveragePlanner::plough(Workspace& ws, const std::vector<std::uint8_t>& mas
     lanes.push_back(count == 1 ? (lo + hi) / 2
                                : lo + static_cast<int>(std::lround(static_cast<double>(k) * (hi - lo) / (count - 1))));
   }
-  std::vector<LaneRun> runs = lane_runs(mask, ws.w, ws.h, ws.x0, ws.y0, rows, lanes);
+  std::vector<LaneRun> runs = lane_runs(mask, ws.w, ws.h, ws.x0, ws.y0, frame, lanes);
   // a run whose cells are all within the footprint radius of the round lies in its swath
   const auto beyond_round = static_cast<float>(options_.cleaning_width_m / 2.0);
   std::erase_if(runs, [&](const LaneRun& run) {
     for (int a = run.lo; a <= run.hi; ++a) {
-      const int l = lanes[static_cast<std::size_t>(run.lane)];
-      if (ws.offset[rows ? ws.local(a, l) : ws.local(l, a)] > beyond_round) return false;
+      const CellIndex c = lane_cell(frame, lanes[static_cast<std::size_t>(run.lane)], a);
+      if (ws.inside(c.x, c.y) && ws.offset[ws.local(c.x, c.y)] > beyond_round) return false;
     }
     return true;
   });
@@ -906,6 +992,50 @@ void CoveragePlanner::append_from(CoverageResult& r, CellIndex& cur, const Round
   append_piece(r, cur, rotated, start);
 }
 
+std::optional<double> CoveragePlanner::slanted_walls_rad(const std::vector<RoundPiece>& pieces) const {
+  // The round's pieces simplified to straight sides; their directions modulo a right angle,
+  // weighted by length, in 1-degree bins smoothed over +-2 degrees: the peak is the walls' way.
+  constexpr int kBins = 90;
+  std::vector<double> weight(kBins, 0.0), sum_sin(kBins, 0.0), sum_cos(kBins, 0.0);
+  const double tolerance = 2.0 * grid_.resolution_m();
+  for (const RoundPiece& piece : pieces) {
+    std::vector<Point2D> pts;
+    pts.reserve(piece.cells.size());
+    for (const CellIndex& c : piece.cells) pts.push_back(grid_.cell_center(c));
+    const std::vector<Point2D> sides = douglas_peucker(pts, tolerance);
+    for (std::size_t k = 1; k < sides.size(); ++k) {
+      const double dx = sides[k].x_m - sides[k - 1].x_m, dy = sides[k].y_m - sides[k - 1].y_m;
+      const double len = std::hypot(dx, dy);
+      if (len < 4.0 * tolerance) continue;
+      // the angle modulo 90 degrees, averaged on the circle of 4x the angle
+      const double q = 4.0 * std::atan2(dy, dx);
+      double deg = std::atan2(std::sin(q), std::cos(q)) / 4.0 * 180.0 / std::numbers::pi;
+      if (deg < 0.0) deg += 90.0;
+      const int bin = std::clamp(static_cast<int>(deg), 0, kBins - 1);
+      weight[static_cast<std::size_t>(bin)] += len;
+      sum_sin[static_cast<std::size_t>(bin)] += len * std::sin(q);
+      sum_cos[static_cast<std::size_t>(bin)] += len * std::cos(q);
+    }
+  }
+  int peak = -1;
+  double peak_w = 0.0;
+  for (int b = 0; b < kBins; ++b) {
+    double w = 0.0;
+    for (int d = -2; d <= 2; ++d) w += weight[static_cast<std::size_t>((b + d + kBins) % kBins)];
+    if (w > peak_w) peak_w = w, peak = b;
+  }
+  if (peak < 0) return std::nullopt;
+  double ss = 0.0, sc = 0.0;
+  for (int d = -2; d <= 2; ++d) {
+    ss += sum_sin[static_cast<std::size_t>((peak + d + kBins) % kBins)];
+    sc += sum_cos[static_cast<std::size_t>((peak + d + kBins) % kBins)];
+  }
+  const double angle = std::atan2(ss, sc) / 4.0;  // (-45, 45] degrees
+  // within a few degrees of the grid's axes the rows and columns are those lanes already
+  if (std::abs(angle) < kSlantedWallsMinRad) return std::nullopt;
+  return angle;
+}
+
 CoverageResult CoveragePlanner::hybrid(const Section& section, std::optional<Point2D> start,
                                        std::optional<Point2D> finish_near) {
   Workspace ws = prepare(section);
@@ -929,7 +1059,23 @@ CoverageResult CoveragePlanner::hybrid(const Section& section, std::optional<Poi
   }
   std::optional<CoverageResult> best;
   double best_cost = std::numeric_limits<double>::infinity();
-  for (const bool rows : {true, false}) {
+  // Rows and columns, and where the walls run slanted to the grid (a pentagonal building, a
+  // wing at an angle), lanes along and across them: lanes on the grid axes end in staircases
+  // at slanted walls and leave wedges the touch-up then visits one by one.
+  std::vector<LaneFrame> frames{kRows, kColumns};
+  {
+    const CellIndex from = start_cell(start);
+    auto pieces = round_pieces(ws, wall, from);
+    if (pieces) {
+      join_pieces(*pieces);  // along a slanted wall the walk breaks into pieces of a few cells
+      if (const auto angle = slanted_walls_rad(*pieces)) {
+        const double c = std::cos(*angle), s = std::sin(*angle);
+        frames.push_back({c, s, -s, c});
+        frames.push_back({-s, c, c, s});
+      }
+    }
+  }
+  for (const LaneFrame& frame : frames) {
     Workspace w = ws;
     CoverageResult res;
     CellIndex cur = start_cell(start);
@@ -938,7 +1084,7 @@ CoverageResult CoveragePlanner::hybrid(const Section& section, std::optional<Poi
       res.rounds = 1;
       join_pieces(*pieces);
     }
-    plough(w, inner, rows, pieces ? *pieces : std::vector<RoundPiece>{}, cur, res, start, finish_near);
+    plough(w, inner, frame, pieces ? *pieces : std::vector<RoundPiece>{}, cur, res, start, finish_near);
     finish(res, w, cur);
     // Lanes across the shorter way cost turns and lane ends: keep the direction whose path is
     // cheaper, a turn counted as options_.turn_cost_m of travel, and the way on to finish_near.
@@ -964,11 +1110,12 @@ CoverageResult CoveragePlanner::boustrophedon(const Section& section, std::optio
   const bool rows = (section.max.x - section.min.x) >= (section.max.y - section.min.y);
   const double spacing = std::max(grid_.resolution_m(), options_.cleaning_width_m - options_.overlap_m);
   const int step = std::max(1, static_cast<int>(std::floor(spacing / grid_.resolution_m() + 1e-9)));
-  const auto [lo, hi] = lane_extent(ws.stand, ws.w, ws.h, rows);
+  const LaneFrame frame = rows ? kRows : kColumns;
+  const auto [lo, hi] = lane_extent(ws.stand, ws.w, ws.h, frame);
   std::vector<int> lanes;
   for (int l = lo; l <= hi; l += step) lanes.push_back(l);
   if (!lanes.empty() && lanes.back() != hi) lanes.push_back(hi);
-  std::vector<LaneRun> iv = lane_runs(ws.stand, ws.w, ws.h, ws.x0, ws.y0, rows, lanes);
+  std::vector<LaneRun> iv = lane_runs(ws.stand, ws.w, ws.h, ws.x0, ws.y0, frame, lanes);
   CellIndex cur = iv.empty() ? CellIndex{0, 0} : iv.front().a;
   if (start) {
     const auto c = grid_.world_to_cell(*start);
