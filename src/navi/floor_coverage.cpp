@@ -4,6 +4,8 @@
 #include <cstdlib>
 #include <deque>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace tripodal::navi {
 
@@ -15,13 +17,14 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-// Breadth-first search over free cells (4-connected) from `from` to the first cell of a section
-// not cleaned yet; the visited marks are a generation stamp, so each search costs only what it
-// explores.
+// Breadth-first search over the cells where the robot's centre may be (4-connected; the path
+// planner's traversable cells, not merely free ones: a one-pixel gap in a wall once let the tour
+// into the room behind it) from `from` to the first cell of a section not cleaned yet; the
+// visited marks are a generation stamp, so each search costs only what it explores.
 class NearestRoom {
  public:
-  NearestRoom(const OccupancyGrid& grid, const SectionSet& rooms)
-      : grid_(grid), rooms_(rooms), stamp_(grid.size(), 0), dist_(grid.size(), 0) {}
+  NearestRoom(const OccupancyGrid& grid, const SectionSet& rooms, const PathPlanner& planner)
+      : grid_(grid), rooms_(rooms), planner_(planner), stamp_(grid.size(), 0), dist_(grid.size(), 0) {}
 
   struct Found {
     int room = -1;
@@ -46,7 +49,7 @@ class NearestRoom {
       const std::size_t next[4] = {x > 0 ? i - 1 : i, x + 1 < w ? i + 1 : i, y > 0 ? i - static_cast<std::size_t>(w) : i,
                                    y + 1 < h ? i + static_cast<std::size_t>(w) : i};
       for (const std::size_t n : next) {
-        if (stamp_[n] == generation_ || grid_.state(n) != Occupancy::free) continue;
+        if (stamp_[n] == generation_ || !planner_.traversable(grid_.cell(n))) continue;
         stamp_[n] = generation_;
         dist_[n] = dist_[i] + 1;
         queue.push_back(n);
@@ -58,25 +61,34 @@ class NearestRoom {
  private:
   const OccupancyGrid& grid_;
   const SectionSet& rooms_;
+  const PathPlanner& planner_;
   std::vector<std::uint32_t> stamp_;
   std::vector<std::uint32_t> dist_;
   std::uint32_t generation_ = 0;
 };
 
-// The free cell nearest p: p's own cell, else the first free one of a growing square around it.
-std::size_t free_cell_near(const OccupancyGrid& grid, Point2D p) {
+constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+
+// The cell nearest p where the robot may stand: p's own cell, else the first of a growing square
+// ring around it. Only the ring's cells are visited: a map with no free cell once cost the cube of
+// its side (seconds on an office floor's grid); plan_floor asks only when there is such a cell.
+std::size_t free_cell_near(const OccupancyGrid& grid, const PathPlanner& planner, Point2D p) {
   const auto c = grid.world_to_cell(p);
   const CellIndex at = c ? *c : CellIndex{0, 0};
-  for (int r = 0; r < std::max(grid.width(), grid.height()); ++r) {
+  const auto free_at = [&](int x, int y) {
+    const CellIndex n{at.x + x, at.y + y};
+    return planner.traversable(n) ? grid.index(n) : kNone;
+  };
+  for (int r = 0; r <= std::max(grid.width(), grid.height()); ++r) {
     for (int dy = -r; dy <= r; ++dy) {
-      for (int dx = -r; dx <= r; ++dx) {
-        if (std::max(std::abs(dx), std::abs(dy)) != r) continue;
-        const CellIndex n{at.x + dx, at.y + dy};
-        if (grid.contains(n) && grid.is_free(n)) return grid.index(n);
+      // the ring's top and bottom rows whole, its sides' two cells in between (row-major order)
+      const int step = std::abs(dy) == r ? 1 : std::max(1, 2 * r);
+      for (int dx = -r; dx <= r; dx += step) {
+        if (const std::size_t i = free_at(dx, dy); i != kNone) return i;
       }
     }
   }
-  return std::numeric_limits<std::size_t>::max();
+  return kNone;
 }
 
 }  // namespace
@@ -84,14 +96,21 @@ std::size_t free_cell_near(const OccupancyGrid& grid, Point2D p) {
 FloorCoverage plan_floor(const OccupancyGrid& grid, const SectionSet& rooms, const CoverageOptions& options, Point2D start,
                          FloorPattern pattern) {
   FloorCoverage out;
+  if (!rooms.sections.empty() && rooms.label.size() != grid.size()) {
+    throw std::invalid_argument("plan_floor: the rooms label " + std::to_string(rooms.label.size()) + " cells, the map has " +
+                                std::to_string(grid.size()) + " (" + std::to_string(grid.width()) + " x " +
+                                std::to_string(grid.height()) + "): rooms of another map");
+  }
   const auto t_setup = Clock::now();
   CoveragePlanner cp(grid, options);
-  NearestRoom nearest(grid, rooms);
+  NearestRoom nearest(grid, rooms, cp.planner());
   out.tour_ms += ms_since(t_setup);
   std::vector<std::uint8_t> cleaned(rooms.sections.size(), 0);
-  std::size_t at = free_cell_near(grid, start);
+  bool any = false;  // a cell where the robot may stand (none on a map of walls)
+  for (std::size_t i = 0; i < grid.size() && !any; ++i) any = cp.planner().traversable(grid.cell(i));
+  std::size_t at = any ? free_cell_near(grid, cp.planner(), start) : kNone;
   Point2D here = start;
-  while (at != std::numeric_limits<std::size_t>::max()) {
+  while (at != kNone) {
     const auto t_tour = Clock::now();
     const NearestRoom::Found next = nearest.search(at, cleaned);
     out.tour_ms += ms_since(t_tour);
@@ -111,7 +130,7 @@ FloorCoverage plan_floor(const OccupancyGrid& grid, const SectionSet& rooms, con
       out.tour_ms += ms_since(t_link);
       if (way.ok()) link = way.length_m;
       here = r.path.back();
-      at = free_cell_near(grid, here);
+      at = free_cell_near(grid, cp.planner(), here);
     } else {
       at = next.cell;  // a room the robot cannot clean: go on from its entrance
     }

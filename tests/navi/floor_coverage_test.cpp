@@ -71,3 +71,82 @@ TEST_CASE("a floor with no room plans nothing") {
   CHECK(f.length_m == 0.0);
   CHECK(f.coverage() == 1.0);
 }
+
+namespace {
+
+OccupancyGrid filled(int w, int h, Occupancy state) {
+  OccupancyGrid g(w, h, 0.05);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) g.set_state({x, y}, state);
+  }
+  return g;
+}
+
+}  // namespace
+
+TEST_CASE("bad floor plans are planned or refused with a message, never a hang") {
+  CoverageOptions o;
+  o.cleaning_width_m = 0.64;
+  o.robot_radius_m = 0.3;
+  SECTION("no free space: nothing to clean, answered at once on an office floor's grid") {
+    // free_cell_near once searched squares of every size around the start, the cube of the side.
+    const OccupancyGrid g = filled(1400, 800, Occupancy::occupied);
+    const FloorCoverage f = plan_floor(g, segment_rooms(g).rooms, o, {35.0, 20.0});
+    CHECK(f.order.empty());
+    CHECK(f.coverage() == 1.0);
+  }
+  SECTION("all free space, no wall drawn: one room, cleaned") {
+    const OccupancyGrid g = filled(120, 100, Occupancy::free);
+    const FloorCoverage f = plan_floor(g, segment_rooms(g).rooms, o, {0.5, 0.5});
+    REQUIRE(f.order.size() == 1);
+    CHECK(f.coverage() >= 0.99);
+  }
+  SECTION("a room smaller than the robot: no way for the robot into it, reported, the rest planned") {
+    // a 4 x 4 m room and, off its right wall through a 0.4 m opening, a 0.4 x 0.4 m niche given
+    // as a room of its own: free cells no footprint reaches
+    OccupancyGrid g = filled(92, 82, Occupancy::occupied);
+    SectionSet rooms;
+    rooms.label.assign(g.size(), -1);
+    const auto add_room = [&](int x0, int y0, int x1, int y1) {
+      Section s;
+      s.id = static_cast<int>(rooms.sections.size());
+      for (int y = y0; y <= y1; ++y) {
+        for (int x = x0; x <= x1; ++x) {
+          g.set_state({x, y}, Occupancy::free);
+          s.cells.push_back(g.index({x, y}));
+          rooms.label[g.index({x, y})] = s.id;
+        }
+      }
+      std::sort(s.cells.begin(), s.cells.end());
+      s.min = {x0, y0};
+      s.max = {x1, y1};
+      s.area_m2 = static_cast<double>(s.cells.size()) * 0.05 * 0.05;
+      s.centroid = {(x0 + x1 + 1) * 0.025, (y0 + y1 + 1) * 0.025};
+      rooms.sections.push_back(std::move(s));
+    };
+    add_room(1, 1, 80, 80);
+    add_room(81, 37, 88, 44);
+    const FloorCoverage f = plan_floor(g, rooms, o, {0.5, 0.5});
+    REQUIRE(f.order.size() == 1);
+    CHECK(f.unreachable == std::vector<int>{1});
+    CHECK(f.coverage() >= 0.99);
+  }
+  SECTION("a one-pixel gap in a wall is no way into the room behind it") {
+    // The closet of the flat behind a wall with a 5 cm gap: free cells touch through it, but no
+    // robot passes; the tour once reached the closet through the gap and "linked" through the wall.
+    OccupancyGrid g = flat();
+    g.set_state({303, 70}, Occupancy::free);
+    const RoomSegmentation seg = segment_rooms(g);
+    const FloorCoverage f = plan_floor(g, seg.rooms, o, {0.5, 0.5});
+    CHECK(f.order.size() == 3);
+    for (const int room : f.order) CHECK(seg.rooms.sections[static_cast<std::size_t>(room)].centroid.x_m < 15.0);
+    CHECK(f.unreachable.size() == 2);
+    CHECK(f.coverage() >= 0.99);
+  }
+  SECTION("rooms of another map are refused with the sizes") {
+    const OccupancyGrid g = flat();
+    const OccupancyGrid other = filled(120, 100, Occupancy::free);
+    CHECK_THROWS_WITH(plan_floor(g, segment_rooms(other).rooms, o, {0.5, 0.5}),
+                      Catch::Contains("rooms of another map") && Catch::Contains("12000 cells"));
+  }
+}

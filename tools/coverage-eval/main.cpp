@@ -184,6 +184,25 @@ Split split(const OccupancyGrid& grid, const std::string& rooms) {
   return s;
 }
 
+// Per section: its reachable area, path length / its own bound, passes and touch-ups, worst first
+// (where a map's excess over the bound lies).
+void print_sections(const std::vector<CoverageResult>& results, double resolution_m, double width_m) {
+  std::vector<std::size_t> order(results.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  const auto excess = [&](std::size_t k) {
+    const CoverageResult& r = results[k];
+    return r.stats.length_m - static_cast<double>(r.reachable_cells) * resolution_m * resolution_m / width_m;
+  };
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return excess(a) > excess(b); });
+  for (const std::size_t k : order) {
+    const CoverageResult& r = results[k];
+    const double m2 = static_cast<double>(r.reachable_cells) * resolution_m * resolution_m;
+    std::printf("    section %zu: %.1f m2, %.1f m (%.2fx, %+.1f m over the bound), %zu turns, %zu passes, %zu touch-ups\n", k, m2,
+                r.stats.length_m, m2 > 0 ? r.stats.length_m / (m2 / width_m) : 0.0, excess(k), r.stats.turns, r.passes,
+                r.touch_ups);
+  }
+}
+
 // Sums over maps per pattern, printed last.
 std::map<Pattern, Figures> totals;
 void add(Pattern p, const Figures& f) {
@@ -299,7 +318,7 @@ void write_picture(const fs::path& file, const OccupancyGrid& grid, const Sectio
 
 int run(int argc, char** argv) {
   std::string ipa, workspace, pictures, rooms;
-  bool segment_only = false;
+  bool segment_only = false, no_touch_up = false;
   std::vector<std::string> pattern_names;
   double expect_precision = -1.0, expect_recall = -1.0, expect_bound = -1.0, expect_worst_bound = -1.0;
   bool verbose = false;
@@ -315,8 +334,8 @@ int run(int argc, char** argv) {
   app.add_option("--workspace", workspace, "MAP.yaml: a map_server map (e.g. configs/worlds/workspace_map.yaml)")
       ->check(CLI::ExistingFile);
   app.add_option("--random", random_rooms, "N: N seeded random rooms (seeds 1..N)")->check(cli::positive_count());
-  app.add_option("--pictures", pictures, "DIR: the workspace's paths per pattern as PNG pictures")->check(cli::writable_folder());
-  app.add_flag("--verbose", verbose, "per-section figures of the workspace");
+  app.add_option("--pictures", pictures, "DIR: the paths per map and pattern as PNG pictures")->check(cli::writable_folder());
+  app.add_flag("--verbose", verbose, "per-section figures (ipa maps: worst excess over the bound first)");
   app.add_option("--width", o.cleaning_width_m, "M: cleaning width (PSR-2's)")
       ->check(cli::positive_number())
       ->capture_default_str();
@@ -327,6 +346,7 @@ int run(int argc, char** argv) {
   app.add_option("--link-margin", o.link_margin_m,
                  "M: CoverageOptions::link_margin_m (the clearance links keep beyond the robot radius)")
       ->check(cli::non_negative_number());
+  app.add_flag("--no-touch-up", no_touch_up, "plan without the touch-up (CoverageOptions::touch_up off): what the passes leave");
   app.add_option("--rooms", rooms,
                  "METHOD: cover the rooms of a room segmentation (morphological, distance_transform, voronoi) instead of the "
                  "section splitter's sections")
@@ -355,6 +375,7 @@ int run(int argc, char** argv) {
                  "'tripodal-coverage-eval --help' for the usage\n";
     return cli::kUsage;
   }
+  o.touch_up = !no_touch_up;
   const auto wanted = [&](Pattern p) {
     return pattern_names.empty() || std::find(pattern_names.begin(), pattern_names.end(), name_of(p)) != pattern_names.end();
   };
@@ -411,8 +432,14 @@ int run(int argc, char** argv) {
         }
         for (const Pattern p : kPatterns) {
           if (!wanted(p)) continue;
-          const Figures f = cover(grid, sections, p, o);
+          std::vector<CoverageResult> results;
+          const Figures f = cover(grid, sections, p, o, &results);
           add(p, f);
+          if (!pictures.empty()) {
+            fs::create_directories(pictures);
+            write_picture(fs::path(pictures) / (name + "_" + name_of(p) + ".png"), grid, sections, results, o.cleaning_width_m);
+          }
+          if (verbose) print_sections(results, grid.resolution_m(), o.cleaning_width_m);
           print_row(name, p, f, o.cleaning_width_m, seg);
           if (p == Pattern::hybrid && f.reachable_m2 > 0)
             hybrid_ratio.push_back(f.length_m / (f.reachable_m2 / o.cleaning_width_m));

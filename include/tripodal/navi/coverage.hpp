@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "tripodal/navi/occupancy_grid.hpp"
@@ -154,6 +155,14 @@ class CoveragePlanner final {
                                       std::optional<Point2D> finish_near = std::nullopt);
 
   [[nodiscard]] const CoverageOptions& options() const noexcept { return options_; }
+
+  /// Where lanes run, in window cells: along (along_x, along_y), one lane per whole step across
+  /// (across_x, across_y); rows and columns on the grid's axes, any angle for slanted walls.
+  struct LaneFrame {
+    double along_x = 1.0, along_y = 0.0, across_x = 0.0, across_y = 1.0;
+  };
+  static constexpr LaneFrame kRows{1.0, 0.0, 0.0, 1.0};
+  static constexpr LaneFrame kColumns{0.0, 1.0, 1.0, 0.0};
   [[nodiscard]] PathPlanner& planner() noexcept { return planner_; }
 
  private:
@@ -161,6 +170,10 @@ class CoveragePlanner final {
   [[nodiscard]] Workspace prepare(const Section& section);
   void link(std::vector<Point2D>& path, CellIndex from, CellIndex to);
   void finish(CoverageResult& r, Workspace& ws, CellIndex cur);
+  /// A touch-up visit to `target` inserted where a leg of the path passes in plain sight of it
+  /// (there and back), when that is shorter than going on from the path's end; the inserted
+  /// points' range, or nullopt (nothing inserted).
+  [[nodiscard]] std::optional<std::pair<std::size_t, std::size_t>> insert_visit(std::vector<Point2D>& path, CellIndex target);
   /// A piece of a round: a chain of boundary cells, closed when its ends touch.
   struct RoundPiece {
     std::vector<CellIndex> cells;
@@ -178,10 +191,15 @@ class CoveragePlanner final {
   [[nodiscard]] bool local_path(CellIndex a, CellIndex b, int margin, std::vector<CellIndex>& between) const;
   /// Links to the piece's first cell and walks it (the start, if the path is empty).
   void append_piece(CoverageResult& r, CellIndex& cur, const RoundPiece& piece, std::optional<Point2D> start);
-  /// Lanes over `mask` (window rows or columns), swept cell by cell of the decomposition, and the
-  /// round's pieces, in one nearest-next tour.
-  void plough(Workspace& ws, const std::vector<std::uint8_t>& mask, bool rows, const std::vector<RoundPiece>& pieces,
+  /// Lanes over `mask` along the frame's direction, swept cell by cell of the decomposition, and
+  /// the round's pieces, in one tour.
+  void plough(Workspace& ws, const std::vector<std::uint8_t>& mask, const LaneFrame& frame, const std::vector<RoundPiece>& pieces,
               CellIndex& cur, CoverageResult& r, std::optional<Point2D> start, std::optional<Point2D> finish_near);
+  /// The direction of the round's straight sides (modulo a right angle, the peak of their
+  /// length-weighted directions) when it is slanted to the grid by at least kSlantedWallsMinRad;
+  /// nullopt when the walls run along the grid's axes (or there are none).
+  [[nodiscard]] std::optional<double> slanted_walls_rad(const std::vector<RoundPiece>& pieces) const;
+  static constexpr double kSlantedWallsMinRad = 0.0524;  // 3 degrees
   /// Up to this many lane cells and open round pieces, plough orders them exactly.
   static constexpr std::size_t kExactTourItems = 10;
   /// Walks a closed piece (the round around an obstacle) from the point of the path since
