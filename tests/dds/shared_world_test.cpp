@@ -102,7 +102,7 @@ class Client {
 };
 
 // Every client asks for a step, then every answer is awaited: one lock-step round of the world.
-void round(const std::vector<Client*>& clients, std::map<Client*, std::pair<double, double>> drive = {}) {
+void step_round(const std::vector<Client*>& clients, std::map<Client*, std::pair<double, double>> drive = {}) {
   for (Client* c : clients) {
     const auto d = drive.find(c);
     c->ask(d == drive.end() ? 0.0 : d->second.first, d == drive.end() ? 0.0 : d->second.second);
@@ -127,7 +127,7 @@ TEST_CASE("dds: one world for three robots: each sees the others, is stopped by 
   Client r1(p, prefix + "1");
   Client r2(p, prefix + "2");
   // Two laser periods (5.5 Hz): the first scan was taken as the body was placed.
-  for (int k = 0; k < 40; ++k) round({&r1, &r2});
+  for (int k = 0; k < 40; ++k) step_round({&r1, &r2});
   const double left = std::numbers::pi / 2;
   CHECK(r1.range_at(left) == Approx(0.9 - 0.25).margin(0.05));
   CHECK(r2.range_at(-left) == Approx(0.9 - 0.25).margin(0.05));
@@ -137,12 +137,12 @@ TEST_CASE("dds: one world for three robots: each sees the others, is stopped by 
 
   SECTION("a robot that joins is seen, one that drives into another is stopped, one that leaves is gone") {
     Client r3(p, prefix + "3");
-    for (int k = 0; k < 40; ++k) round({&r1, &r2, &r3});
+    for (int k = 0; k < 40; ++k) step_round({&r1, &r2, &r3});
     CHECK(r1.range_at(0.0) == Approx(0.9 - 0.25).margin(0.05));
     CHECK(r3.range_at(std::numbers::pi) == Approx(0.9 - 0.25).margin(0.05));
 
     // robot1 drives at robot3 (+x, 0.3 m/s for 3 s): it stops against it, one contact.
-    for (int k = 0; k < 300; ++k) round({&r1, &r2, &r3}, {{&r1, {0.3, 0.0}}});
+    for (int k = 0; k < 300; ++k) step_round({&r1, &r2, &r3}, {{&r1, {0.3, 0.0}}});
     r1.ask();
     const msg::SimState s1 = r1.answer();
     r2.ask();
@@ -156,7 +156,7 @@ TEST_CASE("dds: one world for three robots: each sees the others, is stopped by 
     // robot2 leaves: robot1 no longer sees it.
     r2.leave();
     std::this_thread::sleep_for(500ms);  // its departure reaches the server
-    for (int k = 0; k < 40; ++k) round({&r1, &r3});
+    for (int k = 0; k < 40; ++k) step_round({&r1, &r3});
     CHECK(r1.range_at(left) > 1.0);
 
     r1.leave();

@@ -74,6 +74,7 @@ struct Args {
   double speed = 50.0;
   unsigned domain = 0;
   double lease_s = 5.0;
+  double grace_s = 0.0;
   double timeout_s = 900.0;
   std::optional<double> kill_after_s;
   std::optional<int> kill_robot;
@@ -416,7 +417,9 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
     out.flush();
 
     SteadyClock clock;
-    dds::FleetPlanner planner(robots, units, clock);
+    dds::FleetOptions fo;
+    fo.silence_grace = std::chrono::duration_cast<Duration>(std::chrono::duration<double>(a.grace_s));
+    dds::FleetPlanner planner(robots, units, clock, fo);
     dds::DdsFleet fleet(
         planner, robots,
         dds::DdsFleetOptions{.domain_id = a.domain,
@@ -494,6 +497,7 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
       }
       for (const Children::Ended& e : children.reap()) {
         out << app::fixed(planner.elapsed_s(), 1) << " s  " << e.name << " ended: " << e.how << '\n';
+        planner.robot_gone(e.name);
         // One that never came on DDS will not: no need to wait for the startup timeout. (A robot
         // that was on DDS is declared silent by its lost liveliness, the fleet's DDS path.)
         if (!planner.ready(e.name)) {
@@ -515,6 +519,9 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
     if (timed_out || g_stop != 0) result.succeeded = false;
     children.stop();
     out << result.text();
+    out << "fleet figures: " << app::fixed(result.duration_s, 1) << " s, " << result.reassignments.size() << " reassignments, "
+        << result.done_twice << " units done twice, " << result.cancelled << " cancelled mid-way, " << result.silent.size()
+        << " silences, " << result.back.size() << " back\n";
     if (a.shared_world) {
       const std::string summary = shared_world_summary(dir / "sim_server.log");
       out << "shared world: " << (summary.empty() ? "the sim-server printed no summary (see sim_server.log)" : summary) << "\n";
@@ -551,6 +558,11 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_option("--domain", a->domain, "ID: the DDS domain (ROS_DOMAIN_ID)")->check(CLI::Range(0, 232))->capture_default_str();
   cmd.add_option("--lease-s", a->lease_s, "S: the robots' participant lease: a dead robot is seen silent after S")
       ->check(cli::positive_number())
+      ->capture_default_str();
+  cmd.add_option("--grace-s", a->grace_s,
+                 "S: a silent robot keeps its units S more seconds before they go to the others (a network partition "
+                 "shorter than that changes nothing); a robot back later is used again, keeping the unit it had in hand")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd.add_option("--timeout-s", a->timeout_s, "S: wall time after which the fleet gives up")->check(cli::positive_number())->capture_default_str();
   cmd.add_option("--seed", a->seed, "N: the simulators' seed (default: the world's)")->check(cli::whole_number());

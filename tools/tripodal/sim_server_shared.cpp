@@ -256,7 +256,7 @@ int run_shared_world(const SharedWorldArgs& a, std::ostream& out, std::ostream& 
     };
 
     const auto stall = std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(a.stall_s));
-    std::vector<std::optional<dds::msg::SimStep>> round(n);
+    std::vector<std::optional<dds::msg::SimStep>> this_round(n);
     while (g_stop == 0) {
       std::vector<std::string> left(n);
       std::vector<char> joined(n, 0);
@@ -279,17 +279,17 @@ int run_shared_world(const SharedWorldArgs& a, std::ostream& out, std::ostream& 
         }
         for (std::size_t k = 0; k < n; ++k) {
           SlotInbox& in = inbox[k];
-          round[k].reset();
+          this_round[k].reset();
           if (!in.steps.empty()) {
-            round[k] = in.steps.front();
+            this_round[k] = in.steps.front();
             in.steps.pop_front();
           }
           if (in.left) {
             left[k] = in.left_why;
             in.left = false;
             in.steps.clear();
-            round[k].reset();
-          } else if (round[k] && !slots[k].sim) {
+            this_round[k].reset();
+          } else if (this_round[k] && !slots[k].sim) {
             joined[k] = 1;
           }
         }
@@ -301,8 +301,8 @@ int run_shared_world(const SharedWorldArgs& a, std::ostream& out, std::ostream& 
       bool stepped = false;
       for (std::size_t k = 0; k < n; ++k) {
         Slot& s = slots[k];
-        if (round[k] && s.sim) {
-          serve(s, *round[k]);
+        if (this_round[k] && s.sim) {
+          serve(s, *this_round[k]);
           stepped = true;
         } else if (s.expected) {
           s.expected = false;  // stalled: it stands still until it asks again
