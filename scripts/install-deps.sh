@@ -10,6 +10,7 @@
 #              (cmake -DTRIPODAL_BROWSER_TESTS=ON; ctest -L browser)
 #     ros2-peer  Fast DDS (ROS 2's default middleware), the independent peer of the ROS 2 graph
 #                tests (tests/dds/ros2_peer_test.cpp; without it they are not built)
+#     netns  nftables and iproute2, for scripts/netns_fleet.sh (a fleet across network namespaces)
 #     perf   valgrind (callgrind), for the instruction-count guard scripts/instructions.sh; stress-ng, the
 #            CPU load beside the loop jitter figures (docs/performance.md)
 #   (ThreadSanitizer, scripts/tsan.sh, needs nothing more: libtsan2 comes with g++.)
@@ -55,7 +56,9 @@ for group in "$@"; do
     browser) packages+=(chromium chromium-driver python3-selenium) ;;
     ros2-peer) packages+=(libfastrtps-dev libfastcdr-dev) ;;
     perf) packages+=(valgrind stress-ng) ;;
-    *) echo "install-deps: unknown group '$group' (expected fuzz, tidy, browser, ros2-peer or perf)" >&2; exit 2 ;;
+    # scripts/netns_fleet.sh: a fleet across network namespaces, nftables for loss and partitions.
+    netns) packages+=(nftables iproute2) ;;
+    *) echo "install-deps: unknown group '$group' (expected fuzz, tidy, browser, ros2-peer, perf or netns)" >&2; exit 2 ;;
   esac
 done
 

@@ -5,7 +5,12 @@
 // And a 1 kHz nav_msgs/Odometry stream on rt/<ns>/odom from another process (a copy of itself
 // started with --odom-publisher) to a reader here, with the robot bridge's odometry QoS: what was
 // sent, received, lost, out of order, the publisher's rate and worst overrun, the latency.
-//   tripodal_dds_bench [--domain N] [--odom-seconds S] [benchmark options]
+// BM_CmdVelThroughput: 20,000 Twists written as fast as the writer may (reliable, a history that
+// holds them all) to the echo process, which reports how many it received; samples per second.
+// With --secure, both processes are DDS Security participants of a fleet whose keys the benchmark
+// makes first (make_fleet_keys: authentication, access control, every topic encrypted as the
+// fleet's governance says): run it with and without to see what security costs.
+//   tripodal_dds_bench [--domain N] [--odom-seconds S] [--secure] [benchmark options]
 //   (domain 200, odometry stream 60 s unless given)
 #include <benchmark/benchmark.h>
 #include <signal.h>
@@ -26,6 +31,7 @@
 #include <vector>
 
 #include "tripodal/dds/endpoint.hpp"
+#include "tripodal/dds/security.hpp"
 
 extern char** environ;
 
@@ -38,12 +44,24 @@ std::uint32_t domain_id = 200;
 std::int64_t odom_seconds = 60;
 volatile std::sig_atomic_t stop = 0;
 
+std::string keys_dir;  // --keys DIR: secured, the keys made by the parent
+std::string identity = "bench_main";
+
 std::string ns() { return "tripodal_bench"; }
 
 ParticipantOptions options() {
   ParticipantOptions o;
   o.domain_id = domain_id;
+  if (!keys_dir.empty()) o.security = fleet_identity(keys_dir, identity);
   return o;
+}
+
+constexpr int kBurst = 20000;
+
+Qos burst_qos(Role role) {
+  Qos q = qos_for(TopicKind::state, role);
+  q.depth = kBurst;  // keep every sample of the burst: a reliable writer then never overwrites one
+  return q;
 }
 
 int run_echo() {
@@ -52,6 +70,24 @@ int run_echo() {
   Publisher<msg::Twist> back(p, ros_topic("cmd_vel_echo", ns()), {.kind = TopicKind::command});
   Subscriber<msg::Twist> in(p, ros_topic("cmd_vel", ns()), {.kind = TopicKind::command},
                             [&back](const msg::Twist& t) { back.publish(t); });
+  // The burst: counts what arrives and answers the count when asked (the "done" sample).
+  std::mutex mutex;
+  long long received = 0;
+  Publisher<msg::String> count(p, ros_topic("burst_count", ns()), {.kind = TopicKind::event});
+  Subscriber<msg::Twist> burst(p, ros_topic("burst", ns()), {.kind = TopicKind::state, .qos = burst_qos(Role::subscriber)},
+                               [&](const msg::Twist&) {
+                                 const std::lock_guard lock(mutex);
+                                 ++received;
+                               });
+  Subscriber<msg::String> done(p, ros_topic("burst_done", ns()), {.kind = TopicKind::state}, [&](const msg::String&) {
+    long long n = 0;
+    {
+      const std::lock_guard lock(mutex);
+      n = received;
+      received = 0;
+    }
+    count.publish({std::to_string(n)});
+  });
   while (stop == 0) std::this_thread::sleep_for(10ms);
   return 0;
 }
@@ -96,6 +132,45 @@ void BM_CmdVelRoundTrip(benchmark::State& state) {
   state.counters["max_us"] = us.back();
 }
 BENCHMARK(BM_CmdVelRoundTrip)->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(5000);
+
+// Throughput: a burst of kBurst Twists, written back to back, until the echo process has all of
+// them (every sample acknowledged, then its count asked for and checked).
+void BM_CmdVelThroughput(benchmark::State& state) {
+  Participant p(options());
+  Publisher<msg::Twist> out(p, ros_topic("burst", ns()), {.kind = TopicKind::state, .qos = burst_qos(Role::publisher)});
+  Publisher<msg::String> done(p, ros_topic("burst_done", ns()), {.kind = TopicKind::state});
+  Subscriber<msg::String> count(p, ros_topic("burst_count", ns()), {.kind = TopicKind::event});
+  if (!out.wait_for_subscribers(1, 10s) || !done.wait_for_subscribers(1, 10s) || !count.wait_for_publishers(1, 10s)) {
+    state.SkipWithError("the echo process did not match within 10 s");
+    return;
+  }
+  (void)count.take(100);
+  double rate = 0.0;
+  for (auto _ : state) {
+    msg::Twist t{{0.3, 0.0, 0.0}, {0.0, 0.0, 0.1}};
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < kBurst; ++i) {
+      t.linear.y = i;
+      out.publish(t);
+    }
+    const bool acked = out.wait_for_acknowledgments(60s);
+    const auto end = std::chrono::steady_clock::now();
+    done.publish({"done"});
+    const auto got = count.take_one(10s);
+    if (!acked || !got || std::stoll(got->data) != kBurst) {
+      state.SkipWithError(
+          ("the burst did not arrive whole: " + (got ? got->data : std::string("no count")) + " of " + std::to_string(kBurst))
+              .c_str());
+      return;
+    }
+    const double s = std::chrono::duration<double>(end - start).count();
+    state.SetIterationTime(s);
+    rate = kBurst / s;
+  }
+  state.counters["samples_per_s"] = rate;
+  state.counters["MB_per_s"] = rate * 48.0 / 1e6;  // a Twist's six doubles
+}
+BENCHMARK(BM_CmdVelThroughput)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);
 
 // --- 1 kHz odometry stream ------------------------------------------------------------------
 // The sample's sequence number travels in pose.covariance[0] (a double holds it exactly) and its
@@ -189,9 +264,13 @@ void BM_OdometryStream(benchmark::State& state) {
   std::string self = "/proc/self/exe";
   std::string domain_text = std::to_string(domain_id);
   std::string seconds_text = std::to_string(seconds);
-  std::vector<char*> child{self.data(),         const_cast<char*>("--odom-publisher"),
-                           const_cast<char*>("--domain"), domain_text.data(),
-                           const_cast<char*>("--odom-seconds"), seconds_text.data(), nullptr};
+  std::vector<char*> child{self.data(),        const_cast<char*>("--odom-publisher"), const_cast<char*>("--domain"),
+                           domain_text.data(), const_cast<char*>("--odom-seconds"),   seconds_text.data()};
+  if (!keys_dir.empty()) {
+    child.push_back(const_cast<char*>("--keys"));
+    child.push_back(keys_dir.data());
+  }
+  child.push_back(nullptr);
   pid_t pid = 0;
   if (posix_spawn(&pid, self.c_str(), nullptr, nullptr, child.data(), environ) != 0) {
     state.SkipWithError("cannot start the odometry publisher process");
@@ -274,6 +353,7 @@ int main(int argc, char** argv) {
   std::vector<char*> args;
   bool echo = false;
   bool odom_publisher = false;
+  bool secure = false;
   for (int i = 0; i < argc; ++i) {
     if (std::strcmp(argv[i], "--echo") == 0) {
       echo = true;
@@ -281,11 +361,30 @@ int main(int argc, char** argv) {
       odom_publisher = true;
     } else if (std::strcmp(argv[i], "--domain") == 0 && i + 1 < argc) {
       domain_id = static_cast<std::uint32_t>(std::stoul(argv[++i]));
+    } else if (std::strcmp(argv[i], "--secure") == 0) {
+      secure = true;
+    } else if (std::strcmp(argv[i], "--keys") == 0 && i + 1 < argc) {
+      keys_dir = argv[++i];
+      identity = "bench_peer";  // the parent is bench_main
     } else if (std::strcmp(argv[i], "--odom-seconds") == 0 && i + 1 < argc) {
       odom_seconds = std::stoll(argv[++i]);
     } else {
       args.push_back(argv[i]);
     }
+  }
+  if (secure && keys_dir.empty()) {
+    keys_dir = "/tmp/tripodal_bench_keys_" + std::to_string(::getpid());
+    FleetKeysOptions k;
+    k.out = keys_dir;
+    k.domain_id = domain_id;
+    k.identities = {{"bench_main", FleetRole::operator_tool}, {"bench_peer", FleetRole::robot}};
+    try {
+      make_fleet_keys(k);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "tripodal_dds_bench --secure: %s\n", e.what());
+      return 1;
+    }
+    std::printf("secured: DDS Security with the keys of %s (governance: every topic encrypted)\n", keys_dir.c_str());
   }
   if (echo) return run_echo();
   if (odom_publisher) return run_odom_publisher(odom_seconds);
@@ -303,8 +402,12 @@ int main(int argc, char** argv) {
 
   std::string self = "/proc/self/exe";
   std::string domain_text = std::to_string(domain_id);
-  std::vector<char*> child{self.data(), const_cast<char*>("--echo"), const_cast<char*>("--domain"),
-                           domain_text.data(), nullptr};
+  std::vector<char*> child{self.data(), const_cast<char*>("--echo"), const_cast<char*>("--domain"), domain_text.data()};
+  if (!keys_dir.empty()) {
+    child.push_back(const_cast<char*>("--keys"));
+    child.push_back(keys_dir.data());
+  }
+  child.push_back(nullptr);
   pid_t pid = 0;
   if (posix_spawn(&pid, self.c_str(), nullptr, nullptr, child.data(), environ) != 0) {
     std::perror("tripodal_dds_bench: cannot start the echo process");

@@ -108,6 +108,9 @@ std::string FleetResult::text() const {
     s << "reassigned " << r.unit << " from " << r.from << " to " << r.to << " at " << fixed1(r.at_s) << " s: " << r.reason << '\n';
   }
   for (const std::string& r : silent) s << "silent: " << r << '\n';
+  for (const std::string& r : back) s << "back: " << r << '\n';
+  if (done_twice > 0 || cancelled > 0)
+    s << "work done twice: " << done_twice << " units; cancelled mid-way: " << cancelled << '\n';
   const auto failed = std::count_if(units.begin(), units.end(), [](const FleetUnitResult& u) { return u.state == "failed"; });
   s << "fleet " << (succeeded ? "succeeded" : "did not finish") << ": " << done() << " of " << units.size() << " units done in "
     << fixed1(duration_s) << " s, " << reassignments.size() << (reassignments.size() == 1 ? " reassignment, " : " reassignments, ")
@@ -129,6 +132,9 @@ std::string FleetResult::json() const {
     moves.push_back(Json{{"unit", r.unit}, {"from", r.from}, {"to", r.to}, {"at_s", r.at_s}, {"reason", r.reason}});
   }
   out["silent"] = silent;
+  out["back"] = back;
+  out["done_twice"] = done_twice;
+  out["cancelled"] = cancelled;
   return out.dump(2) + "\n";
 }
 
@@ -147,6 +153,11 @@ struct FleetPlanner::Robot {
   bool paused = false;  // we asked it to pause (nothing to do: its simulation need not run)
   double sent_s = 0.0;   // the last (re)send of the command
   double given_s = 0.0;  // when the unit in hand was given
+  std::optional<double> silent_since_s;  // silent, its units kept until the grace time ends
+  std::string silent_reason;
+  std::optional<std::size_t> lost;  // the unit it had in hand when declared silent
+  double declared_s = 0.0;
+  bool gone = false;  // its process ended
 };
 
 struct FleetPlanner::Unit {
@@ -239,6 +250,24 @@ void FleetPlanner::robot_ready(std::string_view robot) {
 
 void FleetPlanner::finish_unit(Robot& r, bool ok, std::string_view detail) {
   Unit& u = units_[*r.current];
+  if (u.state == Unit::State::done) {  // another robot finished it first (a robot back from a partition)
+    if (ok) {
+      ++done_twice_;
+      note(r.name + " finished " + unit_info_[*r.current].name + ", which " + u.robot + " had done: done twice");
+    }
+    r.current.reset();
+    return;
+  }
+  if (ok) {
+    // One record of what is done: any other robot on this unit stops.
+    for (auto& other : robots_) {
+      if (other.get() == &r || other->current != r.current) continue;
+      ++cancelled_;
+      note(other->name + " is told to cancel " + unit_info_[*r.current].name + ": " + r.name + " finished it");
+      pending_.push_back({other->name, next_id_++, "cancel", {}, unit_info_[*r.current].name});
+      other->current.reset();
+    }
+  }
   u.state = ok ? Unit::State::done : Unit::State::failed;
   u.robot = r.name;
   u.finished_s = seconds();
@@ -310,17 +339,79 @@ void FleetPlanner::redistribute(std::vector<std::size_t> units, const std::strin
 
 void FleetPlanner::robot_silent(std::string_view robot, std::string_view reason) {
   Robot* r = find(robot);
-  if (r == nullptr || !r->alive) return;
-  r->alive = false;
-  const std::string why = r->name + " went silent (" + std::string(reason) + ")";
-  silent_.push_back(r->name + " at " + fixed1(seconds()) + " s: " + std::string(reason));
+  if (r == nullptr || !r->alive || r->silent_since_s) return;
+  r->silent_since_s = seconds();
+  r->silent_reason = std::string(reason);
+  if (options_.silence_grace.count() <= 0) {
+    declare_silent(*r);
+  } else {
+    note(r->name + " is silent (" + r->silent_reason + "): its units wait " + fixed1(to_seconds(options_.silence_grace)) +
+         " s for it");
+  }
+}
+
+void FleetPlanner::declare_silent(Robot& r) {
+  r.alive = false;
+  r.declared_s = seconds();
+  const std::string why = r.name + " went silent (" + r.silent_reason + ")";
+  silent_.push_back(r.name + " at " + fixed1(seconds()) + " s: " + r.silent_reason);
   note(why);
   std::vector<std::size_t> left;
-  if (r->current) left.push_back(*r->current);
-  left.insert(left.end(), r->queue.begin(), r->queue.end());
-  r->current.reset();
-  r->queue.clear();
-  redistribute(std::move(left), r->name, why);
+  r.lost = r.current;
+  if (r.current) left.push_back(*r.current);
+  left.insert(left.end(), r.queue.begin(), r.queue.end());
+  r.current.reset();
+  r.queue.clear();
+  redistribute(std::move(left), r.name, why);
+}
+
+void FleetPlanner::robot_gone(std::string_view robot) {
+  Robot* r = find(robot);
+  if (r == nullptr) return;
+  r->gone = true;
+  r->lost.reset();
+}
+
+void FleetPlanner::robot_back(std::string_view robot) {
+  Robot* r = find(robot);
+  if (r == nullptr || r->gone || !r->silent_since_s) return;
+  const double away = seconds() - *r->silent_since_s;
+  r->silent_since_s.reset();
+  if (r->alive) {
+    note(r->name + " is back after " + fixed1(away) + " s, within the grace time: it keeps its units");
+    return;
+  }
+  r->alive = true;
+  r->answered = true;
+  back_.push_back(r->name + " at " + fixed1(seconds()) + " s (silent " + fixed1(away) + " s)");
+  if (!r->lost) {
+    note(r->name + " is back after " + fixed1(away) + " s");
+    return;
+  }
+  const std::size_t lost = *r->lost;
+  r->lost.reset();
+  Unit& u = units_[lost];
+  const std::string& name = unit_info_[lost].name;
+  r->current = lost;  // it went on with it: nothing new for it before it says how that ended
+  r->given_s = seconds();
+  if (u.state == Unit::State::done || u.state == Unit::State::failed) {
+    note(r->name + " is back after " + fixed1(away) + " s, still on " + name + ", which " + u.robot + " has ended");
+    return;
+  }
+  for (auto& other : robots_) {
+    auto at = std::find(other->queue.begin(), other->queue.end(), lost);
+    if (at == other->queue.end()) continue;
+    other->queue.erase(at);
+    u.assigned.push_back(r->name);
+    u.state = Unit::State::running;
+    u.robot = r->name;
+    reassignments_.push_back({name, other->name, r->name, seconds(), r->name + " is back with it in hand"});
+    note(r->name + " is back after " + fixed1(away) + " s with " + name + " in hand: taken back from " + other->name +
+         "'s queue");
+    return;
+  }
+  note(r->name + " is back after " + fixed1(away) + " s with " + name + " in hand, which " + u.robot +
+       " runs too: the first to finish it keeps it");
 }
 
 void FleetPlanner::take_queued(Robot& idle) {
@@ -344,7 +435,11 @@ void FleetPlanner::take_queued(Robot& idle) {
 
 std::vector<FleetCommand> FleetPlanner::poll() {
   std::vector<FleetCommand> out;
+  out.swap(pending_);
   const double now = seconds();
+  for (auto& rp : robots_) {
+    if (rp->alive && rp->silent_since_s && now - *rp->silent_since_s >= to_seconds(options_.silence_grace)) declare_silent(*rp);
+  }
   for (auto& rp : robots_) {
     if (rp->alive && !rp->ready && now >= to_seconds(options_.startup_timeout)) {
       robot_silent(rp->name, "not on DDS within " + fixed1(to_seconds(options_.startup_timeout)) + " s");
@@ -352,7 +447,7 @@ std::vector<FleetCommand> FleetPlanner::poll() {
   }
   for (auto& rp : robots_) {
     Robot& r = *rp;
-    if (!r.alive || !r.ready) continue;
+    if (!r.alive || !r.ready || r.silent_since_s) continue;
     if (!r.current && r.queue.empty() && options_.take_when_idle) take_queued(r);
     if (!r.current && r.queue.empty() && !r.paused && options_.pause_idle) {
       r.paused = true;
@@ -398,6 +493,9 @@ FleetResult FleetPlanner::result() const {
   res.duration_s = seconds();
   res.reassignments = reassignments_;
   res.silent = silent_;
+  res.back = back_;
+  res.done_twice = done_twice_;
+  res.cancelled = cancelled_;
   std::vector<std::string> missing, failed;
   for (std::size_t i = 0; i < units_.size(); ++i) {
     const Unit& u = units_[i];
@@ -441,6 +539,7 @@ struct DdsFleet::Impl {
   struct Arrival {
     std::size_t robot = 0;
     bool silent = false;
+    bool back = false;
     msg::Event event;
   };
   struct Link {
@@ -474,13 +573,16 @@ struct DdsFleet::Impl {
       l->task.emplace(*participant, ros_topic("tripodal/task", l->name), EndpointOptions{.kind = TopicKind::command, .qos = q});
       EndpointOptions eo{.kind = TopicKind::event};
       eo.on_status = [this, i](const StatusEvent& s) {
-        if (s.kind != StatusKind::liveliness_lost || s.current_count > 0) return;
+        const bool lost = s.kind == StatusKind::liveliness_lost && s.current_count == 0;
+        const bool regained =
+            (s.kind == StatusKind::liveliness_regained || s.kind == StatusKind::publication_matched) && s.current_count > 0;
+        if (!lost && !regained) return;
         std::lock_guard lock(inbox_mutex);
-        inbox.push_back({i, true, {}});
+        inbox.push_back({i, lost, regained, {}});
       };
       l->events.emplace(*participant, ros_topic("tripodal/events", l->name), eo, [this, i](const msg::Event& e) {
         std::lock_guard lock(inbox_mutex);
-        inbox.push_back({i, false, e});
+        inbox.push_back({i, false, false, e});
       });
       links.push_back(std::move(l));
     }
@@ -507,6 +609,8 @@ struct DdsFleet::Impl {
     for (const Arrival& a : arrived) {
       const std::string& name = links[a.robot]->name;
       if (a.silent) planner.robot_silent(name, "liveliness lost");
+      else if (a.back)
+        planner.robot_back(name);
       else planner.robot_event(name, a.event.kind, a.event.source, a.event.detail);
     }
     for (const FleetCommand& c : planner.poll()) {

@@ -55,6 +55,12 @@ void apply_security(dds_qos_t* qos, const SecurityFiles& f, const std::string& w
   for (const auto& p : {f.identity_ca, f.identity_certificate, f.private_key, f.permissions_ca, f.governance, f.permissions}) {
     if (!std::filesystem::is_regular_file(p)) throw DdsError(where + ": security file " + p.string() + " does not exist");
   }
+  if (!f.crl.empty() && !std::filesystem::is_regular_file(f.crl)) {
+    throw DdsError(where + ": security file " + f.crl.string() + " (the revocation list) does not exist");
+  }
+  // Cyclone says only "Error" of a malformed document: its place first.
+  check_security_document(f.governance, false);
+  check_security_document(f.permissions, true);
   const std::filesystem::path lib = security_plugin_dir();
   const auto file = [](const std::filesystem::path& p) { return "file:" + std::filesystem::absolute(p).string(); };
   const std::pair<const char*, std::string> props[] = {
@@ -75,6 +81,8 @@ void apply_security(dds_qos_t* qos, const SecurityFiles& f, const std::string& w
       {"dds.sec.access.permissions", file(f.permissions)},
   };
   for (const auto& [name, value] : props) dds_qset_prop(qos, name, value.c_str());
+  // Cyclone DDS 0.10's authentication takes a CRL under its own name (not in the OMG spec).
+  if (!f.crl.empty()) dds_qset_prop(qos, "org.eclipse.cyclonedds.sec.auth.crl", file(f.crl).c_str());
 }
 
 std::mutex domains_mutex;

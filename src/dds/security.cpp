@@ -3,13 +3,16 @@
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
+#include <tinyxml2.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <fstream>
+#include <iterator>
 #include <set>
 #include <stdexcept>
 
@@ -139,6 +142,7 @@ SecurityFiles fleet_identity(const fs::path& keys_dir, std::string_view identity
   const std::string name(identity);
   SecurityFiles f{keys_dir / "ca.pem", keys_dir / (name + ".pem"),  keys_dir / (name + "_key.pem"),
                   keys_dir / "ca.pem", keys_dir / "governance.p7s", keys_dir / (name + "_permissions.p7s")};
+  if (fs::is_regular_file(keys_dir / "crl.pem")) f.crl = keys_dir / "crl.pem";
   std::string missing;
   for (const fs::path& p : {f.identity_ca, f.identity_certificate, f.private_key, f.governance, f.permissions}) {
     if (!fs::is_regular_file(p)) missing += (missing.empty() ? "" : ", ") + p.string();
@@ -193,6 +197,136 @@ void make_fleet_keys(const FleetKeysOptions& o) {
                permissions_xml("CN=" + name + ",O=" + o.organisation, name, role, o.domain_id, o.valid_days));
     openssl(o.out, {"smime", "-sign", "-in", name + "_permissions.xml", "-text", "-out", name + "_permissions.p7s", "-signer",
                     "ca.pem", "-inkey", "ca_key.pem"});
+  }
+}
+
+void revoke_fleet_identity(const fs::path& keys_dir, std::string_view identity) {
+  const std::string name(identity);
+  const fs::path cert = keys_dir / (name + ".pem");
+  if (!fs::is_regular_file(keys_dir / "ca_key.pem")) {
+    throw DdsError("fleet keys: " + (keys_dir / "ca_key.pem").string() + " does not exist: revoking needs the CA's key");
+  }
+  if (!fs::is_regular_file(cert))
+    throw DdsError("fleet keys: " + cert.string() + " does not exist: no identity '" + name + "' to revoke");
+  // openssl ca's database: the revoked serials, from which each list is made.
+  const fs::path db = keys_dir / "ca_db";
+  fs::create_directories(db);
+  if (!fs::exists(db / "index.txt")) write_file(db / "index.txt", "");
+  if (!fs::exists(db / "crlnumber")) write_file(db / "crlnumber", "01\n");
+  write_file(db / "ca.cnf",
+             "# Made by tripodal fleet keys --revoke: the CA's database for its revocation list.\n"
+             "[ca]\ndefault_ca = fleet\n[fleet]\ndatabase = ca_db/index.txt\ncrlnumber = ca_db/crlnumber\n"
+             "certificate = ca.pem\nprivate_key = ca_key.pem\nnew_certs_dir = ca_db\ndefault_md = sha256\n"
+             "default_crl_days = 3650\npolicy = any\n[any]\ncommonName = supplied\norganizationName = optional\n");
+  openssl(keys_dir, {"ca", "-config", "ca_db/ca.cnf", "-revoke", name + ".pem"});
+  openssl(keys_dir, {"ca", "-config", "ca_db/ca.cnf", "-gencrl", "-out", "crl.pem"});
+}
+
+namespace {
+
+// The signed document's XML and the line of the file it starts on (S/MIME "-text": MIME headers,
+// then the text part's headers, a blank line, the document).
+struct SignedText {
+  std::string xml;
+  int first_line = 1;
+};
+
+std::string located(const fs::path& file, int line, const std::string& what) {
+  return file.string() + ":" + std::to_string(line) + ": error: " + what;
+}
+
+bool parse_date(const char* text) {
+  if (text == nullptr) return false;
+  std::tm tm{};
+  const char* end = strptime(text, "%Y-%m-%dT%H:%M:%S", &tm);
+  return end != nullptr && (*end == '\0' || *end == 'Z' || *end == '+' || *end == '-' || *end == '.');
+}
+
+std::time_t utc_time(const char* text) {
+  std::tm tm{};
+  strptime(text, "%Y-%m-%dT%H:%M:%S", &tm);
+  return timegm(&tm);
+}
+
+}  // namespace
+
+void check_security_document(const fs::path& file, bool permissions) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw DdsError(file.string() + ": error: cannot be read");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const char* kind = permissions ? "permissions" : "governance";
+  if (text.rfind("MIME-Version:", 0) != 0 || text.find("application/x-pkcs7-signature") == std::string::npos) {
+    throw DdsError(located(file, 1,
+                           std::string("the ") + kind +
+                               " document is not signed S/MIME: sign it with the permissions CA (`openssl smime -sign -text "
+                               "-signer ca.pem -inkey ca_key.pem`, as `tripodal fleet-keys` does)"));
+  }
+  SignedText doc;
+  const std::size_t start = text.find("<?xml") != std::string::npos ? text.find("<?xml") : text.find("<dds");
+  if (start == std::string::npos)
+    throw DdsError(located(file, 1, std::string("no XML document inside the signed ") + kind + " file"));
+  const std::size_t end = text.find("</dds>", start);
+  doc.xml = text.substr(start, end == std::string::npos ? std::string::npos : end + 6 - start);
+  doc.first_line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(start), '\n'));
+  tinyxml2::XMLDocument x;
+  if (x.Parse(doc.xml.c_str(), doc.xml.size()) != tinyxml2::XML_SUCCESS) {
+    throw DdsError(located(file, doc.first_line + std::max(x.ErrorLineNum(), 1) - 1,
+                           std::string("the ") + kind + " XML is not well formed: " + x.ErrorStr()));
+  }
+  std::vector<std::string> errors;
+  const auto line_of = [&](const tinyxml2::XMLElement* e) { return doc.first_line + e->GetLineNum() - 1; };
+  const auto need = [&](const tinyxml2::XMLElement* parent, const char* child) -> const tinyxml2::XMLElement* {
+    const tinyxml2::XMLElement* e = parent->FirstChildElement(child);
+    if (e == nullptr)
+      errors.push_back(located(file, line_of(parent), "<" + std::string(parent->Name()) + "> has no <" + child + ">"));
+    return e;
+  };
+  const tinyxml2::XMLElement* root = x.RootElement();
+  if (root == nullptr || std::string(root->Name()) != "dds") {
+    throw DdsError(located(file, root != nullptr ? line_of(root) : doc.first_line,
+                           std::string("the ") + kind + " document's root must be <dds>"));
+  }
+  if (!permissions) {
+    if (const auto* rules = need(root, "domain_access_rules")) {
+      if (rules->FirstChildElement("domain_rule") == nullptr)
+        errors.push_back(located(file, line_of(rules), "<domain_access_rules> has no <domain_rule>"));
+    }
+  } else if (const auto* perms = need(root, "permissions")) {
+    if (perms->FirstChildElement("grant") == nullptr)
+      errors.push_back(located(file, line_of(perms), "<permissions> has no <grant>"));
+    for (const auto* g = perms->FirstChildElement("grant"); g != nullptr; g = g->NextSiblingElement("grant")) {
+      if (g->Attribute("name") == nullptr) errors.push_back(located(file, line_of(g), "<grant> has no name attribute"));
+      if (const auto* subject = need(g, "subject_name"); subject != nullptr && (subject->GetText() == nullptr)) {
+        errors.push_back(located(file, line_of(subject),
+                                 "<subject_name> is empty: the certificate's subject, e.g. CN=robot1,O=tripodal fleet"));
+      }
+      if (const auto* v = need(g, "validity")) {
+        for (const char* bound : {"not_before", "not_after"}) {
+          const auto* b = need(v, bound);
+          if (b == nullptr) continue;
+          if (!parse_date(b->GetText())) {
+            errors.push_back(located(
+                file, line_of(b),
+                "<" + std::string(bound) + "> '" + (b->GetText() ? b->GetText() : "") + "' is not a date YYYY-MM-DDTHH:MM:SS"));
+          } else if (std::string(bound) == "not_after" && utc_time(b->GetText()) < std::time(nullptr)) {
+            errors.push_back(located(file, line_of(b), std::string("the permissions expired on ") + b->GetText() + " (UTC)"));
+          }
+        }
+      }
+      if (g->FirstChildElement("allow_rule") == nullptr && g->FirstChildElement("deny_rule") == nullptr) {
+        errors.push_back(located(file, line_of(g), "<grant> has neither <allow_rule> nor <deny_rule>"));
+      }
+      if (const auto* d = need(g, "default"); d != nullptr && d->GetText() != nullptr) {
+        const std::string v = d->GetText();
+        if (v != "ALLOW" && v != "DENY")
+          errors.push_back(located(file, line_of(d), "<default> is '" + v + "': expected ALLOW or DENY"));
+      }
+    }
+  }
+  if (!errors.empty()) {
+    std::string all;
+    for (const std::string& e : errors) all += (all.empty() ? "" : "\n") + e;
+    throw DdsError(all);
   }
 }
 

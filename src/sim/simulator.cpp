@@ -190,8 +190,23 @@ std::optional<std::size_t> Simulator::visitor_hit(const Pose2D& p) const noexcep
   return std::nullopt;
 }
 
+std::optional<std::size_t> Simulator::other_hit(const Pose2D& p) const noexcept {
+  for (std::size_t i = 0; i < others_.size(); ++i) {
+    if (distance({p.x_m, p.y_m}, others_[i].position) < others_[i].radius_m + world_.robot.radius_m) return i;
+  }
+  return std::nullopt;
+}
+
+void Simulator::set_other_bodies(std::span<const OtherBody> bodies) {
+  others_.assign(bodies.begin(), bodies.end());
+  for (const OtherBody& b : others_) {
+    min_robot_clearance_m_ =
+        std::min(min_robot_clearance_m_, distance({pose_.x_m, pose_.y_m}, b.position) - b.radius_m - world_.robot.radius_m);
+  }
+}
+
 bool Simulator::footprint_blocked(const Pose2D& p) const noexcept {
-  return solid_.disc_overlaps({p.x_m, p.y_m}, world_.robot.radius_m) || visitor_hit(p).has_value();
+  return solid_.disc_overlaps({p.x_m, p.y_m}, world_.robot.radius_m) || visitor_hit(p).has_value() || other_hit(p).has_value();
 }
 
 void Simulator::next_leg(std::size_t index) noexcept {
@@ -326,28 +341,31 @@ bool Simulator::led(std::string_view name) const noexcept {
 }
 
 void Simulator::add_visitors_to_scan(LaserScan& scan) const noexcept {
-  if (visitors_.empty()) return;
+  if (visitors_.empty() && others_.empty()) return;
   const LaserConfig& lc = world_.robot.laser;
   const double c = std::cos(pose_.theta_rad), s = std::sin(pose_.theta_rad);
   const navi::Point2D origin{pose_.x_m + c * lc.mount.x_m - s * lc.mount.y_m, pose_.y_m + s * lc.mount.x_m + c * lc.mount.y_m};
   const double heading = pose_.theta_rad + lc.mount.theta_rad;
+  for (std::size_t k = 0; k < visitors_.size(); ++k)
+    add_disc_to_scan(scan, origin, heading, visitors_[k].position, world_.visitors[k].radius_m);
+  for (const OtherBody& b : others_) add_disc_to_scan(scan, origin, heading, b.position, b.radius_m);
+}
+
+void Simulator::add_disc_to_scan(LaserScan& scan, navi::Point2D origin, double heading, navi::Point2D p,
+                                 double r) const noexcept {
   const double reach = scan.range_max_m;
-  for (std::size_t k = 0; k < visitors_.size(); ++k) {
-    const navi::Point2D p = visitors_[k].position;
-    const double r = world_.visitors[k].radius_m;
-    const double d = distance(origin, p);
-    if (d - r > reach) continue;
-    // Only the beams within the visitor's angular extent can hit it.
-    const double centre = std::atan2(p.y_m - origin.y_m, p.x_m - origin.x_m) - heading;
-    const double half = d > r ? std::asin(r / d) : std::numbers::pi;
-    for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
-      const double a = scan.angle_min_rad + static_cast<double>(i) * scan.angle_increment_rad;
-      if (std::abs(wrap_angle(a - centre)) > half + 1e-9) continue;
-      const double range = ray_circle(origin, std::cos(heading + a), std::sin(heading + a), p, r);
-      if (range < scan.range_min_m || range > reach) continue;
-      const auto f = static_cast<float>(range);
-      if (!(scan.ranges_m[i] <= f)) scan.ranges_m[i] = f;  // an inf or a farther wall: the visitor
-    }
+  const double d = distance(origin, p);
+  if (d - r > reach) return;
+  // Only the beams within the disc's angular extent can hit it.
+  const double centre = std::atan2(p.y_m - origin.y_m, p.x_m - origin.x_m) - heading;
+  const double half = d > r ? std::asin(r / d) : std::numbers::pi;
+  for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
+    const double a = scan.angle_min_rad + static_cast<double>(i) * scan.angle_increment_rad;
+    if (std::abs(wrap_angle(a - centre)) > half + 1e-9) continue;
+    const double range = ray_circle(origin, std::cos(heading + a), std::sin(heading + a), p, r);
+    if (range < scan.range_min_m || range > reach) continue;
+    const auto f = static_cast<float>(range);
+    if (!(scan.ranges_m[i] <= f)) scan.ranges_m[i] = f;  // an inf or a farther wall: the disc
   }
 }
 
@@ -438,7 +456,11 @@ void Simulator::substep(Duration dt) noexcept {
         ++collisions_;
         char where[96];
         const Pose2D touching = integrate_body_displacement(pose_, dx * hi, dy * hi, dth * hi);
-        if (const auto v = visitor_hit(touching); v && !solid_.disc_overlaps({touching.x_m, touching.y_m}, rc.radius_m)) {
+        if (const auto o = other_hit(touching); o && !solid_.disc_overlaps({touching.x_m, touching.y_m}, rc.radius_m)) {
+          ++robot_collisions_;
+          std::snprintf(where, sizeof where, "with robot %u at (%.2f, %.2f)", static_cast<unsigned>(others_[*o].id), pose_.x_m,
+                        pose_.y_m);
+        } else if (const auto v = visitor_hit(touching); v && !solid_.disc_overlaps({touching.x_m, touching.y_m}, rc.radius_m)) {
           ++visitor_collisions_;
           std::snprintf(where, sizeof where, "with %s at (%.2f, %.2f)", world_.visitors[*v].name.c_str(), pose_.x_m, pose_.y_m);
         } else if (touches_sonar_only(touching)) {
@@ -459,6 +481,10 @@ void Simulator::substep(Duration dt) noexcept {
     rotation_rad_ += std::abs(actual.wz_rad_s) * h;
   }
   velocity_ = blocked_ ? Twist2D{} : actual;
+  for (const OtherBody& o : others_) {
+    min_robot_clearance_m_ =
+        std::min(min_robot_clearance_m_, distance({pose_.x_m, pose_.y_m}, o.position) - o.radius_m - rc.radius_m);
+  }
   move_visitors(h);
   move_joints(h);
 
@@ -715,6 +741,17 @@ void Simulator::update_bumpers() noexcept {
     if (k >= bc.sectors) k = bc.sectors - 1;
     mask |= 1U << k;
   }
+  // Other robots likewise.
+  for (const OtherBody& o : others_) {
+    const double gap = distance(o.position, {pose_.x_m, pose_.y_m}) - o.radius_m - world_.robot.radius_m;
+    if (gap >= bc.contact_margin_m) continue;
+    const double a = std::atan2(o.position.y_m - pose_.y_m, o.position.x_m - pose_.x_m) - pose_.theta_rad + 0.5 * sector;
+    double wrapped = std::fmod(a, 2.0 * std::numbers::pi);
+    if (wrapped < 0.0) wrapped += 2.0 * std::numbers::pi;
+    auto k = static_cast<std::uint32_t>(wrapped / sector);
+    if (k >= bc.sectors) k = bc.sectors - 1;
+    mask |= 1U << k;
+  }
   BumperReading& b = bumpers_.edit();
   b.stamp = now_;
   b.count = bc.sectors;
@@ -808,6 +845,40 @@ std::size_t SimRunner::run_until(Time until) noexcept {
     if (pacer_ != nullptr) pacer_->pace(t);
   }
   return cycles;
+}
+
+std::vector<Pose2D> fleet_start_poses(const World& world, std::size_t n, double gap_m) {
+  std::vector<Pose2D> poses;
+  if (n == 0) return poses;
+  poses.push_back(world.start_pose);
+  const SolidMap solid(world.grid);
+  const double r = world.robot.radius_m;
+  const double spacing = 2.0 * r + gap_m;
+  struct Candidate {
+    double d;
+    Pose2D pose;
+  };
+  std::vector<Candidate> candidates;
+  constexpr int kRings = 12;
+  for (int i = -kRings; i <= kRings; ++i) {
+    for (int j = -kRings; j <= kRings; ++j) {
+      if (i == 0 && j == 0) continue;
+      const Pose2D p{world.start_pose.x_m + i * spacing, world.start_pose.y_m + j * spacing, world.start_pose.theta_rad};
+      candidates.push_back({std::hypot(i, j) + 1e-3 * (i + kRings) + 1e-6 * (j + kRings), p});  // ties broken in a fixed order
+    }
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) { return a.d < b.d; });
+  for (const Candidate& c : candidates) {
+    if (poses.size() == n) break;
+    if (solid.disc_overlaps({c.pose.x_m, c.pose.y_m}, r + 0.5 * gap_m)) continue;
+    poses.push_back(c.pose);
+  }
+  if (poses.size() < n) {
+    throw ConfigError(
+        SourceLocation{world.file.string(), 1, 1},
+        "no room for " + std::to_string(n) + " robots around the start pose (found " + std::to_string(poses.size()) + ")");
+  }
+  return poses;
 }
 
 }  // namespace tripodal::sim

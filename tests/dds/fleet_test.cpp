@@ -269,6 +269,126 @@ TEST_CASE("fleet: an idle robot is paused, and resumed before a unit reassigned 
   CHECK(cmds[1].id > cmds[0].id);
 }
 
+TEST_CASE("fleet: a robot silent for less than the grace time keeps its units, then loses them") {
+  SimClock clock;
+  FleetOptions o;
+  o.silence_grace = 10s;
+  o.pause_idle = false;
+  o.take_when_idle = false;
+  FleetPlanner p(robots_at_origin(2), {unit("A", 100), unit("B", 60), unit("C", 50)}, clock, o);
+  p.robot_ready("robot1");
+  p.robot_ready("robot2");
+  for (const FleetCommand& c : p.poll()) accept(p, c);
+  CHECK(p.queue_of("robot2") == std::vector<std::string>{"B", "C"});
+  p.robot_silent("robot2", "liveliness lost");
+  clock.advance(9s);
+  CHECK(p.poll().empty());
+  CHECK(p.alive("robot2"));
+  CHECK(p.queue_of("robot2") == std::vector<std::string>{"B", "C"});
+  p.robot_back("robot2");  // a partition of 9 s: nothing changes
+  clock.advance(5s);
+  CHECK(p.poll().empty());
+  CHECK(p.queue_of("robot2") == std::vector<std::string>{"B", "C"});
+  p.robot_silent("robot2", "liveliness lost");
+  clock.advance(10s);
+  CHECK(p.poll().empty());  // robot1 still busy with A
+  CHECK_FALSE(p.alive("robot2"));
+  CHECK(p.queue_of("robot1") == std::vector<std::string>{"A", "B", "C"});
+  const FleetResult r = p.result();
+  REQUIRE(r.reassignments.size() == 2);
+  CHECK(r.reassignments[0].at_s == Approx(24.0));
+}
+
+TEST_CASE("fleet: a robot back from a partition keeps the unit it had in hand, and no unit is done twice") {
+  SimClock clock;
+  FleetOptions o;
+  o.silence_grace = 2s;
+  o.pause_idle = false;
+  o.take_when_idle = false;  // who does C is not this test's matter
+  // A 100 to robot1; B 60 and C 50 to robot2.
+  FleetPlanner p(robots_at_origin(2), {unit("A", 100), unit("B", 60), unit("C", 50)}, clock, o);
+  p.robot_ready("robot1");
+  p.robot_ready("robot2");
+  for (const FleetCommand& c : p.poll()) accept(p, c);
+  clock.advance(10s);
+  p.robot_silent("robot1", "liveliness lost");
+  clock.advance(2s);
+  (void)p.take_log();
+  CHECK(p.poll().empty());
+  CHECK(p.queue_of("robot2") == std::vector<std::string>{"B", "C", "A"});
+
+  SECTION("back before the other began it: taken back from its queue") {
+    clock.advance(20s);
+    p.robot_back("robot1");
+    CHECK(p.alive("robot1"));
+    CHECK(p.queue_of("robot1") == std::vector<std::string>{"A"});
+    CHECK(p.queue_of("robot2") == std::vector<std::string>{"B", "C"});
+    CHECK(p.poll().empty());  // robot1 is not sent A again: it is on it
+    succeed(p, "robot1", "clean the section A");
+    succeed(p, "robot2", "clean the section B");
+    for (const FleetCommand& c : p.poll()) accept(p, c);
+    succeed(p, "robot2", "clean the section C");
+    REQUIRE(p.finished());
+    const FleetResult r = p.result();
+    CHECK(r.succeeded);
+    CHECK(r.units[0].robot == "robot1");
+    CHECK(r.done_twice == 0);
+    CHECK(r.cancelled == 0);
+    REQUIRE(r.back.size() == 1);
+    CHECK(r.back[0] == "robot1 at 32.0 s (silent 22.0 s)");
+    CHECK(r.reassignments.back().reason == "robot1 is back with it in hand");
+  }
+  SECTION("both on it: the first to finish keeps it, the other is told to cancel") {
+    succeed(p, "robot2", "clean the section B");
+    for (const FleetCommand& c : p.poll()) accept(p, c);
+    succeed(p, "robot2", "clean the section C");
+    std::vector<FleetCommand> cmds = p.poll();
+    REQUIRE(cmds.size() == 1);
+    CHECK(cmds[0].unit == "A");
+    accept(p, cmds[0]);
+    p.robot_back("robot1");
+    succeed(p, "robot1", "clean the section A");
+    cmds = p.poll();
+    REQUIRE(cmds.size() == 1);
+    CHECK(cmds[0].robot == "robot2");
+    CHECK(cmds[0].command == "cancel");
+    p.robot_event("robot2", "task_failed", "planner", "clean the section A: cancelled");  // its answer: no effect
+    REQUIRE(p.finished());
+    const FleetResult r = p.result();
+    CHECK(r.succeeded);
+    CHECK(r.units[0].robot == "robot1");
+    CHECK(r.done_twice == 0);
+    CHECK(r.cancelled == 1);
+  }
+  SECTION("the other finished it first: the returning robot's success is counted as work done twice") {
+    succeed(p, "robot2", "clean the section B");
+    for (const FleetCommand& c : p.poll()) accept(p, c);
+    succeed(p, "robot2", "clean the section C");
+    for (const FleetCommand& c : p.poll()) accept(p, c);
+    succeed(p, "robot2", "clean the section A");
+    p.robot_back("robot1");
+    succeed(p, "robot1", "clean the section A");
+    const FleetResult r = p.result();
+    CHECK(r.succeeded);
+    CHECK(r.units[0].robot == "robot2");
+    CHECK(r.done_twice == 1);
+    CHECK_THAT(r.text(), Catch::Contains("work done twice: 1 units"));
+  }
+}
+
+TEST_CASE("fleet: a robot whose process ended is not back") {
+  SimClock clock;
+  FleetPlanner p(robots_at_origin(2), {unit("A", 100), unit("B", 60)}, clock);
+  p.robot_ready("robot1");
+  p.robot_ready("robot2");
+  for (const FleetCommand& c : p.poll()) accept(p, c);
+  p.robot_gone("robot1");
+  p.robot_silent("robot1", "liveliness lost");
+  p.robot_back("robot1");
+  CHECK_FALSE(p.alive("robot1"));
+  CHECK(p.queue_of("robot2") == std::vector<std::string>{"B", "A"});
+}
+
 TEST_CASE("fleet: when every robot is silent the fleet ends without the rest") {
   SimClock clock;
   FleetPlanner p(robots_at_origin(2), {unit("A", 1), unit("B", 1)}, clock);

@@ -4,9 +4,12 @@
 // whose certificate another CA signed; an observer may read but not write.
 #include "tripodal/dds/security.hpp"
 
+#include <algorithm>
 #include <catch2/catch.hpp>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "child_process.hpp"
@@ -145,4 +148,148 @@ TEST_CASE("security: missing or malformed security files are refused naming the 
   o = secured(fleet, "robot1");
   o.security->permissions = bad;
   CHECK_THROWS_AS(Participant(o), DdsError);
+}
+
+namespace {
+
+// Runs a shell command line (openssl), failing the test with its output when it fails.
+void sh(const std::string& command) {
+  const std::string log = (keys() / "sh.log").string();
+  const int rc = std::system((command + " >" + log + " 2>&1").c_str());
+  std::ifstream in(log);
+  const std::string out((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  INFO(command << "\n" << out);
+  REQUIRE(rc == 0);
+}
+
+// A copy of the fleet's keys folder, to change without touching the other tests' keys.
+fs::path copy_of_fleet(const std::string& name) {
+  const fs::path to = keys() / name;
+  fs::remove_all(to);
+  fs::copy(keys() / "fleet", to, fs::copy_options::recursive);
+  return to;
+}
+
+std::string text_of(const fs::path& file) {
+  std::ifstream in(file);
+  return {(std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()};
+}
+
+// The line (from 1) of the first occurrence of `needle` in `text`.
+int line_of(const std::string& text, const std::string& needle) {
+  const std::size_t at = text.find(needle);
+  REQUIRE(at != std::string::npos);
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+}
+
+}  // namespace
+
+TEST_CASE("security: an expired certificate of the fleet's own CA is refused") {
+  // The operator's identity again, its certificate signed by the fleet's CA but valid in January
+  // 2020 only (openssl ca with explicit dates).
+  const fs::path dir = copy_of_fleet("expired");
+  sh("cd '" + dir.string() +
+     "' && openssl req -new -key operator_key.pem -out operator.csr -subj '/CN=operator/O=tripodal fleet'"
+     " && mkdir -p exp_db && : > exp_db/index.txt && echo 1000 > exp_db/serial"
+     " && printf '[ca]\\ndefault_ca = x\\n[x]\\ndatabase = exp_db/index.txt\\nnew_certs_dir = exp_db\\nserial = exp_db/serial\\n"
+     "default_md = sha256\\npolicy = any\\n[any]\\ncommonName = supplied\\norganizationName = optional\\n' > exp_db/ca.cnf"
+     " && openssl ca -batch -config exp_db/ca.cnf -cert ca.pem -keyfile ca_key.pem -startdate 20200101000000Z"
+     " -enddate 20200201000000Z -in operator.csr -out operator.pem -notext");
+  // In this process: Cyclone refuses to create the participant.
+  CHECK_THROWS_AS(Participant(secured(dir, "operator")), DdsError);
+  // From another process against a secured robot: the peer cannot join (it fails or matches
+  // nothing), and nothing arrives.
+  const std::string topic = ros_topic("cmd_vel", test_namespace() + "_expired");
+  Participant robot(secured(keys() / "fleet", "robot1"));
+  Subscriber<msg::Twist> cmd_vel(robot, topic, {.kind = TopicKind::command});
+  ChildProcess peer(TRIPODAL_DDS_PEER, {"cmd-vel", std::to_string(test_domain(kDomainNumber)), test_namespace() + "_expired", "3",
+                                        dir.string(), "operator"});
+  CHECK(peer.wait(20s) != 0);
+  CHECK_FALSE(cmd_vel.take_one(500ms).has_value());
+}
+
+TEST_CASE("security: a revoked certificate is refused by a robot that has the CA's revocation list") {
+  // A robot's keys with the operator revoked (revoke_fleet_identity: crl.pem beside the keys,
+  // which fleet_identity hands the participant); the operator still has its old keys folder.
+  const fs::path robot_keys = copy_of_fleet("revoking");
+  revoke_fleet_identity(robot_keys, "operator");
+  REQUIRE(fs::is_regular_file(robot_keys / "crl.pem"));
+  CHECK(fleet_identity(robot_keys, "robot1").crl == robot_keys / "crl.pem");
+  CHECK(fleet_identity(keys() / "fleet", "robot1").crl.empty());
+  CHECK_THROWS_WITH(revoke_fleet_identity(robot_keys, "nobody"), Catch::Contains("nobody.pem does not exist"));
+
+  const std::string ns = test_namespace() + "_revoked";
+  const std::string topic = ros_topic("cmd_vel", ns);
+  Participant robot(secured(robot_keys, "robot1"));
+  Subscriber<msg::Twist> cmd_vel(robot, topic, {.kind = TopicKind::command});
+  {
+    ChildProcess revoked(TRIPODAL_DDS_PEER, {"cmd-vel", std::to_string(test_domain(kDomainNumber)), ns, "3",
+                                             (keys() / "fleet").string(), "operator"});
+    CHECK(revoked.wait(20s) == 3);  // matched nothing: the robot refused its certificate
+    CHECK_FALSE(cmd_vel.take_one(500ms).has_value());
+  }
+  {
+    // An identity the list does not name, same CA, is still heard by the same robot.
+    ChildProcess fine(TRIPODAL_DDS_PEER,
+                      {"cmd-vel", std::to_string(test_domain(kDomainNumber)), ns, "2", (keys() / "fleet").string(), "robot1"});
+    CHECK(fine.wait(20s) == 0);
+    CHECK(cmd_vel.take_one(2s).has_value());
+  }
+}
+
+TEST_CASE("security: malformed governance and permissions documents are refused with their lines") {
+  const fs::path dir = copy_of_fleet("malformed");
+  const std::string good = text_of(dir / "robot1_permissions.p7s");
+  const auto refused = [&](const std::string& text) -> std::string {
+    std::ofstream(dir / "robot1_permissions.p7s") << text;
+    try {
+      Participant p(secured(dir, "robot1"));
+    } catch (const DdsError& e) {
+      return e.what();
+    }
+    FAIL("the participant was created");
+    return {};
+  };
+  const std::string file = (dir / "robot1_permissions.p7s").string();
+  {
+    // A tag left open: XML not well formed, at its line.
+    std::string t = good;
+    t.replace(t.find("</subject_name>"), 15, "</subject>");
+    const std::string msg = refused(t);
+    CHECK_THAT(msg, Catch::StartsWith(file + ":" + std::to_string(line_of(t, "</subject>")) +
+                                      ": error: the permissions XML is not well formed"));
+  }
+  {
+    // Every problem at once: a validity that ended, a date that does not parse, a bad default.
+    std::string t = good;
+    const std::size_t nb = t.find("<not_before>") + 12;
+    t.replace(nb, t.find("</not_before>") - nb, "yesterday");
+    const std::size_t na = t.find("<not_after>") + 11;
+    t.replace(na, t.find("</not_after>") - na, "2020-02-01T00:00:00");
+    t.replace(t.find("<default>DENY"), 13, "<default>MAYBE");
+    const std::string msg = refused(t);
+    const std::string at_validity = file + ":" + std::to_string(line_of(t, "<not_after>")) + ": error: ";
+    CHECK_THAT(msg, Catch::Contains(at_validity + "<not_before> 'yesterday' is not a date YYYY-MM-DDTHH:MM:SS"));
+    CHECK_THAT(msg, Catch::Contains(at_validity + "the permissions expired on 2020-02-01T00:00:00 (UTC)"));
+    CHECK_THAT(msg, Catch::Contains(file + ":" + std::to_string(line_of(t, "<default>")) +
+                                    ": error: <default> is 'MAYBE': expected ALLOW or DENY"));
+  }
+  {
+    // A grant without its subject.
+    std::string t = good;
+    const std::size_t s = t.find("      <subject_name>");
+    t.erase(s, t.find('\n', s) + 1 - s);
+    CHECK_THAT(refused(t),
+               Catch::Contains(file + ":" + std::to_string(line_of(t, "<grant")) + ": error: <grant> has no <subject_name>"));
+  }
+  std::ofstream(dir / "robot1_permissions.p7s") << good;
+  // A governance document without its signature.
+  std::ofstream(dir / "governance.p7s") << "<dds>\n  <domain_access_rules/>\n</dds>\n";
+  try {
+    Participant p(secured(dir, "robot1"));
+    FAIL("created");
+  } catch (const DdsError& e) {
+    CHECK_THAT(std::string(e.what()),
+               Catch::StartsWith((dir / "governance.p7s").string() + ":1: error: the governance document is not signed S/MIME"));
+  }
 }

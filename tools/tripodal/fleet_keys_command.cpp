@@ -20,7 +20,9 @@ constexpr std::string_view kDescription =
     "encrypted) and NAME_permissions.p7s (robots and operators publish and subscribe every topic of\n"
     "the domain, observers only subscribe). A robot uses them from its profile's dds section\n"
     "(security: {keys: DIR, identity: NAME}). An identity that exists in DIR is refused, not\n"
-    "overwritten. Keep ca_key.pem off the robots.";
+    "overwritten. Keep ca_key.pem off the robots. --revoke NAME adds NAME's certificate to the CA's\n"
+    "revocation list DIR/crl.pem, which every participant using DIR then checks peers against (copy\n"
+    "it to the robots).";
 
 constexpr std::string_view kExitCodes =
     "exit codes: 0 ok, 1 a name is refused, 2 bad command line, 3 openssl failed or DIR is not writable";
@@ -30,7 +32,20 @@ struct Args {
   std::vector<std::string> robots, operators, observers;
   unsigned domain = 0;
   int days = 365;
+  std::vector<std::string> revoke;
 };
+
+int revoke(const Args& a, std::ostream& out, std::ostream& err) {
+  try {
+    for (const std::string& n : a.revoke) dds::revoke_fleet_identity(a.out, n);
+  } catch (const std::exception& e) {
+    err << "tripodal fleet-keys: " << e.what() << '\n';
+    return kIoError;
+  }
+  out << "revoked " << a.revoke.size() << (a.revoke.size() == 1 ? " identity" : " identities") << "; revocation list " << a.out
+      << "/crl.pem\n";
+  return kOk;
+}
 
 int make(const Args& a, std::ostream& out, std::ostream& err) {
   dds::FleetKeysOptions o;
@@ -65,7 +80,15 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_option("--days", a->days, "N: how long the certificates and permissions are valid")
       ->check(CLI::Range(1, 36500))
       ->capture_default_str();
+  cmd.add_option("--revoke", a->revoke, "NAME: revoke the identity NAME of DIR (its certificate on DIR/crl.pem; repeatable)");
   return [a](std::ostream& out, std::ostream& err) {
+    if (!a->revoke.empty()) {
+      if (!a->robots.empty() || !a->operators.empty() || !a->observers.empty()) {
+        err << "tripodal fleet-keys: --revoke goes alone, not with new identities\n";
+        return static_cast<int>(kUsage);
+      }
+      return revoke(*a, out, err);
+    }
     if (a->robots.empty() && a->operators.empty() && a->observers.empty()) {
       err << "tripodal fleet-keys: give at least one identity (--robot, --operator or --observer)\n";
       return static_cast<int>(kUsage);

@@ -17,6 +17,7 @@
 #include "cli_tool.hpp"
 #include "run_outputs.hpp"
 #include "run_task.hpp"
+#include "sim_server_shared.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/dds/dds_hardware.hpp"
@@ -59,6 +60,8 @@ struct Args {
   double lease_s = 2.0;
   double wait_s = 0.0;
   bool system_network = false;
+  std::optional<int> robots;  // --robots N: one world for N lock-step robots
+  double stall_s = 0.2;
   CLI::Option* realtime = nullptr;  // given at all (with or without SPEED)
   double realtime_speed = 0.0;      // 0: --realtime without SPEED
 };
@@ -88,6 +91,23 @@ std::vector<std::string> wheel_names(std::size_t n) {
 }
 
 int run(const Args& a, std::ostream& out, std::ostream& err) {
+  if (a.robots) {
+    if (a.realtime->count() > 0) {
+      err << "tripodal sim-server: --robots serves lock-step robots; --realtime serves one\n";
+      return kUsage;
+    }
+    return run_shared_world(SharedWorldArgs{.robot = a.robot,
+                                            .world = a.world,
+                                            .robots = *a.robots,
+                                            .prefix = a.ros_namespace.empty() ? "robot" : a.ros_namespace,
+                                            .domain = a.domain,
+                                            .seed = a.seed,
+                                            .lease_s = a.lease_s,
+                                            .wait_s = a.wait_s,
+                                            .stall_s = a.stall_s,
+                                            .system_network = a.system_network},
+                            out, err);
+  }
   for (const auto& f : {a.robot, a.world}) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(f, ec)) {
@@ -322,6 +342,14 @@ cli::Action setup(CLI::App& cmd) {
                                "(for ROS 2 tools; no lock-step)")
                     ->expected(0, 1)
                     ->check(cli::positive_number() | CLI::IsMember({"", "true"}));
+  cmd.add_option("--robots", a->robots,
+                 "N: one world for N lock-step robots on namespaces NS1..NSN (NS: --namespace, default robot), each "
+                 "seeing the others in its laser and stopped by them; robots come and go while it runs")
+      ->check(CLI::Range(1, 16));
+  cmd.add_option("--stall-s", a->stall_s,
+                 "S: with --robots, the wall time a round waits for a robot before stepping the others without it")
+      ->check(cli::positive_number())
+      ->capture_default_str();
   cmd.add_flag("--system-network", a->system_network,
                "Cyclone DDS's own network configuration instead of loopback only");
   return [a](std::ostream& out, std::ostream& err) { return run(*a, out, err); };

@@ -45,7 +45,7 @@ struct FleetRobot {
 struct FleetCommand {
   std::string robot;
   std::uint32_t id = 0;
-  std::string command;  ///< "start", "pause" or "resume"
+  std::string command;  ///< "start", "pause", "resume" or "cancel"
   std::string task;
   std::string unit;
 };
@@ -71,6 +71,9 @@ struct FleetResult {
   std::vector<FleetUnitResult> units;
   std::vector<FleetReassignment> reassignments;
   std::vector<std::string> silent;  ///< "robot3 at 12.4 s: liveliness lost"
+  std::vector<std::string> back;    ///< "robot3 at 40.1 s (silent 30.2 s)": robots that came back
+  std::size_t done_twice = 0;       ///< units a second robot also finished (target 0)
+  std::size_t cancelled = 0;        ///< units a robot was told to stop because another finished it first
   double duration_s = 0.0;
   [[nodiscard]] std::size_t done() const noexcept;
   /// One line per unit, reassignment and silent robot, and a summary line.
@@ -92,6 +95,9 @@ struct FleetOptions {
   /// the robot with the most area not begun (a reassignment too): the balance made at the start
   /// or at a silence is by area, not by how fast each robot turns out to be.
   bool take_when_idle = true;
+  /// How long a silent robot keeps its units before they go to the others: a robot that is back
+  /// within it (a short network partition) goes on as if nothing happened. 0: at once.
+  Duration silence_grace{0};
 };
 
 /// The fleet's logic, fed by its caller (DdsFleet, or a test): which robot is ready, what each
@@ -111,6 +117,14 @@ class FleetPlanner {
   /// The robot went silent (its liveliness lost, its process gone): its unit in hand and those it
   /// had not begun go to the robots still alive.
   void robot_silent(std::string_view robot, std::string_view reason);
+  /// The robot is heard again (its liveliness regained after a partition). Within the grace time
+  /// nothing changes. After it, the robot is used again: the unit it had in hand (it went on with
+  /// it, unaware) is taken back from the robot it was given to when that one has not begun it;
+  /// when both run it, the first to finish it keeps it and the other is told to cancel. A robot
+  /// whose process ended is not back.
+  void robot_back(std::string_view robot);
+  /// The robot's process ended: it will not be back.
+  void robot_gone(std::string_view robot);
 
   /// The commands to send now: the next unit of each ready robot without one in hand (after a
   /// "resume" when it was paused; one taken from another's queue when it has none,
@@ -144,6 +158,10 @@ class FleetPlanner {
   void finish_unit(Robot& r, bool ok, std::string_view detail);
   void redistribute(std::vector<std::size_t> units, const std::string& from, const std::string& reason);
   void take_queued(Robot& idle);
+  void declare_silent(Robot& r);
+  std::size_t done_twice_ = 0, cancelled_ = 0;
+  std::vector<std::string> back_;
+  std::vector<FleetCommand> pending_;  // commands decided outside poll() (a cancel), sent by the next poll()
 
   const Clock& clock_;
   FleetOptions options_;

@@ -22,6 +22,7 @@ struct SecurityFiles {
   std::filesystem::path permissions_ca;        ///< the CA that signed governance and permissions
   std::filesystem::path governance;            ///< signed governance document (S/MIME)
   std::filesystem::path permissions;           ///< this identity's signed permissions (S/MIME)
+  std::filesystem::path crl;                   ///< the CA's revocation list (PEM); empty: none
 };
 
 /// The files of `identity` in a keys directory made by make_fleet_keys. Throws DdsError naming
@@ -47,6 +48,19 @@ struct FleetKeysOptions {
 /// Reuses ca.pem if the directory has one. Throws DdsError with openssl's message when a step
 /// fails, std::invalid_argument for a name that is not a ROS 2 name or given twice.
 void make_fleet_keys(const FleetKeysOptions& options);
+
+/// Revokes `identity`'s certificate: adds it to the CA's revocation list, keys_dir/crl.pem (made
+/// or renewed with `openssl ca -revoke` and `-gencrl`, the CA's database in keys_dir/ca_db/), which
+/// fleet_identity() hands every participant from then on: Cyclone DDS's authentication refuses a
+/// peer whose certificate the list names. Copy crl.pem to every robot. Throws DdsError naming the
+/// file or openssl's message.
+void revoke_fleet_identity(const std::filesystem::path& keys_dir, std::string_view identity);
+
+/// Checks a signed governance or permissions document before Cyclone DDS reads it, so that a
+/// malformed one is refused with its place: every problem as "FILE:LINE: error: WHAT" (not S/MIME,
+/// XML not well formed, a missing or misplaced element, a date that does not parse, permissions
+/// whose validity ended), all of them in one DdsError. Does not check the signature (Cyclone does).
+void check_security_document(const std::filesystem::path& file, bool permissions);
 
 /// Where Cyclone DDS's security plugins are (libdds_security_auth.so ...): $TRIPODAL_DDS_SECURITY_DIR,
 /// or Debian's /usr/lib/<multiarch>/libddsc0debian. Throws DdsError when they are not there.

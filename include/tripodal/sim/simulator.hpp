@@ -58,6 +58,14 @@ struct VisitorState {
   bool giving_way = false; ///< it would come closer to the robot than give_way_m: it waits
 };
 
+/// Another robot of a shared world (`tripodal sim-server --robots N` steps one Simulator per robot
+/// and tells each where the others are): a disc its laser sees and its footprint and bumpers touch.
+struct OtherBody {
+  navi::Point2D position;
+  double radius_m = 0.0;
+  std::uint32_t id = 0;  ///< the server's robot number, named in a collision's detail ("robot 2")
+};
+
 /// A simulated joint (World robot.joints) now.
 struct JointState {
   double position_rad = 0.0;
@@ -162,6 +170,15 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   /// without visitors).
   [[nodiscard]] double min_visitor_clearance_m() const noexcept { return min_visitor_clearance_m_; }
 
+  /// The other robots of a shared world where they are now, until the next call (copied; once the
+  /// storage has grown to the fleet's size no call allocates). They stop this robot as walls do,
+  /// show in its scans and press its bumpers; they do not move by this robot's pushing.
+  void set_other_bodies(std::span<const OtherBody> bodies);
+  /// Contacts of the footprint with another robot (counted in collisions() too).
+  [[nodiscard]] std::uint64_t robot_collisions() const noexcept { return robot_collisions_; }
+  /// The smallest gap between this robot's footprint and another robot's so far (m; +inf alone).
+  [[nodiscard]] double min_robot_clearance_m() const noexcept { return min_robot_clearance_m_; }
+
   /// The joints now, in World robot.joints order; index_of_joint(name) or nullopt.
   [[nodiscard]] const std::vector<JointState>& joints() const noexcept { return joints_; }
   [[nodiscard]] std::optional<std::size_t> joint_index(std::string_view name) const noexcept;
@@ -210,6 +227,9 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   void move_visitors(double h) noexcept;
   void move_joints(double h) noexcept;
   void add_visitors_to_scan(LaserScan& scan) const noexcept;
+  void add_disc_to_scan(LaserScan& scan, navi::Point2D origin, double heading, navi::Point2D centre,
+                        double radius_m) const noexcept;
+  [[nodiscard]] std::optional<std::size_t> other_hit(const Pose2D& p) const noexcept;
   [[nodiscard]] bool footprint_blocked(const Pose2D& p) const noexcept;
   [[nodiscard]] std::optional<std::size_t> visitor_hit(const Pose2D& p) const noexcept;
   struct VisitorWalk {
@@ -281,10 +301,20 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   std::vector<VisitorWalk> walks_;
   std::uint64_t visitor_collisions_ = 0;
   double min_visitor_clearance_m_ = std::numeric_limits<double>::infinity();
+  std::vector<OtherBody> others_;
+  std::uint64_t robot_collisions_ = 0;
+  double min_robot_clearance_m_ = std::numeric_limits<double>::infinity();
   std::vector<JointState> joints_;
   std::vector<std::uint8_t> leds_;
   std::vector<std::string> presses_;
 };
+
+/// Where n robots of one shared world start: robot 1 at world.start_pose, the others on a grid of
+/// spacing 2 radius + gap_m around it, nearest first, each on free floor with gap_m / 2 to spare
+/// from the static map, all with the start pose's heading. `tripodal sim-server --robots N` and
+/// `tripodal fleet --shared-world` compute the same poses from the same world. Throws ConfigError
+/// (at the world file) when the map has no room for n.
+[[nodiscard]] std::vector<Pose2D> fleet_start_poses(const World& world, std::size_t n, double gap_m = 0.4);
 
 /// Paces a simulation to wall time (for --realtime): pace(t) sleeps on `wall` until the wall
 /// time elapsed since the first call is (t - t_first) / speed. Uses only the Clock interface.

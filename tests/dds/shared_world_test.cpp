@@ -1,0 +1,173 @@
+// `tripodal sim-server --robots N`: one world stepped for several lock-step robots. The server is a
+// process of its own; this test is its robots (one set of lock-step endpoints per robot, as the
+// hardware "dds" has), and checks that each sees the others in its laser, is stopped by them, and
+// that robots join and leave while the others run.
+#include <catch2/catch.hpp>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <numbers>
+#include <optional>
+#include <regex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "child_process.hpp"
+#include "dds_test_support.hpp"
+#include "tripodal/dds/dds_hardware.hpp"
+#include "tripodal/dds/endpoint.hpp"
+#include "tripodal/dds/qos.hpp"
+
+using namespace tripodal::dds;
+using namespace tripodal::dds::test;
+using namespace std::chrono_literals;
+
+namespace {
+
+const std::string kTool = TRIPODAL_TOOL;
+const std::string kRobot = std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/psr2.yaml";
+const std::string kWorld = std::string(TRIPODAL_SOURCE_DIR) + "/configs/worlds/workspace.yaml";
+constexpr double kPeriodS = 0.01;
+
+// One lock-step robot of the shared world, without a robot: a step writer, the state and scan readers.
+class Client {
+ public:
+  Client(Participant& p, const std::string& ns) : topics_(ns) {
+    scan_ = std::make_unique<Subscriber<msg::LaserScan>>(p, topics_.scan, EndpointOptions{.kind = TopicKind::state},
+                                                         [this](const msg::LaserScan& s) {
+                                                           const std::lock_guard lock(mutex_);
+                                                           scan_msg_ = s;
+                                                           ++scans_;
+                                                         });
+    state_ = std::make_unique<Subscriber<msg::SimState>>(p, topics_.sim_state, EndpointOptions{.kind = TopicKind::state},
+                                                         [this](const msg::SimState& s) {
+                                                           const std::lock_guard lock(mutex_);
+                                                           state_msg_ = s;
+                                                           cv_.notify_all();
+                                                         });
+    step_ = std::make_unique<Publisher<msg::SimStep>>(p, topics_.sim_step, EndpointOptions{.kind = TopicKind::state});
+    REQUIRE(step_->wait_for_subscribers(1, 10s));
+    REQUIRE(state_->wait_for_publishers(1, 10s));
+  }
+  void leave() { step_.reset(); }
+
+  // Asks for the next step (the robot's clock: step * 10 ms) driving with twist (vx, vy, wz).
+  void ask(double vx = 0.0, double vy = 0.0) {
+    ++step_no_;
+    msg::SimStep s{};
+    s.until = ros_time(tripodal::Time{} + std::chrono::nanoseconds(static_cast<std::int64_t>(step_no_) * 10'000'000));
+    s.cmd_vel.linear.x = vx;
+    s.cmd_vel.linear.y = vy;
+    s.step = step_no_;
+    step_->publish(s);
+  }
+  // Waits for the answer to the last step and every scan it counts.
+  msg::SimState answer() {
+    std::unique_lock lock(mutex_);
+    REQUIRE(cv_.wait_for(lock, 10s, [&] { return state_msg_ && state_msg_->step == step_no_; }));
+    const auto until = std::chrono::steady_clock::now() + 5s;
+    while (scans_ < state_msg_->scans && std::chrono::steady_clock::now() < until) {
+      lock.unlock();
+      std::this_thread::sleep_for(1ms);
+      lock.lock();
+    }
+    return *state_msg_;
+  }
+  // The range of the latest scan's beam nearest `bearing_rad` (the robot's frame; the laser at its centre).
+  double range_at(double bearing_rad) {
+    const std::lock_guard lock(mutex_);
+    REQUIRE(scan_msg_.has_value());
+    const msg::LaserScan& s = *scan_msg_;
+    double a = bearing_rad - s.angle_min;
+    while (a < 0.0) a += 2.0 * std::numbers::pi;
+    const auto i = static_cast<std::size_t>(std::lround(a / s.angle_increment)) % s.ranges.size();
+    return s.ranges[i];
+  }
+
+ private:
+  BaseTopics topics_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::optional<msg::LaserScan> scan_msg_;
+  std::uint32_t scans_ = 0;
+  std::optional<msg::SimState> state_msg_;
+  std::uint32_t step_no_ = 0;
+  std::unique_ptr<Subscriber<msg::LaserScan>> scan_;
+  std::unique_ptr<Subscriber<msg::SimState>> state_;
+  std::unique_ptr<Publisher<msg::SimStep>> step_;
+};
+
+// Every client asks for a step, then every answer is awaited: one lock-step round of the world.
+void step_round(const std::vector<Client*>& clients, std::map<Client*, std::pair<double, double>> drive = {}) {
+  for (Client* c : clients) {
+    const auto d = drive.find(c);
+    c->ask(d == drive.end() ? 0.0 : d->second.first, d == drive.end() ? 0.0 : d->second.second);
+  }
+  for (Client* c : clients) (void)c->answer();
+}
+
+}  // namespace
+
+TEST_CASE("dds: one world for three robots: each sees the others, is stopped by them, and robots come and go",
+          "[dds][sim_server][shared_world]") {
+  const std::string prefix = test_namespace() + "_r";
+  const std::uint32_t domain = test_domain(45);
+  ChildProcess server(kTool,
+                      {"sim-server", "--robot", kRobot, "--world", kWorld, "--robots", "3", "--namespace", prefix, "--domain",
+                       std::to_string(domain), "--wait-s", "60", "--lease-s", "1"},
+                      "/tmp/" + test_namespace() + "_shared_server.log");
+  ParticipantOptions po = test_options(45);
+  Participant p(po);
+  // The workspace's start pose is (0.8, 0.8, 0): robot1 there, robot2 0.9 m to its left (+y),
+  // robot3 0.9 m ahead (+x) (fleet_start_poses, spacing 2 x 0.25 + 0.4 m).
+  Client r1(p, prefix + "1");
+  Client r2(p, prefix + "2");
+  // Two laser periods (5.5 Hz): the first scan was taken as the body was placed.
+  for (int k = 0; k < 40; ++k) step_round({&r1, &r2});
+  const double left = std::numbers::pi / 2;
+  CHECK(r1.range_at(left) == Approx(0.9 - 0.25).margin(0.05));
+  CHECK(r2.range_at(-left) == Approx(0.9 - 0.25).margin(0.05));
+  // Nothing ahead of robot1 yet: robot3 has not come.
+  const double ahead_alone = r1.range_at(0.0);
+  CHECK(ahead_alone > 1.0);
+
+  SECTION("a robot that joins is seen, one that drives into another is stopped, one that leaves is gone") {
+    Client r3(p, prefix + "3");
+    for (int k = 0; k < 40; ++k) step_round({&r1, &r2, &r3});
+    CHECK(r1.range_at(0.0) == Approx(0.9 - 0.25).margin(0.05));
+    CHECK(r3.range_at(std::numbers::pi) == Approx(0.9 - 0.25).margin(0.05));
+
+    // robot1 drives at robot3 (+x, 0.3 m/s for 3 s): it stops against it, one contact.
+    for (int k = 0; k < 300; ++k) step_round({&r1, &r2, &r3}, {{&r1, {0.3, 0.0}}});
+    r1.ask();
+    const msg::SimState s1 = r1.answer();
+    r2.ask();
+    r3.ask();
+    (void)r2.answer();
+    const msg::SimState s3 = r3.answer();
+    CHECK(s1.collisions == 1);
+    CHECK(s1.x == Approx(s3.x - 0.5).margin(0.01));  // touching: centre to centre two radii
+    CHECK(s3.collisions == 0);
+
+    // robot2 leaves: robot1 no longer sees it.
+    r2.leave();
+    std::this_thread::sleep_for(500ms);  // its departure reaches the server
+    for (int k = 0; k < 40; ++k) step_round({&r1, &r3});
+    CHECK(r1.range_at(left) > 1.0);
+
+    r1.leave();
+    r3.leave();
+    REQUIRE(server.wait(15s) == 0);
+    const std::string out = server.output();
+    INFO(out);
+    CHECK(out.find(prefix + "3 joined at (1.70, 0.80)") != std::string::npos);
+    CHECK(std::regex_search(out, std::regex(prefix + "2 left.*0 collisions")));
+    CHECK(out.find("simulator: collision with robot 3") != std::string::npos);
+    CHECK(out.find("sim-server ended: every robot left") != std::string::npos);
+    CHECK(out.find("robot-robot contacts: 1;") != std::string::npos);
+  }
+}

@@ -1,0 +1,345 @@
+// `tripodal sim-server --robots N`: one world, several lock-step robots (sim_server_shared.hpp).
+//
+// The world is one Simulator per robot on the same map, each at its own start pose
+// (sim::fleet_start_poses), coupled every round by the others' bodies (Simulator::set_other_bodies):
+// a robot's laser sees the others, its footprint stops against them and its bumpers feel them. A
+// round steps every robot that asked for its next step; it waits for the robots it expects for at
+// most --stall-s of wall time, after which a robot that has not asked (paused, or busy starting)
+// stands still in the world, not stepped, until it asks again. Robots come (their step writer
+// matched: a fresh body at the slot's start pose) and go (it left or went silent: the body is
+// removed) while the others run.
+#include "sim_server_shared.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <csignal>
+#include <deque>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cli_tool.hpp"
+#include "run_outputs.hpp"
+#include "run_task.hpp"
+#include "tripodal/core/diagnostic.hpp"
+#include "tripodal/dds/dds_hardware.hpp"
+#include "tripodal/dds/endpoint.hpp"
+#include "tripodal/robot/robot.hpp"
+#include "tripodal/robot/robot_profile.hpp"
+#include "tripodal/sim/simulator.hpp"
+#include "tripodal/sim/world.hpp"
+
+namespace tripodal::tool {
+namespace {
+
+using namespace cli;
+
+constexpr int kNoRobot = 4;
+
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void on_shared_server_stop_signal(int) {
+  g_stop = 1;
+}
+
+std::vector<std::string> wheel_names(std::size_t n) {
+  if (n == 2) return {"left_wheel", "right_wheel"};
+  std::vector<std::string> names;
+  for (std::size_t i = 1; i <= n; ++i) names.push_back("wheel_" + std::to_string(i));
+  return names;
+}
+
+// What Cyclone DDS threads hand the serving thread, per robot slot.
+struct SlotInbox {
+  std::deque<dds::msg::SimStep> steps;
+  bool connected = false;  // its step writer is matched
+  std::string left_why;    // set when it left, until the serving thread took it
+  bool left = false;
+};
+
+// One robot of the world as the serving thread sees it.
+struct Slot {
+  std::string ns;
+  Pose2D start;
+  std::unique_ptr<dds::Publisher<dds::msg::LaserScan>> scan;
+  std::unique_ptr<dds::Publisher<dds::msg::JointState>> joints;
+  std::unique_ptr<dds::Publisher<dds::msg::SimState>> state;
+  std::unique_ptr<dds::Subscriber<dds::msg::SimStep>> steps;
+  std::unique_ptr<sim::Simulator> sim;  // while a robot is here
+  bool expected = false;                // answered: its next request is awaited this round
+  std::uint32_t scans = 0, joint_states = 0, last_step = 0;
+  std::size_t laser_seen = 0;
+  std::uint64_t steps_served = 0;
+  dds::msg::JointState js;
+  dds::msg::LaserScan ls;
+  std::vector<double> velocity, position;
+};
+
+}  // namespace
+
+int run_shared_world(const SharedWorldArgs& a, std::ostream& out, std::ostream& err) {
+  for (const auto& f : {a.robot, a.world}) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(f, ec)) {
+      err << "tripodal sim-server: cannot read '" << f.string() << "'\n";
+      return kIoError;
+    }
+  }
+  if (!is_ros_namespace(a.prefix + "1")) {
+    err << "tripodal sim-server: --namespace '" << a.prefix << "' with --robots: '" << a.prefix
+        << "1' is not a ROS 2 namespace: names of letters, digits and '_', not starting with a digit, separated by '/'\n";
+    return kUsage;
+  }
+  try {
+    const RobotProfile profile = load_robot_profile(a.robot);
+    RobotPlugins plugins;
+    app::register_tool_plugins(plugins, nullptr, profile, {});
+    const std::optional<ControllerConfig> base = base_controller_config(profile, plugins.controllers);
+    if (!base)
+      throw ConfigError(profile.where,
+                        "tripodal sim-server simulates the robot's base: the profile needs a loop with a controller");
+    const sim::World world = sim::load_world(a.world);
+    const std::uint64_t seed = a.seed.value_or(world.seed);
+    const auto n = static_cast<std::size_t>(a.robots);
+    const std::vector<Pose2D> starts = sim::fleet_start_poses(world, n);
+
+    dds::ParticipantOptions po;
+    po.domain_id = a.domain;
+    po.network = a.system_network ? dds::Network::system : dds::Network::loopback;
+    po.participant_lease = std::chrono::milliseconds(static_cast<std::int64_t>(a.lease_s * 1000.0));
+    dds::Participant participant(po);
+
+    std::mutex mutex;
+    std::condition_variable cv;
+    std::vector<SlotInbox> inbox(n);
+    std::vector<Slot> slots(n);
+    dds::Qos scan_qos = dds::qos_for(dds::TopicKind::scan, dds::Role::publisher);
+    scan_qos.reliability = dds::Reliability::reliable;  // a lock-step robot counts on every scan
+    for (std::size_t k = 0; k < n; ++k) {
+      Slot& s = slots[k];
+      s.ns = a.prefix + std::to_string(k + 1);
+      s.start = starts[k];
+      const dds::BaseTopics topics(s.ns);
+      s.scan = std::make_unique<dds::Publisher<dds::msg::LaserScan>>(
+          participant, topics.scan, dds::EndpointOptions{.kind = dds::TopicKind::scan, .qos = scan_qos});
+      s.joints = std::make_unique<dds::Publisher<dds::msg::JointState>>(participant, topics.joint_states,
+                                                                        dds::EndpointOptions{.kind = dds::TopicKind::state});
+      s.state = std::make_unique<dds::Publisher<dds::msg::SimState>>(participant, topics.sim_state,
+                                                                     dds::EndpointOptions{.kind = dds::TopicKind::state});
+      auto on_status = [&mutex, &cv, &inbox, k](const dds::StatusEvent& e) {
+        if (e.kind != dds::StatusKind::publication_matched && e.kind != dds::StatusKind::liveliness_lost) return;
+        const std::lock_guard lock(mutex);
+        SlotInbox& in = inbox[k];
+        if (e.current_count > 0) {
+          in.connected = true;
+        } else if (in.connected) {
+          in.connected = false;
+          in.left = true;
+          in.left_why = e.kind == dds::StatusKind::liveliness_lost ? "left or went silent (DDS liveliness lost)" : "left";
+        }
+        cv.notify_all();
+      };
+      s.steps = std::make_unique<dds::Subscriber<dds::msg::SimStep>>(
+          participant, topics.sim_step, dds::EndpointOptions{.kind = dds::TopicKind::state, .on_status = on_status},
+          [&mutex, &cv, &inbox, k](const dds::msg::SimStep& step) {
+            const std::lock_guard lock(mutex);
+            inbox[k].steps.push_back(step);
+            cv.notify_all();
+          });
+    }
+
+    std::signal(SIGINT, on_shared_server_stop_signal);
+    std::signal(SIGTERM, on_shared_server_stop_signal);
+    out << "tripodal sim-server: one world for " << n << " robots (" << profile.name << ", " << base->type << " base), world "
+        << a.world.string() << ", seed " << seed << "; domain " << a.domain << ", namespaces " << slots.front().ns << " to "
+        << slots.back().ns << "\n";
+    for (const Slot& s : slots) {
+      out << "  " << s.ns << " starts at (" << app::fixed(s.start.x_m, 2) << ", " << app::fixed(s.start.y_m, 2) << ", "
+          << app::fixed(s.start.theta_rad, 3) << ")\n";
+    }
+    out.flush();
+
+    const auto began = std::chrono::steady_clock::now();
+    auto elapsed = [&] {
+      return app::fixed(std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count(), 1) + " s  ";
+    };
+    std::uint64_t contacts = 0, rounds = 0;
+    double min_clearance_m = std::numeric_limits<double>::infinity();
+    bool any_came = false;
+    std::string ended = "stopped";
+    int code = kOk;
+    std::vector<sim::OtherBody> others;
+    others.reserve(n);
+
+    // A robot that leaves: its figures, its body out of the world.
+    auto depart = [&](Slot& s, const std::string& why) {
+      if (!s.sim) return;
+      contacts += s.sim->robot_collisions();
+      min_clearance_m = std::min(min_clearance_m, s.sim->min_robot_clearance_m());
+      out << elapsed() << s.ns << " " << why << ": " << s.steps_served << " steps, " << app::fixed(to_seconds(s.sim->now()), 2)
+          << " s simulated, distance " << app::fixed(s.sim->distance_m(), 2) << " m, " << s.sim->collisions() << " collisions ("
+          << s.sim->robot_collisions() << " with robots)\n";
+      for (const sim::SimEvent& e : s.sim->events()) {
+        out << "    " << s.ns << " " << app::fixed(to_seconds(e.stamp), 3) << " s  simulator: " << sim::to_string(e.kind)
+            << (e.detail.empty() ? "" : " " + e.detail) << '\n';
+      }
+      out.flush();
+      s.sim.reset();
+      s.expected = false;
+    };
+    auto arrive = [&](Slot& s) {
+      s.sim = std::make_unique<sim::Simulator>(world, *base, seed);
+      if (!s.sim->set_pose(s.start)) throw std::runtime_error(s.ns + "'s start pose is not free");
+      const std::size_t w = s.sim->wheel_count();
+      s.js = {};
+      s.js.header.frame_id = "base_link";
+      s.js.name = wheel_names(w);
+      s.ls = {};
+      s.ls.header.frame_id = "laser";
+      s.velocity.assign(w, 0.0);
+      s.position.assign(w, 0.0);
+      s.scans = s.joint_states = s.last_step = 0;
+      s.laser_seen = 0;
+      s.steps_served = 0;
+      any_came = true;
+      out << elapsed() << s.ns << " joined at (" << app::fixed(s.start.x_m, 2) << ", " << app::fixed(s.start.y_m, 2) << ")\n";
+      out.flush();
+    };
+    auto serve = [&](Slot& s, const dds::msg::SimStep& step) {
+      sim::Simulator& sim = *s.sim;
+      others.clear();
+      for (std::size_t j = 0; j < n; ++j) {
+        if (&slots[j] == &s || !slots[j].sim) continue;
+        const Pose2D& p = slots[j].sim->pose();
+        others.push_back({{p.x_m, p.y_m}, slots[j].sim->world().robot.radius_m, static_cast<std::uint32_t>(j + 1)});
+      }
+      sim.set_other_bodies(others);
+      sim.command_twist(Twist2D{step.cmd_vel.linear.x, step.cmd_vel.linear.y, step.cmd_vel.angular.z});
+      sim.step_until(dds::tripodal_time(step.until));
+      const LaserResource& laser = sim.laser();
+      if (laser.sequence() != s.laser_seen && laser.has_reading()) {
+        s.laser_seen = laser.sequence();
+        const LaserScan& l = laser.latest();
+        s.ls.header.stamp = dds::ros_time(l.stamp);
+        s.ls.angle_min = static_cast<float>(l.angle_min_rad);
+        s.ls.angle_max = static_cast<float>(l.angle_max_rad);
+        s.ls.angle_increment = static_cast<float>(l.angle_increment_rad);
+        s.ls.time_increment = static_cast<float>(l.time_increment_s);
+        s.ls.scan_time = static_cast<float>(l.scan_time_s);
+        s.ls.range_min = static_cast<float>(l.range_min_m);
+        s.ls.range_max = static_cast<float>(l.range_max_m);
+        s.ls.ranges = l.ranges_m;
+        s.ls.intensities = l.intensities;
+        s.scan->publish(s.ls);
+        ++s.scans;
+      }
+      s.js.header.stamp = dds::ros_time(sim.now());
+      if (sim.read_wheel_states(s.velocity, s.position)) {
+        s.js.position = s.position;
+        s.js.velocity = s.velocity;
+      } else {
+        s.js.position.clear();
+        s.js.velocity.clear();
+      }
+      s.joints->publish(s.js);
+      ++s.joint_states;
+      s.last_step = step.step;
+      ++s.steps_served;
+      const Pose2D& p = sim.pose();
+      s.state->publish(dds::msg::SimState{dds::ros_time(sim.now()), p.x_m, p.y_m, p.theta_rad, sim.distance_m(), s.last_step,
+                                          s.scans, s.joint_states, static_cast<std::uint32_t>(sim.collisions())});
+      s.expected = true;
+    };
+
+    const auto stall = std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(a.stall_s));
+    std::vector<std::optional<dds::msg::SimStep>> this_round(n);
+    while (g_stop == 0) {
+      std::vector<std::string> left(n);
+      std::vector<char> joined(n, 0);
+      {
+        std::unique_lock lock(mutex);
+        // A round starts with the first request and waits for every expected robot, at most `stall`.
+        cv.wait_for(lock, std::chrono::milliseconds(100), [&] {
+          return std::any_of(inbox.begin(), inbox.end(), [](const SlotInbox& in) { return !in.steps.empty() || in.left; });
+        });
+        const auto round_start = std::chrono::steady_clock::now();
+        auto complete = [&] {
+          for (std::size_t k = 0; k < n; ++k) {
+            if (inbox[k].left) return true;
+            if (slots[k].expected && inbox[k].steps.empty()) return false;
+          }
+          return true;
+        };
+        if (std::any_of(inbox.begin(), inbox.end(), [](const SlotInbox& in) { return !in.steps.empty(); })) {
+          cv.wait_until(lock, round_start + stall, complete);
+        }
+        for (std::size_t k = 0; k < n; ++k) {
+          SlotInbox& in = inbox[k];
+          this_round[k].reset();
+          if (!in.steps.empty()) {
+            this_round[k] = in.steps.front();
+            in.steps.pop_front();
+          }
+          if (in.left) {
+            left[k] = in.left_why;
+            in.left = false;
+            in.steps.clear();
+            this_round[k].reset();
+          } else if (this_round[k] && !slots[k].sim) {
+            joined[k] = 1;
+          }
+        }
+      }
+      for (std::size_t k = 0; k < n; ++k) {
+        if (!left[k].empty()) depart(slots[k], left[k]);
+        if (joined[k] != 0) arrive(slots[k]);
+      }
+      bool stepped = false;
+      for (std::size_t k = 0; k < n; ++k) {
+        Slot& s = slots[k];
+        if (this_round[k] && s.sim) {
+          serve(s, *this_round[k]);
+          stepped = true;
+        } else if (s.expected) {
+          s.expected = false;  // stalled: it stands still until it asks again
+        }
+      }
+      if (stepped) ++rounds;
+      const bool anyone = std::any_of(slots.begin(), slots.end(), [](const Slot& s) { return s.sim != nullptr; });
+      bool connected = false;
+      {
+        const std::lock_guard lock(mutex);
+        connected =
+            std::any_of(inbox.begin(), inbox.end(), [](const SlotInbox& in) { return in.connected || !in.steps.empty(); });
+      }
+      if (any_came && !anyone && !connected) {
+        ended = "every robot left";
+        break;
+      }
+      if (!any_came && !connected && a.wait_s > 0.0 &&
+          std::chrono::steady_clock::now() - began > std::chrono::duration<double>(a.wait_s)) {
+        ended = "no robot came within " + app::fixed(a.wait_s, 1) + " s";
+        code = kNoRobot;
+        break;
+      }
+    }
+    for (Slot& s : slots) depart(s, "was here at the end");
+    out << "sim-server ended: " << ended << "; " << rounds << " rounds; robot-robot contacts: " << contacts
+        << "; closest approach between robots: "
+        << (std::isfinite(min_clearance_m) ? app::fixed(min_clearance_m, 3) + " m" : std::string("none (never two robots)"))
+        << "\n";
+    return code;
+  } catch (const ConfigError& e) {
+    err << e.what() << '\n';
+    return kBadInput;
+  } catch (const std::exception& e) {
+    err << "tripodal sim-server: " << e.what() << '\n';
+    return kIoError;
+  }
+}
+
+}  // namespace tripodal::tool
