@@ -6,11 +6,10 @@
 #include <deque>
 #include <fstream>
 #include <iomanip>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <ostream>
 #include <sstream>
-
-#include <nlohmann/json.hpp>
 
 #include "guide_hri.hpp"
 #include "run_outputs.hpp"
@@ -18,8 +17,8 @@
 #include "shutdown.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/hri/hri_module.hpp"
-#include "tripodal/monitor/robot_monitor.hpp"
 #include "tripodal/hri/speech.hpp"
+#include "tripodal/monitor/robot_monitor.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
 #include "tripodal/planner/task_library.hpp"
 #include "tripodal/robot/robot.hpp"
@@ -27,6 +26,7 @@
 #include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/sim/simulator.hpp"
 #include "tripodal/sim/world.hpp"
+#include "visit_audio.hpp"
 
 namespace tripodal::app {
 
@@ -79,7 +79,9 @@ std::string in_quotes(std::string_view s) { return "\"" + std::string(s) + "\"";
 }  // namespace
 
 VisitResult run_visit(const VisitOptions& o) {
-  if (o.visit.empty() && !o.monitor) throw std::invalid_argument("run_visit: without a visit file there must be a monitor to serve");
+  if (o.visit.empty() && !o.monitor && o.audio_device.empty()) {
+    throw std::invalid_argument("run_visit: without a visit file there must be a monitor to serve or live audio");
+  }
   Visit visit;
   if (!o.visit.empty()) {
     visit = load_visit(o.visit);
@@ -131,6 +133,7 @@ VisitResult run_visit(const VisitOptions& o) {
                  GuideHri::Options{[&sim] { return sim.battery_charge(); }, std::move(robot_voice)});
   Voice voice = robot_speaks ? make_voice(hri_module->knowledge_store().base(), guide.tasks(), world->regions) : Voice{{}, {}, voice_off};
   res.voice = voice.ears != nullptr;
+  const std::unique_ptr<VisitAudio> live = open_visit_audio(o, guide.module(), voice.ears.get(), guide.service().voice());
 
   LifecycleRecorder life(false);
   robot->planner().add_observer(life);
@@ -341,13 +344,15 @@ VisitResult run_visit(const VisitOptions& o) {
         }
       }
     }
-    if (next >= visit.steps.size() && waiting == kNone && pending_button == 0 && !robot->planner().busy()) {
+    if (next >= visit.steps.size() && waiting == kNone && pending_button == 0 && !robot->planner().busy() &&
+        (live == nullptr || !o.visit.empty())) {
       // The visit is over; a monitored robot goes on serving its pages until stopped.
       if (!res.completed && !o.visit.empty()) say("the visit is over" + std::string(watch ? "; the monitor goes on serving until stopped" : ""));
       res.completed = true;
       if (!watch) break;
     }
     robot->run_for(period);
+    if (live) live->step(to_seconds(period), say, res.exchanges, to_seconds(clock.now()));
     bool visitor_near = false;
     for (std::size_t i = 0; i < sim.visitors().size(); ++i) {
       const navi::Point2D v = sim.visitors()[i].position;
