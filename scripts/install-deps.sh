@@ -45,6 +45,9 @@ packages+=(wordnet-base wamerican)
 # Its voice (optional, TRIPODAL_VOICE): espeak-ng synthesises, pocketsphinx recognises with the
 # US English acoustic model.
 packages+=(libespeak-ng-dev libpocketsphinx-dev pocketsphinx-en-us)
+# The spoken corpus's room noise (tests/hri/spoken_corpus_test.cpp): sox makes it; without sox the
+# noisy part of that test is skipped with a warning.
+packages+=(sox)
 # Its live audio (optional, TRIPODAL_ALSA): microphone and speaker through ALSA.
 packages+=(libasound2-dev)
 

@@ -3,6 +3,7 @@
 #include <pocketsphinx.h>
 #include <unistd.h>
 
+#include <array>
 #include <cstdlib>
 #include <fstream>
 #include <mutex>
@@ -89,6 +90,10 @@ class PocketsphinxRecognizer final : public SpeechRecognizer {
 
  public:
   explicit PocketsphinxRecognizer(const PocketsphinxOptions& options) {
+    if (!(options.general_model_weight >= 0.0 && options.general_model_weight <= 1.0)) {
+      throw std::invalid_argument("pocketsphinx: general_model_weight is " + std::to_string(options.general_model_weight) +
+                                  "; expected a share in [0, 1]");
+    }
     const std::string hmm = (options.model_dir / "en-us").string();
     const std::string dict = (options.model_dir / "cmudict-en-us.dict").string();
     std::string lm = (options.model_dir / "en-us.lm.bin").string();
@@ -135,6 +140,15 @@ class PocketsphinxRecognizer final : public SpeechRecognizer {
       cmd_ln_free_r(config_);
       remove_files();
       throw std::runtime_error("pocketsphinx: cannot load the model in " + options.model_dir.string());
+    }
+    if (!options.language_model.empty() && options.general_model_weight > 0.0) {
+      const std::string general = (options.model_dir / "en-us.lm.bin").string();
+      if (!interpolate(lm, general, options.general_model_weight)) {
+        ps_free(decoder_);
+        cmd_ln_free_r(config_);
+        remove_files();
+        throw std::runtime_error("pocketsphinx: cannot interpolate the language model with " + general);
+      }
     }
   }
   PocketsphinxRecognizer(const PocketsphinxRecognizer&) = delete;
@@ -187,6 +201,35 @@ class PocketsphinxRecognizer final : public SpeechRecognizer {
   }
 
  private:
+  // The decoder's search becomes the linear interpolation of the domain model (share 1 - weight)
+  // and the general one (weight), over the union of their words that the dictionary has.
+  bool interpolate(const std::string& domain_file, const std::string& general_file, double weight) {
+    cmd_ln_t* config = ps_get_config(decoder_);
+    logmath_t* lmath = ps_get_logmath(decoder_);
+    std::array<ngram_model_t*, 2> models{ngram_model_read(config, domain_file.c_str(), NGRAM_AUTO, lmath),
+                                         ngram_model_read(config, general_file.c_str(), NGRAM_AUTO, lmath)};
+    if (models[0] == nullptr || models[1] == nullptr) {
+      for (ngram_model_t* m : models) {
+        if (m != nullptr) ngram_model_free(m);
+      }
+      return false;
+    }
+    std::array<std::string, 2> names{"domain", "general"};
+    std::array<char*, 2> name_ptrs{names[0].data(), names[1].data()};
+    const std::array<float32, 2> weights{static_cast<float32>(1.0 - weight), static_cast<float32>(weight)};
+    // Some sphinxbase releases retain the models a set is made of, others take them over: with one
+    // reference more, the count after the set was made says which, and the set is left the only owner.
+    for (ngram_model_t* m : models) ngram_model_retain(m);
+    ngram_model_t* set = ngram_model_set_init(config, models.data(), name_ptrs.data(), weights.data(), 2);
+    for (ngram_model_t* m : models) {
+      if (ngram_model_free(m) > 1 || set == nullptr) ngram_model_free(m);
+    }
+    if (set == nullptr) return false;
+    const bool ok = ps_set_lm(decoder_, "interpolated", set) == 0 && ps_set_search(decoder_, "interpolated") == 0;
+    ngram_model_free(set);  // the search holds it
+    return ok;
+  }
+
   void remove_files() noexcept {
     if (!lm_file_.empty()) ::unlink(lm_file_.c_str());
     if (!dict_file_.empty()) ::unlink(dict_file_.c_str());

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <iostream>
+#include <map>
 #include <string>
 
 using namespace tripodal;
@@ -86,9 +87,17 @@ double typed_accuracy(const std::string& file) {
   const std::vector<Expected> set = utterance_set(file);
   std::size_t right = 0;
   std::string misses;
+  // Per kind of the issue (answer, command, refusal, out of domain): right, of.
+  std::map<std::string, std::pair<std::size_t, std::size_t>> per_kind;
   for (const auto& e : set) {
     const HriReply r = jinny.hri.handle(e.say);
     const bool ok = to_string(r.kind) == e.outcome && r.entry_id == e.entry && r.task == e.task;
+    const std::string kind = e.outcome == "answered"       ? "answer"
+                             : e.outcome == "task_started" ? "command"
+                             : e.outcome == "task_refused" ? "refusal"
+                                                           : "out of domain";
+    ++per_kind[kind].second;
+    if (ok) ++per_kind[kind].first;
     if (e.outcome == "not_understood") {
       std::cout << "  (not understood as expected: \"" << e.say << "\", best confidence " << r.confidence << ")\n";
     }
@@ -101,8 +110,10 @@ double typed_accuracy(const std::string& file) {
     }
   }
   const double accuracy = set.empty() ? 0.0 : static_cast<double>(right) / static_cast<double>(set.size());
-  std::cout << "HRI typed utterance set " << file << ": " << right << "/" << set.size() << " right, accuracy "
-            << accuracy * 100.0 << " %\n" << misses;
+  std::cout << "HRI typed utterance set " << file << ": " << right << "/" << set.size() << " right, accuracy " << accuracy * 100.0
+            << " %;";
+  for (const auto& [kind, f] : per_kind) std::cout << " " << kind << " " << f.first << "/" << f.second;
+  std::cout << "\n" << misses;
   return accuracy;
 }
 

@@ -33,8 +33,12 @@ struct SpokenJinny {
                   return std::string();
                 }};
 
-  [[nodiscard]] std::unique_ptr<SpeechRecognizer> recognizer() const {
-    return make_pocketsphinx_recognizer(recognizer_options(speech_corpus(base, tasks.command_forms(), {{"node", {"0", "1"}}})));
+  /// `general_model_weight`: the share of the general English model interpolated with the domain
+  /// model (PocketsphinxOptions); 0, the domain model alone.
+  [[nodiscard]] std::unique_ptr<SpeechRecognizer> recognizer(double general_model_weight = 0.0) const {
+    PocketsphinxOptions o = recognizer_options(speech_corpus(base, tasks.command_forms(), {{"node", {"0", "1"}}}));
+    o.general_model_weight = general_model_weight;
+    return make_pocketsphinx_recognizer(o);
   }
   // The visitor's voice: of five espeak-ng variants at two rates, tried on every third utterance
   // of utterances.yaml, pocketsphinx's US English model hears klatt at 170 words a minute best

@@ -72,6 +72,8 @@ struct Args {
   app::RunOptions options;
   std::filesystem::path visit;  // --visit: the guide demo instead of a task
   bool no_voice = false;
+  std::string audio;                   // --audio DEVICE: live microphone and speaker (ALSA)
+  std::filesystem::path audio_config;  // --audio-config FILE
   std::optional<double> give_way_m;  // --visitors-give-way-m
   std::string faults;
   std::vector<std::string> hardware_params;  // --hardware-param KEY=VALUE
@@ -156,6 +158,8 @@ int run_guide(const Args& args, std::ostream& out, std::ostream& err) {
     vo.seed = o.seed;
     vo.out = o.out;
     vo.voice = !args.no_voice;
+    vo.audio_device = args.audio;
+    vo.audio_config = args.audio_config;
     vo.visitors_give_way_m = args.give_way_m;
     vo.log = &out;
     vo.monitor = o.monitor;
@@ -168,7 +172,10 @@ int run_guide(const Args& args, std::ostream& out, std::ostream& err) {
     vo.max_duration_s = o.max_duration_s;
     vo.stop = &g_stop;
     out << "tripodal run: robot " << o.robot.string() << ", world " << o.world.string()
-        << (args.visit.empty() ? std::string(", no visit file: the monitor's visitors") : ", visit " + args.visit.string()) << "\n";
+        << (!args.visit.empty()  ? ", visit " + args.visit.string()
+            : args.audio.empty() ? std::string(", no visit file: the monitor's visitors")
+                                 : ", no visit file: the visitors at the microphone " + args.audio)
+        << "\n";
     out.flush();
     const app::VisitResult r = app::run_visit(vo);
     out << (args.visit.empty() ? "run ended" : std::string("visit ") + (r.completed ? "completed" : "not completed")) << " (seed " << r.seed
@@ -222,8 +229,10 @@ int run(Args& args, std::ostream& out, std::ostream& err) {
   const std::string& faults = args.faults;
   o.realtime = args.realtime->count() > 0;
   if (args.realtime_speed > 0.0) o.realtime_speed = args.realtime_speed;
-  if (!args.visit.empty() || (o.monitor && o.task.empty() && is_guide_robot(o.robot))) return run_guide(args, out, err);
-  if (args.give_way_m || args.no_voice) {
+  if (!args.visit.empty() || !args.audio.empty() || (o.monitor && o.task.empty() && is_guide_robot(o.robot))) {
+    return run_guide(args, out, err);
+  }
+  if (args.give_way_m || args.no_voice || !args.audio_config.empty()) {
     err << "tripodal run: --no-voice and --visitors-give-way-m go with the guide robot's runs (--visit, or --monitor on a robot with an Hri module)\n";
     return kUsage;
   }
@@ -332,6 +341,10 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_option("--visit", a->visit,
                  "VISIT.yaml: the guide robot's scripted visit (typed and spoken requests, buttons; docs/guide.md) instead of a task");
   cmd.add_flag("--no-voice", a->no_voice, "with --visit: read spoken requests as typed, write no audio");
+  cmd.add_option("--audio", a->audio,
+                 "DEVICE: the guide robot hears the room through this ALSA device and answers on it (\"default\"; docs/hri.md "
+                 "\"Live audio\"); without --visit it runs until --max-duration-s or a signal");
+  cmd.add_option("--audio-config", a->audio_config, "FILE: an ALSA configuration file defining the --audio device");
   cmd.add_option("--visitors-give-way-m", a->give_way_m,
                  "M: the guide robot's runs: every visitor keeps M from the robot (the world's give_way_m); 0: walkers that do "
                  "not yield")

@@ -27,6 +27,7 @@
 #include "tripodal/sim/sim_hardware.hpp"
 #include "tripodal/sim/simulator.hpp"
 #include "tripodal/sim/world.hpp"
+#include "visit_audio.hpp"
 
 namespace tripodal::app {
 
@@ -183,6 +184,7 @@ class GuidedVisit {
   CHri& hri_module_;
   std::unique_ptr<GuideHri> guide_;
   Voice voice_;
+  std::unique_ptr<VisitAudio> live_;  // --audio DEVICE: the room heard and answered live
   LifecycleRecorder life_{false};
   std::unique_ptr<monitor::MonitorServer> server_;
   std::unique_ptr<monitor::RobotMonitor> watch_;
@@ -217,6 +219,7 @@ void GuidedVisit::make_guide(const RobotProfile& profile) {
   voice_ =
       robot_speaks ? make_voice(hri_module_.knowledge_store().base(), guide_->tasks(), world_.regions) : Voice{{}, {}, voice_off};
   res_.voice = voice_.ears != nullptr;
+  live_ = open_visit_audio(o_, guide_->module(), voice_.ears.get(), guide_->service().voice());
 }
 
 void GuidedVisit::say(const std::string& line) {
@@ -426,7 +429,7 @@ void GuidedVisit::drive() {
     end_waiting_task();
     take_presses();
     next_step();
-    if (next_ >= visit_.steps.size() && idle() && !robot_->planner().busy()) {
+    if (next_ >= visit_.steps.size() && idle() && !robot_->planner().busy() && (live_ == nullptr || !o_.visit.empty())) {
       // The visit is over; a monitored robot goes on serving its pages until stopped.
       if (!res_.completed && !o_.visit.empty())
         say("the visit is over" + std::string(watch_ ? "; the monitor goes on serving until stopped" : ""));
@@ -434,6 +437,7 @@ void GuidedVisit::drive() {
       if (!watch_) break;
     }
     robot_->run_for(kPeriod);
+    if (live_) live_->step(to_seconds(kPeriod), [this](const std::string& line) { say(line); }, res_.exchanges, to_seconds(clock_.now()));
     watch_visitors();
     flush_life();
     display();
@@ -479,7 +483,9 @@ void GuidedVisit::finish() {
 }  // namespace
 
 VisitResult run_visit(const VisitOptions& o) {
-  if (o.visit.empty() && !o.monitor) throw std::invalid_argument("run_visit: without a visit file there must be a monitor to serve");
+  if (o.visit.empty() && !o.monitor && o.audio_device.empty()) {
+    throw std::invalid_argument("run_visit: without a visit file there must be a monitor to serve or live audio");
+  }
   Visit visit;
   if (!o.visit.empty()) {
     visit = load_visit(o.visit);

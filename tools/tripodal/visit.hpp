@@ -56,6 +56,11 @@ struct VisitOptions {
   std::optional<std::uint64_t> seed;  ///< default: the world's
   std::filesystem::path out;          ///< dialogue.txt, report.json, answers' WAV files (empty: none)
   bool voice = true;                  ///< false: treat spoken requests as typed even if voice is built
+  /// Live audio (`--audio DEVICE`, visit_audio.hpp): an ALSA PCM the robot hears the room through
+  /// and answers on, besides the visit file's steps; empty: none. `audio_config`: an ALSA
+  /// configuration file defining it (`--audio-config`; empty: the system's).
+  std::string audio_device;
+  std::filesystem::path audio_config;
   /// Overrides every visitor's give_way_m (world file, docs/simulator.md): 0 makes walkers that do
   /// not yield (they stop only at contact). Empty: the world's.
   std::optional<double> visitors_give_way_m;

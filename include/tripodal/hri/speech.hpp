@@ -131,6 +131,12 @@ struct PocketsphinxOptions {
   std::filesystem::path model_dir = "/usr/share/pocketsphinx/model/en-us";
   /// An ARPA language model text (arpa_bigram_model); empty: the general en-us.lm.bin.
   std::string language_model;
+  /// The share (0..1) of the general English model (`model_dir`'s en-us.lm.bin, a trigram of some
+  /// 70,000 words) linearly interpolated with `language_model`: 0 decodes with the domain model
+  /// alone, which hears every sound as one of its sentences; above 0 a question about something
+  /// else is heard as the words it has. Ignored without a `language_model`. Throws
+  /// std::invalid_argument outside [0, 1].
+  double general_model_weight = 0.0;
   /// Further decoder options, name and value ("-lw", "10"), after the defaults.
   std::vector<std::pair<std::string, std::string>> arguments;
   /// Words the dictionary lacks and their pronunciations in its phones ("jinny" -> "JH IH N IY"),
