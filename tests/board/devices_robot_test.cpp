@@ -148,7 +148,7 @@ TEST_CASE("the disinfection robot on its threads against its board and lidar in 
   ::kill(child, SIGKILL);  // unplugged
   ::waitpid(child, nullptr, 0);
   reaper.pid = -1;
-  const bool got_lost = wait_for(lost, 2s);
+  const bool got_lost = wait_for(lost, 15s);  // a sequencing period is slow under ThreadSanitizer
   wall.sleep_until(wall.now() + 200ms);
   robot->stop();
   CHECK(got_sync);
@@ -156,7 +156,7 @@ TEST_CASE("the disinfection robot on its threads against its board and lidar in 
   CHECK(got_lost);
   CHECK(scans_before >= 3);  // the A1 turns at 5.5 Hz
   board::BoardHardware& hw = dynamic_cast<board::BoardHost&>(*robot->hardware()).board();
-  CHECK(hw.link().stats().requests > 100);
+  CHECK(hw.link().stats().requests > 50);       // 100 Hz, fewer under ThreadSanitizer on a loaded machine
   CHECK(hw.link().stats().port_failures >= 1);  // the kill: the pty hung up
   CHECK(hw.link().decoder_stats().errors() == 0);
   const std::array<double, 2> zeros{0.0, 0.0};
