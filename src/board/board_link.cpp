@@ -66,6 +66,9 @@ bool BoardLink::take_link_lost() noexcept {
 
 void BoardLink::fail_stream(Time now) noexcept {
   while (outstanding_size_ > 0) miss(now);
+  // The device is gone or misconfigured: lost now, whatever max_missed allows (nothing more is
+  // sent, so nothing more would be missed), and SYNC again once it is reopened.
+  lose(now);
   stream_failed_ = true;
   next_reopen_ = now;
 }

@@ -226,7 +226,7 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
     busy.store(is_busy, std::memory_order_release);
   };
   auto stopped = [&] { return o.stop != nullptr && *o.stop != 0; };
-  SteadyClock wall;
+  const SteadyClock wall;
   const auto wait = [&] { wall.sleep_until(wall.now() + std::chrono::milliseconds(10)); };
 
   // The task is given before the threads start (the planner's observers then run on one thread):
