@@ -91,7 +91,7 @@ PathStats path_stats(const std::vector<Point2D>& path, double turn_threshold_rad
 
 // Per-section working data on a window around the section's bounding box.
 struct CoveragePlanner::Workspace {
-  int x0 = 0, y0 = 0, w = 0, h = 0;    // window in grid cells
+  int x0 = 0, y0 = 0, w = 0, h = 0;  // window in grid cells
   std::vector<float> offset;           // E, metres; -inf outside the section
   std::vector<std::uint8_t> stand;     // where the robot centre may be
   std::vector<std::size_t> reachable;  // global indices
@@ -295,9 +295,8 @@ void CoveragePlanner::finish(CoverageResult& r, Workspace& ws, CellIndex cur) {
   for (const std::size_t i : ws.reachable) r.covered_cells += ws.cleaned.cleaned(i) ? 1 : 0;
 }
 
-std::optional<std::vector<CoveragePlanner::RoundPiece>> CoveragePlanner::round_pieces(Workspace& ws,
-                                                                                      const std::vector<std::uint8_t>& in_round,
-                                                                                      CellIndex cur) const {
+std::optional<std::vector<CoveragePlanner::RoundPiece>> CoveragePlanner::round_pieces(
+    Workspace& ws, const std::vector<std::uint8_t>& in_round, CellIndex cur) const {
   const std::size_t n = ws.offset.size();
   std::vector<std::uint8_t> boundary(n, 0), used(n, 0), near(n, 0);
   std::vector<std::size_t> boundary_cells;
@@ -328,8 +327,8 @@ std::optional<std::vector<CoveragePlanner::RoundPiece>> CoveragePlanner::round_p
       const int lx = static_cast<int>(li % static_cast<std::size_t>(ws.w));
       const int ly = static_cast<int>(li / static_cast<std::size_t>(ws.w));
       const CellIndex g = ws.global(lx, ly);
-      const long long d =
-          cur.x < 0 ? static_cast<long long>(li) : 1LL * (g.x - cur.x) * (g.x - cur.x) + 1LL * (g.y - cur.y) * (g.y - cur.y);
+      const long long d = cur.x < 0 ? static_cast<long long>(li)
+                                    : 1LL * (g.x - cur.x) * (g.x - cur.x) + 1LL * (g.y - cur.y) * (g.y - cur.y);
       if (d < seed_d) {
         seed_d = d;
         seed = li;
@@ -394,7 +393,8 @@ std::optional<std::vector<CoveragePlanner::RoundPiece>> CoveragePlanner::round_p
   return pieces;
 }
 
-void CoveragePlanner::append_piece(CoverageResult& r, CellIndex& cur, const RoundPiece& piece, std::optional<Point2D> start) {
+void CoveragePlanner::append_piece(CoverageResult& r, CellIndex& cur, const RoundPiece& piece,
+                                   std::optional<Point2D> start) {
   const CellIndex first = piece.cells.front();
   std::vector<Point2D> pts;
   for (const CellIndex& c : piece.cells) pts.push_back(grid_.cell_center(c));
@@ -469,9 +469,9 @@ namespace {
 
 // One run of a lane: the cells of a row (or column) of the window between its ends, inclusive.
 struct LaneRun {
-  int lane = 0;        // position in the list of lanes
+  int lane = 0;      // position in the list of lanes
   int lo = 0, hi = 0;  // along the lane, window cells
-  CellIndex a, b;      // grid cells at lo and hi
+  CellIndex a, b;    // grid cells at lo and hi
   bool done = false;
 };
 
@@ -627,10 +627,8 @@ void CoveragePlanner::plough(Workspace& ws, const std::vector<std::uint8_t>& mas
       bool first = true;
       CellIndex at{};
       sweep_order(c, (w & 2) != 0, (w & 1) != 0, [&](CellIndex from, CellIndex to) {
-        if (first)
-          way.entry = from;
-        else
-          way.inside_m += metres(at, from);
+        if (first) way.entry = from;
+        else way.inside_m += metres(at, from);
         way.inside_m += metres(from, to);
         at = to;
         first = false;
@@ -653,9 +651,8 @@ void CoveragePlanner::plough(Workspace& ws, const std::vector<std::uint8_t>& mas
   // end to it counts too: the next section's path starts there.
   std::vector<std::pair<std::size_t, std::size_t>> tour;  // (item, way)
   const auto end_cost = [&](CellIndex exit) {
-    return finish_near
-               ? std::hypot(grid_.cell_center(exit).x_m - finish_near->x_m, grid_.cell_center(exit).y_m - finish_near->y_m)
-               : 0.0;
+    return finish_near ? std::hypot(grid_.cell_center(exit).x_m - finish_near->x_m, grid_.cell_center(exit).y_m - finish_near->y_m)
+                       : 0.0;
   };
   const CellIndex first_at = cur;
   const auto link_m = [&](CellIndex from, CellIndex to) { return from.x < 0 ? 0.0 : metres(from, to); };
@@ -764,7 +761,7 @@ void CoveragePlanner::join_pieces(std::vector<RoundPiece>& pieces) {
   // round_pieces breaks a chain where it would turn by more than a right angle, so the round
   // around a box comes as its four sides. Ends a few cells apart with a clear line between them
   // are one walk: sides joined at the corners, and a chain whose ends meet is closed.
-  constexpr int kGap = 6;          // cells, Chebyshev: around the corner of a box, a quarter of a pillar
+  constexpr int kGap = 6;  // cells, Chebyshev: around the corner of a box, a quarter of a pillar
   std::vector<CellIndex> between;  // the cells that join two ends, when they are near
   const auto near = [&](CellIndex a, CellIndex b) {
     between.clear();
@@ -909,7 +906,8 @@ void CoveragePlanner::append_from(CoverageResult& r, CellIndex& cur, const Round
   append_piece(r, cur, rotated, start);
 }
 
-CoverageResult CoveragePlanner::hybrid(const Section& section, std::optional<Point2D> start, std::optional<Point2D> finish_near) {
+CoverageResult CoveragePlanner::hybrid(const Section& section, std::optional<Point2D> start,
+                                       std::optional<Point2D> finish_near) {
   Workspace ws = prepare(section);
   if (ws.stand_cells_global.empty()) {
     CoverageResult r;
@@ -1001,10 +999,8 @@ CoverageResult CoveragePlanner::boustrophedon(const Section& section, std::optio
     it.done = true;
     const CellIndex from = flip ? it.b : it.a;
     const CellIndex to = flip ? it.a : it.b;
-    if (r.path.empty())
-      r.path.push_back(grid_.cell_center(from));
-    else
-      link(r.path, cur, from);
+    if (r.path.empty()) r.path.push_back(grid_.cell_center(from));
+    else link(r.path, cur, from);
     if (!(from == to)) r.path.push_back(grid_.cell_center(to));
     cur = to;
     ++r.passes;
