@@ -101,11 +101,11 @@ table inet tripodal_faults {
   chain cut_in { }
   chain cut_out { }
   chain in { type filter hook input priority 0; policy accept;
-    udp dport $lo_port-$hi_port numgen random mod 100 < $loss drop
+    udp dport $lo_port-$hi_port numgen random mod 100 < $loss counter drop
     udp dport $lo_port-$hi_port jump cut_in
   }
   chain out { type filter hook output priority 0; policy accept;
-    udp dport $lo_port-$hi_port numgen random mod 100 < $loss drop
+    udp dport $lo_port-$hi_port numgen random mod 100 < $loss counter drop
     udp dport $lo_port-$hi_port jump cut_out
   }
 }
@@ -152,4 +152,11 @@ ip netns exec tf_fleet "$tool" fleet --robots "$robots" --world "$(realpath "$wo
 rc=${PIPESTATUS[0]}
 set -e
 [[ -f $out/faults.log ]] && cat "$out/faults.log"
+# What the loss rules dropped, per robot host (both ways): the loss is real, not a setting.
+if [[ $loss != 0 ]]; then
+  for ((k = 1; k <= robots; k++)); do
+    n=$(ip netns exec "tf_robot$k" nft list table inet tripodal_faults | grep -o 'counter packets [0-9]*' | awk '{s += $3} END {print s + 0}')
+    echo "loss: robot$k dropped $n packets of the fleet domain"
+  done
+fi
 exit "$rc"

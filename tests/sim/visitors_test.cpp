@@ -272,3 +272,51 @@ TEST_CASE("Jinny's neck is driven through its command channel by the behavior lo
   CHECK_FALSE(loop.coordinator().channel_output(neck).live);
   CHECK(hw.simulator().joints()[0].position_rad == Approx(30.0 * std::numbers::pi / 180.0));  // held
 }
+
+// Other robots of a shared world (tripodal sim-server --robots N): discs the laser sees, the
+// footprint stops against and the bumpers feel, counted apart from walls; and where N robots start.
+TEST_CASE("sim: another robot of a shared world is seen by the laser, stops the body and presses a bumper") {
+  World w = room_world(120, 80, {1.0, 2.0, 0.0});  // 6 m x 4 m, facing +x
+  w.robot.laser = LaserConfig::sick_180();
+  w.robot.laser.noise_stddev_m = 0.0;
+  Simulator sim(w, omni3_base(), 1);
+  const auto ahead = [&] {
+    const LaserScan& s = sim.laser().latest();
+    return s.ranges_m[s.ranges_m.size() / 2];  // the beam straight ahead (180 degrees, 361 beams)
+  };
+  sim.step(std::chrono::milliseconds(100));
+  CHECK(ahead() == Approx(6.0 - 0.05 - 1.0).margin(0.06));  // the far wall
+  const OtherBody other{{2.5, 2.0}, 0.25, 7};
+  sim.set_other_bodies(std::span<const OtherBody>(&other, 1));
+  sim.step(std::chrono::milliseconds(100));
+  CHECK(ahead() == Approx(1.25).margin(0.01));  // its near side
+  CHECK(sim.min_robot_clearance_m() == Approx(1.0).margin(1e-9));
+  sim.command_twist({0.5, 0.0, 0.0});
+  sim.step(std::chrono::seconds(4));
+  CHECK(sim.pose().x_m == Approx(2.0).margin(0.01));  // touching: two radii between the centres
+  CHECK(sim.collisions() == 1);
+  CHECK(sim.robot_collisions() == 1);
+  CHECK(sim.events().back().detail.find("with robot 7") != std::string::npos);
+  CHECK(sim.bumpers().latest().pressed_mask != 0U);
+  // Gone: the way is free again.
+  sim.set_other_bodies({});
+  sim.step(std::chrono::seconds(1));
+  CHECK(sim.pose().x_m > 2.3);
+  CHECK(sim.robot_collisions() == 1);
+}
+
+TEST_CASE("sim: the start poses of a shared world are free, apart, and refused when the map has no room") {
+  const World w = room_world(120, 80, {1.0, 2.0, 0.0});
+  const std::vector<Pose2D> p = fleet_start_poses(w, 6);
+  REQUIRE(p.size() == 6);
+  CHECK(p[0].x_m == 1.0);
+  CHECK(p[0].y_m == 2.0);
+  const SolidMap solid(w.grid);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    CHECK_FALSE(solid.disc_overlaps({p[i].x_m, p[i].y_m}, w.robot.radius_m));
+    for (std::size_t j = 0; j < i; ++j)
+      CHECK(std::hypot(p[i].x_m - p[j].x_m, p[i].y_m - p[j].y_m) >= 2 * w.robot.radius_m + 0.4 - 1e-9);
+  }
+  const World tiny = room_world(24, 24, {0.6, 0.6, 0.0});  // 1.2 m square: one robot only
+  CHECK_THROWS_WITH(fleet_start_poses(tiny, 2), Contains("no room for 2 robots"));
+}
