@@ -1,12 +1,11 @@
 #include "tripodal/board/board_hardware.hpp"
 
+#include <array>
 #include <catch2/catch.hpp>
 
-#include <array>
-
+#include "still_plant.hpp"
 #include "tripodal/board/board_firmware.hpp"
 #include "tripodal/board/serial_line.hpp"
-#include "still_plant.hpp"
 
 using namespace tripodal;
 using namespace tripodal::board;
