@@ -189,13 +189,9 @@ void BM_OdometryStream(benchmark::State& state) {
   std::string self = "/proc/self/exe";
   std::string domain_text = std::to_string(domain_id);
   std::string seconds_text = std::to_string(seconds);
-  std::vector<char*> child{self.data(),
-                           const_cast<char*>("--odom-publisher"),
-                           const_cast<char*>("--domain"),
-                           domain_text.data(),
-                           const_cast<char*>("--odom-seconds"),
-                           seconds_text.data(),
-                           nullptr};
+  std::vector<char*> child{self.data(),         const_cast<char*>("--odom-publisher"),
+                           const_cast<char*>("--domain"), domain_text.data(),
+                           const_cast<char*>("--odom-seconds"), seconds_text.data(), nullptr};
   pid_t pid = 0;
   if (posix_spawn(&pid, self.c_str(), nullptr, nullptr, child.data(), environ) != 0) {
     state.SkipWithError("cannot start the odometry publisher process");
@@ -307,7 +303,8 @@ int main(int argc, char** argv) {
 
   std::string self = "/proc/self/exe";
   std::string domain_text = std::to_string(domain_id);
-  std::vector<char*> child{self.data(), const_cast<char*>("--echo"), const_cast<char*>("--domain"), domain_text.data(), nullptr};
+  std::vector<char*> child{self.data(), const_cast<char*>("--echo"), const_cast<char*>("--domain"),
+                           domain_text.data(), nullptr};
   pid_t pid = 0;
   if (posix_spawn(&pid, self.c_str(), nullptr, nullptr, child.data(), environ) != 0) {
     std::perror("tripodal_dds_bench: cannot start the echo process");

@@ -249,8 +249,7 @@ void register_board_hardware(HardwareRegistry& registry) {
       // frames over a TCP byte stream; reconnected like a reopened tty.
       stream = std::make_unique<TcpStream>(port, port_clock);
     } else {
-      stream =
-          std::make_unique<SerialPort>(port, port_clock, SerialSettings{static_cast<std::uint32_t>(c.parameters.number("baud"))});
+      stream = std::make_unique<SerialPort>(port, port_clock, SerialSettings{static_cast<std::uint32_t>(c.parameters.number("baud"))});
     }
     ByteStream& s = *stream;
     auto hw = std::make_unique<BoardHardware>(s, config, std::move(stream));

@@ -12,8 +12,8 @@ const ModuleManifest& BoardMonitor::static_manifest() {
       ManifestBuilder("BoardMonitor", ModuleKind::other, Layer::sequencing)
           .description("the control board's link and panel as supervisor events (docs/board-protocol.md)")
           .input("board_link")
-          .outputs({"board.link_lost", "board.link_restored", "board.start", "board.pause", "board.home", "board.emergency_stop",
-                    "board.tank_empty", "board.tank_refilled", "board.battery_low"})
+          .outputs({"board.link_lost", "board.link_restored", "board.start", "board.pause", "board.home",
+                    "board.emergency_stop", "board.tank_empty", "board.tank_refilled", "board.battery_low"})
           .number("battery_low_percent", 15.0, "%", "at or below this the task must end and the robot charge", 0.0, 100.0)
           .build();
   return m;

@@ -839,9 +839,7 @@ Engine::~Engine() = default;
 Engine::Engine(Engine&&) noexcept = default;
 Engine& Engine::operator=(Engine&&) noexcept = default;
 
-const StepResult& Engine::step(Time now) {
-  return step(now, std::span<const EventId>{});
-}
+const StepResult& Engine::step(Time now) { return step(now, std::span<const EventId>{}); }
 
 const StepResult& Engine::step(Time now, std::span<const EventId> events) {
   Impl& m = *impl_;

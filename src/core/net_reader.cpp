@@ -417,9 +417,9 @@ void check_event_source(const ReadContext& ctx, const XmlElement* e, const std::
     if (std::find(kinds_of_source->begin(), kinds_of_source->end(), kind) != kinds_of_source->end()) return;
     std::vector<std::string> own;
     for (const auto& k : *kinds_of_source) own.push_back(source + "." + k);
-    ctx.error_at_value(
-        e, "event",
-        "unknown event '" + event + "': '" + source + "' posts " + own[0] + " and " + own[1] + did_you_mean(event, own));
+    ctx.error_at_value(e, "event",
+                       "unknown event '" + event + "': '" + source + "' posts " + own[0] + " and " + own[1] +
+                           did_you_mean(event, own));
     return;
   }
   // Behaviors and processes are named Bh... and Pr...; a process's events are its place's
@@ -433,8 +433,8 @@ void check_event_source(const ReadContext& ctx, const XmlElement* e, const std::
   if (const auto close = closest_name(source, sources)) {
     const auto event_close = closest_name(*close + "." + kind, known_events);
     ctx.error_at_value(e, "event",
-                       "unknown event '" + event + "': no place of net '" + net.id + "' binds '" + source + "'; did you mean '" +
-                           (event_close ? *event_close : *close + "." + kind) + "'?");
+                       "unknown event '" + event + "': no place of net '" + net.id + "' binds '" + source +
+                           "'; did you mean '" + (event_close ? *event_close : *close + "." + kind) + "'?");
   }
 }
 

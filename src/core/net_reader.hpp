@@ -10,10 +10,11 @@
 #include <string>
 #include <string_view>
 
+#include "xml_document.hpp"
+
 #include "tripodal/core/diagnostic.hpp"
 #include "tripodal/core/net_loader.hpp"
 #include "tripodal/core/petri_net.hpp"
-#include "xml_document.hpp"
 #include "xml_locator.hpp"
 
 namespace tripodal::detail {

@@ -506,8 +506,7 @@ struct DdsFleet::Impl {
     }
     for (const Arrival& a : arrived) {
       const std::string& name = links[a.robot]->name;
-      if (a.silent)
-        planner.robot_silent(name, "liveliness lost");
+      if (a.silent) planner.robot_silent(name, "liveliness lost");
       else planner.robot_event(name, a.event.kind, a.event.source, a.event.detail);
     }
     for (const FleetCommand& c : planner.poll()) {

@@ -1,11 +1,12 @@
 #include "tripodal/board/board_hardware.hpp"
 
-#include <array>
 #include <catch2/catch.hpp>
 
-#include "still_plant.hpp"
+#include <array>
+
 #include "tripodal/board/board_firmware.hpp"
 #include "tripodal/board/serial_line.hpp"
+#include "still_plant.hpp"
 
 using namespace tripodal;
 using namespace tripodal::board;

@@ -101,9 +101,8 @@ double typed_accuracy(const std::string& file) {
     }
   }
   const double accuracy = set.empty() ? 0.0 : static_cast<double>(right) / static_cast<double>(set.size());
-  std::cout << "HRI typed utterance set " << file << ": " << right << "/" << set.size() << " right, accuracy " << accuracy * 100.0
-            << " %\n"
-            << misses;
+  std::cout << "HRI typed utterance set " << file << ": " << right << "/" << set.size() << " right, accuracy "
+            << accuracy * 100.0 << " %\n" << misses;
   return accuracy;
 }
 

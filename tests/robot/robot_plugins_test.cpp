@@ -56,8 +56,7 @@ class WinchHardware final : public CHardware {
     static const ModuleManifest m = hardware_manifest("winch_board", "one ideal wheel", {}, {});
     return m;
   }
-  explicit WinchHardware(const HardwareConfig& c)
-      : wheel_(1, c.base != nullptr ? c.base->period : std::chrono::milliseconds(10)) {}
+  explicit WinchHardware(const HardwareConfig& c) : wheel_(1, c.base != nullptr ? c.base->period : std::chrono::milliseconds(10)) {}
 
  protected:
   const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }

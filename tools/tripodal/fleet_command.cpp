@@ -8,7 +8,6 @@
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
-#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cctype>
@@ -26,6 +25,8 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#include <yaml-cpp/yaml.h>
 
 #include "cli_tool.hpp"
 #include "run_outputs.hpp"
@@ -337,8 +338,7 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
     } remove_temporary{dir, temporary};
 
     std::vector<dds::FleetRobot> robots;
-    for (int k = 1; k <= a.robots; ++k)
-      robots.push_back({"robot" + std::to_string(k), world.start_pose.x_m, world.start_pose.y_m});
+    for (int k = 1; k <= a.robots; ++k) robots.push_back({"robot" + std::to_string(k), world.start_pose.x_m, world.start_pose.y_m});
     std::vector<std::string> names;
     names.reserve(units.size());
     for (const dds::FleetUnit& u : units) names.push_back(u.name + " (" + app::fixed(u.area_m2, 1) + " m2)");
@@ -354,11 +354,9 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
 
     SteadyClock clock;
     dds::FleetPlanner planner(robots, units, clock);
-    dds::DdsFleet fleet(
-        planner, robots,
-        dds::DdsFleetOptions{.domain_id = a.domain,
-                             .network = dds::Network::loopback,
-                             .participant_lease = std::chrono::milliseconds(static_cast<long>(a.lease_s * 1000.0))});
+    dds::DdsFleet fleet(planner, robots,
+                        dds::DdsFleetOptions{.domain_id = a.domain, .network = dds::Network::loopback,
+                                             .participant_lease = std::chrono::milliseconds(static_cast<long>(a.lease_s * 1000.0))});
 
     const std::string exe = std::filesystem::read_symlink("/proc/self/exe").string();
     Children children;
@@ -368,16 +366,8 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
       f << fleet_profile(robot, r.name, a.domain, a.lease_s);
       if (!f) throw std::runtime_error("cannot write '" + p.string() + "'");
       f.close();
-      std::vector<std::string> argv{exe,
-                                    "run",
-                                    "--robot",
-                                    p.string(),
-                                    "--world",
-                                    std::filesystem::absolute(a.world).string(),
-                                    "--realtime",
-                                    app::fixed(a.speed, 3),
-                                    "--max-duration-s",
-                                    app::fixed(a.timeout_s * a.speed + 60.0, 1)};
+      std::vector<std::string> argv{exe, "run", "--robot", p.string(), "--world", std::filesystem::absolute(a.world).string(),
+                                    "--realtime", app::fixed(a.speed, 3), "--max-duration-s", app::fixed(a.timeout_s * a.speed + 60.0, 1)};
       if (a.seed) argv.insert(argv.end(), {"--seed", std::to_string(*a.seed)});
       children.spawn(r.name, argv, dir / (r.name + ".log"));
     }

@@ -168,8 +168,7 @@ int run_guide(const Args& args, std::ostream& out, std::ostream& err) {
     vo.max_duration_s = o.max_duration_s;
     vo.stop = &g_stop;
     out << "tripodal run: robot " << o.robot.string() << ", world " << o.world.string()
-        << (args.visit.empty() ? std::string(", no visit file: the monitor's visitors") : ", visit " + args.visit.string())
-        << "\n";
+        << (args.visit.empty() ? std::string(", no visit file: the monitor's visitors") : ", visit " + args.visit.string()) << "\n";
     out.flush();
     const app::VisitResult r = app::run_visit(vo);
     out << (args.visit.empty() ? "run ended" : std::string("visit ") + (r.completed ? "completed" : "not completed")) << " (seed " << r.seed

@@ -183,12 +183,14 @@ class ReportObserver final : public TaskObserver {
   void on_process_started(const ProcessRecord& p) override { current = step_text(p.step); }
   void on_process_succeeded(const ProcessRecord& p) override { add(p, "succeeded"); }
   void on_process_failed(const ProcessRecord& p) override { add(p, "failed: " + p.message); }
-  void on_recovery(const RecoveryRecord& r) override { recoveries.push_back(fixed(to_seconds(r.time), 3) + " " + r.reason); }
+  void on_recovery(const RecoveryRecord& r) override {
+    recoveries.push_back(fixed(to_seconds(r.time), 3) + " " + r.reason);
+  }
 
  private:
   void add(const ProcessRecord& p, const std::string& how) {
-    processes.push_back(fixed(to_seconds(p.started), 3) + "-" + fixed(to_seconds(p.finished.value_or(p.started)), 3) + " " +
-                        p.run + " " + step_text(p.step) + " " + how);
+    processes.push_back(fixed(to_seconds(p.started), 3) + "-" + fixed(to_seconds(p.finished.value_or(p.started)), 3) + " " + p.run +
+                        " " + step_text(p.step) + " " + how);
     current.clear();
   }
 };
@@ -241,6 +243,7 @@ DisinfectionFigures disinfection_figures(sim::SimBoardHardware& hw, const std::v
 }
 
 }  // namespace
+
 
 std::vector<ParameterOverride> simulation_overrides(const RobotProfile& profile, const sim::World& world, std::uint64_t seed) {
   std::vector<ParameterOverride> out;
@@ -343,9 +346,7 @@ class GroundTruth {
     remote_ = dynamic_cast<const dds::DdsHardware*>(hw);
 #endif
   }
-  [[nodiscard]] const sim::Simulator* local() const noexcept {
-    return local_;
-  }
+  [[nodiscard]] const sim::Simulator* local() const noexcept { return local_; }
   /// Any thread: the pose the hardware published after its last advance.
   [[nodiscard]] Pose2D pose() const {
     if (sources_ != nullptr) return sources_->true_pose(Time{}).value_or(start_);
@@ -369,9 +370,7 @@ class GroundTruth {
     return 0;
   }
   /// Of the body, absolute (rad): the simulator's own, or summed from the poses sampled here.
-  [[nodiscard]] double rotation_rad() const {
-    return local_ != nullptr ? local_->rotation_rad() : sampled_rotation_rad_;
-  }
+  [[nodiscard]] double rotation_rad() const { return local_ != nullptr ? local_->rotation_rad() : sampled_rotation_rad_; }
   void sample() {
     const Pose2D p = pose();
     sampled_rotation_rad_ += std::abs(wrap_angle(p.theta_rad - last_.theta_rad));
@@ -534,8 +533,7 @@ RunResult run_task(const RunOptions& o) {
                                                    "{type: board}, {type: dds} or a type derived from sim::SimHardware");
   }
   sim::SimBoardHardware* const board_hw = dynamic_cast<sim::SimBoardHardware*>(robot->hardware());
-  Navigation nav{robot->module<navi::CGridMaps>(), robot->module<navi::CSectionSplitter>(),
-                 robot->module<navi::CCoverageModule>()};
+  Navigation nav{robot->module<navi::CGridMaps>(), robot->module<navi::CSectionSplitter>(), robot->module<navi::CCoverageModule>()};
   if (nav.coverage != nullptr) res.coverage_pattern = nav.coverage->pattern();
   // Cleaning is measured when the robot has SectionSplitter and CoveragePlanner; the map always.
   if (nav.maps == nullptr)
@@ -594,8 +592,8 @@ RunResult run_task(const RunOptions& o) {
     so.allowed_origins = o.monitor_allowed_origins;
     server = std::make_unique<monitor::MonitorServer>(std::move(so));
     // the operator's live maps go beside the run's own outputs
-    watch = std::make_unique<monitor::RobotMonitor>(
-        *robot, clock, *server, monitor::RobotMonitorOptions{.start_paused = o.start_paused, .map_dir = o.out});
+    watch = std::make_unique<monitor::RobotMonitor>(*robot, clock, *server,
+                                                    monitor::RobotMonitorOptions{.start_paused = o.start_paused, .map_dir = o.out});
     server->start();
     if (o.log != nullptr) {
       *o.log << "monitor: " << server->url() << "  (token " << server->token() << (o.start_paused ? "; paused until resumed" : "")
@@ -852,9 +850,9 @@ RunResult run_task(const RunOptions& o) {
     const std::uint64_t messages = recording->finish();
     if (o.log != nullptr) {
       *o.log << "recorded " << messages << " messages into " << o.record.string()
-             << (recording->unrecorded_resources() > 0 ? " (" + std::to_string(recording->unrecorded_resources()) +
-                                                             " resources carry readings MCAP export does not)"
-                                                       : std::string())
+             << (recording->unrecorded_resources() > 0
+                     ? " (" + std::to_string(recording->unrecorded_resources()) + " resources carry readings MCAP export does not)"
+                     : std::string())
              << '\n';
     }
   }
@@ -864,15 +862,13 @@ RunResult run_task(const RunOptions& o) {
   const TaskReport tr = robot->planner().report();
   res.succeeded = tr.state == TaskState::succeeded;
   // With the monitor a task from the console may follow a refused --task: the last task counts.
-  if (res.state.empty() || (serve && res.state == "refused" && tr.state != TaskState::idle))
-    res.state = std::string(to_string(tr.state));
+  if (res.state.empty() || (serve && res.state == "refused" && tr.state != TaskState::idle)) res.state = std::string(to_string(tr.state));
   // A refused task leaves the planner idle: the refusal's words stay the reason.
   const bool only_refused = res.state == "refused" && tr.state == TaskState::idle;
   if (!only_refused && (!serve || tr.state != TaskState::idle)) res.reason = tr.reason;
   res.duration_s = to_seconds(ended);
   res.cleaned_cells = covered();
-  res.coverage =
-      res.reachable_cells == 0 ? 0.0 : static_cast<double>(res.cleaned_cells) / static_cast<double>(res.reachable_cells);
+  res.coverage = res.reachable_cells == 0 ? 0.0 : static_cast<double>(res.cleaned_cells) / static_cast<double>(res.reachable_cells);
   const double res_m = nav.maps->grid().resolution_m();
   res.reachable_area_m2 = static_cast<double>(res.reachable_cells) * res_m * res_m;
   res.total = path_figures(path_all);
@@ -891,8 +887,7 @@ RunResult run_task(const RunOptions& o) {
     res.faults.push_back("localization loss " + fixed(to_seconds(f.start), 1) + "-" + fixed(to_seconds(f.end), 1) + " s");
   }
   for (const sim::SimEvent& e : truth.local() != nullptr ? truth.local()->events() : std::vector<sim::SimEvent>{}) {
-    res.faults.push_back(fixed(to_seconds(e.stamp), 3) + " " + std::string(sim::to_string(e.kind)) +
-                         (e.detail.empty() ? "" : " " + e.detail));
+    res.faults.push_back(fixed(to_seconds(e.stamp), 3) + " " + std::string(sim::to_string(e.kind)) + (e.detail.empty() ? "" : " " + e.detail));
   }
 
   // The planned paths of the three patterns over the same sections (same grid and width).

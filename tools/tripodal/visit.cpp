@@ -6,10 +6,11 @@
 #include <deque>
 #include <fstream>
 #include <iomanip>
-#include <nlohmann/json.hpp>
 #include <numbers>
 #include <ostream>
 #include <sstream>
+
+#include <nlohmann/json.hpp>
 
 #include "guide_hri.hpp"
 #include "run_outputs.hpp"
@@ -17,8 +18,8 @@
 #include "shutdown.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/hri/hri_module.hpp"
-#include "tripodal/hri/speech.hpp"
 #include "tripodal/monitor/robot_monitor.hpp"
+#include "tripodal/hri/speech.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
 #include "tripodal/planner/task_library.hpp"
 #include "tripodal/robot/robot.hpp"
@@ -78,8 +79,7 @@ std::string in_quotes(std::string_view s) { return "\"" + std::string(s) + "\"";
 }  // namespace
 
 VisitResult run_visit(const VisitOptions& o) {
-  if (o.visit.empty() && !o.monitor)
-    throw std::invalid_argument("run_visit: without a visit file there must be a monitor to serve");
+  if (o.visit.empty() && !o.monitor) throw std::invalid_argument("run_visit: without a visit file there must be a monitor to serve");
   Visit visit;
   if (!o.visit.empty()) {
     visit = load_visit(o.visit);
@@ -117,8 +117,7 @@ VisitResult run_visit(const VisitOptions& o) {
   auto& hw = dynamic_cast<sim::SimHardware&>(*robot->hardware());
   const sim::Simulator& sim = hw.simulator();
   CHri* const hri_module = robot->module<CHri>();
-  if (hri_module == nullptr)
-    throw ConfigError(profile.where, "`tripodal run --visit` needs the robot's HRI: hri: [{name, type: Hri, ...}]");
+  if (hri_module == nullptr) throw ConfigError(profile.where, "`tripodal run --visit` needs the robot's HRI: hri: [{name, type: Hri, ...}]");
   if (profile.tasks.empty()) throw ConfigError(profile.where, "`tripodal run --visit` needs the robot's tasks (tasks: FILE)");
   if (CController* c = robot->behavior_loop().controller()) c->reset_odometry(world->start_pose);
 
@@ -130,8 +129,7 @@ VisitResult run_visit(const VisitOptions& o) {
   const bool robot_speaks = robot_voice != nullptr;
   GuideHri guide(*robot, *hri_module, clock, profile.tasks,
                  GuideHri::Options{[&sim] { return sim.battery_charge(); }, std::move(robot_voice)});
-  Voice voice =
-      robot_speaks ? make_voice(hri_module->knowledge_store().base(), guide.tasks(), world->regions) : Voice{{}, {}, voice_off};
+  Voice voice = robot_speaks ? make_voice(hri_module->knowledge_store().base(), guide.tasks(), world->regions) : Voice{{}, {}, voice_off};
   res.voice = voice.ears != nullptr;
 
   LifecycleRecorder life(false);
@@ -146,8 +144,7 @@ VisitResult run_visit(const VisitOptions& o) {
   std::optional<sim::RealtimePacer> pacer;
   if (server_options) {
     server = std::make_unique<monitor::MonitorServer>(std::move(*server_options));
-    watch = std::make_unique<monitor::RobotMonitor>(*robot, clock, *server,
-                                                    monitor::RobotMonitorOptions{.start_paused = o.start_paused});
+    watch = std::make_unique<monitor::RobotMonitor>(*robot, clock, *server, monitor::RobotMonitorOptions{.start_paused = o.start_paused});
     watch->set_hri(&guide.service());
     server->start();
     pacer.emplace(wall, o.realtime_speed);
@@ -180,11 +177,9 @@ VisitResult run_visit(const VisitOptions& o) {
     audio_dir = o.out / "audio";
     std::filesystem::create_directories(audio_dir);
   }
-  if (server)
-    say("monitor: " + server->url() + "  (token " + server->token() + (o.start_paused ? "; paused until resumed" : "") +
-        "; RKMS at /rkms, touch screen at /touch)");
-  say(std::string("voice ") +
-      (res.voice ? "on: requests spoken by espeak-ng and heard by pocketsphinx, answers synthesised" : voice.off_reason) +
+  if (server) say("monitor: " + server->url() + "  (token " + server->token() + (o.start_paused ? "; paused until resumed" : "") +
+                  "; RKMS at /rkms, touch screen at /touch)");
+  say(std::string("voice ") + (res.voice ? "on: requests spoken by espeak-ng and heard by pocketsphinx, answers synthesised" : voice.off_reason) +
       (res.voice && audio_dir.empty() ? " (no --out: answers not written)" : ""));
   std::size_t clip = 0;
   auto speak = [&](const std::string& text) -> std::string {
@@ -206,17 +201,15 @@ VisitResult run_visit(const VisitOptions& o) {
     x.reply = r.text;
     x.wav = speak(r.text);
     seen = guide.service().display().last;
-    say("Jinny [" + x.reply_kind + (x.entry.empty() ? "" : " " + x.entry) + (x.task.empty() ? "" : ", task " + x.task) +
-        "]: " + r.text + (x.wav.empty() ? "" : "  (" + x.wav + ")"));
+    say("Jinny [" + x.reply_kind + (x.entry.empty() ? "" : " " + x.entry) + (x.task.empty() ? "" : ", task " + x.task) + "]: " + r.text +
+        (x.wav.empty() ? "" : "  (" + x.wav + ")"));
   };
   auto check = [&](const VisitStep& s, VisitExchange& x) {
     std::string m;
-    if (!s.expect_outcome.empty() && s.expect_outcome != x.reply_kind)
-      m += "outcome " + x.reply_kind + ", expected " + s.expect_outcome + "; ";
+    if (!s.expect_outcome.empty() && s.expect_outcome != x.reply_kind) m += "outcome " + x.reply_kind + ", expected " + s.expect_outcome + "; ";
     if (!s.expect_entry.empty() && s.expect_entry != x.entry) m += "entry '" + x.entry + "', expected '" + s.expect_entry + "'; ";
     if (!s.expect_task.empty() && s.expect_task != x.task) m += "task '" + x.task + "', expected '" + s.expect_task + "'; ";
-    if (!s.expect_task_end.empty() && s.expect_task_end != x.task_end)
-      m += "task end '" + x.task_end + "', expected '" + s.expect_task_end + "'; ";
+    if (!s.expect_task_end.empty() && s.expect_task_end != x.task_end) m += "task end '" + x.task_end + "', expected '" + s.expect_task_end + "'; ";
     x.as_expected = m.empty();
     x.mismatch = m;
   };
@@ -230,8 +223,7 @@ VisitResult run_visit(const VisitOptions& o) {
     for (const HriReply& r : guide.update()) {
       const std::string wav = speak(r.text);
       seen = guide.service().display().last;
-      say("Jinny [explaining" + (r.entry_id.empty() ? std::string() : " " + r.entry_id) + "]: " + r.text +
-          (wav.empty() ? "" : "  (" + wav + ")"));
+      say("Jinny [explaining" + (r.entry_id.empty() ? std::string() : " " + r.entry_id) + "]: " + r.text + (wav.empty() ? "" : "  (" + wav + ")"));
     }
     if (!shown || *shown != guide.state()) {
       shown = guide.state();
@@ -266,7 +258,7 @@ VisitResult run_visit(const VisitOptions& o) {
   // The exchange whose task is running (a plain index: GCC 12 sees an optional here as maybe unset).
   constexpr std::size_t kNone = static_cast<std::size_t>(-1);
   std::size_t waiting = kNone;
-  std::size_t pending_button = 0;  // button presses on their way to the HRI
+  std::size_t pending_button = 0;      // button presses on their way to the HRI
   std::vector<char> giving_way(sim.visitors().size(), 0);
   display();
   while (clock.now() < deadline && !stopped()) {
@@ -305,10 +297,8 @@ VisitResult run_visit(const VisitOptions& o) {
       if (next == 0) continue;  // pressed on the simulator, not by the visit
       const VisitStep& s = visit.steps[next - 1];
       check(s, res.exchanges.back());
-      if (!x.task.empty())
-        waiting = res.exchanges.size() - 1;
-      else
-        ready_at = clock.now() + from_seconds(s.after_s);
+      if (!x.task.empty()) waiting = res.exchanges.size() - 1;
+      else ready_at = clock.now() + from_seconds(s.after_s);
     }
     const bool idle = waiting == kNone && pending_button == 0;
     if (idle && next < visit.steps.size()) {
@@ -346,17 +336,14 @@ VisitResult run_visit(const VisitOptions& o) {
           record(x, r);
           res.exchanges.push_back(x);
           check(s, res.exchanges.back());
-          if (robot->planner().busy())
-            waiting = res.exchanges.size() - 1;
-          else
-            ready_at = clock.now() + from_seconds(s.after_s);
+          if (robot->planner().busy()) waiting = res.exchanges.size() - 1;
+          else ready_at = clock.now() + from_seconds(s.after_s);
         }
       }
     }
     if (next >= visit.steps.size() && waiting == kNone && pending_button == 0 && !robot->planner().busy()) {
       // The visit is over; a monitored robot goes on serving its pages until stopped.
-      if (!res.completed && !o.visit.empty())
-        say("the visit is over" + std::string(watch ? "; the monitor goes on serving until stopped" : ""));
+      if (!res.completed && !o.visit.empty()) say("the visit is over" + std::string(watch ? "; the monitor goes on serving until stopped" : ""));
       res.completed = true;
       if (!watch) break;
     }
@@ -380,19 +367,17 @@ VisitResult run_visit(const VisitOptions& o) {
   monitor_update();
   res.stopped_by = stop_reason(stop_signal(o.stop));
   if (robot->planner().busy()) {
-    robot->planner().cancel(!res.stopped_by.empty() ? res.stopped_by
-                                                    : "the visit did not end within " + fixed(visit.max_duration_s, 0) + " s");
+    robot->planner().cancel(!res.stopped_by.empty() ? res.stopped_by : "the visit did not end within " + fixed(visit.max_duration_s, 0) + " s");
     robot->step_sequencing();
   }
   // Whatever ended the run, the base is left at rest before the devices close.
-  const BaseStop rest = stop_base(
-      *robot, [&sim] { return std::vector<double>(sim.wheel_commands().begin(), sim.wheel_commands().end()); }, period);
+  const BaseStop rest =
+      stop_base(*robot, [&sim] { return std::vector<double>(sim.wheel_commands().begin(), sim.wheel_commands().end()); }, period);
   res.base_command_at_end_rad_s = rest.command_rad_s;
   res.base_at_rest = rest.at_rest;
   flush_life();
   for (const sim::SimEvent& e : sim.events()) {
-    if (e.kind == sim::SimEvent::Kind::collision)
-      say("simulator: collision " + e.detail + " at " + fixed(to_seconds(e.stamp), 1) + " s");
+    if (e.kind == sim::SimEvent::Kind::collision) say("simulator: collision " + e.detail + " at " + fixed(to_seconds(e.stamp), 1) + " s");
   }
   res.duration_s = to_seconds(clock.now());
   res.distance_m = sim.distance_m();
@@ -401,8 +386,7 @@ VisitResult run_visit(const VisitOptions& o) {
   res.min_visitor_clearance_m = sim.min_visitor_clearance_m();
   res.processes = guide.processes();
   for (const VisitExchange& x : res.exchanges) res.mismatches += x.as_expected ? 0 : 1;
-  if (!res.completed)
-    say(stopped() ? "the run was " + res.stopped_by : "the visit did not end within " + fixed(visit.max_duration_s, 0) + " s");
+  if (!res.completed) say(stopped() ? "the run was " + res.stopped_by : "the visit did not end within " + fixed(visit.max_duration_s, 0) + " s");
   if (!o.out.empty()) {
     write_text(o.out / "dialogue.txt", dialogue.str());
     write_text(o.out / "report.json", res.json());
