@@ -11,6 +11,8 @@
 
 namespace tripodal::navi {
 
+using coverage_detail::dist2;
+
 // ---------------------------------------------------------------- cleaned cells
 
 CleanedCells::CleanedCells(const OccupancyGrid& grid)
@@ -133,6 +135,26 @@ CoveragePlanner::Workspace CoveragePlanner::prepare(const Section& section) {
       ws.stand[li] = e >= 0.0 ? 1 : 0;
     }
   }
+  if (!keep_linked_stand(ws)) return ws;
+  const auto cell_of_local = [&](std::size_t li) {
+    return ws.global(static_cast<int>(li % static_cast<std::size_t>(ws.w)),
+                     static_cast<int>(li / static_cast<std::size_t>(ws.w)));
+  };
+  // reachable: section cells within the footprint radius of a standing cell
+  std::vector<bool> is_stand(n);
+  for (std::size_t li = 0; li < n; ++li) is_stand[li] = ws.stand[li] != 0;
+  const DistanceField to_stand(ws.w, ws.h, grid_.resolution_m(), is_stand, false);
+  for (std::size_t li = 0; li < n; ++li) {
+    if (outside[li]) continue;
+    const std::size_t gi = grid_.index(cell_of_local(li));
+    if (ws.stand[li] != 0) ws.stand_cells_global.push_back(gi);
+    if (to_stand.distance_m(li) <= half + 1e-6) ws.reachable.push_back(gi);  // float distances
+  }
+  return ws;
+}
+
+bool CoveragePlanner::keep_linked_stand(Workspace& ws) {
+  const std::size_t n = ws.stand.size();
   // stand components (8-connected as A* moves); keep those the planner can link to the largest one
   std::vector<int> comp(n, -1);
   std::vector<std::vector<std::size_t>> comps;
@@ -166,7 +188,7 @@ CoveragePlanner::Workspace CoveragePlanner::prepare(const Section& section) {
       }
     }
   }
-  if (comps.empty()) return ws;
+  if (comps.empty()) return false;
   std::size_t main = 0;
   for (std::size_t k = 1; k < comps.size(); ++k) {
     if (comps[k].size() > comps[main].size()) main = k;
@@ -181,17 +203,7 @@ CoveragePlanner::Workspace CoveragePlanner::prepare(const Section& section) {
       for (const std::size_t li : comps[k]) ws.stand[li] = 0;
     }
   }
-  // reachable: section cells within the footprint radius of a standing cell
-  std::vector<bool> is_stand(n);
-  for (std::size_t li = 0; li < n; ++li) is_stand[li] = ws.stand[li] != 0;
-  const DistanceField to_stand(ws.w, ws.h, grid_.resolution_m(), is_stand, false);
-  for (std::size_t li = 0; li < n; ++li) {
-    if (outside[li]) continue;
-    const std::size_t gi = grid_.index(cell_of_local(li));
-    if (ws.stand[li] != 0) ws.stand_cells_global.push_back(gi);
-    if (to_stand.distance_m(li) <= half + 1e-6) ws.reachable.push_back(gi);  // float distances
-  }
-  return ws;
+  return true;
 }
 
 void CoveragePlanner::link(std::vector<Point2D>& path, CellIndex from, CellIndex to) {
@@ -210,91 +222,8 @@ void CoveragePlanner::finish(CoverageResult& r, Workspace& ws, CellIndex cur) {
   const double half = options_.cleaning_width_m / 2.0;
   ws.cleaned.mark_path(r.path, half);
   if (options_.touch_up && !ws.stand_cells_global.empty()) {
-    std::vector<std::size_t> todo;
-    for (const std::size_t i : ws.reachable) {
-      if (!ws.cleaned.cleaned(i)) todo.push_back(i);
-    }
-    const int reach = static_cast<int>(std::ceil(half / grid_.resolution_m()));
-    std::vector<std::uint8_t> left(ws.offset.size(), 0);  // reachable cells, window-local
-    for (const std::size_t i : ws.reachable) {
-      const CellIndex c = grid_.cell(i);
-      left[ws.local(c.x - ws.x0, c.y - ws.y0)] = 1;
-    }
-    while (!todo.empty()) {
-      // nearest uncleaned cell
-      std::size_t best = 0;
-      long long best_d = std::numeric_limits<long long>::max();
-      for (std::size_t k = 0; k < todo.size(); ++k) {
-        const CellIndex c = grid_.cell(todo[k]);
-        const long long d = 1LL * (c.x - cur.x) * (c.x - cur.x) + 1LL * (c.y - cur.y) * (c.y - cur.y);
-        if (d < best_d) {
-          best_d = d;
-          best = k;
-        }
-      }
-      const CellIndex u = grid_.cell(todo[best]);
-      // A standing cell whose footprint covers u and the most cells still left around it (the
-      // nearest to the robot among equals): the cell nearest to the robot alone covered u at the
-      // footprint's edge and little else, so the wedges along a slanted wall took a visit each.
-      std::optional<CellIndex> target;
-      long long target_d = std::numeric_limits<long long>::max();
-      std::size_t target_gain = 0;
-      const double r2 = (half / grid_.resolution_m()) * (half / grid_.resolution_m()) + 1e-9;
-      const auto gain = [&](CellIndex t) {
-        std::size_t g = 0;
-        for (int ey = -reach; ey <= reach; ++ey) {
-          for (int ex = -reach; ex <= reach; ++ex) {
-            if (ex * ex + ey * ey > r2) continue;
-            const int lx = t.x + ex - ws.x0, ly = t.y + ey - ws.y0;
-            if (!ws.inside(lx, ly) || left[ws.local(lx, ly)] == 0) continue;
-            g += ws.cleaned.cleaned(grid_.index({t.x + ex, t.y + ey})) ? 0 : 1;
-          }
-        }
-        return g;
-      };
-      for (int dy = -reach; dy <= reach; ++dy) {
-        for (int dx = -reach; dx <= reach; ++dx) {
-          if (dx * dx + dy * dy > r2) continue;
-          const int lx = u.x + dx - ws.x0, ly = u.y + dy - ws.y0;
-          if (!ws.inside(lx, ly) || ws.stand[ws.local(lx, ly)] == 0) continue;
-          const CellIndex t{u.x + dx, u.y + dy};
-          const long long d = 1LL * (t.x - cur.x) * (t.x - cur.x) + 1LL * (t.y - cur.y) * (t.y - cur.y);
-          const std::size_t g = gain(t);
-          if (g > target_gain || (g == target_gain && d < target_d)) {
-            target_gain = g;
-            target_d = d;
-            target = t;
-          }
-        }
-      }
-      const std::size_t before = r.path.size();
-      if (target) {
-        ++r.touch_ups;
-        if (const auto inserted = insert_visit(r.path, *target)) {
-          for (std::size_t k = inserted->first == 0 ? 0 : inserted->first - 1; k < inserted->second && k + 1 < r.path.size();
-               ++k) {
-            ws.cleaned.mark_segment(r.path[k], r.path[k + 1], half);
-          }
-        } else {
-          if (r.path.empty()) r.path.push_back(grid_.cell_center(*target));
-          link(r.path, cur, *target);
-          cur = *target;
-          for (std::size_t k = before == 0 ? 0 : before - 1; k + 1 < r.path.size(); ++k) {
-            ws.cleaned.mark_segment(r.path[k], r.path[k + 1], half);
-          }
-        }
-        ws.cleaned.mark_disc(grid_.cell_center(*target), half);
-      }
-      ws.cleaned.mark_disc(grid_.cell_center(u), 0.0);  // never pick u again, even if unreachable
-      const auto unclean = [&](std::size_t i) { return !ws.cleaned.cleaned(i); };
-      std::vector<std::size_t> next;
-      next.reserve(todo.size());
-      for (const std::size_t i : todo) {
-        if (unclean(i)) next.push_back(i);
-      }
-      todo.swap(next);
-    }
-    // the forced marks above are not cleaning: recount from the path itself
+    touch_up(r, ws, cur);
+    // the forced marks of the touch-up are not cleaning: recount from the path itself
     ws.cleaned.clear();
     ws.cleaned.mark_path(r.path, half);
   }
@@ -306,6 +235,92 @@ void CoveragePlanner::finish(CoverageResult& r, Workspace& ws, CellIndex cur) {
   r.reachable_cells = ws.reachable.size();
   r.covered_cells = 0;
   for (const std::size_t i : ws.reachable) r.covered_cells += ws.cleaned.cleaned(i) ? 1 : 0;
+}
+
+void CoveragePlanner::touch_up(CoverageResult& r, Workspace& ws, CellIndex cur) {
+  const double half = options_.cleaning_width_m / 2.0;
+  std::vector<std::size_t> todo;
+  for (const std::size_t i : ws.reachable) {
+    if (!ws.cleaned.cleaned(i)) todo.push_back(i);
+  }
+  std::vector<std::uint8_t> left(ws.offset.size(), 0);  // reachable cells, window-local
+  for (const std::size_t i : ws.reachable) {
+    const CellIndex c = grid_.cell(i);
+    left[ws.local(c.x - ws.x0, c.y - ws.y0)] = 1;
+  }
+  while (!todo.empty()) {
+    // nearest uncleaned cell
+    std::size_t best = 0;
+    long long best_d = std::numeric_limits<long long>::max();
+    for (std::size_t k = 0; k < todo.size(); ++k) {
+      const long long d = dist2(grid_.cell(todo[k]), cur);
+      if (d < best_d) {
+        best_d = d;
+        best = k;
+      }
+    }
+    const CellIndex u = grid_.cell(todo[best]);
+    const std::size_t before = r.path.size();
+    if (const std::optional<CellIndex> target = touch_up_target(ws, left, u, cur)) {
+      ++r.touch_ups;
+      if (const auto inserted = insert_visit(r.path, *target)) {
+        for (std::size_t k = inserted->first == 0 ? 0 : inserted->first - 1; k < inserted->second && k + 1 < r.path.size(); ++k) {
+          ws.cleaned.mark_segment(r.path[k], r.path[k + 1], half);
+        }
+      } else {
+        if (r.path.empty()) r.path.push_back(grid_.cell_center(*target));
+        link(r.path, cur, *target);
+        cur = *target;
+        for (std::size_t k = before == 0 ? 0 : before - 1; k + 1 < r.path.size(); ++k) {
+          ws.cleaned.mark_segment(r.path[k], r.path[k + 1], half);
+        }
+      }
+      ws.cleaned.mark_disc(grid_.cell_center(*target), half);
+    }
+    ws.cleaned.mark_disc(grid_.cell_center(u), 0.0);  // never pick u again, even if unreachable
+    std::erase_if(todo, [&](std::size_t i) { return ws.cleaned.cleaned(i); });
+  }
+}
+
+std::optional<CellIndex> CoveragePlanner::touch_up_target(const Workspace& ws, const std::vector<std::uint8_t>& left, CellIndex u,
+                                                          CellIndex cur) const {
+  // A standing cell whose footprint covers u and the most cells still left around it (the
+  // nearest to the robot among equals): the cell nearest to the robot alone covered u at the
+  // footprint's edge and little else, so the wedges along a slanted wall took a visit each.
+  const double half = options_.cleaning_width_m / 2.0;
+  const int reach = static_cast<int>(std::ceil(half / grid_.resolution_m()));
+  const double r2 = (half / grid_.resolution_m()) * (half / grid_.resolution_m()) + 1e-9;
+  const auto gain = [&](CellIndex t) {
+    std::size_t g = 0;
+    for (int ey = -reach; ey <= reach; ++ey) {
+      for (int ex = -reach; ex <= reach; ++ex) {
+        if (ex * ex + ey * ey > r2) continue;
+        const int lx = t.x + ex - ws.x0, ly = t.y + ey - ws.y0;
+        if (!ws.inside(lx, ly) || left[ws.local(lx, ly)] == 0) continue;
+        g += ws.cleaned.cleaned(grid_.index({t.x + ex, t.y + ey})) ? 0 : 1;
+      }
+    }
+    return g;
+  };
+  std::optional<CellIndex> target;
+  long long target_d = std::numeric_limits<long long>::max();
+  std::size_t target_gain = 0;
+  for (int dy = -reach; dy <= reach; ++dy) {
+    for (int dx = -reach; dx <= reach; ++dx) {
+      if (dx * dx + dy * dy > r2) continue;
+      const int lx = u.x + dx - ws.x0, ly = u.y + dy - ws.y0;
+      if (!ws.inside(lx, ly) || ws.stand[ws.local(lx, ly)] == 0) continue;
+      const CellIndex t{u.x + dx, u.y + dy};
+      const long long d = dist2(t, cur);
+      const std::size_t g = gain(t);
+      if (g > target_gain || (g == target_gain && d < target_d)) {
+        target_gain = g;
+        target_d = d;
+        target = t;
+      }
+    }
+  }
+  return target;
 }
 
 std::optional<std::pair<std::size_t, std::size_t>> CoveragePlanner::insert_visit(std::vector<Point2D>& path, CellIndex target) {

@@ -52,51 +52,7 @@ std::optional<std::vector<CoveragePlanner::RoundPiece>> CoveragePlanner::round_p
       }
     }
     if (seed == n) break;
-    // walk the chain, keeping the heading where possible
-    chain.clear();
-    int lx = static_cast<int>(seed % static_cast<std::size_t>(ws.w));
-    int ly = static_cast<int>(seed / static_cast<std::size_t>(ws.w));
-    int hx = 0, hy = 0;
-    for (;;) {
-      const std::size_t li = ws.local(lx, ly);
-      used[li] = 1;
-      chain.push_back(ws.global(lx, ly));
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          if (ws.inside(lx + dx, ly + dy)) near[ws.local(lx + dx, ly + dy)] = 1;
-        }
-      }
-      int best_dx = 0, best_dy = 0;
-      double best_cost = std::numeric_limits<double>::infinity();
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          if ((dx == 0 && dy == 0) || !ws.inside(lx + dx, ly + dy)) continue;
-          const std::size_t k2 = ws.local(lx + dx, ly + dy);
-          if (boundary[k2] == 0 || used[k2] != 0) continue;
-          // as A* does: a diagonal step may not cut the corner of an inflated obstacle
-          if (dx != 0 && dy != 0 &&
-              (!planner_.traversable(ws.global(lx + dx, ly)) || !planner_.traversable(ws.global(lx, ly + dy)))) {
-            continue;
-          }
-          double cost = 0.0;
-          if (hx != 0 || hy != 0) {
-            const double dot = (dx * hx + dy * hy) / (std::hypot(dx, dy) * std::hypot(hx, hy));
-            cost = std::acos(std::clamp(dot, -1.0, 1.0));
-          }
-          if (dx != 0 && dy != 0) cost += 1e-3;  // on a tie, the side step
-          if (cost < best_cost) {
-            best_cost = cost;
-            best_dx = dx;
-            best_dy = dy;
-          }
-        }
-      }
-      if (!std::isfinite(best_cost) || best_cost > 2.0) break;  // dead end or a turn back
-      hx = best_dx;
-      hy = best_dy;
-      lx += best_dx;
-      ly += best_dy;
-    }
+    walk_chain(ws, boundary, used, near, seed, chain);
     if (chain.size() < 3) continue;  // specks: the touch-up visits them if they matter
     const CellIndex first = chain.front();
     const CellIndex last = chain.back();
@@ -108,6 +64,55 @@ std::optional<std::vector<CoveragePlanner::RoundPiece>> CoveragePlanner::round_p
     cur = closed ? first : last;
   }
   return pieces;
+}
+
+void CoveragePlanner::walk_chain(const Workspace& ws, const std::vector<std::uint8_t>& boundary, std::vector<std::uint8_t>& used,
+                                 std::vector<std::uint8_t>& near, std::size_t seed, std::vector<CellIndex>& chain) const {
+  // from the seed, keeping the heading where possible
+  chain.clear();
+  int lx = static_cast<int>(seed % static_cast<std::size_t>(ws.w));
+  int ly = static_cast<int>(seed / static_cast<std::size_t>(ws.w));
+  int hx = 0, hy = 0;
+  for (;;) {
+    const std::size_t li = ws.local(lx, ly);
+    used[li] = 1;
+    chain.push_back(ws.global(lx, ly));
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (ws.inside(lx + dx, ly + dy)) near[ws.local(lx + dx, ly + dy)] = 1;
+      }
+    }
+    int best_dx = 0, best_dy = 0;
+    double best_cost = std::numeric_limits<double>::infinity();
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        if ((dx == 0 && dy == 0) || !ws.inside(lx + dx, ly + dy)) continue;
+        const std::size_t k2 = ws.local(lx + dx, ly + dy);
+        if (boundary[k2] == 0 || used[k2] != 0) continue;
+        // as A* does: a diagonal step may not cut the corner of an inflated obstacle
+        if (dx != 0 && dy != 0 &&
+            (!planner_.traversable(ws.global(lx + dx, ly)) || !planner_.traversable(ws.global(lx, ly + dy)))) {
+          continue;
+        }
+        double cost = 0.0;
+        if (hx != 0 || hy != 0) {
+          const double dot = (dx * hx + dy * hy) / (std::hypot(dx, dy) * std::hypot(hx, hy));
+          cost = std::acos(std::clamp(dot, -1.0, 1.0));
+        }
+        if (dx != 0 && dy != 0) cost += 1e-3;  // on a tie, the side step
+        if (cost < best_cost) {
+          best_cost = cost;
+          best_dx = dx;
+          best_dy = dy;
+        }
+      }
+    }
+    if (!std::isfinite(best_cost) || best_cost > 2.0) break;  // dead end or a turn back
+    hx = best_dx;
+    hy = best_dy;
+    lx += best_dx;
+    ly += best_dy;
+  }
 }
 
 void CoveragePlanner::append_piece(CoverageResult& r, CellIndex& cur, const RoundPiece& piece,

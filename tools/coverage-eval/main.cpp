@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <numbers>
@@ -24,6 +25,7 @@
 
 #include "cli_tool.hpp"
 #include "tripodal/navi/coverage.hpp"
+#include "tripodal/navi/distance_field.hpp"
 #include "tripodal/navi/distance_transform_coverage.hpp"
 #include "tripodal/navi/map_io.hpp"
 #include "tripodal/navi/room_segmentation.hpp"
@@ -316,8 +318,36 @@ void write_picture(const fs::path& file, const OccupancyGrid& grid, const Sectio
   }
 }
 
+// A simulator world made from a floor plan (docs/simulator.md's schema): the plan as a map_server
+// map (PGM), one room over the whole plan named after it ("clean the room NAME"), and the start
+// where the plan's free space is widest (the footprint fits there on any plan with a room).
+void export_world(const fs::path& dir, const std::string& name, const OccupancyGrid& grid) {
+  fs::create_directories(dir);
+  save_map(grid, dir / (name + "_map.yaml"));
+  const DistanceField field(grid);
+  std::size_t best = 0;
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    if (field.distance_m(i) > field.distance_m(best)) best = i;
+  }
+  if (grid.size() == 0 || field.distance_m(best) <= 0.0) throw std::runtime_error(name + ": no free space for a world");
+  const Point2D start = grid.cell_center(grid.cell(best));
+  const double w_m = grid.width() * grid.resolution_m(), h_m = grid.height() * grid.resolution_m();
+  {
+    std::ofstream regions(dir / (name + "_regions.yaml"));
+    regions << "# The whole floor plan " << name << " as one room (tripodal-coverage-eval --export-worlds).\n"
+            << "rooms:\n  - name: \"" << name << "\"\n    rectangle: [0.0, 0.0, " << w_m << ", " << h_m << "]\n";
+    if (!regions) throw std::runtime_error((dir / (name + "_regions.yaml")).string() + ": cannot write");
+  }
+  std::ofstream world(dir / (name + ".yaml"));
+  world << "# A world made from the ipa floor plan " << name << " (tripodal-coverage-eval --export-worlds; evaluation\n"
+        << "# data, not shipped). Paths are relative to this file.\n"
+        << "map: " << name << "_map.yaml\nregions: " << name << "_regions.yaml\n"
+        << "start_pose: [" << start.x_m << ", " << start.y_m << ", 0.0]\nseed: 1\n";
+  if (!world) throw std::runtime_error((dir / (name + ".yaml")).string() + ": cannot write");
+}
+
 int run(int argc, char** argv) {
-  std::string ipa, workspace, pictures, rooms;
+  std::string ipa, workspace, pictures, rooms, worlds;
   bool segment_only = false, no_touch_up = false;
   std::vector<std::string> pattern_names;
   double expect_precision = -1.0, expect_recall = -1.0, expect_bound = -1.0, expect_worst_bound = -1.0;
@@ -346,6 +376,9 @@ int run(int argc, char** argv) {
   app.add_option("--link-margin", o.link_margin_m,
                  "M: CoverageOptions::link_margin_m (the clearance links keep beyond the robot radius)")
       ->check(cli::non_negative_number());
+  app.add_option("--export-worlds", worlds,
+                 "DIR: with --ipa, write a simulator world per plan (NAME.yaml, its map and one room NAME) and plan nothing")
+      ->check(cli::writable_folder());
   app.add_flag("--no-touch-up", no_touch_up, "plan without the touch-up (CoverageOptions::touch_up off): what the passes leave");
   app.add_option("--rooms", rooms,
                  "METHOD: cover the rooms of a room segmentation (morphological, distance_transform, voronoi) instead of the "
@@ -376,6 +409,7 @@ int run(int argc, char** argv) {
     return cli::kUsage;
   }
   o.touch_up = !no_touch_up;
+  if (!worlds.empty()) segment_only = true;  // the worlds only, no plan
   const auto wanted = [&](Pattern p) {
     return pattern_names.empty() || std::find(pattern_names.begin(), pattern_names.end(), name_of(p)) != pattern_names.end();
   };
@@ -416,6 +450,11 @@ int run(int argc, char** argv) {
         const Gray plan = read_png(fs::path(ipa) / (name + ".png"));
         const Gray truth = read_png(fs::path(ipa) / (name + "_gt_segmentation.png"));
         const OccupancyGrid grid = grid_of(plan, 0.05);
+        if (!worlds.empty()) {
+          export_world(worlds, name, grid);
+          std::printf("%s: %s\n", name.c_str(), (fs::path(worlds) / (name + ".yaml")).c_str());
+          continue;
+        }
         const Split cut = split(grid, rooms);
         const SectionSet& sections = cut.sections;
         int truth_rooms = 0;
@@ -451,6 +490,7 @@ int run(int argc, char** argv) {
       };
       std::vector<double> precision, recall;
       for (const Score& sc : scores) precision.push_back(sc.precision), recall.push_back(sc.recall);
+      if (!worlds.empty()) return 0;
       std::printf("\nmean over %zu maps: precision %.3f, recall %.3f", scores.size(), mean(precision), mean(recall));
       if (!hybrid_ratio.empty()) {
         std::printf(", hybrid length / bound %.3f (worst %.3f)", mean(hybrid_ratio),

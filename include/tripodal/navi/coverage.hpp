@@ -168,8 +168,17 @@ class CoveragePlanner final {
  private:
   struct Workspace;
   [[nodiscard]] Workspace prepare(const Section& section);
+  /// Keeps the standing cells' parts (8-connected, as A* moves) that the planner can link to the
+  /// largest one; false when there is no standing cell.
+  bool keep_linked_stand(Workspace& ws);
   void link(std::vector<Point2D>& path, CellIndex from, CellIndex to);
   void finish(CoverageResult& r, Workspace& ws, CellIndex cur);
+  /// Visits the reachable cells still uncleaned, nearest first from `cur`.
+  void touch_up(CoverageResult& r, Workspace& ws, CellIndex cur);
+  /// Where to stand to clean u: the standing cell covering u and the most of the cells `left`
+  /// (reachable, window-local) still uncleaned; nullopt when no standing cell covers u.
+  [[nodiscard]] std::optional<CellIndex> touch_up_target(const Workspace& ws, const std::vector<std::uint8_t>& left, CellIndex u,
+                                                         CellIndex cur) const;
   /// A touch-up visit to `target` inserted where a leg of the path passes in plain sight of it
   /// (there and back), when that is shorter than going on from the path's end; the inserted
   /// points' range, or nullopt (nothing inserted).
@@ -183,6 +192,10 @@ class CoveragePlanner final {
   /// `cur` takes them (nearest piece next); nullopt if it has no boundary.
   [[nodiscard]] std::optional<std::vector<RoundPiece>> round_pieces(Workspace& ws, const std::vector<std::uint8_t>& in_round,
                                                                     CellIndex cur) const;
+  /// The chain of boundary cells walked from `seed`, keeping its heading, until a dead end or a
+  /// turn back; marks its cells used and their neighbours near.
+  void walk_chain(const Workspace& ws, const std::vector<std::uint8_t>& boundary, std::vector<std::uint8_t>& used,
+                  std::vector<std::uint8_t>& near, std::size_t seed, std::vector<CellIndex>& chain) const;
   /// Joins pieces whose ends are a few cells apart in plain sight; marks closed the ones whose
   /// ends meet (hybrid: the round around an obstacle as one loop, not four sides).
   void join_pieces(std::vector<RoundPiece>& pieces);
@@ -191,6 +204,10 @@ class CoveragePlanner final {
   [[nodiscard]] bool local_path(CellIndex a, CellIndex b, int margin, std::vector<CellIndex>& between) const;
   /// Links to the piece's first cell and walks it (the start, if the path is empty).
   void append_piece(CoverageResult& r, CellIndex& cur, const RoundPiece& piece, std::optional<Point2D> start);
+  /// The lanes (whole steps across the frame) spread evenly, at most a lane spacing apart, over
+  /// the part of `mask` that leaves a spacing to the wall round.
+  [[nodiscard]] std::vector<int> place_lanes(const Workspace& ws, const std::vector<std::uint8_t>& mask,
+                                             const LaneFrame& frame) const;
   /// Lanes over `mask` along the frame's direction, swept cell by cell of the decomposition, and
   /// the round's pieces, in one tour.
   void plough(Workspace& ws, const std::vector<std::uint8_t>& mask, const LaneFrame& frame, const std::vector<RoundPiece>& pieces,
