@@ -18,9 +18,13 @@ MapBuilder::MapBuilder(Point2D lower, Point2D upper, MapBuilderOptions options)
   const LoopClosureOptions& loop = options_.loop;
   if (!(loop.keyframe_m > 0.0 && loop.keyframe_rad > 0.0 && loop.every_keyframes >= 1 && loop.min_travel_m >= 0.0 &&
         loop.search_radius_m > 0.0 && loop.submap_keyframes >= 1 && loop.min_quality > 0.0 && loop.min_quality <= 1.0 &&
-        loop.settled_m >= 0.0 && loop.settled_rad >= 0.0)) {
-    d.error({}, "map builder: loop closure options out of range (keyframe_m, keyframe_rad, search_radius_m > 0; "
-                "every_keyframes, submap_keyframes >= 1; min_quality in (0, 1])");
+        loop.settled_m >= 0.0 && loop.settled_rad >= 0.0 && loop.agree_keyframes >= 1 && loop.agree_m > 0.0 &&
+        loop.agree_rad > 0.0 && loop.exclusion_m > 0.0 && loop.distinct_margin >= 0.0 && loop.drift_base_m >= 0.0 &&
+        loop.drift_m_per_m >= 0.0 && loop.drift_base_rad >= 0.0 && loop.drift_rad_per_m >= 0.0)) {
+    d.error({},
+            "map builder: loop closure options out of range (keyframe_m, keyframe_rad, search_radius_m, agree_m, "
+            "agree_rad, exclusion_m > 0; every_keyframes, submap_keyframes, agree_keyframes >= 1; min_quality in "
+            "(0, 1]; margins and drift bounds >= 0)");
   }
   if (!(std::isfinite(options_.resolution_m) && options_.resolution_m > 0.0)) {
     d.error({}, "map builder: resolution_m must be a number > 0, got " + std::to_string(options_.resolution_m));
@@ -209,7 +213,7 @@ void MapBuilder::try_closure() {
   ScanMatcher matcher(submap, closure_matcher_);
   if (matcher.set_scan(keyframes_[c].scan, keyframes_[c].base_from_laser) == 0) return;
   const ScanMatch m = matcher.match_global();
-  if (m.quality < loop.min_quality || std::hypot(m.pose.x_m - here.x_m, m.pose.y_m - here.y_m) > loop.search_radius_m) return;
+  if (!closure_accepted(matcher, submap, m, j)) return;
   const Pose2D j_to_c = compose(inverse(graph_.pose(j)), m.pose);
   const Pose2D off = compose(inverse(j_to_c), compose(inverse(graph_.pose(j)), here));
   graph_.add_edge(j, c, j_to_c, loop.closure_noise, true);
@@ -223,6 +227,66 @@ void MapBuilder::try_closure() {
   redraw();
   pose_ = graph_.pose(c);
   matcher_.reset();  // the tracker's window is refreshed from the redrawn map at the next scan
+}
+
+bool MapBuilder::closure_accepted(ScanMatcher& matcher, const OccupancyGrid& submap, const ScanMatch& best,
+                                  std::size_t candidate) {
+  const LoopClosureOptions& loop = options_.loop;
+  const std::size_t c = keyframes_.size() - 1;
+  const Pose2D& here = graph_.pose(c);
+  if (best.quality < loop.min_quality || std::hypot(best.pose.x_m - here.x_m, best.pose.y_m - here.y_m) > loop.search_radius_m) {
+    ++stats_.weak;
+    return false;
+  }
+  // graph consistency first (it costs nothing): no more correction than the drift since allows
+  const double travel_m = keyframes_[c].travel_m - keyframes_[candidate].travel_m;
+  const Pose2D move = compose(inverse(here), best.pose);
+  if (std::hypot(move.x_m, move.y_m) > loop.drift_base_m + loop.drift_m_per_m * travel_m ||
+      std::abs(move.theta_rad) > loop.drift_base_rad + loop.drift_rad_per_m * travel_m) {
+    ++stats_.implausible;
+    return false;
+  }
+  // agreement: the key scans before this one, each searched on its own in the widest tracking
+  // window around where the correction puts it, must find the same correction of the graph
+  // (map_from_corrected = best * here^-1); a correction that fits one scan by chance moves the
+  // others' best fits elsewhere
+  const Pose2D correction = compose(best.pose, inverse(here));
+  const auto others = static_cast<std::size_t>(std::max(loop.agree_keyframes, 1) - 1);
+  for (std::size_t k = 1; k <= others && k <= c; ++k) {
+    const std::size_t i = c - k;
+    if (matcher.set_scan(keyframes_[i].scan, keyframes_[i].base_from_laser) == 0) continue;
+    const Pose2D expected = compose(correction, graph_.pose(i));
+    const ScanMatch mi = matcher.match(expected, closure_matcher_.max_search_xy_m, closure_matcher_.max_search_theta_rad);
+    const Pose2D d = compose(inverse(expected), mi.pose);
+    if (mi.quality < loop.min_quality || std::hypot(d.x_m, d.y_m) > loop.agree_m || std::abs(d.theta_rad) > loop.agree_rad) {
+      ++stats_.disagreeing;
+      return false;
+    }
+  }
+  // distinctness: the best place away from the winner (its free cells hidden: the global search
+  // places the robot on free cells only) must be clearly worse
+  OccupancyGrid elsewhere = submap;
+  const double r_cells = loop.exclusion_m / elsewhere.resolution_m();
+  const CellIndex centre = elsewhere.cell_at({best.pose.x_m, best.pose.y_m});
+  const int reach = static_cast<int>(std::ceil(r_cells));
+  for (int dy = -reach; dy <= reach; ++dy) {
+    for (int dx = -reach; dx <= reach; ++dx) {
+      const CellIndex cell{centre.x + dx, centre.y + dy};
+      if (std::hypot(dx, dy) <= r_cells && elsewhere.contains(cell) && elsewhere.is_free(cell)) {
+        elsewhere.set_state(cell, Occupancy::unknown);
+      }
+    }
+  }
+  ScanMatcher second_matcher(elsewhere, closure_matcher_);
+  if (second_matcher.set_scan(keyframes_[c].scan, keyframes_[c].base_from_laser) > 0) {
+    const ScanMatch second = second_matcher.match_global();
+    if (std::hypot(second.pose.x_m - best.pose.x_m, second.pose.y_m - best.pose.y_m) > 0.5 * loop.exclusion_m &&
+        second.quality > best.quality - loop.distinct_margin) {
+      ++stats_.ambiguous;
+      return false;
+    }
+  }
+  return true;
 }
 
 ScanMatch MapBuilder::rematch_all_headings() noexcept {

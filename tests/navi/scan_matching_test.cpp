@@ -1,17 +1,16 @@
-#include "tripodal/navi/scan_matching_localizer.hpp"
-
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <filesystem>
 #include <memory>
 #include <numbers>
+#include <vector>
 
+#include "navi_test_util.hpp"
 #include "tripodal/navi/map_builder.hpp"
 #include "tripodal/navi/map_io.hpp"
 #include "tripodal/navi/mapping_module.hpp"
 #include "tripodal/navi/scan_matcher.hpp"
-#include "navi_test_util.hpp"
+#include "tripodal/navi/scan_matching_localizer.hpp"
 #include "tripodal/sim/ray_caster.hpp"
 
 using namespace tripodal;
@@ -344,6 +343,10 @@ TEST_CASE("MapBuilder: loop closure undoes the drift of a map made on odometry a
     o.min_quality = 1.0;  // no scan-to-map correction: odometry alone between closures
     o.loop.enabled = closing;
     o.loop.min_travel_m = 6.0;
+    // odometry alone drifts 0.04 rad per metre here, far beyond what the default bound allows
+    // for (the drift scan-to-map matching leaves): the bound is widened to this odometry's
+    o.loop.drift_m_per_m = 0.4;
+    o.loop.drift_rad_per_m = 0.06;
     auto b = std::make_unique<MapBuilder>(Point2D{-6.5, -7.5}, Point2D{14.5, 11.5}, o);
     DriftingOdometry odo;
     for (int k = 0; k <= 960; k += 2) b->add(scan_at(solid, true_pose(k)), odo.read(true_pose(k)), true_pose(0));
@@ -352,6 +355,9 @@ TEST_CASE("MapBuilder: loop closure undoes the drift of a map made on odometry a
   const auto open = run(false);
   const auto closed = run(true);
   CHECK(open->loop_stats().closures == 0);
+  const LoopClosureStats& stats = closed->loop_stats();
+  INFO("attempts " << stats.attempts << ", refused: weak " << stats.weak << ", implausible " << stats.implausible
+                   << ", disagreeing " << stats.disagreeing << ", ambiguous " << stats.ambiguous);
   CHECK(closed->loop_stats().closures >= 3);
   CHECK(closed->loop_stats().solves >= 1);
   const std::vector<Pose2D> drifted = open->trajectory(), corrected = closed->trajectory();
@@ -373,6 +379,77 @@ TEST_CASE("MapBuilder: loop closure undoes the drift of a map made on odometry a
   const double open_walls = test::wall_agreement(open->grid(), world).fraction();
   INFO("wall agreement: closed " << closed_walls << ", open " << open_walls);
   CHECK(closed_walls > 2.0 * open_walls);
+}
+
+TEST_CASE("MapBuilder: no loop closure in a corridor where every place looks alike", "[navi][scan_matching][pose_graph]") {
+  // a 30 m x 3 m corridor without a feature; the scanner sees 6 m, never an end wall: a scan
+  // matches anywhere along it equally well. Driven 6 m up and 5 m back on odometry 4 % long and
+  // trusting no match, the builder must not close the loop at a place the scans cannot tell
+  // (the look-alike corridors of CSAIL and the Freiburg campus, issue 41)
+  OccupancyGrid world(600, 60, 0.05, Pose2D{0.0, 0.0, 0.0}, Occupancy::free);
+  for (int x = 0; x < 600; ++x) {
+    for (int y : {0, 1, 58, 59}) world.set_state({x, y}, Occupancy::occupied);
+  }
+  const sim::SolidMap solid(world);
+  std::vector<Pose2D> path;
+  for (int k = 0; k <= 30; ++k) path.push_back({8.0 + 0.2 * k, 1.5, 0.0});
+  for (int k = 0; k <= 25; ++k) path.push_back({14.0 - 0.2 * k, 1.5, std::numbers::pi});
+  auto run = [&](const LoopClosureOptions& loop) {
+    MapBuilderOptions o;
+    o.min_quality = 1.0;  // odometry alone between closures
+    o.recovery_margin = 0.0;
+    o.window_m = 8.0;
+    o.resolution_m = 0.1;  // the global searches over a featureless corridor prune little
+    o.loop = loop;
+    o.loop.enabled = true;
+    o.loop.submap_resolution_m = 0.1;
+    o.loop.min_travel_m = 3.0;
+    o.loop.every_keyframes = 5;
+    auto b = std::make_unique<MapBuilder>(Point2D{-2.0, -4.0}, Point2D{32.0, 7.0}, o);
+    Pose2D odom = path.front();
+    for (std::size_t i = 0; i < path.size(); ++i) {
+      if (i > 0) {
+        Pose2D d = compose(inverse(path[i - 1]), path[i]);
+        d.x_m *= 1.04;
+        odom = compose(odom, d);
+      }
+      b->add(scan_at(solid, path[i], 6.0), odom, path.front());
+    }
+    return b;
+  };
+  // the acceptance test of before (one scan, its best match, no check against the graph) closes
+  // the loop there
+  LoopClosureOptions lax;
+  lax.agree_keyframes = 1;
+  lax.exclusion_m = 1000.0;
+  lax.drift_base_m = 1000.0;
+  lax.drift_base_rad = 10.0;
+  const auto before = run(lax);
+  CHECK(before->loop_stats().attempts > 0);
+  CHECK(before->loop_stats().closures > 0);
+  // the default refuses every one of them, and says why: a slide along the corridor larger than
+  // the drift since can explain, the scans before not finding the same correction (each slides
+  // elsewhere), or another place scoring as well
+  const auto now = run(LoopClosureOptions{});
+  const LoopClosureStats& stats = now->loop_stats();
+  CHECK(stats.attempts > 0);
+  CHECK(stats.closures == 0);
+  CHECK(stats.solves == 0);
+  CHECK(stats.weak == 0);
+  CHECK(stats.ambiguous + stats.disagreeing + stats.implausible == stats.attempts);
+  // without the drift bound, agreement and distinctness alone refuse them
+  LoopClosureOptions no_bound;
+  no_bound.drift_base_m = 1000.0;
+  no_bound.drift_base_rad = 10.0;
+  const auto unbounded = run(no_bound);
+  CHECK(unbounded->loop_stats().attempts > 0);
+  CHECK(unbounded->loop_stats().closures == 0);
+  CHECK(unbounded->loop_stats().implausible == 0);
+  CHECK(unbounded->loop_stats().ambiguous + unbounded->loop_stats().disagreeing > 0);
+
+  MapBuilderOptions bad;
+  bad.loop.agree_keyframes = 0;
+  REQUIRE_THROWS_WITH(MapBuilder({0, 0}, {5, 5}, bad), Catch::Contains("agree_keyframes >= 1"));
 }
 
 TEST_CASE("MapBuilder module: maps only between begin and end, crops to what the beams reached, saves a map_server map",

@@ -393,7 +393,7 @@ struct BuildArgs {
   double max_range_m = 30.0;
   double gap_s = 10.0;
   double gap_m = 5.0;
-  bool loop_closure = false;
+  bool loop_closure = navi::LoopClosureOptions{}.enabled;
   double closure_quality = navi::LoopClosureOptions{}.min_quality;
   double recovery_margin = navi::MapBuilderOptions{}.recovery_margin;
   std::filesystem::path trajectory;  // CSV: scan by scan, the match as made (before any closure)
@@ -454,8 +454,9 @@ int map_build(const BuildArgs& a, std::ostream& out, std::ostream& err) {
         << g.width() << " x " << g.height() << " cells written to " << a.out.string() << "\n";
     const navi::LoopClosureStats& loop = b.loop_stats();
     out << "  loop closure: " << (o.loop.enabled ? "" : "off; ") << loop.keyframes << " key scans, " << loop.attempts
-        << " local matches tried, " << loop.closures << " closures kept, " << loop.rejected << " rejected, " << loop.solves
-        << " graph solves\n";
+        << " local matches tried (refused: " << loop.weak << " weak, " << loop.implausible << " beyond the drift, "
+        << loop.disagreeing << " not confirmed by the scans before, " << loop.ambiguous << " ambiguous), " << loop.closures
+        << " closures kept, " << loop.rejected << " dropped by the graph, " << loop.solves << " graph solves\n";
     const navi::MappingHealth& health = b.health();
     out << "  self-check: " << health.weak << " scans matched far below the recent median, " << health.recovered
         << " of them re-matched globally (an odometry jump), " << health.unreliable << " left unreliable\n";
@@ -541,9 +542,11 @@ cli::Action setup_build(CLI::App& cmd) {
       ->capture_default_str()->check(CLI::Range(0.0, 1.0));
   cmd.add_option("--trajectory", a->trajectory, "FILE: CSV of the matches, scan by scan, as made (before closures)")
       ->check(cli::writable_file());
-  cmd.add_flag("--loop-closure", a->loop_closure, "keep a pose graph of key scans and close loops (docs/localization.md)");
-  cmd.add_option("--closure-quality", a->closure_quality, "Q: with --loop-closure, the match quality a closure needs, in (0, 1]")
-      ->capture_default_str()->check(CLI::Range(0.01, 1.0));
+  cmd.add_flag("--loop-closure,!--no-loop-closure", a->loop_closure,
+               "keep a pose graph of key scans and close loops (the default; docs/localization.md)");
+  cmd.add_option("--closure-quality", a->closure_quality, "Q: the match quality a closure needs, in (0, 1]")
+      ->capture_default_str()
+      ->check(CLI::Range(0.01, 1.0));
   channel_options(cmd, a->laser_channel, a->odom_channel, a->pose_channel);
   return [a](std::ostream& out, std::ostream& err) { return map_build(*a, out, err); };
 }

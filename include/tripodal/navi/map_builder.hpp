@@ -16,12 +16,15 @@ namespace tripodal::navi {
 /// Loop closure: the builder keeps a pose graph of key scans (one every keyframe_m or
 /// keyframe_rad of motion) joined by their scan-to-map matches; now and then it matches the
 /// current scan against a local map of the key scans it passed long ago near where it believes it
-/// is, and when that match is good the graph gains a closure, is solved, and the map is drawn
-/// again from the key scans at their solved poses (docs/localization.md, "Loop closure"). Off by
-/// default: on the three CARMEN logs it does not yet beat scan-to-map alone (CSAIL's whole path is
-/// worse with it: closures accepted in look-alike corridors).
+/// is, and when that match passes the acceptance test the graph gains a closure, is solved, and
+/// the map is drawn again from the key scans at their solved poses (docs/localization.md, "Loop
+/// closure"). A good match alone is not enough (issue 41: look-alike corridors bent CSAIL and the
+/// Freiburg campus): the correction must be one the drift since the candidate can explain, the
+/// agree_keyframes - 1 key scans before must each find the same correction by their own search
+/// (the widest tracking window around where it puts them), and the best place outside
+/// exclusion_m of the winner must score distinct_margin lower.
 struct LoopClosureOptions {
-  bool enabled = false;
+  bool enabled = true;
   double keyframe_m = 0.2;
   double keyframe_rad = 0.2;
   int every_keyframes = 10;       ///< a closure is looked for at every this many key scans
@@ -29,6 +32,24 @@ struct LoopClosureOptions {
   double search_radius_m = 5.0;   ///< near the current estimate (the drift a closure can undo)
   int submap_keyframes = 10;      ///< key scans on each side of the candidate make its local map
   double min_quality = 0.55;      ///< the closure's match quality
+  /// Agreement: this many consecutive key scans (the current one and those before it) are each
+  /// matched on the local map, and their corrections of the graph must agree within
+  /// agree_m / agree_rad (one scan in a corridor fits several places; three seen from 0.4 m
+  /// apart rarely pick the same wrong one).
+  int agree_keyframes = 3;
+  double agree_m = 0.15;
+  double agree_rad = 0.05;
+  /// Distinctness: the best pose more than exclusion_m from the winner (the local map's free cells
+  /// there are hidden from a second global search) must score at least distinct_margin lower.
+  double exclusion_m = 1.0;
+  double distinct_margin = 0.05;
+  /// Graph consistency: the closure may move the current key scan by at most
+  /// drift_base_m + drift_m_per_m x (the travel since the candidate), and turn it by at most
+  /// drift_base_rad + drift_rad_per_m x that travel: what scan-to-map drift can explain.
+  double drift_base_m = 0.5;
+  double drift_m_per_m = 0.05;
+  double drift_base_rad = 0.1;
+  double drift_rad_per_m = 0.005;
   /// The local map is drawn this coarse: the global search over it costs a quarter of the
   /// builder's 5 cm, and its sub-cell refinement keeps the closure within the closure noise.
   double submap_resolution_m = 0.05;
@@ -93,6 +114,10 @@ struct MappingHealth {
 struct LoopClosureStats {
   std::size_t keyframes = 0;
   std::size_t attempts = 0;   ///< local matches tried
+  std::size_t weak = 0;       ///< refused: no match of min_quality within search_radius_m
+  std::size_t implausible = 0;  ///< refused: a correction larger than the drift since can explain
+  std::size_t disagreeing = 0;  ///< refused: the consecutive key scans found different corrections
+  std::size_t ambiguous = 0;    ///< refused: another place scored nearly as well
   std::size_t closures = 0;   ///< kept in the graph
   std::size_t rejected = 0;   ///< dropped by the solver as disagreeing with the rest
   std::size_t solves = 0;     ///< graph solves, each followed by a redraw of the map
@@ -133,6 +158,9 @@ class MapBuilder {
   [[nodiscard]] OccupancyGrid grid_of(int x0, int y0, int x1, int y1) const;
   void add_keyframe(const LaserScan& scan, const Pose2D& base_from_laser, bool matched);
   void try_closure();
+  // The refusals of try_closure(), in the order they are checked; true: accepted.
+  [[nodiscard]] bool closure_accepted(ScanMatcher& matcher, const OccupancyGrid& submap, const ScanMatch& best,
+                                      std::size_t candidate);
   void redraw();
   [[nodiscard]] ScanMatch rematch_all_headings() noexcept;
   struct Keyframe {
