@@ -239,6 +239,7 @@ double ScanMatcher::score_bilinear(const GridPose& g) const noexcept {
                ? field_[static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x)]
                : 0.0;
   };
+  const auto last_x = static_cast<unsigned>(width_ - 1), last_y = static_cast<unsigned>(height_ - 1);
   for (std::size_t i = 0; i < px_.size(); ++i) {
     // the field holds cell-centre values: interpolate between the four nearest centres
     const double u = g.x + c * px_[i] - s * py_[i] - 0.5;
@@ -246,7 +247,23 @@ double ScanMatcher::score_bilinear(const GridPose& g) const noexcept {
     const double fu = std::floor(u), fv = std::floor(v);
     const int x = static_cast<int>(fu), y = static_cast<int>(fv);
     const double a = u - fu, b = v - fv;
-    total += (1 - b) * ((1 - a) * at(x, y) + a * at(x + 1, y)) + b * ((1 - a) * at(x, y + 1) + a * at(x + 1, y + 1));
+    // Inside the grid (the common case) the four cells are read without a check each; the same
+    // values, so the same sum.
+    double f00 = 0.0, f10 = 0.0, f01 = 0.0, f11 = 0.0;
+    if (static_cast<unsigned>(x) < last_x && static_cast<unsigned>(y) < last_y) {
+      const float* cell =
+          field_.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x);
+      f00 = cell[0];
+      f10 = cell[1];
+      f01 = cell[width_];
+      f11 = cell[width_ + 1];
+    } else {
+      f00 = at(x, y);
+      f10 = at(x + 1, y);
+      f01 = at(x, y + 1);
+      f11 = at(x + 1, y + 1);
+    }
+    total += (1 - b) * ((1 - a) * f00 + a * f10) + b * ((1 - a) * f01 + a * f11);
   }
   return total;
 }
