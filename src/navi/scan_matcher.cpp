@@ -199,6 +199,27 @@ float ScanMatcher::sum_at(const int* cx, const int* cy, std::size_t count, int d
   return s;
 }
 
+template <int kCells>
+void ScanMatcher::row_sums(const int* cx, const int* cy, std::size_t count, int dx, int dy, float* out) const noexcept {
+  std::array<float, kCells> acc{};
+  const int w = width_;
+  const auto h = static_cast<unsigned>(height_);
+  for (std::size_t i = 0; i < count; ++i) {
+    const auto y = static_cast<unsigned>(cy[i] + dy);
+    if (y >= h) continue;
+    const int x = cx[i] + dx;
+    const float* r = field_.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
+    if (x >= 0 && x + kCells <= w) {
+      for (int j = 0; j < kCells; ++j) acc[static_cast<std::size_t>(j)] += r[x + j];
+    } else {
+      for (int j = 0; j < kCells; ++j) {
+        if (static_cast<unsigned>(x + j) < static_cast<unsigned>(w)) acc[static_cast<std::size_t>(j)] += r[x + j];
+      }
+    }
+  }
+  std::copy(acc.begin(), acc.end(), out);
+}
+
 float ScanMatcher::pooled_sum(int level, const int* cx, const int* cy, std::size_t count, int x, int y) const noexcept {
   const std::vector<float>& f = pooled_[static_cast<std::size_t>(level)];
   const auto w = static_cast<unsigned>(width_ + pad_), h = static_cast<unsigned>(height_ + pad_);
@@ -218,6 +239,7 @@ double ScanMatcher::score_bilinear(const GridPose& g) const noexcept {
                ? field_[static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x)]
                : 0.0;
   };
+  const auto last_x = static_cast<unsigned>(width_ - 1), last_y = static_cast<unsigned>(height_ - 1);
   for (std::size_t i = 0; i < px_.size(); ++i) {
     // the field holds cell-centre values: interpolate between the four nearest centres
     const double u = g.x + c * px_[i] - s * py_[i] - 0.5;
@@ -225,7 +247,23 @@ double ScanMatcher::score_bilinear(const GridPose& g) const noexcept {
     const double fu = std::floor(u), fv = std::floor(v);
     const int x = static_cast<int>(fu), y = static_cast<int>(fv);
     const double a = u - fu, b = v - fv;
-    total += (1 - b) * ((1 - a) * at(x, y) + a * at(x + 1, y)) + b * ((1 - a) * at(x, y + 1) + a * at(x + 1, y + 1));
+    // Inside the grid (the common case) the four cells are read without a check each; the same
+    // values, so the same sum.
+    double f00 = 0.0, f10 = 0.0, f01 = 0.0, f11 = 0.0;
+    if (static_cast<unsigned>(x) < last_x && static_cast<unsigned>(y) < last_y) {
+      const float* cell =
+          field_.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x);
+      f00 = cell[0];
+      f10 = cell[1];
+      f01 = cell[width_];
+      f11 = cell[width_ + 1];
+    } else {
+      f00 = at(x, y);
+      f10 = at(x + 1, y);
+      f01 = at(x, y + 1);
+      f11 = at(x + 1, y + 1);
+    }
+    total += (1 - b) * ((1 - a) * f00 + a * f10) + b * ((1 - a) * f01 + a * f11);
   }
   return total;
 }
@@ -325,16 +363,23 @@ ScanMatch ScanMatcher::match(const Pose2D& predicted, double search_xy_m, double
   const int nt = static_cast<int>(
       std::ceil(std::clamp(search_theta_rad, 0.0, options_.max_search_theta_rad) / options_.angular_step_rad));
   const double step = options_.angular_step_rad;
-  // Branch and bound over one level: every heading's 2 x 2-cell blocks are bounded with the
-  // pooled field, and only blocks whose bound beats the best full score are scored cell by cell.
-  // The answer is the exhaustive search's, at about a quarter of its cost.
+  // Branch and bound over the max-pooled fields (as the global search): every heading's window is
+  // tiled with blocks of 2^top cells (about two per axis), each bounded by the pooled field of its
+  // level; the blocks are explored best bound first, depth first (a block's four sub-blocks, best
+  // first, down to single cells scored exactly), and a block whose bound falls below the best
+  // full score is cut with everything in it. The answer is the exhaustive search's: a bound is
+  // never below the score of a cell it covers (sums of larger terms in the same order).
+  const int side = 2 * nx + 1;
+  int top = 0;
+  while (top < options_.global_levels && (1 << (top + 1)) < side) ++top;
+  const int tile = 1 << top;
   std::size_t count = 0;
   for (int k = -nt; k <= nt; ++k) {
     int* cx = cx_.data() + static_cast<std::size_t>(k + nt) * n;
     int* cy = cy_.data() + static_cast<std::size_t>(k + nt) * n;
     rotate_points(g0.theta + k * step, g0.x, g0.y, n, cx, cy);
-    for (int dy = -nx; dy <= nx; dy += 2) {
-      for (int dx = -nx; dx <= nx; dx += 2) blocks_[count++] = {pooled_sum(1, cx, cy, n, dx, dy), k, dx, dy};
+    for (int dy = -nx; dy <= nx; dy += tile) {
+      for (int dx = -nx; dx <= nx; dx += tile) blocks_[count++] = {pooled_sum(top, cx, cy, n, dx, dy), k, dx, dy};
     }
   }
   std::sort(blocks_.begin(), blocks_.begin() + static_cast<std::ptrdiff_t>(count),
@@ -344,22 +389,53 @@ ScanMatch ScanMatcher::match(const Pose2D& predicted, double search_xy_m, double
   auto nearer = [](int k, int x, int y, int k2, int x2, int y2) {
     return std::abs(k) + std::abs(x) + std::abs(y) < std::abs(k2) + std::abs(x2) + std::abs(y2);
   };
+  // Depth-first stack: at most four sub-blocks per level below the top (no allocation).
+  struct Node {
+    float bound;
+    int level, k, dx, dy;
+  };
+  std::array<Node, 4 * 11 + 1> stack{};
   for (std::size_t c = 0; c < count; ++c) {
     const Block& blk = blocks_[c];
     if (blk.bound < best) break;
+    std::size_t depth = 0;
+    stack[depth++] = {blk.bound, top, blk.k, blk.dx, blk.dy};
     const int* cx = cx_.data() + static_cast<std::size_t>(blk.k + nt) * n;
     const int* cy = cy_.data() + static_cast<std::size_t>(blk.k + nt) * n;
-    for (int dy = blk.dy; dy <= std::min(blk.dy + 1, nx); ++dy) {
-      for (int dx = blk.dx; dx <= std::min(blk.dx + 1, nx); ++dx) {
-        const float sc = sum_at(cx, cy, n, dx, dy);
+    while (depth > 0) {
+      const Node node = stack[--depth];
+      if (node.bound < best) continue;
+      if (node.level == 0) {
         // ties go to the pose nearest the prediction (the odometry is the prior)
-        if (sc > best || (sc == best && nearer(blk.k, dx, dy, bk, bx, by))) {
-          best = sc;
-          bk = blk.k;
-          bx = dx;
-          by = dy;
+        if (node.bound > best || nearer(node.k, node.dx, node.dy, bk, bx, by)) {
+          best = node.bound;
+          bk = node.k;
+          bx = node.dx;
+          by = node.dy;
+        }
+        continue;
+      }
+      const int level = node.level - 1;
+      const int half = 1 << level;
+      std::array<Node, 4> kids{};
+      int m = 0;
+      for (int y = node.dy; y <= std::min(node.dy + half, nx); y += half) {
+        for (int x = node.dx; x <= std::min(node.dx + half, nx); x += half) {
+          const float b = level == 0 ? sum_at(cx, cy, n, x, y) : pooled_sum(level, cx, cy, n, x, y);
+          if (b >= best) kids[static_cast<std::size_t>(m++)] = {b, level, node.k, x, y};
         }
       }
+      // pushed worst first so that the best is explored first
+      // (an insertion sort of at most four: std::stable_sort would allocate its buffer)
+      for (int i = 1; i < m; ++i) {
+        const Node kid = kids[static_cast<std::size_t>(i)];
+        int j = i;
+        for (; j > 0 && kids[static_cast<std::size_t>(j) - 1].bound > kid.bound; --j) {
+          kids[static_cast<std::size_t>(j)] = kids[static_cast<std::size_t>(j) - 1];
+        }
+        kids[static_cast<std::size_t>(j)] = kid;
+      }
+      for (int i = 0; i < m; ++i) stack[depth++] = kids[static_cast<std::size_t>(i)];
     }
   }
   // The covariance from the scores around the best pose, each weighted by how close its quality
@@ -368,12 +444,18 @@ ScanMatch ScanMatcher::match(const Pose2D& predicted, double search_xy_m, double
   std::array<double, 3> m1{};
   std::array<double, 6> m2{};  // xx xy xt yy yt tt
   const double inv_n = 1.0 / static_cast<double>(n);
+  // The scores of a row of cells at once (row_sums): each point adds a run of adjacent cells of the
+  // field, in the same order per cell as sum_at, so every score is the same float.
+  constexpr int kReachCells = 2 * kCovarianceReach + 1;
+  std::array<float, kReachCells> row{};
   for (int k = std::max(-nt, bk - kCovarianceReach); k <= std::min(nt, bk + kCovarianceReach); ++k) {
     const int* cx = cx_.data() + static_cast<std::size_t>(k + nt) * n;
     const int* cy = cy_.data() + static_cast<std::size_t>(k + nt) * n;
     for (int dy = by - kCovarianceReach; dy <= by + kCovarianceReach; ++dy) {
+      row_sums<kReachCells>(cx, cy, n, bx - kCovarianceReach, dy, row.data());
       for (int dx = bx - kCovarianceReach; dx <= bx + kCovarianceReach; ++dx) {
-        const double w = std::exp((sum_at(cx, cy, n, dx, dy) - best) * inv_n / kQualityScale);
+        const float score = row[static_cast<std::size_t>(dx - bx + kCovarianceReach)];
+        const double w = std::exp((score - best) * inv_n / kQualityScale);
         if (w < 1e-6) continue;
         const double vx = (dx - bx) * cell_m_, vy = (dy - by) * cell_m_, vt = (k - bk) * step;
         sw += w;

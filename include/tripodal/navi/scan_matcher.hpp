@@ -131,6 +131,9 @@ class ScanMatcher {
   // Rotates the points by theta into integer cell offsets from (x, y) (cells), in cx_/cy_.
   void rotate_points(double theta, double x, double y, std::size_t count, int* cx, int* cy) const noexcept;
   [[nodiscard]] float sum_at(const int* cx, const int* cy, std::size_t count, int dx, int dy) const noexcept;
+  // sum_at() of kCells adjacent cells (dx ... dx + kCells - 1, dy) in one pass over the points.
+  template <int kCells>
+  void row_sums(const int* cx, const int* cy, std::size_t count, int dx, int dy, float* out) const noexcept;
   [[nodiscard]] float pooled_sum(int level, const int* cx, const int* cy, std::size_t count, int x, int y) const noexcept;
   ScanMatch finish(const GridPose& best, double sum_w, const std::array<double, 6>& moments) const noexcept;
 
