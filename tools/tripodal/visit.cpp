@@ -6,10 +6,11 @@
 #include <deque>
 #include <fstream>
 #include <iomanip>
-#include <nlohmann/json.hpp>
 #include <numbers>
 #include <ostream>
 #include <sstream>
+
+#include <nlohmann/json.hpp>
 
 #include "guide_hri.hpp"
 #include "run_outputs.hpp"
@@ -17,8 +18,8 @@
 #include "shutdown.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/hri/hri_module.hpp"
-#include "tripodal/hri/speech.hpp"
 #include "tripodal/monitor/robot_monitor.hpp"
+#include "tripodal/hri/speech.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
 #include "tripodal/planner/task_library.hpp"
 #include "tripodal/robot/robot.hpp"
