@@ -321,3 +321,14 @@ TEST_CASE("spoken bad input: another language and a stream at the wrong rate are
     nothing_started(fast, text + " at the wrong rate (fast)");
   }
 }
+
+TEST_CASE("the general model's share is refused outside [0, 1], by name", "[voice]") {
+  if (!voice_available()) return;
+  PocketsphinxOptions o;
+  o.language_model = arpa_bigram_model({"guide me to node 1"});
+  for (const double w : {-0.1, 1.5}) {
+    o.general_model_weight = w;
+    CHECK_THROWS_WITH(make_pocketsphinx_recognizer(o),
+                      Catch::Contains("general_model_weight is") && Catch::Contains("expected a share in [0, 1]"));
+  }
+}
