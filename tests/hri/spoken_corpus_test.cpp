@@ -150,7 +150,7 @@ struct Figures {
 // asked about first is right when it is the one meant, and the visitor answers yes then (no
 // otherwise). Every task the planner is asked to start is checked against the one meant.
 Figures speak(const std::vector<Utterance>& set, const Condition& condition, SpeechRecognizer& recognizer,
-              const std::optional<AudioClip>& noise) {
+              const std::optional<AudioClip>& noise, const HriOptions& options = {}) {
   const auto voice = make_espeak_synthesizer({condition.voice, condition.words_per_minute});
   Figures f;
   std::size_t offset = 0;
@@ -164,7 +164,7 @@ Figures speak(const std::vector<Utterance>& set, const Condition& condition, Spe
     const WordErrors e = word_errors(spoken_form(u.text), heard.words);
     f.word_errors += e.errors;
     f.words += e.reference_words;
-    testing::SpokenJinny jinny;
+    testing::SpokenJinny jinny(options);
     const HriReply r = jinny.hri.handle_heard(heard);
     const bool meant_task = u.outcome == "task_started" || (u.outcome == "answered" && !u.task.empty());
     const bool confirmed = meant_task && r.kind == HriReply::Kind::confirm_task && r.task == u.task && r.entry_id == u.entry;
@@ -246,6 +246,14 @@ TEST_CASE("spoken visitors: the whole grid of voices, speeds and noise (a long e
   const double weight = weight_env != nullptr ? std::stod(weight_env) : kGeneralWeight;
   const std::size_t stride = stride_env != nullptr ? std::stoul(stride_env) : 1;
   const std::string grid = grid_env != nullptr ? grid_env : "all";
+  // TRIPODAL_SPOKEN_EVAL_MIN_CONFIDENCE: HriOptions::min_recognition_confidence; TRIPODAL_SPOKEN_EVAL_SETS:
+  // "dev" for the development part alone.
+  HriOptions options;
+  if (const char* c = std::getenv("TRIPODAL_SPOKEN_EVAL_MIN_CONFIDENCE"))
+    options.min_recognition_confidence = std::stod(c);              // NOLINT(concurrency-mt-unsafe)
+  const char* sets_env = std::getenv("TRIPODAL_SPOKEN_EVAL_SETS");  // NOLINT(concurrency-mt-unsafe)
+  std::vector<std::string> files = {"visitors_dev.yaml", "visitors_heldout.yaml"};
+  if (sets_env != nullptr && std::string(sets_env) == "dev") files.pop_back();
   testing::SpokenJinny jinny;
   const auto recognizer = jinny.recognizer(weight);
   const std::optional<AudioClip> noise = room_noise(60.0);
@@ -262,11 +270,12 @@ TEST_CASE("spoken visitors: the whole grid of voices, speeds and noise (a long e
   if ((grid == "all" || grid == "noise") && noise) {
     for (const double snr : {20.0, 10.0, 5.0}) conditions.push_back({"en-us+klatt", 170, snr});
   }
-  std::cout << "general model weight " << weight << ", every " << stride << " utterance(s)\n"
+  std::cout << "general model weight " << weight << ", min_recognition_confidence " << options.min_recognition_confidence
+            << ", every " << stride << " utterance(s)\n"
             << "| set | voice, speed, noise | WER | right | answer | command | refusal | out of domain | wrong tasks |\n";
   for (const auto& c : conditions) {
-    for (const char* file : {"visitors_dev.yaml", "visitors_heldout.yaml"}) {
-      const Figures f = speak(load_set(file, stride), c, *recognizer, noise);
+    for (const std::string& file : files) {
+      const Figures f = speak(load_set(file, stride), c, *recognizer, noise, options);
       std::cout << row(file, c, f) << "\n" << std::flush;
       if (std::getenv("TRIPODAL_SPOKEN_EVAL_MISSES") != nullptr) std::cout << f.misses;  // NOLINT(concurrency-mt-unsafe)
       CHECK(f.wrong_tasks == 0);
@@ -310,5 +319,16 @@ TEST_CASE("spoken bad input: another language and a stream at the wrong rate are
     fast.sample_rate_hz = 44100;
     nothing_started(slow, text + " at the wrong rate (slow)");
     nothing_started(fast, text + " at the wrong rate (fast)");
+  }
+}
+
+TEST_CASE("the general model's share is refused outside [0, 1], by name", "[voice]") {
+  if (!voice_available()) return;
+  PocketsphinxOptions o;
+  o.language_model = arpa_bigram_model({"guide me to node 1"});
+  for (const double w : {-0.1, 1.5}) {
+    o.general_model_weight = w;
+    CHECK_THROWS_WITH(make_pocketsphinx_recognizer(o),
+                      Catch::Contains("general_model_weight is") && Catch::Contains("expected a share in [0, 1]"));
   }
 }

@@ -28,10 +28,19 @@ struct SpokenJinny {
   SimClock clock;
   AnswerProviders providers = make_providers(clock);
   std::vector<std::string> started;  // the tasks the HRI asked the planner to start
-  HriModule hri{base, tasks, hall, providers, [this](const Understanding& u) {
-                  started.push_back(u.task);
-                  return std::string();
-                }};
+  HriModule hri;
+
+  SpokenJinny() : SpokenJinny(HriOptions{}) {}
+  explicit SpokenJinny(HriOptions options)
+      : hri{base,
+            tasks,
+            hall,
+            providers,
+            [this](const Understanding& u) {
+              started.push_back(u.task);
+              return std::string();
+            },
+            std::move(options)} {}
 
   /// `general_model_weight`: the share of the general English model interpolated with the domain
   /// model (PocketsphinxOptions); 0, the domain model alone.
