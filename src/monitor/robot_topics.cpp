@@ -5,9 +5,9 @@
 #include <nlohmann/json.hpp>
 
 #include "robot_panels.hpp"
-#include "tripodal/monitor/wire.hpp"
 #include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/navi/section_splitter.hpp"
+#include "wire.hpp"
 
 namespace tripodal::monitor {
 namespace {
