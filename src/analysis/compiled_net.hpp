@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "../core/net_compile.hpp"
 #include "tripodal/analysis/state_space.hpp"
 #include "tripodal/core/petri_net.hpp"
+#include "tripodal_core_internal/net_compile.hpp"
 
 namespace tripodal::analysis::detail {
 

@@ -10,9 +10,9 @@
 #include <system_error>
 #include <utility>
 
-#include "../core/xml_document.hpp"
-#include "../core/xml_locator.hpp"
 #include "tripodal/core/xml_text.hpp"
+#include "tripodal_core_internal/xml_document.hpp"
+#include "tripodal_core_internal/xml_locator.hpp"
 
 namespace tripodal {
 

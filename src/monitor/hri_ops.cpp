@@ -7,7 +7,7 @@
 #include <variant>
 #include <vector>
 
-#include "tripodal/monitor/wire.hpp"
+#include "wire.hpp"
 
 namespace tripodal::monitor {
 

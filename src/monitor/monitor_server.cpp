@@ -9,22 +9,23 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
 #include <deque>
 #include <fstream>
-#include <algorithm>
-#include <array>
 #include <map>
-#include <optional>
 #include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <thread>
 
-#include <nlohmann/json.hpp>
+#include "wire.hpp"
 
 namespace tripodal::monitor {
 namespace {

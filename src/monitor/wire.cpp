@@ -1,4 +1,4 @@
-#include "tripodal/monitor/wire.hpp"
+#include "wire.hpp"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>

@@ -356,6 +356,16 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
 
+  // Robot::assemble, a step per section of the profile; each adds its problems to `d`.
+  void adopt(CheckedProfile&& checked, const RobotProfile& profile, Diagnostics& d);
+  void build_hardware(const RobotProfile& profile, Diagnostics& d);
+  void build_resources(const RobotProfile& profile, Diagnostics& d);
+  void build_loops(const RobotProfile& profile, Diagnostics& d);
+  void start_behaviors(const RobotProfile& profile, Diagnostics& d);
+  void build_modules(const RobotProfile& profile, Diagnostics& d);
+  void start_modules(Diagnostics& d);
+  void build_sequencing(const RobotProfile& profile);
+
   [[nodiscard]] ControlLoop& behavior_loop() const { return *loops.front(); }
 
   ModuleContext context(Time now) {
@@ -497,173 +507,219 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
   }
 };
 
-Robot::Robot(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+namespace {
 
-Robot::~Robot() { stop(); }
+// Runs one step of assembly, adding the ConfigError it throws to `d`: a profile's problems are
+// reported together, not one per run.
+template <class Fn>
+void collect(Diagnostics& d, const Fn& fn) {
+  try {
+    fn();
+  } catch (const ConfigError& e) {
+    d.append(e.diagnostics());
+  }
+}
 
-std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotPlugins& plugins, Clock& clock,
-                                       RobotOptions options) {
-  auto m = std::make_unique<Impl>(clock, plugins, std::move(options));
-  m->sequencing_period = profile.sequencing_period;
-  m->sequencing_timing = profile.sequencing_timing;
-  m->profile_dir = profile.dir;
-  Diagnostics d;
-  auto collect = [&](const auto& fn) {
-    try {
-      fn();
-    } catch (const ConfigError& e) {
-      d.append(e.diagnostics());
-    }
-  };
-
-  CheckedProfile checked = check_profile(profile, plugins, m->options.load_net, DeclaredTypes::must_be_registered, d);
-  m->description = std::move(checked.description);
-  m->tasks = std::move(checked.tasks);
-  m->recovery = std::move(checked.recovery);
-  m->behavior_types = std::move(checked.behavior_types);
+// The first loop's coordinator: the hardware's command channels, then its inputs, the profile's
+// behaviors in order (earlier ones win ties by priority) under the operator's hand and the safety
+// reflexes.
+CoordinatorConfig behavior_coordinator_config(const RobotProfile& profile, CHardware* hardware) {
+  CoordinatorConfig cc;
+  if (hardware != nullptr) {
+    // The hardware's command channels, fused by this coordinator and written back each cycle.
+    const auto specs = hardware->command_channels().specs();
+    cc.channels.assign(specs.begin(), specs.end());
+  }
+  int priority = static_cast<int>(profile.behaviors.size());
+  // Safety inputs rank above every other input (the monitor's operator too), so no lock
+  // below the emergency stop masks them.
+  const int safety_priority = priority + 1000;
+  // Driving by hand (BhTeleop, set by an operator console) ranks just above every other
+  // normal input, and its lock masks exactly those: the task stops, safety stays.
+  const int top = priority;
+  cc.inputs.push_back(
+      CoordinatorInputConfig{.name = std::string(kTeleopInput), .priority = top + 1, .timeout = std::chrono::milliseconds(200)});
+  cc.locks.push_back(CoordinatorLockConfig{.name = std::string(kTeleopInput), .priority = top});
   for (const ModuleEntry& b : profile.behaviors) {
-    if (!b.safety) m->behavior_defaults.emplace(b.name, parameters_of(b, m->options.parameters));
+    if (b.safety) {
+      cc.inputs.push_back(CoordinatorInputConfig{.name = b.name, .priority = safety_priority, .role = InputRole::safety});
+    } else {
+      cc.inputs.push_back(CoordinatorInputConfig{b.name, priority--});
+    }
   }
-  m->controller_configs = std::move(checked.controllers);
-  m->processes = ProcessRegistry(plugins.processes);
-  for (ProcessDefinition& def : checked.processes) collect([&] { m->processes.add(std::move(def)); });
+  return cc;
+}
 
-  // The hardware.
-  if (profile.hardware && plugins.hardware.contains(profile.hardware->type)) {
-    const ModuleEntry& h = *profile.hardware;
-    collect([&] {
-      HardwareConfig hc;
-      hc.name = h.name;
-      hc.type = h.type;
-      hc.where = h.where;
-      hc.parameters = ParameterSet::resolve(plugins.hardware.manifest(h.type), parameters_of(h, m->options.parameters), h.where);
-      hc.base = m->controller_configs.empty() ? nullptr : &m->controller_configs.front();
-      hc.profile_dir = profile.dir;
-      m->hardware = plugins.hardware.create_at(h.where, h.type, hc);
-      m->hardware->add_resources(m->resources);
-      // Hardware whose link detects faults of its own (a base on DDS) reports them like a resource.
-      if (auto* faults = dynamic_cast<ResourceFaultSource*>(m->hardware.get())) m->fault_sources.emplace_back(h.name, faults);
-      // So do the hardware's own resources that detect faults (the board's lidar): "<resource>.fault".
-      for (std::size_t i = 0; i < m->resources.size(); ++i) {
-        if (auto* faults = dynamic_cast<ResourceFaultSource*>(&m->resources.at(i)))
-          m->fault_sources.emplace_back(m->resources.at(i).name(), faults);
-      }
-    });
+}  // namespace
+
+void Robot::Impl::adopt(CheckedProfile&& checked, const RobotProfile& profile, Diagnostics& d) {
+  sequencing_period = profile.sequencing_period;
+  sequencing_timing = profile.sequencing_timing;
+  profile_dir = profile.dir;
+  description = std::move(checked.description);
+  tasks = std::move(checked.tasks);
+  recovery = std::move(checked.recovery);
+  behavior_types = std::move(checked.behavior_types);
+  for (const ModuleEntry& b : profile.behaviors) {
+    if (!b.safety) behavior_defaults.emplace(b.name, parameters_of(b, options.parameters));
   }
+  controller_configs = std::move(checked.controllers);
+  processes = ProcessRegistry(plugins.processes);
+  for (ProcessDefinition& def : checked.processes) collect(d, [&] { processes.add(std::move(def)); });
+}
+
+// The hardware (the profile's `hardware:`), and the resources it adds.
+void Robot::Impl::build_hardware(const RobotProfile& profile, Diagnostics& d) {
+  if (!profile.hardware || !plugins.hardware.contains(profile.hardware->type)) return;
+  const ModuleEntry& h = *profile.hardware;
+  collect(d, [&] {
+    HardwareConfig hc;
+    hc.name = h.name;
+    hc.type = h.type;
+    hc.where = h.where;
+    hc.parameters = ParameterSet::resolve(plugins.hardware.manifest(h.type), parameters_of(h, options.parameters), h.where);
+    hc.base = controller_configs.empty() ? nullptr : &controller_configs.front();
+    hc.profile_dir = profile.dir;
+    hardware = plugins.hardware.create_at(h.where, h.type, hc);
+    hardware->add_resources(resources);
+    // Hardware whose link detects faults of its own (a base on DDS) reports them like a resource.
+    if (auto* faults = dynamic_cast<ResourceFaultSource*>(hardware.get())) fault_sources.emplace_back(h.name, faults);
+    // So do the hardware's own resources that detect faults (the board's lidar): "<resource>.fault".
+    for (std::size_t i = 0; i < resources.size(); ++i) {
+      if (auto* faults = dynamic_cast<ResourceFaultSource*>(&resources.at(i)))
+        fault_sources.emplace_back(resources.at(i).name(), faults);
+    }
+  });
+}
+
+// The profile's `resources:`.
+void Robot::Impl::build_resources(const RobotProfile& profile, Diagnostics& d) {
   for (const ModuleEntry& e : profile.resources) {
     if (!plugins.resources.contains(e.type)) continue;  // check_profile reported it
-    collect([&] {
-      ResourceConfig rc{e.name, ParameterSet::resolve(plugins.resources.manifest(e.type), parameters_of(e, m->options.parameters), e.where),
-                        e.where, m->hardware.get()};
-      m->own_resources.push_back(plugins.resources.create_at(e.where, e.type, rc));
-      m->resources.add(*m->own_resources.back());
-      if (auto* faults = dynamic_cast<ResourceFaultSource*>(m->own_resources.back().get())) {
-        m->fault_sources.emplace_back(e.name, faults);
-      }
+    collect(d, [&] {
+      ResourceConfig rc{e.name,
+                        ParameterSet::resolve(plugins.resources.manifest(e.type), parameters_of(e, options.parameters), e.where),
+                        e.where, hardware.get()};
+      own_resources.push_back(plugins.resources.create_at(e.where, e.type, rc));
+      resources.add(*own_resources.back());
+      if (auto* faults = dynamic_cast<ResourceFaultSource*>(own_resources.back().get()))
+        fault_sources.emplace_back(e.name, faults);
     });
   }
-  if (d.has_errors()) throw ConfigError(d);
+}
 
-  // The reactive loops. The first runs the behaviors; its coordinator's inputs are the profile's
-  // behaviors in order (earlier ones win ties by priority).
-  m->resources.add(m->odometry);
-  m->resources.add(m->teleop);
+// The reactive loops (`loops:`). The first runs the behaviors.
+void Robot::Impl::build_loops(const RobotProfile& profile, Diagnostics& d) {
+  resources.add(odometry);
+  resources.add(teleop);
   bool first = true;
   std::size_t controller_index = 0;
   for (const LoopEntry& l : profile.loops) {
-    collect([&] {
+    collect(d, [&] {
       std::unique_ptr<CController> controller;
       if (!l.controller.empty()) {
-        if (!m->hardware) throw ConfigError(l.where, "loop '" + l.name + "' drives controller '" + l.controller + "', and the robot has no hardware");
-        controller = plugins.controllers.create(m->controller_configs.at(controller_index++), m->hardware->wheels());
+        if (!hardware)
+          throw ConfigError(l.where,
+                            "loop '" + l.name + "' drives controller '" + l.controller + "', and the robot has no hardware");
+        controller = plugins.controllers.create(controller_configs.at(controller_index++), hardware->wheels());
       }
-      CoordinatorConfig cc;
-      if (first && m->hardware) {
-        // The hardware's command channels, fused by this coordinator and written back each cycle.
-        const auto specs = m->hardware->command_channels().specs();
-        cc.channels.assign(specs.begin(), specs.end());
-      }
-      if (first) {
-        int priority = static_cast<int>(profile.behaviors.size());
-        // Safety inputs rank above every other input (the monitor's operator too), so no lock
-        // below the emergency stop masks them.
-        const int safety_priority = priority + 1000;
-        // Driving by hand (BhTeleop, set by an operator console) ranks just above every other
-        // normal input, and its lock masks exactly those: the task stops, safety stays.
-        const int top = priority;
-        cc.inputs.push_back(CoordinatorInputConfig{
-            .name = std::string(kTeleopInput), .priority = top + 1, .timeout = std::chrono::milliseconds(200)});
-        cc.locks.push_back(CoordinatorLockConfig{.name = std::string(kTeleopInput), .priority = top});
-        for (const ModuleEntry& b : profile.behaviors) {
-          if (b.safety) {
-            cc.inputs.push_back(CoordinatorInputConfig{.name = b.name, .priority = safety_priority, .role = InputRole::safety});
-          } else {
-            cc.inputs.push_back(CoordinatorInputConfig{b.name, priority--});
-          }
-        }
-      }
+      const CoordinatorConfig cc = first ? behavior_coordinator_config(profile, hardware.get()) : CoordinatorConfig{};
       ControlLoopOptions lo;
       lo.name = l.name;
       lo.period = l.period;
       lo.max_path_points = CPathFollowingBehavior::kMaxPathPoints;
-      auto loop = std::make_unique<ControlLoop>(lo, m->resources, CBehaviorCoordinator(cc), std::move(controller));
-      if (first && loop->controller() != nullptr) loop->set_odometry_output(&m->odometry);
-      if (first && m->hardware) loop->set_command_output(&m->hardware->command_channels());
-      m->loops.push_back(std::move(loop));
-      m->loop_timing.push_back(l.timing);
+      auto loop = std::make_unique<ControlLoop>(lo, resources, CBehaviorCoordinator(cc), std::move(controller));
+      if (first && loop->controller() != nullptr) loop->set_odometry_output(&odometry);
+      if (first && hardware) loop->set_command_output(&hardware->command_channels());
+      loops.push_back(std::move(loop));
+      loop_timing.push_back(l.timing);
       first = false;
     });
   }
-  if (m->loops.empty() && !profile.behaviors.empty()) {
+  if (loops.empty() && !profile.behaviors.empty()) {
     d.error(profile.where, "the robot lists behaviors but no loop to run them: add loops: [{name, period_s, controller}]");
   }
-  check_channel_writes(profile, plugins, m->hardware.get(), d);
-  if (!m->loops.empty()) collect([&] { m->loops.front()->activate(std::make_unique<BhTeleop>(), {}, kTeleopInput); });
-  // The safety behaviors run from the start, with the parameters the profile gives them.
-  for (const ModuleEntry& b : profile.behaviors) {
-    if (!b.safety || m->loops.empty() || !plugins.behaviors.contains(b.type)) continue;
-    collect([&] { m->loops.front()->activate(plugins.behaviors.create(b.type), parameters_of(b, m->options.parameters), b.name, b.where); });
-  }
+}
 
-  // The modules of the sequencing loop.
+// The behaviors that run from the start: the operator's hand and the safety behaviors, with the
+// parameters the profile gives them.
+void Robot::Impl::start_behaviors(const RobotProfile& profile, Diagnostics& d) {
+  if (!loops.empty()) collect(d, [&] { loops.front()->activate(std::make_unique<BhTeleop>(), {}, kTeleopInput); });
+  for (const ModuleEntry& b : profile.behaviors) {
+    if (!b.safety || loops.empty() || !plugins.behaviors.contains(b.type)) continue;
+    collect(d, [&] {
+      loops.front()->activate(plugins.behaviors.create(b.type), parameters_of(b, options.parameters), b.name, b.where);
+    });
+  }
+}
+
+// The modules of the sequencing loop (`navigation:`, `hri:`, `modules:`), configured.
+void Robot::Impl::build_modules(const RobotProfile& profile, Diagnostics& d) {
   for (const auto* list : {&profile.navigation, &profile.hri, &profile.modules}) {
     for (const ModuleEntry& e : *list) {
       if (!plugins.modules.contains(e.type)) continue;  // check_profile reported it
-      collect([&] {
+      collect(d, [&] {
         auto mod = plugins.modules.create_at(e.where, e.type);
-        mod->configure(parameters_of(e, m->options.parameters), e.where);
-        m->modules.emplace_back(e.name, std::move(mod));
+        mod->configure(parameters_of(e, options.parameters), e.where);
+        modules.emplace_back(e.name, std::move(mod));
       });
     }
   }
-  if (d.has_errors()) throw ConfigError(d);
-  // Every resource is in the table now (the hardware's, the profile's, the odometry).
-  m->snapshot = std::make_unique<ResourceSnapshot>(m->resources);
-  m->snapshot->publish();
-  m->snapshot->refresh();
-  {
-    ModuleContext ctx = m->context(clock.now());
-    // Not a structured binding: clang 14 (the fuzzing compiler) cannot capture one in a lambda.
-    for (auto& named : m->modules) collect([&] { named.second->start(ctx); });
-  }
-  if (d.has_errors()) throw ConfigError(d);
+}
 
-  m->supervisor = std::make_unique<CProcessSupervisor>(*m, clock, m->options.supervisor);
-  m->knowledge.navigation = &m->navigation;
-  for (auto& [name, mod] : m->modules) {
-    for (const DescribedModule& dm : m->description.modules) {
+// Every resource is in the table now (the hardware's, the profile's, the odometry): the modules
+// start on its first snapshot.
+void Robot::Impl::start_modules(Diagnostics& d) {
+  snapshot = std::make_unique<ResourceSnapshot>(resources);
+  snapshot->publish();
+  snapshot->refresh();
+  ModuleContext ctx = context(clock.now());
+  // Not a structured binding: clang 14 (the fuzzing compiler) cannot capture one in a lambda.
+  for (auto& named : modules) collect(d, [&] { named.second->start(ctx); });
+}
+
+// The supervisor, what the planner knows (the modules' outputs, the navigation), the modules'
+// watchdogs, and the planner.
+void Robot::Impl::build_sequencing(const RobotProfile& profile) {
+  supervisor = std::make_unique<CProcessSupervisor>(*this, clock, options.supervisor);
+  knowledge.navigation = &navigation;
+  for (auto& [name, mod] : modules) {
+    for (const DescribedModule& dm : description.modules) {
       if (dm.name != name) continue;
-      for (const std::string& out : dm.outputs) m->knowledge.providers.emplace_back(out, mod.get());
+      for (const std::string& out : dm.outputs) knowledge.providers.emplace_back(out, mod.get());
     }
   }
   for (const auto* list : {&profile.navigation, &profile.hri, &profile.modules}) {
     for (const ModuleEntry& e : *list) {
-      if (e.watchdog_timeout) m->supervisor->watch_module(e.name, *e.watchdog_timeout, e.watchdog_event);
+      if (e.watchdog_timeout) supervisor->watch_module(e.name, *e.watchdog_timeout, e.watchdog_event);
     }
   }
-  m->planner = std::make_unique<CPlanner>(m->tasks, m->recovery, m->knowledge, m->processes, *m->supervisor, clock,
-                                          m->options.planner);
-  if (!m->loops.empty()) m->behavior_loop().set_navigation(m->navigation);
+  planner = std::make_unique<CPlanner>(tasks, recovery, knowledge, processes, *supervisor, clock, options.planner);
+  if (!loops.empty()) behavior_loop().set_navigation(navigation);
+}
+
+Robot::Robot(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+Robot::~Robot() {
+  stop();
+}
+
+std::unique_ptr<Robot> Robot::assemble(const RobotProfile& profile, const RobotPlugins& plugins, Clock& clock,
+                                       RobotOptions options) {
+  auto m = std::make_unique<Impl>(clock, plugins, std::move(options));
+  Diagnostics d;
+  m->adopt(check_profile(profile, plugins, m->options.load_net, DeclaredTypes::must_be_registered, d), profile, d);
+  m->build_hardware(profile, d);
+  m->build_resources(profile, d);
+  if (d.has_errors()) throw ConfigError(d);
+  m->build_loops(profile, d);
+  check_channel_writes(profile, plugins, m->hardware.get(), d);
+  m->start_behaviors(profile, d);
+  m->build_modules(profile, d);
+  if (d.has_errors()) throw ConfigError(d);
+  m->start_modules(d);
+  if (d.has_errors()) throw ConfigError(d);
+  m->build_sequencing(profile);
   return std::unique_ptr<Robot>(new Robot(std::move(m)));
 }
 

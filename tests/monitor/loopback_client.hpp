@@ -9,7 +9,6 @@
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
-
 #include <chrono>
 #include <cstdint>
 #include <string>
@@ -17,7 +16,7 @@
 #include <thread>
 #include <vector>
 
-#include "tripodal/monitor/wire.hpp"
+#include "../../src/monitor/wire.hpp"
 
 namespace tripodal::monitor::test {
 

@@ -3,19 +3,18 @@
 // history replayed to clients that join (bytes and count), Host and Origin, CSRF-safe commands, the
 // Foxglove sessionId, and malformed Foxglove client messages (docs/monitor.md, "Budgets", "Host
 // and Origin"). Waits are bounded; nothing asserts a timing figure.
-#include <catch2/catch.hpp>
+#include "tripodal/monitor/monitor_server.hpp"
 
+#include <catch2/catch.hpp>
 #include <functional>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <regex>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
+#include "../../src/monitor/wire.hpp"
 #include "loopback_client.hpp"
-#include "tripodal/monitor/monitor_server.hpp"
-#include "tripodal/monitor/wire.hpp"
 
 using namespace tripodal::monitor;
 using namespace tripodal::monitor::test;

@@ -20,6 +20,7 @@
 #include <thread>
 
 #include "../../src/monitor/operator_request.hpp"
+#include "../../src/monitor/wire.hpp"
 #include "../navi/navi_test_util.hpp"
 #include "loopback_client.hpp"
 #include "test_hri_module.hpp"
@@ -28,7 +29,6 @@
 #include "tripodal/builtin/register_all.hpp"
 #include "tripodal/monitor/monitor_server.hpp"
 #include "tripodal/monitor/robot_monitor.hpp"
-#include "tripodal/monitor/wire.hpp"
 #include "tripodal/navi/map_io.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_board.hpp"

@@ -16,9 +16,13 @@
 #include <string_view>
 #include <vector>
 
-#include "tripodal/monitor/wire.hpp"
-
 namespace tripodal::monitor {
+
+/// How much of a request the server reads before it answers 431 or 413.
+struct HttpLimits {
+  std::size_t max_header_bytes = 16 * 1024;  ///< request line and headers
+  std::size_t max_body_bytes = 64 * 1024;
+};
 
 /// How a topic's messages travel to a client whose queue fills up.
 enum class Delivery {

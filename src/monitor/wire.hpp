@@ -1,4 +1,5 @@
-// The wire formats of the monitor server (monitor area, the top of the area graph beside app):
+// The wire formats of the monitor server (monitor area, the top of the area graph beside app),
+// private to the area (never installed; the tests and fuzz targets reach it by its path):
 // HTTP/1.1 requests read with size limits, the WebSocket handshake (RFC 6455: SHA-1 and base64
 // of the key) and WebSocket frames. Written here rather than taken from websocketpp/asio so the
 // server's one poll() thread owns every byte queued per client: that is what lets it shed bulk
@@ -14,6 +15,8 @@
 #include <utility>
 #include <vector>
 
+#include "tripodal/monitor/monitor_server.hpp"  // HttpLimits
+
 namespace tripodal::monitor {
 
 /// SHA-1 of `data` (FIPS 180-4); the WebSocket handshake needs nothing stronger.
@@ -21,11 +24,6 @@ namespace tripodal::monitor {
 [[nodiscard]] std::string base64(std::string_view bytes);
 /// Sec-WebSocket-Accept for a client's Sec-WebSocket-Key.
 [[nodiscard]] std::string websocket_accept(std::string_view key);
-
-struct HttpLimits {
-  std::size_t max_header_bytes = 16 * 1024;  ///< request line and headers
-  std::size_t max_body_bytes = 64 * 1024;
-};
 
 struct HttpRequest {
   std::string method;
