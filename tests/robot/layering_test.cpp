@@ -350,7 +350,7 @@ TEST_CASE("describe shows command channels, who writes and who exports them, R6 
   Diagnostics bad;
   (void)describe_robot(p, plugins, knowledge_inputs(TaskLibrary::load(p.tasks)), bad);
   CHECK_THAT(bad.str(),
-             Catch::Contains("disinfection.yaml:74:") &&
+             Catch::Contains("disinfection.yaml:78:") &&
                  Catch::Contains("behavior 'BhUvLamp' writes the command channel 'uv_lamp' (digital), which hardware 'sim' does "
                                  "not export; it exports none (rule R6)"));
 }

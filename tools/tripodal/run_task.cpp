@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "guide_hri.hpp"
+#include "run_charging.hpp"
 #include "run_outputs.hpp"
 #include "shutdown.hpp"
 #include "tripodal/behaviors/navigation_behaviors.hpp"
@@ -226,7 +227,8 @@ DisinfectionFigures disinfection_figures(sim::SimBoardHardware& hw, const std::v
   f.lamp_floor_dose_coverage = floor_cells == 0 ? 0.0 : static_cast<double>(floor_dosed) / static_cast<double>(floor_cells);
   f.lamp_on_s = to_seconds(hw.uv_dose().lamp_on());
   const board::FirmwareConfig& fc = b.firmware().config();
-  f.battery_used_ah = (soc_at_start - b.firmware().state_of_charge()) * fc.battery_capacity_ah;
+  f.battery_used_ah = b.firmware().charge_drawn_ah();  // what the load drew, charges on the dock aside
+  (void)soc_at_start;
   const double volts = b.firmware().battery().voltage_mv > 0 ? b.firmware().battery().voltage_mv / 1000.0 : board::kBatteryFullV;
   f.lamp_energy_wh = fc.uv_lamp_current_a * 0.5 * (board::kBatteryFullV + volts) * f.lamp_on_s / 3600.0;
   f.uvc_energy_j = hw.uv_dose().lamp().uvc_power_w * f.lamp_on_s;
@@ -678,7 +680,19 @@ RunResult run_task(const RunOptions& o) {
           dose_plan->passes > 1 ? "es" : "", est.time_s, est.charge_ah, available_ah, low_percent);
     }
     std::string why;
-    if (est.charge_ah > available_ah) {
+    const std::optional<ChargingStops> stops =
+        est.charge_ah > available_ah ? plan_charging_stops(profile, *world, fw.config(), est.charge_ah, available_ah, low_percent)
+                                     : std::nullopt;
+    if (stops && o.log != nullptr) {
+      *o.log << fmt::format("more than one charge: {} stop{} at the dock '{}' planned (about {:.0f} s charging)\n", stops->stops,
+                            stops->stops == 1 ? "" : "s", stops->dock, stops->charge_s);
+    }
+    if (stops && o.time_limit_s && est.time_s + stops->charge_s > *o.time_limit_s) {
+      why = fmt::format(
+          "target dose {} J/m2 cannot be reached within the time limit of {:.0f} s: the plan needs about {:.0f} s "
+          "and {:.0f} s of charging at the dock",
+          dose_plan->target_j_m2, *o.time_limit_s, est.time_s, stops->charge_s);
+    } else if (est.charge_ah > available_ah && !stops) {
       why = fmt::format(
           "target dose {} J/m2 cannot be reached within the battery: the plan (lanes {:.2f} m apart at {:.3f} m/s, "
           "{} pass{}) needs about {:.2f} Ah ({:.0f} s), the battery holds {:.2f} Ah above the {}% low mark",
@@ -877,6 +891,7 @@ RunResult run_task(const RunOptions& o) {
   res.cleaning = path_figures(path_cleaning);
   res.processes = report.processes;
   res.recoveries = report.recoveries;
+  res.charging = charging_summary(tr);
   res.collisions = truth.collisions();
   res.robot_steps = robot->behavior_loop().cycles();
   if (threaded) {
