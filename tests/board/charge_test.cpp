@@ -3,10 +3,14 @@
 // insert PrDockCharge, the robot drives to the world's dock, the board reports charging, and the
 // section is taken up again where it stopped. And the dock's faults: occupied, without power.
 #include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "tripodal/board/actuator_behaviors.hpp"
 #include "tripodal/builtin/register_all.hpp"
 #include "tripodal/navi/planning_modules.hpp"
 #include "tripodal/robot/robot.hpp"
@@ -186,4 +190,100 @@ TEST_CASE("a dock's power is read from the world file, and a bad value is locate
   CHECK_FALSE(dock_world("{name: charger, node: charger, powered: false}").docks.at(0).powered);
   CHECK_THROWS_WITH(dock_world("{name: charger, node: charger, powered: maybe}"),
                     Catch::Contains("charge_test.yaml:") && Catch::Contains("powered"));
+}
+
+// --- the panel: buttons through the net, LCD and voice ----------------------------------------------
+
+namespace {
+
+void press(ChargingRobot& r, std::uint8_t button) {
+  r.firmware().set_buttons(button);
+  r.robot->run_for(100ms);  // held over several DRIVE responses: BoardMonitor posts the edge once
+  r.firmware().set_buttons(0);
+  r.robot->run_for(100ms);
+}
+
+std::string lcd(ChargingRobot& r) {
+  return std::string(r.firmware().lcd_line(0));
+}
+
+}  // namespace
+
+TEST_CASE("the pause button stops base, lamp and fog, start takes the section up again, the LCD says so", "[board][panel]") {
+  ChargingRobot r(dock_world());
+  board::BoardFirmware& fw = r.firmware();
+  auto* coverage = r.robot->module<navi::CCoverageModule>();
+  REQUIRE(coverage != nullptr);
+  REQUIRE(r.robot->command("disinfect the room 2111").accepted);
+  r.run_task(30.0, [] {});
+  REQUIRE(fw.uv_lamp());
+  // State, battery (the board's whole percent) and tank (the liquid level module's) on line 0.
+  CHECK_THAT(lcd(r), Catch::Matches("DISINFECT B (99|100)% T [0-9]+%"));
+
+  press(r, board::kButtonPause);
+  r.robot->run_for(1s);
+  CHECK(r.robot->planner().busy());
+  CHECK_FALSE(fw.uv_lamp());
+  CHECK_FALSE(fw.atomizer());
+  CHECK(fw.required_m_s(0) == 0.0);
+  CHECK(fw.required_m_s(1) == 0.0);
+  CHECK_THAT(lcd(r), Catch::Matches("PAUSED B [0-9]+% T [0-9]+%"));
+  const std::size_t cleaned = coverage->cleaned().count();
+  const Pose2D at = r.hw->simulator().pose();
+  r.robot->run_for(10s);
+  CHECK(coverage->cleaned().count() == cleaned);
+  CHECK(std::hypot(r.hw->simulator().pose().x_m - at.x_m, r.hw->simulator().pose().y_m - at.y_m) < 0.01);
+
+  press(r, board::kButtonStart);
+  r.robot->run_for(10s);
+  CHECK(fw.uv_lamp());
+  CHECK_THAT(lcd(r), Catch::StartsWith("DISINFECT B "));
+  CHECK(coverage->cleaned().count() > cleaned);  // going on from where it stopped
+  r.robot->planner().cancel("checked");
+}
+
+TEST_CASE("voice: start when the disinfection starts, stop when the section is done, battery low before the charge",
+          "[board][panel]") {
+  ChargingRobot r(dock_world());
+  board::BoardFirmware& fw = r.firmware();
+  fw.set_state_of_charge(0.18);  // low about a third into the room: the run of the first test
+  REQUIRE(r.robot->command("disinfect the room 2111").accepted);
+  std::vector<int> tracks;  // as the board played them
+  std::uint64_t prompts = fw.counters().voice_prompts;
+  r.run_task(6000.0, [&] {
+    if (fw.counters().voice_prompts != prompts) {
+      prompts = fw.counters().voice_prompts;
+      tracks.push_back(fw.last_voice_track());
+    }
+  });
+  r.robot->run_for(100ms);  // the last track crosses the line after the process has ended
+  if (fw.counters().voice_prompts != prompts) tracks.push_back(fw.last_voice_track());
+  INFO(r.robot->planner().report().str());
+  REQUIRE(r.robot->planner().report().state == TaskState::succeeded);
+  // start, battery low (the fault), start again (the retry after the charge), stop (section done)
+  CHECK(tracks == std::vector<int>{static_cast<int>(board::kTrackStart), static_cast<int>(board::kTrackBatteryLow),
+                                   static_cast<int>(board::kTrackStart), static_cast<int>(board::kTrackStop)});
+}
+
+TEST_CASE("the home button sends the robot to its dock and ends the task there", "[board][panel]") {
+  ChargingRobot r(dock_world());
+  board::BoardFirmware& fw = r.firmware();
+  REQUIRE(r.robot->command("disinfect the room 2111").accepted);
+  r.run_task(30.0, [] {});
+  press(r, board::kButtonHome);
+  r.run_task(600.0, [] {});
+  const TaskReport& report = r.robot->planner().report();
+  INFO(report.str());
+  REQUIRE(report.state == TaskState::failed);
+  REQUIRE(report.recoveries.size() == 1);
+  CHECK(report.recoveries[0].fault == "home button: sent to the dock");
+  CHECK(report.recoveries[0].new_plan == "PrDockCharge()");
+  CHECK(report.reason ==
+        "fault \"home button: sent to the dock\" of PrDisinfection: insert PrDockCharge, then end the task (1/1)");
+  const ProcessRecord* charge = nth_run(report, "PrDockCharge", 0);
+  REQUIRE(charge != nullptr);
+  CHECK(charge->success);
+  CHECK(r.hw->simulator().dock() == 0);  // on the pad
+  CHECK_FALSE(fw.uv_lamp());
+  CHECK(nth_run(report, "PrDisinfection", 1) == nullptr);  // not taken up again
 }

@@ -67,7 +67,7 @@ TEST_CASE("malformed recovery rules are located") {
     FAIL("expected ConfigError");
   } catch (const ConfigError& e) {
     const std::string w = e.what();
-    CHECK_THAT(w, Catch::Contains("r.yaml:3:11: error: 'then': expected one of retry, skip, abort; got 'restart'"));
+    CHECK_THAT(w, Catch::Contains("r.yaml:3:11: error: 'then': expected one of retry, skip, abort, end; got 'restart'"));
     CHECK_THAT(w, Catch::Contains("r.yaml:4:18: error: 'max_retries': expected a whole number from 0 to 1000000, got '-1'"));
     CHECK_THAT(w, Catch::Contains("r.yaml:5:15: error: an inserted step must be a map"));
     CHECK_THAT(w, Catch::Contains("r.yaml:6:5: error: unknown key 'colour' in a recovery rule; expected one of: fault, process, insert, then, max_retries"));
