@@ -1,5 +1,12 @@
 #include "tripodal/board/actuator_behaviors.hpp"
 
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <string_view>
+
+#include "tripodal/board/board_hardware.hpp"
+
 namespace tripodal::board {
 
 const ModuleManifest& BhUvLamp::static_manifest() {
@@ -78,11 +85,51 @@ std::optional<Twist2D> BhLcdText::on_step(const BehaviorContext& /*context*/) no
   return std::nullopt;
 }
 
+const ModuleManifest& BhLcdStatus::static_manifest() {
+  static const ModuleManifest m =
+      ManifestBuilder("BhLcdStatus", ModuleKind::behavior)
+          .description(
+              "the state, the battery and the tank on the LCD's first line while active (channel lcd: the "
+              "board's command 0x33)")
+          .inputs({"battery", "tank"})
+          .writes("lcd", ChannelType::text, "state, battery and tank")
+          .text("state", std::string("READY"), "the state's word, at most 16 characters")
+          .build();
+  return m;
+}
+
+void BhLcdStatus::on_activate(const ParameterSet& params, const BehaviorContext& /*context*/) {
+  state_ = params.string("state").substr(0, 16);
+}
+
+std::optional<Twist2D> BhLcdStatus::on_step(const BehaviorContext& context) noexcept {
+  const BatteryResource* battery = context.resources != nullptr ? context.resources->find<BatteryReading>("battery") : nullptr;
+  const auto* tank = context.resources != nullptr ? context.resources->find<TankReading>("tank") : nullptr;
+  // Whole percent, as the board reports them; fixed buffers: the step must not allocate.
+  const int b =
+      battery != nullptr && battery->has_reading() ? static_cast<int>(std::lround(battery->latest().percentage * 100.0)) : -1;
+  const int t = tank != nullptr && tank->has_reading() ? static_cast<int>(std::lround(tank->latest().percent)) : -1;
+  std::array<char, 16> bs{}, ts{};
+  if (b < 0)
+    (void)std::snprintf(bs.data(), bs.size(), "--");
+  else
+    (void)std::snprintf(bs.data(), bs.size(), "%d%%", b);
+  if (t < 0)
+    (void)std::snprintf(ts.data(), ts.size(), "--");
+  else
+    (void)std::snprintf(ts.data(), ts.size(), "%d%%", t);
+  std::array<char, 64> text{};  // cut to the channel's 32 characters
+  (void)std::snprintf(text.data(), text.size(), "%s B %s T %s", state_.c_str(), bs.data(), ts.data());
+  write_channel(0, ChannelValue::of_text(std::string_view(text.data())));
+  return std::nullopt;
+}
+
 void register_board_behaviors(BehaviorRegistry& registry) {
   registry.add<BhUvLamp>();
   registry.add<BhAtomize>();
   registry.add<BhVoicePrompt>();
   registry.add<BhLcdText>();
+  registry.add<BhLcdStatus>();
 }
 
 }  // namespace tripodal::board

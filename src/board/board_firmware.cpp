@@ -312,11 +312,11 @@ void BoardFirmware::device_loop() noexcept {
   current_a_ = config_.idle_current_a + motor_load * config_.motor_current_a + (uv_lamp_ ? config_.uv_lamp_current_a : 0.0) +
                (atomizer_ ? config_.atomizer_current_a : 0.0) + (fan_ ? config_.fan_current_a : 0.0);
   const double capacity_as = config_.battery_capacity_ah * 3600.0;
-  if (charging_) {
-    soc_ = std::min(1.0, soc_ + config_.charger_current_a * dt / capacity_as);
-  } else {
-    soc_ = std::max(0.0, soc_ - current_a_ * dt / capacity_as);
-  }
+  // On the charger the pack takes what the charger gives beyond the load (constant current, no
+  // taper near full): 5.2 A into 10.4 Ah with the boards' 0.4 A is empty to full in 2.2 h.
+  drawn_as_ += current_a_ * dt;
+  const double net_a = (charging_ ? config_.charger_current_a : 0.0) - current_a_;
+  soc_ = std::clamp(soc_ + net_a * dt / capacity_as, 0.0, 1.0);
   if (now_ >= next_battery_) {
     next_battery_ += config_.battery_period;
     sample_battery();

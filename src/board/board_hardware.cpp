@@ -12,6 +12,14 @@
 
 namespace tripodal::board {
 
+const ModuleManifest& tank_resource_manifest() noexcept {
+  static const ModuleManifest m = ManifestBuilder("TankResource", ModuleKind::resource)
+                                      .description("the disinfectant tank's level (the liquid level module)")
+                                      .output("tank")
+                                      .build();
+  return m;
+}
+
 // Runs the link once per control cycle: the loop polls its resources at the start of each cycle.
 // Its reading is the link's state as a value (BoardLinkReading), mirrored to the sequencing layer.
 class BoardHardware::LinkResource final : public TypedResource<BoardLinkReading> {
@@ -53,7 +61,7 @@ class BoardHardware::LinkResource final : public TypedResource<BoardLinkReading>
 const ModuleManifest& BoardHardware::static_manifest() {
   static const ModuleManifest m = hardware_manifest(
       "board", "a differential base behind the disinfection robot's control board (UART or TCP, docs/board-protocol.md)",
-      {"odometry", "battery", "sonar", "cliff", "bumpers", "board_link", "laser_scan"},
+      {"odometry", "battery", "tank", "sonar", "cliff", "bumpers", "board_link", "laser_scan"},
       {ParameterSpec{"port",
                      ValueType::string,
                      Value{std::string()},
@@ -227,6 +235,13 @@ void BoardHardware::publish(Time now) noexcept {
     b.charging = s.charging;
     battery_.commit();
   }
+  if (link_.has_tank()) {
+    TankReading& t = tank_.edit();
+    t.stamp = now;
+    t.percent = link_.tank_percent();
+    t.empty = link_.tank_empty();
+    tank_.commit();
+  }
   const auto us = link_.ultrasonic_mm();
   if (!us.empty()) {
     SonarReading& r = ultrasonic_.edit();
@@ -245,6 +260,7 @@ void BoardHardware::publish(Time now) noexcept {
 void BoardHardware::on_add_resources(ResourceTable& table) {
   table.add(*link_resource_);  // first: the link runs before the others are read
   table.add(battery_);
+  table.add(tank_);
   table.add(ultrasonic_);
   table.add(cliff_);
   table.add(bumpers_);

@@ -72,7 +72,12 @@ void BoardMonitor::on_update(ModuleContext& context) {
   if (link.has_battery) {
     const BatteryState& b = link.battery;
     const bool low = !b.charging && b.percent <= battery_low_percent_;
-    if (low && !battery_low_) context.post("board.battery_low", fmt::format("battery at {} % ({} mV)", b.percent, b.voltage_mv));
+    // Posted again every battery period (3 s) while low: a process that starts after the edge
+    // (the disinfection of the next section after a drive) hears it too and ends for the charge.
+    if (low && (!battery_low_ || context.now >= next_low_post_)) {
+      context.post("board.battery_low", fmt::format("battery at {} % ({} mV)", b.percent, b.voltage_mv));
+      next_low_post_ = context.now + kBatteryLowRepeat;
+    }
     battery_low_ = low;
   }
   if (!fault.empty()) throw std::runtime_error(fault);

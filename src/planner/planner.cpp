@@ -73,6 +73,7 @@ struct CPlanner::Impl {
   std::optional<std::pair<std::string, std::string>> failure;  // (X place, message): first fault in this net
   std::map<std::string, RecoveryPolicy, std::less<>> own_policies;  // per process: its own rules
   std::map<const RecoveryRule*, int> fired;
+  std::optional<std::string> ending;  // a rule's `then: end`: the reason the task fails once the inserted processes are done
 
   Impl(const TaskLibrary& t, const RecoveryPolicy& r, const TaskKnowledge& k, const ProcessRegistry& p,
        CProcessSupervisor& s, const Clock& c, PlannerOptions o)
@@ -220,6 +221,7 @@ struct CPlanner::Impl {
       return;
     }
     if (d.rule) ++fired[d.rule];
+    if (d.action == RecoveryAction::end) ending = d.reason;
     plan = RecoveryPolicy::remaining_plan(plan, stage, d);
     RecoveryRecord rec{now, step.process, message, d.reason, to_string(plan)};
     report.recoveries.push_back(rec);
@@ -269,6 +271,7 @@ CommandAnswer CPlanner::command(std::string_view command) {
   m.report.initial_plan = to_string(u.plan);
   m.plan = std::move(u.plan);
   m.fired.clear();
+  m.ending.reset();
   m.record_of.clear();
   m.build_net(now);
   spdlog::info("task '{}' started: {}", m.report.task, m.report.initial_plan);
@@ -285,7 +288,10 @@ void CPlanner::step() {
     if (!m.exchange(now)) return;
     const OutcomeState o = m.net->outcome();
     if (o.outcome == Outcome::success) {
-      m.end_task(true, {}, now);
+      if (m.ending)
+        m.end_task(false, *m.ending, now);
+      else
+        m.end_task(true, {}, now);
       return;
     }
     // A quiet point: the net has reached its fault place and no process of the plan still runs,

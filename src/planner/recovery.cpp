@@ -39,8 +39,11 @@ RecoveryPolicy walk(const std::string& text, const std::string& file,
       }
     }
     if (const YAML::Node v = rule_node["then"]) {
-      if (auto a = r.choice(v, "'then'", {"retry", "skip", "abort"})) {
-        rule.then = *a == "retry" ? RecoveryAction::retry : *a == "skip" ? RecoveryAction::skip : RecoveryAction::abort;
+      if (auto a = r.choice(v, "'then'", {"retry", "skip", "abort", "end"})) {
+        rule.then = *a == "retry"  ? RecoveryAction::retry
+                    : *a == "skip" ? RecoveryAction::skip
+                    : *a == "end"  ? RecoveryAction::end
+                                   : RecoveryAction::abort;
       }
     }
     if (const YAML::Node v = rule_node["max_retries"]) {
@@ -121,8 +124,11 @@ RecoveryDecision RecoveryPolicy::decide(const ProcessStep& failed, std::string_v
   for (const auto& s : rule.insert) inserted += (inserted.empty() ? "" : ", ") + s.process;
   d.reason = "fault \"" + std::string(message) + "\" of " + failed.process + ": " +
              (inserted.empty() ? std::string() : "insert " + inserted + ", then ") +
-             (rule.then == RecoveryAction::retry ? "retry" : rule.then == RecoveryAction::skip ? "skip" : "abort") + " (" +
-             std::to_string(times_fired + 1) + "/" + std::to_string(rule.max_retries) + ")";
+             (rule.then == RecoveryAction::retry  ? "retry"
+              : rule.then == RecoveryAction::skip ? "skip"
+              : rule.then == RecoveryAction::end  ? "end the task"
+                                                  : "abort") +
+             " (" + std::to_string(times_fired + 1) + "/" + std::to_string(rule.max_retries) + ")";
   return d;
 }
 
@@ -132,7 +138,9 @@ Plan RecoveryPolicy::remaining_plan(const Plan& plan, std::size_t failed_stage, 
   out.command = plan.command;
   if (decision.action == RecoveryAction::abort || failed_stage >= plan.stages.size()) return out;
   for (const auto& step : decision.insert) out.stages.push_back(PlanStage{{step}});
-  const std::size_t from = decision.action == RecoveryAction::retry ? failed_stage : failed_stage + 1;
+  const std::size_t from = decision.action == RecoveryAction::retry ? failed_stage
+                           : decision.action == RecoveryAction::end ? plan.stages.size()
+                                                                    : failed_stage + 1;
   for (std::size_t s = from; s < plan.stages.size(); ++s) out.stages.push_back(plan.stages[s]);
   return out;
 }

@@ -69,6 +69,9 @@ SimBoardHardware::SimBoardHardware(World world, const ControllerConfig& base, st
 // between two instants.
 void SimBoardHardware::on_advance_to(Time now) noexcept {
   const Time before = sim_.now();
+  // The board's charger input is the dock's contacts (a powered dock's, World::docks): the
+  // firmware then reports charging and its pack charges at the charger's current.
+  board_.firmware().set_charging(sim_.charging());
   board_.advance_to(now);
   if (board_.firmware().uv_lamp()) dose_.expose({sim_.pose().x_m, sim_.pose().y_m}, sim_.now() - before);
   publish_truth();
@@ -83,15 +86,26 @@ const ModuleManifest& SimBoardHardware::static_manifest() {
     outputs.insert(outputs.end(), {"yaw_rate", "ground_truth_pose"});  // laser_scan: the world's laser stands in for the lidar
     std::vector<ParameterSpec> parameters = real.parameters;
     const UvLamp lamp;
-    parameters.insert(parameters.end(), {
-        seed_parameter(),
-        ParameterSpec{"line", ValueType::string, Value{std::string("in_process")}, "",
-                      "what carries the bytes: in_process (the simulated line) or pty (a kernel pseudo-terminal)", {}, {}},
-        ParameterSpec{"tank_l", ValueType::number, Value{board::FirmwareConfig{}.tank_initial_l}, "l",
-                      "disinfectant in the tank at power-on", 0.0, board::FirmwareConfig{}.tank_l},
-        ParameterSpec{"uv_power_w", ValueType::number, Value{lamp.uvc_power_w}, "W", "the lamp's UVC output", 0.0, 1000.0, true},
-        ParameterSpec{"uv_height_m", ValueType::number, Value{lamp.height_m}, "m", "the lamp above the floor", 0.0, 1.0, true},
-        ParameterSpec{"uv_radius_m", ValueType::number, Value{lamp.radius_m}, "m", "the lit disc's radius on the floor", 0.0, 5.0, true}});
+    parameters.insert(
+        parameters.end(),
+        {seed_parameter(),
+         ParameterSpec{"line",
+                       ValueType::string,
+                       Value{std::string("in_process")},
+                       "",
+                       "what carries the bytes: in_process (the simulated line) or pty (a kernel pseudo-terminal)",
+                       {},
+                       {}},
+         ParameterSpec{"tank_l", ValueType::number, Value{board::FirmwareConfig{}.tank_initial_l}, "l",
+                       "disinfectant in the tank at power-on", 0.0, board::FirmwareConfig{}.tank_l},
+         ParameterSpec{"battery_initial", ValueType::number, Value{board::FirmwareConfig{}.battery_initial}, "",
+                       "the pack's state of charge at power-on, 0..1 (a low start sends the robot to its dock)", 0.0, 1.0},
+         ParameterSpec{"charger_current_a", ValueType::number, Value{board::FirmwareConfig{}.charger_current_a}, "A",
+                       "what the dock's charger gives (5.2 A: 0.5 C of the 10.4 Ah pack, about 2 h from empty)", 0.0, 100.0},
+         ParameterSpec{"uv_power_w", ValueType::number, Value{lamp.uvc_power_w}, "W", "the lamp's UVC output", 0.0, 1000.0, true},
+         ParameterSpec{"uv_height_m", ValueType::number, Value{lamp.height_m}, "m", "the lamp above the floor", 0.0, 1.0, true},
+         ParameterSpec{"uv_radius_m", ValueType::number, Value{lamp.radius_m}, "m", "the lit disc's radius on the floor", 0.0,
+                       5.0, true}});
     ModuleManifest r = hardware_manifest("board",
                                          "the control board simulated in process in the embedded simulator's world, "
                                          "every exchange over the line byte for byte (docs/board-protocol.md)",
@@ -116,6 +130,8 @@ void register_sim_board_hardware(HardwareRegistry& registry, const std::shared_p
     board::FirmwareConfig firmware;
     firmware.pulses_per_m = host.pulses_per_m;
     firmware.tank_initial_l = c.parameters.number("tank_l");
+    firmware.battery_initial = c.parameters.number("battery_initial");
+    firmware.charger_current_a = c.parameters.number("charger_current_a");
     // The board has as many cliff sensors as the world's robot (at most 8: the bitmap's segment).
     firmware.cliff_count = std::min(world->robot.cliff.positions.size(), std::size_t{8});
     const std::string& line = c.parameters.string("line");

@@ -515,6 +515,7 @@ void Simulator::substep(Duration dt) noexcept {
     if (dock_ >= 0) log(SimEvent::Kind::undocked, world_.docks[static_cast<std::size_t>(dock_)].name);
     if (dock >= 0) log(SimEvent::Kind::docked, world_.docks[static_cast<std::size_t>(dock)].name);
     dock_ = dock;
+    dock_powered_ = dock >= 0 && world_.docks[static_cast<std::size_t>(dock)].powered;
   }
 
   // Battery: the electronics and any extra load drain it with time, the wheels with distance.

@@ -134,16 +134,17 @@ class Reader {
   yaml::Reader r_;
 };
 
-// `docks: [{name, pose: [x, y, theta] | node: NAME, contact_radius_m, heading_tolerance_deg}]`.
+// `docks: [{name, pose: [x, y, theta] | node: NAME, contact_radius_m, heading_tolerance_deg, powered}]`.
 void read_docks(Reader& r, const YAML::Node& list, World& w) {
   if (!list.IsSequence()) {
-    r.error(list,
-            "docks must be a list of {name, pose | node, contact_radius_m, heading_tolerance_deg}, got " + Reader::kind(list));
+    r.error(list, "docks must be a list of {name, pose | node, contact_radius_m, heading_tolerance_deg, powered}, got " +
+                      Reader::kind(list));
     return;
   }
   std::set<std::string> names;
   for (const auto& item : list) {
-    if (!r.check_map(item, "a docks entry", {"name", "pose", "node", "contact_radius_m", "heading_tolerance_deg"})) continue;
+    if (!r.check_map(item, "a docks entry", {"name", "pose", "node", "contact_radius_m", "heading_tolerance_deg", "powered"}))
+      continue;
     Dock k;
     k.where = r.at(item);
     r.text(item, "name", k.name, "docks entry");
@@ -176,6 +177,7 @@ void read_docks(Reader& r, const YAML::Node& list, World& w) {
     double tolerance_deg = k.heading_tolerance_rad / kDegToRad;
     r.number_at_least(item, "heading_tolerance_deg", tolerance_deg, 0.0, false, "dock '" + k.name + "'");
     k.heading_tolerance_rad = tolerance_deg * kDegToRad;
+    r.boolean(item, "powered", k.powered, "dock '" + k.name + "'");
     w.docks.push_back(std::move(k));
   }
 }

@@ -23,9 +23,10 @@ TEST_CASE("hardware 'board': wheels through DRIVE, odometry from the encoders, s
   BoardHardware hw(line.host(), BoardHardwareConfig{});
   ResourceTable table;
   hw.add_resources(table);
-  REQUIRE(table.size() == 5);
+  REQUIRE(table.size() == 6);
   CHECK(table.at(0).name() == "board_link");
   REQUIRE(table.find<BatteryReading>("battery") != nullptr);
+  REQUIRE(table.find<TankReading>("tank") != nullptr);  // the liquid level module, for the LCD
   REQUIRE(table.find<SonarReading>("ultrasonic") != nullptr);
   REQUIRE(table.find<InfraredReading>("cliff") != nullptr);
   REQUIRE(table.find<BumperReading>("bumpers") != nullptr);

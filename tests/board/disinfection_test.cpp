@@ -124,18 +124,30 @@ TEST_CASE("PrDisinfection: an empty tank pauses the fog and asks for disinfectan
   CHECK_FALSE(fw.uv_lamp());  // cancelled: every behavior deactivated, lamp off
 }
 
-TEST_CASE("PrDisinfection: a low battery ends the task safely, lamp and fog off", "[board][disinfection]") {
+// workspace.yaml has no dock (the dock and charge: tests/board/charge_test.cpp): the robot goes to
+// the charger node to charge, finds no contacts there and the task ends with that reason.
+TEST_CASE("PrDisinfection: a low battery ends the disinfection safely, lamp and fog off, and sends the robot to charge",
+          "[board][disinfection]") {
   DisinfectionRobot r;
   board::BoardFirmware& fw = r.hw->embedded().firmware();
   REQUIRE(r.robot->command("disinfect the room 2111").accepted);
   r.run_task(20.0, [] {});
   REQUIRE(fw.uv_lamp());
   fw.set_state_of_charge(0.10);  // sampled at the board's next 3 s, polled by the host every 3 s
-  r.run_task(10.0, [] {});
+  bool lamp_after_fault = false;
+  r.run_task(300.0, [&] {
+    // Off at the board within a few control periods of the fault (the commands cross the line).
+    const auto& rec = r.robot->planner().report().recoveries;
+    if (!rec.empty() && r.clock.now() > rec[0].time + 100ms) lamp_after_fault = lamp_after_fault || fw.uv_lamp() || fw.atomizer();
+  });
   const TaskReport& report = r.robot->planner().report();
   INFO(report.str());
   CHECK(report.state == TaskState::failed);
-  CHECK_THAT(report.reason, Catch::Contains("battery low: disinfection ended safely"));
+  REQUIRE(report.recoveries.size() == 1);
+  CHECK(report.recoveries[0].fault == "battery low: disinfection ended safely");
+  CHECK(report.recoveries[0].new_plan == "PrDockCharge() -> PrDisinfection(section=A)");
+  CHECK_THAT(report.reason, Catch::Contains("fault \"no contact with the dock\" of PrDockCharge: abort"));
+  CHECK_FALSE(lamp_after_fault);
   r.robot->run_for(100ms);
   CHECK_FALSE(fw.uv_lamp());
   CHECK_FALSE(fw.atomizer());
@@ -183,7 +195,8 @@ struct ChannelRobot {
 
   ChannelRobot() {
     RobotProfile profile = load_robot_profile(kConfigs / "robots/disinfection.yaml");
-    profile.modules.clear();
+    // BoardMonitor out; BatteryMonitor stays: PrDockCharge's guards read its facts.
+    std::erase_if(profile.modules, [](const ModuleEntry& m) { return m.type == "BoardMonitor"; });
     ModuleEntry lcd;
     lcd.kind = ModuleKind::behavior;
     lcd.name = lcd.type = "BhLcdText";
@@ -243,7 +256,7 @@ TEST_CASE("A behavior writing a channel the hardware does not export is refused 
   } catch (const ConfigError& e) {
     const std::string what = e.what();
     CHECK_THAT(what, Catch::Contains("disinfection.yaml:"));
-    CHECK_THAT(what, Catch::Contains("disinfection.yaml:74:"));
+    CHECK_THAT(what, Catch::Contains("disinfection.yaml:78:"));
     CHECK_THAT(what,
                Catch::Contains("behavior 'BhUvLamp' writes the command channel 'uv_lamp' (digital), which hardware 'sim' does "
                                "not export; it exports none (rule R6)"));

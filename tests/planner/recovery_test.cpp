@@ -67,7 +67,7 @@ TEST_CASE("malformed recovery rules are located") {
     FAIL("expected ConfigError");
   } catch (const ConfigError& e) {
     const std::string w = e.what();
-    CHECK_THAT(w, Catch::Contains("r.yaml:3:11: error: 'then': expected one of retry, skip, abort; got 'restart'"));
+    CHECK_THAT(w, Catch::Contains("r.yaml:3:11: error: 'then': expected one of retry, skip, abort, end; got 'restart'"));
     CHECK_THAT(w, Catch::Contains("r.yaml:4:18: error: 'max_retries': expected a whole number from 0 to 1000000, got '-1'"));
     CHECK_THAT(w, Catch::Contains("r.yaml:5:15: error: an inserted step must be a map"));
     CHECK_THAT(w, Catch::Contains("r.yaml:6:5: error: unknown key 'colour' in a recovery rule; expected one of: fault, process, insert, then, max_retries"));
@@ -126,16 +126,33 @@ TEST_CASE("the fault messages a net can post: its fault places that can be marke
   CHECK(postable_fault_messages(shipped_net("PrWait.xml")).empty());
 }
 
+TEST_CASE("end runs the inserted processes and drops the rest of the plan (the home button)") {
+  const auto policy = RecoveryPolicy::load(TRIPODAL_SOURCE_DIR "/configs/tasks/disinfection_recovery.yaml");
+  Plan plan;
+  plan.task = "disinfect";
+  plan.stages.push_back({{{"PrDisinfection", {{"section", "A", {}}}}}});
+  plan.stages.push_back({{{"PrAutoMove", {{"goal", "B.entry", {}}}}}});
+  const auto home = policy.decide(plan.stages[0].steps[0], "home button: sent to the dock", 0);
+  CHECK(home.action == RecoveryAction::end);
+  CHECK(home.reason == "fault \"home button: sent to the dock\" of PrDisinfection: insert PrDockCharge, then end the task (1/1)");
+  CHECK(to_string(RecoveryPolicy::remaining_plan(plan, 0, home)) == "PrDockCharge()");
+  // The low battery charges and takes the same section up again, then the rest.
+  const auto low = policy.decide(plan.stages[0].steps[0], "battery low: disinfection ended safely", 0);
+  CHECK(low.action == RecoveryAction::retry);
+  CHECK(to_string(RecoveryPolicy::remaining_plan(plan, 0, low)) ==
+        "PrDockCharge() -> PrDisinfection(section=A) -> PrAutoMove(goal=B.entry)");
+}
+
 TEST_CASE("every shipped recovery rule matches a fault a shipped net posts, and inserts a process that has a net") {
   const PetriNet automove = shipped_net("PrAutoMove.xml"), cleaning = shipped_net("PrCleaning.xml"),
                  global = shipped_net("PrGlobalLocalization.xml"), wait = shipped_net("PrWait.xml"),
-                 back_off = shipped_net("PrBackOff.xml");
-  const std::vector<ProcessNet> nets{{"PrAutoMove", &automove},
-                                     {"PrCleaning", &cleaning},
-                                     {"PrGlobalLocalization", &global},
-                                     {"PrWait", &wait},
-                                     {"PrBackOff", &back_off}};
-  for (const char* file : {"recovery.yaml", "jinny_recovery.yaml"}) {
+                 back_off = shipped_net("PrBackOff.xml"), disinfection = shipped_net("PrDisinfection.xml"),
+                 dock = shipped_net("PrDockCharge.xml"), reconnect = shipped_net("PrBoardReconnect.xml");
+  const std::vector<ProcessNet> nets{{"PrAutoMove", &automove},         {"PrCleaning", &cleaning},
+                                     {"PrGlobalLocalization", &global}, {"PrWait", &wait},
+                                     {"PrBackOff", &back_off},          {"PrDisinfection", &disinfection},
+                                     {"PrDockCharge", &dock},           {"PrBoardReconnect", &reconnect}};
+  for (const char* file : {"recovery.yaml", "jinny_recovery.yaml", "disinfection_recovery.yaml", "disinfection_devices_recovery.yaml"}) {
     INFO(file);
     Diagnostics d;
     check_recovery_rules(RecoveryPolicy::load(std::string(TRIPODAL_SOURCE_DIR "/configs/tasks/") + file), nets, d);

@@ -337,7 +337,7 @@ TEST_CASE("describe shows command channels, who writes and who exports them, R6 
       text, Catch::Contains(
                 "  BhAtomize (behavior)\n      in:  -\n      out: -\n      writes: atomizer (analog), atomizer_fan (digital)\n"));
   CHECK_THAT(text, Catch::Contains("      channel: uv_lamp (digital) <- BhUvLamp\n"));
-  CHECK_THAT(text, Catch::Contains("      channel: voice (track) <- BhVoicePrompt\n      channel: lcd (text)\n"));
+  CHECK_THAT(text, Catch::Contains("      channel: voice (track) <- BhVoicePrompt\n      channel: lcd (text) <- BhLcdStatus\n"));
   const std::string dot = describe_dot(r);
   CHECK_THAT(dot, Catch::Contains("\"BhUvLamp\" -> \"behavior_coordinator\" [label=\"uv_lamp\", style=bold"));
   CHECK_THAT(dot,
@@ -350,7 +350,7 @@ TEST_CASE("describe shows command channels, who writes and who exports them, R6 
   Diagnostics bad;
   (void)describe_robot(p, plugins, knowledge_inputs(TaskLibrary::load(p.tasks)), bad);
   CHECK_THAT(bad.str(),
-             Catch::Contains("disinfection.yaml:74:") &&
+             Catch::Contains("disinfection.yaml:78:") &&
                  Catch::Contains("behavior 'BhUvLamp' writes the command channel 'uv_lamp' (digital), which hardware 'sim' does "
                                  "not export; it exports none (rule R6)"));
 }

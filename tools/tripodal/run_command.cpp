@@ -293,6 +293,7 @@ int run(Args& args, std::ostream& out, std::ostream& err) {
     else out << "no cleaning in this task; ";
     out << "path " << r.total.length_m << " m, " << r.total.turns << " turns; " << r.duration_s << " s simulated; "
         << r.recoveries.size() << " recoveries\n";
+    if (!r.charging.empty()) out << r.charging << "\n";
     if (const auto& d = r.disinfection) {
       out << "disinfection: " << d->dose_coverage * 100.0 << " % of the reachable floor dosed >= " << d->uv_target_dose_j_m2
           << " J/m2 (median " << d->median_dose_j_m2 << " J/m2, lamp on " << d->lamp_on_s << " s); disinfectant used "

@@ -111,8 +111,7 @@ std::string step_text(const ProcessStep& s) {
 }
 
 DisinfectionFigures disinfection_figures(sim::SimBoardHardware& hw, const std::vector<char>& reachable,
-                                         const std::vector<char>& lamp_floor, const navi::OccupancyGrid& grid, double target_j_m2,
-                                         double soc_at_start) {
+                                         const std::vector<char>& lamp_floor, const navi::OccupancyGrid& grid, double target_j_m2) {
   DisinfectionFigures f;
   board::EmbeddedBoard& b = hw.embedded();
   const std::filesystem::path device = b.device();
@@ -139,7 +138,7 @@ DisinfectionFigures disinfection_figures(sim::SimBoardHardware& hw, const std::v
   f.lamp_floor_dose_coverage = floor_cells == 0 ? 0.0 : static_cast<double>(floor_dosed) / static_cast<double>(floor_cells);
   f.lamp_on_s = to_seconds(hw.uv_dose().lamp_on());
   const board::FirmwareConfig& fc = b.firmware().config();
-  f.battery_used_ah = (soc_at_start - b.firmware().state_of_charge()) * fc.battery_capacity_ah;
+  f.battery_used_ah = b.firmware().charge_drawn_ah();  // what the load drew, charges on the dock aside
   const double volts = b.firmware().battery().voltage_mv > 0 ? b.firmware().battery().voltage_mv / 1000.0 : board::kBatteryFullV;
   f.lamp_energy_wh = fc.uv_lamp_current_a * 0.5 * (board::kBatteryFullV + volts) * f.lamp_on_s / 3600.0;
   f.uvc_energy_j = hw.uv_dose().lamp().uvc_power_w * f.lamp_on_s;

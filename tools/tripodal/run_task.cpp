@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "guide_hri.hpp"
+#include "run_charging.hpp"
 #include "run_devices.hpp"
 #include "run_measures.hpp"
 #include "run_outputs.hpp"
@@ -242,7 +243,7 @@ void check_same_lamp(const Navigation& nav, const sim::SimBoardHardware* board_h
 
 // Why a dose-planned disinfection cannot be done (the battery down to the board monitor's low
 // threshold, or the time limit, cannot carry its estimate `est`); "" when it can. Logs the plan.
-std::string dose_refusal(const RunOptions& o, const RobotProfile& profile, const board::BoardFirmware& fw,
+std::string dose_refusal(const RunOptions& o, const RobotProfile& profile, const sim::World& world, const board::BoardFirmware& fw,
                          const navi::DosePlan& plan, const DoseEstimate& est) {
   double low_percent = 15.0;
   for (const ModuleEntry& e : profile.modules) {
@@ -257,7 +258,21 @@ std::string dose_refusal(const RunOptions& o, const RobotProfile& profile, const
         plan.target_j_m2, plan.spacing_m, plan.speed_m_s, plan.passes, plan.passes > 1 ? "es" : "", est.time_s, est.charge_ah,
         available_ah, low_percent);
   }
-  if (est.charge_ah > available_ah) {
+  // More than one charge: the robot stops at the dock on the way when its profile and the world can.
+  const std::optional<ChargingStops> stops =
+      est.charge_ah > available_ah ? plan_charging_stops(profile, world, fw.config(), est.charge_ah, available_ah, low_percent)
+                                   : std::nullopt;
+  if (stops && o.log != nullptr) {
+    *o.log << fmt::format("more than one charge: {} stop{} at the dock '{}' planned (about {:.0f} s charging)\n", stops->stops,
+                          stops->stops == 1 ? "" : "s", stops->dock, stops->charge_s);
+  }
+  if (stops && o.time_limit_s && est.time_s + stops->charge_s > *o.time_limit_s) {
+    return fmt::format(
+        "target dose {} J/m2 cannot be reached within the time limit of {:.0f} s: the plan needs about {:.0f} s "
+        "and {:.0f} s of charging at the dock",
+        plan.target_j_m2, *o.time_limit_s, est.time_s, stops->charge_s);
+  }
+  if (est.charge_ah > available_ah && !stops) {
     return fmt::format(
         "target dose {} J/m2 cannot be reached within the battery: the plan (lanes {:.2f} m apart at {:.3f} m/s, "
         "{} pass{}) needs about {:.2f} Ah ({:.0f} s), the battery holds {:.2f} Ah above the {}% low mark",
@@ -318,8 +333,7 @@ class TaskRun {
         nav_(checked_navigation(*robot_, profile, *world)),
         start_(world->start_pose),
         dose_plan_(nav_.coverage != nullptr ? nav_.coverage->dose_plan() : no_dose_plan()),
-        target_dose_j_m2_(o.uv_target_dose_j_m2.value_or(dose_plan_ ? dose_plan_->target_j_m2 : kDefaultUvTargetDose)),
-        soc_at_start_(board_hw_ != nullptr ? board_hw_->embedded().firmware().state_of_charge() : 0.0) {
+        target_dose_j_m2_(o.uv_target_dose_j_m2.value_or(dose_plan_ ? dose_plan_->target_j_m2 : kDefaultUvTargetDose)) {
     if (nav_.coverage != nullptr) res_.coverage_pattern = nav_.coverage->pattern();
     check_same_lamp(nav_, board_hw_, dose_plan_);
     if (CController* c = robot_->behavior_loop().controller()) c->reset_odometry(start_);
@@ -396,7 +410,6 @@ class TaskRun {
   Pose2D start_;
   const std::optional<navi::DosePlan>& dose_plan_;
   double target_dose_j_m2_;
-  double soc_at_start_;
   LifecycleRecorder life_{true};
   ReportObserver report_;
   std::unique_ptr<RunRecording> recording_;
@@ -473,7 +486,7 @@ void TaskRun::check_dose_plan() {
   const DoseEstimate est = estimate_dose(*nav_.coverage, *nav_.splitter, room_sections_, {start_.x_m, start_.y_m}, fw.config());
   res_.dose_estimate_s = est.time_s;
   res_.dose_estimate_ah = est.charge_ah;
-  const std::string why = dose_refusal(o_, profile_, fw, *dose_plan_, est);
+  const std::string why = dose_refusal(o_, profile_, world_, fw, *dose_plan_, est);
   if (!why.empty()) {
     robot_->planner().cancel(why);
     robot_->step_sequencing();
@@ -693,6 +706,7 @@ void TaskRun::measure(Time ended) {
   res_.cleaning = path_figures(path_cleaning_);
   res_.processes = report_.processes;
   res_.recoveries = report_.recoveries;
+  res_.charging = charging_summary(tr);
   res_.collisions = truth_.collisions();
   res_.robot_steps = robot_->behavior_loop().cycles();
   if (threaded_) {
@@ -709,7 +723,7 @@ void TaskRun::measure(Time ended) {
   res_.sections = section_figures(nav_, room_sections_);
   if (board_hw_ != nullptr) {
     res_.disinfection =
-        disinfection_figures(*board_hw_, reachable_, lamp_floor_, nav_.maps->grid(), target_dose_j_m2_, soc_at_start_);
+        disinfection_figures(*board_hw_, reachable_, lamp_floor_, nav_.maps->grid(), target_dose_j_m2_);
     if (dose_plan_) {
       res_.disinfection->plan = *dose_plan_;
       res_.disinfection->estimate_s = res_.dose_estimate_s;

@@ -189,6 +189,7 @@ struct RunResult {
   std::optional<DisinfectionFigures> disinfection;  ///< on hardware "board" only
   double dose_estimate_s = 0.0;                     ///< a dose-planned disinfection's up-front time estimate
   double dose_estimate_ah = 0.0;                    ///< and its charge
+  std::string charging;                             ///< the charges at the dock (charging_summary), empty: none
   [[nodiscard]] std::string json() const;
 };
 

@@ -5,6 +5,8 @@
 // faults its behaviors are withdrawn and the channels fall to their safe values: lamp and fog off.
 #pragma once
 
+#include <string>
+
 #include "tripodal/behaviors/behavior.hpp"
 #include "tripodal/behaviors/behavior_registry.hpp"
 
@@ -66,10 +68,29 @@ class BhLcdText final : public CBehavior {
   ChannelValue text_;
 };
 
-/// The voice chip's tracks the disinfection task plays.
-inline constexpr double kTrackAddDisinfectant = 3;
+/// The robot's state on the LCD's first line while active: `state` (a word the net gives, e.g.
+/// DISINFECT, PAUSED), the battery's and the tank's levels from the board's resources, e.g.
+/// "DISINFECT B 67% T 80%" ("--" for a level not read yet). Never finishes.
+class BhLcdStatus final : public CBehavior {
+ public:
+  static const ModuleManifest& static_manifest();
 
-/// Registers BhUvLamp, BhAtomize, BhVoicePrompt and BhLcdText.
+ protected:
+  const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
+  void on_activate(const ParameterSet& params, const BehaviorContext& context) override;
+  std::optional<Twist2D> on_step(const BehaviorContext& context) noexcept override;
+
+ private:
+  std::string state_;
+};
+
+/// The voice chip's tracks the disinfection task plays (the WT2003S's flash, in this order).
+inline constexpr double kTrackStart = 1;
+inline constexpr double kTrackStop = 2;
+inline constexpr double kTrackAddDisinfectant = 3;
+inline constexpr double kTrackBatteryLow = 4;
+
+/// Registers BhUvLamp, BhAtomize, BhVoicePrompt, BhLcdText and BhLcdStatus.
 void register_board_behaviors(BehaviorRegistry& registry);
 
 }  // namespace tripodal::board

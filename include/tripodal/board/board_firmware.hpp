@@ -145,6 +145,8 @@ class BoardFirmware {
   [[nodiscard]] std::int32_t pulses(std::size_t wheel) const noexcept { return motors_[wheel].pulses; }
   [[nodiscard]] double state_of_charge() const noexcept { return soc_; }
   [[nodiscard]] double battery_current_a() const noexcept { return current_a_; }
+  /// The charge the load has drawn since power-on (Ah), whatever the charger put back.
+  [[nodiscard]] double charge_drawn_ah() const noexcept { return drawn_as_ / 3600.0; }
   [[nodiscard]] BatteryState battery() const noexcept { return battery_; }
   [[nodiscard]] double tank_l() const noexcept { return tank_l_; }
   [[nodiscard]] double disinfectant_used_l() const noexcept { return used_l_; }
@@ -217,6 +219,7 @@ class BoardFirmware {
   double soc_ = 1.0;
   double current_a_ = 0.0;
   bool charging_ = false;
+  double drawn_as_ = 0.0;
   BatteryState battery_{};
   double tank_l_ = 0.0;
   double used_l_ = 0.0;

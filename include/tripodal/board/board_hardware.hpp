@@ -54,6 +54,15 @@ struct BoardHardwareConfig {
   LinkConfig link;
 };
 
+/// The liquid level module's reading (resource "tank"): what the LCD shows beside the battery.
+struct TankReading {
+  Time stamp{};
+  double percent = 0.0;  ///< 0..100
+  bool empty = false;
+};
+/// The manifest of the board's resource type "TankResource" (output information "tank").
+[[nodiscard]] const ModuleManifest& tank_resource_manifest() noexcept;
+
 class BoardHardware final : public CHardware, public HardwareInterface, public BoardHost {
  public:
   /// Parameters of type "board": port (the tty), baud, pulses_per_m, response_timeout_s, max_missed,
@@ -102,6 +111,7 @@ class BoardHardware final : public CHardware, public HardwareInterface, public B
   WheelSpeeds speeds_{};
   std::unique_ptr<LinkResource> link_resource_;
   BatteryResource battery_{"battery"};
+  TypedResource<TankReading> tank_{"tank", Duration{0}, tank_resource_manifest()};
   SonarResource ultrasonic_{"ultrasonic"};
   InfraredResource cliff_{"cliff"};
   BumperResource bumpers_{"bumpers"};

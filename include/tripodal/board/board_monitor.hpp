@@ -10,7 +10,8 @@
 //   board.start / board.pause / board.home   a panel button pressed (held edge)
 //   board.emergency_stop  the e-stop pressed: the board has already braked; a fault
 //   board.tank_empty / board.tank_refilled   the liquid level module's empty flag changed
-//   board.battery_low     the battery at or below battery_low_percent (and not charging)
+//   board.battery_low     the battery at or below battery_low_percent (and not charging); again
+//                         every 3 s while it stays low
 // and keeps the fact `board_linked` (the link synchronised) for the nets' guards (PrBoardReconnect
 // waits on it). It only reads: the actuators are command channels the behaviors write (actuator_behaviors.hpp).
 // A fault is also reported as the module's failure ("<module>.fault"), so every running process
@@ -43,7 +44,9 @@ class BoardMonitor final : public CModule {
   std::uint8_t held_ = 0;
   bool tank_empty_ = false;
   bool battery_low_ = false;
+  Time next_low_post_{};
   double battery_low_percent_ = 15.0;
+  static constexpr Duration kBatteryLowRepeat{std::chrono::seconds(3)};
 };
 
 /// Registers the module type "BoardMonitor".

@@ -15,6 +15,7 @@ enum class RecoveryAction {
   retry,  ///< run the inserted processes, then the failed stage again
   skip,   ///< run the inserted processes, then go on after the failed stage
   abort,  ///< the task fails
+  end,    ///< run the inserted processes (the robot sent to its dock), then the task fails with the fault
 };
 
 struct RecoveryRule {

@@ -144,8 +144,8 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   [[nodiscard]] double battery_charge() const noexcept { return soc_; }
   /// A charger plugged in by hand (a test, a tool): charges wherever the robot is.
   void set_charging(bool charging) noexcept { charging_ = charging; }
-  /// Charging: plugged in by hand, or on a dock's contacts (World::docks).
-  [[nodiscard]] bool charging() const noexcept { return charging_ || dock_ >= 0; }
+  /// Charging: plugged in by hand, or on the contacts of a dock with power (World::docks).
+  [[nodiscard]] bool charging() const noexcept { return charging_ || dock_powered_; }
   /// The dock whose contacts the robot touches (index into World::docks), -1 for none.
   [[nodiscard]] int dock() const noexcept { return dock_; }
   /// An extra load on the battery (a UV lamp, a pump), as a fraction of the capacity per second,
@@ -269,6 +269,7 @@ class Simulator final : public HardwareInterface, public navi::GroundTruthSource
   bool fallen_ = false;
   bool charging_ = false;
   int dock_ = -1;
+  bool dock_powered_ = false;  ///< dock_ names a dock whose charger gives current
   double extra_drain_per_s_ = 0.0;
   bool battery_empty_ = false;
   std::uint64_t collisions_ = 0;

@@ -200,12 +200,14 @@ struct StuckCliffSensor {
 /// A charging dock: its contacts touch the robot's while the robot's centre is within
 /// contact_radius_m of `pose` and its heading within heading_tolerance_rad of pose.theta (a
 /// tolerance of pi or more: a charging pad, any heading). While they touch the battery charges
-/// at robot.battery.charge_per_s (BatteryReading::charging is true).
+/// at robot.battery.charge_per_s (BatteryReading::charging is true). A dock without power (its
+/// charger broken or unplugged) touches the robot's contacts but charges nothing.
 struct Dock {
   std::string name;
   Pose2D pose;  ///< map_from_base of the robot docked
   double contact_radius_m = 0.1;
   double heading_tolerance_rad = 0.35;
+  bool powered = true;  ///< false: the charger gives no current
   SourceLocation where;
 };
 
