@@ -164,6 +164,12 @@ def main():
             check_devices(dev, text)
             if dev["link"]["link_losses"] != 0 or dev["link"]["decoder_errors"] != 0:
                 fail("a clean line lost the link or garbled frames", text)
+            # The summary line times a run on devices by the wall clock, not the simulator's.
+            summary = [line for line in text.splitlines() if line.startswith("task succeeded")]
+            if len(summary) != 1 or " s wall clock; " not in summary[0] or "simulated" in summary[0]:
+                fail("the summary line should say the wall-clock time: %r" % summary, text)
+            if report.get("duration_clock") != "wall":
+                fail("report.json duration_clock %r, expected 'wall'" % report.get("duration_clock"), text)
             print("go to the entrance: succeeded in %.1f s (%.1f s wall for the whole command), first SYNC after %.3f s" %
                   (report["duration_s"], time.monotonic() - t0, dev["first_sync_s"]))
         elif mode == "replug":
