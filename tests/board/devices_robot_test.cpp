@@ -4,7 +4,8 @@
 // robot opens the ptys through its hardware "board" (port, lidar_port) as it would /dev/ttyUSB0.
 // Tagged [threads]: scripts/tsan.sh runs it under ThreadSanitizer (the ThreadSanitizer tree builds
 // no tools, hence the fork rather than the tool). The child is killed mid-run ("unplugged"): the
-// sequencing layer sees the loss through the resource snapshot. Bounded waits only.
+// sequencing layer sees the loss through the resource snapshot; or it stops the lidar's motor: the
+// laser's fault reaches the supervisor within the driver's timeout. Bounded waits only.
 #include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
