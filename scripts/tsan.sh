@@ -4,9 +4,10 @@
 # threads, Robot::start/stop with a command from another thread, SourceFile interning, the monitor's
 # server thread against the robot's, the RKMS store written from two threads, the wall-clock
 # runtime (PeriodicRunner, the lock-free resource snapshot and seqlock, PSR-2 cleaning on its own
-# threads at 20x, a starved loop's deadline fault), and the disinfection robot on its threads
-# against its board and lidar in a forked process over ptys, unplugged mid-run (BoardMonitor reading
-# the link through the snapshot). A data race
+# threads at 20x, a starved loop's deadline fault, Jinny answering a visitor and guiding at 10x), and
+# the disinfection robot on its threads against its board and lidar in a forked process over ptys,
+# unplugged mid-run (BoardMonitor reading the link through the snapshot) and with the lidar's motor
+# stopped (the laser's fault within its timeout). A data race
 # or a lock-order inversion fails the run (halt_on_error). Build tree: $BUILD_ROOT/tsan.
 #
 # A new threaded component (a DDS transport) joins by tagging its tests

@@ -43,6 +43,8 @@ class BoardHardware::LinkResource final : public TypedResource<BoardLinkReading>
     r.synchronised = l.synchronised();
     r.has_drive = l.has_drive();
     r.buttons = l.has_drive() ? l.drive().buttons : 0;
+    r.drive_status = l.has_drive() ? l.drive().status : 0;
+    r.drive_stamp = l.drive_stamp();
     r.has_battery = l.has_battery();
     r.battery = l.battery();
     r.has_tank = l.has_tank();
@@ -51,6 +53,7 @@ class BoardHardware::LinkResource final : public TypedResource<BoardLinkReading>
     r.lost_at = l.link_lost_at();
     r.stats = l.stats();
     r.decoder_errors = l.decoder_stats().errors();
+    r.pending_actuator_commands = l.pending_actuator_commands();
     commit();
   }
 

@@ -9,10 +9,10 @@ using nlohmann::json;
 
 // The control board's link as the host sees it (hardware type "board", real or simulated): the
 // panel of the page. Everything here is what the board reported over the line or the host counted.
-json board_json(board::BoardLink& link, Time now) {
-  const board::LinkStats& s = link.stats();
+json board_json(const board::BoardLinkReading& link, Time now) {
+  const board::LinkStats& s = link.stats;
   const double answered = static_cast<double>(s.responses + s.error_responses);
-  json j{{"connected", link.synchronised()},
+  json j{{"connected", link.synchronised},
          {"requests", s.requests},
          {"responses", s.responses},
          {"missed", s.missed},
@@ -22,30 +22,30 @@ json board_json(board::BoardLink& link, Time now) {
          {"reopens", s.reopens},
          {"retries", s.retries},
          {"watchdog_trips", s.watchdog_trips},
-         {"decoder_errors", link.decoder_stats().errors()},
+         {"decoder_errors", link.decoder_errors},
          {"bytes_sent", s.bytes_sent},
          {"bytes_received", s.bytes_received},
          {"round_trip_ms",
           {{"last", to_seconds(s.last_round_trip) * 1e3},
            {"max", to_seconds(s.max_round_trip) * 1e3},
            {"mean", answered > 0 ? to_seconds(s.total_round_trip) * 1e3 / answered : 0.0}}},
-         {"pending_actuator_commands", link.pending_actuator_commands()},
+         {"pending_actuator_commands", link.pending_actuator_commands},
          {"battery", nullptr},
          {"tank", nullptr},
          {"status", nullptr}};
-  if (!link.synchronised()) j["lost_for_s"] = to_seconds(now - link.link_lost_at());
-  if (link.has_battery()) {
-    const board::BatteryState& b = link.battery();
+  if (!link.synchronised) j["lost_for_s"] = to_seconds(now - link.lost_at);
+  if (link.has_battery) {
+    const board::BatteryState& b = link.battery;
     j["battery"] = {{"percent", b.percent}, {"charging", b.charging}, {"voltage_v", b.voltage_mv / 1000.0}};
   }
-  if (link.has_tank()) j["tank"] = {{"percent", link.tank_percent()}, {"empty", link.tank_empty()}};
-  if (link.has_drive()) {
-    const std::uint8_t f = link.drive().status;
+  if (link.has_tank) j["tank"] = {{"percent", link.tank_percent}, {"empty", link.tank_empty}};
+  if (link.has_drive) {
+    const std::uint8_t f = link.drive_status;
     j["status"] = {{"uv_lamp", (f & board::kStatusUvLamp) != 0},
                    {"atomizer", (f & board::kStatusAtomizer) != 0},
                    {"emergency_stop", (f & board::kStatusEmergencyStop) != 0},
                    {"watchdog_latched", (f & board::kStatusLinkLost) != 0},
-                   {"age_s", to_seconds(now - link.drive_stamp())}};
+                   {"age_s", to_seconds(now - link.drive_stamp)}};
   }
   return j;
 }
@@ -97,7 +97,12 @@ json status_panel(Robot& robot, Time now, double t, const MonitorExtras& extras,
   if (const auto* battery = robot.resources().first<BatteryReading>(); battery != nullptr && battery->has_reading()) {
     status["battery"] = battery->latest().percentage;
   }
-  if (auto* host = dynamic_cast<board::BoardHost*>(robot.hardware())) status["board"] = board_json(host->board().link(), now);
+  // The link as the sequencing layer sees it (the resource snapshot): on the robot's own threads
+  // the reactive loop's thread runs the link itself.
+  if (const auto* link = robot.sequencing_resources().find<board::BoardLinkReading>("board_link");
+      link != nullptr && link->has_reading()) {
+    status["board"] = board_json(link->latest(), now);
+  }
   status["hri"] = console.hri != nullptr ? hri_display_json(console.hri->display()) : json(nullptr);
   if (extras.true_pose)
     status["truth"] = {{"x", extras.true_pose->x_m}, {"y", extras.true_pose->y_m}, {"theta", extras.true_pose->theta_rad}};

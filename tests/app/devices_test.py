@@ -13,6 +13,9 @@ MODE:
   sigterm     SIGTERM mid-task: exit 143, report.json "interrupted by SIGTERM", the base at rest
               (the board answered a DRIVE at speed 0), the ports closed (the device simulator
               sees its ptys hung up and another host may open them)
+  lidar_stops the lidar's motor stopped mid-task (SIGUSR1 to tripodal-board-sim): the laser's fault
+              ("no revolution") within its timeout (1 s) and a few periods, not a hang; SIGTERM then
+              ends the run as usual
   no_port     a port that does not exist: exit 1, the path and the reason named
   not_a_tty   a port that is a regular file: exit 1, "tcgetattr: Inappropriate ioctl for device"
   garbage     a pty whose other end answers every request with garbage: no SYNC within 5 s, the
@@ -150,7 +153,7 @@ def main():
     work = tempfile.mkdtemp(prefix="tripodal_devices_")
     devices = None
     try:
-        if mode in ("go_to", "replug", "sigterm", "garbage"):
+        if mode in ("go_to", "replug", "sigterm", "garbage", "lidar_stops"):
             devices, board, lidar = start_devices(board_sim, world, work)
         if mode == "go_to":
             t0 = time.monotonic()
@@ -164,6 +167,12 @@ def main():
             check_devices(dev, text)
             if dev["link"]["link_losses"] != 0 or dev["link"]["decoder_errors"] != 0:
                 fail("a clean line lost the link or garbled frames", text)
+            # The summary line times a run on devices by the wall clock, not the simulator's.
+            summary = [line for line in text.splitlines() if line.startswith("task succeeded")]
+            if len(summary) != 1 or " s wall clock; " not in summary[0] or "simulated" in summary[0]:
+                fail("the summary line should say the wall-clock time: %r" % summary, text)
+            if report.get("duration_clock") != "wall":
+                fail("report.json duration_clock %r, expected 'wall'" % report.get("duration_clock"), text)
             print("go to the entrance: succeeded in %.1f s (%.1f s wall for the whole command), first SYNC after %.3f s" %
                   (report["duration_s"], time.monotonic() - t0, dev["first_sync_s"]))
         elif mode == "replug":
@@ -221,6 +230,25 @@ def main():
             if out2.wait_for(r"board: SYNC answered", 0.1) is None:
                 fail("a second host could not open the ports after the first one ended (exit %d)" % rc2, out2.text())
             print("SIGTERM: exit 143, report interrupted, base at rest, ports reopened by another host")
+        elif mode == "lidar_stops":
+            proc, out = run_robot(exe, source, work, board, lidar, "go to door_2111")
+            if out.wait_for(r"activate BhAutoMove", 30) is None:
+                stop(proc)
+                fail("the robot did not start moving", out.text())
+            time.sleep(2.0)
+            devices.send_signal(signal.SIGUSR1)  # the lidar's motor stops
+            t_stop = time.monotonic()
+            t_fault = out.wait_for(r"no revolution", 10, after=t_stop - 0.5)
+            if t_fault is None:
+                stop(proc)
+                fail("no laser fault within 10 s of the lidar's motor stopping", out.text())
+            proc.send_signal(signal.SIGTERM)
+            rc = finish(proc, out, 20)
+            if rc != 143:
+                fail("after the lidar's fault, SIGTERM: exit %d, expected 143" % rc, out.text())
+            if t_fault - t_stop > 3.0:
+                fail("the laser's fault came %.2f s after the motor stopped (timeout 1 s)" % (t_fault - t_stop), out.text())
+            print("lidar stopped: the laser's fault %.0f ms after the motor stopped (timeout 1 s)" % ((t_fault - t_stop) * 1000.0))
         elif mode in ("no_port", "not_a_tty"):
             configs = os.path.join(source, "configs")
             port = os.path.join(work, "ttyNONE")

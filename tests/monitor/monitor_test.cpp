@@ -529,18 +529,26 @@ TEST_CASE("The status carries the control board's link for a board robot and not
     RobotMonitor watch(*robot, clock, server, RobotMonitorOptions{.min_interval_s = 0.0});
     server.start();
     robot->run_for(std::chrono::seconds(4));  // SYNC, DRIVE every period, the battery (3 s) and the tank (1 s) polled
+    // The loop runs a cycle more after the sequencing layer's last period: the link has moved on,
+    // the status shows the "board_link" snapshot the sequencing layer read (on the robot's own
+    // threads the loop's thread runs the link: the monitor must not read it).
+    robot->behavior_loop().step(clock.now());
     const board::LinkStats& link = dynamic_cast<board::BoardHost&>(*robot->hardware()).board().link().stats();
+    const auto* seen = robot->sequencing_resources().find<board::BoardLinkReading>("board_link");
+    REQUIRE(seen != nullptr);
+    const board::LinkStats& snapshot = seen->latest().stats;
+    REQUIRE(snapshot.requests < link.requests);
     const nlohmann::json status = next_status(server, watch);
     REQUIRE(status.contains("board"));
     const nlohmann::json& b = status["board"];
     INFO(b.dump());
     CHECK(b["connected"].get<bool>());
-    CHECK(b["requests"].get<std::uint64_t>() == link.requests);
+    CHECK(b["requests"].get<std::uint64_t>() == snapshot.requests);
     CHECK(b["requests"].get<std::uint64_t>() > 300);  // a DRIVE each 10 ms period, and the polls
     CHECK(b["missed"].get<std::uint64_t>() == 0);
     CHECK(b["decoder_errors"].get<std::uint64_t>() == 0);
     CHECK(b["watchdog_trips"].get<std::uint64_t>() == 0);
-    CHECK(b["bytes_sent"].get<std::uint64_t>() == link.bytes_sent);
+    CHECK(b["bytes_sent"].get<std::uint64_t>() == snapshot.bytes_sent);
     CHECK(b["bytes_sent"].get<std::uint64_t>() > 0);
     CHECK(b["bytes_received"].get<std::uint64_t>() > 0);
     CHECK(b["round_trip_ms"]["max"].get<double>() > 0.0);
@@ -551,6 +559,8 @@ TEST_CASE("The status carries the control board's link for a board robot and not
     CHECK(b["tank"]["percent"].get<int>() > 0);
     REQUIRE(b["status"].is_object());
     CHECK_FALSE(b["status"]["uv_lamp"].get<bool>());  // no task: the lamp is off
+    CHECK(b["status"]["age_s"].get<double>() >= 0.0);
+    CHECK(b["pending_actuator_commands"].get<std::size_t>() == seen->latest().pending_actuator_commands);
   }
 }
 

@@ -10,8 +10,12 @@
 
 #include "robot_doubles.hpp"
 #include "tripodal/builtin/register_all.hpp"
+#include "tripodal/hri/answer_providers.hpp"
+#include "tripodal/hri/hri_robot_module.hpp"
+#include "tripodal/hri/hri_service.hpp"
 #include "tripodal/navi/planning_modules.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
+#include "tripodal/planner/task_library.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
 
@@ -185,4 +189,90 @@ TEST_CASE("A starved behavior loop posts motion.deadline as a fault the supervis
   CHECK_THAT(life.str(), Catch::Contains("motion: missed its deadline 3 times in a row (period 0.010 s, budget 0.010 s)") ||
                              Catch::Contains("missed its deadline 3 times in a row"));
   CHECK_THAT(robot->planner().report().reason, Catch::Contains("module motion failed: missed its deadline"));
+}
+
+namespace {
+
+// The hall's nodes for the HRI's task templates, as the robot's Hri module answers them from where
+// the robot stands (what the guide application's GuideHri does; read on the sequencing thread).
+class HallKnowledge final : public TaskKnowledge {
+ public:
+  HallKnowledge(const CHri& hri, const Robot& robot) : hri_(hri), robot_(robot) {}
+  [[nodiscard]] ListResult list(std::string_view function, std::string_view argument) const override {
+    const auto a = hri_.answer(function, argument, robot_.navigation());
+    if (!a) return {false, {}, "no " + std::string(function) + "()"};
+    return {a->ok, a->items, a->error};
+  }
+
+ private:
+  const CHri& hri_;
+  const Robot& robot_;
+};
+
+}  // namespace
+
+TEST_CASE("Jinny on its own threads answers a visitor and guides them to a node at 10 times real time", "[robot][threads]") {
+  const auto world = std::make_shared<sim::World>(sim::load_world(kConfigs / "worlds/exhibit_hall.yaml"));
+  RobotPlugins plugins = builtin_plugins(world);
+  const RobotProfile profile = load_robot_profile(kConfigs / "robots/jinny.yaml");
+  ScaledClock clock(10.0);
+  const auto robot = Robot::assemble(profile, plugins, clock);
+  if (CController* c = robot->behavior_loop().controller()) c->reset_odometry(world->start_pose);
+  auto* const hri_module = robot->module<CHri>();
+  REQUIRE(hri_module != nullptr);
+
+  // The HRI as the guide application runs it on the robot's thread: the module's knowledge store,
+  // the hall's nodes, local providers, command inputs to the planner (under the sequencing lock).
+  const TaskLibrary tasks = TaskLibrary::load(kConfigs / "tasks/jinny_guide.yaml");
+  const HallKnowledge hall(*hri_module, *robot);
+  AnswerProviders providers;
+  providers.add("time", std::make_unique<ClockTimeProvider>(clock, std::chrono::hours(14)));
+  providers.add("battery", std::make_unique<BatteryProvider>([] { return 0.82; }));
+  providers.add("weather",
+                std::make_unique<WeatherTableProvider>(clock, std::chrono::hours(14), std::vector<std::string>{"sunny"}));
+  const TaskStarter start_task = [&](const Understanding& u) -> std::string {
+    const CommandAnswer a = robot->planner().command("guide me to node " + u.slots.at("node"));
+    return a.accepted ? std::string() : a.text;
+  };
+  StoreBackedHri service(hri_module->knowledge_store(), tasks, hall, providers, start_task);
+
+  // The visitor's requests, typed on the test's thread, answered on the sequencing thread.
+  std::mutex mutex;
+  std::vector<std::string> requests{"Introduce yourself.", "Could you guide me to node 1, please?"};
+  std::vector<HriReply> replies;
+  std::atomic<std::size_t> answered{0};
+  std::atomic<bool> moving{false}, busy{false};
+  RealtimeOptions ro;
+  ro.after_sequencing = [&](Time) {
+    {
+      const std::lock_guard lock(mutex);
+      if (replies.size() < requests.size()) {
+        replies.push_back(service.ask(requests[replies.size()]));
+        answered.store(replies.size());
+      }
+    }
+    if (robot->behavior_active("BhAutoMove")) moving.store(true);
+    busy.store(robot->planner().busy());
+  };
+  robot->start(ro);
+  const bool got_answers = wait_for([&] { return answered.load() == 2; }, 20s);
+  const bool got_moving = wait_for([&] { return moving.load(); }, 20s);
+  // Guided as far as a few seconds of wall time go (node 1 is some metres away): done or under way.
+  (void)wait_for([&] { return moving.load() && !busy.load(); }, 5s);
+  robot->stop();
+  CHECK_FALSE(robot->started());
+
+  CHECK(got_answers);
+  CHECK(got_moving);
+  const std::lock_guard lock(mutex);
+  REQUIRE(replies.size() == 2);
+  CHECK(replies[0].kind == HriReply::Kind::answered);
+  CHECK(replies[0].entry_id == "introduce");
+  CHECK_THAT(replies[0].text, Catch::StartsWith("Hello, I am Jinny"));
+  CHECK(replies[1].kind == HriReply::Kind::task_started);
+  CHECK(replies[1].task == "guide");
+  const auto& sim = dynamic_cast<sim::SimHardware&>(*robot->hardware()).simulator();
+  CHECK(sim.distance_m() > 0.5);
+  CHECK(sim.collisions() == 0);
+  CHECK((robot->planner().state() == TaskState::succeeded || robot->planner().busy()));
 }

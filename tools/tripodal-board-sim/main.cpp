@@ -30,6 +30,11 @@
 namespace {
 std::atomic<bool> g_stop{false};
 void on_signal(int /*sig*/) { g_stop.store(true); }
+// SIGUSR1: the lidar's motor stops (a stuck rotor; a pty carries no DTR to restart it), or turns again.
+std::atomic<bool> g_toggle_lidar_motor{false};
+void on_toggle_lidar_motor(int /*sig*/) {
+  g_toggle_lidar_motor.store(true);
+}
 
 // The default world: the installed one (PREFIX/share/tripodal/configs, beside PREFIX/bin where
 // this program is), else the source tree's (a build tree's program), else ./configs.
@@ -117,7 +122,8 @@ int run(int argc, char** argv) {
                  "PORT: serve the link over TCP on 127.0.0.1:PORT (0: any free port) instead of a pseudo-terminal")
       ->check(CLI::Range(0, 65535));
   app.add_option("--lidar", lidar_link,
-                 "PATH: also serve an RPLIDAR A1 (docs/lidar.md) on a second pseudo-terminal, this path a symbolic link to it; "
+                 "PATH: also serve an RPLIDAR A1 (docs/lidar.md) on a second pseudo-terminal, this path a symbolic link to it "
+                 "(SIGUSR1 stops its motor, and starts it again); "
                  "it scans the same world");
   app.add_option("--pose-file", pose_file,
                  "FILE: start the robot at the pose in FILE (x_m y_m theta_rad) when it is there, and keep the robot's pose "
@@ -179,6 +185,7 @@ int run(int argc, char** argv) {
     }
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
+    std::signal(SIGUSR1, on_toggle_lidar_motor);
     if (tcp) {
       std::cout << "tripodal-board-sim: board on " << tcp->spec() << " (protocol " << config.protocol->summary() << ")" << std::endl;
     } else {
@@ -193,6 +200,10 @@ int run(int argc, char** argv) {
       next += std::chrono::milliseconds(1);
       clock.sleep_until(next);
       firmware.run_until(clock.now());
+      if (lidar && g_toggle_lidar_motor.exchange(false)) {
+        lidar->set_motor(!lidar->motor_on(), clock.now());
+        std::cout << "tripodal-board-sim: lidar motor " << (lidar->motor_on() ? "on" : "stopped") << " (SIGUSR1)" << std::endl;
+      }
       if (lidar) lidar->run_until(clock.now());
       if (!pose_file.empty() && clock.now() >= next_pose) {
         next_pose += std::chrono::milliseconds(100);

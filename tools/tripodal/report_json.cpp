@@ -55,6 +55,7 @@ std::string RunResult::json() const {
                        {"robot_steps", robot_steps},
                        {"base_at_rest", base_at_rest},
                        {"base_command_at_end_rad_s", base_command_at_end_rad_s}};
+  report["duration_clock"] = wall_clock ? "wall" : "simulated";  // devices on ttys: timed by the wall clock
   if (!loops.empty()) {
     const auto us = [&](Duration d) { return rounded(static_cast<double>(d.count()) / 1000.0, 1); };
     Json list = Json::array();

@@ -291,8 +291,8 @@ int run(Args& args, std::ostream& out, std::ostream& err) {
     out << "task " << r.state << (r.reason.empty() ? "" : ": " + r.reason) << "; ";
     if (r.reachable_cells > 0) out << "coverage " << r.coverage * 100.0 << " % of " << r.reachable_area_m2 << " m2 reachable; ";
     else out << "no cleaning in this task; ";
-    out << "path " << r.total.length_m << " m, " << r.total.turns << " turns; " << r.duration_s << " s simulated; "
-        << r.recoveries.size() << " recoveries\n";
+    out << "path " << r.total.length_m << " m, " << r.total.turns << " turns; " << r.duration_s
+        << (r.wall_clock ? " s wall clock; " : " s simulated; ") << r.recoveries.size() << " recoveries\n";
     if (!r.charging.empty()) out << r.charging << "\n";
     if (const auto& d = r.disinfection) {
       out << "disinfection: " << d->dose_coverage * 100.0 << " % of the reachable floor dosed >= " << d->uv_target_dose_j_m2

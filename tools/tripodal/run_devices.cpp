@@ -299,6 +299,7 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
   if (res.state.empty()) res.state = std::string(to_string(tr.state));
   if (res.reason.empty()) res.reason = tr.reason;
   res.duration_s = to_seconds(ended - task_start);
+  res.wall_clock = true;
   res.cleaned_cells = 0;
   for (std::size_t i = 0; i < reachable.size(); ++i) res.cleaned_cells += (reachable[i] != 0 && cleaned.mask()[i] != 0) ? 1 : 0;
   res.coverage =

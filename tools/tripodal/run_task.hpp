@@ -170,7 +170,8 @@ struct RunResult {
   std::string robot, task;
   std::string coverage_pattern;  ///< "hybrid", "balloon" or "boustrophedon"
   std::uint64_t seed = 0;
-  double duration_s = 0.0;      ///< simulated
+  double duration_s = 0.0;      ///< simulated, or wall-clock time when wall_clock
+  bool wall_clock = false;      ///< devices on ttys (run_devices): the run was timed by the wall clock
   double coverage = 0.0;        ///< of the reachable free area of the room, from the true path
   std::size_t reachable_cells = 0, cleaned_cells = 0;
   double reachable_area_m2 = 0.0;

@@ -27,7 +27,9 @@ struct BoardLinkReading {
   Time stamp{};
   bool synchronised = false;
   bool has_drive = false;
-  std::uint8_t buttons = 0;  ///< held, from the latest DRIVE response
+  std::uint8_t buttons = 0;       ///< held, from the latest DRIVE response
+  std::uint8_t drive_status = 0;  ///< the latest DRIVE response's status flags (kStatusUvLamp, ...)
+  Time drive_stamp{};             ///< when that response arrived
   bool has_battery = false;
   BatteryState battery{};
   bool has_tank = false;
@@ -36,6 +38,7 @@ struct BoardLinkReading {
   Time lost_at{};  ///< of the latest loss (stats.link_losses counts them)
   LinkStats stats{};
   std::uint64_t decoder_errors = 0;
+  std::size_t pending_actuator_commands = 0;  ///< actuator commands not yet acknowledged
 };
 
 /// What holds the robot's BoardHardware: the hardware itself, or a hardware that embeds one (the
