@@ -207,8 +207,9 @@ struct Dock {
   Pose2D pose;  ///< map_from_base of the robot docked
   double contact_radius_m = 0.1;
   double heading_tolerance_rad = 0.35;
-  bool powered = true;  ///< false: the charger gives no current
   SourceLocation where;
+  // Last, so that the positional initialisers written before it existed keep their meaning.
+  bool powered = true;  ///< false: the charger gives no current
 };
 
 /// Which simulated sensor a dead-sensor fault silences.
