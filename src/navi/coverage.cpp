@@ -368,5 +368,4 @@ CellIndex CoveragePlanner::start_cell(std::optional<Point2D> start) const noexce
   return {-1, -1};
 }
 
-
 }  // namespace tripodal::navi

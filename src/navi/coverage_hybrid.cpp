@@ -350,9 +350,7 @@ std::optional<double> CoveragePlanner::slanted_walls_rad(const std::vector<Round
   return angle;
 }
 
-
-CoverageResult CoveragePlanner::hybrid(const Section& section, std::optional<Point2D> start,
-                                       std::optional<Point2D> finish_near) {
+CoverageResult CoveragePlanner::hybrid(const Section& section, std::optional<Point2D> start, std::optional<Point2D> finish_near) {
   Workspace ws = prepare(section);
   if (ws.stand_cells_global.empty()) {
     CoverageResult r;
@@ -414,6 +412,5 @@ CoverageResult CoveragePlanner::hybrid(const Section& section, std::optional<Poi
   }
   return std::move(*best);
 }
-
 
 }  // namespace tripodal::navi

@@ -14,7 +14,7 @@ namespace tripodal::navi {
 
 // Per-section working data on a window around the section's bounding box.
 struct CoveragePlanner::Workspace {
-  int x0 = 0, y0 = 0, w = 0, h = 0;  // window in grid cells
+  int x0 = 0, y0 = 0, w = 0, h = 0;    // window in grid cells
   std::vector<float> offset;           // E, metres; -inf outside the section
   std::vector<std::uint8_t> stand;     // where the robot centre may be
   std::vector<std::size_t> reachable;  // global indices

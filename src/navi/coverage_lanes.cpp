@@ -19,7 +19,7 @@ CellIndex lane_cell(const CoveragePlanner::LaneFrame& f, int lane, int along) no
 
 // The runs of `mask` along the given lanes of the frame (on the axes: window rows or columns).
 std::vector<LaneRun> lane_runs(const std::vector<std::uint8_t>& mask, int w, int h, int x0, int y0,
-                                      const CoveragePlanner::LaneFrame& f, const std::vector<int>& lanes) {
+                               const CoveragePlanner::LaneFrame& f, const std::vector<int>& lanes) {
   std::vector<LaneRun> runs;
   // along positions that can fall in the window: the window's corners projected on the lanes
   double amin = std::numeric_limits<double>::infinity(), amax = -amin;
@@ -71,7 +71,6 @@ std::pair<int, int> lane_extent(const std::vector<std::uint8_t>& mask, int w, in
   return {static_cast<int>(std::lround(lo)), static_cast<int>(std::lround(hi))};
 }
 
-
 }  // namespace coverage_detail
 
 using coverage_detail::LaneRun;
@@ -122,8 +121,10 @@ CoverageResult CoveragePlanner::boustrophedon(const Section& section, std::optio
     it.done = true;
     const CellIndex from = flip ? it.b : it.a;
     const CellIndex to = flip ? it.a : it.b;
-    if (r.path.empty()) r.path.push_back(grid_.cell_center(from));
-    else link(r.path, cur, from);
+    if (r.path.empty())
+      r.path.push_back(grid_.cell_center(from));
+    else
+      link(r.path, cur, from);
     if (!(from == to)) r.path.push_back(grid_.cell_center(to));
     cur = to;
     ++r.passes;

@@ -12,8 +12,9 @@ namespace tripodal::navi {
 
 using coverage_detail::dist2;
 
-std::optional<std::vector<CoveragePlanner::RoundPiece>> CoveragePlanner::round_pieces(
-    Workspace& ws, const std::vector<std::uint8_t>& in_round, CellIndex cur) const {
+std::optional<std::vector<CoveragePlanner::RoundPiece>> CoveragePlanner::round_pieces(Workspace& ws,
+                                                                                      const std::vector<std::uint8_t>& in_round,
+                                                                                      CellIndex cur) const {
   const std::size_t n = ws.offset.size();
   std::vector<std::uint8_t> boundary(n, 0), used(n, 0), near(n, 0);
   std::vector<std::size_t> boundary_cells;
@@ -44,8 +45,8 @@ std::optional<std::vector<CoveragePlanner::RoundPiece>> CoveragePlanner::round_p
       const int lx = static_cast<int>(li % static_cast<std::size_t>(ws.w));
       const int ly = static_cast<int>(li / static_cast<std::size_t>(ws.w));
       const CellIndex g = ws.global(lx, ly);
-      const long long d = cur.x < 0 ? static_cast<long long>(li)
-                                    : 1LL * (g.x - cur.x) * (g.x - cur.x) + 1LL * (g.y - cur.y) * (g.y - cur.y);
+      const long long d =
+          cur.x < 0 ? static_cast<long long>(li) : 1LL * (g.x - cur.x) * (g.x - cur.x) + 1LL * (g.y - cur.y) * (g.y - cur.y);
       if (d < seed_d) {
         seed_d = d;
         seed = li;
@@ -115,8 +116,7 @@ void CoveragePlanner::walk_chain(const Workspace& ws, const std::vector<std::uin
   }
 }
 
-void CoveragePlanner::append_piece(CoverageResult& r, CellIndex& cur, const RoundPiece& piece,
-                                   std::optional<Point2D> start) {
+void CoveragePlanner::append_piece(CoverageResult& r, CellIndex& cur, const RoundPiece& piece, std::optional<Point2D> start) {
   const CellIndex first = piece.cells.front();
   std::vector<Point2D> pts;
   for (const CellIndex& c : piece.cells) pts.push_back(grid_.cell_center(c));
@@ -184,7 +184,7 @@ void CoveragePlanner::join_pieces(std::vector<RoundPiece>& pieces) {
   // round_pieces breaks a chain where it would turn by more than a right angle, so the round
   // around a box comes as its four sides. Ends a few cells apart with a clear line between them
   // are one walk: sides joined at the corners, and a chain whose ends meet is closed.
-  constexpr int kGap = 6;  // cells, Chebyshev: around the corner of a box, a quarter of a pillar
+  constexpr int kGap = 6;          // cells, Chebyshev: around the corner of a box, a quarter of a pillar
   std::vector<CellIndex> between;  // the cells that join two ends, when they are near
   const auto near = [&](CellIndex a, CellIndex b) {
     between.clear();
@@ -328,6 +328,5 @@ void CoveragePlanner::append_from(CoverageResult& r, CellIndex& cur, const Round
   std::rotate(rotated.cells.begin(), rotated.cells.begin() + static_cast<std::ptrdiff_t>(entry), rotated.cells.end());
   append_piece(r, cur, rotated, start);
 }
-
 
 }  // namespace tripodal::navi

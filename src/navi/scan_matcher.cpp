@@ -454,7 +454,8 @@ ScanMatch ScanMatcher::match(const Pose2D& predicted, double search_xy_m, double
     for (int dy = by - kCovarianceReach; dy <= by + kCovarianceReach; ++dy) {
       row_sums<kReachCells>(cx, cy, n, bx - kCovarianceReach, dy, row.data());
       for (int dx = bx - kCovarianceReach; dx <= bx + kCovarianceReach; ++dx) {
-        const float score = row[static_cast<std::size_t>(dx - bx + kCovarianceReach)];
+        const int column = dx - bx + kCovarianceReach;  // 0 .. kReachCells - 1
+        const float score = row[static_cast<std::size_t>(column)];
         const double w = std::exp((score - best) * inv_n / kQualityScale);
         if (w < 1e-6) continue;
         const double vx = (dx - bx) * cell_m_, vy = (dy - by) * cell_m_, vt = (k - bk) * step;

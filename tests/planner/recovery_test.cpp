@@ -152,7 +152,8 @@ TEST_CASE("every shipped recovery rule matches a fault a shipped net posts, and 
                                      {"PrGlobalLocalization", &global}, {"PrWait", &wait},
                                      {"PrBackOff", &back_off},          {"PrDisinfection", &disinfection},
                                      {"PrDockCharge", &dock},           {"PrBoardReconnect", &reconnect}};
-  for (const char* file : {"recovery.yaml", "jinny_recovery.yaml", "disinfection_recovery.yaml", "disinfection_devices_recovery.yaml"}) {
+  for (const char* file :
+       {"recovery.yaml", "jinny_recovery.yaml", "disinfection_recovery.yaml", "disinfection_devices_recovery.yaml"}) {
     INFO(file);
     Diagnostics d;
     check_recovery_rules(RecoveryPolicy::load(std::string(TRIPODAL_SOURCE_DIR "/configs/tasks/") + file), nets, d);

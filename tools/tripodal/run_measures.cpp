@@ -111,7 +111,8 @@ std::string step_text(const ProcessStep& s) {
 }
 
 DisinfectionFigures disinfection_figures(sim::SimBoardHardware& hw, const std::vector<char>& reachable,
-                                         const std::vector<char>& lamp_floor, const navi::OccupancyGrid& grid, double target_j_m2) {
+                                         const std::vector<char>& lamp_floor, const navi::OccupancyGrid& grid,
+                                         double target_j_m2) {
   DisinfectionFigures f;
   board::EmbeddedBoard& b = hw.embedded();
   const std::filesystem::path device = b.device();

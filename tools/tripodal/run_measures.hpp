@@ -68,7 +68,8 @@ class ReportObserver final : public TaskObserver {
 // The dose of each reachable cell (the dose map is on the world's grid, the reachable cells on the
 // robot's map: matched by the cell centre), the tank, and both sides of the link.
 DisinfectionFigures disinfection_figures(sim::SimBoardHardware& hw, const std::vector<char>& reachable,
-                                         const std::vector<char>& lamp_floor, const navi::OccupancyGrid& grid, double target_j_m2);
+                                         const std::vector<char>& lamp_floor, const navi::OccupancyGrid& grid,
+                                         double target_j_m2);
 
 // The sections the current plan of `planner` names (its steps' `section` parameters), in order.
 std::vector<std::string> plan_sections(const CPlanner& planner);

@@ -243,8 +243,8 @@ void check_same_lamp(const Navigation& nav, const sim::SimBoardHardware* board_h
 
 // Why a dose-planned disinfection cannot be done (the battery down to the board monitor's low
 // threshold, or the time limit, cannot carry its estimate `est`); "" when it can. Logs the plan.
-std::string dose_refusal(const RunOptions& o, const RobotProfile& profile, const sim::World& world, const board::BoardFirmware& fw,
-                         const navi::DosePlan& plan, const DoseEstimate& est) {
+std::string dose_refusal(const RunOptions& o, const RobotProfile& profile, const sim::World& world,
+                         const board::BoardFirmware& fw, const navi::DosePlan& plan, const DoseEstimate& est) {
   double low_percent = 15.0;
   for (const ModuleEntry& e : profile.modules) {
     if (e.type != "BoardMonitor") continue;
@@ -722,8 +722,7 @@ void TaskRun::measure(Time ended) {
   }
   res_.sections = section_figures(nav_, room_sections_);
   if (board_hw_ != nullptr) {
-    res_.disinfection =
-        disinfection_figures(*board_hw_, reachable_, lamp_floor_, nav_.maps->grid(), target_dose_j_m2_);
+    res_.disinfection = disinfection_figures(*board_hw_, reachable_, lamp_floor_, nav_.maps->grid(), target_dose_j_m2_);
     if (dose_plan_) {
       res_.disinfection->plan = *dose_plan_;
       res_.disinfection->estimate_s = res_.dose_estimate_s;

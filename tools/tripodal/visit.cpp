@@ -6,11 +6,10 @@
 #include <deque>
 #include <fstream>
 #include <iomanip>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <ostream>
 #include <sstream>
-
-#include <nlohmann/json.hpp>
 
 #include "guide_hri.hpp"
 #include "run_outputs.hpp"
@@ -18,8 +17,8 @@
 #include "shutdown.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/hri/hri_module.hpp"
-#include "tripodal/monitor/robot_monitor.hpp"
 #include "tripodal/hri/speech.hpp"
+#include "tripodal/monitor/robot_monitor.hpp"
 #include "tripodal/planner/lifecycle_recorder.hpp"
 #include "tripodal/planner/task_library.hpp"
 #include "tripodal/robot/robot.hpp"
@@ -437,7 +436,9 @@ void GuidedVisit::drive() {
       if (!watch_) break;
     }
     robot_->run_for(kPeriod);
-    if (live_) live_->step(to_seconds(kPeriod), [this](const std::string& line) { say(line); }, res_.exchanges, to_seconds(clock_.now()));
+    if (live_)
+      live_->step(
+          to_seconds(kPeriod), [this](const std::string& line) { say(line); }, res_.exchanges, to_seconds(clock_.now()));
     watch_visitors();
     flush_life();
     display();
