@@ -122,27 +122,27 @@ TEST_CASE("dds: one world for three robots: each sees the others, is stopped by 
                       "/tmp/" + test_namespace() + "_shared_server.log");
   ParticipantOptions po = test_options(45);
   Participant p(po);
-  // The workspace's start pose is (0.8, 0.8, 0): robot1 there, robot2 0.9 m to its left (+y),
-  // robot3 0.9 m ahead (+x) (fleet_start_poses, spacing 2 x 0.25 + 0.4 m).
+  // The workspace's start pose is (0.8, 0.8, 0): robot1 there, robot2 1.6 m to its left (+y),
+  // robot3 1.6 m ahead (+x) (fleet_starts: spacing 2 x 0.25 + kFleetStartGap_m, 1.1 m).
   Client r1(p, prefix + "1");
   Client r2(p, prefix + "2");
   // Two laser periods (5.5 Hz): the first scan was taken as the body was placed.
   for (int k = 0; k < 40; ++k) step_round({&r1, &r2});
   const double left = std::numbers::pi / 2;
-  CHECK(r1.range_at(left) == Approx(0.9 - 0.25).margin(0.05));
-  CHECK(r2.range_at(-left) == Approx(0.9 - 0.25).margin(0.05));
+  CHECK(r1.range_at(left) == Approx(1.6 - 0.25).margin(0.05));
+  CHECK(r2.range_at(-left) == Approx(1.6 - 0.25).margin(0.05));
   // Nothing ahead of robot1 yet: robot3 has not come.
   const double ahead_alone = r1.range_at(0.0);
-  CHECK(ahead_alone > 1.0);
+  CHECK(ahead_alone > 2.0);
 
   SECTION("a robot that joins is seen, one that drives into another is stopped, one that leaves is gone") {
     Client r3(p, prefix + "3");
     for (int k = 0; k < 40; ++k) step_round({&r1, &r2, &r3});
-    CHECK(r1.range_at(0.0) == Approx(0.9 - 0.25).margin(0.05));
-    CHECK(r3.range_at(std::numbers::pi) == Approx(0.9 - 0.25).margin(0.05));
+    CHECK(r1.range_at(0.0) == Approx(1.6 - 0.25).margin(0.05));
+    CHECK(r3.range_at(std::numbers::pi) == Approx(1.6 - 0.25).margin(0.05));
 
-    // robot1 drives at robot3 (+x, 0.3 m/s for 3 s): it stops against it, one contact.
-    for (int k = 0; k < 300; ++k) step_round({&r1, &r2, &r3}, {{&r1, {0.3, 0.0}}});
+    // robot1 drives at robot3 (+x, 0.3 m/s for 5 s, 1.1 m between them): it stops against it, one contact.
+    for (int k = 0; k < 500; ++k) step_round({&r1, &r2, &r3}, {{&r1, {0.3, 0.0}}});
     r1.ask();
     const msg::SimState s1 = r1.answer();
     r2.ask();
@@ -157,14 +157,14 @@ TEST_CASE("dds: one world for three robots: each sees the others, is stopped by 
     r2.leave();
     std::this_thread::sleep_for(500ms);  // its departure reaches the server
     for (int k = 0; k < 40; ++k) step_round({&r1, &r3});
-    CHECK(r1.range_at(left) > 1.0);
+    CHECK(r1.range_at(left) > 2.0);
 
     r1.leave();
     r3.leave();
     REQUIRE(server.wait(15s) == 0);
     const std::string out = server.output();
     INFO(out);
-    CHECK(out.find(prefix + "3 joined at (1.70, 0.80)") != std::string::npos);
+    CHECK(out.find(prefix + "3 joined at (2.40, 0.80)") != std::string::npos);
     CHECK(std::regex_search(out, std::regex(prefix + "2 left.*0 collisions")));
     CHECK(out.find("simulator: collision with robot 3") != std::string::npos);
     CHECK(out.find("sim-server ended: every robot left") != std::string::npos);

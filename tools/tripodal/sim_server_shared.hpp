@@ -13,6 +13,7 @@ namespace tripodal::tool {
 
 struct SharedWorldArgs {
   std::filesystem::path robot, world;
+  std::filesystem::path fleet;   ///< a fleet file (fleet_file.hpp): its robots instead of `robots` x `robot`
   int robots = 2;                ///< slots robot1..robotN (namespaces `prefix`1..N)
   std::string prefix = "robot";  ///< namespace of robot k: prefix + k
   unsigned domain = 0;
