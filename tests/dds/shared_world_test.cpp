@@ -1,7 +1,8 @@
 // `tripodal sim-server --robots N`: one world stepped for several lock-step robots. The server is a
 // process of its own; this test is its robots (one set of lock-step endpoints per robot, as the
 // hardware "dds" has), and checks that each sees the others in its laser, is stopped by them, and
-// that robots join and leave while the others run.
+// that robots join and leave while the others run; and that a robot on the hardware dds has the
+// simulator's other sensors (gyro, bumpers, cliff, battery) through the server.
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <cmath>
@@ -18,9 +19,13 @@
 
 #include "child_process.hpp"
 #include "dds_test_support.hpp"
+#include "tripodal/builtin/register_all.hpp"
+#include "tripodal/controllers/base_kinematics.hpp"
 #include "tripodal/dds/dds_hardware.hpp"
 #include "tripodal/dds/endpoint.hpp"
 #include "tripodal/dds/qos.hpp"
+#include "tripodal/robot/robot.hpp"
+#include "tripodal/robot/robot_profile.hpp"
 
 using namespace tripodal::dds;
 using namespace tripodal::dds::test;
@@ -170,4 +175,96 @@ TEST_CASE("dds: one world for three robots: each sees the others, is stopped by 
     CHECK(out.find("sim-server ended: every robot left") != std::string::npos);
     CHECK(out.find("robot-robot contacts: 1;") != std::string::npos);
   }
+}
+
+TEST_CASE("dds: a robot on hardware dds has the simulator's gyro, bumpers, cliff and battery: its bumpers feel another robot",
+          "[dds][sim_server][shared_world]") {
+  const std::string prefix = test_namespace() + "_s";
+  const std::uint32_t domain = test_domain(46);
+  ChildProcess server(kTool,
+                      {"sim-server", "--robot", kRobot, "--world", kWorld, "--robots", "2", "--namespace", prefix, "--domain",
+                       std::to_string(domain), "--wait-s", "60", "--lease-s", "1"},
+                      "/tmp/" + test_namespace() + "_sensors_server.log");
+  const auto base =
+      tripodal::base_controller_config(tripodal::load_robot_profile(kRobot), tripodal::builtin_plugins().controllers);
+  REQUIRE(base.has_value());
+  tripodal::HardwareRegistry registry{"hardware type"};
+  register_dds_hardware(registry);
+  tripodal::HardwareConfig config;
+  config.type = "dds";
+  config.where = tripodal::SourceLocation{"robot.yaml", 12, 3};
+  config.base = &*base;
+  config.parameters = tripodal::ParameterSet::resolve(DdsHardware::static_manifest(),
+                                                      {{"namespace", tripodal::Value{prefix + "1"}},
+                                                       {"domain_id", tripodal::Value{static_cast<double>(domain)}},
+                                                       {"sensors", tripodal::Value{std::string("gyro, bumpers,cliff,battery")}}},
+                                                      config.where);
+  auto hw = registry.create_at(config.where, "dds", config);
+  tripodal::ResourceTable table;
+  hw->add_resources(table);
+  const auto* gyro = table.find<tripodal::GyroReading>("gyro");
+  const auto* bumpers = table.find<tripodal::BumperReading>("bumpers");
+  const auto* cliff = table.find<tripodal::InfraredReading>("cliff");
+  const auto* battery = table.find<tripodal::BatteryReading>("battery");
+  REQUIRE(gyro != nullptr);
+  REQUIRE(bumpers != nullptr);
+  REQUIRE(cliff != nullptr);
+  REQUIRE(battery != nullptr);
+
+  ParticipantOptions po;
+  po.domain_id = domain;  // the hardware's participant options: one Cyclone domain per process and id
+  Participant p(po);
+  Client r2(p, prefix + "2");  // 1.6 m to the left (+y) of robot 1, standing still
+  tripodal::BaseKinematics kinematics(*base);
+  std::vector<double> wheels(kinematics.wheel_count(), 0.0);
+  std::vector<double> velocity(wheels.size()), position(wheels.size());
+  const tripodal::Time t0{};
+  // One lock-step period: robot 2 asks, robot 1 (the hardware) advances, robot 2 takes its answer.
+  auto step = [&](int k) {
+    r2.ask();
+    hw->advance_to(t0 + std::chrono::milliseconds(10 * k));
+    (void)r2.answer();
+    REQUIRE(hw->wheels().read_wheel_states(velocity, position));
+  };
+  for (int k = 1; k <= 20; ++k) step(k);
+  REQUIRE(battery->has_reading());
+  const double charge_at_start = battery->latest().percentage;
+  CHECK(charge_at_start > 0.9);
+  CHECK_FALSE(battery->latest().charging);
+  CHECK(gyro->has_reading());
+  CHECK(std::abs(gyro->latest().yaw_rate_rad_s) < 0.02);  // standing still: the gyro's noise only
+  CHECK(bumpers->latest().count == 4);                    // the workspace's PSR-2: 4 sectors
+  CHECK(bumpers->latest().pressed_mask == 0);
+  CHECK(cliff->latest().cliff == std::vector<std::uint8_t>{0, 0, 0});  // three sensors over the floor
+
+  // Robot 1 drives left at 0.3 m/s into robot 2 (1.1 m between them): its bumpers press.
+  kinematics.inverse(tripodal::Twist2D{0.0, 0.3, 0.0}, wheels);
+  bool pressed = false;
+  for (int k = 21; k <= 600 && !pressed; ++k) {
+    REQUIRE(hw->wheels().write_wheel_velocities(wheels));
+    step(k);
+    pressed = bumpers->latest().pressed_mask != 0;
+  }
+  CHECK(pressed);
+  CHECK(battery->latest().percentage < charge_at_start);  // driving drained it
+  CHECK(gyro->latest().stamp > t0);
+  auto& dds_hw = dynamic_cast<DdsHardware&>(*hw);
+  CHECK(dds_hw.link_up());
+  REQUIRE(dds_hw.truth().has_value());
+  CHECK(dds_hw.truth()->map_from_base.y_m > 1.8);  // stopped against robot 2 at (0.8, 2.4), 0.5 m centre to centre
+}
+
+TEST_CASE("dds: hardware dds refuses an unknown sensor, at the profile's hardware entry", "[dds][sim_server]") {
+  const auto base =
+      tripodal::base_controller_config(tripodal::load_robot_profile(kRobot), tripodal::builtin_plugins().controllers);
+  REQUIRE(base.has_value());
+  tripodal::HardwareConfig config;
+  config.type = "dds";
+  config.where = tripodal::SourceLocation{"robot.yaml", 12, 3};
+  config.base = &*base;
+  config.parameters = tripodal::ParameterSet::resolve(DdsHardware::static_manifest(),
+                                                      {{"sensors", tripodal::Value{std::string("gyro,sonar")}}}, config.where);
+  CHECK_THROWS_WITH(DdsHardware(config),
+                    Catch::Contains("robot.yaml:12:3: error: hardware 'dds' sensors: unknown sensor 'sonar'; "
+                                    "expected some of gyro, bumpers, cliff, battery"));
 }

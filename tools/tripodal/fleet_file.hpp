@@ -42,8 +42,8 @@ struct FleetMember {
 [[nodiscard]] std::vector<Pose2D> fleet_starts(const sim::World& world, const std::vector<FleetMember>& members);
 
 /// The gap between two robots' bodies at the start: wide enough that a robot's laser still sees
-/// the walls past the robots around it (with 0.4 m, eight PSR-2s in a 3 x 3 block each lost the
-/// map within 11 s; docs/distribution.md).
+/// the walls past the robots around it (with 0.4 m, five to eight of eight PSR-2s in a 3 x 3 block
+/// lost the map 10.9 s into their sections; docs/distribution.md, "Eight robots in one world").
 inline constexpr double kFleetStartGap_m = 1.1;
 
 /// The members as a fleet file, their start poses given (what `tripodal fleet` hands its

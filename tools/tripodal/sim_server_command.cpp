@@ -249,9 +249,17 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
       ++joint_states;
       last_step = step;
       const Pose2D& p = sim.pose();
-      state.publish(dds::msg::SimState{dds::ros_time(sim.now()), p.x_m, p.y_m, p.theta_rad, sim.distance_m(),
-                                       last_step, scans, joint_states,
-                                       static_cast<std::uint32_t>(sim.collisions())});
+      dds::msg::SimState answer{dds::ros_time(sim.now()),
+                                p.x_m,
+                                p.y_m,
+                                p.theta_rad,
+                                sim.distance_m(),
+                                last_step,
+                                scans,
+                                joint_states,
+                                static_cast<std::uint32_t>(sim.collisions())};
+      put_sensors(answer, sim);
+      state.publish(answer);
       if (clock) clock->publish(dds::msg::Clock{dds::ros_time(sim.now())});
     };
     // Lock-step: the command over the step, the world advanced to its end, then what it gave.

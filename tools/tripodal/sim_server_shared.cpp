@@ -84,6 +84,33 @@ struct Slot {
 
 }  // namespace
 
+void put_sensors(dds::msg::SimState& state, sim::Simulator& sim) {
+  const sim::SimRobotConfig& rc = sim.world().robot;
+  state.sensors = 0;
+  if (rc.gyro.enabled && sim.gyro().has_reading()) {
+    state.sensors |= dds::msg::kSimGyro;
+    state.gyro_yaw_rate = sim.gyro().latest().yaw_rate_rad_s;
+    state.gyro_yaw = sim.gyro().latest().yaw_rad;
+  }
+  if (rc.bumpers.enabled && sim.bumpers().has_reading()) {
+    state.sensors |= dds::msg::kSimBumpers;
+    state.bumpers_pressed = sim.bumpers().latest().pressed_mask;
+    state.bumper_count = sim.bumpers().latest().count;
+  }
+  if (rc.cliff.enabled && sim.cliff().has_reading()) {
+    state.sensors |= dds::msg::kSimCliff;
+    state.cliff = sim.cliff().latest().cliff;
+  }
+  if (rc.battery.enabled && sim.battery().has_reading()) {
+    state.sensors |= dds::msg::kSimBattery;
+    const BatteryReading& b = sim.battery().latest();
+    state.battery_voltage = b.voltage_v;
+    state.battery_current = b.current_a;
+    state.battery_percentage = b.percentage;
+    state.battery_charging = b.charging;
+  }
+}
+
 int run_shared_world(const SharedWorldArgs& a, std::ostream& out, std::ostream& err) {
   for (const auto& f : {a.fleet.empty() ? a.robot : a.fleet, a.world}) {
     std::error_code ec;
@@ -266,8 +293,17 @@ int run_shared_world(const SharedWorldArgs& a, std::ostream& out, std::ostream& 
       s.last_step = step.step;
       ++s.steps_served;
       const Pose2D& p = sim.pose();
-      s.state->publish(dds::msg::SimState{dds::ros_time(sim.now()), p.x_m, p.y_m, p.theta_rad, sim.distance_m(), s.last_step,
-                                          s.scans, s.joint_states, static_cast<std::uint32_t>(sim.collisions())});
+      dds::msg::SimState state{dds::ros_time(sim.now()),
+                               p.x_m,
+                               p.y_m,
+                               p.theta_rad,
+                               sim.distance_m(),
+                               s.last_step,
+                               s.scans,
+                               s.joint_states,
+                               static_cast<std::uint32_t>(sim.collisions())};
+      put_sensors(state, sim);
+      s.state->publish(state);
       s.expected = true;
     };
 
