@@ -530,6 +530,7 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
         argv.insert(argv.end(), {"--hardware", "dds", "--hardware-param", "namespace=" + m.ns, "--hardware-param",
                                  "domain_id=" + std::to_string(sim_domain), "--hardware-param",
                                  "loopback=" + std::string(a.sim_loopback ? "true" : "false")});
+        if (!m.sensors.empty()) argv.insert(argv.end(), {"--hardware-param", "sensors=" + m.sensors});
       }
       children.spawn(r.name, argv, dir / (r.name + ".log"), a.launcher);
     }

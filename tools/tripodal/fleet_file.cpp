@@ -33,7 +33,7 @@ std::vector<FleetMember> load_fleet_file(const std::filesystem::path& file) {
     for (std::size_t i = 0; i < robots.size(); ++i) {
       const YAML::Node e = robots[i];
       const std::string what = "robots[" + std::to_string(i) + "]";
-      if (!r.expect_map(e, what) || !r.expect_keys(e, {"name", "profile", "namespace", "start_pose"}, what)) continue;
+      if (!r.expect_map(e, what) || !r.expect_keys(e, {"name", "profile", "namespace", "start_pose", "sensors"}, what)) continue;
       FleetMember m;
       m.where = r.at(e);
       bool twice = false;  // its name's namespace then clashes too: said once
@@ -79,6 +79,16 @@ std::vector<FleetMember> load_fleet_file(const std::filesystem::path& file) {
           }
         }
       }
+      if (const YAML::Node s = e["sensors"]) {
+        if (const auto v = r.names(s, what + ".sensors")) {
+          for (const std::string& sensor : *v) {
+            if (sensor != "gyro" && sensor != "bumpers" && sensor != "cliff" && sensor != "battery") {
+              r.error(s, what + ".sensors: unknown sensor '" + sensor + "'; expected some of gyro, bumpers, cliff, battery");
+            }
+            m.sensors += (m.sensors.empty() ? "" : ",") + sensor;
+          }
+        }
+      }
       if (const YAML::Node s = e["start_pose"]) {
         if (const auto v = r.numbers(s, what + ".start_pose", 3, 3, "[x_m, y_m, theta_rad]")) {
           m.start = Pose2D{(*v)[0], (*v)[1], (*v)[2]};
@@ -95,7 +105,7 @@ std::vector<FleetMember> numbered_fleet(int n, const std::filesystem::path& prof
   std::vector<FleetMember> out;
   for (int k = 1; k <= n; ++k) {
     const std::string name = prefix + std::to_string(k);
-    out.push_back({name, name, profile, std::nullopt, SourceLocation{"--robots", 1, 1}});
+    out.push_back({name, name, profile, std::nullopt, {}, SourceLocation{"--robots", 1, 1}});
   }
   return out;
 }
@@ -150,6 +160,7 @@ std::string fleet_file_text(const std::vector<FleetMember>& members, const std::
     e["name"] = members[i].name;
     e["namespace"] = members[i].ns;
     e["profile"] = std::filesystem::absolute(members[i].profile).string();
+    if (!members[i].sensors.empty()) e["sensors"] = YAML::Load("[" + members[i].sensors + "]");
     YAML::Node pose(YAML::NodeType::Sequence);
     pose.SetStyle(YAML::EmitterStyle::Flow);
     pose.push_back(starts.at(i).x_m);

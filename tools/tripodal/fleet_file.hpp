@@ -24,12 +24,14 @@ struct FleetMember {
   std::string ns;                 ///< its DDS namespace (default: the name), unique
   std::filesystem::path profile;  ///< absolute
   std::optional<Pose2D> start;    ///< where its body starts in a shared world (default: fleet_start_poses)
+  std::string sensors;            ///< in a shared world, the hardware dds's sensors ("gyro,bumpers"; default none)
   SourceLocation where;           ///< the file's entry, for errors found later (a start pose not free)
 };
 
 /// The robots a fleet file names, in its order. Every problem of the file (not a list, unknown
 /// keys, a name or namespace given twice or not a ROS 2 name, a profile that cannot be read, a
-/// start pose that is not three numbers) is a ConfigError located at FILE:LINE:COL, all at once.
+/// start pose that is not three numbers, a sensor the hardware dds does not know) is a ConfigError located at FILE:LINE:COL, all
+/// at once.
 [[nodiscard]] std::vector<FleetMember> load_fleet_file(const std::filesystem::path& file);
 
 /// `n` robots robot1..robotN (namespace prefix + k) of one profile, no start pose of their own.
