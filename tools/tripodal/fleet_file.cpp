@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "../../src/common/yaml_reader.hpp"
+#include "run_outputs.hpp"
 #include "tripodal/robot/robot_profile.hpp"
 #include "tripodal/sim/ray_caster.hpp"
 #include "tripodal/sim/simulator.hpp"
@@ -118,21 +119,28 @@ std::vector<Pose2D> fleet_starts(const sim::World& world, const std::vector<Flee
   for (const FleetMember& m : members) {
     if (!m.start) continue;
     if (solid.disc_overlaps({m.start->x_m, m.start->y_m}, r)) {
-      d.error(m.where, "robot '" + m.name + "': its start pose (" + std::to_string(m.start->x_m) + ", " +
-                           std::to_string(m.start->y_m) + ") is not free floor of " + world.file.string() +
-                           " for a body of radius " + std::to_string(r) + " m");
+      d.error(m.where, "robot '" + m.name + "': its start pose (" + app::fixed(m.start->x_m, 2) + ", " +
+                           app::fixed(m.start->y_m, 2) + ") is not free floor of " + world.file.string() +
+                           " for a body of radius " + app::fixed(r, 2) + " m");
     }
     for (const FleetMember* o : given) {
       if (std::hypot(o->start->x_m - m.start->x_m, o->start->y_m - m.start->y_m) < 2.0 * r + 0.1) {
-        d.error(m.where, "robot '" + m.name + "' starts within " + std::to_string(2.0 * r + 0.1) + " m of robot '" + o->name +
-                             "' (bodies of radius " + std::to_string(r) + " m)");
+        d.error(m.where, "robot '" + m.name + "' starts within " + app::fixed(2.0 * r + 0.1, 2) + " m of robot '" + o->name +
+                             "' (bodies of radius " + app::fixed(r, 2) + " m)");
       }
     }
     given.push_back(&m);
   }
   if (d.has_errors()) throw ConfigError(std::move(d));
-  // The grid's places, nearest the world's start pose first, minus those a given pose takes.
-  std::vector<Pose2D> grid = sim::fleet_start_poses(world, members.size() + given.size(), kFleetStartGap_m);
+  // The grid's places, nearest the world's start pose first, minus those a given pose takes (up
+  // to four each: those closer to it than the grid's spacing).
+  const std::size_t wanted = members.size() - given.size();
+  std::vector<Pose2D> grid;
+  try {
+    grid = sim::fleet_start_poses(world, wanted + 4 * given.size(), kFleetStartGap_m);
+  } catch (const ConfigError&) {
+    grid = sim::fleet_start_poses(world, wanted, kFleetStartGap_m);  // throws "no room for N robots"
+  }
   std::vector<Pose2D> out;
   std::size_t next = 0;
   for (const FleetMember& m : members) {
@@ -141,9 +149,13 @@ std::vector<Pose2D> fleet_starts(const sim::World& world, const std::vector<Flee
       continue;
     }
     for (;; ++next) {
-      const Pose2D& p = grid.at(next);
+      if (next >= grid.size()) {
+        throw ConfigError(m.where, "robot '" + m.name + "': no free place left for it around the start pose of " +
+                                       world.file.string() + " beside the start poses given; give it one");
+      }
+      const Pose2D& p = grid[next];
       const bool taken = std::any_of(given.begin(), given.end(), [&](const FleetMember* g) {
-        return std::hypot(g->start->x_m - p.x_m, g->start->y_m - p.y_m) < 2.0 * r + kFleetStartGap_m;
+        return std::hypot(g->start->x_m - p.x_m, g->start->y_m - p.y_m) < 2.0 * r + kFleetStartGap_m - 1e-6;
       });
       if (!taken) break;
     }
