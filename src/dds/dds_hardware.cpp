@@ -1,7 +1,9 @@
 // The hardware type "dds": a base and its laser behind DDS, in lock-step with a simulator or not.
 #include "tripodal/dds/dds_hardware.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <utility>
 
 #include "tripodal/robot/robot_profile.hpp"
@@ -22,20 +24,20 @@ const ModuleManifest& DdsHardware::static_manifest() {
       "a base and its laser behind DDS (ROS 2 topics cmd_vel, joint_states, scan): tripodal sim-server or a "
       "base driver",
       {"laser_scan"},
-      {parameter::text("namespace", "",
-                       "ROS 2 namespace of the base's topics (the sim-server's --namespace); empty: none"),
+      {parameter::text("namespace", "", "ROS 2 namespace of the base's topics (the sim-server's --namespace); empty: none"),
        parameter::number("domain_id", 0.0, "", "DDS domain (ROS_DOMAIN_ID)", 0.0, 232.0),
-       parameter::flag("loopback", true,
-                       "stay on 127.0.0.1 (false: Cyclone DDS's own network configuration)"),
+       parameter::flag("loopback", true, "stay on 127.0.0.1 (false: Cyclone DDS's own network configuration)"),
        parameter::flag("lock_step", true,
                        "the base is a simulator (tripodal sim-server) that advances with the robot's clock; "
                        "false: a real "
                        "base on its own time"),
-       parameter::number("step_timeout_s", 5.0, "s",
-                         "lock-step: the longest wait for the simulator's answer (wall time)", 0.001, 3600.0),
-       parameter::number("connect_timeout_s", 10.0, "s",
-                         "lock-step: the longest wait for the simulator at the start (wall time)", 0.001,
-                         3600.0)});
+       parameter::number("step_timeout_s", 5.0, "s", "lock-step: the longest wait for the simulator's answer (wall time)", 0.001,
+                         3600.0),
+       parameter::number("connect_timeout_s", 10.0, "s", "lock-step: the longest wait for the simulator at the start (wall time)",
+                         0.001, 3600.0),
+       parameter::text("sensors", "",
+                       "the simulator's sensors the robot has besides the laser, comma-separated: gyro, bumpers, "
+                       "cliff, battery (resources of those names; empty: none)")});
   return m;
 }
 
@@ -46,6 +48,15 @@ const ControllerConfig& base_of(const HardwareConfig& c) {
   Diagnostics d;
   if (c.base == nullptr)
     d.error(c.where, "hardware '" + c.type + "' needs the robot's base controller (its wheel geometry)");
+  std::string sensors = c.parameters.string("sensors");
+  std::replace(sensors.begin(), sensors.end(), ',', ' ');
+  std::istringstream words(sensors);
+  for (std::string w; words >> w;) {
+    if (w != "gyro" && w != "bumpers" && w != "cliff" && w != "battery") {
+      d.error(c.where,
+              "hardware '" + c.type + "' sensors: unknown sensor '" + w + "'; expected some of gyro, bumpers, cliff, battery");
+    }
+  }
   const std::string& ns = c.parameters.string("namespace");
   if (!is_ros_namespace(ns)) {
     d.error(c.where, "hardware '" + c.type + "' namespace '" + ns +
@@ -89,6 +100,17 @@ DdsHardware::DdsHardware(const HardwareConfig& config)
     cv_.notify_all();
   };
   laser_ = std::make_unique<DdsLaserResource>("laser", std::move(lo));
+  const std::string& sensors = config.parameters.string("sensors");
+  const auto named = [&](std::string_view n) {
+    std::string padded = "," + sensors + ",";
+    padded.erase(std::remove(padded.begin(), padded.end(), ' '), padded.end());
+    return padded.find("," + std::string(n) + ",") != std::string::npos;
+  };
+  const Duration sensor_age = std::chrono::milliseconds(500);  // as the laser's
+  if (named("gyro")) gyro_ = std::make_unique<GyroResource>("gyro", sensor_age);
+  if (named("bumpers")) bumpers_ = std::make_unique<BumperResource>("bumpers", sensor_age);
+  if (named("cliff")) cliff_ = std::make_unique<InfraredResource>("cliff", sensor_age);
+  if (named("battery")) battery_ = std::make_unique<BatteryResource>("battery", sensor_age);
 
   // A simulator (or base driver) that goes away is the hardware's fault.
   auto on_status = [this](const StatusEvent& e) {
@@ -147,6 +169,48 @@ DdsHardware::~DdsHardware() {
 
 void DdsHardware::on_add_resources(ResourceTable& table) {
   table.add(*laser_);
+  if (gyro_) table.add(*gyro_);
+  if (bumpers_) table.add(*bumpers_);
+  if (cliff_) table.add(*cliff_);
+  if (battery_) table.add(*battery_);
+}
+
+// The answer's sensors into the resources the profile asked for; one the simulator's world does
+// not give is the hardware's fault (a profile that counts on bumpers must not run without them).
+void DdsHardware::take_sensors(const msg::SimState& s) {
+  const Time t = tripodal_time(s.stamp);
+  const auto missing = [&](const char* name) {
+    fail(std::string("the simulator gives no ") + name + " (its world has none); the hardware's sensors parameter names it");
+  };
+  if (gyro_) {
+    if ((s.sensors & msg::kSimGyro) == 0) return missing("gyro");
+    GyroReading& r = gyro_->edit();
+    r.stamp = t;
+    r.yaw_rate_rad_s = s.gyro_yaw_rate;
+    r.yaw_rad = s.gyro_yaw;
+    gyro_->commit();
+  }
+  if (bumpers_) {
+    if ((s.sensors & msg::kSimBumpers) == 0) return missing("bumpers");
+    BumperReading& r = bumpers_->edit();
+    r.stamp = t;
+    r.count = s.bumper_count;
+    r.pressed_mask = s.bumpers_pressed;
+    bumpers_->commit();
+  }
+  if (cliff_) {
+    if ((s.sensors & msg::kSimCliff) == 0) return missing("cliff sensors");
+    InfraredReading& r = cliff_->edit();
+    r.stamp = t;
+    r.cliff.assign(s.cliff.begin(), s.cliff.end());  // within the capacity after the first step
+    cliff_->commit();
+  }
+  if (battery_) {
+    if ((s.sensors & msg::kSimBattery) == 0) return missing("battery");
+    BatteryReading& r = battery_->edit();
+    r = {t, s.battery_voltage, s.battery_current, s.battery_percentage, s.battery_charging};
+    battery_->commit();
+  }
 }
 
 Twist2D DdsHardware::commanded_twist() const noexcept {
@@ -223,7 +287,10 @@ void DdsHardware::advance(Time now) {
   if (!lock_step_) {
     std::lock_guard lock(mutex_);
     if (simulator_silent_ && !lost_) fail(silent_why_);
-    if (state_) truth_ = truth_of(*state_);
+    if (state_) {
+      truth_ = truth_of(*state_);
+      take_sensors(*state_);
+    }
     return;
   }
   if (lost_ || (!connected_ && !connect())) return;
@@ -254,6 +321,7 @@ void DdsHardware::advance(Time now) {
     return;
   }
   truth_ = truth_of(*state_);
+  take_sensors(*state_);
 }
 
 void register_dds_hardware(HardwareRegistry& registry) {

@@ -562,15 +562,17 @@ struct DdsFleet::Impl {
     po.domain_id = o.domain_id;
     po.network = o.network;
     po.participant_lease = o.participant_lease;
+    po.security = o.security;
     participant = std::make_unique<Participant>(po);
     for (std::size_t i = 0; i < robots.size(); ++i) {
       auto l = std::make_unique<Link>();
       l->name = robots[i].name;
+      const std::string& ns = robots[i].ns.empty() ? robots[i].name : robots[i].ns;
       // A resume and a start go together: a history of one could drop the first before it is
       // acknowledged. (The robot's reader hands each sample to a callback as it arrives.)
       Qos q = qos_for(TopicKind::command, Role::publisher);
       q.depth = 16;
-      l->task.emplace(*participant, ros_topic("tripodal/task", l->name), EndpointOptions{.kind = TopicKind::command, .qos = q});
+      l->task.emplace(*participant, ros_topic("tripodal/task", ns), EndpointOptions{.kind = TopicKind::command, .qos = q});
       EndpointOptions eo{.kind = TopicKind::event};
       eo.on_status = [this, i](const StatusEvent& s) {
         const bool lost = s.kind == StatusKind::liveliness_lost && s.current_count == 0;
@@ -580,7 +582,7 @@ struct DdsFleet::Impl {
         std::lock_guard lock(inbox_mutex);
         inbox.push_back({i, lost, regained, {}});
       };
-      l->events.emplace(*participant, ros_topic("tripodal/events", l->name), eo, [this, i](const msg::Event& e) {
+      l->events.emplace(*participant, ros_topic("tripodal/events", ns), eo, [this, i](const msg::Event& e) {
         std::lock_guard lock(inbox_mutex);
         inbox.push_back({i, false, false, e});
       });

@@ -348,10 +348,46 @@ struct TypeSupport<msg::SimState> {
   using C = tripodal_msgs_msg_dds__SimState_;
   static const dds_topic_descriptor_t* descriptor() { return &tripodal_msgs_msg_dds__SimState__desc; }
   static C to_c(const msg::SimState& m) {
-    return {detail::to_c(m.stamp), m.x, m.y, m.theta, m.distance, m.step, m.scans, m.joint_states, m.collisions};
+    return {detail::to_c(m.stamp),
+            m.x,
+            m.y,
+            m.theta,
+            m.distance,
+            m.step,
+            m.scans,
+            m.joint_states,
+            m.collisions,
+            m.gyro_yaw_rate,
+            m.gyro_yaw,
+            m.battery_voltage,
+            m.battery_current,
+            m.battery_percentage,
+            m.bumpers_pressed,
+            m.bumper_count,
+            m.sensors,
+            m.battery_charging ? 1U : 0U,
+            view_sequence<dds_sequence_uint8>(m.cliff)};
   }
   static msg::SimState from_c(const C& c) {
-    return {detail::from_c(c.stamp), c.x, c.y, c.theta, c.distance, c.step, c.scans, c.joint_states, c.collisions};
+    return {detail::from_c(c.stamp),
+            c.x,
+            c.y,
+            c.theta,
+            c.distance,
+            c.step,
+            c.scans,
+            c.joint_states,
+            c.collisions,
+            c.gyro_yaw_rate,
+            c.gyro_yaw,
+            c.battery_voltage,
+            c.battery_current,
+            c.battery_percentage,
+            c.bumpers_pressed,
+            c.bumper_count,
+            c.sensors,
+            c.battery_charging != 0,
+            copy_sequence<std::uint8_t>(c.cliff)};
   }
 };
 

@@ -223,7 +223,31 @@ TEST_CASE("dds: golden CDR bytes of every message type", "[dds]") {
     check_golden(p, s, CdrWriter().time(s.until).twist(s.cmd_vel).u32(s.step).bytes());
     const auto t = sample_sim_state();
     check_golden(p, t,
-                 CdrWriter().time(t.stamp).f64(t.x).f64(t.y).f64(t.theta).f64(t.distance).u32(t.step).u32(t.scans)
-                     .u32(t.joint_states).u32(t.collisions).bytes());
+                 CdrWriter()
+                     .time(t.stamp)
+                     .f64(t.x)
+                     .f64(t.y)
+                     .f64(t.theta)
+                     .f64(t.distance)
+                     .u32(t.step)
+                     .u32(t.scans)
+                     .u32(t.joint_states)
+                     .u32(t.collisions)
+                     // the sensors: doubles at offset 56 (aligned), four uint32 (the charging flag
+                     // one of them), then the cliff sequence: its length and its three bytes
+                     .f64(t.gyro_yaw_rate)
+                     .f64(t.gyro_yaw)
+                     .f64(t.battery_voltage)
+                     .f64(t.battery_current)
+                     .f64(t.battery_percentage)
+                     .u32(t.bumpers_pressed)
+                     .u32(t.bumper_count)
+                     .u32(t.sensors)
+                     .u32(t.battery_charging ? 1 : 0)
+                     .u32(3)
+                     .u8(0)
+                     .u8(1)
+                     .u8(0)
+                     .bytes());
   }
 }

@@ -1,7 +1,8 @@
 // `tripodal sim-server --robots N`: one world stepped for several lock-step robots. The server is a
 // process of its own; this test is its robots (one set of lock-step endpoints per robot, as the
 // hardware "dds" has), and checks that each sees the others in its laser, is stopped by them, and
-// that robots join and leave while the others run.
+// that robots join and leave while the others run; and that a robot on the hardware dds has the
+// simulator's other sensors (gyro, bumpers, cliff, battery) through the server.
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <cmath>
@@ -18,9 +19,13 @@
 
 #include "child_process.hpp"
 #include "dds_test_support.hpp"
+#include "tripodal/builtin/register_all.hpp"
+#include "tripodal/controllers/base_kinematics.hpp"
 #include "tripodal/dds/dds_hardware.hpp"
 #include "tripodal/dds/endpoint.hpp"
 #include "tripodal/dds/qos.hpp"
+#include "tripodal/robot/robot.hpp"
+#include "tripodal/robot/robot_profile.hpp"
 
 using namespace tripodal::dds;
 using namespace tripodal::dds::test;
@@ -122,27 +127,27 @@ TEST_CASE("dds: one world for three robots: each sees the others, is stopped by 
                       "/tmp/" + test_namespace() + "_shared_server.log");
   ParticipantOptions po = test_options(45);
   Participant p(po);
-  // The workspace's start pose is (0.8, 0.8, 0): robot1 there, robot2 0.9 m to its left (+y),
-  // robot3 0.9 m ahead (+x) (fleet_start_poses, spacing 2 x 0.25 + 0.4 m).
+  // The workspace's start pose is (0.8, 0.8, 0): robot1 there, robot2 1.6 m to its left (+y),
+  // robot3 1.6 m ahead (+x) (fleet_starts: spacing 2 x 0.25 + kFleetStartGap_m, 1.1 m).
   Client r1(p, prefix + "1");
   Client r2(p, prefix + "2");
   // Two laser periods (5.5 Hz): the first scan was taken as the body was placed.
   for (int k = 0; k < 40; ++k) step_round({&r1, &r2});
   const double left = std::numbers::pi / 2;
-  CHECK(r1.range_at(left) == Approx(0.9 - 0.25).margin(0.05));
-  CHECK(r2.range_at(-left) == Approx(0.9 - 0.25).margin(0.05));
+  CHECK(r1.range_at(left) == Approx(1.6 - 0.25).margin(0.05));
+  CHECK(r2.range_at(-left) == Approx(1.6 - 0.25).margin(0.05));
   // Nothing ahead of robot1 yet: robot3 has not come.
   const double ahead_alone = r1.range_at(0.0);
-  CHECK(ahead_alone > 1.0);
+  CHECK(ahead_alone > 2.0);
 
   SECTION("a robot that joins is seen, one that drives into another is stopped, one that leaves is gone") {
     Client r3(p, prefix + "3");
     for (int k = 0; k < 40; ++k) step_round({&r1, &r2, &r3});
-    CHECK(r1.range_at(0.0) == Approx(0.9 - 0.25).margin(0.05));
-    CHECK(r3.range_at(std::numbers::pi) == Approx(0.9 - 0.25).margin(0.05));
+    CHECK(r1.range_at(0.0) == Approx(1.6 - 0.25).margin(0.05));
+    CHECK(r3.range_at(std::numbers::pi) == Approx(1.6 - 0.25).margin(0.05));
 
-    // robot1 drives at robot3 (+x, 0.3 m/s for 3 s): it stops against it, one contact.
-    for (int k = 0; k < 300; ++k) step_round({&r1, &r2, &r3}, {{&r1, {0.3, 0.0}}});
+    // robot1 drives at robot3 (+x, 0.3 m/s for 5 s, 1.1 m between them): it stops against it, one contact.
+    for (int k = 0; k < 500; ++k) step_round({&r1, &r2, &r3}, {{&r1, {0.3, 0.0}}});
     r1.ask();
     const msg::SimState s1 = r1.answer();
     r2.ask();
@@ -157,17 +162,109 @@ TEST_CASE("dds: one world for three robots: each sees the others, is stopped by 
     r2.leave();
     std::this_thread::sleep_for(500ms);  // its departure reaches the server
     for (int k = 0; k < 40; ++k) step_round({&r1, &r3});
-    CHECK(r1.range_at(left) > 1.0);
+    CHECK(r1.range_at(left) > 2.0);
 
     r1.leave();
     r3.leave();
     REQUIRE(server.wait(15s) == 0);
     const std::string out = server.output();
     INFO(out);
-    CHECK(out.find(prefix + "3 joined at (1.70, 0.80)") != std::string::npos);
+    CHECK(out.find(prefix + "3 joined at (2.40, 0.80)") != std::string::npos);
     CHECK(std::regex_search(out, std::regex(prefix + "2 left.*0 collisions")));
     CHECK(out.find("simulator: collision with robot 3") != std::string::npos);
     CHECK(out.find("sim-server ended: every robot left") != std::string::npos);
     CHECK(out.find("robot-robot contacts: 1;") != std::string::npos);
   }
+}
+
+TEST_CASE("dds: a robot on hardware dds has the simulator's gyro, bumpers, cliff and battery: its bumpers feel another robot",
+          "[dds][sim_server][shared_world]") {
+  const std::string prefix = test_namespace() + "_s";
+  const std::uint32_t domain = test_domain(46);
+  ChildProcess server(kTool,
+                      {"sim-server", "--robot", kRobot, "--world", kWorld, "--robots", "2", "--namespace", prefix, "--domain",
+                       std::to_string(domain), "--wait-s", "60", "--lease-s", "1"},
+                      "/tmp/" + test_namespace() + "_sensors_server.log");
+  const auto base =
+      tripodal::base_controller_config(tripodal::load_robot_profile(kRobot), tripodal::builtin_plugins().controllers);
+  REQUIRE(base.has_value());
+  tripodal::HardwareRegistry registry{"hardware type"};
+  register_dds_hardware(registry);
+  tripodal::HardwareConfig config;
+  config.type = "dds";
+  config.where = tripodal::SourceLocation{"robot.yaml", 12, 3};
+  config.base = &*base;
+  config.parameters = tripodal::ParameterSet::resolve(DdsHardware::static_manifest(),
+                                                      {{"namespace", tripodal::Value{prefix + "1"}},
+                                                       {"domain_id", tripodal::Value{static_cast<double>(domain)}},
+                                                       {"sensors", tripodal::Value{std::string("gyro, bumpers,cliff,battery")}}},
+                                                      config.where);
+  auto hw = registry.create_at(config.where, "dds", config);
+  tripodal::ResourceTable table;
+  hw->add_resources(table);
+  const auto* gyro = table.find<tripodal::GyroReading>("gyro");
+  const auto* bumpers = table.find<tripodal::BumperReading>("bumpers");
+  const auto* cliff = table.find<tripodal::InfraredReading>("cliff");
+  const auto* battery = table.find<tripodal::BatteryReading>("battery");
+  REQUIRE(gyro != nullptr);
+  REQUIRE(bumpers != nullptr);
+  REQUIRE(cliff != nullptr);
+  REQUIRE(battery != nullptr);
+
+  ParticipantOptions po;
+  po.domain_id = domain;  // the hardware's participant options: one Cyclone domain per process and id
+  Participant p(po);
+  Client r2(p, prefix + "2");  // 1.6 m to the left (+y) of robot 1, standing still
+  tripodal::BaseKinematics kinematics(*base);
+  std::vector<double> wheels(kinematics.wheel_count(), 0.0);
+  std::vector<double> velocity(wheels.size()), position(wheels.size());
+  const tripodal::Time t0{};
+  // One lock-step period: robot 2 asks, robot 1 (the hardware) advances, robot 2 takes its answer.
+  auto step = [&](int k) {
+    r2.ask();
+    hw->advance_to(t0 + std::chrono::milliseconds(10 * k));
+    (void)r2.answer();
+    REQUIRE(hw->wheels().read_wheel_states(velocity, position));
+  };
+  for (int k = 1; k <= 20; ++k) step(k);
+  REQUIRE(battery->has_reading());
+  const double charge_at_start = battery->latest().percentage;
+  CHECK(charge_at_start > 0.9);
+  CHECK_FALSE(battery->latest().charging);
+  CHECK(gyro->has_reading());
+  CHECK(std::abs(gyro->latest().yaw_rate_rad_s) < 0.02);  // standing still: the gyro's noise only
+  CHECK(bumpers->latest().count == 4);                    // the workspace's PSR-2: 4 sectors
+  CHECK(bumpers->latest().pressed_mask == 0);
+  CHECK(cliff->latest().cliff == std::vector<std::uint8_t>{0, 0, 0});  // three sensors over the floor
+
+  // Robot 1 drives left at 0.3 m/s into robot 2 (1.1 m between them): its bumpers press.
+  kinematics.inverse(tripodal::Twist2D{0.0, 0.3, 0.0}, wheels);
+  bool pressed = false;
+  for (int k = 21; k <= 600 && !pressed; ++k) {
+    REQUIRE(hw->wheels().write_wheel_velocities(wheels));
+    step(k);
+    pressed = bumpers->latest().pressed_mask != 0;
+  }
+  CHECK(pressed);
+  CHECK(battery->latest().percentage < charge_at_start);  // driving drained it
+  CHECK(gyro->latest().stamp > t0);
+  auto& dds_hw = dynamic_cast<DdsHardware&>(*hw);
+  CHECK(dds_hw.link_up());
+  REQUIRE(dds_hw.truth().has_value());
+  CHECK(dds_hw.truth()->map_from_base.y_m > 1.8);  // stopped against robot 2 at (0.8, 2.4), 0.5 m centre to centre
+}
+
+TEST_CASE("dds: hardware dds refuses an unknown sensor, at the profile's hardware entry", "[dds][sim_server]") {
+  const auto base =
+      tripodal::base_controller_config(tripodal::load_robot_profile(kRobot), tripodal::builtin_plugins().controllers);
+  REQUIRE(base.has_value());
+  tripodal::HardwareConfig config;
+  config.type = "dds";
+  config.where = tripodal::SourceLocation{"robot.yaml", 12, 3};
+  config.base = &*base;
+  config.parameters = tripodal::ParameterSet::resolve(DdsHardware::static_manifest(),
+                                                      {{"sensors", tripodal::Value{std::string("gyro,sonar")}}}, config.where);
+  CHECK_THROWS_WITH(DdsHardware(config),
+                    Catch::Contains("robot.yaml:12:3: error: hardware 'dds' sensors: unknown sensor 'sonar'; "
+                                    "expected some of gyro, bumpers, cliff, battery"));
 }

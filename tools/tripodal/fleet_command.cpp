@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "cli_tool.hpp"
+#include "fleet_file.hpp"
 #include "run_outputs.hpp"
 #include "tripodal/core/clock.hpp"
 #include "tripodal/core/diagnostic.hpp"
@@ -61,7 +62,9 @@ constexpr std::string_view kDescription =
     "(robotK.log); without, they go to a temporary folder that is removed. The robots run at\n"
     "--speed times real time. --kill-robot K --kill-after-s S kills robot K with SIGKILL S seconds\n"
     "after it was given its first unit (the test of a robot lost mid-task). The robots are stopped\n"
-    "when the fleet ends, fails or is interrupted (Ctrl-C, SIGTERM).";
+    "when the fleet ends, fails or is interrupted (Ctrl-C, SIGTERM). --fleet FILE names the robots\n"
+    "instead (name, profile, namespace and start pose each); --keys DIR secures the fleet's domain\n"
+    "with the keys of tripodal fleet-keys.";
 
 constexpr std::string_view kExitCodes =
     "exit codes: 0 every unit done, 1 bad profile/world/task, 2 bad command line, 3 I/O error (a file,\n"
@@ -69,6 +72,7 @@ constexpr std::string_view kExitCodes =
 
 struct Args {
   int robots = 0;
+  std::filesystem::path fleet;  // a fleet file: its robots instead of --robots N x --robot
   std::filesystem::path world, robot, out;
   std::string task;
   double speed = 50.0;
@@ -84,6 +88,8 @@ struct Args {
   bool sim_loopback = true;
   bool system_network = false;  // the fleet's DDS on Cyclone's own configuration (CYCLONEDDS_URI)
   std::string launcher;         // a command before each process, {name} replaced (ip netns exec ns_{name})
+  std::filesystem::path keys;   // DDS Security: the fleet's keys (tripodal fleet-keys); empty: not secured
+  std::string identity = "fleet";  // the fleet tool's identity in them
 };
 
 volatile std::sig_atomic_t g_stop = 0;
@@ -189,7 +195,7 @@ void absolutize(YAML::Node node, const std::filesystem::path& dir) {
 // The profile of robot `ns`: the given one with a dds: section of its own (any dds: section of the
 // original is replaced).
 std::string fleet_profile(const std::filesystem::path& profile, const std::string& ns, unsigned domain, double lease_s,
-                          bool loopback) {
+                          bool loopback, const std::filesystem::path& keys = {}, const std::string& identity = {}) {
   YAML::Node root = YAML::LoadFile(profile.string());
   absolutize(root, std::filesystem::absolute(profile).parent_path());
   root.remove("dds");
@@ -202,6 +208,12 @@ std::string fleet_profile(const std::filesystem::path& profile, const std::strin
   YAML::Node publish(YAML::NodeType::Sequence);
   publish.push_back("events");  // the fleet follows the events only; the rest would cost CPU
   d["publish"] = publish;
+  if (!keys.empty()) {  // the robot's identity in the fleet's keys: it takes commands only from the CA's identities
+    YAML::Node sec(YAML::NodeType::Map);
+    sec["keys"] = std::filesystem::absolute(keys).string();
+    sec["identity"] = identity;
+    d["security"] = sec;
+  }
   root["dds"] = d;
   YAML::Emitter e;
   e << root;
@@ -354,17 +366,21 @@ std::vector<std::string> last_lines(const std::filesystem::path& file, std::size
 
 
 int run(const Args& a, std::ostream& out, std::ostream& err) {
+  if ((a.robots > 0) == !a.fleet.empty()) {
+    err << "tripodal fleet: give the robots either as --robots N (of one profile, --robot) or as a fleet file (--fleet FILE)\n";
+    return kUsage;
+  }
   if (a.kill_robot.has_value() != a.kill_after_s.has_value()) {
     err << "tripodal fleet: --kill-robot and --kill-after-s go together\n";
     return kUsage;
   }
-  if (a.kill_robot && (*a.kill_robot < 1 || *a.kill_robot > a.robots)) {
+  if (a.kill_robot && a.robots > 0 && (*a.kill_robot < 1 || *a.kill_robot > a.robots)) {
     err << "tripodal fleet: --kill-robot " << *a.kill_robot << ": expected a robot from 1 to " << a.robots << "\n";
     return kUsage;
   }
   const std::filesystem::path robot =
       a.robot.empty() ? std::filesystem::absolute(a.world).parent_path().parent_path() / "robots" / "psr2.yaml" : a.robot;
-  for (const auto& f : {a.world, robot}) {
+  for (const auto& f : {a.world, a.fleet.empty() ? robot : a.fleet}) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(f, ec)) {
       err << "tripodal fleet: cannot read '" << f.string() << "'" << (a.robot.empty() && f == robot ? " (the default --robot)" : "")
@@ -372,12 +388,37 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
       return kIoError;
     }
   }
+  const unsigned sim_domain = a.sim_domain.value_or(a.domain + 1);
+  if (a.shared_world && sim_domain > 232) {
+    err << "tripodal fleet: --domain " << a.domain << " with --shared-world: the simulator's domain would be " << sim_domain
+        << ", beyond 232; give --sim-domain ID\n";
+    return kUsage;
+  }
   std::filesystem::path dir = a.out;
   bool temporary = false;
   try {
-    const RobotProfile profile = load_robot_profile(robot);
+    const std::vector<FleetMember> members = a.fleet.empty() ? numbered_fleet(a.robots, robot) : load_fleet_file(a.fleet);
+    if (a.kill_robot && (*a.kill_robot < 1 || *a.kill_robot > static_cast<int>(members.size()))) {
+      err << "tripodal fleet: --kill-robot " << *a.kill_robot << ": expected a robot from 1 to " << members.size() << "\n";
+      return kUsage;
+    }
     const sim::World world = sim::load_world(a.world);
-    const std::vector<dds::FleetUnit> units = units_of(a.task, world, profile);
+    const std::vector<dds::FleetUnit> units = units_of(a.task, world, load_robot_profile(members.front().profile));
+    // Every robot splits the room with its own profile's splitter: the fleet's units must be
+    // every robot's sections, or "clean the section B" would mean another floor to each.
+    for (const FleetMember& m : members) {
+      if (m.profile == members.front().profile) continue;
+      const std::vector<dds::FleetUnit> own = units_of(a.task, world, load_robot_profile(m.profile));
+      const bool same =
+          own.size() == units.size() && std::equal(own.begin(), own.end(), units.begin(), [](const auto& x, const auto& y) {
+            return x.name == y.name && std::abs(x.area_m2 - y.area_m2) < 1e-6;
+          });
+      if (!same) {
+        throw ConfigError(m.where, "robot '" + m.name + "': its profile " + m.profile.string() + " divides \"" + a.task +
+                                       "\" into other units than robot '" + members.front().name +
+                                       "''s: the robots of a fleet must split rooms alike (their SectionSplitter parameters)");
+      }
+    }
 
     if (dir.empty()) {
       std::string tmpl = (std::filesystem::temp_directory_path() / "tripodal-fleet-XXXXXX").string();
@@ -396,25 +437,54 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
     } remove_temporary{dir, temporary};
 
     std::vector<dds::FleetRobot> robots;
-    const std::vector<Pose2D> starts = a.shared_world ? sim::fleet_start_poses(world, static_cast<std::size_t>(a.robots))
-                                                      : std::vector<Pose2D>(static_cast<std::size_t>(a.robots), world.start_pose);
-    for (int k = 1; k <= a.robots; ++k) {
-      const Pose2D& p = starts[static_cast<std::size_t>(k - 1)];
-      robots.push_back({"robot" + std::to_string(k), p.x_m, p.y_m});
+    std::vector<Pose2D> starts;
+    if (a.shared_world) {
+      starts = fleet_starts(world, members);
+    } else {  // each robot in a world of its own: its given start pose, or the world's
+      for (const FleetMember& m : members) starts.push_back(m.start.value_or(world.start_pose));
     }
-    const unsigned sim_domain = a.sim_domain.value_or(a.domain + 1);
+    for (std::size_t k = 0; k < members.size(); ++k)
+      robots.push_back({members[k].name, starts[k].x_m, starts[k].y_m, members[k].ns});
     std::vector<std::string> names;
     names.reserve(units.size());
     for (const dds::FleetUnit& u : units) names.push_back(u.name + " (" + app::fixed(u.area_m2, 1) + " m2)");
-    out << "tripodal fleet: " << a.robots << " robots, world " << a.world.string() << ", task \"" << a.task << "\": " << units.size()
-        << " units:";
+    out << "tripodal fleet: " << members.size() << " robots, world " << a.world.string() << ", task \"" << a.task
+        << "\": " << units.size() << " units:";
     for (const std::string& n : names) out << " " << n;
     out << "\n";
     if (units.size() < robots.size()) {
       const std::size_t idle = robots.size() - units.size();
       out << "(" << idle << (idle == 1 ? " robot gets" : " robots get") << " no unit at first: more robots than units)\n";
     }
+    if (!a.fleet.empty()) {
+      for (std::size_t k = 0; k < members.size(); ++k) {
+        out << "  " << members[k].name << ": " << members[k].profile.filename().string() << ", namespace " << members[k].ns
+            << ", starts at (" << app::fixed(starts[k].x_m, 2) << ", " << app::fixed(starts[k].y_m, 2) << ", "
+            << app::fixed(starts[k].theta_rad, 3) << ")\n";
+      }
+    }
     out.flush();
+
+    // Secured: every identity's files are there before anything starts (a robot without its
+    // certificate would only be seen silent, its reason in its log).
+    std::optional<dds::SecurityFiles> security;
+    if (!a.keys.empty()) {
+      try {
+        security = dds::fleet_identity(a.keys, a.identity);
+      } catch (const dds::DdsError& e) {
+        throw std::invalid_argument("--keys " + a.keys.string() + " --identity " + a.identity + ": " + e.what());
+      }
+      for (const FleetMember& m : members) {
+        try {
+          (void)dds::fleet_identity(a.keys, m.name);
+        } catch (const dds::DdsError& e) {
+          throw ConfigError(m.where, "robot '" + m.name + "' has no identity in " + a.keys.string() + ": " + e.what() +
+                                         " (tripodal fleet-keys --out " + a.keys.string() + " --robot " + m.name + ")");
+        }
+      }
+      out << "secured: DDS Security with the keys in " << a.keys.string() << ", the fleet as '" << a.identity
+          << "', each robot as its name\n";
+    }
 
     SteadyClock clock;
     dds::FleetOptions fo;
@@ -424,18 +494,20 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
         planner, robots,
         dds::DdsFleetOptions{.domain_id = a.domain,
                              .network = a.system_network ? dds::Network::system : dds::Network::loopback,
-                             .participant_lease = std::chrono::milliseconds(static_cast<long>(a.lease_s * 1000.0))});
+                             .participant_lease = std::chrono::milliseconds(static_cast<long>(a.lease_s * 1000.0)),
+                             .security = security});
 
     const std::string exe = std::filesystem::read_symlink("/proc/self/exe").string();
     Children children;
     for (const dds::FleetRobot& r : robots) {
+      const FleetMember& m = members[static_cast<std::size_t>(&r - robots.data())];
       const std::filesystem::path p = dir / (r.name + ".yaml");
       std::ofstream f(p);
-      f << fleet_profile(robot, r.name, a.domain, a.lease_s, !a.system_network);
+      f << fleet_profile(m.profile, m.ns, a.domain, a.lease_s, !a.system_network, a.keys, m.name);
       if (!f) throw std::runtime_error("cannot write '" + p.string() + "'");
       f.close();
       std::filesystem::path world_file = std::filesystem::absolute(a.world);
-      if (a.shared_world) {
+      if (a.shared_world || m.start) {  // its localizer starts where its body is
         world_file = dir / (r.name + "_world.yaml");
         std::ofstream w(world_file);
         w << fleet_world(a.world, starts[static_cast<std::size_t>(&r - robots.data())]);
@@ -455,23 +527,29 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
       if (a.shared_world) {
         // The body is the server's; its DDS domain is another than the fleet's, so that a network
         // fault between a robot and the fleet (scripts/netns_fleet.sh) is not one of its physics.
-        argv.insert(argv.end(), {"--hardware", "dds", "--hardware-param", "namespace=" + r.name, "--hardware-param",
+        argv.insert(argv.end(), {"--hardware", "dds", "--hardware-param", "namespace=" + m.ns, "--hardware-param",
                                  "domain_id=" + std::to_string(sim_domain), "--hardware-param",
                                  "loopback=" + std::string(a.sim_loopback ? "true" : "false")});
+        if (!m.sensors.empty()) argv.insert(argv.end(), {"--hardware-param", "sensors=" + m.sensors});
       }
       children.spawn(r.name, argv, dir / (r.name + ".log"), a.launcher);
     }
     if (a.shared_world) {
-      std::vector<std::string> argv{exe,           "sim-server",
-                                    "--robot",     robot.string(),
-                                    "--world",     std::filesystem::absolute(a.world).string(),
-                                    "--robots",    std::to_string(a.robots),
-                                    "--domain",    std::to_string(sim_domain),
-                                    "--namespace", "robot"};
+      // The server reads who stands where from the fleet's own file, so that the two agree.
+      const std::filesystem::path fleet_yaml = dir / "fleet.yaml";
+      std::ofstream ff(fleet_yaml);
+      ff << fleet_file_text(members, starts);
+      if (!ff) throw std::runtime_error("cannot write '" + fleet_yaml.string() + "'");
+      ff.close();
+      std::vector<std::string> argv{exe,        "sim-server",
+                                    "--fleet",  fleet_yaml.string(),
+                                    "--world",  std::filesystem::absolute(a.world).string(),
+                                    "--domain", std::to_string(sim_domain)};
       if (a.seed) argv.insert(argv.end(), {"--seed", std::to_string(*a.seed)});
       if (!a.sim_loopback) argv.emplace_back("--system-network");
       children.spawn("sim-server", argv, dir / "sim_server.log", a.launcher);
-      out << "shared world: tripodal sim-server for " << a.robots << " robots on domain " << sim_domain << " (sim_server.log)\n";
+      out << "shared world: tripodal sim-server for " << members.size() << " robots on domain " << sim_domain
+          << " (sim_server.log)\n";
     }
 
     // Every way the fleet may be told to end stops its robots first: a closed output (`| head`,
@@ -549,10 +627,16 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
 
 cli::Action setup(CLI::App& cmd) {
   auto a = std::make_shared<Args>();
-  cmd.add_option("--robots", a->robots, "N: how many robots (processes), 1 to 16")->required()->check(CLI::Range(1, 16));
-  cmd.add_option("--world", a->world, "WORLD.yaml: the world every robot runs in (its own copy)")->required();
+  auto* robots = cmd.add_option("--robots", a->robots, "N: how many robots (processes), 1 to 16")->check(CLI::Range(1, 16));
+  cmd.add_option("--world", a->world, "WORLD.yaml: the world every robot runs in (its own copy, or one with --shared-world)")
+      ->required();
   cmd.add_option("--task", a->task, "\"COMMAND\": \"clean the room 3211\" (by sections) or \"clean the rooms 2111 and 2133\"")->required();
   cmd.add_option("--robot", a->robot, "ROBOT.yaml: the robots' profile (default: robots/psr2.yaml beside the world's folder)");
+  cmd.add_option("--fleet", a->fleet,
+                 "FILE: the robots by name, each with its profile, namespace and start pose (a fleet file, "
+                 "docs/distribution.md), instead of --robots N of one --robot profile")
+      ->excludes(robots)
+      ->excludes("--robot");
   cmd.add_option("--out", a->out, "DIR: fleet.json, fleet.txt, the robots' profiles and logs")->check(cli::writable_folder());
   cmd.add_option("--speed", a->speed, "X: the robots run at X times real time")->check(cli::positive_number())->capture_default_str();
   cmd.add_option("--domain", a->domain, "ID: the DDS domain (ROS_DOMAIN_ID)")->check(CLI::Range(0, 232))->capture_default_str();
@@ -579,6 +663,11 @@ cli::Action setup(CLI::App& cmd) {
   cmd.add_flag("--system-network", a->system_network,
                "the fleet's and the robots' DDS on Cyclone DDS's own configuration (CYCLONEDDS_URI), not loopback: "
                "for robots on other hosts or network namespaces");
+  cmd.add_option("--keys", a->keys,
+                 "DIR: DDS Security on the fleet's domain with the keys tripodal fleet-keys made: the fleet tool as "
+                 "--identity, each robot as its name (its profile's dds: security); the simulator's link stays unsecured")
+      ->check(CLI::ExistingDirectory);
+  cmd.add_option("--identity", a->identity, "NAME: with --keys, the fleet tool's identity in them")->capture_default_str();
   cmd.add_option("--launcher", a->launcher,
                  "\"CMD\": words put before each process's command line, {name} replaced by robotK or sim-server "
                  "(\"ip netns exec tfleet_{name}\": each in its own network namespace)");

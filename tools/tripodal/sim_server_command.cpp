@@ -61,6 +61,7 @@ struct Args {
   double wait_s = 0.0;
   bool system_network = false;
   std::optional<int> robots;  // --robots N: one world for N lock-step robots
+  std::filesystem::path fleet;  // --fleet FILE: one world for the robots it names
   double stall_s = 0.2;
   CLI::Option* realtime = nullptr;  // given at all (with or without SPEED)
   double realtime_speed = 0.0;      // 0: --realtime without SPEED
@@ -91,14 +92,19 @@ std::vector<std::string> wheel_names(std::size_t n) {
 }
 
 int run(const Args& a, std::ostream& out, std::ostream& err) {
-  if (a.robots) {
+  if (a.robot.empty() && a.fleet.empty()) {
+    err << "tripodal sim-server: give the robot's profile (--robot ROBOT.yaml) or a fleet file (--fleet FILE)\n";
+    return kUsage;
+  }
+  if (a.robots || !a.fleet.empty()) {
     if (a.realtime->count() > 0) {
-      err << "tripodal sim-server: --robots serves lock-step robots; --realtime serves one\n";
+      err << "tripodal sim-server: --robots and --fleet serve lock-step robots; --realtime serves one\n";
       return kUsage;
     }
     return run_shared_world(SharedWorldArgs{.robot = a.robot,
                                             .world = a.world,
-                                            .robots = *a.robots,
+                                            .fleet = a.fleet,
+                                            .robots = a.robots.value_or(0),
                                             .prefix = a.ros_namespace.empty() ? "robot" : a.ros_namespace,
                                             .domain = a.domain,
                                             .seed = a.seed,
@@ -243,9 +249,17 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
       ++joint_states;
       last_step = step;
       const Pose2D& p = sim.pose();
-      state.publish(dds::msg::SimState{dds::ros_time(sim.now()), p.x_m, p.y_m, p.theta_rad, sim.distance_m(),
-                                       last_step, scans, joint_states,
-                                       static_cast<std::uint32_t>(sim.collisions())});
+      dds::msg::SimState answer{dds::ros_time(sim.now()),
+                                p.x_m,
+                                p.y_m,
+                                p.theta_rad,
+                                sim.distance_m(),
+                                last_step,
+                                scans,
+                                joint_states,
+                                static_cast<std::uint32_t>(sim.collisions())};
+      put_sensors(answer, sim);
+      state.publish(answer);
       if (clock) clock->publish(dds::msg::Clock{dds::ros_time(sim.now())});
     };
     // Lock-step: the command over the step, the world advanced to its end, then what it gave.
@@ -319,7 +333,7 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
 
 cli::Action setup(CLI::App& cmd) {
   auto a = std::make_shared<Args>();
-  cmd.add_option("--robot", a->robot, "ROBOT.yaml: the robot profile whose base is simulated")->required();
+  auto* robot = cmd.add_option("--robot", a->robot, "ROBOT.yaml: the robot profile whose base is simulated");
   cmd.add_option("--world", a->world, "WORLD.yaml: map, start pose, sensors and faults of the simulation")
       ->required();
   cmd.add_option("--namespace", a->ros_namespace,
@@ -346,6 +360,12 @@ cli::Action setup(CLI::App& cmd) {
                  "N: one world for N lock-step robots on namespaces NS1..NSN (NS: --namespace, default robot), each "
                  "seeing the others in its laser and stopped by them; robots come and go while it runs")
       ->check(CLI::Range(1, 16));
+  cmd.add_option("--fleet", a->fleet,
+                 "FILE: one world for the robots a fleet file names (name, profile, namespace, start pose each; "
+                 "docs/distribution.md), in lock-step as with --robots")
+      ->excludes(robot)
+      ->excludes("--robots")
+      ->excludes("--namespace");
   cmd.add_option("--stall-s", a->stall_s,
                  "S: with --robots, the wall time a round waits for a robot before stepping the others without it")
       ->check(cli::positive_number())

@@ -1,7 +1,7 @@
 // `tripodal sim-server --robots N`: one world, several lock-step robots (sim_server_shared.hpp).
 //
 // The world is one Simulator per robot on the same map, each at its own start pose
-// (sim::fleet_start_poses), coupled every round by the others' bodies (Simulator::set_other_bodies):
+// (a fleet file's, or fleet_starts' grid), coupled every round by the others' bodies (Simulator::set_other_bodies):
 // a robot's laser sees the others, its footprint stops against them and its bumpers feel them. A
 // round steps every robot that asked for its next step; it waits for the robots it expects for at
 // most --stall-s of wall time, after which a robot that has not asked (paused, or busy starting)
@@ -17,6 +17,7 @@
 #include <csignal>
 #include <deque>
 #include <limits>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -24,6 +25,7 @@
 #include <vector>
 
 #include "cli_tool.hpp"
+#include "fleet_file.hpp"
 #include "run_outputs.hpp"
 #include "run_task.hpp"
 #include "tripodal/core/diagnostic.hpp"
@@ -65,6 +67,7 @@ struct SlotInbox {
 struct Slot {
   std::string ns;
   Pose2D start;
+  const std::pair<std::string, ControllerConfig>* base = nullptr;  // its profile's name and base
   std::unique_ptr<dds::Publisher<dds::msg::LaserScan>> scan;
   std::unique_ptr<dds::Publisher<dds::msg::JointState>> joints;
   std::unique_ptr<dds::Publisher<dds::msg::SimState>> state;
@@ -81,31 +84,67 @@ struct Slot {
 
 }  // namespace
 
+void put_sensors(dds::msg::SimState& state, sim::Simulator& sim) {
+  const sim::SimRobotConfig& rc = sim.world().robot;
+  state.sensors = 0;
+  if (rc.gyro.enabled && sim.gyro().has_reading()) {
+    state.sensors |= dds::msg::kSimGyro;
+    state.gyro_yaw_rate = sim.gyro().latest().yaw_rate_rad_s;
+    state.gyro_yaw = sim.gyro().latest().yaw_rad;
+  }
+  if (rc.bumpers.enabled && sim.bumpers().has_reading()) {
+    state.sensors |= dds::msg::kSimBumpers;
+    state.bumpers_pressed = sim.bumpers().latest().pressed_mask;
+    state.bumper_count = sim.bumpers().latest().count;
+  }
+  if (rc.cliff.enabled && sim.cliff().has_reading()) {
+    state.sensors |= dds::msg::kSimCliff;
+    state.cliff = sim.cliff().latest().cliff;
+  }
+  if (rc.battery.enabled && sim.battery().has_reading()) {
+    state.sensors |= dds::msg::kSimBattery;
+    const BatteryReading& b = sim.battery().latest();
+    state.battery_voltage = b.voltage_v;
+    state.battery_current = b.current_a;
+    state.battery_percentage = b.percentage;
+    state.battery_charging = b.charging;
+  }
+}
+
 int run_shared_world(const SharedWorldArgs& a, std::ostream& out, std::ostream& err) {
-  for (const auto& f : {a.robot, a.world}) {
+  for (const auto& f : {a.fleet.empty() ? a.robot : a.fleet, a.world}) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(f, ec)) {
       err << "tripodal sim-server: cannot read '" << f.string() << "'\n";
       return kIoError;
     }
   }
-  if (!is_ros_namespace(a.prefix + "1")) {
+  if (a.fleet.empty() && !is_ros_namespace(a.prefix + "1")) {
     err << "tripodal sim-server: --namespace '" << a.prefix << "' with --robots: '" << a.prefix
         << "1' is not a ROS 2 namespace: names of letters, digits and '_', not starting with a digit, separated by '/'\n";
     return kUsage;
   }
   try {
-    const RobotProfile profile = load_robot_profile(a.robot);
-    RobotPlugins plugins;
-    app::register_tool_plugins(plugins, nullptr, profile, {});
-    const std::optional<ControllerConfig> base = base_controller_config(profile, plugins.controllers);
-    if (!base)
-      throw ConfigError(profile.where,
-                        "tripodal sim-server simulates the robot's base: the profile needs a loop with a controller");
+    const std::vector<FleetMember> members =
+        a.fleet.empty() ? numbered_fleet(a.robots, a.robot, a.prefix) : load_fleet_file(a.fleet);
+    // Each robot's base is its own profile's (a fleet file may mix an omni PSR-2 and a
+    // differential robot); profiles read once each.
+    std::map<std::filesystem::path, std::pair<std::string, ControllerConfig>> bases;
+    for (const FleetMember& m : members) {
+      if (bases.count(m.profile) != 0) continue;
+      const RobotProfile profile = load_robot_profile(m.profile);
+      RobotPlugins plugins;
+      app::register_tool_plugins(plugins, nullptr, profile, {});
+      const std::optional<ControllerConfig> base = base_controller_config(profile, plugins.controllers);
+      if (!base)
+        throw ConfigError(profile.where,
+                          "tripodal sim-server simulates the robot's base: the profile needs a loop with a controller");
+      bases.emplace(m.profile, std::make_pair(profile.name, *base));
+    }
     const sim::World world = sim::load_world(a.world);
     const std::uint64_t seed = a.seed.value_or(world.seed);
-    const auto n = static_cast<std::size_t>(a.robots);
-    const std::vector<Pose2D> starts = sim::fleet_start_poses(world, n);
+    const std::size_t n = members.size();
+    const std::vector<Pose2D> starts = fleet_starts(world, members);
 
     dds::ParticipantOptions po;
     po.domain_id = a.domain;
@@ -121,8 +160,9 @@ int run_shared_world(const SharedWorldArgs& a, std::ostream& out, std::ostream& 
     scan_qos.reliability = dds::Reliability::reliable;  // a lock-step robot counts on every scan
     for (std::size_t k = 0; k < n; ++k) {
       Slot& s = slots[k];
-      s.ns = a.prefix + std::to_string(k + 1);
+      s.ns = members[k].ns;
       s.start = starts[k];
+      s.base = &bases.at(members[k].profile);
       const dds::BaseTopics topics(s.ns);
       s.scan = std::make_unique<dds::Publisher<dds::msg::LaserScan>>(
           participant, topics.scan, dds::EndpointOptions{.kind = dds::TopicKind::scan, .qos = scan_qos});
@@ -154,12 +194,15 @@ int run_shared_world(const SharedWorldArgs& a, std::ostream& out, std::ostream& 
 
     std::signal(SIGINT, on_shared_server_stop_signal);
     std::signal(SIGTERM, on_shared_server_stop_signal);
-    out << "tripodal sim-server: one world for " << n << " robots (" << profile.name << ", " << base->type << " base), world "
-        << a.world.string() << ", seed " << seed << "; domain " << a.domain << ", namespaces " << slots.front().ns << " to "
-        << slots.back().ns << "\n";
+    out << "tripodal sim-server: one world for " << n << " robots";
+    if (a.fleet.empty()) out << " (" << slots.front().base->first << ", " << slots.front().base->second.type << " base)";
+    out << ", world " << a.world.string() << ", seed " << seed << "; domain " << a.domain << ", namespaces " << slots.front().ns
+        << " to " << slots.back().ns << "\n";
     for (const Slot& s : slots) {
       out << "  " << s.ns << " starts at (" << app::fixed(s.start.x_m, 2) << ", " << app::fixed(s.start.y_m, 2) << ", "
-          << app::fixed(s.start.theta_rad, 3) << ")\n";
+          << app::fixed(s.start.theta_rad, 3) << ")";
+      if (!a.fleet.empty()) out << ": " << s.base->first << ", " << s.base->second.type << " base";
+      out << "\n";
     }
     out.flush();
 
@@ -192,7 +235,7 @@ int run_shared_world(const SharedWorldArgs& a, std::ostream& out, std::ostream& 
       s.expected = false;
     };
     auto arrive = [&](Slot& s) {
-      s.sim = std::make_unique<sim::Simulator>(world, *base, seed);
+      s.sim = std::make_unique<sim::Simulator>(world, s.base->second, seed);
       if (!s.sim->set_pose(s.start)) throw std::runtime_error(s.ns + "'s start pose is not free");
       const std::size_t w = s.sim->wheel_count();
       s.js = {};
@@ -250,8 +293,17 @@ int run_shared_world(const SharedWorldArgs& a, std::ostream& out, std::ostream& 
       s.last_step = step.step;
       ++s.steps_served;
       const Pose2D& p = sim.pose();
-      s.state->publish(dds::msg::SimState{dds::ros_time(sim.now()), p.x_m, p.y_m, p.theta_rad, sim.distance_m(), s.last_step,
-                                          s.scans, s.joint_states, static_cast<std::uint32_t>(sim.collisions())});
+      dds::msg::SimState state{dds::ros_time(sim.now()),
+                               p.x_m,
+                               p.y_m,
+                               p.theta_rad,
+                               sim.distance_m(),
+                               s.last_step,
+                               s.scans,
+                               s.joint_states,
+                               static_cast<std::uint32_t>(sim.collisions())};
+      put_sensors(state, sim);
+      s.state->publish(state);
       s.expected = true;
     };
 

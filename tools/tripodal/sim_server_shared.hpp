@@ -9,10 +9,18 @@
 #include <ostream>
 #include <string>
 
+namespace tripodal::dds::msg {
+struct SimState;
+}
+namespace tripodal::sim {
+class Simulator;
+}
+
 namespace tripodal::tool {
 
 struct SharedWorldArgs {
   std::filesystem::path robot, world;
+  std::filesystem::path fleet;   ///< a fleet file (fleet_file.hpp): its robots instead of `robots` x `robot`
   int robots = 2;                ///< slots robot1..robotN (namespaces `prefix`1..N)
   std::string prefix = "robot";  ///< namespace of robot k: prefix + k
   unsigned domain = 0;
@@ -22,6 +30,11 @@ struct SharedWorldArgs {
   double stall_s = 0.2;  ///< wall time a round waits for a robot before stepping without it
   bool system_network = false;
 };
+
+/// The robot's other sensors after a step, into the state the server answers with: the gyro,
+/// bumpers, cliff sensors and battery its world gives it (SimState::sensors says which), so that
+/// a robot on hardware dds has them as on the in-process simulator. Both servers use it.
+void put_sensors(dds::msg::SimState& state, sim::Simulator& sim);
 
 /// Serves until every robot that came has left, a signal, or (with wait_s) no robot came; prints
 /// per-robot and total figures ("robot-robot contacts: N"). Returns the tool's exit code.

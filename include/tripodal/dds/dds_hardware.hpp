@@ -17,6 +17,7 @@
 #include "tripodal/dds/endpoint.hpp"
 #include "tripodal/dds/robot_modules.hpp"
 #include "tripodal/hardware/hardware.hpp"
+#include "tripodal/resources/resource.hpp"
 #include "tripodal/resources/resource_faults.hpp"
 
 namespace tripodal::dds {
@@ -39,7 +40,10 @@ struct SimTruth {
 // Wheels: the controller's wheel velocities become a body twist by the base's forward kinematics
 // (HardwareConfig::base) and go out as geometry_msgs/Twist on cmd_vel; the wheel states are the
 // latest sensor_msgs/JointState of joint_states (names in the base's wheel order). Sensors: a
-// laser resource "laser" fed by sensor_msgs/LaserScan on scan (DdsLaserResource).
+// laser resource "laser" fed by sensor_msgs/LaserScan on scan (DdsLaserResource), and those the
+// parameter `sensors` names ("gyro,bumpers,cliff,battery", default none) as resources of those
+// names, fed by the simulator's answer (SimState's sensor fields, after every step); a sensor the
+// simulator's world does not give is a fault of the hardware.
 //
 // Lock-step (parameter lock_step, default true: the other side is `tripodal sim-server`):
 // advance_to(t) sends tripodal_msgs/SimStep {t, the twist} and waits until the simulator answers
@@ -54,7 +58,7 @@ struct SimTruth {
 // Not final: the `tripodal run` tool adds the world's map to it (navi::MapSource).
 class DdsHardware : public CHardware, public HardwareInterface, public ResourceFaultSource {
  public:
-  // Parameters: namespace, domain_id, loopback, lock_step, step_timeout_s, connect_timeout_s.
+  // Parameters: namespace, domain_id, loopback, lock_step, step_timeout_s, connect_timeout_s, sensors.
   static const ModuleManifest& static_manifest();
   // Throws ConfigError (located at the entry) without a base controller; DdsError when DDS fails.
   explicit DdsHardware(const HardwareConfig& config);
@@ -84,6 +88,7 @@ class DdsHardware : public CHardware, public HardwareInterface, public ResourceF
 
  private:
   void advance(Time now);
+  void take_sensors(const msg::SimState& s);  // under mutex_
   void fail(std::string why) noexcept;
   bool connect() noexcept;
   [[nodiscard]] Twist2D commanded_twist() const noexcept;
@@ -111,6 +116,10 @@ class DdsHardware : public CHardware, public HardwareInterface, public ResourceF
 
   std::unique_ptr<Participant> participant_;
   std::unique_ptr<DdsLaserResource> laser_;
+  std::unique_ptr<GyroResource> gyro_;  // those the parameter sensors names, else null
+  std::unique_ptr<BumperResource> bumpers_;
+  std::unique_ptr<InfraredResource> cliff_;
+  std::unique_ptr<BatteryResource> battery_;
   std::unique_ptr<Publisher<msg::Twist>> cmd_vel_;
   std::unique_ptr<Publisher<msg::SimStep>> sim_step_;
   std::unique_ptr<Subscriber<msg::JointState>> joint_states_;

@@ -31,6 +31,7 @@ struct FleetUnit {
 struct FleetRobot {
   std::string name;
   double x_m = 0.0, y_m = 0.0;
+  std::string ns{};  ///< its DDS namespace (a fleet file may give one); empty: the name
 };
 
 /// The balanced assignment: units by decreasing area, each to the robot with the least area so far;
@@ -188,6 +189,9 @@ struct DdsFleetOptions {
   /// leases are theirs (their profiles' participant_lease_s), and decide how soon a dead robot
   /// is seen.
   std::chrono::milliseconds participant_lease{std::chrono::seconds(10)};
+  /// DDS Security: the fleet tool's identity (security.hpp, fleet_identity); unset, not secured.
+  /// Its robots must then be secured by the same CA (their profiles' dds: security).
+  std::optional<SecurityFiles> security{};
 };
 
 /// The fleet planner on DDS: a participant, per robot a TaskCommand publisher on

@@ -228,8 +228,23 @@ struct SimState {
   std::uint32_t scans = 0;
   std::uint32_t joint_states = 0;
   std::uint32_t collisions = 0;
+  // The robot's other simulated sensors after the step, those `sensors` flags (kSimGyro, ...):
+  // what the hardware dds hands the robot as its gyro, bumpers, cliff and battery resources.
+  double gyro_yaw_rate = 0.0;  // rad/s
+  double gyro_yaw = 0.0;       // rad
+  double battery_voltage = 0.0;
+  double battery_current = 0.0;       // A, positive when charging
+  double battery_percentage = 0.0;    // 0..1
+  std::uint32_t bumpers_pressed = 0;  // bit i: bumper i
+  std::uint32_t bumper_count = 0;
+  std::uint32_t sensors = 0;
+  bool battery_charging = false;    // a uint32 on the wire (no padding before the sequence)
+  std::vector<std::uint8_t> cliff;  // 1: a cliff under sensor i
   bool operator==(const SimState&) const = default;
 };
+
+// SimState::sensors' flags: the sensors the simulator's world gives the robot.
+inline constexpr std::uint32_t kSimGyro = 1, kSimBumpers = 2, kSimCliff = 4, kSimBattery = 8;
 
 }  // namespace msg
 
