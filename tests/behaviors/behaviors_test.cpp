@@ -1,11 +1,10 @@
 // CBehavior lifecycle, the registry, parameters, and the built-in behaviors on a kinematic model.
-#include "tripodal/behaviors/behavior.hpp"
-
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <numbers>
 #include <random>
 
+#include "tripodal/behaviors/behavior.hpp"
 #include "tripodal/behaviors/behavior_registry.hpp"
 #include "tripodal/behaviors/builtin_behaviors.hpp"
 #include "tripodal/controllers/kinematics.hpp"
@@ -298,8 +297,8 @@ namespace {
 // BhAvoidObstacle's envelope written plainly, beam by beam (no tables of its own, no blocks, no
 // skipping): the specification its optimised step must reproduce bit for bit. Directions as the
 // behavior rounds them (float cosines of the laser-frame angle), arithmetic in double.
-VelocityEnvelope reference_avoid_envelope(const LaserScan& scan, double stop_m, double slow_m, double max_speed,
-                                          double r, double lx, double ly, double lyaw) {
+VelocityEnvelope reference_avoid_envelope(const LaserScan& scan, double stop_m, double slow_m, double max_speed, double r,
+                                          double lx, double ly, double lyaw) {
   constexpr double kInf = VelocityEnvelope::kInf;
   double front = kInf, back = kInf, left = kInf, right = kInf;
   const auto rmin = static_cast<float>(scan.range_min_m);
@@ -353,8 +352,8 @@ TEST_CASE("BhAvoidObstacle's envelope equals the plain per-beam computation exac
     const double clutter = unit(rng);
     for (float& r : s.ranges_m) {
       const double u = unit(rng);
-      r = u < 0.02   ? std::numeric_limits<float>::quiet_NaN()
-          : u < 0.04 ? std::numeric_limits<float>::infinity()
+      r = u < 0.02      ? std::numeric_limits<float>::quiet_NaN()
+          : u < 0.04    ? std::numeric_limits<float>::infinity()
           : u < clutter ? static_cast<float>(0.01 + 1.5 * unit(rng))
                         : static_cast<float>(1.0 + 10.0 * unit(rng));
     }
