@@ -1,10 +1,14 @@
 #include "tripodal/behaviors/builtin_behaviors.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <stdexcept>
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 #include "tripodal/behaviors/behavior_registry.hpp"
 #include "stale_watch.hpp"
@@ -359,31 +363,51 @@ std::optional<Twist2D> BhAvoidObstacle::on_step(const BehaviorContext& context) 
   // Clearance from the footprint along each body axis direction, over the beams whose return
   // lies in the corridor the footprint sweeps when moving along that axis.
   constexpr double kInf = VelocityEnvelope::kInf;
-  double front = kInf, back = kInf, left = kInf, right = kInf;
+  // Clearance along +x (front), -x (back), +y (left), -y (right).
+  enum Axis : std::size_t { kFront, kBack, kLeft, kRight };
+  double along[4] = {kInf, kInf, kInf, kInf};
   const double r = radius_m_;
   const auto n = static_cast<std::size_t>(cos_.size());
   const float* ranges = scan.ranges_m.data();
   // Only returns closer than the slow-down zone can restrict anything; testing the raw range
-  // first skips the far majority of beams with one well-predicted branch.
+  // first skips the far majority of beams.
   const auto rmin = static_cast<float>(scan.range_min_m);
   const auto near = static_cast<float>(std::min(scan.range_max_m, r + slow_m_ + std::hypot(laser_x_m_, laser_y_m_)));
   const double reach2 = (r + slow_m_) * (r + slow_m_);  // a return closer than r + slow_m_ counts
-  auto visit = [&](std::size_t i) noexcept {
+  // A return off the corridors limits an axis by (d - r) * d / |coordinate| >= d - r (below).
+  // That costs a square root and a division, so it is skipped where it cannot change the
+  // envelope: when d - r exceeds the axis's clearance so far (it would not lower the minimum) or
+  // slow_m_ (any clearance beyond slow_m_ allows full speed). Compared as squared distances,
+  // with a relative margin far above the few roundings of the candidate, so that what is skipped
+  // is strictly above the bound and the envelope is bit for bit the one every return computes.
+  constexpr double kMargin = 1.0 + 1e-6;
+  auto skip_beyond2 = [&](double clearance) noexcept {
+    const double bound = std::min(clearance, slow_m_);
+    if (bound < 0.0) return -1.0;  // a point inside the footprint: no candidate (>= 0) is lower
+    const double d = (bound + r) * kMargin;
+    return d * d;
+  };
+  double beyond2[4];
+  for (double& b : beyond2) b = skip_beyond2(kInf);
+  auto lower = [&](std::size_t axis, double clearance) noexcept {
+    if (clearance < along[axis]) {
+      along[axis] = clearance;
+      beyond2[axis] = skip_beyond2(clearance);
+    }
+  };
+  // One return within [rmin, near].
+  auto visit_near = [&](std::size_t i) noexcept {
     const float range = ranges[i];
-    if (!(range >= rmin && range <= near)) return;  // also skips NaN and no-return values
     const auto k = static_cast<Eigen::Index>(i);
     const double x = laser_x_m_ + range * static_cast<double>(cos_[k]);
     const double y = laser_y_m_ + range * static_cast<double>(sin_[k]);
+    const std::size_t x_axis = x > 0.0 ? kFront : kBack;
+    const std::size_t y_axis = y > 0.0 ? kLeft : kRight;
+    const double ax = std::abs(x), ay = std::abs(y);
     // Clearance from the footprint along each axis direction, over the points in the corridor
     // the footprint sweeps when moving along that axis.
-    if (std::abs(y) <= r) {
-      if (x > 0.0) front = std::min(front, x - r);
-      else back = std::min(back, -x - r);
-    }
-    if (std::abs(x) <= r) {
-      if (y > 0.0) left = std::min(left, y - r);
-      else right = std::min(right, -y - r);
-    }
+    if (ay <= r) lower(x_axis, ax - r);
+    if (ax <= r) lower(y_axis, ay - r);
     // Outside those corridors too: a base that turns while it moves (a differential drive on a
     // curve) sweeps beyond the straight corridor, and a person walks into it from the side. A
     // return at bearing a from an axis closes on the footprint at cos(a) of the speed along that
@@ -393,52 +417,47 @@ std::optional<Twist2D> BhAvoidObstacle::on_step(const BehaviorContext& context) 
     // gap / cos(a) = gap * d / |x|. Per return this was std::hypot and four divisions, which
     // doubled the reactive cycle's instructions (issue 42).
     const double d2 = x * x + y * y;
-    if (d2 < reach2 && d2 > 0.0) {
+    const bool on_x = d2 <= beyond2[x_axis], on_y = d2 <= beyond2[y_axis];
+    if ((on_x || on_y) && d2 < reach2 && d2 > 0.0) {
       constexpr double kAbeam = 0.1;
       const double d = std::sqrt(d2);
       const double gap_d = std::max(d - r, 0.0) * d;
       const double abeam = kAbeam * d;
-      const double ax = std::abs(x), ay = std::abs(y);
-      if (ax > abeam) {
-        double& along = x > 0.0 ? front : back;
-        along = std::min(along, gap_d / ax);
-      }
-      if (ay > abeam) {
-        double& along = y > 0.0 ? left : right;
-        along = std::min(along, gap_d / ay);
-      }
+      if (on_x && ax > abeam) lower(x_axis, gap_d / ax);
+      if (on_y && ay > abeam) lower(y_axis, gap_d / ay);
     }
   };
-  // Blocks of 2 x kLanes beams are tested at once (SIMD compares) and skipped when none is near;
-  // "any lane set" is tested on two 64-bit halves (two instructions where the four lanes took
-  // ten, when the block loop was a third of this behavior's instructions).
-  using Lanes = float __attribute__((vector_size(4 * sizeof(float))));
-  using Halves = std::uint64_t __attribute__((vector_size(2 * sizeof(std::uint64_t))));
-  constexpr std::size_t kLanes = 4;
-  constexpr std::size_t kBlock = 2 * kLanes;
-  const Lanes lo = {rmin, rmin, rmin, rmin};
-  const Lanes hi = {near, near, near, near};
   std::size_t i = 0;
+#if defined(__SSE2__)
+  // Blocks of 16 beams are tested with SIMD compares, their lanes' results packed into a 16-bit
+  // mask (movmskps); a block without a near return costs one test, and in the others only the
+  // near returns are visited, by their set bits (the far ones of a block took a scalar test each,
+  // and the block loop was a third of this behavior's instructions at 8 beams per block).
+  constexpr std::size_t kBlock = 16;
+  const __m128 lo = _mm_set1_ps(rmin), hi = _mm_set1_ps(near);
+  auto lanes_near = [&](const float* p) noexcept {
+    const __m128 v = _mm_loadu_ps(p);  // NaN compares false: skipped like a far return
+    return static_cast<unsigned>(_mm_movemask_ps(_mm_and_ps(_mm_cmpge_ps(v, lo), _mm_cmple_ps(v, hi))));
+  };
   for (; i + kBlock <= n; i += kBlock) {
-    Lanes a, b;
-    std::memcpy(&a, ranges + i, sizeof a);
-    std::memcpy(&b, ranges + i + kLanes, sizeof b);
-    const auto hit = ((a >= lo) & (a <= hi)) | ((b >= lo) & (b <= hi));
-    Halves halves;
-    std::memcpy(&halves, &hit, sizeof halves);
-    if ((halves[0] | halves[1]) == 0) continue;
-    for (std::size_t j = i; j < i + kBlock; ++j) visit(j);
+    unsigned mask = lanes_near(ranges + i) | (lanes_near(ranges + i + 4) << 4U) | (lanes_near(ranges + i + 8) << 8U) |
+                    (lanes_near(ranges + i + 12) << 12U);
+    for (; mask != 0; mask &= mask - 1) visit_near(i + static_cast<std::size_t>(std::countr_zero(mask)));
   }
-  for (; i < n; ++i) visit(i);
+#endif
+  for (; i < n; ++i) {
+    const float range = ranges[i];
+    if (range >= rmin && range <= near) visit_near(i);  // also skips NaN and no-return values
+  }
   const double span = slow_m_ - stop_m_;
   auto allowed = [&](double clearance) noexcept {
     if (clearance > slow_m_) return kInf;
     return max_speed_ * std::clamp((clearance - stop_m_) / span, 0.0, 1.0);
   };
-  env.vx_hi_m_s = allowed(front);
-  env.vx_lo_m_s = -allowed(back);
-  env.vy_hi_m_s = allowed(left);
-  env.vy_lo_m_s = -allowed(right);
+  env.vx_hi_m_s = allowed(along[kFront]);
+  env.vx_lo_m_s = -allowed(along[kBack]);
+  env.vy_hi_m_s = allowed(along[kLeft]);
+  env.vy_lo_m_s = -allowed(along[kRight]);
   envelope_ = env;
   set_envelope(env);
   return std::nullopt;

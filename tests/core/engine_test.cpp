@@ -514,6 +514,47 @@ TEST_CASE("immediate transitions cycling are stopped with a livelock naming the 
   }
 }
 
+TEST_CASE("a step's result starts empty whatever the previous step filled in (livelock, dropped events, time error)") {
+  PetriNet net;
+  net.add_place(make_place("start", 1));
+  net.add_place(make_place("a"));
+  net.add_place(make_place("b"));
+  net.add_transition(make_transition("enter"));
+  net.add_transition(make_transition("ab"));
+  net.add_transition(make_transition("ba"));
+  net.add_arc("start", "enter");
+  net.add_arc("enter", "a");
+  net.add_arc("a", "ab");
+  net.add_arc("ab", "b");
+  net.add_arc("b", "ba");
+  net.add_arc("ba", "a");
+  EngineOptions options;
+  options.max_firings_per_instant = 10;
+  Engine e(net, {}, options);
+  const StepResult& r = e.step(at(0), {"never"});
+  REQUIRE(r.status == StepStatus::livelock);
+  REQUIRE_FALSE(r.loop.empty());
+  REQUIRE_FALSE(r.error.empty());
+  REQUIRE(r.unconsumed_events.size() == 1);
+  // The next step livelocks again (the cycle is still enabled): what it reports is its own.
+  const StepResult& again = e.step(at(1));
+  CHECK(again.unconsumed_events.empty());
+  CHECK(again.loop.size() == 2);
+
+  // A net that goes quiet: its idle steps report nothing of the step before.
+  Engine quiet(test::ring_net(3, from_seconds(1.0)));
+  CHECK(quiet.step(at(5), {"no.such.event"}).unconsumed_events.size() == 1);
+  REQUIRE(quiet.step(at(4)).status == StepStatus::time_regressed);
+  const StepResult& idle = quiet.step(at(5));
+  CHECK(idle.ok());
+  CHECK(idle.firings == 0);
+  CHECK(idle.error.empty());
+  CHECK(idle.unconsumed_events.empty());
+  CHECK(idle.loop.empty());
+  CHECK(idle.activated.empty());
+  CHECK(idle.deactivated.empty());
+}
+
 TEST_CASE("a budget of zero is rejected") {
   EngineOptions options;
   options.max_firings_per_instant = 0;
