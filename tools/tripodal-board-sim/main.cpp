@@ -3,7 +3,10 @@
 // board's UART (/dev/ttyUSB0) and speaks the protocol of docs/board-protocol.md byte for byte. The
 // board's wheels move the embedded simulator's robot in the given world in real time. It speaks
 // the protocol profile given (--protocol; the thesis's by default), over the pseudo-terminal or,
-// with --tcp, over TCP on loopback as the board's ESP8266 backup link would.
+// with --tcp, over TCP on loopback as the board's ESP8266 backup link would. With --speed S its
+// time runs S times the wall clock's — the plant, the firmware's tick and watchdog, the lidar's
+// rotation and its nodes' byte timing — for a host that runs at the same speed (tripodal run
+// --realtime S): a whole task against the device processes in a fraction of its time.
 #include <atomic>
 #include <csignal>
 #include <cstdio>
@@ -91,6 +94,7 @@ int run(int argc, char** argv) {
   double wheel_separation_m = 0.42;
   double duration_s = 0.0;
   double link_timeout_s = 0.2;
+  double speed = 1.0;
   double tank_l = 1.5;
   std::string protocol = "thesis";
   int tcp_port = -1;
@@ -107,8 +111,13 @@ int run(int argc, char** argv) {
   app.add_option("--wheel-separation-m", wheel_separation_m, "M: wheel separation")
       ->check(tripodal::cli::positive_number())
       ->capture_default_str();
-  app.add_option("--duration-s", duration_s, "S: stop after this many seconds (0: at SIGINT or SIGTERM)")
+  app.add_option("--duration-s", duration_s, "S: stop after this many (simulated) seconds (0: at SIGINT or SIGTERM)")
       ->check(tripodal::cli::non_negative_number())
+      ->capture_default_str();
+  app.add_option("--speed", speed,
+                 "S: the board's and the lidar's time runs S times the wall clock's (their byte timing, watchdog and "
+                 "plant alike); the host must run at the same speed (tripodal run --realtime S)")
+      ->check(CLI::Range(0.1, 50.0))
       ->capture_default_str();
   app.add_option("--link-timeout-s", link_timeout_s, "S: the board's link watchdog")
       ->check(tripodal::cli::positive_number())
@@ -140,7 +149,9 @@ int run(int argc, char** argv) {
   }
 
   try {
-    SteadyClock clock;
+    // One clock for the plant, the firmware and the lidar: at --speed S everything the devices time
+    // (ticks, watchdog, the lidar's samples, the motors) runs S times faster, alike.
+    ScaledClock clock(speed);
     sim::World world = sim::load_world(world_file);
     if (!pose_file.empty()) {
       if (const auto p = read_pose(pose_file)) world.start_pose = *p;
@@ -193,11 +204,15 @@ int run(int argc, char** argv) {
                 << config.protocol->summary() << ")" << std::endl;
     }
 
+    if (speed != 1.0) std::cout << "tripodal-board-sim: at " << speed << "x the wall clock" << std::endl;
     const Time end = duration_s > 0.0 ? clock.now() + from_seconds(duration_s) : Time::max();
     Time next = clock.now();
     Time next_pose = next;
+    // A pass every millisecond of wall time: the firmware and the lidar run what is due by then
+    // (several of their 1 ms ticks at a speed-up).
+    const Duration pass = from_seconds(0.001 * speed);
     while (!g_stop.load() && clock.now() < end) {
-      next += std::chrono::milliseconds(1);
+      next += pass;
       clock.sleep_until(next);
       firmware.run_until(clock.now());
       if (lidar && g_toggle_lidar_motor.exchange(false)) {
