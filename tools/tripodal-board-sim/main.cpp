@@ -7,6 +7,8 @@
 // time runs S times the wall clock's — the plant, the firmware's tick and watchdog, the lidar's
 // rotation and its nodes' byte timing — for a host that runs at the same speed (tripodal run
 // --realtime S): a whole task against the device processes in a fraction of its time.
+#include <unistd.h>
+
 #include <atomic>
 #include <csignal>
 #include <cstdio>
@@ -73,6 +75,24 @@ void write_pose(const std::filesystem::path& file, const tripodal::Pose2D& p) {
   std::error_code ignored;
   std::filesystem::rename(tmp, file, ignored);  // whole or not at all, for a reader after a kill
 }
+
+// A device's transmitter does not wait for its reader: what does not fit in the pseudo-terminal
+// now is dropped, as a UART's bytes are lost when the host's buffer is full. PseudoTerminal::write
+// waits up to 1 ms for room, which for the lidar's nodes (one write each) starved the board's
+// firmware on this same thread behind a host that read late, so that the devices fell behind
+// their own clock (the host then saw no revolution for seconds).
+class DeviceTransmitter final : public tripodal::board::ByteStream {
+ public:
+  explicit DeviceTransmitter(tripodal::board::PseudoTerminal& pty) noexcept : pty_(pty) {}
+  bool write(std::span<const std::uint8_t> bytes) noexcept override {
+    const ssize_t n = ::write(pty_.master_fd(), bytes.data(), bytes.size());  // the master is non-blocking
+    return n == static_cast<ssize_t>(bytes.size());
+  }
+  std::ptrdiff_t read(std::span<std::uint8_t> out, tripodal::Time deadline) noexcept override { return pty_.read(out, deadline); }
+
+ private:
+  tripodal::board::PseudoTerminal& pty_;
+};
 
 constexpr std::string_view kExitCodes =
     "exit codes: 0 ok, 1 the board could not start (bad world or protocol profile), 2 bad command line, 3 "
@@ -162,6 +182,7 @@ int run(int argc, char** argv) {
     sim::Simulator simulator(std::move(world), base, 1, clock.now());
     sim::SimBoardPlant plant(simulator, wheel_radius_m);
     std::unique_ptr<board::PseudoTerminal> pty;
+    std::unique_ptr<DeviceTransmitter> pty_out;
     std::unique_ptr<board::TcpServerStream> tcp;
     board::ByteStream* line = nullptr;
     if (tcp_port >= 0) {
@@ -169,7 +190,8 @@ int run(int argc, char** argv) {
       line = tcp.get();
     } else {
       pty = std::make_unique<board::PseudoTerminal>(clock);
-      line = pty.get();
+      pty_out = std::make_unique<DeviceTransmitter>(*pty);
+      line = pty_out.get();
     }
     board::FirmwareConfig config;
     config.link_timeout = from_seconds(link_timeout_s);
@@ -183,12 +205,14 @@ int run(int argc, char** argv) {
     // The lidar: the A1 emulated on its own pseudo-terminal, its ranges cast in the world the
     // board's wheels move the robot in, on the same clock.
     std::unique_ptr<board::PseudoTerminal> lidar_pty;
+    std::unique_ptr<DeviceTransmitter> lidar_out;
     std::unique_ptr<sim::SimLidarScene> lidar_scene;
     std::unique_ptr<sim::RplidarEmulator> lidar;
     if (!lidar_link.empty()) {
       lidar_pty = std::make_unique<board::PseudoTerminal>(clock);
       lidar_scene = std::make_unique<sim::SimLidarScene>(simulator);
-      lidar = std::make_unique<sim::RplidarEmulator>(*lidar_pty, *lidar_scene, sim::RplidarEmulatorConfig{}, clock.now());
+      lidar_out = std::make_unique<DeviceTransmitter>(*lidar_pty);
+      lidar = std::make_unique<sim::RplidarEmulator>(*lidar_out, *lidar_scene, sim::RplidarEmulatorConfig{}, clock.now());
       std::filesystem::remove(lidar_link);
       std::filesystem::create_symlink(lidar_pty->slave_path(), lidar_link);
       std::cout << "tripodal-board-sim: RPLIDAR A1 on " << lidar_pty->slave_path().string() << " (" << lidar_link
