@@ -13,7 +13,7 @@
 #   SPEED       environment: the devices and the robot both at SPEED times the wall clock (default
 #               1): tripodal-board-sim --speed SPEED, tripodal run --realtime SPEED; the line's byte
 #               timing, the board's watchdog and the host's link timeouts scale alike (room 2111 at
-#               5x: under 2 minutes)
+#               4x: about 2.5 minutes on a loaded machine)
 #   RESPONSE_TIMEOUT_S, MAX_MISSED  environment: the link's tolerance of late answers (default the
 #               profile's, a Linux host's without real-time scheduling: 0.05 s and 4; a navigation
 #               board with SCHED_FIFO may use 0.01 s and 1)
