@@ -12,9 +12,16 @@ const ModuleManifest& BoardMonitor::static_manifest() {
       ManifestBuilder("BoardMonitor", ModuleKind::other, Layer::sequencing)
           .description("the control board's link and panel as supervisor events (docs/board-protocol.md)")
           .input("board_link")
-          .outputs({"board_linked", "board.link_lost", "board.link_restored", "board.start", "board.pause", "board.home",
-                    "board.emergency_stop", "board.tank_empty", "board.tank_refilled", "board.battery_low"})
+          .outputs({"board_linked", "board.link_lost", "board.link_restored", "board.link_blip", "board.start", "board.pause",
+                    "board.home", "board.emergency_stop", "board.tank_empty", "board.tank_refilled", "board.battery_low"})
           .number("battery_low_percent", 15.0, "%", "at or below this the task must end and the robot charge", 0.0, 100.0)
+          // A host without real-time scheduling (a desktop, a shared machine) is now and then not
+          // scheduled for longer than the board's watchdog (200 ms): the board stops the motors and
+          // the host resynchronises at its next cycle. Such a blip is not worth failing the task for.
+          .number("link_grace_s", 0.0, "s",
+                  "a lost link answering SYNC again within this is a blip (board.link_blip), not a fault; 0: every "
+                  "loss is a fault at once (a real-time host)",
+                  0.0, 60.0)
           .build();
   return m;
 }
@@ -29,9 +36,13 @@ void BoardMonitor::on_start(ModuleContext& context) {
   started_ = true;
   link_up_ = false;
   losses_seen_ = 0;
+  pending_loss_ = false;
 }
 
-void BoardMonitor::on_configure(const ParameterSet& params) { battery_low_percent_ = params.number("battery_low_percent"); }
+void BoardMonitor::on_configure(const ParameterSet& params) {
+  battery_low_percent_ = params.number("battery_low_percent");
+  link_grace_ = from_seconds(params.number("link_grace_s"));
+}
 
 void BoardMonitor::on_update(ModuleContext& context) {
   if (!started_ || context.resources == nullptr) return;
@@ -39,19 +50,38 @@ void BoardMonitor::on_update(ModuleContext& context) {
   if (resource == nullptr || !resource->has_reading()) return;
   const BoardLinkReading& link = resource->latest();
   std::string fault;
+  const auto lost = [&](Time at) {
+    context.post("board.link_lost",
+                 fmt::format("link lost at {:.3f} s: no valid response from the board ({} missed, {} error responses so far)",
+                             to_seconds(at), link.stats.missed, link.stats.error_responses));
+    fault = "link lost";
+  };
   if (link.stats.link_losses > losses_seen_) {
     // Counted, not taken: the snapshot may skip a period, never a loss.
     losses_seen_ = link.stats.link_losses;
-    context.post("board.link_lost",
-                 fmt::format("link lost at {:.3f} s: no valid response from the board ({} missed, {} error responses so far)",
-                             to_seconds(link.lost_at), link.stats.missed, link.stats.error_responses));
     context.set_fact("board_linked", Value{false});
-    fault = "link lost";
     link_up_ = false;
+    if (link_grace_.count() > 0 && !pending_loss_) {
+      pending_loss_ = true;  // a fault only if SYNC is not answered again within the grace
+      lost_at_ = link.lost_at;
+    } else if (link_grace_.count() == 0) {
+      lost(link.lost_at);
+    }
   } else if (!link_up_ && link.synchronised) {
-    if (link.stats.link_losses > 0) context.post("board.link_restored", "SYNC answered again");
+    if (pending_loss_) {
+      context.post("board.link_blip",
+                   fmt::format("link lost at {:.3f} s and SYNC answered again {:.0f} ms later: the task goes on",
+                               to_seconds(lost_at_), to_seconds(link.stamp - lost_at_) * 1000.0));
+      pending_loss_ = false;
+    } else if (link.stats.link_losses > 0) {
+      context.post("board.link_restored", "SYNC answered again");
+    }
     context.set_fact("board_linked", Value{true});
     link_up_ = true;
+  }
+  if (pending_loss_ && context.now - lost_at_ >= link_grace_) {
+    pending_loss_ = false;
+    lost(lost_at_);
   }
   // Buttons from the DRIVE response of every control period: a press is a held edge.
   const std::uint8_t held = link.synchronised && link.has_drive ? link.buttons : held_;

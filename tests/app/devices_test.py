@@ -1,12 +1,20 @@
 """The robot against its devices in another process, over real pseudo-terminals: starts the built
 tripodal-board-sim (the control board and the RPLIDAR A1 on two ptys, one world) and the real
 `tripodal run --hardware-param port=... --hardware-param lidar_port=... --realtime` against them,
-at 1x wall clock, every wait bounded.
+at 1x wall clock (speedup: both at 4x), every wait bounded. The link's tolerance is the profile's, a
+Linux host's without real-time scheduling (docs/board-protocol.md, "Against devices").
 
 usage: devices_test.py TRIPODAL BOARD_SIM SOURCE_DIR MODE
 MODE:
   go_to       a short task ("go to the entrance", about 15 s) succeeds, localizing from the lidar;
               report.json and devices.json checked (link requests, missed, decoder errors, scans)
+  blip        the robot's process stopped (SIGSTOP) for 0.6 s mid-move, longer than the board's
+              watchdog (200 ms), as a loaded host may leave it unscheduled: the board stops the
+              motors, the link is lost and answers SYNC again at once; the task goes on without a
+              recovery (BoardMonitor's link_grace_s) and succeeds
+  speedup     the whole disinfection of room 2111 (about 9 minutes at 1x) with the device simulator
+              and the robot both at 4x (tripodal-board-sim --speed 4, --realtime 4): succeeds,
+              coverage, link and lidar figures checked, within 4.5 minutes of wall clock
   replug      the board's process killed mid-task and started again ("unplug and replug"): the
               fault posted, the task stopped, the link resynchronised and the task resumed to its
               end; prints the time from the kill to the fault and from the restart to the resume
@@ -14,7 +22,8 @@ MODE:
               (the board answered a DRIVE at speed 0), the ports closed (the device simulator
               sees its ptys hung up and another host may open them)
   lidar_stops the lidar's motor stopped mid-task (SIGUSR1 to tripodal-board-sim): the laser's fault
-              ("no revolution") within its timeout (1 s) and a few periods, not a hang; SIGTERM then
+              ("no revolution") within its timeout (the profile's lidar_timeout_s, 2 s) and a few
+              periods, not a hang; SIGTERM then
               ends the run as usual
   no_port     a port that does not exist: exit 1, the path and the reason named
   not_a_tty   a port that is a regular file: exit 1, "tcgetattr: Inappropriate ioctl for device"
@@ -33,12 +42,10 @@ import tempfile
 import threading
 import time
 
-
-# The profile's link (a response within 10 ms, the first one missed loses it) is the navigation
-# board's, a real-time host; this test's host is a shared CI machine whose load delays a process's
-# wake-up by tens of milliseconds: a late answer is tolerated here, a dead board is still found at
-# once (its port hangs up).
-LINK_TOLERANCE = ["--hardware-param", "response_timeout_s=0.05", "--hardware-param", "max_missed=3"]
+# The speed-up of the `speedup` mode: the devices and the robot at 4x the wall clock (room 2111 in
+# about 2.7 minutes); every time of both (byte timing, watchdog, link and lidar timeouts) scales
+# alike, so the host's tolerance of a late wake-up in wall time is the profile's divided by 4.
+SPEEDUP = 4
 
 
 def fail(message, output=""):
@@ -79,10 +86,11 @@ class Output:
         return None
 
 
-def start_devices(board_sim, world, work):
+def start_devices(board_sim, world, work, speed=1):
     board, lidar = os.path.join(work, "board"), os.path.join(work, "lidar")
     pose = os.path.join(work, "pose.txt")
-    proc = subprocess.Popen([board_sim, "--world", world, "--link", board, "--lidar", lidar, "--pose-file", pose],
+    proc = subprocess.Popen([board_sim, "--speed", str(speed), "--world", world, "--link", board, "--lidar", lidar,
+                             "--pose-file", pose],
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     end = time.monotonic() + 20
     while time.monotonic() < end and not (os.path.exists(board) and os.path.exists(lidar)):
@@ -93,11 +101,11 @@ def start_devices(board_sim, world, work):
     return proc, board, lidar
 
 
-def run_robot(exe, source, work, board, lidar, task, extra=()):
+def run_robot(exe, source, work, board, lidar, task, extra=(), speed=1, max_duration_s=150):
     configs = os.path.join(source, "configs")
     cmd = [exe, "run", "--robot", os.path.join(configs, "robots", "disinfection_lidar.yaml"), "--world",
            os.path.join(configs, "worlds", "workspace.yaml"), "--hardware-param", "port=" + board, "--realtime",
-           "--task", task, "--out", os.path.join(work, "out"), "--max-duration-s", "150"] + LINK_TOLERANCE
+           str(speed), "--task", task, "--out", os.path.join(work, "out"), "--max-duration-s", str(max_duration_s)]
     if lidar:
         cmd[8:8] = ["--hardware-param", "lidar_port=" + lidar]
     cmd += list(extra)
@@ -135,9 +143,9 @@ def stop(proc):
             proc.wait()
 
 
-def check_devices(dev, text, lidar=True):
+def check_devices(dev, text, lidar=True, min_answered=0.98):
     link = dev["link"]
-    if link["requests"] < 100 or link["responses"] < 0.98 * link["requests"]:
+    if link["requests"] < 100 or link["responses"] < min_answered * link["requests"]:
         fail("the link answered %d of %d requests" % (link["responses"], link["requests"]), text)
     if lidar and dev["lidar"]["scans"] < 20:
         fail("%d lidar scans received" % dev["lidar"]["scans"], text)
@@ -153,8 +161,10 @@ def main():
     work = tempfile.mkdtemp(prefix="tripodal_devices_")
     devices = None
     try:
-        if mode in ("go_to", "replug", "sigterm", "garbage", "lidar_stops"):
+        if mode in ("go_to", "replug", "sigterm", "garbage", "lidar_stops", "blip"):
             devices, board, lidar = start_devices(board_sim, world, work)
+        elif mode == "speedup":
+            devices, board, lidar = start_devices(board_sim, world, work, speed=SPEEDUP)
         if mode == "go_to":
             t0 = time.monotonic()
             proc, out = run_robot(exe, source, work, board, lidar, "go to the entrance")
@@ -175,6 +185,54 @@ def main():
                 fail("report.json duration_clock %r, expected 'wall'" % report.get("duration_clock"), text)
             print("go to the entrance: succeeded in %.1f s (%.1f s wall for the whole command), first SYNC after %.3f s" %
                   (report["duration_s"], time.monotonic() - t0, dev["first_sync_s"]))
+        elif mode == "blip":
+            proc, out = run_robot(exe, source, work, board, lidar, "go to door_2111")
+            if out.wait_for(r"activate BhAutoMove", 30) is None:
+                stop(proc)
+                fail("the robot did not start moving", out.text())
+            time.sleep(2.0)
+            proc.send_signal(signal.SIGSTOP)  # the host not scheduled: longer than the board's watchdog
+            time.sleep(0.6)
+            proc.send_signal(signal.SIGCONT)
+            t_cont = time.monotonic()
+            if out.wait_for(r"board: link lost", 10, after=t_cont - 0.1) is None:
+                stop(proc)
+                fail("the board's watchdog did not trip (no link loss after 0.6 s stopped)", out.text())
+            rc = finish(proc, out, 150)
+            text = out.text()
+            report = read_json(work, "report.json", text)
+            if rc != 0 or report["state"] != "succeeded":
+                fail("after the blip: exit %d, state %s (%s)" % (rc, report["state"], report.get("reason", "")), text)
+            if report.get("recoveries"):
+                fail("a blip of the link burnt a recovery: %s" % report["recoveries"], text)
+            dev = read_json(work, "devices.json", text)
+            check_devices(dev, text, min_answered=0.9)  # a loaded machine's own blips besides this one
+            if dev["link"]["link_losses"] < 1:
+                fail("no loss in devices.json: %s" % dev["link"], text)
+            print("blip: the host stopped 0.6 s; %d link losses (%d watchdog trips), outages %s; the task went on without a "
+                  "recovery and succeeded in %.1f s" % (dev["link"]["link_losses"], dev["link"]["watchdog_trips"],
+                                                       ", ".join("%.0f ms" % ((o["restored_s"] - o["lost_s"]) * 1000.0)
+                                                                 for o in dev["outages"]), report["duration_s"]))
+        elif mode == "speedup":
+            t0 = time.monotonic()
+            proc, out = run_robot(exe, source, work, board, lidar, "disinfect the room 2111", speed=SPEEDUP, max_duration_s=900)
+            rc = finish(proc, out, 270)
+            wall_s = time.monotonic() - t0
+            text = out.text()
+            report = read_json(work, "report.json", text)
+            if rc != 0 or report["state"] != "succeeded":
+                fail("at %gx: exit" % SPEEDUP + " %d, state %s (%s)" % (rc, report["state"], report.get("reason", "")), text)
+            if report["coverage"] < 0.9:
+                fail("at %gx: coverage %.3f of the reachable area" % (SPEEDUP, report["coverage"]), text)
+            if report.get("realtime", {}).get("speed") != SPEEDUP:
+                fail("report.json realtime speed %r, expected %g" % (report.get("realtime", {}).get("speed"), SPEEDUP), text)
+            dev = read_json(work, "devices.json", text)
+            check_devices(dev, text, min_answered=0.9)  # a loaded machine's blips, 4x as many in wall time
+            if dev["lidar"]["scans"] < 0.9 * 5.5 * report["duration_s"]:
+                fail("%d lidar scans in %.0f s of the devices' time (5.5 Hz)" % (dev["lidar"]["scans"], report["duration_s"]), text)
+            print("room 2111 at %gx: succeeded, coverage %.1f %% of %.1f m2, %.0f s of the devices' time in %.0f s of wall "
+                  "clock, %d recoveries, %d link losses" % (SPEEDUP, report["coverage"] * 100.0, report["reachable_area_m2"], report["duration_s"],
+                                                     wall_s, len(report.get("recoveries", [])), dev["link"]["link_losses"]))
         elif mode == "replug":
             proc, out = run_robot(exe, source, work, board, lidar, "go to door_2111")
             if out.wait_for(r"activate BhAutoMove", 30) is None:
@@ -246,9 +304,9 @@ def main():
             rc = finish(proc, out, 20)
             if rc != 143:
                 fail("after the lidar's fault, SIGTERM: exit %d, expected 143" % rc, out.text())
-            if t_fault - t_stop > 3.0:
-                fail("the laser's fault came %.2f s after the motor stopped (timeout 1 s)" % (t_fault - t_stop), out.text())
-            print("lidar stopped: the laser's fault %.0f ms after the motor stopped (timeout 1 s)" % ((t_fault - t_stop) * 1000.0))
+            if t_fault - t_stop > 4.0:
+                fail("the laser's fault came %.2f s after the motor stopped (timeout 2 s)" % (t_fault - t_stop), out.text())
+            print("lidar stopped: the laser's fault %.0f ms after the motor stopped (timeout 2 s)" % ((t_fault - t_stop) * 1000.0))
         elif mode in ("no_port", "not_a_tty"):
             configs = os.path.join(source, "configs")
             port = os.path.join(work, "ttyNONE")

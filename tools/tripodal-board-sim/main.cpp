@@ -3,7 +3,12 @@
 // board's UART (/dev/ttyUSB0) and speaks the protocol of docs/board-protocol.md byte for byte. The
 // board's wheels move the embedded simulator's robot in the given world in real time. It speaks
 // the protocol profile given (--protocol; the thesis's by default), over the pseudo-terminal or,
-// with --tcp, over TCP on loopback as the board's ESP8266 backup link would.
+// with --tcp, over TCP on loopback as the board's ESP8266 backup link would. With --speed S its
+// time runs S times the wall clock's — the plant, the firmware's tick and watchdog, the lidar's
+// rotation and its nodes' byte timing — for a host that runs at the same speed (tripodal run
+// --realtime S): a whole task against the device processes in a fraction of its time.
+#include <unistd.h>
+
 #include <atomic>
 #include <csignal>
 #include <cstdio>
@@ -71,6 +76,24 @@ void write_pose(const std::filesystem::path& file, const tripodal::Pose2D& p) {
   std::filesystem::rename(tmp, file, ignored);  // whole or not at all, for a reader after a kill
 }
 
+// A device's transmitter does not wait for its reader: what does not fit in the pseudo-terminal
+// now is dropped, as a UART's bytes are lost when the host's buffer is full. PseudoTerminal::write
+// waits up to 1 ms for room, which for the lidar's nodes (one write each) starved the board's
+// firmware on this same thread behind a host that read late, so that the devices fell behind
+// their own clock (the host then saw no revolution for seconds).
+class DeviceTransmitter final : public tripodal::board::ByteStream {
+ public:
+  explicit DeviceTransmitter(tripodal::board::PseudoTerminal& pty) noexcept : pty_(pty) {}
+  bool write(std::span<const std::uint8_t> bytes) noexcept override {
+    const ssize_t n = ::write(pty_.master_fd(), bytes.data(), bytes.size());  // the master is non-blocking
+    return n == static_cast<ssize_t>(bytes.size());
+  }
+  std::ptrdiff_t read(std::span<std::uint8_t> out, tripodal::Time deadline) noexcept override { return pty_.read(out, deadline); }
+
+ private:
+  tripodal::board::PseudoTerminal& pty_;
+};
+
 constexpr std::string_view kExitCodes =
     "exit codes: 0 ok, 1 the board could not start (bad world or protocol profile), 2 bad command line, 3 "
     "the world file cannot "
@@ -91,6 +114,7 @@ int run(int argc, char** argv) {
   double wheel_separation_m = 0.42;
   double duration_s = 0.0;
   double link_timeout_s = 0.2;
+  double speed = 1.0;
   double tank_l = 1.5;
   std::string protocol = "thesis";
   int tcp_port = -1;
@@ -107,8 +131,13 @@ int run(int argc, char** argv) {
   app.add_option("--wheel-separation-m", wheel_separation_m, "M: wheel separation")
       ->check(tripodal::cli::positive_number())
       ->capture_default_str();
-  app.add_option("--duration-s", duration_s, "S: stop after this many seconds (0: at SIGINT or SIGTERM)")
+  app.add_option("--duration-s", duration_s, "S: stop after this many (simulated) seconds (0: at SIGINT or SIGTERM)")
       ->check(tripodal::cli::non_negative_number())
+      ->capture_default_str();
+  app.add_option("--speed", speed,
+                 "S: the board's and the lidar's time runs S times the wall clock's (their byte timing, watchdog and "
+                 "plant alike); the host must run at the same speed (tripodal run --realtime S)")
+      ->check(CLI::Range(0.1, 50.0))
       ->capture_default_str();
   app.add_option("--link-timeout-s", link_timeout_s, "S: the board's link watchdog")
       ->check(tripodal::cli::positive_number())
@@ -140,7 +169,9 @@ int run(int argc, char** argv) {
   }
 
   try {
-    SteadyClock clock;
+    // One clock for the plant, the firmware and the lidar: at --speed S everything the devices time
+    // (ticks, watchdog, the lidar's samples, the motors) runs S times faster, alike.
+    ScaledClock clock(speed);
     sim::World world = sim::load_world(world_file);
     if (!pose_file.empty()) {
       if (const auto p = read_pose(pose_file)) world.start_pose = *p;
@@ -151,6 +182,7 @@ int run(int argc, char** argv) {
     sim::Simulator simulator(std::move(world), base, 1, clock.now());
     sim::SimBoardPlant plant(simulator, wheel_radius_m);
     std::unique_ptr<board::PseudoTerminal> pty;
+    std::unique_ptr<DeviceTransmitter> pty_out;
     std::unique_ptr<board::TcpServerStream> tcp;
     board::ByteStream* line = nullptr;
     if (tcp_port >= 0) {
@@ -158,7 +190,8 @@ int run(int argc, char** argv) {
       line = tcp.get();
     } else {
       pty = std::make_unique<board::PseudoTerminal>(clock);
-      line = pty.get();
+      pty_out = std::make_unique<DeviceTransmitter>(*pty);
+      line = pty_out.get();
     }
     board::FirmwareConfig config;
     config.link_timeout = from_seconds(link_timeout_s);
@@ -172,12 +205,14 @@ int run(int argc, char** argv) {
     // The lidar: the A1 emulated on its own pseudo-terminal, its ranges cast in the world the
     // board's wheels move the robot in, on the same clock.
     std::unique_ptr<board::PseudoTerminal> lidar_pty;
+    std::unique_ptr<DeviceTransmitter> lidar_out;
     std::unique_ptr<sim::SimLidarScene> lidar_scene;
     std::unique_ptr<sim::RplidarEmulator> lidar;
     if (!lidar_link.empty()) {
       lidar_pty = std::make_unique<board::PseudoTerminal>(clock);
       lidar_scene = std::make_unique<sim::SimLidarScene>(simulator);
-      lidar = std::make_unique<sim::RplidarEmulator>(*lidar_pty, *lidar_scene, sim::RplidarEmulatorConfig{}, clock.now());
+      lidar_out = std::make_unique<DeviceTransmitter>(*lidar_pty);
+      lidar = std::make_unique<sim::RplidarEmulator>(*lidar_out, *lidar_scene, sim::RplidarEmulatorConfig{}, clock.now());
       std::filesystem::remove(lidar_link);
       std::filesystem::create_symlink(lidar_pty->slave_path(), lidar_link);
       std::cout << "tripodal-board-sim: RPLIDAR A1 on " << lidar_pty->slave_path().string() << " (" << lidar_link
@@ -193,11 +228,15 @@ int run(int argc, char** argv) {
                 << config.protocol->summary() << ")" << std::endl;
     }
 
+    if (speed != 1.0) std::cout << "tripodal-board-sim: at " << speed << "x the wall clock" << std::endl;
     const Time end = duration_s > 0.0 ? clock.now() + from_seconds(duration_s) : Time::max();
     Time next = clock.now();
     Time next_pose = next;
+    // A pass every millisecond of wall time: the firmware and the lidar run what is due by then
+    // (several of their 1 ms ticks at a speed-up).
+    const Duration pass = from_seconds(0.001 * speed);
     while (!g_stop.load() && clock.now() < end) {
-      next += std::chrono::milliseconds(1);
+      next += pass;
       clock.sleep_until(next);
       firmware.run_until(clock.now());
       if (lidar && g_toggle_lidar_motor.exchange(false)) {

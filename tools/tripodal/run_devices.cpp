@@ -28,7 +28,7 @@ namespace tripodal::app {
 
 namespace {
 
-constexpr Duration kSyncWait = std::chrono::seconds(5);  // a board that has not answered SYNC by then is not there
+constexpr double kSyncWaitS = 5.0;  // wall-clock seconds: a board that has not answered SYNC by then is not there
 
 std::string json_string(const std::string& s) {
   std::string out = "\"";
@@ -52,14 +52,15 @@ std::string DeviceFigures::json() const {
   return fmt::format(
       "{{\n  \"port\": {},\n  \"lidar_port\": {},\n  \"first_sync_s\": {:.3f},\n"
       "  \"link\": {{\"requests\": {}, \"responses\": {}, \"missed\": {}, \"error_responses\": {}, \"retries\": {}, "
-      "\"link_losses\": {}, \"resyncs\": {}, \"reopens\": {}, \"port_failures\": {}, \"decoder_errors\": {}, "
+      "\"link_losses\": {}, \"watchdog_trips\": {}, \"resyncs\": {}, \"reopens\": {}, \"port_failures\": {}, "
+      "\"decoder_errors\": {}, "
       "\"bytes_sent\": {}, \"bytes_received\": {}, \"max_round_trip_ms\": {:.3f}}},\n"
       "  \"lidar\": {{\"scans\": {}, \"dropped\": {}, \"decoder_errors\": {}, \"restarts\": {}, \"faults\": {}}},\n"
       "  \"outages\": {}\n}}\n",
       json_string(port), json_string(lidar_port), first_sync_s, link.requests, link.responses, link.missed, link.error_responses,
-      link.retries, link.link_losses, link.resyncs, link.reopens, link.port_failures, decoder_errors, link.bytes_sent,
-      link.bytes_received, to_seconds(link.max_round_trip) * 1000.0, lidar_scans, lidar_dropped, lidar_decoder_errors,
-      lidar_restarts, lidar_faults, outs);
+      link.retries, link.link_losses, link.watchdog_trips, link.resyncs, link.reopens, link.port_failures, decoder_errors,
+      link.bytes_sent, link.bytes_received, to_seconds(link.max_round_trip) * 1000.0, lidar_scans, lidar_dropped,
+      lidar_decoder_errors, lidar_restarts, lidar_faults, outs);
 }
 
 bool runs_on_devices(const RobotProfile& profile) {
@@ -78,8 +79,12 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
     throw ConfigError(SourceLocation{option, 1, 1}, std::string(option) + ": " + why + " (the board is on " + port + ")");
   };
   if (!o.realtime) refuse("--realtime", "a robot on its devices runs on wall-clock time: add --realtime");
-  if (o.realtime_speed != 1.0)
-    refuse("--realtime", fmt::format("devices on a tty run at 1x, not {}: give --realtime alone", o.realtime_speed));
+  // A speed-up is for devices that run at the same speed (tripodal-board-sim --speed S): the line's
+  // byte timing, the board's watchdog and the host's link timeouts then scale alike. A real device
+  // runs at 1x.
+  const double speed = o.realtime_speed;
+  if (!(speed >= 0.1 && speed <= 50.0))
+    refuse("--realtime", fmt::format("SPEED {} for devices: from 0.1 to 50 (the device simulator's --speed)", speed));
   if (!o.board_line.empty()) refuse("--board", "the simulated board's line; a port is given");
   if (!o.faults.empty()) refuse("--faults", "injected into a simulated world; the world is the device's");
   if (!o.record.empty()) refuse("--record", "records a run on simulated time");
@@ -114,8 +119,10 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
   RunResult res;
   res.robot = profile.name;
   res.task = o.task;
-  res.realtime_speed = 1.0;
-  ScaledClock clock(1.0);
+  res.realtime_speed = speed;
+  // The robot's time: the wall clock's at 1x; at a speed-up the devices' (tripodal-board-sim --speed),
+  // so that every period and timeout of the host (the link's response timeout, the lidar's) scales alike.
+  ScaledClock clock(speed);
   const auto robot = Robot::assemble(profile, plugins, clock, ro);
   auto* host = dynamic_cast<board::BoardHost*>(robot->hardware());
   if (host == nullptr) throw ConfigError(where, "hardware 'board' with a port: expected the control board's hardware");
@@ -241,11 +248,12 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
   }
   busy.store(robot->planner().busy(), std::memory_order_release);
   const Time task_start = clock.now();
+  const Time wall_start = wall.now();
   robot->start(std::move(rto));
   if (o.log != nullptr) {
     for (const std::string& w : robot->realtime_warnings()) *o.log << w << '\n';
   }
-  const Time sync_by = clock.now() + kSyncWait;
+  const Time sync_by = clock.now() + from_seconds(kSyncWaitS * speed);
   while (!synced.load(std::memory_order_acquire) && clock.now() < sync_by && !stopped()) wait();
   if (!synced.load(std::memory_order_acquire) && !stopped()) {
     robot->stop();
@@ -253,7 +261,7 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
     res.state = "failed";
     res.reason = fmt::format(
         "the board on {} did not answer SYNC within {:.0f} s ({} requests sent, {} bytes received, {} decoder errors)", port,
-        to_seconds(kSyncWait), s.requests, s.bytes_received, hw.link().decoder_stats().errors());
+        kSyncWaitS, s.requests, s.bytes_received, hw.link().decoder_stats().errors());
   } else {
     const Time deadline = task_start + from_seconds(o.max_duration_s);
     while (clock.now() < deadline && !stopped() && (o.task.empty() || busy.load(std::memory_order_acquire))) wait();
@@ -299,7 +307,7 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
   if (res.state.empty()) res.state = std::string(to_string(tr.state));
   if (res.reason.empty()) res.reason = tr.reason;
   res.duration_s = to_seconds(ended - task_start);
-  res.wall_clock = true;
+  res.wall_clock = speed == 1.0;  // at a speed-up the devices' time, S times the wall clock's
   res.cleaned_cells = 0;
   for (std::size_t i = 0; i < reachable.size(); ++i) res.cleaned_cells += (reachable[i] != 0 && cleaned.mask()[i] != 0) ? 1 : 0;
   res.coverage =
@@ -336,6 +344,9 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
       *o.log << fmt::format("; lidar on {}: {} scans, {} dropped, {} decoder errors, {} restarts", lidar_port, dev.lidar_scans,
                             dev.lidar_dropped, dev.lidar_decoder_errors, dev.lidar_restarts);
     *o.log << '\n';
+    if (speed != 1.0)
+      *o.log << fmt::format("devices: at {}x: {:.1f} s of the devices' time in {:.1f} s of wall clock\n", speed, res.duration_s,
+                            to_seconds(wall.now() - wall_start));
     for (const DeviceFigures::Outage& u : dev.outages) {
       *o.log << fmt::format("devices: link lost at {:.3f} s, restored at {:.3f} s, task moving again at {:.3f} s\n", u.lost_s,
                             u.restored_s, u.resumed_s);

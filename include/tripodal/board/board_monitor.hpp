@@ -5,8 +5,11 @@
 // and posts
 //   board.link_lost       the host missed a response (missing, late or corrupt): a fault, whose
 //                         message is "link lost" (a recovery rule matches it: the details are the
-//                         event's message)
+//                         event's message); with link_grace_s > 0, only when the link is still lost
+//                         that long after the loss (a blip shorter than that is no fault)
 //   board.link_restored   SYNC answered again after a loss
+//   board.link_blip       SYNC answered again within link_grace_s: the task goes on (the board's
+//                         watchdog held the motors meanwhile); not a fault
 //   board.start / board.pause / board.home   a panel button pressed (held edge)
 //   board.emergency_stop  the e-stop pressed: the board has already braked; a fault
 //   board.tank_empty / board.tank_refilled   the liquid level module's empty flag changed
@@ -41,6 +44,10 @@ class BoardMonitor final : public CModule {
   bool started_ = false;
   bool link_up_ = false;
   std::uint64_t losses_seen_ = 0;
+  // A loss not yet a fault: within link_grace_ of lost_at_ (link_grace_ > 0).
+  bool pending_loss_ = false;
+  Time lost_at_{};
+  Duration link_grace_{0};
   std::uint8_t held_ = 0;
   bool tank_empty_ = false;
   bool battery_low_ = false;
