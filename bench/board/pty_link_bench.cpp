@@ -42,7 +42,7 @@ struct IdlePlant final : BoardPlant {
 // `on_arrival` false, the requests wait for the next tick (the loop before issue 42: p99 1.9 ms).
 class BoardThread {
  public:
-  explicit BoardThread(const SteadyClock& clock, bool on_arrival = true, FirmwareConfig config = {})
+  explicit BoardThread(const SteadyClock& clock, bool on_arrival = true, const FirmwareConfig& config = {})
       : clock_(clock), pty_(clock), firmware_(config, pty_, plant_, clock.now()) {
     thread_ = std::thread([this, on_arrival] {
       Time next = clock_.now();
