@@ -64,6 +64,24 @@ void BoardFirmware::run_until(Time now) noexcept {
   }
 }
 
+void BoardFirmware::on_receive(Time now) noexcept {
+  run_until(now);
+  receive();
+}
+
+bool serve_until(BoardFirmware& firmware, int fd, const Clock& clock, Time deadline) noexcept {
+  const Time now = clock.now();
+  if (now >= deadline) return false;
+  if (!wait_readable(fd, clock.wall_duration(deadline - now))) {
+    // A timeout, or a wake-up without bytes (a signal, a hung-up line): the rest of the wait as a
+    // sleep, so a caller looping until its tick never spins.
+    clock.sleep_until(deadline);
+    return false;
+  }
+  firmware.on_receive(clock.now());
+  return true;
+}
+
 void BoardFirmware::tick() noexcept {
   ++tick_ms_;
   receive();

@@ -133,6 +133,14 @@ Duration read_wait(Time now, Time deadline) noexcept {
   return std::clamp(deadline - now, Duration{0}, kMaxReadWait);
 }
 
+bool wait_readable(int fd, Duration max_wait) noexcept {
+  if (fd < 0) return false;
+  pollfd p{fd, POLLIN, 0};
+  const auto ns = std::max(max_wait, Duration{0}).count();
+  const timespec timeout{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
+  return ::ppoll(&p, 1, &timeout, nullptr) > 0 && (p.revents & POLLIN) != 0;
+}
+
 std::string_view raw_settings_mismatch(int fd, std::uint32_t baud) noexcept {
   const BaudRate* rate = find_rate(baud);
   if (rate == nullptr) return "baud not supported";

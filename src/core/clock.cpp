@@ -42,6 +42,10 @@ void ScaledClock::sleep_until(Time deadline) const noexcept {
   wall_.sleep_until(Time{Duration{static_cast<Duration::rep>(wall_ns) + 1}});
 }
 
+Duration ScaledClock::wall_duration(Duration d) const noexcept {
+  return Duration{static_cast<Duration::rep>(static_cast<double>(d.count()) / speed_)};
+}
+
 void SimClock::advance(Duration d) noexcept {
   if (d.count() > 0) now_.fetch_add(d.count(), std::memory_order_acq_rel);
 }

@@ -1,5 +1,7 @@
 // Internal: the XML document behind the net loaders (native format and PNML). tinyxml2 parses the
-// text; this adds what diagnostics need and tinyxml2 does not keep: the byte offset of every
+// text (the common document, without references, CDATA or a DOCTYPE, is read in one pass by the
+// plain reader instead, to the same tree: tinyxml2's DOM was half a net's load, issue 42); this
+// adds what diagnostics need and tinyxml2 does not keep: the byte offset of every
 // element and attribute (so each diagnostic can name LINE:COL), names and values as views with
 // their lengths, and the few XML 1.0 well-formedness rules tinyxml2 lets through.
 //
@@ -65,6 +67,7 @@ class XmlElement {
  private:
   friend class XmlDocument;
   friend class XmlTreeBuilder;
+  friend class XmlPlainReader;
   static constexpr std::uint32_t kNone = 0xFFFFFFFFU;
 
   const XmlDocument* doc_ = nullptr;
@@ -85,8 +88,9 @@ struct XmlError {
   std::string message;
 };
 
-/// A parsed document. Views into the source and into tinyxml2's copy of it: the text given to
-/// parse() must outlive it. Not copyable or movable (elements point back at it).
+/// A parsed document. Views into the source and into the document's own copies of what tinyxml2
+/// decoded (its DOM is released at the end of parse()): the text given to parse() must outlive it. Not copyable or movable
+/// (elements point back at it).
 class XmlDocument {
  public:
   XmlDocument();
@@ -97,8 +101,10 @@ class XmlDocument {
   ~XmlDocument();
 
   /// Parses `text` (UTF-8; ISO-8859-1 when its XML declaration says so). Returns false at the
-  /// first error, described by error(); the tree is then empty.
-  bool parse(std::string_view text);
+  /// first error, described by error(); the tree is then empty. The common document is read in
+  /// one pass without tinyxml2's DOM (the plain reader); the rest, and every error, through
+  /// tinyxml2. `plain_reader` false: tinyxml2 always (tests compare the two).
+  bool parse(std::string_view text, bool plain_reader = true);
 
   [[nodiscard]] const XmlElement* root() const noexcept { return elements_.empty() ? nullptr : &elements_[0]; }
   [[nodiscard]] const XmlError& error() const noexcept { return error_; }
@@ -106,6 +112,8 @@ class XmlDocument {
   /// was declared ISO-8859-1 and had bytes beyond ASCII.
   [[nodiscard]] std::string_view source() const noexcept { return text_; }
   [[nodiscard]] std::size_t element_count() const noexcept { return elements_.size(); }
+  /// Whether the last successful parse was the plain reader's (no tinyxml2 DOM built).
+  [[nodiscard]] bool read_plain() const noexcept { return read_plain_; }
 
   struct LineColumn {
     int line = 1;
@@ -120,6 +128,7 @@ class XmlDocument {
  private:
   friend class XmlElement;
   friend class XmlTreeBuilder;
+  friend class XmlPlainReader;
 
   void clear();
 
@@ -129,8 +138,10 @@ class XmlDocument {
   std::vector<XmlElement> elements_;
   std::vector<XmlAttribute> attributes_;
   std::deque<std::string> joined_;  // texts of several pieces (around children, CDATA); stable addresses
+  std::string owned_;               // decoded values and texts copied out of tinyxml2's buffer before its DOM goes
   mutable std::vector<std::size_t> line_starts_;  // built on the first line_column() call
   XmlError error_;
+  bool read_plain_ = false;
 };
 
 // Inline: the readers walk every element through these.

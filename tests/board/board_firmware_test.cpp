@@ -357,3 +357,26 @@ TEST_CASE("cliff judgment: a robot switched on over a drop sees it at the first 
   const Response r = b.response(Command::bump);
   CHECK(r.payload[1] == 0x01);
 }
+
+// Issue 42 item 5: a request waited for the next 1 ms tick before its answer (p99 1.9 ms over a
+// pty). The receive interrupt answers it as soon as its bytes are in.
+TEST_CASE("on_receive answers a request between ticks, as soon as its bytes have arrived", "[board][firmware]") {
+  Bench b;
+  b.run_for(1ms);  // the tick at 1 ms has run; the next is at 2 ms
+  std::array<std::uint8_t, kMaxFrameBytes> out{};
+  const std::size_t n = encode_request(static_cast<std::uint8_t>(Command::sync), {}, out);
+  REQUIRE(b.line.host().write(std::span<const std::uint8_t>(out.data(), n)));
+  b.clock.advance(b.line.byte_time() * static_cast<std::int64_t>(n));  // the request is in: 1.43 ms
+  std::array<std::uint8_t, 64> in{};
+  b.board->run_until(b.clock.now());
+  b.clock.advance(b.line.byte_time() * static_cast<std::int64_t>(n));  // 1.87 ms: an echo would be in
+  CHECK(b.line.host().read(in, b.clock.now()) == 0);                   // ticks alone: not yet answered
+  CHECK_FALSE(b.board->synchronised());
+
+  b.board->on_receive(b.clock.now());
+  CHECK(b.board->synchronised());
+  CHECK(b.board->now() == Time{} + 1ms);                               // no tick ran early
+  b.clock.advance(b.line.byte_time() * static_cast<std::int64_t>(n));  // 2.3 ms: sent at 1.87 ms
+  CHECK(b.line.host().read(in, b.clock.now()) == static_cast<std::ptrdiff_t>(n));
+  CHECK(std::equal(in.begin(), in.begin() + static_cast<std::ptrdiff_t>(n), out.begin()));
+}

@@ -270,3 +270,40 @@ TEST_CASE("a noisy line through a pty: resync after garbage, errors counted, no 
     }
   }
 }
+
+// Issue 42 item 5: the board's real-time loop woke on a 1 ms timer, so a request waited for the
+// next tick. serve_until wakes on the request's bytes: with a deadline far away, it returns as
+// soon as they are in, answered (a timeout would return false, at the deadline).
+TEST_CASE("serve_until wakes on a request's bytes over a pseudo-terminal and answers it at once", "[board][serial][pty]") {
+  const SteadyClock real;
+  PseudoTerminal pty{real};
+  SerialPort port{pty.slave_path(), real};
+  StillPlant plant;
+  BoardFirmware board{FirmwareConfig{}, pty, plant, real.now()};
+  const Time start = real.now();
+  CHECK_FALSE(serve_until(board, pty.master_fd(), real, start));  // deadline passed: no wait
+
+  std::array<std::uint8_t, kMaxFrameBytes> out{};
+  const std::size_t n = encode_request(*board.protocol().id(Command::sync), {}, out, board.protocol().frame);
+  REQUIRE(n > 0);
+  REQUIRE(port.write(std::span<const std::uint8_t>(out.data(), n)));
+  const Time deadline = real.now() + 60s;
+  bool woke = false;
+  while (!board.synchronised() && (woke = serve_until(board, pty.master_fd(), real, deadline))) {
+  }
+  REQUIRE(woke);
+  CHECK(board.synchronised());
+  CHECK(board.counters().requests == 1);
+  CHECK(board.now() < deadline);  // the ticks ran to the bytes' arrival, not to the deadline
+  // The thesis's board echoes SYNC unchanged (section 3.3.3): the request comes back.
+  REQUIRE(board.protocol().sync_echo);
+  std::array<std::uint8_t, 64> in{};
+  std::size_t got_total = 0;
+  for (int i = 0; i < 100 && got_total < n; ++i) {
+    const std::ptrdiff_t got = port.read(std::span(in).subspan(got_total), real.now() + 1ms);
+    REQUIRE(got >= 0);
+    got_total += static_cast<std::size_t>(got);
+  }
+  REQUIRE(got_total == n);
+  CHECK(std::equal(in.begin(), in.begin() + static_cast<std::ptrdiff_t>(n), out.begin()));
+}

@@ -30,6 +30,16 @@ TEST_CASE("SteadyClock is monotonic and starts near zero") {
   CHECK(b - a >= 1ms);
 }
 
+TEST_CASE("wall_duration: how long a clock's duration lasts on the wall, the timeout an OS wait needs") {
+  // A poll() that must end by a deadline of a sped-up clock waits the wall time to it, not the
+  // clock's own duration (the board simulator at --speed 4 once waited 4 ms per 1 ms pass).
+  CHECK(ScaledClock(4.0).wall_duration(4ms) == 1ms);
+  CHECK(ScaledClock(0.5).wall_duration(1ms) == 2ms);
+  CHECK(ScaledClock(1.0).wall_duration(3ms) == 3ms);
+  CHECK(SteadyClock().wall_duration(3ms) == 3ms);
+  CHECK(SimClock().wall_duration(3ms) == 3ms);
+}
+
 TEST_CASE("seconds conversions round to the nearest nanosecond") {
   CHECK(to_seconds(1500ms) == Approx(1.5));
   CHECK(from_seconds(0.25) == 250ms);

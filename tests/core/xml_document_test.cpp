@@ -4,10 +4,14 @@
 // value bytes back to the source, the XML 1.0 rules tinyxml2 lets through (references, '<' in
 // values, UTF-8, control characters, encodings, one root), tinyxml2's errors placed at a line and
 // column, and the loaders' FILE:LINE:COL for malformed XML.
-#include <catch2/catch.hpp>
+#include "../../src/core/xml_document.hpp"
 
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <optional>
 #include <random>
@@ -16,7 +20,6 @@
 #include <utility>
 #include <vector>
 
-#include "../../src/core/xml_document.hpp"
 #include "tripodal/core/net_loader.hpp"
 
 using tripodal::detail::XmlAttribute;
@@ -858,4 +861,153 @@ TEST_CASE("xml document: the loaders report malformed XML as FILE:LINE:COL at th
       "</pnml>\n";
   CHECK_THAT(load_errors(pnml, "bad.pnml"),
              Catch::Contains("bad.pnml:4:34: error: malformed XML: unknown entity '&eacute" + kUnknownEntityTail));
+}
+
+// --- the plain reader ---------------------------------------------------------------------
+
+namespace {
+
+// Both readers' trees of `text`, element by element in document order: the same names, offsets,
+// lines, columns, texts, attributes (names, values, offsets) and the same shape.
+void check_same_tree(const std::string& text) {
+  XmlDocument plain;
+  XmlDocument through_tinyxml2;
+  const bool plain_ok = plain.parse(text);
+  const bool tinyxml2_ok = through_tinyxml2.parse(text, /*plain_reader=*/false);
+  CHECK_FALSE(through_tinyxml2.read_plain());
+  REQUIRE(plain_ok == tinyxml2_ok);
+  if (!plain_ok) {
+    CHECK(plain.error().offset == through_tinyxml2.error().offset);
+    CHECK(plain.error().message == through_tinyxml2.error().message);
+    return;
+  }
+  REQUIRE(plain.element_count() == through_tinyxml2.element_count());
+  std::vector<std::pair<const XmlElement*, const XmlElement*>> pending{{plain.root(), through_tinyxml2.root()}};
+  while (!pending.empty()) {
+    const auto [a, b] = pending.back();
+    pending.pop_back();
+    REQUIRE((a == nullptr) == (b == nullptr));
+    if (a == nullptr) continue;
+    CHECK(a->name() == b->name());
+    CHECK(a->offset() == b->offset());
+    CHECK(a->line() == b->line());
+    CHECK(a->column() == b->column());
+    CHECK(a->text() == b->text());
+    REQUIRE(a->attributes().size() == b->attributes().size());
+    for (std::size_t i = 0; i < a->attributes().size(); ++i) {
+      const XmlAttribute& x = a->attributes()[i];
+      const XmlAttribute& y = b->attributes()[i];
+      CHECK(x.name == y.name);
+      CHECK(x.value == y.value);
+      CHECK(x.name_offset == y.name_offset);
+      CHECK(x.value_offset == y.value_offset);
+      CHECK(x.value_end == y.value_end);
+    }
+    pending.emplace_back(a->next_sibling(), b->next_sibling());
+    pending.emplace_back(a->first_child(), b->first_child());
+  }
+}
+
+}  // namespace
+
+TEST_CASE("xml document: the plain reader and tinyxml2 build the same tree") {
+  // Documents the plain reader reads itself (no reference, CDATA, DOCTYPE, CR in values or text,
+  // text in one piece): the tree is the one tinyxml2's path builds.
+  const std::vector<std::string> plain = {
+      "<a/>",
+      "<a></a>",
+      "\xEF\xBB\xBF<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<!-- c -->\n<net id='n' x = \"1\" y=''>\n"
+      "  <place id=\"p\" description=\"a > b, 'quoted'\"/>\n  <!-- <not an element> -->\n"
+      "  <transition id=\"t\">\n    <behavior name=\"B\"><param name=\"k\" value=\"v\"/></behavior>\n  </transition>\n"
+      "</net>\n<!-- after -->\n",
+      "<pnml>\r\n  <net id=\"n\">\r\n    <place id=\"p\"><name><text>  P one &gt; </text></name></place>\r\n  </net>\r\n</pnml>",
+      "<pnml><net id=\"n\"><place id=\"p\"><name><text>P one</text></name></place></net></pnml>",
+      "<r a:b=\"1\" _c.d-e=\"2\">text with \"quotes\" and 'apostrophes' &amp; more</r>",
+      "<r>\n\t<e\n\t\tk=\"v\"\n\t/>\n\t<e k='v'>x</e>\n</r>",
+  };
+  for (const std::string& text : plain) {
+    INFO("text: " << text);
+    check_same_tree(text);
+  }
+  XmlDocument doc;
+  REQUIRE(doc.parse(plain[2]));
+  CHECK(doc.read_plain());
+  REQUIRE(doc.parse(plain[4]));
+  CHECK(doc.read_plain());
+  REQUIRE(doc.parse(plain[3]));  // a reference in the text: tinyxml2 decodes it
+  CHECK_FALSE(doc.read_plain());
+  CHECK(doc.root()->first_child()->first_child()->first_child()->first_child()->text() == "P one >");
+
+  // What it leaves to tinyxml2, and errors: the same tree, or the same error at the same place.
+  const std::vector<std::string> other = {
+      "<a><![CDATA[x]]></a>",
+      "<a>x<b/>y</a>",
+      "<a v=\"&#65;\"/>",
+      "<a v=\"1\r\n2\"/>",
+      "<!DOCTYPE a><a/>",
+      "<a><?pi x?></a>",
+      "<a x=\"1\"y=\"2\"/>",
+      "<a></b>",
+      "<a>",
+      "<a x=\"1\" x=\"2\"/>",
+      "<a/><b/>",
+      "<a/>text",
+      "",
+      "  ",
+      "<a x=1/>",
+      "<a <b/>",
+      "</a>",
+      "<\xC3\xA9l\xC3\xA9ment/>",
+      "<a></a >",
+      "<a x=\"<\"/>",
+      "<a>&bogus;</a>",
+      "<a/><?xml version=\"1.0\"?>",
+      "<!-- unterminated <a/>",
+      "<a><!-- unterminated </a>",
+  };
+  for (const std::string& text : other) {
+    INFO("text: " << text);
+    check_same_tree(text);
+  }
+  // Nested deeper than the plain reader goes: tinyxml2's, the same tree.
+  std::string deep;
+  for (int k = 0; k < 60; ++k) deep += "<d>";
+  for (int k = 0; k < 60; ++k) deep += "</d>";
+  check_same_tree(deep);
+  REQUIRE(doc.parse(deep));
+  CHECK_FALSE(doc.read_plain());
+
+  // The seeded random documents (comments, CDATA, references, CR LF, text around children):
+  // whichever reader takes each, the tree is tinyxml2's.
+  std::size_t read_plain = 0;
+  for (std::uint32_t seed = 1; seed <= 400; ++seed) {
+    RandomDocument gen(seed);
+    const std::string text = gen.make();
+    INFO("seed " << seed);
+    check_same_tree(text);
+    read_plain += doc.parse(text) && doc.read_plain() ? 1 : 0;
+  }
+  CHECK(read_plain > 0);
+}
+
+TEST_CASE("xml document: the plain reader reads the shipped nets as tinyxml2 does") {
+  std::size_t files = 0;
+  std::size_t read_plain = 0;
+  for (const char* dir : {"configs/petri", "docs/examples", "examples", "tests/data/nets", "tests/data/analysis"}) {
+    const std::filesystem::path root = std::filesystem::path(TRIPODAL_SOURCE_DIR) / dir;
+    if (!std::filesystem::exists(root)) continue;
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(root)) {
+      const std::string ext = entry.path().extension().string();
+      if (ext != ".xml" && ext != ".pnml") continue;
+      std::ifstream in(entry.path(), std::ios::binary);
+      const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      INFO(entry.path().string());
+      check_same_tree(text);
+      XmlDocument doc;
+      read_plain += doc.parse(text) && doc.read_plain() ? 1 : 0;
+      ++files;
+    }
+  }
+  CHECK(files >= 20);
+  CHECK(read_plain * 2 >= files);  // most shipped nets need no tinyxml2 DOM
 }

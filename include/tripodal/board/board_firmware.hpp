@@ -15,6 +15,7 @@
 #include "tripodal/board/frame.hpp"
 #include "tripodal/board/protocol_profile.hpp"
 #include "tripodal/board/serial_port.hpp"
+#include "tripodal/core/clock.hpp"
 #include "tripodal/core/time.hpp"
 
 namespace tripodal::board {
@@ -121,6 +122,10 @@ class BoardFirmware {
   /// and runs the device loop (link watchdog, motors, battery, tank, sensors). Never throws or
   /// allocates.
   void run_until(Time now) noexcept;
+  /// The UART's receive interrupt: runs the ticks due up to `now`, then answers the requests
+  /// whose bytes have arrived at once, not at the next tick (a real board answers on reception;
+  /// a 1 ms tick alone adds up to 1 ms to every round trip). Never throws or allocates.
+  void on_receive(Time now) noexcept;
 
   // --- the panel and the environment (tests, the tool) ---
   void set_buttons(std::uint8_t held) noexcept;
@@ -225,5 +230,12 @@ class BoardFirmware {
   double used_l_ = 0.0;
   FirmwareCounters counters_;
 };
+
+/// The firmware in real time between two ticks: waits on `fd` (the line's descriptor: the
+/// pseudo-terminal's master) until bytes arrive or `deadline` passes on `clock`, and answers what
+/// arrived at once (BoardFirmware::on_receive). True when bytes arrived (the caller loops until its
+/// tick is due); false at the deadline. With fd < 0 (a stream without one), or a descriptor that
+/// hung up, it sleeps until the deadline and the requests wait for the next tick.
+bool serve_until(BoardFirmware& firmware, int fd, const Clock& clock, Time deadline) noexcept;
 
 }  // namespace tripodal::board

@@ -46,6 +46,10 @@ class ByteStream {
 inline constexpr Duration kMaxReadWait = std::chrono::milliseconds(1);
 /// How long a read with `deadline` waits at `now`: deadline - now, within [0, kMaxReadWait].
 [[nodiscard]] Duration read_wait(Time now, Time deadline) noexcept;
+/// Waits until `fd` has bytes to read, at most `max_wait` (ppoll: the wake-up is the bytes'
+/// arrival, not a timer's tick). True when it has; false on timeout, a signal, or a descriptor
+/// that failed or hung up (the caller's read finds out which). Does not read.
+[[nodiscard]] bool wait_readable(int fd, Duration max_wait) noexcept;
 
 /// Line settings; the thesis's are the defaults.
 struct SerialSettings {

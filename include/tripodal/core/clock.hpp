@@ -17,6 +17,9 @@ class Clock {
   /// Blocks the calling thread until now() >= deadline. The default yields in a loop (right for
   /// a clock another thread advances); SteadyClock sleeps on the OS's absolute monotonic timer.
   virtual void sleep_until(Time deadline) const noexcept;
+  /// How long `d` of this clock lasts on the wall clock: the timeout to hand an OS wait (poll, a
+  /// condition variable) that must end by a deadline of this clock. The default is `d` itself.
+  [[nodiscard]] virtual Duration wall_duration(Duration d) const noexcept { return d; }
 };
 
 /// Monotonic real time (std::chrono::steady_clock); its epoch is the moment it was constructed.
@@ -42,6 +45,8 @@ class ScaledClock final : public Clock {
   explicit ScaledClock(double speed = 1.0) noexcept : speed_(speed > 0.0 ? speed : 1.0) {}
   [[nodiscard]] Time now() const noexcept override;
   void sleep_until(Time deadline) const noexcept override;
+  /// `d` / speed: at 4x, 4 ms of this clock pass in 1 ms of wall time.
+  [[nodiscard]] Duration wall_duration(Duration d) const noexcept override;
   [[nodiscard]] double speed() const noexcept { return speed_; }
 
  private:
