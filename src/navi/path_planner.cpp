@@ -199,7 +199,17 @@ PlannedPath PathPlanner::plan_around(Point2D start, Point2D goal, std::span<cons
       }
     }
   }
-  return plan(start, goal);
+  // A detour starts where a safety stop or the laser held the robot: the way out of the margin
+  // (plan(Point2D, Point2D)) knows nothing of the points just closed, so it is not taken here.
+  const std::optional<CellIndex> goal_cell = grid_.world_to_cell(goal);
+  if (!start_cell || !goal_cell) return plan(start, goal);  // the outside-the-map messages
+  PlannedPath out = plan(*start_cell, *goal_cell);
+  if (out.ok()) {
+    out.waypoints.front() = start;
+    out.waypoints.back() = goal;
+    out.length_m = polyline_length_m(out.waypoints);
+  }
+  return out;
 }
 
 PlannedPath PathPlanner::plan(CellIndex start, CellIndex goal, double keep_clearance_m) {
