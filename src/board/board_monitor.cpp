@@ -1,6 +1,7 @@
 #include "tripodal/board/board_monitor.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <stdexcept>
 #include <string>
@@ -22,6 +23,9 @@ const ModuleManifest& BoardMonitor::static_manifest() {
                   "a lost link answering SYNC again within this is a blip (board.link_blip), not a fault; 0: every "
                   "loss is a fault at once (a real-time host)",
                   0.0, 60.0)
+          .text("start_task", std::string(),
+                "the task the start button starts when none runs, in plain words (\"disinfect the room 2111\"); "
+                "empty: the button only resumes a paused task")
           .build();
   return m;
 }
@@ -42,6 +46,22 @@ void BoardMonitor::on_start(ModuleContext& context) {
 void BoardMonitor::on_configure(const ParameterSet& params) {
   battery_low_percent_ = params.number("battery_low_percent");
   link_grace_ = from_seconds(params.number("link_grace_s"));
+  start_task_ = params.string("start_task");
+}
+
+// With a task running the button is the nets' (PrDisinfection resumes on board.start); at rest it
+// starts the profile's task, as an operator at the dock expects of the robot's one start button.
+void BoardMonitor::start_pressed(ModuleContext& context) const {
+  if (context.task_running) return;
+  if (start_task_.empty()) {
+    spdlog::warn(
+        "{}: start button pressed, no task running and none to start: BoardMonitor's parameter start_task "
+        "names none (e.g. start_task: \"disinfect the room 2111\")",
+        where().str());
+    return;
+  }
+  spdlog::info("start button pressed, no task running: \"{}\" (BoardMonitor's start_task)", start_task_);
+  context.command(start_task_);
 }
 
 void BoardMonitor::on_update(ModuleContext& context) {
@@ -87,7 +107,10 @@ void BoardMonitor::on_update(ModuleContext& context) {
   const std::uint8_t held = link.synchronised && link.has_drive ? link.buttons : held_;
   const auto pressed = static_cast<std::uint8_t>(held & ~held_);
   held_ = held;
-  if ((pressed & kButtonStart) != 0) context.post("board.start", "start button");
+  if ((pressed & kButtonStart) != 0) {
+    context.post("board.start", "start button");
+    start_pressed(context);
+  }
   if ((pressed & kButtonPause) != 0) context.post("board.pause", "pause button");
   if ((pressed & kButtonHome) != 0) context.post("board.home", "home button");
   if ((pressed & kButtonEmergencyStop) != 0) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <queue>
 #include <sstream>
 
@@ -107,14 +108,57 @@ PlannedPath PathPlanner::plan(Point2D start, Point2D goal) {
     out.message = msg.str();
     return out;
   }
-  out = plan(*s, *g);
+  const std::optional<CellIndex> out_of_margin = traversable(*s) ? std::nullopt : way_out(*s);
+  out = plan(out_of_margin.value_or(*s), *g);
   if (out.ok()) {
-    // Keep the exact end points rather than the cell centres.
-    out.waypoints.front() = start;
+    // Keep the exact end points rather than the cell centres; a start inside the margin first
+    // goes straight to the cell the search started from.
+    if (out_of_margin) {
+      out.cells.insert(out.cells.begin(), *s);
+      out.waypoints.insert(out.waypoints.begin(), start);
+      if (out.waypoints.size() == 2) out.waypoints.push_back(goal);  // the way out was the whole way
+    } else {
+      out.waypoints.front() = start;
+    }
     out.waypoints.back() = goal;
     out.length_m = polyline_length_m(out.waypoints);
   }
   return out;
+}
+
+std::optional<CellIndex> PathPlanner::way_out(CellIndex start) const {
+  if (!grid_.contains(start)) return std::nullopt;
+  const double here = clearance_m(start);
+  if (field_.distance_m(grid_.index(start)) <= 0.0 || here < options_.robot_radius_m - options_.start_tolerance_m) {
+    return std::nullopt;
+  }
+  const double res = grid_.resolution_m();
+  const int reach = static_cast<int>(std::ceil(options_.start_tolerance_m / res)) + 1;
+  const Point2D from = grid_.cell_center(start);
+  // Straight from the start cell to c, every cell passed at least as clear as the start's.
+  const auto outward = [&](CellIndex c) {
+    const Point2D to = grid_.cell_center(c);
+    const double len = std::hypot(to.x_m - from.x_m, to.y_m - from.y_m);
+    const int steps = std::max(1, static_cast<int>(std::ceil(len / (0.25 * res))));
+    for (int k = 1; k < steps; ++k) {
+      const double t = static_cast<double>(k) / steps;
+      const auto cell = grid_.world_to_cell({from.x_m + t * (to.x_m - from.x_m), from.y_m + t * (to.y_m - from.y_m)});
+      if (!cell || clearance_m(*cell) < here) return false;
+    }
+    return true;
+  };
+  std::optional<CellIndex> best;
+  int best_d2 = std::numeric_limits<int>::max();
+  for (int dy = -reach; dy <= reach; ++dy) {
+    for (int dx = -reach; dx <= reach; ++dx) {
+      const CellIndex c{start.x + dx, start.y + dy};
+      const int d2 = dx * dx + dy * dy;
+      if (d2 >= best_d2 || !traversable(c) || !outward(c)) continue;
+      best = c;
+      best_d2 = d2;
+    }
+  }
+  return best;
 }
 
 PlannedPath PathPlanner::plan_around(Point2D start, Point2D goal, std::span<const Point2D> obstacles, double margin_m) {
@@ -155,7 +199,17 @@ PlannedPath PathPlanner::plan_around(Point2D start, Point2D goal, std::span<cons
       }
     }
   }
-  return plan(start, goal);
+  // A detour starts where a safety stop or the laser held the robot: the way out of the margin
+  // (plan(Point2D, Point2D)) knows nothing of the points just closed, so it is not taken here.
+  const std::optional<CellIndex> goal_cell = grid_.world_to_cell(goal);
+  if (!start_cell || !goal_cell) return plan(start, goal);  // the outside-the-map messages
+  PlannedPath out = plan(*start_cell, *goal_cell);
+  if (out.ok()) {
+    out.waypoints.front() = start;
+    out.waypoints.back() = goal;
+    out.length_m = polyline_length_m(out.waypoints);
+  }
+  return out;
 }
 
 PlannedPath PathPlanner::plan(CellIndex start, CellIndex goal, double keep_clearance_m) {

@@ -1,5 +1,7 @@
 #include "tripodal/navi/planning_modules.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -192,6 +194,10 @@ void CPathPlanningModule::on_behavior_activated(const BehaviorActivation& activa
   }
   PlannedPath plan = maps_->planner().plan(from, *goal);
   if (!plan.ok()) {
+    // The behavior's reason is static text (NavigationData::path_failure); where the robot stood
+    // and why the planner refused go to the log.
+    spdlog::warn("PathPlanner: no path to '{}' from ({:.3f}, {:.3f}): {}", params.string("goal"), from.x_m, from.y_m,
+                 plan.message);
     path_.fail("no path to the goal", context);
     return;
   }

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <optional>
+#include <system_error>
 
 #include "../common/yaml_reader.hpp"
 #include "tripodal/core/net_loader.hpp"
@@ -18,14 +20,54 @@ bool iequals(std::string_view a, std::string_view b) {
          });
 }
 
-RecoveryPolicy walk(const std::string& text, const std::string& file,
-                    const std::function<bool(std::string_view)>& is_known_process) {
+using KnownProcess = std::function<bool(std::string_view)>;
+
+RecoveryPolicy parse(const std::string& text, const std::string& file, const KnownProcess& is_known_process,
+                     std::vector<std::filesystem::path>& chain);
+
+// `include: [FILE, ...]`: the rules of other files (relative to this one), after this file's own,
+// so that a robot's file shares a family's rules (charging) and adds its own (its devices' link).
+// The first rule that matches decides: this file's rules win over the included ones.
+void read_includes(const YAML::Node& list, const std::string& file, yaml::Reader& r, const KnownProcess& is_known_process,
+                   std::vector<std::filesystem::path>& chain, std::vector<RecoveryRule>& rules) {
+  if (!r.expect_list(list, "'include'")) return;
+  for (const auto& item : list) {
+    const std::optional<std::string> name = r.text(item, "an included recovery rules file", true);
+    if (!name) continue;
+    std::filesystem::path path = *name;
+    if (path.is_relative()) path = std::filesystem::path(file).parent_path() / path;
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) {
+      r.error(item, "include: no recovery rules file '" + path.string() + "'");
+      continue;
+    }
+    const std::filesystem::path canonical = std::filesystem::weakly_canonical(path, ec);
+    if (std::find(chain.begin(), chain.end(), canonical) != chain.end()) {
+      std::string cycle;
+      for (const auto& f : chain) cycle += f.filename().string() + " -> ";
+      r.error(item, "include: '" + path.string() + "' includes itself (" + cycle + canonical.filename().string() + ")");
+      continue;
+    }
+    try {
+      const RecoveryPolicy included = parse(yaml::read_file(path), path.string(), is_known_process, chain);
+      rules.insert(rules.end(), included.rules().begin(), included.rules().end());
+    } catch (const ConfigError& e) {
+      r.diagnostics().append(e.diagnostics());
+    }
+  }
+}
+
+RecoveryPolicy walk(const std::string& text, const std::string& file, const KnownProcess& is_known_process,
+                    std::vector<std::filesystem::path>& chain) {
   const YAML::Node root = yaml::parse(text, file);
   Diagnostics d;
   yaml::Reader r(file, d);
   std::vector<RecoveryRule> rules;
-  if (!r.expect_keys(root, {"recovery"}, "the recovery rules file")) throw ConfigError(d);
-  const YAML::Node list = r.require(root, "recovery", "the recovery rules file", "a list of rules");
+  if (!r.expect_keys(root, {"recovery", "include"}, "the recovery rules file")) throw ConfigError(d);
+  // A file of includes only (a robot that adds nothing of its own) needs no `recovery:`.
+  const YAML::Node list = root["include"] && !root["recovery"]
+                              ? YAML::Node(YAML::NodeType::Sequence)
+                              : r.require(root, "recovery", "the recovery rules file", "a list of rules");
   if (!list || !r.expect_list(list, "'recovery'")) throw ConfigError(d);
   for (const auto& rule_node : list) {
     RecoveryRule rule;
@@ -75,13 +117,28 @@ RecoveryPolicy walk(const std::string& text, const std::string& file,
     if (!rule_node["fault"]) r.error(rule_node, "a recovery rule: missing 'fault' (the fault message it handles)");
     rules.push_back(std::move(rule));
   }
+  if (const YAML::Node includes = root["include"]) read_includes(includes, file, r, is_known_process, chain, rules);
   if (d.has_errors()) throw ConfigError(d);
   return RecoveryPolicy(std::move(rules));
 }
 
-RecoveryPolicy parse(const std::string& text, const std::string& file,
-                     const std::function<bool(std::string_view)>& is_known_process) {
-  return yaml::guarded(file, [&] { return walk(text, file, is_known_process); });
+RecoveryPolicy parse(const std::string& text, const std::string& file, const KnownProcess& is_known_process,
+                     std::vector<std::filesystem::path>& chain) {
+  std::error_code ec;
+  chain.push_back(std::filesystem::weakly_canonical(file, ec));
+  try {
+    RecoveryPolicy out = yaml::guarded(file, [&] { return walk(text, file, is_known_process, chain); });
+    chain.pop_back();
+    return out;
+  } catch (...) {
+    chain.pop_back();
+    throw;
+  }
+}
+
+RecoveryPolicy parse(const std::string& text, const std::string& file, const KnownProcess& is_known_process) {
+  std::vector<std::filesystem::path> chain;
+  return parse(text, file, is_known_process, chain);
 }
 
 }  // namespace

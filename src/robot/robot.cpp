@@ -8,6 +8,7 @@
 #include <set>
 #include <stdexcept>
 #include <thread>
+#include <utility>
 
 #include "tripodal/behaviors/navigation_behaviors.hpp"
 #include "tripodal/behaviors/safety_behaviors.hpp"
@@ -327,6 +328,7 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
   RobotKnowledge knowledge;
   std::unique_ptr<CProcessSupervisor> supervisor;
   std::unique_ptr<CPlanner> planner;
+  std::vector<std::string> requested_commands;  // by the modules this period (ModuleContext::commands)
 
   // The behaviors the supervisor activated, as the reactive loop reports them.
   struct ActiveBehavior {
@@ -378,6 +380,7 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
     ctx.path_ids = &path_ids;
     ctx.profile_dir = profile_dir;
     if (!loops.empty()) ctx.feedback = behavior_loop().navigation_feedback();
+    ctx.task_running = planner && planner->busy();
     return ctx;
   }
 
@@ -389,6 +392,8 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
     ctx.facts.clear();
     if (ctx.heartbeat) supervisor->heartbeat(module);
     ctx.heartbeat = false;
+    for (std::string& c : ctx.commands) requested_commands.push_back(std::move(c));
+    ctx.commands.clear();
   }
 
   template <class Fn>
@@ -498,6 +503,9 @@ struct Robot::Impl final : public BehaviorHost, public ModuleDirectory {
     }
     ModuleContext ctx = context(now);
     for_each_module(ctx, [&](CModule& m) { m.update(ctx); });
+    // What the modules asked for at rest (the panel's start button): the planner's answer, a
+    // started task or a refusal, reaches its observers as a command's would.
+    for (const std::string& c : std::exchange(requested_commands, {})) (void)planner->command(c);
     if (planner->busy()) {
       planner->step();
     } else {

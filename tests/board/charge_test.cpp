@@ -2,6 +2,10 @@
 // a low battery ends PrDisinfection, the recovery rules (configs/tasks/disinfection_recovery.yaml)
 // insert PrDockCharge, the robot drives to the world's dock, the board reports charging, and the
 // section is taken up again where it stopped. And the dock's faults: occupied, without power.
+#include <spdlog/sinks/ringbuffer_sink.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdint>
@@ -13,6 +17,8 @@
 #include "tripodal/board/actuator_behaviors.hpp"
 #include "tripodal/builtin/register_all.hpp"
 #include "tripodal/navi/planning_modules.hpp"
+#include "tripodal/planner/lifecycle_recorder.hpp"
+#include "tripodal/planner/recovery.hpp"
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_board.hpp"
 #include "tripodal/sim/world.hpp"
@@ -48,12 +54,17 @@ struct ChargingRobot {
 
   // `charger_a`: the dock's charger current. The realistic 5.2 A (0.5 C, about 2 h from empty) is
   // the figure's run (docs/board-protocol.md); these tests charge at 20.8 A (2 C) to stay short.
-  explicit ChargingRobot(sim::World w, double charger_a = 20.8) : world(std::make_shared<const sim::World>(std::move(w))) {
+  // `profile_file`: one of the shipped disinfection profiles; `overrides`: parameters beyond the
+  // lanes without a dose plan.
+  explicit ChargingRobot(sim::World w, double charger_a = 20.8, const std::string& profile_file = "robots/disinfection.yaml",
+                         const std::vector<ParameterOverride>& overrides = {})
+      : world(std::make_shared<const sim::World>(std::move(w))) {
     register_all(plugins, world);
-    RobotProfile profile = load_robot_profile(kConfigs / "robots/disinfection.yaml");
+    RobotProfile profile = load_robot_profile(kConfigs / profile_file);
     profile.hardware->parameters["charger_current_a"] = std::to_string(charger_a);
     RobotOptions ro;
     ro.parameters.push_back({"coverage", "dose_target_j_m2", "0"});  // the lanes without a dose plan: shorter
+    ro.parameters.insert(ro.parameters.end(), overrides.begin(), overrides.end());
     robot = Robot::assemble(profile, plugins, clock, ro);
     hw = &dynamic_cast<sim::SimBoardHardware&>(*robot->hardware());
     if (CController* c = robot->behavior_loop().controller()) c->reset_odometry(world->start_pose);
@@ -286,4 +297,136 @@ TEST_CASE("the home button sends the robot to its dock and ends the task there",
   CHECK(r.hw->simulator().dock() == 0);  // on the pad
   CHECK_FALSE(fw.uv_lamp());
   CHECK(nth_run(report, "PrDisinfection", 1) == nullptr);  // not taken up again
+}
+
+// --- the start button at rest: the robot waiting at its dock starts its round ------------------------
+
+namespace {
+
+// What spdlog's default logger says while it lives (the robot's log lines).
+class LogCapture {
+ public:
+  LogCapture() : sink_(std::make_shared<spdlog::sinks::ringbuffer_sink_mt>(64)) {
+    spdlog::default_logger()->sinks().push_back(sink_);
+  }
+  ~LogCapture() { spdlog::default_logger()->sinks().pop_back(); }
+  LogCapture(const LogCapture&) = delete;
+  LogCapture& operator=(const LogCapture&) = delete;
+  [[nodiscard]] std::string text() const {
+    std::string all;
+    for (const std::string& l : sink_->last_formatted()) all += l;
+    return all;
+  }
+
+ private:
+  std::shared_ptr<spdlog::sinks::ringbuffer_sink_mt> sink_;
+};
+
+bool refused_a_command(const LifecycleRecorder& life) {
+  for (const LifecycleEntry& e : life.entries()) {
+    if (e.text.find("command refused") != std::string::npos) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+TEST_CASE("the start button with no task running starts the profile's start task, once", "[board][panel]") {
+  LifecycleRecorder life;  // outlives the robot, whose planner holds it
+  ChargingRobot r(dock_world());
+  r.robot->planner().add_observer(life);
+  board::BoardFirmware& fw = r.firmware();
+  r.robot->run_for(2s);
+  REQUIRE_FALSE(r.robot->planner().busy());  // waiting: nothing runs until the operator presses start
+
+  press(r, board::kButtonStart);
+  REQUIRE(r.robot->planner().busy());
+  CHECK(r.robot->planner().report().command == "disinfect the room 2111");  // BoardMonitor's start_task
+  REQUIRE_FALSE(life.entries().empty());
+  CHECK_THAT(life.entries().front().text, Catch::StartsWith("task disinfect started (\"disinfect the room 2111\")"));
+  r.run_task(30.0, [] {});
+  CHECK(fw.uv_lamp());  // the round is under way: section A disinfected
+
+  // Pressed again while it runs: the net's button (PrDisinfection resumes on it), no second task.
+  press(r, board::kButtonStart);
+  r.robot->run_for(1s);
+  CHECK(r.robot->planner().busy());
+  CHECK_FALSE(refused_a_command(life));
+  CHECK(fw.uv_lamp());
+  r.robot->planner().cancel("checked");
+  r.robot->planner().remove_observer(life);
+}
+
+TEST_CASE("the start button with no task running and no start task: nothing starts, the log says why", "[board][panel]") {
+  ChargingRobot r(dock_world(), 20.8, "robots/disinfection.yaml", {{"board", "start_task", ""}});
+  const LogCapture log;
+  press(r, board::kButtonStart);
+  r.robot->run_for(1s);
+  CHECK_FALSE(r.robot->planner().busy());
+  CHECK(r.robot->planner().state() == TaskState::idle);
+  CHECK_THAT(log.text(), Catch::Contains("disinfection.yaml:") &&
+                             Catch::Contains("start button pressed, no task running and none to start: BoardMonitor's "
+                                             "parameter start_task names none"));
+}
+
+// --- every shipped disinfection profile charges ------------------------------------------------------
+
+TEST_CASE("every shipped disinfection profile docks and charges on a low battery: rules, process, facts",
+          "[board][charge][config]") {
+  std::vector<std::filesystem::path> profiles;
+  for (const auto& e : std::filesystem::directory_iterator(kConfigs / "robots")) {
+    if (e.path().filename().string().starts_with("disinfection")) profiles.push_back(e.path());
+  }
+  REQUIRE(profiles.size() >= 2);  // disinfection.yaml, disinfection_lidar.yaml
+  auto world = std::make_shared<const sim::World>(dock_world());
+  RobotPlugins plugins;
+  register_all(plugins, world);
+  for (const std::filesystem::path& file : profiles) {
+    INFO(file.filename().string());
+    const RobotProfile profile = load_robot_profile(file);
+    Diagnostics d;
+    (void)check_robot(profile, plugins, d);
+    CHECK(d.error_count() == 0);
+    CHECK(std::any_of(profile.processes.begin(), profile.processes.end(),
+                      [](const ProcessEntry& p) { return p.name == "PrDockCharge"; }));
+    CHECK(std::any_of(profile.modules.begin(), profile.modules.end(),
+                      [](const ModuleEntry& m) { return m.type == "BatteryMonitor"; }));
+    REQUIRE_FALSE(profile.recovery.empty());
+    const RecoveryPolicy rules = RecoveryPolicy::load(profile.recovery);
+    const ProcessStep disinfection{"PrDisinfection", {{"section", "A", {}}}};
+    const RecoveryDecision low = rules.decide(disinfection, "battery low: disinfection ended safely", 0);
+    CHECK(low.action == RecoveryAction::retry);
+    REQUIRE(low.insert.size() == 1);
+    CHECK(low.insert[0].process == "PrDockCharge");
+    CHECK(rules.decide(disinfection, "home button: sent to the dock", 0).action == RecoveryAction::end);
+    CHECK(rules.decide({"PrDockCharge", {}}, "charging stopped", 0).action == RecoveryAction::abort);
+  }
+}
+
+TEST_CASE("the lidar profile: a low battery docks, charges and resumes the section where it stopped", "[board][charge]") {
+  // The scan-matching localizer starts where the world puts the robot (room 2111), not at the
+  // profile's charger pose.
+  ChargingRobot r(
+      dock_world(), 20.8, "robots/disinfection_lidar.yaml",
+      {{"localizer", "initial_x_m", "5.0"}, {"localizer", "initial_y_m", "6.0"}, {"localizer", "initial_theta_rad", "1.5708"}});
+  board::BoardFirmware& fw = r.firmware();
+  fw.set_state_of_charge(0.18);
+  REQUIRE(r.robot->command("disinfect the room 2111").accepted);
+  bool board_said_charging = false;
+  r.run_task(6000.0, [&] { board_said_charging = board_said_charging || r.hw->board().link().battery().charging; });
+  const TaskReport& report = r.robot->planner().report();
+  INFO(report.str());
+  REQUIRE(report.state == TaskState::succeeded);
+  REQUIRE(report.recoveries.size() == 1);
+  CHECK(report.recoveries[0].fault == "battery low: disinfection ended safely");
+  CHECK(report.recoveries[0].new_plan == "PrDockCharge() -> PrDisinfection(section=A)");
+  const ProcessRecord* charge = nth_run(report, "PrDockCharge", 0);
+  const ProcessRecord* resumed = nth_run(report, "PrDisinfection", 1);
+  REQUIRE(charge != nullptr);
+  REQUIRE(resumed != nullptr);
+  CHECK(charge->success);
+  CHECK(resumed->success);
+  CHECK(board_said_charging);
+  CHECK(fw.state_of_charge() > 0.85);
+  CHECK(r.robot->module<navi::CCoverageModule>()->progress().at("A").finished);
 }

@@ -174,6 +174,34 @@ TEST_CASE("PathPlanner: across the demo workspace", "[navi][planner][workspace]"
   CHECK(r.length_m < std::hypot(8.2, 30.2) * 1.15);
 }
 
+// Room 3211 after a charge: section C ended with the robot at (9.221, 17.747), its cell 5 mm
+// inside the 0.3 m the planner keeps from the east wall (the lane's end along it, the follower's
+// tracking error), and PrAutoMove to D.entry failed with "no path to the goal": the start was in
+// collision. It stands there; it must be able to leave.
+TEST_CASE("PathPlanner: a start a few millimetres inside the margin leads straight out, never nearer the wall",
+          "[navi][planner][workspace]") {
+  const MapFile m = load_map(std::string(TRIPODAL_SOURCE_DIR) + "/configs/worlds/workspace_map.yaml");
+  PathPlanner p(m.grid, {.robot_radius_m = 0.3});
+  const Point2D end_of_c{9.2214, 17.7467};
+  const auto cell = m.grid.world_to_cell(end_of_c);
+  REQUIRE(cell);
+  REQUIRE_FALSE(p.traversable(*cell));  // the cause: the planner's start in collision
+  CHECK(p.clearance_m(*cell) > 0.28);
+  const PlannedPath r = p.plan(end_of_c, Point2D{5.0, 25.0});  // into section D
+  INFO(r.message);
+  REQUIRE(r.ok());
+  CHECK(r.waypoints.front().x_m == end_of_c.x_m);
+  CHECK(r.waypoints.front().y_m == end_of_c.y_m);
+  REQUIRE(r.cells.size() >= 2);
+  CHECK(r.cells.front() == *cell);
+  for (std::size_t i = 1; i < r.cells.size(); ++i) CHECK(p.traversable(r.cells[i]));  // out, then as always
+  // The way out is short: to the nearest cell of full clearance.
+  CHECK(std::hypot(r.waypoints[1].x_m - end_of_c.x_m, r.waypoints[1].y_m - end_of_c.y_m) < 0.1);
+  // Deeper than the tolerance it is a collision, as before ("clear failures").
+  PathPlanner strict(m.grid, {.robot_radius_m = 0.3, .start_tolerance_m = 0.0});
+  CHECK(strict.plan(end_of_c, Point2D{5.0, 25.0}).status == PlanStatus::start_in_collision);
+}
+
 namespace {
 
 // Least distance from the polyline (sampled every centimetre) to the square of any occupied cell.

@@ -1,7 +1,10 @@
 #include "tripodal/planner/recovery.hpp"
 
-#include <catch2/catch.hpp>
+#include <unistd.h>
 
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -240,4 +243,92 @@ TEST_CASE("PrBackOff succeeds when BhBackOff is done or failed, and after 8 s wh
   const SimulationResult held = run("");
   CHECK(held.outcome == Outcome::success);
   CHECK(to_seconds(held.end_time) == Approx(8.0));
+}
+
+// --- include: a robot's rules file shares a family's rules -----------------------------------------
+
+namespace {
+
+// A folder of rules files for one test, removed after it.
+class RulesDir {
+ public:
+  RulesDir() : path_(std::filesystem::temp_directory_path() / ("tripodal_recovery_" + std::to_string(::getpid()))) {
+    std::filesystem::create_directories(path_);
+  }
+  ~RulesDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  RulesDir(const RulesDir&) = delete;
+  RulesDir& operator=(const RulesDir&) = delete;
+  std::filesystem::path write(const std::string& name, const std::string& text) const {
+    std::ofstream(path_ / name) << text;
+    return path_of(name);
+  }
+  [[nodiscard]] std::filesystem::path path_of(const std::string& name) const { return path_ / name; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+}  // namespace
+
+TEST_CASE("include: the included file's rules follow the file's own, which win for the same fault") {
+  const RulesDir dir;
+  dir.write("family.yaml", R"(recovery:
+  - fault: battery low
+    process: PrDisinfection
+    insert:
+      - PrDockCharge: {}
+    then: retry
+  - fault: path blocked
+    then: abort
+)");
+  const auto robot = dir.write("robot.yaml", R"(include: [family.yaml]
+recovery:
+  - fault: path blocked
+    insert:
+      - PrWait: {}
+    then: retry
+)");
+  const RecoveryPolicy policy = RecoveryPolicy::load(robot);
+  REQUIRE(policy.rules().size() == 3);
+  CHECK(policy.rules()[0].fault == "path blocked");
+  CHECK(policy.rules()[1].fault == "battery low");
+  CHECK(policy.rules()[1].where.str().find("family.yaml:2:5") != std::string::npos);  // located in its own file
+  const ProcessStep drive{"PrAutoMove", {}};
+  CHECK(policy.decide(drive, "path blocked", 0).action == RecoveryAction::retry);  // the robot's rule
+  Plan plan;
+  plan.task = "disinfect";
+  plan.stages.push_back({{{"PrDisinfection", {}}}});
+  const auto low = policy.decide(plan.stages[0].steps[0], "battery low", 0);
+  CHECK(to_string(RecoveryPolicy::remaining_plan(plan, 0, low)) == "PrDockCharge() -> PrDisinfection()");
+  // A file of includes only.
+  CHECK(RecoveryPolicy::load(dir.write("only.yaml", "include: [family.yaml]\n")).rules().size() == 2);
+}
+
+TEST_CASE("include: a missing file and a file that includes itself are errors at the entry") {
+  const RulesDir dir;
+  dir.write("a.yaml", "include: [b.yaml]\nrecovery: []\n");
+  dir.write("b.yaml", "include: [a.yaml]\nrecovery: []\n");
+  const auto missing = dir.write("missing.yaml", "recovery: []\ninclude:\n  - nowhere.yaml\n");
+  CHECK_THROWS_WITH(RecoveryPolicy::load(missing), Catch::Contains("missing.yaml:3:5: error: include: no recovery rules file") &&
+                                                       Catch::Contains("nowhere.yaml"));
+  CHECK_THROWS_WITH(
+      RecoveryPolicy::load(dir.path_of("a.yaml")),
+      Catch::Contains("b.yaml:1:11: error: include: ") && Catch::Contains("includes itself (a.yaml -> b.yaml -> a.yaml)"));
+  CHECK_THROWS_WITH(RecoveryPolicy::load(dir.write("bad.yaml", "include: family.yaml\nrecovery: []\n")),
+                    Catch::Contains("bad.yaml:1:10") && Catch::Contains("'include'"));
+}
+
+TEST_CASE("the lidar profile's rules file includes the disinfection rules: low battery, home button, blocked drive") {
+  const auto policy = RecoveryPolicy::load(TRIPODAL_SOURCE_DIR "/configs/tasks/disinfection_devices_recovery.yaml");
+  const ProcessStep disinfection{"PrDisinfection", {{"section", "A", {}}}};
+  const auto low = policy.decide(disinfection, "battery low: disinfection ended safely", 0);
+  CHECK(low.action == RecoveryAction::retry);
+  CHECK(low.reason ==
+        "fault \"battery low: disinfection ended safely\" of PrDisinfection: insert PrDockCharge, then retry (1/6)");
+  CHECK(policy.decide(disinfection, "home button: sent to the dock", 0).action == RecoveryAction::end);
+  CHECK(policy.decide({"PrAutoMove", {}}, "path blocked", 0).action == RecoveryAction::retry);
+  CHECK(policy.decide({"PrAutoMove", {}}, "module board failed: link lost", 0).action == RecoveryAction::retry);
 }

@@ -16,12 +16,15 @@
 //   board.battery_low     the battery at or below battery_low_percent (and not charging); again
 //                         every 3 s while it stays low
 // and keeps the fact `board_linked` (the link synchronised) for the nets' guards (PrBoardReconnect
-// waits on it). It only reads: the actuators are command channels the behaviors write (actuator_behaviors.hpp).
+// waits on it). Start pressed with no task running asks the planner for the task the parameter
+// start_task names (the robot waiting at its dock starts its round), or logs that none is named.
+// It only reads: the actuators are command channels the behaviors write (actuator_behaviors.hpp).
 // A fault is also reported as the module's failure ("<module>.fault"), so every running process
 // fails unless its net takes the event, and the planner's recovery rules decide.
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include "tripodal/board/board_hardware.hpp"
 #include "tripodal/processes/module.hpp"
@@ -41,6 +44,8 @@ class BoardMonitor final : public CModule {
   void on_configure(const ParameterSet& params) override;
 
  private:
+  void start_pressed(ModuleContext& context) const;
+
   bool started_ = false;
   bool link_up_ = false;
   std::uint64_t losses_seen_ = 0;
@@ -53,6 +58,7 @@ class BoardMonitor final : public CModule {
   bool battery_low_ = false;
   Time next_low_post_{};
   double battery_low_percent_ = 15.0;
+  std::string start_task_;
   static constexpr Duration kBatteryLowRepeat{std::chrono::seconds(3)};
 };
 

@@ -23,6 +23,12 @@ struct PathPlannerOptions {
   /// tracking error: A* cells nearer than this cost more (up to 1 + kClearanceWeight times a
   /// step at the robot radius), and a shortcut never comes nearer than the cells it replaces.
   double preferred_clearance_m = 0.0;
+  /// A robot stands where its follower left it: at the end of a lane along a wall it may stand a
+  /// few millimetres inside the margin the planner keeps (tracking error, the lane's cells). A
+  /// start (plan(Point2D, Point2D)) with at least robot_radius_m - start_tolerance_m of clearance
+  /// is not in collision: the plan first leads straight out to the nearest cell of full clearance,
+  /// never nearer the obstacle than the robot stands.
+  double start_tolerance_m = 0.1;
 };
 
 enum class PlanStatus { ok, start_outside_map, goal_outside_map, start_in_collision, goal_in_collision, unreachable };
@@ -49,7 +55,8 @@ class PathPlanner final {
  public:
   PathPlanner(const OccupancyGrid& grid, PathPlannerOptions options = {});
 
-  /// Plans from start to goal (map frame, metres).
+  /// Plans from start to goal (map frame, metres); a start within start_tolerance_m of the
+  /// robot radius gets the way out first (PathPlannerOptions::start_tolerance_m).
   [[nodiscard]] PlannedPath plan(Point2D start, Point2D goal);
   /// Plans between two cells.
   [[nodiscard]] PlannedPath plan(CellIndex start, CellIndex goal) { return plan(start, goal, options_.preferred_clearance_m); }
@@ -91,6 +98,10 @@ class PathPlanner final {
   [[nodiscard]] const PathPlannerOptions& options() const noexcept { return options_; }
 
  private:
+  // The nearest traversable cell a straight move from `start` reaches without coming nearer an
+  // obstacle, when start lies within start_tolerance_m of the robot radius; nullopt otherwise.
+  [[nodiscard]] std::optional<CellIndex> way_out(CellIndex start) const;
+
   OccupancyGrid grid_;
   PathPlannerOptions options_;
   DistanceField field_;

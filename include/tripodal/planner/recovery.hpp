@@ -30,8 +30,9 @@ class RecoveryPolicy {
   RecoveryPolicy() = default;
   explicit RecoveryPolicy(std::vector<RecoveryRule> rules) : rules_(std::move(rules)) {}
 
-  /// Loads rules from YAML (`recovery:` list; docs/planner.md); throws ConfigError with every
-  /// error located.
+  /// Loads rules from YAML (`recovery:` list; docs/planner.md), then those of the files its
+  /// `include:` list names (relative to it; a rule of the file itself wins); throws ConfigError
+  /// with every error located (a missing or self-including file at its entry).
   static RecoveryPolicy load(const std::filesystem::path& file,
                              const std::function<bool(std::string_view)>& is_known_process = {});
   static RecoveryPolicy load_from_string(std::string_view yaml, std::string_view name,

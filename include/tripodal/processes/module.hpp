@@ -90,8 +90,17 @@ struct ModuleContext {
   /// keeps the latest value of each, so a process started later reads it too.
   std::vector<std::pair<std::string, Value>> facts;
   bool heartbeat = false;                        ///< the module is alive (supervisor watchdog)
+  /// Whether the planner runs a task (set by the robot before each update): a panel's start
+  /// button starts one only when none runs.
+  bool task_running = false;
+  /// Task commands in plain words the module asks for while no task runs (the panel's start
+  /// button, BoardMonitor's start_task): after the modules' update the robot gives them to the
+  /// planner as Robot::command would; a refusal is the planner's ("command refused" in the life cycle).
+  std::vector<std::string> commands;
 
   void post(std::string event, std::string message = {}) { events.push_back({now, std::move(event), std::move(message)}); }
+  /// Asks the planner for a task (see `commands`).
+  void command(std::string text) { commands.push_back(std::move(text)); }
   /// Sets a fact the running processes' nets declare. A type that sets facts lists them among its
   /// manifest's outputs: the profile check (check_robot) finds there who provides a fact a net reads.
   void set_fact(std::string name, Value value) { facts.emplace_back(std::move(name), std::move(value)); }
