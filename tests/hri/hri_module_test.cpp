@@ -391,6 +391,18 @@ TEST_CASE("a word corrected into a command's verb does not make a question a com
   CHECK(jinny.hri.handle("take me to node").kind == HriReply::Kind::task_refused);
 }
 
+TEST_CASE("an entry that starts a task answers only when it covers the input as surely as a command (issue 37)") {
+  Jinny jinny;
+  // "see" and "time" are in the visit to PSR-1 ("I want to see PSR-1"), not enough to start it.
+  HriReply r = jinny.hri.handle("See you next time");
+  CHECK(r.task.empty());
+  CHECK(jinny.started.empty());
+  // Said whole, the visit still starts.
+  r = jinny.hri.handle("I want to see the cleaning robot");
+  CHECK(r.entry_id == "show_node1");
+  CHECK(jinny.started.size() == 1);
+}
+
 TEST_CASE("LED buttons: a press is the request bound to the button, an unbound button does nothing") {
   HriOptions options;
   options.buttons = {{"hello", "Introduce yourself."}, {"tour", "Guide me to node 1"}};
