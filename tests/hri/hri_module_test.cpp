@@ -432,16 +432,19 @@ TEST_CASE("the internal state the HRI displays: task, process, fault") {
 }
 
 TEST_CASE("the visitor development set (issue 37) is answered right typed") {
-  // 225 utterances written in one sitting from the base's answers and the task list (issue 37):
-  // 98/135 at commit ea75fae, before the lexicon; 109/135 with it (the lexicon was tuned here).
-  REQUIRE(utterance_set("visitors_dev.yaml").size() >= 130);
-  CHECK(typed_accuracy("visitors_dev.yaml") >= 0.80);
+  // 441 utterances in two batches written in one sitting each from the base's answers and the task
+  // list (issue 37); this part was tuned on. First batch: 98/135 at commit ea75fae, before the
+  // lexicon; 108/135 with it. Both batches: 225/265 before the second round (answers, word counts,
+  // senses in use), 234/265 after it.
+  REQUIRE(utterance_set("visitors_dev.yaml").size() >= 260);
+  CHECK(typed_accuracy("visitors_dev.yaml") >= 0.85);
 }
 
 TEST_CASE("the visitor held-out set (issue 37) is answered right typed") {
-  // Never tuned on: 61/90 at commit ea75fae, 64/90 with the lexicon when first run.
-  REQUIRE(utterance_set("visitors_heldout.yaml").size() >= 90);
-  CHECK(typed_accuracy("visitors_heldout.yaml") >= 0.70);
+  // Never tuned on: 143/176 before the second round, 141/176 after it (the first batch alone:
+  // 61/90 at commit ea75fae, 67/90 with the lexicon).
+  REQUIRE(utterance_set("visitors_heldout.yaml").size() >= 170);
+  CHECK(typed_accuracy("visitors_heldout.yaml") >= 0.78);
 }
 
 TEST_CASE("no typed utterance of any set starts a task it did not ask for") {
@@ -457,5 +460,5 @@ TEST_CASE("no typed utterance of any set starts a task it did not ask for") {
       if (started) CHECK(r.task == e.task);
     }
   }
-  CHECK(inputs >= 380);
+  CHECK(inputs >= 640);
 }
