@@ -412,6 +412,18 @@ HriModule::Decision HriModule::decide(std::string_view utterance) const {
     hits.erase(std::remove_if(hits.begin(), hits.end(), [&](const RetrievalHit& h) { return !entries_[h.entry].action.empty(); }),
                hits.end());
   }
+  // Starting a task asks for more than answering: an entry that starts one answers only when it
+  // covers the utterance as surely as a command that starts like one ("see you next time" shares
+  // "see" and "time" with "I want to see PSR-1" and started the guide).
+  if (!d.retrieval.hits.empty() && !entries_[d.retrieval.hits.front().entry].action.empty() &&
+      d.retrieval.hits.front().confidence < options_.command_confidence_threshold) {
+    auto& hits = d.retrieval.hits;
+    hits.erase(std::remove_if(hits.begin(), hits.end(),
+                              [&](const RetrievalHit& h) {
+                                return !entries_[h.entry].action.empty() && h.confidence < options_.command_confidence_threshold;
+                              }),
+               hits.end());
+  }
   const Retrieval& r = d.retrieval;
   const bool confident = !r.hits.empty() && r.hits.front().confidence >= options_.confidence_threshold;
   // The verb as typed: a correction that made one ("cook pasta" -> "look") is no command.

@@ -21,6 +21,19 @@ constexpr Xapian::termcount kTopicWdf = 2;
 constexpr Xapian::termcount kQuestionWdf = 1;
 // How much a stop word of the utterance counts in the ranking, relative to a content word.
 constexpr double kStopWordScale = 0.2;
+// How much an entry's answer tells of what the entry is about, against its keywords and questions:
+// "which robot patrols at night" is about PSR-1, whose answer says it patrols the building at night,
+// but an answer also says things the entry is not about ("just in time for this festival").
+constexpr Xapian::termcount kAnswerWdf = 1;
+constexpr double kAnswerCloseness = 0.6;
+// A word no entry has weighs what a word of ordinary text tells: a rare one (a name, "chess") as the
+// rarest of the base, a common one ("need", "use", "year") less, by its count in the Semantic
+// Concordance (1 - kCommonWordSlope ln(1 + count), never below kCommonWordFloor of it: "year", 450, weighs 63 %), so one
+// everyday word does not sink a question whose telling words an entry has.
+constexpr double kCommonWordSlope = 0.06;
+constexpr double kCommonWordFloor = 0.25;
+// The related words whose mention in an answer counts (synonyms, derivations, similar adjectives).
+constexpr double kDerivationOrCloser = 0.8;
 
 // True when one word is the other with one letter doubled ("helo", "hello").
 bool differs_by_doubling(std::string_view a, std::string_view b) {
@@ -49,6 +62,18 @@ struct KnowledgeIndex::Impl {
   std::map<std::size_t, std::vector<std::pair<std::string, Xapian::doccount>>> by_length;
 
   [[nodiscard]] std::string term(const std::string& word) const { return "Z" + stem(word); }
+  // The same word in an entry's answer.
+  [[nodiscard]] static std::string answer_term(const std::string& t) { return "A" + t.substr(1); }
+
+  void index_answer(Xapian::Document& doc, std::string_view text) {
+    for (const auto& w : hri::words(text)) {
+      if (hri::is_stop_word(w) || w.size() < 3) continue;
+      doc.add_term(answer_term(term(w)), kAnswerWdf);
+      if (options.lexicon) {
+        for (const auto& f : options.lexicon->base_forms(w)) doc.add_term(answer_term(term(f)), kAnswerWdf);
+      }
+    }
+  }
 
   void index_text(Xapian::Document& doc, std::string_view text, Xapian::termcount wdf, std::set<std::string>& words_seen) {
     const std::vector<std::string> ws = hri::words(text);
@@ -81,6 +106,20 @@ struct KnowledgeIndex::Impl {
         }
         for (const auto& rel : options.lexicon->related(w)) {
           if (db.term_exists(term(rel.word))) g.terms.emplace_back(term(rel.word), rel.closeness);
+          if (rel.closeness >= kDerivationOrCloser && db.term_exists(answer_term(term(rel.word)))) {
+            g.terms.emplace_back(answer_term(term(rel.word)), rel.closeness * kAnswerCloseness);
+          }
+        }
+      }
+      // The word and its base forms in the entries' answers.
+      if (!hri::has_digit(w) && w.size() >= 3) {
+        std::vector<std::string> forms{w};
+        if (options.lexicon) {
+          for (const auto& f : options.lexicon->base_forms(w)) forms.push_back(f);
+        }
+        for (const auto& f : forms) {
+          const std::string a = answer_term(term(f));
+          if (db.term_exists(a)) g.terms.emplace_back(a, kAnswerCloseness);
         }
       }
       out.push_back(std::move(g));
@@ -132,6 +171,9 @@ KnowledgeIndex::KnowledgeIndex(const KnowledgeBase& base, RetrievalOptions optio
     x.index_text(doc, e.topic, kTopicWdf, seen);
     for (const auto& q : e.questions) x.index_text(doc, q, kQuestionWdf, seen);
     // Documents are numbered from 1 in the order added: docid - 1 is the entry's index.
+    // The answer of an entry that starts a task says what the robot will do ("I will take you to
+    // node 0"), not what the visitor asked: matched, it made "take me to node" start the visit.
+    if (e.action.empty()) x.index_answer(doc, e.answer);
     x.db.add_document(doc);
     for (const auto& w : seen) ++word_entries[w];
   }
@@ -209,7 +251,12 @@ Retrieval KnowledgeIndex::search_unguarded(std::string_view utterance) const {
       double& q = query_terms[t];
       q = std::max(q, closeness);
     }
-    weight[i] = idf_of(groups[i].terms.front().first);
+    const std::string& own = groups[i].terms.front().first;
+    weight[i] = idf_of(own);
+    if (x.options.lexicon && x.db.get_termfreq(own) == 0) {
+      const double count = static_cast<double>(x.options.lexicon->frequency(content[i]));
+      weight[i] *= std::max(kCommonWordFloor, 1.0 - kCommonWordSlope * std::log1p(count));
+    }
     total += weight[i];
   }
 
@@ -241,7 +288,9 @@ Retrieval KnowledgeIndex::search_unguarded(std::string_view utterance) const {
       double best = 0.0;
       for (const auto& [t, closeness] : groups[i].terms) {
         if (matching.count(t) == 0) continue;
-        best = std::max(best, t == groups[i].terms.front().first ? weight[i] : std::min(weight[i], idf_of(t)) * closeness);
+        // An answer's word is the utterance's own word (or a close relative), as telling as itself.
+        const bool own_or_answer = t == groups[i].terms.front().first || t.front() == 'A';
+        best = std::max(best, own_or_answer ? weight[i] * closeness : std::min(weight[i], idf_of(t)) * closeness);
       }
       matched += best;
     }

@@ -29,6 +29,10 @@ constexpr double kHypernym = 0.5;
 constexpr double kHyponym = 0.7;
 constexpr double kDerivation = 0.8;
 constexpr double kSimilar = 0.8;
+// A sense counts when the Semantic Concordance met it at least this share as often as the word's
+// first sense: "song" is a piece of music, not a bird's call (which made "sing me a song" a
+// question about Jinny's name, "what should I call you").
+constexpr double kMinSenseShare = 0.25;
 
 // WordNet's detachment rules (morphy): the suffix of an inflected form and what replaces it.
 struct Detachment {
@@ -67,6 +71,37 @@ struct Lexicon::Impl {
   // Per part of speech: irregular forms and their base forms ("made" -> "make").
   std::array<std::unordered_map<std::string, std::vector<std::string>>, 4> exceptions;
   std::unordered_set<std::string> word_list;
+  // Each lemma's tagged occurrences in the Semantic Concordance, over its senses and parts of speech.
+  std::unordered_map<std::string, std::size_t> counts;
+  // Each sense's count, by "lemma%ss_type#sense" (ss_type 1 noun, 2 verb, 3 adjective, 4 adverb).
+  std::unordered_map<std::string, std::size_t> sense_counts;
+
+  [[nodiscard]] std::size_t sense_count(const std::string& lemma, std::size_t pos, std::size_t sense) const {
+    const auto it = sense_counts.find(lemma + "%" + std::to_string(pos + 1) + "#" + std::to_string(sense));
+    return it == sense_counts.end() ? 0 : it->second;
+  }
+
+  void read_counts(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) {
+      spdlog::warn("hri: {}: cannot open WordNet's sense counts; every word counts as rare", path);
+      return;
+    }
+    // "know%2:31:01:: 1 672": a sense key (lemma%...), its sense number, its count.
+    std::string key;
+    std::size_t sense = 0;
+    std::size_t count = 0;
+    while (in >> key >> sense >> count) {
+      const std::size_t percent = key.find('%');
+      if (percent == std::string::npos) continue;
+      counts[key.substr(0, percent)] += count;
+      if (percent + 1 < key.size()) {
+        // Satellite adjectives (5) are numbered among the adjectives (3).
+        const char type = key[percent + 1] == '5' ? '3' : key[percent + 1];
+        sense_counts[key.substr(0, percent) + "%" + type + "#" + std::to_string(sense)] += count;
+      }
+    }
+  }
 
   void read_index(std::size_t pos) {
     const std::string path = wordnet_dir + "/index." + std::string(kPosNames[pos]);
@@ -205,6 +240,7 @@ Lexicon::Lexicon(const LexiconPaths& paths) : impl_(std::make_unique<Impl>()) {
     impl_->read_index(pos);
     impl_->read_exceptions(pos);
   }
+  impl_->read_counts(paths.sense_counts);
   std::istringstream in(read_file(paths.word_list));
   std::string w;
   while (std::getline(in, w)) {
@@ -222,7 +258,10 @@ Lexicon& Lexicon::operator=(Lexicon&&) noexcept = default;
 std::shared_ptr<const Lexicon> Lexicon::system() {
   static const std::shared_ptr<const Lexicon> lexicon = [] {
     LexiconPaths paths;
-    if (const char* dir = std::getenv("TRIPODAL_WORDNET_DIR")) paths.wordnet_dir = dir;
+    if (const char* dir = std::getenv("TRIPODAL_WORDNET_DIR")) {
+      paths.wordnet_dir = dir;
+      paths.sense_counts = std::string(dir) + "/cntlist.rev";
+    }
     if (const char* list = std::getenv("TRIPODAL_WORD_LIST")) paths.word_list = list;
     try {
       return std::make_shared<const Lexicon>(paths);
@@ -249,6 +288,15 @@ bool Lexicon::is_english(std::string_view word) const {
   // common one; function words ("whose") are in the word list only.
   if (forms.empty()) return impl_->word_list.count(w) != 0;
   return std::any_of(forms.begin(), forms.end(), [&](const auto& f) { return impl_->index[f.first].at(f.second).tagged > 0; });
+}
+
+std::size_t Lexicon::frequency(std::string_view word) const {
+  if (!impl_) return 0;
+  std::size_t best = 0;
+  for (const auto& [pos, f] : impl_->all_forms(std::string(word))) {
+    if (const auto it = impl_->counts.find(f); it != impl_->counts.end()) best = std::max(best, it->second);
+  }
+  return best;
 }
 
 std::vector<std::string> Lexicon::base_forms(std::string_view word) const {
@@ -278,7 +326,13 @@ std::vector<RelatedWord> Lexicon::related(std::string_view word) const {
     // to words a visitor does not mean ("capital" as "first-rate").
     const Impl::Lemma& lemma = x.index[pos].at(form);
     const std::size_t senses = std::min(lemma.offsets.size(), std::max<std::size_t>(1, lemma.tagged));
+    const std::size_t first_count = x.sense_count(form, pos, 1);
     for (std::size_t k = 0; k < senses; ++k) {
+      // A sense met far less often than the word's first is not what a visitor means by it
+      // ("song" as a bird's call).
+      if (k > 0 && static_cast<double>(x.sense_count(form, pos, k + 1)) < kMinSenseShare * static_cast<double>(first_count)) {
+        continue;
+      }
       const std::uint32_t offset = lemma.offsets[k];
       const Impl::Synset s = x.synset(pos, offset);
       note(s.words, kSynonym);

@@ -55,12 +55,13 @@ std::string_view expand_chat_word(std::string_view word) noexcept {
 bool is_stop_word(std::string_view word) noexcept {
   // Sorted for binary search. Kept short on purpose: "who", "where", "how" and "you" stay out
   // because entries are told apart by them ("who are you" vs "where are you").
-  static constexpr std::array<std::string_view, 66> kStop = {
-      "a", "about", "am", "an", "and", "any", "anything", "are", "at", "be", "can", "could", "d", "do",
-      "does", "for", "give", "i", "in", "is", "it", "just", "kindly", "know", "let", "ll", "m", "me", "might",
-      "my", "now", "of", "on", "or", "please", "pls", "re", "s", "say", "shall", "should", "so", "some",
-      "something", "t", "tell", "than", "that", "the", "there", "this", "to", "too", "us", "ve", "very",
-      "want", "was", "we", "what", "whats", "will", "with", "would", "yes", "your"};
+  static constexpr std::array<std::string_view, 68> kStop = {
+      "a",      "about", "am",    "an",    "and",  "any",   "anything", "are", "at",   "be",        "can",    "could",
+      "d",      "do",    "does",  "for",   "give", "i",     "in",       "is",  "it",   "just",      "kindly", "know",
+      "let",    "ll",    "m",     "may",   "me",   "might", "must",     "my",  "now",  "of",        "on",     "or",
+      "please", "pls",   "re",    "s",     "say",  "shall", "should",   "so",  "some", "something", "t",      "tell",
+      "than",   "that",  "the",   "there", "this", "to",    "too",      "us",  "ve",   "very",      "want",   "was",
+      "we",     "what",  "whats", "will",  "with", "would", "yes",      "your"};
   return std::binary_search(kStop.begin(), kStop.end(), word);
 }
 

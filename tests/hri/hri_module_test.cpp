@@ -391,6 +391,18 @@ TEST_CASE("a word corrected into a command's verb does not make a question a com
   CHECK(jinny.hri.handle("take me to node").kind == HriReply::Kind::task_refused);
 }
 
+TEST_CASE("an entry that starts a task answers only when it covers the input as surely as a command (issue 37)") {
+  Jinny jinny;
+  // "see" and "time" are in the visit to PSR-1 ("I want to see PSR-1"), not enough to start it.
+  HriReply r = jinny.hri.handle("See you next time");
+  CHECK(r.task.empty());
+  CHECK(jinny.started.empty());
+  // Said whole, the visit still starts.
+  r = jinny.hri.handle("I want to see the cleaning robot");
+  CHECK(r.entry_id == "show_node1");
+  CHECK(jinny.started.size() == 1);
+}
+
 TEST_CASE("LED buttons: a press is the request bound to the button, an unbound button does nothing") {
   HriOptions options;
   options.buttons = {{"hello", "Introduce yourself."}, {"tour", "Guide me to node 1"}};
@@ -420,16 +432,19 @@ TEST_CASE("the internal state the HRI displays: task, process, fault") {
 }
 
 TEST_CASE("the visitor development set (issue 37) is answered right typed") {
-  // 225 utterances written in one sitting from the base's answers and the task list (issue 37):
-  // 98/135 at commit ea75fae, before the lexicon; 109/135 with it (the lexicon was tuned here).
-  REQUIRE(utterance_set("visitors_dev.yaml").size() >= 130);
-  CHECK(typed_accuracy("visitors_dev.yaml") >= 0.80);
+  // 441 utterances in two batches written in one sitting each from the base's answers and the task
+  // list (issue 37); this part was tuned on. First batch: 98/135 at commit ea75fae, before the
+  // lexicon; 108/135 with it. Both batches: 225/265 before the second round (answers, word counts,
+  // senses in use), 234/265 after it.
+  REQUIRE(utterance_set("visitors_dev.yaml").size() >= 260);
+  CHECK(typed_accuracy("visitors_dev.yaml") >= 0.85);
 }
 
 TEST_CASE("the visitor held-out set (issue 37) is answered right typed") {
-  // Never tuned on: 61/90 at commit ea75fae, 64/90 with the lexicon when first run.
-  REQUIRE(utterance_set("visitors_heldout.yaml").size() >= 90);
-  CHECK(typed_accuracy("visitors_heldout.yaml") >= 0.70);
+  // Never tuned on: 143/176 before the second round, 141/176 after it (the first batch alone:
+  // 61/90 at commit ea75fae, 67/90 with the lexicon).
+  REQUIRE(utterance_set("visitors_heldout.yaml").size() >= 170);
+  CHECK(typed_accuracy("visitors_heldout.yaml") >= 0.78);
 }
 
 TEST_CASE("no typed utterance of any set starts a task it did not ask for") {
@@ -445,5 +460,5 @@ TEST_CASE("no typed utterance of any set starts a task it did not ask for") {
       if (started) CHECK(r.task == e.task);
     }
   }
-  CHECK(inputs >= 380);
+  CHECK(inputs >= 640);
 }

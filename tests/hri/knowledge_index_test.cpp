@@ -62,3 +62,18 @@ TEST_CASE("typo correction uses the base's words and the extra vocabulary, withi
   CHECK(r.corrected == "weather");
   CHECK(r.hits.front().entry == 0);
 }
+
+TEST_CASE("an entry's answer counts too, less than its keywords and questions (issue 37)") {
+  KnowledgeBase kb;
+  kb.put({"psr1", "PSR-1", {"psr-1"}, {"What is PSR-1?"}, "PSR-1 patrols the building at night.", "", {}});
+  kb.put({"psr2", "PSR-2", {"psr-2", "robot"}, {"What is PSR-2?"}, "PSR-2 cleans.", "", {}});
+  const KnowledgeIndex index(kb);
+  // Only PSR-1's answer says it patrols at night.
+  const Retrieval r = index.search("which robot patrols at night");
+  REQUIRE_FALSE(r.hits.empty());
+  CHECK(r.hits.front().entry == 0);
+  CHECK(r.hits.front().confidence > 0.3);  // without the answer: 0 (measured 0.35)
+  CHECK(r.hits.front().confidence < 1.0);  // a match in an answer covers less than one in a question
+  // Words of one or two letters and stop words of an answer match nothing.
+  CHECK(index.search("at").hits.empty());
+}

@@ -57,6 +57,40 @@ TEST_CASE("the system lexicon knows English words, their base forms and related 
   }
 }
 
+TEST_CASE("the lexicon knows how common a word is, and relates a word through its senses in use only (issue 37)") {
+  const auto lexicon = Lexicon::system();
+  REQUIRE_FALSE(lexicon->empty());
+  // The Semantic Concordance's counts: everyday words are common, names and rare words are not.
+  CHECK(lexicon->frequency("know") > 500);
+  CHECK(lexicon->frequency("year") > lexicon->frequency("music"));
+  CHECK(lexicon->frequency("running") >= lexicon->frequency("run"));  // the commonest base form's count
+  CHECK(lexicon->frequency("samsung") == 0);
+  CHECK(lexicon->frequency("xqzt") == 0);
+  // "song" is a piece of music; its rare sense "a bird's call" no longer relates it to "call" (which
+  // made "sing me a song" a question about what to call Jinny).
+  CHECK_FALSE(has_related(*lexicon, "song", "call"));
+  CHECK(has_related(*lexicon, "song", "ballad"));
+}
+
+TEST_CASE("a common word the base lacks does not sink the entry of the telling words (issue 37)") {
+  const KnowledgeBase jinny = KnowledgeBase::load(TRIPODAL_SOURCE_DIR "/configs/hri/jinny.xml");
+  const KnowledgeIndex index(jinny, {.lexicon = Lexicon::system()});
+  const auto id = [&](const Retrieval& r) { return jinny.entries()[r.hits.front().entry].id; };
+  // "running" and "out" are everyday words: battery covers most of what is asked.
+  const Retrieval r = index.search("are you running out of battery");
+  REQUIRE_FALSE(r.hits.empty());
+  CHECK(id(r) == "battery");
+  // ... and covers more than with a rare word in its place (measured 0.50 against 0.34).
+  const Retrieval rare = index.search("are you xylophoning out of battery");
+  REQUIRE_FALSE(rare.hits.empty());
+  CHECK(r.hits.front().confidence > rare.hits.front().confidence + 0.1);
+  // A rare word the base lacks ("samsung") still weighs as much as the base's rarest.
+  const Retrieval name = index.search("samsung stock");
+  REQUIRE_FALSE(name.hits.empty());
+  CHECK(id(name) == "stock");
+  CHECK(name.hits.front().confidence < 0.5);
+}
+
 TEST_CASE("a lexicon whose files are missing or malformed is refused naming the file") {
   LexiconPaths missing;
   missing.wordnet_dir = "/nonexistent/wordnet";

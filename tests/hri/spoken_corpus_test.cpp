@@ -215,15 +215,15 @@ TEST_CASE("spoken visitors: a subset heard through the interpolated model, clean
   }
   testing::SpokenJinny jinny;
   const auto recognizer = jinny.recognizer(kGeneralWeight);
-  // Every ninth utterance of both parts: 25 of 225.
+  // Every ninth utterance of both parts: 50 of 441.
   std::vector<Utterance> subset = load_set("visitors_dev.yaml", 9);
   for (auto& u : load_set("visitors_heldout.yaml", 9)) subset.push_back(std::move(u));
-  REQUIRE(subset.size() >= 25);
+  REQUIRE(subset.size() >= 45);
   const Figures clean = speak(subset, {}, *recognizer, std::nullopt);
   std::cout << row("visitors, every 9th", {}, clean) << "\n" << clean.misses;
   CHECK(clean.wrong_tasks == 0);
-  CHECK(clean.accuracy() >= 0.35);
-  CHECK(clean.wer() <= 0.45);
+  CHECK(clean.accuracy() >= 0.55);  // measured 31/50 = 62 %, WER 17.3 % (issue 37, second round)
+  CHECK(clean.wer() <= 0.25);
   const std::optional<AudioClip> noise = room_noise(20.0);
   if (!noise) {
     WARN("sox is not installed: the room-noise part is skipped (scripts/install-deps.sh installs it)");
@@ -233,7 +233,7 @@ TEST_CASE("spoken visitors: a subset heard through the interpolated model, clean
   const Figures in_noise = speak(subset, noisy, *recognizer, noise);
   std::cout << row("visitors, every 9th", noisy, in_noise) << "\n" << in_noise.misses;
   CHECK(in_noise.wrong_tasks == 0);
-  CHECK(in_noise.accuracy() >= 0.25);
+  CHECK(in_noise.accuracy() >= 0.40);  // measured 24/50 = 48 %, WER 32.4 %
 }
 
 TEST_CASE("spoken visitors: the whole grid of voices, speeds and noise (a long evaluation)", "[.spoken-eval]") {

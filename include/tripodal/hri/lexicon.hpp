@@ -23,6 +23,9 @@ struct RelatedWord {
 struct LexiconPaths {
   std::string wordnet_dir = "/usr/share/wordnet";
   std::string word_list = "/usr/share/dict/american-english";
+  /// WordNet's sense counts in the Semantic Concordance (`cntlist.rev`): how often a word is met in
+  /// text. Optional: a missing file leaves every word's `frequency` 0.
+  std::string sense_counts = "/usr/share/wordnet/cntlist.rev";
 };
 
 /// Read-only after construction; safe to share between threads.
@@ -54,6 +57,12 @@ class Lexicon {
   /// WordNet's base forms of `word` ("made" -> "make", "toilets" -> "toilet"), the word itself
   /// first when WordNet has it; empty when WordNet knows no form of it.
   [[nodiscard]] std::vector<std::string> base_forms(std::string_view word) const;
+
+  /// How often the word is met in ordinary English text: the Semantic Concordance's count of its
+  /// most used base form, summed over that form's senses ("know" 954, "year" 450, "music" 65,
+  /// "samsung" 0). A word every conversation uses ("need", "use") tells little of what a question
+  /// is about; a rare one (a name, "chess") tells a lot. 0 for a word WordNet lacks.
+  [[nodiscard]] std::size_t frequency(std::string_view word) const;
 
   /// Single words related to `word` through its base forms' senses in use (at least the most
   /// frequent one): synonyms (closeness 1),
