@@ -354,8 +354,9 @@ int eval_one(const EvalArgs& a, const std::filesystem::path& file, std::ostream&
   }
   out << "  global:        " << converged << "/" << a.global_trials << " starts converged (within 0.3 m), " << wrong
       << " settled on a wrong place; scans to converge mean " << std::setprecision(1) << mean(scans_needed) << " (max "
-      << (scans_needed.empty() ? 0.0 : *std::max_element(scans_needed.begin(), scans_needed.end())) << "); "
+      << (scans_needed.empty() ? 0.0 : *std::max_element(scans_needed.begin(), scans_needed.end())) << "); " << std::fixed
       << std::setprecision(0) << mean(search_ms) << " ms CPU per scan while searching\n";
+  out.unsetf(std::ios::floatfield);
   return kOk;
 }
 
