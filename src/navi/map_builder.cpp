@@ -18,13 +18,13 @@ MapBuilder::MapBuilder(Point2D lower, Point2D upper, MapBuilderOptions options)
   const LoopClosureOptions& loop = options_.loop;
   if (!(loop.keyframe_m > 0.0 && loop.keyframe_rad > 0.0 && loop.every_keyframes >= 1 && loop.min_travel_m >= 0.0 &&
         loop.search_radius_m > 0.0 && loop.submap_keyframes >= 1 && loop.min_quality > 0.0 && loop.min_quality <= 1.0 &&
-        loop.settled_m >= 0.0 && loop.settled_rad >= 0.0 && loop.agree_keyframes >= 1 && loop.agree_m > 0.0 &&
-        loop.agree_rad > 0.0 && loop.exclusion_m > 0.0 && loop.distinct_margin >= 0.0 && loop.drift_base_m >= 0.0 &&
-        loop.drift_m_per_m >= 0.0 && loop.drift_base_rad >= 0.0 && loop.drift_rad_per_m >= 0.0)) {
+        loop.settled_chi2 >= 0.0 && loop.agree_keyframes >= 1 && loop.agree_m > 0.0 && loop.agree_rad > 0.0 &&
+        loop.exclusion_m > 0.0 && loop.distinct_margin >= 0.0 && loop.drift_base_m >= 0.0 && loop.drift_m_per_m >= 0.0 &&
+        loop.drift_base_rad >= 0.0 && loop.drift_rad_per_m >= 0.0)) {
     d.error({},
             "map builder: loop closure options out of range (keyframe_m, keyframe_rad, search_radius_m, agree_m, "
             "agree_rad, exclusion_m > 0; every_keyframes, submap_keyframes, agree_keyframes >= 1; min_quality in "
-            "(0, 1]; margins and drift bounds >= 0)");
+            "(0, 1]; margins, drift bounds and settled_chi2 >= 0)");
   }
   if (!(std::isfinite(options_.resolution_m) && options_.resolution_m > 0.0)) {
     d.error({}, "map builder: resolution_m must be a number > 0, got " + std::to_string(options_.resolution_m));
@@ -218,7 +218,13 @@ void MapBuilder::try_closure() {
   const Pose2D off = compose(inverse(j_to_c), compose(inverse(graph_.pose(j)), here));
   graph_.add_edge(j, c, j_to_c, loop.closure_noise, true);
   ++stats_.closures;
-  if (std::hypot(off.x_m, off.y_m) <= loop.settled_m && std::abs(off.theta_rad) <= loop.settled_rad) return;
+  const double off_chi2 =
+      (off.x_m * off.x_m + off.y_m * off.y_m) / (loop.closure_noise.sigma_xy_m * loop.closure_noise.sigma_xy_m) +
+      off.theta_rad * off.theta_rad / (loop.closure_noise.sigma_theta_rad * loop.closure_noise.sigma_theta_rad);
+  if (off_chi2 <= loop.settled_chi2) {
+    ++stats_.settled;
+    return;
+  }
   const PoseGraphReport report = graph_.optimize();
   ++stats_.solves;
   stats_.rejected += report.rejected;

@@ -47,6 +47,7 @@ void validate(const ScanMatcherOptions& o, const SourceLocation& where) {
                                                   std::to_string(o.global_max_range_m));
   need(o.global_levels >= 1 && o.global_levels <= 10, "global_levels must be 1..10, got " +
                                                           std::to_string(o.global_levels));
+  need(o.global_max_nodes >= 0, "global_max_nodes must be >= 0 (0: no budget), got " + std::to_string(o.global_max_nodes));
   need(std::isfinite(o.max_search_xy_m) && o.max_search_xy_m >= 0.0 && o.max_search_xy_m <= 5.0,
        "max_search_xy_m must be 0..5 m, got " + std::to_string(o.max_search_xy_m));
   need(std::isfinite(o.max_search_theta_rad) && o.max_search_theta_rad >= 0.0 &&
@@ -107,6 +108,16 @@ ScanMatcher::ScanMatcher(const OccupancyGrid& map, ScanMatcherOptions options, c
     field_[i] = std::isfinite(d) ? static_cast<float>(std::exp(k * d * d)) : 0.0f;
   }
 
+  free_sum_.assign(static_cast<std::size_t>(width_ + 1) * static_cast<std::size_t>(height_ + 1), 0);
+  for (int y = 0; y < height_; ++y) {
+    int row = 0;
+    for (int x = 0; x < width_; ++x) {
+      row += map_.is_free({x, y}) ? 1 : 0;
+      const std::size_t at =
+          static_cast<std::size_t>(y + 1) * static_cast<std::size_t>(width_ + 1) + static_cast<std::size_t>(x) + 1;
+      free_sum_[at] = free_sum_[at - static_cast<std::size_t>(width_ + 1)] + row;
+    }
+  }
   // Max-pooled pyramid for the global search, on the domain extended by pad_ below and left.
   const int levels = options_.global_levels;
   pad_ = 1 << levels;
@@ -502,6 +513,15 @@ ScanMatch ScanMatcher::track(const Pose2D& predicted, const Pose2D& motion, cons
   return m;
 }
 
+bool ScanMatcher::any_free(int x, int y, int side) const noexcept {
+  const int x0 = std::max(x, 0), y0 = std::max(y, 0);
+  const int x1 = std::min(x + side, width_), y1 = std::min(y + side, height_);
+  if (x0 >= x1 || y0 >= y1) return false;
+  const auto w = static_cast<std::size_t>(width_ + 1);
+  auto at = [&](int cx, int cy) { return free_sum_[static_cast<std::size_t>(cy) * w + static_cast<std::size_t>(cx)]; };
+  return at(x1, y1) - at(x0, y1) - at(x1, y0) + at(x0, y0) > 0;
+}
+
 ScanMatch ScanMatcher::match_global() {
   // Only the nearer points: a heading step moves a far point by several cells, which the
   // pooled bounds would not cover.
@@ -537,11 +557,18 @@ ScanMatch ScanMatcher::match_global() {
   const int top = options_.global_levels;
   const int tile = 1 << top;
   std::vector<Candidate> roots;
+  std::size_t nodes = 0;
+  const auto budget = static_cast<std::size_t>(options_.global_max_nodes);
+  bool stopped = false;
   for (int a = 0; a < headings; ++a) {
     const int* ox = gcx_.data() + static_cast<std::size_t>(a) * m;
     const int* oy = gcy_.data() + static_cast<std::size_t>(a) * m;
     for (int y = 0; y < height_; y += tile) {
-      for (int x = 0; x < width_; x += tile) roots.push_back({pooled_sum(top, ox, oy, m, x, y), a, x, y});
+      for (int x = 0; x < width_; x += tile) {
+        if (!any_free(x, y, tile)) continue;  // no free cell: no pose here
+        roots.push_back({pooled_sum(top, ox, oy, m, x, y), a, x, y});
+        ++nodes;
+      }
     }
   }
   auto by_score = [](const Candidate& l, const Candidate& r) { return l.score > r.score; };
@@ -550,7 +577,7 @@ ScanMatch ScanMatcher::match_global() {
   Candidate winner{-1.0f, 0, 0, 0};
   // depth-first, best child first: the first leaves found set a high bar that prunes the rest
   auto branch = [&](auto&& self, const Candidate& c, int level) -> void {
-    if (c.score <= best) return;
+    if (c.score <= best || stopped) return;
     if (level == 0) {
       if (map_.is_free({c.x, c.y})) {
         best = c.score;
@@ -563,10 +590,15 @@ ScanMatch ScanMatcher::match_global() {
     const int* oy = gcy_.data() + static_cast<std::size_t>(c.a) * m;
     std::array<Candidate, 4> kids;
     int count = 0;
+    if (budget > 0 && nodes - roots.size() >= budget) {
+      stopped = true;
+      return;
+    }
     for (int k = 0; k < 4; ++k) {
       const int x = c.x + (k & 1) * half, y = c.y + (k >> 1) * half;
-      if (x >= width_ || y >= height_) continue;
+      if (x >= width_ || y >= height_ || !any_free(x, y, half)) continue;
       kids[static_cast<std::size_t>(count++)] = {pooled_sum(level - 1, ox, oy, m, x, y), c.a, x, y};
+      ++nodes;
     }
     // best first; an insertion sort of at most four (std::sort here trips GCC 12's bounds check)
     for (int i = 1; i < count; ++i) {
@@ -577,12 +609,17 @@ ScanMatch ScanMatcher::match_global() {
     for (int k = 0; k < count; ++k) self(self, kids[static_cast<std::size_t>(k)], level - 1);
   };
   for (const Candidate& c : roots) {
-    if (c.score <= best) break;
+    if (c.score <= best || stopped) break;
     branch(branch, c, top);
   }
+  out.nodes = nodes;
+  out.exhaustive = !stopped;
   if (winner.score < 0.0f) return out;
   const GridPose g{winner.x + 0.5, winner.y + 0.5, theta0 + winner.a * step};
-  return match(from_grid(g));
+  ScanMatch refined = match(from_grid(g));
+  refined.nodes = nodes;
+  refined.exhaustive = !stopped;
+  return refined;
 }
 
 void RecentQualities::add(double quality) noexcept {

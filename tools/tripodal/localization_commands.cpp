@@ -1,19 +1,20 @@
 // `tripodal localization eval` and `tripodal map build`: the scan-matching localizer and the map
 // builder run on recorded logs (CARMEN logs or tripodal traces), scored against the logs' corrected
 // laser poses (docs/localization.md has the figures and the commands that made them).
+#include <unistd.h>
+
 #include <algorithm>
-#include <chrono>
 #include <cmath>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <memory>
 #include <optional>
 #include <ostream>
-#include <sstream>
 #include <random>
+#include <sstream>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 #include "cli_tool.hpp"
@@ -237,8 +238,14 @@ struct EvalArgs {
   std::string laser_channel = "front_laser", odom_channel = "odom", pose_channel = "laser_pose";
 };
 
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+// The tools' times are the process's CPU time, not wall time: the machines these run on are
+// shared, and a starved process's wall time says nothing about the code (issue 41).
+std::clock_t cpu_now() noexcept {
+  return std::clock();
+}
+double ms_since(std::clock_t t0) noexcept {
+  return 1000.0 * static_cast<double>(cpu_now() - t0) / static_cast<double>(CLOCKS_PER_SEC);
+}
 
 int eval_one(const EvalArgs& a, const std::filesystem::path& file, std::ostream& out) {
   const Log log = read_log(file, a.laser_channel, a.odom_channel, a.pose_channel);
@@ -279,7 +286,7 @@ int eval_one(const EvalArgs& a, const std::filesystem::path& file, std::ostream&
     PoseErrors e;
     double ms = 0.0;
     for (std::size_t i = 0; i < log.scans.size(); ++i) {
-      const auto t0 = Clock::now();
+      const auto t0 = cpu_now();
       loc.step(log.scans[i].scan, odom[i], log.scans[i].scan.stamp, events);
       if (recover && !loc.localized()) loc.relocalize();
       ms += ms_since(t0);
@@ -296,7 +303,7 @@ int eval_one(const EvalArgs& a, const std::filesystem::path& file, std::ostream&
     out << e.format("scans");
     const std::uint64_t unreliable = loc.unreliable_scans();
     out << "; localizer.lost " << lost << " times; " << unreliable << " scans unreliable; " << std::setprecision(2)
-        << ms / static_cast<double>(log.scans.size()) << " ms per scan\n";
+        << ms / static_cast<double>(log.scans.size()) << " ms CPU per scan\n";
     // the localizer's own word on its estimate, printed where a reader looks for the figures
     if (lost > 0 || 20 * unreliable > log.scans.size()) {
       out << "  WARNING: the localizer judged " << unreliable << " of " << log.scans.size()
@@ -329,7 +336,7 @@ int eval_one(const EvalArgs& a, const std::filesystem::path& file, std::ostream&
     std::vector<ModuleEvent> ev;
     bool done = false, accepted_wrong = false;
     for (std::size_t i = k0; i < log.scans.size() && i < k0 + static_cast<std::size_t>(a.global_max_scans); ++i) {
-      const auto t0 = Clock::now();
+      const auto t0 = cpu_now();
       g.step(log.scans[i].scan, odom[i], log.scans[i].scan.stamp, ev);
       if (!g.localized()) g.relocalize();  // PrGlobalLocalization: a search on every scan while lost
       search_ms.push_back(ms_since(t0));
@@ -345,10 +352,11 @@ int eval_one(const EvalArgs& a, const std::filesystem::path& file, std::ostream&
     }
     if (!done && accepted_wrong) ++wrong;
   }
-  out << "  global:        " << converged << "/" << a.global_trials << " starts converged (within 0.3 m), "
-      << wrong << " settled on a wrong place; scans to converge mean " << std::setprecision(1) << mean(scans_needed)
-      << " (max " << (scans_needed.empty() ? 0.0 : *std::max_element(scans_needed.begin(), scans_needed.end()))
-      << "); " << std::setprecision(0) << mean(search_ms) << " ms per scan while searching\n";
+  out << "  global:        " << converged << "/" << a.global_trials << " starts converged (within 0.3 m), " << wrong
+      << " settled on a wrong place; scans to converge mean " << std::setprecision(1) << mean(scans_needed) << " (max "
+      << (scans_needed.empty() ? 0.0 : *std::max_element(scans_needed.begin(), scans_needed.end())) << "); " << std::fixed
+      << std::setprecision(0) << mean(search_ms) << " ms CPU per scan while searching\n";
+  out.unsetf(std::ios::floatfield);
   return kOk;
 }
 
@@ -396,7 +404,7 @@ struct BuildArgs {
   bool loop_closure = navi::LoopClosureOptions{}.enabled;
   double closure_quality = navi::LoopClosureOptions{}.min_quality;
   double recovery_margin = navi::MapBuilderOptions{}.recovery_margin;
-  std::filesystem::path trajectory;  // CSV: scan by scan, the match as made (before any closure)
+  std::filesystem::path trajectory;  // CSV: scan by scan, the match as made, the final pose, the reference
   std::string laser_channel = "front_laser", odom_channel = "odom", pose_channel = "laser_pose";
 };
 
@@ -425,38 +433,49 @@ int map_build(const BuildArgs& a, std::ostream& out, std::ostream& err) {
     o.loop.min_quality = a.closure_quality;
     o.recovery_margin = a.recovery_margin;
     navi::MapBuilder b(lo, hi, o);
-    std::ofstream csv;
-    if (!a.trajectory.empty()) {
-      csv.open(a.trajectory);
-      if (!csv) throw std::runtime_error(a.trajectory.string() + ": cannot be written");
-      csv << "scan,x_m,y_m,theta_rad,quality,weak,recovered,unreliable\n";
-    }
-    std::vector<Pose2D> est;
-    est.reserve(log.scans.size());
-    const auto t0 = Clock::now();
+    std::ostringstream rows;  // the matches as made; the final poses are known only at the end
+    const auto t0 = cpu_now();
     for (const LoggedScan& s : log.scans) {
       const navi::MappingHealth before = b.health();
       const Pose2D p = b.add(s.scan, s.odom);
-      if (csv.is_open()) {
+      if (!a.trajectory.empty()) {
         const navi::MappingHealth& h = b.health();
-        csv << (h.scans - 1) << ',' << p.x_m << ',' << p.y_m << ',' << p.theta_rad << ',' << b.last_quality() << ','
-            << (h.weak - before.weak) << ',' << (h.recovered - before.recovered) << ','
-            << (h.unreliable - before.unreliable) << '\n';
+        rows << (h.scans - 1) << ',' << p.x_m << ',' << p.y_m << ',' << p.theta_rad << ',' << b.last_quality() << ','
+             << (h.weak - before.weak) << ',' << (h.recovered - before.recovered) << ',' << (h.unreliable - before.unreliable)
+             << '\n';
       }
     }
     const double ms = ms_since(t0);
     // scored on the poses as the graph places them at the end (a closure moves past poses too)
-    est = b.trajectory();
+    const std::vector<Pose2D> est = b.trajectory();
+    if (!a.trajectory.empty()) {
+      std::ofstream csv(a.trajectory);
+      if (!csv) throw std::runtime_error(a.trajectory.string() + ": cannot be written");
+      csv << "scan,x_m,y_m,theta_rad,quality,weak,recovered,unreliable,final_x_m,final_y_m,final_theta_rad,ref_x_m,ref_y_m,ref_"
+             "theta_rad\n";
+      std::istringstream made(rows.str());
+      std::string row;
+      for (std::size_t i = 0; i < est.size() && std::getline(made, row); ++i) {
+        csv << row << ',' << est[i].x_m << ',' << est[i].y_m << ',' << est[i].theta_rad;
+        const LoggedScan& s = log.scans[i];
+        if (s.has_reference)
+          csv << ',' << s.reference.x_m << ',' << s.reference.y_m << ',' << s.reference.theta_rad;
+        else
+          csv << ",,,";
+        csv << '\n';
+      }
+    }
     const OccupancyGrid g = b.grid();
     navi::save_map(g, a.out);
     out << log.name << ": " << log.scans.size() << " scans mapped in " << std::fixed << std::setprecision(1) << ms / 1000.0
-        << " s (" << std::setprecision(2) << ms / static_cast<double>(log.scans.size()) << " ms per scan); map "
-        << g.width() << " x " << g.height() << " cells written to " << a.out.string() << "\n";
+        << " s CPU (" << std::setprecision(2) << ms / static_cast<double>(log.scans.size()) << " ms per scan); map " << g.width()
+        << " x " << g.height() << " cells written to " << a.out.string() << "\n";
     const navi::LoopClosureStats& loop = b.loop_stats();
     out << "  loop closure: " << (o.loop.enabled ? "" : "off; ") << loop.keyframes << " key scans, " << loop.attempts
         << " local matches tried (refused: " << loop.weak << " weak, " << loop.implausible << " beyond the drift, "
         << loop.disagreeing << " not confirmed by the scans before, " << loop.ambiguous << " ambiguous), " << loop.closures
-        << " closures kept, " << loop.rejected << " dropped by the graph, " << loop.solves << " graph solves\n";
+        << " closures kept (" << loop.settled << " within their own noise: no solve), " << loop.rejected
+        << " dropped by the graph, " << loop.solves << " graph solves\n";
     const navi::MappingHealth& health = b.health();
     out << "  self-check: " << health.weak << " scans matched far below the recent median, " << health.recovered
         << " of them re-matched globally (an odometry jump), " << health.unreliable << " left unreliable\n";
@@ -540,7 +559,8 @@ cli::Action setup_build(CLI::App& cmd) {
   cmd.add_option("--recovery-margin", a->recovery_margin,
                  "Q: a match this far below the recent median is re-matched globally (0: never)")
       ->capture_default_str()->check(CLI::Range(0.0, 1.0));
-  cmd.add_option("--trajectory", a->trajectory, "FILE: CSV of the matches, scan by scan, as made (before closures)")
+  cmd.add_option("--trajectory", a->trajectory,
+                 "FILE: CSV of the matches, scan by scan, as made and as the graph places them at the end")
       ->check(cli::writable_file());
   cmd.add_flag("--loop-closure,!--no-loop-closure", a->loop_closure,
                "keep a pose graph of key scans and close loops (the default; docs/localization.md)");
