@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cctype>
 
-#include "../common/yaml_reader.hpp"
 #include "tripodal/core/net_loader.hpp"
+#include "tripodal_common_internal/yaml_reader.hpp"
 
 namespace tripodal {
 

@@ -4,9 +4,10 @@
 // value bytes back to the source, the XML 1.0 rules tinyxml2 lets through (references, '<' in
 // values, UTF-8, control characters, encodings, one root), tinyxml2's errors placed at a line and
 // column, and the loaders' FILE:LINE:COL for malformed XML.
-#include <catch2/catch.hpp>
+#include "tripodal_core_internal/xml_document.hpp"
 
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -16,7 +17,6 @@
 #include <utility>
 #include <vector>
 
-#include "../../src/core/xml_document.hpp"
 #include "tripodal/core/net_loader.hpp"
 
 using tripodal::detail::XmlAttribute;

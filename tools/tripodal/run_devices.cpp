@@ -103,7 +103,7 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
       if (!world.regions_file.empty() && e.parameters.count("regions") == 0)
         ro.parameters.push_back({e.name, "regions", std::filesystem::absolute(world.regions_file).string()});
     }
-    if (e.type != navi::CCoverageModule::static_manifest().name) continue;
+    if (e.type != navi::CCoveragePlanner::static_manifest().name) continue;
     if (!o.pattern.empty()) ro.parameters.push_back({e.name, "pattern", o.pattern});
     if (!o.dose_plan)
       ro.parameters.push_back({e.name, "dose_target_j_m2", "0"});
@@ -121,7 +121,7 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
   if (host == nullptr) throw ConfigError(where, "hardware 'board' with a port: expected the control board's hardware");
   board::BoardHardware& hw = host->board();
   Navigation nav{robot->module<navi::CGridMaps>(), robot->module<navi::CSectionSplitter>(),
-                 robot->module<navi::CCoverageModule>()};
+                 robot->module<navi::CCoveragePlanner>()};
   if (nav.maps == nullptr)
     throw ConfigError(profile.where, "`tripodal run` measures the run on the map: the robot needs a GridMaps module");
   if (nav.coverage != nullptr) res.coverage_pattern = nav.coverage->pattern();

@@ -68,7 +68,7 @@ std::vector<char> reachable_area(const Navigation& nav, navi::PathPlanner& plann
   return reach;
 }
 
-DoseEstimate estimate_dose(navi::CCoverageModule& cov, const navi::CSectionSplitter& splitter,
+DoseEstimate estimate_dose(navi::CCoveragePlanner& cov, const navi::CSectionSplitter& splitter,
                            const std::vector<std::string>& sections, Point2D from, const board::FirmwareConfig& fw) {
   double yaw_rate = 1.0;
   for (const ParameterSpec& p : BhCleaningTwoWheel::static_manifest().parameters) {

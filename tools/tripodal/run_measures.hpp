@@ -41,7 +41,7 @@ struct DoseEstimate {
   double charge_ah = 0.0;
   double path_m = 0.0;
 };
-DoseEstimate estimate_dose(navi::CCoverageModule& cov, const navi::CSectionSplitter& splitter,
+DoseEstimate estimate_dose(navi::CCoveragePlanner& cov, const navi::CSectionSplitter& splitter,
                            const std::vector<std::string>& sections, navi::Point2D from, const board::FirmwareConfig& fw);
 
 // "PrCleaning(section=A)": a process step as the report names it.

@@ -55,7 +55,8 @@ std::vector<ParameterOverride> simulation_overrides(const RobotProfile& profile,
     out.push_back({profile.hardware->name, "seed", std::to_string(seed)});
   }
   for (const ModuleEntry& e : profile.navigation) {
-    if (e.type == navi::CLocalizer::static_manifest().name) out.push_back({e.name, "seed", std::to_string(seed % (1ULL << 52))});
+    if (e.type == navi::CGroundTruthLocalizer::static_manifest().name)
+      out.push_back({e.name, "seed", std::to_string(seed % (1ULL << 52))});
     if (e.type == navi::CScanMatchingLocalizer::static_manifest().name) {
       // The robot starts on its charger, whose place in the map it knows: the world's start pose
       // (the profile's initial pose is the workspace's charger; another world starts elsewhere).
@@ -192,7 +193,7 @@ RobotOptions run_robot_options(const RunOptions& o, const RobotProfile& profile,
   ro.parameters = simulation_overrides(profile, world, seed);
   if (!o.board_line.empty()) ro.parameters.push_back({profile.hardware->name, "line", o.board_line});
   for (const ModuleEntry& e : profile.navigation) {
-    if (e.type != navi::CCoverageModule::static_manifest().name) continue;
+    if (e.type != navi::CCoveragePlanner::static_manifest().name) continue;
     if (!o.pattern.empty()) ro.parameters.push_back({e.name, "pattern", o.pattern});
     // The dose the lanes are planned for (the profile's dose_target_j_m2 otherwise).
     if (!o.dose_plan)
@@ -216,7 +217,7 @@ GroundTruth checked_truth(Robot& robot, const RobotProfile& profile, const sim::
 
 // Cleaning is measured when the robot has SectionSplitter and CoveragePlanner; the map always.
 Navigation checked_navigation(Robot& robot, const RobotProfile& profile, const sim::World& world) {
-  Navigation nav{robot.module<navi::CGridMaps>(), robot.module<navi::CSectionSplitter>(), robot.module<navi::CCoverageModule>()};
+  Navigation nav{robot.module<navi::CGridMaps>(), robot.module<navi::CSectionSplitter>(), robot.module<navi::CCoveragePlanner>()};
   if (nav.maps == nullptr)
     throw ConfigError(profile.where, "`tripodal run` measures the run on the map: the robot needs a GridMaps module");
   if (nav.maps->robot_radius_m() < world.robot.radius_m) {
