@@ -377,11 +377,7 @@ class TaskRun {
   [[nodiscard]] bool is_cleaning() const {
     return robot_->behavior_active("BhCleaning") || robot_->behavior_active("BhCleaningTwoWheel");
   }
-  [[nodiscard]] std::size_t covered() const {
-    std::size_t n = 0;
-    for (std::size_t i = 0; i < reachable_.size(); ++i) n += (reachable_[i] != 0 && cleaned_.cleaned(i)) ? 1 : 0;
-    return n;
-  }
+  [[nodiscard]] std::size_t covered() const { return cleaned_reachable(reachable_, cleaned_); }
   void give_task();
   void check_dose_plan();
   void flush_log();
@@ -696,15 +692,9 @@ void TaskRun::measure(Time ended) {
   const bool only_refused = res_.state == "refused" && tr.state == TaskState::idle;
   if (!only_refused && (!serve_ || tr.state != TaskState::idle)) res_.reason = tr.reason;
   res_.duration_s = to_seconds(ended);
-  res_.cleaned_cells = covered();
-  res_.coverage =
-      res_.reachable_cells == 0 ? 0.0 : static_cast<double>(res_.cleaned_cells) / static_cast<double>(res_.reachable_cells);
-  const double res_m = nav_.maps->grid().resolution_m();
-  res_.reachable_area_m2 = static_cast<double>(res_.reachable_cells) * res_m * res_m;
-  res_.total = path_figures(path_all_);
-  res_.total.length_m = truth_.distance_m();
+  set_floor_figures(res_, nav_, reachable_, cleaned_, path_all_, path_cleaning_);
+  res_.total.length_m = truth_.distance_m();  // the ground truth's, not the sampled path's
   res_.total.rotation_rad = truth_.rotation_rad();
-  res_.cleaning = path_figures(path_cleaning_);
   res_.processes = report_.processes;
   res_.recoveries = report_.recoveries;
   res_.charging = charging_summary(tr);
