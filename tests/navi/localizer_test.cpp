@@ -126,8 +126,8 @@ TEST_CASE("CGroundTruthLocalizer: bad parameters and fault schedules are reporte
 TEST_CASE("Navigation modules: every one is created by name and configured with defaults", "[navi][modules]") {
   ModuleRegistry reg("module type");
   register_navigation_modules(reg);
-  REQUIRE(reg.names() == std::vector<std::string>{"CoveragePlanner", "GridMaps", "Localizer", "MapBuilder", "PathPlanner", "ScanMatchingLocalizer",
-                                                  "SectionSplitter"});
+  REQUIRE(reg.names() == std::vector<std::string>{"CoveragePlanner", "GridMaps", "GroundTruthLocalizer", "MapBuilder",
+                                                  "PathPlanner", "ScanMatchingLocalizer", "SectionSplitter"});
   for (const std::string& name : reg.names()) {
     std::unique_ptr<CModule> m = reg.create(name);
     REQUIRE(m != nullptr);
