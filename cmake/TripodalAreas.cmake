@@ -13,6 +13,13 @@
 # that includes an area linked only PRIVATE, a cycle of links, a relative include of another
 # area's private header) is checked by cmake/check_layers.cmake, a CTest (tripodal_layers:*).
 # INTERNAL areas (src/common) have no public headers and no include tree.
+#
+# tripodal_add_internal_headers(<area>)
+#   creates tripodal_<area>_internal, an INTERFACE target never installed or exported, through
+#   which another area, a tool, a test or a fuzz target that links it PRIVATE names the area's
+#   private headers "tripodal_<area>_internal/<header>" (a symbolic link to src/<area>/ in the build
+#   directory) instead of a "../<area>/" path; cmake/check_layers.cmake checks such an include
+#   like one of the area's public headers.
 
 define_property(GLOBAL PROPERTY TRIPODAL_AREAS
   BRIEF_DOCS "Architectural areas, each a library target tripodal_<area>"
@@ -47,6 +54,15 @@ function(tripodal_add_area area)
   set_property(GLOBAL APPEND PROPERTY TRIPODAL_AREAS ${area})
   set_property(TARGET ${target} PROPERTY TRIPODAL_PUBLIC_AREAS "${arg_PUBLIC}")
   set_property(TARGET ${target} PROPERTY TRIPODAL_PRIVATE_AREAS "${arg_PRIVATE}")
+endfunction()
+
+function(tripodal_add_internal_headers area)
+  set(target tripodal_${area}_internal)
+  set(dir ${PROJECT_BINARY_DIR}/internal/${area})
+  add_library(${target} INTERFACE)
+  file(MAKE_DIRECTORY ${dir})
+  file(CREATE_LINK ${PROJECT_SOURCE_DIR}/src/${area} ${dir}/${target} SYMBOLIC)
+  target_include_directories(${target} INTERFACE $<BUILD_INTERFACE:${dir}>)
 endfunction()
 
 # Writes the declared graph as a CMake script (set(TRIPODAL_AREAS ...), set(TRIPODAL_AREA_<a>_PUBLIC

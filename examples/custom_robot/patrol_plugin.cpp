@@ -1,37 +1,37 @@
-// A patrol robot's own hardware type (with its own command channel), resource, behavior, base controller, navigation
-// module and process type as a shared-library plugin (docs/plugins.md): its profile's `plugins:` names it, so
-// `tripodal run` and custom_robot both find them.
+// A patrol robot's own hardware type (with its own command channel and resource), behavior, base controller and
+// process type as a shared-library plugin (docs/plugins.md): its profile's `plugins:` names it, so `tripodal run` and
+// custom_robot both find them.
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
 
 #include "tripodal/controllers/differential_drive_controller.hpp"
-#include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/robot/plugin_library.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
 
 using namespace tripodal;
 namespace {
-struct BeaconReading {
+struct BeaconReading {  // what the beacon's driver reads: flashing and beeping?
   Time stamp{};
   bool on = false;
-};  // what the beacon's driver reads: flashing and beeping?
+};
 
-/// The base's configuration as the simulator reads it: a differential base (the controller type "patrol_drive" is one).
+// The base as the simulator reads it: a differential base (the controller type "patrol_drive" is one).
 ControllerConfig as_differential(ControllerConfig c) {
   c.type = "differential";
   apply_parameters(c);
   return c;
 }
 
-/// Hardware "sim_with_beacon": the simulator (parameters as "sim") and the warning beacon (LED + buzzer), a command
-/// channel "beacon" of the application's own that a behavior switches; it sounds while on and the base turns in place.
+/// Hardware "sim_with_beacon": the simulator (parameters as "sim") and the warning beacon (LED + buzzer): a command
+/// channel "beacon" of the application's own that a behavior switches, and the resource "beacon" saying whether it
+/// sounds (while on and the base turns in place), which the hardware publishes like the simulator's sensors.
 class BeaconBase final : public sim::SimHardware {
  public:
   static inline const ModuleManifest kManifest = [](ModuleManifest m) {
     m.name = "sim_with_beacon";
-    m.outputs.push_back("beacon_state");
+    m.outputs.push_back("beacon");
     m.command_channels.push_back(
         {.name = "beacon", .type = ChannelType::digital, .unit = "", .description = "the beacon sounds"});
     return m;
@@ -41,39 +41,24 @@ class BeaconBase final : public sim::SimHardware {
       : SimHardware(with_base(c, c.base ? as_differential(*c.base) : ControllerConfig{})) {
     export_channel(kManifest.command_channels.front());
   }
-  [[nodiscard]] const BeaconReading& beacon() const noexcept { return beacon_; }
 
  private:
-  [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return kManifest; }
-  void on_advance_to(Time now) noexcept override {
-    SimHardware::on_advance_to(now);
-    const Twist2D& v = simulator().velocity();
-    beacon_ = {now, command_channels().value(0).on() && std::abs(v.wz_rad_s) > 0.3 && std::abs(v.vx_m_s) < 0.05};
-  }
   static HardwareConfig with_base(HardwareConfig c, const ControllerConfig& base) {  // `base` lives for the constructor
     if (c.base != nullptr) c.base = &base;
     return c;
   }
-  BeaconReading beacon_;
-};
-
-/// Resource type "BeaconResource": the beacon's driver, which the reactive loop polls every cycle.
-class BeaconResource final : public TypedResource<BeaconReading> {
- public:
-  static inline const ModuleManifest kManifest = ManifestBuilder("BeaconResource", ModuleKind::resource)
-                                                     .description("the beacon")
-                                                     .input("beacon_state")
-                                                     .output("beacon")
-                                                     .build();
-  static const ModuleManifest& static_manifest() { return kManifest; }
-  explicit BeaconResource(const ResourceConfig& c)
-      : TypedResource(c.name, Duration{0}, kManifest), board_(dynamic_cast<const BeaconBase*>(c.hardware)) {
-    if (board_ == nullptr) throw ConfigError(c.where, "resource '" + c.name + "' reads the beacon of hardware 'sim_with_beacon'");
+  [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return kManifest; }
+  void on_add_resources(ResourceTable& table) override {
+    SimHardware::on_add_resources(table);
+    table.add(beacon_);
   }
-
- private:
-  void on_poll(Time /*now*/) noexcept override { publish(board_->beacon()); }
-  const BeaconBase* board_;
+  void on_advance_to(Time now) noexcept override {
+    SimHardware::on_advance_to(now);
+    const Twist2D& v = simulator().velocity();
+    beacon_.publish({now, command_channels().value(0).on() && std::abs(v.wz_rad_s) > 0.3 && std::abs(v.vx_m_s) < 0.05});
+  }
+  static inline const ModuleManifest kBeacon = ManifestBuilder("BeaconResource", ModuleKind::resource).output("beacon").build();
+  TypedResource<BeaconReading> beacon_{"beacon", Duration{0}, kBeacon};  // (its manifest is kept by reference)
 };
 
 /// BhAnnounce: announces an arrival by turning in place until the beacon has sounded for beacon_s.
@@ -115,52 +100,24 @@ class PatrolDrive final : public CController {
   }(DifferentialDriveController::static_manifest());
   static const ModuleManifest& static_manifest() { return kManifest; }
   PatrolDrive(const ControllerConfig& c, HardwareInterface& wheels)
-      : CController(c.period),
-        drive_(as_differential(c), wheels),
-        cruise_m_s_(c.parameters.number("cruise_m_s")),
-        timeout_(c.cmd_timeout) {}
+      : CController(c.period), drive_(as_differential(c), wheels), cruise_m_s_(c.parameters.number("cruise_m_s")) {}
 
  private:
   const ModuleManifest& do_manifest() const noexcept override { return kManifest; }
   BaseCapabilities do_capabilities() const noexcept override { return drive_.capabilities(); }
   std::span<const double> do_wheel_commands() const noexcept override { return drive_.wheel_commands(); }
-  Duration command_timeout() const noexcept override { return timeout_; }
+  Duration command_timeout() const noexcept override { return drive_.config().cmd_timeout; }
   void on_reset_odometry() noexcept override { drive_.reset_odometry(odometry().pose); }
   ControlStatus on_update(Time now, Duration, const Twist2D& command, bool, Twist2D& limited,
-                          OdometryReading& odometry) noexcept override {
+                          OdometryReading& odom) noexcept override {
     drive_.set_command({std::clamp(command.vx_m_s, -cruise_m_s_, cruise_m_s_), command.vy_m_s, command.wz_rad_s}, now);
     const ControlStatus status = drive_.update(now);
     limited = drive_.limited_command();
-    odometry = drive_.odometry();
+    odom = drive_.odometry();
     return status;
   }
   DifferentialDriveController drive_;
   double cruise_m_s_;
-  Duration timeout_;
-};
-
-/// Navigation module "RoomWatcher": posts room.entered when the pose estimate enters another room.
-class RoomWatcher final : public navi::CNaviModules {
- public:
-  static inline const ModuleManifest kManifest = navi::navi_manifest("RoomWatcher", "posts room.entered on entering another room",
-                                                                     {"map_from_base", "grid_map"}, {"room.entered"}, {});
-  static const ModuleManifest& static_manifest() { return kManifest; }
-  [[nodiscard]] const std::string& room() const noexcept { return room_; }
-
- private:
-  [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return kManifest; }
-  void on_start(ModuleContext& context) override {
-    if ((maps_ = context.modules->find<navi::CGridMaps>()) == nullptr) throw ConfigError(where(), "RoomWatcher needs GridMaps");
-  }
-  void on_update(ModuleContext& context) override {
-    const Pose2D& p = context.navigation->map_from_base;
-    const navi::Region* in = nullptr;  // rooms may nest (a hall holds its rooms): the smallest counts
-    for (const navi::Region& r : maps_->regions().rooms)
-      if (r.contains({p.x_m, p.y_m}) && (in == nullptr || r.area_m2() < in->area_m2())) in = &r;
-    if (context.navigation->localized && in != nullptr && in->name != room_) context.post("room.entered", room_ = in->name);
-  }
-  const navi::CGridMaps* maps_ = nullptr;
-  std::string room_;
 };
 
 /// Process type "announce": the profile counts an announcement in turns, the behavior in seconds.
@@ -181,9 +138,7 @@ class PrAnnounce final : public CProcess {
 
 TRIPODAL_REGISTER_PLUGINS(plugins) {
   plugins.hardware.add<BeaconBase>();
-  plugins.resources.add<BeaconResource>();
   plugins.controllers.add<PatrolDrive>();
   plugins.behaviors.add<BhAnnounce>();
-  plugins.modules.add<RoomWatcher>();
   plugins.processes.add<PrAnnounce>();
 }

@@ -8,8 +8,8 @@
 #include <cctype>
 #include <string_view>
 
-#include "../../src/monitor/wire.hpp"
 #include "../fuzz_target.hpp"
+#include "tripodal_monitor_internal/wire.hpp"
 
 namespace {
 

@@ -3,12 +3,13 @@
 // Properties: nothing throws; a refused request names a field in each error and its answer is JSON
 // that serialises; an accepted one is an op of the schema, typed as that op, with every budget the
 // robot keeps (task, ack and breakpoint texts, runs, history limit) held and its texts XML's.
+#include "tripodal_monitor_internal/operator_request.hpp"
+
 #include <string>
 #include <string_view>
 #include <variant>
 
 #include "../fuzz_target.hpp"
-#include "../../src/monitor/operator_request.hpp"
 #include "tripodal/core/xml_text.hpp"
 
 namespace {

@@ -7,8 +7,8 @@
 #include <string>
 #include <string_view>
 
-#include "../../src/monitor/wire.hpp"
 #include "../fuzz_target.hpp"
+#include "tripodal_monitor_internal/wire.hpp"
 
 namespace {
 

@@ -17,19 +17,6 @@ constexpr double kSameBodyM = 0.3;
 
 }  // namespace
 
-const ModuleManifest& JointResource::static_manifest() {
-  static const ModuleManifest m = [] {
-    ModuleManifest mm;
-    mm.name = "JointResource";
-    mm.layer = Layer::reactive;
-    mm.kind = ModuleKind::resource;
-    mm.description = "a neck or arm joint's state: position, speed, the command it follows, limits";
-    mm.outputs = {"joint_state"};
-    return mm;
-  }();
-  return m;
-}
-
 // --- BhFaceVisitor ----------------------------------------------------------------------------
 
 const ModuleManifest& BhFaceVisitor::static_manifest() {

@@ -1,15 +1,15 @@
 #include "tripodal/board/protocol_profile.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <map>
 #include <set>
 
-#include <fmt/format.h>
-
-#include "../common/yaml_reader.hpp"
 #include "tripodal/board/frame.hpp"
+#include "tripodal_common_internal/yaml_reader.hpp"
 
 namespace tripodal::board {
 namespace detail {

@@ -178,9 +178,9 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
     if (try_reload(pending_reload->request, pending_reload->run, pending_reload->text, pending_reload->source, last)) pending_reload.reset();
   }
 
-  // Live mapping (navi::CMappingModule): begin, end, status, save NAME into options.map_dir.
+  // Live mapping (navi::CMapBuilder): begin, end, status, save NAME into options.map_dir.
   void map_request(std::uint64_t id, const MapRequest& m) {
-    auto* mapper = robot.module<navi::CMappingModule>();
+    auto* mapper = robot.module<navi::CMapBuilder>();
     if (mapper == nullptr) return reply(id, 404, {{"error", "map: the robot has no MapBuilder module (add one to its profile's navigation)"}});
     const auto status = [&] {
       return json{{"mapping", mapper->mapping()}, {"scans", mapper->scans()}, {"quality", mapper->last_quality()}};

@@ -40,40 +40,40 @@ std::vector<LocalizationFault> parse_fault_schedule(const std::string& text, con
   return out;
 }
 
-CLocalizer::CLocalizer(const GroundTruthSource* truth, LocalizerOptions options)
+CGroundTruthLocalizer::CGroundTruthLocalizer(const GroundTruthSource* truth, LocalizerOptions options)
     : truth_(truth), options_(std::move(options)), rng_(options_.seed) {}
 
-const ModuleManifest& CLocalizer::static_manifest() {
+const ModuleManifest& CGroundTruthLocalizer::static_manifest() {
   static const ModuleManifest m = navi_manifest(
-      "Localizer",
+      "GroundTruthLocalizer",
       "pose estimate from the simulator's ground truth with seeded noise and injected faults; posts "
       "localizer.ok / localizer.lost",
       {"ground_truth_pose"}, {"map_from_base", "position_fix", "localizer.ok", "localizer.lost"},
-      {ParameterSpec{"noise_xy_m", ValueType::number, Value{0.02}, "m", "position noise (standard deviation per axis)",
-                     0.0, std::nullopt},
+      {ParameterSpec{"noise_xy_m", ValueType::number, Value{0.02}, "m", "position noise (standard deviation per axis)", 0.0,
+                     std::nullopt},
        ParameterSpec{"noise_theta_rad", ValueType::number, Value{0.01}, "rad", "heading noise (standard deviation)", 0.0,
                      std::nullopt},
-       ParameterSpec{"lost_threshold_m", ValueType::number, Value{0.3}, "m",
-                     "position error beyond which the estimate disagrees", 1e-6, std::nullopt},
+       ParameterSpec{"lost_threshold_m", ValueType::number, Value{0.3}, "m", "position error beyond which the estimate disagrees",
+                     1e-6, std::nullopt},
        ParameterSpec{"lost_threshold_rad", ValueType::number, Value{0.35}, "rad",
                      "heading error beyond which the estimate disagrees", 1e-6, std::nullopt},
        ParameterSpec{"fault_offset_m", ValueType::number, Value{2.0}, "m", "estimate jump when a fault starts", 0.0,
                      std::nullopt},
        ParameterSpec{"recover_at_fault_end", ValueType::boolean, Value{false}, "",
-                     "estimate returns by itself when a fault window ends (else global localization is needed)",
-                     std::nullopt, std::nullopt},
+                     "estimate returns by itself when a fault window ends (else global localization is needed)", std::nullopt,
+                     std::nullopt},
        ParameterSpec{"seed", ValueType::number, Value{1.0}, "", "noise seed: the same seed gives the same run", 0.0,
                      std::nullopt},
        ParameterSpec{"faults", ValueType::string, Value{std::string()}, "s",
-                     "loss windows \"START-END; START-END\" in seconds of simulated time", std::nullopt,
-                     std::nullopt},
+                     "loss windows \"START-END; START-END\" in seconds of simulated time", std::nullopt, std::nullopt},
        ParameterSpec{"serves", ValueType::string, Value{std::string("BhGlobalLocalization")}, "",
                      "the behavior during whose activation it attempts global position fixes (its parameter "
-                     "attempt_period_s)", std::nullopt, std::nullopt}});
+                     "attempt_period_s)",
+                     std::nullopt, std::nullopt}});
   return m;
 }
 
-void CLocalizer::on_configure(const ParameterSet& params) {
+void CGroundTruthLocalizer::on_configure(const ParameterSet& params) {
   fix_attempts_.serves = params.string("serves");
   LocalizerOptions o;
   o.noise_xy_m = params.number("noise_xy_m");
@@ -91,7 +91,7 @@ void CLocalizer::on_configure(const ParameterSet& params) {
   estimate_.reset();
 }
 
-bool CLocalizer::in_fault(Time now) const noexcept {
+bool CGroundTruthLocalizer::in_fault(Time now) const noexcept {
   if (truth_ != nullptr && truth_->localization_lost(now)) return true;
   for (const LocalizationFault& f : options_.faults) {
     if (now >= f.start && now < f.end) return true;
@@ -99,26 +99,27 @@ bool CLocalizer::in_fault(Time now) const noexcept {
   return false;
 }
 
-bool CLocalizer::relocalize(Time now) noexcept {
+bool CGroundTruthLocalizer::relocalize(Time now) noexcept {
   if (truth_ == nullptr || in_fault(now) || !truth_->true_pose(now)) return false;
   corrupted_ = false;
   return true;
 }
 
-void CLocalizer::publish(NavigationData& data) const noexcept {
+void CGroundTruthLocalizer::publish(NavigationData& data) const noexcept {
   if (estimate_) data.map_from_base = *estimate_;
   data.pose_stamp = stamp_;
   data.localized = localized();
 }
 
-void CLocalizer::on_start(ModuleContext& context) {
+void CGroundTruthLocalizer::on_start(ModuleContext& context) {
   if (truth_ == nullptr) truth_ = dynamic_cast<const GroundTruthSource*>(context.hardware);
   if (truth_ == nullptr) {
-    throw ConfigError(where(), "Localizer estimates the pose from a simulation's ground truth, and the robot's hardware gives none");
+    throw ConfigError(
+        where(), "GroundTruthLocalizer estimates the pose from a simulation's ground truth, and the robot's hardware gives none");
   }
 }
 
-void CLocalizer::on_update(ModuleContext& context) {
+void CGroundTruthLocalizer::on_update(ModuleContext& context) {
   step(context.now, context.events);
   if (fix_attempts_.due(context.now) && relocalize(context.now)) ++fixes_;
   context.heartbeat = true;
@@ -126,15 +127,15 @@ void CLocalizer::on_update(ModuleContext& context) {
   context.navigation->fixes = fixes_;
 }
 
-void CLocalizer::on_behavior_activated(const BehaviorActivation& activation, ModuleContext& context) {
+void CGroundTruthLocalizer::on_behavior_activated(const BehaviorActivation& activation, ModuleContext& context) {
   fix_attempts_.activated(activation, context.now);
 }
 
-void CLocalizer::on_behavior_deactivated(std::string_view behavior, ModuleContext& /*context*/) {
+void CGroundTruthLocalizer::on_behavior_deactivated(std::string_view behavior, ModuleContext& /*context*/) {
   fix_attempts_.deactivated(behavior);
 }
 
-void CLocalizer::step(Time now, std::vector<ModuleEvent>& out) noexcept {
+void CGroundTruthLocalizer::step(Time now, std::vector<ModuleEvent>& out) noexcept {
   if (!configured()) return;
   if (truth_ == nullptr) return;
   const std::optional<Pose2D> truth = truth_->true_pose(now);

@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <tuple>
 
-#include "../common/yaml_reader.hpp"
+#include "tripodal_common_internal/yaml_reader.hpp"
 
 namespace tripodal::navi {
 

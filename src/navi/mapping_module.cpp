@@ -7,11 +7,11 @@
 
 namespace tripodal::navi {
 
-CMappingModule::CMappingModule(MappingOptions options) : options_(options) {}
+CMapBuilder::CMapBuilder(MappingOptions options) : options_(options) {}
 
-CMappingModule::~CMappingModule() = default;
+CMapBuilder::~CMapBuilder() = default;
 
-const ModuleManifest& CMappingModule::static_manifest() {
+const ModuleManifest& CMapBuilder::static_manifest() {
   const MappingOptions d;
   static const ModuleManifest m = navi_manifest(
       "MapBuilder",
@@ -35,7 +35,7 @@ const ModuleManifest& CMappingModule::static_manifest() {
   return m;
 }
 
-void CMappingModule::on_configure(const ParameterSet& params) {
+void CMapBuilder::on_configure(const ParameterSet& params) {
   MappingOptions o = options_;
   o.base_from_laser = {params.number("laser_x_m"), params.number("laser_y_m"), params.number("laser_yaw_rad")};
   o.builder.resolution_m = params.number("resolution_m");
@@ -53,13 +53,13 @@ void CMappingModule::on_configure(const ParameterSet& params) {
   options_ = o;
 }
 
-void CMappingModule::on_start(ModuleContext& context) {
+void CMapBuilder::on_start(ModuleContext& context) {
   laser_ = &sensor_of<LaserScan>(context, laser_name_, "MapBuilder", "a laser scanner", "laser", where());
   odometry_ = &sensor_of<OdometryReading>(context, odometry_name_, "MapBuilder", "odometry", "odometry", where());
   if (options_.begin_at_start) begin();
 }
 
-void CMappingModule::on_update(ModuleContext& /*context*/) {
+void CMapBuilder::on_update(ModuleContext& /*context*/) {
   if (laser_ == nullptr || odometry_ == nullptr || !laser_->has_reading() || !odometry_->has_reading()) return;
   const LaserScan& scan = laser_->latest();
   if (has_scan_ && scan.stamp == last_scan_stamp_) return;
@@ -68,7 +68,7 @@ void CMappingModule::on_update(ModuleContext& /*context*/) {
   add(scan, odometry_->latest().pose);
 }
 
-void CMappingModule::begin(const Pose2D& start) {
+void CMapBuilder::begin(const Pose2D& start) {
   const double half = options_.size_m / 2.0;
   auto builder = std::make_unique<MapBuilder>(Point2D{start.x_m - half, start.y_m - half},
                                               Point2D{start.x_m + half, start.y_m + half}, options_.builder);
@@ -80,32 +80,32 @@ void CMappingModule::begin(const Pose2D& start) {
   scans_ = 0;
 }
 
-void CMappingModule::end() noexcept {
+void CMapBuilder::end() noexcept {
   const std::lock_guard lock(mutex_);
   mapping_ = false;
 }
 
-bool CMappingModule::mapping() const noexcept {
+bool CMapBuilder::mapping() const noexcept {
   const std::lock_guard lock(mutex_);
   return mapping_;
 }
 
-std::size_t CMappingModule::scans() const noexcept {
+std::size_t CMapBuilder::scans() const noexcept {
   const std::lock_guard lock(mutex_);
   return scans_;
 }
 
-Pose2D CMappingModule::pose() const noexcept {
+Pose2D CMapBuilder::pose() const noexcept {
   const std::lock_guard lock(mutex_);
   return pose_;
 }
 
-double CMappingModule::last_quality() const noexcept {
+double CMapBuilder::last_quality() const noexcept {
   const std::lock_guard lock(mutex_);
   return builder_ ? builder_->last_quality() : 0.0;
 }
 
-void CMappingModule::add(const LaserScan& scan, const Pose2D& odom_from_base) {
+void CMapBuilder::add(const LaserScan& scan, const Pose2D& odom_from_base) {
   const std::lock_guard lock(mutex_);
   if (!mapping_ || !builder_) return;
   pose_ = builder_->add(scan, odom_from_base, start_, options_.base_from_laser);
@@ -132,7 +132,7 @@ void CMappingModule::add(const LaserScan& scan, const Pose2D& odom_from_base) {
   ++scans_;
 }
 
-std::optional<OccupancyGrid> CMappingModule::map() const {
+std::optional<OccupancyGrid> CMapBuilder::map() const {
   const std::lock_guard lock(mutex_);
   if (!builder_ || scans_ == 0) return std::nullopt;
   // one cell of margin: the walls the beams ended on
@@ -140,7 +140,7 @@ std::optional<OccupancyGrid> CMappingModule::map() const {
   return builder_->grid_within({min_x_m_ - m, min_y_m_ - m}, {max_x_m_ + m, max_y_m_ + m});
 }
 
-void CMappingModule::save(const std::filesystem::path& yaml_file) const {
+void CMapBuilder::save(const std::filesystem::path& yaml_file) const {
   const std::optional<OccupancyGrid> grid = map();
   if (!grid) throw ConfigError(where(), "MapBuilder: no map to save yet (begin mapping and drive: each laser scan adds to it)");
   save_map(*grid, yaml_file);

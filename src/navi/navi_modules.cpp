@@ -30,11 +30,11 @@ void GlobalFixAttempts::activated(const BehaviorActivation& activation, Time now
 void register_navigation_modules(ModuleRegistry& registry) {
   registry.add<CGridMaps>();
   registry.add<CSectionSplitter>();
-  registry.add<CLocalizer>();
+  registry.add<CGroundTruthLocalizer>();
   registry.add<CScanMatchingLocalizer>();
-  registry.add<CMappingModule>();
-  registry.add<CPathPlanningModule>();
-  registry.add<CCoverageModule>();
+  registry.add<CMapBuilder>();
+  registry.add<CPathPlanner>();
+  registry.add<CCoveragePlanner>();
 }
 
 }  // namespace tripodal::navi

@@ -134,9 +134,9 @@ Point2D PublishedPath::at(double s) const noexcept {
 }
 
 // ---------------------------------------------------------------------------------------------
-// CPathPlanningModule
+// CPathPlanner
 
-const ModuleManifest& CPathPlanningModule::static_manifest() {
+const ModuleManifest& CPathPlanner::static_manifest() {
   static const ModuleManifest m = navi_manifest(
       "PathPlanner",
       "plans the shortest collision-free path (A*) to a path-following behavior's goal and replans around "
@@ -147,16 +147,18 @@ const ModuleManifest& CPathPlanningModule::static_manifest() {
   return m;
 }
 
-void CPathPlanningModule::on_configure(const ParameterSet& params) { serves_ = split_names(params.string("serves")); }
+void CPathPlanner::on_configure(const ParameterSet& params) {
+  serves_ = split_names(params.string("serves"));
+}
 
-void CPathPlanningModule::on_start(ModuleContext& context) {
+void CPathPlanner::on_start(ModuleContext& context) {
   maps_ = context.modules != nullptr ? context.modules->find<CGridMaps>() : nullptr;
   if (maps_ == nullptr) throw ConfigError(where(), "PathPlanner needs the robot's map: add a GridMaps module");
   splitter_ = context.modules->find<CSectionSplitter>();
-  coverage_ = context.modules->find<CCoverageModule>();
+  coverage_ = context.modules->find<CCoveragePlanner>();
 }
 
-std::optional<Point2D> CPathPlanningModule::resolve_goal(std::string_view name, Point2D from) {
+std::optional<Point2D> CPathPlanner::resolve_goal(std::string_view name, Point2D from) {
   constexpr std::string_view kEntry = ".entry";
   if (name.size() > kEntry.size() && name.substr(name.size() - kEntry.size()) == kEntry) {
     const Section* s = splitter_ != nullptr ? splitter_->section(name.substr(0, name.size() - kEntry.size())) : nullptr;
@@ -181,7 +183,7 @@ std::optional<Point2D> CPathPlanningModule::resolve_goal(std::string_view name, 
   return std::nullopt;
 }
 
-void CPathPlanningModule::on_behavior_activated(const BehaviorActivation& activation, ModuleContext& context) {
+void CPathPlanner::on_behavior_activated(const BehaviorActivation& activation, ModuleContext& context) {
   if (!serves(serves_, activation.behavior)) return;
   active_ = true;
   const ParameterSet params = activation.resolved();
@@ -205,7 +207,7 @@ void CPathPlanningModule::on_behavior_activated(const BehaviorActivation& activa
   path_.publish(plan.waypoints, 0.0, true, context);
 }
 
-void CPathPlanningModule::on_update(ModuleContext& context) {
+void CPathPlanner::on_update(ModuleContext& context) {
   if (!active_ || context.feedback.path_id != path_.id() || !replanner_.due(context.feedback, context.now)) return;
   if (!replanner_.observe(*maps_, context)) return;  // nothing new seen: the same plan again
   PlannedPath plan = maps_->planner().plan_around(point_of(context.navigation->map_from_base), goal_, replanner_.obstacles(),
@@ -214,16 +216,16 @@ void CPathPlanningModule::on_update(ModuleContext& context) {
   if (plan.ok()) path_.publish(plan.waypoints, 0.0, true, context);
 }
 
-void CPathPlanningModule::on_behavior_deactivated(std::string_view behavior, ModuleContext& context) {
+void CPathPlanner::on_behavior_deactivated(std::string_view behavior, ModuleContext& context) {
   if (!serves(serves_, behavior)) return;
   active_ = false;
   path_.withdraw(context);
 }
 
 // ---------------------------------------------------------------------------------------------
-// CCoverageModule
+// CCoveragePlanner
 
-const ModuleManifest& CCoverageModule::static_manifest() {
+const ModuleManifest& CCoveragePlanner::static_manifest() {
   static const ModuleManifest m = navi_manifest(
       "CoveragePlanner",
       "gives the cleaning behaviors their section's coverage path (hybrid: a balloon round along walls and "
@@ -278,7 +280,7 @@ const ModuleManifest& CCoverageModule::static_manifest() {
   return m;
 }
 
-void CCoverageModule::on_configure(const ParameterSet& params) {
+void CCoveragePlanner::on_configure(const ParameterSet& params) {
   options_.cleaning_width_m = params.number("cleaning_width_m");
   options_.overlap_m = params.number("overlap_m");
   options_.lane_overlap_m = params.number("lane_overlap_m");
@@ -314,7 +316,7 @@ void CCoverageModule::on_configure(const ParameterSet& params) {
   planner_.reset();
 }
 
-void CCoverageModule::on_start(ModuleContext& context) {
+void CCoveragePlanner::on_start(ModuleContext& context) {
   maps_ = context.modules != nullptr ? context.modules->find<CGridMaps>() : nullptr;
   if (maps_ == nullptr) throw ConfigError(where(), "CoveragePlanner needs the robot's map: add a GridMaps module");
   splitter_ = context.modules->find<CSectionSplitter>();
@@ -323,7 +325,7 @@ void CCoverageModule::on_start(ModuleContext& context) {
   (void)planner();  // built now, not in the first period that needs it
 }
 
-CoveragePlanner& CCoverageModule::planner() {
+CoveragePlanner& CCoveragePlanner::planner() {
   if (!planner_) {
     CoverageOptions o = options_;
     o.robot_radius_m = maps_->robot_radius_m();
@@ -332,7 +334,7 @@ CoveragePlanner& CCoverageModule::planner() {
   return *planner_;
 }
 
-CoverageResult CCoverageModule::plan(const Section& section, Point2D from) {
+CoverageResult CCoveragePlanner::plan(const Section& section, Point2D from) {
   if (pattern_ == "boustrophedon") return planner().boustrophedon(section, from);
   if (pattern_ == "balloon") return planner().balloon(section, from);
   CoverageResult r = planner().hybrid(section, from, next_section_centroid(section));
@@ -359,7 +361,7 @@ CoverageResult CCoverageModule::plan(const Section& section, Point2D from) {
   return r;
 }
 
-std::optional<Point2D> CCoverageModule::next_section_centroid(const Section& section) const {
+std::optional<Point2D> CCoveragePlanner::next_section_centroid(const Section& section) const {
   // The planner visits a room's sections nearest first (CSectionSplitter::on_answer), so the
   // next one is most likely the nearest section not cleaned yet; a path that ends on its side
   // saves the walk across this one.
@@ -377,14 +379,14 @@ std::optional<Point2D> CCoverageModule::next_section_centroid(const Section& sec
   return next;
 }
 
-const CoverageResult& CCoverageModule::entry_plan(const Section& section, Point2D from) {
+const CoverageResult& CCoveragePlanner::entry_plan(const Section& section, Point2D from) {
   if (auto p = progress_.find(section.name); p != progress_.end() && !p->second.finished) return p->second.plan;
   auto it = entry_plans_.find(section.name);
   if (it == entry_plans_.end()) it = entry_plans_.emplace(section.name, plan(section, from)).first;
   return it->second;
 }
 
-double CCoverageModule::section_coverage(const Section& section) const {
+double CCoveragePlanner::section_coverage(const Section& section) const {
   const auto it = progress_.find(section.name);
   if (it == progress_.end() || !maps_) return 0.0;
   CleanedCells reach(maps_->grid());
@@ -396,7 +398,7 @@ double CCoverageModule::section_coverage(const Section& section) const {
   return cleaned_.coverage(cells);
 }
 
-void CCoverageModule::on_behavior_activated(const BehaviorActivation& activation, ModuleContext& context) {
+void CCoveragePlanner::on_behavior_activated(const BehaviorActivation& activation, ModuleContext& context) {
   if (!serves(serves_, activation.behavior)) return;
   const ParameterSet params = activation.resolved();
   replanner_.reset(params);
@@ -425,7 +427,7 @@ void CCoverageModule::on_behavior_activated(const BehaviorActivation& activation
   rejoin(from, context);
 }
 
-void CCoverageModule::rejoin(Point2D from, ModuleContext& context) {
+void CCoveragePlanner::rejoin(Point2D from, ModuleContext& context) {
   // The follower steers straight at the path's next point: from where a kidnapping (or a
   // recovery that moved the robot) left it, that line may pass an obstacle of the map at any
   // distance, and the laser watch ignores what the map holds. The way back goes round it.
@@ -447,7 +449,7 @@ void CCoverageModule::rejoin(Point2D from, ModuleContext& context) {
   resume_m_ = active_->done_m;
 }
 
-void CCoverageModule::on_update(ModuleContext& context) {
+void CCoveragePlanner::on_update(ModuleContext& context) {
   if (active_ == nullptr) return;
   const NavigationData& navi = *context.navigation;
   // The cleaned cells: under the footprint, from the pose the robot trusts.
@@ -474,7 +476,7 @@ void CCoverageModule::on_update(ModuleContext& context) {
   if (following && replanner_.due(fb, context.now)) plan_detour(navi.map_from_base, context);
 }
 
-void CCoverageModule::plan_detour(const Pose2D& pose, ModuleContext& context) {
+void CCoveragePlanner::plan_detour(const Pose2D& pose, ModuleContext& context) {
   if (!replanner_.observe(*maps_, context)) return;
   // The first point of the coverage path beyond the progress that is clear of everything seen,
   // by the robot radius, the detour margin and the depth the laser could not see.
@@ -500,7 +502,7 @@ void CCoverageModule::plan_detour(const Pose2D& pose, ModuleContext& context) {
   resume_m_ = resume;
 }
 
-void CCoverageModule::on_behavior_deactivated(std::string_view behavior, ModuleContext& context) {
+void CCoveragePlanner::on_behavior_deactivated(std::string_view behavior, ModuleContext& context) {
   if (!serves(serves_, behavior)) return;
   active_ = nullptr;
   detouring_ = false;

@@ -5,7 +5,7 @@
 #include <limits>
 #include <set>
 
-#include "../common/yaml_reader.hpp"
+#include "tripodal_common_internal/yaml_reader.hpp"
 
 namespace tripodal::navi {
 

@@ -7,8 +7,8 @@
 #include <optional>
 #include <system_error>
 
-#include "../common/yaml_reader.hpp"
 #include "tripodal/core/net_loader.hpp"
+#include "tripodal_common_internal/yaml_reader.hpp"
 
 namespace tripodal {
 

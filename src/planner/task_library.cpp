@@ -6,7 +6,7 @@
 #include <cctype>
 #include <set>
 
-#include "../common/yaml_reader.hpp"
+#include "tripodal_common_internal/yaml_reader.hpp"
 
 namespace tripodal {
 

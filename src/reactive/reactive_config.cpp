@@ -11,8 +11,8 @@
 #include <set>
 #include <sstream>
 
-#include "../common/yaml_reader.hpp"
 #include "tripodal/core/value.hpp"
+#include "tripodal_common_internal/yaml_reader.hpp"
 
 namespace tripodal {
 
@@ -407,23 +407,6 @@ ReactiveConfig parse_reactive_config(std::string_view text, const std::string& f
 
 ReactiveConfig load_reactive_config(const std::string& path, const ControllerRegistry& registry) {
   return parse_reactive_config(yaml::read_file(path), path, registry);
-}
-
-std::unique_ptr<ControlLoop> make_control_loop(const ReactiveConfig& reactive, const LoopConfig& config,
-                                               ResourceTable& resources, HardwareInterface* hardware,
-                                               const ControllerRegistry& registry) {
-  std::unique_ptr<CController> controller;
-  if (!config.controller.empty()) {
-    const ControllerConfig* cc = reactive.find_controller(config.controller);
-    if (cc == nullptr) throw ConfigError(config.where, "loop '" + config.name + "': unknown controller '" + config.controller + "'");
-    if (hardware == nullptr) throw ConfigError(config.where, "loop '" + config.name + "': controller '" + config.controller + "' needs a hardware interface");
-    controller = registry.create(*cc, *hardware);
-  }
-  ControlLoopOptions options;
-  options.name = config.name;
-  options.period = config.period;
-  options.max_behaviors = config.max_behaviors;
-  return std::make_unique<ControlLoop>(options, resources, CBehaviorCoordinator(config.coordinator), std::move(controller));
 }
 
 }  // namespace tripodal

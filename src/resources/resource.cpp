@@ -57,6 +57,12 @@ const ModuleManifest& resource_manifest<GyroReading>() noexcept {
   static const ModuleManifest m = make_resource_manifest("GyroResource", "gyro", "yaw-rate gyro");
   return m;
 }
+template <>
+const ModuleManifest& resource_manifest<JointReading>() noexcept {
+  static const ModuleManifest m = make_resource_manifest(
+      "JointResource", "joint_state", "a neck or arm joint's state: position, speed, the command it follows, limits");
+  return m;
+}
 
 void ResourceTable::add(CResource& resource) {
   if (find(resource.name()) != nullptr) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -190,6 +191,86 @@ std::vector<std::string> knowledge_inputs(const TaskLibrary& tasks) {
   return {out.begin(), out.end()};
 }
 
+namespace {
+
+// Calls `fn` with the registry of the entry's family: hardware, behaviors, controllers, resources or
+// (every other kind) modules.
+template <class Fn>
+auto with_registry(const RobotPlugins& plugins, const ModuleEntry& e, bool is_hardware, Fn&& fn) {
+  if (is_hardware) return fn(plugins.hardware);
+  if (e.kind == ModuleKind::behavior) return fn(plugins.behaviors);
+  if (e.kind == ModuleKind::controller) return fn(plugins.controllers);
+  if (e.kind == ModuleKind::resource) return fn(plugins.resources);
+  return fn(plugins.modules);
+}
+
+// One entry of the profile as the diagram shows it: from its type's manifest, or from what the
+// profile declares of a type not implemented yet; nullopt for an unknown type (reported).
+std::optional<DescribedModule> describe_entry(const ModuleEntry& e, bool is_hardware, const RobotPlugins& plugins,
+                                              Diagnostics& d) {
+  DescribedModule dm;
+  dm.name = e.name;
+  dm.type = e.type;
+  dm.kind = e.kind;
+  dm.where = e.where;
+  dm.description = e.description;
+  dm.from = e.from;
+  dm.hardware = is_hardware;
+  const ModuleManifest* m = with_registry(plugins, e, is_hardware, [&](const auto& r) { return r.find(e.type); });
+  if (m != nullptr) {
+    dm.layer = m->layer;
+    if (e.layer || e.inputs || e.outputs) {
+      // One manifest per type: the diagram must show what the code does, not a second copy.
+      d.error(e.where, "module '" + e.name + "' re-declares " +
+                           (e.layer    ? "layer"
+                            : e.inputs ? "inputs"
+                                       : "outputs") +
+                           " of its registered type '" + e.type + "' (a " + std::string(to_string(m->layer)) + "-layer " +
+                           std::string(to_string(m->kind)) +
+                           "); remove layer, inputs and outputs: the diagram comes from the type's own manifest");
+    }
+    if (!is_hardware && m->kind != ModuleKind::other && m->kind != e.kind) {
+      d.error(e.where, "module '" + e.name + "': type '" + e.type + "' is a " + std::string(to_string(m->kind)) +
+                           ", but it is listed as a " + std::string(to_string(e.kind)));
+    }
+    dm.inputs = m->inputs;
+    dm.outputs = m->outputs;
+    dm.writes = m->writes;
+    dm.channels = m->command_channels;
+    if (dm.description.empty()) dm.description = m->description;
+    return dm;
+  }
+  if (e.layer) {
+    dm.layer = *e.layer;  // declared in the profile: a module designed before it is implemented
+    dm.inputs = e.inputs.value_or(std::vector<std::string>{});
+    dm.outputs = e.outputs.value_or(std::vector<std::string>{});
+    return dm;
+  }
+  const std::string kind = is_hardware ? std::string("hardware type") : std::string(to_string(e.kind)) + " type";
+  const std::vector<std::string> known = with_registry(plugins, e, is_hardware, [](const auto& r) { return r.names(); });
+  d.error(e.where,
+          unknown_name_message(kind, e.type, known) + "; register it, or declare it here with layer, inputs and outputs");
+  return std::nullopt;
+}
+
+// The robot's own modules, in every diagram: planner, process supervisor, behavior coordinator.
+DescribedModule core_module(std::string name, std::string type, ModuleKind kind, Layer layer, std::string description,
+                            std::vector<std::string> inputs, std::vector<std::string> outputs, const SourceLocation& where) {
+  DescribedModule m;
+  m.name = std::move(name);
+  m.type = std::move(type);
+  m.kind = kind;
+  m.layer = layer;
+  m.core = true;
+  m.description = std::move(description);
+  m.inputs = std::move(inputs);
+  m.outputs = std::move(outputs);
+  m.where = where;
+  return m;
+}
+
+}  // namespace
+
 RobotDescription describe_robot(const RobotProfile& profile, const RobotPlugins& plugins,
                                 const std::vector<std::string>& planner_inputs, Diagnostics& d) {
   RobotDescription out;
@@ -197,106 +278,20 @@ RobotDescription describe_robot(const RobotProfile& profile, const RobotPlugins&
   out.description = profile.description;
   std::vector<std::string> pin = planner_inputs;
   pin.push_back("process_result");
-  out.modules.push_back(DescribedModule{CoreNames::kPlanner,
-                                        "CPlanner",
-                                        ModuleKind::planner,
-                                        Layer::deliberate,
-                                        true,
-                                        "turns task commands into plans of process modules; recovers from faults",
-                                        pin,
-                                        {"process_plan"},
-                                        profile.where,
-                                        {},
-                                        {},
-                                        {},
-                                        false});
-  out.modules.push_back(DescribedModule{CoreNames::kSupervisor,
-                                        "CProcessSupervisor",
-                                        ModuleKind::other,
-                                        Layer::sequencing,
-                                        true,
-                                        "runs the processes' nets, activates behaviors, posts faults",
-                                        {"process_plan"},
-                                        {"process_result"},
-                                        profile.where,
-                                        {},
-                                        {},
-                                        {},
-                                        false});
-  out.modules.push_back(DescribedModule{CoreNames::kCoordinator,
-                                        "CBehaviorCoordinator",
-                                        ModuleKind::other,
-                                        Layer::reactive,
-                                        true,
-                                        "fuses the commands and the command channels of the active behaviors",
-                                        {"behavior_command*"},
-                                        {"cmd_vel"},
-                                        profile.where,
-                                        {},
-                                        {},
-                                        {},
-                                        false});
-  std::vector<const ModuleEntry*> entries;
-  if (profile.hardware) entries.push_back(&*profile.hardware);
-  for (const ModuleEntry* e : profile.all_modules()) entries.push_back(e);
-  for (const ModuleEntry* e : entries) {
-    const bool is_hardware = profile.hardware && e == &*profile.hardware;
-    const ModuleManifest* m = nullptr;
-    if (is_hardware) m = plugins.hardware.find(e->type);
-    else if (e->kind == ModuleKind::behavior) m = plugins.behaviors.find(e->type);
-    else if (e->kind == ModuleKind::controller) m = plugins.controllers.find(e->type);
-    else if (e->kind == ModuleKind::resource) m = plugins.resources.find(e->type);
-    else m = plugins.modules.find(e->type);
-    DescribedModule dm;
-    dm.name = e->name;
-    dm.type = e->type;
-    dm.kind = e->kind;
-    dm.where = e->where;
-    dm.description = e->description;
-    dm.from = e->from;
-    dm.hardware = is_hardware;
-    if (m != nullptr) {
-      dm.layer = m->layer;
-      if (e->layer || e->inputs || e->outputs) {
-        // One manifest per type: the diagram must show what the code does, not a second copy.
-        d.error(e->where, "module '" + e->name + "' re-declares " + (e->layer ? "layer" : e->inputs ? "inputs" : "outputs") +
-                              " of its registered type '" + e->type + "' (a " + std::string(to_string(m->layer)) +
-                              "-layer " + std::string(to_string(m->kind)) +
-                              "); remove layer, inputs and outputs: the diagram comes from the type's own manifest");
-      }
-      if (!is_hardware && m->kind != ModuleKind::other && m->kind != e->kind) {
-        d.error(e->where, "module '" + e->name + "': type '" + e->type + "' is a " + std::string(to_string(m->kind)) +
-                              ", but it is listed as a " + std::string(to_string(e->kind)));
-      }
-      dm.inputs = m->inputs;
-      dm.outputs = m->outputs;
-      dm.writes = m->writes;
-      dm.channels = m->command_channels;
-      if (dm.description.empty()) dm.description = m->description;
-    } else if (e->layer) {
-      dm.layer = *e->layer;  // declared in the profile: a module designed before it is implemented
-      dm.inputs = e->inputs.value_or(std::vector<std::string>{});
-      dm.outputs = e->outputs.value_or(std::vector<std::string>{});
-    } else {
-      std::vector<std::string> known;
-      std::string kind = std::string(to_string(e->kind)) + " type";
-      if (is_hardware) {
-        known = plugins.hardware.names();
-        kind = "hardware type";
-      } else if (e->kind == ModuleKind::behavior) {
-        known = plugins.behaviors.names();
-      } else if (e->kind == ModuleKind::controller) {
-        known = plugins.controllers.names();
-      } else if (e->kind == ModuleKind::resource) {
-        known = plugins.resources.names();
-      } else {
-        known = plugins.modules.names();
-      }
-      d.error(e->where, unknown_name_message(kind, e->type, known) +
-                            "; register it, or declare it here with layer, inputs and outputs");
-      continue;
-    }
-    out.modules.push_back(std::move(dm));
+  out.modules.push_back(core_module(CoreNames::kPlanner, "CPlanner", ModuleKind::planner, Layer::deliberate,
+                                    "turns task commands into plans of process modules; recovers from faults", pin,
+                                    {"process_plan"}, profile.where));
+  out.modules.push_back(core_module(CoreNames::kSupervisor, "CProcessSupervisor", ModuleKind::other, Layer::sequencing,
+                                    "runs the processes' nets, activates behaviors, posts faults", {"process_plan"},
+                                    {"process_result"}, profile.where));
+  out.modules.push_back(core_module(CoreNames::kCoordinator, "CBehaviorCoordinator", ModuleKind::other, Layer::reactive,
+                                    "fuses the commands and the command channels of the active behaviors", {"behavior_command*"},
+                                    {"cmd_vel"}, profile.where));
+  if (profile.hardware) {
+    if (auto dm = describe_entry(*profile.hardware, true, plugins, d)) out.modules.push_back(std::move(*dm));
+  }
+  for (const ModuleEntry* e : profile.all_modules()) {
+    if (auto dm = describe_entry(*e, false, plugins, d)) out.modules.push_back(std::move(*dm));
   }
   for (const ProcessEntry& p : profile.processes) out.processes.push_back(p.name);
   check_layering(out.modules, d);

@@ -18,6 +18,7 @@
 #include "tripodal/reactive/reactive_config.hpp"
 #include "tripodal/resources/resource_faults.hpp"
 #include "tripodal/robot/battery_monitor.hpp"
+#include "tripodal_reactive_internal/sim_loop_driver.hpp"
 
 namespace tripodal {
 
@@ -135,42 +136,34 @@ void check_facts(const RobotProfile& profile, const CheckedProfile& checked, Dia
 // noted (the diagram of a design, whose modules may not be implemented yet).
 enum class DeclaredTypes { must_be_registered, may_be_designs };
 
-// Every check of a profile that builds no instance — the tasks and recovery rules, the diagram's
-// providers and layering, every type registered, the process nets against the behaviors the profile
-// lists, the controllers' reactive configurations — so that `tripodal describe` (check_robot) says
-// what Robot::assemble would refuse. Problems go to `d`, located.
-CheckedProfile check_profile(const RobotProfile& profile, const RobotPlugins& plugins,
-                             std::function<PetriNet(const std::filesystem::path&)> load, DeclaredTypes declared, Diagnostics& d) {
-  CheckedProfile out;
-  auto collect = [&](const auto& fn) {
-    try {
-      fn();
-    } catch (const ConfigError& e) {
-      d.append(e.diagnostics());
+// The names the checks of a profile look up: its processes and its behaviors, the safety ones
+// apart (the loop's own, active from the start: the nets do not activate them).
+class ProfileNames {
+ public:
+  explicit ProfileNames(const RobotProfile& profile) : profile_(profile) {
+    for (const ModuleEntry& b : profile.behaviors) {
+      if (!b.safety) behavior_types_.emplace(b.name, b.type);
     }
-  };
-  std::vector<std::string> process_names;
-  for (const ProcessEntry& p : profile.processes) process_names.push_back(p.name);
-  auto is_process = [&](std::string_view n) { return std::find(process_names.begin(), process_names.end(), n) != process_names.end(); };
-  // Safety behaviors are the loop's own, active from the start: the nets do not activate them.
-  for (const ModuleEntry& b : profile.behaviors) {
-    if (!b.safety) out.behavior_types.emplace(b.name, b.type);
   }
-  auto is_safety = [&](std::string_view n) {
-    return std::any_of(profile.behaviors.begin(), profile.behaviors.end(), [&](const ModuleEntry& b) { return b.safety && b.name == n; });
-  };
-  auto is_behavior = [&](std::string_view n) { return out.behavior_types.count(n) != 0; };
-
-  if (!profile.tasks.empty()) {
-    collect([&] { out.tasks = TaskLibrary::load(profile.tasks, TaskLoadOptions{is_process}); });
+  [[nodiscard]] bool is_process(std::string_view n) const {
+    return std::any_of(profile_.processes.begin(), profile_.processes.end(), [&](const ProcessEntry& p) { return p.name == n; });
   }
-  if (!profile.recovery.empty()) collect([&] { out.recovery = RecoveryPolicy::load(profile.recovery, is_process); });
+  [[nodiscard]] bool is_behavior(std::string_view n) const { return behavior_types_.count(n) != 0; }
+  [[nodiscard]] bool is_safety(std::string_view n) const {
+    return std::any_of(profile_.behaviors.begin(), profile_.behaviors.end(),
+                       [&](const ModuleEntry& b) { return b.safety && b.name == n; });
+  }
+  [[nodiscard]] const std::map<std::string, std::string, std::less<>>& behavior_types() const noexcept { return behavior_types_; }
 
-  out.description = describe_robot(profile, plugins, knowledge_inputs(out.tasks), d);
+ private:
+  const RobotProfile& profile_;
+  std::map<std::string, std::string, std::less<>> behavior_types_;  // profile name -> type
+};
 
-  // A type declared in the profile (layer, inputs, outputs) draws the diagram of a module designed
-  // before it is implemented; running needs the type itself. (describe_robot reported the
-  // undeclared unknown ones.)
+// A type declared in the profile (layer, inputs, outputs) draws the diagram of a module designed
+// before it is implemented; running needs the type itself. (describe_robot reported the undeclared
+// unknown ones.)
+void check_declared_types(const RobotProfile& profile, const RobotPlugins& plugins, DeclaredTypes declared, Diagnostics& d) {
   std::vector<const ModuleEntry*> entries;
   if (profile.hardware) entries.push_back(&*profile.hardware);
   for (const ModuleEntry* e : profile.all_modules()) entries.push_back(e);
@@ -189,61 +182,91 @@ CheckedProfile check_profile(const RobotProfile& profile, const RobotPlugins& pl
       d.warning(e->where, std::move(why) + " (a design: `tripodal run` refuses it)");
     }
   }
+}
 
-  // Processes: nets, parameters and their own recovery rules.
+// One process of the profile: its nets, parameters and own recovery rules; a place binding a
+// behavior the robot does not list, or runs as a safety behavior, is an error. Throws ConfigError
+// for a net that does not load.
+ProcessDefinition check_process(const ProcessEntry& p, const ProfileNames& names,
+                                const std::function<PetriNet(const std::filesystem::path&)>& load, Diagnostics& d) {
+  ProcessDefinition def;
+  def.name = p.name;
+  def.type = p.type;
+  def.parameters = p.parameters;
+  def.where = p.where;
+  def.net = load(p.net);
+  if (!p.module.empty()) {
+    def.module = load(p.module);
+    check_module_net(*def.module, p.name, d);
+  }
+  if (!p.recovery.empty()) {
+    def.recovery = RecoveryPolicy::load(p.recovery, [&](std::string_view n) { return names.is_process(n); }).rules();
+  }
+  for (const Place& place : def.net.places()) {
+    if (!place.behavior) continue;
+    const std::string& behavior = place.behavior->behavior;
+    const char* why = names.is_safety(behavior)
+                          ? "which the robot runs as a safety behavior (safety: true: always active, never a net's)"
+                      : !names.is_behavior(behavior) ? "which the robot does not list under behaviors"
+                                                     : nullptr;
+    if (why == nullptr) continue;
+    d.error(p.net_where.line > 0 ? p.net_where : p.where, "process '" + p.name + "': place '" + place.id + "' of " +
+                                                              p.net.filename().string() + " binds behavior '" + behavior + "', " +
+                                                              why);
+  }
+  return def;
+}
+
+// Every check of a profile that builds no instance — the tasks and recovery rules, the diagram's
+// providers and layering, every type registered, the process nets against the behaviors the profile
+// lists, the controllers' reactive configurations — so that `tripodal describe` (check_robot) says
+// what Robot::assemble would refuse. Problems go to `d`, located.
+CheckedProfile check_profile(const RobotProfile& profile, const RobotPlugins& plugins,
+                             std::function<PetriNet(const std::filesystem::path&)> load, DeclaredTypes declared, Diagnostics& d) {
+  CheckedProfile out;
+  auto collect = [&](const auto& fn) {
+    try {
+      fn();
+    } catch (const ConfigError& e) {
+      d.append(e.diagnostics());
+    }
+  };
+  const ProfileNames names(profile);
+  out.behavior_types = names.behavior_types();
+  auto is_process = [&](std::string_view n) { return names.is_process(n); };
+  if (!profile.tasks.empty()) {
+    collect([&] { out.tasks = TaskLibrary::load(profile.tasks, TaskLoadOptions{is_process}); });
+  }
+  if (!profile.recovery.empty()) collect([&] { out.recovery = RecoveryPolicy::load(profile.recovery, is_process); });
+
+  out.description = describe_robot(profile, plugins, knowledge_inputs(out.tasks), d);
+  check_declared_types(profile, plugins, declared, d);
+
   if (!load) {
     load = [&](const std::filesystem::path& f) {
       LoadOptions lo;
-      // A safety behavior is known, so that a net binding it is refused below with the reason.
-      lo.is_known_behavior = [&](std::string_view n) { return is_behavior(n) || is_safety(n); };
+      // A safety behavior is known, so that a net binding it is refused by check_process, with the reason.
+      lo.is_known_behavior = [&](std::string_view n) { return names.is_behavior(n) || names.is_safety(n); };
       for (const ModuleEntry& b : profile.behaviors) lo.behavior_names.push_back(b.name);
       lo.structural_warnings = false;
       return load_net_or_throw(f, lo);
     };
   }
-  for (const ProcessEntry& p : profile.processes) {
-    collect([&] {
-      ProcessDefinition def;
-      def.name = p.name;
-      def.type = p.type;
-      def.parameters = p.parameters;
-      def.where = p.where;
-      def.net = load(p.net);
-      if (!p.module.empty()) {
-        def.module = load(p.module);
-        check_module_net(*def.module, p.name, d);
-      }
-      if (!p.recovery.empty()) def.recovery = RecoveryPolicy::load(p.recovery, is_process).rules();
-      for (const Place& place : def.net.places()) {
-        if (place.behavior && is_safety(place.behavior->behavior)) {
-          d.error(p.net_where.line > 0 ? p.net_where : p.where,
-                  "process '" + p.name + "': place '" + place.id + "' of " + p.net.filename().string() + " binds behavior '" +
-                      place.behavior->behavior + "', which the robot runs as a safety behavior (safety: true: always active, never a net's)");
-        } else if (place.behavior && !is_behavior(place.behavior->behavior)) {
-          d.error(p.net_where.line > 0 ? p.net_where : p.where,
-                  "process '" + p.name + "': place '" + place.id + "' of " + p.net.filename().string() + " binds behavior '" +
-                      place.behavior->behavior + "', which the robot does not list under behaviors");
-        }
-      }
-      out.processes.push_back(std::move(def));
-    });
-  }
-
+  for (const ProcessEntry& p : profile.processes) collect([&] { out.processes.push_back(check_process(p, names, load, d)); });
   check_facts(profile, out, d);
 
   // Behaviors are created anew at each activation; here their types are checked.
   for (const ModuleEntry& b : profile.behaviors) {
-    if (!plugins.behaviors.contains(b.type)) continue;  // reported above
-    if (b.name != b.type) {
+    if (plugins.behaviors.contains(b.type) && b.name != b.type) {  // (an unknown type is reported above)
       d.error(b.where, "behavior '" + b.name + "' is of type '" + b.type + "'; behaviors are known to the nets by their type name");
     }
   }
-
   // The base controllers' configurations, read through the application's controller types.
   for (const LoopEntry& l : profile.loops) {
-    if (l.controller.empty()) continue;
     for (const ModuleEntry& c : profile.controllers) {
-      if (c.name == l.controller) collect([&] { out.controllers.push_back(controller_config(profile, c, plugins.controllers)); });
+      if (!l.controller.empty() && c.name == l.controller) {
+        collect([&] { out.controllers.push_back(controller_config(profile, c, plugins.controllers)); });
+      }
     }
   }
   return out;

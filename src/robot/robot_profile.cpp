@@ -9,7 +9,7 @@
 #include <set>
 #include <sstream>
 
-#include "../common/yaml_reader.hpp"
+#include "tripodal_common_internal/yaml_reader.hpp"
 
 namespace tripodal {
 

@@ -831,23 +831,6 @@ void RealtimePacer::pace(Time sim_now) noexcept {
   wall_.sleep_until(wall_start_ + Duration{static_cast<Duration::rep>(elapsed)});
 }
 
-SimRunner::SimRunner(Simulator& sim, SimClock& clock, Duration physics_period)
-    : sim_(sim), clock_(clock), driver_(clock), period_(physics_period.count() > 0 ? physics_period : std::chrono::milliseconds(10)) {
-  clock_.set(sim_.now());
-}
-
-std::size_t SimRunner::run_until(Time until) noexcept {
-  // Cycles due now run first, on the readings the simulator sampled at this time.
-  std::size_t cycles = driver_.run_until(std::max(clock_.now(), sim_.now()));
-  while (sim_.now() < until) {
-    const Time t = std::min(sim_.now() + period_, until);
-    sim_.step_until(t);
-    cycles += driver_.run_until(t);
-    if (pacer_ != nullptr) pacer_->pace(t);
-  }
-  return cycles;
-}
-
 std::vector<Pose2D> fleet_start_poses(const World& world, std::size_t n, double gap_m) {
   std::vector<Pose2D> poses;
   if (n == 0) return poses;

@@ -10,8 +10,8 @@
 #include <set>
 #include <sstream>
 
-#include "../common/yaml_reader.hpp"
 #include "tripodal/sim/ray_caster.hpp"
+#include "tripodal_common_internal/yaml_reader.hpp"
 
 namespace tripodal::sim {
 

@@ -94,7 +94,7 @@ TEST_CASE("a low battery: the disinfection robot docks, charges and resumes the 
   ChargingRobot r(dock_world());
   board::BoardFirmware& fw = r.firmware();
   fw.set_state_of_charge(0.18);  // 3 % above the 15 % mark: low about a third into room 2111
-  auto* coverage = r.robot->module<navi::CCoverageModule>();
+  auto* coverage = r.robot->module<navi::CCoveragePlanner>();
   REQUIRE(coverage != nullptr);
   REQUIRE(r.robot->command("disinfect the room 2111").accepted);
 
@@ -223,7 +223,7 @@ std::string lcd(ChargingRobot& r) {
 TEST_CASE("the pause button stops base, lamp and fog, start takes the section up again, the LCD says so", "[board][panel]") {
   ChargingRobot r(dock_world());
   board::BoardFirmware& fw = r.firmware();
-  auto* coverage = r.robot->module<navi::CCoverageModule>();
+  auto* coverage = r.robot->module<navi::CCoveragePlanner>();
   REQUIRE(coverage != nullptr);
   REQUIRE(r.robot->command("disinfect the room 2111").accepted);
   r.run_task(30.0, [] {});

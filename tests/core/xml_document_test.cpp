@@ -4,7 +4,7 @@
 // value bytes back to the source, the XML 1.0 rules tinyxml2 lets through (references, '<' in
 // values, UTF-8, control characters, encodings, one root), tinyxml2's errors placed at a line and
 // column, and the loaders' FILE:LINE:COL for malformed XML.
-#include "../../src/core/xml_document.hpp"
+#include "tripodal_core_internal/xml_document.hpp"
 
 #include <algorithm>
 #include <catch2/catch.hpp>

@@ -16,7 +16,7 @@
 #include <thread>
 #include <vector>
 
-#include "../../src/monitor/wire.hpp"
+#include "tripodal_monitor_internal/wire.hpp"
 
 namespace tripodal::monitor::test {
 

@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "../../src/monitor/wire.hpp"
 #include "loopback_client.hpp"
+#include "tripodal_monitor_internal/wire.hpp"
 
 using namespace tripodal::monitor;
 using namespace tripodal::monitor::test;

@@ -19,8 +19,6 @@
 #include <string>
 #include <thread>
 
-#include "../../src/monitor/operator_request.hpp"
-#include "../../src/monitor/wire.hpp"
 #include "../navi/navi_test_util.hpp"
 #include "loopback_client.hpp"
 #include "test_hri_module.hpp"
@@ -33,6 +31,8 @@
 #include "tripodal/robot/robot.hpp"
 #include "tripodal/sim/sim_board.hpp"
 #include "tripodal/sim/sim_hardware.hpp"
+#include "tripodal_monitor_internal/operator_request.hpp"
+#include "tripodal_monitor_internal/wire.hpp"
 
 using namespace tripodal;
 using namespace tripodal::monitor;

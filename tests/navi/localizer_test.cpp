@@ -20,7 +20,7 @@ class Straight final : public GroundTruthSource {
 
 Time at(double s) { return time_from_seconds(s); }
 
-std::vector<ModuleEvent> run(CLocalizer& loc, double until_s, double dt_s = 0.1) {
+std::vector<ModuleEvent> run(CGroundTruthLocalizer& loc, double until_s, double dt_s = 0.1) {
   std::vector<ModuleEvent> events;
   for (double t = 0.0; t <= until_s + 1e-9; t += dt_s) loc.step(at(t), events);
   return events;
@@ -28,9 +28,9 @@ std::vector<ModuleEvent> run(CLocalizer& loc, double until_s, double dt_s = 0.1)
 
 }  // namespace
 
-TEST_CASE("CLocalizer: ok at start, lost during a fault, ok after global localization", "[navi][localizer]") {
+TEST_CASE("CGroundTruthLocalizer: ok at start, lost during a fault, ok after global localization", "[navi][localizer]") {
   Straight truth;
-  CLocalizer loc(&truth);
+  CGroundTruthLocalizer loc(&truth);
   loc.configure({{"faults", Value{std::string("2-4")}}, {"seed", Value{7.0}}});
   std::vector<ModuleEvent> ev = run(loc, 1.0);
   REQUIRE(ev.size() == 1);
@@ -60,12 +60,12 @@ TEST_CASE("CLocalizer: ok at start, lost during a fault, ok after global localiz
   CHECK(nd.pose_stamp == at(6.1));
 }
 
-TEST_CASE("CLocalizer: recover_at_fault_end brings the estimate back by itself", "[navi][localizer]") {
+TEST_CASE("CGroundTruthLocalizer: recover_at_fault_end brings the estimate back by itself", "[navi][localizer]") {
   Straight truth;
   LocalizerOptions o;
   o.recover_at_fault_end = true;
   o.faults = {{at(1.0), at(2.0)}};
-  CLocalizer loc(&truth, o);
+  CGroundTruthLocalizer loc(&truth, o);
   loc.configure({{"recover_at_fault_end", Value{true}}, {"faults", Value{std::string("1-2")}}});
   const std::vector<ModuleEvent> ev = run(loc, 3.0);
   REQUIRE(ev.size() == 3);
@@ -75,10 +75,10 @@ TEST_CASE("CLocalizer: recover_at_fault_end brings the estimate back by itself",
   CHECK(to_seconds(ev[2].stamp) == Approx(2.0).margin(0.11));
 }
 
-TEST_CASE("CLocalizer: the same seed gives the same estimates, another seed others", "[navi][localizer]") {
+TEST_CASE("CGroundTruthLocalizer: the same seed gives the same estimates, another seed others", "[navi][localizer]") {
   Straight truth;
   const auto trace = [&](double seed) {
-    CLocalizer loc(&truth);
+    CGroundTruthLocalizer loc(&truth);
     loc.configure({{"seed", Value{seed}}, {"faults", Value{std::string("0.5-0.8")}}});
     std::vector<Pose2D> poses;
     std::vector<ModuleEvent> ev;
@@ -92,26 +92,26 @@ TEST_CASE("CLocalizer: the same seed gives the same estimates, another seed othe
   CHECK(trace(3) != trace(4));
 }
 
-TEST_CASE("CLocalizer: noise beyond the threshold reads as lost, no truth, no events", "[navi][localizer]") {
+TEST_CASE("CGroundTruthLocalizer: noise beyond the threshold reads as lost, no truth, no events", "[navi][localizer]") {
   Straight truth;
-  CLocalizer noisy(&truth);
+  CGroundTruthLocalizer noisy(&truth);
   noisy.configure({{"noise_xy_m", Value{5.0}}});
   std::vector<ModuleEvent> ev = run(noisy, 2.0);
   bool lost = false;
   for (const ModuleEvent& e : ev) lost = lost || e.name == "localizer.lost";
   CHECK(lost);
-  CLocalizer blind(nullptr);
+  CGroundTruthLocalizer blind(nullptr);
   blind.configure();
   CHECK(run(blind, 1.0).empty());
   CHECK_FALSE(blind.estimate().has_value());
   CHECK_FALSE(blind.relocalize(at(0)));
   // before configure() a step does nothing
-  CLocalizer unconfigured(&truth);
+  CGroundTruthLocalizer unconfigured(&truth);
   CHECK(run(unconfigured, 1.0).empty());
 }
 
-TEST_CASE("CLocalizer: bad parameters and fault schedules are reported", "[navi][localizer][errors]") {
-  CLocalizer loc;
+TEST_CASE("CGroundTruthLocalizer: bad parameters and fault schedules are reported", "[navi][localizer][errors]") {
+  CGroundTruthLocalizer loc;
   CHECK_THROWS_WITH(loc.configure({{"noise_xy_m", Value{-1.0}}}, SourceLocation{"net.xml", 12, 3}),
                     Catch::Contains("net.xml:12:3") && Catch::Contains("noise_xy_m"));
   CHECK_THROWS_WITH(loc.configure({{"no_such", Value{1.0}}}), Catch::Contains("no_such"));
@@ -126,8 +126,8 @@ TEST_CASE("CLocalizer: bad parameters and fault schedules are reported", "[navi]
 TEST_CASE("Navigation modules: every one is created by name and configured with defaults", "[navi][modules]") {
   ModuleRegistry reg("module type");
   register_navigation_modules(reg);
-  REQUIRE(reg.names() == std::vector<std::string>{"CoveragePlanner", "GridMaps", "Localizer", "MapBuilder", "PathPlanner", "ScanMatchingLocalizer",
-                                                  "SectionSplitter"});
+  REQUIRE(reg.names() == std::vector<std::string>{"CoveragePlanner", "GridMaps", "GroundTruthLocalizer", "MapBuilder",
+                                                  "PathPlanner", "ScanMatchingLocalizer", "SectionSplitter"});
   for (const std::string& name : reg.names()) {
     std::unique_ptr<CModule> m = reg.create(name);
     REQUIRE(m != nullptr);
@@ -140,9 +140,9 @@ TEST_CASE("Navigation modules: every one is created by name and configured with 
     m->configure();
     CHECK(m->configured());
   }
-  CHECK_THROWS_WITH(reg.create("Localiser"), Catch::Contains("unknown module type 'Localiser'") &&
-                                                 Catch::Contains("did you mean 'Localizer'?"));
-  CHECK_THROWS_WITH(reg.add<CLocalizer>(), Catch::Contains("already registered"));
+  CHECK_THROWS_WITH(reg.create("GroundTruthLocaliser"), Catch::Contains("unknown module type 'GroundTruthLocaliser'") &&
+                                                            Catch::Contains("did you mean 'GroundTruthLocalizer'?"));
+  CHECK_THROWS_WITH(reg.add<CGroundTruthLocalizer>(), Catch::Contains("already registered"));
 }
 
 TEST_CASE("CSectionSplitter: configured from parameters", "[navi][modules]") {

@@ -1,4 +1,4 @@
-// The sequencing layer's navigation modules (GridMaps, SectionSplitter, Localizer, PathPlanner,
+// The sequencing layer's navigation modules (GridMaps, SectionSplitter, GroundTruthLocalizer, PathPlanner,
 // CoveragePlanner) serving the path-following behaviors: first the pieces on their own (published
 // paths, replanning, goal names, coverage resume), then a whole small robot on the simulator, its
 // process supervisor running a one-place net that binds the behavior under test, with the modules
@@ -90,8 +90,8 @@ sim::World world(double w_m, double h_m, bool pillar, Pose2D start, const std::v
 struct Modules final : public ModuleDirectory {
   std::unique_ptr<navi::CGridMaps> maps = std::make_unique<navi::CGridMaps>();
   std::unique_ptr<navi::CSectionSplitter> splitter = std::make_unique<navi::CSectionSplitter>();
-  std::unique_ptr<navi::CCoverageModule> coverage = std::make_unique<navi::CCoverageModule>();
-  std::unique_ptr<navi::CPathPlanningModule> planner = std::make_unique<navi::CPathPlanningModule>();
+  std::unique_ptr<navi::CCoveragePlanner> coverage = std::make_unique<navi::CCoveragePlanner>();
+  std::unique_ptr<navi::CPathPlanner> planner = std::make_unique<navi::CPathPlanner>();
   NavigationData navigation;
   std::uint32_t path_ids = 0;
 
@@ -170,7 +170,7 @@ std::string task_net(const std::string& id, const Task& t) {
   return xml + "</net>\n";
 }
 
-// `localizer`: more parameters of the Localizer (", faults: 0-5"). The nets of the tasks are
+// `localizer`: more parameters of the GroundTruthLocalizer (", faults: 0-5"). The nets of the tasks are
 // `folder`/task<i>.xml.
 std::string profile(bool omni, const std::string& localizer, const std::filesystem::path& folder,
                     std::size_t tasks) {
@@ -186,8 +186,7 @@ std::string profile(bool omni, const std::string& localizer, const std::filesyst
   y += "  - {name: motion, period_s: 0.01, controller: base}\n";
   y += "navigation:\n";
   y += "  - {name: maps, type: GridMaps, parameters: {robot_radius_m: 0.25}}\n";
-  y += "  - {name: localizer, type: Localizer, parameters: {noise_xy_m: 0, noise_theta_rad: 0" + localizer +
-       "}}\n";
+  y += "  - {name: localizer, type: GroundTruthLocalizer, parameters: {noise_xy_m: 0, noise_theta_rad: 0" + localizer + "}}\n";
   y += "  - {name: section_splitter, type: SectionSplitter}\n";
   y += "  - {name: path_planner, type: PathPlanner}\n";
   y += "  - {name: coverage, type: CoveragePlanner, parameters: {cleaning_width_m: 0.45}}\n";
@@ -266,10 +265,8 @@ class NavRobot {
   [[nodiscard]] sim::Simulator& sim() {
     return dynamic_cast<sim::SimHardware&>(*robot_->hardware()).simulator();
   }
-  [[nodiscard]] navi::CPathPlanningModule& path_planner() {
-    return *robot_->module<navi::CPathPlanningModule>();
-  }
-  [[nodiscard]] navi::CCoverageModule& coverage() { return *robot_->module<navi::CCoverageModule>(); }
+  [[nodiscard]] navi::CPathPlanner& path_planner() { return *robot_->module<navi::CPathPlanner>(); }
+  [[nodiscard]] navi::CCoveragePlanner& coverage() { return *robot_->module<navi::CCoveragePlanner>(); }
   [[nodiscard]] const navi::Section& section(std::string_view name) {
     const navi::Section* s = robot_->module<navi::CSectionSplitter>()->section(name);
     REQUIRE(s != nullptr);

@@ -541,7 +541,7 @@ TEST_CASE("MapBuilder module: maps only between begin and end, crops to what the
   const sim::SolidMap solid(world);
   MappingOptions o;
   o.size_m = 30.0;
-  CMappingModule mapper(o);
+  CMapBuilder mapper(o);
   DriftingOdometry odo;
   CHECK_FALSE(mapper.map().has_value());
   mapper.add(scan_at(solid, true_pose(0)), odo.read(true_pose(0)));  // not mapping yet: ignored
@@ -577,10 +577,10 @@ TEST_CASE("MapBuilder module: maps only between begin and end, crops to what the
 TEST_CASE("MapBuilder and ScanMatchingLocalizer refuse to start without their sensors, naming what is missing",
           "[navi][scan_matching][mapping]") {
   ModuleContext none;  // a robot without resources
-  CMappingModule mapper;
+  CMapBuilder mapper;
   mapper.configure({}, SourceLocation{"robot.yaml", 40, 5});
   CHECK_THROWS_WITH(mapper.start(none), Catch::Contains("robot.yaml:40:5: error: MapBuilder needs a laser scanner, and the robot has no laser resource"));
-  CMappingModule named;
+  CMapBuilder named;
   named.configure({{"laser", Value{std::string("front")}}}, SourceLocation{"robot.yaml", 44, 5});
   CHECK_THROWS_WITH(named.start(none), Catch::Contains("robot.yaml:44:5: error: MapBuilder: no laser resource named 'front'"));
   CScanMatchingLocalizer localizer;

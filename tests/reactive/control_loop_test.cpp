@@ -13,6 +13,7 @@
 #include "tripodal/behaviors/builtin_behaviors.hpp"
 #include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/controllers/kinematics.hpp"
+#include "tripodal_reactive_internal/sim_loop_driver.hpp"
 
 using namespace tripodal;
 using namespace std::chrono_literals;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "tripodal/reactive/control_loop.hpp"
+#include "tripodal_reactive_internal/sim_loop_driver.hpp"
 
 using namespace tripodal;
 using namespace std::chrono_literals;

@@ -5,10 +5,12 @@
 #include <cmath>
 #include <numbers>
 
+#include "../support/control_loops.hpp"
 #include "tripodal/controllers/ideal_hardware.hpp"
 
 using namespace tripodal;
 using namespace std::chrono_literals;
+using tripodal::test::make_control_loop;
 
 namespace {
 // The built-in controller types, as an application's plugin set has them.

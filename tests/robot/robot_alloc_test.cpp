@@ -35,7 +35,7 @@ TEST_CASE("The PSR-2 robot's reactive loop allocates nothing over 10,000 periods
   // with only the reactive cycles counted.
   ControlLoop& loop = robot->behavior_loop();
   auto& sim = dynamic_cast<sim::SimHardware&>(*robot->hardware()).simulator();
-  const auto* coverage = robot->module<navi::CCoverageModule>();
+  const auto* coverage = robot->module<navi::CCoveragePlanner>();
   REQUIRE(coverage->progress().count("A") == 1);
   const double progress_before = coverage->progress().at("A").done_m;
   const double distance_before = sim.distance_m();

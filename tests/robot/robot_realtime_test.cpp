@@ -65,7 +65,7 @@ TEST_CASE("PSR-2 cleans on its own threads at 20 times real time", "[robot][thre
   std::atomic<bool> busy{true};
   std::atomic<int> periods{0};
   std::atomic<bool> cleaning_seen{false};
-  const auto* coverage = robot->module<navi::CCoverageModule>();
+  const auto* coverage = robot->module<navi::CCoveragePlanner>();
   RealtimeOptions ro;
   ro.after_sequencing = [&](Time) {
     periods.fetch_add(1);

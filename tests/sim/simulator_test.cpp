@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "../support/builtin_registries.hpp"
+#include "../support/control_loops.hpp"
+#include "../support/sim_runner.hpp"
 #include "sim_test_util.hpp"
 #include "tripodal/behaviors/behavior_registry.hpp"
 #include "tripodal/controllers/kinematics.hpp"
@@ -20,6 +22,8 @@ using namespace tripodal;
 using namespace tripodal::sim;
 using namespace tripodal::sim::test;
 using namespace std::chrono_literals;
+using tripodal::test::make_control_loop;
+using tripodal::test::SimRunner;
 
 namespace {
 
@@ -257,7 +261,7 @@ TEST_CASE("Simulator: localization loss windows drive the navi localizer from gr
   World world = room_world(81, 81, {2.0, 2.0, 0.0});
   world.faults.localization_loss = navi::parse_fault_schedule("1-2");
   Simulator sim(std::move(world), omni3_base(), 1);
-  navi::CLocalizer loc(&sim);
+  navi::CGroundTruthLocalizer loc(&sim);
   loc.configure({{"seed", Value{3.0}}});
   for (const navi::LocalizationFault& f : sim.world().faults.localization_loss) loc.add_fault(f);
   std::vector<ModuleEvent> ev;

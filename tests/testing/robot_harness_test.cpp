@@ -47,7 +47,7 @@ RobotProfile psr2() {
   RobotProfile p = load_robot_profile(kConfigs / "robots/psr2.yaml");
   for (ModuleEntry& e : p.navigation) {
     if (e.name != "localizer") continue;
-    e.type = "Localizer";
+    e.type = "GroundTruthLocalizer";
     e.parameters = {{"noise_xy_m", "0.005"}, {"noise_theta_rad", "0.005"}};
   }
   return p;

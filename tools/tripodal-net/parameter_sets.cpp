@@ -1,8 +1,8 @@
 #include "parameter_sets.hpp"
 
-#include "../../src/common/yaml_reader.hpp"
 #include "tripodal/core/registry.hpp"
 #include "tripodal/robot/robot_profile.hpp"
+#include "tripodal_common_internal/yaml_reader.hpp"
 
 namespace tripodal::net_tool {
 

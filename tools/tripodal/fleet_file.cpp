@@ -8,7 +8,7 @@
 #include <map>
 #include <sstream>
 
-#include "../../src/common/yaml_reader.hpp"
+#include "tripodal_common_internal/yaml_reader.hpp"
 #include "run_outputs.hpp"
 #include "tripodal/robot/robot_profile.hpp"
 #include "tripodal/sim/ray_caster.hpp"

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <iomanip>
 #include <ostream>
+#include <string_view>
 #include <vector>
 
 #include "run_measures.hpp"
@@ -108,7 +109,7 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
       if (!world.regions_file.empty() && e.parameters.count("regions") == 0)
         ro.parameters.push_back({e.name, "regions", std::filesystem::absolute(world.regions_file).string()});
     }
-    if (e.type != navi::CCoverageModule::static_manifest().name) continue;
+    if (e.type != navi::CCoveragePlanner::static_manifest().name) continue;
     if (!o.pattern.empty()) ro.parameters.push_back({e.name, "pattern", o.pattern});
     if (!o.dose_plan)
       ro.parameters.push_back({e.name, "dose_target_j_m2", "0"});
@@ -128,7 +129,7 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
   if (host == nullptr) throw ConfigError(where, "hardware 'board' with a port: expected the control board's hardware");
   board::BoardHardware& hw = host->board();
   Navigation nav{robot->module<navi::CGridMaps>(), robot->module<navi::CSectionSplitter>(),
-                 robot->module<navi::CCoverageModule>()};
+                 robot->module<navi::CCoveragePlanner>()};
   if (nav.maps == nullptr)
     throw ConfigError(profile.where, "`tripodal run` measures the run on the map: the robot needs a GridMaps module");
   if (nav.coverage != nullptr) res.coverage_pattern = nav.coverage->pattern();
@@ -137,6 +138,8 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
 
   LifecycleRecorder life(true);
   robot->planner().add_observer(life);
+  ReportObserver report;  // the processes and recoveries, as run_task reports them
+  robot->planner().add_observer(report);
   robot->supervisor().add_observer(life);
   DeviceFigures dev;
   dev.port = port;
@@ -162,15 +165,7 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
     o.log->flush();
   };
   const auto measure_room = [&] {
-    room_sections.clear();
-    for (const PlanStage& stage : robot->planner().current_plan().stages) {
-      for (const ProcessStep& step : stage.steps) {
-        for (const BindingParam& p : step.params) {
-          if (p.name == "section" && std::find(room_sections.begin(), room_sections.end(), p.value) == room_sections.end())
-            room_sections.push_back(p.value);
-        }
-      }
-    }
+    room_sections = plan_sections(robot->planner());
     reachable = reachable_area(nav, reach_planner, room_sections, start, half_width);
     res.reachable_cells = static_cast<std::size_t>(std::count(reachable.begin(), reachable.end(), char{1}));
   };
@@ -283,11 +278,14 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
   }
 
   // The robot's threads have stopped: this thread runs the link now. The wheels commanded zero,
-  // the lamp and the fog off, until the board has answered a DRIVE sent after that.
+  // the lamp and the fog at their channels' safe values (off; the board applies the channels at its
+  // next cycle, as in the run), until the board has answered a DRIVE sent after that.
   const std::array<double, 2> zeros{0.0, 0.0};
   (void)hw.write_wheel_velocities(zeros);
-  (void)hw.command(board::Command::uv_lamp, std::array<std::uint8_t, 1>{0});
-  (void)hw.command(board::Command::atomizer, std::array<std::uint8_t, 2>{0, 0});
+  CommandChannels& channels = hw.command_channels();
+  for (const std::string_view name : {"uv_lamp", "atomizer", "atomizer_fan"}) {
+    if (const auto i = channels.find(name)) channels.set(*i, channels.spec(*i).safe);
+  }
   const Time zero_sent = clock.now();
   bool zero_answered = false;
   for (int i = 0; i < 50 && !zero_answered; ++i) {
@@ -308,21 +306,9 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
   if (res.reason.empty()) res.reason = tr.reason;
   res.duration_s = to_seconds(ended - task_start);
   res.wall_clock = speed == 1.0;  // at a speed-up the devices' time, S times the wall clock's
-  res.cleaned_cells = 0;
-  for (std::size_t i = 0; i < reachable.size(); ++i) res.cleaned_cells += (reachable[i] != 0 && cleaned.mask()[i] != 0) ? 1 : 0;
-  res.coverage =
-      res.reachable_cells == 0 ? 0.0 : static_cast<double>(res.cleaned_cells) / static_cast<double>(res.reachable_cells);
-  const double res_m = nav.maps->grid().resolution_m();
-  res.reachable_area_m2 = static_cast<double>(res.reachable_cells) * res_m * res_m;
-  res.total = path_figures(path_all);
-  res.cleaning = path_figures(path_cleaning);
-  for (const LifecycleEntry& e : life.entries()) {
-    const bool recovery = e.text.rfind("recovery: ", 0) == 0;
-    const bool finished = e.text.rfind("process ", 0) == 0 &&
-                          (e.text.find(" succeeded") != std::string::npos || e.text.find(" failed: ") != std::string::npos);
-    if (recovery) res.recoveries.push_back(fixed(to_seconds(e.time), 3) + " " + e.text.substr(10));
-    if (finished) res.processes.push_back(fixed(to_seconds(e.time), 3) + " " + e.text.substr(8));
-  }
+  set_floor_figures(res, nav, reachable, cleaned, path_all, path_cleaning);
+  res.processes = report.processes;
+  res.recoveries = report.recoveries;
   res.robot_steps = robot->behavior_loop().cycles();
   res.loops = robot->timing();
 

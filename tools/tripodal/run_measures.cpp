@@ -68,7 +68,7 @@ std::vector<char> reachable_area(const Navigation& nav, navi::PathPlanner& plann
   return reach;
 }
 
-DoseEstimate estimate_dose(navi::CCoverageModule& cov, const navi::CSectionSplitter& splitter,
+DoseEstimate estimate_dose(navi::CCoveragePlanner& cov, const navi::CSectionSplitter& splitter,
                            const std::vector<std::string>& sections, Point2D from, const board::FirmwareConfig& fw) {
   double yaw_rate = 1.0;
   for (const ParameterSpec& p : BhCleaningTwoWheel::static_manifest().parameters) {
@@ -153,6 +153,26 @@ DisinfectionFigures disinfection_figures(sim::SimBoardHardware& hw, const std::v
   f.bytes_to_host = b.line().board().bytes_sent();
   f.bytes_lost = b.line().host().bytes_lost() + b.line().board().bytes_lost();
   return f;
+}
+
+std::size_t cleaned_reachable(const std::vector<char>& reachable, const navi::CleanedCells& cleaned) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < reachable.size(); ++i) n += (reachable[i] != 0 && cleaned.cleaned(i)) ? 1 : 0;
+  return n;
+}
+
+void set_floor_figures(RunResult& res, const Navigation& nav, const std::vector<char>& reachable,
+                       const navi::CleanedCells& cleaned, const std::vector<navi::Point2D>& path_all,
+                       const std::vector<navi::Point2D>& path_cleaning) {
+  res.reachable_cells =
+      static_cast<std::size_t>(std::count_if(reachable.begin(), reachable.end(), [](char c) { return c != 0; }));
+  res.cleaned_cells = cleaned_reachable(reachable, cleaned);
+  res.coverage =
+      res.reachable_cells == 0 ? 0.0 : static_cast<double>(res.cleaned_cells) / static_cast<double>(res.reachable_cells);
+  const double res_m = nav.maps->grid().resolution_m();
+  res.reachable_area_m2 = static_cast<double>(res.reachable_cells) * res_m * res_m;
+  res.total = path_figures(path_all);
+  res.cleaning = path_figures(path_cleaning);
 }
 
 std::vector<std::string> plan_sections(const CPlanner& planner) {

@@ -41,7 +41,7 @@ struct DoseEstimate {
   double charge_ah = 0.0;
   double path_m = 0.0;
 };
-DoseEstimate estimate_dose(navi::CCoverageModule& cov, const navi::CSectionSplitter& splitter,
+DoseEstimate estimate_dose(navi::CCoveragePlanner& cov, const navi::CSectionSplitter& splitter,
                            const std::vector<std::string>& sections, navi::Point2D from, const board::FirmwareConfig& fw);
 
 // "PrCleaning(section=A)": a process step as the report names it.
@@ -70,6 +70,15 @@ class ReportObserver final : public TaskObserver {
 DisinfectionFigures disinfection_figures(sim::SimBoardHardware& hw, const std::vector<char>& reachable,
                                          const std::vector<char>& lamp_floor, const navi::OccupancyGrid& grid,
                                          double target_j_m2);
+
+// The report's figures of the floor and the path, the same on the simulator (run_task.cpp) and on
+// devices (run_devices.cpp): the reachable cells and of them those cleaned, the coverage, the
+// reachable area, the figures of the whole path and of its cleaning part.
+void set_floor_figures(RunResult& res, const Navigation& nav, const std::vector<char>& reachable,
+                       const navi::CleanedCells& cleaned, const std::vector<navi::Point2D>& path_all,
+                       const std::vector<navi::Point2D>& path_cleaning);
+// Of the reachable cells, those cleaned.
+[[nodiscard]] std::size_t cleaned_reachable(const std::vector<char>& reachable, const navi::CleanedCells& cleaned);
 
 // The sections the current plan of `planner` names (its steps' `section` parameters), in order.
 std::vector<std::string> plan_sections(const CPlanner& planner);

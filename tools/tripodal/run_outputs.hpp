@@ -27,7 +27,7 @@ namespace tripodal::app {
 struct Navigation {
   const navi::CGridMaps* maps = nullptr;
   const navi::CSectionSplitter* splitter = nullptr;
-  navi::CCoverageModule* coverage = nullptr;
+  navi::CCoveragePlanner* coverage = nullptr;
 };
 
 /// One 10 Hz sample of the run: the simulator's true pose and the robot's estimate.

@@ -55,7 +55,8 @@ std::vector<ParameterOverride> simulation_overrides(const RobotProfile& profile,
     out.push_back({profile.hardware->name, "seed", std::to_string(seed)});
   }
   for (const ModuleEntry& e : profile.navigation) {
-    if (e.type == navi::CLocalizer::static_manifest().name) out.push_back({e.name, "seed", std::to_string(seed % (1ULL << 52))});
+    if (e.type == navi::CGroundTruthLocalizer::static_manifest().name)
+      out.push_back({e.name, "seed", std::to_string(seed % (1ULL << 52))});
     if (e.type == navi::CScanMatchingLocalizer::static_manifest().name) {
       // The robot starts on its charger, whose place in the map it knows: the world's start pose
       // (the profile's initial pose is the workspace's charger; another world starts elsewhere).
@@ -192,7 +193,7 @@ RobotOptions run_robot_options(const RunOptions& o, const RobotProfile& profile,
   ro.parameters = simulation_overrides(profile, world, seed);
   if (!o.board_line.empty()) ro.parameters.push_back({profile.hardware->name, "line", o.board_line});
   for (const ModuleEntry& e : profile.navigation) {
-    if (e.type != navi::CCoverageModule::static_manifest().name) continue;
+    if (e.type != navi::CCoveragePlanner::static_manifest().name) continue;
     if (!o.pattern.empty()) ro.parameters.push_back({e.name, "pattern", o.pattern});
     // The dose the lanes are planned for (the profile's dose_target_j_m2 otherwise).
     if (!o.dose_plan)
@@ -216,7 +217,7 @@ GroundTruth checked_truth(Robot& robot, const RobotProfile& profile, const sim::
 
 // Cleaning is measured when the robot has SectionSplitter and CoveragePlanner; the map always.
 Navigation checked_navigation(Robot& robot, const RobotProfile& profile, const sim::World& world) {
-  Navigation nav{robot.module<navi::CGridMaps>(), robot.module<navi::CSectionSplitter>(), robot.module<navi::CCoverageModule>()};
+  Navigation nav{robot.module<navi::CGridMaps>(), robot.module<navi::CSectionSplitter>(), robot.module<navi::CCoveragePlanner>()};
   if (nav.maps == nullptr)
     throw ConfigError(profile.where, "`tripodal run` measures the run on the map: the robot needs a GridMaps module");
   if (nav.maps->robot_radius_m() < world.robot.radius_m) {
@@ -376,11 +377,7 @@ class TaskRun {
   [[nodiscard]] bool is_cleaning() const {
     return robot_->behavior_active("BhCleaning") || robot_->behavior_active("BhCleaningTwoWheel");
   }
-  [[nodiscard]] std::size_t covered() const {
-    std::size_t n = 0;
-    for (std::size_t i = 0; i < reachable_.size(); ++i) n += (reachable_[i] != 0 && cleaned_.cleaned(i)) ? 1 : 0;
-    return n;
-  }
+  [[nodiscard]] std::size_t covered() const { return cleaned_reachable(reachable_, cleaned_); }
   void give_task();
   void check_dose_plan();
   void flush_log();
@@ -695,15 +692,9 @@ void TaskRun::measure(Time ended) {
   const bool only_refused = res_.state == "refused" && tr.state == TaskState::idle;
   if (!only_refused && (!serve_ || tr.state != TaskState::idle)) res_.reason = tr.reason;
   res_.duration_s = to_seconds(ended);
-  res_.cleaned_cells = covered();
-  res_.coverage =
-      res_.reachable_cells == 0 ? 0.0 : static_cast<double>(res_.cleaned_cells) / static_cast<double>(res_.reachable_cells);
-  const double res_m = nav_.maps->grid().resolution_m();
-  res_.reachable_area_m2 = static_cast<double>(res_.reachable_cells) * res_m * res_m;
-  res_.total = path_figures(path_all_);
-  res_.total.length_m = truth_.distance_m();
+  set_floor_figures(res_, nav_, reachable_, cleaned_, path_all_, path_cleaning_);
+  res_.total.length_m = truth_.distance_m();  // the ground truth's, not the sampled path's
   res_.total.rotation_rad = truth_.rotation_rad();
-  res_.cleaning = path_figures(path_cleaning_);
   res_.processes = report_.processes;
   res_.recoveries = report_.recoveries;
   res_.charging = charging_summary(tr);

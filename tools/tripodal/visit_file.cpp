@@ -2,7 +2,7 @@
 // expected, loaded with every problem located.
 #include <yaml-cpp/yaml.h>
 
-#include "../../src/common/yaml_reader.hpp"
+#include "tripodal_common_internal/yaml_reader.hpp"
 #include "visit.hpp"
 
 namespace tripodal::app {

@@ -1,8 +1,9 @@
 // Gestures as behaviors (paper, section 4, Table 3: Jinny's interaction elements): BhFaceVisitor
 // turns the base to face the visitor the laser sees, BhNeckGesture moves a neck or arm joint to a
-// position. A joint's state is a resource (JointResource) its driver (the simulator's joint,
-// sim/sim_hardware.hpp, or a servo board) publishes; its position is a command channel the
-// hardware exports under the joint's name (core/command_channel.hpp), written by the behavior.
+// position. A joint's state is a resource (JointResource, resources/resource.hpp) its driver (the
+// simulator's joint, sim/sim_hardware.hpp, or a servo board) publishes; its position is a command
+// channel the hardware exports under the joint's name (core/command_channel.hpp), written by the
+// behavior.
 #pragma once
 
 #include <optional>
@@ -12,26 +13,6 @@
 #include "tripodal/behaviors/behavior_registry.hpp"
 
 namespace tripodal {
-
-/// A joint's state: position and speed, the command it follows, its limits.
-struct JointReading {
-  Time stamp{};
-  double position_rad = 0.0;
-  double velocity_rad_s = 0.0;
-  double target_rad = 0.0;  ///< the command being followed (clamped to the limits)
-  double min_rad = 0.0;
-  double max_rad = 0.0;
-  friend bool operator==(const JointReading&, const JointReading&) = default;
-};
-
-/// A joint's state as a resource (output information "joint_state"). It is read only: the joint
-/// is moved through its command channel.
-class JointResource final : public TypedResource<JointReading> {
- public:
-  static const ModuleManifest& static_manifest();
-  explicit JointResource(std::string name, Duration max_age = Duration{0})
-      : TypedResource<JointReading>(std::move(name), max_age, static_manifest()) {}
-};
 
 /// Turns the base on the spot to face the visitor: the nearest laser return within max_range_m
 /// that the map does not hold (NavigationData::map; every return counts without one). Succeeds

@@ -99,7 +99,7 @@ struct CoverageResult {
   /// centres (dense), lanes and links as straight legs.
   std::vector<Point2D> path;
   /// Speed limit (m/s) of each leg of the path (entry i: path[i] to path[i + 1]); empty: none.
-  /// A dose-planned disinfection fills it (navi/dose_planner.hpp, CCoverageModule).
+  /// A dose-planned disinfection fills it (navi/dose_planner.hpp, CCoveragePlanner).
   std::vector<double> speed_m_s;
   std::size_t passes = 0;         ///< rounds' contour pieces or plough lanes
   std::size_t rounds = 0;         ///< balloon only: offsets from the wall

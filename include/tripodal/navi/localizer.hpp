@@ -1,4 +1,4 @@
-// CLocalizer, the localizer navigation module for simulation (sequencing layer): it estimates the
+// CGroundTruthLocalizer, the localizer navigation module for simulation (sequencing layer): it estimates the
 // robot's pose from a ground-truth source (the simulator) with seeded noise and an injectable
 // fault schedule, and posts localizer.ok / localizer.lost when its estimate starts or stops
 // agreeing with the actual position, the events the process PrCleaning's low-level net waits for
@@ -52,13 +52,13 @@ struct LocalizerOptions {
   std::vector<LocalizationFault> faults;
 };
 
-/// Type "Localizer". As a module of the robot it takes the ground truth from the robot's hardware
+/// Type "GroundTruthLocalizer". As a module of the robot it takes the ground truth from the robot's hardware
 /// (the simulator) at start, updates and publishes its estimate every sequencing period, keeps the
 /// supervisor's watchdog fed, and attempts a global position fix every attempt_period_s while
 /// BhGlobalLocalization is active (NavigationData::fixes counts the fixes accepted).
-class CLocalizer final : public CNaviModules {
+class CGroundTruthLocalizer final : public CNaviModules {
  public:
-  explicit CLocalizer(const GroundTruthSource* truth = nullptr, LocalizerOptions options = {});
+  explicit CGroundTruthLocalizer(const GroundTruthSource* truth = nullptr, LocalizerOptions options = {});
 
   static const ModuleManifest& static_manifest();
 

@@ -1,4 +1,4 @@
-// CMappingModule, live mapping as a navigation module (sequencing layer): the thesis's mapping run,
+// CMapBuilder, live mapping as a navigation module (sequencing layer): the thesis's mapping run,
 // in which the robot is driven by hand (the monitor's console) while each new laser scan is matched
 // and inserted into a growing occupancy grid (navi::MapBuilder); save() writes the map so far as a
 // map_server map the robot is later localized on. Idle until begin(): a robot may carry it always.
@@ -34,10 +34,10 @@ struct MappingOptions {
 /// is the robot's pose when mapping began (the origin, heading along x) unless begin() is given
 /// another start. Its methods may be called from the thread that runs the robot's sequencing
 /// loop and from another one (the monitor's): a mutex guards the map.
-class CMappingModule final : public CNaviModules {
+class CMapBuilder final : public CNaviModules {
  public:
-  explicit CMappingModule(MappingOptions options = {});
-  ~CMappingModule() override;
+  explicit CMapBuilder(MappingOptions options = {});
+  ~CMapBuilder() override;
 
   static const ModuleManifest& static_manifest();
 

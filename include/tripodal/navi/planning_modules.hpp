@@ -1,6 +1,6 @@
 // The planners of the sequencing layer that serve the reactive layer's path-following behaviors:
-// CPathPlanningModule (type "PathPlanner") plans BhAutoMove's path to its goal and replans around
-// obstacles the map does not hold; CCoverageModule (type "CoveragePlanner") gives the cleaning
+// CPathPlanner (type "PathPlanner") plans BhAutoMove's path to its goal and replans around
+// obstacles the map does not hold; CCoveragePlanner (type "CoveragePlanner") gives the cleaning
 // behaviors their section's coverage path (hybrid, balloon or boustrophedon), resumes a section where its
 // coverage stopped, plans detours around unexpected obstacles and records the cleaned cells. Both
 // publish through NavigationData and read the behaviors' NavigationFeedback; planning never runs in
@@ -22,7 +22,7 @@
 
 namespace tripodal::navi {
 
-class CCoverageModule;
+class CCoveragePlanner;
 
 /// Replanning around what blocks a path-following behavior: when the behavior has reported being
 /// blocked for replan_after_s (and again every replan_after_s), at most max_replans times per
@@ -76,7 +76,7 @@ class PublishedPath {
 /// section's coverage path from here, a map node, a room or a section: their centroids) and plans
 /// with A* on the map inflated by the robot's radius; the behavior fails with "unknown goal" or
 /// "no path to the goal" when it cannot.
-class CPathPlanningModule final : public CNaviModules {
+class CPathPlanner final : public CNaviModules {
  public:
   static const ModuleManifest& static_manifest();
   /// Where a goal name points, from `from`; nullopt for an unknown name.
@@ -97,7 +97,7 @@ class CPathPlanningModule final : public CNaviModules {
   std::vector<std::string> serves_;
   CGridMaps* maps_ = nullptr;
   const CSectionSplitter* splitter_ = nullptr;
-  CCoverageModule* coverage_ = nullptr;
+  CCoveragePlanner* coverage_ = nullptr;
   bool active_ = false;
   Point2D goal_;
   ObstacleReplanner replanner_;
@@ -109,7 +109,7 @@ class CPathPlanningModule final : public CNaviModules {
 /// activation for that section stopped; while the behavior runs it records the cleaned cells under
 /// the cleaning footprint (from the localized pose) and the progress along the path, and plans a
 /// detour to the first point of the path clear of an obstacle that blocks it.
-class CCoverageModule final : public CNaviModules {
+class CCoveragePlanner final : public CNaviModules {
  public:
   static const ModuleManifest& static_manifest();
 

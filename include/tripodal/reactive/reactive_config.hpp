@@ -41,11 +41,4 @@ struct ReactiveConfig {
 /// Reads and parses the file at `path`; ConfigError also when it cannot be read.
 [[nodiscard]] ReactiveConfig load_reactive_config(const std::string& path, const ControllerRegistry& registry);
 
-/// Builds the loop `config` describes: its coordinator, and its controller (created through
-/// `registry` on `hardware`, which must outlive the loop; may be null when the loop has no
-/// controller). Throws ConfigError for an unknown controller name.
-[[nodiscard]] std::unique_ptr<ControlLoop> make_control_loop(const ReactiveConfig& reactive, const LoopConfig& config,
-                                                             ResourceTable& resources, HardwareInterface* hardware,
-                                                             const ControllerRegistry& registry);
-
 }  // namespace tripodal

@@ -79,4 +79,16 @@ struct GyroReading {
   friend bool operator==(const GyroReading&, const GyroReading&) = default;
 };
 
+/// A neck or arm joint's state: position and speed, the command it follows, its limits. Read only:
+/// the joint moves through the position channel its hardware exports (core/command_channel.hpp).
+struct JointReading {
+  Time stamp{};
+  double position_rad = 0.0;
+  double velocity_rad_s = 0.0;
+  double target_rad = 0.0;  ///< the command being followed (clamped to the limits)
+  double min_rad = 0.0;
+  double max_rad = 0.0;
+  friend bool operator==(const JointReading&, const JointReading&) = default;
+};
+
 }  // namespace tripodal

@@ -110,7 +110,7 @@ class CResource {
 /// Static manifests of the generic typed resources, one per reading kind (type name and output
 /// information name): "OdometryResource"/"odometry", "LaserResource"/"laser_scan",
 /// "SonarResource"/"sonar", "InfraredResource"/"infrared", "BumperResource"/"bumpers",
-/// "BatteryResource"/"battery", "GyroResource"/"gyro".
+/// "BatteryResource"/"battery", "GyroResource"/"gyro", "JointResource"/"joint_state".
 template <class Reading>
 const ModuleManifest& resource_manifest() noexcept;
 
@@ -198,6 +198,7 @@ using InfraredResource = TypedResource<InfraredReading>;
 using BumperResource = TypedResource<BumperReading>;
 using BatteryResource = TypedResource<BatteryReading>;
 using GyroResource = TypedResource<GyroReading>;
+using JointResource = TypedResource<JointReading>;
 
 template <> const ModuleManifest& resource_manifest<OdometryReading>() noexcept;
 template <> const ModuleManifest& resource_manifest<LaserScan>() noexcept;
@@ -206,6 +207,8 @@ template <> const ModuleManifest& resource_manifest<InfraredReading>() noexcept;
 template <> const ModuleManifest& resource_manifest<BumperReading>() noexcept;
 template <> const ModuleManifest& resource_manifest<BatteryReading>() noexcept;
 template <> const ModuleManifest& resource_manifest<GyroReading>() noexcept;
+template <>
+const ModuleManifest& resource_manifest<JointReading>() noexcept;
 
 class ResourceTable;
 

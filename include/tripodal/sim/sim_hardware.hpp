@@ -10,12 +10,12 @@
 #include <string>
 #include <vector>
 
-#include "tripodal/behaviors/gesture_behaviors.hpp"
 #include "tripodal/core/snapshot.hpp"
 #include "tripodal/hardware/buttons.hpp"
 #include "tripodal/hardware/hardware.hpp"
 #include "tripodal/navi/grid_maps.hpp"
 #include "tripodal/navi/localizer.hpp"
+#include "tripodal/resources/resource.hpp"
 #include "tripodal/sim/simulator.hpp"
 #include "tripodal/sim/world.hpp"
 

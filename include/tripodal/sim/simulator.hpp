@@ -2,8 +2,9 @@
 // as the controllers' HardwareInterface (wheel velocities in, wheel states out), moves the base on
 // the world's grid, publishes the sensor resources (laser, bumpers, cliff, gyro, battery, encoder
 // odometry) and is the navi localizer's ground truth. Deterministic: the same world, base and
-// seed give a bit-identical run. Time advances only by step(); SimRunner steps it together with
-// the control loops on a SimClock, and RealtimePacer slows that to wall time for --realtime.
+// seed give a bit-identical run. Time advances only by step(); a Robot on it (hardware type "sim")
+// steps it together with its loops on a SimClock, and RealtimePacer slows that to wall time for
+// --realtime.
 #pragma once
 
 #include <cstdint>
@@ -74,7 +75,7 @@ struct JointState {
   bool at_limit = false;       ///< the last command was beyond a limit (clamped)
 };
 
-/// The simulator. Threading: one thread calls everything (the SimRunner's caller).
+/// The simulator. Threading: one thread calls everything (Robot::run_until's caller).
 class Simulator final : public HardwareInterface, public navi::GroundTruthSource {
  public:
   /// `base` gives the wheel geometry: type "differential" (wheels [left, right]), "omni" or
@@ -331,32 +332,6 @@ class RealtimePacer final {
   bool started_ = false;
   Time sim_start_{};
   Time wall_start_{};
-};
-
-/// Runs a Simulator and control loops together on one SimClock. Every physics period the
-/// simulator advances to t first (its sensors sample at t), then the loop cycles due by t run on
-/// those readings and write the wheel commands applied over the next period. Faster than real
-/// time unless a RealtimePacer is set.
-class SimRunner final {
- public:
-  /// The clock is moved to the simulator's time if it is behind.
-  SimRunner(Simulator& sim, SimClock& clock, Duration physics_period = std::chrono::milliseconds(10));
-  /// Adds a loop (not owned); its first cycle is at the current time.
-  void add(ControlLoop& loop) { driver_.add(loop); }
-  /// Paces every physics period to wall time (nullptr: as fast as possible). Not owned.
-  void set_pacer(RealtimePacer* pacer) noexcept { pacer_ = pacer; }
-  /// Runs until `until`; returns the number of loop cycles run.
-  std::size_t run_until(Time until) noexcept;
-  std::size_t run_for(Duration d) noexcept { return run_until(clock_.now() + d); }
-  [[nodiscard]] Simulator& simulator() noexcept { return sim_; }
-  [[nodiscard]] Duration physics_period() const noexcept { return period_; }
-
- private:
-  Simulator& sim_;
-  SimClock& clock_;
-  SimLoopDriver driver_;
-  Duration period_;
-  RealtimePacer* pacer_ = nullptr;
 };
 
 }  // namespace tripodal::sim

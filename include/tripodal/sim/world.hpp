@@ -236,8 +236,8 @@ struct Kidnapping {
 /// The faults injected in a run. A localization loss window blinds the laser (it keeps
 /// publishing scans, with no return: the scanner dazzled), the physical cause a laser localizer
 /// detects from its match quality; the windows are the navi localizer's own type
-/// (navi::LocalizationFault), so the ground-truth test double CLocalizer can take them as flags
-/// (CLocalizer::add_fault()). Blocked paths are World::obstacles with an appearance time.
+/// (navi::LocalizationFault), so the ground-truth test double CGroundTruthLocalizer can take them as flags
+/// (CGroundTruthLocalizer::add_fault()). Blocked paths are World::obstacles with an appearance time.
 struct FaultSchedule {
   std::vector<navi::LocalizationFault> localization_loss;
   std::vector<SensorOutage> dead_sensors;

@@ -24,7 +24,7 @@ namespace tripodal::testing {
 struct TraceHardwareOptions {
   std::filesystem::path trace;  ///< a trace, or a rosbag2 bag (converted with the default topic mapping)
   /// An odometry channel of map_from_base poses (the recorded robot's true or corrected pose) the
-  /// localizer reads as ground truth; empty: none (a robot with a Localizer then stays lost).
+  /// localizer reads as ground truth; empty: none (a robot with a GroundTruthLocalizer then stays lost).
   std::string localization_channel;
   /// Channels not replayed because the robot computes them itself: by default the controller's
   /// odometry, which integrates the commanded wheels here.
