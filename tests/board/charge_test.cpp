@@ -428,5 +428,5 @@ TEST_CASE("the lidar profile: a low battery docks, charges and resumes the secti
   CHECK(resumed->success);
   CHECK(board_said_charging);
   CHECK(fw.state_of_charge() > 0.85);
-  CHECK(r.robot->module<navi::CCoverageModule>()->progress().at("A").finished);
+  CHECK(r.robot->module<navi::CCoveragePlanner>()->progress().at("A").finished);
 }
