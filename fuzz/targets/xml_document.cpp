@@ -11,7 +11,7 @@
 
 namespace {
 
-std::string describe(const tripodal::XmlElement* e) {
+std::string describe(const tripodal::detail::XmlElement* e) {
   return e == nullptr ? std::string("(none)") : std::string(e->name()) + " at offset " + std::to_string(e->offset());
 }
 
@@ -19,6 +19,7 @@ std::string describe(const tripodal::XmlElement* e) {
 
 TRIPODAL_FUZZ_TARGET(bytes) {
   using namespace tripodal;
+  using namespace tripodal::detail;
   const std::string_view text = fuzz::as_text(bytes);
   XmlDocument plain;
   XmlDocument reference;
