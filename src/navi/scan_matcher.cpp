@@ -517,7 +517,7 @@ bool ScanMatcher::any_free(int x, int y, int side) const noexcept {
   const int x0 = std::max(x, 0), y0 = std::max(y, 0);
   const int x1 = std::min(x + side, width_), y1 = std::min(y + side, height_);
   if (x0 >= x1 || y0 >= y1) return false;
-  const auto w = static_cast<std::size_t>(width_ + 1);
+  const std::size_t w = static_cast<std::size_t>(width_) + 1;
   auto at = [&](int cx, int cy) { return free_sum_[static_cast<std::size_t>(cy) * w + static_cast<std::size_t>(cx)]; };
   return at(x1, y1) - at(x0, y1) - at(x1, y0) + at(x0, y0) > 0;
 }
