@@ -2,12 +2,13 @@
 // the common document, tinyxml2 the rest and every error. For any input both must agree: the
 // same verdict, the same error at the same offset, or the same tree element by element (names,
 // offsets, texts, attributes and their source offsets). A difference is a finding.
+#include "tripodal_core_internal/xml_document.hpp"
+
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "../fuzz_target.hpp"
-#include "tripodal_core_internal/xml_document.hpp"
 
 namespace {
 
@@ -41,8 +42,7 @@ TRIPODAL_FUZZ_TARGET(bytes) {
     fuzz::require((a == nullptr) == (b == nullptr), "both trees have the same shape", describe(a) + " / " + describe(b));
     if (a == nullptr) continue;
     const bool same = a->name() == b->name() && a->offset() == b->offset() && a->line() == b->line() &&
-                      a->column() == b->column() && a->text() == b->text() &&
-                      a->attributes().size() == b->attributes().size();
+                      a->column() == b->column() && a->text() == b->text() && a->attributes().size() == b->attributes().size();
     fuzz::require(same, "each element is read alike", describe(a) + " / " + describe(b));
     for (std::size_t i = 0; i < a->attributes().size(); ++i) {
       const XmlAttribute& x = a->attributes()[i];

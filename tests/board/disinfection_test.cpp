@@ -1,9 +1,9 @@
 // The disinfection robot end to end on the simulator: configs/robots/disinfection.yaml on the
 // simulated board (hardware type "board", every exchange over the in-process line byte for byte),
 // the task "disinfect the room ..." through PrAutoMove and PrDisinfection.
-#include <fstream>
 #include <catch2/catch.hpp>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <string>
 

@@ -2,8 +2,8 @@
 // layering rules R1-R5 (docs/processes.md), refusals to assemble, and the describe renderings.
 #include "tripodal/robot/layering.hpp"
 
-#include <fstream>
 #include <catch2/catch.hpp>
+#include <fstream>
 
 #include "robot_doubles.hpp"
 #include "tripodal/board/actuator_behaviors.hpp"

@@ -86,9 +86,9 @@ struct Args {
   bool shared_world = false;           // one sim-server world for every robot
   std::optional<unsigned> sim_domain;  // its DDS domain (default --domain + 1)
   bool sim_loopback = true;
-  bool system_network = false;  // the fleet's DDS on Cyclone's own configuration (CYCLONEDDS_URI)
-  std::string launcher;         // a command before each process, {name} replaced (ip netns exec ns_{name})
-  std::filesystem::path keys;   // DDS Security: the fleet's keys (tripodal fleet-keys); empty: not secured
+  bool system_network = false;     // the fleet's DDS on Cyclone's own configuration (CYCLONEDDS_URI)
+  std::string launcher;            // a command before each process, {name} replaced (ip netns exec ns_{name})
+  std::filesystem::path keys;      // DDS Security: the fleet's keys (tripodal fleet-keys); empty: not secured
   std::string identity = "fleet";  // the fleet tool's identity in them
 };
 

@@ -8,12 +8,12 @@
 #include <map>
 #include <sstream>
 
-#include "tripodal_common_internal/yaml_reader.hpp"
 #include "run_outputs.hpp"
 #include "tripodal/robot/robot_profile.hpp"
 #include "tripodal/sim/ray_caster.hpp"
 #include "tripodal/sim/simulator.hpp"
 #include "tripodal/sim/world.hpp"
+#include "tripodal_common_internal/yaml_reader.hpp"
 
 namespace tripodal::tool {
 

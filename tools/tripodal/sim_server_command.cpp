@@ -60,7 +60,7 @@ struct Args {
   double lease_s = 2.0;
   double wait_s = 0.0;
   bool system_network = false;
-  std::optional<int> robots;  // --robots N: one world for N lock-step robots
+  std::optional<int> robots;    // --robots N: one world for N lock-step robots
   std::filesystem::path fleet;  // --fleet FILE: one world for the robots it names
   double stall_s = 0.2;
   CLI::Option* realtime = nullptr;  // given at all (with or without SPEED)
