@@ -3,10 +3,10 @@
 // the task "disinfect the room ..." through PrAutoMove and PrDisinfection.
 #include <catch2/catch.hpp>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <string>
 
+#include "../support/file_lines.hpp"
 #include "tripodal/board/actuator_behaviors.hpp"
 #include "tripodal/board/board_monitor.hpp"
 #include "tripodal/builtin/register_all.hpp"
@@ -243,21 +243,6 @@ TEST_CASE("The board's lamp, atomizer, voice and LCD are command channels the be
   CHECK(fw.lcd_line(0).empty());
 }
 
-namespace {
-
-// "disinfection.yaml:N:" where N is the line of the profile's BhUvLamp entry: the refusal is
-// located there, and the profile gains lines as the robot grows.
-std::string uv_lamp_entry(const std::string& profile) {
-  std::ifstream in(profile);
-  std::string line;
-  for (int n = 1; std::getline(in, line); ++n) {
-    if (line == "  - BhUvLamp") return "disinfection.yaml:" + std::to_string(n) + ":";
-  }
-  return "no '  - BhUvLamp' line in " + profile;
-}
-
-}  // namespace
-
 TEST_CASE("A behavior writing a channel the hardware does not export is refused at assembly, located", "[board][channels]") {
   const auto world = std::make_shared<const sim::World>(sim::load_world(kConfigs / "worlds/workspace.yaml"));
   SimClock clock;
@@ -272,7 +257,7 @@ TEST_CASE("A behavior writing a channel the hardware does not export is refused 
   } catch (const ConfigError& e) {
     const std::string what = e.what();
     CHECK_THAT(what, Catch::Contains("disinfection.yaml:"));
-    CHECK_THAT(what, Catch::Contains(uv_lamp_entry((kConfigs / "robots/disinfection.yaml").string())));
+    CHECK_THAT(what, Catch::Contains(tripodal::test::located_line(kConfigs / "robots/disinfection.yaml", "  - BhUvLamp")));
     CHECK_THAT(what,
                Catch::Contains("behavior 'BhUvLamp' writes the command channel 'uv_lamp' (digital), which hardware 'sim' does "
                                "not export; it exports none (rule R6)"));

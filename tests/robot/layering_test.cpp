@@ -3,8 +3,8 @@
 #include "tripodal/robot/layering.hpp"
 
 #include <catch2/catch.hpp>
-#include <fstream>
 
+#include "../support/file_lines.hpp"
 #include "robot_doubles.hpp"
 #include "tripodal/board/actuator_behaviors.hpp"
 #include "tripodal/board/board_monitor.hpp"
@@ -325,21 +325,6 @@ TEST_CASE("describe_text lists modules by layer, describe_dot draws clusters and
   CHECK_THAT(dot, Catch::Contains("\"process_supervisor\" -> \"BhCleaning\" [style=dashed"));
 }
 
-namespace {
-
-// "disinfection.yaml:N:" where N is the line of the profile's BhUvLamp entry: the refusal is
-// located there, and the profile gains lines as the robot grows.
-std::string uv_lamp_entry(const std::string& profile) {
-  std::ifstream in(profile);
-  std::string line;
-  for (int n = 1; std::getline(in, line); ++n) {
-    if (line == "  - BhUvLamp") return "disinfection.yaml:" + std::to_string(n) + ":";
-  }
-  return "no '  - BhUvLamp' line in " + profile;
-}
-
-}  // namespace
-
 TEST_CASE("describe shows command channels, who writes and who exports them, R6 refuses a channel the hardware lacks",
           "[robot][channels]") {
   RobotPlugins plugins = builtin_plugins(nullptr);
@@ -366,7 +351,8 @@ TEST_CASE("describe shows command channels, who writes and who exports them, R6 
   Diagnostics bad;
   (void)describe_robot(p, plugins, knowledge_inputs(TaskLibrary::load(p.tasks)), bad);
   CHECK_THAT(bad.str(),
-             Catch::Contains(uv_lamp_entry(std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/disinfection.yaml")) &&
+             Catch::Contains(tripodal::test::located_line(std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/disinfection.yaml",
+                                                          "  - BhUvLamp")) &&
                  Catch::Contains("behavior 'BhUvLamp' writes the command channel 'uv_lamp' (digital), which hardware 'sim' does "
                                  "not export; it exports none (rule R6)"));
 }
