@@ -281,6 +281,11 @@ void BoardLink::miss(Time now, bool rescan) noexcept {
   check_port_now_ = true;
   // A frame cut short by the loss would hold up the next one: give it up and re-scan.
   if (rescan && decoder_.partial()) (void)decoder_.abandon_partial();
+  // One stall, one miss: the requests in flight time out together (DRIVE and a poll each
+  // period, and the late answers that then arrive out of order), and counting each would lose
+  // the link after little more than one response_timeout whatever max_missed says.
+  if (consecutive_missed_ > 0 && now - last_counted_miss_ < config_.response_timeout) return;
+  last_counted_miss_ = now;
   if (++consecutive_missed_ >= config_.max_missed) lose(now);
 }
 

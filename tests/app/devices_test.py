@@ -158,6 +158,21 @@ def check_devices(dev, text, lidar=True, min_answered=0.95):
            dev["lidar"]["scans"], dev["lidar"]["dropped"], dev["lidar"]["decoder_errors"]))
 
 
+def longest_pass_ms(sim_text, text):
+    """tripodal-board-sim's longest time between two of its 1 ms passes (it prints it at exit)."""
+    m = re.search(r"longest pass ([0-9.]+) ms of wall clock", sim_text)
+    if m is None:
+        fail("tripodal-board-sim printed no longest pass", text + sim_text)
+    return float(m.group(1))
+
+
+def robot_lateness_ms(report):
+    """The robot's largest period error over its loops (report.json "realtime"/"loops": the
+    profile's reactive loop "motion" and "sequencing"): how long its process went unscheduled."""
+    late = [l["period_error_us"]["max"] for l in report.get("realtime", {}).get("loops", [])]
+    return max(late) / 1000.0 if late else 0.0
+
+
 def main():
     exe, board_sim, source, mode = sys.argv[1:5]
     world = os.path.join(source, "configs", "worlds", "workspace.yaml")
@@ -178,16 +193,30 @@ def main():
                 fail("exit %d, state %s (%s)" % (rc, report["state"], report.get("reason", "")), text)
             dev = read_json(work, "devices.json", text)
             check_devices(dev, text)
-            if dev["link"]["link_losses"] != 0 or dev["link"]["decoder_errors"] != 0:
-                fail("a clean line lost the link or garbled frames", text)
+            if dev["link"]["decoder_errors"] != 0:
+                fail("a clean line garbled frames", text)
+            stop(devices)
+            sim_text = devices.stdout.read()
+            stall_ms = max(longest_pass_ms(sim_text, text), robot_lateness_ms(report))
+            if dev["link"]["link_losses"] != 0:
+                # The link's tolerance is 200 ms without answers (4 misses, one per 50 ms); a clean
+                # line loses it only when one of the two processes was not scheduled for about
+                # that long (a CI machine under load: seen once, the task riding it out as a blip).
+                if stall_ms < 100.0:
+                    fail("a clean line lost the link %d times while both processes were scheduled on time "
+                         "(longest stall %.1f ms)" % (dev["link"]["link_losses"], stall_ms), text + sim_text)
+                if report.get("recoveries"):
+                    fail("a link lost to a %.0f ms stall needed a recovery" % stall_ms, text)
+                print("the link was lost %d times, each a stall of this host (longest %.0f ms): ridden out" %
+                      (dev["link"]["link_losses"], stall_ms))
             # The summary line times a run on devices by the wall clock, not the simulator's.
             summary = [line for line in text.splitlines() if line.startswith("task succeeded")]
             if len(summary) != 1 or " s wall clock; " not in summary[0] or "simulated" in summary[0]:
                 fail("the summary line should say the wall-clock time: %r" % summary, text)
             if report.get("duration_clock") != "wall":
                 fail("report.json duration_clock %r, expected 'wall'" % report.get("duration_clock"), text)
-            print("go to the entrance: succeeded in %.1f s (%.1f s wall for the whole command), first SYNC after %.3f s" %
-                  (report["duration_s"], time.monotonic() - t0, dev["first_sync_s"]))
+            print("go to the entrance: succeeded in %.1f s (%.1f s wall for the whole command), first SYNC after %.3f s; "
+                  "longest stall of either process %.1f ms" % (report["duration_s"], time.monotonic() - t0, dev["first_sync_s"], stall_ms))
         elif mode == "blip":
             proc, out = run_robot(exe, source, work, board, lidar, "go to door_2111")
             if out.wait_for(r"activate BhAutoMove", 30) is None:
@@ -212,6 +241,10 @@ def main():
             check_devices(dev, text, min_answered=0.9)  # a loaded machine's own blips besides this one
             if dev["link"]["link_losses"] < 1:
                 fail("no loss in devices.json: %s" % dev["link"], text)
+            # The robot's own deadline watch saw the stop (go_to reads the same figure to tell a
+            # stalled host from a faulty line).
+            if robot_lateness_ms(report) < 500.0:
+                fail("the robot's loops' largest period error is %.1f ms after a 600 ms stop" % robot_lateness_ms(report), text)
             print("blip: the host stopped 0.6 s; %d link losses (%d watchdog trips), outages %s; the task went on without a "
                   "recovery and succeeded in %.1f s" % (dev["link"]["link_losses"], dev["link"]["watchdog_trips"],
                                                        ", ".join("%.0f ms" % ((o["restored_s"] - o["lost_s"]) * 1000.0)

@@ -16,12 +16,16 @@ namespace {
 // Host and board on one simulated line and clock: the board ticks every 1 ms, the host's control
 // loop cycles every 10 ms.
 struct Rig {
+  Rig() = default;
+  explicit Rig(const LinkConfig& config) : link_config(config) {}
+
   SimClock clock;
   SerialLine line{clock};
   StillPlant plant;
   FirmwareConfig firmware_config;
   BoardFirmware board{firmware_config, line.board(), plant};
-  BoardLink link{line.host()};
+  LinkConfig link_config{};
+  BoardLink link{line.host(), link_config};
   WheelSpeeds speeds{};
   std::uint64_t losses_seen = 0;
   Time first_loss_seen{};
@@ -80,6 +84,34 @@ TEST_CASE("a board that stops answering: link lost within two periods, motors st
   r.run_for(100ms);
   CHECK(r.link.synchronised());
   CHECK(r.link.stats().resyncs == 2);
+  CHECK(r.link.stats().link_losses == 1);
+}
+
+// A host without real-time scheduling (the disinfection profiles: response_timeout 50 ms,
+// max_missed 4) must ride out a stall shorter than the board's 200 ms watchdog. The stall times
+// out both requests in flight each period; counted one by one they lost the link after 100 ms.
+TEST_CASE("a stall misses every request in flight once: max_missed x response_timeout of silence lose the link", "[board][link]") {
+  LinkConfig config;
+  config.response_timeout = 50ms;
+  config.max_missed = 4;
+  Rig r(config);
+  r.speeds = {300, 300};
+  r.run_for(1s);
+  REQUIRE(r.link.synchronised());
+  const Time last_good = r.link.drive_stamp();
+  const std::uint64_t missed_before = r.link.stats().missed;
+  r.line.board().set_connected(false);
+  r.run_for(150ms);
+  CHECK(r.losses_seen == 0);  // 150 ms of silence: a blip the link rides out
+  CHECK(r.link.synchronised());
+  CHECK(r.link.stats().missed - missed_before >= 4);  // each request is still counted as missed
+  r.run_for(350ms);
+  CHECK(r.losses_seen == 1);
+  CHECK(r.first_loss_seen - last_good >= 200ms);
+  CHECK(r.first_loss_seen - last_good <= 230ms);
+  r.line.board().set_connected(true);
+  r.run_for(100ms);
+  CHECK(r.link.synchronised());
   CHECK(r.link.stats().link_losses == 1);
 }
 

@@ -9,6 +9,8 @@
 // --realtime S): a whole task against the device processes in a fraction of its time.
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <atomic>
 #include <csignal>
 #include <cstdio>
@@ -235,7 +237,14 @@ int run(int argc, char** argv) {
     // A pass every millisecond of wall time: the firmware and the lidar run what is due by then
     // (several of their 1 ms ticks at a speed-up).
     const Duration pass = from_seconds(0.001 * speed);
+    // The longest time between two passes: a pass takes about 1 ms, so a longer one is this
+    // process not scheduled (a loaded host), which a host would read as a stalled board.
+    Duration longest_pass{};
+    Time pass_start = clock.now();
     while (!g_stop.load() && clock.now() < end) {
+      const Time t = clock.now();
+      longest_pass = std::max(longest_pass, t - pass_start);
+      pass_start = t;
       next += pass;
       // Between passes, each request is answered as its bytes arrive (over TCP: at the next pass).
       while (board::serve_until(firmware, pty ? pty->master_fd() : -1, clock, next)) {
@@ -255,6 +264,10 @@ int run(int argc, char** argv) {
     const auto& d = firmware.decoder_stats();
     std::cout << "tripodal-board-sim: " << c.requests << " requests answered, " << c.error_responses << " error responses, "
               << d.errors() << " decoder errors, " << c.watchdog_trips << " watchdog trips, " << c.resyncs << " synchronisations"
+              << std::endl;
+    std::array<char, 32> longest_ms{};
+    std::snprintf(longest_ms.data(), longest_ms.size(), "%.1f", to_seconds(longest_pass) / speed * 1000.0);
+    std::cout << "tripodal-board-sim: longest pass " << longest_ms.data() << " ms of wall clock (1 ms when scheduled on time)"
               << std::endl;
     if (!link.empty() && pty) std::filesystem::remove(link);
     if (lidar) {

@@ -28,6 +28,9 @@ struct LinkConfig {
   /// checks it).
   Duration response_timeout{std::chrono::milliseconds(10)};
   /// Consecutive missing, late or erroneous responses that make the link lost (1: the first).
+  /// A stall of the host or the board misses every request in flight at once: misses less than
+  /// response_timeout apart count once, so max_missed in a row means at least
+  /// (max_missed - 1) x response_timeout without an answer after the first miss.
   std::uint32_t max_missed = 1;
   Duration battery_period{std::chrono::seconds(3)};
   Duration tank_period{std::chrono::seconds(1)};
@@ -156,6 +159,7 @@ class BoardLink {
   std::size_t queue_head_ = 0;
   std::size_t queue_size_ = 0;
   std::uint32_t consecutive_missed_ = 0;
+  Time last_counted_miss_{};  // of consecutive_missed_'s latest increment
   bool synchronised_ = false;
   bool lost_pending_ = false;
   bool stream_failed_ = false;  // read or write failed: reopen every reopen_period
