@@ -90,7 +90,8 @@ TEST_CASE("a board that stops answering: link lost within two periods, motors st
 // A host without real-time scheduling (the disinfection profiles: response_timeout 50 ms,
 // max_missed 4) must ride out a stall shorter than the board's 200 ms watchdog. The stall times
 // out both requests in flight each period; counted one by one they lost the link after 100 ms.
-TEST_CASE("a stall misses every request in flight once: max_missed x response_timeout of silence lose the link", "[board][link]") {
+TEST_CASE("a stall misses every request in flight once: max_missed x response_timeout of silence lose the link",
+          "[board][link]") {
   LinkConfig config;
   config.response_timeout = 50ms;
   config.max_missed = 4;
