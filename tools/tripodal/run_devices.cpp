@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <iomanip>
 #include <ostream>
@@ -30,6 +29,7 @@ namespace tripodal::app {
 namespace {
 
 constexpr double kSyncWaitS = 5.0;  // wall-clock seconds: a board that has not answered SYNC by then is not there
+constexpr Duration kBrakeMax = std::chrono::seconds(3);  // the devices' time the base may take to brake at the end
 
 std::string json_string(const std::string& s) {
   std::string out = "\"";
@@ -305,16 +305,17 @@ void cancel_unfinished(const RunOptions& o, Robot& robot, RunResult& res) {
   if (res.state.empty() || sig != 0) res.state = sig != 0 ? "interrupted" : "timed out";
 }
 
-// The robot's threads have stopped: this thread runs the link now. The wheels commanded zero,
-// the lamp and the fog at their channels' safe values (off; the board applies the channels at its
-// next cycle, as in the run), until the board has answered a DRIVE sent after that. Whether it did.
-bool rest_on_devices(board::BoardHardware& hw, const Clock& clock) {
-  const std::array<double, 2> zeros{0.0, 0.0};
-  (void)hw.write_wheel_velocities(zeros);
+// The robot's threads have stopped: this thread runs the link now. The lamp and the fog at their
+// channels' safe values (off; the board applies the channels at its next cycle, as in the run),
+// the wheels braked to zero through the base's controller (its limits, as every cycle of the
+// run), until the board has answered a DRIVE sent after that. Whether it did.
+bool rest_on_devices(Robot& robot, board::BoardHardware& hw, const Clock& clock) {
   CommandChannels& channels = hw.command_channels();
   for (const std::string_view name : {"uv_lamp", "atomizer", "atomizer_fan"}) {
     if (const auto i = channels.find(name)) channels.set(*i, channels.spec(*i).safe);
   }
+  if (CController* c = robot.behavior_loop().controller())
+    (void)brake_through_controller(*c, clock, kBrakeMax, [&hw](Time now) { hw.cycle(now); });
   const Time zero_sent = clock.now();
   bool zero_answered = false;
   for (int i = 0; i < 50 && !zero_answered; ++i) {
@@ -440,7 +441,7 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
   m.print_lifecycle();
 
   res.base_command_at_end_rad_s = {0.0, 0.0};
-  res.base_at_rest = rest_on_devices(hw, clock);
+  res.base_at_rest = rest_on_devices(*robot, hw, clock);
   if (o.log != nullptr && !res.base_at_rest)
     *o.log << "board: no answer to the last DRIVE (speeds 0): its watchdog stops the motors\n";
 
