@@ -238,6 +238,85 @@ void read_laser(Reader& r, const YAML::Node& n, LaserConfig& c) {
 void read_joints(Reader& r, const YAML::Node& n, std::vector<JointConfig>& out);
 void read_buttons(Reader& r, const YAML::Node& n, std::vector<ButtonConfig>& out);
 
+void read_odometry(Reader& r, const YAML::Node& o, SimRobotConfig& rc) {
+  if (!r.check_map(o, "robot.odometry", {"name", "noise_ratio", "scale_error_stddev", "rate_hz"})) return;
+  r.text(o, "name", rc.odometry.name, "robot.odometry");
+  r.number_at_least(o, "noise_ratio", rc.odometry.noise_ratio, 0.0, false, "robot.odometry");
+  r.number_at_least(o, "scale_error_stddev", rc.odometry.scale_error_stddev, 0.0, false, "robot.odometry");
+  r.number_at_least(o, "rate_hz", rc.odometry.rate_hz, 0.0, true, "robot.odometry");
+}
+
+void read_gyro(Reader& r, const YAML::Node& g, SimRobotConfig& rc) {
+  if (!r.check_map(g, "robot.gyro", {"name", "enabled", "noise_stddev_rad_s", "bias_rad_s", "rate_hz"})) return;
+  r.text(g, "name", rc.gyro.name, "robot.gyro");
+  r.boolean(g, "enabled", rc.gyro.enabled, "robot.gyro");
+  r.number_at_least(g, "noise_stddev_rad_s", rc.gyro.noise_stddev_rad_s, 0.0, false, "robot.gyro");
+  if (const YAML::Node b = g["bias_rad_s"]) {
+    if (auto v = r.number(b, "robot.gyro.bias_rad_s")) rc.gyro.bias_rad_s = *v;
+  }
+  r.number_at_least(g, "rate_hz", rc.gyro.rate_hz, 0.0, true, "robot.gyro");
+}
+
+void read_bumpers(Reader& r, const YAML::Node& b, SimRobotConfig& rc) {
+  if (!r.check_map(b, "robot.bumpers", {"name", "enabled", "sectors", "contact_margin_m", "rate_hz"})) return;
+  r.text(b, "name", rc.bumpers.name, "robot.bumpers");
+  r.boolean(b, "enabled", rc.bumpers.enabled, "robot.bumpers");
+  if (const YAML::Node s = b["sectors"]) {
+    if (auto v = r.number(s, "robot.bumpers.sectors")) {
+      if (*v < 1.0 || *v > 32.0 || std::floor(*v) != *v) {
+        r.error(s, "robot.bumpers.sectors must be a whole number from 1 to 32, got " + s.Scalar());
+      } else {
+        rc.bumpers.sectors = static_cast<std::uint32_t>(*v);
+      }
+    }
+  }
+  r.number_at_least(b, "contact_margin_m", rc.bumpers.contact_margin_m, 0.0, false, "robot.bumpers");
+  r.number_at_least(b, "rate_hz", rc.bumpers.rate_hz, 0.0, true, "robot.bumpers");
+}
+
+void read_cliff(Reader& r, const YAML::Node& c, SimRobotConfig& rc) {
+  if (!r.check_map(c, "robot.cliff", {"name", "enabled", "positions", "rate_hz"})) return;
+  r.text(c, "name", rc.cliff.name, "robot.cliff");
+  r.boolean(c, "enabled", rc.cliff.enabled, "robot.cliff");
+  r.number_at_least(c, "rate_hz", rc.cliff.rate_hz, 0.0, true, "robot.cliff");
+  const YAML::Node p = c["positions"];
+  if (!p) return;
+  if (!p.IsSequence()) {
+    r.error(p, "robot.cliff.positions must be a list of [x, y] (base frame, metres), got " + Reader::kind(p));
+    return;
+  }
+  rc.cliff.positions.clear();
+  for (const auto& item : p) {
+    if (auto v = r.numbers(item, "robot.cliff.positions", 2, 0, "[x, y] (base frame, metres)")) {
+      rc.cliff.positions.push_back({(*v)[0], (*v)[1]});
+    }
+  }
+}
+
+void read_battery(Reader& r, const YAML::Node& b, SimRobotConfig& rc) {
+  const std::string w = "robot.battery";
+  if (!r.check_map(b, w,
+                   {"name", "enabled", "initial", "capacity_ah", "voltage_empty_v", "voltage_full_v", "drain_per_s",
+                    "drain_per_m", "charge_per_s", "rate_hz"})) {
+    return;
+  }
+  BatteryConfig& bc = rc.battery;
+  r.text(b, "name", bc.name, w);
+  r.boolean(b, "enabled", bc.enabled, w);
+  r.number_at_least(b, "initial", bc.initial, 0.0, false, w);
+  if (bc.initial > 1.0) r.error(b["initial"], w + ".initial is a state of charge: expected 0..1, got " + b["initial"].Scalar());
+  r.number_at_least(b, "capacity_ah", bc.capacity_ah, 0.0, true, w);
+  r.number_at_least(b, "voltage_empty_v", bc.voltage_empty_v, 0.0, false, w);
+  r.number_at_least(b, "voltage_full_v", bc.voltage_full_v, 0.0, true, w);
+  if (bc.voltage_full_v <= bc.voltage_empty_v) {
+    r.error(b["voltage_full_v"] ? b["voltage_full_v"] : b, w + ": expected voltage_empty_v < voltage_full_v");
+  }
+  r.number_at_least(b, "drain_per_s", bc.drain_per_s, 0.0, false, w);
+  r.number_at_least(b, "drain_per_m", bc.drain_per_m, 0.0, false, w);
+  r.number_at_least(b, "charge_per_s", bc.charge_per_s, 0.0, false, w);
+  r.number_at_least(b, "rate_hz", bc.rate_hz, 0.0, true, w);
+}
+
 void read_robot(Reader& r, const YAML::Node& n, SimRobotConfig& rc) {
   if (!r.check_map(n, "robot", {"radius_m", "max_substep_s", "laser", "odometry", "gyro", "bumpers", "cliff", "battery", "joints",
                                 "buttons"})) {
@@ -256,82 +335,11 @@ void read_robot(Reader& r, const YAML::Node& n, SimRobotConfig& rc) {
   if (const YAML::Node l = n["laser"]) read_laser(r, l, rc.laser);
   if (const YAML::Node j = n["joints"]) read_joints(r, j, rc.joints);
   if (const YAML::Node b = n["buttons"]) read_buttons(r, b, rc.buttons);
-  if (const YAML::Node o = n["odometry"]) {
-    if (r.check_map(o, "robot.odometry", {"name", "noise_ratio", "scale_error_stddev", "rate_hz"})) {
-      r.text(o, "name", rc.odometry.name, "robot.odometry");
-      r.number_at_least(o, "noise_ratio", rc.odometry.noise_ratio, 0.0, false, "robot.odometry");
-      r.number_at_least(o, "scale_error_stddev", rc.odometry.scale_error_stddev, 0.0, false, "robot.odometry");
-      r.number_at_least(o, "rate_hz", rc.odometry.rate_hz, 0.0, true, "robot.odometry");
-    }
-  }
-  if (const YAML::Node g = n["gyro"]) {
-    if (r.check_map(g, "robot.gyro", {"name", "enabled", "noise_stddev_rad_s", "bias_rad_s", "rate_hz"})) {
-      r.text(g, "name", rc.gyro.name, "robot.gyro");
-      r.boolean(g, "enabled", rc.gyro.enabled, "robot.gyro");
-      r.number_at_least(g, "noise_stddev_rad_s", rc.gyro.noise_stddev_rad_s, 0.0, false, "robot.gyro");
-      if (const YAML::Node b = g["bias_rad_s"]) {
-        if (auto v = r.number(b, "robot.gyro.bias_rad_s")) rc.gyro.bias_rad_s = *v;
-      }
-      r.number_at_least(g, "rate_hz", rc.gyro.rate_hz, 0.0, true, "robot.gyro");
-    }
-  }
-  if (const YAML::Node b = n["bumpers"]) {
-    if (r.check_map(b, "robot.bumpers", {"name", "enabled", "sectors", "contact_margin_m", "rate_hz"})) {
-      r.text(b, "name", rc.bumpers.name, "robot.bumpers");
-      r.boolean(b, "enabled", rc.bumpers.enabled, "robot.bumpers");
-      if (const YAML::Node s = b["sectors"]) {
-        if (auto v = r.number(s, "robot.bumpers.sectors")) {
-          if (*v < 1.0 || *v > 32.0 || std::floor(*v) != *v) {
-            r.error(s, "robot.bumpers.sectors must be a whole number from 1 to 32, got " + s.Scalar());
-          } else {
-            rc.bumpers.sectors = static_cast<std::uint32_t>(*v);
-          }
-        }
-      }
-      r.number_at_least(b, "contact_margin_m", rc.bumpers.contact_margin_m, 0.0, false, "robot.bumpers");
-      r.number_at_least(b, "rate_hz", rc.bumpers.rate_hz, 0.0, true, "robot.bumpers");
-    }
-  }
-  if (const YAML::Node c = n["cliff"]) {
-    if (r.check_map(c, "robot.cliff", {"name", "enabled", "positions", "rate_hz"})) {
-      r.text(c, "name", rc.cliff.name, "robot.cliff");
-      r.boolean(c, "enabled", rc.cliff.enabled, "robot.cliff");
-      r.number_at_least(c, "rate_hz", rc.cliff.rate_hz, 0.0, true, "robot.cliff");
-      if (const YAML::Node p = c["positions"]) {
-        if (!p.IsSequence()) {
-          r.error(p, "robot.cliff.positions must be a list of [x, y] (base frame, metres), got " + Reader::kind(p));
-        } else {
-          rc.cliff.positions.clear();
-          for (const auto& item : p) {
-            if (auto v = r.numbers(item, "robot.cliff.positions", 2, 0, "[x, y] (base frame, metres)")) {
-              rc.cliff.positions.push_back({(*v)[0], (*v)[1]});
-            }
-          }
-        }
-      }
-    }
-  }
-  if (const YAML::Node b = n["battery"]) {
-    const std::string w = "robot.battery";
-    if (r.check_map(b, w, {"name", "enabled", "initial", "capacity_ah", "voltage_empty_v", "voltage_full_v",
-                           "drain_per_s", "drain_per_m", "charge_per_s", "rate_hz"})) {
-      BatteryConfig& bc = rc.battery;
-      r.text(b, "name", bc.name, w);
-      r.boolean(b, "enabled", bc.enabled, w);
-      r.number_at_least(b, "initial", bc.initial, 0.0, false, w);
-      if (bc.initial > 1.0) r.error(b["initial"], w + ".initial is a state of charge: expected 0..1, got " + b["initial"].Scalar());
-      r.number_at_least(b, "capacity_ah", bc.capacity_ah, 0.0, true, w);
-      r.number_at_least(b, "voltage_empty_v", bc.voltage_empty_v, 0.0, false, w);
-      r.number_at_least(b, "voltage_full_v", bc.voltage_full_v, 0.0, true, w);
-      if (bc.voltage_full_v <= bc.voltage_empty_v) {
-        r.error(b["voltage_full_v"] ? b["voltage_full_v"] : b, w + ": expected voltage_empty_v < voltage_full_v");
-      }
-      r.number_at_least(b, "drain_per_s", bc.drain_per_s, 0.0, false, w);
-      r.number_at_least(b, "drain_per_m", bc.drain_per_m, 0.0, false, w);
-      r.number_at_least(b, "charge_per_s", bc.charge_per_s, 0.0, false, w);
-      r.number_at_least(b, "rate_hz", bc.rate_hz, 0.0, true, w);
-    }
-  }
+  if (const YAML::Node o = n["odometry"]) read_odometry(r, o, rc);
+  if (const YAML::Node g = n["gyro"]) read_gyro(r, g, rc);
+  if (const YAML::Node b = n["bumpers"]) read_bumpers(r, b, rc);
+  if (const YAML::Node c = n["cliff"]) read_cliff(r, c, rc);
+  if (const YAML::Node b = n["battery"]) read_battery(r, b, rc);
 }
 
 void read_joints(Reader& r, const YAML::Node& n, std::vector<JointConfig>& out) {
