@@ -212,70 +212,137 @@ PlannedPath PathPlanner::plan_around(Point2D start, Point2D goal, std::span<cons
   return out;
 }
 
-PlannedPath PathPlanner::plan(CellIndex start, CellIndex goal, double keep_clearance_m) {
-  PlannedPath out;
+namespace {
+
+constexpr float kSqrt2 = 1.41421356F;
+// Scaling h by (1 + 1/1000) breaks the ties among the many equal-cost grid paths in favour of
+// progress; a path found is at most 0.1 % longer than the shortest (in practice equal).
+constexpr float kTieBreak = 1.001F;
+
+// The octile distance from padded cell p to `goal`, tie-broken: A*'s heuristic.
+float octile(std::uint32_t p, int padded_width, CellIndex goal) noexcept {
+  const int x = static_cast<int>(p % static_cast<std::uint32_t>(padded_width)) - 1;
+  const int y = static_cast<int>(p / static_cast<std::uint32_t>(padded_width)) - 1;
+  const float dx = static_cast<float>(std::abs(x - goal.x));
+  const float dy = static_cast<float>(std::abs(y - goal.y));
+  return kTieBreak * ((dx > dy) ? dx + (kSqrt2 - 1.0F) * dy : dy + (kSqrt2 - 1.0F) * dx);
+}
+
+struct Node {
+  float f;
+  float h;
+  std::uint32_t i;
+};
+
+// Why no path can be planned between `start` and `goal` (outside the grid, in collision), in
+// out.status and out.message; false when one can.
+bool refuse_ends(const PathPlanner& planner, CellIndex start, CellIndex goal, PlannedPath& out) {
+  const OccupancyGrid& grid = planner.grid();
   std::ostringstream msg;
   const auto describe = [&](const char* what, CellIndex c) {
     msg << what << " cell (" << c.x << ", " << c.y << ")";
-    if (grid_.contains(c)) {
-      msg << " has clearance " << field_.clearance_m(grid_.index(c)) << " m, the robot radius is "
-          << options_.robot_radius_m << " m";
+    if (grid.contains(c)) {
+      msg << " has clearance " << planner.distance_field().clearance_m(grid.index(c)) << " m, the robot radius is "
+          << planner.options().robot_radius_m << " m";
     } else {
-      msg << " is outside the " << grid_.width() << " x " << grid_.height() << " grid";
+      msg << " is outside the " << grid.width() << " x " << grid.height() << " grid";
     }
   };
-  if (!grid_.contains(start)) {
+  if (!grid.contains(start)) {
     out.status = PlanStatus::start_outside_map;
     describe("start", start);
-  } else if (!grid_.contains(goal)) {
+  } else if (!grid.contains(goal)) {
     out.status = PlanStatus::goal_outside_map;
     describe("goal", goal);
-  } else if (!traversable(start)) {
+  } else if (!planner.traversable(start)) {
     out.status = PlanStatus::start_in_collision;
     describe("start", start);
-  } else if (!traversable(goal)) {
+  } else if (!planner.traversable(goal)) {
     out.status = PlanStatus::goal_in_collision;
     describe("goal", goal);
   }
-  if (!msg.str().empty()) {
-    out.message = msg.str();
-    return out;
-  }
+  out.message = msg.str();
+  return !out.message.empty();
+}
 
+std::string unreachable_message(CellIndex start, CellIndex goal, double robot_radius_m, std::size_t expanded) {
+  std::ostringstream msg;
+  msg << "no collision-free path from cell (" << start.x << ", " << start.y << ") to cell (" << goal.x << ", " << goal.y
+      << ") for a robot of radius " << robot_radius_m << " m (" << expanded << " cells reachable)";
+  return msg.str();
+}
+
+// The path's cells, start to goal, read back from the goal through A*'s parents (padded indices).
+std::vector<CellIndex> trace_back(const std::vector<std::uint32_t>& parent, int padded_width, std::uint32_t si,
+                                  std::uint32_t gi) {
+  const auto pw = static_cast<std::uint32_t>(padded_width);
+  std::vector<CellIndex> cells;
+  for (std::uint32_t i = gi;; i = parent[i]) {
+    cells.push_back({static_cast<int>(i % pw) - 1, static_cast<int>(i / pw) - 1});
+    if (i == si) break;
+  }
+  std::reverse(cells.begin(), cells.end());
+  return cells;
+}
+
+double cells_length(const std::vector<CellIndex>& k) {
+  double len = 0.0;
+  for (std::size_t i = 1; i < k.size(); ++i) len += std::hypot(k[i].x - k[i - 1].x, k[i].y - k[i - 1].y);
+  return len;
+}
+
+// String pulling: extend each straight leg while the next path cell stays visible. Done from
+// both ends, the shorter result kept: the greedy pull depends on its direction. With a
+// clearance to keep a leg keeps it, or at least the least clearance of the cells it
+// replaces: a shortcut does not undo the way A* took around a corner.
+std::vector<CellIndex> pull_string(const PathPlanner& planner, const std::vector<CellIndex>& cells, double keep_clearance_m) {
+  const bool keep_clear = keep_clearance_m > planner.options().robot_radius_m;
+  const auto pull = [&](const std::vector<CellIndex>& path) {
+    std::vector<CellIndex> k{path[0]};
+    std::size_t i = 0;
+    while (i + 1 < path.size()) {
+      std::size_t j = i + 1;
+      double least = keep_clear ? std::min({keep_clearance_m, planner.clearance_m(path[i]), planner.clearance_m(path[j])}) : 0.0;
+      while (j + 1 < path.size()) {
+        const double with_next = keep_clear ? std::min(least, planner.clearance_m(path[j + 1])) : 0.0;
+        if (!planner.line_of_sight(path[i], path[j + 1], with_next)) break;
+        least = with_next;
+        ++j;
+      }
+      k.push_back(path[j]);
+      i = j;
+    }
+    return k;
+  };
+  std::vector<CellIndex> kept = pull(cells);
+  const std::vector<CellIndex> reversed(cells.rbegin(), cells.rend());
+  const std::vector<CellIndex> back = pull(reversed);
+  if (cells_length(back) < cells_length(kept) - 1e-9) kept.assign(back.rbegin(), back.rend());
+  return kept;
+}
+
+}  // namespace
+
+PlannedPath PathPlanner::plan(CellIndex start, CellIndex goal, double keep_clearance_m) {
+  PlannedPath out;
+  if (refuse_ends(*this, start, goal, out)) return out;
   if (++search_id_ == 0) {  // wrapped: invalidate every stamp
     std::fill(stamp_.begin(), stamp_.end(), 0);
     search_id_ = 1;
   }
-  constexpr float kSqrt2 = 1.41421356F;
-  // Scaling h by (1 + 1/1000) breaks the ties among the many equal-cost grid paths in favour of
-  // progress; a path found is at most 0.1 % longer than the shortest (in practice equal).
-  constexpr float kTieBreak = 1.001F;
   const int pw = padded_width_;
-  const auto octile = [&](std::uint32_t p) {
-    const int x = static_cast<int>(p % static_cast<std::uint32_t>(pw)) - 1;
-    const int y = static_cast<int>(p / static_cast<std::uint32_t>(pw)) - 1;
-    const float dx = static_cast<float>(std::abs(x - goal.x));
-    const float dy = static_cast<float>(std::abs(y - goal.y));
-    return kTieBreak * ((dx > dy) ? dx + (kSqrt2 - 1.0F) * dy : dy + (kSqrt2 - 1.0F) * dx);
-  };
-  struct Node {
-    float f;
-    float h;
-    std::uint32_t i;
-  };
   // Ties on f go to the node nearer the goal, which keeps A* from widening on open floors.
   const auto worse = [](const Node& a, const Node& b) { return a.f > b.f || (a.f == b.f && a.h > b.h); };
   std::vector<Node> heap_storage;
   heap_storage.reserve(4096);
   std::priority_queue<Node, std::vector<Node>, decltype(worse)> open(worse, std::move(heap_storage));
-  const auto padded = [&](CellIndex c) { return static_cast<std::uint32_t>((c.y + 1) * pw + c.x + 1); };
-  const std::uint32_t si = padded(start);
-  const std::uint32_t gi = padded(goal);
+  const auto si = static_cast<std::uint32_t>(padded_index(start.x, start.y));
+  const auto gi = static_cast<std::uint32_t>(padded_index(goal.x, goal.y));
   stamp_[si] = search_id_;
   g_[si] = 0.0F;
   closed_[si] = 0;
   parent_[si] = si;
-  open.push({octile(si), octile(si), si});
+  open.push({octile(si, pw, goal), octile(si, pw, goal), si});
   // straight moves first; diagonal k uses straight moves kSide[k][0..1] as its two sides
   const std::int32_t steps[8] = {1, -1, pw, -pw, pw + 1, -pw + 1, pw - 1, -pw - 1};
   static constexpr int kSide[8][2] = {{0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 2}, {0, 3}, {1, 2}, {1, 3}};
@@ -315,60 +382,17 @@ PlannedPath PathPlanner::plan(CellIndex start, CellIndex goal, double keep_clear
       }
       g_[ni] = ng;
       parent_[ni] = n.i;
-      const float h = octile(ni);
+      const float h = octile(ni, pw, goal);
       open.push({ng + h, h, ni});
     }
   }
   if (!found) {
     out.status = PlanStatus::unreachable;
-    msg << "no collision-free path from cell (" << start.x << ", " << start.y << ") to cell (" << goal.x << ", "
-        << goal.y << ") for a robot of radius " << options_.robot_radius_m << " m (" << out.expanded
-        << " cells reachable)";
-    out.message = msg.str();
+    out.message = unreachable_message(start, goal, options_.robot_radius_m, out.expanded);
     return out;
   }
-  for (std::uint32_t i = gi;; i = parent_[i]) {
-    out.cells.push_back({static_cast<int>(i % static_cast<std::uint32_t>(pw)) - 1,
-                         static_cast<int>(i / static_cast<std::uint32_t>(pw)) - 1});
-    if (i == si) break;
-  }
-  std::reverse(out.cells.begin(), out.cells.end());
-
-  std::vector<CellIndex> kept;
-  if (options_.shortcut) {
-    // String pulling: extend each straight leg while the next path cell stays visible. Done from
-    // both ends, the shorter result kept: the greedy pull depends on its direction. With a
-    // clearance to keep a leg keeps it, or at least the least clearance of the cells it
-    // replaces: a shortcut does not undo the way A* took around a corner.
-    const auto pull = [&](const std::vector<CellIndex>& cells) {
-      std::vector<CellIndex> k{cells[0]};
-      std::size_t i = 0;
-      while (i + 1 < cells.size()) {
-        std::size_t j = i + 1;
-        double least = keep_clear ? std::min({keep_clearance_m, clearance_m(cells[i]), clearance_m(cells[j])}) : 0.0;
-        while (j + 1 < cells.size()) {
-          const double with_next = keep_clear ? std::min(least, clearance_m(cells[j + 1])) : 0.0;
-          if (!line_of_sight(cells[i], cells[j + 1], with_next)) break;
-          least = with_next;
-          ++j;
-        }
-        k.push_back(cells[j]);
-        i = j;
-      }
-      return k;
-    };
-    const auto length = [&](const std::vector<CellIndex>& k) {
-      double len = 0.0;
-      for (std::size_t i = 1; i < k.size(); ++i) len += std::hypot(k[i].x - k[i - 1].x, k[i].y - k[i - 1].y);
-      return len;
-    };
-    kept = pull(out.cells);
-    std::vector<CellIndex> reversed(out.cells.rbegin(), out.cells.rend());
-    std::vector<CellIndex> back = pull(reversed);
-    if (length(back) < length(kept) - 1e-9) kept.assign(back.rbegin(), back.rend());
-  } else {
-    kept = out.cells;
-  }
+  out.cells = trace_back(parent_, pw, si, gi);
+  const std::vector<CellIndex> kept = options_.shortcut ? pull_string(*this, out.cells, keep_clearance_m) : out.cells;
   out.waypoints.reserve(kept.size());
   for (const CellIndex& c : kept) out.waypoints.push_back(grid_.cell_center(c));
   out.length_m = polyline_length_m(out.waypoints);

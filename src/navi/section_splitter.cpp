@@ -238,17 +238,12 @@ SectionSet sections_of_labels(const OccupancyGrid& grid, const std::vector<int>&
   return out;
 }
 
-SectionSet CSectionSplitter::split(const OccupancyGrid& grid) const {
-  if (rooms_) return segment_rooms(grid, *rooms_).rooms;
-  SectionSet out;
-  const int w = grid.width(), h = grid.height();
-  const std::size_t n = grid.size();
-  out.label.assign(n, -1);
-  if (n == 0) return out;
-  const double cell_area = grid.resolution_m() * grid.resolution_m();
+namespace {
 
-  // 1. the outer wall: non-free cells reachable from the border through non-free cells
-  std::vector<std::uint8_t> wall(n, 0);
+// The outer wall: the non-free cells reachable from the map's border through non-free cells.
+std::vector<std::uint8_t> outer_wall(const OccupancyGrid& grid) {
+  const int w = grid.width(), h = grid.height();
+  std::vector<std::uint8_t> wall(grid.size(), 0);
   std::deque<std::size_t> queue;
   const auto seed = [&](int x, int y) {
     const std::size_t i = grid.index({x, y});
@@ -275,10 +270,19 @@ SectionSet CSectionSplitter::split(const OccupancyGrid& grid) const {
       }
     }
   }
-  // isolated obstacles: the remaining occupied components
-  std::vector<std::uint8_t> row_has(static_cast<std::size_t>(h), 0);
+  return wall;
+}
+
+// The isolated obstacles (the occupied components off the outer wall, of at least
+// `min_area_m2`): counted, and the rows they cover, in out.obstacle_rows.
+void find_isolated_obstacles(const OccupancyGrid& grid, const std::vector<std::uint8_t>& wall, double min_area_m2,
+                             SectionSet& out) {
+  const std::size_t n = grid.size();
+  const double cell_area = grid.resolution_m() * grid.resolution_m();
+  std::vector<std::uint8_t> row_has(static_cast<std::size_t>(grid.height()), 0);
   std::vector<std::uint8_t> seen(n, 0);
   std::vector<std::size_t> comp;
+  std::deque<std::size_t> queue;
   for (std::size_t i = 0; i < n; ++i) {
     if (seen[i] != 0 || wall[i] != 0 || grid.state(i) != Occupancy::occupied) continue;
     comp.clear();
@@ -301,30 +305,32 @@ SectionSet CSectionSplitter::split(const OccupancyGrid& grid) const {
         }
       }
     }
-    if (static_cast<double>(comp.size()) * cell_area < options_.min_obstacle_area_m2) continue;
+    if (static_cast<double>(comp.size()) * cell_area < min_area_m2) continue;
     ++out.isolated_obstacles;
     for (const std::size_t j : comp) row_has[static_cast<std::size_t>(grid.cell(j).y)] = 1;
   }
-  for (int y = 0; y < h; ++y) {
+  for (int y = 0; y < grid.height(); ++y) {
     if (row_has[static_cast<std::size_t>(y)] != 0) out.obstacle_rows.push_back(y);
   }
+}
 
-  // 2. candidate walls in the middle of the gaps between obstacle bands
+// Virtual walls (out.virtual_wall_rows) in the middle of the gaps between obstacle bands, kept
+// where they leave tall enough strips, measured from the free rows actually present.
+void place_virtual_walls(const OccupancyGrid& grid, const SectionSplitterOptions& options, SectionSet& out) {
   std::vector<int> candidates;
-  const int min_gap_rows = std::max(1, static_cast<int>(std::ceil(options_.min_gap_m / grid.resolution_m() - 1e-9)));
+  const int min_gap_rows = std::max(1, static_cast<int>(std::ceil(options.min_gap_m / grid.resolution_m() - 1e-9)));
   for (std::size_t k = 1; k < out.obstacle_rows.size(); ++k) {
     const int prev = out.obstacle_rows[k - 1], next = out.obstacle_rows[k];
     if (next - prev - 1 >= min_gap_rows) candidates.push_back((prev + next) / 2);  // wall between r and r+1
   }
-  // 3. keep walls that leave tall enough strips; measure from the free rows actually present
-  int first_free = h, last_free = -1;
-  for (std::size_t i = 0; i < n; ++i) {
+  int first_free = grid.height(), last_free = -1;
+  for (std::size_t i = 0; i < grid.size(); ++i) {
     if (grid.state(i) == Occupancy::free) {
       first_free = std::min(first_free, grid.cell(i).y);
       last_free = std::max(last_free, grid.cell(i).y);
     }
   }
-  const int min_rows = static_cast<int>(std::ceil(options_.min_section_height_m / grid.resolution_m()));
+  const int min_rows = static_cast<int>(std::ceil(options.min_section_height_m / grid.resolution_m()));
   int last_kept = first_free - 1;  // the strip above a wall at r starts at r + 1
   for (const int r : candidates) {
     if (r - last_kept >= min_rows && last_free - r >= min_rows) {
@@ -332,12 +338,16 @@ SectionSet CSectionSplitter::split(const OccupancyGrid& grid) const {
       last_kept = r;
     }
   }
-  std::vector<std::uint8_t> cut_above(static_cast<std::size_t>(h), 0);
-  for (const int r : out.virtual_wall_rows) cut_above[static_cast<std::size_t>(r)] = 1;
+}
 
-  // 4. free components, not crossing a virtual wall
-  std::vector<int> comp_of(n, -1);
+// The free components, 4-connected, not crossing a virtual wall (cut_above[r]: a wall between
+// rows r and r + 1); comp_of: each cell's component, -1 for none.
+std::vector<std::vector<std::size_t>> free_components(const OccupancyGrid& grid, const std::vector<std::uint8_t>& cut_above,
+                                                      std::vector<int>& comp_of) {
+  const std::size_t n = grid.size();
+  comp_of.assign(n, -1);
   std::vector<std::vector<std::size_t>> comps;
+  std::deque<std::size_t> queue;
   for (std::size_t i = 0; i < n; ++i) {
     if (comp_of[i] >= 0 || grid.state(i) != Occupancy::free) continue;
     const int id = static_cast<int>(comps.size());
@@ -362,9 +372,14 @@ SectionSet CSectionSplitter::split(const OccupancyGrid& grid) const {
       }
     }
   }
-  // merge small components into the neighbour across a wall with the longest shared border;
-  // smallest first so a chain of slivers ends in a large section
-  const std::size_t min_cells = static_cast<std::size_t>(std::ceil(options_.min_section_area_m2 / cell_area));
+  return comps;
+}
+
+// Merges components below `min_cells` into the neighbour across a wall with the longest shared
+// border, smallest first so a chain of slivers ends in a large section (one with no neighbour is
+// dropped); one label per kept root, cell by cell (-1: none).
+std::vector<int> merged_labels(const OccupancyGrid& grid, const std::vector<std::vector<std::size_t>>& comps,
+                               const std::vector<int>& comp_of, std::size_t min_cells) {
   std::vector<int> parent(comps.size());
   for (std::size_t k = 0; k < comps.size(); ++k) parent[k] = static_cast<int>(k);
   const auto root = [&](int k) {
@@ -399,14 +414,37 @@ SectionSet CSectionSplitter::split(const OccupancyGrid& grid) const {
     parent[static_cast<std::size_t>(rk)] = best->first;
     size[static_cast<std::size_t>(best->first)] += size[static_cast<std::size_t>(rk)];
   }
-  // one label per kept root; sections_of_labels numbers them in scan order
-  std::vector<int> root_label(n, -1);
-  for (std::size_t i = 0; i < n; ++i) {
+  std::vector<int> root_label(grid.size(), -1);
+  for (std::size_t i = 0; i < grid.size(); ++i) {
     if (comp_of[i] < 0) continue;
     const int r = root(comp_of[i]);
     if (dropped[static_cast<std::size_t>(r)] == 0) root_label[i] = r;
   }
-  SectionSet labelled = sections_of_labels(grid, root_label);
+  return root_label;
+}
+
+}  // namespace
+
+SectionSet CSectionSplitter::split(const OccupancyGrid& grid) const {
+  if (rooms_) return segment_rooms(grid, *rooms_).rooms;
+  SectionSet out;
+  const std::size_t n = grid.size();
+  out.label.assign(n, -1);
+  if (n == 0) return out;
+  const double cell_area = grid.resolution_m() * grid.resolution_m();
+
+  // 1. the outer wall, then the isolated obstacles and the rows they cover
+  find_isolated_obstacles(grid, outer_wall(grid), options_.min_obstacle_area_m2, out);
+  // 2. and 3. the virtual walls between obstacle bands
+  place_virtual_walls(grid, options_, out);
+  std::vector<std::uint8_t> cut_above(static_cast<std::size_t>(grid.height()), 0);
+  for (const int r : out.virtual_wall_rows) cut_above[static_cast<std::size_t>(r)] = 1;
+  // 4. free components, not crossing a virtual wall; the small ones merged into a neighbour
+  std::vector<int> comp_of;
+  const std::vector<std::vector<std::size_t>> comps = free_components(grid, cut_above, comp_of);
+  const std::size_t min_cells = static_cast<std::size_t>(std::ceil(options_.min_section_area_m2 / cell_area));
+  // sections_of_labels numbers the kept roots in scan order
+  SectionSet labelled = sections_of_labels(grid, merged_labels(grid, comps, comp_of, min_cells));
   out.sections = std::move(labelled.sections);
   out.label = std::move(labelled.label);
   return out;

@@ -238,6 +238,85 @@ void read_laser(Reader& r, const YAML::Node& n, LaserConfig& c) {
 void read_joints(Reader& r, const YAML::Node& n, std::vector<JointConfig>& out);
 void read_buttons(Reader& r, const YAML::Node& n, std::vector<ButtonConfig>& out);
 
+void read_odometry(Reader& r, const YAML::Node& o, SimRobotConfig& rc) {
+  if (!r.check_map(o, "robot.odometry", {"name", "noise_ratio", "scale_error_stddev", "rate_hz"})) return;
+  r.text(o, "name", rc.odometry.name, "robot.odometry");
+  r.number_at_least(o, "noise_ratio", rc.odometry.noise_ratio, 0.0, false, "robot.odometry");
+  r.number_at_least(o, "scale_error_stddev", rc.odometry.scale_error_stddev, 0.0, false, "robot.odometry");
+  r.number_at_least(o, "rate_hz", rc.odometry.rate_hz, 0.0, true, "robot.odometry");
+}
+
+void read_gyro(Reader& r, const YAML::Node& g, SimRobotConfig& rc) {
+  if (!r.check_map(g, "robot.gyro", {"name", "enabled", "noise_stddev_rad_s", "bias_rad_s", "rate_hz"})) return;
+  r.text(g, "name", rc.gyro.name, "robot.gyro");
+  r.boolean(g, "enabled", rc.gyro.enabled, "robot.gyro");
+  r.number_at_least(g, "noise_stddev_rad_s", rc.gyro.noise_stddev_rad_s, 0.0, false, "robot.gyro");
+  if (const YAML::Node b = g["bias_rad_s"]) {
+    if (auto v = r.number(b, "robot.gyro.bias_rad_s")) rc.gyro.bias_rad_s = *v;
+  }
+  r.number_at_least(g, "rate_hz", rc.gyro.rate_hz, 0.0, true, "robot.gyro");
+}
+
+void read_bumpers(Reader& r, const YAML::Node& b, SimRobotConfig& rc) {
+  if (!r.check_map(b, "robot.bumpers", {"name", "enabled", "sectors", "contact_margin_m", "rate_hz"})) return;
+  r.text(b, "name", rc.bumpers.name, "robot.bumpers");
+  r.boolean(b, "enabled", rc.bumpers.enabled, "robot.bumpers");
+  if (const YAML::Node s = b["sectors"]) {
+    if (auto v = r.number(s, "robot.bumpers.sectors")) {
+      if (*v < 1.0 || *v > 32.0 || std::floor(*v) != *v) {
+        r.error(s, "robot.bumpers.sectors must be a whole number from 1 to 32, got " + s.Scalar());
+      } else {
+        rc.bumpers.sectors = static_cast<std::uint32_t>(*v);
+      }
+    }
+  }
+  r.number_at_least(b, "contact_margin_m", rc.bumpers.contact_margin_m, 0.0, false, "robot.bumpers");
+  r.number_at_least(b, "rate_hz", rc.bumpers.rate_hz, 0.0, true, "robot.bumpers");
+}
+
+void read_cliff(Reader& r, const YAML::Node& c, SimRobotConfig& rc) {
+  if (!r.check_map(c, "robot.cliff", {"name", "enabled", "positions", "rate_hz"})) return;
+  r.text(c, "name", rc.cliff.name, "robot.cliff");
+  r.boolean(c, "enabled", rc.cliff.enabled, "robot.cliff");
+  r.number_at_least(c, "rate_hz", rc.cliff.rate_hz, 0.0, true, "robot.cliff");
+  const YAML::Node p = c["positions"];
+  if (!p) return;
+  if (!p.IsSequence()) {
+    r.error(p, "robot.cliff.positions must be a list of [x, y] (base frame, metres), got " + Reader::kind(p));
+    return;
+  }
+  rc.cliff.positions.clear();
+  for (const auto& item : p) {
+    if (auto v = r.numbers(item, "robot.cliff.positions", 2, 0, "[x, y] (base frame, metres)")) {
+      rc.cliff.positions.push_back({(*v)[0], (*v)[1]});
+    }
+  }
+}
+
+void read_battery(Reader& r, const YAML::Node& b, SimRobotConfig& rc) {
+  const std::string w = "robot.battery";
+  if (!r.check_map(b, w,
+                   {"name", "enabled", "initial", "capacity_ah", "voltage_empty_v", "voltage_full_v", "drain_per_s",
+                    "drain_per_m", "charge_per_s", "rate_hz"})) {
+    return;
+  }
+  BatteryConfig& bc = rc.battery;
+  r.text(b, "name", bc.name, w);
+  r.boolean(b, "enabled", bc.enabled, w);
+  r.number_at_least(b, "initial", bc.initial, 0.0, false, w);
+  if (bc.initial > 1.0) r.error(b["initial"], w + ".initial is a state of charge: expected 0..1, got " + b["initial"].Scalar());
+  r.number_at_least(b, "capacity_ah", bc.capacity_ah, 0.0, true, w);
+  r.number_at_least(b, "voltage_empty_v", bc.voltage_empty_v, 0.0, false, w);
+  r.number_at_least(b, "voltage_full_v", bc.voltage_full_v, 0.0, true, w);
+  if (bc.voltage_full_v <= bc.voltage_empty_v) {
+    r.error(b["voltage_full_v"] ? b["voltage_full_v"] : b, w + ": expected voltage_empty_v < voltage_full_v");
+  }
+  r.number_at_least(b, "drain_per_s", bc.drain_per_s, 0.0, false, w);
+  r.number_at_least(b, "drain_per_m", bc.drain_per_m, 0.0, false, w);
+  r.number_at_least(b, "charge_per_s", bc.charge_per_s, 0.0, false, w);
+  r.number_at_least(b, "rate_hz", bc.rate_hz, 0.0, true, w);
+}
+
 void read_robot(Reader& r, const YAML::Node& n, SimRobotConfig& rc) {
   if (!r.check_map(n, "robot", {"radius_m", "max_substep_s", "laser", "odometry", "gyro", "bumpers", "cliff", "battery", "joints",
                                 "buttons"})) {
@@ -256,82 +335,11 @@ void read_robot(Reader& r, const YAML::Node& n, SimRobotConfig& rc) {
   if (const YAML::Node l = n["laser"]) read_laser(r, l, rc.laser);
   if (const YAML::Node j = n["joints"]) read_joints(r, j, rc.joints);
   if (const YAML::Node b = n["buttons"]) read_buttons(r, b, rc.buttons);
-  if (const YAML::Node o = n["odometry"]) {
-    if (r.check_map(o, "robot.odometry", {"name", "noise_ratio", "scale_error_stddev", "rate_hz"})) {
-      r.text(o, "name", rc.odometry.name, "robot.odometry");
-      r.number_at_least(o, "noise_ratio", rc.odometry.noise_ratio, 0.0, false, "robot.odometry");
-      r.number_at_least(o, "scale_error_stddev", rc.odometry.scale_error_stddev, 0.0, false, "robot.odometry");
-      r.number_at_least(o, "rate_hz", rc.odometry.rate_hz, 0.0, true, "robot.odometry");
-    }
-  }
-  if (const YAML::Node g = n["gyro"]) {
-    if (r.check_map(g, "robot.gyro", {"name", "enabled", "noise_stddev_rad_s", "bias_rad_s", "rate_hz"})) {
-      r.text(g, "name", rc.gyro.name, "robot.gyro");
-      r.boolean(g, "enabled", rc.gyro.enabled, "robot.gyro");
-      r.number_at_least(g, "noise_stddev_rad_s", rc.gyro.noise_stddev_rad_s, 0.0, false, "robot.gyro");
-      if (const YAML::Node b = g["bias_rad_s"]) {
-        if (auto v = r.number(b, "robot.gyro.bias_rad_s")) rc.gyro.bias_rad_s = *v;
-      }
-      r.number_at_least(g, "rate_hz", rc.gyro.rate_hz, 0.0, true, "robot.gyro");
-    }
-  }
-  if (const YAML::Node b = n["bumpers"]) {
-    if (r.check_map(b, "robot.bumpers", {"name", "enabled", "sectors", "contact_margin_m", "rate_hz"})) {
-      r.text(b, "name", rc.bumpers.name, "robot.bumpers");
-      r.boolean(b, "enabled", rc.bumpers.enabled, "robot.bumpers");
-      if (const YAML::Node s = b["sectors"]) {
-        if (auto v = r.number(s, "robot.bumpers.sectors")) {
-          if (*v < 1.0 || *v > 32.0 || std::floor(*v) != *v) {
-            r.error(s, "robot.bumpers.sectors must be a whole number from 1 to 32, got " + s.Scalar());
-          } else {
-            rc.bumpers.sectors = static_cast<std::uint32_t>(*v);
-          }
-        }
-      }
-      r.number_at_least(b, "contact_margin_m", rc.bumpers.contact_margin_m, 0.0, false, "robot.bumpers");
-      r.number_at_least(b, "rate_hz", rc.bumpers.rate_hz, 0.0, true, "robot.bumpers");
-    }
-  }
-  if (const YAML::Node c = n["cliff"]) {
-    if (r.check_map(c, "robot.cliff", {"name", "enabled", "positions", "rate_hz"})) {
-      r.text(c, "name", rc.cliff.name, "robot.cliff");
-      r.boolean(c, "enabled", rc.cliff.enabled, "robot.cliff");
-      r.number_at_least(c, "rate_hz", rc.cliff.rate_hz, 0.0, true, "robot.cliff");
-      if (const YAML::Node p = c["positions"]) {
-        if (!p.IsSequence()) {
-          r.error(p, "robot.cliff.positions must be a list of [x, y] (base frame, metres), got " + Reader::kind(p));
-        } else {
-          rc.cliff.positions.clear();
-          for (const auto& item : p) {
-            if (auto v = r.numbers(item, "robot.cliff.positions", 2, 0, "[x, y] (base frame, metres)")) {
-              rc.cliff.positions.push_back({(*v)[0], (*v)[1]});
-            }
-          }
-        }
-      }
-    }
-  }
-  if (const YAML::Node b = n["battery"]) {
-    const std::string w = "robot.battery";
-    if (r.check_map(b, w, {"name", "enabled", "initial", "capacity_ah", "voltage_empty_v", "voltage_full_v",
-                           "drain_per_s", "drain_per_m", "charge_per_s", "rate_hz"})) {
-      BatteryConfig& bc = rc.battery;
-      r.text(b, "name", bc.name, w);
-      r.boolean(b, "enabled", bc.enabled, w);
-      r.number_at_least(b, "initial", bc.initial, 0.0, false, w);
-      if (bc.initial > 1.0) r.error(b["initial"], w + ".initial is a state of charge: expected 0..1, got " + b["initial"].Scalar());
-      r.number_at_least(b, "capacity_ah", bc.capacity_ah, 0.0, true, w);
-      r.number_at_least(b, "voltage_empty_v", bc.voltage_empty_v, 0.0, false, w);
-      r.number_at_least(b, "voltage_full_v", bc.voltage_full_v, 0.0, true, w);
-      if (bc.voltage_full_v <= bc.voltage_empty_v) {
-        r.error(b["voltage_full_v"] ? b["voltage_full_v"] : b, w + ": expected voltage_empty_v < voltage_full_v");
-      }
-      r.number_at_least(b, "drain_per_s", bc.drain_per_s, 0.0, false, w);
-      r.number_at_least(b, "drain_per_m", bc.drain_per_m, 0.0, false, w);
-      r.number_at_least(b, "charge_per_s", bc.charge_per_s, 0.0, false, w);
-      r.number_at_least(b, "rate_hz", bc.rate_hz, 0.0, true, w);
-    }
-  }
+  if (const YAML::Node o = n["odometry"]) read_odometry(r, o, rc);
+  if (const YAML::Node g = n["gyro"]) read_gyro(r, g, rc);
+  if (const YAML::Node b = n["bumpers"]) read_bumpers(r, b, rc);
+  if (const YAML::Node c = n["cliff"]) read_cliff(r, c, rc);
+  if (const YAML::Node b = n["battery"]) read_battery(r, b, rc);
 }
 
 void read_joints(Reader& r, const YAML::Node& n, std::vector<JointConfig>& out) {
@@ -576,36 +584,28 @@ void read_faults(Reader& r, const YAML::Node& n, FaultSchedule& f) {
   }
 }
 
-World walk_world(std::string_view text, const std::filesystem::path& file) {
-  const std::string fname = file.string();
-  const YAML::Node root = yaml::parse(text, fname);
-  Reader r(fname);
-  World w;
-  w.file = file;
-  if (!r.check_map(
-          root, "the world file",
-          {"map", "regions", "start_pose", "seed", "robot", "drops", "obstacles", "visitors", "docks", "faults", "sonar_only"})) {
-    throw ConfigError(std::move(r.diagnostics()));
+// A file the world names, relative to the world file's folder `dir`; an error when it is not there.
+std::optional<std::filesystem::path> resolve_file(Reader& r, const YAML::Node& n, const std::string& key,
+                                                  const std::filesystem::path& dir) {
+  if (!n.IsScalar() || n.Scalar().empty()) {
+    r.error(n, key + " must be a file path, got " + Reader::kind(n));
+    return std::nullopt;
   }
-  const std::filesystem::path dir = file.parent_path();
-  auto resolve = [&](const YAML::Node& n, const std::string& key) -> std::optional<std::filesystem::path> {
-    if (!n.IsScalar() || n.Scalar().empty()) {
-      r.error(n, key + " must be a file path, got " + Reader::kind(n));
-      return std::nullopt;
-    }
-    std::filesystem::path p = n.Scalar();
-    if (p.is_relative()) p = dir / p;
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(p, ec)) {
-      r.error(n, key + " file '" + n.Scalar() + "' not found (looked for " + p.string() + ")");
-      return std::nullopt;
-    }
-    return p;
-  };
+  std::filesystem::path p = n.Scalar();
+  if (p.is_relative()) p = dir / p;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(p, ec)) {
+    r.error(n, key + " file '" + n.Scalar() + "' not found (looked for " + p.string() + ")");
+    return std::nullopt;
+  }
+  return p;
+}
 
+// The map (required) and the regions file; whether the map loaded.
+bool read_map_and_regions(Reader& r, const YAML::Node& root, const std::filesystem::path& dir, World& w) {
   bool have_map = false;
   if (const YAML::Node m = root["map"]) {
-    if (auto p = resolve(m, "map")) {
+    if (auto p = resolve_file(r, m, "map", dir)) {
       try {
         w.grid = navi::load_map(*p).grid;
         w.map_file = *p;
@@ -618,7 +618,7 @@ World walk_world(std::string_view text, const std::filesystem::path& file) {
     r.error(root, "the world file needs map: a ROS map_server YAML file (relative to the world file)");
   }
   if (const YAML::Node g = root["regions"]) {
-    if (auto p = resolve(g, "regions")) {
+    if (auto p = resolve_file(r, g, "regions", dir)) {
       try {
         w.regions = navi::load_regions(*p);
         w.regions_file = *p;
@@ -627,6 +627,192 @@ World walk_world(std::string_view text, const std::filesystem::path& file) {
       }
     }
   }
+  return have_map;
+}
+
+void read_drops(Reader& r, const YAML::Node& drops, World& w) {
+  if (!drops.IsSequence()) {
+    r.error(drops, "drops must be a list of {name, rectangle | polygon | region}, got " + Reader::kind(drops));
+    return;
+  }
+  for (const auto& item : drops) {
+    if (!r.check_map(item, "a drops entry", {"name", "rectangle", "polygon", "region", "depth_m"})) continue;
+    DropArea a;
+    a.where = r.at(item);
+    r.text(item, "name", a.name, "drops entry");
+    if (const YAML::Node depth = item["depth_m"]) {
+      if (auto v = r.number(depth, "drops entry depth_m")) {
+        if (!(*v > 0.0)) r.error(depth, "drops entry depth_m must be > 0 (how far the floor falls), got " + depth.Scalar());
+        a.depth_m = *v;
+      }
+    }
+    const YAML::Node region = item["region"];
+    const int given = (item["rectangle"] ? 1 : 0) + (item["polygon"] ? 1 : 0) + (region ? 1 : 0);
+    if (given != 1) {
+      r.error(item, "a drops entry needs exactly one of rectangle, polygon or region (a room of the regions file)");
+      continue;
+    }
+    if (region) {
+      const navi::Region* room = region.IsScalar() ? w.regions.room(region.Scalar()) : nullptr;
+      if (room == nullptr) {
+        r.error(region,
+                "unknown region " + Reader::kind(region) + (w.regions_file.empty() ? " (the world names no regions file)" : ""));
+        continue;
+      }
+      a.polygon = room->polygon;
+      if (a.name.empty()) a.name = room->name;
+    } else if (auto s = r.shape(item, "drops entry")) {
+      a.polygon = std::move(*s);
+    } else {
+      continue;
+    }
+    w.drops.push_back(std::move(a));
+  }
+}
+
+void read_sonar_only(Reader& r, const YAML::Node& glass, World& w) {
+  if (!glass.IsSequence()) {
+    r.error(glass,
+            "sonar_only must be a list of {name, rectangle | polygon} (glass walls, low tables), got " + Reader::kind(glass));
+    return;
+  }
+  std::set<std::string> names;
+  for (const auto& item : glass) {
+    if (!r.check_map(item, "a sonar_only entry", {"name", "rectangle", "polygon"})) continue;
+    SonarOnlyObstacle o;
+    o.where = r.at(item);
+    r.text(item, "name", o.name, "sonar_only entry");
+    if (o.name.empty()) o.name = "sonar_only " + std::to_string(w.sonar_only.size() + 1);
+    if (!names.insert(o.name).second) r.error(item["name"] ? item["name"] : item, "duplicate sonar_only name '" + o.name + "'");
+    if (!item["rectangle"] && !item["polygon"]) {
+      r.error(item, "sonar_only '" + o.name + "' needs rectangle: [x_min, y_min, x_max, y_max] or polygon: [[x, y], ...]");
+      continue;
+    }
+    if (auto s = r.shape(item, "sonar_only '" + o.name + "'")) {
+      o.polygon = std::move(*s);
+      w.sonar_only.push_back(std::move(o));
+    }
+  }
+}
+
+void read_obstacles(Reader& r, const YAML::Node& obs, World& w) {
+  if (!obs.IsSequence()) {
+    r.error(obs, "obstacles must be a list of {name, rectangle | polygon, appear_s, disappear_s}, got " + Reader::kind(obs));
+    return;
+  }
+  std::set<std::string> names;
+  for (const auto& item : obs) {
+    if (!r.check_map(item, "an obstacles entry", {"name", "rectangle", "polygon", "appear_s", "disappear_s"})) continue;
+    DynamicObstacle o;
+    o.where = r.at(item);
+    r.text(item, "name", o.name, "obstacles entry");
+    if (o.name.empty()) o.name = "obstacle " + std::to_string(w.obstacles.size() + 1);
+    if (!names.insert(o.name).second) r.error(item["name"] ? item["name"] : item, "duplicate obstacle name '" + o.name + "'");
+    auto s = r.shape(item, "obstacle '" + o.name + "'");
+    if (!s && !item["rectangle"] && !item["polygon"]) {
+      r.error(item, "obstacle '" + o.name + "' needs rectangle: [x_min, y_min, x_max, y_max] or polygon: [[x, y], ...]");
+    }
+    double appear = 0.0;
+    if (const YAML::Node a = item["appear_s"]) {
+      if (auto v = r.number(a, "appear_s")) {
+        if (*v < 0.0) r.error(a, "appear_s must be >= 0, got " + a.Scalar());
+        appear = *v;
+      }
+    }
+    o.appear = time_from_seconds(appear);
+    if (const YAML::Node dis = item["disappear_s"]) {
+      if (auto v = r.number(dis, "disappear_s")) {
+        if (*v <= appear) {
+          r.error(dis, "disappear_s must be later than appear_s (" + std::to_string(appear) + "), got " + dis.Scalar());
+        }
+        o.disappear = time_from_seconds(*v);
+      }
+    }
+    if (s) {
+      o.polygon = std::move(*s);
+      w.obstacles.push_back(std::move(o));
+    }
+  }
+}
+
+// A visitor walks only where the map is open: its waypoints and the legs between them, sampled
+// every 5 cm, must leave its disc clear of the static map.
+void check_visitor_paths(Reader& r, const SolidMap& solid, const World& w) {
+  for (const Visitor& v : w.visitors) {
+    const std::size_t n = v.path.size();
+    const std::size_t legs = n == 1 ? 1 : (v.loop ? n : n - 1);
+    for (std::size_t i = 0; i < legs; ++i) {
+      const navi::Point2D a = v.path[i], b = v.path[(i + 1) % n];
+      const double len = std::hypot(b.x_m - a.x_m, b.y_m - a.y_m);
+      const int samples = std::max(1, static_cast<int>(std::ceil(len / 0.05)));
+      for (int k = 0; k <= samples; ++k) {
+        const double f = static_cast<double>(k) / samples;
+        const navi::Point2D p{a.x_m + f * (b.x_m - a.x_m), a.y_m + f * (b.y_m - a.y_m)};
+        if (solid.disc_overlaps(p, v.radius_m)) {
+          r.diagnostics().error(v.where, fmt::format("visitor '{}': at ({:.2f}, {:.2f}), on its path from waypoint {} to {}, its "
+                                                     "disc (radius {} m) overlaps an occupied cell or leaves the map",
+                                                     v.name, p.x_m, p.y_m, i + 1, (i + 1) % n + 1, v.radius_m));
+          k = samples + 1;
+          i = legs;
+        }
+      }
+    }
+  }
+}
+
+// Where the world puts the robot (its start, kidnappings, docks) and the visitors, against the map.
+void check_on_the_map(Reader& r, const YAML::Node& start, const World& w) {
+  const SolidMap solid(w.grid);
+  const navi::CellIndex c = w.grid.cell_at({w.start_pose.x_m, w.start_pose.y_m});
+  if (!w.grid.contains(c)) {
+    r.error(start, "start_pose is outside the map");
+  } else if (!w.grid.is_free(c)) {
+    r.error(start, "start_pose is not on a free cell of the map");
+  } else if (solid.disc_overlaps({w.start_pose.x_m, w.start_pose.y_m}, w.robot.radius_m)) {
+    r.error(start, "at start_pose the robot's footprint (radius " + std::to_string(w.robot.radius_m) +
+                       " m) overlaps an occupied cell or leaves the map");
+  }
+  check_visitor_paths(r, solid, w);
+  for (const StuckCliffSensor& st : w.faults.stuck_cliff) {
+    if (st.index >= w.robot.cliff.positions.size()) {
+      r.diagnostics().error(
+          st.where, fmt::format("stuck_cliff.index {} names no cliff sensor: the robot has {} (robot.cliff.positions)", st.index,
+                                w.robot.cliff.positions.size()));
+    }
+  }
+  // A glass pane over the start: the robot would start inside it.
+  const navi::Point2D start_point{w.start_pose.x_m, w.start_pose.y_m};
+  for (const SonarOnlyObstacle& o : w.sonar_only) {
+    if (navi::Region{o.name, o.polygon, o.where}.contains(start_point)) {
+      r.diagnostics().error(o.where, "sonar_only '" + o.name + "' covers start_pose: the robot would start inside it");
+    }
+  }
+  for (const Kidnapping& k : w.faults.kidnappings) {
+    if (solid.disc_overlaps({k.to.x_m, k.to.y_m}, w.robot.radius_m)) {
+      r.diagnostics().error(k.where, "kidnap.to: there the robot's footprint (radius " + std::to_string(w.robot.radius_m) +
+                                         " m) overlaps an occupied cell or leaves the map");
+    }
+  }
+  for (const Dock& k : w.docks) {
+    if (solid.disc_overlaps({k.pose.x_m, k.pose.y_m}, w.robot.radius_m)) {
+      r.diagnostics().error(k.where, "dock '" + k.name + "': docked there, the robot's footprint (radius " +
+                                         std::to_string(w.robot.radius_m) + " m) overlaps an occupied cell or leaves the map");
+    }
+  }
+}
+
+World walk_world(std::string_view text, const std::filesystem::path& file) {
+  const std::string fname = file.string();
+  const YAML::Node root = yaml::parse(text, fname);
+  Reader r(fname);
+  World w;
+  w.file = file;
+  if (!r.check_map(
+          root, "the world file",
+          {"map", "regions", "start_pose", "seed", "robot", "drops", "obstacles", "visitors", "docks", "faults", "sonar_only"})) {
+    throw ConfigError(std::move(r.diagnostics()));
+  }
+  const bool have_map = read_map_and_regions(r, root, file.parent_path(), w);
   const YAML::Node start = root["start_pose"];
   if (start) {
     if (auto p = r.pose(start, "start_pose")) w.start_pose = *p;
@@ -641,176 +827,13 @@ World walk_world(std::string_view text, const std::filesystem::path& file) {
     }
   }
   if (const YAML::Node rb = root["robot"]) read_robot(r, rb, w.robot);
-
-  if (const YAML::Node drops = root["drops"]) {
-    if (!drops.IsSequence()) {
-      r.error(drops, "drops must be a list of {name, rectangle | polygon | region}, got " + Reader::kind(drops));
-    } else {
-      for (const auto& item : drops) {
-        if (!r.check_map(item, "a drops entry", {"name", "rectangle", "polygon", "region", "depth_m"})) continue;
-        DropArea a;
-        a.where = r.at(item);
-        r.text(item, "name", a.name, "drops entry");
-        if (const YAML::Node depth = item["depth_m"]) {
-          if (auto v = r.number(depth, "drops entry depth_m")) {
-            if (!(*v > 0.0)) r.error(depth, "drops entry depth_m must be > 0 (how far the floor falls), got " + depth.Scalar());
-            a.depth_m = *v;
-          }
-        }
-        const YAML::Node region = item["region"];
-        const int given = (item["rectangle"] ? 1 : 0) + (item["polygon"] ? 1 : 0) + (region ? 1 : 0);
-        if (given != 1) {
-          r.error(item, "a drops entry needs exactly one of rectangle, polygon or region (a room of the regions file)");
-          continue;
-        }
-        if (region) {
-          const navi::Region* room = region.IsScalar() ? w.regions.room(region.Scalar()) : nullptr;
-          if (room == nullptr) {
-            r.error(region, "unknown region " + Reader::kind(region) + (w.regions_file.empty() ? " (the world names no regions file)" : ""));
-            continue;
-          }
-          a.polygon = room->polygon;
-          if (a.name.empty()) a.name = room->name;
-        } else if (auto s = r.shape(item, "drops entry")) {
-          a.polygon = std::move(*s);
-        } else {
-          continue;
-        }
-        w.drops.push_back(std::move(a));
-      }
-    }
-  }
-
-  if (const YAML::Node glass = root["sonar_only"]) {
-    if (!glass.IsSequence()) {
-      r.error(glass,
-              "sonar_only must be a list of {name, rectangle | polygon} (glass walls, low tables), got " + Reader::kind(glass));
-    } else {
-      std::set<std::string> names;
-      for (const auto& item : glass) {
-        if (!r.check_map(item, "a sonar_only entry", {"name", "rectangle", "polygon"})) continue;
-        SonarOnlyObstacle o;
-        o.where = r.at(item);
-        r.text(item, "name", o.name, "sonar_only entry");
-        if (o.name.empty()) o.name = "sonar_only " + std::to_string(w.sonar_only.size() + 1);
-        if (!names.insert(o.name).second)
-          r.error(item["name"] ? item["name"] : item, "duplicate sonar_only name '" + o.name + "'");
-        if (!item["rectangle"] && !item["polygon"]) {
-          r.error(item, "sonar_only '" + o.name + "' needs rectangle: [x_min, y_min, x_max, y_max] or polygon: [[x, y], ...]");
-          continue;
-        }
-        if (auto s = r.shape(item, "sonar_only '" + o.name + "'")) {
-          o.polygon = std::move(*s);
-          w.sonar_only.push_back(std::move(o));
-        }
-      }
-    }
-  }
-
-  if (const YAML::Node obs = root["obstacles"]) {
-    if (!obs.IsSequence()) {
-      r.error(obs, "obstacles must be a list of {name, rectangle | polygon, appear_s, disappear_s}, got " + Reader::kind(obs));
-    } else {
-      std::set<std::string> names;
-      for (const auto& item : obs) {
-        if (!r.check_map(item, "an obstacles entry", {"name", "rectangle", "polygon", "appear_s", "disappear_s"})) continue;
-        DynamicObstacle o;
-        o.where = r.at(item);
-        r.text(item, "name", o.name, "obstacles entry");
-        if (o.name.empty()) o.name = "obstacle " + std::to_string(w.obstacles.size() + 1);
-        if (!names.insert(o.name).second) r.error(item["name"] ? item["name"] : item, "duplicate obstacle name '" + o.name + "'");
-        auto s = r.shape(item, "obstacle '" + o.name + "'");
-        if (!s && !item["rectangle"] && !item["polygon"]) {
-          r.error(item, "obstacle '" + o.name + "' needs rectangle: [x_min, y_min, x_max, y_max] or polygon: [[x, y], ...]");
-        }
-        double appear = 0.0;
-        if (const YAML::Node a = item["appear_s"]) {
-          if (auto v = r.number(a, "appear_s")) {
-            if (*v < 0.0) r.error(a, "appear_s must be >= 0, got " + a.Scalar());
-            appear = *v;
-          }
-        }
-        o.appear = time_from_seconds(appear);
-        if (const YAML::Node dis = item["disappear_s"]) {
-          if (auto v = r.number(dis, "disappear_s")) {
-            if (*v <= appear) {
-              r.error(dis, "disappear_s must be later than appear_s (" + std::to_string(appear) + "), got " + dis.Scalar());
-            }
-            o.disappear = time_from_seconds(*v);
-          }
-        }
-        if (s) {
-          o.polygon = std::move(*s);
-          w.obstacles.push_back(std::move(o));
-        }
-      }
-    }
-  }
-
+  if (const YAML::Node drops = root["drops"]) read_drops(r, drops, w);
+  if (const YAML::Node glass = root["sonar_only"]) read_sonar_only(r, glass, w);
+  if (const YAML::Node obs = root["obstacles"]) read_obstacles(r, obs, w);
   if (const YAML::Node docks = root["docks"]) read_docks(r, docks, w);
   if (const YAML::Node f = root["faults"]) read_faults(r, f, w.faults);
   if (const YAML::Node v = root["visitors"]) read_visitors(r, v, w.visitors);
-
-  if (have_map && start && !r.diagnostics().has_errors()) {
-    const SolidMap solid(w.grid);
-    const navi::CellIndex c = w.grid.cell_at({w.start_pose.x_m, w.start_pose.y_m});
-    if (!w.grid.contains(c)) {
-      r.error(start, "start_pose is outside the map");
-    } else if (!w.grid.is_free(c)) {
-      r.error(start, "start_pose is not on a free cell of the map");
-    } else if (solid.disc_overlaps({w.start_pose.x_m, w.start_pose.y_m}, w.robot.radius_m)) {
-      r.error(start, "at start_pose the robot's footprint (radius " + std::to_string(w.robot.radius_m) +
-                         " m) overlaps an occupied cell or leaves the map");
-    }
-    // A visitor walks only where the map is open: its waypoints and the legs between them, sampled
-    // every 5 cm, must leave its disc clear of the static map.
-    for (const Visitor& v : w.visitors) {
-      const std::size_t n = v.path.size();
-      const std::size_t legs = n == 1 ? 1 : (v.loop ? n : n - 1);
-      for (std::size_t i = 0; i < legs; ++i) {
-        const navi::Point2D a = v.path[i], b = v.path[(i + 1) % n];
-        const double len = std::hypot(b.x_m - a.x_m, b.y_m - a.y_m);
-        const int samples = std::max(1, static_cast<int>(std::ceil(len / 0.05)));
-        for (int k = 0; k <= samples; ++k) {
-          const double f = static_cast<double>(k) / samples;
-          const navi::Point2D p{a.x_m + f * (b.x_m - a.x_m), a.y_m + f * (b.y_m - a.y_m)};
-          if (solid.disc_overlaps(p, v.radius_m)) {
-            r.diagnostics().error(v.where, fmt::format("visitor '{}': at ({:.2f}, {:.2f}), on its path from waypoint {} to {}, its "
-                                                       "disc (radius {} m) overlaps an occupied cell or leaves the map",
-                                                       v.name, p.x_m, p.y_m, i + 1, (i + 1) % n + 1, v.radius_m));
-            k = samples + 1;
-            i = legs;
-          }
-        }
-      }
-    }
-    for (const StuckCliffSensor& st : w.faults.stuck_cliff) {
-      if (st.index >= w.robot.cliff.positions.size()) {
-        r.diagnostics().error(st.where,
-                              fmt::format("stuck_cliff.index {} names no cliff sensor: the robot has {} (robot.cliff.positions)",
-                                          st.index, w.robot.cliff.positions.size()));
-      }
-    }
-    // A glass pane over the start: the robot would start inside it.
-    const navi::Point2D start_point{w.start_pose.x_m, w.start_pose.y_m};
-    for (const SonarOnlyObstacle& o : w.sonar_only) {
-      if (navi::Region{o.name, o.polygon, o.where}.contains(start_point)) {
-        r.diagnostics().error(o.where, "sonar_only '" + o.name + "' covers start_pose: the robot would start inside it");
-      }
-    }
-    for (const Kidnapping& k : w.faults.kidnappings) {
-      if (solid.disc_overlaps({k.to.x_m, k.to.y_m}, w.robot.radius_m)) {
-        r.diagnostics().error(k.where, "kidnap.to: there the robot's footprint (radius " + std::to_string(w.robot.radius_m) +
-                                           " m) overlaps an occupied cell or leaves the map");
-      }
-    }
-    for (const Dock& k : w.docks) {
-      if (solid.disc_overlaps({k.pose.x_m, k.pose.y_m}, w.robot.radius_m)) {
-        r.diagnostics().error(k.where, "dock '" + k.name + "': docked there, the robot's footprint (radius " +
-                                           std::to_string(w.robot.radius_m) + " m) overlaps an occupied cell or leaves the map");
-      }
-    }
-  }
+  if (have_map && start && !r.diagnostics().has_errors()) check_on_the_map(r, start, w);
   if (r.diagnostics().has_errors()) throw ConfigError(std::move(r.diagnostics()));
   return w;
 }

@@ -1,5 +1,6 @@
 // The pieces of `tripodal run` that are not the robot: the PNG encoder (decoded back with zlib),
 // the path figures of the report, the report's JSON, and the run's refusals of bad input.
+#include <unistd.h>
 #include <zlib.h>
 
 #include <catch2/catch.hpp>
@@ -9,10 +10,12 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
-#include <unistd.h>
 
-#include "run_task.hpp"
 #include "png.hpp"
+#include "run_task.hpp"
+#include "shutdown.hpp"
+#include "tripodal/controllers/differential_drive_controller.hpp"
+#include "tripodal/controllers/ideal_hardware.hpp"
 #include "tripodal/core/diagnostic.hpp"
 
 using namespace tripodal;
@@ -48,6 +51,42 @@ std::vector<Chunk> chunks(const std::string& png) {
 }
 
 const std::filesystem::path kSource = TRIPODAL_SOURCE_DIR;
+
+// A clock whose sleep moves it to the deadline at once: braking on it takes no wall time.
+class SteppingClock final : public Clock {
+ public:
+  [[nodiscard]] Time now() const noexcept override { return now_; }
+  void sleep_until(Time deadline) const noexcept override { now_ = std::max(now_, deadline); }
+
+ private:
+  mutable Time now_{};
+};
+
+// A differential base (Jinny's wheels) braking at 2 m/s^2, driven at 0.5 m/s as the behavior
+// loop left it when its thread stopped.
+struct MovingBase {
+  ControllerConfig config = [] {
+    ControllerConfig c;
+    c.name = "base";
+    c.type = "differential";
+    c.period = std::chrono::milliseconds(10);
+    c.differential = {0.4, 0.1};
+    c.limits.vx.max_acceleration = 1.0;
+    c.limits.vx.max_deceleration = 2.0;
+    return c;
+  }();
+  IdealWheelHardware wheels{2, config.period};
+  DifferentialDriveController controller{config, wheels};
+  SteppingClock clock;
+
+  MovingBase() {
+    for (int k = 0; k < 100; ++k) {
+      controller.set_command({0.5, 0.0, 0.0}, clock.now());
+      (void)controller.update(clock.now());
+      clock.sleep_until(clock.now() + config.period);
+    }
+  }
+};
 
 }  // namespace
 
@@ -268,4 +307,30 @@ TEST_CASE("run_task: a run without a task writes a valid map and report, a signa
   CHECK(interrupted["stopped_by"] == "interrupted by SIGTERM");
   CHECK(interrupted["base_at_rest"] == true);
   std::filesystem::remove_all(out);
+}
+
+TEST_CASE("stop: after the threads, the base brakes to zero through its controller's limits", "[app][shutdown]") {
+  // Before, the wheels were written zero at once beside the controller: the hardware held 0 while
+  // the controller still said 0.5 m/s (limited_command, wheel_commands), and a tall robot could tip.
+  MovingBase base;
+  REQUIRE(base.controller.limited_command().vx_m_s == Approx(0.5));
+  REQUIRE(base.wheels.commands()[0] == Approx(5.0));  // 0.5 m/s on 0.1 m wheels
+  const Time from = base.clock.now();
+  const std::size_t writes = base.wheels.writes();
+  int periods = 0;
+  CHECK(brake_through_controller(base.controller, base.clock, std::chrono::seconds(3), [&](Time) { ++periods; }));
+  for (const double w : base.wheels.commands()) CHECK(w == 0.0);
+  for (const double w : base.controller.wheel_commands()) CHECK(w == 0.0);
+  CHECK(base.controller.limited_command().vx_m_s == 0.0);
+  // 0.5 m/s at 2 m/s^2: 0.25 s, one write per 10 ms period, not one write of zeros.
+  CHECK(to_seconds(base.clock.now() - from) == Approx(0.25).margin(0.011));
+  CHECK(base.wheels.writes() - writes >= 25);
+  CHECK(periods >= 25);
+}
+
+TEST_CASE("stop: a brake cut short by its limit says the base is not at rest", "[app][shutdown]") {
+  MovingBase base;
+  CHECK_FALSE(brake_through_controller(base.controller, base.clock, std::chrono::milliseconds(100)));
+  CHECK(base.controller.limited_command().vx_m_s == Approx(0.3).margin(0.021));  // 0.5 - 2 * 0.1
+  CHECK(base.wheels.commands()[0] > 0.0);
 }

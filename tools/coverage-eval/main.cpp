@@ -346,7 +346,8 @@ void export_world(const fs::path& dir, const std::string& name, const OccupancyG
   if (!world) throw std::runtime_error((dir / (name + ".yaml")).string() + ": cannot write");
 }
 
-int run(int argc, char** argv) {
+// The command line: which floor plans, which patterns, what to write and what to expect.
+struct EvalArgs {
   std::string ipa, workspace, pictures, rooms, worlds;
   bool segment_only = false, no_touch_up = false;
   std::vector<std::string> pattern_names;
@@ -354,18 +355,25 @@ int run(int argc, char** argv) {
   bool verbose = false;
   int random_rooms = 0;
   CoverageOptions o;
-  o.cleaning_width_m = 0.64;
-  o.robot_radius_m = 0.3;
-  CLI::App app{
-      "Evaluates the coverage patterns (hybrid, balloon, boustrophedon, distance_transform) on floor plans: the ipa maps,\n"
-      "a map_server map, or seeded random rooms (docs/coverage.md).\n"};
-  app.add_option("--ipa", ipa, "DIR: the ipa floor plans (NAME.png + NAME_gt_segmentation.png), e.g. ../shared/data/ipa-maps")
+
+  EvalArgs() {
+    o.cleaning_width_m = 0.64;
+    o.robot_radius_m = 0.3;
+  }
+  [[nodiscard]] bool wanted(Pattern p) const {
+    return pattern_names.empty() || std::find(pattern_names.begin(), pattern_names.end(), name_of(p)) != pattern_names.end();
+  }
+};
+
+void add_options(CLI::App& app, EvalArgs& a) {
+  CoverageOptions& o = a.o;
+  app.add_option("--ipa", a.ipa, "DIR: the ipa floor plans (NAME.png + NAME_gt_segmentation.png), e.g. ../shared/data/ipa-maps")
       ->check(CLI::ExistingDirectory);
-  app.add_option("--workspace", workspace, "MAP.yaml: a map_server map (e.g. configs/worlds/workspace_map.yaml)")
+  app.add_option("--workspace", a.workspace, "MAP.yaml: a map_server map (e.g. configs/worlds/workspace_map.yaml)")
       ->check(CLI::ExistingFile);
-  app.add_option("--random", random_rooms, "N: N seeded random rooms (seeds 1..N)")->check(cli::positive_count());
-  app.add_option("--pictures", pictures, "DIR: the paths per map and pattern as PNG pictures")->check(cli::writable_folder());
-  app.add_flag("--verbose", verbose, "per-section figures (ipa maps: worst excess over the bound first)");
+  app.add_option("--random", a.random_rooms, "N: N seeded random rooms (seeds 1..N)")->check(cli::positive_count());
+  app.add_option("--pictures", a.pictures, "DIR: the paths per map and pattern as PNG pictures")->check(cli::writable_folder());
+  app.add_flag("--verbose", a.verbose, "per-section figures (ipa maps: worst excess over the bound first)");
   app.add_option("--width", o.cleaning_width_m, "M: cleaning width (PSR-2's)")
       ->check(cli::positive_number())
       ->capture_default_str();
@@ -376,161 +384,196 @@ int run(int argc, char** argv) {
   app.add_option("--link-margin", o.link_margin_m,
                  "M: CoverageOptions::link_margin_m (the clearance links keep beyond the robot radius)")
       ->check(cli::non_negative_number());
-  app.add_option("--export-worlds", worlds,
+  app.add_option("--export-worlds", a.worlds,
                  "DIR: with --ipa, write a simulator world per plan (NAME.yaml, its map and one room NAME) and plan nothing")
       ->check(cli::writable_folder());
-  app.add_flag("--no-touch-up", no_touch_up, "plan without the touch-up (CoverageOptions::touch_up off): what the passes leave");
-  app.add_option("--rooms", rooms,
+  app.add_flag("--no-touch-up", a.no_touch_up,
+               "plan without the touch-up (CoverageOptions::touch_up off): what the passes leave");
+  app.add_option("--rooms", a.rooms,
                  "METHOD: cover the rooms of a room segmentation (morphological, distance_transform, voronoi) instead of the "
                  "section splitter's sections")
       ->check(CLI::IsMember({"morphological", "distance_transform", "voronoi"}));
-  app.add_flag("--segment-only", segment_only, "with --ipa: only the room segmentation's precision and recall, no coverage");
-  app.add_option("--pattern", pattern_names,
+  app.add_flag("--segment-only", a.segment_only, "with --ipa: only the room segmentation's precision and recall, no coverage");
+  app.add_option("--pattern", a.pattern_names,
                  "NAME: only this pattern (repeatable): balloon, boustrophedon, hybrid, distance_transform")
       ->check(CLI::IsMember({"balloon", "boustrophedon", "hybrid", "distance_transform"}));
-  app.add_option("--expect-precision", expect_precision, "P: with --ipa, exit 1 unless the mean room precision is at least P")
+  app.add_option("--expect-precision", a.expect_precision, "P: with --ipa, exit 1 unless the mean room precision is at least P")
       ->check(CLI::Range(0.0, 1.0));
-  app.add_option("--expect-recall", expect_recall, "R: with --ipa, exit 1 unless the mean room recall is at least R")
+  app.add_option("--expect-recall", a.expect_recall, "R: with --ipa, exit 1 unless the mean room recall is at least R")
       ->check(CLI::Range(0.0, 1.0));
-  app.add_option("--expect-bound", expect_bound,
+  app.add_option("--expect-bound", a.expect_bound,
                  "X: with --ipa, exit 1 unless the hybrid's mean length / bound over the maps is at most X")
       ->check(cli::positive_number());
-  app.add_option("--expect-worst-bound", expect_worst_bound,
+  app.add_option("--expect-worst-bound", a.expect_worst_bound,
                  "X: with --ipa, exit 1 unless the hybrid's length / bound is at most X on every map")
       ->check(cli::positive_number());
+}
+
+// --workspace: every wanted pattern on one map_server map.
+void eval_workspace(const EvalArgs& a) {
+  const CoverageOptions& o = a.o;
+  const MapFile m = load_map(a.workspace);
+  const SectionSet sections = split(m.grid, a.rooms).sections;
+  header(false);
+  for (const Pattern p : kPatterns) {
+    if (!a.wanted(p)) continue;
+    std::vector<CoverageResult> results;
+    print_row(fs::path(a.workspace).stem().string(), p, cover(m.grid, sections, p, o, &results), o.cleaning_width_m);
+    if (!a.pictures.empty()) {
+      fs::create_directories(a.pictures);
+      write_picture(fs::path(a.pictures) / (std::string(name_of(p)) + ".png"), m.grid, sections, results, o.cleaning_width_m);
+    }
+    if (a.verbose) {
+      for (const CoverageResult& r : results) {
+        std::printf("    %.1f m, %zu turns, %zu passes, %zu touch-ups\n", r.stats.length_m, r.stats.turns, r.passes, r.touch_ups);
+      }
+    }
+  }
+  std::printf("\n");
+}
+
+// The ipa floor plans in `dir` (NAME.png beside NAME_gt_segmentation.png), by name.
+std::vector<std::string> ipa_names(const std::string& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string f = e.path().filename().string();
+    const std::string suffix = "_gt_segmentation.png";
+    if (f.size() > suffix.size() && f.ends_with(suffix)) names.push_back(f.substr(0, f.size() - suffix.size()));
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// One ipa plan: its world exported, or its segmentation scored and every wanted pattern run on
+// it (the hybrid's length / bound kept).
+void eval_ipa_map(const EvalArgs& a, const std::string& name, std::vector<Score>& scores, std::vector<double>& hybrid_ratio) {
+  const CoverageOptions& o = a.o;
+  const Gray plan = read_png(fs::path(a.ipa) / (name + ".png"));
+  const Gray truth = read_png(fs::path(a.ipa) / (name + "_gt_segmentation.png"));
+  const OccupancyGrid grid = grid_of(plan, 0.05);
+  if (!a.worlds.empty()) {
+    export_world(a.worlds, name, grid);
+    std::printf("%s: %s\n", name.c_str(), (fs::path(a.worlds) / (name + ".yaml")).c_str());
+    return;
+  }
+  const Split cut = split(grid, a.rooms);
+  const SectionSet& sections = cut.sections;
+  int truth_rooms = 0;
+  const std::vector<int> gt = rooms_of(truth, 400, truth_rooms);  // rooms of at least 1 m2
+  char ms[32];
+  std::snprintf(ms, sizeof ms, " %.1f |", cut.ms);
+  Score score;
+  const bool comparable = truth.width == plan.width && truth.height == plan.height;
+  const std::string seg = (comparable ? segmentation(sections, gt, truth_rooms, &score) : " - | - | - | - |") + ms;
+  if (comparable) scores.push_back(score);
+  if (a.segment_only) {
+    std::printf("| %s | %s |%s\n", name.c_str(), a.rooms.empty() ? "splitter" : a.rooms.c_str(), seg.c_str());
+    return;
+  }
+  for (const Pattern p : kPatterns) {
+    if (!a.wanted(p)) continue;
+    std::vector<CoverageResult> results;
+    const Figures f = cover(grid, sections, p, o, &results);
+    add(p, f);
+    if (!a.pictures.empty()) {
+      fs::create_directories(a.pictures);
+      write_picture(fs::path(a.pictures) / (name + "_" + name_of(p) + ".png"), grid, sections, results, o.cleaning_width_m);
+    }
+    if (a.verbose) print_sections(results, grid.resolution_m(), o.cleaning_width_m);
+    print_row(name, p, f, o.cleaning_width_m, seg);
+    if (p == Pattern::hybrid && f.reachable_m2 > 0) hybrid_ratio.push_back(f.length_m / (f.reachable_m2 / o.cleaning_width_m));
+  }
+}
+
+// The means over the ipa maps, and what falls short of the expectations (a test over the ipa
+// set: tests/app, tripodal_coverage_eval_ipa:*), one line each.
+std::string ipa_expectations(const EvalArgs& a, const std::vector<Score>& scores, const std::vector<double>& hybrid_ratio) {
+  auto mean = [](const std::vector<double>& v) {
+    return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+  };
+  std::vector<double> precision, recall;
+  for (const Score& sc : scores) precision.push_back(sc.precision), recall.push_back(sc.recall);
+  std::printf("\nmean over %zu maps: precision %.3f, recall %.3f", scores.size(), mean(precision), mean(recall));
+  if (!hybrid_ratio.empty()) {
+    std::printf(", hybrid length / bound %.3f (worst %.3f)", mean(hybrid_ratio),
+                *std::max_element(hybrid_ratio.begin(), hybrid_ratio.end()));
+  }
+  std::printf("\n");
+  std::string failures;
+  if (a.expect_precision >= 0 && mean(precision) < a.expect_precision)
+    failures += "mean precision below the expected " + std::to_string(a.expect_precision) + "\n";
+  if (a.expect_recall >= 0 && mean(recall) < a.expect_recall)
+    failures += "mean recall below the expected " + std::to_string(a.expect_recall) + "\n";
+  if ((a.expect_bound > 0 || a.expect_worst_bound > 0) && hybrid_ratio.empty())
+    failures += "no hybrid figures to check (--pattern hybrid)\n";
+  if (a.expect_bound > 0 && !hybrid_ratio.empty() && mean(hybrid_ratio) > a.expect_bound) {
+    failures += "mean hybrid length / bound above the expected " + std::to_string(a.expect_bound) + "\n";
+  }
+  if (a.expect_worst_bound > 0 && !hybrid_ratio.empty() &&
+      *std::max_element(hybrid_ratio.begin(), hybrid_ratio.end()) > a.expect_worst_bound) {
+    failures += "worst hybrid length / bound above the expected " + std::to_string(a.expect_worst_bound) + "\n";
+  }
+  return failures;
+}
+
+// --ipa: every plan, then the means and the totals; adds what falls short to `failures`. False
+// when it only exported worlds (the run ends there).
+bool eval_ipa(const EvalArgs& a, std::string& failures) {
+  const std::vector<std::string> names = ipa_names(a.ipa);
+  header(true);
+  std::vector<Score> scores;
+  std::vector<double> hybrid_ratio;
+  for (const std::string& name : names) eval_ipa_map(a, name, scores, hybrid_ratio);
+  if (!a.worlds.empty()) return false;
+  failures += ipa_expectations(a, scores, hybrid_ratio);
+  if (!a.segment_only) {
+    for (const Pattern p : kPatterns) {
+      if (a.wanted(p)) print_row("all ipa maps", p, totals[p], a.o.cleaning_width_m);
+    }
+  }
+  totals.clear();
+  std::printf("\n");
+  return true;
+}
+
+// --random N: every wanted pattern over N seeded rooms, in total.
+void eval_random_rooms(const EvalArgs& a) {
+  header(false);
+  for (int s = 1; s <= a.random_rooms; ++s) {
+    const OccupancyGrid grid = random_room(static_cast<unsigned>(s), 0.05);
+    const SectionSet sections = CSectionSplitter().split(grid);
+    for (const Pattern p : kPatterns) {
+      if (a.wanted(p)) add(p, cover(grid, sections, p, a.o));
+    }
+  }
+  for (const Pattern p : kPatterns) {
+    if (a.wanted(p)) print_row(std::to_string(a.random_rooms) + " random rooms", p, totals[p], a.o.cleaning_width_m);
+  }
+}
+
+int run(int argc, char** argv) {
+  EvalArgs a;
+  CLI::App app{
+      "Evaluates the coverage patterns (hybrid, balloon, boustrophedon, distance_transform) on floor plans: the ipa maps,\n"
+      "a map_server map, or seeded random rooms (docs/coverage.md).\n"};
+  add_options(app, a);
   if (auto code =
           cli::parse_command_line(app, "tripodal-coverage-eval",
                                   "exit codes: 0 ok, 1 a map could not be read or covered, 2 bad command line", argc, argv)) {
     return *code;
   }
-  if (ipa.empty() && workspace.empty() && random_rooms <= 0) {
+  if (a.ipa.empty() && a.workspace.empty() && a.random_rooms <= 0) {
     std::cerr << "tripodal-coverage-eval: give --ipa DIR, --workspace MAP.yaml or --random N\nrun "
                  "'tripodal-coverage-eval --help' for the usage\n";
     return cli::kUsage;
   }
-  o.touch_up = !no_touch_up;
-  if (!worlds.empty()) segment_only = true;  // the worlds only, no plan
-  const auto wanted = [&](Pattern p) {
-    return pattern_names.empty() || std::find(pattern_names.begin(), pattern_names.end(), name_of(p)) != pattern_names.end();
-  };
+  a.o.touch_up = !a.no_touch_up;
+  if (!a.worlds.empty()) a.segment_only = true;  // the worlds only, no plan
   std::string failures;
   try {
-    if (!workspace.empty()) {
-      const MapFile m = load_map(workspace);
-      const SectionSet sections = split(m.grid, rooms).sections;
-      header(false);
-      for (const Pattern p : kPatterns) {
-        if (!wanted(p)) continue;
-        std::vector<CoverageResult> results;
-        print_row(fs::path(workspace).stem().string(), p, cover(m.grid, sections, p, o, &results), o.cleaning_width_m);
-        if (!pictures.empty()) {
-          fs::create_directories(pictures);
-          write_picture(fs::path(pictures) / (std::string(name_of(p)) + ".png"), m.grid, sections, results, o.cleaning_width_m);
-        }
-        if (verbose) {
-          for (const CoverageResult& r : results) {
-            std::printf("    %.1f m, %zu turns, %zu passes, %zu touch-ups\n", r.stats.length_m, r.stats.turns, r.passes, r.touch_ups);
-          }
-        }
-      }
-      std::printf("\n");
-    }
-    if (!ipa.empty()) {
-      std::vector<std::string> names;
-      for (const auto& e : fs::directory_iterator(ipa)) {
-        const std::string f = e.path().filename().string();
-        const std::string suffix = "_gt_segmentation.png";
-        if (f.size() > suffix.size() && f.ends_with(suffix)) names.push_back(f.substr(0, f.size() - suffix.size()));
-      }
-      std::sort(names.begin(), names.end());
-      header(true);
-      std::vector<Score> scores;
-      std::vector<double> hybrid_ratio;
-      for (const std::string& name : names) {
-        const Gray plan = read_png(fs::path(ipa) / (name + ".png"));
-        const Gray truth = read_png(fs::path(ipa) / (name + "_gt_segmentation.png"));
-        const OccupancyGrid grid = grid_of(plan, 0.05);
-        if (!worlds.empty()) {
-          export_world(worlds, name, grid);
-          std::printf("%s: %s\n", name.c_str(), (fs::path(worlds) / (name + ".yaml")).c_str());
-          continue;
-        }
-        const Split cut = split(grid, rooms);
-        const SectionSet& sections = cut.sections;
-        int truth_rooms = 0;
-        const std::vector<int> gt = rooms_of(truth, 400, truth_rooms);  // rooms of at least 1 m2
-        char ms[32];
-        std::snprintf(ms, sizeof ms, " %.1f |", cut.ms);
-        Score score;
-        const bool comparable = truth.width == plan.width && truth.height == plan.height;
-        const std::string seg = (comparable ? segmentation(sections, gt, truth_rooms, &score) : " - | - | - | - |") + ms;
-        if (comparable) scores.push_back(score);
-        if (segment_only) {
-          std::printf("| %s | %s |%s\n", name.c_str(), rooms.empty() ? "splitter" : rooms.c_str(), seg.c_str());
-          continue;
-        }
-        for (const Pattern p : kPatterns) {
-          if (!wanted(p)) continue;
-          std::vector<CoverageResult> results;
-          const Figures f = cover(grid, sections, p, o, &results);
-          add(p, f);
-          if (!pictures.empty()) {
-            fs::create_directories(pictures);
-            write_picture(fs::path(pictures) / (name + "_" + name_of(p) + ".png"), grid, sections, results, o.cleaning_width_m);
-          }
-          if (verbose) print_sections(results, grid.resolution_m(), o.cleaning_width_m);
-          print_row(name, p, f, o.cleaning_width_m, seg);
-          if (p == Pattern::hybrid && f.reachable_m2 > 0)
-            hybrid_ratio.push_back(f.length_m / (f.reachable_m2 / o.cleaning_width_m));
-        }
-      }
-      // The expectations (a test over the ipa set: tests/app, tripodal_coverage_eval_ipa:*).
-      auto mean = [](const std::vector<double>& v) {
-        return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
-      };
-      std::vector<double> precision, recall;
-      for (const Score& sc : scores) precision.push_back(sc.precision), recall.push_back(sc.recall);
-      if (!worlds.empty()) return 0;
-      std::printf("\nmean over %zu maps: precision %.3f, recall %.3f", scores.size(), mean(precision), mean(recall));
-      if (!hybrid_ratio.empty()) {
-        std::printf(", hybrid length / bound %.3f (worst %.3f)", mean(hybrid_ratio),
-                    *std::max_element(hybrid_ratio.begin(), hybrid_ratio.end()));
-      }
-      std::printf("\n");
-      if (expect_precision >= 0 && mean(precision) < expect_precision)
-        failures += "mean precision below the expected " + std::to_string(expect_precision) + "\n";
-      if (expect_recall >= 0 && mean(recall) < expect_recall)
-        failures += "mean recall below the expected " + std::to_string(expect_recall) + "\n";
-      if ((expect_bound > 0 || expect_worst_bound > 0) && hybrid_ratio.empty())
-        failures += "no hybrid figures to check (--pattern hybrid)\n";
-      if (expect_bound > 0 && !hybrid_ratio.empty() && mean(hybrid_ratio) > expect_bound) {
-        failures += "mean hybrid length / bound above the expected " + std::to_string(expect_bound) + "\n";
-      }
-      if (expect_worst_bound > 0 && !hybrid_ratio.empty() &&
-          *std::max_element(hybrid_ratio.begin(), hybrid_ratio.end()) > expect_worst_bound) {
-        failures += "worst hybrid length / bound above the expected " + std::to_string(expect_worst_bound) + "\n";
-      }
-      if (!segment_only) {
-        for (const Pattern p : kPatterns) {
-          if (wanted(p)) print_row("all ipa maps", p, totals[p], o.cleaning_width_m);
-        }
-      }
-      totals.clear();
-      std::printf("\n");
-    }
-    if (random_rooms > 0) {
-      header(false);
-      for (int s = 1; s <= random_rooms; ++s) {
-        const OccupancyGrid grid = random_room(static_cast<unsigned>(s), 0.05);
-        const SectionSet sections = CSectionSplitter().split(grid);
-        for (const Pattern p : kPatterns) {
-          if (wanted(p)) add(p, cover(grid, sections, p, o));
-        }
-      }
-      for (const Pattern p : kPatterns) {
-        if (wanted(p)) print_row(std::to_string(random_rooms) + " random rooms", p, totals[p], o.cleaning_width_m);
-      }
-    }
+    if (!a.workspace.empty()) eval_workspace(a);
+    if (!a.ipa.empty() && !eval_ipa(a, failures)) return 0;
+    if (a.random_rooms > 0) eval_random_rooms(a);
   } catch (const std::exception& e) {
     std::cerr << "tripodal-coverage-eval: " << e.what() << "\n";
     return 1;

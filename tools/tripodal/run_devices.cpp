@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <iomanip>
 #include <ostream>
@@ -30,6 +29,7 @@ namespace tripodal::app {
 namespace {
 
 constexpr double kSyncWaitS = 5.0;  // wall-clock seconds: a board that has not answered SYNC by then is not there
+constexpr Duration kBrakeMax = std::chrono::seconds(3);  // the devices' time the base may take to brake at the end
 
 std::string json_string(const std::string& s) {
   std::string out = "\"";
@@ -70,12 +70,10 @@ bool runs_on_devices(const RobotProfile& profile) {
   return it != profile.hardware->parameters.end() && !it->second.empty();
 }
 
-RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
-  const SourceLocation& where = profile.hardware->where;
-  const std::string port = profile.hardware->parameters.at("port");
-  const auto lidar_it = profile.hardware->parameters.find("lidar_port");
-  const std::string lidar_port = lidar_it != profile.hardware->parameters.end() ? lidar_it->second : std::string();
-  // What needs a simulator in this process, or a run on simulated time, does not go with devices.
+namespace {
+
+// What needs a simulator in this process, or a run on simulated time, does not go with devices.
+void refuse_simulated_options(const RunOptions& o, const RobotProfile& profile, const std::string& port) {
   const auto refuse = [&](const char* option, const std::string& why) {
     throw ConfigError(SourceLocation{option, 1, 1}, std::string(option) + ": " + why + " (the board is on " + port + ")");
   };
@@ -91,17 +89,27 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
   if (!o.record.empty()) refuse("--record", "records a run on simulated time");
   if (o.monitor) refuse("--monitor", "the monitor paces a run on simulated time; not yet beside devices");
   if (profile.dds) throw ConfigError(profile.dds->where, "dds: a robot on devices runs without DDS here");
+}
 
-  // The world gives the map only: the robot's moves and sensors are the devices'.
-  const sim::World world = sim::load_world(o.world);
+// The world gives the map only: the robot's moves and sensors are the devices'.
+sim::World load_map_world(const std::filesystem::path& file) {
+  sim::World world = sim::load_world(file);
   if (world.map_file.empty())
-    throw ConfigError(SourceLocation{o.world.string(), 1, 1},
+    throw ConfigError(SourceLocation{file.string(), 1, 1},
                       "a robot on devices loads the world's map: the world names no map file");
-  RobotPlugins plugins;
+  return world;
+}
+
+// The built-in types with the real board as the hardware "board", not the simulated one.
+void add_device_plugins(RobotPlugins& plugins, const RobotProfile& profile, const RunOptions& o) {
   register_all(plugins);
-  plugins.hardware = HardwareRegistry{"hardware type"};  // the real board, not the simulated one
+  plugins.hardware = HardwareRegistry{"hardware type"};
   board::register_board_hardware(plugins.hardware);
   (void)load_profile_plugins(profile, plugins, o.plugins);
+}
+
+// The map and regions from the world, the coverage pattern and dose target from the options.
+RobotOptions device_robot_options(const RobotProfile& profile, const sim::World& world, const RunOptions& o) {
   RobotOptions ro;
   for (const ModuleEntry& e : profile.navigation) {
     if (e.type == navi::CGridMaps::static_manifest().name && e.parameters.count("map") == 0) {
@@ -116,6 +124,277 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
     else if (o.uv_target_dose_j_m2)
       ro.parameters.push_back({e.name, "dose_target_j_m2", fmt::format("{}", *o.uv_target_dose_j_m2)});
   }
+  return ro;
+}
+
+board::BoardHardware& board_of(Robot& robot, const SourceLocation& where) {
+  auto* host = dynamic_cast<board::BoardHost*>(robot.hardware());
+  if (host == nullptr) throw ConfigError(where, "hardware 'board' with a port: expected the control board's hardware");
+  return host->board();
+}
+
+// What the run measures on the sequencing thread, after each of its periods: the lifecycle's
+// lines, the board's link as the sequencing layer sees it, the floor cleaned and the path. The
+// main thread reads it once the robot's threads have stopped (but `synced` and `busy`, atomics it
+// polls meanwhile).
+class DeviceMeasures {
+ public:
+  DeviceMeasures(Robot& robot, const Navigation& nav, const LifecycleRecorder& life, DeviceFigures& dev, RunResult& res,
+                 std::ostream* log, const Pose2D& start)
+      : reachable(nav.maps->grid().size(), 0),
+        cleaned(nav.maps->grid()),  // from the localized pose: no ground truth here
+        robot_(robot),
+        nav_(nav),
+        life_(life),
+        dev_(dev),
+        res_(res),
+        log_(log),
+        start_(start),
+        reach_planner_(nav.maps->grid(), navi::PathPlannerOptions{.robot_radius_m = nav.maps->robot_radius_m()}),
+        half_width_(nav.coverage != nullptr ? nav.coverage->footprint_width_m() / 2.0 : 0.0),
+        last_(start) {}
+
+  void after_sequencing(Time now);
+  // The lifecycle's lines not printed yet, but the firings.
+  void print_lifecycle() {
+    for (; printed_ < life_.entries().size(); ++printed_) {
+      const LifecycleEntry& e = life_.entries()[printed_];
+      if (e.text.find(" fire ") == std::string::npos) log(e.time, e.text);
+    }
+  }
+  void log(Time t, const std::string& text) const {
+    if (log_ == nullptr) return;
+    *log_ << std::setw(9) << fixed(to_seconds(t), 1) << " s  " << text << '\n';
+    log_->flush();
+  }
+  [[nodiscard]] const std::string& port() const noexcept { return dev_.port; }
+
+  std::atomic<bool> synced{false}, busy{false};
+  std::vector<char> reachable;
+  navi::CleanedCells cleaned;
+  std::vector<TrajectorySample> traj;
+  std::vector<navi::Point2D> path_all, path_cleaning;
+
+ private:
+  void watch_link(Time now);
+  void measure_room() {
+    room_sections_ = plan_sections(robot_.planner());
+    reachable = reachable_area(nav_, reach_planner_, room_sections_, start_, half_width_);
+    res_.reachable_cells = static_cast<std::size_t>(std::count(reachable.begin(), reachable.end(), char{1}));
+  }
+  [[nodiscard]] bool moving() const {
+    return robot_.behavior_active("BhAutoMove") || robot_.behavior_active("BhCleaningTwoWheel");
+  }
+
+  Robot& robot_;
+  const Navigation& nav_;
+  const LifecycleRecorder& life_;
+  DeviceFigures& dev_;
+  RunResult& res_;
+  std::ostream* log_;
+  Pose2D start_;
+  std::vector<std::string> room_sections_;
+  navi::PathPlanner reach_planner_;
+  double half_width_;
+  bool measured_busy_ = false, was_cleaning_ = false, link_up_ = false;
+  std::uint64_t losses_seen_ = 0;
+  Pose2D last_;
+  Time next_sample_{};
+  std::size_t printed_ = 0;
+};
+
+// The board's link as the sequencing layer sees it (the snapshot of the resource board_link): its
+// first SYNC, each loss and return, and when the task moves again after one.
+void DeviceMeasures::watch_link(Time now) {
+  if (const auto* r = robot_.sequencing_resources().find<board::BoardLinkReading>("board_link");
+      r != nullptr && r->has_reading()) {
+    const board::BoardLinkReading& l = r->latest();
+    if (l.stats.link_losses > losses_seen_) {
+      losses_seen_ = l.stats.link_losses;
+      dev_.outages.push_back({to_seconds(now), -1.0, -1.0});
+      log(now, fmt::format("board: link lost ({} missed, {} port failures so far): the motors stop", l.stats.missed,
+                           l.stats.port_failures));
+      link_up_ = false;
+    } else if (l.synchronised && !link_up_) {
+      link_up_ = true;
+      if (!synced.load(std::memory_order_relaxed)) {
+        dev_.first_sync_s = to_seconds(now);
+        log(now, "board: SYNC answered on " + dev_.port);
+      } else if (!dev_.outages.empty()) {
+        dev_.outages.back().restored_s = to_seconds(now);
+        log(now, fmt::format("board: link restored (SYNC answered again, {} reopens of the port)", l.stats.reopens));
+      }
+      synced.store(true, std::memory_order_release);
+    }
+  }
+  if (!dev_.outages.empty() && dev_.outages.back().restored_s >= 0.0 && dev_.outages.back().resumed_s < 0.0 && moving()) {
+    dev_.outages.back().resumed_s = to_seconds(now);
+    log(now, "board: the task moves again");
+  }
+}
+
+void DeviceMeasures::after_sequencing(Time now) {
+  print_lifecycle();
+  watch_link(now);
+  const bool is_busy = robot_.planner().busy();
+  if (is_busy && !measured_busy_) measure_room();
+  measured_busy_ = is_busy;
+  // The cleaned cells and the path from the localizer's estimate: the true pose is the device
+  // simulator's (or the world's), not this process's.
+  const NavigationData& navi = robot_.navigation();
+  const Pose2D pose = navi.map_from_base;
+  const bool cleaning = robot_.behavior_active("BhCleaningTwoWheel") || robot_.behavior_active("BhCleaning");
+  if (cleaning && navi.localized) {
+    if (was_cleaning_)
+      cleaned.mark_segment({last_.x_m, last_.y_m}, {pose.x_m, pose.y_m}, half_width_);
+    else
+      cleaned.mark_disc({pose.x_m, pose.y_m}, half_width_);
+  }
+  was_cleaning_ = cleaning && navi.localized;
+  last_ = pose;
+  if (now >= next_sample_) {  // 10 Hz trajectory
+    next_sample_ = now + std::chrono::milliseconds(100);
+    traj.push_back({now, pose, pose, navi.localized, cleaning});
+    path_all.push_back({pose.x_m, pose.y_m});
+    if (cleaning) path_cleaning.push_back({pose.x_m, pose.y_m});
+  }
+  busy.store(is_busy, std::memory_order_release);
+}
+
+// The task is given before the threads start (the planner's observers then run on one thread):
+// it waits, standing still, for the board's first SYNC.
+void give_task(const RunOptions& o, Robot& robot, RunResult& res) {
+  if (o.task.empty()) return;
+  const CommandAnswer answer = robot.command(o.task);
+  if (answer.accepted) return;
+  res.state = "refused";
+  res.reason = answer.text;
+  if (o.log != nullptr) *o.log << answer.text << '\n';
+}
+
+// Waits (on the wall clock, the robot on its threads) for the board's first SYNC, then for the
+// task's end, the run's deadline or a signal. A board that does not answer ends the run "failed".
+void await_end(const RunOptions& o, Robot& robot, board::BoardHardware& hw, const ScaledClock& clock, const SteadyClock& wall,
+               Time task_start, const DeviceMeasures& m, RunResult& res) {
+  const auto stopped = [&] { return o.stop != nullptr && *o.stop != 0; };
+  const auto wait = [&] { wall.sleep_until(wall.now() + std::chrono::milliseconds(10)); };
+  const Time sync_by = clock.now() + from_seconds(kSyncWaitS * res.realtime_speed);
+  while (!m.synced.load(std::memory_order_acquire) && clock.now() < sync_by && !stopped()) wait();
+  if (!m.synced.load(std::memory_order_acquire) && !stopped()) {
+    robot.stop();
+    const board::LinkStats& s = hw.link().stats();
+    res.state = "failed";
+    res.reason = fmt::format(
+        "the board on {} did not answer SYNC within {:.0f} s ({} requests sent, {} bytes received, {} decoder errors)", m.port(),
+        kSyncWaitS, s.requests, s.bytes_received, hw.link().decoder_stats().errors());
+    return;
+  }
+  const Time deadline = task_start + from_seconds(o.max_duration_s);
+  while (clock.now() < deadline && !stopped() && (o.task.empty() || m.busy.load(std::memory_order_acquire))) wait();
+}
+
+// The threads have stopped: a task still running is cancelled, with the reason the run ends for.
+void cancel_unfinished(const RunOptions& o, Robot& robot, RunResult& res) {
+  const int sig = stop_signal(o.stop);
+  res.stopped_by = stop_reason(sig);
+  if (!robot.planner().busy()) return;
+  robot.planner().cancel(sig != 0              ? res.stopped_by
+                         : !res.reason.empty() ? res.reason
+                                               : "no end within " + fixed(o.max_duration_s, 0) + " s");
+  robot.step_sequencing();
+  if (res.state.empty() || sig != 0) res.state = sig != 0 ? "interrupted" : "timed out";
+}
+
+// The robot's threads have stopped: this thread runs the link now. The lamp and the fog at their
+// channels' safe values (off; the board applies the channels at its next cycle, as in the run),
+// the wheels braked to zero through the base's controller (its limits, as every cycle of the
+// run), until the board has answered a DRIVE sent after that. Whether it did.
+bool rest_on_devices(Robot& robot, board::BoardHardware& hw, const Clock& clock) {
+  CommandChannels& channels = hw.command_channels();
+  for (const std::string_view name : {"uv_lamp", "atomizer", "atomizer_fan"}) {
+    if (const auto i = channels.find(name)) channels.set(*i, channels.spec(*i).safe);
+  }
+  if (CController* c = robot.behavior_loop().controller())
+    (void)brake_through_controller(*c, clock, kBrakeMax, [&hw](Time now) { hw.cycle(now); });
+  const Time zero_sent = clock.now();
+  bool zero_answered = false;
+  for (int i = 0; i < 50 && !zero_answered; ++i) {
+    hw.cycle(clock.now());
+    zero_answered = hw.link().synchronised() && hw.link().has_drive() &&
+                    hw.link().drive_stamp() > zero_sent + std::chrono::milliseconds(10) &&
+                    hw.link().pending_actuator_commands() == 0;
+    clock.sleep_until(clock.now() + std::chrono::milliseconds(10));
+  }
+  return zero_answered;
+}
+
+// The task's outcome and the floor's figures, as run_task reports them.
+void set_task_figures(RunResult& res, Robot& robot, const Navigation& nav, const DeviceMeasures& m,
+                      const ReportObserver& report) {
+  const TaskReport tr = robot.planner().report();
+  res.succeeded = tr.state == TaskState::succeeded;
+  if (res.state.empty()) res.state = std::string(to_string(tr.state));
+  if (res.reason.empty()) res.reason = tr.reason;
+  set_floor_figures(res, nav, m.reachable, m.cleaned, m.path_all, m.path_cleaning);
+  res.processes = report.processes;
+  res.recoveries = report.recoveries;
+  res.robot_steps = robot.behavior_loop().cycles();
+  res.loops = robot.timing();
+}
+
+void read_device_figures(DeviceFigures& dev, board::BoardHardware& hw) {
+  dev.link = hw.link().stats();
+  dev.decoder_errors = hw.link().decoder_stats().errors();
+  if (const board::RplidarA1* lidar = hw.lidar()) {
+    const board::RplidarStats& l = lidar->stats();
+    dev.lidar_scans = l.scans;
+    dev.lidar_dropped = l.dropped;
+    dev.lidar_decoder_errors = l.decoder_errors;
+    dev.lidar_restarts = l.restarts;
+    dev.lidar_faults = l.faults;
+  }
+}
+
+// The devices' summary lines; `wall_s`: the wall-clock seconds the run took (said at a speed-up).
+void log_device_figures(std::ostream& log, const DeviceFigures& dev, double speed, double duration_s, double wall_s) {
+  log << fmt::format("devices: board on {}: {} requests, {} responses, {} missed, {} decoder errors, {} link losses, {} reopens",
+                     dev.port, dev.link.requests, dev.link.responses, dev.link.missed, dev.decoder_errors, dev.link.link_losses,
+                     dev.link.reopens);
+  if (!dev.lidar_port.empty())
+    log << fmt::format("; lidar on {}: {} scans, {} dropped, {} decoder errors, {} restarts", dev.lidar_port, dev.lidar_scans,
+                       dev.lidar_dropped, dev.lidar_decoder_errors, dev.lidar_restarts);
+  log << '\n';
+  if (speed != 1.0)
+    log << fmt::format("devices: at {}x: {:.1f} s of the devices' time in {:.1f} s of wall clock\n", speed, duration_s, wall_s);
+  for (const DeviceFigures::Outage& u : dev.outages) {
+    log << fmt::format("devices: link lost at {:.3f} s, restored at {:.3f} s, task moving again at {:.3f} s\n", u.lost_s,
+                       u.restored_s, u.resumed_s);
+  }
+  log.flush();
+}
+
+void write_device_outputs(const std::filesystem::path& out, const Navigation& nav, const DeviceMeasures& m, const RunResult& res,
+                          const DeviceFigures& dev, const LifecycleRecorder& life) {
+  std::filesystem::create_directories(out);
+  write_png(out / "map.png", draw_map(nav, m.cleaned, m.reachable, m.traj));
+  write_text(out / "trajectory.csv", trajectory_csv(m.traj));
+  write_text(out / "report.json", res.json());
+  write_text(out / "devices.json", dev.json());
+  write_text(out / "lifecycle.txt", life.str());
+}
+
+}  // namespace
+
+RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
+  const std::string port = profile.hardware->parameters.at("port");
+  const auto lidar_it = profile.hardware->parameters.find("lidar_port");
+  const std::string lidar_port = lidar_it != profile.hardware->parameters.end() ? lidar_it->second : std::string();
+  refuse_simulated_options(o, profile, port);
+  const double speed = o.realtime_speed;
+  const sim::World world = load_map_world(o.world);
+  RobotPlugins plugins;
+  add_device_plugins(plugins, profile, o);
+  const RobotOptions ro = device_robot_options(profile, world, o);
 
   RunResult res;
   res.robot = profile.name;
@@ -125,9 +404,7 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
   // so that every period and timeout of the host (the link's response timeout, the lidar's) scales alike.
   ScaledClock clock(speed);
   const auto robot = Robot::assemble(profile, plugins, clock, ro);
-  auto* host = dynamic_cast<board::BoardHost*>(robot->hardware());
-  if (host == nullptr) throw ConfigError(where, "hardware 'board' with a port: expected the control board's hardware");
-  board::BoardHardware& hw = host->board();
+  board::BoardHardware& hw = board_of(*robot, profile.hardware->where);
   Navigation nav{robot->module<navi::CGridMaps>(), robot->module<navi::CSectionSplitter>(),
                  robot->module<navi::CCoveragePlanner>()};
   if (nav.maps == nullptr)
@@ -144,209 +421,36 @@ RunResult run_on_devices(const RunOptions& o, const RobotProfile& profile) {
   DeviceFigures dev;
   dev.port = port;
   dev.lidar_port = lidar_port;
-
-  // Measured on the sequencing thread, after each of its periods; read here once it has stopped.
-  std::vector<std::string> room_sections;
-  std::vector<char> reachable(nav.maps->grid().size(), 0);
-  navi::PathPlanner reach_planner(nav.maps->grid(), navi::PathPlannerOptions{.robot_radius_m = nav.maps->robot_radius_m()});
-  navi::CleanedCells cleaned(nav.maps->grid());  // from the localized pose: no ground truth here
-  std::vector<TrajectorySample> traj;
-  std::vector<navi::Point2D> path_all, path_cleaning;
-  const double half_width = nav.coverage != nullptr ? nav.coverage->footprint_width_m() / 2.0 : 0.0;
-  bool measured_busy = false, was_cleaning = false, link_up = false;
-  std::uint64_t losses_seen = 0;
-  Pose2D last = start;
-  Time next_sample{};
-  std::size_t printed = 0;
-  std::atomic<bool> synced{false}, busy{false};
-  const auto log = [&](Time t, const std::string& text) {
-    if (o.log == nullptr) return;
-    *o.log << std::setw(9) << fixed(to_seconds(t), 1) << " s  " << text << '\n';
-    o.log->flush();
-  };
-  const auto measure_room = [&] {
-    room_sections = plan_sections(robot->planner());
-    reachable = reachable_area(nav, reach_planner, room_sections, start, half_width);
-    res.reachable_cells = static_cast<std::size_t>(std::count(reachable.begin(), reachable.end(), char{1}));
-  };
-  const auto moving = [&] { return robot->behavior_active("BhAutoMove") || robot->behavior_active("BhCleaningTwoWheel"); };
-
+  DeviceMeasures m(*robot, nav, life, dev, res, o.log, start);
   RealtimeOptions rto;
-  rto.after_sequencing = [&](Time now) {
-    for (; printed < life.entries().size(); ++printed) {
-      const LifecycleEntry& e = life.entries()[printed];
-      if (e.text.find(" fire ") == std::string::npos) log(e.time, e.text);
-    }
-    // The board's link as the sequencing layer sees it (the snapshot of the resource board_link).
-    if (const auto* r = robot->sequencing_resources().find<board::BoardLinkReading>("board_link");
-        r != nullptr && r->has_reading()) {
-      const board::BoardLinkReading& l = r->latest();
-      if (l.stats.link_losses > losses_seen) {
-        losses_seen = l.stats.link_losses;
-        dev.outages.push_back({to_seconds(now), -1.0, -1.0});
-        log(now, fmt::format("board: link lost ({} missed, {} port failures so far): the motors stop", l.stats.missed,
-                             l.stats.port_failures));
-        link_up = false;
-      } else if (l.synchronised && !link_up) {
-        link_up = true;
-        if (!synced.load(std::memory_order_relaxed)) {
-          dev.first_sync_s = to_seconds(now);
-          log(now, "board: SYNC answered on " + port);
-        } else if (!dev.outages.empty()) {
-          dev.outages.back().restored_s = to_seconds(now);
-          log(now, fmt::format("board: link restored (SYNC answered again, {} reopens of the port)", l.stats.reopens));
-        }
-        synced.store(true, std::memory_order_release);
-      }
-    }
-    if (!dev.outages.empty() && dev.outages.back().restored_s >= 0.0 && dev.outages.back().resumed_s < 0.0 && moving()) {
-      dev.outages.back().resumed_s = to_seconds(now);
-      log(now, "board: the task moves again");
-    }
-    const bool is_busy = robot->planner().busy();
-    if (is_busy && !measured_busy) measure_room();
-    measured_busy = is_busy;
-    // The cleaned cells and the path from the localizer's estimate: the true pose is the device
-    // simulator's (or the world's), not this process's.
-    const NavigationData& navi = robot->navigation();
-    const Pose2D pose = navi.map_from_base;
-    const bool cleaning = robot->behavior_active("BhCleaningTwoWheel") || robot->behavior_active("BhCleaning");
-    if (cleaning && navi.localized) {
-      if (was_cleaning)
-        cleaned.mark_segment({last.x_m, last.y_m}, {pose.x_m, pose.y_m}, half_width);
-      else
-        cleaned.mark_disc({pose.x_m, pose.y_m}, half_width);
-    }
-    was_cleaning = cleaning && navi.localized;
-    last = pose;
-    if (now >= next_sample) {  // 10 Hz trajectory
-      next_sample = now + std::chrono::milliseconds(100);
-      traj.push_back({now, pose, pose, navi.localized, cleaning});
-      path_all.push_back({pose.x_m, pose.y_m});
-      if (cleaning) path_cleaning.push_back({pose.x_m, pose.y_m});
-    }
-    busy.store(is_busy, std::memory_order_release);
-  };
-  auto stopped = [&] { return o.stop != nullptr && *o.stop != 0; };
-  const SteadyClock wall;
-  const auto wait = [&] { wall.sleep_until(wall.now() + std::chrono::milliseconds(10)); };
+  rto.after_sequencing = [&m](Time now) { m.after_sequencing(now); };
 
-  // The task is given before the threads start (the planner's observers then run on one thread):
-  // it waits, standing still, for the board's first SYNC.
-  if (!o.task.empty()) {
-    const CommandAnswer answer = robot->command(o.task);
-    if (!answer.accepted) {
-      res.state = "refused";
-      res.reason = answer.text;
-      if (o.log != nullptr) *o.log << answer.text << '\n';
-    }
-  }
-  busy.store(robot->planner().busy(), std::memory_order_release);
+  give_task(o, *robot, res);
+  m.busy.store(robot->planner().busy(), std::memory_order_release);
+  const SteadyClock wall;
   const Time task_start = clock.now();
   const Time wall_start = wall.now();
   robot->start(std::move(rto));
   if (o.log != nullptr) {
     for (const std::string& w : robot->realtime_warnings()) *o.log << w << '\n';
   }
-  const Time sync_by = clock.now() + from_seconds(kSyncWaitS * speed);
-  while (!synced.load(std::memory_order_acquire) && clock.now() < sync_by && !stopped()) wait();
-  if (!synced.load(std::memory_order_acquire) && !stopped()) {
-    robot->stop();
-    const board::LinkStats& s = hw.link().stats();
-    res.state = "failed";
-    res.reason = fmt::format(
-        "the board on {} did not answer SYNC within {:.0f} s ({} requests sent, {} bytes received, {} decoder errors)", port,
-        kSyncWaitS, s.requests, s.bytes_received, hw.link().decoder_stats().errors());
-  } else {
-    const Time deadline = task_start + from_seconds(o.max_duration_s);
-    while (clock.now() < deadline && !stopped() && (o.task.empty() || busy.load(std::memory_order_acquire))) wait();
-  }
+  await_end(o, *robot, hw, clock, wall, task_start, m, res);
   robot->stop();
   const Time ended = clock.now();
-  const int sig = stop_signal(o.stop);
-  res.stopped_by = stop_reason(sig);
-  if (robot->planner().busy()) {
-    robot->planner().cancel(sig != 0              ? res.stopped_by
-                            : !res.reason.empty() ? res.reason
-                                                  : "no end within " + fixed(o.max_duration_s, 0) + " s");
-    robot->step_sequencing();
-    if (res.state.empty() || sig != 0) res.state = sig != 0 ? "interrupted" : "timed out";
-  }
-  for (; printed < life.entries().size(); ++printed) {
-    const LifecycleEntry& e = life.entries()[printed];
-    if (e.text.find(" fire ") == std::string::npos) log(e.time, e.text);
-  }
+  cancel_unfinished(o, *robot, res);
+  m.print_lifecycle();
 
-  // The robot's threads have stopped: this thread runs the link now. The wheels commanded zero,
-  // the lamp and the fog at their channels' safe values (off; the board applies the channels at its
-  // next cycle, as in the run), until the board has answered a DRIVE sent after that.
-  const std::array<double, 2> zeros{0.0, 0.0};
-  (void)hw.write_wheel_velocities(zeros);
-  CommandChannels& channels = hw.command_channels();
-  for (const std::string_view name : {"uv_lamp", "atomizer", "atomizer_fan"}) {
-    if (const auto i = channels.find(name)) channels.set(*i, channels.spec(*i).safe);
-  }
-  const Time zero_sent = clock.now();
-  bool zero_answered = false;
-  for (int i = 0; i < 50 && !zero_answered; ++i) {
-    hw.cycle(clock.now());
-    zero_answered = hw.link().synchronised() && hw.link().has_drive() &&
-                    hw.link().drive_stamp() > zero_sent + std::chrono::milliseconds(10) &&
-                    hw.link().pending_actuator_commands() == 0;
-    clock.sleep_until(clock.now() + std::chrono::milliseconds(10));
-  }
   res.base_command_at_end_rad_s = {0.0, 0.0};
-  res.base_at_rest = zero_answered;
-  if (o.log != nullptr && !zero_answered)
+  res.base_at_rest = rest_on_devices(*robot, hw, clock);
+  if (o.log != nullptr && !res.base_at_rest)
     *o.log << "board: no answer to the last DRIVE (speeds 0): its watchdog stops the motors\n";
 
-  const TaskReport tr = robot->planner().report();
-  res.succeeded = tr.state == TaskState::succeeded;
-  if (res.state.empty()) res.state = std::string(to_string(tr.state));
-  if (res.reason.empty()) res.reason = tr.reason;
+  set_task_figures(res, *robot, nav, m, report);
   res.duration_s = to_seconds(ended - task_start);
   res.wall_clock = speed == 1.0;  // at a speed-up the devices' time, S times the wall clock's
-  set_floor_figures(res, nav, reachable, cleaned, path_all, path_cleaning);
-  res.processes = report.processes;
-  res.recoveries = report.recoveries;
-  res.robot_steps = robot->behavior_loop().cycles();
-  res.loops = robot->timing();
-
-  dev.link = hw.link().stats();
-  dev.decoder_errors = hw.link().decoder_stats().errors();
-  if (const board::RplidarA1* lidar = hw.lidar()) {
-    const board::RplidarStats& l = lidar->stats();
-    dev.lidar_scans = l.scans;
-    dev.lidar_dropped = l.dropped;
-    dev.lidar_decoder_errors = l.decoder_errors;
-    dev.lidar_restarts = l.restarts;
-    dev.lidar_faults = l.faults;
-  }
-  if (o.log != nullptr) {
-    *o.log << fmt::format(
-        "devices: board on {}: {} requests, {} responses, {} missed, {} decoder errors, {} link losses, {} reopens", port,
-        dev.link.requests, dev.link.responses, dev.link.missed, dev.decoder_errors, dev.link.link_losses, dev.link.reopens);
-    if (!lidar_port.empty())
-      *o.log << fmt::format("; lidar on {}: {} scans, {} dropped, {} decoder errors, {} restarts", lidar_port, dev.lidar_scans,
-                            dev.lidar_dropped, dev.lidar_decoder_errors, dev.lidar_restarts);
-    *o.log << '\n';
-    if (speed != 1.0)
-      *o.log << fmt::format("devices: at {}x: {:.1f} s of the devices' time in {:.1f} s of wall clock\n", speed, res.duration_s,
-                            to_seconds(wall.now() - wall_start));
-    for (const DeviceFigures::Outage& u : dev.outages) {
-      *o.log << fmt::format("devices: link lost at {:.3f} s, restored at {:.3f} s, task moving again at {:.3f} s\n", u.lost_s,
-                            u.restored_s, u.resumed_s);
-    }
-    o.log->flush();
-  }
-  if (!o.out.empty()) {
-    std::filesystem::create_directories(o.out);
-    write_png(o.out / "map.png", draw_map(nav, cleaned, reachable, traj));
-    write_text(o.out / "trajectory.csv", trajectory_csv(traj));
-    write_text(o.out / "report.json", res.json());
-    write_text(o.out / "devices.json", dev.json());
-    write_text(o.out / "lifecycle.txt", life.str());
-  }
+  read_device_figures(dev, hw);
+  if (o.log != nullptr) log_device_figures(*o.log, dev, speed, res.duration_s, to_seconds(wall.now() - wall_start));
+  if (!o.out.empty()) write_device_outputs(o.out, nav, m, res, dev, life);
   return res;
 }
 

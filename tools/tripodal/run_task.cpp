@@ -676,8 +676,8 @@ void TaskRun::rest_base() {
   } else if (const sim::Simulator* s = truth_.local()) {
     commanded = [s] { return std::vector<double>(s->wheel_commands().begin(), s->wheel_commands().end()); };
   }
-  // On the robot's own threads (stopped by now) the wheels are commanded zero at once.
-  const BaseStop rest = stop_base(*robot_, commanded, threaded_ ? Duration{0} : tick_period_);
+  // On the robot's own threads (stopped by now) the controller brakes the wheels on this thread.
+  const BaseStop rest = stop_base(*robot_, clock_, commanded, threaded_ ? Duration{0} : tick_period_);
   res_.base_command_at_end_rad_s = rest.command_rad_s;
   res_.base_at_rest = rest.at_rest;
 }

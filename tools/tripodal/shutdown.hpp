@@ -8,9 +8,11 @@
 #include <string>
 #include <vector>
 
+#include "tripodal/core/clock.hpp"
 #include "tripodal/core/time.hpp"
 
 namespace tripodal {
+class CController;
 class Robot;
 }  // namespace tripodal
 
@@ -33,10 +35,22 @@ struct BaseStop {
 /// the base is in another process and cannot be read back.
 using WheelCommands = std::function<std::vector<double>()>;
 
-/// Brings the base to rest once the run's work is cancelled: runs the robot on (at most
-/// `max_brake`, simulated) while its controller brakes through the base's limits, until
-/// `commanded` reads all zero, then writes zero wheel velocities. The result is what `commanded`
-/// reads last (without it, the zeros written).
-BaseStop stop_base(Robot& robot, const WheelCommands& commanded, Duration tick, Duration max_brake = std::chrono::seconds(3));
+/// Brakes the base through its controller on the calling thread, once the robot's threads have
+/// stopped: every controller period of `clock`, `each_period(now)` (the hardware's own cycle:
+/// a simulator's physics, the board's link), then the controller commanded zero and updated —
+/// its limits, its kinematics, the hardware's wheels: the path every behavior-loop cycle takes —
+/// until the wheel velocities it writes are all zero or `max_brake` has passed. Returns whether
+/// they are all zero.
+bool brake_through_controller(CController& controller, const Clock& clock, Duration max_brake,
+                              const std::function<void(Time)>& each_period = {});
+
+/// Brings the base to rest once the run's work is cancelled, through the base's controller (the
+/// one path the wheels are driven by): runs the robot on (at most `max_brake`, simulated) while its
+/// controller brakes through the base's limits, until `commanded` reads all zero; with `tick` 0
+/// (the robot's threads stopped) brakes on this thread on `clock` (brake_through_controller). The
+/// result is what `commanded` reads last (without it, the controller's last wheel commands); at
+/// rest when those and the controller's are all zero.
+BaseStop stop_base(Robot& robot, const Clock& clock, const WheelCommands& commanded, Duration tick,
+                   Duration max_brake = std::chrono::seconds(3));
 
 }  // namespace tripodal::app

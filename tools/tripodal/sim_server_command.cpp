@@ -91,29 +91,28 @@ std::vector<std::string> wheel_names(std::size_t n) {
   return names;
 }
 
-int run(const Args& a, std::ostream& out, std::ostream& err) {
-  if (a.robot.empty() && a.fleet.empty()) {
-    err << "tripodal sim-server: give the robot's profile (--robot ROBOT.yaml) or a fleet file (--fleet FILE)\n";
+// --robots and --fleet: one world for lock-step robots (sim_server_shared.cpp).
+int run_shared(const Args& a, std::ostream& out, std::ostream& err) {
+  if (a.realtime->count() > 0) {
+    err << "tripodal sim-server: --robots and --fleet serve lock-step robots; --realtime serves one\n";
     return kUsage;
   }
-  if (a.robots || !a.fleet.empty()) {
-    if (a.realtime->count() > 0) {
-      err << "tripodal sim-server: --robots and --fleet serve lock-step robots; --realtime serves one\n";
-      return kUsage;
-    }
-    return run_shared_world(SharedWorldArgs{.robot = a.robot,
-                                            .world = a.world,
-                                            .fleet = a.fleet,
-                                            .robots = a.robots.value_or(0),
-                                            .prefix = a.ros_namespace.empty() ? "robot" : a.ros_namespace,
-                                            .domain = a.domain,
-                                            .seed = a.seed,
-                                            .lease_s = a.lease_s,
-                                            .wait_s = a.wait_s,
-                                            .stall_s = a.stall_s,
-                                            .system_network = a.system_network},
-                            out, err);
-  }
+  return run_shared_world(SharedWorldArgs{.robot = a.robot,
+                                          .world = a.world,
+                                          .fleet = a.fleet,
+                                          .robots = a.robots.value_or(0),
+                                          .prefix = a.ros_namespace.empty() ? "robot" : a.ros_namespace,
+                                          .domain = a.domain,
+                                          .seed = a.seed,
+                                          .lease_s = a.lease_s,
+                                          .wait_s = a.wait_s,
+                                          .stall_s = a.stall_s,
+                                          .system_network = a.system_network},
+                          out, err);
+}
+
+// The files to read and the namespace to serve under; kOk when they will do.
+int check_single_args(const Args& a, std::ostream& err) {
   for (const auto& f : {a.robot, a.world}) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(f, ec)) {
@@ -127,30 +126,45 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
            "separated by '/'\n";
     return kUsage;
   }
-  try {
-    const RobotProfile profile = load_robot_profile(a.robot);
-    // The controller types `tripodal run` knows (the same registration), so that the base of any
-    // profile `run` takes is simulated here.
-    RobotPlugins plugins;
-    app::register_tool_plugins(plugins, nullptr, profile, {});
-    const std::optional<ControllerConfig> base = base_controller_config(profile, plugins.controllers);
-    if (!base)
-      throw ConfigError(
-          profile.where,
-          "tripodal sim-server simulates the robot's base: the profile needs a loop with a controller");
-    sim::World world = sim::load_world(a.world);
-    const std::uint64_t seed = a.seed.value_or(world.seed);
-    sim::Simulator sim(std::move(world), *base, seed);
+  return kOk;
+}
 
-    dds::ParticipantOptions po;
-    po.domain_id = a.domain;
-    po.network = a.system_network ? dds::Network::system : dds::Network::loopback;
-    po.participant_lease = std::chrono::milliseconds(static_cast<std::int64_t>(a.lease_s * 1000.0));
-    dds::Participant participant(po);
-    const dds::BaseTopics topics(a.ros_namespace);
+// The base the profile's loop controls. The controller types `tripodal run` knows (the same
+// registration), so that the base of any profile `run` takes is simulated here.
+ControllerConfig simulated_base(const RobotProfile& profile) {
+  RobotPlugins plugins;
+  app::register_tool_plugins(plugins, nullptr, profile, {});
+  const std::optional<ControllerConfig> base = base_controller_config(profile, plugins.controllers);
+  if (!base)
+    throw ConfigError(profile.where,
+                      "tripodal sim-server simulates the robot's base: the profile needs a loop with a controller");
+  return *base;
+}
 
-    Inbox inbox;
-    // The robot's step writer: its requests, and the robot leaving (its process ended or died).
+dds::ParticipantOptions participant_options(const Args& a) {
+  dds::ParticipantOptions po;
+  po.domain_id = a.domain;
+  po.network = a.system_network ? dds::Network::system : dds::Network::loopback;
+  po.participant_lease = std::chrono::milliseconds(static_cast<std::int64_t>(a.lease_s * 1000.0));
+  return po;
+}
+
+// What the robot sends: with --realtime its cmd_vel, else its step requests and its step writer's
+// coming and going (its process ended or died).
+struct Requests {
+  std::optional<dds::Subscriber<dds::msg::SimStep>> steps;
+  std::optional<dds::Subscriber<dds::msg::Twist>> cmd_vel;
+
+  Requests(bool realtime, dds::Participant& participant, const dds::BaseTopics& topics, Inbox& inbox) {
+    if (realtime) {
+      cmd_vel.emplace(participant, topics.cmd_vel, dds::EndpointOptions{.kind = dds::TopicKind::command},
+                      [&inbox](const dds::msg::Twist& t) {
+                        std::lock_guard lock(inbox.mutex);
+                        inbox.cmd_vel = t;
+                        inbox.cmd_vel_at = std::chrono::steady_clock::now();
+                      });
+      return;
+    }
     auto on_status = [&inbox](const dds::StatusEvent& e) {
       if (e.kind != dds::StatusKind::publication_matched && e.kind != dds::StatusKind::liveliness_lost)
         return;
@@ -164,164 +178,216 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
       }
       inbox.cv.notify_all();
     };
-    const bool realtime = a.realtime->count() > 0;
-    std::optional<dds::Subscriber<dds::msg::SimStep>> steps;
-    std::optional<dds::Subscriber<dds::msg::Twist>> cmd_vel;
-    std::optional<dds::Publisher<dds::msg::Clock>> clock;
-    if (realtime) {
-      cmd_vel.emplace(participant, topics.cmd_vel, dds::EndpointOptions{.kind = dds::TopicKind::command},
-                      [&inbox](const dds::msg::Twist& t) {
-                        std::lock_guard lock(inbox.mutex);
-                        inbox.cmd_vel = t;
-                        inbox.cmd_vel_at = std::chrono::steady_clock::now();
-                      });
-      clock.emplace(participant, topics.clock, dds::EndpointOptions{.kind = dds::TopicKind::state});
-    } else {
-      steps.emplace(participant, topics.sim_step,
-                    dds::EndpointOptions{.kind = dds::TopicKind::state, .on_status = on_status},
-                    [&inbox](const dds::msg::SimStep& s) {
-                      std::lock_guard lock(inbox.mutex);
-                      inbox.steps.push_back(s);
-                      inbox.cv.notify_all();
-                    });
-    }
-    // Reliable scans: a lock-step robot counts on every one (ROS 2's best-effort readers match too).
-    dds::Qos scan_qos = dds::qos_for(dds::TopicKind::scan, dds::Role::publisher);
-    scan_qos.reliability = dds::Reliability::reliable;
-    dds::Publisher<dds::msg::LaserScan> scan(participant, topics.scan,
-                                             {.kind = dds::TopicKind::scan, .qos = scan_qos});
-    dds::Publisher<dds::msg::JointState> joints(participant, topics.joint_states,
-                                                {.kind = dds::TopicKind::state});
-    dds::Publisher<dds::msg::SimState> state(participant, topics.sim_state, {.kind = dds::TopicKind::state});
+    steps.emplace(participant, topics.sim_step, dds::EndpointOptions{.kind = dds::TopicKind::state, .on_status = on_status},
+                  [&inbox](const dds::msg::SimStep& s) {
+                    std::lock_guard lock(inbox.mutex);
+                    inbox.steps.push_back(s);
+                    inbox.cv.notify_all();
+                  });
+  }
+};
 
-    std::signal(SIGINT, on_sim_server_stop_signal);
-    std::signal(SIGTERM, on_sim_server_stop_signal);
-    out << "tripodal sim-server: robot " << profile.name << " (" << base->type << " base, "
-        << sim.wheel_count() << " wheels), world " << a.world.string() << ", seed " << seed << "; domain "
-        << a.domain << ", serving " << topics.scan << ", " << topics.joint_states << ", " << topics.sim_state
-        << (realtime ? ", " + topics.clock + " at " +
-                           app::fixed(a.realtime_speed > 0.0 ? a.realtime_speed : 1.0, 1) +
-                           " times real time; commands on " + topics.cmd_vel
-                     : "; steps on " + topics.sim_step)
-        << "\n";
-    out.flush();
+// The simulated robot as served: its sensors and state published after each step, lock-step or
+// free-running.
+class ServedRobot {
+ public:
+  ServedRobot(sim::Simulator& sim, dds::Participant& participant, const dds::BaseTopics& topics, bool realtime)
+      : sim_(sim),
+        clock_(realtime ? std::make_optional<dds::Publisher<dds::msg::Clock>>(participant, topics.clock,
+                                                                              dds::EndpointOptions{.kind = dds::TopicKind::state})
+                        : std::nullopt),
+        scan_(participant, topics.scan, {.kind = dds::TopicKind::scan, .qos = reliable_scans()}),
+        joints_(participant, topics.joint_states, {.kind = dds::TopicKind::state}),
+        state_(participant, topics.sim_state, {.kind = dds::TopicKind::state}),
+        velocity_(sim.wheel_count()),
+        position_(sim.wheel_count()) {
+    js_.header.frame_id = "base_link";
+    js_.name = wheel_names(sim.wheel_count());
+    ls_.header.frame_id = "laser";
+  }
 
-    const std::size_t n = sim.wheel_count();
-    dds::msg::JointState js;
-    js.header.frame_id = "base_link";
-    js.name = wheel_names(n);
-    dds::msg::LaserScan ls;
-    ls.header.frame_id = "laser";
-    std::vector<double> velocity(n), position(n);
-    std::uint32_t scans = 0, joint_states = 0, last_step = 0;
-    std::size_t laser_seen = 0;
-    const auto started = std::chrono::steady_clock::now();
-    std::string ended = "stopped";
-    int code = kOk;
-    // After a step: what the sensors gave, then the state (and with --realtime the clock).
-    auto publish = [&](std::uint32_t step) {
-      const LaserResource& laser = sim.laser();
-      if (laser.sequence() != laser_seen && laser.has_reading()) {
-        laser_seen = laser.sequence();
-        const LaserScan& l = laser.latest();
-        ls.header.stamp = dds::ros_time(l.stamp);
-        ls.angle_min = static_cast<float>(l.angle_min_rad);
-        ls.angle_max = static_cast<float>(l.angle_max_rad);
-        ls.angle_increment = static_cast<float>(l.angle_increment_rad);
-        ls.time_increment = static_cast<float>(l.time_increment_s);
-        ls.scan_time = static_cast<float>(l.scan_time_s);
-        ls.range_min = static_cast<float>(l.range_min_m);
-        ls.range_max = static_cast<float>(l.range_max_m);
-        ls.ranges = l.ranges_m;
-        ls.intensities = l.intensities;
-        scan.publish(ls);
-        ++scans;
-      }
-      js.header.stamp = dds::ros_time(sim.now());
-      if (sim.read_wheel_states(velocity, position)) {
-        js.position = position;
-        js.velocity = velocity;
-      } else {  // the odometry is dead: states without values, as the in-process read fails
-        js.position.clear();
-        js.velocity.clear();
-      }
-      joints.publish(js);
-      ++joint_states;
-      last_step = step;
-      const Pose2D& p = sim.pose();
-      dds::msg::SimState answer{dds::ros_time(sim.now()),
-                                p.x_m,
-                                p.y_m,
-                                p.theta_rad,
-                                sim.distance_m(),
-                                last_step,
-                                scans,
-                                joint_states,
-                                static_cast<std::uint32_t>(sim.collisions())};
-      put_sensors(answer, sim);
-      state.publish(answer);
-      if (clock) clock->publish(dds::msg::Clock{dds::ros_time(sim.now())});
-    };
-    // Lock-step: the command over the step, the world advanced to its end, then what it gave.
-    auto serve = [&](const dds::msg::SimStep& s) {
-      sim.command_twist(Twist2D{s.cmd_vel.linear.x, s.cmd_vel.linear.y, s.cmd_vel.angular.z});
-      sim.step_until(dds::tripodal_time(s.until));
-      publish(s.step);
-    };
-    // Real time: a physics period at a time, paced to the wall clock, with the latest cmd_vel
-    // (none within kCmdTimeout: the base stops, as a ROS 2 base driver does).
-    if (realtime) {
-      constexpr auto kPeriod = std::chrono::milliseconds(10);
-      constexpr auto kCmdTimeout = std::chrono::milliseconds(500);
-      SteadyClock wall;
-      sim::RealtimePacer pacer(wall, a.realtime_speed > 0.0 ? a.realtime_speed : 1.0);
-      std::uint32_t periods = 0;
-      publish(periods);
-      while (g_stop == 0) {
-        Twist2D command{};
-        {
-          std::lock_guard lock(inbox.mutex);
-          if (inbox.cmd_vel && std::chrono::steady_clock::now() - inbox.cmd_vel_at < kCmdTimeout) {
-            command = {inbox.cmd_vel->linear.x, inbox.cmd_vel->linear.y, inbox.cmd_vel->angular.z};
-          }
-        }
-        sim.command_twist(command);
-        sim.step(kPeriod);
-        publish(++periods);
-        pacer.pace(sim.now());
-      }
-    }
-    while (!realtime && g_stop == 0) {
-      std::unique_lock lock(inbox.mutex);
-      // Wakes for a request or a departure, and every 100 ms to see a signal.
-      inbox.cv.wait_for(lock, std::chrono::milliseconds(100),
-                        [&] { return !inbox.steps.empty() || inbox.client_left; });
-      if (!inbox.steps.empty()) {
-        const dds::msg::SimStep s = inbox.steps.front();
-        inbox.steps.pop_front();
-        lock.unlock();
-        serve(s);
-        continue;
-      }
-      if (inbox.client_left) {
-        ended = "the robot " + inbox.left_why;
-        break;
-      }
-      if (!inbox.had_client && a.wait_s > 0.0 &&
-          std::chrono::steady_clock::now() - started > std::chrono::duration<double>(a.wait_s)) {
-        ended = "no robot came within " + app::fixed(a.wait_s, 1) + " s";
-        code = kNoRobot;
-        break;
+  // Real time: a physics period at a time, paced to the wall clock, with the latest cmd_vel
+  // (none within kCmdTimeout: the base stops, as a ROS 2 base driver does), until a signal.
+  void run_realtime(const Args& a, Inbox& inbox);
+  // Lock-step: serves the robot's step requests until it leaves, a signal, or none came within
+  // --wait-s (kNoRobot); says why in `ended`.
+  int run_lockstep(const Args& a, Inbox& inbox, std::chrono::steady_clock::time_point started, std::string& ended);
+  [[nodiscard]] std::uint32_t last_step() const noexcept { return last_step_; }
+
+ private:
+  // Reliable scans: a lock-step robot counts on every one (ROS 2's best-effort readers match too).
+  static dds::Qos reliable_scans() {
+    dds::Qos qos = dds::qos_for(dds::TopicKind::scan, dds::Role::publisher);
+    qos.reliability = dds::Reliability::reliable;
+    return qos;
+  }
+  void publish(std::uint32_t step);
+  void publish_scan();
+  // Lock-step: the command over the step, the world advanced to its end, then what it gave.
+  void serve(const dds::msg::SimStep& s) {
+    sim_.command_twist(Twist2D{s.cmd_vel.linear.x, s.cmd_vel.linear.y, s.cmd_vel.angular.z});
+    sim_.step_until(dds::tripodal_time(s.until));
+    publish(s.step);
+  }
+
+  sim::Simulator& sim_;
+  std::optional<dds::Publisher<dds::msg::Clock>> clock_;
+  dds::Publisher<dds::msg::LaserScan> scan_;
+  dds::Publisher<dds::msg::JointState> joints_;
+  dds::Publisher<dds::msg::SimState> state_;
+  dds::msg::JointState js_;
+  dds::msg::LaserScan ls_;
+  std::vector<double> velocity_, position_;
+  std::uint32_t scans_ = 0, joint_states_ = 0, last_step_ = 0;
+  std::size_t laser_seen_ = 0;
+};
+
+void ServedRobot::publish_scan() {
+  const LaserResource& laser = sim_.laser();
+  if (laser.sequence() == laser_seen_ || !laser.has_reading()) return;
+  laser_seen_ = laser.sequence();
+  const LaserScan& l = laser.latest();
+  ls_.header.stamp = dds::ros_time(l.stamp);
+  ls_.angle_min = static_cast<float>(l.angle_min_rad);
+  ls_.angle_max = static_cast<float>(l.angle_max_rad);
+  ls_.angle_increment = static_cast<float>(l.angle_increment_rad);
+  ls_.time_increment = static_cast<float>(l.time_increment_s);
+  ls_.scan_time = static_cast<float>(l.scan_time_s);
+  ls_.range_min = static_cast<float>(l.range_min_m);
+  ls_.range_max = static_cast<float>(l.range_max_m);
+  ls_.ranges = l.ranges_m;
+  ls_.intensities = l.intensities;
+  scan_.publish(ls_);
+  ++scans_;
+}
+
+// After a step: what the sensors gave, then the state (and with --realtime the clock).
+void ServedRobot::publish(std::uint32_t step) {
+  publish_scan();
+  js_.header.stamp = dds::ros_time(sim_.now());
+  if (sim_.read_wheel_states(velocity_, position_)) {
+    js_.position = position_;
+    js_.velocity = velocity_;
+  } else {  // the odometry is dead: states without values, as the in-process read fails
+    js_.position.clear();
+    js_.velocity.clear();
+  }
+  joints_.publish(js_);
+  ++joint_states_;
+  last_step_ = step;
+  const Pose2D& p = sim_.pose();
+  dds::msg::SimState answer{dds::ros_time(sim_.now()),
+                            p.x_m,
+                            p.y_m,
+                            p.theta_rad,
+                            sim_.distance_m(),
+                            last_step_,
+                            scans_,
+                            joint_states_,
+                            static_cast<std::uint32_t>(sim_.collisions())};
+  put_sensors(answer, sim_);
+  state_.publish(answer);
+  if (clock_) clock_->publish(dds::msg::Clock{dds::ros_time(sim_.now())});
+}
+
+void ServedRobot::run_realtime(const Args& a, Inbox& inbox) {
+  constexpr auto kPeriod = std::chrono::milliseconds(10);
+  constexpr auto kCmdTimeout = std::chrono::milliseconds(500);
+  SteadyClock wall;
+  sim::RealtimePacer pacer(wall, a.realtime_speed > 0.0 ? a.realtime_speed : 1.0);
+  std::uint32_t periods = 0;
+  publish(periods);
+  while (g_stop == 0) {
+    Twist2D command{};
+    {
+      std::lock_guard lock(inbox.mutex);
+      if (inbox.cmd_vel && std::chrono::steady_clock::now() - inbox.cmd_vel_at < kCmdTimeout) {
+        command = {inbox.cmd_vel->linear.x, inbox.cmd_vel->linear.y, inbox.cmd_vel->angular.z};
       }
     }
-    out << "sim-server ended: " << ended << "; " << last_step << (realtime ? " periods" : " steps served")
-        << "; " << app::fixed(to_seconds(sim.now()), 2) << " s simulated; distance "
-        << app::fixed(sim.distance_m(), 2) << " m; " << sim.collisions() << " collisions\n";
-    for (const sim::SimEvent& e : sim.events()) {
-      out << app::fixed(to_seconds(e.stamp), 3) << " s  simulator: " << sim::to_string(e.kind)
-          << (e.detail.empty() ? "" : " " + e.detail) << '\n';
+    sim_.command_twist(command);
+    sim_.step(kPeriod);
+    publish(++periods);
+    pacer.pace(sim_.now());
+  }
+}
+
+int ServedRobot::run_lockstep(const Args& a, Inbox& inbox, std::chrono::steady_clock::time_point started, std::string& ended) {
+  while (g_stop == 0) {
+    std::unique_lock lock(inbox.mutex);
+    // Wakes for a request or a departure, and every 100 ms to see a signal.
+    inbox.cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return !inbox.steps.empty() || inbox.client_left; });
+    if (!inbox.steps.empty()) {
+      const dds::msg::SimStep s = inbox.steps.front();
+      inbox.steps.pop_front();
+      lock.unlock();
+      serve(s);
+      continue;
     }
-    return code;
+    if (inbox.client_left) {
+      ended = "the robot " + inbox.left_why;
+      return kOk;
+    }
+    if (!inbox.had_client && a.wait_s > 0.0 &&
+        std::chrono::steady_clock::now() - started > std::chrono::duration<double>(a.wait_s)) {
+      ended = "no robot came within " + app::fixed(a.wait_s, 1) + " s";
+      return kNoRobot;
+    }
+  }
+  return kOk;
+}
+
+// One robot's simulator served until it leaves or the server is stopped; the exit code.
+int serve_one_robot(const Args& a, std::ostream& out) {
+  const RobotProfile profile = load_robot_profile(a.robot);
+  const ControllerConfig base = simulated_base(profile);
+  sim::World world = sim::load_world(a.world);
+  const std::uint64_t seed = a.seed.value_or(world.seed);
+  sim::Simulator sim(std::move(world), base, seed);
+  dds::Participant participant(participant_options(a));
+  const dds::BaseTopics topics(a.ros_namespace);
+  Inbox inbox;
+  const bool realtime = a.realtime->count() > 0;
+  const Requests requests(realtime, participant, topics, inbox);
+  ServedRobot served(sim, participant, topics, realtime);
+
+  std::signal(SIGINT, on_sim_server_stop_signal);
+  std::signal(SIGTERM, on_sim_server_stop_signal);
+  out << "tripodal sim-server: robot " << profile.name << " (" << base.type << " base, " << sim.wheel_count()
+      << " wheels), world " << a.world.string() << ", seed " << seed << "; domain " << a.domain << ", serving " << topics.scan
+      << ", " << topics.joint_states << ", " << topics.sim_state
+      << (realtime ? ", " + topics.clock + " at " + app::fixed(a.realtime_speed > 0.0 ? a.realtime_speed : 1.0, 1) +
+                         " times real time; commands on " + topics.cmd_vel
+                   : "; steps on " + topics.sim_step)
+      << "\n";
+  out.flush();
+
+  const auto started = std::chrono::steady_clock::now();
+  std::string ended = "stopped";
+  int code = kOk;
+  if (realtime)
+    served.run_realtime(a, inbox);
+  else
+    code = served.run_lockstep(a, inbox, started, ended);
+  out << "sim-server ended: " << ended << "; " << served.last_step() << (realtime ? " periods" : " steps served") << "; "
+      << app::fixed(to_seconds(sim.now()), 2) << " s simulated; distance " << app::fixed(sim.distance_m(), 2) << " m; "
+      << sim.collisions() << " collisions\n";
+  for (const sim::SimEvent& e : sim.events()) {
+    out << app::fixed(to_seconds(e.stamp), 3) << " s  simulator: " << sim::to_string(e.kind)
+        << (e.detail.empty() ? "" : " " + e.detail) << '\n';
+  }
+  return code;
+}
+
+int run(const Args& a, std::ostream& out, std::ostream& err) {
+  if (a.robot.empty() && a.fleet.empty()) {
+    err << "tripodal sim-server: give the robot's profile (--robot ROBOT.yaml) or a fleet file (--fleet FILE)\n";
+    return kUsage;
+  }
+  if (a.robots || !a.fleet.empty()) return run_shared(a, out, err);
+  if (const int code = check_single_args(a, err); code != kOk) return code;
+  try {
+    return serve_one_robot(a, out);
   } catch (const ConfigError& e) {
     err << e.what() << '\n';
     return kBadInput;

@@ -111,7 +111,26 @@ void put_sensors(dds::msg::SimState& state, sim::Simulator& sim) {
   }
 }
 
-int run_shared_world(const SharedWorldArgs& a, std::ostream& out, std::ostream& err) {
+namespace {
+
+// The robots' inboxes and what guards them: Cyclone DDS threads fill them, the serving thread
+// empties them.
+struct Inboxes {
+  explicit Inboxes(std::size_t n) : slots(n) {}
+  std::mutex mutex;
+  std::condition_variable cv;
+  std::vector<SlotInbox> slots;
+};
+
+// What the serving thread took from the inboxes for one round, robot by robot.
+struct Round {
+  std::vector<std::optional<dds::msg::SimStep>> steps;  // the step it asked for
+  std::vector<std::string> left;                        // why it left (empty: it did not)
+  std::vector<char> joined;                             // it asked its first step
+};
+
+// The files to read, and the namespace the robots are numbered in; kOk when they will do.
+int check_shared_args(const SharedWorldArgs& a, std::ostream& err) {
   for (const auto& f : {a.fleet.empty() ? a.robot : a.fleet, a.world}) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(f, ec)) {
@@ -124,266 +143,343 @@ int run_shared_world(const SharedWorldArgs& a, std::ostream& out, std::ostream& 
         << "1' is not a ROS 2 namespace: names of letters, digits and '_', not starting with a digit, separated by '/'\n";
     return kUsage;
   }
+  return kOk;
+}
+
+using Bases = std::map<std::filesystem::path, std::pair<std::string, ControllerConfig>>;
+
+// Each robot's base is its own profile's (a fleet file may mix an omni PSR-2 and a differential
+// robot); profiles read once each.
+Bases load_bases(const std::vector<FleetMember>& members) {
+  Bases bases;
+  for (const FleetMember& m : members) {
+    if (bases.count(m.profile) != 0) continue;
+    const RobotProfile profile = load_robot_profile(m.profile);
+    RobotPlugins plugins;
+    app::register_tool_plugins(plugins, nullptr, profile, {});
+    const std::optional<ControllerConfig> base = base_controller_config(profile, plugins.controllers);
+    if (!base)
+      throw ConfigError(profile.where,
+                        "tripodal sim-server simulates the robot's base: the profile needs a loop with a controller");
+    bases.emplace(m.profile, std::make_pair(profile.name, *base));
+  }
+  return bases;
+}
+
+dds::ParticipantOptions participant_options(const SharedWorldArgs& a) {
+  dds::ParticipantOptions po;
+  po.domain_id = a.domain;
+  po.network = a.system_network ? dds::Network::system : dds::Network::loopback;
+  po.participant_lease = std::chrono::milliseconds(static_cast<std::int64_t>(a.lease_s * 1000.0));
+  return po;
+}
+
+// Slot k's topics in its namespace: its sensors published, its step requests and its step
+// writer's coming and going delivered into inbox k.
+void open_slot(Slot& s, std::size_t k, dds::Participant& participant, Inboxes& inboxes) {
+  dds::Qos scan_qos = dds::qos_for(dds::TopicKind::scan, dds::Role::publisher);
+  scan_qos.reliability = dds::Reliability::reliable;  // a lock-step robot counts on every scan
+  const dds::BaseTopics topics(s.ns);
+  s.scan = std::make_unique<dds::Publisher<dds::msg::LaserScan>>(
+      participant, topics.scan, dds::EndpointOptions{.kind = dds::TopicKind::scan, .qos = scan_qos});
+  s.joints = std::make_unique<dds::Publisher<dds::msg::JointState>>(participant, topics.joint_states,
+                                                                    dds::EndpointOptions{.kind = dds::TopicKind::state});
+  s.state = std::make_unique<dds::Publisher<dds::msg::SimState>>(participant, topics.sim_state,
+                                                                 dds::EndpointOptions{.kind = dds::TopicKind::state});
+  auto on_status = [&inboxes, k](const dds::StatusEvent& e) {
+    if (e.kind != dds::StatusKind::publication_matched && e.kind != dds::StatusKind::liveliness_lost) return;
+    const std::lock_guard lock(inboxes.mutex);
+    SlotInbox& in = inboxes.slots[k];
+    if (e.current_count > 0) {
+      in.connected = true;
+    } else if (in.connected) {
+      in.connected = false;
+      in.left = true;
+      in.left_why = e.kind == dds::StatusKind::liveliness_lost ? "left or went silent (DDS liveliness lost)" : "left";
+    }
+    inboxes.cv.notify_all();
+  };
+  s.steps = std::make_unique<dds::Subscriber<dds::msg::SimStep>>(
+      participant, topics.sim_step, dds::EndpointOptions{.kind = dds::TopicKind::state, .on_status = on_status},
+      [&inboxes, k](const dds::msg::SimStep& step) {
+        const std::lock_guard lock(inboxes.mutex);
+        inboxes.slots[k].steps.push_back(step);
+        inboxes.cv.notify_all();
+      });
+}
+
+void print_world(std::ostream& out, const SharedWorldArgs& a, const std::vector<Slot>& slots, std::uint64_t seed) {
+  out << "tripodal sim-server: one world for " << slots.size() << " robots";
+  if (a.fleet.empty()) out << " (" << slots.front().base->first << ", " << slots.front().base->second.type << " base)";
+  out << ", world " << a.world.string() << ", seed " << seed << "; domain " << a.domain << ", namespaces " << slots.front().ns
+      << " to " << slots.back().ns << "\n";
+  for (const Slot& s : slots) {
+    out << "  " << s.ns << " starts at (" << app::fixed(s.start.x_m, 2) << ", " << app::fixed(s.start.y_m, 2) << ", "
+        << app::fixed(s.start.theta_rad, 3) << ")";
+    if (!a.fleet.empty()) out << ": " << s.base->first << ", " << s.base->second.type << " base";
+    out << "\n";
+  }
+  out.flush();
+}
+
+// Waits for a round's requests: the round starts with the first request and waits for every
+// expected robot, at most `stall`. Takes one request per robot, and who left or joined.
+void gather_round(Inboxes& inboxes, const std::vector<Slot>& slots, std::chrono::steady_clock::duration stall, Round& r) {
+  const std::size_t n = slots.size();
+  std::vector<SlotInbox>& inbox = inboxes.slots;
+  std::unique_lock lock(inboxes.mutex);
+  inboxes.cv.wait_for(lock, std::chrono::milliseconds(100), [&] {
+    return std::any_of(inbox.begin(), inbox.end(), [](const SlotInbox& in) { return !in.steps.empty() || in.left; });
+  });
+  const auto round_start = std::chrono::steady_clock::now();
+  auto complete = [&] {
+    for (std::size_t k = 0; k < n; ++k) {
+      if (inbox[k].left) return true;
+      if (slots[k].expected && inbox[k].steps.empty()) return false;
+    }
+    return true;
+  };
+  if (std::any_of(inbox.begin(), inbox.end(), [](const SlotInbox& in) { return !in.steps.empty(); })) {
+    inboxes.cv.wait_until(lock, round_start + stall, complete);
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    SlotInbox& in = inbox[k];
+    r.steps[k].reset();
+    if (!in.steps.empty()) {
+      r.steps[k] = in.steps.front();
+      in.steps.pop_front();
+    }
+    if (in.left) {
+      r.left[k] = in.left_why;
+      in.left = false;
+      in.steps.clear();
+      r.steps[k].reset();
+    } else if (r.steps[k] && !slots[k].sim) {
+      r.joined[k] = 1;
+    }
+  }
+}
+
+// A robot's step writer is matched, or its requests wait.
+bool anyone_connected(Inboxes& inboxes) {
+  const std::lock_guard lock(inboxes.mutex);
+  return std::any_of(inboxes.slots.begin(), inboxes.slots.end(),
+                     [](const SlotInbox& in) { return in.connected || !in.steps.empty(); });
+}
+
+// The world as the serving thread runs it: the robots' bodies come, step and go; the figures of
+// the whole run.
+class SharedWorld {
+ public:
+  SharedWorld(const sim::World& world, std::uint64_t seed, std::vector<Slot>& slots, std::ostream& out)
+      : world_(world), seed_(seed), slots_(slots), out_(out), began_(std::chrono::steady_clock::now()) {
+    others_.reserve(slots.size());
+  }
+
+  // Rounds until a signal, every robot gone, or none came within `a.wait_s`; the exit code.
+  int serve_rounds(const SharedWorldArgs& a, Inboxes& inboxes);
+  void depart(Slot& s, const std::string& why);
+  void print_end(std::ostream& out) const {
+    out << "sim-server ended: " << ended_ << "; " << rounds_ << " rounds; robot-robot contacts: " << contacts_
+        << "; closest approach between robots: "
+        << (std::isfinite(min_clearance_m_) ? app::fixed(min_clearance_m_, 3) + " m" : std::string("none (never two robots)"))
+        << "\n";
+  }
+
+ private:
+  void arrive(Slot& s);
+  void serve(Slot& s, const dds::msg::SimStep& step);
+  void publish_scan(Slot& s);
+  void publish_state(Slot& s);
+  [[nodiscard]] std::string elapsed() const {
+    return app::fixed(std::chrono::duration<double>(std::chrono::steady_clock::now() - began_).count(), 1) + " s  ";
+  }
+
+  const sim::World& world_;
+  std::uint64_t seed_;
+  std::vector<Slot>& slots_;
+  std::ostream& out_;
+  std::chrono::steady_clock::time_point began_;
+  std::uint64_t contacts_ = 0, rounds_ = 0;
+  double min_clearance_m_ = std::numeric_limits<double>::infinity();
+  bool any_came_ = false;
+  std::string ended_ = "stopped";
+  std::vector<sim::OtherBody> others_;
+};
+
+// A robot that leaves: its figures, its body out of the world.
+void SharedWorld::depart(Slot& s, const std::string& why) {
+  if (!s.sim) return;
+  contacts_ += s.sim->robot_collisions();
+  min_clearance_m_ = std::min(min_clearance_m_, s.sim->min_robot_clearance_m());
+  out_ << elapsed() << s.ns << " " << why << ": " << s.steps_served << " steps, " << app::fixed(to_seconds(s.sim->now()), 2)
+       << " s simulated, distance " << app::fixed(s.sim->distance_m(), 2) << " m, " << s.sim->collisions() << " collisions ("
+       << s.sim->robot_collisions() << " with robots)\n";
+  for (const sim::SimEvent& e : s.sim->events()) {
+    out_ << "    " << s.ns << " " << app::fixed(to_seconds(e.stamp), 3) << " s  simulator: " << sim::to_string(e.kind)
+         << (e.detail.empty() ? "" : " " + e.detail) << '\n';
+  }
+  out_.flush();
+  s.sim.reset();
+  s.expected = false;
+}
+
+// A robot that asks its first step: a fresh body at its slot's start pose.
+void SharedWorld::arrive(Slot& s) {
+  s.sim = std::make_unique<sim::Simulator>(world_, s.base->second, seed_);
+  if (!s.sim->set_pose(s.start)) throw std::runtime_error(s.ns + "'s start pose is not free");
+  const std::size_t w = s.sim->wheel_count();
+  s.js = {};
+  s.js.header.frame_id = "base_link";
+  s.js.name = wheel_names(w);
+  s.ls = {};
+  s.ls.header.frame_id = "laser";
+  s.velocity.assign(w, 0.0);
+  s.position.assign(w, 0.0);
+  s.scans = s.joint_states = s.last_step = 0;
+  s.laser_seen = 0;
+  s.steps_served = 0;
+  any_came_ = true;
+  out_ << elapsed() << s.ns << " joined at (" << app::fixed(s.start.x_m, 2) << ", " << app::fixed(s.start.y_m, 2) << ")\n";
+  out_.flush();
+}
+
+// Its laser's scan when there is a new one.
+void SharedWorld::publish_scan(Slot& s) {
+  const LaserResource& laser = s.sim->laser();
+  if (laser.sequence() == s.laser_seen || !laser.has_reading()) return;
+  s.laser_seen = laser.sequence();
+  const LaserScan& l = laser.latest();
+  s.ls.header.stamp = dds::ros_time(l.stamp);
+  s.ls.angle_min = static_cast<float>(l.angle_min_rad);
+  s.ls.angle_max = static_cast<float>(l.angle_max_rad);
+  s.ls.angle_increment = static_cast<float>(l.angle_increment_rad);
+  s.ls.time_increment = static_cast<float>(l.time_increment_s);
+  s.ls.scan_time = static_cast<float>(l.scan_time_s);
+  s.ls.range_min = static_cast<float>(l.range_min_m);
+  s.ls.range_max = static_cast<float>(l.range_max_m);
+  s.ls.ranges = l.ranges_m;
+  s.ls.intensities = l.intensities;
+  s.scan->publish(s.ls);
+  ++s.scans;
+}
+
+// Its wheels' joint states and the simulator's state (the true pose, the sensors).
+void SharedWorld::publish_state(Slot& s) {
+  sim::Simulator& sim = *s.sim;
+  s.js.header.stamp = dds::ros_time(sim.now());
+  if (sim.read_wheel_states(s.velocity, s.position)) {
+    s.js.position = s.position;
+    s.js.velocity = s.velocity;
+  } else {
+    s.js.position.clear();
+    s.js.velocity.clear();
+  }
+  s.joints->publish(s.js);
+  ++s.joint_states;
+  const Pose2D& p = sim.pose();
+  dds::msg::SimState state{dds::ros_time(sim.now()),
+                           p.x_m,
+                           p.y_m,
+                           p.theta_rad,
+                           sim.distance_m(),
+                           s.last_step,
+                           s.scans,
+                           s.joint_states,
+                           static_cast<std::uint32_t>(sim.collisions())};
+  put_sensors(state, sim);
+  s.state->publish(state);
+}
+
+// One robot's step, the others' bodies where they are now.
+void SharedWorld::serve(Slot& s, const dds::msg::SimStep& step) {
+  sim::Simulator& sim = *s.sim;
+  others_.clear();
+  for (std::size_t j = 0; j < slots_.size(); ++j) {
+    if (&slots_[j] == &s || !slots_[j].sim) continue;
+    const Pose2D& p = slots_[j].sim->pose();
+    others_.push_back({{p.x_m, p.y_m}, slots_[j].sim->world().robot.radius_m, static_cast<std::uint32_t>(j + 1)});
+  }
+  sim.set_other_bodies(others_);
+  sim.command_twist(Twist2D{step.cmd_vel.linear.x, step.cmd_vel.linear.y, step.cmd_vel.angular.z});
+  sim.step_until(dds::tripodal_time(step.until));
+  publish_scan(s);
+  s.last_step = step.step;
+  ++s.steps_served;
+  publish_state(s);
+  s.expected = true;
+}
+
+int SharedWorld::serve_rounds(const SharedWorldArgs& a, Inboxes& inboxes) {
+  const std::size_t n = slots_.size();
+  const auto stall = std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(a.stall_s));
+  Round r;
+  r.steps.resize(n);
+  while (g_stop == 0) {
+    r.left.assign(n, std::string());
+    r.joined.assign(n, 0);
+    gather_round(inboxes, slots_, stall, r);
+    for (std::size_t k = 0; k < n; ++k) {
+      if (!r.left[k].empty()) depart(slots_[k], r.left[k]);
+      if (r.joined[k] != 0) arrive(slots_[k]);
+    }
+    bool stepped = false;
+    for (std::size_t k = 0; k < n; ++k) {
+      Slot& s = slots_[k];
+      if (r.steps[k] && s.sim) {
+        serve(s, *r.steps[k]);
+        stepped = true;
+      } else if (s.expected) {
+        s.expected = false;  // stalled: it stands still until it asks again
+      }
+    }
+    if (stepped) ++rounds_;
+    const bool anyone = std::any_of(slots_.begin(), slots_.end(), [](const Slot& s) { return s.sim != nullptr; });
+    const bool connected = anyone_connected(inboxes);
+    if (any_came_ && !anyone && !connected) {
+      ended_ = "every robot left";
+      return kOk;
+    }
+    if (!any_came_ && !connected && a.wait_s > 0.0 &&
+        std::chrono::steady_clock::now() - began_ > std::chrono::duration<double>(a.wait_s)) {
+      ended_ = "no robot came within " + app::fixed(a.wait_s, 1) + " s";
+      return kNoRobot;
+    }
+  }
+  return kOk;
+}
+
+}  // namespace
+
+int run_shared_world(const SharedWorldArgs& a, std::ostream& out, std::ostream& err) {
+  if (const int code = check_shared_args(a, err); code != kOk) return code;
   try {
     const std::vector<FleetMember> members =
         a.fleet.empty() ? numbered_fleet(a.robots, a.robot, a.prefix) : load_fleet_file(a.fleet);
-    // Each robot's base is its own profile's (a fleet file may mix an omni PSR-2 and a
-    // differential robot); profiles read once each.
-    std::map<std::filesystem::path, std::pair<std::string, ControllerConfig>> bases;
-    for (const FleetMember& m : members) {
-      if (bases.count(m.profile) != 0) continue;
-      const RobotProfile profile = load_robot_profile(m.profile);
-      RobotPlugins plugins;
-      app::register_tool_plugins(plugins, nullptr, profile, {});
-      const std::optional<ControllerConfig> base = base_controller_config(profile, plugins.controllers);
-      if (!base)
-        throw ConfigError(profile.where,
-                          "tripodal sim-server simulates the robot's base: the profile needs a loop with a controller");
-      bases.emplace(m.profile, std::make_pair(profile.name, *base));
-    }
+    const Bases bases = load_bases(members);
     const sim::World world = sim::load_world(a.world);
     const std::uint64_t seed = a.seed.value_or(world.seed);
     const std::size_t n = members.size();
     const std::vector<Pose2D> starts = fleet_starts(world, members);
 
-    dds::ParticipantOptions po;
-    po.domain_id = a.domain;
-    po.network = a.system_network ? dds::Network::system : dds::Network::loopback;
-    po.participant_lease = std::chrono::milliseconds(static_cast<std::int64_t>(a.lease_s * 1000.0));
-    dds::Participant participant(po);
-
-    std::mutex mutex;
-    std::condition_variable cv;
-    std::vector<SlotInbox> inbox(n);
+    dds::Participant participant(participant_options(a));
+    Inboxes inboxes(n);
     std::vector<Slot> slots(n);
-    dds::Qos scan_qos = dds::qos_for(dds::TopicKind::scan, dds::Role::publisher);
-    scan_qos.reliability = dds::Reliability::reliable;  // a lock-step robot counts on every scan
     for (std::size_t k = 0; k < n; ++k) {
       Slot& s = slots[k];
       s.ns = members[k].ns;
       s.start = starts[k];
       s.base = &bases.at(members[k].profile);
-      const dds::BaseTopics topics(s.ns);
-      s.scan = std::make_unique<dds::Publisher<dds::msg::LaserScan>>(
-          participant, topics.scan, dds::EndpointOptions{.kind = dds::TopicKind::scan, .qos = scan_qos});
-      s.joints = std::make_unique<dds::Publisher<dds::msg::JointState>>(participant, topics.joint_states,
-                                                                        dds::EndpointOptions{.kind = dds::TopicKind::state});
-      s.state = std::make_unique<dds::Publisher<dds::msg::SimState>>(participant, topics.sim_state,
-                                                                     dds::EndpointOptions{.kind = dds::TopicKind::state});
-      auto on_status = [&mutex, &cv, &inbox, k](const dds::StatusEvent& e) {
-        if (e.kind != dds::StatusKind::publication_matched && e.kind != dds::StatusKind::liveliness_lost) return;
-        const std::lock_guard lock(mutex);
-        SlotInbox& in = inbox[k];
-        if (e.current_count > 0) {
-          in.connected = true;
-        } else if (in.connected) {
-          in.connected = false;
-          in.left = true;
-          in.left_why = e.kind == dds::StatusKind::liveliness_lost ? "left or went silent (DDS liveliness lost)" : "left";
-        }
-        cv.notify_all();
-      };
-      s.steps = std::make_unique<dds::Subscriber<dds::msg::SimStep>>(
-          participant, topics.sim_step, dds::EndpointOptions{.kind = dds::TopicKind::state, .on_status = on_status},
-          [&mutex, &cv, &inbox, k](const dds::msg::SimStep& step) {
-            const std::lock_guard lock(mutex);
-            inbox[k].steps.push_back(step);
-            cv.notify_all();
-          });
+      open_slot(s, k, participant, inboxes);
     }
 
     std::signal(SIGINT, on_shared_server_stop_signal);
     std::signal(SIGTERM, on_shared_server_stop_signal);
-    out << "tripodal sim-server: one world for " << n << " robots";
-    if (a.fleet.empty()) out << " (" << slots.front().base->first << ", " << slots.front().base->second.type << " base)";
-    out << ", world " << a.world.string() << ", seed " << seed << "; domain " << a.domain << ", namespaces " << slots.front().ns
-        << " to " << slots.back().ns << "\n";
-    for (const Slot& s : slots) {
-      out << "  " << s.ns << " starts at (" << app::fixed(s.start.x_m, 2) << ", " << app::fixed(s.start.y_m, 2) << ", "
-          << app::fixed(s.start.theta_rad, 3) << ")";
-      if (!a.fleet.empty()) out << ": " << s.base->first << ", " << s.base->second.type << " base";
-      out << "\n";
-    }
-    out.flush();
-
-    const auto began = std::chrono::steady_clock::now();
-    auto elapsed = [&] {
-      return app::fixed(std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count(), 1) + " s  ";
-    };
-    std::uint64_t contacts = 0, rounds = 0;
-    double min_clearance_m = std::numeric_limits<double>::infinity();
-    bool any_came = false;
-    std::string ended = "stopped";
-    int code = kOk;
-    std::vector<sim::OtherBody> others;
-    others.reserve(n);
-
-    // A robot that leaves: its figures, its body out of the world.
-    auto depart = [&](Slot& s, const std::string& why) {
-      if (!s.sim) return;
-      contacts += s.sim->robot_collisions();
-      min_clearance_m = std::min(min_clearance_m, s.sim->min_robot_clearance_m());
-      out << elapsed() << s.ns << " " << why << ": " << s.steps_served << " steps, " << app::fixed(to_seconds(s.sim->now()), 2)
-          << " s simulated, distance " << app::fixed(s.sim->distance_m(), 2) << " m, " << s.sim->collisions() << " collisions ("
-          << s.sim->robot_collisions() << " with robots)\n";
-      for (const sim::SimEvent& e : s.sim->events()) {
-        out << "    " << s.ns << " " << app::fixed(to_seconds(e.stamp), 3) << " s  simulator: " << sim::to_string(e.kind)
-            << (e.detail.empty() ? "" : " " + e.detail) << '\n';
-      }
-      out.flush();
-      s.sim.reset();
-      s.expected = false;
-    };
-    auto arrive = [&](Slot& s) {
-      s.sim = std::make_unique<sim::Simulator>(world, s.base->second, seed);
-      if (!s.sim->set_pose(s.start)) throw std::runtime_error(s.ns + "'s start pose is not free");
-      const std::size_t w = s.sim->wheel_count();
-      s.js = {};
-      s.js.header.frame_id = "base_link";
-      s.js.name = wheel_names(w);
-      s.ls = {};
-      s.ls.header.frame_id = "laser";
-      s.velocity.assign(w, 0.0);
-      s.position.assign(w, 0.0);
-      s.scans = s.joint_states = s.last_step = 0;
-      s.laser_seen = 0;
-      s.steps_served = 0;
-      any_came = true;
-      out << elapsed() << s.ns << " joined at (" << app::fixed(s.start.x_m, 2) << ", " << app::fixed(s.start.y_m, 2) << ")\n";
-      out.flush();
-    };
-    auto serve = [&](Slot& s, const dds::msg::SimStep& step) {
-      sim::Simulator& sim = *s.sim;
-      others.clear();
-      for (std::size_t j = 0; j < n; ++j) {
-        if (&slots[j] == &s || !slots[j].sim) continue;
-        const Pose2D& p = slots[j].sim->pose();
-        others.push_back({{p.x_m, p.y_m}, slots[j].sim->world().robot.radius_m, static_cast<std::uint32_t>(j + 1)});
-      }
-      sim.set_other_bodies(others);
-      sim.command_twist(Twist2D{step.cmd_vel.linear.x, step.cmd_vel.linear.y, step.cmd_vel.angular.z});
-      sim.step_until(dds::tripodal_time(step.until));
-      const LaserResource& laser = sim.laser();
-      if (laser.sequence() != s.laser_seen && laser.has_reading()) {
-        s.laser_seen = laser.sequence();
-        const LaserScan& l = laser.latest();
-        s.ls.header.stamp = dds::ros_time(l.stamp);
-        s.ls.angle_min = static_cast<float>(l.angle_min_rad);
-        s.ls.angle_max = static_cast<float>(l.angle_max_rad);
-        s.ls.angle_increment = static_cast<float>(l.angle_increment_rad);
-        s.ls.time_increment = static_cast<float>(l.time_increment_s);
-        s.ls.scan_time = static_cast<float>(l.scan_time_s);
-        s.ls.range_min = static_cast<float>(l.range_min_m);
-        s.ls.range_max = static_cast<float>(l.range_max_m);
-        s.ls.ranges = l.ranges_m;
-        s.ls.intensities = l.intensities;
-        s.scan->publish(s.ls);
-        ++s.scans;
-      }
-      s.js.header.stamp = dds::ros_time(sim.now());
-      if (sim.read_wheel_states(s.velocity, s.position)) {
-        s.js.position = s.position;
-        s.js.velocity = s.velocity;
-      } else {
-        s.js.position.clear();
-        s.js.velocity.clear();
-      }
-      s.joints->publish(s.js);
-      ++s.joint_states;
-      s.last_step = step.step;
-      ++s.steps_served;
-      const Pose2D& p = sim.pose();
-      dds::msg::SimState state{dds::ros_time(sim.now()),
-                               p.x_m,
-                               p.y_m,
-                               p.theta_rad,
-                               sim.distance_m(),
-                               s.last_step,
-                               s.scans,
-                               s.joint_states,
-                               static_cast<std::uint32_t>(sim.collisions())};
-      put_sensors(state, sim);
-      s.state->publish(state);
-      s.expected = true;
-    };
-
-    const auto stall = std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(a.stall_s));
-    std::vector<std::optional<dds::msg::SimStep>> this_round(n);
-    while (g_stop == 0) {
-      std::vector<std::string> left(n);
-      std::vector<char> joined(n, 0);
-      {
-        std::unique_lock lock(mutex);
-        // A round starts with the first request and waits for every expected robot, at most `stall`.
-        cv.wait_for(lock, std::chrono::milliseconds(100), [&] {
-          return std::any_of(inbox.begin(), inbox.end(), [](const SlotInbox& in) { return !in.steps.empty() || in.left; });
-        });
-        const auto round_start = std::chrono::steady_clock::now();
-        auto complete = [&] {
-          for (std::size_t k = 0; k < n; ++k) {
-            if (inbox[k].left) return true;
-            if (slots[k].expected && inbox[k].steps.empty()) return false;
-          }
-          return true;
-        };
-        if (std::any_of(inbox.begin(), inbox.end(), [](const SlotInbox& in) { return !in.steps.empty(); })) {
-          cv.wait_until(lock, round_start + stall, complete);
-        }
-        for (std::size_t k = 0; k < n; ++k) {
-          SlotInbox& in = inbox[k];
-          this_round[k].reset();
-          if (!in.steps.empty()) {
-            this_round[k] = in.steps.front();
-            in.steps.pop_front();
-          }
-          if (in.left) {
-            left[k] = in.left_why;
-            in.left = false;
-            in.steps.clear();
-            this_round[k].reset();
-          } else if (this_round[k] && !slots[k].sim) {
-            joined[k] = 1;
-          }
-        }
-      }
-      for (std::size_t k = 0; k < n; ++k) {
-        if (!left[k].empty()) depart(slots[k], left[k]);
-        if (joined[k] != 0) arrive(slots[k]);
-      }
-      bool stepped = false;
-      for (std::size_t k = 0; k < n; ++k) {
-        Slot& s = slots[k];
-        if (this_round[k] && s.sim) {
-          serve(s, *this_round[k]);
-          stepped = true;
-        } else if (s.expected) {
-          s.expected = false;  // stalled: it stands still until it asks again
-        }
-      }
-      if (stepped) ++rounds;
-      const bool anyone = std::any_of(slots.begin(), slots.end(), [](const Slot& s) { return s.sim != nullptr; });
-      bool connected = false;
-      {
-        const std::lock_guard lock(mutex);
-        connected =
-            std::any_of(inbox.begin(), inbox.end(), [](const SlotInbox& in) { return in.connected || !in.steps.empty(); });
-      }
-      if (any_came && !anyone && !connected) {
-        ended = "every robot left";
-        break;
-      }
-      if (!any_came && !connected && a.wait_s > 0.0 &&
-          std::chrono::steady_clock::now() - began > std::chrono::duration<double>(a.wait_s)) {
-        ended = "no robot came within " + app::fixed(a.wait_s, 1) + " s";
-        code = kNoRobot;
-        break;
-      }
-    }
-    for (Slot& s : slots) depart(s, "was here at the end");
-    out << "sim-server ended: " << ended << "; " << rounds << " rounds; robot-robot contacts: " << contacts
-        << "; closest approach between robots: "
-        << (std::isfinite(min_clearance_m) ? app::fixed(min_clearance_m, 3) + " m" : std::string("none (never two robots)"))
-        << "\n";
+    print_world(out, a, slots, seed);
+    SharedWorld shared(world, seed, slots, out);
+    const int code = shared.serve_rounds(a, inboxes);
+    for (Slot& s : slots) shared.depart(s, "was here at the end");
+    shared.print_end(out);
     return code;
   } catch (const ConfigError& e) {
     err << e.what() << '\n';

@@ -458,7 +458,7 @@ void GuidedVisit::finish() {
   // Whatever ended the run, the base is left at rest before the devices close.
   const sim::Simulator& sim = sim_;
   const BaseStop rest = stop_base(
-      *robot_, [&sim] { return std::vector<double>(sim.wheel_commands().begin(), sim.wheel_commands().end()); }, kPeriod);
+      *robot_, clock_, [&sim] { return std::vector<double>(sim.wheel_commands().begin(), sim.wheel_commands().end()); }, kPeriod);
   res_.base_command_at_end_rad_s = rest.command_rad_s;
   res_.base_at_rest = rest.at_rest;
   flush_life();
