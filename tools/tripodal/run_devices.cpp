@@ -198,6 +198,7 @@ class DeviceMeasures {
   double half_width_;
   bool measured_busy_ = false, was_cleaning_ = false, link_up_ = false;
   std::uint64_t losses_seen_ = 0;
+  std::uint64_t resyncs_at_loss_ = 0;  // the link's resyncs when losses_seen_ last rose
   Pose2D last_;
   Time next_sample_{};
   std::size_t printed_ = 0;
@@ -210,7 +211,14 @@ void DeviceMeasures::watch_link(Time now) {
       r != nullptr && r->has_reading()) {
     const board::BoardLinkReading& l = r->latest();
     if (l.stats.link_losses > losses_seen_) {
+      // Back and lost again between two samples of this loop: the SYNC answered since the previous
+      // loss says that outage ended, before this loss (the link's own stamp of it).
+      if (!dev_.outages.empty() && dev_.outages.back().restored_s < 0.0 && l.stats.resyncs > resyncs_at_loss_) {
+        dev_.outages.back().restored_s = to_seconds(l.lost_at);
+        log(now, "board: link restored and lost again since the last look");
+      }
       losses_seen_ = l.stats.link_losses;
+      resyncs_at_loss_ = l.stats.resyncs;
       dev_.outages.push_back({to_seconds(now), -1.0, -1.0});
       log(now, fmt::format("board: link lost ({} missed, {} port failures so far): the motors stop", l.stats.missed,
                            l.stats.port_failures));
