@@ -114,10 +114,10 @@ bool BackOffReflex::update(bool triggered, Time now, double heading_rad, Side si
     hold_until_ = now + from_seconds(options_.hold_s);
   }
   if (phase_ == Phase::holding) {
-    // Ahead: released once turned well away (a detour). From a side: once heading no more toward
-    // that side than at the contact, the arc having moved the body off it.
-    const bool turned_away =
-        side_ == Side::ahead ? std::abs(turn_toward_side_rad()) > options_.release_turn_rad : turn_toward_side_rad() <= 0.0;
+    // Ahead: released once turned well away (a detour). From a side: once heading about along the
+    // obstacle again (the way on), the arc having moved the body off it.
+    const bool turned_away = side_ == Side::ahead ? std::abs(turn_toward_side_rad()) > options_.release_turn_rad
+                                                  : turn_toward_side_rad() <= options_.side_release_rad;
     if (now >= hold_until_ || turned_away) phase_ = Phase::idle;
   }
   return fresh;
@@ -232,7 +232,11 @@ const ModuleManifest& BhBumperGuard::static_manifest() {
                "away from along an arc, not straight along the obstacle",
                0.0, 3.2),
         number("side_turn_rad", 0.6, "rad",
-               "the arc backed from a side contact turns this far over back_off_m (the rear away from the contact)", 0.0, 1.6)};
+               "the arc backed from a side contact turns this far over back_off_m (the rear away from the contact)", 0.0, 1.6),
+        number("side_release_rad", 0.3, "rad",
+               "after a side contact the hold ends once the robot heads no more than this toward that side (relative to "
+               "its heading at the contact): the way on along the obstacle",
+               0.0, 1.6)};
     for (ParameterSpec& s : reflex_parameters(0.1)) p.push_back(std::move(s));
     return behavior_manifest("BhBumperGuard",
                              "bump safety reflex: a front bump switch stops the robot and backs it off (along an arc "
@@ -253,6 +257,12 @@ void BhBumperGuard::on_activate(const ParameterSet& params, const BehaviorContex
   side_angle_rad_ = params.number("side_angle_rad");
   BackOffReflex::Options options = reflex_options(params);
   options.side_turn_rad = params.number("side_turn_rad");
+  options.side_release_rad = params.number("side_release_rad");
+  if (options.side_turn_rad > 0.0 && options.side_release_rad >= options.side_turn_rad) {
+    throw ConfigError(SourceLocation{}, "BhBumperGuard: side_release_rad (" + std::to_string(options.side_release_rad) +
+                                            ") must be less than side_turn_rad (" + std::to_string(options.side_turn_rad) +
+                                            "), else the hold after a side contact ends as the backing does");
+  }
   reflex_.configure(options);
   reflex_.reset();
   hazard_count_ = 0;

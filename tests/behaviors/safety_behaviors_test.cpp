@@ -288,9 +288,9 @@ TEST_CASE("BhBumperGuard: a bump on a side backs the robot off along an arc away
     CHECK(w.navi.map_from_base.x_m < 1.0);
     REQUIRE(w.step(guard).has_value());  // holding: no forward motion toward the glass
     CHECK(w.step(guard)->vx_hi_m_s == 0.0);
-    w.navi.map_from_base.theta_rad = 0.3;  // turning back: still heading toward the glass
+    w.navi.map_from_base.theta_rad = 0.4;  // turning back: still heading toward the glass
     REQUIRE(w.step(guard).has_value());
-    w.navi.map_from_base.theta_rad = -0.01;  // along it again (or away): the way on is free
+    w.navi.map_from_base.theta_rad = 0.25;  // about along it again (side_release_rad 0.3): the way on is free
     CHECK_FALSE(w.step(guard).has_value());
   }
   SECTION("right") {
@@ -308,4 +308,12 @@ TEST_CASE("BhBumperGuard: a bump on a side backs the robot off along an arc away
     CHECK(e->wz_lo_rad_s == 0.0);
     CHECK(e->wz_hi_rad_s == 0.0);
   }
+}
+
+TEST_CASE("BhBumperGuard: a side hold that would end as the backing does is refused, the parameters named",
+          "[behaviors][safety]") {
+  Readings w;
+  BhBumperGuard guard;
+  CHECK_THROWS_WITH(guard.activate(ParameterValues{{"side_turn_rad", Value{0.3}}, {"side_release_rad", Value{0.5}}}, w.ctx),
+                    Catch::Contains("side_release_rad (0.500000) must be less than side_turn_rad (0.300000)"));
 }

@@ -28,7 +28,8 @@ class BackOffReflex {
     double hold_s = 12.0;           ///< then no forward translation this long (rotation free)...
     double release_turn_rad = 1.0;  ///< ...unless the robot turned this far from its heading at the trigger
     double max_back_off_m = 0.4;    ///< backing while the trigger stays on stops here (a stuck sensor)
-    double side_turn_rad = 0.6;     ///< a trigger on a side: the backing arc turns this far over back_off_m
+    double side_turn_rad = 0.6;     ///< a trigger on a side: the backing arc turns this far over back_off_m...
+    double side_release_rad = 0.3;  ///< ...and the hold ends heading no more than this toward that side
   };
   enum class Phase : std::uint8_t { idle, backing, holding };
   /// Where the trigger is on the body. A differential base cannot move sideways, so straight back
@@ -48,8 +49,8 @@ class BackOffReflex {
   /// sequencing layer planned); a hold that lasts (no way around) outlasts the path follower's
   /// blocked timeout, which ends its activity with "path blocked" rather than driving at the
   /// hazard again and again. After a side trigger the way on may lie straight ahead, along the
-  /// obstacle the arc has moved the body off: the hold ends once the robot has turned back to its
-  /// heading at the trigger or beyond it, away from that side.
+  /// obstacle the arc has moved the body off: the hold ends once the robot has turned back to
+  /// within side_release_rad of its heading at the trigger toward that side, or beyond it.
   bool update(bool triggered, Time now, double heading_rad = 0.0, Side side = Side::ahead) noexcept;
   /// The envelope of the phase (nullopt when idle).
   [[nodiscard]] std::optional<VelocityEnvelope> envelope(Time now) const noexcept;
