@@ -222,6 +222,10 @@ struct ChannelRobot {
     RobotProfile profile = load_robot_profile(kConfigs / "robots/disinfection.yaml");
     // BoardMonitor out; BatteryMonitor stays: PrDockCharge's guards read its facts.
     std::erase_if(profile.modules, [](const ModuleEntry& m) { return m.type == "BoardMonitor"; });
+    // ...and with it the process that waits for its fact board_linked after a lost link, and the
+    // rules that insert it (no task runs here).
+    std::erase_if(profile.processes, [](const ProcessEntry& p) { return p.name == "PrBoardReconnect"; });
+    profile.recovery.clear();
     ModuleEntry lcd;
     lcd.kind = ModuleKind::behavior;
     lcd.name = lcd.type = "BhLcdText";
