@@ -93,12 +93,19 @@ void report_hazards(const BehaviorContext& context, const std::array<Pose2D, N>&
 
 // --- BackOffReflex ----------------------------------------------------------------------------
 
-bool BackOffReflex::update(bool triggered, Time now, double heading_rad) noexcept {
+double BackOffReflex::turn_toward_side_rad() const noexcept {
+  const double turn = std::remainder(heading_rad_ - heading0_rad_, 2.0 * std::numbers::pi);
+  return side_ == Side::right ? -turn : turn;
+}
+
+bool BackOffReflex::update(bool triggered, Time now, double heading_rad, Side side) noexcept {
   bool fresh = false;
+  heading_rad_ = heading_rad;
   if (triggered && phase_ != Phase::backing) {
     phase_ = Phase::backing;
     started_ = now;
     heading0_rad_ = heading_rad;
+    side_ = side;
     fresh = true;
   }
   if (triggered) back_until_ = now + from_seconds(options_.back_off_m / options_.back_speed_m_s);
@@ -106,10 +113,12 @@ bool BackOffReflex::update(bool triggered, Time now, double heading_rad) noexcep
     phase_ = Phase::holding;
     hold_until_ = now + from_seconds(options_.hold_s);
   }
-  if (phase_ == Phase::holding &&
-      (now >= hold_until_ ||
-       std::abs(std::remainder(heading_rad - heading0_rad_, 2.0 * std::numbers::pi)) > options_.release_turn_rad)) {
-    phase_ = Phase::idle;
+  if (phase_ == Phase::holding) {
+    // Ahead: released once turned well away (a detour). From a side: once heading about along the
+    // obstacle again (the way on), the arc having moved the body off it.
+    const bool turned_away = side_ == Side::ahead ? std::abs(turn_toward_side_rad()) > options_.release_turn_rad
+                                                  : turn_toward_side_rad() <= options_.side_release_rad;
+    if (now >= hold_until_ || turned_away) phase_ = Phase::idle;
   }
   return fresh;
 }
@@ -123,9 +132,17 @@ std::optional<VelocityEnvelope> BackOffReflex::envelope(Time now) const noexcept
       // Straight back, the way the robot came (the sensors look ahead of the wheels), no farther
       // than max_back_off_m: a trigger still on then (a stuck sensor) leaves the robot standing.
       const bool too_far = to_seconds(now - started_) * options_.back_speed_m_s >= options_.max_back_off_m;
-      e.vx_lo_m_s = e.vx_hi_m_s = too_far || now >= back_until_ ? 0.0 : -options_.back_speed_m_s;
+      const bool backs = !too_far && now < back_until_;
+      e.vx_lo_m_s = e.vx_hi_m_s = backs ? -options_.back_speed_m_s : 0.0;
       e.vy_lo_m_s = e.vy_hi_m_s = 0.0;
-      e.wz_lo_rad_s = e.wz_hi_rad_s = 0.0;
+      // From a side, an arc of side_turn_rad over back_off_m, rear away from the contact: turning
+      // toward the contact's side while backing (counter-clockwise for the left).
+      double wz = 0.0;
+      if (backs && side_ != Side::ahead && options_.back_off_m > 0.0 && turn_toward_side_rad() < options_.side_turn_rad) {
+        wz = options_.side_turn_rad * options_.back_speed_m_s / options_.back_off_m;
+        if (side_ == Side::right) wz = -wz;
+      }
+      e.wz_lo_rad_s = e.wz_hi_rad_s = wz;
       return e;
     }
     case Phase::holding:
@@ -209,9 +226,21 @@ const ModuleManifest& BhBumperGuard::static_manifest() {
         number("back_mask", 4.0, "", "bits of the bump switches at the back (pressed alone: no backing)", 0.0, 255.0),
         number("sectors", 4.0, "", "the switches' equal sectors round the body, sector 0 ahead (for the contact's place)", 1.0,
                32.0),
-        number("robot_radius_m", 0.25, "m", "radius of the circular footprint", 0.0, 5.0)};
+        number("robot_radius_m", 0.25, "m", "radius of the circular footprint", 0.0, 5.0),
+        number("side_angle_rad", 1.0, "rad",
+               "pressed sectors whose mean direction is this far or more off ahead are a contact on that side: backed "
+               "away from along an arc, not straight along the obstacle",
+               0.0, 3.2),
+        number("side_turn_rad", 0.6, "rad",
+               "the arc backed from a side contact turns this far over back_off_m (the rear away from the contact)", 0.0, 1.6),
+        number("side_release_rad", 0.3, "rad",
+               "after a side contact the hold ends once the robot heads no more than this toward that side (relative to "
+               "its heading at the contact): the way on along the obstacle",
+               0.0, 1.6)};
     for (ParameterSpec& s : reflex_parameters(0.1)) p.push_back(std::move(s));
-    return behavior_manifest("BhBumperGuard", "bump safety reflex: a front bump switch stops the robot and backs it off",
+    return behavior_manifest("BhBumperGuard",
+                             "bump safety reflex: a front bump switch stops the robot and backs it off (along an arc "
+                             "away from a contact on a side)",
                              {"bumpers"}, std::move(p));
   }();
   return m;
@@ -225,7 +254,16 @@ void BhBumperGuard::on_activate(const ParameterSet& params, const BehaviorContex
   back_mask_ = static_cast<std::uint32_t>(params.number("back_mask"));
   sectors_ = static_cast<std::uint32_t>(params.number("sectors"));
   radius_m_ = params.number("robot_radius_m");
-  reflex_.configure(reflex_options(params));
+  side_angle_rad_ = params.number("side_angle_rad");
+  BackOffReflex::Options options = reflex_options(params);
+  options.side_turn_rad = params.number("side_turn_rad");
+  options.side_release_rad = params.number("side_release_rad");
+  if (options.side_turn_rad > 0.0 && options.side_release_rad >= options.side_turn_rad) {
+    throw ConfigError(SourceLocation{}, "BhBumperGuard: side_release_rad (" + std::to_string(options.side_release_rad) +
+                                            ") must be less than side_turn_rad (" + std::to_string(options.side_turn_rad) +
+                                            "), else the hold after a side contact ends as the backing does");
+  }
+  reflex_.configure(options);
   reflex_.reset();
   hazard_count_ = 0;
   if (bumpers_ == nullptr) fail("no bumper resource");
@@ -235,16 +273,25 @@ std::optional<Twist2D> BhBumperGuard::on_step(const BehaviorContext& context) no
   std::uint32_t pressed = 0;
   if (bumpers_->is_fresh(context.now)) pressed = bumpers_->latest().pressed_mask;
   const std::uint32_t front = pressed & ~back_mask_;
-  if (front != 0 && context.navi != nullptr) {
-    hazard_count_ = 0;
-    for (std::uint32_t i = 0; i < sectors_ && i < 32 && hazard_count_ < hazards_.size(); ++i) {
-      if ((front & (1U << i)) == 0) continue;
-      const double a = 2.0 * std::numbers::pi * i / sectors_;
+  // The contact's mean direction (body frame): ahead, or on a side (left and right at once, a
+  // narrow gap, cancel out: ahead, straight back).
+  double sum_x = 0.0, sum_y = 0.0;
+  if (front != 0 && context.navi != nullptr) hazard_count_ = 0;
+  for (std::uint32_t i = 0; i < sectors_ && i < 32; ++i) {
+    if ((front & (1U << i)) == 0) continue;
+    const double a = 2.0 * std::numbers::pi * i / sectors_;
+    sum_x += std::cos(a);
+    sum_y += std::sin(a);
+    if (context.navi != nullptr && hazard_count_ < hazards_.size()) {
       const double r = radius_m_ + 0.05;
       hazards_[hazard_count_++] = to_map(context.navi->map_from_base, r * std::cos(a), r * std::sin(a));
     }
   }
-  (void)reflex_.update(front != 0, context.now, context.navi != nullptr ? context.navi->map_from_base.theta_rad : 0.0);
+  BackOffReflex::Side side = BackOffReflex::Side::ahead;
+  if (std::hypot(sum_x, sum_y) > 1e-6 && std::abs(std::atan2(sum_y, sum_x)) >= side_angle_rad_) {
+    side = sum_y > 0.0 ? BackOffReflex::Side::left : BackOffReflex::Side::right;
+  }
+  (void)reflex_.update(front != 0, context.now, context.navi != nullptr ? context.navi->map_from_base.theta_rad : 0.0, side);
   std::optional<VelocityEnvelope> e = reflex_.envelope(context.now);
   if (!e) hazard_count_ = 0;
   if ((pressed & back_mask_) != 0) {

@@ -3,6 +3,7 @@
 #include "tripodal/behaviors/safety_behaviors.hpp"
 
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <limits>
 
 #include "tripodal/behaviors/behavior_coordinator.hpp"
@@ -148,6 +149,8 @@ TEST_CASE("BhBumperGuard: a front bump backs off, a back bump alone forbids back
   REQUIRE(e.has_value());
   CHECK(e->vx_lo_m_s == -0.1);
   CHECK(e->vx_hi_m_s == -0.1);
+  CHECK(e->wz_lo_rad_s == 0.0);  // ahead: straight back, the way it came
+  CHECK(e->wz_hi_rad_s == 0.0);
   REQUIRE(w.feedback.hazard_count == 1);
   CHECK(w.feedback.hazards[0].x_m == Approx(1.3));  // radius 0.25 + 0.05 ahead
   w.set_bumps(0x4);                                 // the back one only (front released): no backing into it
@@ -240,4 +243,77 @@ TEST_CASE("BhCliffGuard: the hold ends early once the robot has turned away (tow
   REQUIRE(w.step(guard).has_value());
   w.navi.map_from_base.theta_rad = -1.1;  // turned away
   CHECK_FALSE(w.step(guard).has_value());
+}
+
+namespace {
+
+// The robot beside a wall (glass) its left (or right) side touches: the bump reflex drives it,
+// its commands integrated as a differential base moves (the reflex's envelope pinned, so the
+// command is the envelope). Returns the body's gap to the wall once the backing is done, and
+// leaves the robot holding.
+double back_from_side_bump(Readings& w, BhBumperGuard& guard, std::uint32_t sector_bit, double wall_side) {
+  w.navi.map_from_base = {1.0, 2.0, 0.0};
+  const double wall_y = 2.0 + wall_side * 0.255;  // 5 mm from the 0.25 m footprint
+  w.set_bumps(sector_bit);
+  for (int k = 0; k < 400; ++k) {
+    const auto e = w.step(guard);
+    REQUIRE(e.has_value());
+    if (e->vx_lo_m_s != e->vx_hi_m_s || e->wz_lo_rad_s != e->wz_hi_rad_s) break;  // holding
+    const double dt = 0.01, v = e->vx_lo_m_s, wz = e->wz_lo_rad_s;
+    Pose2D& p = w.navi.map_from_base;
+    p.x_m += v * std::cos(p.theta_rad) * dt;
+    p.y_m += v * std::sin(p.theta_rad) * dt;
+    p.theta_rad += wz * dt;
+    if (std::abs(p.y_m - wall_y) > 0.25 + 0.005) w.set_bumps(0);  // off the wall: released
+  }
+  CHECK(guard.take_signal().empty());
+  return std::abs(w.navi.map_from_base.y_m - wall_y) - 0.25;
+}
+
+}  // namespace
+
+// Driving along glass, a side switch pressed: straight back would slide the body along the glass
+// (a differential base cannot move sideways), so it backs along an arc whose rear swings away
+// from the contact, and drives on along the obstacle once heading along it again.
+TEST_CASE("BhBumperGuard: a bump on a side backs the robot off along an arc away from it, not along the obstacle",
+          "[behaviors][safety]") {
+  Readings w;
+  BhBumperGuard guard;  // the profile's: 4 sectors, sector 1 the left, 3 the right, back_off_m 0.1
+  guard.activate(ParameterValues{{"back_off_m", Value{0.1}}, {"hold_s", Value{12.0}}}, w.ctx);
+  SECTION("left") {
+    const double gap = back_from_side_bump(w, guard, 0x2, +1.0);
+    WARN("a left bump: the body 5 mm from the wall before, " << gap * 1000.0 << " mm after backing");
+    CHECK(gap > 0.025);
+    CHECK(w.navi.map_from_base.theta_rad == Approx(0.6).margin(0.02));  // the front turned toward the side
+    CHECK(w.navi.map_from_base.x_m < 1.0);
+    REQUIRE(w.step(guard).has_value());  // holding: no forward motion toward the glass
+    CHECK(w.step(guard)->vx_hi_m_s == 0.0);
+    w.navi.map_from_base.theta_rad = 0.4;  // turning back: still heading toward the glass
+    REQUIRE(w.step(guard).has_value());
+    w.navi.map_from_base.theta_rad = 0.25;  // about along it again (side_release_rad 0.3): the way on is free
+    CHECK_FALSE(w.step(guard).has_value());
+  }
+  SECTION("right") {
+    const double gap = back_from_side_bump(w, guard, 0x8, -1.0);
+    CHECK(gap > 0.025);
+    CHECK(w.navi.map_from_base.theta_rad == Approx(-0.6).margin(0.02));
+    w.navi.map_from_base.theta_rad = 0.01;
+    CHECK_FALSE(w.step(guard).has_value());
+  }
+  SECTION("both sides at once (a narrow gap): straight back") {
+    w.set_bumps(0xA);
+    const auto e = w.step(guard);
+    REQUIRE(e.has_value());
+    CHECK(e->vx_lo_m_s == -0.1);
+    CHECK(e->wz_lo_rad_s == 0.0);
+    CHECK(e->wz_hi_rad_s == 0.0);
+  }
+}
+
+TEST_CASE("BhBumperGuard: a side hold that would end as the backing does is refused, the parameters named",
+          "[behaviors][safety]") {
+  Readings w;
+  BhBumperGuard guard;
+  CHECK_THROWS_WITH(guard.activate(ParameterValues{{"side_turn_rad", Value{0.3}}, {"side_release_rad", Value{0.5}}}, w.ctx),
+                    Catch::Contains("side_release_rad (0.500000) must be less than side_turn_rad (0.300000)"));
 }

@@ -403,6 +403,40 @@ TEST_CASE("every shipped disinfection profile docks and charges on a low battery
   }
 }
 
+// Issue 35's closing note: disinfection.yaml had no rule for the board's link lost (its task failed)
+// and disinfection_lidar.yaml no safety reflex (its robot drove down a stairwell). Every shipped
+// disinfection profile now has both: the link lost waits for SYNC and retries the step, and the
+// cliff, bump and ultrasonic guards are safety inputs.
+TEST_CASE("every shipped disinfection profile recovers a lost board link and has the safety reflexes",
+          "[board][safety][config]") {
+  std::vector<std::filesystem::path> profiles;
+  for (const auto& e : std::filesystem::directory_iterator(kConfigs / "robots")) {
+    if (e.path().filename().string().starts_with("disinfection")) profiles.push_back(e.path());
+  }
+  REQUIRE(profiles.size() >= 2);
+  for (const std::filesystem::path& file : profiles) {
+    INFO(file.filename().string());
+    const RobotProfile profile = load_robot_profile(file);
+    CHECK(std::any_of(profile.processes.begin(), profile.processes.end(),
+                      [](const ProcessEntry& p) { return p.name == "PrBoardReconnect"; }));
+    REQUIRE_FALSE(profile.recovery.empty());
+    const RecoveryPolicy rules = RecoveryPolicy::load(profile.recovery);
+    for (const ProcessStep& step : {ProcessStep{"PrDisinfection", {{"section", "A", {}}}}, ProcessStep{"PrAutoMove", {}},
+                                    ProcessStep{"PrDockCharge", {}}}) {
+      INFO(step.process);
+      const RecoveryDecision lost = rules.decide(step, "module board failed: link lost", 0);
+      CHECK(lost.action == RecoveryAction::retry);
+      REQUIRE(lost.insert.size() == 1);
+      CHECK(lost.insert[0].process == "PrBoardReconnect");
+    }
+    for (const char* guard : {"BhCliffGuard", "BhBumperGuard", "BhSonarGuard"}) {
+      INFO(guard);
+      CHECK(std::any_of(profile.behaviors.begin(), profile.behaviors.end(),
+                        [&](const ModuleEntry& b) { return b.type == guard && b.safety; }));
+    }
+  }
+}
+
 TEST_CASE("the lidar profile: a low battery docks, charges and resumes the section where it stopped", "[board][charge]") {
   // The scan-matching localizer starts where the world puts the robot (room 2111), not at the
   // profile's charger pose.

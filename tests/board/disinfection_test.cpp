@@ -2,6 +2,7 @@
 // simulated board (hardware type "board", every exchange over the in-process line byte for byte),
 // the task "disinfect the room ..." through PrAutoMove and PrDisinfection.
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -154,7 +155,13 @@ TEST_CASE("PrDisinfection: a low battery ends the disinfection safely, lamp and 
   CHECK_FALSE(fw.atomizer());
 }
 
-TEST_CASE("the disinfection task faults within two periods of a dead board link, and the board stops the motors", "[board][disinfection]") {
+// The board's cable pulled mid-task and plugged in again 3 s later. The process faults within two
+// control periods, the board's watchdog stops the motors, the robot stands still while the link is
+// down, and the recovery rules (disinfection_recovery.yaml, as the lidar profile's) wait for SYNC
+// and take the section up again: the task ends in success. Before those rules were the plain
+// profile's the task failed with "module board failed: link lost".
+TEST_CASE("a dead board link stops the motors within two periods, and the task resumes once SYNC answers again",
+          "[board][disinfection]") {
   DisinfectionRobot r;
   board::BoardFirmware& fw = r.hw->embedded().firmware();
   REQUIRE(r.robot->command("disinfect the room 2111").accepted);
@@ -162,22 +169,39 @@ TEST_CASE("the disinfection task faults within two periods of a dead board link,
   REQUIRE(r.robot->planner().busy());
   const Time cut = r.clock.now();
   r.hw->embedded().line().host().set_connected(false);  // the cable pulled: no request reaches the board
-  Time failed_at{};
-  r.run_task(1.0, [&] {
-    if (!r.robot->planner().busy() && failed_at == Time{}) failed_at = r.clock.now();
-  });
+  r.run_task(1.0, [] {});
   const TaskReport& report = r.robot->planner().report();
   INFO(report.str());
-  REQUIRE(report.state == TaskState::failed);
-  CHECK_THAT(report.reason, Catch::Contains("module board failed: link lost"));
+  REQUIRE(r.robot->planner().busy());  // not ended: recovering
+  REQUIRE(report.recoveries.size() == 1);
+  CHECK(report.recoveries[0].fault == "module board failed: link lost");
+  CHECK(report.recoveries[0].new_plan == "PrBoardReconnect() -> PrDisinfection(section=A)");
   // The request already on the line at the cut is answered; the first lost one is sent at
   // cut + 10 ms, missed at the link's cycle 10 ms later, and the process faults 10 ms after that.
-  CHECK(failed_at - cut <= 30ms);
-  r.robot->run_for(300ms);  // the board's watchdog: 200 ms without a valid request
+  CHECK(report.recoveries[0].time - cut <= 30ms);
+  // The board's watchdog (200 ms without a valid request) has stopped the motors: the robot stands.
   CHECK(fw.counters().watchdog_trips == 1);
   CHECK(fw.link_lost());
   CHECK(fw.required_m_s(0) == 0.0);
   CHECK(fw.required_m_s(1) == 0.0);
+  const Pose2D stopped = r.hw->simulator().pose();
+  r.run_task(2.0, [] {});
+  CHECK(std::hypot(r.hw->simulator().pose().x_m - stopped.x_m, r.hw->simulator().pose().y_m - stopped.y_m) < 0.001);
+  // Plugged in again: SYNC answered, PrBoardReconnect succeeds, the section is taken up again.
+  r.hw->embedded().line().host().set_connected(true);
+  r.run_task(1500.0, [] {});
+  INFO(report.str());
+  CHECK(report.state == TaskState::succeeded);
+  CHECK(report.recoveries.size() == 1);
+  int reconnects = 0, disinfections = 0;
+  for (const ProcessRecord& p : report.processes) {
+    reconnects += p.step.process == "PrBoardReconnect" && p.success ? 1 : 0;
+    disinfections += p.step.process == "PrDisinfection" ? 1 : 0;
+  }
+  CHECK(reconnects == 1);
+  CHECK(disinfections == 2);  // the failed run and the one taken up again
+  CHECK(r.hw->board().link().synchronised());
+  CHECK(r.hw->board().link().stats().resyncs >= 1);
 }
 
 // --- the board's actuators as command channels -------------------------------------------------------
@@ -198,6 +222,10 @@ struct ChannelRobot {
     RobotProfile profile = load_robot_profile(kConfigs / "robots/disinfection.yaml");
     // BoardMonitor out; BatteryMonitor stays: PrDockCharge's guards read its facts.
     std::erase_if(profile.modules, [](const ModuleEntry& m) { return m.type == "BoardMonitor"; });
+    // ...and with it the process that waits for its fact board_linked after a lost link, and the
+    // rules that insert it (no task runs here).
+    std::erase_if(profile.processes, [](const ProcessEntry& p) { return p.name == "PrBoardReconnect"; });
+    profile.recovery.clear();
     ModuleEntry lcd;
     lcd.kind = ModuleKind::behavior;
     lcd.name = lcd.type = "BhLcdText";
