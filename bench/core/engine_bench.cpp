@@ -89,11 +89,12 @@ class PnpRing final : public PetriNetPlans::PetriNet<PetriNetPlans::Place, Petri
   explicit PnpRing(std::size_t n) {
     std::vector<PetriNetPlans::Place*> ring;
     for (std::size_t i = 0; i < n; ++i) {
-      ring.push_back(new PetriNetPlans::Place(i == 0 ? 1U : 0U));  // owned by the net (clearAll)
+      // PNP's net owns its nodes as raw pointers (deleted by clearAll).
+      ring.push_back(new PetriNetPlans::Place(i == 0 ? 1U : 0U));  // NOLINT(cppcoreguidelines-owning-memory)
       places.insert(ring.back());
     }
     for (std::size_t i = 0; i < n; ++i) {
-      auto* t = new PetriNetPlans::Transition();
+      auto* t = new PetriNetPlans::Transition();  // NOLINT(cppcoreguidelines-owning-memory)
       transitions.insert(t);
       addEdge(ring[i], t);
       addEdge(t, ring[(i + 1) % n]);
