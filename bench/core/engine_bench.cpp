@@ -3,8 +3,14 @@
 // second on a ring whose every transition waits for an event.
 #include <benchmark/benchmark.h>
 
-#include "instructions.hpp"
+#ifdef TRIPODAL_HAVE_PNP
+#include <pnp/petrinet.h>
+#endif
+
+#include <vector>
+
 #include "../../tests/core/engine_test_nets.hpp"
+#include "instructions.hpp"
 #include "tripodal/core/engine.hpp"
 
 using namespace tripodal;
@@ -70,6 +76,50 @@ void BM_OneFiringStep(benchmark::State& state) {
 }
 BENCHMARK(BM_OneFiringStep);
 [[maybe_unused]] const bool kOneFiringTwin = tripodal::bench::register_instruction_twin("BM_OneFiringStep", BM_OneFiringStep);
+
+// The peer's side of the one-firing comparison (issue 42 item 2): Petri Net Plans' PetriNet::fireAll
+// on the same ring of 10 places with one token, so each call fires one transition. PNP's net is a
+// header-only template (not in Debian): bench/core/CMakeLists.txt uses it when PNP_INCLUDE_DIR holds
+// pnp/petrinet.h (e.g. -DPNP_INCLUDE_DIR=PetriNetPlans/PNP/include), else the bench is skipped.
+#ifdef TRIPODAL_HAVE_PNP
+// PNP fills a net's place set through its XML instantiator only (a friend); a subclass builds the
+// ring in code.
+class PnpRing final : public PetriNetPlans::PetriNet<PetriNetPlans::Place, PetriNetPlans::Transition> {
+ public:
+  explicit PnpRing(std::size_t n) {
+    std::vector<PetriNetPlans::Place*> ring;
+    for (std::size_t i = 0; i < n; ++i) {
+      // PNP's net owns its nodes as raw pointers (deleted by clearAll).
+      ring.push_back(new PetriNetPlans::Place(i == 0 ? 1U : 0U));  // NOLINT(cppcoreguidelines-owning-memory)
+      places.insert(ring.back());
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      auto* t = new PetriNetPlans::Transition();  // NOLINT(cppcoreguidelines-owning-memory)
+      transitions.insert(t);
+      addEdge(ring[i], t);
+      addEdge(t, ring[(i + 1) % n]);
+    }
+    resetInitialMarking();
+  }
+};
+#endif
+
+void BM_PnpFireAll(benchmark::State& state) {
+#ifdef TRIPODAL_HAVE_PNP
+  PnpRing net(10);
+  std::size_t calls = 0;
+  for (auto _ : state) {
+    calls += net.fireAll() ? 1 : 0;
+  }
+  if (calls != static_cast<std::size_t>(state.iterations())) state.SkipWithError("a call fired nothing");
+  state.SetItemsProcessed(static_cast<std::int64_t>(calls));
+#else
+  state.SkipWithError(
+      "Petri Net Plans not found at configure time (not in Debian; -DPNP_INCLUDE_DIR=PetriNetPlans/PNP/include); "
+      "issue 42's figure: 128 ns per one-firing fireAll");
+#endif
+}
+BENCHMARK(BM_PnpFireAll);
 
 // Nothing enabled to fire: a step that only advances the time (most periods of a supervisor).
 void BM_IdleStep(benchmark::State& state) {

@@ -73,9 +73,10 @@ bool serve_until(BoardFirmware& firmware, int fd, const Clock& clock, Time deadl
   const Time now = clock.now();
   if (now >= deadline) return false;
   if (!wait_readable(fd, clock.wall_duration(deadline - now))) {
-    // A timeout, or a wake-up without bytes (a signal, a hung-up line): the rest of the wait as a
-    // sleep, so a caller looping until its tick never spins.
-    clock.sleep_until(deadline);
+    // A wake-up without bytes before the deadline (a signal, a hung-up line): the rest of the wait
+    // as a sleep, so a caller looping until its tick never spins. After the usual timeout the
+    // deadline has passed: no second system call, once per tick.
+    if (clock.now() < deadline) clock.sleep_until(deadline);
     return false;
   }
   firmware.on_receive(clock.now());

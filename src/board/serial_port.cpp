@@ -90,10 +90,19 @@ std::string_view mismatch_of(const termios& t, const BaudRate& rate) noexcept {
   throw std::runtime_error(fmt::format("{}: {}: {}", what, step, std::strerror(errno)));
 }
 
-// One bounded wait for input, then one non-blocking read.
+// One bounded wait for input, then one non-blocking read. Without a wait (the control loops and
+// the firmware take what has arrived, every cycle) the read comes first: when bytes are there it
+// is the only system call (the ppoll before it was a second one on the round trip's path). An
+// empty read is ambiguous (with VMIN = VTIME = 0 a tty reads 0 bytes both when nothing has
+// arrived and when the other end hung up), so the poll below still decides that case.
 std::ptrdiff_t read_fd(int fd, std::span<std::uint8_t> out, Duration wait) noexcept {
   if (fd < 0) return -1;
   if (out.empty()) return 0;
+  if (wait <= Duration{0}) {
+    const ssize_t n = ::read(fd, out.data(), out.size());
+    if (n > 0) return n;
+    if (n < 0 && errno != EAGAIN && errno != EINTR) return -1;
+  }
   pollfd p{fd, POLLIN, 0};
   const auto ns = wait.count();
   const timespec timeout{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};

@@ -69,6 +69,10 @@ struct Watch {
   TransitionIndex transition = 0;
   Tokens lo = 0;
   Tokens hi = std::numeric_limits<Tokens>::max();
+  // This bound is the transition's whole enabling condition (one Check, no guard): when it holds
+  // the transition is enabled without a call to check(). Most transitions of a sequencing net
+  // (one input place, no guard) are of this shape.
+  bool alone = false;
 };
 
 /// A set of small integers with O(log64 n) insert, erase and find-first: one bit per element at
@@ -185,6 +189,12 @@ class TimerHeap {
   [[nodiscard]] bool empty() const noexcept { return heap_.empty(); }
   [[nodiscard]] const Entry& top() const noexcept { return heap_.front(); }
   [[nodiscard]] bool contains(TransitionIndex t) const noexcept { return pos_[t] != kNone; }
+  /// The top is the only entry at its deadline (its children, the next candidates, are later).
+  [[nodiscard]] bool top_alone() const noexcept {
+    const std::size_t n = heap_.size();
+    const Time d = heap_.front().deadline;
+    return (n < 2 || heap_[1].deadline > d) && (n < 3 || heap_[2].deadline > d);
+  }
 
   void push(TransitionIndex t, Time deadline, std::uint32_t rank) noexcept {
     assert(heap_.size() < heap_.capacity());
@@ -347,15 +357,22 @@ struct Engine::Impl {
         std::span<const Value* const>(slots.data() + slot_begin[t], slot_begin[t + 1] - slot_begin[t]));
   }
 
-  // Immediate transitions, the common case, are handled inline; the others out of line.
+  // Immediate and delayed transitions, the common cases, are handled inline; event transitions
+  // out of line.
   void disable(TransitionIndex t) noexcept {
     TransitionCode& tc = code[t];
     if (!tc.enabled) return;
     tc.enabled = false;
     if (tc.kind == Kind::immediate) {
       ready.erase(tc.rank);
+    } else if (tc.kind == Kind::delayed) {
+      if (timers.contains(t)) {
+        timers.remove(t);
+      } else {
+        ready.erase(tc.rank);  // due: it waits in the ready set
+      }
     } else {
-      disable_timed_or_event(t);
+      disable_event(t);
     }
   }
 
@@ -364,30 +381,18 @@ struct Engine::Impl {
     tc.enabled = true;
     if (tc.kind == Kind::immediate) {
       ready.insert(tc.rank);
-    } else {
-      enable_timed_or_event(t);
-    }
-  }
-
-  [[gnu::noinline]] void disable_timed_or_event(TransitionIndex t) noexcept {
-    const TransitionCode& tc = code[t];
-    if (tc.kind == Kind::event) {
-      event_enabled[event_of[t]].erase(listener_pos[t]);
-    } else if (timers.contains(t)) {
-      timers.remove(t);
-    } else {
-      ready.erase(tc.rank);  // due: it waits in the ready set
-    }
-  }
-
-  [[gnu::noinline]] void enable_timed_or_event(TransitionIndex t) noexcept {
-    const TransitionCode& tc = code[t];
-    if (tc.kind == Kind::event) {
-      since[t] = now;  // an event transition with a delay passes events on until it has waited
-      event_enabled[event_of[t]].insert(listener_pos[t]);
-    } else {
+    } else if (tc.kind == Kind::delayed) {
       timers.push(t, now + delay[t], tc.rank);
+    } else {
+      enable_event(t);
     }
+  }
+
+  [[gnu::noinline]] void disable_event(TransitionIndex t) noexcept { event_enabled[event_of[t]].erase(listener_pos[t]); }
+
+  [[gnu::noinline]] void enable_event(TransitionIndex t) noexcept {
+    since[t] = now;  // an event transition with a delay passes events on until it has waited
+    event_enabled[event_of[t]].insert(listener_pos[t]);
   }
 
   void update(TransitionIndex t) noexcept {
@@ -413,7 +418,7 @@ struct Engine::Impl {
   }
 
   // Returns false when the livelock budget is exhausted (nothing fired then).
-  bool fire(TransitionIndex t, std::string_view event) {
+  [[gnu::always_inline]] bool fire(TransitionIndex t, std::string_view event) {
     if (instant_firings == options.max_firings_per_instant) [[unlikely]] {
       report_livelock();
       return false;
@@ -438,7 +443,7 @@ struct Engine::Impl {
         const bool holds = tokens >= w->lo && tokens <= w->hi;
         if (code[w->transition].enabled) {
           if (!holds) disable(w->transition);
-        } else if (holds && check(w->transition)) {
+        } else if (holds && (w->alone || check(w->transition))) {
           enable(w->transition);
         }
       }
@@ -544,6 +549,38 @@ struct Engine::Impl {
   [[nodiscard]] bool idle_until(Time to) const noexcept {
     return ready.empty() && (timers.empty() || timers.top().deadline > to);
   }
+  // One delayed transition falls due and nothing else is ready or due at its deadline: what most
+  // supervisor steps that fire do. It fires at once, as advance() would fire it (first in the ready
+  // set, which would hold it alone), without passing through the ready set.
+  // Called when the step is not idle: then an empty ready set means a timer is due.
+  [[nodiscard]] bool lone_timer_due() const noexcept { return ready.empty() && timers.top_alone(); }
+  bool fire_lone_timer() {
+    const Time due = timers.top().deadline;
+    if (due > now) {
+      now = due;
+      instant_firings = 0;
+    }
+    // Not in the ready set: if the firing disables it, or it restarts, the ready set's erase of its
+    // rank clears a bit that is already clear.
+    if (!fire(timers.pop(), {})) return false;
+    return settle();
+  }
+  // A step that is not idle. One timer due alone (a supervisor's common firing step) fires
+  // without advance()'s loops; what it enables settles, and anything else goes through advance().
+  // Out of line, so that the idle step does not save the registers this needs.
+  [[gnu::noinline]] void fire_until(Time to) {
+    if (lone_timer_due()) {
+      if (!fire_lone_timer()) return;
+      if (idle_until(to)) {
+        if (to > now) {
+          now = to;
+          instant_firings = 0;
+        }
+        return;
+      }
+    }
+    advance(to);
+  }
   void finish_step() {
     if (!touched_list.empty()) [[unlikely]]
       report_bound_changes();  // most steps change no bound place
@@ -624,8 +661,9 @@ void Engine::Impl::compile_structure() {
     code[t].check_begin = static_cast<std::uint32_t>(checks.size());
     const std::size_t first_change = changes.size();
     detail::fold_transition(net, tr, {}, checks, changes);
+    const bool alone = checks.size() - code[t].check_begin == 1 && code[t].guard == nullptr;
     for (std::size_t i = code[t].check_begin; i < checks.size(); ++i) {
-      place_watchers[checks[i].place].push_back(Watch{t, checks[i].lo, checks[i].hi});
+      place_watchers[checks[i].place].push_back(Watch{t, checks[i].lo, checks[i].hi, alone});
     }
     code[t].effect_begin = static_cast<std::uint32_t>(effects.size());
     for (std::size_t i = first_change; i < changes.size(); ++i) {
@@ -873,11 +911,10 @@ const StepResult& Engine::step(Time now) {
       m.now = now;
       m.instant_firings = 0;
     }
-    m.finish_step();  // bound places marked by a reset are reported by the first step
-    return m.result;
+  } else {
+    m.fire_until(now);
   }
-  m.advance(now);
-  m.finish_step();
+  m.finish_step();  // bound places marked by a reset are reported by the first step
   return m.result;
 }
 

@@ -307,3 +307,25 @@ TEST_CASE("serve_until wakes on a request's bytes over a pseudo-terminal and ans
   REQUIRE(got_total == n);
   CHECK(std::equal(in.begin(), in.begin() + static_cast<std::ptrdiff_t>(n), out.begin()));
 }
+
+// The board's loop times out in serve_until once per 1 ms tick: the timeout already ends at the
+// deadline, so the "rest of the wait" sleep (for a wake-up without bytes before it) must not be a
+// second system call then. A real clock that counts the sleeps it is asked for.
+TEST_CASE("serve_until's timeout at the deadline does not sleep again", "[board][serial][pty]") {
+  struct CountingClock final : Clock {
+    SteadyClock real;
+    mutable int sleeps = 0;
+    [[nodiscard]] Time now() const noexcept override { return real.now(); }
+    void sleep_until(Time deadline) const noexcept override {
+      ++sleeps;
+      real.sleep_until(deadline);
+    }
+  };
+  const CountingClock clock;
+  PseudoTerminal pty{clock};
+  StillPlant plant;
+  BoardFirmware board{FirmwareConfig{}, pty, plant, clock.now()};
+  // Nothing is sent: ppoll waits the whole 2 ms and returns at (or after) the deadline.
+  CHECK_FALSE(serve_until(board, pty.master_fd(), clock, clock.now() + 2ms));
+  CHECK(clock.sleeps == 0);
+}

@@ -356,6 +356,86 @@ TEST_CASE("due delayed transitions fire in deadline order, each with what it ena
   CHECK(h.firings()[2].time == at(3.0));
 }
 
+// step(now) without events fires a timer due alone on a path of its own (Engine::Impl::fire_until);
+// what it enables must still settle at its deadline, before later timers, and ties go through the
+// ready set in rank order.
+TEST_CASE("step(now): a timer due alone fires at its deadline, then what it enables, then later timers") {
+  PetriNet net;
+  net.add_place(make_place("a", 1));
+  net.add_place(make_place("b"));
+  net.add_place(make_place("c"));
+  net.add_place(make_place("d"));
+  net.add_place(make_place("x", 1));
+  net.add_place(make_place("y"));
+  Transition first = make_transition("first");
+  first.delay = from_seconds(1.0);
+  net.add_transition(std::move(first));
+  net.add_transition(make_transition("then"));  // immediate, enabled by first
+  Transition second = make_transition("second");
+  second.delay = from_seconds(1.0);
+  net.add_transition(std::move(second));
+  Transition tie = make_transition("tie");  // due at 2.0 with second; declared later: fires after it
+  tie.delay = from_seconds(2.0);
+  net.add_transition(std::move(tie));
+  net.add_arc("a", "first");
+  net.add_arc("first", "b");
+  net.add_arc("b", "then");
+  net.add_arc("then", "c");
+  net.add_arc("c", "second");
+  net.add_arc("second", "d");
+  net.add_arc("x", "tie");
+  net.add_arc("tie", "y");
+
+  SECTION("observed") {
+    Engine e(net);
+    HistoryRecorder h;
+    e.add_observer(h);
+    CHECK(e.step(at(0.5)).firings == 0);
+    const StepResult& r = e.step(at(1.5));
+    CHECK(r.ok());
+    CHECK(r.firings == 2);
+    REQUIRE(h.transition_ids() == Ids{"first", "then"});
+    CHECK(h.firings()[0].time == at(1.0));
+    CHECK(h.firings()[1].time == at(1.0));
+    CHECK(e.now() == at(1.5));
+    CHECK(e.step(at(10.0)).firings == 2);
+    REQUIRE(h.transition_ids() == Ids{"first", "then", "second", "tie"});
+    CHECK(h.firings()[2].time == at(2.0));
+    CHECK(h.firings()[3].time == at(2.0));
+    CHECK(e.now() == at(10.0));
+  }
+  SECTION("unobserved: one coarse step") {
+    Engine e(net);
+    const StepResult& r = e.step(at(10.0));
+    CHECK(r.ok());
+    CHECK(r.firings == 4);
+    CHECK(e.tokens(place_of(net, "d")) == 1);
+    CHECK(e.tokens(place_of(net, "y")) == 1);
+    CHECK_FALSE(e.next_deadline().has_value());
+  }
+}
+
+TEST_CASE("step(now): a timer due alone that starts an immediate cycle ends in a livelock") {
+  PetriNet net;
+  net.add_place(make_place("start", 1));
+  net.add_place(make_place("spin"));
+  Transition go = make_transition("go");
+  go.delay = from_seconds(1.0);
+  net.add_transition(std::move(go));
+  net.add_transition(make_transition("loop"));
+  net.add_arc("start", "go");
+  net.add_arc("go", "spin");
+  net.add_arc("spin", "loop");
+  net.add_arc("loop", "spin");
+  EngineOptions options;
+  options.max_firings_per_instant = 10;
+  Engine e(net, {}, options);
+  const StepResult& r = e.step(at(2.0));
+  CHECK(r.status == StepStatus::livelock);
+  CHECK(r.firings == 10);
+  CHECK(r.loop == std::vector<TransitionIndex>{*net.find_transition("loop")});
+}
+
 TEST_CASE("an event transition with a delay takes its event only after the delay") {
   PetriNet net;
   net.add_place(make_place("p", 1));
