@@ -7,6 +7,10 @@
 #include <string>
 #include <utility>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "tripodal/navi/distance_field.hpp"
 
 namespace tripodal::navi {
@@ -23,6 +27,13 @@ constexpr double kQualityScale = 0.05;
 constexpr int kCovarianceReach = 4;
 
 bool positive_finite(double v) { return std::isfinite(v) && v > 0.0; }
+
+// static_cast<int>(std::floor(v)) for v well within the range of int, without the floor's range
+// and sign handling: the cast truncates towards zero, one too high for a negative non-integer.
+int floor_int(double v) noexcept {
+  const int t = static_cast<int>(v);
+  return t - static_cast<int>(v < t);
+}
 
 }  // namespace
 
@@ -118,10 +129,12 @@ ScanMatcher::ScanMatcher(const OccupancyGrid& map, ScanMatcherOptions options, c
       free_sum_[at] = free_sum_[at - static_cast<std::size_t>(width_ + 1)] + row;
     }
   }
-  // Max-pooled pyramid for the global search, on the domain extended by pad_ below and left.
+  // Max-pooled pyramid for the searches, on the domain extended by pad_ cells of zeros on every side
+  // (a tile partly outside the grid still bounds its inside; the tracking search reads a point's
+  // cells near the grid's edges without a check each).
   const int levels = options_.global_levels;
   pad_ = 1 << levels;
-  const int ew = width_ + pad_, eh = height_ + pad_;
+  const int ew = width_ + 2 * pad_, eh = height_ + 2 * pad_;
   pooled_.assign(static_cast<std::size_t>(levels) + 1, std::vector<float>(static_cast<std::size_t>(ew) * eh, 0.0f));
   for (int y = 0; y < height_; ++y) {
     for (int x = 0; x < width_; ++x) {
@@ -153,6 +166,7 @@ ScanMatcher::ScanMatcher(const OccupancyGrid& map, ScanMatcherOptions options, c
   const std::size_t headings = 2 * static_cast<std::size_t>(nt) + 1;
   cx_.resize(headings * n);
   cy_.resize(headings * n);
+  at_.resize(headings * n);
   const std::size_t side = static_cast<std::size_t>(nx) + 1;
   blocks_.resize(headings * side * side);
 }
@@ -192,48 +206,152 @@ Pose2D ScanMatcher::from_grid(const GridPose& g) const noexcept {
   return {p.x_m, p.y_m, wrap_angle(g.theta + map_.origin().theta_rad)};
 }
 
-void ScanMatcher::rotate_points(double theta, double x, double y, std::size_t count, int* cx, int* cy) const noexcept {
+ScanMatcher::Rotated ScanMatcher::rotated(std::size_t heading, std::size_t count) noexcept {
+  const std::size_t from = heading * count;
+  return {cx_.data() + from, cy_.data() + from, at_.data() + from};
+}
+
+void ScanMatcher::rotate_points(double theta, double x, double y, std::size_t count, int reach,
+                                const Rotated& out) const noexcept {
   const double c = std::cos(theta) / cell_m_, s = std::sin(theta) / cell_m_;
-  for (std::size_t i = 0; i < count; ++i) {
-    cx[i] = static_cast<int>(std::floor(x + c * px_[i] - s * py_[i]));
-    cy[i] = static_cast<int>(std::floor(y + s * px_[i] + c * py_[i]));
+  const int ew = width_ + 2 * pad_;
+  auto place = [&](std::size_t i, int cx, int cy) {
+    out.cx[i] = cx;
+    out.cy[i] = cy;
+    const bool inside = cx - reach >= -pad_ && cx + reach < width_ + pad_ && cy - reach >= -pad_ && cy + reach < height_ + pad_;
+    out.at[i] = inside ? (cy + pad_) * ew + cx + pad_ : -1;
+  };
+  std::size_t i = 0;
+#if defined(__SSE2__)
+  // two points per pass in SSE2 doubles, each lane the scalar code's operations in its order
+  const __m128d vc = _mm_set1_pd(c), vs = _mm_set1_pd(s), vx = _mm_set1_pd(x), vy = _mm_set1_pd(y);
+  // inside: lo < cx < hi and the same in y, as place() below
+  const __m128i lo_x = _mm_set1_epi32(reach - pad_ - 1), hi_x = _mm_set1_epi32(width_ + pad_ - reach);
+  const __m128i lo_y = _mm_set1_epi32(reach - pad_ - 1), hi_y = _mm_set1_epi32(height_ + pad_ - reach);
+  const __m128i stride = _mm_set1_epi32(ew), base = _mm_set1_epi32(pad_ * ew + pad_);
+  for (; i + 2 <= count; i += 2) {
+    const __m128d px = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(px_.data() + i))));
+    const __m128d py = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(py_.data() + i))));
+    const __m128d u = _mm_sub_pd(_mm_add_pd(vx, _mm_mul_pd(vc, px)), _mm_mul_pd(vs, py));
+    const __m128d v = _mm_add_pd(_mm_add_pd(vy, _mm_mul_pd(vs, px)), _mm_mul_pd(vc, py));
+    // floor: truncated towards zero, then one less where that rose above (negative non-integers);
+    // the comparison's all-ones lanes are -1 as integers
+    const __m128i tu = _mm_cvttpd_epi32(u), tv = _mm_cvttpd_epi32(v);
+    const __m128i below_u = _mm_shuffle_epi32(_mm_castpd_si128(_mm_cmplt_pd(u, _mm_cvtepi32_pd(tu))), 0x08);
+    const __m128i below_v = _mm_shuffle_epi32(_mm_castpd_si128(_mm_cmplt_pd(v, _mm_cvtepi32_pd(tv))), 0x08);
+    const __m128i cu = _mm_add_epi32(tu, below_u), cv = _mm_add_epi32(tv, below_v);
+    // the index in the padded grid, cv * ew by the unsigned 32 x 32 -> 64 bit product of lanes 0
+    // and 2 (the low 32 bits are the signed product's), and -1 for a point not inside
+    const __m128i rows = _mm_shuffle_epi32(_mm_mul_epu32(_mm_shuffle_epi32(cv, 0x10), stride), 0x08);
+    const __m128i index = _mm_add_epi32(_mm_add_epi32(rows, cu), base);
+    const __m128i inside = _mm_and_si128(_mm_and_si128(_mm_cmpgt_epi32(cu, lo_x), _mm_cmplt_epi32(cu, hi_x)),
+                                         _mm_and_si128(_mm_cmpgt_epi32(cv, lo_y), _mm_cmplt_epi32(cv, hi_y)));
+    const __m128i at = _mm_or_si128(_mm_and_si128(inside, index), _mm_andnot_si128(inside, _mm_set1_epi32(-1)));
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(out.cx + i), cu);
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(out.cy + i), cv);
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(out.at + i), at);
   }
+#endif
+  for (; i < count; ++i) place(i, floor_int(x + c * px_[i] - s * py_[i]), floor_int(y + s * px_[i] + c * py_[i]));
 }
 
-float ScanMatcher::sum_at(const int* cx, const int* cy, std::size_t count, int dx, int dy) const noexcept {
-  float s = 0.0f;
-  const auto w = static_cast<unsigned>(width_), h = static_cast<unsigned>(height_);
+template <int kSums>
+void ScanMatcher::padded_sums(int level, const Rotated& r, std::size_t count, const int* dx, const int* dy,
+                              float* out) const noexcept {
+  const float* f = pooled_[static_cast<std::size_t>(level)].data();
+  const int ew = width_ + 2 * pad_;
+  const auto w = static_cast<unsigned>(ew), h = static_cast<unsigned>(height_ + 2 * pad_);
+  std::array<int, kSums> offset{};
+  for (int j = 0; j < kSums; ++j) offset[static_cast<std::size_t>(j)] = dy[j] * ew + dx[j];
+  std::array<float, kSums> acc{};
   for (std::size_t i = 0; i < count; ++i) {
-    const auto x = static_cast<unsigned>(cx[i] + dx), y = static_cast<unsigned>(cy[i] + dy);
-    if (x < w && y < h) s += field_[static_cast<std::size_t>(y) * w + x];
-  }
-  return s;
-}
-
-template <int kCells>
-void ScanMatcher::row_sums(const int* cx, const int* cy, std::size_t count, int dx, int dy, float* out) const noexcept {
-  std::array<float, kCells> acc{};
-  const int w = width_;
-  const auto h = static_cast<unsigned>(height_);
-  for (std::size_t i = 0; i < count; ++i) {
-    const auto y = static_cast<unsigned>(cy[i] + dy);
-    if (y >= h) continue;
-    const int x = cx[i] + dx;
-    const float* r = field_.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(w);
-    if (x >= 0 && x + kCells <= w) {
-      for (int j = 0; j < kCells; ++j) acc[static_cast<std::size_t>(j)] += r[x + j];
-    } else {
-      for (int j = 0; j < kCells; ++j) {
-        if (static_cast<unsigned>(x + j) < static_cast<unsigned>(w)) acc[static_cast<std::size_t>(j)] += r[x + j];
-      }
+    const int at = r.at[i];
+    if (at >= 0) {
+      for (int j = 0; j < kSums; ++j) acc[static_cast<std::size_t>(j)] += f[at + offset[static_cast<std::size_t>(j)]];
+      continue;
+    }
+    for (int j = 0; j < kSums; ++j) {
+      const auto ex = static_cast<unsigned>(r.cx[i] + dx[j] + pad_), ey = static_cast<unsigned>(r.cy[i] + dy[j] + pad_);
+      if (ex < w && ey < h) acc[static_cast<std::size_t>(j)] += f[static_cast<std::size_t>(ey) * w + ex];
     }
   }
   std::copy(acc.begin(), acc.end(), out);
 }
 
+void ScanMatcher::padded_sums(int level, const Rotated& r, std::size_t count, const int* dx, const int* dy, int m,
+                              float* out) const noexcept {
+  switch (m) {
+    case 1:
+      padded_sums<1>(level, r, count, dx, dy, out);
+      break;
+    case 2:
+      padded_sums<2>(level, r, count, dx, dy, out);
+      break;
+    case 3:
+      padded_sums<3>(level, r, count, dx, dy, out);
+      break;
+    default:
+      padded_sums<4>(level, r, count, dx, dy, out);
+      break;
+  }
+}
+
+template <int kCells>
+void ScanMatcher::row_sums(const Rotated& r, std::size_t count, int dx, int dy, float* out) const noexcept {
+  const float* f = pooled_[0].data();
+  const int ew = width_ + 2 * pad_;
+  const auto w = static_cast<unsigned>(ew), h = static_cast<unsigned>(height_ + 2 * pad_);
+  const int offset = dy * ew + dx;
+  // A point whose row leaves the padded grid adds 0 to the cells outside: x + 0.0f is x (the sums
+  // are never -0), so the same floats as skipping them.
+  auto checked_row = [&](std::size_t i, float* row) {
+    const auto ey = static_cast<unsigned>(r.cy[i] + dy + pad_);
+    for (int j = 0; j < kCells; ++j) {
+      const auto ex = static_cast<unsigned>(r.cx[i] + dx + j + pad_);
+      row[j] = ex < w && ey < h ? f[static_cast<std::size_t>(ey) * w + ex] : 0.0f;
+    }
+  };
+#if defined(__SSE2__)
+  // four cells per SSE2 addition: each lane adds the same floats in the same order as a scalar sum
+  constexpr std::size_t kQuads = kCells / 4;
+  static_assert(kQuads > 0);
+  __m128 quad[kQuads];  // NOLINT(cppcoreguidelines-avoid-c-arrays): std::array drops __m128's alignment attribute
+  for (__m128& q : quad) q = _mm_setzero_ps();
+  std::array<float, kCells - 4 * kQuads> rest{};
+  std::array<float, kCells> spill{};
+  for (std::size_t i = 0; i < count; ++i) {
+    const float* row = nullptr;
+    if (r.at[i] >= 0) {
+      row = f + r.at[i] + offset;
+    } else {
+      checked_row(i, spill.data());
+      row = spill.data();
+    }
+    for (std::size_t q = 0; q < kQuads; ++q) quad[q] = _mm_add_ps(quad[q], _mm_loadu_ps(row + 4 * q));
+    for (std::size_t j = 0; j < rest.size(); ++j) rest[j] += row[4 * kQuads + j];
+  }
+  for (std::size_t q = 0; q < kQuads; ++q) _mm_storeu_ps(out + 4 * q, quad[q]);
+  std::copy(rest.begin(), rest.end(), out + 4 * kQuads);
+#else
+  std::array<float, kCells> acc{};
+  std::array<float, kCells> spill{};
+  for (std::size_t i = 0; i < count; ++i) {
+    const float* row = nullptr;
+    if (r.at[i] >= 0) {
+      row = f + r.at[i] + offset;
+    } else {
+      checked_row(i, spill.data());
+      row = spill.data();
+    }
+    for (int j = 0; j < kCells; ++j) acc[static_cast<std::size_t>(j)] += row[j];
+  }
+  std::copy(acc.begin(), acc.end(), out);
+#endif
+}
+
 float ScanMatcher::pooled_sum(int level, const int* cx, const int* cy, std::size_t count, int x, int y) const noexcept {
   const std::vector<float>& f = pooled_[static_cast<std::size_t>(level)];
-  const auto w = static_cast<unsigned>(width_ + pad_), h = static_cast<unsigned>(height_ + pad_);
+  const auto w = static_cast<unsigned>(width_ + 2 * pad_), h = static_cast<unsigned>(height_ + 2 * pad_);
   float s = 0.0f;
   for (std::size_t i = 0; i < count; ++i) {
     const auto ex = static_cast<unsigned>(cx[i] + x + pad_), ey = static_cast<unsigned>(cy[i] + y + pad_);
@@ -244,56 +362,112 @@ float ScanMatcher::pooled_sum(int level, const int* cx, const int* cy, std::size
 
 double ScanMatcher::score_bilinear(const GridPose& g) const noexcept {
   const double c = std::cos(g.theta) / cell_m_, s = std::sin(g.theta) / cell_m_;
-  double total = 0.0;
   auto at = [&](int x, int y) -> double {
     return static_cast<unsigned>(x) < static_cast<unsigned>(width_) && static_cast<unsigned>(y) < static_cast<unsigned>(height_)
                ? field_[static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x)]
                : 0.0;
   };
+  // The four cells from (x, y) up and right, 0 outside the grid. Inside the grid (the common
+  // case) they are read without a check each: the same values, so the same sum.
   const auto last_x = static_cast<unsigned>(width_ - 1), last_y = static_cast<unsigned>(height_ - 1);
-  for (std::size_t i = 0; i < px_.size(); ++i) {
+  auto corners = [&](int x, int y, std::array<double, 4>& f) {
+    if (static_cast<unsigned>(x) < last_x && static_cast<unsigned>(y) < last_y) {
+      const float* cell =
+          field_.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x);
+      f = {cell[0], cell[1], cell[width_], cell[width_ + 1]};
+    } else {
+      f = {at(x, y), at(x + 1, y), at(x, y + 1), at(x + 1, y + 1)};
+    }
+  };
+  const std::size_t n = px_.size();
+  double total = 0.0;
+  std::size_t i = 0;
+#if defined(__SSE2__)
+  // Two points per pass, in SSE2 doubles: every lane computes what the scalar code below does (the
+  // same operations in the same order, no fused multiply-add), and the lanes are added to the total
+  // in the points' order, so the sum is the same double.
+  const __m128d vc = _mm_set1_pd(c), vs = _mm_set1_pd(s), gx = _mm_set1_pd(g.x), gy = _mm_set1_pd(g.y);
+  const __m128d half = _mm_set1_pd(0.5), one = _mm_set1_pd(1.0);
+  auto floor_pd = [&](__m128d v) {
+    // truncated towards zero, then one less where that rose above (negative non-integers)
+    const __m128d t = _mm_cvtepi32_pd(_mm_cvttpd_epi32(v));
+    return _mm_sub_pd(t, _mm_and_pd(_mm_cmplt_pd(v, t), one));
+  };
+  // two adjacent floats of the field as two doubles
+  auto pair = [](const float* p) { return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)))); };
+  std::array<double, 4> f0{}, f1{};
+  for (; i + 2 <= n; i += 2) {
+    const __m128d px = pair(px_.data() + i), py = pair(py_.data() + i);
+    const __m128d u = _mm_sub_pd(_mm_sub_pd(_mm_add_pd(gx, _mm_mul_pd(vc, px)), _mm_mul_pd(vs, py)), half);
+    const __m128d v = _mm_sub_pd(_mm_add_pd(_mm_add_pd(gy, _mm_mul_pd(vs, px)), _mm_mul_pd(vc, py)), half);
+    const __m128d fu = floor_pd(u), fv = floor_pd(v);
+    const __m128i xs = _mm_cvttpd_epi32(fu), ys = _mm_cvttpd_epi32(fv);
+    const int x0 = _mm_cvtsi128_si32(xs), y0 = _mm_cvtsi128_si32(ys);
+    const int x1 = _mm_cvtsi128_si32(_mm_srli_si128(xs, 4)), y1 = _mm_cvtsi128_si32(_mm_srli_si128(ys, 4));
+    __m128d f00, f10, f01, f11;
+    if (static_cast<unsigned>(x0) < last_x && static_cast<unsigned>(y0) < last_y && static_cast<unsigned>(x1) < last_x &&
+        static_cast<unsigned>(y1) < last_y) {
+      // each point's two rows of two cells as doubles, then the lanes regrouped by corner
+      const float* c0 =
+          field_.data() + static_cast<std::size_t>(y0) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x0);
+      const float* c1 =
+          field_.data() + static_cast<std::size_t>(y1) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x1);
+      const __m128d b0 = pair(c0), t0 = pair(c0 + width_), b1 = pair(c1), t1 = pair(c1 + width_);
+      f00 = _mm_unpacklo_pd(b0, b1);
+      f10 = _mm_unpackhi_pd(b0, b1);
+      f01 = _mm_unpacklo_pd(t0, t1);
+      f11 = _mm_unpackhi_pd(t0, t1);
+    } else {
+      corners(x0, y0, f0);
+      corners(x1, y1, f1);
+      f00 = _mm_setr_pd(f0[0], f1[0]);
+      f10 = _mm_setr_pd(f0[1], f1[1]);
+      f01 = _mm_setr_pd(f0[2], f1[2]);
+      f11 = _mm_setr_pd(f0[3], f1[3]);
+    }
+    const __m128d a = _mm_sub_pd(u, fu), b = _mm_sub_pd(v, fv);
+    const __m128d na = _mm_sub_pd(one, a), nb = _mm_sub_pd(one, b);
+    const __m128d lower = _mm_add_pd(_mm_mul_pd(na, f00), _mm_mul_pd(a, f10));
+    const __m128d upper = _mm_add_pd(_mm_mul_pd(na, f01), _mm_mul_pd(a, f11));
+    const __m128d value = _mm_add_pd(_mm_mul_pd(nb, lower), _mm_mul_pd(b, upper));
+    total += _mm_cvtsd_f64(value);
+    total += _mm_cvtsd_f64(_mm_unpackhi_pd(value, value));
+  }
+#endif
+  std::array<double, 4> f{};
+  for (; i < n; ++i) {
     // the field holds cell-centre values: interpolate between the four nearest centres
     const double u = g.x + c * px_[i] - s * py_[i] - 0.5;
     const double v = g.y + s * px_[i] + c * py_[i] - 0.5;
     const double fu = std::floor(u), fv = std::floor(v);
-    const int x = static_cast<int>(fu), y = static_cast<int>(fv);
     const double a = u - fu, b = v - fv;
-    // Inside the grid (the common case) the four cells are read without a check each; the same
-    // values, so the same sum.
-    double f00 = 0.0, f10 = 0.0, f01 = 0.0, f11 = 0.0;
-    if (static_cast<unsigned>(x) < last_x && static_cast<unsigned>(y) < last_y) {
-      const float* cell =
-          field_.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x);
-      f00 = cell[0];
-      f10 = cell[1];
-      f01 = cell[width_];
-      f11 = cell[width_ + 1];
-    } else {
-      f00 = at(x, y);
-      f10 = at(x + 1, y);
-      f01 = at(x, y + 1);
-      f11 = at(x + 1, y + 1);
-    }
-    total += (1 - b) * ((1 - a) * f00 + a * f10) + b * ((1 - a) * f01 + a * f11);
+    corners(static_cast<int>(fu), static_cast<int>(fv), f);
+    total += (1 - b) * ((1 - a) * f[0] + a * f[1]) + b * ((1 - a) * f[2] + a * f[3]);
   }
   return total;
 }
 
-ScanMatcher::GridPose ScanMatcher::hill_climb(GridPose g, double step_cells, double step_rad) const noexcept {
+ScanMatcher::GridPose ScanMatcher::hill_climb(GridPose g, double step_cells, double step_rad, double* score) const noexcept {
   double best = score_bilinear(g);
+  // After a move, the neighbour back where the climb came from scores what that pose scored, less
+  // than the best: it is not scored again (only when its coordinates are the same doubles).
+  GridPose from{std::nan(""), std::nan(""), std::nan("")};
   for (int halvings = 0, moves = 0; halvings < 4 && moves < 60; ++moves) {
     const GridPose around[6] = {{g.x + step_cells, g.y, g.theta}, {g.x - step_cells, g.y, g.theta},
                                 {g.x, g.y + step_cells, g.theta}, {g.x, g.y - step_cells, g.theta},
                                 {g.x, g.y, g.theta + step_rad},   {g.x, g.y, g.theta - step_rad}};
     int pick = -1;
     for (int k = 0; k < 6; ++k) {
-      const double s = score_bilinear(around[k]);
+      const GridPose& p = around[k];
+      if (p.x == from.x && p.y == from.y && p.theta == from.theta) continue;
+      const double s = score_bilinear(p);
       if (s > best) {
         best = s;
         pick = k;
       }
     }
     if (pick >= 0) {
+      from = g;
       g = around[pick];
     } else {
       step_cells *= 0.5;
@@ -301,6 +475,7 @@ ScanMatcher::GridPose ScanMatcher::hill_climb(GridPose g, double step_cells, dou
       ++halvings;
     }
   }
+  *score = best;
   return g;
 }
 
@@ -384,14 +559,33 @@ ScanMatch ScanMatcher::match(const Pose2D& predicted, double search_xy_m, double
   int top = 0;
   while (top < options_.global_levels && (1 << (top + 1)) < side) ++top;
   const int tile = 1 << top;
+  // every cell a point is read at: the window, and the covariance's reach around any cell of it
+  const int reach = nx + kCovarianceReach;
   std::size_t count = 0;
   for (int k = -nt; k <= nt; ++k) {
-    int* cx = cx_.data() + static_cast<std::size_t>(k + nt) * n;
-    int* cy = cy_.data() + static_cast<std::size_t>(k + nt) * n;
-    rotate_points(g0.theta + k * step, g0.x, g0.y, n, cx, cy);
+    const int heading = k + nt;
+    const Rotated r = rotated(static_cast<std::size_t>(heading), n);
+    rotate_points(g0.theta + k * step, g0.x, g0.y, n, reach, r);
+    // the heading's blocks, bounded four at a time in one pass over the points
+    std::array<int, 4> bx{}, by{};
+    std::array<float, 4> bound{};
+    int m = 0;
+    auto flush = [&] {
+      padded_sums(top, r, n, bx.data(), by.data(), m, bound.data());
+      for (int j = 0; j < m; ++j) {
+        const auto i = static_cast<std::size_t>(j);
+        blocks_[count++] = {bound[i], k, bx[i], by[i]};
+      }
+      m = 0;
+    };
     for (int dy = -nx; dy <= nx; dy += tile) {
-      for (int dx = -nx; dx <= nx; dx += tile) blocks_[count++] = {pooled_sum(top, cx, cy, n, dx, dy), k, dx, dy};
+      for (int dx = -nx; dx <= nx; dx += tile) {
+        bx[static_cast<std::size_t>(m)] = dx;
+        by[static_cast<std::size_t>(m)] = dy;
+        if (++m == 4) flush();
+      }
     }
+    if (m > 0) flush();
   }
   std::sort(blocks_.begin(), blocks_.begin() + static_cast<std::ptrdiff_t>(count),
             [](const Block& l, const Block& r) { return l.bound > r.bound; });
@@ -411,8 +605,8 @@ ScanMatch ScanMatcher::match(const Pose2D& predicted, double search_xy_m, double
     if (blk.bound < best) break;
     std::size_t depth = 0;
     stack[depth++] = {blk.bound, top, blk.k, blk.dx, blk.dy};
-    const int* cx = cx_.data() + static_cast<std::size_t>(blk.k + nt) * n;
-    const int* cy = cy_.data() + static_cast<std::size_t>(blk.k + nt) * n;
+    const int heading = blk.k + nt;
+    const Rotated r = rotated(static_cast<std::size_t>(heading), n);
     while (depth > 0) {
       const Node node = stack[--depth];
       if (node.bound < best) continue;
@@ -428,13 +622,23 @@ ScanMatch ScanMatcher::match(const Pose2D& predicted, double search_xy_m, double
       }
       const int level = node.level - 1;
       const int half = 1 << level;
-      std::array<Node, 4> kids{};
-      int m = 0;
+      // the (up to four) sub-blocks, bounded (level 0: scored) in one pass over the points
+      std::array<int, 4> kx{}, ky{};
+      std::array<float, 4> kb{};
+      int all = 0;
       for (int y = node.dy; y <= std::min(node.dy + half, nx); y += half) {
         for (int x = node.dx; x <= std::min(node.dx + half, nx); x += half) {
-          const float b = level == 0 ? sum_at(cx, cy, n, x, y) : pooled_sum(level, cx, cy, n, x, y);
-          if (b >= best) kids[static_cast<std::size_t>(m++)] = {b, level, node.k, x, y};
+          kx[static_cast<std::size_t>(all)] = x;
+          ky[static_cast<std::size_t>(all)] = y;
+          ++all;
         }
+      }
+      padded_sums(level, r, n, kx.data(), ky.data(), all, kb.data());
+      std::array<Node, 4> kids{};
+      int m = 0;
+      for (int j = 0; j < all; ++j) {
+        const auto i = static_cast<std::size_t>(j);
+        if (kb[i] >= best) kids[static_cast<std::size_t>(m++)] = {kb[i], level, node.k, kx[i], ky[i]};
       }
       // pushed worst first so that the best is explored first
       // (an insertion sort of at most four: std::stable_sort would allocate its buffer)
@@ -456,14 +660,14 @@ ScanMatch ScanMatcher::match(const Pose2D& predicted, double search_xy_m, double
   std::array<double, 6> m2{};  // xx xy xt yy yt tt
   const double inv_n = 1.0 / static_cast<double>(n);
   // The scores of a row of cells at once (row_sums): each point adds a run of adjacent cells of the
-  // field, in the same order per cell as sum_at, so every score is the same float.
+  // field, in the same order per cell as a single cell's score, so every score is the same float.
   constexpr int kReachCells = 2 * kCovarianceReach + 1;
   std::array<float, kReachCells> row{};
   for (int k = std::max(-nt, bk - kCovarianceReach); k <= std::min(nt, bk + kCovarianceReach); ++k) {
-    const int* cx = cx_.data() + static_cast<std::size_t>(k + nt) * n;
-    const int* cy = cy_.data() + static_cast<std::size_t>(k + nt) * n;
+    const int heading = k + nt;
+    const Rotated r = rotated(static_cast<std::size_t>(heading), n);
     for (int dy = by - kCovarianceReach; dy <= by + kCovarianceReach; ++dy) {
-      row_sums<kReachCells>(cx, cy, n, bx - kCovarianceReach, dy, row.data());
+      row_sums<kReachCells>(r, n, bx - kCovarianceReach, dy, row.data());
       for (int dx = bx - kCovarianceReach; dx <= bx + kCovarianceReach; ++dx) {
         const int column = dx - bx + kCovarianceReach;  // 0 .. kReachCells - 1
         const float score = row[static_cast<std::size_t>(column)];
@@ -484,9 +688,10 @@ ScanMatch ScanMatcher::match(const Pose2D& predicted, double search_xy_m, double
     }
   }
   const GridPose coarse{g0.x + bx, g0.y + by, g0.theta + bk * step};
-  const GridPose fine = hill_climb(coarse, 0.5, 0.5 * step);
+  double fine_score = 0.0;
+  const GridPose fine = hill_climb(coarse, 0.5, 0.5 * step, &fine_score);
   out.pose = from_grid(fine);
-  out.quality = score_bilinear(fine) * inv_n;
+  out.quality = fine_score * inv_n;
   const double mx = m1[0] / sw, my = m1[1] / sw, mt = m1[2] / sw;
   // the discretisation's own uncertainty (uniform over a step) is the floor
   const double fx = cell_m_ * cell_m_ / 12.0, ft = step * step / 12.0;

@@ -89,12 +89,13 @@ struct ScanMatch {
 /// A likelihood-field matcher: each cell holds exp(-d^2 / 2 sigma^2), d the distance to the
 /// nearest wall surface (navi::DistanceField); a pose scores the sum over the scan's points.
 /// Tracking is a correlative search (every heading step x every cell of the window, the
-/// translations as index offsets of the rotated points, pruned by a one-level branch and bound
-/// on 2 x 2-cell blocks) followed by a sub-cell hill climb on the bilinear field; the covariance
-/// comes from the score distribution around the best pose. The global
-/// search is a branch and bound over max-pooled fields (as Cartographer's), so its answer is the
-/// best pose of the discretisation, not a sampled guess. Every buffer is sized at construction:
-/// set_scan() and match() do not allocate.
+/// translations as index offsets of the rotated points, pruned by a branch and bound over the
+/// max-pooled fields) followed by a sub-cell hill climb on the bilinear field; the covariance
+/// comes from the score distribution around the best pose. Its inner loops use SSE2 where the
+/// target has it, with the scalar code's operations in its order: the same doubles either way.
+/// The global search is a branch and bound over max-pooled fields (as Cartographer's), so its
+/// answer is the best pose of the discretisation, not a sampled guess. Every buffer is sized at
+/// construction: set_scan() and match() do not allocate.
 class ScanMatcher {
  public:
   /// Precomputes the fields of `map` (O(cells x levels)). Throws ConfigError located at where
@@ -137,13 +138,29 @@ class ScanMatcher {
   [[nodiscard]] GridPose to_grid(const Pose2D& p) const noexcept;
   [[nodiscard]] Pose2D from_grid(const GridPose& g) const noexcept;
   [[nodiscard]] double score_bilinear(const GridPose& g) const noexcept;
-  [[nodiscard]] GridPose hill_climb(GridPose g, double step_cells, double step_rad) const noexcept;
-  // Rotates the points by theta into integer cell offsets from (x, y) (cells), in cx_/cy_.
-  void rotate_points(double theta, double x, double y, std::size_t count, int* cx, int* cy) const noexcept;
-  [[nodiscard]] float sum_at(const int* cx, const int* cy, std::size_t count, int dx, int dy) const noexcept;
-  // sum_at() of kCells adjacent cells (dx ... dx + kCells - 1, dy) in one pass over the points.
+  // The climb from g; its score (score_bilinear of the pose returned) in *score.
+  [[nodiscard]] GridPose hill_climb(GridPose g, double step_cells, double step_rad, double* score) const noexcept;
+  // A heading's points rotated into the grid: the cell of each point as an offset from the cell of
+  // the window's centre, and its index in the padded fields (pooled_) when every cell the tracking
+  // search may read for it (up to `reach` cells away) lies in the padded grid, else -1 (those
+  // points are read with a check each).
+  struct Rotated {
+    int* cx;
+    int* cy;
+    int* at;
+  };
+  [[nodiscard]] Rotated rotated(std::size_t heading, std::size_t count) noexcept;
+  void rotate_points(double theta, double x, double y, std::size_t count, int reach, const Rotated& out) const noexcept;
+  // The sums over the points of the padded field of `level` at kSums offsets (dx[j], dy[j]) in one
+  // pass (independent accumulators). Each sum adds the points in their order, a point outside the
+  // padded grid adding nothing: level 0 gives the exact score of a cell, a level above a bound.
+  template <int kSums>
+  void padded_sums(int level, const Rotated& r, std::size_t count, const int* dx, const int* dy, float* out) const noexcept;
+  void padded_sums(int level, const Rotated& r, std::size_t count, const int* dx, const int* dy, int m,
+                   float* out) const noexcept;
+  // The exact scores of kCells adjacent cells (dx ... dx + kCells - 1, dy) in one pass.
   template <int kCells>
-  void row_sums(const int* cx, const int* cy, std::size_t count, int dx, int dy, float* out) const noexcept;
+  void row_sums(const Rotated& r, std::size_t count, int dx, int dy, float* out) const noexcept;
   [[nodiscard]] float pooled_sum(int level, const int* cx, const int* cy, std::size_t count, int x, int y) const noexcept;
   ScanMatch finish(const GridPose& best, double sum_w, const std::array<double, 6>& moments) const noexcept;
 
@@ -153,12 +170,13 @@ class ScanMatcher {
   int width_ = 0, height_ = 0;
   std::vector<float> field_;                 // the likelihood field, width x height
   // pooled_[h]: max of the field over the 2^h x 2^h cells from (x, y), on the domain extended
-  // by pad_ cells below and left (a tile partly outside the grid still bounds its inside)
+  // by pad_ cells of zeros on every side (a tile partly outside the grid still bounds its inside);
+  // pooled_[0] is the field itself, padded
   std::vector<std::vector<float>> pooled_;
   int pad_ = 1;
   std::vector<float> px_, py_, range_;       // points in the base frame, metres
   double origin_x_ = 0.0, origin_y_ = 0.0;   // the scanner in the base frame, metres
-  std::vector<int> cx_, cy_;                 // rotated points of every heading of the window, cells
+  std::vector<int> cx_, cy_, at_;            // rotated points of every heading of the window (Rotated)
   struct Block {
     float bound;
     int k, dx, dy;
