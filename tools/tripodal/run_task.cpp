@@ -107,9 +107,17 @@ std::unique_ptr<DdsBridge> make_dds_bridge(Robot&, const Clock&, const RobotProf
 // Hardware "dds" for `tripodal run`: the base in another process, the map the world's, as a real
 // robot loads its map while its base is elsewhere.
 #ifdef TRIPODAL_HAVE_DDS
+// The world's joints (a neck) as the hardware dds carries them: the sim-server simulates the same world's.
+std::vector<dds::DdsJoint> dds_joints_of(const sim::World* world) {
+  std::vector<dds::DdsJoint> out;
+  if (world == nullptr) return out;
+  for (const sim::JointConfig& j : world->robot.joints) out.push_back({j.name, j.min_rad, j.max_rad, j.initial_rad, j.rate_hz});
+  return out;
+}
 class WorldDdsHardware final : public dds::DdsHardware, public navi::MapSource {
  public:
-  WorldDdsHardware(const HardwareConfig& c, std::shared_ptr<const sim::World> world) : DdsHardware(c), world_(std::move(world)) {}
+  WorldDdsHardware(const HardwareConfig& c, std::shared_ptr<const sim::World> world)
+      : DdsHardware(c, dds_joints_of(world.get())), world_(std::move(world)) {}
   [[nodiscard]] const navi::OccupancyGrid& world_map() const noexcept override { return world_->grid; }
   [[nodiscard]] const navi::RegionMap& world_regions() const noexcept override { return world_->regions; }
 

@@ -193,6 +193,7 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
     dds::Publisher<dds::msg::JointState> joints(participant, topics.joint_states,
                                                 {.kind = dds::TopicKind::state});
     dds::Publisher<dds::msg::SimState> state(participant, topics.sim_state, {.kind = dds::TopicKind::state});
+    ButtonInbox buttons(participant, a.ros_namespace);
 
     std::signal(SIGINT, on_sim_server_stop_signal);
     std::signal(SIGTERM, on_sim_server_stop_signal);
@@ -265,6 +266,8 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
     // Lock-step: the command over the step, the world advanced to its end, then what it gave.
     auto serve = [&](const dds::msg::SimStep& s) {
       sim.command_twist(Twist2D{s.cmd_vel.linear.x, s.cmd_vel.linear.y, s.cmd_vel.angular.z});
+      apply_joint_targets(s, sim);
+      buttons.press_on(sim);
       sim.step_until(dds::tripodal_time(s.until));
       publish(s.step);
     };
@@ -286,6 +289,7 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
           }
         }
         sim.command_twist(command);
+        buttons.press_on(sim);
         sim.step(kPeriod);
         publish(++periods);
         pacer.pace(sim.now());
