@@ -24,8 +24,9 @@ const ModuleManifest& DdsHardware::static_manifest() {
       "a base and its laser behind DDS (ROS 2 topics cmd_vel, joint_states, scan): tripodal sim-server or a "
       "base driver",
       // What it may give, as the simulator's type lists it: the sensors beyond the laser are those
-      // its parameter `sensors` names (a profile's BatteryMonitor reads "battery" from it).
-      {"laser_scan", "yaw_rate", "bumpers", "cliff", "battery"},
+      // its parameter `sensors` names (a profile's BatteryMonitor reads "battery" from it), the
+      // joints those of the world it is given (BhNeckGesture reads "joint_state").
+      {"laser_scan", "yaw_rate", "bumpers", "cliff", "battery", "joint_state"},
       {parameter::text("namespace", "", "ROS 2 namespace of the base's topics (the sim-server's --namespace); empty: none"),
        parameter::number("domain_id", 0.0, "", "DDS domain (ROS_DOMAIN_ID)", 0.0, 232.0),
        parameter::flag("loopback", true, "stay on 127.0.0.1 (false: Cyclone DDS's own network configuration)"),
