@@ -10,18 +10,20 @@
 # bodies, not a network): --loss PCT drops that share of its packets both ways (nftables
 # `numgen random`), --partition K:AT:FOR drops all of robot K's packets from AT to AT+FOR seconds
 # after the robots started, then heals. --delay-ms needs `tc netem`; without it (these machines'
-# kernel) it is skipped with a note.
+# kernel) it is skipped with a note. --secure puts DDS Security on the fleet's domain: keys made by
+# `tripodal fleet-keys` in OUT/keys (robot1..N and the fleet tool's identity `fleet`), every
+# robot's commands and events authenticated and encrypted across the veth network.
 #
 #   sudo scripts/netns_fleet.sh [--robots 4] [--loss 10] [--partition 2:10:30] [--grace-s 10]
 #        [--task "clean the room 3211"] [--speed 50] [--domain 70] [--out DIR] [--build build/release]
-#        [--ci]   (CI: not root or no ip/nft: print SKIPPED and exit 0)
+#        [--secure] [--ci]   (CI: not root or no ip/nft: print SKIPPED and exit 0)
 # Exit code: the fleet's (0 every unit done), 77 skipped, 2 bad arguments.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 robots=4 loss=0 partition="" delay_ms=0 grace_s=10 lease_s=5 speed=50 domain=70 ci=0
 task="clean the room 3211" world=configs/worlds/workspace.yaml robot=configs/robots/psr2.yaml
-build=build/release out="" timeout_s=600 keep=0
+build=build/release out="" timeout_s=600 keep=0 secure=0
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --robots) robots=$2; shift 2 ;;
@@ -39,6 +41,7 @@ while [[ $# -gt 0 ]]; do
     --build) build=$2; shift 2 ;;
     --timeout-s) timeout_s=$2; shift 2 ;;
     --keep) keep=1; shift ;;
+    --secure) secure=1; shift ;;
     --ci) ci=1; shift ;;
     *) echo "netns_fleet.sh: unknown argument '$1' (see the script's head)" >&2; exit 2 ;;
   esac
@@ -144,11 +147,22 @@ if [[ -n $partition ]]; then
   partition_pid=$!
 fi
 
+# DDS Security: a fleet CA, an identity per robot and one for the fleet tool (an operator).
+secure_args=()
+if [[ $secure -eq 1 ]]; then
+  rm -rf "$out/keys"
+  fleet_keys=(--out "$out/keys" --operator fleet --domain "$domain")
+  for ((k = 1; k <= robots; k++)); do fleet_keys+=(--robot "robot$k"); done
+  "$tool" fleet-keys "${fleet_keys[@]}" >"$out/fleet_keys.log" || { cat "$out/fleet_keys.log" >&2; exit 2; }
+  secure_args=(--keys "$out/keys")
+  faults+=", DDS Security on the fleet domain"
+fi
+
 echo "netns_fleet: $robots robots in ${#hosts[@]} namespaces on bridge br0 (10.231.0.0/24); faults: $faults; out $out"
 set +e
 ip netns exec tf_fleet "$tool" fleet --robots "$robots" --world "$(realpath "$world")" --robot "$(realpath "$robot")" \
   --task "$task" --domain "$domain" --speed "$speed" --lease-s "$lease_s" --grace-s "$grace_s" --timeout-s "$timeout_s" \
-  --shared-world --system-network --sim-system-network --launcher "ip netns exec tf_{name}" --out "$out" | tee "$out/fleet.out"
+  --shared-world --system-network --sim-system-network --launcher "ip netns exec tf_{name}" --out "$out" "${secure_args[@]}" | tee "$out/fleet.out"
 rc=${PIPESTATUS[0]}
 set -e
 [[ -f $out/faults.log ]] && cat "$out/faults.log"

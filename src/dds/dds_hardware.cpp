@@ -23,7 +23,10 @@ const ModuleManifest& DdsHardware::static_manifest() {
       "dds",
       "a base and its laser behind DDS (ROS 2 topics cmd_vel, joint_states, scan): tripodal sim-server or a "
       "base driver",
-      {"laser_scan"},
+      // What it may give, as the simulator's type lists it: the sensors beyond the laser are those
+      // its parameter `sensors` names (a profile's BatteryMonitor reads "battery" from it), the
+      // joints those of the world it is given (BhNeckGesture reads "joint_state").
+      {"laser_scan", "yaw_rate", "bumpers", "cliff", "battery", "joint_state"},
       {parameter::text("namespace", "", "ROS 2 namespace of the base's topics (the sim-server's --namespace); empty: none"),
        parameter::number("domain_id", 0.0, "", "DDS domain (ROS_DOMAIN_ID)", 0.0, 232.0),
        parameter::flag("loopback", true, "stay on 127.0.0.1 (false: Cyclone DDS's own network configuration)"),
@@ -77,7 +80,7 @@ std::chrono::milliseconds millis(double seconds) {
 
 }  // namespace
 
-DdsHardware::DdsHardware(const HardwareConfig& config)
+DdsHardware::DdsHardware(const HardwareConfig& config, std::vector<DdsJoint> joints)
     : kinematics_(base_of(config)),
       topics_(config.parameters.string("namespace")),
       lock_step_(config.parameters.boolean("lock_step")),
@@ -111,6 +114,20 @@ DdsHardware::DdsHardware(const HardwareConfig& config)
   if (named("bumpers")) bumpers_ = std::make_unique<BumperResource>("bumpers", sensor_age);
   if (named("cliff")) cliff_ = std::make_unique<InfraredResource>("cliff", sensor_age);
   if (named("battery")) battery_ = std::make_unique<BatteryResource>("battery", sensor_age);
+  // The joints: a position channel each, held where it was last sent (a servo stays), from where
+  // it starts, as the simulator's own hardware exports them.
+  joints_ = std::move(joints);
+  for (const DdsJoint& j : joints_) {
+    if (!(j.min_rad < j.max_rad) || !(j.rate_hz > 0.0)) {
+      throw ConfigError(config.where,
+                        "hardware '" + config.type + "' joint '" + j.name + "': expected min_rad < max_rad and rate_hz > 0");
+    }
+    joint_resources_.push_back(std::make_unique<JointResource>(j.name, 3 * from_seconds(1.0 / j.rate_hz)));
+    const double start = std::clamp(j.initial_rad, j.min_rad, j.max_rad);
+    export_channel(ChannelSpec{j.name, ChannelType::joint_position, ChannelValue::of(start), true, Duration{0}, j.min_rad,
+                               j.max_rad, "rad", "the position joint " + j.name + " goes to"});
+    joint_sent_.push_back(start);
+  }
 
   // A simulator (or base driver) that goes away is the hardware's fault.
   auto on_status = [this](const StatusEvent& e) {
@@ -173,6 +190,7 @@ void DdsHardware::on_add_resources(ResourceTable& table) {
   if (bumpers_) table.add(*bumpers_);
   if (cliff_) table.add(*cliff_);
   if (battery_) table.add(*battery_);
+  for (auto& j : joint_resources_) table.add(*j);
 }
 
 // The answer's sensors into the resources the profile asked for; one the simulator's world does
@@ -211,6 +229,32 @@ void DdsHardware::take_sensors(const msg::SimState& s) {
     r = {t, s.battery_voltage, s.battery_current, s.battery_percentage, s.battery_charging};
     battery_->commit();
   }
+  for (std::size_t i = 0; i < joints_.size(); ++i) {
+    const DdsJoint& j = joints_[i];
+    if (i >= s.joint_names.size() || s.joint_names[i] != j.name || i >= s.joint_position.size() || i >= s.joint_velocity.size() ||
+        i >= s.joint_target.size()) {
+      return fail("the simulator gives no joint '" + j.name + "' as its joint " + std::to_string(i + 1) +
+                  " (its world's joints are another list)");
+    }
+    joint_resources_[i]->edit() = {t, s.joint_position[i], s.joint_velocity[i], s.joint_target[i], j.min_rad, j.max_rad};
+    joint_resources_[i]->commit();
+  }
+  presses_.insert(presses_.end(), s.button_presses.begin(), s.button_presses.end());
+}
+
+// The joints' targets when a command channel changed since the last step (the simulator keeps
+// them otherwise), in the world's joint order, which the simulator's is (take_sensors checks the
+// names); empty: nothing to send.
+std::vector<double> DdsHardware::joint_targets() {
+  if (joints_.empty()) return {};
+  const CommandChannels& commands = command_channels();
+  bool changed = false;
+  for (std::size_t i = 0; i < joints_.size(); ++i) {
+    const double v = commands.value(i).number;
+    if (v != joint_sent_[i]) changed = true;
+    joint_sent_[i] = v;
+  }
+  return changed ? joint_sent_ : std::vector<double>{};
 }
 
 Twist2D DdsHardware::commanded_twist() const noexcept {
@@ -297,8 +341,7 @@ void DdsHardware::advance(Time now) {
   const Twist2D t = commanded_twist();
   const std::uint32_t step = ++step_;
   try {
-    sim_step_->publish(
-        msg::SimStep{ros_time(now), {{t.vx_m_s, t.vy_m_s, 0.0}, {0.0, 0.0, t.wz_rad_s}}, step});
+    sim_step_->publish(msg::SimStep{ros_time(now), {{t.vx_m_s, t.vy_m_s, 0.0}, {0.0, 0.0, t.wz_rad_s}}, step, joint_targets()});
   } catch (const std::exception& e) {
     fail(std::string("the step request could not be sent: ") + e.what());
     return;

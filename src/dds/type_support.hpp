@@ -339,15 +339,26 @@ template <>
 struct TypeSupport<msg::SimStep> {
   using C = tripodal_msgs_msg_dds__SimStep_;
   static const dds_topic_descriptor_t* descriptor() { return &tripodal_msgs_msg_dds__SimStep__desc; }
-  static C to_c(const msg::SimStep& m) { return {detail::to_c(m.until), detail::to_c(m.cmd_vel), m.step}; }
-  static msg::SimStep from_c(const C& c) { return {detail::from_c(c.until), detail::from_c(c.cmd_vel), c.step}; }
+  static C to_c(const msg::SimStep& m) {
+    return {detail::to_c(m.until), detail::to_c(m.cmd_vel), m.step, view_sequence<dds_sequence_double>(m.joint_targets)};
+  }
+  static msg::SimStep from_c(const C& c) {
+    return {detail::from_c(c.until), detail::from_c(c.cmd_vel), c.step, copy_sequence<double>(c.joint_targets)};
+  }
 };
 
 template <>
 struct TypeSupport<msg::SimState> {
   using C = tripodal_msgs_msg_dds__SimState_;
+  struct Scratch {  // the string sequences' pointers, alive until the write returns
+    std::vector<char*> joint_names, button_presses;
+  };
   static const dds_topic_descriptor_t* descriptor() { return &tripodal_msgs_msg_dds__SimState__desc; }
-  static C to_c(const msg::SimState& m) {
+  static C to_c(const msg::SimState& m, Scratch& scratch) {
+    scratch.joint_names.clear();
+    for (const std::string& n : m.joint_names) scratch.joint_names.push_back(view(n));
+    scratch.button_presses.clear();
+    for (const std::string& n : m.button_presses) scratch.button_presses.push_back(view(n));
     return {detail::to_c(m.stamp),
             m.x,
             m.y,
@@ -366,9 +377,21 @@ struct TypeSupport<msg::SimState> {
             m.bumper_count,
             m.sensors,
             m.battery_charging ? 1U : 0U,
-            view_sequence<dds_sequence_uint8>(m.cliff)};
+            view_sequence<dds_sequence_uint8>(m.cliff),
+            view_sequence<dds_sequence_string>(scratch.joint_names),
+            view_sequence<dds_sequence_double>(m.joint_position),
+            view_sequence<dds_sequence_double>(m.joint_velocity),
+            view_sequence<dds_sequence_double>(m.joint_target),
+            view_sequence<dds_sequence_string>(scratch.button_presses)};
   }
   static msg::SimState from_c(const C& c) {
+    const auto strings = [](const dds_sequence_string& q) {
+      std::vector<std::string> out;
+      if (q._buffer != nullptr) {
+        for (std::uint32_t i = 0; i < q._length; ++i) out.push_back(text(q._buffer[i]));
+      }
+      return out;
+    };
     return {detail::from_c(c.stamp),
             c.x,
             c.y,
@@ -387,7 +410,12 @@ struct TypeSupport<msg::SimState> {
             c.bumper_count,
             c.sensors,
             c.battery_charging != 0,
-            copy_sequence<std::uint8_t>(c.cliff)};
+            copy_sequence<std::uint8_t>(c.cliff),
+            strings(c.joint_names),
+            copy_sequence<double>(c.joint_position),
+            copy_sequence<double>(c.joint_velocity),
+            copy_sequence<double>(c.joint_target),
+            strings(c.button_presses)};
   }
 };
 

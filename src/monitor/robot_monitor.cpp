@@ -331,8 +331,8 @@ struct RobotMonitor::Impl final : TaskObserver, SupervisorObserver {
     const auto wall = std::chrono::steady_clock::now();
     if (wall - last_publish >= std::chrono::duration<double>(options.min_interval_s)) {
       last_publish = wall;
-      topics.publish_periodic(extras,
-                              ConsoleState{paused, pause_reason, breakpoints, driving, behavior_params, last_firing, hri});
+      topics.publish_periodic(extras, ConsoleState{paused, pause_reason, breakpoints, driving, behavior_params, last_firing, hri,
+                                                   options.robot_name, options.identity});
     }
     if (extras.cleaned_mask != nullptr && wall - last_cleaned >= std::chrono::duration<double>(options.cleaned_interval_s)) {
       last_cleaned = wall;

@@ -76,7 +76,9 @@ json status_panel(Robot& robot, Time now, double t, const MonitorExtras& extras,
     const CResource& r = robot.resources().at(i);
     resources.push_back({{"name", r.name()}, {"age_s", r.has_reading() ? json(to_seconds(now - r.stamp())) : json(nullptr)}});
   }
-  json status{{"time_s", t},
+  json status{{"robot", std::string(console.robot_name)},
+              {"identity", console.identity.empty() ? json(nullptr) : json(std::string(console.identity))},
+              {"time_s", t},
               {"paused", console.paused},
               {"pause_reason", console.paused ? std::string(console.pause_reason) : ""},
               {"task_state", std::string(to_string(robot.planner().state()))},

@@ -67,7 +67,7 @@ RobotTopics::RobotTopics(Robot& robot, const Clock& clock, MonitorServer& server
       Delivery::bulk);
   ch_lifecycle_ = server_.advertise(
       "/lifecycle", "tripodal.LifecycleEntry",
-      R"({"type":"object","properties":{"time_s":{"type":"number"},"kind":{"type":"string"},"text":{"type":"string"}}})",
+      R"({"type":"object","properties":{"robot":{"type":"string","description":"the robot's name"},"identity":{"type":["string","null"],"description":"how the fleet reaches it: DDS domain, namespace and security identity; null when not on DDS"},"time_s":{"type":"number"},"kind":{"type":"string"},"text":{"type":"string"}}})",
       Delivery::event);
   ch_status_ = server_.advertise(
       "/status", "tripodal.Status",

@@ -39,6 +39,8 @@ struct ConsoleState {
   const std::map<std::string, std::string, std::less<>>& behavior_params;  ///< behavior -> "a=1, b=2"
   const std::map<std::string, std::string, std::less<>>& last_firing;      ///< run -> transition id
   HriService* hri = nullptr;
+  std::string_view robot_name;  ///< RobotMonitorOptions::robot_name, identity
+  std::string_view identity;
 };
 
 class RobotTopics final {

@@ -220,7 +220,8 @@ TEST_CASE("dds: golden CDR bytes of every message type", "[dds]") {
   SECTION("tripodal_msgs/SimStep and SimState") {
     const auto s = sample_sim_step();
     // the twist's doubles align to 8 right after the 8-byte time
-    check_golden(p, s, CdrWriter().time(s.until).twist(s.cmd_vel).u32(s.step).bytes());
+    // then the joints' targets: the length, then a double aligned to 8
+    check_golden(p, s, CdrWriter().time(s.until).twist(s.cmd_vel).u32(s.step).u32(1).f64(s.joint_targets[0]).bytes());
     const auto t = sample_sim_state();
     check_golden(p, t,
                  CdrWriter()
@@ -248,6 +249,18 @@ TEST_CASE("dds: golden CDR bytes of every message type", "[dds]") {
                      .u8(0)
                      .u8(1)
                      .u8(0)
+                     // the joints (names, then a double each aligned to 8) and the buttons pressed
+                     .u32(1)
+                     .str("neck")
+                     .u32(1)
+                     .f64(t.joint_position[0])
+                     .u32(1)
+                     .f64(t.joint_velocity[0])
+                     .u32(1)
+                     .f64(t.joint_target[0])
+                     .u32(2)
+                     .str("hello")
+                     .str("help")
                      .bytes());
   }
 }

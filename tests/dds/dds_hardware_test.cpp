@@ -107,3 +107,40 @@ TEST_CASE("dds: hardware dds refuses a namespace ROS 2 would not take and a robo
                                           SourceLocation{"robot.yaml", 12, 3}),
                     Catch::Contains("step_timeout_s"));
 }
+
+// A profile whose modules read the battery (the disinfection robot's BatteryMonitor) passes the
+// start-up check on hardware dds as on sim: the type says what it may give, as the simulator's
+// does (it once listed the laser only: "missing provider ... needs 'battery'").
+TEST_CASE("dds: a profile reading the battery passes the robot's check on hardware dds", "[dds]") {
+  RobotProfile profile = load_robot_profile(std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/psr2.yaml");
+  REQUIRE(profile.hardware.has_value());
+  profile.hardware->type = "dds";
+  profile.hardware->parameters = {{"sensors", "battery"}};
+  ModuleEntry monitor;
+  monitor.name = "battery_monitor";
+  monitor.type = "BatteryMonitor";
+  monitor.where = SourceLocation{"robot.yaml", 40, 5};
+  profile.modules.push_back(monitor);
+  RobotPlugins plugins = builtin_plugins();
+  register_dds_hardware(plugins.hardware);
+  Diagnostics d;
+  (void)check_robot(profile, plugins, d);
+  INFO(d.str());
+  CHECK_FALSE(d.has_errors());
+}
+
+// Jinny's profile (its BhNeckGesture reads joint_state, its HRI the buttons) passes the start-up
+// check on hardware dds, which carries the world's joints (it once stopped at "missing provider:
+// reactive behavior 'BhNeckGesture' needs 'joint_state'").
+TEST_CASE("dds: the guide robot's profile with its neck passes the robot's check on hardware dds", "[dds]") {
+  RobotProfile profile = load_robot_profile(std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/jinny.yaml");
+  REQUIRE(profile.hardware.has_value());
+  profile.hardware->type = "dds";
+  profile.hardware->parameters.clear();
+  RobotPlugins plugins = builtin_plugins();
+  register_dds_hardware(plugins.hardware);
+  Diagnostics d;
+  (void)check_robot(profile, plugins, d);
+  INFO(d.str());
+  CHECK_FALSE(d.has_errors());
+}

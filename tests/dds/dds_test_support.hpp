@@ -108,10 +108,12 @@ inline msg::LaserScan sample_scan() {
 inline msg::JointState sample_joint_state() {
   return {sample_header("base"), {"wheel_1", "wheel_2", "wheel_3"}, {0.5, -1.25, 2.0}, {3.5, -0.75, 0.0}, {}};
 }
-inline msg::SimStep sample_sim_step() { return {{78, 900000000}, sample_twist(), 7801}; }
+inline msg::SimStep sample_sim_step() {
+  return {{78, 900000000}, sample_twist(), 7801, {0.5}};
+}
 inline msg::SimState sample_sim_state() {
-  return {{78, 900000000}, 4.5,   -2.25, 1.5, 30.125, 7801, 783,      7802, 2, 0.125, -1.5, 24.5,
-          -1.25,           0.875, 5,     4,   15,     true, {0, 1, 0}};
+  return {{78, 900000000}, 4.5,   -2.25, 1.5, 30.125, 7801, 783,       7802,     2,      0.125,  -1.5,  24.5,
+          -1.25,           0.875, 5,     4,   15,     true, {0, 1, 0}, {"neck"}, {0.25}, {-0.5}, {0.5}, {"hello", "help"}};
 }
 inline msg::OccupancyGrid sample_grid() {
   msg::OccupancyGrid g{sample_header("map"), {{1700000000, 5}, 0.05F, 4, 3, {{-1.0, -2.0, 0.0}, {}}}, {}};

@@ -268,3 +268,76 @@ TEST_CASE("dds: hardware dds refuses an unknown sensor, at the profile's hardwar
                     Catch::Contains("robot.yaml:12:3: error: hardware 'dds' sensors: unknown sensor 'sonar'; "
                                     "expected some of gyro, bumpers, cliff, battery"));
 }
+
+// Jinny's neck and LED buttons through the sim-server (the exhibit hall's robot: a neck of
+// +-40 deg at 60 deg/s, buttons hello, help, weather): the hardware dds exports the neck's
+// position channel and its joint resource; a command written to the channel goes with the step,
+// the neck turns to it in the server's world and its state comes back; a button pressed over DDS
+// (another process's finger on rt/<ns>/tripodal/press_button) comes out of the hardware's button
+// panel, once. Before, the hardware carried neither (the profile stayed on `sim`).
+TEST_CASE("dds: a robot on hardware dds turns its neck and hears its buttons through the sim-server",
+          "[dds][sim_server][shared_world]") {
+  const std::string jinny = std::string(TRIPODAL_SOURCE_DIR) + "/configs/robots/jinny.yaml";
+  const std::string hall = std::string(TRIPODAL_SOURCE_DIR) + "/configs/worlds/exhibit_hall.yaml";
+  const std::string prefix = test_namespace() + "_j";
+  const std::uint32_t domain = test_domain(47);
+  ChildProcess server(kTool,
+                      {"sim-server", "--robot", jinny, "--world", hall, "--robots", "1", "--namespace", prefix, "--domain",
+                       std::to_string(domain), "--wait-s", "60", "--lease-s", "1"},
+                      "/tmp/" + test_namespace() + "_joints_server.log");
+  const auto base =
+      tripodal::base_controller_config(tripodal::load_robot_profile(jinny), tripodal::builtin_plugins().controllers);
+  REQUIRE(base.has_value());
+  tripodal::HardwareConfig config;
+  config.type = "dds";
+  config.where = tripodal::SourceLocation{"robot.yaml", 12, 3};
+  config.base = &*base;
+  config.parameters = tripodal::ParameterSet::resolve(
+      DdsHardware::static_manifest(),
+      {{"namespace", tripodal::Value{prefix + "1"}}, {"domain_id", tripodal::Value{static_cast<double>(domain)}}}, config.where);
+  const double limit = 40.0 * std::numbers::pi / 180.0;
+  DdsHardware hw(config, {DdsJoint{"neck", -limit, limit, 0.0, 50.0}});
+  const auto channel = hw.command_channels().find("neck");
+  REQUIRE(channel.has_value());
+  CHECK(hw.command_channels().spec(*channel).type == tripodal::ChannelType::joint_position);
+  tripodal::ResourceTable table;
+  hw.add_resources(table);
+  const auto* neck = table.find<tripodal::JointReading>("neck");
+  REQUIRE(neck != nullptr);
+
+  int k = 0;
+  auto step = [&] {
+    ++k;
+    hw.advance_to(tripodal::Time{} + std::chrono::milliseconds(10 * k));
+  };
+  for (int i = 0; i < 5; ++i) step();
+  REQUIRE(neck->has_reading());
+  CHECK(std::abs(neck->latest().position_rad) < 1e-9);
+  CHECK(neck->latest().max_rad == Approx(limit));
+
+  // The behavior loop's fused command: turn the head to 0.5 rad (about 0.48 s at 60 deg/s).
+  hw.command_channels().set(*channel, tripodal::ChannelValue::of(0.5));
+  for (int i = 0; i < 80; ++i) step();
+  CHECK(hw.link_up());
+  CHECK(neck->latest().target_rad == Approx(0.5));
+  CHECK(neck->latest().position_rad == Approx(0.5).margin(1e-6));
+  CHECK(neck->latest().stamp == tripodal::Time{} + std::chrono::milliseconds(10 * k));
+
+  // A visitor presses "hello" (and a name the world has no button of, which is dropped).
+  ParticipantOptions po;
+  po.domain_id = domain;
+  Participant p(po);
+  Publisher<msg::String> press(p, ros_topic("tripodal/press_button", prefix + "1"), EndpointOptions{.kind = TopicKind::event});
+  REQUIRE(press.wait_for_subscribers(1, 10s));
+  press.publish(msg::String{"nosuch"});
+  press.publish(msg::String{"hello"});
+  std::vector<std::string> presses;
+  for (int i = 0; i < 500 && presses.empty(); ++i) {
+    step();
+    presses = hw.take_button_presses();
+    if (presses.empty()) std::this_thread::sleep_for(1ms);  // the press crosses DDS beside the steps
+  }
+  CHECK(presses == std::vector<std::string>{"hello"});
+  for (int i = 0; i < 5; ++i) step();
+  CHECK(hw.take_button_presses().empty());  // once
+}

@@ -860,6 +860,33 @@ TEST_CASE("/status of a robot without an HRI has hri null", "[monitor][robot][di
   server.stop();
 }
 
+// An operator with one monitor page per robot of a fleet sees which robot each is: its name and
+// how the fleet reaches it (the DDS domain, namespace and security identity); null off DDS.
+TEST_CASE("/status says which robot the monitor shows and its DDS identity", "[monitor][robot][display]") {
+  Psr2 psr2;
+  SECTION("a robot of a secured fleet") {
+    MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+    RobotMonitor watch(*psr2.robot, psr2.clock, server,
+                       RobotMonitorOptions{.min_interval_s = 0.0,
+                                           .robot_name = "robot3",
+                                           .identity = "DDS domain 78, namespace 'robot3', secured as 'robot3' (keys /k)"});
+    server.start();
+    const nlohmann::json status = next_status(server, watch);
+    CHECK(status["robot"] == "robot3");
+    CHECK(status["identity"] == "DDS domain 78, namespace 'robot3', secured as 'robot3' (keys /k)");
+    server.stop();
+  }
+  SECTION("a robot off DDS") {
+    MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});
+    RobotMonitor watch(*psr2.robot, psr2.clock, server, RobotMonitorOptions{.min_interval_s = 0.0, .robot_name = "psr2"});
+    server.start();
+    const nlohmann::json status = next_status(server, watch);
+    CHECK(status["robot"] == "psr2");
+    CHECK(status["identity"].is_null());
+    server.stop();
+  }
+}
+
 TEST_CASE("RKMS ops on a robot without an HRI module are refused with 404", "[monitor][robot][rkms]") {
   Psr2 psr2;
   MonitorServer server(MonitorServerOptions{.token = "t0ken-for-tests"});

@@ -243,6 +243,13 @@ std::string fleet_world(const std::filesystem::path& world, const Pose2D& start)
          "\n";
 }
 
+// "gyro, bumpers" or "none", for people.
+std::string sensors_text(std::string list) {
+  if (list.empty()) return "none";
+  for (std::size_t at = list.find(','); at != std::string::npos; at = list.find(',', at + 2)) list.insert(at + 1, " ");
+  return list;
+}
+
 // The server's closing line ("... robot-robot contacts: N; closest approach between robots: X m"),
 // or empty.
 std::string shared_world_summary(const std::filesystem::path& log) {
@@ -460,8 +467,13 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
       for (std::size_t k = 0; k < members.size(); ++k) {
         out << "  " << members[k].name << ": " << members[k].profile.filename().string() << ", namespace " << members[k].ns
             << ", starts at (" << app::fixed(starts[k].x_m, 2) << ", " << app::fixed(starts[k].y_m, 2) << ", "
-            << app::fixed(starts[k].theta_rad, 3) << ")\n";
+            << app::fixed(starts[k].theta_rad, 3) << ")";
+        if (a.shared_world) out << ", sensors " << sensors_text(members[k].sensors.value_or(world_sensors(world)));
+        out << "\n";
       }
+    } else if (a.shared_world) {
+      out << "sensors of each robot's body besides the laser: " << sensors_text(world_sensors(world))
+          << " (the world's robot, as hardware sim gives them)\n";
     }
     out.flush();
 
@@ -530,7 +542,8 @@ int run(const Args& a, std::ostream& out, std::ostream& err) {
         argv.insert(argv.end(), {"--hardware", "dds", "--hardware-param", "namespace=" + m.ns, "--hardware-param",
                                  "domain_id=" + std::to_string(sim_domain), "--hardware-param",
                                  "loopback=" + std::string(a.sim_loopback ? "true" : "false")});
-        if (!m.sensors.empty()) argv.insert(argv.end(), {"--hardware-param", "sensors=" + m.sensors});
+        const std::string sensors = m.sensors.value_or(world_sensors(world));
+        if (!sensors.empty()) argv.insert(argv.end(), {"--hardware-param", "sensors=" + sensors});
       }
       children.spawn(r.name, argv, dir / (r.name + ".log"), a.launcher);
     }

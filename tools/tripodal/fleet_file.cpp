@@ -82,11 +82,12 @@ std::vector<FleetMember> load_fleet_file(const std::filesystem::path& file) {
       }
       if (const YAML::Node s = e["sensors"]) {
         if (const auto v = r.names(s, what + ".sensors")) {
+          m.sensors.emplace();
           for (const std::string& sensor : *v) {
             if (sensor != "gyro" && sensor != "bumpers" && sensor != "cliff" && sensor != "battery") {
               r.error(s, what + ".sensors: unknown sensor '" + sensor + "'; expected some of gyro, bumpers, cliff, battery");
             }
-            m.sensors += (m.sensors.empty() ? "" : ",") + sensor;
+            *m.sensors += (m.sensors->empty() ? "" : ",") + sensor;
           }
         }
       }
@@ -108,6 +109,19 @@ std::vector<FleetMember> numbered_fleet(int n, const std::filesystem::path& prof
     const std::string name = prefix + std::to_string(k);
     out.push_back({name, name, profile, std::nullopt, {}, SourceLocation{"--robots", 1, 1}});
   }
+  return out;
+}
+
+std::string world_sensors(const sim::World& world) {
+  const sim::SimRobotConfig& rc = world.robot;
+  std::string out;
+  const auto add = [&](bool enabled, const char* name) {
+    if (enabled) out += (out.empty() ? "" : ",") + std::string(name);
+  };
+  add(rc.gyro.enabled, "gyro");
+  add(rc.bumpers.enabled, "bumpers");
+  add(rc.cliff.enabled, "cliff");
+  add(rc.battery.enabled, "battery");
   return out;
 }
 
@@ -172,7 +186,7 @@ std::string fleet_file_text(const std::vector<FleetMember>& members, const std::
     e["name"] = members[i].name;
     e["namespace"] = members[i].ns;
     e["profile"] = std::filesystem::absolute(members[i].profile).string();
-    if (!members[i].sensors.empty()) e["sensors"] = YAML::Load("[" + members[i].sensors + "]");
+    if (members[i].sensors) e["sensors"] = YAML::Load("[" + *members[i].sensors + "]");
     YAML::Node pose(YAML::NodeType::Sequence);
     pose.SetStyle(YAML::EmitterStyle::Flow);
     pose.push_back(starts.at(i).x_m);

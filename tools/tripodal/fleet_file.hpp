@@ -24,7 +24,9 @@ struct FleetMember {
   std::string ns;                 ///< its DDS namespace (default: the name), unique
   std::filesystem::path profile;  ///< absolute
   std::optional<Pose2D> start;    ///< where its body starts in a shared world (default: fleet_start_poses)
-  std::string sensors;            ///< in a shared world, the hardware dds's sensors ("gyro,bumpers"; default none)
+  /// In a shared world, the hardware dds's sensors ("gyro,bumpers"; "" none); not given: the
+  /// world's (world_sensors), as the in-process simulator gives them.
+  std::optional<std::string> sensors;
   SourceLocation where;           ///< the file's entry, for errors found later (a start pose not free)
 };
 
@@ -47,6 +49,12 @@ struct FleetMember {
 /// the walls past the robots around it (with 0.4 m, five to eight of eight PSR-2s in a 3 x 3 block
 /// lost the map 10.9 s into their sections; docs/distribution.md, "Eight robots in one world").
 inline constexpr double kFleetStartGap_m = 1.1;
+
+/// The sensors a robot's body in `world` has besides the laser, as the hardware dds names them
+/// ("gyro,bumpers,cliff,battery", those the world's `robot:` enables): what the in-process simulator
+/// (hardware sim) gives a robot of that world, so what a fleet's robot on a shared world gets unless
+/// its fleet file entry names its own — a profile that runs on `sim` finds the same resources.
+[[nodiscard]] std::string world_sensors(const sim::World& world);
 
 /// The members as a fleet file, their start poses given (what `tripodal fleet` hands its
 /// sim-server).

@@ -107,9 +107,17 @@ std::unique_ptr<DdsBridge> make_dds_bridge(Robot&, const Clock&, const RobotProf
 // Hardware "dds" for `tripodal run`: the base in another process, the map the world's, as a real
 // robot loads its map while its base is elsewhere.
 #ifdef TRIPODAL_HAVE_DDS
+// The world's joints (a neck) as the hardware dds carries them: the sim-server simulates the same world's.
+std::vector<dds::DdsJoint> dds_joints_of(const sim::World* world) {
+  std::vector<dds::DdsJoint> out;
+  if (world == nullptr) return out;
+  for (const sim::JointConfig& j : world->robot.joints) out.push_back({j.name, j.min_rad, j.max_rad, j.initial_rad, j.rate_hz});
+  return out;
+}
 class WorldDdsHardware final : public dds::DdsHardware, public navi::MapSource {
  public:
-  WorldDdsHardware(const HardwareConfig& c, std::shared_ptr<const sim::World> world) : DdsHardware(c), world_(std::move(world)) {}
+  WorldDdsHardware(const HardwareConfig& c, std::shared_ptr<const sim::World> world)
+      : DdsHardware(c, dds_joints_of(world.get())), world_(std::move(world)) {}
   [[nodiscard]] const navi::OccupancyGrid& world_map() const noexcept override { return world_->grid; }
   [[nodiscard]] const navi::RegionMap& world_regions() const noexcept override { return world_->regions; }
 
@@ -295,7 +303,15 @@ struct MonitorParts {
   std::unique_ptr<monitor::MonitorServer> server;
   std::unique_ptr<monitor::RobotMonitor> watch;
 };
-MonitorParts start_monitor(const RunOptions& o, Robot& robot, const Clock& clock) {
+// Which robot the monitor shows, for an operator with one page per robot of a fleet: how the
+// fleet reaches it (empty: not on DDS).
+std::string monitor_identity(const RobotProfile& p) {
+  if (!p.dds) return {};
+  std::string out = "DDS domain " + std::to_string(p.dds->domain_id) + ", namespace '" + p.dds->ros_namespace + "'";
+  if (p.dds->security_identity.empty()) return out + ", not secured";
+  return out + ", secured as '" + p.dds->security_identity + "' (keys " + p.dds->security_keys.string() + ")";
+}
+MonitorParts start_monitor(const RunOptions& o, Robot& robot, const Clock& clock, const RobotProfile& profile) {
   MonitorParts m;
   if (!o.monitor) return m;
   monitor::MonitorServerOptions so = monitor::server_options(*o.monitor, o.monitor_token_file);
@@ -305,7 +321,9 @@ MonitorParts start_monitor(const RunOptions& o, Robot& robot, const Clock& clock
   m.server = std::make_unique<monitor::MonitorServer>(std::move(so));
   // the operator's live maps go beside the run's own outputs
   m.watch = std::make_unique<monitor::RobotMonitor>(
-      robot, clock, *m.server, monitor::RobotMonitorOptions{.start_paused = o.start_paused, .map_dir = o.out});
+      robot, clock, *m.server,
+      monitor::RobotMonitorOptions{
+          .start_paused = o.start_paused, .map_dir = o.out, .robot_name = profile.name, .identity = monitor_identity(profile)});
   m.server->start();
   if (o.log != nullptr) {
     *o.log << "monitor: " << m.server->url() << "  (token " << m.server->token()
@@ -451,7 +469,7 @@ void TaskRun::start() {
     o_.log->flush();
   }
   if (!threaded_ && (o_.realtime || o_.monitor || serve_dds_)) pacer_.emplace(wall_, o_.realtime ? o_.realtime_speed : 1.0);
-  monitor_ = start_monitor(o_, *robot_, clock_);
+  monitor_ = start_monitor(o_, *robot_, clock_, profile_);
   serve_ = monitor_.watch != nullptr || serve_dds_;
 
   if (!threaded_) robot_->run_until(sim_clock_.now());  // the localizer's first estimate, before the planner asks where to start

@@ -191,7 +191,8 @@ struct Requests {
 // free-running.
 class ServedRobot {
  public:
-  ServedRobot(sim::Simulator& sim, dds::Participant& participant, const dds::BaseTopics& topics, bool realtime)
+  ServedRobot(sim::Simulator& sim, dds::Participant& participant, const dds::BaseTopics& topics, bool realtime,
+              const std::string& ros_namespace)
       : sim_(sim),
         clock_(realtime ? std::make_optional<dds::Publisher<dds::msg::Clock>>(participant, topics.clock,
                                                                               dds::EndpointOptions{.kind = dds::TopicKind::state})
@@ -199,6 +200,7 @@ class ServedRobot {
         scan_(participant, topics.scan, {.kind = dds::TopicKind::scan, .qos = reliable_scans()}),
         joints_(participant, topics.joint_states, {.kind = dds::TopicKind::state}),
         state_(participant, topics.sim_state, {.kind = dds::TopicKind::state}),
+        buttons_(participant, ros_namespace),
         velocity_(sim.wheel_count()),
         position_(sim.wheel_count()) {
     js_.header.frame_id = "base_link";
@@ -226,6 +228,8 @@ class ServedRobot {
   // Lock-step: the command over the step, the world advanced to its end, then what it gave.
   void serve(const dds::msg::SimStep& s) {
     sim_.command_twist(Twist2D{s.cmd_vel.linear.x, s.cmd_vel.linear.y, s.cmd_vel.angular.z});
+    apply_joint_targets(s, sim_);
+    buttons_.press_on(sim_);
     sim_.step_until(dds::tripodal_time(s.until));
     publish(s.step);
   }
@@ -235,6 +239,7 @@ class ServedRobot {
   dds::Publisher<dds::msg::LaserScan> scan_;
   dds::Publisher<dds::msg::JointState> joints_;
   dds::Publisher<dds::msg::SimState> state_;
+  ButtonInbox buttons_;
   dds::msg::JointState js_;
   dds::msg::LaserScan ls_;
   std::vector<double> velocity_, position_;
@@ -306,6 +311,7 @@ void ServedRobot::run_realtime(const Args& a, Inbox& inbox) {
       }
     }
     sim_.command_twist(command);
+    buttons_.press_on(sim_);
     sim_.step(kPeriod);
     publish(++periods);
     pacer.pace(sim_.now());
@@ -349,7 +355,7 @@ int serve_one_robot(const Args& a, std::ostream& out) {
   Inbox inbox;
   const bool realtime = a.realtime->count() > 0;
   const Requests requests(realtime, participant, topics, inbox);
-  ServedRobot served(sim, participant, topics, realtime);
+  ServedRobot served(sim, participant, topics, realtime, a.ros_namespace);
 
   std::signal(SIGINT, on_sim_server_stop_signal);
   std::signal(SIGTERM, on_sim_server_stop_signal);

@@ -72,6 +72,7 @@ struct Slot {
   std::unique_ptr<dds::Publisher<dds::msg::JointState>> joints;
   std::unique_ptr<dds::Publisher<dds::msg::SimState>> state;
   std::unique_ptr<dds::Subscriber<dds::msg::SimStep>> steps;
+  std::unique_ptr<ButtonInbox> buttons;
   std::unique_ptr<sim::Simulator> sim;  // while a robot is here
   bool expected = false;                // answered: its next request is awaited this round
   std::uint32_t scans = 0, joint_states = 0, last_step = 0;
@@ -109,6 +110,48 @@ void put_sensors(dds::msg::SimState& state, sim::Simulator& sim) {
     state.battery_percentage = b.percentage;
     state.battery_charging = b.charging;
   }
+  const std::vector<sim::JointConfig>& joints = rc.joints;
+  state.joint_names.resize(joints.size());
+  state.joint_position.resize(joints.size());
+  state.joint_velocity.resize(joints.size());
+  state.joint_target.resize(joints.size());
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    const sim::JointState& j = sim.joints()[i];
+    state.joint_names[i] = joints[i].name;
+    state.joint_position[i] = j.position_rad;
+    state.joint_velocity[i] = j.velocity_rad_s;
+    state.joint_target[i] = j.target_rad;
+  }
+  state.button_presses = sim.take_button_presses();
+}
+
+void apply_joint_targets(const dds::msg::SimStep& step, sim::Simulator& sim) {
+  if (step.joint_targets.size() != sim.world().robot.joints.size()) return;
+  for (std::size_t i = 0; i < step.joint_targets.size(); ++i) {
+    if (!std::isnan(step.joint_targets[i])) (void)sim.command_joint(i, step.joint_targets[i]);
+  }
+}
+
+ButtonInbox::ButtonInbox(dds::Participant& participant, const std::string& ns)
+    : subscriber_(std::make_unique<dds::Subscriber<dds::msg::String>>(participant, dds::ros_topic("tripodal/press_button", ns),
+                                                                      dds::EndpointOptions{.kind = dds::TopicKind::event},
+                                                                      [this](const dds::msg::String& m) {
+                                                                        const std::lock_guard lock(mutex_);
+                                                                        names_.push_back(m.data);
+                                                                      })) {}
+
+// The subscriber first: its callback uses the members.
+ButtonInbox::~ButtonInbox() {
+  subscriber_.reset();
+}
+
+void ButtonInbox::press_on(sim::Simulator& sim) {
+  std::vector<std::string> names;
+  {
+    const std::lock_guard lock(mutex_);
+    names.swap(names_);
+  }
+  for (const std::string& n : names) (void)sim.press_button(n);
 }
 
 namespace {
@@ -186,6 +229,7 @@ void open_slot(Slot& s, std::size_t k, dds::Participant& participant, Inboxes& i
                                                                     dds::EndpointOptions{.kind = dds::TopicKind::state});
   s.state = std::make_unique<dds::Publisher<dds::msg::SimState>>(participant, topics.sim_state,
                                                                  dds::EndpointOptions{.kind = dds::TopicKind::state});
+  s.buttons = std::make_unique<ButtonInbox>(participant, s.ns);
   auto on_status = [&inboxes, k](const dds::StatusEvent& e) {
     if (e.kind != dds::StatusKind::publication_matched && e.kind != dds::StatusKind::liveliness_lost) return;
     const std::lock_guard lock(inboxes.mutex);
@@ -402,6 +446,8 @@ void SharedWorld::serve(Slot& s, const dds::msg::SimStep& step) {
   }
   sim.set_other_bodies(others_);
   sim.command_twist(Twist2D{step.cmd_vel.linear.x, step.cmd_vel.linear.y, step.cmd_vel.angular.z});
+  apply_joint_targets(step, sim);
+  s.buttons->press_on(sim);
   sim.step_until(dds::tripodal_time(step.until));
   publish_scan(s);
   s.last_step = step.step;

@@ -5,13 +5,16 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <ostream>
 #include <string>
+#include <vector>
 
-namespace tripodal::dds::msg {
-struct SimState;
-}
+#include "tripodal/dds/endpoint.hpp"
+#include "tripodal/dds/messages.hpp"
+
 namespace tripodal::sim {
 class Simulator;
 }
@@ -35,6 +38,29 @@ struct SharedWorldArgs {
 /// bumpers, cliff sensors and battery its world gives it (SimState::sensors says which), so that
 /// a robot on hardware dds has them as on the in-process simulator. Both servers use it.
 void put_sensors(dds::msg::SimState& state, sim::Simulator& sim);
+
+/// The step's joint targets into the simulator, in its world's joint order (a NaN, or a list of
+/// another length: that joint's, or every, target unchanged): a robot's neck on hardware dds.
+void apply_joint_targets(const dds::msg::SimStep& step, sim::Simulator& sim);
+
+/// A robot's LED buttons pressed over DDS: a button's name as std_msgs/String on
+/// rt/<ns>/tripodal/press_button (a visitor's finger from another process: a test, a kiosk),
+/// pressed on its simulator before its next step and so reported in that step's SimState. A name
+/// its world has no button of is dropped (the simulator refuses it).
+class ButtonInbox {
+ public:
+  ButtonInbox(dds::Participant& participant, const std::string& ns);
+  ~ButtonInbox();
+  ButtonInbox(const ButtonInbox&) = delete;
+  ButtonInbox& operator=(const ButtonInbox&) = delete;
+  /// Presses on `sim` what came since the last call, oldest first.
+  void press_on(sim::Simulator& sim);
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::string> names_;  // under mutex_: written on a Cyclone DDS thread
+  std::unique_ptr<dds::Subscriber<dds::msg::String>> subscriber_;
+};
 
 /// Serves until every robot that came has left, a signal, or (with wait_s) no robot came; prints
 /// per-robot and total figures ("robot-robot contacts: N"). Returns the tool's exit code.

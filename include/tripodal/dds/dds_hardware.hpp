@@ -11,11 +11,13 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tripodal/controllers/base_kinematics.hpp"
 #include "tripodal/dds/endpoint.hpp"
 #include "tripodal/dds/robot_modules.hpp"
+#include "tripodal/hardware/buttons.hpp"
 #include "tripodal/hardware/hardware.hpp"
 #include "tripodal/resources/resource.hpp"
 #include "tripodal/resources/resource_faults.hpp"
@@ -37,13 +39,25 @@ struct SimTruth {
   std::uint32_t collisions = 0;
 };
 
+// A joint of the robot's body behind DDS (a neck), as the simulator's world declares it: a
+// position command channel and a JointResource of its name (docs/distribution.md).
+struct DdsJoint {
+  std::string name;
+  double min_rad = -1.0, max_rad = 1.0;
+  double initial_rad = 0.0;
+  double rate_hz = 50.0;  // its state's rate: the resource goes stale after three periods
+};
+
 // Wheels: the controller's wheel velocities become a body twist by the base's forward kinematics
 // (HardwareConfig::base) and go out as geometry_msgs/Twist on cmd_vel; the wheel states are the
 // latest sensor_msgs/JointState of joint_states (names in the base's wheel order). Sensors: a
 // laser resource "laser" fed by sensor_msgs/LaserScan on scan (DdsLaserResource), and those the
 // parameter `sensors` names ("gyro,bumpers,cliff,battery", default none) as resources of those
 // names, fed by the simulator's answer (SimState's sensor fields, after every step); a sensor the
-// simulator's world does not give is a fault of the hardware.
+// simulator's world does not give is a fault of the hardware. Joints (given at construction, the
+// world's: `tripodal run` passes them): a position command channel and a JointResource each,
+// the targets sent with the step when a command changed, the states from the answer; a joint the
+// simulator does not report is a fault. Buttons (ButtonPanel): the presses the answer carries.
 //
 // Lock-step (parameter lock_step, default true: the other side is `tripodal sim-server`):
 // advance_to(t) sends tripodal_msgs/SimStep {t, the twist} and waits until the simulator answers
@@ -56,12 +70,13 @@ struct SimTruth {
 // Without lock-step, time is the base's own: commands go out as written, states come as they come.
 //
 // Not final: the `tripodal run` tool adds the world's map to it (navi::MapSource).
-class DdsHardware : public CHardware, public HardwareInterface, public ResourceFaultSource {
+class DdsHardware : public CHardware, public HardwareInterface, public ResourceFaultSource, public ButtonPanel {
  public:
   // Parameters: namespace, domain_id, loopback, lock_step, step_timeout_s, connect_timeout_s, sensors.
   static const ModuleManifest& static_manifest();
-  // Throws ConfigError (located at the entry) without a base controller; DdsError when DDS fails.
-  explicit DdsHardware(const HardwareConfig& config);
+  // Throws ConfigError (located at the entry) without a base controller or with a joint whose
+  // limits are not min < max; DdsError when DDS fails.
+  explicit DdsHardware(const HardwareConfig& config, std::vector<DdsJoint> joints = {});
   ~DdsHardware() override;
 
   [[nodiscard]] const BaseTopics& topics() const noexcept { return topics_; }
@@ -79,6 +94,8 @@ class DdsHardware : public CHardware, public HardwareInterface, public ResourceF
   bool read_wheel_states(std::span<double> velocity_rad_s, std::span<double> position_rad) noexcept override;
 
   [[nodiscard]] std::vector<std::string> take_faults() override { return faults_.take(); }
+  // ButtonPanel: the LED buttons pressed on the simulator since the last call, oldest first.
+  [[nodiscard]] std::vector<std::string> take_button_presses() override { return std::exchange(presses_, {}); }
 
  protected:
   [[nodiscard]] const ModuleManifest& do_manifest() const noexcept override { return static_manifest(); }
@@ -92,6 +109,7 @@ class DdsHardware : public CHardware, public HardwareInterface, public ResourceF
   void fail(std::string why) noexcept;
   bool connect() noexcept;
   [[nodiscard]] Twist2D commanded_twist() const noexcept;
+  [[nodiscard]] std::vector<double> joint_targets();
 
   BaseKinematics kinematics_;
   BaseTopics topics_;
@@ -103,6 +121,10 @@ class DdsHardware : public CHardware, public HardwareInterface, public ResourceF
   bool connected_ = false;
   bool lost_ = false;
   std::optional<SimTruth> truth_;
+  std::vector<DdsJoint> joints_;
+  std::vector<std::unique_ptr<JointResource>> joint_resources_;
+  std::vector<double> joint_sent_;  // the targets last sent (rad), the channels' values in joint order
+  std::vector<std::string> presses_;
 
   // Written on Cyclone DDS threads, read on the loop's: guarded by mutex_, changes signalled on cv_.
   mutable std::mutex mutex_;

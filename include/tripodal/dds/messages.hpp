@@ -213,6 +213,8 @@ struct SimStep {
   Time until;
   Twist cmd_vel;
   std::uint32_t step = 0;  // from 1
+  // The joints' targets (rad) in the order of SimState::joint_names; empty: unchanged.
+  std::vector<double> joint_targets;
   bool operator==(const SimStep&) const = default;
 };
 
@@ -240,6 +242,13 @@ struct SimState {
   std::uint32_t sensors = 0;
   bool battery_charging = false;    // a uint32 on the wire (no padding before the sequence)
   std::vector<std::uint8_t> cliff;  // 1: a cliff under sensor i
+  // The robot's joints after the step (its world's, in order) and the LED buttons pressed during
+  // it (names, oldest first): the hardware dds's joint resources and button panel.
+  std::vector<std::string> joint_names;
+  std::vector<double> joint_position;  // rad
+  std::vector<double> joint_velocity;  // rad/s
+  std::vector<double> joint_target;    // rad
+  std::vector<std::string> button_presses;
   bool operator==(const SimState&) const = default;
 };
 

@@ -41,6 +41,11 @@ struct RobotMonitorOptions {
   /// the first module of the robot that implements HriService (the HRI module of its profile,
   /// which names the knowledge file), if any. Must outlive the monitor.
   HriService* hri = nullptr;
+  /// Which robot this is, for an operator watching a fleet: its name (the profile's) and how the
+  /// fleet reaches it ("DDS domain 78, namespace 'robot1', secured as 'robot1' (keys ...)"; empty:
+  /// not on DDS). On /status as `robot` and `identity` (null when empty).
+  std::string robot_name;
+  std::string identity;
 };
 
 /// What the application knows beyond the robot: the simulator's true pose, the measured coverage
