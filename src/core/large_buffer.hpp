@@ -1,7 +1,7 @@
 // Internal: the allocator of the loaders' large per-load arrays (the XML tree of a big net: tens of
 // MB each, issue 42). Such an array is fresh memory every load (above glibc's mmap threshold), and
 // its first touch costs one page fault per 4 KiB page: a third of a 100,000-place net's load went to
-// the kernel. From 4 MiB on, the array is aligned to 2 MiB and offered to transparent huge pages
+// the kernel. From 16 MiB on, the array is aligned to 2 MiB and offered to transparent huge pages
 // (Linux madvise; a hint the kernel may decline), so a 2 MiB region faults once, and the tree
 // takes fewer TLB entries while the readers walk it. Below that, and elsewhere, std::allocator.
 #pragma once
@@ -50,7 +50,9 @@ class LargeBufferAllocator {
 
  private:
   static constexpr std::size_t kHugePage = std::size_t{2} << 20;
-  static constexpr std::size_t kHugeFrom = std::size_t{4} << 20;
+  // Arrays below glibc's mmap ceiling (32 MiB) are, once freed, reused from the heap already
+  // faulted in: only those near and above it are fresh memory every load.
+  static constexpr std::size_t kHugeFrom = std::size_t{16} << 20;
   static constexpr std::size_t kMaxBytes = std::size_t{1} << 47;  // beyond any address space
   static constexpr bool huge(std::size_t n) noexcept {
     return n >= kHugeFrom / sizeof(T);

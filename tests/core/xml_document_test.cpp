@@ -1013,13 +1013,13 @@ TEST_CASE("xml document: the plain reader reads the shipped nets as tinyxml2 doe
 }
 
 TEST_CASE("the large-buffer allocator keeps values across growth and aligns big arrays to 2 MiB") {
-  // The XML tree of a big net lives in these arrays (huge pages from 4 MiB on, plain allocation
+  // The XML tree of a big net lives in these arrays (huge pages from 16 MiB on, plain allocation
   // below): both sides of the line, and growth across it, keep every element.
   std::vector<std::uint64_t, tripodal::detail::LargeBufferAllocator<std::uint64_t>> values;
-  constexpr std::uint64_t kCount = 1'500'000;  // 12 MB
+  constexpr std::uint64_t kCount = 3'000'000;  // 24 MB
   for (std::uint64_t i = 0; i < kCount; ++i) {
     values.push_back(i * 7 + 1);
-    if (i == 1000) CHECK(values.capacity() * sizeof(std::uint64_t) < (std::size_t{4} << 20));
+    if (i == 1000) CHECK(values.capacity() * sizeof(std::uint64_t) < (std::size_t{16} << 20));
   }
   CHECK(reinterpret_cast<std::uintptr_t>(values.data()) % (std::uintptr_t{2} << 20) == 0);
   bool all = true;
