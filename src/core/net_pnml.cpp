@@ -2,7 +2,7 @@
 // dialect (no <page>, labels in <value>). tripodal's extensions travel in
 // <toolspecific tool="tripodal" version="1"> using the native format's attribute syntax; what a
 // P/T net cannot express is refused with a located error, never read as something else.
-#include <map>
+#include <functional>
 #include <set>
 #include <unordered_map>
 
@@ -13,6 +13,7 @@ namespace tripodal::detail {
 namespace {
 
 constexpr std::string_view kTool = "tripodal";
+constexpr std::size_t kPrefetchAhead = 8;  // arcs ahead whose ends are prefetched
 constexpr std::string_view kIsoPtNet = "http://www.pnml.org/version-2009/grammar/ptnet";
 
 bool is_pt_net_type(std::string_view type) {
@@ -26,10 +27,92 @@ bool is_foreign_annotation(std::string_view name) {
          name == "declaration" || name == "declarations" || name == "structure";
 }
 
+// PNML ids (pages, places, transitions, arcs) share one name space. An open-addressing table
+// of (hash, element) pairs, 8 bytes a slot, at most half full: one hash and usually one probe per
+// id, no allocation per id; the id itself is compared (read back from the element) only when the
+// 32-bit hashes agree. (A std::unordered_map<std::string, SourceLocation> made a node, a string
+// and a location per id: a third of a 10,000-place PNML load.)
+class IdTable {
+ public:
+  /// `root`: the document's first element (the elements lie in one array after it).
+  explicit IdTable(const XmlElement* root) : root_(root) {}
+  void reserve(std::size_t ids) {
+    while ((ids + 1) * 2 > slots_.size()) grow();
+  }
+  /// The element that first claimed `id`; nullptr when `id` is new (it is then `e`'s).
+  const XmlElement* claim(std::string_view id, const XmlElement* e) {
+    if ((size_ + 1) * 2 > slots_.size()) grow();
+    const std::size_t mask = slots_.size() - 1;
+    const auto hash = static_cast<std::uint32_t>(std::hash<std::string_view>{}(id));
+    for (std::size_t i = hash & mask;; i = (i + 1) & mask) {
+      Slot& slot = slots_[i];
+      if (slot.element == 0) {
+        slot = Slot{hash, static_cast<std::uint32_t>(e - root_) + 1};
+        ++size_;
+        return nullptr;
+      }
+      if (slot.hash != hash) continue;
+      const XmlElement* first = root_ + (slot.element - 1);
+      if (first->attribute("id") == id) return first;
+    }
+  }
+
+ private:
+  struct Slot {
+    std::uint32_t hash = 0;
+    std::uint32_t element = 0;  ///< 0: empty; else the element's index + 1
+  };
+  void grow() {
+    std::vector<Slot> old = std::move(slots_);
+    slots_.assign(old.empty() ? 1024 : old.size() * 2, Slot{});
+    const std::size_t mask = slots_.size() - 1;
+    for (const Slot& slot : old) {
+      if (slot.element == 0) continue;
+      std::size_t i = slot.hash & mask;
+      while (slots_[i].element != 0) i = (i + 1) & mask;
+      slots_[i] = slot;
+    }
+  }
+  const XmlElement* root_;
+  std::vector<Slot> slots_;
+  std::size_t size_ = 0;
+};
+
+// A (source, target) pair of ids, for the halves of read arcs.
+struct IdPairHash {
+  std::size_t operator()(const std::pair<std::string_view, std::string_view>& p) const noexcept {
+    const std::size_t h = std::hash<std::string_view>{}(p.first);
+    return h ^ (std::hash<std::string_view>{}(p.second) + 0x9E3779B97F4A7C15ULL + (h << 6) + (h >> 2));
+  }
+};
+
+// The places, transitions and other elements with ids (arcs, pages) under a net or page, nested
+// pages included: the net and the id table reserve room for them once.
+struct NodeCounts {
+  std::size_t places = 0;
+  std::size_t transitions = 0;
+  std::size_t others = 0;
+};
+void count_nodes(const XmlElement* e, NodeCounts& counts) {
+  for (const auto* c = e->first_child(); c != nullptr; c = c->next_sibling()) {
+    const std::string_view n = c->name();
+    if (n == "arc")
+      ++counts.others;
+    else if (n == "place")
+      ++counts.places;
+    else if (n == "transition")
+      ++counts.transitions;
+    else if (n == "page") {
+      ++counts.others;
+      count_nodes(c, counts);
+    }
+  }
+}
+
 struct RawArc {
   const XmlElement* e = nullptr;
-  std::string source;
-  std::string target;
+  std::string_view source;  // views into the document
+  std::string_view target;
   Tokens weight = 1;
   ArcKind kind = ArcKind::normal;
   bool tripodal_read = false;  ///< half of a read arc exported as a self-loop
@@ -38,7 +121,7 @@ struct RawArc {
 
 class PnmlReader {
  public:
-  PnmlReader(const ReadContext& ctx, PetriNet& net) : ctx_(ctx), net_(net) {}
+  PnmlReader(const ReadContext& ctx, PetriNet& net, const XmlElement* root) : ctx_(ctx), net_(net), ids_(root) {}
 
   void read_net(const XmlElement* e) {
     check_attributes(ctx_, e, {"id", "type"});
@@ -57,6 +140,10 @@ class PnmlReader {
     for (const auto* c = e->first_child("toolspecific"); c != nullptr; c = c->next_sibling("toolspecific")) {
       if (const auto* ext = tripodal_extension(c, "net")) read_net_extension(ext);
     }
+    NodeCounts counts;
+    count_nodes(e, counts);
+    net_.reserve(counts.places, counts.transitions);
+    ids_.reserve(counts.places + counts.transitions + counts.others);
     read_container(e, true);
     if (net_.name.empty()) net_.name = net_.id;  // as in the native format
     resolve_arcs();
@@ -107,7 +194,8 @@ class PnmlReader {
   }
 
   // A label's value: <text> (ISO) or <value> (JARP).
-  std::optional<std::pair<std::string, const XmlElement*>> label_value(const XmlElement* label) {
+  // A view into the document (its text is already trimmed).
+  std::optional<std::pair<std::string_view, const XmlElement*>> label_value(const XmlElement* label) {
     const XmlElement* value = nullptr;
     for (const auto* c = label->first_child(); c != nullptr; c = c->next_sibling()) {
       const std::string_view n = c->name();
@@ -122,18 +210,18 @@ class PnmlReader {
       ctx_.error(label, "label <" + std::string(label->name()) + "> has no <text> (or JARP <value>)");
       return std::nullopt;
     }
-    return std::make_pair(trimmed_text(value), value);
+    return std::make_pair(value->text(), value);
   }
 
-  std::optional<std::string> claim_id(const XmlElement* e) {
+  std::optional<std::string_view> claim_id(const XmlElement* e) {
     auto id = required(ctx_, e, "id");
     if (!id) return std::nullopt;
-    const auto [it, inserted] = ids_.emplace(*id, ctx_.loc.element(e));
-    if (!inserted) {
-      ctx_.error_at_value(e, "id", "duplicate id '" + std::string(*id) + "' (first defined at " + it->second.str() + ")");
+    if (const XmlElement* first = ids_.claim(*id, e)) {
+      ctx_.error_at_value(e, "id",
+                          "duplicate id '" + std::string(*id) + "' (first defined at " + ctx_.loc.element(first).str() + ")");
       return std::nullopt;
     }
-    return std::string(*id);
+    return id;
   }
 
   void read_container(const XmlElement* e, bool is_net) {
@@ -148,7 +236,7 @@ class PnmlReader {
         read_container(c, false);
       } else if (n == "name") {
         if (is_net) {
-          if (auto v = label_value(c)) net_.name = v->first;
+          if (auto v = label_value(c)) net_.name.assign(v->first);
         } else {
           label_value(c);
         }
@@ -175,7 +263,7 @@ class PnmlReader {
     for (const auto* c = e->first_child(); c != nullptr; c = c->next_sibling()) {
       const std::string_view n = c->name();
       if (n == "name") {
-        if (auto v = label_value(c)) p.name = v->first;
+        if (auto v = label_value(c)) p.name.assign(v->first);
       } else if (n == "initialMarking") {
         if (auto v = label_value(c)) {
           if (auto tokens = parse_count(ctx_, v->second, "", v->first, 0, "token count")) {
@@ -206,7 +294,7 @@ class PnmlReader {
     for (const auto* c = e->first_child(); c != nullptr; c = c->next_sibling()) {
       const std::string_view n = c->name();
       if (n == "name") {
-        if (auto v = label_value(c)) t.name = v->first;
+        if (auto v = label_value(c)) t.name.assign(v->first);
       } else if (n == "toolspecific") {
         if (const auto* x = tripodal_extension(c, "transition")) read_transition_details(ctx_, x, t, net_, false);
       } else if (n == "graphics") {
@@ -261,7 +349,7 @@ class PnmlReader {
         std::optional<std::string> text;
         if (const auto value = optional_attr(c, "value")) text = std::string(*value);
         if (!text) {
-          if (auto v = label_value(c)) text = v->first;
+          if (auto v = label_value(c)) text = std::string(v->first);
         }
         const auto kind = text ? arc_type(c, "", *text) : std::nullopt;
         ok = ok && kind;
@@ -292,12 +380,16 @@ class PnmlReader {
   // Arcs may name nodes declared later (or on another page): connected after everything is read.
   void resolve_arcs() {
     // The transition -> place halves of read arcs, by (source, target).
-    std::map<std::pair<std::string, std::string>, std::vector<std::size_t>> returns;
+    std::unordered_map<std::pair<std::string_view, std::string_view>, std::vector<std::size_t>, IdPairHash> returns;
     for (std::size_t i = 0; i < arcs_.size(); ++i) {
       const RawArc& b = arcs_[i];
       if (b.tripodal_read && b.kind == ArcKind::normal) returns[{b.source, b.target}].push_back(i);
     }
     for (std::size_t i = 0; i < arcs_.size(); ++i) {
+      if (i + kPrefetchAhead < arcs_.size()) {  // the net's id index outgrows the caches (net_xml.cpp)
+        net_.prefetch_node(arcs_[i + kPrefetchAhead].source);
+        net_.prefetch_node(arcs_[i + kPrefetchAhead].target);
+      }
       RawArc& a = arcs_[i];
       if (a.consumed) continue;
       if (!a.tripodal_read) {
@@ -307,7 +399,8 @@ class PnmlReader {
       // A read arc travels as the self-loop p -> t -> p (its meaning for every other P/T tool);
       // both halves carry the tripodal mark and fold back into one read arc.
       if (a.kind != ArcKind::normal) {
-        ctx_.error(a.e, "tripodal read arc '" + a.source + "' -> '" + a.target + "' must not also be an inhibitor or read arc");
+        ctx_.error(a.e, "tripodal read arc '" + std::string(a.source) + "' -> '" + std::string(a.target) +
+                            "' must not also be an inhibitor or read arc");
         continue;
       }
       if (!net_.find_place(a.source)) {
@@ -327,8 +420,9 @@ class PnmlReader {
         }
       }
       if (back == nullptr) {
-        ctx_.error(a.e, "tripodal read arc '" + a.source + "' -> '" + a.target + "' has no matching arc '" + a.target +
-                            "' -> '" + a.source + "' of weight " + std::to_string(a.weight));
+        ctx_.error(a.e, "tripodal read arc '" + std::string(a.source) + "' -> '" + std::string(a.target) +
+                            "' has no matching arc '" + std::string(a.target) + "' -> '" + std::string(a.source) +
+                            "' of weight " + std::to_string(a.weight));
         continue;
       }
       back->consumed = true;
@@ -337,15 +431,15 @@ class PnmlReader {
     }
     for (const auto& a : arcs_) {
       if (a.tripodal_read && !a.consumed && net_.find_transition(a.source) && a.kind == ArcKind::normal) {
-        ctx_.error(a.e, "tripodal read arc '" + a.source + "' -> '" + a.target + "' has no matching arc '" + a.target +
-                            "' -> '" + a.source + "'");
+        ctx_.error(a.e, "tripodal read arc '" + std::string(a.source) + "' -> '" + std::string(a.target) +
+                            "' has no matching arc '" + std::string(a.target) + "' -> '" + std::string(a.source) + "'");
       }
     }
   }
 
   const ReadContext& ctx_;
   PetriNet& net_;
-  std::unordered_map<std::string, SourceLocation> ids_;  // hashed: one look-up per element of a large net
+  IdTable ids_;
   std::vector<RawArc> arcs_;
 };
 
@@ -383,7 +477,7 @@ PetriNet read_pnml(const XmlElement* root, const ReadContext& ctx) {
     return net;
   }
   net.where = ctx.loc.element(net_element);
-  PnmlReader(ctx, net).read_net(net_element);
+  PnmlReader(ctx, net, root).read_net(net_element);
   return net;
 }
 

@@ -12,6 +12,9 @@ namespace tripodal::detail {
 namespace {
 
 constexpr std::string_view kNetChildren = "parameter, fact, place, transition, arc";
+// How many nodes or arcs ahead the net's id index is prefetched: enough for a memory access to
+// land while the elements in between are read (about 50 ns each).
+constexpr std::size_t kPrefetchAhead = 8;
 
 }  // namespace
 
@@ -61,7 +64,11 @@ PetriNet read_native(const XmlElement* root, const ReadContext& ctx) {
   // `add` creates the node in the net; `scratch` (built once: most nodes are added) takes one
   // that cannot be added.
   const auto read_nodes = [&](const std::vector<const XmlElement*>& elements, auto add, auto& scratch, auto details) {
-    for (const XmlElement* c : elements) {
+    for (std::size_t i = 0; i < elements.size(); ++i) {
+      if (i + kPrefetchAhead < elements.size()) {
+        if (auto ahead = elements[i + kPrefetchAhead]->attribute("id")) net.prefetch_node(*ahead);
+      }
+      const XmlElement* c = elements[i];
       const auto id = required(ctx, c, "id");
       std::remove_reference_t<decltype(scratch)>* node = nullptr;
       if (id) {
@@ -88,7 +95,13 @@ PetriNet read_native(const XmlElement* root, const ReadContext& ctx) {
              [&](std::string_view id, SourceLocation where) -> Transition& { return net.new_transition(id, where); },
              scratch_transition, read_transition_details);
   static constexpr std::array<std::string_view, 4> kArcAttributes{"source", "target", "weight", "kind"};
-  for (const XmlElement* c : arcs) {
+  for (std::size_t i = 0; i < arcs.size(); ++i) {
+    if (i + kPrefetchAhead < arcs.size()) {
+      const XmlElement* ahead = arcs[i + kPrefetchAhead];
+      if (auto from = ahead->attribute("source")) net.prefetch_node(*from);
+      if (auto to = ahead->attribute("target")) net.prefetch_node(*to);
+    }
+    const XmlElement* c = arcs[i];
     AttributeValues<kArcAttributes.size()> attr;
     read_attributes(ctx, c, kArcAttributes, attr.found);
     check_no_text(ctx, c);

@@ -113,6 +113,11 @@ std::optional<PetriNet::NodeRef> PetriNet::find_node(std::string_view node_id) c
   return NodeRef{(code & 1U) != 0, code >> 1};
 }
 
+void PetriNet::prefetch_node(std::string_view node_id) const noexcept {
+  if (id_slots_.empty()) return;
+  __builtin_prefetch(&id_slots_[id_key(node_id).hash & (id_slots_.size() - 1)]);
+}
+
 std::size_t PetriNet::claim_slot(std::string_view node_id, IdKey& key) {
   grow_index(places_.size() + transitions_.size() + 1);
   key = id_key(node_id);

@@ -697,7 +697,14 @@ class XmlPlainReader {
     while (true) {
       if (s_[i] != '<') {
         if (open_.empty()) return false;
-        const std::size_t lt = s_.find('<', i);
+        // Most text between tags is indentation: skipped here without a search for the '<'.
+        std::size_t j = i;
+        while (j < n && is_blank(s_[j])) ++j;
+        if (j < n && s_[j] == '<') {
+          i = j;
+          continue;
+        }
+        const std::size_t lt = s_.find('<', j);
         if (lt == std::string_view::npos) return false;
         if (!text(i, lt)) return false;
         i = lt;
@@ -731,8 +738,19 @@ class XmlPlainReader {
   }
 
  private:
-  static bool name_start(char c) noexcept { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_' || c == ':'; }
-  static bool name_char(char c) noexcept { return name_start(c) || (c >= '0' && c <= '9') || c == '.' || c == '-'; }
+  // One table look-up per byte of a name (names are a third of a document's bytes): bit 1 a
+  // name's first byte, bit 2 any later one.
+  static constexpr std::array<std::uint8_t, 256> kNameBytes = [] {
+    std::array<std::uint8_t, 256> t{};
+    for (int c = 0; c < 256; ++c) {
+      const bool start = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_' || c == ':';
+      const bool later = start || (c >= '0' && c <= '9') || c == '.' || c == '-';
+      t[static_cast<std::size_t>(c)] = static_cast<std::uint8_t>((start ? 1U : 0U) | (later ? 2U : 0U));
+    }
+    return t;
+  }();
+  static bool name_start(char c) noexcept { return (kNameBytes[static_cast<unsigned char>(c)] & 1U) != 0; }
+  static bool name_char(char c) noexcept { return (kNameBytes[static_cast<unsigned char>(c)] & 2U) != 0; }
   // The end of the ASCII name at s_[p], or p when none starts there.
   std::size_t name_end(std::size_t p) const noexcept {
     if (p >= s_.size() || !name_start(s_[p])) return p;

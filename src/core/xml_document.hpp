@@ -21,6 +21,8 @@
 #include <string_view>
 #include <vector>
 
+#include "large_buffer.hpp"
+
 namespace tinyxml2 {
 class XMLDocument;
 }
@@ -135,8 +137,8 @@ class XmlDocument {
   std::unique_ptr<tinyxml2::XMLDocument> xml_;
   std::string latin1_decoded_;  // the source, when it had to be decoded from ISO-8859-1
   std::string_view text_;
-  std::vector<XmlElement> elements_;
-  std::vector<XmlAttribute> attributes_;
+  std::vector<XmlElement, LargeBufferAllocator<XmlElement>> elements_;
+  std::vector<XmlAttribute, LargeBufferAllocator<XmlAttribute>> attributes_;
   std::deque<std::string> joined_;  // texts of several pieces (around children, CDATA); stable addresses
   std::string owned_;               // decoded values and texts copied out of tinyxml2's buffer before its DOM goes
   mutable std::vector<std::size_t> line_starts_;  // built on the first line_column() call

@@ -207,6 +207,53 @@ TEST_CASE("PNML: what a P/T net cannot hold is refused with a location") {
   CHECK_THAT(errors_of("<net id=\"x\"/>"), Catch::Contains("bad.pnml:1:1: error: unexpected root element <net>: expected <pnml>"));
 }
 
+TEST_CASE("PNML: pages, places, transitions and arcs share one id space, in any order") {
+  // An arc's id taken again by a place declared after it, a page's by a transition, and many ids
+  // (past the id table's first size) before a duplicate of the last one: each duplicate names
+  // where the id was first defined.
+  CHECK_THAT(errors_of(iso(kPtNet, kTwoNodes + "      <arc id=\"a\" source=\"p\" target=\"t\"/>\n"
+                                               "      <place id=\"a\"/>\n")),
+             Catch::Contains("bad.pnml:8:18: error: duplicate id 'a' (first defined at bad.pnml:7:7)"));
+  CHECK_THAT(errors_of(iso(kPtNet, kTwoNodes + "      <transition id=\"pg\"/>\n")),
+             Catch::Contains("bad.pnml:7:23: error: duplicate id 'pg' (first defined at bad.pnml:4:5)"));
+  CHECK_THAT(errors_of(iso(kPtNet, kTwoNodes + "      <arc id=\"p\" source=\"p\" target=\"t\"/>\n")),
+             Catch::Contains("bad.pnml:7:16: error: duplicate id 'p' (first defined at bad.pnml:5:7)"));
+  std::string many;
+  for (int i = 0; i < 3000; ++i) many += "      <place id=\"q" + std::to_string(i) + "\"/>\n";  // lines 5 to 3004
+  many += "      <transition id=\"q2999\"/>\n";                                                 // line 3005
+  const std::string errors = errors_of(iso(kPtNet, many));
+  CHECK_THAT(errors, Catch::Contains("bad.pnml:3005:23: error: duplicate id 'q2999' (first defined at bad.pnml:3004:7)"));
+  CHECK(errors.find("duplicate id 'q") == errors.rfind("duplicate id 'q"));  // that one only
+}
+
+TEST_CASE("PNML: read arcs fold back from their two halves in any order") {
+  // The return half (t -> p) before the forward half, and two read arcs on one place.
+  const std::string mark = "<toolspecific tool=\"tripodal\" version=\"1\"><arc kind=\"read\"/></toolspecific>";
+  const std::string page = kTwoNodes +
+                           "      <transition id=\"u\"/>\n"
+                           "      <arc id=\"b1\" source=\"t\" target=\"p\">" +
+                           mark +
+                           "</arc>\n"
+                           "      <arc id=\"f1\" source=\"p\" target=\"t\">" +
+                           mark +
+                           "</arc>\n"
+                           "      <arc id=\"f2\" source=\"p\" target=\"u\">" +
+                           mark +
+                           "</arc>\n"
+                           "      <arc id=\"b2\" source=\"u\" target=\"p\">" +
+                           mark + "</arc>\n";
+  Diagnostics d;
+  const auto net = load_net_from_string(iso(kPtNet, page), "ok.pnml", d);
+  INFO(d.str());
+  REQUIRE(net.has_value());
+  for (const auto& t : net->transitions()) {
+    INFO(t.id);
+    CHECK(t.reads.size() == 1);
+    CHECK(t.inputs.empty());
+    CHECK(t.outputs.empty());
+  }
+}
+
 TEST_CASE("PNML: the tripodal extension is checked like the native format") {
   const std::string ts_version =
       kTwoNodes + "      <transition id=\"u\"><toolspecific tool=\"tripodal\" version=\"9\"><transition event=\"e\"/></toolspecific></transition>\n";

@@ -79,6 +79,18 @@ TEST_CASE("ids of every length are found exactly, across table growth") {
   CHECK_FALSE(net.find_place(std::string("x\0\0\0", 4)));
 }
 
+TEST_CASE("prefetch_node is a hint that leaves the net as it was") {
+  PetriNet net;
+  net.prefetch_node("p");  // an empty net: no table yet
+  net.add_place({.id = "p"});
+  net.prefetch_node("p");
+  net.prefetch_node("not there");
+  net.prefetch_node("");
+  CHECK(net.places().size() == 1);
+  CHECK(net.find_place("p") == PlaceIndex(0));
+  CHECK_FALSE(net.find_place("not there"));
+}
+
 TEST_CASE("new_place and new_transition add a node to be filled in where it lies") {
   PetriNet net;
   net.reserve(2, 1);

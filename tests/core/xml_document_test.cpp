@@ -1011,3 +1011,21 @@ TEST_CASE("xml document: the plain reader reads the shipped nets as tinyxml2 doe
   CHECK(files >= 20);
   CHECK(read_plain * 2 >= files);  // most shipped nets need no tinyxml2 DOM
 }
+
+TEST_CASE("the large-buffer allocator keeps values across growth and aligns big arrays to 2 MiB") {
+  // The XML tree of a big net lives in these arrays (huge pages from 16 MiB on, plain allocation
+  // below): both sides of the line, and growth across it, keep every element.
+  std::vector<std::uint64_t, tripodal::detail::LargeBufferAllocator<std::uint64_t>> values;
+  constexpr std::uint64_t kCount = 3'000'000;  // 24 MB
+  for (std::uint64_t i = 0; i < kCount; ++i) {
+    values.push_back(i * 7 + 1);
+    if (i == 1000) CHECK(values.capacity() * sizeof(std::uint64_t) < (std::size_t{16} << 20));
+  }
+  CHECK(reinterpret_cast<std::uintptr_t>(values.data()) % (std::uintptr_t{2} << 20) == 0);
+  bool all = true;
+  for (std::uint64_t i = 0; i < kCount; ++i) all = all && values[i] == i * 7 + 1;
+  CHECK(all);
+  values.resize(10);
+  values.shrink_to_fit();  // back below the line: freed as it was allocated
+  CHECK(values.back() == 9 * 7 + 1);
+}
