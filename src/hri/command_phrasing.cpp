@@ -61,9 +61,23 @@ const std::vector<Phrase>& openings() {
 // Said after a request; stripped repeatedly.
 const std::vector<Phrase>& tails() {
   static const std::vector<Phrase> list = {
-      {"for", "me"},  {"for", "us"},  {"if", "you", "can"},  {"if", "you", "could"},  {"if", "you", "would"},
-      {"if", "possible"},  {"if", "you", "please"},  {"right", "now"},  {"now"},  {"please"},  {"jinny"},
-      {"thanks"},  {"thank", "you"},  {"ok"},  {"okay"},  // not "robot": "explain this robot"
+      {"for", "me"},
+      {"for", "us"},
+      {"to", "me"},
+      {"to", "us"},
+      {"if", "you", "can"},
+      {"if", "you", "could"},
+      {"if", "you", "would"},
+      {"if", "possible"},
+      {"if", "you", "please"},
+      {"right", "now"},
+      {"now"},
+      {"please"},
+      {"jinny"},
+      {"thanks"},
+      {"thank", "you"},
+      {"ok"},
+      {"okay"},  // not "robot": "explain this robot"
   };
   return list;
 }

@@ -3,6 +3,7 @@
 #include <xapian.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <set>
@@ -34,6 +35,39 @@ constexpr double kCommonWordSlope = 0.06;
 constexpr double kCommonWordFloor = 0.25;
 // The related words whose mention in an answer counts (synonyms, derivations, similar adjectives).
 constexpr double kDerivationOrCloser = 0.8;
+// Question words and "you" tell entries apart ("who are you" vs "where are you"), but say less of
+// what a question is about than its other words: "how are you programmed" is about programs, not
+// about an entry because its questions open with "how".
+constexpr double kFunctionWordScale = 0.8;
+
+// An adjective said of the robot ("are you tired", "you look happy") asks how it feels; the entry
+// with "feel" is about that, a little less surely than one with the word itself.
+constexpr double kSaidOfYouCloseness = 0.8;
+
+// The words of `ws` said of the one spoken to: the adjective after "you" ("you look tired") or after
+// "are you" ("are you feeling happy"), with a verb of being or seeming and an adverb of degree between.
+std::set<std::string> said_of_you(const std::vector<std::string>& ws, const Lexicon& lexicon) {
+  static constexpr std::array<std::string_view, 8> kLinking = {"are", "re", "look", "looks", "seem", "seems", "feel", "feeling"};
+  static constexpr std::array<std::string_view, 5> kDegree = {"so", "very", "really", "quite", "bit"};
+  const auto is_in = [](const auto& list, const std::string& w) { return std::find(list.begin(), list.end(), w) != list.end(); };
+  std::set<std::string> out;
+  for (std::size_t k = 0; k < ws.size(); ++k) {
+    if (ws[k] != "you") continue;
+    // "are you ...", or "you are / look / seem ...": "can you fly" says nothing of how it is.
+    bool linked = k > 0 && ws[k - 1] == "are";
+    std::size_t j = k + 1;
+    for (; j < ws.size() && (is_in(kLinking, ws[j]) || is_in(kDegree, ws[j]) || ws[j] == "a"); ++j) {
+      if (is_in(kLinking, ws[j])) linked = true;
+    }
+    if (linked && j < ws.size() && lexicon.is_adjective(ws[j])) out.insert(ws[j]);
+  }
+  return out;
+}
+
+bool is_function_word(std::string_view w) {
+  static constexpr std::array<std::string_view, 8> kWords = {"how", "when", "where", "which", "who", "whom", "why", "you"};
+  return std::find(kWords.begin(), kWords.end(), w) != kWords.end();
+}
 
 // True when one word is the other with one letter doubled ("helo", "hello").
 bool differs_by_doubling(std::string_view a, std::string_view b) {
@@ -60,6 +94,10 @@ struct KnowledgeIndex::Impl {
   // Candidates of the typo correction by length, each with how many entries use it (ties go to
   // the more common word).
   std::map<std::size_t, std::vector<std::pair<std::string, Xapian::doccount>>> by_length;
+  // Per entry (by index): its words as written. Ties go to the entry with the visitor's own words:
+  // "hour" is the time's, "hours" the opening hours'.
+  std::vector<std::set<std::string>> surface;
+  std::string robot_name;  // said to the robot, not about anything ("thank you very much, jinny")
 
   [[nodiscard]] std::string term(const std::string& word) const { return "Z" + stem(word); }
   // The same word in an entry's answer.
@@ -77,6 +115,7 @@ struct KnowledgeIndex::Impl {
 
   void index_text(Xapian::Document& doc, std::string_view text, Xapian::termcount wdf, std::set<std::string>& words_seen) {
     const std::vector<std::string> ws = hri::words(text);
+    surface.back().insert(ws.begin(), ws.end());
     for (const auto& w : ws) {
       words_seen.insert(w);
       // Stop words are indexed too: the query weighs them little, but they tell apart entries
@@ -92,12 +131,15 @@ struct KnowledgeIndex::Impl {
 
   // Each word's own term, and when no entry has it, the terms of the words the lexicon relates to
   // it that some entry has (only those: the others could not match).
-  [[nodiscard]] std::vector<WordTerms> word_terms(const std::vector<std::string>& ws) const {
+  [[nodiscard]] std::vector<WordTerms> word_terms(const std::vector<std::string>& ws, const std::set<std::string>& of_you) const {
     std::vector<WordTerms> out;
     out.reserve(ws.size());
     for (const auto& w : ws) {
       WordTerms g;
       g.terms.emplace_back(term(w), 1.0);
+      if (of_you.count(w) != 0 && !db.term_exists(term(w)) && db.term_exists(term("feel"))) {
+        g.terms.emplace_back(term("feel"), kSaidOfYouCloseness);
+      }
       // Words of one or two letters are abbreviations more often than words ("no" is WordNet's
       // "number"): they are matched as they are.
       if (options.lexicon && w.size() >= 3 && !db.term_exists(term(w)) && !hri::has_digit(w)) {
@@ -163,10 +205,12 @@ struct KnowledgeIndex::Impl {
 KnowledgeIndex::KnowledgeIndex(const KnowledgeBase& base, RetrievalOptions options) : impl_(std::make_unique<Impl>()) {
   Impl& x = *impl_;
   x.options = std::move(options);
+  if (const auto name = hri::words(base.robot()); name.size() == 1) x.robot_name = name.front();
   std::map<std::string, Xapian::doccount> word_entries;
   for (const KnowledgeEntry& e : base.entries()) {
     Xapian::Document doc;
     std::set<std::string> seen;
+    x.surface.emplace_back();
     for (const auto& k : e.keywords) x.index_text(doc, k, kKeywordWdf, seen);
     x.index_text(doc, e.topic, kTopicWdf, seen);
     for (const auto& q : e.questions) x.index_text(doc, q, kQuestionWdf, seen);
@@ -222,7 +266,7 @@ Retrieval KnowledgeIndex::search_unguarded(std::string_view utterance) const {
   std::vector<std::string> stop;
   std::set<std::string> seen;  // a word said twice counts once
   for (const auto& w : ws) {
-    if (seen.insert(w).second) (hri::is_stop_word(w) ? stop : content).push_back(w);
+    if (seen.insert(w).second) (hri::is_stop_word(w) || w == x.robot_name ? stop : content).push_back(w);
   }
   std::set<std::string> stop_terms;
   if (content.empty()) {
@@ -242,7 +286,8 @@ Retrieval KnowledgeIndex::search_unguarded(std::string_view utterance) const {
   // word the lexicon relates to it covers part of that weight.
   const double n = static_cast<double>(x.db.get_doccount());
   auto idf_of = [&](const std::string& t) { return std::log((n + 1.0) / (static_cast<double>(x.db.get_termfreq(t)) + 0.5)); };
-  const std::vector<WordTerms> groups = x.word_terms(content);
+  const std::vector<WordTerms> groups =
+      x.word_terms(content, x.options.lexicon ? said_of_you(ws, *x.options.lexicon) : std::set<std::string>{});
   std::map<std::string, double> query_terms;  // term -> its best closeness over the words
   std::vector<double> weight(groups.size());
   double total = 0.0;
@@ -257,6 +302,7 @@ Retrieval KnowledgeIndex::search_unguarded(std::string_view utterance) const {
       const double count = static_cast<double>(x.options.lexicon->frequency(content[i]));
       weight[i] *= std::max(kCommonWordFloor, 1.0 - kCommonWordSlope * std::log1p(count));
     }
+    if (is_function_word(content[i])) weight[i] *= kFunctionWordScale;
     total += weight[i];
   }
 
@@ -276,9 +322,11 @@ Retrieval KnowledgeIndex::search_unguarded(std::string_view utterance) const {
   }
   enquire.set_query(query);
   const Xapian::MSet mset = enquire.get_mset(0, static_cast<Xapian::doccount>(x.options.max_results));
+  std::vector<std::size_t> own_words(x.surface.size(), 0);
   for (auto it = mset.begin(); it != mset.end(); ++it) {
     RetrievalHit hit;
     hit.entry = static_cast<std::size_t>(*it - 1);
+    for (const auto& w : content) own_words[hit.entry] += x.surface.at(hit.entry).count(w);
     hit.weight = it.get_weight();
     std::set<std::string> matching(enquire.get_matching_terms_begin(it), enquire.get_matching_terms_end(it));
     double matched = 0.0;
@@ -299,8 +347,11 @@ Retrieval KnowledgeIndex::search_unguarded(std::string_view utterance) const {
   }
   // The entry that covers most of the utterance first: BM25 alone would put an entry matched
   // through several loosely related words ahead of one with the utterance's own telling word.
-  std::stable_sort(r.hits.begin(), r.hits.end(),
-                   [](const RetrievalHit& a, const RetrievalHit& b) { return a.confidence > b.confidence; });
+  // Between entries that cover it equally, the one with the visitor's own words as written.
+  std::stable_sort(r.hits.begin(), r.hits.end(), [&](const RetrievalHit& a, const RetrievalHit& b) {
+    if (a.confidence != b.confidence) return a.confidence > b.confidence;
+    return own_words[a.entry] > own_words[b.entry];
+  });
   return r;
 }
 

@@ -290,6 +290,12 @@ bool Lexicon::is_english(std::string_view word) const {
   return std::any_of(forms.begin(), forms.end(), [&](const auto& f) { return impl_->index[f.first].at(f.second).tagged > 0; });
 }
 
+bool Lexicon::is_adjective(std::string_view word) const {
+  if (!impl_) return false;
+  const auto forms = impl_->all_forms(std::string(word));
+  return std::any_of(forms.begin(), forms.end(), [](const auto& f) { return kPosNames.at(f.first) == "adj"; });
+}
+
 std::size_t Lexicon::frequency(std::string_view word) const {
   if (!impl_) return 0;
   std::size_t best = 0;

@@ -228,6 +228,10 @@ TEST_CASE("consent: heard, only a command parsed whole and heard surely starts a
   r = j.hri.handle_heard({"um jinny could you take us to node zero please", 0.8, {}});
   CHECK(r.kind == HriReply::Kind::task_started);
   CHECK(to_string(r.plan) == "PrAutoMove(goal=node0)");
+  // A tail naming the listeners ("to us", "for me") is politeness, not part of the command.
+  r = j.hri.handle_heard({"explain the robot at node one to us", 0.8, {}});
+  CHECK(r.kind == HriReply::Kind::task_started);
+  CHECK(r.task == "explain");
   // Sure, but only typo correction or an alternative made it a command: asked first.
   r = j.hri.handle_heard({"gide me to node one", 0.9, {}});
   CHECK(r.kind == HriReply::Kind::confirm_task);
@@ -237,7 +241,8 @@ TEST_CASE("consent: heard, only a command parsed whole and heard surely starts a
   r = j.hri.handle_heard({"show me the cleaning robot", 0.9, {}});
   CHECK(r.kind == HriReply::Kind::confirm_task);
   CHECK(r.entry_id == "show_node1");
-  CHECK(j.started == std::vector<std::string>{"PrAutoMove(goal=node0)"});
+  CHECK(j.started.size() == 2);
+  CHECK(j.started.front() == "PrAutoMove(goal=node0)");
 }
 
 TEST_CASE("consent: bad input is answered politely or ignored, never a crash, never a task") {

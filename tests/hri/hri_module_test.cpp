@@ -435,16 +435,17 @@ TEST_CASE("the visitor development set (issue 37) is answered right typed") {
   // 441 utterances in two batches written in one sitting each from the base's answers and the task
   // list (issue 37); this part was tuned on. First batch: 98/135 at commit ea75fae, before the
   // lexicon; 108/135 with it. Both batches: 225/265 before the second round (answers, word counts,
-  // senses in use), 234/265 after it.
-  REQUIRE(utterance_set("visitors_dev.yaml").size() >= 260);
-  CHECK(typed_accuracy("visitors_dev.yaml") >= 0.85);
+  // senses in use), 234/265 after it. Third round (ties, the robot's name, question words, adjectives
+  // said of the robot, "to us"; a third batch of 72): 306/337 (the first 265: 242/265).
+  REQUIRE(utterance_set("visitors_dev.yaml").size() >= 330);
+  CHECK(typed_accuracy("visitors_dev.yaml") >= 0.89);
 }
 
 TEST_CASE("the visitor held-out set (issue 37) is answered right typed") {
-  // Never tuned on: 143/176 before the second round, 141/176 after it (the first batch alone:
-  // 61/90 at commit ea75fae, 67/90 with the lexicon).
+  // Never tuned on: 143/176 before the second round, 141/176 after it, 143/176 after the third (the
+  // first batch alone: 61/90 at commit ea75fae, 67/90 with the lexicon).
   REQUIRE(utterance_set("visitors_heldout.yaml").size() >= 170);
-  CHECK(typed_accuracy("visitors_heldout.yaml") >= 0.78);
+  CHECK(typed_accuracy("visitors_heldout.yaml") >= 0.79);
 }
 
 TEST_CASE("no typed utterance of any set starts a task it did not ask for") {

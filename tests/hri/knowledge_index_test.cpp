@@ -77,3 +77,32 @@ TEST_CASE("an entry's answer counts too, less than its keywords and questions (i
   // Words of one or two letters and stop words of an answer match nothing.
   CHECK(index.search("at").hits.empty());
 }
+
+TEST_CASE("between entries that cover an utterance equally, the one with its words as written comes first (issue 37)") {
+  KnowledgeBase kb;
+  kb.put({"hours", "opening hours", {"opening hours", "hours", "open"}, {"What are the opening hours?"}, "10 to 6.", "", {}});
+  kb.put({"time", "the time", {"time", "hour"}, {"What time is it?"}, "Noon.", "", {}});
+  const KnowledgeIndex index(kb);
+  // "hour" and "hours" share a stem: both entries cover the question whole, the time has "hour" as said.
+  const Retrieval r = index.search("what is the hour");
+  REQUIRE(r.hits.size() >= 2);
+  CHECK(r.hits[0].confidence == r.hits[1].confidence);
+  CHECK(kb.entries()[r.hits.front().entry].id == "time");
+  CHECK(kb.entries()[index.search("what are the hours").hits.front().entry].id == "hours");
+}
+
+TEST_CASE("the robot's name said to it is not what an utterance is about (issue 37)") {
+  KnowledgeBase kb;
+  kb.set_robot("jinny");
+  kb.put({"introduce", "who I am", {"name", "jinny"}, {"Who are you?"}, "I am Jinny.", "", {}});
+  kb.put({"thanks", "thanks", {"thanks"}, {"Thank you."}, "You are welcome.", "", {}});
+  const KnowledgeIndex index(kb);
+  const Retrieval r = index.search("thanks, jinny");
+  REQUIRE_FALSE(r.hits.empty());
+  CHECK(kb.entries()[r.hits.front().entry].id == "thanks");
+  CHECK(r.hits.front().confidence == Approx(1.0));  // before: 0.5, tied with the introduction
+  // Alone, the name is what the visitor asks about.
+  const Retrieval alone = index.search("Jinny?");
+  REQUIRE_FALSE(alone.hits.empty());
+  CHECK(kb.entries()[alone.hits.front().entry].id == "introduce");
+}

@@ -146,3 +146,29 @@ TEST_CASE("with the lexicon, English words are not corrected and unknown words m
   REQUIRE_FALSE(built.hits.empty());
   CHECK(built.hits.front().entry == 0);
 }
+
+TEST_CASE("an adjective said of the robot asks how it feels (issue 37)") {
+  const auto lexicon = Lexicon::system();
+  REQUIRE_FALSE(lexicon->empty());
+  CHECK(lexicon->is_adjective("tired"));
+  CHECK(lexicon->is_adjective("happier"));  // through its base form
+  CHECK_FALSE(lexicon->is_adjective("robot"));
+  KnowledgeBase kb;
+  kb.put({"feeling", "how I feel", {"feel", "fine"}, {"How do you feel?"}, "Fine.", "", {}});
+  kb.put({"move", "how I move", {"move", "wheels"}, {"How do you move?"}, "On wheels.", "", {}});
+  const KnowledgeIndex index(kb, {.lexicon = lexicon});
+  // The base has neither word; said of the robot, they ask how it is.
+  for (const char* said : {"are you tired", "are you feeling happy", "you look so sad"}) {
+    INFO(said);
+    const Retrieval r = index.search(said);
+    REQUIRE_FALSE(r.hits.empty());
+    CHECK(kb.entries()[r.hits.front().entry].id == "feeling");
+    // Well ahead of the entry that shares only "you" with it (before: the two tied).
+    CHECK(r.hits.front().confidence > 0.4);
+    if (r.hits.size() > 1) CHECK(r.hits[1].confidence < r.hits.front().confidence - 0.2);
+  }
+  // Not without a verb of being or seeming: "can you fly" says nothing of how the robot is.
+  const Retrieval fly = index.search("can you fly");
+  CHECK(std::none_of(fly.hits.begin(), fly.hits.end(),
+                     [&](const RetrievalHit& h) { return kb.entries()[h.entry].id == "feeling" && h.confidence >= 0.5; }));
+}

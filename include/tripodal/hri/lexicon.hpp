@@ -54,6 +54,9 @@ class Lexicon {
   /// Lower case.
   [[nodiscard]] bool is_english(std::string_view word) const;
 
+  /// True when WordNet has the word, or a base form of it, as an adjective ("tired", "happier").
+  [[nodiscard]] bool is_adjective(std::string_view word) const;
+
   /// WordNet's base forms of `word` ("made" -> "make", "toilets" -> "toilet"), the word itself
   /// first when WordNet has it; empty when WordNet knows no form of it.
   [[nodiscard]] std::vector<std::string> base_forms(std::string_view word) const;

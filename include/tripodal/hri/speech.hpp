@@ -99,8 +99,9 @@ struct WordErrors {
                                             const std::function<bool(std::string_view)>& known = {});
 
 /// What visitors may say to a robot, for arpa_bigram_model: the base's question forms and keyword
-/// phrases, and every command form with its optional words left in and out and each {slot}
-/// replaced by each of `slot_values` (slots without values are left out of the corpus).
+/// phrases, the sentences of its answers that start no task and have no placeholder (what a visitor
+/// asks about next uses the answer's words: "information desk", "cafeteria"), and every command form with its optional words left
+/// in and out and each {slot} replaced by each of `slot_values` (slots without values are left out of the corpus).
 [[nodiscard]] std::vector<std::string> speech_corpus(const KnowledgeBase& base, const std::vector<std::string>& command_forms,
                                                      const std::map<std::string, std::vector<std::string>>& slot_values);
 
