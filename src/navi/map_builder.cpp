@@ -135,7 +135,13 @@ Pose2D MapBuilder::add(const LaserScan& scan, const Pose2D& odom_from_base, cons
       // not while falling back: the matches are not believed there, and the search costs six
       // wide matches a scan (the infinite corridor's 109 ms per scan)
       const ScanMatch g = fallback ? ScanMatch{} : rematch_all_headings();
-      if (g.quality >= typical - margin && g.quality >= m.quality + options_.recovery_gain) {
+      // a turn the odometry did not report is no odometry jump: on the infinite corridor two
+      // such "recoveries" (91 and 90 degrees at scans 104 and 117, junctions that look alike)
+      // laid the rest of the map backwards; seattle's jump is the odometry's own 80 degrees
+      const double unexplained_rad =
+          std::abs(wrap_angle(g.pose.theta_rad - pose_.theta_rad)) - (odometry_turn_rad_ + std::abs(motion.theta_rad));
+      if (g.quality >= typical - margin && g.quality >= m.quality + options_.recovery_gain &&
+          unexplained_rad <= options_.recovery_tolerance_rad) {
         m = g;
         ++health_.recovered;
       } else {
@@ -149,6 +155,8 @@ Pose2D MapBuilder::add(const LaserScan& scan, const Pose2D& odom_from_base, cons
     } else if (fallback && far_from_odometry(m.pose, motion)) {
       m.quality = 0.0;
     }
+    // the odometry's turn while the matches were weak: what a recovery may undo
+    odometry_turn_rad_ = untrusted ? odometry_turn_rad_ + std::abs(motion.theta_rad) : 0.0;
     untrusted_bits_ = (untrusted_bits_ << 1U) | (untrusted ? 1U : 0U);
     recorded_ = std::min(recorded_ + 1, options_.fallback_scans);
     last_quality_ = m.quality;

@@ -95,7 +95,9 @@ struct MapBuilderOptions {
   /// scans, beyond any tracking window): a match more than recovery_margin below the median of
   /// the recent matches is searched again over every heading within the widest window around the
   /// odometry's position, and that match is taken when it is a usual one (within recovery_margin
-  /// of the median) and better than the tracked one by recovery_gain. Otherwise the weak match is
+  /// of the median), better than the tracked one by recovery_gain, and turns the pose by no more
+  /// than the odometry turned since the matches went weak (+ recovery_tolerance_rad): a jump
+  /// of the odometry is undone, a turn it never reported is not made. Otherwise the weak match is
   /// taken only if it stays within recovery_tolerance (+ 0.3 per metre / radian moved) of the
   /// odometry's prediction. 0 margin: off.
   double recovery_margin = 0.15;
@@ -111,9 +113,10 @@ struct MapBuilderOptions {
   /// and the scan is inserted where the odometry puts it. Issue 41: on the infinite corridor
   /// 1,592 of 1,941 matches were weak, and taking those within the tolerance (0.3 m per scan,
   /// sliding along the corridor) made the map 13.4 m off aligned against the odometry's 3.5 m.
-  /// 15 of 20: CSAIL (tuned on) has 12 of 20 once, where its matches were right.
+  /// Off by default (1.0): at 0.75 (15 of 20; CSAIL, tuned on, has 12 of 20 once) it halved the
+  /// corridor's error but worsened fhw, acapulco and the campus (docs/localization.md).
   int fallback_scans = 20;
-  double fallback_share = 0.75;
+  double fallback_share = 1.0;
   LoopClosureOptions loop;
 };
 
@@ -217,6 +220,7 @@ class MapBuilder {
   MappingHealth health_;
   std::uint64_t untrusted_bits_ = 0;  // the last fallback_scans matches, bit 0 the newest: 1 untrusted
   int recorded_ = 0;                  // matches recorded in untrusted_bits_ (up to fallback_scans)
+  double odometry_turn_rad_ = 0.0;    // the odometry's turn over the untrusted scans before this one
 };
 
 }  // namespace tripodal::navi
