@@ -109,6 +109,8 @@ Pose2D MapBuilder::add(const LaserScan& scan, const Pose2D& odom_from_base, cons
     pose_ = compose(pose_, motion);
   }
   last_odom_ = odom_from_base;
+  turns_rad_[turn_next_] = std::abs(motion.theta_rad);
+  turn_next_ = (turn_next_ + 1) % turns_rad_.size();
   if (!matcher_ || since_refresh_ >= options_.refresh_every_scans) {
     const OccupancyGrid g = grid_around({pose_.x_m, pose_.y_m});
     if (g.width() >= 2 && g.height() >= 2 && g.count(Occupancy::occupied) > 0) {
@@ -138,8 +140,7 @@ Pose2D MapBuilder::add(const LaserScan& scan, const Pose2D& odom_from_base, cons
       // a turn the odometry did not report is no odometry jump: on the infinite corridor two
       // such "recoveries" (91 and 90 degrees at scans 104 and 117, junctions that look alike)
       // laid the rest of the map backwards; seattle's jump is the odometry's own 80 degrees
-      const double unexplained_rad =
-          std::abs(wrap_angle(g.pose.theta_rad - pose_.theta_rad)) - (odometry_turn_rad_ + std::abs(motion.theta_rad));
+      const double unexplained_rad = std::abs(wrap_angle(g.pose.theta_rad - pose_.theta_rad)) - recent_turn_rad();
       if (g.quality >= typical - margin && g.quality >= m.quality + options_.recovery_gain &&
           unexplained_rad <= options_.recovery_tolerance_rad) {
         m = g;
@@ -155,8 +156,6 @@ Pose2D MapBuilder::add(const LaserScan& scan, const Pose2D& odom_from_base, cons
     } else if (fallback && far_from_odometry(m.pose, motion)) {
       m.quality = 0.0;
     }
-    // the odometry's turn while the matches were weak: what a recovery may undo
-    odometry_turn_rad_ = untrusted ? odometry_turn_rad_ + std::abs(motion.theta_rad) : 0.0;
     untrusted_bits_ = (untrusted_bits_ << 1U) | (untrusted ? 1U : 0U);
     recorded_ = std::min(recorded_ + 1, options_.fallback_scans);
     last_quality_ = m.quality;
@@ -337,6 +336,12 @@ bool MapBuilder::far_from_odometry(const Pose2D& match, const Pose2D& motion) co
   const double moved = std::hypot(motion.x_m, motion.y_m);
   return std::hypot(c.x_m, c.y_m) > options_.recovery_tolerance_m + 0.3 * moved ||
          std::abs(c.theta_rad) > options_.recovery_tolerance_rad + 0.3 * std::abs(motion.theta_rad);
+}
+
+double MapBuilder::recent_turn_rad() const noexcept {
+  double sum = 0.0;
+  for (double t : turns_rad_) sum += t;
+  return sum;
 }
 
 bool MapBuilder::fallback_on() const noexcept {

@@ -3,6 +3,7 @@
 // thesis's mapping run), matching each scan against the map made so far with navi::ScanMatcher.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -96,7 +97,7 @@ struct MapBuilderOptions {
   /// the recent matches is searched again over every heading within the widest window around the
   /// odometry's position, and that match is taken when it is a usual one (within recovery_margin
   /// of the median), better than the tracked one by recovery_gain, and turns the pose by no more
-  /// than the odometry turned since the matches went weak (+ recovery_tolerance_rad): a jump
+  /// than the odometry turned over the last ten scans (+ recovery_tolerance_rad): a jump
   /// of the odometry is undone, a turn it never reported is not made. Otherwise the weak match is
   /// taken only if it stays within recovery_tolerance (+ 0.3 per metre / radian moved) of the
   /// odometry's prediction. 0 margin: off.
@@ -192,6 +193,7 @@ class MapBuilder {
   [[nodiscard]] bool far_from_odometry(const Pose2D& match, const Pose2D& motion) const noexcept;
   // Whether more than fallback_share of the last fallback_scans matches were untrusted.
   [[nodiscard]] bool fallback_on() const noexcept;
+  [[nodiscard]] double recent_turn_rad() const noexcept;
   struct Keyframe {
     LaserScan scan;
     Pose2D base_from_laser;
@@ -220,7 +222,10 @@ class MapBuilder {
   MappingHealth health_;
   std::uint64_t untrusted_bits_ = 0;  // the last fallback_scans matches, bit 0 the newest: 1 untrusted
   int recorded_ = 0;                  // matches recorded in untrusted_bits_ (up to fallback_scans)
-  double odometry_turn_rad_ = 0.0;    // the odometry's turn over the untrusted scans before this one
+  // the odometry's turn (absolute) over the last ten scans, this one included: what a recovery
+  // may undo (seattle's jump is found weak a few scans after it)
+  std::array<double, 10> turns_rad_{};
+  std::size_t turn_next_ = 0;
 };
 
 }  // namespace tripodal::navi
