@@ -1,6 +1,7 @@
 #include "tripodal/navi/map_builder.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -33,6 +34,11 @@ MapBuilder::MapBuilder(Point2D lower, Point2D upper, MapBuilderOptions options)
     d.error({}, "map builder: expected hit_log_odds > 0, miss_log_odds < 0 and clamp_log_odds > 0");
   }
   if (options_.refresh_every_scans < 1) d.error({}, "map builder: refresh_every_scans must be >= 1");
+  if (!(options_.fallback_scans >= 1 && options_.fallback_scans <= 64 && options_.fallback_share > 0.0 &&
+        options_.fallback_share <= 1.0)) {
+    d.error({}, "map builder: expected fallback_scans in [1, 64] and fallback_share in (0, 1], got " +
+                    std::to_string(options_.fallback_scans) + " and " + std::to_string(options_.fallback_share));
+  }
   if (!(std::isfinite(options_.window_m) && options_.window_m > 0.0)) {
     d.error({}, "map builder: window_m must be a number > 0, got " + std::to_string(options_.window_m));
   }
@@ -103,6 +109,8 @@ Pose2D MapBuilder::add(const LaserScan& scan, const Pose2D& odom_from_base, cons
     pose_ = compose(pose_, motion);
   }
   last_odom_ = odom_from_base;
+  turns_rad_[turn_next_] = std::abs(motion.theta_rad);
+  turn_next_ = (turn_next_ + 1) % turns_rad_.size();
   if (!matcher_ || since_refresh_ >= options_.refresh_every_scans) {
     const OccupancyGrid g = grid_around({pose_.x_m, pose_.y_m});
     if (g.width() >= 2 && g.height() >= 2 && g.count(Occupancy::occupied) > 0) {
@@ -114,34 +122,46 @@ Pose2D MapBuilder::add(const LaserScan& scan, const Pose2D& odom_from_base, cons
   ++health_.scans;
   if (matcher_) {
     ++since_refresh_;
+    const bool fallback = fallback_on();  // judged on the matches before this one
+    health_.in_fallback += fallback ? 1 : 0;
     matcher_->set_scan(scan, base_from_laser);
     ScanMatch m = matcher_->track(pose_, motion, options_.window);
     const double typical = qualities_.typical();
     const double margin = options_.recovery_margin;
+    bool untrusted = false;
     if (margin > 0.0 && typical > 0.0 && m.quality < typical - margin) {
       // Far weaker than usual: the odometry may have turned (or not) beyond the window. Mapping
       // on would lay the rest of the map at the wrong angle, so search every heading around the
       // odometry's position. Not the whole map: a corridor elsewhere often looks as good.
       ++health_.weak;
-      const ScanMatch g = rematch_all_headings();
-      if (g.quality >= typical - margin && g.quality >= m.quality + options_.recovery_gain) {
+      // not while falling back: the matches are not believed there, and the search costs six
+      // wide matches a scan (the infinite corridor's 109 ms per scan)
+      const ScanMatch g = fallback ? ScanMatch{} : rematch_all_headings();
+      // a turn the odometry did not report is no odometry jump: on the infinite corridor two
+      // such "recoveries" (91 and 90 degrees at scans 104 and 117, junctions that look alike)
+      // laid the rest of the map backwards; seattle's jump is the odometry's own 80 degrees
+      const double unexplained_rad = std::abs(wrap_angle(g.pose.theta_rad - pose_.theta_rad)) - recent_turn_rad();
+      if (g.quality >= typical - margin && g.quality >= m.quality + options_.recovery_gain &&
+          unexplained_rad <= options_.recovery_tolerance_rad) {
         m = g;
         ++health_.recovered;
       } else {
         ++health_.unreliable;
+        untrusted = true;
         // a weak match that moves the pose far from the odometry is not taken (a corridor's
-        // match slides along it): the odometry's word is kept
-        const Pose2D c = compose(inverse(pose_), m.pose);
-        const double moved = std::hypot(motion.x_m, motion.y_m);
-        if (std::hypot(c.x_m, c.y_m) > options_.recovery_tolerance_m + 0.3 * moved ||
-            std::abs(c.theta_rad) > options_.recovery_tolerance_rad + 0.3 * std::abs(motion.theta_rad)) {
-          m.quality = 0.0;
-        }
+        // match slides along it): the odometry's word is kept; while most matches are
+        // untrusted, not even a near one (0.3 m a scan adds up along a corridor)
+        if (fallback || far_from_odometry(m.pose, motion)) m.quality = 0.0;
       }
+    } else if (fallback && far_from_odometry(m.pose, motion)) {
+      m.quality = 0.0;
     }
+    untrusted_bits_ = (untrusted_bits_ << 1U) | (untrusted ? 1U : 0U);
+    recorded_ = std::min(recorded_ + 1, options_.fallback_scans);
     last_quality_ = m.quality;
     matched = m.quality >= options_.min_quality;
     if (matched) pose_ = m.pose;
+    health_.odometry_only += fallback && !matched ? 1 : 0;
     if (typical <= 0.0 || m.quality >= typical - margin) qualities_.add(m.quality);
   }
   travel_m_ += std::hypot(motion.x_m, motion.y_m);
@@ -309,6 +329,28 @@ ScanMatch MapBuilder::rematch_all_headings() noexcept {
     if (m.quality > best.quality) best = m;
   }
   return best;
+}
+
+bool MapBuilder::far_from_odometry(const Pose2D& match, const Pose2D& motion) const noexcept {
+  const Pose2D c = compose(inverse(pose_), match);
+  const double moved = std::hypot(motion.x_m, motion.y_m);
+  return std::hypot(c.x_m, c.y_m) > options_.recovery_tolerance_m + 0.3 * moved ||
+         std::abs(c.theta_rad) > options_.recovery_tolerance_rad + 0.3 * std::abs(motion.theta_rad);
+}
+
+double MapBuilder::recent_turn_rad() const noexcept {
+  double sum = 0.0;
+  for (double t : turns_rad_) sum += t;
+  return sum;
+}
+
+bool MapBuilder::fallback_on() const noexcept {
+  if (recorded_ < options_.fallback_scans) return false;
+  const std::uint64_t mask = options_.fallback_scans >= 64
+                                 ? ~std::uint64_t{0}
+                                 : (std::uint64_t{1} << static_cast<unsigned>(options_.fallback_scans)) - 1U;
+  const auto untrusted = static_cast<double>(std::popcount(untrusted_bits_ & mask));
+  return untrusted > options_.fallback_share * static_cast<double>(options_.fallback_scans);
 }
 
 void MapBuilder::redraw() {

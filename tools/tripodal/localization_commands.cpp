@@ -404,6 +404,7 @@ struct BuildArgs {
   bool loop_closure = navi::LoopClosureOptions{}.enabled;
   double closure_quality = navi::LoopClosureOptions{}.min_quality;
   double recovery_margin = navi::MapBuilderOptions{}.recovery_margin;
+  double fallback_share = navi::MapBuilderOptions{}.fallback_share;
   std::filesystem::path trajectory;  // CSV: scan by scan, the match as made, the final pose, the reference
   std::string laser_channel = "front_laser", odom_channel = "odom", pose_channel = "laser_pose";
 };
@@ -432,6 +433,7 @@ int map_build(const BuildArgs& a, std::ostream& out, std::ostream& err) {
     o.loop.enabled = a.loop_closure;
     o.loop.min_quality = a.closure_quality;
     o.recovery_margin = a.recovery_margin;
+    o.fallback_share = a.fallback_share;
     navi::MapBuilder b(lo, hi, o);
     std::ostringstream rows;  // the matches as made; the final poses are known only at the end
     const auto t0 = cpu_now();
@@ -479,6 +481,9 @@ int map_build(const BuildArgs& a, std::ostream& out, std::ostream& err) {
     const navi::MappingHealth& health = b.health();
     out << "  self-check: " << health.weak << " scans matched far below the recent median, " << health.recovered
         << " of them re-matched globally (an odometry jump), " << health.unreliable << " left unreliable\n";
+    // the odometry fallback: where most matches were untrusted, the map is the odometry's
+    out << "  odometry fallback: " << health.in_fallback << " scans while most of the last " << o.fallback_scans
+        << " matches were untrusted, " << health.odometry_only << " of them mapped on the odometry alone\n";
     if (20 * health.unreliable > health.scans) {
       out << "  WARNING: " << health.unreliable << " of " << health.scans
           << " scans were mapped on matches the builder does not trust: the map may be wrong there\n";
@@ -559,6 +564,10 @@ cli::Action setup_build(CLI::App& cmd) {
   cmd.add_option("--recovery-margin", a->recovery_margin,
                  "Q: a match this far below the recent median is re-matched globally (0: never)")
       ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+  cmd.add_option("--fallback-share", a->fallback_share,
+                 "S: above this share of untrusted matches among the last 20, map on the odometry alone (1: never)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.01, 1.0));
   cmd.add_option("--trajectory", a->trajectory,
                  "FILE: CSV of the matches, scan by scan, as made and as the graph places them at the end")
       ->check(cli::writable_file());
