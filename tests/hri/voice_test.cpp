@@ -128,27 +128,18 @@ TEST_CASE("the speech corpus expands optional words and slots of the command for
                                            "yes please", "no thanks"});
 }
 
-TEST_CASE("the speech corpus has the answers' sentences, without placeholders or the answers of entries that start a task") {
+// The answers' sentences were in the corpus for a while (issue 37, third round): the exhibit hall
+// visit's spoken "Thank you" was then heard as "that two" (tripodal_run_cli:guide_visit_exhibit_hall).
+TEST_CASE("the speech corpus holds what visitors say, not the robot's answers") {
   KnowledgeBase kb;
-  kb.put({"exit",
-          "the way out",
-          {"exit"},
-          {"Where is the exit?"},
-          "The exit is behind you. Ask at the desk! It is {time}.",
-          "",
-          {}});
-  kb.put({"visit", "a visit", {"visit"}, {"Show me PSR-1."}, "Follow me. I will take you there.", "guide me to node 0", {}});
+  kb.put({"exit", "the way out", {"exit"}, {"Where is the exit?"}, "The exit is behind you. Ask at the desk!", "", {}});
   const auto corpus = speech_corpus(kb, {}, {});
   const auto has = [&](const std::string& s) { return std::find(corpus.begin(), corpus.end(), s) != corpus.end(); };
-  // A visitor asks about what the robot said ("where is the desk?"): the answer's words are in the model.
-  CHECK(has("The exit is behind you"));
-  CHECK(has("Ask at the desk"));
-  // Not a sentence with a placeholder (its words are not known), nor what the robot says when it starts a task.
+  CHECK(has("Where is the exit?"));
+  CHECK(has("exit"));
   CHECK_FALSE(
-      std::any_of(corpus.begin(), corpus.end(), [](const std::string& s) { return s.find("It is") != std::string::npos; }));
-  CHECK_FALSE(has("Follow me"));
-  CHECK_FALSE(has("I will take you there"));
-  CHECK(has("guide me to node 0"));
+      std::any_of(corpus.begin(), corpus.end(), [](const std::string& s) { return s.find("behind you") != std::string::npos; }));
+  CHECK_FALSE(has("Ask at the desk"));
 }
 
 TEST_CASE("espeak-ng's phoneme mnemonics become the dictionary's ARPAbet phones") {
