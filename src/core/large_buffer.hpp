@@ -40,7 +40,8 @@ class LargeBufferAllocator {
       std::allocator<T>().deallocate(p, n);
       return;
     }
-    ::operator delete (p, rounded(n), std::align_val_t{kHugePage});
+    // Unsized: clang before 17 does not declare sized deallocation without -fsized-deallocation.
+    ::operator delete (p, std::align_val_t{kHugePage});
   }
 
   template <typename U>

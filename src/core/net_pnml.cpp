@@ -374,7 +374,7 @@ class PnmlReader {
     if (!ok) return;
     arc.source = *source;
     arc.target = *target;
-    arcs_.push_back(std::move(arc));
+    arcs_.push_back(arc);
   }
 
   // Arcs may name nodes declared later (or on another page): connected after everything is read.
