@@ -129,18 +129,6 @@ int check_single_args(const Args& a, std::ostream& err) {
   return kOk;
 }
 
-// The base the profile's loop controls. The controller types `tripodal run` knows (the same
-// registration), so that the base of any profile `run` takes is simulated here.
-ControllerConfig simulated_base(const RobotProfile& profile) {
-  RobotPlugins plugins;
-  app::register_tool_plugins(plugins, nullptr, profile, {});
-  const std::optional<ControllerConfig> base = base_controller_config(profile, plugins.controllers);
-  if (!base)
-    throw ConfigError(profile.where,
-                      "tripodal sim-server simulates the robot's base: the profile needs a loop with a controller");
-  return *base;
-}
-
 dds::ParticipantOptions participant_options(const Args& a) {
   dds::ParticipantOptions po;
   po.domain_id = a.domain;

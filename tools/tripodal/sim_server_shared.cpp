@@ -37,6 +37,19 @@
 #include "tripodal/sim/world.hpp"
 
 namespace tripodal::tool {
+
+// The base the profile's loop controls. The controller types `tripodal run` knows (the same
+// registration), so that the base of any profile `run` takes is simulated here.
+ControllerConfig simulated_base(const RobotProfile& profile) {
+  RobotPlugins plugins;
+  app::register_tool_plugins(plugins, nullptr, profile, {});
+  const std::optional<ControllerConfig> base = base_controller_config(profile, plugins.controllers);
+  if (!base)
+    throw ConfigError(profile.where,
+                      "tripodal sim-server simulates the robot's base: the profile needs a loop with a controller");
+  return *base;
+}
+
 namespace {
 
 using namespace cli;
@@ -198,13 +211,7 @@ Bases load_bases(const std::vector<FleetMember>& members) {
   for (const FleetMember& m : members) {
     if (bases.count(m.profile) != 0) continue;
     const RobotProfile profile = load_robot_profile(m.profile);
-    RobotPlugins plugins;
-    app::register_tool_plugins(plugins, nullptr, profile, {});
-    const std::optional<ControllerConfig> base = base_controller_config(profile, plugins.controllers);
-    if (!base)
-      throw ConfigError(profile.where,
-                        "tripodal sim-server simulates the robot's base: the profile needs a loop with a controller");
-    bases.emplace(m.profile, std::make_pair(profile.name, *base));
+    bases.emplace(m.profile, std::make_pair(profile.name, simulated_base(profile)));
   }
   return bases;
 }

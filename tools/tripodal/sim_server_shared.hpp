@@ -12,8 +12,10 @@
 #include <string>
 #include <vector>
 
+#include "tripodal/controllers/controller_config.hpp"
 #include "tripodal/dds/endpoint.hpp"
 #include "tripodal/dds/messages.hpp"
+#include "tripodal/robot/robot_profile.hpp"
 
 namespace tripodal::sim {
 class Simulator;
@@ -65,5 +67,9 @@ class ButtonInbox {
 /// Serves until every robot that came has left, a signal, or (with wait_s) no robot came; prints
 /// per-robot and total figures ("robot-robot contacts: N"). Returns the tool's exit code.
 int run_shared_world(const SharedWorldArgs& a, std::ostream& out, std::ostream& err);
+
+/// The base the profile's loop controls, as the sim-servers simulate it (the controller types
+/// `tripodal run` knows); a located ConfigError when no loop has a controller.
+ControllerConfig simulated_base(const RobotProfile& profile);
 
 }  // namespace tripodal::tool
