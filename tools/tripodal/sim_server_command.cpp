@@ -129,14 +129,6 @@ int check_single_args(const Args& a, std::ostream& err) {
   return kOk;
 }
 
-dds::ParticipantOptions participant_options(const Args& a) {
-  dds::ParticipantOptions po;
-  po.domain_id = a.domain;
-  po.network = a.system_network ? dds::Network::system : dds::Network::loopback;
-  po.participant_lease = std::chrono::milliseconds(static_cast<std::int64_t>(a.lease_s * 1000.0));
-  return po;
-}
-
 // What the robot sends: with --realtime its cmd_vel, else its step requests and its step writer's
 // coming and going (its process ended or died).
 struct Requests {
@@ -240,16 +232,7 @@ void ServedRobot::publish_scan() {
   if (laser.sequence() == laser_seen_ || !laser.has_reading()) return;
   laser_seen_ = laser.sequence();
   const LaserScan& l = laser.latest();
-  ls_.header.stamp = dds::ros_time(l.stamp);
-  ls_.angle_min = static_cast<float>(l.angle_min_rad);
-  ls_.angle_max = static_cast<float>(l.angle_max_rad);
-  ls_.angle_increment = static_cast<float>(l.angle_increment_rad);
-  ls_.time_increment = static_cast<float>(l.time_increment_s);
-  ls_.scan_time = static_cast<float>(l.scan_time_s);
-  ls_.range_min = static_cast<float>(l.range_min_m);
-  ls_.range_max = static_cast<float>(l.range_max_m);
-  ls_.ranges = l.ranges_m;
-  ls_.intensities = l.intensities;
+  put_scan(l, ls_);
   scan_.publish(ls_);
   ++scans_;
 }
@@ -338,7 +321,7 @@ int serve_one_robot(const Args& a, std::ostream& out) {
   sim::World world = sim::load_world(a.world);
   const std::uint64_t seed = a.seed.value_or(world.seed);
   sim::Simulator sim(std::move(world), base, seed);
-  dds::Participant participant(participant_options(a));
+  dds::Participant participant(served_participant(a.domain, a.system_network, a.lease_s));
   const dds::BaseTopics topics(a.ros_namespace);
   Inbox inbox;
   const bool realtime = a.realtime->count() > 0;

@@ -38,6 +38,27 @@
 
 namespace tripodal::tool {
 
+dds::ParticipantOptions served_participant(unsigned domain, bool system_network, double lease_s) {
+  dds::ParticipantOptions po;
+  po.domain_id = domain;
+  po.network = system_network ? dds::Network::system : dds::Network::loopback;
+  po.participant_lease = std::chrono::milliseconds(static_cast<std::int64_t>(lease_s * 1000.0));
+  return po;
+}
+
+void put_scan(const LaserScan& l, dds::msg::LaserScan& m) {
+  m.header.stamp = dds::ros_time(l.stamp);
+  m.angle_min = static_cast<float>(l.angle_min_rad);
+  m.angle_max = static_cast<float>(l.angle_max_rad);
+  m.angle_increment = static_cast<float>(l.angle_increment_rad);
+  m.time_increment = static_cast<float>(l.time_increment_s);
+  m.scan_time = static_cast<float>(l.scan_time_s);
+  m.range_min = static_cast<float>(l.range_min_m);
+  m.range_max = static_cast<float>(l.range_max_m);
+  m.ranges = l.ranges_m;
+  m.intensities = l.intensities;
+}
+
 // The base the profile's loop controls. The controller types `tripodal run` knows (the same
 // registration), so that the base of any profile `run` takes is simulated here.
 ControllerConfig simulated_base(const RobotProfile& profile) {
@@ -214,14 +235,6 @@ Bases load_bases(const std::vector<FleetMember>& members) {
     bases.emplace(m.profile, std::make_pair(profile.name, simulated_base(profile)));
   }
   return bases;
-}
-
-dds::ParticipantOptions participant_options(const SharedWorldArgs& a) {
-  dds::ParticipantOptions po;
-  po.domain_id = a.domain;
-  po.network = a.system_network ? dds::Network::system : dds::Network::loopback;
-  po.participant_lease = std::chrono::milliseconds(static_cast<std::int64_t>(a.lease_s * 1000.0));
-  return po;
 }
 
 // Slot k's topics in its namespace: its sensors published, its step requests and its step
@@ -401,16 +414,7 @@ void SharedWorld::publish_scan(Slot& s) {
   if (laser.sequence() == s.laser_seen || !laser.has_reading()) return;
   s.laser_seen = laser.sequence();
   const LaserScan& l = laser.latest();
-  s.ls.header.stamp = dds::ros_time(l.stamp);
-  s.ls.angle_min = static_cast<float>(l.angle_min_rad);
-  s.ls.angle_max = static_cast<float>(l.angle_max_rad);
-  s.ls.angle_increment = static_cast<float>(l.angle_increment_rad);
-  s.ls.time_increment = static_cast<float>(l.time_increment_s);
-  s.ls.scan_time = static_cast<float>(l.scan_time_s);
-  s.ls.range_min = static_cast<float>(l.range_min_m);
-  s.ls.range_max = static_cast<float>(l.range_max_m);
-  s.ls.ranges = l.ranges_m;
-  s.ls.intensities = l.intensities;
+  put_scan(l, s.ls);
   s.scan->publish(s.ls);
   ++s.scans;
 }
@@ -515,7 +519,7 @@ int run_shared_world(const SharedWorldArgs& a, std::ostream& out, std::ostream& 
     const std::size_t n = members.size();
     const std::vector<Pose2D> starts = fleet_starts(world, members);
 
-    dds::Participant participant(participant_options(a));
+    dds::Participant participant(served_participant(a.domain, a.system_network, a.lease_s));
     Inboxes inboxes(n);
     std::vector<Slot> slots(n);
     for (std::size_t k = 0; k < n; ++k) {

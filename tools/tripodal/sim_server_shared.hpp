@@ -15,6 +15,7 @@
 #include "tripodal/controllers/controller_config.hpp"
 #include "tripodal/dds/endpoint.hpp"
 #include "tripodal/dds/messages.hpp"
+#include "tripodal/resources/readings.hpp"
 #include "tripodal/robot/robot_profile.hpp"
 
 namespace tripodal::sim {
@@ -67,6 +68,12 @@ class ButtonInbox {
 /// Serves until every robot that came has left, a signal, or (with wait_s) no robot came; prints
 /// per-robot and total figures ("robot-robot contacts: N"). Returns the tool's exit code.
 int run_shared_world(const SharedWorldArgs& a, std::ostream& out, std::ostream& err);
+
+/// The sim-servers' DDS participant: the domain, loopback or the system's network, the lease.
+dds::ParticipantOptions served_participant(unsigned domain, bool system_network, double lease_s);
+
+/// A laser reading as the sensor_msgs/LaserScan both sim-servers publish (the header's frame kept).
+void put_scan(const LaserScan& scan, dds::msg::LaserScan& message);
 
 /// The base the profile's loop controls, as the sim-servers simulate it (the controller types
 /// `tripodal run` knows); a located ConfigError when no loop has a controller.
